@@ -1,0 +1,5 @@
+"""``python -m spinectl``: the command-line interface."""
+
+from spinectl.cli import main
+
+raise SystemExit(main())

@@ -1,0 +1,68 @@
+"""The ``spinectl`` command line.
+
+Each sub-command lives in its own module with a ``register(subparsers)``
+function; :data:`COMMANDS` lists them. Errors a user can cause
+(:class:`~spinectl.errors.SpinectlError`, bad arguments) end as one line on
+stderr and exit code 2, without a traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+from ..errors import SpinectlError
+
+COMMANDS = (
+    "config_cmd",
+    "stability_cmd",
+)
+"""Modules of :mod:`spinectl.cli` that each register one sub-command."""
+
+EXIT_USAGE = 2
+
+
+class _Parser(argparse.ArgumentParser):
+    """ArgumentParser whose errors are one line and exit 2."""
+
+    def error(self, message):  # noqa: D401 - argparse API
+        raise _UsageError(f"{self.prog}: {message}")
+
+
+class _UsageError(Exception):
+    pass
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The full argument parser with every registered sub-command."""
+    from .. import __version__
+
+    parser = _Parser(
+        prog="spinectl",
+        description="Control-theoretic analysis of spinal stability (Wagner et al. 2012).",
+    )
+    parser.add_argument("--version", action="version", version=f"spinectl {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    sub.required = True
+    for name in COMMANDS:
+        importlib.import_module(f"{__name__}.{name}").register(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the CLI; return the exit code (0 ok, 2 bad input, 1 other failure)."""
+    try:
+        args = build_parser().parse_args(argv)
+        return int(args.func(args) or 0)
+    except _UsageError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return EXIT_USAGE
+    except SpinectlError as exc:
+        print(f"spinectl: error: {exc}", file=sys.stderr)
+        return EXIT_USAGE
+    except KeyboardInterrupt:
+        print("spinectl: interrupted", file=sys.stderr)
+        return 130
+    except BrokenPipeError:
+        return 0

@@ -1,0 +1,67 @@
+"""Options and helpers shared by the sub-commands."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+
+from ..config import load_config
+from ..errors import ParameterError
+from ..io import atomic_write_text
+from ..params import Model
+
+
+def add_model_options(parser: argparse.ArgumentParser) -> None:
+    """``--config FILE`` and ``--preset NAME``, on every command."""
+    group = parser.add_argument_group("model")
+    group.add_argument("--config", metavar="FILE", help="TOML file overriding the preset's parameters")
+    group.add_argument("--preset", metavar="NAME", help="built-in parameter preset (default: 'default')")
+
+
+def load_model(args: argparse.Namespace) -> Model:
+    """The model named by ``--preset`` and ``--config``."""
+    return load_config(args.config, preset=args.preset)
+
+
+def finite_float(name: str):
+    """An argparse ``type`` accepting finite floats only, naming the option on error."""
+
+    def convert(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name} must be a number (got {text!r})") from None
+        if not math.isfinite(value):
+            raise argparse.ArgumentTypeError(f"{name} must be finite (got {text!r})")
+        return value
+
+    convert.__name__ = name
+    return convert
+
+
+def float_list(name: str):
+    """An argparse ``type`` for comma-separated finite floats, e.g. ``10,5,3``."""
+    one = finite_float(name)
+
+    def convert(text: str) -> list[float]:
+        return [one(part) for part in text.split(",") if part.strip()]
+
+    convert.__name__ = name
+    return convert
+
+
+def emit_json(payload: dict, out: str | None = None) -> None:
+    """Print ``payload`` as JSON, or write it atomically to ``out``."""
+    text = json.dumps(payload, indent=2, allow_nan=True) + "\n"
+    if out:
+        atomic_write_text(out, text)
+    else:
+        sys.stdout.write(text)
+
+
+def require(condition: bool, field: str, message: str) -> None:
+    """Raise :class:`ParameterError` for ``field`` unless ``condition``."""
+    if not condition:
+        raise ParameterError(field, message)

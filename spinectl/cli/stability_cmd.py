@@ -1,0 +1,111 @@
+"""``spinectl stability``: self-stability and counter torque of every segment."""
+
+from __future__ import annotations
+
+from ..config import set_parameter
+from ..stability import StabilityResult, segment_stability
+from ..units import cm2_to_m2, m2_to_cm2
+from ._common import add_model_options, emit_json, finite_float, float_list, load_model
+
+
+def register(sub) -> None:
+    parser = sub.add_parser(
+        "stability",
+        help="eigenvalues, self-stability and counter torque of each segment",
+        description="Linearise every lumbar segment about the upright posture and report its "
+        "stiffness, damping, eigenvalues (paper, eq. 1), self-stability and local counter torque.",
+    )
+    add_position_options(parser)
+    parser.add_argument(
+        "--pcsa",
+        type=float_list("--pcsa"),
+        required=True,
+        metavar="CM2,...",
+        help="PCSA [cm^2]: one value per pair (each muscle of the pair) or one per muscle",
+    )
+    parser.add_argument("--K", type=finite_float("--K"), help="passive stiffness K [N m/rad] (overrides the model)")
+    parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    add_model_options(parser)
+    parser.set_defaults(func=run)
+
+
+def add_position_options(parser) -> None:
+    """``--E`` and ``--Lambda`` in metres."""
+    parser.add_argument("--E", type=finite_float("--E"), default=0.0, help="eccentricity E [m] (default 0)")
+    parser.add_argument("--Lambda", type=finite_float("--Lambda"), default=0.0, help="lordosis Lambda [m] (default 0)")
+
+
+def model_with_overrides(args):
+    """The model of ``--preset``/``--config`` with ``--K`` applied."""
+    model = load_model(args)
+    if getattr(args, "K", None) is not None:
+        model = set_parameter(model, "passive.stiffness", args.K)
+    return model
+
+
+def run(args) -> int:
+    model = model_with_overrides(args)
+    result = segment_stability(model, args.E, args.Lambda, cm2_to_m2(args.pcsa))
+    if args.json:
+        emit_json(result_to_json(model, result))
+    else:
+        print(format_table(model, result))
+    return 0
+
+
+def result_to_json(model, result: StabilityResult) -> dict:
+    """The JSON document of ``spinectl stability --json`` (units in the key names)."""
+    pcsa = m2_to_cm2(result.pcsa)
+    return {
+        "E_m": result.eccentricity,
+        "Lambda_m": result.lordosis,
+        "K_Nm_per_rad": model.passive.stiffness,
+        "K_convention": model.passive.convention,
+        "pcsa_cm2": dict(zip(model.muscle_names, pcsa.tolist())),
+        "total_pcsa_cm2": float(pcsa.sum()),
+        "segments": [
+            {
+                "name": name,
+                "stiffness_Nm_per_rad": float(result.stiffness[k]),
+                "damping_Nms_per_rad": float(result.damping[k]),
+                "inertia_kgm2": float(result.inertia[k]),
+                "eigenvalues": [[float(z.real), float(z.imag)] for z in result.eigenvalues[k]],
+                "self_stable": bool(result.self_stable[k]),
+                "counter_torque_Nm": float(result.counter_torque[k]),
+            }
+            for k, name in enumerate(result.segment_names)
+        ],
+        "all_self_stable": result.all_self_stable,
+        "counter_torque_norm_Nm": result.counter_torque_norm,
+    }
+
+
+def _complex(z: complex) -> str:
+    return f"{z.real:9.3f}{z.imag:+9.3f}j"
+
+
+def format_table(model, result: StabilityResult) -> str:
+    """A readable per-segment table."""
+    pcsa = m2_to_cm2(result.pcsa)
+    lines = [
+        f"E = {result.eccentricity * 100:.2f} cm, Lambda = {result.lordosis * 100:.2f} cm, "
+        f"K = {model.passive.stiffness:g} N m/rad ({model.passive.convention})",
+        "PCSA [cm^2]: " + ", ".join(f"{n} {p:.2f}" for n, p in zip(model.muscle_names, pcsa))
+        + f"  (total {pcsa.sum():.2f})",
+        "",
+        f"{'segment':8} {'S [N m/rad]':>12} {'D [N m s/rad]':>14} {'theta [kg m2]':>14} "
+        f"{'lambda_1 [1/s]':>20} {'lambda_2 [1/s]':>20} {'stable':>7} {'CT [N m]':>10}",
+    ]
+    for k, name in enumerate(result.segment_names):
+        eig = result.eigenvalues[k]
+        lines.append(
+            f"{name:8} {result.stiffness[k]:12.3f} {result.damping[k]:14.4f} {result.inertia[k]:14.4f} "
+            f"{_complex(eig[0]):>20} {_complex(eig[1]):>20} {'yes' if result.self_stable[k] else 'NO':>7} "
+            f"{result.counter_torque[k]:10.3f}"
+        )
+    lines += ["", f"||CT|| = {result.counter_torque_norm:.3f} N m; "
+              f"self-stable: {'all segments' if result.all_self_stable else 'NOT all segments'}"]
+    return "\n".join(lines)
+
+
+__all__ = ["register", "run", "result_to_json", "format_table", "add_position_options"]

@@ -1,0 +1,42 @@
+"""Exceptions of spinectl.
+
+Every error a user can cause derives from :class:`SpinectlError`; the CLI maps
+it to one line on stderr and exit code 2. Subclasses also derive from the
+builtin that fits (python-control's convention), so ``except ValueError`` in
+user code keeps working.
+"""
+
+from __future__ import annotations
+
+
+class SpinectlError(Exception):
+    """Base class of every error that spinectl raises on purpose."""
+
+
+class ParameterError(SpinectlError, ValueError):
+    """A parameter has a wrong type, is not finite or is out of range.
+
+    Parameters
+    ----------
+    field : str
+        Dotted name of the offending parameter, e.g. ``"body.mass"``.
+    message : str
+        What is allowed, e.g. ``"must be > 0 (got -3.0)"``.
+    """
+
+    def __init__(self, field: str, message: str):
+        self.field = field
+        self.message = message
+        super().__init__(f"{field}: {message}")
+
+    def under(self, prefix: str) -> ParameterError:
+        """Return the same error with ``prefix`` prepended to the field name."""
+        return type(self)(f"{prefix}.{self.field}" if prefix else self.field, self.message)
+
+
+class ConfigError(ParameterError):
+    """A configuration file cannot be read: missing, not TOML, unknown key."""
+
+
+class ModelError(SpinectlError, ValueError):
+    """A configuration is valid parameter by parameter but not as a whole."""

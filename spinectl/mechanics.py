@@ -1,0 +1,282 @@
+"""Segment mechanics: torques of fibres and gravity about the centres of rotation.
+
+Pure array functions, SI units. For CoR k the part above it (thoracic cage,
+upper attachments, point mass) rotates by alpha about CoR k; the pelvis and
+all lower attachments stay fixed (paper, Methods: "we assumed all other CoR to
+be fixed"). alpha is counter-clockwise (towards -x for a point above) and
+measured from the upright configuration; torques are positive
+counter-clockwise.
+
+Everything muscular is linear in PCSA, so the linearisation is stored per unit
+PCSA [per m^2]: :func:`segment_coefficients` returns the torque, stiffness
+dM/dalpha and damping dM/domega of every muscle about every CoR, and the
+gravity terms, which together define every problem spinectl solves.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import geometry, muscle
+from .params import Model
+
+
+def rotate(vectors, alpha):
+    """Rotate 2-vectors counter-clockwise by ``alpha`` [rad]; broadcasts."""
+    vectors = np.asarray(vectors, float)
+    cos, sin = np.cos(alpha), np.sin(alpha)
+    x, y = vectors[..., 0], vectors[..., 1]
+    return np.stack([cos * x - sin * y, sin * x + cos * y], axis=-1)
+
+
+def cross2(a, b):
+    """z-component of the cross product of 2-vectors."""
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+def fibre_length_and_lever_arm(upper, lower, cor, alpha=0.0):
+    """Length and signed lever arm of fibres with the upper body rotated by alpha.
+
+    With u = R(alpha)(U - c) and p = P - c (U upper, P lower attachment, c the
+    CoR), the fibre vector e = p - u, l = |e| and h = (u x e) / l, so that a
+    tension T gives the torque T h about c. Equivalently h = -dl/dalpha
+    (virtual work), which makes the shortening velocity v = h omega.
+
+    Parameters
+    ----------
+    upper, lower : array_like, shape (..., 2)
+        Attachment points in the upright configuration [m].
+    cor : array_like, shape (..., 2)
+        Centre of rotation [m].
+    alpha : array_like
+        Rotation of the upper body about ``cor`` [rad].
+
+    Returns
+    -------
+    length, lever_arm : numpy.ndarray
+        l [m] and h [m].
+    """
+    u = rotate(np.asarray(upper) - cor, alpha)
+    e = np.asarray(lower) - cor - u
+    length = np.hypot(e[..., 0], e[..., 1])
+    return length, cross2(u, e) / length
+
+
+def lever_arm_slope(upper, lower, cor):
+    """dh/dalpha at alpha = 0 [m/rad], analytic.
+
+    From l'' = (p . u - h^2) / l at alpha = 0 (differentiate l' = -(e . J u)/l
+    once more, J the quarter turn) and h = -l': dh/dalpha = (h^2 - p . u) / l.
+    """
+    u = np.asarray(upper) - cor
+    p = np.asarray(lower) - cor
+    length, h = fibre_length_and_lever_arm(upper, lower, cor)
+    return (h**2 - np.sum(p * u, axis=-1)) / length
+
+
+def fibre_torque(alpha, omega, upper, lower, cor, fibre_params, errata):
+    """Nonlinear torque of fibres per unit isometric force, M_i / f_iso [m].
+
+    M_i = h_i f_l(l_i) f_H(h_i omega) (paper, Methods: M_i = h_i f_li f_Hi),
+    with l_opt = optimal_length_ratio * l0 and l0 the upright length.
+
+    Parameters
+    ----------
+    alpha : array_like
+        Rotation about the CoR [rad].
+    omega : array_like
+        Angular velocity [rad/s].
+    upper, lower, cor : array_like, shape (..., 2)
+        Upright attachment points and CoR [m].
+    fibre_params : Fibre
+    errata : Errata
+    """
+    l0 = np.linalg.norm(np.asarray(lower) - np.asarray(upper), axis=-1)
+    l_opt = fibre_params.optimal_length_ratio * l0
+    hill = muscle.hill_constants(l_opt, fibre_params, errata)
+    length, h = fibre_length_and_lever_arm(upper, lower, cor, alpha)
+    f_l = muscle.force_length(length, l_opt, fibre_params)
+    f_h = muscle.force_velocity(h * omega, hill)
+    return h * f_l * f_h
+
+
+def muscle_torque_per_pcsa(model: Model, cor, alpha, omega):
+    """Nonlinear torque of every muscle about a CoR per unit PCSA [N m / m^2].
+
+    Sums :func:`fibre_torque` over each muscle's fibres, each fibre carrying
+    1/n of the muscle's PCSA, times the specific tension (f_iso per PCSA).
+
+    Parameters
+    ----------
+    model : Model
+    cor : array_like, shape (..., 2)
+        CoR position [m].
+    alpha, omega : array_like
+        Rotation [rad] and angular velocity [rad/s] of the upper body about ``cor``;
+        broadcast against ``cor[..., 0]``.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., n_muscles)
+    """
+    upper, lower, share = geometry.all_fibres(model)
+    c = np.asarray(cor, float)[..., None, :]
+    a = np.asarray(alpha, float)[..., None]
+    w = np.asarray(omega, float)[..., None]
+    per_fiso = fibre_torque(a, w, upper, lower, c, model.fibre, model.errata)
+    return per_fiso @ (model.fibre.specific_tension * share)
+
+
+def gravity_sign(model: Model) -> float:
+    """+1 for the destabilising (corrected) sign of gravity, -1 for the printed one."""
+    return 1.0 if model.errata.gravity_sign == "destabilising" else -1.0
+
+
+def gravity_torque(alpha, cor, model: Model):
+    """Torque of the point mass about a CoR, M_ext [N m].
+
+    With r = R(alpha)(m_pos - c), the torque of the weight (0, -m g) is
+    -m g r_x. For a mass above the CoR this is m g |r| sin(angle from
+    vertical), an inverted pendulum: dM_ext/dalpha = m g r_y > 0. This is the
+    design page's gravity erratum; the paper prints M_ext = -m g r sin(alpha)
+    (``errata.gravity_sign = "printed"`` negates the whole torque).
+
+    Parameters
+    ----------
+    alpha : array_like
+        Rotation about the CoR [rad].
+    cor : array_like, shape (..., 2)
+        CoR position [m].
+    model : Model
+    """
+    r = rotate(geometry.mass_position(model) - np.asarray(cor), alpha)
+    weight = model.body.mass * model.body.gravity
+    return gravity_sign(model) * (-weight * r[..., 0])
+
+
+def inertia(cor, model: Model):
+    """Moment of inertia of the upper body about a CoR, theta_k [kg m^2].
+
+    theta_k = m (r_k^2 + rho^2), r_k the CoR-to-mass distance and rho the
+    radius of gyration (design page, One segment: default m r_k^2).
+    """
+    r = geometry.mass_position(model) - np.asarray(cor)
+    return model.body.mass * (np.sum(r**2, axis=-1) + model.body.radius_of_gyration**2)
+
+
+def passive_stiffness(model: Model, inertia_k):
+    """Passive stiffness K as a physical torque stiffness [N m/rad], per CoR.
+
+    'physical': K itself. 'paper': eq. 2 subtracts K from d(omega')/dalpha,
+    i.e. K theta_k from dM/dalpha (design page, erratum eq. 2).
+    """
+    k = model.passive.stiffness
+    if model.passive.convention == "paper":
+        return k * np.asarray(inertia_k)
+    return np.full(np.shape(inertia_k), k)
+
+
+@dataclass(frozen=True)
+class SegmentCoefficients:
+    """The linearised segment mechanics at one or many (E, Lambda).
+
+    Muscular terms are per unit PCSA of each muscle [per m^2]; a PCSA vector
+    ``pcsa`` [m^2] gives e.g. the stiffness ``stiffness_per_pcsa @ pcsa``.
+    Leading dimensions are those of the broadcast (E, Lambda).
+
+    Attributes
+    ----------
+    torque_per_pcsa : numpy.ndarray, shape (..., n_cor, n_muscles)
+        Muscle torque at the upright equilibrium [N m / m^2].
+    stiffness_per_pcsa : numpy.ndarray, shape (..., n_cor, n_muscles)
+        dM/dalpha [N m/rad / m^2]; negative is stabilising.
+    damping_per_pcsa : numpy.ndarray, shape (..., n_cor, n_muscles)
+        dM/domega [N m s/rad / m^2]; always <= 0 (Hill slope).
+    gravity_torque : numpy.ndarray, shape (..., n_cor)
+        M_ext at the upright equilibrium [N m].
+    gravity_stiffness : numpy.ndarray, shape (..., n_cor)
+        dM_ext/dalpha [N m/rad]; positive (destabilising) with the corrected sign.
+    passive_stiffness : numpy.ndarray, shape (..., n_cor)
+        K as a physical stiffness [N m/rad], entering dM/dalpha as -K.
+    inertia : numpy.ndarray, shape (..., n_cor)
+        theta_k [kg m^2].
+    """
+
+    torque_per_pcsa: np.ndarray
+    stiffness_per_pcsa: np.ndarray
+    damping_per_pcsa: np.ndarray
+    gravity_torque: np.ndarray
+    gravity_stiffness: np.ndarray
+    passive_stiffness: np.ndarray
+    inertia: np.ndarray
+
+    def stiffness(self, pcsa):
+        """Total dM_k/dalpha [N m/rad] for muscle PCSAs ``pcsa`` [m^2], shape (..., n_muscles)."""
+        muscular = np.einsum("...km,...m->...k", self.stiffness_per_pcsa, np.asarray(pcsa, float))
+        return muscular + self.gravity_stiffness - self.passive_stiffness
+
+    def damping(self, pcsa):
+        """Total dM_k/domega [N m s/rad] for muscle PCSAs ``pcsa`` [m^2]."""
+        return np.einsum("...km,...m->...k", self.damping_per_pcsa, np.asarray(pcsa, float))
+
+    def counter_torque(self, pcsa):
+        """Local counter torques CT_k [N m] making the upright posture an equilibrium.
+
+        CT_k = -(sum_i M_i + M_ext) at alpha = 0, omega = 0 (paper, Methods;
+        design page, One segment). Affine in PCSA.
+        """
+        muscular = np.einsum("...km,...m->...k", self.torque_per_pcsa, np.asarray(pcsa, float))
+        return -(muscular + self.gravity_torque)
+
+
+def segment_coefficients(model: Model, eccentricity, lordosis) -> SegmentCoefficients:
+    """Linearised torques, stiffness and damping of every muscle about every CoR.
+
+    Per fibre at alpha = 0, omega = 0, per unit f_iso (so times specific
+    tension per unit PCSA; each fibre carries 1/n of its muscle's PCSA):
+
+    - torque:    M = h f_l(l0)                         (paper: M_i = h_i f_li f_Hi, f_H(0) = f_iso)
+    - stiffness: dM/dalpha = h' f_l - h^2 f_l'         (h' from :func:`lever_arm_slope`, dl/dalpha = -h)
+    - damping:   dM/domega = h^2 f_l f_H'(0)           (v = h omega)
+
+    Parameters
+    ----------
+    model : Model
+    eccentricity, lordosis : array_like
+        E and Lambda [m]; broadcast together.
+
+    Returns
+    -------
+    SegmentCoefficients
+    """
+    cor = geometry.cor_positions(eccentricity, lordosis, model.geometry)  # (..., K, 2)
+    upper, lower, share = geometry.all_fibres(model)  # (F, 2), (F, 2), (F, M)
+    l0 = np.linalg.norm(lower - upper, axis=-1)
+    l_opt = model.fibre.optimal_length_ratio * l0
+    f_l = muscle.force_length(l0, l_opt, model.fibre)
+    f_l_slope = muscle.force_length_slope(l0, l_opt, model.fibre)
+    hill = muscle.hill_constants(l_opt, model.fibre, model.errata)
+    f_h_slope = muscle.force_velocity_slope(np.zeros_like(l0), hill)
+
+    c = cor[..., None, :]  # (..., K, 1, 2) against fibres (F, 2)
+    _, h = fibre_length_and_lever_arm(upper, lower, c)
+    h_slope = lever_arm_slope(upper, lower, c)
+    # per unit f_iso of each fibre, then summed into muscles per unit PCSA
+    to_muscle = model.fibre.specific_tension * share
+    torque = (h * f_l) @ to_muscle
+    stiffness = (h_slope * f_l - h**2 * f_l_slope) @ to_muscle
+    damping = (h**2 * f_l * f_h_slope) @ to_muscle
+
+    theta = inertia(cor, model)
+    r_y = model.body.mass_height - cor[..., 1]
+    return SegmentCoefficients(
+        torque_per_pcsa=torque,
+        stiffness_per_pcsa=stiffness,
+        damping_per_pcsa=damping,
+        gravity_torque=gravity_torque(0.0, cor, model),
+        gravity_stiffness=gravity_sign(model) * model.body.mass * model.body.gravity * r_y,
+        passive_stiffness=passive_stiffness(model, theta),
+        inertia=theta,
+    )

@@ -1,0 +1,117 @@
+"""Muscle fibre mechanics: force-length and Hill force-velocity relations.
+
+Pure array functions. Forces are returned per unit isometric force (divide by
+f_iso = specific_tension * PCSA), so every quantity is linear in PCSA (design
+page, Muscle). Velocities are *shortening* velocities: v >= 0 concentric.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .params import Errata, Fibre
+
+
+def force_length(length, optimal_length, fibre: Fibre):
+    """Force-length factor f_l [1] (paper, Methods; its refs 17, 18).
+
+    f_l = exp(-(((l / l_opt)^k1 - 1) / k2)^2)
+
+    Parameters
+    ----------
+    length : array_like
+        Fibre length l [m].
+    optimal_length : array_like
+        Optimal fibre length l_opt [m] (paper: 1.2 l0).
+    fibre : Fibre
+        Supplies k1 and k2 [1].
+    """
+    u = ((np.asarray(length) / optimal_length) ** fibre.k1 - 1.0) / fibre.k2
+    return np.exp(-(u**2))
+
+
+def force_length_slope(length, optimal_length, fibre: Fibre):
+    """Derivative df_l/dl of :func:`force_length` [1/m], analytic.
+
+    df_l/dl = f_l * (-2 u / k2) * k1 (l/l_opt)^(k1 - 1) / l_opt, u = ((l/l_opt)^k1 - 1)/k2.
+    Positive on the ascending limb (l < l_opt).
+    """
+    ratio = np.asarray(length) / optimal_length
+    u = (ratio**fibre.k1 - 1.0) / fibre.k2
+    return np.exp(-(u**2)) * (-2.0 * u / fibre.k2) * fibre.k1 * ratio ** (fibre.k1 - 1.0) / optimal_length
+
+
+@dataclass(frozen=True)
+class HillConstants:
+    """Hill constants per unit f_iso: a, c, A, C in units of f_iso; b, B in m/s.
+
+    From the paper (Methods; its refs 15, 21-23): a = f_iso/4, b = v_max/4,
+    c = b (f_iso + a), A = f_ecc f_iso, B = (A - f_iso) b^2 / c and, with
+    erratum C, C = (A - f_iso) B (printed: C = (A - f_iso) b).
+    """
+
+    a: np.ndarray
+    b: np.ndarray
+    c: np.ndarray
+    A: np.ndarray
+    B: np.ndarray
+    C: np.ndarray
+
+
+def max_velocity(optimal_length, fibre: Fibre):
+    """v_max = (vmax_slow + vmax_fast_gain FT) l_opt [m/s] (paper: (6 + 10 FT) l_opt)."""
+    return (fibre.vmax_slow + fibre.vmax_fast_gain * fibre.fast_twitch) * np.asarray(optimal_length)
+
+
+def hill_constants(optimal_length, fibre: Fibre, errata: Errata) -> HillConstants:
+    """Hill constants per unit f_iso for fibres of optimal length ``optimal_length`` [m].
+
+    Parameters
+    ----------
+    optimal_length : array_like
+        l_opt [m].
+    fibre : Fibre
+        hill_a, hill_b, vmax_*, fast_twitch, eccentric_enhancement.
+    errata : Errata
+        ``eccentric_constant``: 'corrected' C = (A - 1) B or 'printed' C = (A - 1) b
+        (design page, erratum C).
+    """
+    a = fibre.hill_a
+    b = fibre.hill_b * max_velocity(optimal_length, fibre)
+    c = b * (1.0 + a)
+    A = fibre.eccentric_enhancement
+    B = (A - 1.0) * b**2 / c
+    C = (A - 1.0) * (B if errata.eccentric_constant == "corrected" else b)
+    return HillConstants(np.asarray(a), b, c, np.asarray(A), B, C)
+
+
+def force_velocity(velocity, hill: HillConstants):
+    """Hill force-velocity factor f_H / f_iso [1], both branches (paper, Methods).
+
+    Concentric (v >= 0): f_H = c / (v + b) - a.
+    Eccentric (v < 0):   f_H = C / (v - B) + A.
+
+    Parameters
+    ----------
+    velocity : array_like
+        Shortening velocity v [m/s].
+    hill : HillConstants
+    """
+    v = np.asarray(velocity, float)
+    concentric = hill.c / (np.where(v >= 0, v, 0.0) + hill.b) - hill.a
+    eccentric = hill.C / (np.where(v < 0, v, 0.0) - hill.B) + hill.A
+    return np.where(v >= 0, concentric, eccentric)
+
+
+def force_velocity_slope(velocity, hill: HillConstants):
+    """Derivative d(f_H/f_iso)/dv [s/m], analytic; at v = 0 the concentric branch's.
+
+    Concentric: -c / (v + b)^2; eccentric: -C / (v - B)^2. With erratum C both
+    equal -(1 + a)/b at v = 0, so the damping is well defined.
+    """
+    v = np.asarray(velocity, float)
+    concentric = -hill.c / (np.where(v >= 0, v, 0.0) + hill.b) ** 2
+    eccentric = -hill.C / (np.where(v < 0, v, 0.0) - hill.B) ** 2
+    return np.where(v >= 0, concentric, eccentric)

@@ -1,0 +1,289 @@
+"""Model parameters as frozen dataclasses.
+
+Every number the model uses lives here, with its unit and source in the field
+metadata (``unit``, ``doc``); there are no magic numbers in the physics
+modules. All values are SI (m, kg, N, s, rad) except where the field says
+otherwise. Instances validate themselves on construction and raise
+:class:`~spinectl.errors.ParameterError` naming the field.
+
+Reading and writing TOML lives in :mod:`spinectl.config`; this module does no
+I/O. The design page (``shared/design/model.md``) fixes the reading of the
+paper (Wagner et al. 2012, "the paper") that these defaults encode.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+
+from . import _validate as v
+from .errors import ParameterError
+
+SIDES = ("ventral", "dorsal")
+"""Sides of an antagonistic pair: ``ventral`` is +x, ``dorsal`` its mirror at -x.
+
+In the coronal plane read them as right (+x) and left (-x).
+"""
+
+
+def param(default, unit: str, doc: str):
+    """A dataclass field carrying its unit and documentation."""
+    kwargs = {"default_factory": lambda: default} if isinstance(default, (list, dict)) else {"default": default}
+    return field(metadata={"unit": unit, "doc": doc}, **kwargs)
+
+
+@dataclass(frozen=True)
+class Body:
+    """The upper body, a point mass above the lumbar spine (paper, Methods)."""
+
+    mass: float = param(
+        40.0,
+        "kg",
+        "Point mass m of the upper body. Not stated in the paper; head, arms and trunk above "
+        "L3 are about 55 % of a 73 kg body (Dempster 1955 segment fractions, as tabulated by "
+        "Winter 2009, Biomechanics and Motor Control of Human Movement, table 4.1).",
+    )
+    mass_height: float = param(0.326, "m", "Height y of the point mass above P2 (paper: 326 mm).")
+    gravity: float = param(9.81, "m/s^2", "Gravitational acceleration g.")
+    radius_of_gyration: float = param(
+        0.0,
+        "m",
+        "Radius of gyration of the upper body about the point mass; the inertia about CoR k "
+        "is m (r_k^2 + rho^2). 0 reproduces the paper's point mass (design page, One segment).",
+    )
+
+    def __post_init__(self):
+        v.positive("mass", self.mass)
+        v.positive("mass_height", self.mass_height)
+        v.positive("gravity", self.gravity)
+        v.non_negative("radius_of_gyration", self.radius_of_gyration)
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """Spine line and centres of rotation (paper, Methods; design page, Geometry)."""
+
+    cor_names: tuple[str, ...] = param(
+        ("L1L2", "L2L3", "L3L4", "L4L5", "L5S1"), "", "Names of the centres of rotation, top to bottom."
+    )
+    cor_heights: tuple[float, ...] = param(
+        (0.145, 0.106, 0.072, 0.035, 0.005),
+        "m",
+        "Heights y of the centres of rotation above P2 (paper, from its ref. 16).",
+    )
+    spine_length: float = param(0.176, "m", "Height of P1 (thoracic joint) above P2 (pelvic joint); paper: 176 mm.")
+    spline_bc: str = param(
+        "natural",
+        "",
+        "End conditions of the cubic spline through P2, P3, P1: 'natural' (design default), "
+        "'clamped' (zero slope at both ends) or 'not-a-knot' (a parabola for three points).",
+    )
+    eccentricity_range: tuple[float, ...] = param(
+        (-0.10, 0.10), "m", "Modelled range of the eccentricity E; the paper studies 0 to 0.08 m."
+    )
+    lordosis_range: tuple[float, ...] = param(
+        (-0.10, 0.10), "m", "Modelled range of the lordosis Lambda; the paper studies 0 to 0.08 m."
+    )
+
+    def __post_init__(self):
+        n = len(self.cor_heights)
+        heights = v.real_vector("cor_heights", self.cor_heights)
+        object.__setattr__(self, "cor_heights", heights)
+        if n < 1:
+            raise ParameterError("cor_heights", "must name at least one centre of rotation")
+        if len(self.cor_names) != n or not all(isinstance(s, str) for s in self.cor_names):
+            raise ParameterError("cor_names", f"must be {n} strings, one per entry of cor_heights")
+        object.__setattr__(self, "cor_names", tuple(self.cor_names))
+        length = v.positive("spine_length", self.spine_length)
+        if any(b >= a for a, b in zip(heights, heights[1:])):
+            raise ParameterError("cor_heights", f"must be strictly decreasing, top to bottom (got {list(heights)})")
+        if not all(0 <= h <= length for h in heights):
+            raise ParameterError("cor_heights", f"must lie on the spine, in [0, spine_length={length:g}] m")
+        v.choice("spline_bc", self.spline_bc, ("natural", "clamped", "not-a-knot"))
+        for name in ("eccentricity_range", "lordosis_range"):
+            lo, hi = v.real_vector(name, getattr(self, name), 2)
+            if lo >= hi:
+                raise ParameterError(name, f"must be [low, high] with low < high (got [{lo:g}, {hi:g}])")
+            object.__setattr__(self, name, (lo, hi))
+
+
+@dataclass(frozen=True)
+class Fibre:
+    """Force-length and Hill force-velocity properties of every global muscle fibre."""
+
+    specific_tension: float = param(
+        25.0e4, "N/m^2", "Isometric force per PCSA, f_iso / PCSA (paper: 25 N/cm^2 = 2.5e5 N/m^2)."
+    )
+    optimal_length_ratio: float = param(
+        1.2, "1", "l_opt / l0, optimal length over equilibrium length (paper: l_opt = 1.2 l0, ascending limb)."
+    )
+    k1: float = param(0.96, "1", "Exponent k1 of the force-length relation (paper).")
+    k2: float = param(0.35, "1", "Width k2 of the force-length relation (paper).")
+    fast_twitch: float = param(0.5, "1", "Fraction FT of fast-twitch fibres (paper: 0.5).")
+    vmax_slow: float = param(6.0, "l_opt/s", "v_max = (vmax_slow + vmax_fast_gain FT) l_opt (paper: 6).")
+    vmax_fast_gain: float = param(10.0, "l_opt/s", "v_max = (vmax_slow + vmax_fast_gain FT) l_opt (paper: 10).")
+    hill_a: float = param(0.25, "1", "a / f_iso of the Hill curve (paper: a = f_iso / 4).")
+    hill_b: float = param(0.25, "1", "b / v_max of the Hill curve (paper: b = v_max / 4).")
+    eccentric_enhancement: float = param(
+        1.5, "1", "f_ecc: the eccentric force tends to A = f_ecc f_iso (paper, its ref. 24: 1.5)."
+    )
+
+    def __post_init__(self):
+        v.positive("specific_tension", self.specific_tension)
+        ratio = v.positive("optimal_length_ratio", self.optimal_length_ratio)
+        if ratio <= 1.0:
+            raise ParameterError(
+                "optimal_length_ratio", f"must be > 1 so that muscles act on the ascending limb (got {ratio:g})"
+            )
+        v.positive("k1", self.k1)
+        v.positive("k2", self.k2)
+        v.in_range("fast_twitch", self.fast_twitch, 0.0, 1.0)
+        v.positive("vmax_slow", self.vmax_slow)
+        v.non_negative("vmax_fast_gain", self.vmax_fast_gain)
+        v.positive("hill_a", self.hill_a)
+        v.positive("hill_b", self.hill_b)
+        ecc = v.real("eccentric_enhancement", self.eccentric_enhancement)
+        if ecc <= 1.0:
+            raise ParameterError("eccentric_enhancement", f"must be > 1 (got {ecc:g})")
+
+
+@dataclass(frozen=True)
+class MusclePair:
+    """One antagonistic pair of global muscles, mirror-symmetric about x = 0.
+
+    The coordinates are those of the ventral (+x) muscle; the dorsal one is its
+    mirror image. Each muscle runs from the thoracic cage (``upper``, moves with
+    the upper body) to the pelvis (``lower``, fixed) as ``fibres`` parallel
+    fibres spread over ``spread`` across the line of action (paper, Methods).
+    The paper gives no coordinates; the defaults are anatomical estimates
+    (see ``docs/parameters.md``) to be calibrated (issue: calibration).
+    """
+
+    name: str = param("straight", "", "Name of the pair.")
+    upper: tuple[float, ...] = param((0.12, 0.24), "m", "(x, y) of the upper (thoracic) attachment, ventral side.")
+    lower: tuple[float, ...] = param((0.12, 0.0), "m", "(x, y) of the lower (pelvic) attachment, ventral side.")
+    spread: float = param(0.03, "m", "Width of the attachment surface across which the fibres are spread.")
+    fibres: int = param(5, "1", "Number of parallel fibres (paper: 5).")
+
+    def __post_init__(self):
+        if not isinstance(self.name, str) or not self.name:
+            raise ParameterError("name", f"must be a non-empty string (got {self.name!r})")
+        upper = v.real_vector("upper", self.upper, 2)
+        lower = v.real_vector("lower", self.lower, 2)
+        object.__setattr__(self, "upper", upper)
+        object.__setattr__(self, "lower", lower)
+        if math.dist(upper, lower) <= 0:
+            raise ParameterError("upper", "must differ from lower (a fibre needs a length)")
+        if upper[1] <= lower[1]:
+            raise ParameterError("upper", f"must lie above lower (got y {upper[1]:g} <= {lower[1]:g})")
+        v.non_negative("spread", self.spread)
+        v.integer("fibres", self.fibres, 1)
+
+
+def _default_muscles() -> tuple[MusclePair, ...]:
+    return (
+        MusclePair("straight", (0.12, 0.24), (0.12, 0.0), 0.03, 5),
+        MusclePair("oblique_outer", (0.16, 0.22), (0.07, 0.0), 0.03, 5),
+        MusclePair("oblique_inner", (0.07, 0.22), (0.16, 0.0), 0.03, 5),
+    )
+
+
+@dataclass(frozen=True)
+class Passive:
+    """Passive stiffness K of the ligamentous sheath (paper, Elastic elements, eq. 2)."""
+
+    stiffness: float = param(0.0, "N m/rad", "K; the paper's value is 15 N m/rad (its ref. 26). 0 = Figure 3.")
+    convention: str = param(
+        "physical",
+        "",
+        "'physical': K adds -K to dM/dalpha (i.e. -K/theta to d(omega')/dalpha). 'paper': eq. 2 as "
+        "printed, -K subtracted from d(omega')/dalpha itself (K then read in 1/s^2). Design page, erratum eq. 2.",
+    )
+
+    def __post_init__(self):
+        v.non_negative("stiffness", self.stiffness)
+        v.choice("convention", self.convention, ("physical", "paper"))
+
+
+@dataclass(frozen=True)
+class Errata:
+    """Choices between the paper's printed formulas and their corrections (design page)."""
+
+    gravity_sign: str = param(
+        "destabilising",
+        "",
+        "'destabilising': dM_ext/dalpha = +m g r cos(alpha), an inverted pendulum (erratum). "
+        "'printed': M_ext = -m g r sin(alpha) as printed, which makes gravity stabilising.",
+    )
+    eccentric_constant: str = param(
+        "corrected",
+        "",
+        "'corrected': C = (A - f_iso) B, continuous in value and slope at v = 0 (erratum C). "
+        "'printed': C = (A - f_iso) b as printed; the Hill curve then jumps at v = 0.",
+    )
+
+    def __post_init__(self):
+        v.choice("gravity_sign", self.gravity_sign, ("destabilising", "printed"))
+        v.choice("eccentric_constant", self.eccentric_constant, ("corrected", "printed"))
+
+
+@dataclass(frozen=True)
+class Optimisation:
+    """Settings of the minimum-PCSA and counter-torque problems (design page, The optimisation)."""
+
+    activation: str = param(
+        "paired", "", "'paired': one PCSA per antagonistic pair (both sides equal); 'independent': one per muscle."
+    )
+    stability_margin: float = param(
+        0.0, "N m/rad", "Required margin: dM_k/dalpha <= -stability_margin at every CoR."
+    )
+    pcsa_max: float = param(math.inf, "m^2", "Upper bound on the PCSA of each decision variable (inf = none).")
+    ct_tolerance: float = param(
+        1e-3, "1", "Relative slack on the minimum total PCSA within which ||CT||_2 is minimised."
+    )
+
+    def __post_init__(self):
+        v.choice("activation", self.activation, ("paired", "independent"))
+        v.non_negative("stability_margin", self.stability_margin)
+        pmax = v.non_negative("pcsa_max", self.pcsa_max, allow_inf=True)
+        if pmax == 0:
+            raise ParameterError("pcsa_max", "must be > 0 (got 0)")
+        v.non_negative("ct_tolerance", self.ct_tolerance)
+
+
+@dataclass(frozen=True)
+class Model:
+    """The whole parameter set of one spinectl model."""
+
+    body: Body = field(default_factory=Body, metadata={"doc": "Upper-body mass and inertia."})
+    geometry: Geometry = field(default_factory=Geometry, metadata={"doc": "Spine line and CoRs."})
+    fibre: Fibre = field(default_factory=Fibre, metadata={"doc": "Muscle fibre properties."})
+    muscles: tuple[MusclePair, ...] = field(
+        default_factory=_default_muscles, metadata={"doc": "The antagonistic pairs of global muscles."}
+    )
+    passive: Passive = field(default_factory=Passive, metadata={"doc": "Passive stiffness K."})
+    errata: Errata = field(default_factory=Errata, metadata={"doc": "Printed formula or correction."})
+    optimisation: Optimisation = field(default_factory=Optimisation, metadata={"doc": "Optimiser settings."})
+
+    def __post_init__(self):
+        object.__setattr__(self, "muscles", tuple(self.muscles))
+        if not self.muscles:
+            raise ParameterError("muscles", "must list at least one muscle pair")
+        names = [m.name for m in self.muscles]
+        if len(set(names)) != len(names):
+            raise ParameterError("muscles", f"names must be unique (got {names})")
+
+    @property
+    def muscle_names(self) -> tuple[str, ...]:
+        """Names of the individual muscles, ``<pair>_<side>``, in column order."""
+        return tuple(f"{m.name}_{side}" for m in self.muscles for side in SIDES)
+
+    @property
+    def pair_names(self) -> tuple[str, ...]:
+        """Names of the antagonistic pairs."""
+        return tuple(m.name for m in self.muscles)
+
+    def replace(self, **changes) -> Model:
+        """Return a copy with top-level sections replaced (see :func:`dataclasses.replace`)."""
+        return dataclasses.replace(self, **changes)

@@ -1,0 +1,1 @@
+"""Built-in parameter presets, one TOML file each (see :mod:`spinectl.config`)."""

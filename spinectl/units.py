@@ -1,0 +1,21 @@
+"""Unit conversions at the edges (CLI, reports, plots, JSON).
+
+The numeric core is SI; PCSA is shown in cm^2, the paper's unit.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+M2_PER_CM2 = 1e-4
+"""Square metres per square centimetre."""
+
+
+def cm2_to_m2(value):
+    """PCSA [cm^2] -> [m^2]."""
+    return np.asarray(value, float) * M2_PER_CM2
+
+
+def m2_to_cm2(value):
+    """PCSA [m^2] -> [cm^2]."""
+    return np.asarray(value, float) / M2_PER_CM2
