@@ -87,7 +87,8 @@ def expand_pcsa(model: Model, pcsa) -> np.ndarray:
         pcsa = pcsa @ geometry.pairing_matrix(n_pairs).T
     elif pcsa.shape[-1:] != (2 * n_pairs,):
         raise ParameterError(
-            "pcsa", f"must have {n_pairs} values (one per pair) or {2 * n_pairs} (one per muscle); got {pcsa.shape[-1:]}"
+            "pcsa",
+            f"must have {n_pairs} values (one per pair) or {2 * n_pairs} (one per muscle); got {pcsa.shape[-1:]}",
         )
     if not np.all(np.isfinite(pcsa)) or np.any(pcsa < 0):
         raise ParameterError("pcsa", "must be finite and >= 0")

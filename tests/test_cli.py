@@ -26,14 +26,23 @@ def test_stability_table(capsys):
 
 
 def test_stability_json_schema(capsys):
-    code, out, _ = run(["stability", "--E", "0.03", "--Lambda", "0.04", "--pcsa", "10,10,10", "--K", "15", "--json"], capsys)
+    code, out, _ = run(
+        ["stability", "--E", "0.03", "--Lambda", "0.04", "--pcsa", "10,10,10", "--K", "15", "--json"], capsys
+    )
     assert code == 0
     doc = json.loads(out)
     assert doc["E_m"] == 0.03 and doc["Lambda_m"] == 0.04 and doc["K_Nm_per_rad"] == 15
     assert len(doc["pcsa_cm2"]) == 6 and doc["total_pcsa_cm2"] == pytest.approx(60)
     seg = doc["segments"][0]
-    for key in ("name", "stiffness_Nm_per_rad", "damping_Nms_per_rad", "inertia_kgm2", "eigenvalues",
-                "self_stable", "counter_torque_Nm"):
+    for key in (
+        "name",
+        "stiffness_Nm_per_rad",
+        "damping_Nms_per_rad",
+        "inertia_kgm2",
+        "eigenvalues",
+        "self_stable",
+        "counter_torque_Nm",
+    ):
         assert key in seg
     assert len(seg["eigenvalues"]) == 2 and len(seg["eigenvalues"][0]) == 2
     norm = sum(s["counter_torque_Nm"] ** 2 for s in doc["segments"]) ** 0.5
@@ -80,6 +89,8 @@ def test_bad_config_values_from_file(tmp_path, capsys):
 def test_module_entry_point_runs_in_a_subprocess():
     proc = subprocess.run(
         [sys.executable, "-m", "spinectl", "stability", "--E", "1", "--pcsa", "1,1,1"],
-        capture_output=True, text=True, check=False,
+        capture_output=True,
+        text=True,
+        check=False,
     )
     assert proc.returncode == 2 and "Traceback" not in proc.stderr and proc.stderr.count("\n") == 1

@@ -32,7 +32,8 @@ def test_damping_is_central_difference_of_nonlinear_torque(model, rng):
     coeffs = mechanics.segment_coefficients(model, E, L)
     cor = geometry.cor_positions(E, L, model.geometry)
     fd = (
-        mechanics.muscle_torque_per_pcsa(model, cor, 0.0, STEP) - mechanics.muscle_torque_per_pcsa(model, cor, 0.0, -STEP)
+        mechanics.muscle_torque_per_pcsa(model, cor, 0.0, STEP)
+        - mechanics.muscle_torque_per_pcsa(model, cor, 0.0, -STEP)
     ) / (2 * STEP)
     np.testing.assert_allclose(coeffs.damping_per_pcsa, fd, atol=1e-6 * np.abs(fd).max())
     assert np.all(coeffs.damping_per_pcsa <= 0)
@@ -42,7 +43,9 @@ def test_torque_coefficient_is_nonlinear_torque_at_rest(model, rng):
     E, L = _random_positions(rng)
     coeffs = mechanics.segment_coefficients(model, E, L)
     cor = geometry.cor_positions(E, L, model.geometry)
-    np.testing.assert_allclose(coeffs.torque_per_pcsa, mechanics.muscle_torque_per_pcsa(model, cor, 0.0, 0.0), rtol=1e-12)
+    np.testing.assert_allclose(
+        coeffs.torque_per_pcsa, mechanics.muscle_torque_per_pcsa(model, cor, 0.0, 0.0), rtol=1e-12
+    )
 
 
 @pytest.mark.parametrize("sign", ["destabilising", "printed"])

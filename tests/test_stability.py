@@ -7,7 +7,7 @@ import pytest
 
 from spinectl import mechanics, muscle
 from spinectl.errors import ParameterError
-from spinectl.params import Errata, Model, Passive
+from spinectl.params import Errata, Passive
 from spinectl.stability import eigenvalues, jacobian, segment_stability, self_stable
 
 ZERO = np.zeros(3)
@@ -98,8 +98,13 @@ def test_self_stable_margin():
 
 @pytest.mark.parametrize(
     ("E", "L", "pcsa", "field"),
-    [(0.5, 0.0, ZERO, "E"), (0.0, -0.2, ZERO, "Lambda"), (np.nan, 0.0, ZERO, "E"), (0.0, 0.0, [1, 2], "pcsa"),
-     (0.0, 0.0, [-1, 0, 0], "pcsa")],
+    [
+        (0.5, 0.0, ZERO, "E"),
+        (0.0, -0.2, ZERO, "Lambda"),
+        (np.nan, 0.0, ZERO, "E"),
+        (0.0, 0.0, [1, 2], "pcsa"),
+        (0.0, 0.0, [-1, 0, 0], "pcsa"),
+    ],
 )
 def test_bad_input_names_the_field(model, E, L, pcsa, field):
     with pytest.raises(ParameterError) as info:

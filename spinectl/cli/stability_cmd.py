@@ -61,7 +61,7 @@ def result_to_json(model, result: StabilityResult) -> dict:
         "Lambda_m": result.lordosis,
         "K_Nm_per_rad": model.passive.stiffness,
         "K_convention": model.passive.convention,
-        "pcsa_cm2": dict(zip(model.muscle_names, pcsa.tolist())),
+        "pcsa_cm2": dict(zip(model.muscle_names, pcsa.tolist(), strict=False)),
         "total_pcsa_cm2": float(pcsa.sum()),
         "segments": [
             {
@@ -90,7 +90,8 @@ def format_table(model, result: StabilityResult) -> str:
     lines = [
         f"E = {result.eccentricity * 100:.2f} cm, Lambda = {result.lordosis * 100:.2f} cm, "
         f"K = {model.passive.stiffness:g} N m/rad ({model.passive.convention})",
-        "PCSA [cm^2]: " + ", ".join(f"{n} {p:.2f}" for n, p in zip(model.muscle_names, pcsa))
+        "PCSA [cm^2]: "
+        + ", ".join(f"{n} {p:.2f}" for n, p in zip(model.muscle_names, pcsa, strict=False))
         + f"  (total {pcsa.sum():.2f})",
         "",
         f"{'segment':8} {'S [N m/rad]':>12} {'D [N m s/rad]':>14} {'theta [kg m2]':>14} "
@@ -103,8 +104,11 @@ def format_table(model, result: StabilityResult) -> str:
             f"{_complex(eig[0]):>20} {_complex(eig[1]):>20} {'yes' if result.self_stable[k] else 'NO':>7} "
             f"{result.counter_torque[k]:10.3f}"
         )
-    lines += ["", f"||CT|| = {result.counter_torque_norm:.3f} N m; "
-              f"self-stable: {'all segments' if result.all_self_stable else 'NOT all segments'}"]
+    lines += [
+        "",
+        f"||CT|| = {result.counter_torque_norm:.3f} N m; "
+        f"self-stable: {'all segments' if result.all_self_stable else 'NOT all segments'}",
+    ]
     return "\n".join(lines)
 
 
