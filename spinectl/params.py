@@ -246,6 +246,12 @@ class Optimisation:
     ct_tolerance: float = param(
         1e-3, "1", "Relative slack on the minimum total PCSA within which ||CT||_2 is minimised."
     )
+    solver_tolerance: float = param(
+        1e-9,
+        "1",
+        "Feasibility and relative-gap tolerance of the conic solver (Clarabel; SCS as fallback). Tight, "
+        "so that the per-point reference and the fast path agree to 1e-6 (docs/optimisation.md).",
+    )
 
     def __post_init__(self):
         v.choice("activation", self.activation, ("paired", "independent"))
@@ -254,6 +260,7 @@ class Optimisation:
         if pmax == 0:
             raise ParameterError("pcsa_max", "must be > 0 (got 0)")
         v.non_negative("ct_tolerance", self.ct_tolerance)
+        v.in_range("solver_tolerance", self.solver_tolerance, 1e-14, 1e-4)
 
 
 @dataclass(frozen=True)
