@@ -36,6 +36,7 @@ def atomic_path(target: str | Path, *, directory: bool = False) -> Iterator[Path
         fd, name = tempfile.mkstemp(prefix=prefix, suffix=".tmp" + target.suffix, dir=target.parent)
         os.close(fd)
         tmp = Path(name)
+    _as_if_created(tmp, directory)
     try:
         yield tmp
         if directory and target.exists():
@@ -54,8 +55,36 @@ def atomic_path(target: str | Path, *, directory: bool = False) -> Iterator[Path
         raise
 
 
+def _as_if_created(path: Path, directory: bool) -> None:
+    """Give a temporary the permissions a plain ``open``/``mkdir`` would (mkstemp makes it private)."""
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(path, (0o777 if directory else 0o666) & ~umask)
+
+
 def atomic_write_text(target: str | Path, text: str) -> Path:
     """Write ``text`` to ``target`` atomically; return the target path."""
     with atomic_path(target) as tmp:
         tmp.write_text(text)
     return Path(target)
+
+
+@contextlib.contextmanager
+def staged_directory(target: str | Path) -> Iterator[Path]:
+    """Yield an empty staging folder; on success move each of its files into ``target``.
+
+    Every file lands by an atomic rename, all at the end: an interrupted run
+    leaves ``target`` as it was, and files already in ``target`` that the run
+    does not write are kept. On an exception the staging folder is removed.
+    """
+    target = Path(target)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    stage = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent))
+    _as_if_created(stage, directory=True)
+    try:
+        yield stage
+        target.mkdir(exist_ok=True)
+        for item in sorted(stage.iterdir()):
+            os.replace(item, target / item.name)
+    finally:
+        shutil.rmtree(stage, ignore_errors=True)

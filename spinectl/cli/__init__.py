@@ -17,6 +17,9 @@ from ..errors import SpinectlError
 COMMANDS = (
     "config_cmd",
     "stability_cmd",
+    "sweep_cmd",
+    "plot_cmd",
+    "reproduce_cmd",
 )
 """Modules of :mod:`spinectl.cli` that each register one sub-command."""
 
