@@ -94,7 +94,7 @@ def sweep(
     l_axis = np.atleast_1d(np.asarray(lordosis, float))
     validate_position(model, e_axis, l_axis)
     e_grid, l_grid = (a.ravel() for a in np.meshgrid(e_axis, l_axis, indexing="ij"))
-    columns: dict[str, list] = {}
+    arrays: dict[str, np.ndarray] = {}  # filled chunk by chunk: no copies of the answer beyond the answer
     per_point = 0
     disable = None if progress is None else not progress  # None: tqdm shows it on a terminal only
     with tqdm(total=e_grid.size, disable=disable, unit="pt", desc="sweep") as bar:
@@ -110,9 +110,11 @@ def sweep(
                 result = batch.solve_points(data, tol, progress=bar.update)
             per_point += result.per_point
             for name, values in _chunk_columns(result, coeffs).items():
-                columns.setdefault(name, []).append(values)
+                if name not in arrays:
+                    arrays[name] = np.empty((e_grid.size,) + values.shape[1:], values.dtype)
+                arrays[name][part] = values
     shape = (e_axis.size, l_axis.size)
-    arrays = {name: np.concatenate(parts).reshape(shape + parts[0].shape[1:]) for name, parts in columns.items()}
+    arrays = {name: values.reshape(shape + values.shape[1:]) for name, values in arrays.items()}
     return _dataset(model, e_axis, l_axis, arrays, method, per_point)
 
 
