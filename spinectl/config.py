@@ -29,7 +29,13 @@ def list_presets() -> list[str]:
 
 
 def load_preset(name: str = "default") -> Model:
-    """The built-in preset ``name`` as a :class:`~spinectl.params.Model`."""
+    """The built-in preset ``name`` as a :class:`~spinectl.params.Model`.
+
+    Parameters
+    ----------
+    name : str
+        One of :func:`list_presets`.
+    """
     presets = list_presets()
     if name not in presets:
         raise ConfigError("preset", f"must be one of {', '.join(map(repr, presets))} (got {name!r})")
@@ -80,6 +86,13 @@ def merge(base: Model, data: dict) -> Model:
     """``base`` with the (partial, nested) parameters in ``data`` replacing its own.
 
     ``muscles``, a list, replaces the whole list when given.
+
+    Parameters
+    ----------
+    base : Model
+        The parameters to start from.
+    data : dict
+        Nested parameters as read from TOML, e.g. ``{"body": {"mass": 50.0}}`` (SI units).
     """
     merged = _deep_merge(to_dict(base), data)
     return from_dict(Model, merged)
@@ -96,7 +109,17 @@ def _deep_merge(base: dict, new: dict) -> dict:
 
 
 def set_parameter(model: Model, dotted: str, value) -> Model:
-    """Return ``model`` with one parameter replaced, e.g. ``"body.mass"`` or ``"muscles.0.spread"``."""
+    """Return ``model`` with one parameter replaced, e.g. ``"body.mass"`` or ``"muscles.0.spread"``.
+
+    Parameters
+    ----------
+    model : Model
+        The parameters to start from.
+    dotted : str
+        Dotted path of the parameter; list items by index.
+    value : object
+        The new value, in the parameter's unit (see ``docs/parameters.md``); validated.
+    """
     data = to_dict(model)
     node = data
     keys = dotted.split(".")
@@ -133,7 +156,13 @@ def _unknown_message(key: str, allowed) -> str:
 
 
 def to_dict(obj) -> dict:
-    """Nested plain dict (lists for tuples) of a parameter dataclass."""
+    """Nested plain dict (lists for tuples) of a parameter dataclass.
+
+    Parameters
+    ----------
+    obj : dataclass instance
+        A :class:`~spinectl.params.Model` or one of its sections.
+    """
     out = {}
     for f in dataclasses.fields(obj):
         value = getattr(obj, f.name)
@@ -149,6 +178,15 @@ def to_dict(obj) -> dict:
 
 def from_dict(cls, data: dict, path: str = ""):
     """Build the dataclass ``cls`` from a nested dict, validating every field.
+
+    Parameters
+    ----------
+    cls : type
+        A parameter dataclass, e.g. :class:`~spinectl.params.Model`.
+    data : dict
+        Its fields, nested as in TOML (SI units).
+    path : str
+        Dotted path of ``cls`` inside the model, prefixed to error field names.
 
     Raises
     ------
@@ -190,7 +228,13 @@ def _convert(hint, value, path: str):
 
 
 def dump_toml(model: Model) -> str:
-    """The fully resolved parameter set as TOML, with units and docs as comments."""
+    """The fully resolved parameter set as TOML, with units and docs as comments.
+
+    Parameters
+    ----------
+    model : Model
+        The parameters to write.
+    """
     lines = ["# spinectl model parameters (SI units unless a comment says otherwise)", ""]
     for f in dataclasses.fields(model):
         value = getattr(model, f.name)

@@ -30,7 +30,13 @@ class ParameterError(SpinectlError, ValueError):
         super().__init__(f"{field}: {message}")
 
     def under(self, prefix: str) -> ParameterError:
-        """Return the same error with ``prefix`` prepended to the field name."""
+        """Return the same error with ``prefix`` prepended to the field name.
+
+        Parameters
+        ----------
+        prefix : str
+            Dotted path of the section, e.g. ``"body"``; empty leaves the name unchanged.
+        """
         return type(self)(f"{prefix}.{self.field}" if prefix else self.field, self.message)
 
 

@@ -55,7 +55,15 @@ def atomic_path(target: str | Path, *, directory: bool = False) -> Iterator[Path
 
 
 def atomic_write_text(target: str | Path, text: str) -> Path:
-    """Write ``text`` to ``target`` atomically; return the target path."""
+    """Write ``text`` to ``target`` atomically; return the target path.
+
+    Parameters
+    ----------
+    target : str or Path
+        Final file.
+    text : str
+        Its whole content.
+    """
     with atomic_path(target) as tmp:
         tmp.write_text(text)
     return Path(target)

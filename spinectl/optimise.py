@@ -70,6 +70,13 @@ def problem_data(model: Model, coeffs: SegmentCoefficients) -> ProblemData:
 
     ``optimisation.activation = "paired"`` gives one variable per pair (both
     muscles equal, co-contraction); ``"independent"`` one per muscle.
+
+    Parameters
+    ----------
+    model : Model
+        Supplies the ``optimisation`` settings.
+    coeffs : SegmentCoefficients
+        Per-unit-PCSA mechanics from :func:`~spinectl.mechanics.segment_coefficients`.
     """
     n_muscles = coeffs.stiffness_per_pcsa.shape[-1]
     if model.optimisation.activation == "paired":
@@ -110,6 +117,11 @@ def _constraints(x: cp.Variable, data: ProblemData) -> list:
 def min_pcsa_lp(data: ProblemData) -> tuple[str, np.ndarray | None]:
     """Solve the minimum-PCSA LP at one point.
 
+    Parameters
+    ----------
+    data : ProblemData
+        The problem at one (E, Lambda) (no leading dimensions).
+
     Returns
     -------
     status : str
@@ -127,6 +139,20 @@ def min_counter_torque_socp(data: ProblemData, total_max: float) -> tuple[str, n
     """Least ||CT||_2 over self-stable activations with total PCSA <= ``total_max`` [cm^2].
 
     CT = -(torque @ x + gravity_torque) (paper, Methods; design page, The optimisation).
+
+    Parameters
+    ----------
+    data : ProblemData
+        The problem at one (E, Lambda) (no leading dimensions).
+    total_max : float
+        Bound on the total PCSA ``weights @ x`` [cm^2].
+
+    Returns
+    -------
+    status : str
+        As for :func:`min_pcsa_lp`.
+    x : numpy.ndarray or None
+        Decision variables of least ||CT||_2 [cm^2], None unless optimal.
     """
     x = cp.Variable(data.weights.size)
     ct = -(data.torque @ x + data.gravity_torque)

@@ -28,7 +28,17 @@ In the coronal plane read them as right (+x) and left (-x).
 
 
 def param(default, unit: str, doc: str):
-    """A dataclass field carrying its unit and documentation."""
+    """A dataclass field carrying its unit and documentation.
+
+    Parameters
+    ----------
+    default : object
+        Default value, in ``unit``; a list or dict becomes a default factory.
+    unit : str
+        Unit of the value, e.g. ``"N m/rad"``; ``"1"`` for a ratio, ``""`` for text.
+    doc : str
+        What the parameter is and where its value comes from.
+    """
     kwargs = {"default_factory": lambda: default} if isinstance(default, (list, dict)) else {"default": default}
     return field(metadata={"unit": unit, "doc": doc}, **kwargs)
 

@@ -47,6 +47,15 @@ def eigenvalues(stiffness, damping, inertia):
     lambda_{1,2} = D/(2 theta) +- sqrt(D^2/(4 theta^2) + S/theta) (paper, eq. 1,
     with d(omega')/d(omega) = D/theta and d(omega')/d(alpha) = S/theta).
     The root with the larger real part comes first.
+
+    Parameters
+    ----------
+    stiffness : array_like
+        S = dM/dalpha [N m/rad].
+    damping : array_like
+        D = dM/domega [N m s/rad].
+    inertia : array_like
+        theta [kg m^2].
     """
     s, d, theta = (np.asarray(x, float) for x in (stiffness, damping, inertia))
     half = d / (2.0 * theta)
@@ -55,7 +64,15 @@ def eigenvalues(stiffness, damping, inertia):
 
 
 def self_stable(eigs, margin: float = 0.0):
-    """True where every eigenvalue has real part < -margin [1/s]."""
+    """True where every eigenvalue has real part < -margin [1/s].
+
+    Parameters
+    ----------
+    eigs : array_like, shape (..., 2)
+        Eigenvalues [1/s], e.g. from :func:`eigenvalues`.
+    margin : float
+        Required distance of the real parts from zero [1/s].
+    """
     return np.all(np.real(eigs) < -margin, axis=-1)
 
 
@@ -63,6 +80,13 @@ def validate_position(model: Model, eccentricity, lordosis) -> None:
     """Raise :class:`ParameterError` if E or Lambda is outside the modelled range.
 
     The ranges are ``geometry.eccentricity_range`` and ``geometry.lordosis_range`` [m].
+
+    Parameters
+    ----------
+    model : Model
+        Supplies the modelled ranges.
+    eccentricity, lordosis : array_like
+        E and Lambda [m].
     """
     for name, value, (lo, hi) in (
         ("E", eccentricity, model.geometry.eccentricity_range),
@@ -80,6 +104,13 @@ def expand_pcsa(model: Model, pcsa) -> np.ndarray:
     """Per-muscle PCSA [m^2] from per-muscle (2 n values) or per-pair (n values, each side) input.
 
     With n values, both muscles of pair j get ``pcsa[j]`` (paired activation).
+
+    Parameters
+    ----------
+    model : Model
+        Supplies the muscle pairs.
+    pcsa : array_like, shape (..., n) or (..., 2 n)
+        PCSA [m^2], finite and >= 0.
     """
     pcsa = np.asarray(pcsa, float)
     n_pairs = len(model.muscles)

@@ -51,7 +51,13 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the CLI; return the exit code (0 ok, 2 bad input, 1 other failure)."""
+    """Run the CLI; return the exit code (0 ok, 2 bad input, 1 other failure).
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments after ``spinectl``; default ``sys.argv[1:]``.
+    """
     try:
         args = build_parser().parse_args(argv)
         return int(args.func(args) or 0)

@@ -9,6 +9,13 @@ from ._common import add_model_options, emit_json, finite_float, float_list, loa
 
 
 def register(sub) -> None:
+    """Add the ``stability`` sub-command to the ``spinectl`` parser.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The sub-command action of :func:`spinectl.cli.build_parser`.
+    """
     parser = sub.add_parser(
         "stability",
         help="eigenvalues, self-stability and counter torque of each segment",
@@ -30,13 +37,25 @@ def register(sub) -> None:
 
 
 def add_position_options(parser) -> None:
-    """``--E`` and ``--Lambda`` in metres."""
+    """``--E`` and ``--Lambda`` in metres.
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        The sub-command's parser.
+    """
     parser.add_argument("--E", type=finite_float("--E"), default=0.0, help="eccentricity E [m] (default 0)")
     parser.add_argument("--Lambda", type=finite_float("--Lambda"), default=0.0, help="lordosis Lambda [m] (default 0)")
 
 
 def model_with_overrides(args):
-    """The model of ``--preset``/``--config`` with ``--K`` applied."""
+    """The model of ``--preset``/``--config`` with ``--K`` applied.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments; ``K`` [N m/rad] is optional.
+    """
     model = load_model(args)
     if getattr(args, "K", None) is not None:
         model = set_parameter(model, "passive.stiffness", args.K)
@@ -44,6 +63,18 @@ def model_with_overrides(args):
 
 
 def run(args) -> int:
+    """Run ``spinectl stability``: print the table, or JSON with ``--json``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments: ``E``, ``Lambda`` [m], ``pcsa`` [cm^2], ``K``, ``json`` and the model options.
+
+    Returns
+    -------
+    int
+        Exit code 0.
+    """
     model = model_with_overrides(args)
     result = segment_stability(model, args.E, args.Lambda, cm2_to_m2(args.pcsa))
     if args.json:
@@ -54,7 +85,15 @@ def run(args) -> int:
 
 
 def result_to_json(model, result: StabilityResult) -> dict:
-    """The JSON document of ``spinectl stability --json`` (units in the key names)."""
+    """The JSON document of ``spinectl stability --json`` (units in the key names).
+
+    Parameters
+    ----------
+    model : Model
+        The model the result was computed with (muscle names, K).
+    result : StabilityResult
+        Output of :func:`~spinectl.stability.segment_stability`.
+    """
     pcsa = m2_to_cm2(result.pcsa)
     return {
         "E_m": result.eccentricity,
@@ -85,7 +124,15 @@ def _complex(z: complex) -> str:
 
 
 def format_table(model, result: StabilityResult) -> str:
-    """A readable per-segment table."""
+    """A readable per-segment table.
+
+    Parameters
+    ----------
+    model : Model
+        The model the result was computed with (muscle names, K).
+    result : StabilityResult
+        Output of :func:`~spinectl.stability.segment_stability`.
+    """
     pcsa = m2_to_cm2(result.pcsa)
     lines = [
         f"E = {result.eccentricity * 100:.2f} cm, Lambda = {result.lordosis * 100:.2f} cm, "
