@@ -137,16 +137,11 @@ def set_parameter(model: Model, dotted: str, value) -> Model:
     """
     data = to_dict(model)
     node = data
-    keys = dotted.split(".")
-    for key in keys[:-1]:
+    *parents, last = dotted.split(".")
+    for key in parents:
         node = _child(node, key, dotted)
-    last = keys[-1]
-    if isinstance(node, list):
-        node[_index(node, last, dotted)] = value
-    else:
-        if last not in node:
-            raise ConfigError(dotted, _unknown_message(last, node))
-        node[last] = value
+    _child(node, last, dotted)  # the last key must exist too: same checks, same messages
+    node[int(last) if isinstance(node, list) else last] = value
     return from_dict(Model, data)
 
 
