@@ -147,8 +147,9 @@ def arithmetic_guard(eccentricity, lordosis):
         with np.errstate(over="raise", divide="raise", invalid="raise"):
             yield
     except (FloatingPointError, OverflowError, ZeroDivisionError) as exc:
+        reason = str(exc) if isinstance(exc, FloatingPointError) else type(exc).__name__  # numpy's say where
         raise ModelError(
-            f"the model's arithmetic fails {_where(eccentricity, lordosis)} ({exc}); "
+            f"the model's arithmetic fails {_where(eccentricity, lordosis)} ({reason}); "
             "is a parameter or an input orders of magnitude off? (units are SI: m, kg, N, s)"
         ) from None
 
