@@ -53,7 +53,7 @@ def finite_float(name: str):
             raise argparse.ArgumentTypeError(f"{name} must be a number (got {text!r})") from None
         if not math.isfinite(value):
             raise argparse.ArgumentTypeError(f"{name} must be finite (got {text!r})")
-        return value
+        return value + 0.0  # -0 becomes 0
 
     convert.__name__ = name
     return convert
