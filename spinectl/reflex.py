@@ -15,8 +15,8 @@ quasi-polynomial
 A root crosses the imaginary axis at s = j w only where |Q(jw)| = |P(jw)|, i.e.
 F(w^2) = 0 with F(x) = theta^2 x^2 + (2 S theta + D^2 - kd^2) x + S^2 - kp^2,
 and then only at the delays tau = (phi + 2 pi k) / w, phi = arg(-Q/P) mod 2 pi.
-The sign of F'(w^2) is the direction of the crossing (Cooke and van den Driessche
-1986): + destabilising, - stabilising.
+The sign of F'(w^2) is the direction of the crossing (Cooke and Grossman 1982;
+Cooke and van den Driessche 1986): + destabilising, - stabilising.
 
 theta = 0 with kd = 0 is accepted too: the first-order-plus-delay loop of the
 textbooks (a retarded equation); theta = 0 with kd != 0 would be of neutral type
