@@ -38,6 +38,8 @@ def bode(loops: Mapping[str, ct.TransferFunction], path, omega_limits=None, titl
         PNG to write.
     omega_limits : (float, float), optional
         Frequency range [rad/s]; python-control's default otherwise.
+    title : str, optional
+        Figure title.
     """
     plot = ct.bode_plot(
         list(loops.values()), omega_limits=omega_limits, label=list(loops), title=title or "Reflex loop L(jw)"
@@ -46,7 +48,17 @@ def bode(loops: Mapping[str, ct.TransferFunction], path, omega_limits=None, titl
 
 
 def nyquist(loops: Mapping[str, ct.TransferFunction], path, title: str = "") -> Path:
-    """Nyquist plot of the loops; an open-loop unstable segment must circle -1 once counter-clockwise."""
+    """Nyquist plot of the loops; an open-loop unstable segment must circle -1 once counter-clockwise.
+
+    Parameters
+    ----------
+    loops : mapping of str to TransferFunction
+        Segment name -> loop.
+    path : str or Path
+        PNG to write.
+    title : str, optional
+        Figure title.
+    """
     plot = ct.nyquist_plot(list(loops.values()), label=list(loops), title=title or "Nyquist plot of L(jw)")
     return _save(plot.figure, path)
 
@@ -56,6 +68,15 @@ def time_response(responses: Mapping[str, Simulation], path, title: str = "") ->
 
     Each panel is scaled to the response with the reflex; a response without it that
     diverges leaves the panel (the simulation stops at ``sim_divergence``).
+
+    Parameters
+    ----------
+    responses : mapping of str to Simulation
+        Segment name -> a batch of two runs (:func:`spinectl.simulate.simulate`).
+    path : str or Path
+        PNG to write.
+    title : str, optional
+        Figure title.
     """
     fig, axes = plt.subplots(len(responses), 1, sharex=True, figsize=(7, 1.6 * len(responses) + 1), squeeze=False)
     for ax, (name, sim) in zip(axes[:, 0], responses.items(), strict=True):

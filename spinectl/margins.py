@@ -60,6 +60,14 @@ def operating_point(model: Model, eccentricity: float, lordosis: float, activati
     """PCSA = activation x ``solve_point(model, E, Lambda).pcsa`` and the segments it gives.
 
     An infeasible optimum is reported in ``status`` with NaN values, never raised.
+
+    Parameters
+    ----------
+    model : Model
+    eccentricity, lordosis : float
+        E and Lambda [m].
+    activation : float
+        Fraction of the minimum stabilising PCSA [1]; 0 skips the optimiser.
     """
     validate_position(model, eccentricity, lordosis)
     coeffs = segment_coefficients(model, float(eccentricity), float(lordosis))
@@ -135,7 +143,21 @@ class SegmentMargins:
 
 
 def segment_margins(name, stiffness, damping, inertia, kp, kd, delay: float, order: int) -> SegmentMargins:
-    """All margins of one segment's reflex loop (see :class:`SegmentMargins`)."""
+    """All margins of one segment's reflex loop (see :class:`SegmentMargins`).
+
+    Parameters
+    ----------
+    name : str
+        Name of the CoR.
+    stiffness, damping, inertia : float
+        S [N m/rad], D [N m s/rad], theta [kg m^2]; NaN gives NaN margins.
+    kp, kd : float
+        Reflex gains [N m/rad], [N m s/rad].
+    delay : float
+        tau [s].
+    order : int
+        Order of the Padé approximant.
+    """
     s, d, theta, kp, kd = (float(x) for x in (stiffness, damping, inertia, kp, kd))
     exact = reflex.delay_margin(s, d, theta, kp, kd)
     pm, w_c = reflex.phase_margin(s, d, theta, kp, kd, delay)

@@ -12,7 +12,7 @@ quasi-polynomial
 
     Delta(s, tau) = P(s) + Q(s) exp(-s tau),  P(s) = theta s^2 - D s - S,  Q(s) = kp + kd s.
 
-A root crosses the imaginary axis at s = j w only where |Q(jw)| = |P(jw)|, i.e.
+A root crosses the imaginary axis at s = j w only where abs(Q(jw)) = abs(P(jw)), i.e.
 F(w^2) = 0 with F(x) = theta^2 x^2 + (2 S theta + D^2 - kd^2) x + S^2 - kp^2,
 and then only at the delays tau = (phi + 2 pi k) / w, phi = arg(-Q/P) mod 2 pi.
 The sign of F'(w^2) is the direction of the crossing (Cooke and Grossman 1982;
@@ -36,7 +36,7 @@ STATUS = ("finite", "delay_independent", "unstable_without_delay", "undefined")
 
 - ``finite``: stable without delay; it loses stability at the finite delay margin.
 - ``delay_independent``: stable without delay and no root can reach the imaginary
-  axis (|Q(jw)| != |P(jw)| for every w > 0): stable for every delay, margin = inf.
+  axis (abs(Q(jw)) != abs(P(jw)) for every w > 0): stable for every delay, margin = inf.
   This is where self-stability makes the delay irrelevant.
 - ``unstable_without_delay``: not stable even at tau = 0 (kp <= S or kd <= D):
   margin = 0, the largest tau_m with stability on all of [0, tau_m) being none.
@@ -84,7 +84,15 @@ def default_gains(stiffness, damping, inertia, gain_factor, damping_ratio):
 
 
 def stable_without_delay(stiffness, damping, kp, kd):
-    """True where theta s^2 + (kd - D) s + (kp - S) is Hurwitz: kd > D and kp > S (theta > 0)."""
+    """True where theta s^2 + (kd - D) s + (kp - S) is Hurwitz: kd > D and kp > S (theta > 0).
+
+    Parameters
+    ----------
+    stiffness, damping : array_like
+        S [N m/rad], D [N m s/rad].
+    kp, kd : array_like
+        Reflex gains [N m/rad], [N m s/rad].
+    """
     s, d, kp, kd = _arrays(stiffness, damping, kp, kd)
     return (kd > d) & (kp > s)
 
@@ -99,7 +107,7 @@ class Crossings:
     Attributes
     ----------
     frequency : numpy.ndarray, shape (..., 2)
-        w > 0 with |Q(jw)| = |P(jw)|, the gain crossover of the loop [rad/s].
+        w > 0 with abs(Q(jw)) = abs(P(jw)), the gain crossover of the loop [rad/s].
     phase : numpy.ndarray, shape (..., 2)
         phi = arg(-Q(jw)/P(jw)) in [0, 2 pi) [rad]: the delay must add w tau = phi (mod 2 pi).
     direction : numpy.ndarray, shape (..., 2)
@@ -120,8 +128,19 @@ def crossings(stiffness, damping, inertia, kp, kd) -> Crossings:
     """Crossing frequencies, phases and directions of the delayed reflex loop.
 
     Solves F(x) = theta^2 x^2 + (2 S theta + D^2 - kd^2) x + (S^2 - kp^2) = 0,
-    from |kp + j kd w|^2 = (S + theta w^2)^2 + D^2 w^2 (``docs/reflex.md``), for x = w^2 > 0.
+    from abs(kp + j kd w)^2 = (S + theta w^2)^2 + D^2 w^2 (``docs/reflex.md``), for x = w^2 > 0.
     w = 0 is never a crossing for kp != S: there exp(0) = 1 and Delta(0) = kp - S.
+
+    Parameters
+    ----------
+    stiffness, damping, inertia : array_like
+        S [N m/rad], D [N m s/rad], theta [kg m^2].
+    kp, kd : array_like
+        Reflex gains [N m/rad], [N m s/rad].
+
+    Returns
+    -------
+    Crossings
     """
     s, d, theta, kp, kd = _arrays(stiffness, damping, inertia, kp, kd)
     a, b, c = theta**2, 2.0 * s * theta + d**2 - kd**2, s**2 - kp**2
@@ -214,7 +233,20 @@ def right_half_plane_roots(stiffness, damping, inertia, kp, kd, delay):
     N(tau) = N(0) + 2 sum over crossings of direction * #{k >= 0: phi/w + 2 pi k/w < tau}:
     every crossing moves a conjugate pair (retarded type: no root comes from
     infinity). N(0) counts the roots of theta s^2 + (kd - D) s + (kp - S).
-    Returns a float array (NaN where an input is NaN).
+
+    Parameters
+    ----------
+    stiffness, damping, inertia : array_like
+        S [N m/rad], D [N m s/rad], theta [kg m^2].
+    kp, kd : array_like
+        Reflex gains [N m/rad], [N m s/rad].
+    delay : array_like
+        tau [s].
+
+    Returns
+    -------
+    numpy.ndarray
+        The count, as floats (NaN where an input is NaN).
     """
     s, d, theta, kp, kd, tau = _arrays(stiffness, damping, inertia, kp, kd, delay)
     c0, c1 = kp - s, kd - d
@@ -232,6 +264,15 @@ def stable_at_delay(stiffness, damping, inertia, kp, kd, delay):
 
     Exact for every delay, also beyond the delay margin (stability switches). A root
     fixed at s = 0 (kp = S) or on the axis at tau = 0 (kd = D) counts as unstable.
+
+    Parameters
+    ----------
+    stiffness, damping, inertia : array_like
+        S [N m/rad], D [N m s/rad], theta [kg m^2].
+    kp, kd : array_like
+        Reflex gains [N m/rad], [N m s/rad].
+    delay : array_like
+        tau [s].
     """
     s, d, theta, kp, kd, tau = _arrays(stiffness, damping, inertia, kp, kd, delay)
     count = right_half_plane_roots(s, d, theta, kp, kd, tau)
@@ -246,6 +287,20 @@ def phase_margin(stiffness, damping, inertia, kp, kd, delay):
     PM = 180 deg + arg L(j w_c) = phi - w_c tau, wrapped to [-pi, pi) as python-control does;
     so PM / w_c is the delay that may still be added when 0 < PM < pi.
     inf and NaN (no crossover) like python-control's ``stability_margins``.
+
+    Parameters
+    ----------
+    stiffness, damping, inertia : array_like
+        S [N m/rad], D [N m s/rad], theta [kg m^2].
+    kp, kd : array_like
+        Reflex gains [N m/rad], [N m s/rad].
+    delay : array_like
+        tau [s].
+
+    Returns
+    -------
+    phase_margin, crossover : numpy.ndarray
+        PM [rad] and w_c [rad/s].
     """
     cr = crossings(stiffness, damping, inertia, kp, kd)
     tau = np.asarray(delay, float)
@@ -265,6 +320,11 @@ def pade_coefficients(order: int) -> np.ndarray:
 
     c_k = (2n - k)! n! / ((2n)! k! (n - k)!) (Baker and Graves-Morris, Padé Approximants,
     1996; e.g. n = 1: q = 1 + x/2; n = 2: q = 1 + x/2 + x^2/12), lowest power first, c_0 = 1.
+
+    Parameters
+    ----------
+    order : int
+        n >= 1.
     """
     n = int(order)
     return np.array(
@@ -282,6 +342,13 @@ def pade_phase_lag(y, order: int):
     (all in Re < 0, so every term is continuous): increases from 0 to n pi, where the
     true delay's lag y grows without bound. Its magnitude is exactly 1: the Padé
     loop has the same crossover frequencies as the true one.
+
+    Parameters
+    ----------
+    y : array_like
+        w tau [rad].
+    order : int
+        Order n of the approximant.
     """
     roots = np.roots(pade_coefficients(order)[::-1])
     y = np.asarray(y, float)[..., None]
@@ -292,6 +359,13 @@ def pade_inverse_lag(phase, order: int):
     """The y >= 0 with :func:`pade_phase_lag` (y) = ``phase`` [rad]; inf where phase >= n pi.
 
     Vectorised bisection on u = (2/pi) atan(y) in [0, 1), where the lag is monotone.
+
+    Parameters
+    ----------
+    phase : array_like
+        Lag to reach [rad].
+    order : int
+        Order n of the approximant.
     """
     phase = np.asarray(phase, float)
     lo, hi = np.zeros_like(phase), np.ones_like(phase)
@@ -309,6 +383,15 @@ def pade_delay_margin(stiffness, damping, inertia, kp, kd, order: int) -> DelayM
     Same crossings as the exact loop (the approximant is all-pass); only the phase
     differs, so the critical delay of a crossing is y/w with lag(y) = phi, and none
     when phi >= n pi. Converges to :func:`delay_margin` as the order grows.
+
+    Parameters
+    ----------
+    stiffness, damping, inertia : array_like
+        S [N m/rad], D [N m s/rad], theta [kg m^2].
+    kp, kd : array_like
+        Reflex gains [N m/rad], [N m s/rad].
+    order : int
+        Order n of the approximant.
     """
     cr = crossings(stiffness, damping, inertia, kp, kd)
     first = pade_inverse_lag(cr.phase, order) / cr.frequency
@@ -318,6 +401,15 @@ def pade_delay_margin(stiffness, damping, inertia, kp, kd, order: int) -> DelayM
 
 def pade_convergence(stiffness, damping, inertia, kp, kd, orders):
     """Padé delay margins and their errors against the exact margin, for several orders.
+
+    Parameters
+    ----------
+    stiffness, damping, inertia : array_like
+        S [N m/rad], D [N m s/rad], theta [kg m^2].
+    kp, kd : array_like
+        Reflex gains [N m/rad], [N m s/rad].
+    orders : sequence of int
+        Orders n of the approximants.
 
     Returns
     -------

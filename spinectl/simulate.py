@@ -73,6 +73,11 @@ class SegmentPlant:
         computed with the same expression at (0, 0) (see :func:`segment_plant`), so
         the equilibrium is exact to rounding and small responses are not swamped by
         a constant offset.
+
+        Parameters
+        ----------
+        alpha, omega : array_like
+            Angle [rad] and angular velocity [rad/s] of the segment.
         """
         return _torque_without_ct(self, alpha, omega) + self.counter_torque
 
@@ -88,7 +93,18 @@ def _torque_without_ct(plant: SegmentPlant, alpha, omega):
 
 
 def segment_plant(model: Model, eccentricity: float, lordosis: float, segment, pcsa) -> SegmentPlant:
-    """The :class:`SegmentPlant` of CoR ``segment`` (index or name) at (E, Lambda) with ``pcsa`` [m^2]."""
+    """The :class:`SegmentPlant` of one CoR at a configuration and activation.
+
+    Parameters
+    ----------
+    model : Model
+    eccentricity, lordosis : float
+        E and Lambda [m].
+    segment : int or str
+        Index or name of the CoR.
+    pcsa : array_like, shape (n_muscles,)
+        PCSA of each muscle [m^2].
+    """
     names = model.geometry.cor_names
     if isinstance(segment, str):
         if segment not in names:
@@ -124,9 +140,9 @@ class Simulation:
     delay, kp, kd : numpy.ndarray, shape (batch,)
         [s], [N m/rad], [N m s/rad].
     diverged : numpy.ndarray of bool, shape (batch,)
-        |alpha| exceeded ``sim_divergence``.
+        abs(alpha) exceeded ``sim_divergence``.
     growth_rate : numpy.ndarray, shape (batch,)
-        Growth of the peak |alpha| from the middle to the last third [1/s]; inf if diverged.
+        Growth of the peak abs(alpha) from the middle to the last third [1/s]; inf if diverged.
     """
 
     time: np.ndarray
@@ -165,12 +181,21 @@ def _delayed(t_query, step, k, alpha, omega, acc, start):
 
 
 def growth_rate(time, alpha, perturbation: float):
-    """Growth rate [1/s] of the peak |alpha| from the middle to the last third of the run.
+    """Growth rate [1/s] of the peak abs(alpha) from the middle to the last third of the run.
 
     ln(max over the last third / max over the middle third) / (duration / 3): the
     transient of the first third is skipped; the windows should span an oscillation
     period. A response below sqrt(machine epsilon) times the perturbation is rounding
     noise and counts as decayed (-inf).
+
+    Parameters
+    ----------
+    time : numpy.ndarray, shape (n,)
+        [s].
+    alpha : numpy.ndarray, shape (batch, n)
+        Angles [rad].
+    perturbation : float
+        Initial angle [rad].
     """
     n = time.size
     a, b = n // 3, 2 * n // 3
@@ -248,6 +273,18 @@ def simulated_delay_margin(plant: SegmentPlant, kp, kd, settings: Reflex, low, h
     Each round simulates ``batch`` delays spread evenly inside [low, high] in one
     batched run and keeps the interval between the last stable and the first unstable
     one; ``batch = 1`` is plain bisection. The bracket shrinks by batch + 1 per round.
+
+    Parameters
+    ----------
+    plant : SegmentPlant
+    kp, kd : float
+        Reflex gains [N m/rad], [N m s/rad].
+    settings : Reflex
+        Simulation settings (see :func:`simulate`).
+    low, high : float
+        Initial bracket of delays [s]: stable at ``low``, unstable at ``high``.
+    batch, rounds : int
+        Delays simulated per round, and rounds.
 
     Returns
     -------

@@ -46,13 +46,27 @@ def segment_system(stiffness: float, damping: float, inertia: float, name: str |
 
 
 def pade_delay(delay: float, order: int) -> ct.TransferFunction:
-    """exp(-s delay) as python-control's [order/order] Padé approximant (1 for no delay)."""
+    """exp(-s delay) as python-control's [order/order] Padé approximant (1 for no delay).
+
+    Parameters
+    ----------
+    delay : float
+        tau [s].
+    order : int
+        Order of the approximant.
+    """
     num, den = ct.pade(delay, order)
     return ct.tf(num, den, inputs=["u"], outputs=["u_delayed"])
 
 
 def reflex_controller(kp: float, kd: float) -> ct.TransferFunction:
-    """C(s) = kp + kd s [N m/rad], from alpha to the reflex torque (before the delay and sign)."""
+    """C(s) = kp + kd s [N m/rad], from alpha to the reflex torque (before the delay and sign).
+
+    Parameters
+    ----------
+    kp, kd : float
+        Reflex gains [N m/rad], [N m s/rad].
+    """
     return ct.tf([kd, kp], [1.0], inputs=["alpha"], outputs=["reflex"])
 
 
@@ -85,7 +99,19 @@ def closed_loop(stiffness, damping, inertia, kp, kd, delay: float, order: int, n
     realised): the plant with both states as outputs, fed back through the gain
     row [kp, kd] and the Padé system. Input: a disturbing torque [N m]; output: alpha.
     Its poles converge to the rightmost roots of the quasi-polynomial as the order grows.
-    Parameters as in :func:`loop_transfer`; ``name`` names the system.
+
+    Parameters
+    ----------
+    stiffness, damping, inertia : float
+        S [N m/rad], D [N m s/rad], theta [kg m^2].
+    kp, kd : float
+        Reflex gains [N m/rad], [N m s/rad].
+    delay : float
+        tau [s].
+    order : int
+        Order of the Padé approximant.
+    name : str, optional
+        System name.
     """
     plant = segment_system(stiffness, damping, inertia)
     full = ct.ss(plant.A, plant.B, np.eye(2), np.zeros((2, 1)))
@@ -104,7 +130,7 @@ class LoopMargins:
     once counter-clockwise, and the loop gain k is only stable in an interval
     (gain_margin_lower, gain_margin_upper) around 1, the lower end > 0 (at least S/kp:
     too weak a reflex cannot hold the segment). Both ends are the phase crossovers'
-    1/|L| nearest to 1 from below and above; they are meaningful only if the closed
+    1/abs(L) nearest to 1 from below and above; they are meaningful only if the closed
     loop is stable (``stable``), else NaN.
 
     Attributes
@@ -136,8 +162,16 @@ def loop_margins(loop: ct.TransferFunction, stable: bool) -> LoopMargins:
     """python-control's margins of ``loop`` with the lower/upper reading of :class:`LoopMargins`.
 
     The closed-loop stability only changes with a gain factor k where k L(jw) = -1,
-    i.e. at k = 1/|L(jw)| on the phase crossovers (``stability_margins(returnall=True)``),
+    i.e. at k = 1/abs(L(jw)) on the phase crossovers (``stability_margins(returnall=True)``),
     so a stable loop stays stable for k between the nearest of these below and above 1.
+
+    Parameters
+    ----------
+    loop : control.TransferFunction
+        L(s), e.g. from :func:`loop_transfer`.
+    stable : bool
+        Whether the closed loop is stable at k = 1 (decide it exactly, with
+        :func:`spinectl.reflex.stable_at_delay`); if not, the gain interval is NaN.
     """
     gm, pm, _, wpc, wgc, _ = ct.stability_margins(loop)
     all_gm = np.asarray(ct.stability_margins(loop, returnall=True)[0], float)

@@ -15,6 +15,13 @@ from .stability_cmd import add_position_options
 
 
 def register(sub) -> None:
+    """Add the ``margins`` sub-command to the ``spinectl`` parser.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The sub-command action of :func:`spinectl.cli.build_parser`.
+    """
     parser = sub.add_parser(
         "margins",
         help="delay, gain and phase margins of a delayed PD reflex at each segment",
@@ -43,7 +50,13 @@ OVERRIDES = (("delay", "reflex.delay"), ("activation", "reflex.activation"), ("p
 
 
 def model_with_overrides(args):
-    """The model of ``--preset``/``--config`` with the reflex options applied (validated there)."""
+    """The model of ``--preset``/``--config`` with the reflex options applied (validated there).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments; ``delay`` [s], ``activation``, ``pade_order``, ``kp``, ``kd`` are optional.
+    """
     model = load_model(args)
     for option, dotted in OVERRIDES:
         value = getattr(args, option)
@@ -57,6 +70,19 @@ def model_with_overrides(args):
 
 
 def run(args) -> int:
+    """Run ``spinectl margins``: print the table, or JSON with ``--json``; plots with ``--plot``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments: ``E``, ``Lambda`` [m], the reflex options, ``json``, ``plot``
+        and the model options.
+
+    Returns
+    -------
+    int
+        Exit code 0 (also for an infeasible optimum, reported as a status).
+    """
     model = model_with_overrides(args)
     report = analyse(model, args.E, args.Lambda, kp=args.kp, kd=args.kd)
     if args.plot:
@@ -73,6 +99,15 @@ def write_plots(model, report: MarginsReport, folder: Path) -> list[Path]:
 
     A segment without reflex (kp = kd = 0, e.g. self-stable under the default rule)
     has no loop to draw; if no segment has one, only response.png is written.
+
+    Parameters
+    ----------
+    model : Model
+        The model of the report (simulation settings, geometry).
+    report : MarginsReport
+        Output of :func:`spinectl.margins.analyse`.
+    folder : Path
+        Folder for the PNGs (created if missing).
     """
     from .. import control_plots, simulate, systems  # matplotlib only when plotting
 
@@ -114,8 +149,12 @@ def write_plots(model, report: MarginsReport, folder: Path) -> list[Path]:
 def frequency_range(report: MarginsReport) -> tuple[float, float]:
     """A decade below the slowest and above the fastest rate of the loops [rad/s].
 
-    The rates: each segment's sqrt(|S|/theta), |D|/theta and crossover, and
+    The rates: each segment's sqrt(abs(S)/theta), abs(D)/theta and crossover, and
     order/tau, beyond which the Padé phase saturates.
+
+    Parameters
+    ----------
+    report : MarginsReport
     """
     rates = [report.pade_order / report.delay] if report.delay > 0 else []
     for s in report.segments:
@@ -156,7 +195,15 @@ def _segment_json(s: SegmentMargins) -> dict:
 
 
 def report_to_json(model, report: MarginsReport) -> dict:
-    """The JSON document of ``spinectl margins --json`` (units in the key names)."""
+    """The JSON document of ``spinectl margins --json`` (units in the key names).
+
+    Parameters
+    ----------
+    model : Model
+        The model of the report (muscle names, gain mode).
+    report : MarginsReport
+        Output of :func:`spinectl.margins.analyse`.
+    """
     point = report.point
     return {
         "E_m": point.eccentricity,
@@ -177,7 +224,15 @@ def _num(value: float, width: int, digits: int) -> str:
 
 
 def format_table(model, report: MarginsReport) -> str:
-    """A readable per-segment table."""
+    """A readable per-segment table.
+
+    Parameters
+    ----------
+    model : Model
+        The model of the report (gain mode).
+    report : MarginsReport
+        Output of :func:`spinectl.margins.analyse`.
+    """
     point = report.point
     lines = [
         f"E = {point.eccentricity * 100:.2f} cm, Lambda = {point.lordosis * 100:.2f} cm, "
