@@ -18,9 +18,10 @@ and then only at the delays tau = (phi + 2 pi k) / w, phi = arg(-Q/P) mod 2 pi.
 The sign of F'(w^2) is the direction of the crossing (Cooke and Grossman 1982;
 Cooke and van den Driessche 1986): + destabilising, - stabilising.
 
-theta = 0 with kd = 0 is accepted too: the first-order-plus-delay loop of the
-textbooks (a retarded equation); theta = 0 with kd != 0 would be of neutral type
-and is not covered.
+theta = 0 with kd = 0 is accepted by :func:`delay_margin` and :func:`phase_margin`
+too: the first-order-plus-delay loop of the textbooks (a retarded equation);
+theta = 0 with kd != 0 would be of neutral type and is not covered, and the root
+counting (:func:`right_half_plane_roots`, :func:`critical_gains`) assumes theta > 0.
 """
 
 from __future__ import annotations

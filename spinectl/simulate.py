@@ -290,7 +290,7 @@ def simulated_delay_margin(plant: SegmentPlant, kp, kd, settings: Reflex, low, h
     -------
     low, high : float
         Delays [s] with the simulation stable at ``low`` and unstable at ``high``
-        (assumed of the initial bracket).
+        (the initial bracket must be so).
     """
     for _ in range(rounds):
         delays = np.linspace(low, high, batch + 2)[1:-1]
