@@ -13,10 +13,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import reflex, stability, systems
-from .mechanics import segment_coefficients
 from .optimise import solve_point
 from .params import Model
-from .stability import validate_position
+from .stability import checked_coefficients
 
 SKIPPED = "skipped"
 """Optimum status when activation = 0: the optimiser is not consulted (no co-contraction)."""
@@ -69,8 +68,7 @@ def operating_point(model: Model, eccentricity: float, lordosis: float, activati
     activation : float
         Fraction of the minimum stabilising PCSA [1]; 0 skips the optimiser.
     """
-    validate_position(model, eccentricity, lordosis)
-    coeffs = segment_coefficients(model, float(eccentricity), float(lordosis))
+    coeffs = checked_coefficients(model, float(eccentricity), float(lordosis))
     if activation == 0:
         status, pcsa = SKIPPED, np.zeros(len(model.muscle_names))
     else:

@@ -32,6 +32,15 @@ MAX_FIBRES = 1000
 uses 5); the bound keeps the per-fibre arrays of a sweep within memory."""
 
 
+MAX_PADE_ORDER = 20
+"""Highest Padé order of the reflex delay: beyond it the transfer-function coefficients span
+more than the float range can resolve, and order 6 is already exact to rounding (docs/reflex.md)."""
+
+MAX_ACTIVATION = 10.0
+"""Largest activation of the reflex section, a sanity bound: ten times the co-contraction that
+self-stability needs (a larger value is more likely a PCSA typed in place of a fraction)."""
+
+
 def param(default, unit: str, doc: str):
     """A dataclass field carrying its unit and documentation.
 
@@ -318,13 +327,13 @@ class Reflex:
         "(force generation adds another 50-100 ms).",
     )
     pade_order: int = param(
-        5, "1", "Order of the Pade approximant of exp(-s tau) in the python-control models (1 to pade_order_max)."
+        5, "1", f"Order of the Pade approximant of exp(-s tau) in the python-control models, 1 to {MAX_PADE_ORDER}."
     )
     activation: float = param(
         0.5,
         "1",
         "Global-muscle activation as a fraction of the minimum stabilising PCSA (optimise.solve_point): "
-        "0 = no co-contraction, reflex only; 1 = self-stable, no reflex needed.",
+        f"0 = no co-contraction, reflex only; 1 = self-stable, no reflex needed; at most {MAX_ACTIVATION:g}.",
     )
     gains: str = param(
         "rule",
@@ -362,35 +371,36 @@ class Reflex:
         "rad",
         "A simulation stops as unstable once |alpha| exceeds this angle (the linear verdict no longer holds).",
     )
-    pade_order_max: int = param(
-        20, "1", "Largest accepted pade_order; higher orders are ill-conditioned as transfer functions."
-    )
-    activation_max: float = param(
-        10.0, "1", "Largest accepted activation (a sanity bound: ten times the co-contraction self-stability needs)."
-    )
 
     def __post_init__(self):
-        v.non_negative("delay", self.delay)
-        top = v.integer("pade_order_max", self.pade_order_max, 1)
-        order = v.integer("pade_order", self.pade_order, 1)
-        if order > top:
-            raise ParameterError("pade_order", f"must be <= pade_order_max = {top} (got {order})")
-        v.in_range("activation", self.activation, 0.0, v.positive("activation_max", self.activation_max))
-        v.choice("gains", self.gains, ("rule", "explicit"))
         factor = v.real("gain_factor", self.gain_factor)
         if factor <= 1.0:
             raise ParameterError("gain_factor", f"must be > 1, or the reflex cannot stabilise (got {factor:g})")
-        v.positive("damping_ratio", self.damping_ratio)
-        v.non_negative("kp", self.kp)
-        v.non_negative("kd", self.kd)
+        v.choice("gains", self.gains, ("rule", "explicit"))
         duration = v.positive("sim_duration", self.sim_duration)
         step = v.positive("sim_time_step", self.sim_time_step)
         if step >= duration:
             raise ParameterError("sim_time_step", f"must be < sim_duration = {duration:g} s (got {step:g})")
-        limit = v.in_range("sim_divergence", self.sim_divergence, 0.0, math.pi / 2)
+        limit = v.positive("sim_divergence", self.sim_divergence)
+        if limit > math.pi / 2:
+            raise ParameterError("sim_divergence", f"must be <= pi/2 rad, a quarter turn (got {limit:g})")
         kick = v.positive("sim_perturbation", self.sim_perturbation)
-        if not 0 < kick < limit:
+        if kick >= limit:
             raise ParameterError("sim_perturbation", f"must be < sim_divergence = {limit:g} rad (got {kick:g})")
+        _store(
+            self,
+            delay=v.non_negative("delay", self.delay),
+            pade_order=v.integer("pade_order", self.pade_order, 1, MAX_PADE_ORDER),
+            activation=v.in_range("activation", self.activation, 0.0, MAX_ACTIVATION),
+            gain_factor=factor,
+            damping_ratio=v.positive("damping_ratio", self.damping_ratio),
+            kp=v.non_negative("kp", self.kp),
+            kd=v.non_negative("kd", self.kd),
+            sim_duration=duration,
+            sim_time_step=step,
+            sim_perturbation=kick,
+            sim_divergence=limit,
+        )
 
 
 @dataclass(frozen=True)

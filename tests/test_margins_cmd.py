@@ -80,7 +80,7 @@ def test_plot_writes_three_pngs(tmp_path, capsys):
     [
         (["margins", "--delay", "-1"], "reflex.delay: must be >= 0"),
         (["margins", "--activation", "11"], "reflex.activation: must be in [0, 10]"),
-        (["margins", "--pade-order", "0"], "reflex.pade_order: must be >= 1"),
+        (["margins", "--pade-order", "0"], "reflex.pade_order: must be an integer in [1, 20]"),
         (["margins", "--pade-order", "2.5"], "invalid int value"),
         (["margins", "--kp", "-1"], "reflex.kp: must be >= 0"),
         (["margins", "--delay", "inf"], "--delay must be finite"),
