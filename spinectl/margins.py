@@ -15,7 +15,7 @@ import numpy as np
 from . import reflex, stability, systems
 from .optimise import solve_point
 from .params import Model
-from .stability import checked_coefficients
+from .stability import arithmetic_guard, checked_coefficients
 
 SKIPPED = "skipped"
 """Optimum status when activation = 0: the optimiser is not consulted (no co-contraction)."""
@@ -113,7 +113,8 @@ class SegmentMargins:
         Stable range (lower, upper) of a common factor on kp and kd [1], from
         python-control on the Padé loop (:class:`spinectl.systems.LoopMargins`).
     python_control : systems.LoopMargins or None
-        python-control's own reading of the Padé loop; None where undefined.
+        python-control's own reading of the Padé loop; None where undefined, or where its
+        polynomial arithmetic overflows (very short delays at high Padé orders).
     kp_min, kp_max : float
         Range of kp that stabilises the segment at the delay, given kd [N m/rad].
     stable_at_delay : bool
@@ -162,7 +163,7 @@ def segment_margins(name, stiffness, damping, inertia, kp, kd, delay: float, ord
     stable = bool(reflex.stable_at_delay(s, d, theta, kp, kd, delay))
     kp_min, kp_max = reflex.critical_gains(s, d, theta, kd, delay)
     defined = all(np.isfinite(x) for x in (s, d, theta, kp, kd))
-    pc = systems.loop_margins(systems.loop_transfer(s, d, theta, kp, kd, delay, order), stable) if defined else None
+    pc = _python_control_margins(s, d, theta, kp, kd, delay, order, stable) if defined else None
     return SegmentMargins(
         name=name,
         stiffness=s,
@@ -183,6 +184,19 @@ def segment_margins(name, stiffness, damping, inertia, kp, kd, delay: float, ord
         kp_max=float(kp_max),
         stable_at_delay=stable,
     )
+
+
+def _python_control_margins(s, d, theta, kp, kd, delay, order, stable):
+    """python-control's margins of the Padé loop, or None where its polynomial arithmetic overflows.
+
+    Its Padé coefficients grow like (1/tau)^n, so very short delays at high orders
+    overflow in ``stability_margins``; the exact margins do not depend on it.
+    """
+    try:
+        with np.errstate(over="raise", divide="raise", invalid="raise"):
+            return systems.loop_margins(systems.loop_transfer(s, d, theta, kp, kd, delay, order), stable)
+    except FloatingPointError:
+        return None
 
 
 @dataclass(frozen=True)
@@ -218,8 +232,14 @@ def analyse(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None
     """
     settings = model.reflex
     point = operating_point(model, eccentricity, lordosis, settings.activation)
+    with arithmetic_guard(eccentricity, lordosis):  # absurd gains or delays: a ModelError, not NaN and warnings
+        segments = _segments(model, point, settings, kp, kd)
+    return MarginsReport(point=point, delay=settings.delay, pade_order=settings.pade_order, segments=segments)
+
+
+def _segments(model, point, settings, kp, kd) -> tuple[SegmentMargins, ...]:
     kps, kds = reflex.resolve_gains(point.stiffness, point.damping, point.inertia, settings, kp, kd)
-    segments = tuple(
+    return tuple(
         segment_margins(
             name,
             point.stiffness[k],
@@ -232,4 +252,3 @@ def analyse(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None
         )
         for k, name in enumerate(model.geometry.cor_names)
     )
-    return MarginsReport(point=point, delay=settings.delay, pade_order=settings.pade_order, segments=segments)

@@ -32,9 +32,10 @@ MAX_FIBRES = 1000
 uses 5); the bound keeps the per-fibre arrays of a sweep within memory."""
 
 
-MAX_PADE_ORDER = 20
-"""Highest Padé order of the reflex delay: beyond it the transfer-function coefficients span
-more than the float range can resolve, and order 6 is already exact to rounding (docs/reflex.md)."""
+MAX_PADE_ORDER = 10
+"""Highest Padé order of the reflex delay. Order 6 is already exact to rounding for the
+spine's loops (docs/reflex.md); from order 9 python-control's polynomial margins overflow
+for delays of a few microseconds, its coefficients growing like (1/tau)^n."""
 
 MAX_ACTIVATION = 10.0
 """Largest activation of the reflex section, a sanity bound: ten times the co-contraction that

@@ -468,12 +468,12 @@ def critical_gains(stiffness, damping, inertia, kd, delay, lobes: int = 8, point
         [N m/rad]; kp_max = inf at tau = 0.
     """
     s, d, theta, kd, tau = _arrays(stiffness, damping, inertia, kd, delay)
-    y = np.linspace(0.0, lobes * np.pi, lobes * points_per_lobe + 1)[1:]
+    y = np.linspace(0.0, lobes * np.pi, lobes * points_per_lobe + 1)
     t = np.where(tau > 0, tau, 1.0)[..., None]
     s_, d_, th_, kd_ = (x[..., None] for x in (s, d, theta, kd))
 
-    def h_over_w(yy):  # h(w) tau / w, as a function of y = w tau; finite as y -> 0
-        return (th_ * yy**2 / t**2 + s_) * np.sin(yy) * t / yy + d_ * np.cos(yy) - kd_
+    def h_over_w(yy):  # h(w) / w as a function of y = w tau, finite at y = 0 (sinc), so the grid starts there
+        return (th_ * yy**2 / t**2 + s_) * t * np.sinc(yy / np.pi) + d_ * np.cos(yy) - kd_
 
     roots = _bracketed_roots(h_over_w, np.broadcast_to(y, s.shape + y.shape))
     w = roots / t

@@ -29,6 +29,9 @@ from . import geometry, mechanics
 from .errors import ParameterError
 from .params import Model, Reflex
 
+MAX_STEPS = 1_000_000
+"""Most time steps of one simulation: four arrays of this many rows per run, about a minute of work."""
+
 _NOISE = np.sqrt(np.finfo(float).eps)
 """A response that decays below this fraction of its perturbation is in rounding noise: stable."""
 
@@ -233,6 +236,12 @@ def simulate(plant: SegmentPlant, kp, kd, delay, settings: Reflex, perturbation=
     positive = tau[tau > 0]
     step = min(settings.sim_time_step, positive.min()) if positive.size else settings.sim_time_step
     n = int(np.ceil(settings.sim_duration / step))
+    if n > MAX_STEPS:
+        raise ParameterError(
+            "reflex.delay",
+            f"a simulation of {settings.sim_duration:g} s with steps of at most the delay {step:g} s needs "
+            f"{n} steps, more than {MAX_STEPS}; use a longer delay or a shorter sim_duration",
+        )
     time = np.arange(n + 1) * step
     alpha, omega, acc, u_hist = (np.zeros((n + 1, tau.size)) for _ in range(4))
     alpha[0] = start

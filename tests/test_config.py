@@ -104,8 +104,8 @@ def test_every_parameter_has_a_unit_and_documentation():
     ("text", "field", "needle"),
     [
         ("[reflex]\ndelay = -0.1\n", "reflex.delay", ">= 0"),
-        ("[reflex]\npade_order = 0\n", "reflex.pade_order", "in [1, 20]"),
-        ("[reflex]\npade_order = 21\n", "reflex.pade_order", "in [1, 20]"),
+        ("[reflex]\npade_order = 0\n", "reflex.pade_order", "in [1, 10]"),
+        ("[reflex]\npade_order = 11\n", "reflex.pade_order", "in [1, 10]"),
         ("[reflex]\nsim_divergence = 2.0\n", "reflex.sim_divergence", "<= pi/2"),
         ("[reflex]\npade_order = 5.0\n", "reflex.pade_order", "must be an integer"),
         ("[reflex]\nactivation = -0.5\n", "reflex.activation", "in [0, 10]"),

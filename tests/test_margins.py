@@ -60,3 +60,12 @@ def test_infeasible_optimum_is_an_answer_not_an_exception(model):
     for seg in report.segments:
         assert np.isnan(seg.stiffness) and np.isnan(seg.delay_margin) and seg.delay_margin_status == "undefined"
         assert not seg.stable_at_delay and seg.python_control is None
+
+
+def test_python_control_overflow_leaves_the_exact_margins(model):
+    """Padé order 10 at a 1 us delay: python-control's polynomial margins overflow (coefficients
+    ~ (1/tau)^10); its reading is dropped (None, NaN gain margins), the exact analysis stands."""
+    report = margins.analyse(_with_reflex(model, activation=0.0, delay=1e-6, pade_order=10), E, LAMBDA)
+    for seg in report.segments:
+        assert seg.python_control is None and np.isnan(seg.gain_margin)
+        assert 0.1 < seg.delay_margin < 0.2 and seg.stable_at_delay

@@ -239,3 +239,13 @@ def test_landscape_is_pointwise_and_keeps_inf_for_self_stable_segments(rng):
     assert idle.any() and np.all(grid.delay_margin[idle] == np.inf)  # self-stable, no reflex: any delay
     finite = np.isfinite(grid.delay_margin) & (grid.delay_margin > 0)
     assert np.all(grid.stable_at_delay[finite] == (grid.delay_margin[finite] > settings.delay))
+
+
+def test_critical_gains_for_a_tiny_delay():
+    """tau = 1 us: the upper gain sits at w tau << 1, below the first grid point of the search
+    unless the grid starts at w = 0; the exact root count confirms both ends."""
+    kd = float(reflex.default_gains(S0, D0, THETA0, 1.5, 1.0)[1])
+    lo, hi = reflex.critical_gains(S0, D0, THETA0, kd, 1e-6)
+    assert lo == pytest.approx(S0) and 1e6 * S0 > hi > 1e3 * S0
+    inside_outside = reflex.stable_at_delay(S0, D0, THETA0, np.array([0.999, 1.001]) * hi, kd, 1e-6)
+    assert inside_outside.tolist() == [True, False]

@@ -156,7 +156,7 @@ OUT_OF_RANGE = {
     "optimisation.pcsa_max": [0.0, -1.0, -math.inf],
     "optimisation.ct_tolerance": [-1e-3],
     "reflex.delay": [-0.1],
-    "reflex.pade_order": [0, 21],
+    "reflex.pade_order": [0, 11],
     "reflex.activation": [-0.1, 10.5],
     "reflex.gain_factor": [1.0, 0.5],
     "reflex.damping_ratio": [0.0],

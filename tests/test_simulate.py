@@ -117,3 +117,9 @@ def test_simulation_is_deterministic_and_validates_the_delay(model):
         simulate.simulate(plant, 80.0, 3.0, -0.1, short)
     with pytest.raises(ParameterError, match="segment"):
         simulate.segment_plant(model, E, LAMBDA, "L9L10", HALF)
+
+
+def test_too_many_steps_are_refused(model):
+    plant = simulate.segment_plant(model, E, LAMBDA, L3L4, HALF)
+    with pytest.raises(ParameterError, match="steps"):
+        simulate.simulate(plant, 80.0, 3.0, 1e-9, FAST)

@@ -112,22 +112,16 @@ def write_plots(model, report: MarginsReport, folder: Path) -> list[Path]:
     from .. import control_plots, simulate, systems  # matplotlib only when plotting
 
     point, settings = report.point, model.reflex
-    usable = [(k, s) for k, s in enumerate(report.segments) if s.python_control is not None]
+    usable = [(k, s) for k, s in enumerate(report.segments) if np.isfinite(s.stiffness)]  # NaN: infeasible
     where = (
         f"E = {point.eccentricity * 100:g} cm, Lambda = {point.lordosis * 100:g} cm, activation {point.activation:g}"
     )
-    written = []
     loops = {
         s.name: systems.loop_transfer(s.stiffness, s.damping, s.inertia, s.kp, s.kd, report.delay, report.pade_order)
         for _, s in usable
         if s.kp > 0 or s.kd > 0
     }
-    if loops:
-        title = f"Reflex loops, Pade {report.pade_order}; {where}"
-        written.append(control_plots.bode(loops, folder / "bode.png", frequency_range(report), title))
-        title = f"Nyquist, tau = {report.delay:g} s; {where}"
-        written.append(control_plots.nyquist(loops, folder / "nyquist.png", title))
-    responses = {
+    responses = {  # simulated before anything is written: a failure leaves no partial set of plots
         s.name: simulate.simulate(
             simulate.segment_plant(model, point.eccentricity, point.lordosis, k, point.pcsa),
             [s.kp, 0.0],
@@ -137,6 +131,12 @@ def write_plots(model, report: MarginsReport, folder: Path) -> list[Path]:
         )
         for k, s in usable
     }
+    written = []
+    if loops:
+        title = f"Reflex loops, Pade {report.pade_order}; {where}"
+        written.append(control_plots.bode(loops, folder / "bode.png", frequency_range(report), title))
+        title = f"Nyquist, tau = {report.delay:g} s; {where}"
+        written.append(control_plots.nyquist(loops, folder / "nyquist.png", title))
     if responses:
         title = f"Response to a perturbation; {where}"
         written.append(control_plots.time_response(responses, folder / "response.png", title))
