@@ -9,8 +9,9 @@ Layers (each depends only on those above it in this list):
 
 - parameters: :mod:`spinectl.params`, :mod:`spinectl.config`
 - physics: :mod:`spinectl.geometry`, :mod:`spinectl.muscle`, :mod:`spinectl.mechanics`
-- analysis: :mod:`spinectl.stability`
-- edges: :mod:`spinectl.io`, :mod:`spinectl.cli`
+- analysis: :mod:`spinectl.stability`, :mod:`spinectl.reflex`, :mod:`spinectl.systems`,
+  :mod:`spinectl.simulate`, :mod:`spinectl.margins`
+- edges: :mod:`spinectl.io`, :mod:`spinectl.control_plots`, :mod:`spinectl.cli`
 """
 
 from .config import dump_toml, list_presets, load_config, load_preset

@@ -111,6 +111,12 @@ KINDS = {
     "optimisation.stability_margin": REAL,
     "optimisation.pcsa_max": REAL_OR_INF,
     "optimisation.ct_tolerance": REAL,
+    "reflex.delay": REAL,
+    "reflex.pade_order": INT,
+    "reflex.activation": REAL,
+    "reflex.gains": CHOICE,
+    **{f"reflex.{name}": REAL for name in ("gain_factor", "damping_ratio", "kp", "kd")},
+    **{f"reflex.sim_{name}": REAL for name in ("duration", "time_step", "perturbation", "divergence")},
 }
 """The kind of every parameter: which wrong types to try on it."""
 
@@ -149,6 +155,17 @@ OUT_OF_RANGE = {
     "optimisation.stability_margin": [-0.1],
     "optimisation.pcsa_max": [0.0, -1.0, -math.inf],
     "optimisation.ct_tolerance": [-1e-3],
+    "reflex.delay": [-0.1],
+    "reflex.pade_order": [0, 11],
+    "reflex.activation": [-0.1, 10.5],
+    "reflex.gain_factor": [1.0, 0.5],
+    "reflex.damping_ratio": [0.0],
+    "reflex.kp": [-1.0],
+    "reflex.kd": [-1.0],
+    "reflex.sim_duration": [0.0],
+    "reflex.sim_time_step": [0.0, 20.0],  # 20 s: not below the 12 s duration
+    "reflex.sim_perturbation": [0.0, 0.3],  # 0.3 rad: not below the 0.2 rad divergence angle
+    "reflex.sim_divergence": [-0.1, 2.0],
 }
 """Values of the right type that the physics forbids, each blamed on the field itself."""
 
@@ -185,7 +202,7 @@ def invalid_values(dotted: str):
     }[kind]
     if kind == CHOICE:
         allowed = {"natural", "clamped", "not-a-knot", "physical", "paper", "destabilising", "printed"}
-        allowed |= {"corrected", "paired", "independent"}
+        allowed |= {"corrected", "paired", "independent", "rule", "explicit"}
         by_kind = by_kind.filter(lambda x: not (isinstance(x, str) and x in allowed))
     return st.one_of(by_kind, st.sampled_from(OUT_OF_RANGE[dotted])) if dotted in OUT_OF_RANGE else by_kind
 

@@ -18,6 +18,7 @@ from ..errors import SpinectlError
 COMMANDS = (
     "config_cmd",
     "stability_cmd",
+    "margins_cmd",
 )
 """Modules of :mod:`spinectl.cli` that each register one sub-command."""
 
