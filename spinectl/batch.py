@@ -65,7 +65,17 @@ class BlockOptimum:
 
 
 def block_diagonal(blocks) -> sp.csc_matrix:
-    """The block-diagonal sparse matrix of ``blocks``, shape (P, r, c) -> (P r, P c)."""
+    """The block-diagonal sparse matrix of ``blocks``.
+
+    Parameters
+    ----------
+    blocks : array_like, shape (P, r, c)
+        One dense block per point.
+
+    Returns
+    -------
+    scipy.sparse.csc_matrix, shape (P r, P c)
+    """
     blocks = np.asarray(blocks, float)
     n, r, c = blocks.shape
     rows = np.broadcast_to(np.arange(n)[:, None, None] * r + np.arange(r)[None, :, None], blocks.shape)
@@ -137,6 +147,11 @@ def feasible_points(data: ProblemData) -> np.ndarray | None:
     always feasible; a point is feasible iff its least violation v_p is zero,
     read as below :data:`optimise.SLAB_FACTOR` solver tolerances of its bound.
     None if the phase-1 problem itself fails.
+
+    Parameters
+    ----------
+    data : ProblemData
+        A block of points (leading dimension P).
     """
     n_points, n_cor, n = data.stiffness.shape
     lhs, rhs = optimise.inequalities(data)
@@ -181,6 +196,13 @@ def solve_stacked(data: ProblemData, ct_tolerance: float) -> BlockOptimum:
     Points that a stacked problem leaves unsolved (a failed block, or an
     inaccurate one whose answer does not polish) go to the per-point
     reference, so the answer is always complete.
+
+    Parameters
+    ----------
+    data : ProblemData
+        A block of points (leading dimension P).
+    ct_tolerance : float
+        Relative band on the minimum total PCSA [1].
     """
     n_points, n = len(data.stiffness), data.weights.size
     status = np.full(n_points, "optimal", dtype=object)
@@ -204,7 +226,14 @@ def solve_stacked(data: ProblemData, ct_tolerance: float) -> BlockOptimum:
 def solve_points(data: ProblemData, ct_tolerance: float, progress=None) -> BlockOptimum:
     """Stages 1-3 for a block of points, one cvxpy reference solve per point.
 
-    ``progress``, if given, is called with 1 after every point.
+    Parameters
+    ----------
+    data : ProblemData
+        A block of points (leading dimension P).
+    ct_tolerance : float
+        Relative band on the minimum total PCSA [1].
+    progress : callable, optional
+        Called with 1 after every point (e.g. a tqdm bar's ``update``).
     """
     status, total, x = _per_point(data, ct_tolerance, progress)
     return _block_optimum(data, status, total, x, per_point=len(total))

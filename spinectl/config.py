@@ -16,6 +16,7 @@ import typing
 from importlib import resources
 from pathlib import Path
 
+from ._validate import escaped, show
 from .errors import ConfigError, ParameterError
 from .params import Model
 
@@ -29,10 +30,16 @@ def list_presets() -> list[str]:
 
 
 def load_preset(name: str = "default") -> Model:
-    """The built-in preset ``name`` as a :class:`~spinectl.params.Model`."""
+    """The built-in preset ``name`` as a :class:`~spinectl.params.Model`.
+
+    Parameters
+    ----------
+    name : str
+        One of :func:`list_presets`.
+    """
     presets = list_presets()
-    if name not in presets:
-        raise ConfigError("preset", f"must be one of {', '.join(map(repr, presets))} (got {name!r})")
+    if not isinstance(name, str) or name not in presets:
+        raise ConfigError("preset", f"must be one of {', '.join(map(repr, presets))} (got {show(name)})")
     text = resources.files(PRESET_PACKAGE).joinpath(f"{name}.toml").read_text()
     return _model_from_text(text, source=f"preset {name!r}", is_preset=True)
 
@@ -49,22 +56,35 @@ def load_config(path: str | Path | None = None, preset: str | None = None) -> Mo
         Base preset; overrides the file's own ``preset`` key. Default ``"default"``.
     """
     if path is None:
-        return load_preset(preset or "default")
-    path = Path(path)
+        return load_preset("default" if preset is None else preset)
+    return _model_from_text(_read(Path(path)), source=str(path), preset=preset)
+
+
+def _read(path: Path) -> str:
+    """The text of a configuration file, or a :class:`ConfigError` saying why not."""
+    shown = show(str(path))
     try:
-        text = path.read_text()
-    except FileNotFoundError:
-        raise ConfigError("config", f"file not found: {path}") from None
-    except (IsADirectoryError, PermissionError, UnicodeDecodeError) as exc:
-        raise ConfigError("config", f"cannot read {path}: {exc.__class__.__name__}") from None
-    return _model_from_text(text, source=str(path), preset=preset)
+        if not path.exists():
+            raise ConfigError("config", f"file not found: {shown}")
+        if not path.is_file():  # a folder, or a device such as /dev/zero that never ends
+            raise ConfigError("config", f"not a regular file: {shown}")
+        return path.read_text(encoding="utf-8")  # TOML is UTF-8 whatever the locale
+    except ConfigError:
+        raise
+    except UnicodeDecodeError:
+        raise ConfigError("config", f"{shown} is not UTF-8 text") from None
+    except (OSError, ValueError) as exc:  # permissions, name too long, a NUL byte in the name
+        reason = getattr(exc, "strerror", None) or exc.__class__.__name__
+        raise ConfigError("config", f"cannot read {shown}: {reason}") from None
 
 
 def _parse(text: str, source: str) -> dict:
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise ConfigError("config", f"{source} is not valid TOML ({exc})") from None
+        raise ConfigError("config", f"{show(source)} is not valid TOML ({exc})") from None
+    except RecursionError:  # tomllib recurses once per level of nested arrays
+        raise ConfigError("config", f"{show(source)} nests arrays or tables too deeply") from None
 
 
 def _model_from_text(text: str, source: str, preset: str | None = None, is_preset: bool = False) -> Model:
@@ -72,14 +92,22 @@ def _model_from_text(text: str, source: str, preset: str | None = None, is_prese
     base_name = data.pop("preset", None)
     if is_preset:
         return from_dict(Model, data)
-    base = load_preset(preset or base_name or "default")
-    return merge(base, data)
+    if preset is None:
+        preset = "default" if base_name is None else base_name
+    return merge(load_preset(preset), data)
 
 
 def merge(base: Model, data: dict) -> Model:
     """``base`` with the (partial, nested) parameters in ``data`` replacing its own.
 
     ``muscles``, a list, replaces the whole list when given.
+
+    Parameters
+    ----------
+    base : Model
+        The parameters to start from.
+    data : dict
+        Nested parameters as read from TOML, e.g. ``{"body": {"mass": 50.0}}`` (SI units).
     """
     merged = _deep_merge(to_dict(base), data)
     return from_dict(Model, merged)
@@ -96,44 +124,58 @@ def _deep_merge(base: dict, new: dict) -> dict:
 
 
 def set_parameter(model: Model, dotted: str, value) -> Model:
-    """Return ``model`` with one parameter replaced, e.g. ``"body.mass"`` or ``"muscles.0.spread"``."""
+    """Return ``model`` with one parameter replaced, e.g. ``"body.mass"`` or ``"muscles.0.spread"``.
+
+    Parameters
+    ----------
+    model : Model
+        The parameters to start from.
+    dotted : str
+        Dotted path of the parameter; list items by index.
+    value : object
+        The new value, in the parameter's unit (see ``docs/parameters.md``); validated.
+    """
     data = to_dict(model)
     node = data
-    keys = dotted.split(".")
-    for key in keys[:-1]:
+    *parents, last = dotted.split(".")
+    for key in parents:
         node = _child(node, key, dotted)
-    last = keys[-1]
-    if isinstance(node, list):
-        node[_index(node, last, dotted)] = value
-    else:
-        if last not in node:
-            raise ConfigError(dotted, _unknown_message(last, node))
-        node[last] = value
+    _child(node, last, dotted)  # the last key must exist too: same checks, same messages
+    node[int(last) if isinstance(node, list) else last] = value
     return from_dict(Model, data)
 
 
 def _child(node, key: str, dotted: str):
     if isinstance(node, list):
         return node[_index(node, key, dotted)]
-    if not isinstance(node, dict) or key not in node:
-        raise ConfigError(dotted, _unknown_message(key, node if isinstance(node, dict) else {}))
+    if not isinstance(node, dict):
+        raise ConfigError(dotted, f"{key!r} follows a value that is not a table")
+    if key not in node:
+        raise ConfigError(dotted, _unknown_message(key, node))
     return node[key]
 
 
 def _index(node: list, key: str, dotted: str) -> int:
-    if not key.isdigit() or int(key) >= len(node):
-        raise ConfigError(dotted, f"index {key!r} must be an integer below {len(node)}")
+    # isdecimal and isascii: int() accepts exactly these digits ('²'.isdigit() is true)
+    if not (key.isascii() and key.isdecimal()) or int(key) >= len(node):
+        raise ConfigError(dotted, f"index {show(key)} must be an integer below {len(node)}")
     return int(key)
 
 
 def _unknown_message(key: str, allowed) -> str:
     close = difflib.get_close_matches(key, list(allowed), n=1)
     hint = f"; did you mean {close[0]!r}?" if close else ""
-    return f"unknown key (allowed: {', '.join(sorted(allowed))}){hint}"
+    return f"unknown key {show(key)} (allowed: {', '.join(sorted(allowed))}){hint}"
 
 
 def to_dict(obj) -> dict:
-    """Nested plain dict (lists for tuples) of a parameter dataclass."""
+    """Nested plain dict (lists for tuples) of a parameter dataclass.
+
+    Parameters
+    ----------
+    obj : dataclass instance
+        A :class:`~spinectl.params.Model` or one of its sections.
+    """
     out = {}
     for f in dataclasses.fields(obj):
         value = getattr(obj, f.name)
@@ -150,6 +192,15 @@ def to_dict(obj) -> dict:
 def from_dict(cls, data: dict, path: str = ""):
     """Build the dataclass ``cls`` from a nested dict, validating every field.
 
+    Parameters
+    ----------
+    cls : type
+        A parameter dataclass, e.g. :class:`~spinectl.params.Model`.
+    data : dict
+        Its fields, nested as in TOML (SI units).
+    path : str
+        Dotted path of ``cls`` inside the model, prefixed to error field names.
+
     Raises
     ------
     ConfigError
@@ -158,11 +209,12 @@ def from_dict(cls, data: dict, path: str = ""):
         For a value that fails validation; the field is named with its full path.
     """
     if not isinstance(data, dict):
-        raise ConfigError(path or "config", f"must be a table (got {data!r})")
+        raise ConfigError(path or "config", f"must be a table (got {show(data)})")
     fields = {f.name: f for f in dataclasses.fields(cls)}
     for key in data:
         if key not in fields:
-            raise ConfigError(f"{path}.{key}" if path else key, _unknown_message(key, fields))
+            shown = escaped(key)  # a quoted TOML key may hold a newline
+            raise ConfigError(f"{path}.{shown}" if path else shown, _unknown_message(key, fields))
     hints = typing.get_type_hints(cls)
     kwargs = {}
     for name, value in data.items():
@@ -180,17 +232,23 @@ def _convert(hint, value, path: str):
     args = typing.get_args(hint)
     if typing.get_origin(hint) is tuple and args and dataclasses.is_dataclass(args[0]):
         if not isinstance(value, list):
-            raise ConfigError(path, f"must be an array of tables (got {value!r})")
+            raise ConfigError(path, f"must be an array of tables (got {show(value)})")
         return tuple(from_dict(args[0], item, f"{path}.{i}") for i, item in enumerate(value))
     if typing.get_origin(hint) is tuple:
         if not isinstance(value, (list, tuple)):
-            raise ParameterError(path, f"must be a list (got {value!r})")
+            raise ParameterError(path, f"must be a list (got {show(value)})")
         return tuple(value)
     return value
 
 
 def dump_toml(model: Model) -> str:
-    """The fully resolved parameter set as TOML, with units and docs as comments."""
+    """The fully resolved parameter set as TOML, with units and docs as comments.
+
+    Parameters
+    ----------
+    model : Model
+        The parameters to write.
+    """
     lines = ["# spinectl model parameters (SI units unless a comment says otherwise)", ""]
     for f in dataclasses.fields(model):
         value = getattr(model, f.name)

@@ -30,7 +30,13 @@ class ParameterError(SpinectlError, ValueError):
         super().__init__(f"{field}: {message}")
 
     def under(self, prefix: str) -> ParameterError:
-        """Return the same error with ``prefix`` prepended to the field name."""
+        """Return the same error with ``prefix`` prepended to the field name.
+
+        Parameters
+        ----------
+        prefix : str
+            Dotted path of the section, e.g. ``"body"``; empty leaves the name unchanged.
+        """
         return type(self)(f"{prefix}.{self.field}" if prefix else self.field, self.message)
 
 
@@ -39,4 +45,17 @@ class ConfigError(ParameterError):
 
 
 class ModelError(SpinectlError, ValueError):
-    """A configuration is valid parameter by parameter but not as a whole."""
+    """A configuration is valid parameter by parameter but not as a whole.
+
+    Raised where E and Lambda are known (:func:`spinectl.stability.validate_position`):
+    a fibre attachment on a centre of rotation, or parameters so far off that
+    the arithmetic overflows.
+    """
+
+
+class OutputError(SpinectlError, OSError):
+    """An output cannot be written (folder not writable, a folder in the way, ...).
+
+    Raised before anything is renamed onto the target, so the previous output
+    is left intact (see :func:`spinectl.io.atomic_path`).
+    """

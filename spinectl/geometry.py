@@ -33,7 +33,7 @@ def lordosis_shape(geometry: Geometry) -> np.ndarray:
     spline is linear in its data, so with P1 and P2 at x = -E and P3 at
     x = -E + Lambda the line is x(y) = -E + Lambda phi(y), phi being the spline
     through (0, 0), (L/2, 1), (L, 0). For natural end conditions
-    phi = 1.5 s - 0.5 s^3 with s = 1 - |y - L/2| / (L/2).
+    phi = 1.5 s - 0.5 s^3 with s = 1 - abs(y - L/2) / (L/2).
 
     Parameters
     ----------
@@ -74,7 +74,13 @@ def cor_positions(eccentricity, lordosis, geometry: Geometry) -> np.ndarray:
 
 
 def mass_position(model: Model) -> np.ndarray:
-    """Position of the upper-body point mass, (0, mass_height) [m] (paper, Methods)."""
+    """Position of the upper-body point mass, (0, mass_height) [m] (paper, Methods).
+
+    Parameters
+    ----------
+    model : Model
+        Supplies ``body.mass_height`` [m].
+    """
     return np.array([0.0, model.body.mass_height])
 
 
@@ -83,6 +89,13 @@ def fibre_offsets(n: int, spread: float) -> np.ndarray:
 
     Evenly spaced and centred: ``linspace(-spread/2, spread/2, n)``; a single
     fibre lies on the line of action.
+
+    Parameters
+    ----------
+    n : int
+        Number of fibres [1].
+    spread : float
+        Width of the attachment surface [m].
     """
     if n == 1:
         return np.zeros(1)
@@ -96,6 +109,11 @@ def pair_fibres(pair: MusclePair) -> tuple[np.ndarray, np.ndarray]:
     along the unit normal by :func:`fibre_offsets` (paper: "five parallel
     muscle fibers, to simulate physiologically realistic surfaces of
     attachment"). The dorsal muscle is the mirror image x -> -x.
+
+    Parameters
+    ----------
+    pair : MusclePair
+        Attachments of the ventral muscle [m], spread [m] and number of fibres.
 
     Returns
     -------
@@ -116,6 +134,11 @@ def all_fibres(model: Model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Every fibre of every muscle, with the matrix that sums fibres into muscles.
 
     Each fibre carries an equal share of its muscle's PCSA.
+
+    Parameters
+    ----------
+    model : Model
+        Supplies the muscle pairs.
 
     Returns
     -------
@@ -144,5 +167,10 @@ def pairing_matrix(n_pairs: int) -> np.ndarray:
     Paired activation gives both sides of a pair the same PCSA (design page,
     The optimisation), so each pair's total PCSA is twice its per-side value;
     the decision variable here is the per-side PCSA.
+
+    Parameters
+    ----------
+    n_pairs : int
+        Number of antagonistic pairs.
     """
     return np.repeat(np.eye(n_pairs), 2, axis=0)

@@ -13,6 +13,8 @@ import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
+from .errors import OutputError
+
 
 @contextlib.contextmanager
 def atomic_path(target: str | Path, *, directory: bool = False) -> Iterator[Path]:
@@ -26,27 +28,25 @@ def atomic_path(target: str | Path, *, directory: bool = False) -> Iterator[Path
         Create the temporary as a folder.
 
     On an exception the temporary is removed and ``target`` is left untouched.
+    The new output gets the previous one's permissions, or the usual ones of a
+    new file (the umask), not the private mode of a temporary.
+
+    Raises
+    ------
+    OutputError
+        The folder cannot be created or written, or ``target`` cannot be
+        replaced (e.g. a folder where a file should go). Exceptions of the
+        writer itself propagate unchanged.
     """
     target = Path(target)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    prefix = f".{target.name}."
-    if directory:
-        tmp = Path(tempfile.mkdtemp(prefix=prefix, suffix=".tmp", dir=target.parent))
-    else:
-        fd, name = tempfile.mkstemp(prefix=prefix, suffix=".tmp" + target.suffix, dir=target.parent)
-        os.close(fd)
-        tmp = Path(name)
-    _as_if_created(tmp, directory)
+    with _output_errors(target):
+        target.parent.mkdir(parents=True, exist_ok=True)
+        tmp = _temporary(target, directory)
     try:
         yield tmp
-        if directory and target.exists():
-            old = target.with_name(prefix + "old")
-            shutil.rmtree(old, ignore_errors=True)
-            os.replace(target, old)
-            os.replace(tmp, target)
-            shutil.rmtree(old, ignore_errors=True)
-        else:
-            os.replace(tmp, target)
+        with _output_errors(target):
+            _set_mode(tmp, target, directory)
+            _replace(tmp, target, directory)
     except BaseException:
         if tmp.is_dir():
             shutil.rmtree(tmp, ignore_errors=True)
@@ -55,17 +55,64 @@ def atomic_path(target: str | Path, *, directory: bool = False) -> Iterator[Path
         raise
 
 
-def _as_if_created(path: Path, directory: bool) -> None:
-    """Give a temporary the permissions a plain ``open``/``mkdir`` would (mkstemp makes it private)."""
-    umask = os.umask(0)
-    os.umask(umask)
-    os.chmod(path, (0o777 if directory else 0o666) & ~umask)
+@contextlib.contextmanager
+def _output_errors(target: Path):
+    try:
+        yield
+    except OSError as exc:
+        reason = exc.strerror or exc.__class__.__name__
+        raise OutputError(f"cannot write {str(target)!r}: {reason}") from None
+
+
+def _temporary(target: Path, directory: bool) -> Path:
+    prefix = f".{target.name}."
+    if directory:
+        return Path(tempfile.mkdtemp(prefix=prefix, suffix=".tmp", dir=target.parent))
+    fd, name = tempfile.mkstemp(prefix=prefix, suffix=".tmp" + target.suffix, dir=target.parent)
+    os.close(fd)
+    return Path(name)
+
+
+def _set_mode(tmp: Path, target: Path, directory: bool) -> None:
+    """Give ``tmp`` the mode of the output it replaces, or the umask's default (mkstemp makes 0600)."""
+    if target.exists():
+        mode = target.stat().st_mode
+    else:
+        umask = os.umask(0)  # the only way to read it; restored at once (sweeps use processes, not threads)
+        os.umask(umask)
+        mode = (0o777 if directory else 0o666) & ~umask
+    os.chmod(tmp, mode & 0o7777)
+
+
+def _replace(tmp: Path, target: Path, directory: bool) -> None:
+    if not (directory and target.exists()):
+        os.replace(tmp, target)
+        return
+    # A folder cannot be renamed over a non-empty one: move the old aside first,
+    # and put it back if the new one cannot take its place.
+    old = target.with_name(f".{target.name}.old")
+    shutil.rmtree(old, ignore_errors=True)
+    os.replace(target, old)
+    try:
+        os.replace(tmp, target)
+    except BaseException:
+        os.replace(old, target)
+        raise
+    shutil.rmtree(old, ignore_errors=True)
 
 
 def atomic_write_text(target: str | Path, text: str) -> Path:
-    """Write ``text`` to ``target`` atomically; return the target path."""
+    """Write ``text`` to ``target`` atomically (UTF-8); return the target path.
+
+    Parameters
+    ----------
+    target : str or Path
+        Final file.
+    text : str
+        Its whole content.
+    """
     with atomic_path(target) as tmp:
-        tmp.write_text(text)
+        tmp.write_text(text, encoding="utf-8")
     return Path(target)
 
 
@@ -76,15 +123,28 @@ def staged_directory(target: str | Path) -> Iterator[Path]:
     Every file lands by an atomic rename, all at the end: an interrupted run
     leaves ``target`` as it was, and files already in ``target`` that the run
     does not write are kept. On an exception the staging folder is removed.
+
+    Parameters
+    ----------
+    target : str or Path
+        The output folder (created if missing).
+
+    Raises
+    ------
+    OutputError
+        The folders cannot be created or the files not moved into ``target``.
     """
     target = Path(target)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    stage = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent))
-    _as_if_created(stage, directory=True)
+    with _output_errors(target):
+        target.parent.mkdir(parents=True, exist_ok=True)
+        stage = _temporary(target, directory=True)
+        _set_mode(stage, target.parent / f".{target.name}.new", directory=True)
     try:
         yield stage
-        target.mkdir(exist_ok=True)
-        for item in sorted(stage.iterdir()):
-            os.replace(item, target / item.name)
+        with _output_errors(target):
+            target.mkdir(exist_ok=True)
+            for item in sorted(stage.iterdir()):
+                _set_mode(item, target / item.name, item.is_dir())
+                os.replace(item, target / item.name)
     finally:
         shutil.rmtree(stage, ignore_errors=True)

@@ -47,7 +47,17 @@ ZERO_TORQUE = 1e-6
 
 @dataclass(frozen=True)
 class Landmarks:
-    """The landscapes a measurement needs: K = 0, K = 15 (model's convention), K = 15 (other convention)."""
+    """The landscapes a measurement needs.
+
+    Attributes
+    ----------
+    k0 : xarray.Dataset
+        K = 0 (Figures 3 and 4).
+    k15 : xarray.Dataset, optional
+        K = 15 N m/rad with the model's convention (Figure S1).
+    k15_other : xarray.Dataset, optional
+        K = 15 N m/rad with the other convention.
+    """
 
     k0: xr.Dataset
     k15: xr.Dataset | None = None
@@ -84,7 +94,13 @@ class Landmark:
     measure: Callable[[Landmarks], float]
 
     def agrees(self, value: float) -> bool:
-        """Whether ``value`` matches the paper's value under :attr:`relation`."""
+        """Whether ``value`` matches the paper's value under :attr:`relation`.
+
+        Parameters
+        ----------
+        value : float
+            spinectl's measurement, in :attr:`unit`.
+        """
         if not np.isfinite(value):
             return False
         if self.relation == "<":
@@ -97,7 +113,17 @@ class Landmark:
 
 
 def at(dataset: xr.Dataset, name: str, position) -> float:
-    """The value of variable ``name`` at (E, Lambda) = ``position`` [m], nearest grid point."""
+    """The value of a variable at one position, from the nearest grid point.
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        A landscape with dimensions E and Lambda.
+    name : str
+        Variable name.
+    position : tuple of float
+        (E, Lambda) [m].
+    """
     e, lam = position
     return float(dataset[name].sel(E=e, Lambda=lam, method="nearest"))
 
@@ -108,6 +134,15 @@ def line_slope(dataset: xr.Dataset, name: str, pick: str) -> float:
     Only columns E > 0 whose extremum lies strictly inside the Lambda range
     count (an extremum on the edge says the line left the grid); least squares
     through the origin. NaN if no column counts.
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        A landscape with dimensions E and Lambda.
+    name : str
+        Variable name.
+    pick : {'max', 'min'}
+        Ridge or valley.
     """
     field = dataset[name].transpose("E", "Lambda").values
     index = np.nanargmax(field, axis=1) if pick == "max" else np.nanargmin(field, axis=1)
@@ -321,7 +356,15 @@ LANDMARKS: tuple[Landmark, ...] = (
 
 @dataclass(frozen=True)
 class Measurement:
-    """A landmark with spinectl's value and whether it agrees."""
+    """A landmark with spinectl's value and whether it agrees.
+
+    Attributes
+    ----------
+    landmark : Landmark
+    value : float
+        spinectl's value, in the landmark's unit (NaN if not measurable).
+    agrees : bool
+    """
 
     landmark: Landmark
     value: float
@@ -329,7 +372,12 @@ class Measurement:
 
 
 def measure(landmarks: Landmarks) -> list[Measurement]:
-    """Measure every landmark of :data:`LANDMARKS` from the landscapes."""
+    """Measure every landmark of :data:`LANDMARKS` from the landscapes.
+
+    Parameters
+    ----------
+    landmarks : Landmarks
+    """
     out = []
     for mark in LANDMARKS:
         value = float(mark.measure(landmarks))
@@ -340,7 +388,16 @@ def measure(landmarks: Landmarks) -> list[Measurement]:
 def local_pcsa_equivalent(counter_torque, specific_tension: float, lever_arm: float = LOCAL_LEVER_ARM):
     """A counter torque [N m] as the PCSA [m^2] of a local muscle with ``lever_arm`` [m].
 
-    PCSA = |CT| / (lever_arm * specific_tension) (paper, Discussion: 30 N m at
+    PCSA = abs(CT) / (lever_arm * specific_tension) (paper, Discussion: 30 N m at
     7 cm and 25 N/cm^2 is about 17 cm^2).
+
+    Parameters
+    ----------
+    counter_torque : array_like
+        [N m].
+    specific_tension : float
+        f_iso per PCSA [N/m^2].
+    lever_arm : float
+        Lever arm of the local muscle [m].
     """
     return np.abs(counter_torque) / (lever_arm * specific_tension)

@@ -24,7 +24,15 @@ from .params import Model
 
 
 def rotate(vectors, alpha):
-    """Rotate 2-vectors counter-clockwise by ``alpha`` [rad]; broadcasts."""
+    """Rotate 2-vectors counter-clockwise by ``alpha`` [rad]; broadcasts.
+
+    Parameters
+    ----------
+    vectors : array_like, shape (..., 2)
+        (x, y) components [any length unit].
+    alpha : array_like
+        Angle [rad], counter-clockwise positive.
+    """
     vectors = np.asarray(vectors, float)
     cos, sin = np.cos(alpha), np.sin(alpha)
     x, y = vectors[..., 0], vectors[..., 1]
@@ -32,7 +40,13 @@ def rotate(vectors, alpha):
 
 
 def cross2(a, b):
-    """z-component of the cross product of 2-vectors."""
+    """z-component of the cross product of 2-vectors, a_x b_y - a_y b_x.
+
+    Parameters
+    ----------
+    a, b : numpy.ndarray, shape (..., 2)
+        The vectors; broadcast together.
+    """
     return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
 
 
@@ -40,7 +54,7 @@ def fibre_length_and_lever_arm(upper, lower, cor, alpha=0.0):
     """Length and signed lever arm of fibres with the upper body rotated by alpha.
 
     With u = R(alpha)(U - c) and p = P - c (U upper, P lower attachment, c the
-    CoR), the fibre vector e = p - u, l = |e| and h = (u x e) / l, so that a
+    CoR), the fibre vector e = p - u, l = norm(e) and h = (u x e) / l, so that a
     tension T gives the torque T h about c. Equivalently h = -dl/dalpha
     (virtual work), which makes the shortening velocity v = h omega.
 
@@ -69,6 +83,13 @@ def lever_arm_slope(upper, lower, cor):
 
     From l'' = (p . u - h^2) / l at alpha = 0 (differentiate l' = -(e . J u)/l
     once more, J the quarter turn) and h = -l': dh/dalpha = (h^2 - p . u) / l.
+
+    Parameters
+    ----------
+    upper, lower : array_like, shape (..., 2)
+        Attachment points in the upright configuration [m].
+    cor : array_like, shape (..., 2)
+        Centre of rotation [m].
     """
     u = np.asarray(upper) - cor
     p = np.asarray(lower) - cor
@@ -130,7 +151,13 @@ def muscle_torque_per_pcsa(model: Model, cor, alpha, omega):
 
 
 def gravity_sign(model: Model) -> float:
-    """+1 for the destabilising (corrected) sign of gravity, -1 for the printed one."""
+    """+1 for the destabilising (corrected) sign of gravity, -1 for the printed one.
+
+    Parameters
+    ----------
+    model : Model
+        Supplies ``errata.gravity_sign``.
+    """
     return 1.0 if model.errata.gravity_sign == "destabilising" else -1.0
 
 
@@ -138,7 +165,7 @@ def gravity_torque(alpha, cor, model: Model):
     """Torque of the point mass about a CoR, M_ext [N m].
 
     With r = R(alpha)(m_pos - c), the torque of the weight (0, -m g) is
-    -m g r_x. For a mass above the CoR this is m g |r| sin(angle from
+    -m g r_x. For a mass above the CoR this is m g norm(r) sin(angle from
     vertical), an inverted pendulum: dM_ext/dalpha = m g r_y > 0. This is the
     design page's gravity erratum; the paper prints M_ext = -m g r sin(alpha)
     (``errata.gravity_sign = "printed"`` negates the whole torque).
@@ -161,6 +188,13 @@ def inertia(cor, model: Model):
 
     theta_k = m (r_k^2 + rho^2), r_k the CoR-to-mass distance and rho the
     radius of gyration (design page, One segment: default m r_k^2).
+
+    Parameters
+    ----------
+    cor : array_like, shape (..., 2)
+        CoR position [m].
+    model : Model
+        Supplies the mass [kg], its height [m] and the radius of gyration [m].
     """
     r = geometry.mass_position(model) - np.asarray(cor)
     return model.body.mass * (np.sum(r**2, axis=-1) + model.body.radius_of_gyration**2)
@@ -171,6 +205,13 @@ def passive_stiffness(model: Model, inertia_k):
 
     'physical': K itself. 'paper': eq. 2 subtracts K from d(omega')/dalpha,
     i.e. K theta_k from dM/dalpha (design page, erratum eq. 2).
+
+    Parameters
+    ----------
+    model : Model
+        Supplies ``passive.stiffness`` and ``passive.convention``.
+    inertia_k : array_like
+        theta_k of each CoR [kg m^2]; sets the output shape.
     """
     k = model.passive.stiffness
     if model.passive.convention == "paper":
@@ -213,12 +254,24 @@ class SegmentCoefficients:
     inertia: np.ndarray
 
     def stiffness(self, pcsa):
-        """Total dM_k/dalpha [N m/rad] for muscle PCSAs ``pcsa`` [m^2], shape (..., n_muscles)."""
+        """Total dM_k/dalpha [N m/rad]: muscles, gravity and passive stiffness.
+
+        Parameters
+        ----------
+        pcsa : array_like, shape (..., n_muscles)
+            PCSA of each muscle [m^2].
+        """
         muscular = np.einsum("...km,...m->...k", self.stiffness_per_pcsa, np.asarray(pcsa, float))
         return muscular + self.gravity_stiffness - self.passive_stiffness
 
     def damping(self, pcsa):
-        """Total dM_k/domega [N m s/rad] for muscle PCSAs ``pcsa`` [m^2]."""
+        """Total dM_k/domega [N m s/rad] of the muscles.
+
+        Parameters
+        ----------
+        pcsa : array_like, shape (..., n_muscles)
+            PCSA of each muscle [m^2].
+        """
         return np.einsum("...km,...m->...k", self.damping_per_pcsa, np.asarray(pcsa, float))
 
     def counter_torque(self, pcsa):
@@ -226,6 +279,11 @@ class SegmentCoefficients:
 
         CT_k = -(sum_i M_i + M_ext) at alpha = 0, omega = 0 (paper, Methods;
         design page, One segment). Affine in PCSA.
+
+        Parameters
+        ----------
+        pcsa : array_like, shape (..., n_muscles)
+            PCSA of each muscle [m^2].
         """
         muscular = np.einsum("...km,...m->...k", self.torque_per_pcsa, np.asarray(pcsa, float))
         return -(muscular + self.gravity_torque)

@@ -37,6 +37,15 @@ def force_length_slope(length, optimal_length, fibre: Fibre):
 
     df_l/dl = f_l * (-2 u / k2) * k1 (l/l_opt)^(k1 - 1) / l_opt, u = ((l/l_opt)^k1 - 1)/k2.
     Positive on the ascending limb (l < l_opt).
+
+    Parameters
+    ----------
+    length : array_like
+        Fibre length l [m].
+    optimal_length : array_like
+        Optimal fibre length l_opt [m].
+    fibre : Fibre
+        Supplies k1 and k2 [1].
     """
     ratio = np.asarray(length) / optimal_length
     u = (ratio**fibre.k1 - 1.0) / fibre.k2
@@ -50,6 +59,21 @@ class HillConstants:
     From the paper (Methods; its refs 15, 21-23): a = f_iso/4, b = v_max/4,
     c = b (f_iso + a), A = f_ecc f_iso, B = (A - f_iso) b^2 / c and, with
     erratum C, C = (A - f_iso) B (printed: C = (A - f_iso) b).
+
+    Attributes
+    ----------
+    a : numpy.ndarray
+        a / f_iso [1].
+    b : numpy.ndarray
+        b [m/s].
+    c : numpy.ndarray
+        c / f_iso [m/s].
+    A : numpy.ndarray
+        A / f_iso [1], the eccentric asymptote.
+    B : numpy.ndarray
+        B [m/s].
+    C : numpy.ndarray
+        C / f_iso [m/s].
     """
 
     a: np.ndarray
@@ -61,7 +85,15 @@ class HillConstants:
 
 
 def max_velocity(optimal_length, fibre: Fibre):
-    """v_max = (vmax_slow + vmax_fast_gain FT) l_opt [m/s] (paper: (6 + 10 FT) l_opt)."""
+    """v_max = (vmax_slow + vmax_fast_gain FT) l_opt [m/s] (paper: (6 + 10 FT) l_opt).
+
+    Parameters
+    ----------
+    optimal_length : array_like
+        l_opt [m].
+    fibre : Fibre
+        Supplies vmax_slow, vmax_fast_gain [l_opt/s] and fast_twitch [1].
+    """
     return (fibre.vmax_slow + fibre.vmax_fast_gain * fibre.fast_twitch) * np.asarray(optimal_length)
 
 
@@ -110,6 +142,12 @@ def force_velocity_slope(velocity, hill: HillConstants):
 
     Concentric: -c / (v + b)^2; eccentric: -C / (v - B)^2. With erratum C both
     equal -(1 + a)/b at v = 0, so the damping is well defined.
+
+    Parameters
+    ----------
+    velocity : array_like
+        Shortening velocity v [m/s].
+    hill : HillConstants
     """
     v = np.asarray(velocity, float)
     concentric = -hill.c / (np.where(v >= 0, v, 0.0) + hill.b) ** 2

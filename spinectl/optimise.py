@@ -32,9 +32,9 @@ import cvxpy as cp
 import numpy as np
 
 from . import geometry, polish
-from .mechanics import SegmentCoefficients, segment_coefficients
+from .mechanics import SegmentCoefficients
 from .params import Model
-from .stability import validate_position
+from .stability import checked_coefficients
 from .units import M2_PER_CM2
 
 SOLVERS = ("CLARABEL", "SCS")
@@ -106,7 +106,13 @@ class ProblemData:
     torque_scale: np.ndarray | None = None
 
     def point(self, index) -> ProblemData:
-        """The data of one grid point (``index`` into the leading dimensions)."""
+        """The data of one grid point, or of a subset of points.
+
+        Parameters
+        ----------
+        index : int, slice or array of int
+            Index into the leading dimensions.
+        """
         return replace(
             self,
             stiffness=self.stiffness[index],
@@ -117,7 +123,13 @@ class ProblemData:
         )
 
     def counter_torque(self, x):
-        """CT [N m] for decision variables ``x`` [cm^2], shape (..., n_var) (paper, Methods)."""
+        """CT [N m] for decision variables ``x`` (paper, Methods: CT makes the upright posture an equilibrium).
+
+        Parameters
+        ----------
+        x : array_like, shape (..., n_var)
+            Decision variables [cm^2].
+        """
         return -(np.einsum("...kn,...n->...k", self.torque, np.asarray(x, float)) + self.gravity_torque)
 
 
@@ -126,6 +138,13 @@ def problem_data(model: Model, coeffs: SegmentCoefficients) -> ProblemData:
 
     ``optimisation.activation = "paired"`` gives one variable per pair (both
     muscles equal, co-contraction); ``"independent"`` one per muscle.
+
+    Parameters
+    ----------
+    model : Model
+        Supplies the ``optimisation`` settings.
+    coeffs : SegmentCoefficients
+        Per-unit-PCSA mechanics from :func:`~spinectl.mechanics.segment_coefficients`.
     """
     n_muscles = coeffs.stiffness_per_pcsa.shape[-1]
     if model.optimisation.activation == "paired":
@@ -147,7 +166,7 @@ def problem_data(model: Model, coeffs: SegmentCoefficients) -> ProblemData:
 
 
 def ct_slab(torque, x_ct, tolerance: float | None, scale=None):
-    """Linear constraints |rows @ x - centre| <= half_width that fix CT(x) = CT(x_ct).
+    """Linear constraints abs(rows @ x - centre) <= half_width that fix CT(x) = CT(x_ct).
 
     Only the row space of T constrains CT (:data:`RANK_RTOL`), so rank-deficient
     T (always, see the module docstring) gives no redundant constraints; where
@@ -189,7 +208,15 @@ def ct_slab(torque, x_ct, tolerance: float | None, scale=None):
 
 
 def solver_options(solver: str, tolerance: float | None) -> dict:
-    """Keyword options for ``solver`` (cvxpy name) giving feasibility and gap ``tolerance``."""
+    """Keyword options for a cvxpy solver giving a feasibility and gap tolerance.
+
+    Parameters
+    ----------
+    solver : str
+        cvxpy's name of the solver, e.g. 'CLARABEL'.
+    tolerance : float or None
+        [1]; None: the solver's defaults.
+    """
     if tolerance is None:
         return {}
     if solver == "CLARABEL":
@@ -200,15 +227,26 @@ def solver_options(solver: str, tolerance: float | None) -> dict:
 
 
 def _solve(problem: cp.Problem, tolerance: float | None = None) -> str:
-    """Solve with the first solver that answers; return the cvxpy status or 'solver_error'."""
+    """Solve with the first solver that answers; return the cvxpy status or 'solver_error'.
+
+    An 'optimal' status without finite values for the variables (a broken
+    solver) does not count as an answer.
+    """
     for solver in SOLVERS:
         try:
             problem.solve(solver=solver, **solver_options(solver, tolerance))
         except (cp.error.SolverError, ArithmeticError, ValueError):
             continue
-        if problem.status in OK_STATUSES or problem.status in INFEASIBLE_STATUSES:
+        if problem.status in OK_STATUSES and _has_values(problem):
+            return problem.status
+        if problem.status in INFEASIBLE_STATUSES:
             return problem.status
     return SOLVER_ERROR
+
+
+def _has_values(problem: cp.Problem) -> bool:
+    values = [v.value for v in problem.variables()]
+    return all(v is not None and np.all(np.isfinite(v)) for v in values)
 
 
 def inequalities(data: ProblemData, total_max=np.inf, x_ct=None) -> tuple[np.ndarray, np.ndarray]:
@@ -219,6 +257,14 @@ def inequalities(data: ProblemData, total_max=np.inf, x_ct=None) -> tuple[np.nda
     all points or for none), and, if ``x_ct`` is given, the two sides of the
     slab of :func:`ct_slab` that fixes CT (a row T does not act on reads
     0 <= half width).
+
+    Parameters
+    ----------
+    data : ProblemData
+    total_max : float or array_like, shape (...)
+        Budget on the total PCSA w.x [cm^2]; inf: no band.
+    x_ct : array_like, shape (..., n_var), optional
+        A stage-2 optimum whose counter torques to keep [cm^2].
 
     Returns
     -------
@@ -253,6 +299,12 @@ def objective(data: ProblemData, stage: str):
     """The objective of ``stage`` as 1/2 x'Hx + q'x: (H or None, q); vectorised.
 
     ||CT||^2 = ||T x + g||^2 = x'T'Tx + 2 g'T x + g'g, the constant dropped.
+
+    Parameters
+    ----------
+    data : ProblemData
+    stage : str
+        One of :data:`STAGES`.
     """
     lead, n = data.stiffness.shape[:-2], data.weights.size
     if stage == "min_pcsa":
@@ -269,6 +321,18 @@ def polished(data: ProblemData, stage: str, x0, total_max=np.inf, x_ct=None):
     Polishing imposes CT(x) = CT(x_ct) exactly, as equalities on the row space
     of T, where the solver had the slab of :func:`ct_slab`. Returns x [cm^2]
     and whether it is a verified KKT point, both vectorised over leading dimensions.
+
+    Parameters
+    ----------
+    data : ProblemData
+    stage : str
+        One of :data:`STAGES`.
+    x0 : array_like, shape (..., n_var)
+        The solver's answer [cm^2].
+    total_max : float or array_like
+        The band of the stage [cm^2], as for :func:`inequalities`.
+    x_ct : array_like, optional
+        The stage-2 optimum whose counter torques stage 3 keeps [cm^2].
     """
     hessian, linear = objective(data, stage)
     lhs, rhs = inequalities(data, total_max)
@@ -299,6 +363,11 @@ def _ct_expression(data: ProblemData, x):
 def min_pcsa_lp(data: ProblemData) -> tuple[str, np.ndarray | None]:
     """Stage 1: the minimum-PCSA LP at one point.
 
+    Parameters
+    ----------
+    data : ProblemData
+        The problem at one (E, Lambda) (no leading dimensions).
+
     Returns
     -------
     status : str
@@ -313,7 +382,21 @@ def min_counter_torque_socp(data: ProblemData, total_max: float) -> tuple[str, n
     """Stage 2: least ||CT||_2 over self-stable activations with total PCSA <= ``total_max`` [cm^2].
 
     CT = -(torque @ x + gravity_torque) (paper, Methods; design page, The
-    optimisation). ``total_max = inf`` drops the band (minimum-norm activations).
+    optimisation). Solved as the SOCP min ||CT||_2, then polished.
+
+    Parameters
+    ----------
+    data : ProblemData
+        The problem at one (E, Lambda) (no leading dimensions).
+    total_max : float
+        Bound on the total PCSA ``weights @ x`` [cm^2]; inf drops the band (minimum-norm activations).
+
+    Returns
+    -------
+    status : str
+        As for :func:`min_pcsa_lp`.
+    x : numpy.ndarray or None
+        Decision variables of least ||CT||_2 [cm^2], None unless optimal.
     """
     return _stage(data, "counter_torque", lambda x: cp.norm(_ct_expression(data, x), 2), total_max)
 
@@ -322,6 +405,21 @@ def least_norm_activation_qp(data: ProblemData, total_max: float, x_ct) -> tuple
     """Stage 3: the activation of least ||x||_2 in the band with the counter torques of ``x_ct``.
 
     CT(x) = CT(x_ct) is imposed through :func:`ct_slab`.
+
+    Parameters
+    ----------
+    data : ProblemData
+        The problem at one (E, Lambda).
+    total_max : float
+        The band [cm^2].
+    x_ct : array_like
+        The stage-2 optimum [cm^2].
+
+    Returns
+    -------
+    status : str
+    x : numpy.ndarray or None
+        [cm^2], None unless optimal.
     """
     return _stage(data, "least_norm", cp.sum_squares, total_max, x_ct)
 
@@ -331,6 +429,19 @@ def least_total_pcsa_lp(data: ProblemData, x_ct) -> tuple[str, np.ndarray | None
 
     With ``x_ct`` of least ||CT|| over all of F this is the far end of the
     Pareto front: more PCSA buys no lower ||CT||.
+
+    Parameters
+    ----------
+    data : ProblemData
+        The problem at one (E, Lambda).
+    x_ct : array_like
+        An activation of least ||CT|| [cm^2].
+
+    Returns
+    -------
+    status : str
+    x : numpy.ndarray or None
+        [cm^2], None unless optimal.
     """
     return _stage(data, "min_pcsa", lambda x: data.weights @ x, np.inf, x_ct)
 
@@ -341,6 +452,13 @@ def optimum(data: ProblemData, ct_tolerance: float) -> tuple[str, float, np.ndar
     ``ct_tolerance = inf`` gives the minimum-norm activation: stage 2 without the
     band, then :func:`least_total_pcsa_lp` instead of the least-norm tie-break.
     The total is NaN and x None unless every stage is optimal.
+
+    Parameters
+    ----------
+    data : ProblemData
+        The problem at one (E, Lambda).
+    ct_tolerance : float
+        Relative band on the minimum total PCSA [1].
     """
     status, x = min_pcsa_lp(data)
     if x is None:
@@ -411,6 +529,14 @@ def to_si(data: ProblemData, total, x) -> tuple[np.ndarray, np.ndarray, np.ndarr
     """Minimum PCSA [m^2], per-muscle PCSA [m^2] and CT [N m] from a total and x [cm^2].
 
     Vectorised over leading dimensions; NaN in, NaN out.
+
+    Parameters
+    ----------
+    data : ProblemData
+    total : array_like, shape (...)
+        Minimum total PCSA [cm^2].
+    x : array_like, shape (..., n_var)
+        Chosen decision variables [cm^2].
     """
     x = np.asarray(x, float)
     pcsa = np.einsum("mn,...n->...m", data.to_muscles, x) * M2_PER_CM2
@@ -418,7 +544,17 @@ def to_si(data: ProblemData, total, x) -> tuple[np.ndarray, np.ndarray, np.ndarr
 
 
 def point_optimum(data: ProblemData, ct_tolerance: float, eccentricity=np.nan, lordosis=np.nan) -> PointOptimum:
-    """:func:`optimum` as a :class:`PointOptimum` in SI units (NaN unless optimal)."""
+    """:func:`optimum` as a :class:`PointOptimum` in SI units (NaN unless optimal).
+
+    Parameters
+    ----------
+    data : ProblemData
+        The problem at one (E, Lambda).
+    ct_tolerance : float
+        Relative band on the minimum total PCSA [1]; inf: the minimum-norm activation.
+    eccentricity, lordosis : float
+        E and Lambda [m], recorded in the result.
+    """
     status, total, x = optimum(data, ct_tolerance)
     if x is None:
         x = np.full(data.weights.size, np.nan)
@@ -427,8 +563,7 @@ def point_optimum(data: ProblemData, ct_tolerance: float, eccentricity=np.nan, l
 
 
 def _point_data(model: Model, eccentricity: float, lordosis: float) -> ProblemData:
-    validate_position(model, eccentricity, lordosis)
-    return problem_data(model, segment_coefficients(model, float(eccentricity), float(lordosis)))
+    return problem_data(model, checked_coefficients(model, float(eccentricity), float(lordosis)))
 
 
 def solve_point(model: Model, eccentricity: float, lordosis: float) -> PointOptimum:
@@ -455,6 +590,12 @@ def min_norm_activation(model: Model, eccentricity: float, lordosis: float) -> P
     No budget on the total PCSA (design page: "also offer minimum-norm
     activations"); ties broken by least total PCSA. ``min_pcsa`` is still the
     minimum total PCSA of stage 1, ``total_pcsa`` what this activation uses.
+
+    Parameters
+    ----------
+    model : Model
+    eccentricity, lordosis : float
+        E and Lambda [m].
     """
     data = _point_data(model, eccentricity, lordosis)
     return point_optimum(data, np.inf, eccentricity, lordosis)
@@ -489,6 +630,14 @@ def pareto_front(model: Model, eccentricity: float, lordosis: float, n_points: i
     Stage 2 with the budget as a cvxpy Parameter, for ``n_points`` budgets
     evenly spaced from the minimum total PCSA to the total of the minimum-norm
     activation. An infeasible point gives empty arrays and its status.
+
+    Parameters
+    ----------
+    model : Model
+    eccentricity, lordosis : float
+        E and Lambda [m].
+    n_points : int
+        Number of budgets.
     """
     data = _point_data(model, eccentricity, lordosis)
     far = point_optimum(data, np.inf)

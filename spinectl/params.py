@@ -27,10 +27,46 @@ In the coronal plane read them as right (+x) and left (-x).
 """
 
 
+MAX_FIBRES = 1000
+"""Most fibres per muscle. Fibres only discretise the attachment surface (the paper
+uses 5); the bound keeps the per-fibre arrays of a sweep within memory."""
+
+
+MAX_PADE_ORDER = 10
+"""Highest Padé order of the reflex delay. Order 6 is already exact to rounding for the
+spine's loops (docs/reflex.md); from order 9 python-control's polynomial margins overflow
+for delays of a few microseconds, its coefficients growing like (1/tau)^n."""
+
+MAX_ACTIVATION = 10.0
+"""Largest activation of the reflex section, a sanity bound: ten times the co-contraction that
+self-stability needs (a larger value is more likely a PCSA typed in place of a fraction)."""
+
+
 def param(default, unit: str, doc: str):
-    """A dataclass field carrying its unit and documentation."""
+    """A dataclass field carrying its unit and documentation.
+
+    Parameters
+    ----------
+    default : object
+        Default value, in ``unit``; a list or dict becomes a default factory.
+    unit : str
+        Unit of the value, e.g. ``"N m/rad"``; ``"1"`` for a ratio, ``""`` for text.
+    doc : str
+        What the parameter is and where its value comes from.
+    """
     kwargs = {"default_factory": lambda: default} if isinstance(default, (list, dict)) else {"default": default}
     return field(metadata={"unit": unit, "doc": doc}, **kwargs)
+
+
+SOLVER_TOLERANCE_RANGE = (1e-12, 1e-6)
+"""Allowed ``optimisation.solver_tolerance`` [1]: interior-point solvers stall below 1e-12 in double
+precision; above 1e-6 the two solution paths need not agree to the 1e-6 the fast path promises."""
+
+
+def _store(obj, **values) -> None:
+    """Store validated, normalised values (plain floats, tuples) on a frozen dataclass."""
+    for name, value in values.items():
+        object.__setattr__(obj, name, value)
 
 
 @dataclass(frozen=True)
@@ -54,10 +90,13 @@ class Body:
     )
 
     def __post_init__(self):
-        v.positive("mass", self.mass)
-        v.positive("mass_height", self.mass_height)
-        v.positive("gravity", self.gravity)
-        v.non_negative("radius_of_gyration", self.radius_of_gyration)
+        _store(
+            self,
+            mass=v.positive("mass", self.mass),
+            mass_height=v.positive("mass_height", self.mass_height),
+            gravity=v.positive("gravity", self.gravity),
+            radius_of_gyration=v.non_negative("radius_of_gyration", self.radius_of_gyration),
+        )
 
 
 @dataclass(frozen=True)
@@ -87,15 +126,17 @@ class Geometry:
     )
 
     def __post_init__(self):
-        n = len(self.cor_heights)
         heights = v.real_vector("cor_heights", self.cor_heights)
-        object.__setattr__(self, "cor_heights", heights)
-        if n < 1:
+        if not heights:
             raise ParameterError("cor_heights", "must name at least one centre of rotation")
-        if len(self.cor_names) != n or not all(isinstance(s, str) for s in self.cor_names):
-            raise ParameterError("cor_names", f"must be {n} strings, one per entry of cor_heights")
-        object.__setattr__(self, "cor_names", tuple(self.cor_names))
+        names = v.labels("cor_names", self.cor_names)
+        if len(names) != len(heights):
+            raise ParameterError(
+                "cor_names", f"must have one name per entry of cor_heights ({len(heights)}; got {len(names)})"
+            )
+        _store(self, cor_heights=heights, cor_names=names)
         length = v.positive("spine_length", self.spine_length)
+        _store(self, spine_length=length)
         if any(b >= a for a, b in zip(heights, heights[1:], strict=False)):
             raise ParameterError("cor_heights", f"must be strictly decreasing, top to bottom (got {list(heights)})")
         if not all(0 <= h <= length for h in heights):
@@ -105,7 +146,7 @@ class Geometry:
             lo, hi = v.real_vector(name, getattr(self, name), 2)
             if lo >= hi:
                 raise ParameterError(name, f"must be [low, high] with low < high (got [{lo:g}, {hi:g}])")
-            object.__setattr__(self, name, (lo, hi))
+            _store(self, **{name: (lo, hi)})
 
 
 @dataclass(frozen=True)
@@ -130,22 +171,27 @@ class Fibre:
     )
 
     def __post_init__(self):
-        v.positive("specific_tension", self.specific_tension)
         ratio = v.positive("optimal_length_ratio", self.optimal_length_ratio)
         if ratio <= 1.0:
             raise ParameterError(
                 "optimal_length_ratio", f"must be > 1 so that muscles act on the ascending limb (got {ratio:g})"
             )
-        v.positive("k1", self.k1)
-        v.positive("k2", self.k2)
-        v.in_range("fast_twitch", self.fast_twitch, 0.0, 1.0)
-        v.positive("vmax_slow", self.vmax_slow)
-        v.non_negative("vmax_fast_gain", self.vmax_fast_gain)
-        v.positive("hill_a", self.hill_a)
-        v.positive("hill_b", self.hill_b)
         ecc = v.real("eccentric_enhancement", self.eccentric_enhancement)
         if ecc <= 1.0:
             raise ParameterError("eccentric_enhancement", f"must be > 1 (got {ecc:g})")
+        _store(
+            self,
+            specific_tension=v.positive("specific_tension", self.specific_tension),
+            optimal_length_ratio=ratio,
+            k1=v.positive("k1", self.k1),
+            k2=v.positive("k2", self.k2),
+            fast_twitch=v.in_range("fast_twitch", self.fast_twitch, 0.0, 1.0),
+            vmax_slow=v.positive("vmax_slow", self.vmax_slow),
+            vmax_fast_gain=v.non_negative("vmax_fast_gain", self.vmax_fast_gain),
+            hill_a=v.positive("hill_a", self.hill_a),
+            hill_b=v.positive("hill_b", self.hill_b),
+            eccentric_enhancement=ecc,
+        )
 
 
 @dataclass(frozen=True)
@@ -163,22 +209,32 @@ class MusclePair:
     name: str = param("straight", "", "Name of the pair.")
     upper: tuple[float, ...] = param((0.12, 0.24), "m", "(x, y) of the upper (thoracic) attachment, ventral side.")
     lower: tuple[float, ...] = param((0.12, 0.0), "m", "(x, y) of the lower (pelvic) attachment, ventral side.")
-    spread: float = param(0.03, "m", "Width of the attachment surface across which the fibres are spread.")
-    fibres: int = param(5, "1", "Number of parallel fibres (paper: 5).")
+    spread: float = param(
+        0.03, "m", "Width of the attachment surface across which the fibres are spread; less than the fibre length."
+    )
+    fibres: int = param(5, "1", f"Number of parallel fibres (paper: 5), at most {MAX_FIBRES}.")
 
     def __post_init__(self):
-        if not isinstance(self.name, str) or not self.name:
-            raise ParameterError("name", f"must be a non-empty string (got {self.name!r})")
+        name = v.label("name", self.name)
         upper = v.real_vector("upper", self.upper, 2)
         lower = v.real_vector("lower", self.lower, 2)
-        object.__setattr__(self, "upper", upper)
-        object.__setattr__(self, "lower", lower)
-        if math.dist(upper, lower) <= 0:
-            raise ParameterError("upper", "must differ from lower (a fibre needs a length)")
         if upper[1] <= lower[1]:
             raise ParameterError("upper", f"must lie above lower (got y {upper[1]:g} <= {lower[1]:g})")
-        v.non_negative("spread", self.spread)
-        v.integer("fibres", self.fibres, 1)
+        length = math.dist(upper, lower)
+        if not math.isfinite(length):
+            raise ParameterError("upper", f"must lie a finite distance from lower (got {upper} and {lower})")
+        spread = v.non_negative("spread", self.spread)
+        if spread >= length:
+            # a muscle is longer than its attachment is wide; catches a spread typed in cm
+            raise ParameterError("spread", f"must be smaller than the fibre length {length:g} m (got {spread:g})")
+        _store(
+            self,
+            name=name,
+            upper=upper,
+            lower=lower,
+            spread=spread,
+            fibres=v.integer("fibres", self.fibres, 1, MAX_FIBRES),
+        )
 
 
 def _default_muscles() -> tuple[MusclePair, ...]:
@@ -202,7 +258,7 @@ class Passive:
     )
 
     def __post_init__(self):
-        v.non_negative("stiffness", self.stiffness)
+        _store(self, stiffness=v.non_negative("stiffness", self.stiffness))
         v.choice("convention", self.convention, ("physical", "paper"))
 
 
@@ -249,18 +305,116 @@ class Optimisation:
     solver_tolerance: float = param(
         1e-9,
         "1",
-        "Feasibility and relative-gap tolerance of the conic solver (Clarabel; SCS as fallback). Tight, "
-        "so that the per-point reference and the fast path agree to 1e-6 (docs/optimisation.md).",
+        "Feasibility and relative-gap tolerance of the conic solver (Clarabel; SCS as fallback) and of the "
+        "KKT check that polishes its answers. Tight, so that the per-point reference and the fast path "
+        f"agree to 1e-6 (docs/optimisation.md); {SOLVER_TOLERANCE_RANGE[0]:g} to {SOLVER_TOLERANCE_RANGE[1]:g}.",
     )
 
     def __post_init__(self):
         v.choice("activation", self.activation, ("paired", "independent"))
-        v.non_negative("stability_margin", self.stability_margin)
         pmax = v.non_negative("pcsa_max", self.pcsa_max, allow_inf=True)
         if pmax == 0:
             raise ParameterError("pcsa_max", "must be > 0 (got 0)")
-        v.non_negative("ct_tolerance", self.ct_tolerance)
-        v.in_range("solver_tolerance", self.solver_tolerance, 1e-14, 1e-4)
+        _store(
+            self,
+            stability_margin=v.non_negative("stability_margin", self.stability_margin),
+            pcsa_max=pmax,
+            ct_tolerance=v.non_negative("ct_tolerance", self.ct_tolerance),
+            solver_tolerance=v.in_range("solver_tolerance", self.solver_tolerance, *SOLVER_TOLERANCE_RANGE),
+        )
+
+
+@dataclass(frozen=True)
+class Reflex:
+    """Delayed PD reflex per segment and its time-domain simulation (design page, Reflex with delay).
+
+    Beyond the paper, which discusses reflexes in words only (Discussion: "reflexes are
+    delayed by up to 100 ms ... the force generation of the muscles takes another
+    50-100 ms"). The reflex torque is u = -(kp alpha + kd omega)(t - delay); see
+    ``docs/reflex.md`` for the default gain rule and the margins.
+    """
+
+    delay: float = param(
+        0.1,
+        "s",
+        "Reflex delay tau. The paper's Discussion: reflexes follow a perturbation by up to 100 ms "
+        "(force generation adds another 50-100 ms).",
+    )
+    pade_order: int = param(
+        5, "1", f"Order of the Pade approximant of exp(-s tau) in the python-control models, 1 to {MAX_PADE_ORDER}."
+    )
+    activation: float = param(
+        0.5,
+        "1",
+        "Global-muscle activation as a fraction of the minimum stabilising PCSA (optimise.solve_point): "
+        f"0 = no co-contraction, reflex only; 1 = self-stable, no reflex needed; at most {MAX_ACTIVATION:g}.",
+    )
+    gains: str = param(
+        "rule",
+        "",
+        "'rule': kp and kd from the default rule (gain_factor, damping_ratio); 'explicit': the kp and kd below.",
+    )
+    gain_factor: float = param(
+        1.5,
+        "1",
+        "Default rule: kp = gain_factor * max(S, 0), the stiffness deficit below self-stability times this "
+        "factor (> 1, so that the net stiffness kp - S is positive). 1.5 leaves half the deficit as net "
+        "stiffness and, with damping_ratio 1, gives the reflex-only spine about the largest delay margin "
+        "the rule can (docs/reflex.md).",
+    )
+    damping_ratio: float = param(
+        1.0,
+        "1",
+        "Default rule: kd = max(0, 2 zeta sqrt(theta (kp - S)) + D), the derivative gain that gives the "
+        "delay-free closed loop this damping ratio zeta (1: critical damping), after the muscles' own "
+        "damping D <= 0.",
+    )
+    kp: float = param(0.0, "N m/rad", "Proportional reflex gain, used when gains = 'explicit'.")
+    kd: float = param(0.0, "N m s/rad", "Derivative reflex gain, used when gains = 'explicit'.")
+    sim_duration: float = param(
+        12.0, "s", "Length of a nonlinear simulation; should span several periods of the slowest oscillation."
+    )
+    sim_time_step: float = param(
+        0.004, "s", "Fixed RK4 step of the simulation (reduced to the delay when the delay is shorter)."
+    )
+    sim_perturbation: float = param(
+        1e-3, "rad", "Initial angle: the segment is held at this angle (omega = 0) and released at t = 0."
+    )
+    sim_divergence: float = param(
+        0.2,
+        "rad",
+        "A simulation stops as unstable once |alpha| exceeds this angle (the linear verdict no longer holds).",
+    )
+
+    def __post_init__(self):
+        factor = v.real("gain_factor", self.gain_factor)
+        if factor <= 1.0:
+            raise ParameterError("gain_factor", f"must be > 1, or the reflex cannot stabilise (got {factor:g})")
+        v.choice("gains", self.gains, ("rule", "explicit"))
+        duration = v.positive("sim_duration", self.sim_duration)
+        step = v.positive("sim_time_step", self.sim_time_step)
+        if step >= duration:
+            raise ParameterError("sim_time_step", f"must be < sim_duration = {duration:g} s (got {step:g})")
+        limit = v.positive("sim_divergence", self.sim_divergence)
+        if limit > math.pi / 2:
+            raise ParameterError("sim_divergence", f"must be <= pi/2 rad, a quarter turn (got {limit:g})")
+        kick = v.positive("sim_perturbation", self.sim_perturbation)
+        if kick >= limit:
+            raise ParameterError("sim_perturbation", f"must be < sim_divergence = {limit:g} rad (got {kick:g})")
+        _store(
+            self,
+            delay=v.non_negative("delay", self.delay),
+            pade_order=v.integer("pade_order", self.pade_order, 1, MAX_PADE_ORDER),
+            activation=v.in_range("activation", self.activation, 0.0, MAX_ACTIVATION),
+            gain_factor=factor,
+            damping_ratio=v.positive("damping_ratio", self.damping_ratio),
+            kp=v.non_negative("kp", self.kp),
+            kd=v.non_negative("kd", self.kd),
+            sim_duration=duration,
+            sim_time_step=step,
+            sim_perturbation=kick,
+            sim_divergence=limit,
+        )
 
 
 @dataclass(frozen=True)
@@ -276,14 +430,32 @@ class Model:
     passive: Passive = field(default_factory=Passive, metadata={"doc": "Passive stiffness K."})
     errata: Errata = field(default_factory=Errata, metadata={"doc": "Printed formula or correction."})
     optimisation: Optimisation = field(default_factory=Optimisation, metadata={"doc": "Optimiser settings."})
+    reflex: Reflex = field(default_factory=Reflex, metadata={"doc": "Delayed reflex and its simulation."})
 
     def __post_init__(self):
-        object.__setattr__(self, "muscles", tuple(self.muscles))
-        if not self.muscles:
+        for f in dataclasses.fields(self):  # each section's default factory is its class
+            section = getattr(self, f.name)
+            if f.name != "muscles" and not isinstance(section, f.default_factory):
+                raise ParameterError(f.name, f"must be a {f.default_factory.__name__} (got {v.show(section)})")
+        muscles = self.muscles
+        if isinstance(muscles, MusclePair) or not isinstance(muscles, (tuple, list)):
+            raise ParameterError("muscles", f"must be a list of MusclePair (got {v.show(muscles)})")
+        if not muscles:
             raise ParameterError("muscles", "must list at least one muscle pair")
-        names = [m.name for m in self.muscles]
-        if len(set(names)) != len(names):
-            raise ParameterError("muscles", f"names must be unique (got {names})")
+        for i, pair in enumerate(muscles):
+            if not isinstance(pair, MusclePair):
+                raise ParameterError(f"muscles.{i}", f"must be a MusclePair (got {v.show(pair)})")
+            if pair.name in [m.name for m in muscles[:i]]:
+                raise ParameterError(f"muscles.{i}.name", f"must be unique among the pairs (repeated: {pair.name!r})")
+        _store(self, muscles=tuple(muscles))
+        top = self.geometry.cor_heights[0]
+        if self.body.mass_height <= top:
+            # every segment is an inverted pendulum: the mass above the joint (design page, One segment)
+            raise ParameterError(
+                "body.mass_height",
+                f"must lie above the top centre of rotation {self.geometry.cor_names[0]} at {top:g} m "
+                f"(got {self.body.mass_height:g})",
+            )
 
     @property
     def muscle_names(self) -> tuple[str, ...]:

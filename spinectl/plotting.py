@@ -74,7 +74,13 @@ def _k_label(dataset: xr.Dataset) -> str:
 
 
 def min_pcsa_figure(dataset: xr.Dataset) -> Figure:
-    """Figure 3 (K = 0) or S1 (K > 0): minimum PCSA for self-stability of every segment."""
+    """Figure 3 (K = 0) or S1 (K > 0): minimum PCSA for self-stability of every segment.
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        One landscape (scalar K).
+    """
     name = "Fig. 3" if float(dataset["K"]) == 0 else "Fig. S1"
     title = f"{name}: minimum PCSA for self-stability, {_k_label(dataset)}"
     fig, _, _ = _landscape(dataset["min_pcsa_cm2"], title, "minimum PCSA [cm²]")
@@ -85,7 +91,14 @@ def counter_torque_figure(dataset: xr.Dataset, specific_tension: float) -> Figur
     """Figure 4: ||CT|| at the chosen activation, the +-30 N m limit and the paper's optimum.
 
     The colour bar's label converts ||CT|| into the PCSA of a local muscle
-    with the paper's 7 cm lever arm (``specific_tension`` [N/m^2]).
+    with the paper's 7 cm lever arm.
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        One landscape (scalar K).
+    specific_tension : float
+        f_iso per PCSA [N/m^2].
     """
     title = f"Fig. 4: local counter torques ‖CT‖, {_k_label(dataset)}"
     field = dataset["counter_torque_norm_Nm"]
@@ -106,14 +119,26 @@ def counter_torque_figure(dataset: xr.Dataset, specific_tension: float) -> Figur
 
 
 def save_figure(fig: Figure, path: str | Path) -> Path:
-    """Write ``fig`` as PNG at ``path`` atomically."""
+    """Write a figure as PNG atomically.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+    path : str or Path
+    """
     with atomic_path(path) as tmp:
         fig.savefig(tmp, format="png", dpi=DPI)
     return Path(path)
 
 
 def figure_names(stiffness: float) -> tuple[str, str]:
-    """File names of the minimum-PCSA and counter-torque figures for passive stiffness K [N m/rad]."""
+    """File names of the minimum-PCSA and counter-torque figures.
+
+    Parameters
+    ----------
+    stiffness : float
+        Passive stiffness K [N m/rad]; 0 gives Figures 3 and 4, else S1 and 4 with K in the name.
+    """
     if stiffness == 0:
         return "fig3_min_pcsa.png", "fig4_counter_torque.png"
     return f"figS1_min_pcsa_K{stiffness:g}.png", f"fig4_counter_torque_K{stiffness:g}.png"

@@ -57,7 +57,13 @@ def _number(value: float) -> str:
 
 
 def landmark_table(measurements: Sequence[Measurement]) -> str:
-    """The landmark table as Markdown: name, paper, spinectl, unit, agrees, how measured, where in the paper."""
+    """The landmark table as Markdown: name, paper, spinectl, unit, agrees, how measured, where in the paper.
+
+    Parameters
+    ----------
+    measurements : sequence of Measurement
+        From :func:`spinectl.landmarks.measure`.
+    """
     lines = [
         "| landmark | paper | spinectl | unit | agrees | how spinectl measures it | where the paper says it |",
         "| --- | --- | --- | --- | --- | --- | --- |",
@@ -102,7 +108,15 @@ def _halving(measurements: Sequence[Measurement], run: Run) -> str:
 
 
 def render(measurements: Sequence[Measurement], run: Run) -> str:
-    """The Markdown report of a reproduction run."""
+    """The Markdown report of a reproduction run.
+
+    Parameters
+    ----------
+    measurements : sequence of Measurement
+        From :func:`spinectl.landmarks.measure`.
+    run : Run
+        Facts about the run.
+    """
     agree = sum(m.agrees for m in measurements)
     files = "\n".join(f"- [`{name}`]({name})" for name in run.files)
     return f"""# spinectl reproduction of Wagner et al. (2012)

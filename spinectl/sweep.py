@@ -20,10 +20,9 @@ from tqdm.auto import tqdm
 from . import __version__, batch, config
 from .errors import ParameterError
 from .io import atomic_path
-from .mechanics import segment_coefficients
 from .optimise import problem_data
 from .params import Model
-from .stability import validate_position
+from .stability import checked_coefficients
 from .units import M2_PER_CM2, m2_to_cm2
 
 METHODS = ("fast", "per-point")
@@ -40,6 +39,13 @@ PAPER_REFERENCE = (
 
 def parse_grid(spec: str, name: str) -> np.ndarray:
     """A grid axis from ``"start:stop:num"`` (inclusive, metres) or a single value.
+
+    Parameters
+    ----------
+    spec : str
+        E.g. ``"0:0.08:81"`` or ``"0.03"``.
+    name : str
+        The option, for the error message.
 
     Raises
     ------
@@ -92,7 +98,6 @@ def sweep(
         raise ParameterError("chunk_size", f"must be >= 1 (got {chunk_size})")
     e_axis = np.atleast_1d(np.asarray(eccentricity, float))
     l_axis = np.atleast_1d(np.asarray(lordosis, float))
-    validate_position(model, e_axis, l_axis)
     e_grid, l_grid = (a.ravel() for a in np.meshgrid(e_axis, l_axis, indexing="ij"))
     arrays: dict[str, np.ndarray] = {}  # filled chunk by chunk: no copies of the answer beyond the answer
     per_point = 0
@@ -100,7 +105,7 @@ def sweep(
     with tqdm(total=e_grid.size, disable=disable, unit="pt", desc="sweep") as bar:
         for start in range(0, e_grid.size, int(chunk_size)):
             part = slice(start, start + int(chunk_size))
-            coeffs = segment_coefficients(model, e_grid[part], l_grid[part])
+            coeffs = checked_coefficients(model, e_grid[part], l_grid[part])  # raises for bad input
             data = problem_data(model, coeffs)
             tol = model.optimisation.ct_tolerance
             if method == "fast":
@@ -188,6 +193,16 @@ def stiffness_sweep(model: Model, stiffnesses, eccentricity, lordosis, **options
 
     ``config_toml`` is then the model of the first K; the ``K`` coordinate gives each one's
     ``passive.stiffness`` (convention: ``passive_convention``).
+
+    Parameters
+    ----------
+    model : Model
+    stiffnesses : sequence of float
+        K values [N m/rad].
+    eccentricity, lordosis : array_like, 1-D
+        Grid axes [m].
+    **options
+        Passed to :func:`sweep`.
     """
     parts = [
         sweep(config.set_parameter(model, "passive.stiffness", float(k)), eccentricity, lordosis, **options)
@@ -199,19 +214,41 @@ def stiffness_sweep(model: Model, stiffnesses, eccentricity, lordosis, **options
 
 
 def model_of(dataset: xr.Dataset) -> Model:
-    """The resolved model a Dataset was computed with (from its ``config_toml`` attribute)."""
+    """The resolved model a Dataset was computed with (from its ``config_toml`` attribute).
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        From :func:`sweep` or :func:`load`.
+    """
     return config.from_dict(Model, tomllib.loads(dataset.attrs["config_toml"]))
 
 
 def save(dataset: xr.Dataset, path: str | Path) -> Path:
-    """Write ``dataset`` to NetCDF at ``path`` atomically (:func:`spinectl.io.atomic_path`)."""
+    """Write a Dataset to NetCDF atomically (:func:`spinectl.io.atomic_path`).
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+    path : str or Path
+    """
     with atomic_path(path) as tmp:
         dataset.to_netcdf(tmp, engine="netcdf4")
     return Path(path)
 
 
 def load(path: str | Path) -> xr.Dataset:
-    """Read a Dataset written by :func:`save` fully into memory (the file is closed again)."""
+    """Read a Dataset written by :func:`save` fully into memory (the file is closed again).
+
+    Parameters
+    ----------
+    path : str or Path
+
+    Raises
+    ------
+    ParameterError
+        The file is missing or not NetCDF (field ``results``).
+    """
     path = Path(path)
     if not path.is_file():
         raise ParameterError("results", f"file not found: {path}")

@@ -12,10 +12,22 @@ M2_PER_CM2 = 1e-4
 
 
 def cm2_to_m2(value):
-    """PCSA [cm^2] -> [m^2]."""
+    """PCSA [cm^2] -> [m^2].
+
+    Parameters
+    ----------
+    value : array_like
+        PCSA [cm^2].
+    """
     return np.asarray(value, float) * M2_PER_CM2
 
 
 def m2_to_cm2(value):
-    """PCSA [m^2] -> [cm^2]."""
+    """PCSA [m^2] -> [cm^2].
+
+    Parameters
+    ----------
+    value : array_like
+        PCSA [m^2].
+    """
     return np.asarray(value, float) / M2_PER_CM2

@@ -98,3 +98,23 @@ def test_every_parameter_has_a_unit_and_documentation():
     """Fails on an undocumented parameter (python-control's convention)."""
     undocumented = [name for name, f in _parameter_fields() if not f.metadata.get("doc") or "unit" not in f.metadata]
     assert undocumented == []
+
+
+@pytest.mark.parametrize(
+    ("text", "field", "needle"),
+    [
+        ("[reflex]\ndelay = -0.1\n", "reflex.delay", ">= 0"),
+        ("[reflex]\npade_order = 0\n", "reflex.pade_order", "in [1, 10]"),
+        ("[reflex]\npade_order = 11\n", "reflex.pade_order", "in [1, 10]"),
+        ("[reflex]\nsim_divergence = 2.0\n", "reflex.sim_divergence", "<= pi/2"),
+        ("[reflex]\npade_order = 5.0\n", "reflex.pade_order", "must be an integer"),
+        ("[reflex]\nactivation = -0.5\n", "reflex.activation", "in [0, 10]"),
+        ("[reflex]\ngain_factor = 1.0\n", "reflex.gain_factor", "> 1"),
+        ("[reflex]\ngains = 'auto'\n", "reflex.gains", "one of"),
+        ("[reflex]\nsim_perturbation = 0.3\n", "reflex.sim_perturbation", "< sim_divergence"),
+        ("[reflex]\nsim_time_step = 20.0\n", "reflex.sim_time_step", "< sim_duration"),
+    ],
+)
+def test_reflex_section_is_validated(tmp_path, text, field, needle):
+    err = _error_for(tmp_path, text)
+    assert err.field == field and needle in str(err)

@@ -12,11 +12,13 @@ import argparse
 import importlib
 import sys
 
+from .._validate import printable
 from ..errors import SpinectlError
 
 COMMANDS = (
     "config_cmd",
     "stability_cmd",
+    "margins_cmd",
     "sweep_cmd",
     "plot_cmd",
     "reproduce_cmd",
@@ -27,14 +29,25 @@ EXIT_USAGE = 2
 
 
 class _Parser(argparse.ArgumentParser):
-    """ArgumentParser whose errors are one line and exit 2."""
+    """ArgumentParser whose errors are one line and exit 2, and that never calls ``sys.exit``."""
 
     def error(self, message):  # noqa: D401 - argparse API
         raise _UsageError(f"{self.prog}: {message}")
 
+    def exit(self, status=0, message=None):  # --help and --version end here
+        if message:
+            sys.stderr.write(message)
+        raise _ParserExit(status)
+
 
 class _UsageError(Exception):
     pass
+
+
+class _ParserExit(Exception):
+    def __init__(self, status: int):
+        super().__init__(status)
+        self.status = status
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -54,15 +67,23 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the CLI; return the exit code (0 ok, 2 bad input, 1 other failure)."""
+    """Run the CLI; return the exit code (0 ok, 2 bad input, 1 other failure).
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments after ``spinectl``; default ``sys.argv[1:]``.
+    """
     try:
         args = build_parser().parse_args(argv)
         return int(args.func(args) or 0)
+    except _ParserExit as exc:
+        return exc.status
     except _UsageError as exc:
-        print(f"error: {exc}", file=sys.stderr)
+        print(f"error: {printable(str(exc))}", file=sys.stderr)
         return EXIT_USAGE
     except SpinectlError as exc:
-        print(f"spinectl: error: {exc}", file=sys.stderr)
+        print(f"spinectl: error: {printable(str(exc))}", file=sys.stderr)
         return EXIT_USAGE
     except KeyboardInterrupt:
         print("spinectl: interrupted", file=sys.stderr)

@@ -14,19 +14,37 @@ from ..params import Model
 
 
 def add_model_options(parser: argparse.ArgumentParser) -> None:
-    """``--config FILE`` and ``--preset NAME``, on every command."""
+    """``--config FILE`` and ``--preset NAME``, on every command.
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        The (sub-)command's parser; the options go into a group named "model".
+    """
     group = parser.add_argument_group("model")
     group.add_argument("--config", metavar="FILE", help="TOML file overriding the preset's parameters")
     group.add_argument("--preset", metavar="NAME", help="built-in parameter preset (default: 'default')")
 
 
 def load_model(args: argparse.Namespace) -> Model:
-    """The model named by ``--preset`` and ``--config``."""
+    """The model named by ``--preset`` and ``--config``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments with ``config`` and ``preset`` (see :func:`add_model_options`).
+    """
     return load_config(args.config, preset=args.preset)
 
 
 def finite_float(name: str):
-    """An argparse ``type`` accepting finite floats only, naming the option on error."""
+    """An argparse ``type`` accepting finite floats only, naming the option on error.
+
+    Parameters
+    ----------
+    name : str
+        The option, e.g. ``"--E"``, as named in the error message.
+    """
 
     def convert(text: str) -> float:
         try:
@@ -35,14 +53,20 @@ def finite_float(name: str):
             raise argparse.ArgumentTypeError(f"{name} must be a number (got {text!r})") from None
         if not math.isfinite(value):
             raise argparse.ArgumentTypeError(f"{name} must be finite (got {text!r})")
-        return value
+        return value + 0.0  # -0 becomes 0
 
     convert.__name__ = name
     return convert
 
 
 def float_list(name: str):
-    """An argparse ``type`` for comma-separated finite floats, e.g. ``10,5,3``."""
+    """An argparse ``type`` for comma-separated finite floats, e.g. ``10,5,3``.
+
+    Parameters
+    ----------
+    name : str
+        The option, e.g. ``"--pcsa"``, as named in the error message.
+    """
     one = finite_float(name)
 
     def convert(text: str) -> list[float]:
@@ -53,7 +77,15 @@ def float_list(name: str):
 
 
 def emit_json(payload: dict, out: str | None = None) -> None:
-    """Print ``payload`` as JSON, or write it atomically to ``out``."""
+    """Print ``payload`` as JSON, or write it atomically to ``out``.
+
+    Parameters
+    ----------
+    payload : dict
+        JSON-serialisable document; NaN is written as ``NaN``.
+    out : str, optional
+        Output file; default standard output.
+    """
     text = json.dumps(payload, indent=2, allow_nan=True) + "\n"
     if out:
         atomic_write_text(out, text)
@@ -62,6 +94,16 @@ def emit_json(payload: dict, out: str | None = None) -> None:
 
 
 def require(condition: bool, field: str, message: str) -> None:
-    """Raise :class:`ParameterError` for ``field`` unless ``condition``."""
+    """Raise :class:`ParameterError` for ``field`` unless ``condition``.
+
+    Parameters
+    ----------
+    condition : bool
+        What must hold.
+    field : str
+        The option or parameter named in the error, e.g. ``"--pcsa"``.
+    message : str
+        What is allowed, e.g. ``"must be >= 0"``.
+    """
     if not condition:
         raise ParameterError(field, message)

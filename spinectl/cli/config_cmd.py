@@ -9,6 +9,13 @@ from ._common import add_model_options, load_model
 
 
 def register(sub) -> None:
+    """Add the ``config`` sub-command to the ``spinectl`` parser.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The sub-command action of :func:`spinectl.cli.build_parser`.
+    """
     parser = sub.add_parser("config", help="show model parameters or list presets")
     actions = parser.add_subparsers(dest="action", metavar="ACTION")
     actions.required = True

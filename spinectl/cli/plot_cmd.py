@@ -6,6 +6,13 @@ from .. import plotting, sweep
 
 
 def register(sub) -> None:
+    """Add the ``plot`` sub-command to the ``spinectl`` parser.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The sub-command action of :func:`spinectl.cli.build_parser`.
+    """
     parser = sub.add_parser(
         "plot",
         help="draw Figures 3, 4 (and S1 for K > 0) from a sweep's NetCDF file",
@@ -18,6 +25,18 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
+    """Run ``spinectl plot``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments (see :func:`register`).
+
+    Returns
+    -------
+    int
+        Exit code 0.
+    """
     dataset = sweep.load(args.results)
     model = sweep.model_of(dataset)
     for path in plotting.draw_figures(dataset, args.out, model.fibre.specific_tension):

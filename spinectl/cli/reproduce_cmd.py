@@ -33,6 +33,13 @@ LANDSCAPES = "landscapes.nc"
 
 
 def register(sub) -> None:
+    """Add the ``reproduce`` sub-command to the ``spinectl`` parser.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The sub-command action of :func:`spinectl.cli.build_parser`.
+    """
     parser = sub.add_parser(
         "reproduce",
         help="run the paper's study: landscapes, figures and a landmark report",
@@ -48,6 +55,18 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
+    """Run ``spinectl reproduce``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments (see :func:`register`).
+
+    Returns
+    -------
+    int
+        Exit code 0.
+    """
     if args.points < 3:
         raise ParameterError("--points", f"must be >= 3 (got {args.points})")
     source = f"config file {args.config}" if args.config else f"preset `{args.preset or 'default'}`"

@@ -11,6 +11,13 @@ from ._common import add_model_options, emit_json, finite_float, float_list, loa
 
 
 def register(sub) -> None:
+    """Add the ``stability`` sub-command to the ``spinectl`` parser.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The sub-command action of :func:`spinectl.cli.build_parser`.
+    """
     parser = sub.add_parser(
         "stability",
         help="eigenvalues, self-stability and counter torque of each segment",
@@ -32,13 +39,25 @@ def register(sub) -> None:
 
 
 def add_position_options(parser) -> None:
-    """``--E`` and ``--Lambda`` in metres."""
+    """``--E`` and ``--Lambda`` in metres.
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        The sub-command's parser.
+    """
     parser.add_argument("--E", type=finite_float("--E"), default=0.0, help="eccentricity E [m] (default 0)")
     parser.add_argument("--Lambda", type=finite_float("--Lambda"), default=0.0, help="lordosis Lambda [m] (default 0)")
 
 
 def model_with_overrides(args):
-    """The model of ``--preset``/``--config`` with ``--K`` applied."""
+    """The model of ``--preset``/``--config`` with ``--K`` applied.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments; ``K`` [N m/rad] is optional.
+    """
     model = load_model(args)
     if getattr(args, "K", None) is not None:
         model = set_parameter(model, "passive.stiffness", args.K)
@@ -46,6 +65,18 @@ def model_with_overrides(args):
 
 
 def run(args) -> int:
+    """Run ``spinectl stability``: print the table, or JSON with ``--json``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments: ``E``, ``Lambda`` [m], ``pcsa`` [cm^2], ``K``, ``json`` and the model options.
+
+    Returns
+    -------
+    int
+        Exit code 0.
+    """
     model = model_with_overrides(args)
     pcsa = cm2_to_m2(args.pcsa) if args.pcsa is not None else minimum_stabilising_pcsa(model, args.E, args.Lambda)
     result = segment_stability(model, args.E, args.Lambda, pcsa)
@@ -57,7 +88,19 @@ def run(args) -> int:
 
 
 def minimum_stabilising_pcsa(model, eccentricity: float, lordosis: float):
-    """The chosen activation of :func:`spinectl.optimise.solve_point` [m^2]; an error if there is none."""
+    """The chosen activation of :func:`spinectl.optimise.solve_point` [m^2]; an error if there is none.
+
+    Parameters
+    ----------
+    model : Model
+    eccentricity, lordosis : float
+        E and Lambda [m].
+
+    Raises
+    ------
+    ModelError
+        No activation within the bounds stabilises every segment (or the solver failed).
+    """
     optimum = solve_point(model, eccentricity, lordosis)
     if not optimum.ok:
         raise ModelError(
@@ -70,7 +113,15 @@ def minimum_stabilising_pcsa(model, eccentricity: float, lordosis: float):
 def result_to_json(model, result: StabilityResult, given: bool = True) -> dict:
     """The JSON document of ``spinectl stability --json`` (units in the key names).
 
-    ``pcsa_source`` is 'given' (``--pcsa``) or 'min_pcsa' (the optimiser's chosen activation).
+    Parameters
+    ----------
+    model : Model
+        The model the result was computed with (muscle names, K).
+    result : StabilityResult
+        Output of :func:`~spinectl.stability.segment_stability`.
+    given : bool
+        Whether the PCSA was given (``--pcsa``); ``pcsa_source`` is then 'given',
+        else 'min_pcsa' (the optimiser's chosen activation).
     """
     pcsa = m2_to_cm2(result.pcsa)
     return {
@@ -103,7 +154,17 @@ def _complex(z: complex) -> str:
 
 
 def format_table(model, result: StabilityResult, given: bool = True) -> str:
-    """A readable per-segment table."""
+    """A readable per-segment table.
+
+    Parameters
+    ----------
+    model : Model
+        The model the result was computed with (muscle names, K).
+    result : StabilityResult
+        Output of :func:`~spinectl.stability.segment_stability`.
+    given : bool
+        Whether the PCSA was given (``--pcsa``) or is the minimum stabilising one.
+    """
     pcsa = m2_to_cm2(result.pcsa)
     lines = [
         f"E = {result.eccentricity * 100:.2f} cm, Lambda = {result.lordosis * 100:.2f} cm, "

@@ -15,6 +15,13 @@ DEFAULT_AXIS = "0:0.08:81"
 
 
 def register(sub) -> None:
+    """Add the ``sweep`` sub-command to the ``spinectl`` parser.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The sub-command action of :func:`spinectl.cli.build_parser`.
+    """
     parser = sub.add_parser(
         "sweep",
         help="minimum PCSA and counter torques on an E x Lambda grid (NetCDF)",
@@ -37,6 +44,18 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
+    """Run ``spinectl sweep``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments (see :func:`register`).
+
+    Returns
+    -------
+    int
+        Exit code 0.
+    """
     model = load_model(args)
     e_axis, l_axis = sweep.parse_grid(args.E, "--E"), sweep.parse_grid(args.Lambda, "--Lambda")
     options = {"method": args.method, "chunk_size": args.chunk_size}
@@ -53,7 +72,17 @@ def run(args) -> int:
 
 
 def summary(dataset, path, seconds: float) -> str:
-    """One line: what was written, how many points solved, the ranges of both landscapes."""
+    """One line: what was written, how many points solved, the ranges of both landscapes.
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        The sweep.
+    path : str or Path
+        Where it was written.
+    seconds : float
+        Wall time [s].
+    """
     status = dataset["status"].values
     pcsa, torque = dataset["min_pcsa_cm2"].values, dataset["counter_torque_norm_Nm"].values
     ok = np.isfinite(pcsa)

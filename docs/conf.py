@@ -1,0 +1,58 @@
+"""Sphinx configuration of the spinectl documentation.
+
+Build from the repository root (warnings are errors, as in CI)::
+
+    python -m sphinx -W --keep-going -b html docs docs/_build/html
+
+Markdown pages go through MyST (myst-nb, which will also render the
+notebooks); docstrings through autodoc and numpydoc. The reference pages
+(parameters, command line, API) are generated from the code at each build by
+the local extension in ``_ext/spinectl_docs``.
+"""
+
+import sys
+from pathlib import Path
+
+DOCS = Path(__file__).resolve().parent
+sys.path.insert(0, str(DOCS / "_ext"))
+sys.path.insert(0, str(DOCS.parent))  # this checkout's spinectl, installed or not
+
+import spinectl  # noqa: E402
+
+project = "spinectl"
+author = "spinectl developers"
+copyright = "spinectl developers, BSD-3-Clause"
+release = version = spinectl.__version__
+
+extensions = [
+    "myst_nb",  # MyST Markdown pages, and notebooks
+    "numpydoc",
+    "sphinx.ext.autodoc",
+    "sphinx.ext.mathjax",
+    "sphinx.ext.viewcode",
+    "spinectl_docs",
+]
+
+root_doc = "index"
+exclude_patterns = ["_build", "_generated", "**/.ipynb_checkpoints"]
+
+# MyST: $...$ and $$...$$ math, \begin{align} environments
+myst_enable_extensions = ["dollarmath", "amsmath"]
+nb_execution_mode = "off"  # notebooks are rendered as stored
+
+# autodoc + numpydoc
+autodoc_member_order = "bysource"
+autodoc_typehints = "signature"
+numpydoc_show_class_members = False  # autodoc lists the members itself
+numpydoc_xref_param_type = False
+
+# no intersphinx: the build runs without network
+
+html_theme = "alabaster"
+html_title = f"spinectl {release}"
+html_theme_options = {
+    "description": "Control-theoretic analysis of spinal stability (Wagner et al. 2012)",
+    "fixed_sidebar": True,
+    "page_width": "1160px",  # room for the equations and the parameter tables
+    "sidebar_width": "230px",
+}

@@ -1,0 +1,136 @@
+"""CLI fuzzing: random argument lists never raise, exit 0 or 2, and exit 2 with exactly one line.
+
+Arguments mix the real command and option names with numbers (NaN, inf, huge,
+signed zero, unicode digits), comma lists, unicode garbage, undecodable
+surrogates, missing values and the names of prepared configuration files
+(valid, invalid, overflowing, an attachment on a CoR). Bounded to about 20 s.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import warnings
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from spinectl.cli import main
+
+CONFIG_FILES = {
+    "good.toml": "[body]\nmass = 55.0\n",
+    "bad.toml": "[body]\nmass = -1.0\n",
+    "typo.toml": "[bodyy]\nmass = 1.0\n",
+    "not_toml.toml": "[body\n",
+    "overflow.toml": "[body]\nradius_of_gyration = 1e300\n",
+    "on_cor.toml": '[[muscles]]\nname = "p"\nupper = [0.1, 0.3]\nlower = [0.0, 0.005]\nspread = 0.0\nfibres = 1\n',
+}
+"""Files in the fuzzing folder; on_cor.toml puts an attachment on L5S1 at E = Lambda = 0."""
+
+OPTIONS = ["--E", "--Lambda", "--pcsa", "--K", "--json", "--config", "--preset", "--help", "-h", "--version"]
+WORDS = ["stability", "config", "show", "presets", "default", "--", "-", "=", *CONFIG_FILES]
+PREFIXES = [[], ["stability"], ["stability", "--pcsa", "10,10,10"], ["config", "show"], ["config", "presets"]]
+
+number_texts = st.one_of(
+    st.floats().map(repr),
+    st.integers(-(10**400), 10**400).map(str),
+    st.sampled_from(["nan", "-nan", "inf", "-inf", "1e999", "-0", "1_0", "0x10", "", " ", "1e-400", "١", "５"]),
+)
+tokens = st.one_of(
+    st.sampled_from(OPTIONS + WORDS),
+    number_texts,
+    st.lists(number_texts, max_size=7).map(",".join),
+    st.tuples(st.sampled_from(OPTIONS), number_texts).map("=".join),
+    st.text(max_size=12),
+    st.sampled_from(["\udcff", "a\nb", "\u2028", "\x00", "é" * 3]),
+)
+garbled = st.tuples(st.sampled_from(PREFIXES), st.lists(tokens, max_size=8)).map(lambda t: [*t[0], *t[1]])
+"""Mostly caught by argparse."""
+
+
+def mostly(valid, odd=number_texts):
+    """Valid values three times in four, so that most lists get past argparse."""
+    return st.one_of(valid, valid, valid, odd)
+
+
+pcsa_lists = st.lists(st.floats(0, 100).map(repr), min_size=3, max_size=3).map(",".join)
+values = {
+    "--E": mostly(st.floats(-0.12, 0.12).map(repr)),
+    "--Lambda": mostly(st.floats(-0.12, 0.12).map(repr)),
+    "--K": mostly(st.floats(0, 100).map(repr)),
+    "--pcsa": mostly(pcsa_lists, st.lists(number_texts, max_size=7).map(",".join)),
+    "--config": st.one_of(st.sampled_from(sorted(CONFIG_FILES)), st.text(max_size=8)),
+    "--preset": st.one_of(st.just("default"), st.text(max_size=8)),
+}
+COMMAND_OPTIONS = {"stability": sorted(values), "config show": ["--config", "--preset"]}
+
+
+@st.composite
+def well_formed(draw) -> list[str]:
+    """Real options with random values: these get past argparse into the model and the physics."""
+    command = draw(st.sampled_from(sorted(COMMAND_OPTIONS)))
+    argv = command.split()
+    for name in draw(st.lists(st.sampled_from(COMMAND_OPTIONS[command]), unique=True)):
+        argv += [name, draw(values[name])]
+    if command == "stability" and "--pcsa" not in argv and draw(st.booleans()):
+        argv += ["--pcsa", draw(pcsa_lists)]
+    return argv + (["--json"] if command == "stability" and draw(st.booleans()) else [])
+
+
+argument_lists = st.one_of(garbled, well_formed())
+
+
+@pytest.fixture(scope="module")
+def fuzz_folder(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("fuzz")
+    for name, text in CONFIG_FILES.items():
+        (folder / name).write_text(text)
+    return folder
+
+
+def run(argv: list[str]) -> tuple[int, str, str]:
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err), warnings.catch_warnings():
+        warnings.simplefilter("error")  # a warning would be an unexplained extra line on stderr
+        code = main(argv)
+    return code, out.getvalue(), err.getvalue()
+
+
+def check(argv: list[str]) -> None:
+    code, _, err = run(argv)
+    assert code in (0, 2), (argv, code, err)
+    if code == 2:
+        assert err.endswith("\n") and err.count("\n") == 1 and len(err.splitlines()) == 1, (argv, err)
+        assert "Traceback" not in err
+    else:
+        assert err == "", (argv, err)
+
+
+@settings(max_examples=1500, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(argument_lists)
+def test_random_arguments_never_raise(fuzz_folder, argv):
+    with contextlib.chdir(fuzz_folder):  # relative --config names; nothing outside is read
+        check(argv)
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["--version"],
+        ["stability", "--help"],
+        ["stability", "--pcsa", "1,1,1", "a\nb"],
+        ["stability", "--pcsa", "1e300,1e300,1e300"],
+        ["stability", "--pcsa", "10,10,10", "--config", "overflow.toml"],
+        ["stability", "--pcsa", "10,10,10", "--config", "on_cor.toml"],
+        ["stability", "--pcsa", "10", "--config", "\x00"],
+        ["stability", "--pcsa", "10,10,10", "--config", "x" * 5000],
+        ["config", "show", "--preset", ""],
+        ["config", "show", "--config", "/dev/zero"],
+        ["\udcff"],
+    ],
+)
+def test_arguments_that_used_to_escape(fuzz_folder, argv):
+    """Each of these once raised SystemExit, a raw exception, or printed two lines."""
+    with contextlib.chdir(fuzz_folder):
+        check(argv)

@@ -1,0 +1,23 @@
+"""Bode, Nyquist and time-response plots: written atomically as PNG files."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from spinectl import control_plots, simulate, systems
+from spinectl.params import Reflex
+
+PNG = b"\x89PNG\r\n\x1a\n"
+
+
+def test_plots_are_pngs_and_leave_no_temporaries(tmp_path, model):
+    loops = {"L3L4": systems.loop_transfer(50.0, -15.0, 2.6, 75.0, 1.3, 0.1, 5)}
+    plant = simulate.segment_plant(model, 0.03, 0.04, 2, np.array([15, 15, 0, 0, 0.2, 0.2]) * 1e-4)
+    runs = {"L3L4": simulate.simulate(plant, [75.0, 0.0], [1.3, 0.0], 0.1, Reflex(sim_duration=0.3))}
+    written = [
+        control_plots.bode(loops, tmp_path / "bode.png", omega_limits=(0.1, 100.0)),
+        control_plots.nyquist(loops, tmp_path / "nyquist.png"),
+        control_plots.time_response(runs, tmp_path / "response.png"),
+    ]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bode.png", "nyquist.png", "response.png"]
+    assert all(p.read_bytes()[:8] == PNG for p in written)

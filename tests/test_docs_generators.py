@@ -1,0 +1,63 @@
+"""The generators of the reference pages in docs/_ext (the Sphinx build itself runs in .ci/run)."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from spinectl.config import to_dict
+from spinectl.params import Model
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "docs" / "_ext"))
+from spinectl_docs import api, cli, guide, parameters  # noqa: E402
+
+
+def test_parameters_page_lists_every_parameter_with_its_unit():
+    # the parameters as the TOML dict has them, independently of the field metadata the page is built from
+    page = parameters.markdown()
+    rows = 0
+    for section, fields in to_dict(Model()).items():
+        if isinstance(fields, dict):
+            for name in fields:
+                assert f"| `{section}.{name}` |" in page
+                rows += 1
+        else:  # a list of tables, e.g. muscles: one row per field, one default column per entry
+            for name in fields[0]:
+                assert f"| `{name}` |" in page
+                rows += 1
+    assert rows > 30
+    assert "| `body.mass` | kg | `40.0` |" in page
+
+
+def test_cli_page_walks_sub_sub_commands_and_skips_aliases():
+    parser = argparse.ArgumentParser(prog="tool")
+    sub = parser.add_subparsers(dest="command")
+    group = sub.add_parser("group", help="a group", aliases=["g"])
+    inner = group.add_subparsers(dest="action")
+    leaf = inner.add_parser("leaf", help="the leaf")
+    leaf.add_argument("--width", type=float, default=2.5, help="width [m], default %(default)s")
+    page = cli.markdown(parser)
+    assert "## `tool`" in page and "### `tool group`" in page and "#### `tool group leaf`" in page
+    assert page.count("### `tool group`") == 1  # the alias g is the same parser
+    assert "| `--width WIDTH` | 2.5 | width \\[m\\], default 2.5 |" in page
+
+
+def test_cli_page_has_every_spinectl_command():
+    page = cli.markdown()
+    for command in ("spinectl config show", "spinectl config presets", "spinectl stability"):
+        assert f"`{command}`" in page
+
+
+def test_api_stub_per_module_and_reexports():
+    names = api.module_names()
+    assert "spinectl.mechanics" in names and "spinectl.__main__" not in names
+    assert ".. automodule:: spinectl.mechanics" in api.stub("spinectl.mechanics")
+    assert ":py:obj:`~spinectl.params.Model`" in api.stub("spinectl")
+
+
+def test_guide_pages_leave_out_the_index_and_the_references(tmp_path):
+    for name in ("index.md", "model.md", "api.md", "cli.md", "parameters.md", "reflex.md", "optimisation.md"):
+        (tmp_path / name).write_text("# x\n")
+    (tmp_path / "_generated").mkdir()
+    assert guide.guide_pages(tmp_path) == ["model", "optimisation", "reflex"]

@@ -1,0 +1,105 @@
+"""``spinectl margins``: JSON schema, table, plots and clean failures."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from spinectl import reflex
+from spinectl.cli import main
+
+REQUIRED = (
+    "name",
+    "stiffness_Nm_per_rad",
+    "damping_Nms_per_rad",
+    "inertia_kgm2",
+    "kp_Nm_per_rad",
+    "kd_Nms_per_rad",
+    "gain_margin",
+    "phase_margin_deg",
+    "crossover_rad_s",
+    "delay_margin_s",
+    "delay_margin_pade_s",
+    "stable_at_delay",
+)
+
+
+def run(argv, capsys):
+    code = main(argv)
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_json_schema_and_values(capsys):
+    code, out, _ = run(["margins", "--delay", "0.1", "--activation", "0", "--pade-order", "3", "--json"], capsys)
+    assert code == 0
+    doc = json.loads(out)
+    assert doc["delay_s"] == 0.1 and doc["pade_order"] == 3 and doc["optimum_status"] == "skipped"
+    assert [s["name"] for s in doc["segments"]] == ["L1L2", "L2L3", "L3L4", "L4L5", "L5S1"]
+    for seg in doc["segments"]:
+        assert all(key in seg for key in REQUIRED)
+        exact = reflex.delay_margin(
+            seg["stiffness_Nm_per_rad"],
+            seg["damping_Nms_per_rad"],
+            seg["inertia_kgm2"],
+            seg["kp_Nm_per_rad"],
+            seg["kd_Nms_per_rad"],
+        )
+        assert seg["delay_margin_s"] == pytest.approx(float(exact.margin), rel=1e-12)
+        assert seg["stable_at_delay"] == (0.1 < seg["delay_margin_s"])
+
+
+def test_self_stable_margins_are_infinite_in_json(capsys):
+    code, out, _ = run(["margins", "--E", "0.03", "--Lambda", "0.04", "--activation", "1", "--json"], capsys)
+    assert code == 0
+    segments = json.loads(out)["segments"]
+    assert all(
+        s["delay_margin_s"] == float("inf") and s["delay_margin_status"] == "delay_independent" for s in segments
+    )
+
+
+def test_table(capsys):
+    code, out, _ = run(["margins", "--activation", "0", "--kp", "150", "--kd", "20"], capsys)
+    assert code == 0 and "L5S1" in out and "tau_m" in out and "150.00" in out
+
+
+def test_plot_writes_three_pngs(tmp_path, capsys):
+    config = tmp_path / "short.toml"
+    config.write_text("[reflex]\nsim_duration = 1.0\nactivation = 0.0\n")
+    out = tmp_path / "plots"
+    code, _, _ = run(["margins", "--config", str(config), "--plot", str(out)], capsys)
+    assert code == 0
+    files = sorted(p.name for p in out.iterdir())
+    assert files == ["bode.png", "nyquist.png", "response.png"]  # and no temporary left behind
+    assert all((out / f).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" for f in files)
+
+
+@pytest.mark.parametrize(
+    ("argv", "needle"),
+    [
+        (["margins", "--delay", "-1"], "reflex.delay: must be >= 0"),
+        (["margins", "--activation", "11"], "reflex.activation: must be in [0, 10]"),
+        (["margins", "--pade-order", "0"], "reflex.pade_order: must be an integer in [1, 10]"),
+        (["margins", "--pade-order", "2.5"], "invalid int value"),
+        (["margins", "--kp", "-1"], "reflex.kp: must be >= 0"),
+        (["margins", "--delay", "inf"], "--delay must be finite"),
+        (["margins", "--E", "0.5"], "E: must be in"),
+    ],
+)
+def test_bad_input_is_one_line_exit_2(argv, needle, capsys):
+    code, out, err = run(argv, capsys)
+    assert code == 2 and needle in err and out == ""
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+
+
+@pytest.mark.parametrize("argv", [["--kp", "1e308"], ["--kd", "1e300"], ["--delay", "1e308"]])
+def test_absurd_magnitudes_are_a_model_error(argv, capsys):
+    code, _, err = run(["margins", *argv], capsys)
+    assert code == 2 and "arithmetic fails" in err and len(err.strip().splitlines()) == 1
+
+
+def test_plot_writes_nothing_when_the_simulation_cannot_run(tmp_path, capsys):
+    """A 1 ns delay needs 1.2e10 steps: refused before any PNG is written."""
+    code, _, err = run(["margins", "--delay", "1e-9", "--plot", str(tmp_path / "p")], capsys)
+    assert code == 2 and "reflex.delay" in err and not (tmp_path / "p").exists()
