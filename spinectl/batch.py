@@ -119,10 +119,14 @@ def stacked_qp(hessian, linear, lhs, rhs, tolerance: float | None) -> tuple[str,
         quad = sp.triu(block_diagonal(hessian), format="csc")
     lhs_matrix = block_diagonal(lhs)
     cones = [clarabel.NonnegativeConeT(lhs_matrix.shape[0])]
-    solver = clarabel.DefaultSolver(quad, linear.ravel(), lhs_matrix, np.ravel(rhs), cones, _settings(tolerance))
-    solution = solver.solve()
+    try:
+        solver = clarabel.DefaultSolver(quad, linear.ravel(), lhs_matrix, np.ravel(rhs), cones, _settings(tolerance))
+        solution = solver.solve()
+    except (ValueError, RuntimeError, ArithmeticError):  # bad data or a solver panic: the block is unsolved
+        return optimise.SOLVER_ERROR, np.full((n_points, n), np.nan)
+    x = np.asarray(solution.x, float).reshape(n_points, n)
     status = _STATUS.get(solution.status, optimise.SOLVER_ERROR)
-    return status, np.asarray(solution.x).reshape(n_points, n)
+    return (status if np.all(np.isfinite(x)) else optimise.SOLVER_ERROR), x
 
 
 def _stage(data: ProblemData, stage: str, total_max=np.inf, x_ct=None) -> tuple[str, np.ndarray, np.ndarray]:

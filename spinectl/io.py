@@ -138,7 +138,6 @@ def staged_directory(target: str | Path) -> Iterator[Path]:
     with _output_errors(target):
         target.parent.mkdir(parents=True, exist_ok=True)
         stage = _temporary(target, directory=True)
-        _set_mode(stage, target.parent / f".{target.name}.new", directory=True)
     try:
         yield stage
         with _output_errors(target):

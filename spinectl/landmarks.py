@@ -132,8 +132,9 @@ def line_slope(dataset: xr.Dataset, name: str, pick: str) -> float:
     """Slope of the line Lambda = s E through the per-E arg-max (or arg-min) of ``name`` over Lambda [1].
 
     Only columns E > 0 whose extremum lies strictly inside the Lambda range
-    count (an extremum on the edge says the line left the grid); least squares
-    through the origin. NaN if no column counts.
+    count (an extremum on the edge says the line left the grid), and only
+    columns with a value (infeasible points are NaN); least squares through
+    the origin. NaN if no column counts.
 
     Parameters
     ----------
@@ -145,10 +146,11 @@ def line_slope(dataset: xr.Dataset, name: str, pick: str) -> float:
         Ridge or valley.
     """
     field = dataset[name].transpose("E", "Lambda").values
-    index = np.nanargmax(field, axis=1) if pick == "max" else np.nanargmin(field, axis=1)
+    sign = 1.0 if pick == "max" else -1.0
+    index = np.argmax(np.where(np.isnan(field), -np.inf, sign * field), axis=1)
     e = dataset["E"].values
     lam = dataset["Lambda"].values[index]
-    inside = (e > 0) & (index > 0) & (index < field.shape[1] - 1)
+    inside = (e > 0) & (index > 0) & (index < field.shape[1] - 1) & ~np.all(np.isnan(field), axis=1)
     if not inside.any():
         return np.nan
     return float(np.sum(e[inside] * lam[inside]) / np.sum(e[inside] ** 2))
@@ -177,6 +179,8 @@ def _ct_ratio(top, bottom) -> Callable[[Landmarks], float]:
 def _best_lordosis(d: Landmarks) -> float:
     """Lambda [cm] of least ‖CT‖ at E = 3 cm."""
     column = d.k0["counter_torque_norm_Nm"].sel(E=OPTIMUM[0], method="nearest")
+    if np.all(np.isnan(column.values)):
+        return np.nan
     return float(column["Lambda"][int(np.nanargmin(column.values))]) * 100.0
 
 

@@ -15,9 +15,13 @@ stiffness) and the counter torques CT(x) = -(T x + g), affine in x:
 3. the chosen activation, unique: least ||x||_2 in the band with CT(x) = CT*
    (a QP; the tie-break that makes both solution paths report the same x).
 
-Minimum-norm activations are stages 2-3 without the band (least ||CT|| over
-all self-stable activations); the Pareto front is stage 2 for budgets from
-t* up to the total PCSA of the minimum-norm activation.
+Every stage is solved with cvxpy (Clarabel, SCS as fallback) and its answer
+polished to the exact optimum (:mod:`spinectl.polish`).
+
+Minimum-norm activations are stage 2 without the band (least ||CT|| over all
+self-stable activations), then the least total PCSA with that CT; the Pareto
+front is stage 2 for budgets from t* up to the total PCSA of the minimum-norm
+activation.
 
 Results are returned in SI (m^2). Infeasible points are answers, not
 exceptions: NaN values and a ``status``. :mod:`spinectl.batch` solves the

@@ -57,16 +57,24 @@ def _mark_positions(ax) -> None:
 
 
 def _landscape(field: xr.DataArray, title: str, label: str):
-    """A filled contour of ``field`` (dims E, Lambda) with A-D marked; returns (figure, axes, colour bar)."""
+    """A filled contour of ``field`` (dims E, Lambda) with A-D marked; returns (figure, axes).
+
+    Infeasible points (NaN) stay white, and the title says how many there are.
+    """
+    values = np.ma.masked_invalid(field.transpose("Lambda", "E").values)
+    infeasible = int(values.mask.sum()) if np.ma.is_masked(values) else 0
+    if infeasible:
+        title += f"\nwhite: no self-stable activation within the bounds ({infeasible} of {values.size} points)"
     fig, ax = _axes(title)
     e = field["E"].values * CM_PER_M
     lam = field["Lambda"].values * CM_PER_M
-    values = np.ma.masked_invalid(field.transpose("Lambda", "E").values)
-    filled = ax.contourf(e, lam, values, levels=LEVELS, cmap="viridis")
-    colour_bar = fig.colorbar(filled, ax=ax)
-    colour_bar.set_label(label)
+    if infeasible < values.size:
+        filled = ax.contourf(e, lam, values, levels=LEVELS, cmap="viridis")
+        fig.colorbar(filled, ax=ax).set_label(label)
+    ax.set_xlim(e.min(), e.max())
+    ax.set_ylim(lam.min(), lam.max())
     _mark_positions(ax)
-    return fig, ax, colour_bar
+    return fig, ax
 
 
 def _k_label(dataset: xr.Dataset) -> str:
@@ -83,7 +91,7 @@ def min_pcsa_figure(dataset: xr.Dataset) -> Figure:
     """
     name = "Fig. 3" if float(dataset["K"]) == 0 else "Fig. S1"
     title = f"{name}: minimum PCSA for self-stability, {_k_label(dataset)}"
-    fig, _, _ = _landscape(dataset["min_pcsa_cm2"], title, "minimum PCSA [cm²]")
+    fig, _ = _landscape(dataset["min_pcsa_cm2"], title, "minimum PCSA [cm²]")
     return fig
 
 
@@ -107,10 +115,10 @@ def counter_torque_figure(dataset: xr.Dataset, specific_tension: float) -> Figur
         f"‖CT‖ [N m]\n({landmarks.CT_LIMIT:g} N m = {limit_pcsa:.0f} cm² of local muscle "
         f"at {landmarks.LOCAL_LEVER_ARM * CM_PER_M:g} cm lever arm)"
     )
-    fig, ax, _ = _landscape(field, title, label)
+    fig, ax = _landscape(field, title, label)
     e, lam = field["E"].values * CM_PER_M, field["Lambda"].values * CM_PER_M
     values = np.ma.masked_invalid(field.transpose("Lambda", "E").values)
-    if np.nanmin(values) < landmarks.CT_LIMIT < np.nanmax(values):
+    if values.count() and values.min() < landmarks.CT_LIMIT < values.max():
         limit = ax.contour(e, lam, values, levels=[landmarks.CT_LIMIT], colors="white", linestyles="--")
         ax.clabel(limit, fmt=lambda _: f"±{landmarks.CT_LIMIT:g} N m", fontsize=8)
     ax.plot(*(np.array(landmarks.OPTIMUM) * CM_PER_M), "*", color="red", markersize=10, label="paper's optimum")

@@ -31,6 +31,14 @@ METHODS = ("fast", "per-point")
 DEFAULT_CHUNK = 1024
 """Grid points per stacked problem: large enough that Python overheads vanish, small enough to keep memory flat."""
 
+MAX_GRID_POINTS = 1_000_000
+"""Largest grid of one sweep: the answer alone takes about 1.2 kB a point (1.2 GB here),
+and at about 0.2 ms a point the fast path needs some minutes. A larger request is more
+likely a typo (a step count in place of a point count) than a plan."""
+
+REQUIRED = ("min_pcsa_cm2", "counter_torque_norm_Nm", "status", "K")
+"""What :func:`load` insists on finding: the variables the figures and landmarks read."""
+
 PAPER_REFERENCE = (
     "Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012) Spinal lordosis optimizes "
     "the requirements for a stable erect posture. Theor Biol Med Model 9:13"
@@ -98,6 +106,8 @@ def sweep(
         raise ParameterError("chunk_size", f"must be >= 1 (got {chunk_size})")
     e_axis = np.atleast_1d(np.asarray(eccentricity, float))
     l_axis = np.atleast_1d(np.asarray(lordosis, float))
+    if e_axis.ndim != 1 or l_axis.ndim != 1 or e_axis.size * l_axis.size > MAX_GRID_POINTS:
+        raise ParameterError("grid", f"must be two 1-D axes with at most {MAX_GRID_POINTS:,} points in all")
     e_grid, l_grid = (a.ravel() for a in np.meshgrid(e_axis, l_axis, indexing="ij"))
     arrays: dict[str, np.ndarray] = {}  # filled chunk by chunk: no copies of the answer beyond the answer
     per_point = 0
@@ -247,12 +257,17 @@ def load(path: str | Path) -> xr.Dataset:
     Raises
     ------
     ParameterError
-        The file is missing or not NetCDF (field ``results``).
+        The file is missing, not NetCDF or not a sweep (field ``results``).
     """
     path = Path(path)
     if not path.is_file():
         raise ParameterError("results", f"file not found: {path}")
     try:
-        return xr.load_dataset(path, engine="netcdf4")
+        dataset = xr.load_dataset(path, engine="netcdf4")
     except (OSError, ValueError) as exc:
         raise ParameterError("results", f"{path} is not a spinectl NetCDF file ({exc.__class__.__name__})") from None
+    missing = [name for name in (*REQUIRED, "E", "Lambda") if name not in dataset.variables]
+    if missing or "config_toml" not in dataset.attrs:
+        what = ", ".join(missing) or "attribute config_toml"
+        raise ParameterError("results", f"{path} is not a spinectl sweep (missing {what})")
+    return dataset

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import types
 
 import numpy as np
 import pytest
@@ -84,3 +85,17 @@ def test_an_inaccurate_block_is_polished_not_redone(model, monkeypatch):
     fast = batch.solve_stacked(data, model.optimisation.ct_tolerance)
     assert fast.per_point < len(GRID) ** 2 // 2
     _assert_same(fast, ref)
+
+
+def test_a_raising_solver_is_an_unsolved_block(model, monkeypatch):
+    """Clarabel raising (bad data, a panic) must not escape: the block goes to the reference."""
+
+    class Exploding:
+        def __init__(self, *args, **kwargs):
+            raise RuntimeError("simulated panic")
+
+    stacked_only = types.SimpleNamespace(**{**vars(batch.clarabel), "DefaultSolver": Exploding})
+    monkeypatch.setattr(batch, "clarabel", stacked_only)  # cvxpy's own Clarabel, for the reference, still works
+    data = _data(model)
+    fast = batch.solve_stacked(data, model.optimisation.ct_tolerance)
+    assert fast.per_point == len(GRID) ** 2 and set(fast.status) == {"optimal"}

@@ -52,3 +52,13 @@ def test_every_landmark_says_where_and_how():
 def test_local_pcsa_of_the_paper_limit():
     """Paper, Discussion: 30 N m at a 7 cm lever arm is about 17 cm^2 (25 N/cm^2): 30/(0.07*25) = 17.1."""
     assert landmarks.local_pcsa_equivalent(30.0, 25e4) * 1e4 == pytest.approx(17.14, abs=0.01)
+
+
+def test_infeasible_columns_do_not_break_the_measurements():
+    """NaN (infeasible) points are skipped; an all-NaN landscape measures NaN, never raises."""
+    ds = _landscape(lambda e, lam: 40 - 1e4 * (lam - 1.7 * e) ** 2, lambda e, lam: 1e3 * np.abs(lam - e))
+    ds["min_pcsa_cm2"][40:, :] = np.nan
+    assert landmarks.line_slope(ds, "min_pcsa_cm2", "max") == pytest.approx(1.7, abs=0.02)
+    empty = ds.copy(data={k: np.full(v.shape, np.nan) for k, v in ds.data_vars.items()})
+    measured = landmarks.measure(landmarks.Landmarks(empty, empty, empty))
+    assert all(np.isnan(m.value) and not m.agrees for m in measured)

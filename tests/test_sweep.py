@@ -93,3 +93,21 @@ def test_cli_sweep_bad_input(tmp_path, capsys):
     err = capsys.readouterr().err
     assert code == 2 and "E: must be in" in err and len(err.strip().splitlines()) == 1
     assert not (tmp_path / "r.nc").exists()
+
+
+def test_load_rejects_what_is_not_a_sweep(tmp_path):
+    other = tmp_path / "other.nc"
+    xr.Dataset({"x": ("t", [1.0])}).to_netcdf(other)
+    text = tmp_path / "text.nc"
+    text.write_text("not netcdf")
+    for path, needle in ((other, "not a spinectl sweep"), (text, "not a spinectl NetCDF file")):
+        with pytest.raises(ParameterError) as info:
+            sweep.load(path)
+        assert info.value.field == "results" and needle in str(info.value)
+
+
+def test_an_absurd_grid_is_refused_before_any_work(model):
+    axis = np.zeros(1001)
+    with pytest.raises(ParameterError) as info:
+        sweep.sweep(model, axis, axis)
+    assert info.value.field == "grid"
