@@ -179,8 +179,7 @@ def _stages(data: ProblemData, ct_tolerance: float, first=None) -> tuple[np.ndar
 
     ``first``: the result of stage 1 for this block, if already solved.
     """
-    n_points, n = len(data.stiffness), data.weights.size
-    failed = (np.full(n_points, np.nan), np.full((n_points, n), np.nan), np.zeros(n_points, bool))
+    failed = (*_unsolved(data), np.zeros(len(data.stiffness), bool))
     status, x, good = _stage(data, "min_pcsa") if first is None else first
     if not good.any():
         return failed
@@ -208,9 +207,9 @@ def solve_stacked(data: ProblemData, ct_tolerance: float) -> BlockOptimum:
     ct_tolerance : float
         Relative band on the minimum total PCSA [1].
     """
-    n_points, n = len(data.stiffness), data.weights.size
+    n_points = len(data.stiffness)
     status = np.full(n_points, "optimal", dtype=object)
-    total, x = np.full(n_points, np.nan), np.full((n_points, n), np.nan)
+    total, x = _unsolved(data)
     feasible = np.arange(n_points)
     first = _stage(data, "min_pcsa")
     if first[0] in optimise.INFEASIBLE_STATUSES:
@@ -244,16 +243,21 @@ def solve_points(data: ProblemData, ct_tolerance: float, progress=None) -> Block
 
 
 def _per_point(data: ProblemData, ct_tolerance: float, progress=None):
-    n_points, n = len(data.stiffness), data.weights.size
-    total, x = np.full(n_points, np.nan), np.full((n_points, n), np.nan)
-    status = np.empty(n_points, dtype=object)
-    for i in range(n_points):
+    total, x = _unsolved(data)
+    status = np.empty(len(total), dtype=object)
+    for i in range(len(total)):
         status[i], total[i], x_i = optimise.optimum(data.point(i), ct_tolerance)
         if x_i is not None:
             x[i] = x_i
         if progress is not None:
             progress(1)
     return status, total, x
+
+
+def _unsolved(data: ProblemData) -> tuple[np.ndarray, np.ndarray]:
+    """NaN totals and x [cm^2] for a block: what a point holds until it is solved."""
+    n_points = len(data.stiffness)
+    return np.full(n_points, np.nan), np.full((n_points, data.weights.size), np.nan)
 
 
 def _block_optimum(data: ProblemData, status, total, x, per_point: int) -> BlockOptimum:
