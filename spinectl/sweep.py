@@ -67,8 +67,10 @@ def parse_grid(spec: str, name: str) -> np.ndarray:
         start, stop, num = float(parts[0]), float(parts[1]), int(parts[2])
     except (ValueError, IndexError):
         raise ParameterError(name, f"must be START:STOP:NUM in metres, e.g. 0:0.08:81 (got {spec!r})") from None
-    if len(parts) != 3 or num < 1 or not start <= stop or not np.isfinite([start, stop]).all():
-        raise ParameterError(name, f"must be START:STOP:NUM with START <= STOP and NUM >= 1 (got {spec!r})")
+    if len(parts) != 3 or not 1 <= num <= MAX_GRID_POINTS or not start <= stop or not np.isfinite([start, stop]).all():
+        raise ParameterError(
+            name, f"must be START:STOP:NUM with START <= STOP and 1 <= NUM <= {MAX_GRID_POINTS:,} (got {spec!r})"
+        )
     return np.linspace(start, stop, num)
 
 

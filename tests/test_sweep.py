@@ -73,7 +73,7 @@ def test_parse_grid(spec, expected):
     np.testing.assert_allclose(sweep.parse_grid(spec, "--E"), expected)
 
 
-@pytest.mark.parametrize("spec", ["0:0.08", "a:b:c", "0.08:0:5", "0:1:0", "0:nan:3"])
+@pytest.mark.parametrize("spec", ["0:0.08", "a:b:c", "0.08:0:5", "0:1:0", "0:nan:3", "0:0.08:1000000000"])
 def test_parse_grid_rejects(spec):
     with pytest.raises(ParameterError) as info:
         sweep.parse_grid(spec, "--E")
