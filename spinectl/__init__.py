@@ -9,9 +9,16 @@ Layers (each depends only on those above it in this list):
 
 - parameters: :mod:`spinectl.params`, :mod:`spinectl.config`
 - physics: :mod:`spinectl.geometry`, :mod:`spinectl.muscle`, :mod:`spinectl.mechanics`
-- analysis: :mod:`spinectl.stability`, :mod:`spinectl.reflex`, :mod:`spinectl.systems`,
-  :mod:`spinectl.simulate`, :mod:`spinectl.margins`
-- edges: :mod:`spinectl.io`, :mod:`spinectl.control_plots`, :mod:`spinectl.cli`
+- analysis: :mod:`spinectl.stability`, :mod:`spinectl.optimise` (per-point
+  reference), :mod:`spinectl.polish`, :mod:`spinectl.batch` (fast path),
+  :mod:`spinectl.reflex`, :mod:`spinectl.systems`, :mod:`spinectl.simulate`,
+  :mod:`spinectl.margins`
+- edges: :mod:`spinectl.sweep`, :mod:`spinectl.landmarks`, :mod:`spinectl.plotting`,
+  :mod:`spinectl.report`, :mod:`spinectl.io`, :mod:`spinectl.control_plots`,
+  :mod:`spinectl.cli`
+
+The optimiser and the edges are not imported here (cvxpy, matplotlib and
+xarray take a second to import); ``from spinectl import optimise, sweep``.
 """
 
 from .config import dump_toml, list_presets, load_config, load_preset

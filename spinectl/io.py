@@ -114,3 +114,36 @@ def atomic_write_text(target: str | Path, text: str) -> Path:
     with atomic_path(target) as tmp:
         tmp.write_text(text, encoding="utf-8")
     return Path(target)
+
+
+@contextlib.contextmanager
+def staged_directory(target: str | Path) -> Iterator[Path]:
+    """Yield an empty staging folder; on success move each of its files into ``target``.
+
+    Every file lands by an atomic rename, all at the end: an interrupted run
+    leaves ``target`` as it was, and files already in ``target`` that the run
+    does not write are kept. On an exception the staging folder is removed.
+
+    Parameters
+    ----------
+    target : str or Path
+        The output folder (created if missing).
+
+    Raises
+    ------
+    OutputError
+        The folders cannot be created or the files not moved into ``target``.
+    """
+    target = Path(target)
+    with _output_errors(target):
+        target.parent.mkdir(parents=True, exist_ok=True)
+        stage = _temporary(target, directory=True)
+    try:
+        yield stage
+        with _output_errors(target):
+            target.mkdir(exist_ok=True)
+            for item in sorted(stage.iterdir()):
+                _set_mode(item, target / item.name, item.is_dir())
+                os.replace(item, target / item.name)
+    finally:
+        shutil.rmtree(stage, ignore_errors=True)

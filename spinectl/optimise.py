@@ -1,34 +1,71 @@
 """Minimum PCSA and counter torques at one configuration: the readable reference.
 
-Design page, "The optimisation at each grid point":
+Design page, "The optimisation at each grid point". With the decision
+variables x [cm^2], the self-stable set F = {S x <= b, 0 <= x <= pcsa_max}
+(S_k(x) = dM_k/dalpha affine in x, b = -margin - gravity + passive
+stiffness) and the counter torques CT(x) = -(T x + g), affine in x:
 
-- minimum PCSA (Figure 3): the LP  min w.x  s.t.  S_k(x) <= -margin for every
-  CoR k, 0 <= x <= pcsa_max, with S_k(x) = dM_k/dalpha affine in the PCSA x;
-- counter torques (Figure 4): among activations with w.x <= (1 + tol) * min,
-  the one of least ||CT||_2 (an SOCP); CT is affine in x.
+1. minimum PCSA (Figure 3), the LP  t* = min w.x over F;
+2. counter torques (Figure 4), the SOCP  min ||CT(x)||_2 over F within the
+   band w.x <= (1 + ct_tolerance) t*. Its CT* is unique (the point of least
+   norm in a convex set), but x need not be: the torque of a planar force
+   system about a point p is affine in p, so T has rank <= 3, and rank 1 with
+   paired activation (CT_k is then proportional to the CoR's x, and every
+   activation gives CT = 0 at position A);
+3. the chosen activation, unique: least ||x||_2 in the band with CT(x) = CT*
+   (a QP; the tie-break that makes both solution paths report the same x).
 
-Decision variables are in cm^2 (well scaled against torques in N m); results
-are returned in SI (m^2). Infeasible points are answers, not exceptions:
-NaN values and a ``status``.
+Every stage is solved with cvxpy (Clarabel, SCS as fallback) and its answer
+polished to the exact optimum (:mod:`spinectl.polish`).
+
+Minimum-norm activations are stage 2 without the band (least ||CT|| over all
+self-stable activations), then the least total PCSA with that CT; the Pareto
+front is stage 2 for budgets from t* up to the total PCSA of the minimum-norm
+activation.
+
+Results are returned in SI (m^2). Infeasible points are answers, not
+exceptions: NaN values and a ``status``. :mod:`spinectl.batch` solves the
+same problems for a block of points at once and is checked against this module.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import cvxpy as cp
 import numpy as np
 
-from . import geometry
-from .mechanics import SegmentCoefficients, segment_coefficients
+from . import geometry, polish
+from .mechanics import SegmentCoefficients
 from .params import Model
-from .stability import validate_position
+from .stability import checked_coefficients
 from .units import M2_PER_CM2
 
 SOLVERS = ("CLARABEL", "SCS")
 """Solvers tried in order: Clarabel, then SCS as the fallback when Clarabel fails."""
 
 OK_STATUSES = (cp.OPTIMAL, cp.OPTIMAL_INACCURATE)
+INFEASIBLE_STATUSES = (cp.INFEASIBLE, cp.INFEASIBLE_INACCURATE)
+SOLVER_ERROR = "solver_error"
+
+DEFAULT_TOLERANCE = 1e-8
+"""Clarabel's default feasibility and gap tolerance, used where none is given."""
+
+SLAB_FACTOR = 10.0
+"""Half width of the slab that fixes CT in stage 3, in solver tolerances.
+
+It must exceed the feasibility error of the stage-2 optimum (about one
+tolerance) so that the slab meets the feasible set in its interior, and be
+small enough that CT moves by far less than the 1e-6 agreement (docs/optimisation.md).
+"""
+
+RANK_RTOL = float(np.sqrt(np.finfo(float).eps))
+"""Singular values of T below this fraction of a single muscle's torque are rounding, not torque.
+
+A direction that changes CT by less than 1.5e-8 of one muscle's torque is below
+every tolerance of the comparison; keeping it would pin x along a direction
+that T does not really act on (e.g. at position A, where the pairs cancel).
+"""
 
 
 @dataclass(frozen=True)
@@ -54,6 +91,12 @@ class ProblemData:
         Per-muscle PCSA [cm^2] = to_muscles @ x.
     upper : float
         Bound on every x [cm^2] (inf = none).
+    tolerance : float or None
+        Solver tolerance [1] (``optimisation.solver_tolerance``); None = solver defaults.
+    torque_scale : numpy.ndarray or None, shape (...)
+        Largest torque of a single muscle per cm^2 [N m per cm^2]: the size of the
+        terms whose sums (pairs, CoR offsets) make up ``torque``, so the scale of
+        its rounding error (:func:`ct_slab`). None = the largest singular value of ``torque``.
     """
 
     stiffness: np.ndarray
@@ -63,6 +106,35 @@ class ProblemData:
     weights: np.ndarray
     to_muscles: np.ndarray
     upper: float
+    tolerance: float | None = None
+    torque_scale: np.ndarray | None = None
+
+    def point(self, index) -> ProblemData:
+        """The data of one grid point, or of a subset of points.
+
+        Parameters
+        ----------
+        index : int, slice or array of int
+            Index into the leading dimensions.
+        """
+        return replace(
+            self,
+            stiffness=self.stiffness[index],
+            stiffness_bound=self.stiffness_bound[index],
+            torque=self.torque[index],
+            gravity_torque=self.gravity_torque[index],
+            torque_scale=None if self.torque_scale is None else self.torque_scale[index],
+        )
+
+    def counter_torque(self, x):
+        """CT [N m] for decision variables ``x`` (paper, Methods: CT makes the upright posture an equilibrium).
+
+        Parameters
+        ----------
+        x : array_like, shape (..., n_var)
+            Decision variables [cm^2].
+        """
+        return -(np.einsum("...kn,...n->...k", self.torque, np.asarray(x, float)) + self.gravity_torque)
 
 
 def problem_data(model: Model, coeffs: SegmentCoefficients) -> ProblemData:
@@ -92,30 +164,208 @@ def problem_data(model: Model, coeffs: SegmentCoefficients) -> ProblemData:
         weights=to_muscles.sum(axis=0),
         to_muscles=to_muscles,
         upper=model.optimisation.pcsa_max / M2_PER_CM2,
+        tolerance=model.optimisation.solver_tolerance,
+        torque_scale=np.abs(coeffs.torque_per_pcsa).max(axis=(-2, -1)) * M2_PER_CM2,
     )
 
 
-def _solve(problem: cp.Problem) -> str:
-    """Solve with the first solver that answers; return the cvxpy status or 'solver_error'."""
+def ct_slab(torque, x_ct, tolerance: float | None, scale=None):
+    """Linear constraints abs(rows @ x - centre) <= half_width that fix CT(x) = CT(x_ct).
+
+    Only the row space of T constrains CT (:data:`RANK_RTOL`), so rank-deficient
+    T (always, see the module docstring) gives no redundant constraints; where
+    T = 0 (position A, paired) nothing is fixed. The slab has a half width of
+    :data:`SLAB_FACTOR` times the solver tolerance (relative to the size of
+    ``x_ct``) rather than zero, so that the feasible set keeps an interior even
+    where the stage-2 optimum is a single vertex. Vectorised over leading dimensions.
+
+    Parameters
+    ----------
+    torque : array_like, shape (..., n_cor, n_var)
+        T [N m per cm^2].
+    x_ct : array_like, shape (..., n_var)
+        A stage-2 optimum [cm^2].
+    tolerance : float or None
+        Solver tolerance [1]; None means the solver default, taken as 1e-8.
+    scale : array_like, shape (...), optional
+        :attr:`ProblemData.torque_scale` [N m per cm^2]; default the largest singular value.
+
+    Returns
+    -------
+    rows : numpy.ndarray, shape (..., r, n_var)
+        Orthonormal right singular vectors of T, r = min(n_cor, n_var) [1].
+    keep : numpy.ndarray of bool, shape (..., r)
+        Rows whose singular value exceeds :data:`RANK_RTOL` times ``scale``.
+    centre : numpy.ndarray, shape (..., r)
+        rows @ x_ct [cm^2].
+    half_width : numpy.ndarray, shape (...)
+        [cm^2].
+    """
+    x_ct = np.asarray(x_ct, float)
+    _, sing, rows = np.linalg.svd(np.asarray(torque, float), full_matrices=False)
+    scale = sing[..., 0] if scale is None else np.asarray(scale, float)
+    keep = sing > RANK_RTOL * scale[..., None]
+    centre = np.einsum("...rn,...n->...r", rows, x_ct)
+    tol = DEFAULT_TOLERANCE if tolerance is None else tolerance
+    half_width = SLAB_FACTOR * tol * (1.0 + np.max(np.abs(x_ct), axis=-1))
+    return rows, keep, centre, half_width
+
+
+def solver_options(solver: str, tolerance: float | None) -> dict:
+    """Keyword options for a cvxpy solver giving a feasibility and gap tolerance.
+
+    Parameters
+    ----------
+    solver : str
+        cvxpy's name of the solver, e.g. 'CLARABEL'.
+    tolerance : float or None
+        [1]; None: the solver's defaults.
+    """
+    if tolerance is None:
+        return {}
+    if solver == "CLARABEL":
+        return {"tol_gap_abs": tolerance, "tol_gap_rel": tolerance, "tol_feas": tolerance}
+    if solver == "SCS":
+        return {"eps_abs": tolerance, "eps_rel": tolerance}
+    return {}
+
+
+def _solve(problem: cp.Problem, tolerance: float | None = None) -> str:
+    """Solve with the first solver that answers; return the cvxpy status or 'solver_error'.
+
+    An 'optimal' status without finite values for the variables (a broken
+    solver) does not count as an answer.
+    """
     for solver in SOLVERS:
         try:
-            problem.solve(solver=solver)
+            problem.solve(solver=solver, **solver_options(solver, tolerance))
         except (cp.error.SolverError, ArithmeticError, ValueError):
             continue
-        if problem.status in OK_STATUSES or problem.status in (cp.INFEASIBLE, cp.INFEASIBLE_INACCURATE):
+        if problem.status in OK_STATUSES and _has_values(problem):
             return problem.status
-    return "solver_error"
+        if problem.status in INFEASIBLE_STATUSES:
+            return problem.status
+    return SOLVER_ERROR
 
 
-def _constraints(x: cp.Variable, data: ProblemData) -> list:
-    cons = [data.stiffness @ x <= data.stiffness_bound, x >= 0]
+def _has_values(problem: cp.Problem) -> bool:
+    values = [v.value for v in problem.variables()]
+    return all(v is not None and np.all(np.isfinite(v)) for v in values)
+
+
+def inequalities(data: ProblemData, total_max=np.inf, x_ct=None) -> tuple[np.ndarray, np.ndarray]:
+    """The constraints of a stage as G x <= h; vectorised over leading dimensions.
+
+    Rows, in order: S x <= b (every CoR self-stable with the margin), -x <= 0,
+    x <= upper (if finite), w.x <= total_max (the band, if finite; finite for
+    all points or for none), and, if ``x_ct`` is given, the two sides of the
+    slab of :func:`ct_slab` that fixes CT (a row T does not act on reads
+    0 <= half width).
+
+    Parameters
+    ----------
+    data : ProblemData
+    total_max : float or array_like, shape (...)
+        Budget on the total PCSA w.x [cm^2]; inf: no band.
+    x_ct : array_like, shape (..., n_var), optional
+        A stage-2 optimum whose counter torques to keep [cm^2].
+
+    Returns
+    -------
+    lhs : numpy.ndarray, shape (..., r, n_var)
+        G [N m/rad per cm^2 for stiffness rows, 1 otherwise].
+    rhs : numpy.ndarray, shape (..., r)
+        h [N m/rad or cm^2].
+    """
+    lead, n = data.stiffness.shape[:-2], data.weights.size
+    eye = np.broadcast_to(np.eye(n), lead + (n, n))
+    lhs, rhs = [data.stiffness, -eye], [data.stiffness_bound, np.zeros(lead + (n,))]
     if np.isfinite(data.upper):
-        cons.append(x <= data.upper)
-    return cons
+        lhs.append(eye)
+        rhs.append(np.full(lead + (n,), data.upper))
+    total_max = np.broadcast_to(np.asarray(total_max, float), lead)
+    if np.all(np.isfinite(total_max)):
+        lhs.append(np.broadcast_to(data.weights, lead + (1, n)))
+        rhs.append(total_max[..., None])
+    if x_ct is not None:
+        rows, keep, centre, half_width = ct_slab(data.torque, x_ct, data.tolerance, data.torque_scale)
+        rows, centre = rows * keep[..., None], centre * keep
+        lhs += [rows, -rows]
+        rhs += [centre + half_width[..., None], half_width[..., None] - centre]
+    return np.concatenate(lhs, axis=-2), np.concatenate(rhs, axis=-1)
+
+
+STAGES = ("min_pcsa", "counter_torque", "least_norm")
+"""The objectives: total PCSA w.x, ||CT||^2 (same minimisers as ||CT||), ||x||^2."""
+
+
+def objective(data: ProblemData, stage: str):
+    """The objective of ``stage`` as 1/2 x'Hx + q'x: (H or None, q); vectorised.
+
+    ||CT||^2 = ||T x + g||^2 = x'T'Tx + 2 g'T x + g'g, the constant dropped.
+
+    Parameters
+    ----------
+    data : ProblemData
+    stage : str
+        One of :data:`STAGES`.
+    """
+    lead, n = data.stiffness.shape[:-2], data.weights.size
+    if stage == "min_pcsa":
+        return None, np.broadcast_to(data.weights, lead + (n,))
+    if stage == "counter_torque":
+        hessian = 2.0 * np.einsum("...kn,...km->...nm", data.torque, data.torque)
+        return hessian, 2.0 * np.einsum("...kn,...k->...n", data.torque, data.gravity_torque)
+    return np.broadcast_to(2.0 * np.eye(n), lead + (n, n)), np.zeros(lead + (n,))
+
+
+def polished(data: ProblemData, stage: str, x0, total_max=np.inf, x_ct=None):
+    """The exact optimum of ``stage`` from the solver's answer ``x0`` (:func:`spinectl.polish.polish`).
+
+    Polishing imposes CT(x) = CT(x_ct) exactly, as equalities on the row space
+    of T, where the solver had the slab of :func:`ct_slab`. Returns x [cm^2]
+    and whether it is a verified KKT point, both vectorised over leading dimensions.
+
+    Parameters
+    ----------
+    data : ProblemData
+    stage : str
+        One of :data:`STAGES`.
+    x0 : array_like, shape (..., n_var)
+        The solver's answer [cm^2].
+    total_max : float or array_like
+        The band of the stage [cm^2], as for :func:`inequalities`.
+    x_ct : array_like, optional
+        The stage-2 optimum whose counter torques stage 3 keeps [cm^2].
+    """
+    hessian, linear = objective(data, stage)
+    lhs, rhs = inequalities(data, total_max)
+    eq_lhs = eq_rhs = None
+    if x_ct is not None:
+        rows, keep, centre, _ = ct_slab(data.torque, x_ct, data.tolerance, data.torque_scale)
+        eq_lhs, eq_rhs = rows * keep[..., None], centre * keep
+    tol = DEFAULT_TOLERANCE if data.tolerance is None else data.tolerance
+    return polish.polish(hessian, linear, lhs, rhs, x0, tol, RANK_RTOL, eq_lhs, eq_rhs)
+
+
+def _stage(data: ProblemData, stage: str, cost, total_max=np.inf, x_ct=None) -> tuple[str, np.ndarray | None]:
+    """Minimise ``cost(x)`` (a cvxpy expression builder) over G x <= h, then polish."""
+    lhs, rhs = inequalities(data, total_max, x_ct)
+    x = cp.Variable(data.weights.size)
+    problem = cp.Problem(cp.Minimize(cost(x)), [lhs @ x <= rhs])
+    status = _solve(problem, data.tolerance)
+    if status not in OK_STATUSES:
+        return status, None
+    x_opt, verified = polished(data, stage, x.value, total_max, x_ct)
+    return (cp.OPTIMAL if verified else status), x_opt
+
+
+def _ct_expression(data: ProblemData, x):
+    return -(data.torque @ x + data.gravity_torque)
 
 
 def min_pcsa_lp(data: ProblemData) -> tuple[str, np.ndarray | None]:
-    """Solve the minimum-PCSA LP at one point.
+    """Stage 1: the minimum-PCSA LP at one point.
 
     Parameters
     ----------
@@ -129,23 +379,21 @@ def min_pcsa_lp(data: ProblemData) -> tuple[str, np.ndarray | None]:
     x : numpy.ndarray or None
         Optimal decision variables [cm^2], None unless optimal.
     """
-    x = cp.Variable(data.weights.size)
-    problem = cp.Problem(cp.Minimize(data.weights @ x), _constraints(x, data))
-    status = _solve(problem)
-    return status, (x.value if status in OK_STATUSES else None)
+    return _stage(data, "min_pcsa", lambda x: data.weights @ x)
 
 
 def min_counter_torque_socp(data: ProblemData, total_max: float) -> tuple[str, np.ndarray | None]:
-    """Least ||CT||_2 over self-stable activations with total PCSA <= ``total_max`` [cm^2].
+    """Stage 2: least ||CT||_2 over self-stable activations with total PCSA <= ``total_max`` [cm^2].
 
-    CT = -(torque @ x + gravity_torque) (paper, Methods; design page, The optimisation).
+    CT = -(torque @ x + gravity_torque) (paper, Methods; design page, The
+    optimisation). Solved as the SOCP min ||CT||_2, then polished.
 
     Parameters
     ----------
     data : ProblemData
         The problem at one (E, Lambda) (no leading dimensions).
     total_max : float
-        Bound on the total PCSA ``weights @ x`` [cm^2].
+        Bound on the total PCSA ``weights @ x`` [cm^2]; inf drops the band (minimum-norm activations).
 
     Returns
     -------
@@ -154,12 +402,88 @@ def min_counter_torque_socp(data: ProblemData, total_max: float) -> tuple[str, n
     x : numpy.ndarray or None
         Decision variables of least ||CT||_2 [cm^2], None unless optimal.
     """
-    x = cp.Variable(data.weights.size)
-    ct = -(data.torque @ x + data.gravity_torque)
-    cons = _constraints(x, data) + [data.weights @ x <= total_max]
-    problem = cp.Problem(cp.Minimize(cp.norm(ct, 2)), cons)
-    status = _solve(problem)
-    return status, (x.value if status in OK_STATUSES else None)
+    return _stage(data, "counter_torque", lambda x: cp.norm(_ct_expression(data, x), 2), total_max)
+
+
+def least_norm_activation_qp(data: ProblemData, total_max: float, x_ct) -> tuple[str, np.ndarray | None]:
+    """Stage 3: the activation of least ||x||_2 in the band with the counter torques of ``x_ct``.
+
+    CT(x) = CT(x_ct) is imposed through :func:`ct_slab`.
+
+    Parameters
+    ----------
+    data : ProblemData
+        The problem at one (E, Lambda).
+    total_max : float
+        The band [cm^2].
+    x_ct : array_like
+        The stage-2 optimum [cm^2].
+
+    Returns
+    -------
+    status : str
+    x : numpy.ndarray or None
+        [cm^2], None unless optimal.
+    """
+    return _stage(data, "least_norm", cp.sum_squares, total_max, x_ct)
+
+
+def least_total_pcsa_lp(data: ProblemData, x_ct) -> tuple[str, np.ndarray | None]:
+    """The least total PCSA among self-stable activations with the counter torques of ``x_ct``.
+
+    With ``x_ct`` of least ||CT|| over all of F this is the far end of the
+    Pareto front: more PCSA buys no lower ||CT||.
+
+    Parameters
+    ----------
+    data : ProblemData
+        The problem at one (E, Lambda).
+    x_ct : array_like
+        An activation of least ||CT|| [cm^2].
+
+    Returns
+    -------
+    status : str
+    x : numpy.ndarray or None
+        [cm^2], None unless optimal.
+    """
+    return _stage(data, "min_pcsa", lambda x: data.weights @ x, np.inf, x_ct)
+
+
+def optimum(data: ProblemData, ct_tolerance: float) -> tuple[str, float, np.ndarray | None]:
+    """Stages 1-3 at one point: status, minimum total PCSA [cm^2], chosen x [cm^2].
+
+    ``ct_tolerance = inf`` gives the minimum-norm activation: stage 2 without the
+    band, then :func:`least_total_pcsa_lp` instead of the least-norm tie-break.
+    The total is NaN and x None unless every stage is optimal.
+
+    Parameters
+    ----------
+    data : ProblemData
+        The problem at one (E, Lambda).
+    ct_tolerance : float
+        Relative band on the minimum total PCSA [1].
+    """
+    status, x = min_pcsa_lp(data)
+    if x is None:
+        return status, np.nan, None
+    total = float(data.weights @ x)
+    limit = total * (1.0 + ct_tolerance)
+    status_ct, x_ct = min_counter_torque_socp(data, limit)
+    if x_ct is None:
+        return status_ct, np.nan, None
+    if np.isinf(limit):
+        status_tie, x_tie = least_total_pcsa_lp(data, x_ct)
+    else:
+        status_tie, x_tie = least_norm_activation_qp(data, limit, x_ct)
+    if x_tie is None:
+        return status_tie, np.nan, None
+    return worst_status(status, status_ct, status_tie), total, np.maximum(x_tie, 0.0)
+
+
+def worst_status(*statuses: str) -> str:
+    """'optimal_inaccurate' if any stage was inaccurate, else 'optimal' (for optimal stages)."""
+    return cp.OPTIMAL_INACCURATE if cp.OPTIMAL_INACCURATE in statuses else cp.OPTIMAL
 
 
 @dataclass(frozen=True)
@@ -176,7 +500,8 @@ class PointOptimum:
     min_pcsa : float
         Minimum total PCSA for self-stability of every segment [m^2]; NaN unless optimal.
     pcsa : numpy.ndarray, shape (n_muscles,)
-        Chosen activation: least ||CT|| within ``ct_tolerance`` of the minimum [m^2]; NaN unless optimal.
+        Chosen activation [m^2]: least ||CT|| within ``ct_tolerance`` of the minimum,
+        ties broken by least ||x||_2 (module docstring); NaN unless optimal.
     counter_torque : numpy.ndarray, shape (n_cor,)
         CT_k at the chosen activation [N m].
     """
@@ -194,9 +519,55 @@ class PointOptimum:
         return float(np.linalg.norm(self.counter_torque))
 
     @property
+    def total_pcsa(self) -> float:
+        """Total PCSA of the chosen activation [m^2] (>= ``min_pcsa``)."""
+        return float(np.sum(self.pcsa))
+
+    @property
     def ok(self) -> bool:
         """True if the optimum was found."""
         return self.status in OK_STATUSES
+
+
+def to_si(data: ProblemData, total, x) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Minimum PCSA [m^2], per-muscle PCSA [m^2] and CT [N m] from a total and x [cm^2].
+
+    Vectorised over leading dimensions; NaN in, NaN out.
+
+    Parameters
+    ----------
+    data : ProblemData
+    total : array_like, shape (...)
+        Minimum total PCSA [cm^2].
+    x : array_like, shape (..., n_var)
+        Chosen decision variables [cm^2].
+    """
+    x = np.asarray(x, float)
+    pcsa = np.einsum("mn,...n->...m", data.to_muscles, x) * M2_PER_CM2
+    return np.asarray(total, float) * M2_PER_CM2, pcsa, data.counter_torque(x)
+
+
+def point_optimum(data: ProblemData, ct_tolerance: float, eccentricity=np.nan, lordosis=np.nan) -> PointOptimum:
+    """:func:`optimum` as a :class:`PointOptimum` in SI units (NaN unless optimal).
+
+    Parameters
+    ----------
+    data : ProblemData
+        The problem at one (E, Lambda).
+    ct_tolerance : float
+        Relative band on the minimum total PCSA [1]; inf: the minimum-norm activation.
+    eccentricity, lordosis : float
+        E and Lambda [m], recorded in the result.
+    """
+    status, total, x = optimum(data, ct_tolerance)
+    if x is None:
+        x = np.full(data.weights.size, np.nan)
+    min_pcsa, pcsa, counter_torque = to_si(data, total, x)
+    return PointOptimum(float(eccentricity), float(lordosis), status, float(min_pcsa), pcsa, counter_torque)
+
+
+def _point_data(model: Model, eccentricity: float, lordosis: float) -> ProblemData:
+    return problem_data(model, checked_coefficients(model, float(eccentricity), float(lordosis)))
 
 
 def solve_point(model: Model, eccentricity: float, lordosis: float) -> PointOptimum:
@@ -205,7 +576,7 @@ def solve_point(model: Model, eccentricity: float, lordosis: float) -> PointOpti
     Parameters
     ----------
     model : Model
-        ``optimisation`` sets activation mode, margin, bounds and tolerance.
+        ``optimisation`` sets activation mode, margin, bounds and tolerances.
     eccentricity, lordosis : float
         E and Lambda [m].
 
@@ -213,28 +584,83 @@ def solve_point(model: Model, eccentricity: float, lordosis: float) -> PointOpti
     -------
     PointOptimum
     """
-    validate_position(model, eccentricity, lordosis)
-    coeffs = segment_coefficients(model, float(eccentricity), float(lordosis))
-    data = problem_data(model, coeffs)
-    n_muscles, n_cor = data.to_muscles.shape[0], data.stiffness.shape[0]
-    status, x = min_pcsa_lp(data)
-    if x is not None:
-        total = float(data.weights @ x)
-        limit = total * (1.0 + model.optimisation.ct_tolerance)
-        status_ct, x_ct = min_counter_torque_socp(data, limit)
-        if x_ct is not None:
-            x = x_ct
-        else:
-            status = status_ct
-    if x is None or status not in OK_STATUSES:
-        nan = np.full(n_muscles, np.nan)
-        return PointOptimum(float(eccentricity), float(lordosis), status, np.nan, nan, np.full(n_cor, np.nan))
-    pcsa = data.to_muscles @ np.maximum(x, 0.0) * M2_PER_CM2
-    return PointOptimum(
-        eccentricity=float(eccentricity),
-        lordosis=float(lordosis),
-        status=status,
-        min_pcsa=total * M2_PER_CM2,
-        pcsa=pcsa,
-        counter_torque=coeffs.counter_torque(pcsa),
-    )
+    data = _point_data(model, eccentricity, lordosis)
+    return point_optimum(data, model.optimisation.ct_tolerance, eccentricity, lordosis)
+
+
+def min_norm_activation(model: Model, eccentricity: float, lordosis: float) -> PointOptimum:
+    """The minimum-norm activation: least ||CT||_2 over all self-stable activations.
+
+    No budget on the total PCSA (design page: "also offer minimum-norm
+    activations"); ties broken by least total PCSA. ``min_pcsa`` is still the
+    minimum total PCSA of stage 1, ``total_pcsa`` what this activation uses.
+
+    Parameters
+    ----------
+    model : Model
+    eccentricity, lordosis : float
+        E and Lambda [m].
+    """
+    data = _point_data(model, eccentricity, lordosis)
+    return point_optimum(data, np.inf, eccentricity, lordosis)
+
+
+@dataclass(frozen=True)
+class ParetoFront:
+    """Least ||CT||_2 against the budget of total PCSA at one configuration.
+
+    Attributes
+    ----------
+    eccentricity, lordosis : float
+        E and Lambda [m].
+    total_pcsa : numpy.ndarray, shape (n,)
+        Budgets on the total PCSA [m^2], from the minimum to that of the minimum-norm activation.
+    counter_torque_norm : numpy.ndarray, shape (n,)
+        Least ||CT||_2 within each budget [N m]; non-increasing.
+    status : tuple of str
+        Solver status per budget.
+    """
+
+    eccentricity: float
+    lordosis: float
+    total_pcsa: np.ndarray
+    counter_torque_norm: np.ndarray
+    status: tuple[str, ...]
+
+
+def pareto_front(model: Model, eccentricity: float, lordosis: float, n_points: int = 21) -> ParetoFront:
+    """The Pareto front between total PCSA and ||CT||_2 (design page, The optimisation).
+
+    Stage 2 with the budget as a cvxpy Parameter, for ``n_points`` budgets
+    evenly spaced from the minimum total PCSA to the total of the minimum-norm
+    activation. An infeasible point gives empty arrays and its status.
+
+    Parameters
+    ----------
+    model : Model
+    eccentricity, lordosis : float
+        E and Lambda [m].
+    n_points : int
+        Number of budgets.
+    """
+    data = _point_data(model, eccentricity, lordosis)
+    far = point_optimum(data, np.inf)
+    if not far.ok:
+        return ParetoFront(float(eccentricity), float(lordosis), np.array([]), np.array([]), (far.status,))
+    lowest = far.min_pcsa / M2_PER_CM2
+    budgets = np.linspace(lowest, max(far.total_pcsa / M2_PER_CM2, lowest), n_points)
+    norms, statuses = [], []
+    lhs, rhs = inequalities(data)
+    budget = cp.Parameter(nonneg=True)
+    x = cp.Variable(data.weights.size)
+    constraints = [lhs @ x <= rhs, data.weights @ x <= budget]
+    problem = cp.Problem(cp.Minimize(cp.norm(_ct_expression(data, x), 2)), constraints)
+    for value in budgets:
+        budget.value = value
+        status = _solve(problem, data.tolerance)
+        statuses.append(status)
+        norm = np.nan
+        if status in OK_STATUSES:
+            norm = np.linalg.norm(data.counter_torque(polished(data, "counter_torque", x.value, value)[0]))
+        norms.append(norm)
+    return ParetoFront(float(eccentricity), float(lordosis), budgets * M2_PER_CM2, np.asarray(norms), tuple(statuses))

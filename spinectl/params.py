@@ -58,6 +58,11 @@ def param(default, unit: str, doc: str):
     return field(metadata={"unit": unit, "doc": doc}, **kwargs)
 
 
+SOLVER_TOLERANCE_RANGE = (1e-12, 1e-6)
+"""Allowed ``optimisation.solver_tolerance`` [1]: interior-point solvers stall below 1e-12 in double
+precision; above 1e-6 the two solution paths need not agree to the 1e-6 the fast path promises."""
+
+
 def _store(obj, **values) -> None:
     """Store validated, normalised values (plain floats, tuples) on a frozen dataclass."""
     for name, value in values.items():
@@ -297,6 +302,13 @@ class Optimisation:
     ct_tolerance: float = param(
         1e-3, "1", "Relative slack on the minimum total PCSA within which ||CT||_2 is minimised."
     )
+    solver_tolerance: float = param(
+        1e-9,
+        "1",
+        "Feasibility and relative-gap tolerance of the conic solver (Clarabel; SCS as fallback) and of the "
+        "KKT check that polishes its answers. Tight, so that the per-point reference and the fast path "
+        f"agree to 1e-6 (docs/optimisation.md); {SOLVER_TOLERANCE_RANGE[0]:g} to {SOLVER_TOLERANCE_RANGE[1]:g}.",
+    )
 
     def __post_init__(self):
         v.choice("activation", self.activation, ("paired", "independent"))
@@ -308,6 +320,7 @@ class Optimisation:
             stability_margin=v.non_negative("stability_margin", self.stability_margin),
             pcsa_max=pmax,
             ct_tolerance=v.non_negative("ct_tolerance", self.ct_tolerance),
+            solver_tolerance=v.in_range("solver_tolerance", self.solver_tolerance, *SOLVER_TOLERANCE_RANGE),
         )
 
 

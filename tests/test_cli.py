@@ -9,7 +9,7 @@ import tomllib
 
 import pytest
 
-from spinectl import config
+from spinectl import config, optimise
 from spinectl.cli import main
 
 
@@ -65,7 +65,6 @@ def test_config_show_is_loadable_toml(capsys, tmp_path):
         (["stability", "--E", "nan", "--pcsa", "1,1,1"], "--E must be finite"),
         (["stability", "--pcsa", "1,1"], "pcsa: must have 3 values"),
         (["stability", "--pcsa", "a"], "--pcsa must be a number"),
-        (["stability"], "--pcsa"),
         (["stability", "--pcsa", "1,1,1", "--config", "/no/such.toml"], "file not found"),
         (["stability", "--pcsa", "1,1,1", "--preset", "nope"], "preset: must be one of"),
         (["stability", "--pcsa", "1,1,1", "--K", "-1"], "passive.stiffness: must be >= 0"),
@@ -77,6 +76,26 @@ def test_bad_input_is_one_line_exit_2(argv, needle, capsys):
     assert code == 2
     assert needle in err
     assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+
+
+def test_stability_defaults_to_the_minimum_stabilising_pcsa(capsys):
+    """Without --pcsa the optimiser's chosen activation is used: self-stable, total = solve_point's."""
+    code, out, _ = run(["stability", "--E", "0.03", "--Lambda", "0.04", "--json"], capsys)
+    assert code == 0
+    doc = json.loads(out)
+    assert doc["pcsa_source"] == "min_pcsa" and doc["all_self_stable"]
+    expected = optimise.solve_point(config.load_preset("default"), 0.03, 0.04)
+    assert doc["total_pcsa_cm2"] == pytest.approx(expected.total_pcsa * 1e4, rel=1e-9)
+    code, out, _ = run(["stability", "--E", "0.03", "--Lambda", "0.04"], capsys)
+    assert code == 0 and "minimum stabilising" in out
+
+
+def test_stability_without_a_stabilising_pcsa_is_exit_2(tmp_path, capsys):
+    """At most 1 cm^2 per muscle cannot hold the upright body: no default PCSA exists."""
+    path = tmp_path / "weak.toml"
+    path.write_text("[optimisation]\npcsa_max = 1e-4\n")
+    code, _, err = run(["stability", "--config", str(path)], capsys)
+    assert code == 2 and "no activation stabilises" in err and len(err.strip().splitlines()) == 1
 
 
 def test_bad_config_values_from_file(tmp_path, capsys):

@@ -111,6 +111,7 @@ KINDS = {
     "optimisation.stability_margin": REAL,
     "optimisation.pcsa_max": REAL_OR_INF,
     "optimisation.ct_tolerance": REAL,
+    "optimisation.solver_tolerance": REAL,
     "reflex.delay": REAL,
     "reflex.pade_order": INT,
     "reflex.activation": REAL,
@@ -155,6 +156,7 @@ OUT_OF_RANGE = {
     "optimisation.stability_margin": [-0.1],
     "optimisation.pcsa_max": [0.0, -1.0, -math.inf],
     "optimisation.ct_tolerance": [-1e-3],
+    "optimisation.solver_tolerance": [0.0, 1e-13, 1e-3],
     "reflex.delay": [-0.1],
     "reflex.pade_order": [0, 11],
     "reflex.activation": [-0.1, 10.5],
@@ -493,7 +495,6 @@ def test_the_fallback_solver_answers_when_clarabel_fails(monkeypatch, model):
     np.testing.assert_allclose(fallback.counter_torque_norm, reference.counter_torque_norm, rtol=1e-3)
 
 
-@pytest.mark.xfail(strict=True, reason="optimise.solve_point keeps 'optimal' when the solver gives no solution")
 def test_optimal_without_a_solution_is_not_reported_as_optimal(monkeypatch, model):
     _failing_solve(monkeypatch, status=cp.OPTIMAL)
     optimum = solve_point(model, 0.03, 0.04)

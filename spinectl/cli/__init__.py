@@ -19,6 +19,9 @@ COMMANDS = (
     "config_cmd",
     "stability_cmd",
     "margins_cmd",
+    "sweep_cmd",
+    "plot_cmd",
+    "reproduce_cmd",
 )
 """Modules of :mod:`spinectl.cli` that each register one sub-command."""
 

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 from ..config import set_parameter
+from ..errors import ModelError
+from ..optimise import solve_point
 from ..stability import StabilityResult, segment_stability
 from ..units import cm2_to_m2, m2_to_cm2
 from ._common import add_model_options, emit_json, finite_float, float_list, load_model
@@ -26,9 +28,9 @@ def register(sub) -> None:
     parser.add_argument(
         "--pcsa",
         type=float_list("--pcsa"),
-        required=True,
         metavar="CM2,...",
-        help="PCSA [cm^2]: one value per pair (each muscle of the pair) or one per muscle",
+        help="PCSA [cm^2]: one value per pair (each muscle of the pair) or one per muscle "
+        "(default: the minimum stabilising PCSA, the optimiser's chosen activation)",
     )
     parser.add_argument("--K", type=finite_float("--K"), help="passive stiffness K [N m/rad] (overrides the model)")
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
@@ -76,15 +78,39 @@ def run(args) -> int:
         Exit code 0.
     """
     model = model_with_overrides(args)
-    result = segment_stability(model, args.E, args.Lambda, cm2_to_m2(args.pcsa))
+    pcsa = cm2_to_m2(args.pcsa) if args.pcsa is not None else minimum_stabilising_pcsa(model, args.E, args.Lambda)
+    result = segment_stability(model, args.E, args.Lambda, pcsa)
     if args.json:
-        emit_json(result_to_json(model, result))
+        emit_json(result_to_json(model, result, given=args.pcsa is not None))
     else:
-        print(format_table(model, result))
+        print(format_table(model, result, given=args.pcsa is not None))
     return 0
 
 
-def result_to_json(model, result: StabilityResult) -> dict:
+def minimum_stabilising_pcsa(model, eccentricity: float, lordosis: float):
+    """The chosen activation of :func:`spinectl.optimise.solve_point` [m^2]; an error if there is none.
+
+    Parameters
+    ----------
+    model : Model
+    eccentricity, lordosis : float
+        E and Lambda [m].
+
+    Raises
+    ------
+    ModelError
+        No activation within the bounds stabilises every segment (or the solver failed).
+    """
+    optimum = solve_point(model, eccentricity, lordosis)
+    if not optimum.ok:
+        raise ModelError(
+            f"pcsa: no activation stabilises every segment at E = {eccentricity:g} m, Lambda = {lordosis:g} m "
+            f"(optimiser status {optimum.status}); give --pcsa"
+        )
+    return optimum.pcsa
+
+
+def result_to_json(model, result: StabilityResult, given: bool = True) -> dict:
     """The JSON document of ``spinectl stability --json`` (units in the key names).
 
     Parameters
@@ -93,6 +119,9 @@ def result_to_json(model, result: StabilityResult) -> dict:
         The model the result was computed with (muscle names, K).
     result : StabilityResult
         Output of :func:`~spinectl.stability.segment_stability`.
+    given : bool
+        Whether the PCSA was given (``--pcsa``); ``pcsa_source`` is then 'given',
+        else 'min_pcsa' (the optimiser's chosen activation).
     """
     pcsa = m2_to_cm2(result.pcsa)
     return {
@@ -100,6 +129,7 @@ def result_to_json(model, result: StabilityResult) -> dict:
         "Lambda_m": result.lordosis,
         "K_Nm_per_rad": model.passive.stiffness,
         "K_convention": model.passive.convention,
+        "pcsa_source": "given" if given else "min_pcsa",
         "pcsa_cm2": dict(zip(model.muscle_names, pcsa.tolist(), strict=False)),
         "total_pcsa_cm2": float(pcsa.sum()),
         "segments": [
@@ -123,7 +153,7 @@ def _complex(z: complex) -> str:
     return f"{z.real:9.3f}{z.imag:+9.3f}j"
 
 
-def format_table(model, result: StabilityResult) -> str:
+def format_table(model, result: StabilityResult, given: bool = True) -> str:
     """A readable per-segment table.
 
     Parameters
@@ -132,12 +162,14 @@ def format_table(model, result: StabilityResult) -> str:
         The model the result was computed with (muscle names, K).
     result : StabilityResult
         Output of :func:`~spinectl.stability.segment_stability`.
+    given : bool
+        Whether the PCSA was given (``--pcsa``) or is the minimum stabilising one.
     """
     pcsa = m2_to_cm2(result.pcsa)
     lines = [
         f"E = {result.eccentricity * 100:.2f} cm, Lambda = {result.lordosis * 100:.2f} cm, "
         f"K = {model.passive.stiffness:g} N m/rad ({model.passive.convention})",
-        "PCSA [cm^2]: "
+        ("PCSA [cm^2]: " if given else "PCSA [cm^2] (minimum stabilising, chosen activation): ")
         + ", ".join(f"{n} {p:.2f}" for n, p in zip(model.muscle_names, pcsa, strict=False))
         + f"  (total {pcsa.sum():.2f})",
         "",
