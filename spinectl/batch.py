@@ -157,10 +157,10 @@ def feasible_points(data: ProblemData) -> np.ndarray | None:
     data : ProblemData
         A block of points (leading dimension P).
     """
-    n_points, n_cor, n = data.stiffness.shape
+    n_points, n_rows, n = data.stability.shape
     lhs, rhs = optimise.inequalities(data)
     violation = np.zeros(lhs.shape[:2] + (1,))
-    violation[:, :n_cor] = -1.0
+    violation[:, :n_rows] = -1.0
     floor = np.zeros((n_points, 1, n + 1))
     floor[..., -1] = -1.0
     lhs = np.concatenate([np.concatenate([lhs, violation], axis=2), floor], axis=1)
@@ -171,7 +171,7 @@ def feasible_points(data: ProblemData) -> np.ndarray | None:
     if status != "optimal":
         return None
     tol = optimise.DEFAULT_TOLERANCE if data.tolerance is None else data.tolerance
-    return v[:, -1] <= optimise.SLAB_FACTOR * tol * (1.0 + np.abs(data.stiffness_bound).max(axis=-1))
+    return v[:, -1] <= optimise.SLAB_FACTOR * tol * (1.0 + np.abs(data.stability_bound).max(axis=-1))
 
 
 def _stages(data: ProblemData, ct_tolerance: float, first=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -179,7 +179,7 @@ def _stages(data: ProblemData, ct_tolerance: float, first=None) -> tuple[np.ndar
 
     ``first``: the result of stage 1 for this block, if already solved.
     """
-    failed = (*_unsolved(data), np.zeros(len(data.stiffness), bool))
+    failed = (*_unsolved(data), np.zeros(len(data.stability), bool))
     status, x, good = _stage(data, "min_pcsa") if first is None else first
     if not good.any():
         return failed
@@ -207,7 +207,7 @@ def solve_stacked(data: ProblemData, ct_tolerance: float) -> BlockOptimum:
     ct_tolerance : float
         Relative band on the minimum total PCSA [1].
     """
-    n_points = len(data.stiffness)
+    n_points = len(data.stability)
     status = np.full(n_points, "optimal", dtype=object)
     total, x = _unsolved(data)
     feasible = np.arange(n_points)
@@ -256,7 +256,7 @@ def _per_point(data: ProblemData, ct_tolerance: float, progress=None):
 
 def _unsolved(data: ProblemData) -> tuple[np.ndarray, np.ndarray]:
     """NaN totals and x [cm^2] for a block: what a point holds until it is solved."""
-    n_points = len(data.stiffness)
+    n_points = len(data.stability)
     return np.full(n_points, np.nan), np.full((n_points, data.weights.size), np.nan)
 
 

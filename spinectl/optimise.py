@@ -30,6 +30,7 @@ same problems for a block of points at once and is checked against this module.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, replace
 
 import cvxpy as cp
@@ -76,11 +77,14 @@ class ProblemData:
 
     Attributes
     ----------
-    stiffness : numpy.ndarray, shape (..., n_cor, n_var)
-        dM_k/dalpha per unit x [N m/rad per cm^2].
-    stiffness_bound : numpy.ndarray, shape (..., n_cor)
-        Constraint right-hand side: stiffness @ x <= stiffness_bound [N m/rad],
-        i.e. -margin - (gravity - passive) stiffness.
+    stability : numpy.ndarray, shape (..., 2 n_cor, n_var)
+        The self-stability constraints ``stability @ x <= stability_bound``: rows
+        0..n_cor-1 are dM_k/dalpha per unit x [N m/rad per cm^2], rows n_cor..
+        dM_k/domega per unit x [N m s/rad per cm^2]. Both eigenvalues of eq. 1
+        have negative real part iff S_k < 0 and D_k < 0.
+    stability_bound : numpy.ndarray, shape (..., 2 n_cor)
+        Right-hand side: -stability_margin - (gravity - passive) stiffness [N m/rad]
+        for the stiffness rows, -damping_margin [N m s/rad] for the damping rows.
     torque : numpy.ndarray, shape (..., n_cor, n_var)
         Muscle torque per unit x [N m per cm^2].
     gravity_torque : numpy.ndarray, shape (..., n_cor)
@@ -99,8 +103,8 @@ class ProblemData:
         its rounding error (:func:`ct_slab`). None = the largest singular value of ``torque``.
     """
 
-    stiffness: np.ndarray
-    stiffness_bound: np.ndarray
+    stability: np.ndarray
+    stability_bound: np.ndarray
     torque: np.ndarray
     gravity_torque: np.ndarray
     weights: np.ndarray
@@ -119,8 +123,8 @@ class ProblemData:
         """
         return replace(
             self,
-            stiffness=self.stiffness[index],
-            stiffness_bound=self.stiffness_bound[index],
+            stability=self.stability[index],
+            stability_bound=self.stability_bound[index],
             torque=self.torque[index],
             gravity_torque=self.gravity_torque[index],
             torque_scale=None if self.torque_scale is None else self.torque_scale[index],
@@ -156,9 +160,12 @@ def problem_data(model: Model, coeffs: SegmentCoefficients) -> ProblemData:
     else:
         to_muscles = np.eye(n_muscles)
     per_var = to_muscles * M2_PER_CM2  # m^2 of each muscle per cm^2 of x
+    opt = model.optimisation
+    stiffness_bound = -opt.stability_margin - (coeffs.gravity_stiffness - coeffs.passive_stiffness)
+    damping_bound = np.full_like(stiffness_bound, -opt.damping_margin)
     return ProblemData(
-        stiffness=coeffs.stiffness_per_pcsa @ per_var,
-        stiffness_bound=-model.optimisation.stability_margin - (coeffs.gravity_stiffness - coeffs.passive_stiffness),
+        stability=np.concatenate([coeffs.stiffness_per_pcsa @ per_var, coeffs.damping_per_pcsa @ per_var], axis=-2),
+        stability_bound=np.concatenate([stiffness_bound, damping_bound], axis=-1),
         torque=coeffs.torque_per_pcsa @ per_var,
         gravity_torque=coeffs.gravity_torque,
         weights=to_muscles.sum(axis=0),
@@ -234,11 +241,15 @@ def _solve(problem: cp.Problem, tolerance: float | None = None) -> str:
     """Solve with the first solver that answers; return the cvxpy status or 'solver_error'.
 
     An 'optimal' status without finite values for the variables (a broken
-    solver) does not count as an answer.
+    solver) does not count as an answer. cvxpy's warnings (e.g. "Solution may
+    be inaccurate") are silenced: the status records them, and a command-line
+    user must see one line, not solver chatter.
     """
     for solver in SOLVERS:
         try:
-            problem.solve(solver=solver, **solver_options(solver, tolerance))
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")  # only solver code runs in this block
+                problem.solve(solver=solver, **solver_options(solver, tolerance))
         except (cp.error.SolverError, ArithmeticError, ValueError):
             continue
         if problem.status in OK_STATUSES and _has_values(problem):
@@ -256,7 +267,8 @@ def _has_values(problem: cp.Problem) -> bool:
 def inequalities(data: ProblemData, total_max=np.inf, x_ct=None) -> tuple[np.ndarray, np.ndarray]:
     """The constraints of a stage as G x <= h; vectorised over leading dimensions.
 
-    Rows, in order: S x <= b (every CoR self-stable with the margin), -x <= 0,
+    Rows, in order: the stability rows (S_k <= -stability_margin and
+    D_k <= -damping_margin at every CoR, :class:`ProblemData`), -x <= 0,
     x <= upper (if finite), w.x <= total_max (the band, if finite; finite for
     all points or for none), and, if ``x_ct`` is given, the two sides of the
     slab of :func:`ct_slab` that fixes CT (a row T does not act on reads
@@ -277,9 +289,9 @@ def inequalities(data: ProblemData, total_max=np.inf, x_ct=None) -> tuple[np.nda
     rhs : numpy.ndarray, shape (..., r)
         h [N m/rad or cm^2].
     """
-    lead, n = data.stiffness.shape[:-2], data.weights.size
+    lead, n = data.stability.shape[:-2], data.weights.size
     eye = np.broadcast_to(np.eye(n), lead + (n, n))
-    lhs, rhs = [data.stiffness, -eye], [data.stiffness_bound, np.zeros(lead + (n,))]
+    lhs, rhs = [data.stability, -eye], [data.stability_bound, np.zeros(lead + (n,))]
     if np.isfinite(data.upper):
         lhs.append(eye)
         rhs.append(np.full(lead + (n,), data.upper))
@@ -310,7 +322,7 @@ def objective(data: ProblemData, stage: str):
     stage : str
         One of :data:`STAGES`.
     """
-    lead, n = data.stiffness.shape[:-2], data.weights.size
+    lead, n = data.stability.shape[:-2], data.weights.size
     if stage == "min_pcsa":
         return None, np.broadcast_to(data.weights, lead + (n,))
     if stage == "counter_torque":

@@ -298,6 +298,13 @@ class Optimisation:
         "the optimum strictly self-stable rather than marginal (a zero eigenvalue); it costs well under "
         "0.1 cm^2 of PCSA.",
     )
+    damping_margin: float = param(
+        0.01,
+        "N m s/rad",
+        "Required damping: dM_k/domega <= -damping_margin at every CoR. Self-stability needs both "
+        "eigenvalues in the left half-plane (paper, eq. 1), so D_k < 0 as well as S_k < 0; where passive "
+        "stiffness alone makes S_k < 0, a zero PCSA would leave an undamped centre. Costs about 0.05 cm^2.",
+    )
     pcsa_max: float = param(math.inf, "m^2", "Upper bound on the PCSA of each decision variable (inf = none).")
     ct_tolerance: float = param(
         1e-3, "1", "Relative slack on the minimum total PCSA within which ||CT||_2 is minimised."
@@ -318,6 +325,7 @@ class Optimisation:
         _store(
             self,
             stability_margin=v.non_negative("stability_margin", self.stability_margin),
+            damping_margin=v.non_negative("damping_margin", self.damping_margin),
             pcsa_max=pmax,
             ct_tolerance=v.non_negative("ct_tolerance", self.ct_tolerance),
             solver_tolerance=v.in_range("solver_tolerance", self.solver_tolerance, *SOLVER_TOLERANCE_RANGE),

@@ -122,7 +122,7 @@ def sweep(
             tol = model.optimisation.ct_tolerance
             if method == "fast":
                 result = batch.solve_stacked(data, tol)
-                bar.update(len(data.stiffness))
+                bar.update(len(data.stability))
             else:
                 result = batch.solve_points(data, tol, progress=bar.update)
             per_point += result.per_point

@@ -45,7 +45,7 @@ def test_minimum_is_minimal(model, E, L):
     for j in np.flatnonzero(x > 1e-6 * x.max()):
         lowered = x.copy()
         lowered[j] *= 0.99
-        assert np.any(data.stiffness @ lowered > data.stiffness_bound)
+        assert np.any(data.stability @ lowered > data.stability_bound)
     opt = optimise.solve_point(model, E, L)
     assert not segment_stability(model, E, L, 0.98 * opt.pcsa).all_self_stable
 
@@ -135,3 +135,16 @@ def test_independent_activation_needs_no_more_pcsa_than_paired(model):
         assert optimise.solve_point(independent, E, L).min_pcsa <= optimise.solve_point(model, E, L).min_pcsa * (
             1 + 1e-9
         )
+
+
+def test_passive_stiffness_alone_still_needs_muscle_damping(model):
+    """K = 500 N m/rad exceeds gravity at every CoR (m g r <= 40 * 9.81 * 0.321 = 126 N m/rad),
+    so S_k < 0 with no muscle; but then D_k = 0 and eq. 1 gives an undamped centre (+-j w).
+    The damping rows (D_k <= -damping_margin) make the optimum a small PCSA with D_k < 0
+    at every CoR, hence truly self-stable."""
+    stiff = model.replace(passive=dataclasses.replace(model.passive, stiffness=500.0))
+    opt = optimise.solve_point(stiff, 0.03, 0.04)
+    assert opt.ok and 0 < opt.min_pcsa < 1e-4  # under 1 cm^2
+    result = segment_stability(stiff, 0.03, 0.04, opt.pcsa)
+    assert np.all(result.damping <= -stiff.optimisation.damping_margin * (1 - 1e-6))
+    assert result.self_stable.all()

@@ -141,11 +141,14 @@ def test_min_pcsa_is_proportional_to_mass_without_passive_stiffness(model, posit
     Why: the LP is  min w.x  s.t.  A x <= -(m g r_y - K) - margin,  0 <= x <= pcsa_max,
     every constraint linear in the PCSA x (design page, Muscle: everything muscular is
     linear in PCSA). With K = 0, margin = 0 and pcsa_max = inf the constant term is
-    -m g r_y, so x is feasible for m iff c x is feasible for c m, and the optimum scales
+    -m g r_y (and the damping rows' bound is -damping_margin = 0), so x is feasible for m iff c x
+    is feasible for c m, and the optimum scales
     by c. The counter torque CT = -(T x + M_ext) is then c times as large as well.
     """
     E, L = position
-    light = model.replace(optimisation=dataclasses.replace(model.optimisation, stability_margin=0.0))
+    light = model.replace(
+        optimisation=dataclasses.replace(model.optimisation, stability_margin=0.0, damping_margin=0.0)
+    )
     heavy = light.replace(body=dataclasses.replace(model.body, mass=model.body.mass * factor))
     a, b = solve_point(light, E, L), solve_point(heavy, E, L)
     assert a.ok == b.ok, (a.status, b.status)
