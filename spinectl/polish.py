@@ -147,5 +147,7 @@ def _nonnegative_multipliers(lhs, gradient, active, n_eq, tolerance) -> bool:
     inequality = lhs[:n_ineq][active[:n_ineq]].T
     equality = lhs[n_ineq:].T
     columns = np.concatenate([inequality, equality, -equality], axis=1)
+    if columns.shape[1] == 0:  # nothing active: scipy 1.17's nnls aborts the process on an empty matrix
+        return bool(np.all(np.abs(gradient) <= tolerance))
     multipliers, _ = nnls(columns, -gradient)
     return bool(np.all(np.abs(columns @ multipliers + gradient) <= tolerance))

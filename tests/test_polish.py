@@ -56,3 +56,14 @@ def test_an_interior_start_reaches_the_constrained_optimum():
     x, ok = polish(2 * np.eye(2), [-6.0, 0.0], _box(2), np.ones(4), [0.5, -0.2], TOL, RTOL)
     assert ok
     np.testing.assert_allclose(x, [1.0, 0.0], atol=1e-14)
+
+
+def test_an_interior_lp_start_with_nothing_active_is_settled():
+    """min x on [-1, 1] from the interior x0 = 0.3: no row is active and the gradient 1 is not zero,
+    so x0 is no KKT point and comes back unverified (the sign check sees no columns at all;
+    scipy 1.17's nnls aborted the process on such an empty matrix). Near the optimum, the lower
+    bound -1, it verifies."""
+    x, ok = polish(None, [1.0], _box(1), np.ones(2), [0.3], TOL, RTOL)
+    assert not ok and x == 0.3
+    x, ok = polish(None, [1.0], _box(1), np.ones(2), [-1.0 + 1e-9], TOL, RTOL)
+    assert ok and x == -1.0
