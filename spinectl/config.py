@@ -135,13 +135,27 @@ def set_parameter(model: Model, dotted: str, value) -> Model:
     value : object
         The new value, in the parameter's unit (see ``docs/parameters.md``); validated.
     """
+    return set_parameters(model, {dotted: value})
+
+
+def set_parameters(model: Model, values: dict) -> Model:
+    """Return ``model`` with several parameters replaced at once (validated once, at the end).
+
+    Parameters
+    ----------
+    model : Model
+        The parameters to start from.
+    values : dict
+        Dotted path (as for :func:`set_parameter`) to new value.
+    """
     data = to_dict(model)
-    node = data
-    *parents, last = dotted.split(".")
-    for key in parents:
-        node = _child(node, key, dotted)
-    _child(node, last, dotted)  # the last key must exist too: same checks, same messages
-    node[int(last) if isinstance(node, list) else last] = value
+    for dotted, value in values.items():
+        node = data
+        *parents, last = dotted.split(".")
+        for key in parents:
+            node = _child(node, key, dotted)
+        _child(node, last, dotted)  # the last key must exist too: same checks, same messages
+        node[int(last) if isinstance(node, list) else last] = value
     return from_dict(Model, data)
 
 
