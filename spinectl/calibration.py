@@ -128,9 +128,10 @@ FREE_PARAMETERS: tuple[FreeParameter, ...] = (
         55.0,
         ("body.mass",),
         "Upper-body point mass m.",
-        "Head, arms and trunk above L3 are 47-55 % of the body mass (Dempster 1955 segment fractions as "
-        "tabulated by Winter 2009, Biomechanics and Motor Control of Human Movement, table 4.1); adult body "
-        "masses of 50-100 kg (about the 5th percentile woman to the 95th percentile man) give 24-55 kg.",
+        "Head, neck, arms, thorax and half the abdomen are 47 % of the body mass in Dempster's segment "
+        "fractions (Winter 2009, Biomechanics and Motor Control of Human Movement, table 4.1: "
+        "8.1 + 2 x 5.0 + 21.6 + 13.9/2); the default preset reads 55 %. Adult body masses of about "
+        "50-100 kg (estimate) give about 24-55 kg.",
     ),
     FreeParameter(
         "straight_x",
@@ -859,7 +860,7 @@ class Sensitivity:
     Attributes
     ----------
     landmarks : tuple of str
-        The landmarks differentiated (continuous ones with a positive value).
+        The landmarks differentiated: continuous ones with a positive value, not exact zeros.
     jacobian : numpy.ndarray, shape (n_landmarks, n_parameters)
         d log(landmark) / d(parameter / width of its bounds) [1].
     singular_values : numpy.ndarray, shape (n_parameters,)
@@ -898,7 +899,8 @@ def sensitivity(
         return {m.landmark.name: m.value for m in found}
 
     base = logs(centre)
-    names = tuple(n for n, v in base.items() if n not in STEP_LANDMARKS and np.isfinite(v) and v > 0)
+    exact = {m.name for m in landmarks.LANDMARKS if m.relation == "="}  # zero up to rounding: no log-ratio
+    names = tuple(n for n, v in base.items() if n not in STEP_LANDMARKS and n not in exact and v > 0)
     columns = []
     for i in range(len(parameters)):
         up, down = centre.copy(), centre.copy()

@@ -10,7 +10,7 @@ from spinectl.config import to_dict
 from spinectl.params import Model
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "docs" / "_ext"))
-from spinectl_docs import api, cli, guide, parameters  # noqa: E402
+from spinectl_docs import api, cli, guide, parameters, reproduction  # noqa: E402
 
 
 def test_parameters_page_lists_every_parameter_with_its_unit():
@@ -61,3 +61,17 @@ def test_guide_pages_leave_out_the_index_and_the_references(tmp_path):
         (tmp_path / name).write_text("# x\n")
     (tmp_path / "_generated").mkdir()
     assert guide.guide_pages(tmp_path) == ["model", "optimisation", "reflex"]
+
+
+def test_reproduction_tables_list_every_landmark_and_free_parameter():
+    """docs/reproduction.md's tables: one row per landmark (with its verdict) and per free parameter
+    (with its bounds and the preset's value, read from the preset file)."""
+    from spinectl import calibration, landmarks
+    from spinectl import reproduction as verdicts
+
+    table = reproduction.landmark_table()
+    for mark in landmarks.LANDMARKS:
+        row = next(line for line in table.splitlines() if line.startswith(f"| `{mark.name}` |"))
+        assert verdicts.VERDICTS[mark.name].verdict in row
+    params = reproduction.parameter_table()
+    assert all(f"| `{p.name}` | {p.unit} | {p.lower:g} | {p.upper:g} |" in params for p in calibration.FREE_PARAMETERS)

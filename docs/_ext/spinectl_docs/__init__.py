@@ -10,7 +10,9 @@ text changed, so that incremental builds stay incremental):
 - ``_generated/api-modules.md`` and ``api/<module>.rst``: one autodoc page per
   module of the package, found by walking it;
 - ``_generated/guide-toctree.md``: the toctree of the guide pages, every
-  top-level page except the index and the reference pages.
+  top-level page except the index and the reference pages;
+- ``_generated/calibration-parameters.md`` and ``_generated/landmark-verdicts.md``:
+  the tables of ``reproduction.md`` (free parameters, verdict of every landmark).
 
 ``_generated/`` is excluded from the sources (its files are included by
 ``parameters.md``, ``cli.md``, ``api.md`` and ``index.md``); ``api/`` and
@@ -23,7 +25,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from . import api, cli, fields, guide, parameters
+from . import api, cli, fields, guide, parameters, reproduction
 
 GENERATED = "_generated"
 
@@ -50,6 +52,8 @@ def generate(app) -> None:
         if old.name not in stubs:  # a module that was removed or renamed
             old.unlink()
     write_if_changed(out / "guide-toctree.md", guide.toctree_markdown(src))
+    write_if_changed(out / "calibration-parameters.md", reproduction.parameter_table())
+    write_if_changed(out / "landmark-verdicts.md", reproduction.landmark_table())
 
 
 def setup(app):
