@@ -74,10 +74,10 @@ def _v(name: str, value: float, verdict: str, reason: str = "") -> Verdict:
 
 
 _FALL = (
-    "with paired activation both sides co-contract at every E, so the fall with E is at most about "
-    "1.9-fold for a mass >= 24 kg (the threefold fall needs independent activation)"
+    "paired activation co-contracts both sides at every E, so the PCSA falls at most about 2-fold "
+    "for a mass >= 24 kg (independent activation gives the threefold fall)"
 )
-_SPLINE = "‖CT‖ = F(E, Λ) ‖x‖ with x the CoRs' offsets from the mass: the spline fixes ‖x‖"
+_SPLINE = "‖CT‖ = F ‖x‖, x the CoRs' offsets from the mass, fixed by the spline"
 
 VERDICTS: dict[str, Verdict] = {
     v.name: v
@@ -89,11 +89,11 @@ VERDICTS: dict[str, Verdict] = {
         _v("ridge_slope", 1.97, REPRODUCED, "where the binding CoR, L1L2, lies under the mass: Λ = E/φ = 1.97 E"),
         _v("ridge_over_B", 1.88, STRUCTURAL, _FALL),
         _v("ct_A", 0.0, REPRODUCED, "symmetric pairs cancel and the mass is above every CoR"),
-        _v("ct_valley_slope", 1.24, STRUCTURAL, f"{_SPLINE}, whose minimum lies at Λ = 1.28 E"),
+        _v("ct_valley_slope", 1.24, STRUCTURAL, f"{_SPLINE}: least at Λ = 1.28 E (independent activation: 1.06)"),
         _v("ct_B", 107.0, REPRODUCED, "every CoR is 8 cm behind the mass"),
-        _v("ct_D_over_C", 1.31, STRUCTURAL, f"{_SPLINE}: ‖x(D)‖/‖x(C)‖ = 1.37, and F(D) < F(C)"),
-        _v("ct_B_over_C", 1.44, STRUCTURAL, f"{_SPLINE}: ‖x(B)‖/‖x(C)‖ = 1.98, and F(B) < F(C)"),
-        _v("ct_D_over_C_text", 3.44, STRUCTURAL, f"{_SPLINE}: ‖x(D)‖/‖x(C)‖ = 3.94, and F(D) < F(C)"),
+        _v("ct_D_over_C", 1.31, STRUCTURAL, f"{_SPLINE}; ‖x(D)‖/‖x(C)‖ = 1.37 and F(D) < F(C)"),
+        _v("ct_B_over_C", 1.44, STRUCTURAL, f"{_SPLINE}; ‖x(B)‖/‖x(C)‖ = 1.98 and F(B) < F(C)"),
+        _v("ct_D_over_C_text", 3.44, STRUCTURAL, f"{_SPLINE}; ‖x(D)‖/‖x(C)‖ = 3.94 and F(D) < F(C)"),
         _v("ct_B_over_C_text", 3.77, COMPROMISE, "‖x(B)‖/‖x(C)‖ = 5.71 needs F(B)/F(C) = 0.53: the threefold fall"),
         _v("ct_D_over_C_ridge", 1.86, REPRODUCED, "‖x(D)‖/‖x(C)‖ = 2.14 on this reading of C"),
         _v("ct_B_over_C_ridge", 2.04, STRUCTURAL, "‖x(B)‖/‖x(C)‖ = 3.11 needs F(B) = F(C), but the PCSA falls with E"),

@@ -9,6 +9,7 @@ import pytest
 
 from spinectl import calibration, config, landmarks, sweep
 from spinectl.calibration import Target
+from spinectl.calibration.fit import _Objective
 from spinectl.cli import main
 from spinectl.errors import ParameterError
 
@@ -87,7 +88,7 @@ def test_a_rejected_geometry_costs_the_most_not_an_exception(model):
     attachments at L5S1's height (5 mm), the dorsal end of oblique_outer (x = -7 cm) lies on L5S1 at
     E = 7 cm, Lambda = 0, a point of the 1 cm grid; 2 cm lower, no fibre touches a CoR."""
     targets = calibration.paper_targets()
-    objective = calibration._Objective(model, calibration.parameter_set(["lower_y"]), targets, SMALL, ("paper",))
+    objective = _Objective(model, calibration.parameter_set(["lower_y"]), targets, SMALL, ("paper",))
     worst = calibration.MISSING_PENALTY * sum(t.weight for t in targets)
     assert objective([-0.02]) < worst
     assert objective([model.geometry.cor_heights[-1]]) == worst
@@ -128,7 +129,7 @@ def test_the_fit_is_never_worse_than_the_start(model):
     parameters = calibration.parameter_set(["mass"])
     base = calibration.with_stiffness(model, 0.0, "paper")
     targets = calibration.paper_targets()
-    start_loss = calibration._Objective(base, parameters, targets, SMALL, ("paper",))([base.body.mass])
+    start_loss = _Objective(base, parameters, targets, SMALL, ("paper",))([base.body.mass])
     result = calibration.calibrate(
         base, parameters, conventions=("paper",), points=SMALL, verify_points=SMALL, popsize=2, generations=1, refine=0
     )

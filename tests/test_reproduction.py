@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from importlib import resources
+
 import numpy as np
 import pytest
 
@@ -36,8 +38,8 @@ def test_the_preset_keeps_every_landmark_within_the_documented_tolerance(measure
 
 def test_the_preset_is_what_the_calibration_wrote(preset):
     """The preset's header records how it was made, and its free parameters lie inside their bounds."""
-    text = (calibration.__file__.rsplit("/", 1)[0] + "/presets/wagner2012.toml").replace("\\", "/")
-    header = open(text, encoding="utf-8").read().split("\n[body]")[0]
+    text = resources.files("spinectl.presets").joinpath(f"{reproduction.PRESET}.toml").read_text(encoding="utf-8")
+    header = text.split("\n[body]")[0]
     assert "# Produced by: spinectl calibrate" in header and "--seed 0" in header and "# Loss: " in header
     for p, value in zip(calibration.FREE_PARAMETERS, calibration.from_model(preset), strict=True):
         assert p.lower <= value <= p.upper, p.name
