@@ -17,7 +17,7 @@ import numpy as np
 import xarray as xr
 from tqdm.auto import tqdm
 
-from . import __version__, batch, config
+from . import __version__, batch, config, reflex
 from .errors import ParameterError
 from .io import atomic_path
 from .optimise import problem_data
@@ -126,7 +126,7 @@ def sweep(
             else:
                 result = batch.solve_points(data, tol, progress=bar.update)
             per_point += result.per_point
-            for name, values in _chunk_columns(result, coeffs).items():
+            for name, values in _chunk_columns(result, coeffs, model).items():
                 if name not in arrays:
                     arrays[name] = np.empty((e_grid.size,) + values.shape[1:], values.dtype)
                 arrays[name][part] = values
@@ -135,9 +135,9 @@ def sweep(
     return _dataset(model, e_axis, l_axis, arrays, method, per_point)
 
 
-def _chunk_columns(result: batch.BlockOptimum, coeffs) -> dict[str, np.ndarray]:
+def _chunk_columns(result: batch.BlockOptimum, coeffs, model: Model) -> dict[str, np.ndarray]:
     """The Dataset's variables for one chunk, in the units of their names."""
-    return {
+    return _reflex_columns(model, coeffs, result.pcsa) | {
         "min_pcsa_cm2": m2_to_cm2(result.min_pcsa),
         "pcsa_cm2": m2_to_cm2(result.pcsa),
         "counter_torque_Nm": result.counter_torque,
@@ -150,6 +150,28 @@ def _chunk_columns(result: batch.BlockOptimum, coeffs) -> dict[str, np.ndarray]:
         "gravity_torque_Nm": coeffs.gravity_torque,
         "passive_stiffness_Nm_per_rad": coeffs.passive_stiffness,
         "inertia_kgm2": coeffs.inertia,
+    }
+
+
+def _reflex_columns(model: Model, coeffs, pcsa) -> dict[str, np.ndarray]:
+    """Delayed PD reflex at every point and segment (docs/reflex.md), vectorised.
+
+    The global muscles are active at ``reflex.activation`` times the chosen
+    activation (1: self-stable, no reflex needed; 0: reflex only); the gains
+    follow ``reflex``. The delay margin does not depend on the delay, so
+    ``delay_margin_s > tau`` answers "stable at delay tau" for any tau.
+    Infeasible points (NaN PCSA) get NaN and status 'undefined'.
+    """
+    active = model.reflex.activation * pcsa
+    maps = reflex.landscape(coeffs.stiffness(active), coeffs.damping(active), coeffs.inertia, model.reflex)
+    return {
+        "reflex_kp_Nm_per_rad": maps.kp,
+        "reflex_kd_Nms_per_rad": maps.kd,
+        "delay_margin_s": maps.delay_margin,
+        "delay_margin_pade_s": maps.delay_margin_pade,
+        "delay_margin_status": np.asarray(reflex.STATUS, dtype=object)[maps.delay_margin_status],
+        "stable_at_delay": maps.stable_at_delay,
+        "spine_delay_margin_s": np.min(maps.delay_margin, axis=-1),
     }
 
 
@@ -166,6 +188,13 @@ VARIABLES = {
     "gravity_torque_Nm": ("N m", "torque M_ext of the point mass about CoR k, upright"),
     "passive_stiffness_Nm_per_rad": ("N m rad-1", "passive stiffness K as a torque stiffness (enters dM/dalpha as -K)"),
     "inertia_kgm2": ("kg m2", "moment of inertia theta_k of the upper body about CoR k"),
+    "reflex_kp_Nm_per_rad": ("N m rad-1", "proportional gain kp of the delayed reflex (reflex settings)"),
+    "reflex_kd_Nms_per_rad": ("N m s rad-1", "derivative gain kd of the delayed reflex (reflex settings)"),
+    "delay_margin_s": ("s", "exact delay margin of the reflex loop at reflex.activation x chosen PCSA"),
+    "delay_margin_pade_s": ("s", "Pade estimate of the delay margin at reflex.pade_order"),
+    "delay_margin_status": ("", "finite, delay_independent (inf), unstable_without_delay (0) or undefined (NaN)"),
+    "stable_at_delay": ("", "closed loop stable with the delay reflex.delay (exact)"),
+    "spine_delay_margin_s": ("s", "smallest delay margin over the segments: the delay the whole spine tolerates"),
 }
 """Every data variable: units (UDUNITS) and long name."""
 
@@ -195,6 +224,8 @@ def _dataset(model: Model, e_axis, l_axis, arrays: dict, method: str, per_point:
         "points_solved_per_point": per_point,
         "passive_convention": model.passive.convention,
         "activation": model.optimisation.activation,
+        "reflex_delay_s": model.reflex.delay,
+        "reflex_activation": model.reflex.activation,
         "config_toml": config.dump_toml(model),
     }
     return xr.Dataset(data_vars, coords, attrs)
