@@ -144,6 +144,13 @@ def test_unquoted_dotted_keys_and_aliases_read_as_parameters(tmp_path):
     assert parsed.overrides((1, 0)) == {"body.mass": 45, "reflex.delay": 0.05}
 
 
+def test_the_example_in_the_docs_is_a_valid_study():
+    page = (ROOT / "docs" / "studies.md").read_text()
+    example = study.parse_study(page.split("```toml\n", 1)[1].split("```", 1)[0])
+    assert example.dims == ("body.mass", "K", "delay", "sample") and example.shape == (3, 2, 3, 20)
+    assert example.model.reflex.activation == 0.5 and example.tile == (50, 81) and example.n_chunks == 720
+
+
 def test_digest_ignores_comments_and_follows_values():
     base = study.parse_study(STUDY).digest()
     assert study.parse_study("# another comment\n" + STUDY.replace(" = ", "=")).digest() == base
@@ -246,6 +253,17 @@ def test_two_local_workers_on_loopback_give_the_same_bits(reference, tmp_path, m
     assert all(a.startswith("tcp://127.0.0.1:") for a in result.addresses)
     assert listening and set(listening) == {"127.0.0.1"}
     xr.testing.assert_identical(study.load(tmp_path / "two.zarr"), reference)
+
+
+def test_an_existing_cluster_by_its_address(reference, tmp_path):
+    """``scheduler='tcp://...'``: the study connects to a cluster it did not start, and leaves it running."""
+    from distributed import LocalCluster
+
+    with LocalCluster(n_workers=1, threads_per_worker=1, host="127.0.0.1", dashboard_address=None) as cluster:
+        address = cluster.scheduler_address
+        result = study.run_study(study.parse_study(STUDY), tmp_path / "s.zarr", scheduler=address, progress=False)
+        assert result.where == address and len(cluster.scheduler_info["workers"]) == 1
+    xr.testing.assert_identical(study.load(tmp_path / "s.zarr"), reference)
 
 
 # --- interruption and resume ---------------------------------------------------------------------

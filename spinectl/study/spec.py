@@ -338,7 +338,8 @@ class Study:
     def _check_combination(self, combination) -> None:
         """One combination of values together, at the corners of the grid; errors name the combination."""
         overrides = self.overrides(combination)
-        where = f" (study combination {', '.join(f'{k} = {show(x)}' for k, x in overrides.items())})"
+        values = ", ".join(f"{k} = {show(x)}" for k, x in overrides.items())
+        where = f" (study combination {values})" if values else ""
         e_range, l_range = (min(self.eccentricity), max(self.eccentricity)), (min(self.lordosis), max(self.lordosis))
         try:
             validate_position(config.set_parameters(self.model, overrides), *np.meshgrid(e_range, l_range))
