@@ -22,6 +22,7 @@ import itertools
 import logging
 import os
 import re
+import signal
 import time
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -302,7 +303,13 @@ def _executor(scheduler: str | None, workers: int | None, n_todo: int, connect_t
         silence_logs=logging.ERROR,
     )
     with cluster, Client(cluster, set_as_default=False) as client:
+        client.run(_ignore_interrupts)
         yield _Distributed(client, f"{n} local worker{'s' * (n != 1)}")
+
+
+def _ignore_interrupts() -> None:
+    """In a local worker: leave Ctrl-C to the command, which closes the cluster (no worker tracebacks)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 @contextlib.contextmanager

@@ -58,7 +58,7 @@ MAX_COMBINATIONS = 10_000
 """Most combinations of the parameter axes and samples: each is validated before any work
 starts (a few ms each: half a minute at most), and each needs at least one chunk."""
 
-SECTIONS = {"study": "base model, outputs, chunk size", "model": "parameter overrides", "axes": "", "samples": ""}
+SECTIONS = ("study", "model", "axes", "samples")
 STUDY_KEYS = ("preset", "config", "outputs", "chunk_size", "description")
 SAMPLE_KEYS = ("count", "seed", "parameters")
 RANGE_KEYS = ("start", "stop", "num")
@@ -101,8 +101,9 @@ def _check_name(where: str, parameter: str, model: Model) -> None:
             node = _child(node, key, parameter)
         except ConfigError as exc:
             raise ConfigError(where, exc.message) from None
-    if isinstance(node, (dict, list)):
-        raise ParameterError(where, f"{parameter} is a table or a list: name one of its values, e.g. {parameter}.0")
+    if isinstance(node, (dict, list)) and node:
+        example = f"{parameter}.{next(iter(node)) if isinstance(node, dict) else 0}"
+        raise ParameterError(where, f"{parameter} is a table or a list: name one of its values, e.g. {example}")
 
 
 @dataclass(frozen=True)
