@@ -46,6 +46,12 @@ ADDRESS = re.compile(r"^(tcp|tls|ucx|inproc|ws|wss)://\S+$")
 CONNECT_TIMEOUT = 10.0
 """Seconds to wait for a remote scheduler before giving up [s]."""
 
+KEEP_MALLOC = "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_"
+"""Dask sets ``MALLOC_TRIM_THRESHOLD_=65536`` in its workers so that glibc hands freed memory back at
+once; the fast path allocates and frees many arrays of a few hundred kB per chunk and then runs about
+15 % slower (measured on one chunk of 4010 points). Local workers keep glibc's own threshold; a chunk's
+memory is bounded anyway (the benchmark's peak, docs/studies.md)."""
+
 WORKERS_PER_CORE = 4
 """Most local workers per core: the solver is CPU-bound, more only costs memory."""
 
@@ -287,6 +293,7 @@ def _executor(scheduler: str | None, workers: int | None, n_todo: int, connect_t
     if scheduler == SYNCHRONOUS or (scheduler is None and n_todo <= 1):
         yield _InProcess()
         return
+    import dask
     from distributed import Client, LocalCluster
 
     if scheduler is not None:
@@ -294,14 +301,15 @@ def _executor(scheduler: str | None, workers: int | None, n_todo: int, connect_t
             yield _Distributed(client, scheduler)
         return
     n = min(workers or _cores(), n_todo)
-    cluster = LocalCluster(
-        n_workers=n,
-        threads_per_worker=1,  # cvxpy is not thread-safe; one process per worker
-        processes=True,
-        host="127.0.0.1",  # loopback only: nothing listens on another address
-        dashboard_address=None,
-        silence_logs=logging.ERROR,
-    )
+    with dask.config.set({KEEP_MALLOC: None}):  # unset in the workers' environment, see KEEP_MALLOC
+        cluster = LocalCluster(
+            n_workers=n,
+            threads_per_worker=1,  # cvxpy is not thread-safe; one process per worker
+            processes=True,
+            host="127.0.0.1",  # loopback only: nothing listens on another address
+            dashboard_address=None,
+            silence_logs=logging.ERROR,
+        )
     with cluster, Client(cluster, set_as_default=False) as client:
         client.run(_ignore_interrupts)
         yield _Distributed(client, f"{n} local worker{'s' * (n != 1)}")
