@@ -81,6 +81,7 @@ BAD_STUDIES = [
     (study_with('"muscles.0.upper" = [0.1]'), ParameterError, 'axes."muscles.0.upper"', "name one of its values"),
     (study_with('"muscles.0.name" = ["a"]'), ParameterError, 'axes."muscles.0.name"', "must not rename"),
     (study_with('K = [0.0]\n"passive.stiffness" = [1.0]'), ParameterError, 'axes."passive.stiffness"', "axes.K sets"),
+    (study_with('"body.mass" = [1.0]\nbody.mass = [2.0]'), ParameterError, 'axes."body.mass"', "is given twice"),
     ("[axes]\nLambda = [0.0]\n", ParameterError, "axes.E", "is required"),
     ("[axes]\nE = { start = 0.0, stop = 0.08 }\nLambda = [0.0]\n", ParameterError, "axes.E", "missing num"),
     ("[axes]\nE = { start = 0.08, stop = 0.0, num = 3 }\nLambda = [0.0]\n", ParameterError, "axes.E.stop", ">= start"),

@@ -214,6 +214,9 @@ class Samples:
         object.__setattr__(self, "seed", v.integer("samples.seed", self.seed, 0))
         if not self.parameters:
             raise ParameterError("samples.parameters", "must name at least one parameter to draw")
+        names = [p.parameter for p in self.parameters]
+        for name in {n for n in names if names.count(n) > 1}:
+            raise ParameterError(_quoted("samples.parameters", name), "is given twice")
         draws = {p.parameter: p.draw(self.count, self.seed) for p in self.parameters}
         for values in draws.values():
             values.flags.writeable = False
@@ -481,7 +484,7 @@ def parse_study(text: str, base_dir: str | Path = ".", source: str = "study") ->
             raise ConfigError(escaped(key), f"must be a table (got {show(data[key])})")
     head = data.get("study", {})
     _known_keys(head, STUDY_KEYS, "study")
-    axes = _flatten(data.get("axes", {}), lambda x: any(k in x for k in RANGE_KEYS))
+    axes = _flatten("axes", data.get("axes", {}), lambda x: any(k in x for k in RANGE_KEYS))
     for name in GRID:
         if name not in axes:
             raise ParameterError(f"axes.{name}", "is required: a list of values or { start, stop, num } [m]")
@@ -503,16 +506,21 @@ def _known_keys(table: dict, allowed, where: str) -> None:
             raise ConfigError(f"{where}.{escaped(key)}", _unknown_message(key, allowed))
 
 
-def _flatten(table: dict, is_leaf, prefix: str = "") -> dict:
+def _flatten(section: str, table: dict, is_leaf, prefix: str = "") -> dict:
     """Dotted keys from nested tables: ``body.mass = [...]`` unquoted is ``{"body": {"mass": [...]}}`` in TOML."""
-    out = {}
+    out: dict = {}
     for key, value in table.items():
         name = f"{prefix}{key}"
-        if isinstance(value, dict) and value and not is_leaf(value):
-            out |= _flatten(value, is_leaf, f"{name}.")
-        else:
-            out[name] = value
+        parts = _flatten(section, value, is_leaf, f"{name}.") if _is_table(value, is_leaf) else {name: value}
+        for dotted in parts:
+            if dotted in out:  # "body.mass" quoted and body.mass unquoted are two keys to TOML
+                raise ParameterError(_quoted(section, dotted), "is given twice")
+        out |= parts
     return out
+
+
+def _is_table(value, is_leaf) -> bool:
+    return isinstance(value, dict) and bool(value) and not is_leaf(value)
 
 
 def _values(where: str, value) -> tuple:
@@ -561,7 +569,7 @@ def _samples(table: dict) -> Samples:
     if not isinstance(drawn, dict):
         raise ParameterError("samples.parameters", f"must be a table of distributions (got {show(drawn)})")
     parameters = []
-    for name, spec in _flatten(drawn, lambda x: "distribution" in x).items():
+    for name, spec in _flatten("samples.parameters", drawn, lambda x: "distribution" in x).items():
         where = _quoted("samples.parameters", name)
         if not isinstance(spec, dict) or "distribution" not in spec:
             raise ParameterError(where, "must be { distribution = ..., <its arguments> }, see docs/studies.md")
