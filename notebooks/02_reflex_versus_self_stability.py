@@ -33,10 +33,6 @@ PRESET = os.environ.get("SPINECTL_NB_PRESET", "")  # "": the calibrated "wagner2
 
 # %%
 # %matplotlib inline
-import warnings
-
-# spinectl.sweep imports tqdm.auto, which warns in a kernel without ipywidgets; no progress bars are shown here
-warnings.filterwarnings("ignore", message="IProgress not found")
 
 import control as ct
 import matplotlib.pyplot as plt
