@@ -56,3 +56,16 @@ def test_an_interior_start_reaches_the_constrained_optimum():
     x, ok = polish(2 * np.eye(2), [-6.0, 0.0], _box(2), np.ones(4), [0.5, -0.2], TOL, RTOL)
     assert ok
     np.testing.assert_allclose(x, [1.0, 0.0], atol=1e-14)
+
+
+def test_no_active_rows_does_not_reach_nnls():
+    """With no active inequality and no equality the multiplier fit has no columns; SciPy's
+    nnls aborts the interpreter on such a matrix (found by the CLI fuzz test), so the
+    check answers directly: stationary iff the gradient is zero (to tolerance)."""
+    from spinectl.polish import _nonnegative_multipliers
+
+    lhs = np.eye(3)
+    inactive = np.zeros(3, bool)
+    assert _nonnegative_multipliers(lhs, np.zeros(3), inactive, 0, 1e-9)
+    assert not _nonnegative_multipliers(lhs, np.array([1.0, 0.0, 0.0]), inactive, 0, 1e-9)
+    assert not _nonnegative_multipliers(lhs, np.array([np.nan, 0.0, 0.0]), np.ones(3, bool), 0, 1e-9)

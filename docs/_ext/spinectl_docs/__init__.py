@@ -10,11 +10,14 @@ text changed, so that incremental builds stay incremental):
 - ``_generated/api-modules.md`` and ``api/<module>.rst``: one autodoc page per
   module of the package, found by walking it;
 - ``_generated/guide-toctree.md``: the toctree of the guide pages, every
-  top-level page except the index and the reference pages.
+  top-level page except the index and the reference pages;
+- ``notebooks/*.ipynb`` and ``_generated/notebooks-toctree.md``: copies of the
+  notebooks of the repository's ``notebooks/`` and their toctree, included by
+  ``notebooks.md`` (myst-nb executes them).
 
 ``_generated/`` is excluded from the sources (its files are included by
-``parameters.md``, ``cli.md``, ``api.md`` and ``index.md``); ``api/`` and
-``_generated/`` are not in git. At ``autodoc-process-docstring`` it adds a
+``parameters.md``, ``cli.md``, ``api.md``, ``index.md`` and ``notebooks.md``);
+``api/``, ``notebooks/`` and ``_generated/`` are not in git. At ``autodoc-process-docstring`` it adds a
 numpydoc "Parameters" section built from the same metadata to the parameter
 dataclasses, so that their API pages document every field.
 """
@@ -23,7 +26,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from . import api, cli, fields, guide, parameters
+from . import api, cli, fields, guide, notebooks, parameters
 
 GENERATED = "_generated"
 
@@ -50,6 +53,8 @@ def generate(app) -> None:
         if old.name not in stubs:  # a module that was removed or renamed
             old.unlink()
     write_if_changed(out / "guide-toctree.md", guide.toctree_markdown(src))
+    pages = notebooks.copy_notebooks(notebooks.sources(src.parent), src, write_if_changed)
+    write_if_changed(out / "notebooks-toctree.md", notebooks.toctree_markdown(pages))
 
 
 def setup(app):
