@@ -29,7 +29,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from tqdm.auto import tqdm
+from tqdm import tqdm  # plain: tqdm.auto warns in kernels without ipywidgets (as the sweep)
 
 from .. import config, sweep
 from ..errors import ParameterError
