@@ -135,13 +135,30 @@ def set_parameter(model: Model, dotted: str, value) -> Model:
     value : object
         The new value, in the parameter's unit (see ``docs/parameters.md``); validated.
     """
+    return set_parameters(model, {dotted: value})
+
+
+def set_parameters(model: Model, values: dict) -> Model:
+    """Return ``model`` with several parameters replaced at once, validated together.
+
+    Together, because some parameters constrain each other (e.g. ``body.mass_height`` must
+    lie above ``geometry.cor_heights``): one at a time, a valid pair could fail half-way.
+
+    Parameters
+    ----------
+    model : Model
+        The parameters to start from.
+    values : dict
+        New values by dotted path, as in :func:`set_parameter`.
+    """
     data = to_dict(model)
-    node = data
-    *parents, last = dotted.split(".")
-    for key in parents:
-        node = _child(node, key, dotted)
-    _child(node, last, dotted)  # the last key must exist too: same checks, same messages
-    node[int(last) if isinstance(node, list) else last] = value
+    for dotted, value in values.items():
+        node = data
+        *parents, last = dotted.split(".")
+        for key in parents:
+            node = _child(node, key, dotted)
+        _child(node, last, dotted)  # the last key must exist too: same checks, same messages
+        node[int(last) if isinstance(node, list) else last] = value
     return from_dict(Model, data)
 
 

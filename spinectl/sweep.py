@@ -111,28 +111,63 @@ def sweep(
     if e_axis.ndim != 1 or l_axis.ndim != 1 or e_axis.size * l_axis.size > MAX_GRID_POINTS:
         raise ParameterError("grid", f"must be two 1-D axes with at most {MAX_GRID_POINTS:,} points in all")
     e_grid, l_grid = (a.ravel() for a in np.meshgrid(e_axis, l_axis, indexing="ij"))
-    arrays: dict[str, np.ndarray] = {}  # filled chunk by chunk: no copies of the answer beyond the answer
-    per_point = 0
     disable = None if progress is None else not progress  # None: tqdm shows it on a terminal only
     with tqdm(total=e_grid.size, disable=disable, unit="pt", desc="sweep") as bar:
-        for start in range(0, e_grid.size, int(chunk_size)):
-            part = slice(start, start + int(chunk_size))
-            coeffs = checked_coefficients(model, e_grid[part], l_grid[part])  # raises for bad input
-            data = problem_data(model, coeffs)
-            tol = model.optimisation.ct_tolerance
-            if method == "fast":
-                result = batch.solve_stacked(data, tol)
-                bar.update(len(data.stability))
-            else:
-                result = batch.solve_points(data, tol, progress=bar.update)
-            per_point += result.per_point
-            for name, values in _chunk_columns(result, coeffs, model).items():
-                if name not in arrays:
-                    arrays[name] = np.empty((e_grid.size,) + values.shape[1:], values.dtype)
-                arrays[name][part] = values
+        options = {"method": method, "chunk_size": chunk_size, "update": bar.update}
+        arrays, per_point = point_columns(model, e_grid, l_grid, **options)
     shape = (e_axis.size, l_axis.size)
     arrays = {name: values.reshape(shape + values.shape[1:]) for name, values in arrays.items()}
     return _dataset(model, e_axis, l_axis, arrays, method, per_point)
+
+
+def point_columns(
+    model: Model, eccentricity, lordosis, *, method: str = "fast", chunk_size: int = DEFAULT_CHUNK, update=None
+) -> tuple[dict[str, np.ndarray], int]:
+    """Every variable of :data:`VARIABLES` at the points (E_i, Lambda_i), solved chunk by chunk.
+
+    The fast path solves each chunk of ``chunk_size`` consecutive points as one
+    stacked problem, so the answer depends on the chunking only through the
+    solver's tolerance; the same points in the same chunks give the same bits.
+
+    Parameters
+    ----------
+    model : Model
+        The parameters; ``passive.stiffness`` is K.
+    eccentricity, lordosis : array_like, shape (P,)
+        E and Lambda of each point [m].
+    method : {'fast', 'per-point'}
+    chunk_size : int
+        Points per chunk.
+    update : callable, optional
+        Called with the number of points solved, after each chunk (fast) or point (per-point).
+
+    Returns
+    -------
+    columns : dict of str to numpy.ndarray
+        Each variable with leading dimension P, in the units of its name.
+    per_point : int
+        Points that the per-point reference solved (all of them with ``method='per-point'``).
+    """
+    e_grid, l_grid = np.asarray(eccentricity, float), np.asarray(lordosis, float)
+    update = update or (lambda n: None)
+    arrays: dict[str, np.ndarray] = {}  # filled chunk by chunk: no copies of the answer beyond the answer
+    per_point = 0
+    for start in range(0, e_grid.size, int(chunk_size)):
+        part = slice(start, start + int(chunk_size))
+        coeffs = checked_coefficients(model, e_grid[part], l_grid[part])  # raises for bad input
+        data = problem_data(model, coeffs)
+        tol = model.optimisation.ct_tolerance
+        if method == "fast":
+            result = batch.solve_stacked(data, tol)
+            update(len(data.stability))
+        else:
+            result = batch.solve_points(data, tol, progress=update)
+        per_point += result.per_point
+        for name, values in _chunk_columns(result, coeffs, model).items():
+            if name not in arrays:
+                arrays[name] = np.empty((e_grid.size,) + values.shape[1:], values.dtype)
+            arrays[name][part] = values
+    return arrays, per_point
 
 
 def _chunk_columns(result: batch.BlockOptimum, coeffs, model: Model) -> dict[str, np.ndarray]:
@@ -199,21 +234,44 @@ VARIABLES = {
 """Every data variable: units (UDUNITS) and long name."""
 
 
-def _dims(name: str, ndim: int) -> tuple[str, ...]:
+def dims_of(name: str, ndim: int) -> tuple[str, ...]:
+    """Dimensions of the variable ``name`` on the grid, from the number of its dimensions.
+
+    Parameters
+    ----------
+    name : str
+        A key of :data:`VARIABLES`.
+    ndim : int
+        2 (E, Lambda), 3 (plus segment, or muscle for ``pcsa_cm2``) or 4 (plus segment and muscle).
+    """
     extra = {3: ("muscle",) if name == "pcsa_cm2" else ("segment",), 4: ("segment", "muscle")}
     return ("E", "Lambda") + extra.get(ndim, ())
 
 
-def _dataset(model: Model, e_axis, l_axis, arrays: dict, method: str, per_point: int) -> xr.Dataset:
-    data_vars = {
-        name: xr.Variable(_dims(name, arr.ndim), arr, {"units": VARIABLES[name][0], "long_name": VARIABLES[name][1]})
-        for name, arr in arrays.items()
-    }
-    coords = {
+def grid_coordinates(model: Model, e_axis, l_axis) -> dict:
+    """The coordinates ``E``, ``Lambda``, ``segment`` and ``muscle`` of a landscape, with units and names.
+
+    Parameters
+    ----------
+    model : Model
+        Supplies the names of the segments and muscles.
+    e_axis, l_axis : array_like, 1-D
+        Grid axes E and Lambda [m].
+    """
+    return {
         "E": ("E", e_axis, {"units": "m", "long_name": "eccentricity of the spine"}),
         "Lambda": ("Lambda", l_axis, {"units": "m", "long_name": "lordosis: horizontal offset of P3"}),
         "segment": ("segment", list(model.geometry.cor_names), {"long_name": "centre of rotation"}),
         "muscle": ("muscle", list(model.muscle_names), {"long_name": "global muscle"}),
+    }
+
+
+def _dataset(model: Model, e_axis, l_axis, arrays: dict, method: str, per_point: int) -> xr.Dataset:
+    data_vars = {
+        name: xr.Variable(dims_of(name, arr.ndim), arr, {"units": VARIABLES[name][0], "long_name": VARIABLES[name][1]})
+        for name, arr in arrays.items()
+    }
+    coords = grid_coordinates(model, e_axis, l_axis) | {
         "K": ((), model.passive.stiffness, {"units": "N m rad-1", "long_name": "passive stiffness K"}),
     }
     attrs = {
