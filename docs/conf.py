@@ -4,18 +4,22 @@ Build from the repository root (warnings are errors, as in CI)::
 
     python -m sphinx -W --keep-going -b html docs docs/_build/html
 
-Markdown pages go through MyST (myst-nb, which will also render the
+Markdown pages go through MyST (myst-nb, which also executes and renders the
 notebooks); docstrings through autodoc and numpydoc. The reference pages
 (parameters, command line, API) are generated from the code at each build by
-the local extension in ``_ext/spinectl_docs``.
+the local extension in ``_ext/spinectl_docs``, which also copies the notebooks
+of ``notebooks/`` into ``docs/notebooks/``.
 """
 
+import os
 import sys
 from pathlib import Path
 
 DOCS = Path(__file__).resolve().parent
 sys.path.insert(0, str(DOCS / "_ext"))
 sys.path.insert(0, str(DOCS.parent))  # this checkout's spinectl, installed or not
+# the notebooks' kernels too: they inherit this environment
+os.environ["PYTHONPATH"] = os.pathsep.join(filter(None, [str(DOCS.parent), os.environ.get("PYTHONPATH")]))
 
 import spinectl  # noqa: E402
 
@@ -38,7 +42,15 @@ exclude_patterns = ["_build", "_generated", "**/.ipynb_checkpoints"]
 
 # MyST: $...$ and $$...$$ math, \begin{align} environments
 myst_enable_extensions = ["dollarmath", "amsmath"]
-nb_execution_mode = "off"  # notebooks are rendered as stored
+# Notebooks: committed without outputs, executed at every build ("force"), so that
+# the pages always show what the code computes now. "cache" keys on the notebook's
+# cells only, and would show stale figures after a change to spinectl itself;
+# "off" would need outputs in git. A grid of 33 x 33 (2.5 mm) keeps the build to
+# about a minute; SPINECTL_NB_GRID=81 in the environment gives the paper's grid.
+nb_execution_mode = "force"
+nb_execution_timeout = 600  # s per cell
+nb_execution_raise_on_error = True  # a failing notebook fails the build
+os.environ.setdefault("SPINECTL_NB_GRID", "33")
 
 # autodoc + numpydoc
 autodoc_member_order = "bysource"

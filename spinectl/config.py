@@ -139,14 +139,17 @@ def set_parameter(model: Model, dotted: str, value) -> Model:
 
 
 def set_parameters(model: Model, values: dict) -> Model:
-    """Return ``model`` with several parameters replaced at once (validated once, at the end).
+    """Return ``model`` with several parameters replaced at once, validated together.
+
+    Together, because some parameters constrain each other (e.g. ``body.mass_height`` must
+    lie above ``geometry.cor_heights``): one at a time, a valid pair could fail half-way.
 
     Parameters
     ----------
     model : Model
         The parameters to start from.
     values : dict
-        Dotted path (as for :func:`set_parameter`) to new value.
+        New values by dotted path, as in :func:`set_parameter`.
     """
     data = to_dict(model)
     for dotted, value in values.items():

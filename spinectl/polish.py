@@ -147,7 +147,11 @@ def _nonnegative_multipliers(lhs, gradient, active, n_eq, tolerance) -> bool:
     inequality = lhs[:n_ineq][active[:n_ineq]].T
     equality = lhs[n_ineq:].T
     columns = np.concatenate([inequality, equality, -equality], axis=1)
-    if columns.shape[1] == 0:  # nothing active: scipy 1.17's nnls aborts the process on an empty matrix
+    if not (np.all(np.isfinite(columns)) and np.all(np.isfinite(gradient))):
+        return False  # nnls raises on inf/NaN; such a point is no verified optimum
+    if columns.shape[1] == 0:
+        # No active row: stationary iff the gradient vanishes. SciPy's nnls aborts the
+        # interpreter (double free) on a matrix without columns (scipy 1.17; cf. scipy#24866).
         return bool(np.all(np.abs(gradient) <= tolerance))
     multipliers, _ = nnls(columns, -gradient)
     return bool(np.all(np.abs(columns @ multipliers + gradient) <= tolerance))

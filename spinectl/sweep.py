@@ -15,9 +15,9 @@ from pathlib import Path
 
 import numpy as np
 import xarray as xr
-from tqdm.auto import tqdm
+from tqdm import tqdm
 
-from . import __version__, batch, config
+from . import __version__, batch, config, reflex
 from .errors import ParameterError
 from .io import atomic_path
 from .optimise import problem_data
@@ -111,33 +111,68 @@ def sweep(
     if e_axis.ndim != 1 or l_axis.ndim != 1 or e_axis.size * l_axis.size > MAX_GRID_POINTS:
         raise ParameterError("grid", f"must be two 1-D axes with at most {MAX_GRID_POINTS:,} points in all")
     e_grid, l_grid = (a.ravel() for a in np.meshgrid(e_axis, l_axis, indexing="ij"))
-    arrays: dict[str, np.ndarray] = {}  # filled chunk by chunk: no copies of the answer beyond the answer
-    per_point = 0
     disable = None if progress is None else not progress  # None: tqdm shows it on a terminal only
     with tqdm(total=e_grid.size, disable=disable, unit="pt", desc="sweep") as bar:
-        for start in range(0, e_grid.size, int(chunk_size)):
-            part = slice(start, start + int(chunk_size))
-            coeffs = checked_coefficients(model, e_grid[part], l_grid[part])  # raises for bad input
-            data = problem_data(model, coeffs)
-            tol = model.optimisation.ct_tolerance
-            if method == "fast":
-                result = batch.solve_stacked(data, tol)
-                bar.update(len(data.stability))
-            else:
-                result = batch.solve_points(data, tol, progress=bar.update)
-            per_point += result.per_point
-            for name, values in _chunk_columns(result, coeffs).items():
-                if name not in arrays:
-                    arrays[name] = np.empty((e_grid.size,) + values.shape[1:], values.dtype)
-                arrays[name][part] = values
+        options = {"method": method, "chunk_size": chunk_size, "update": bar.update}
+        arrays, per_point = point_columns(model, e_grid, l_grid, **options)
     shape = (e_axis.size, l_axis.size)
     arrays = {name: values.reshape(shape + values.shape[1:]) for name, values in arrays.items()}
     return _dataset(model, e_axis, l_axis, arrays, method, per_point)
 
 
-def _chunk_columns(result: batch.BlockOptimum, coeffs) -> dict[str, np.ndarray]:
+def point_columns(
+    model: Model, eccentricity, lordosis, *, method: str = "fast", chunk_size: int = DEFAULT_CHUNK, update=None
+) -> tuple[dict[str, np.ndarray], int]:
+    """Every variable of :data:`VARIABLES` at the points (E_i, Lambda_i), solved chunk by chunk.
+
+    The fast path solves each chunk of ``chunk_size`` consecutive points as one
+    stacked problem, so the answer depends on the chunking only through the
+    solver's tolerance; the same points in the same chunks give the same bits.
+
+    Parameters
+    ----------
+    model : Model
+        The parameters; ``passive.stiffness`` is K.
+    eccentricity, lordosis : array_like, shape (P,)
+        E and Lambda of each point [m].
+    method : {'fast', 'per-point'}
+    chunk_size : int
+        Points per chunk.
+    update : callable, optional
+        Called with the number of points solved, after each chunk (fast) or point (per-point).
+
+    Returns
+    -------
+    columns : dict of str to numpy.ndarray
+        Each variable with leading dimension P, in the units of its name.
+    per_point : int
+        Points that the per-point reference solved (all of them with ``method='per-point'``).
+    """
+    e_grid, l_grid = np.asarray(eccentricity, float), np.asarray(lordosis, float)
+    update = update or (lambda n: None)
+    arrays: dict[str, np.ndarray] = {}  # filled chunk by chunk: no copies of the answer beyond the answer
+    per_point = 0
+    for start in range(0, e_grid.size, int(chunk_size)):
+        part = slice(start, start + int(chunk_size))
+        coeffs = checked_coefficients(model, e_grid[part], l_grid[part])  # raises for bad input
+        data = problem_data(model, coeffs)
+        tol = model.optimisation.ct_tolerance
+        if method == "fast":
+            result = batch.solve_stacked(data, tol)
+            update(len(data.stability))
+        else:
+            result = batch.solve_points(data, tol, progress=update)
+        per_point += result.per_point
+        for name, values in _chunk_columns(result, coeffs, model).items():
+            if name not in arrays:
+                arrays[name] = np.empty((e_grid.size,) + values.shape[1:], values.dtype)
+            arrays[name][part] = values
+    return arrays, per_point
+
+
+def _chunk_columns(result: batch.BlockOptimum, coeffs, model: Model) -> dict[str, np.ndarray]:
     """The Dataset's variables for one chunk, in the units of their names."""
-    return {
+    return _reflex_columns(model, coeffs, result.pcsa) | {
         "min_pcsa_cm2": m2_to_cm2(result.min_pcsa),
         "pcsa_cm2": m2_to_cm2(result.pcsa),
         "counter_torque_Nm": result.counter_torque,
@@ -150,6 +185,28 @@ def _chunk_columns(result: batch.BlockOptimum, coeffs) -> dict[str, np.ndarray]:
         "gravity_torque_Nm": coeffs.gravity_torque,
         "passive_stiffness_Nm_per_rad": coeffs.passive_stiffness,
         "inertia_kgm2": coeffs.inertia,
+    }
+
+
+def _reflex_columns(model: Model, coeffs, pcsa) -> dict[str, np.ndarray]:
+    """Delayed PD reflex at every point and segment (docs/reflex.md), vectorised.
+
+    The global muscles are active at ``reflex.activation`` times the chosen
+    activation (1: self-stable, no reflex needed; 0: reflex only); the gains
+    follow ``reflex``. The delay margin does not depend on the delay, so
+    ``delay_margin_s > tau`` answers "stable at delay tau" for any tau.
+    Infeasible points (NaN PCSA) get NaN and status 'undefined'.
+    """
+    active = model.reflex.activation * pcsa
+    maps = reflex.landscape(coeffs.stiffness(active), coeffs.damping(active), coeffs.inertia, model.reflex)
+    return {
+        "reflex_kp_Nm_per_rad": maps.kp,
+        "reflex_kd_Nms_per_rad": maps.kd,
+        "delay_margin_s": maps.delay_margin,
+        "delay_margin_pade_s": maps.delay_margin_pade,
+        "delay_margin_status": np.asarray(reflex.STATUS, dtype=object)[maps.delay_margin_status],
+        "stable_at_delay": maps.stable_at_delay,
+        "spine_delay_margin_s": np.min(maps.delay_margin, axis=-1),
     }
 
 
@@ -166,25 +223,55 @@ VARIABLES = {
     "gravity_torque_Nm": ("N m", "torque M_ext of the point mass about CoR k, upright"),
     "passive_stiffness_Nm_per_rad": ("N m rad-1", "passive stiffness K as a torque stiffness (enters dM/dalpha as -K)"),
     "inertia_kgm2": ("kg m2", "moment of inertia theta_k of the upper body about CoR k"),
+    "reflex_kp_Nm_per_rad": ("N m rad-1", "proportional gain kp of the delayed reflex (reflex settings)"),
+    "reflex_kd_Nms_per_rad": ("N m s rad-1", "derivative gain kd of the delayed reflex (reflex settings)"),
+    "delay_margin_s": ("s", "exact delay margin of the reflex loop at reflex.activation x chosen PCSA"),
+    "delay_margin_pade_s": ("s", "Pade estimate of the delay margin at reflex.pade_order"),
+    "delay_margin_status": ("", "finite, delay_independent (inf), unstable_without_delay (0) or undefined (NaN)"),
+    "stable_at_delay": ("", "closed loop stable with the delay reflex.delay (exact)"),
+    "spine_delay_margin_s": ("s", "smallest delay margin over the segments: the delay the whole spine tolerates"),
 }
 """Every data variable: units (UDUNITS) and long name."""
 
 
-def _dims(name: str, ndim: int) -> tuple[str, ...]:
+def dims_of(name: str, ndim: int) -> tuple[str, ...]:
+    """Dimensions of the variable ``name`` on the grid, from the number of its dimensions.
+
+    Parameters
+    ----------
+    name : str
+        A key of :data:`VARIABLES`.
+    ndim : int
+        2 (E, Lambda), 3 (plus segment, or muscle for ``pcsa_cm2``) or 4 (plus segment and muscle).
+    """
     extra = {3: ("muscle",) if name == "pcsa_cm2" else ("segment",), 4: ("segment", "muscle")}
     return ("E", "Lambda") + extra.get(ndim, ())
 
 
-def _dataset(model: Model, e_axis, l_axis, arrays: dict, method: str, per_point: int) -> xr.Dataset:
-    data_vars = {
-        name: xr.Variable(_dims(name, arr.ndim), arr, {"units": VARIABLES[name][0], "long_name": VARIABLES[name][1]})
-        for name, arr in arrays.items()
-    }
-    coords = {
+def grid_coordinates(model: Model, e_axis, l_axis) -> dict:
+    """The coordinates ``E``, ``Lambda``, ``segment`` and ``muscle`` of a landscape, with units and names.
+
+    Parameters
+    ----------
+    model : Model
+        Supplies the names of the segments and muscles.
+    e_axis, l_axis : array_like, 1-D
+        Grid axes E and Lambda [m].
+    """
+    return {
         "E": ("E", e_axis, {"units": "m", "long_name": "eccentricity of the spine"}),
         "Lambda": ("Lambda", l_axis, {"units": "m", "long_name": "lordosis: horizontal offset of P3"}),
         "segment": ("segment", list(model.geometry.cor_names), {"long_name": "centre of rotation"}),
         "muscle": ("muscle", list(model.muscle_names), {"long_name": "global muscle"}),
+    }
+
+
+def _dataset(model: Model, e_axis, l_axis, arrays: dict, method: str, per_point: int) -> xr.Dataset:
+    data_vars = {
+        name: xr.Variable(dims_of(name, arr.ndim), arr, {"units": VARIABLES[name][0], "long_name": VARIABLES[name][1]})
+        for name, arr in arrays.items()
+    }
+    coords = grid_coordinates(model, e_axis, l_axis) | {
         "K": ((), model.passive.stiffness, {"units": "N m rad-1", "long_name": "passive stiffness K"}),
     }
     attrs = {
@@ -195,6 +282,8 @@ def _dataset(model: Model, e_axis, l_axis, arrays: dict, method: str, per_point:
         "points_solved_per_point": per_point,
         "passive_convention": model.passive.convention,
         "activation": model.optimisation.activation,
+        "reflex_delay_s": model.reflex.delay,
+        "reflex_activation": model.reflex.activation,
         "config_toml": config.dump_toml(model),
     }
     return xr.Dataset(data_vars, coords, attrs)

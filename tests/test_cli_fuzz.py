@@ -134,3 +134,60 @@ def test_arguments_that_used_to_escape(fuzz_folder, argv):
     """Each of these once raised SystemExit, a raw exception, or printed two lines."""
     with contextlib.chdir(fuzz_folder):
         check(argv)
+
+
+grid_specs = mostly(
+    st.tuples(st.floats(0, 0.04), st.floats(0.04, 0.08), st.integers(1, 3)).map(lambda t: f"{t[0]!r}:{t[1]!r}:{t[2]}"),
+    st.one_of(
+        st.tuples(st.floats(-0.12, 0.12), st.floats(-0.12, 0.12), st.integers(-1, 3)).map(
+            lambda t: f"{t[0]!r}:{t[1]!r}:{t[2]}"
+        ),
+        st.lists(number_texts, max_size=3).map(":".join),
+    ),
+)
+ANALYSIS_VALUES = {
+    "--E": mostly(st.floats(-0.12, 0.12).map(repr)),
+    "--Lambda": mostly(st.floats(-0.12, 0.12).map(repr)),
+    "--delay": mostly(st.floats(0, 0.5).map(repr)),
+    "--kp": mostly(st.floats(0, 500).map(repr)),
+    "--kd": mostly(st.floats(0, 50).map(repr)),
+    "--activation": mostly(st.floats(0, 1.5).map(repr)),
+    "--pade-order": mostly(st.integers(0, 12).map(str)),
+    "--K": mostly(st.floats(0, 100).map(repr)),
+    "--method": st.sampled_from(["fast", "per-point", "slow"]),
+    "--chunk-size": mostly(st.integers(-1, 20).map(str)),
+    "--config": st.sampled_from(sorted(CONFIG_FILES)),
+}
+ANALYSIS_COMMANDS = {
+    "margins": ["--E", "--Lambda", "--delay", "--kp", "--kd", "--activation", "--pade-order", "--config"],
+    "sweep --out out.nc": ["--K", "--method", "--chunk-size", "--config"],
+    "plot tiny.nc --out figures": ["--E"],  # plot takes no such option: an argparse error
+}
+
+
+@st.composite
+def analysis_arguments(draw) -> list[str]:
+    """The analysis commands with real options and random values; sweeps stay tiny (<= 3 x 3)."""
+    command = draw(st.sampled_from(sorted(ANALYSIS_COMMANDS)))
+    argv = command.split()
+    if argv[0] == "sweep":
+        argv += ["--E", draw(grid_specs), "--Lambda", draw(grid_specs)]
+    for name in draw(st.lists(st.sampled_from(ANALYSIS_COMMANDS[command]), unique=True, max_size=4)):
+        argv += [name, draw(ANALYSIS_VALUES.get(name, number_texts))]
+    return argv
+
+
+@pytest.fixture(scope="module")
+def analysis_folder(fuzz_folder):
+    """The fuzzing folder plus a tiny sweep for 'plot' to read."""
+    with contextlib.chdir(fuzz_folder):
+        assert main(["sweep", "--E", "0:0.08:2", "--Lambda", "0:0.08:2", "--out", "tiny.nc"]) == 0
+    return fuzz_folder
+
+
+@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(analysis_arguments())
+def test_random_arguments_to_the_analysis_commands_never_raise(analysis_folder, argv):
+    """margins, sweep and plot: the same contract, fewer examples (each runs a solver or draws)."""
+    with contextlib.chdir(analysis_folder):
+        check(argv)

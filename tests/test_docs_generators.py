@@ -10,7 +10,7 @@ from spinectl.config import to_dict
 from spinectl.params import Model
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "docs" / "_ext"))
-from spinectl_docs import api, cli, guide, parameters, reproduction  # noqa: E402
+from spinectl_docs import api, cli, guide, notebooks, parameters, reproduction, write_if_changed  # noqa: E402
 
 
 def test_parameters_page_lists_every_parameter_with_its_unit():
@@ -61,6 +61,29 @@ def test_guide_pages_leave_out_the_index_and_the_references(tmp_path):
         (tmp_path / name).write_text("# x\n")
     (tmp_path / "_generated").mkdir()
     assert guide.guide_pages(tmp_path) == ["model", "optimisation", "reflex"]
+
+
+def test_notebooks_are_copied_listed_and_pruned(tmp_path):
+    repository, src = tmp_path / "repo", tmp_path / "repo" / "docs"
+    (repository / "notebooks").mkdir(parents=True)
+    for name in ("02_b.ipynb", "01_a.ipynb"):
+        (repository / "notebooks" / name).write_text(f'{{"name": "{name}"}}')
+    (repository / "notebooks" / "01_a.py").write_text("# the jupytext pair: not a page")
+    (src / "notebooks").mkdir(parents=True)
+    (src / "notebooks" / "00_removed.ipynb").write_text("{}")
+
+    pages = notebooks.copy_notebooks(notebooks.sources(repository), src, write_if_changed)
+
+    assert pages == ["notebooks/01_a", "notebooks/02_b"]
+    assert sorted(p.name for p in (src / "notebooks").iterdir()) == ["01_a.ipynb", "02_b.ipynb"]
+    assert (src / "notebooks" / "02_b.ipynb").read_text() == '{"name": "02_b.ipynb"}'
+    assert notebooks.toctree_markdown(pages).splitlines()[-3:] == ["notebooks/01_a", "notebooks/02_b", "```"]
+
+
+def test_the_notebooks_page_is_a_guide_page_with_their_toctree():
+    docs = Path(__file__).resolve().parents[1] / "docs"
+    assert "notebooks" in guide.guide_pages(docs)
+    assert "```{include} _generated/notebooks-toctree.md" in (docs / "notebooks.md").read_text()
 
 
 def test_reproduction_tables_list_every_landmark_and_free_parameter():

@@ -111,3 +111,22 @@ def test_an_absurd_grid_is_refused_before_any_work(model):
     with pytest.raises(ParameterError) as info:
         sweep.sweep(model, axis, axis)
     assert info.value.field == "grid"
+
+
+def test_delay_margins_in_the_sweep_equal_the_margins_report():
+    """Second path: the per-point ``margins.analyse`` (per-point optimum, python-control
+    alongside) gives the same gains, delay margins and verdicts as the vectorised sweep."""
+    from spinectl import margins
+
+    model = Model()
+    E, L = np.array([0.0, 0.03]), np.array([0.04, 0.08])
+    ds = sweep.sweep(model, E, L, progress=False)
+    for e in E:
+        for lam in L:
+            report = margins.analyse(model, float(e), float(lam))
+            point = ds.sel(E=e, Lambda=lam)
+            for k, seg in enumerate(report.segments):
+                assert point.reflex_kp_Nm_per_rad.values[k] == pytest.approx(seg.kp, rel=1e-6)
+                assert point.delay_margin_s.values[k] == pytest.approx(seg.delay_margin, rel=1e-6)
+                assert bool(point.stable_at_delay.values[k]) == seg.stable_at_delay
+            assert float(point.spine_delay_margin_s) == pytest.approx(min(s.delay_margin for s in report.segments))

@@ -22,6 +22,7 @@ COMMANDS = (
     "sweep_cmd",
     "plot_cmd",
     "reproduce_cmd",
+    "study_cmd",
     "calibrate_cmd",
 )
 """Modules of :mod:`spinectl.cli` that each register one sub-command."""

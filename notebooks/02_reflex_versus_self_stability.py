@@ -1,0 +1,302 @@
+# %% [markdown]
+# # Delayed reflex versus self-stability
+#
+# The paper analyses self-stability only, "the stable performance of a musculoskeletal system without neuronal
+# feedback", and argues for it in the Discussion: "reflexes are delayed by up to 100 ms following a perturbation,
+# and due to the electromechanical processes the force generation of the muscles takes another 50-100 ms.
+# Therefore, maintaining stability with time-delayed reflexive control is challenging [...]. Reflex loops will
+# increase the stability margin and thus reduce the required co-contraction [...]. If the spinal column is already
+# a self-stable system, the reflex delays are much less problematic for stable control."
+#
+# This notebook puts numbers on that paragraph. Each lumbar joint $k$, linearised at the upright posture, is
+#
+# $$
+# \theta_k\,\ddot\alpha = S_k\,\alpha + D_k\,\dot\alpha + u, \qquad
+# u(t) = -\bigl(k_p\,\alpha + k_d\,\dot\alpha\bigr)(t - \tau),
+# $$
+#
+# with the stiffness $S_k = \partial M/\partial\alpha$ (muscles, gravity, passive $K$), the Hill damping
+# $D_k = \partial M/\partial\omega \le 0$ and a delayed PD reflex. Without the reflex the joint is self-stable
+# when $S_k < 0$ (paper, eq. 1). The global muscles work at an **activation** $a$, a fraction of the minimum
+# stabilising PCSA of Figure 3: $a = 0$ is no co-contraction (reflex only), $a = 1$ is self-stable. The reflex
+# follows spinectl's default rule: $k_p = g\max(S_k, 0)$, the stiffness deficit times a gain factor $g > 1$ so
+# that some stiffness is left to spare, and $k_d$ for a given damping ratio of the loop without delay (docs:
+# *Delayed reflexes*; `reflex.gain_factor`, `reflex.damping_ratio`). The **delay margin** $\tau_m$ is
+# the largest delay with the loop stable for every delay below it, computed exactly from the characteristic
+# quasi-polynomial; it is infinite where no delay can destabilise the joint.
+
+# %% tags=["parameters"]
+import os
+
+GRID = int(os.environ.get("SPINECTL_NB_GRID", "81"))  # points per axis over 0-8 cm: 81 is the paper's 1 mm step
+PRESET = os.environ.get("SPINECTL_NB_PRESET", "")  # "": the calibrated "wagner2012" if installed, else "default"
+
+# %%
+# %matplotlib inline
+
+import control as ct
+import matplotlib.pyplot as plt
+import numpy as np
+import pandas as pd
+from matplotlib.colors import ListedColormap
+from matplotlib.patches import Patch
+
+import spinectl
+from spinectl import config, landmarks, margins, optimise, reflex, simulate, sweep, systems
+
+preset = PRESET or ("wagner2012" if "wagner2012" in spinectl.list_presets() else "default")
+model = spinectl.load_preset(preset)
+POSITION = landmarks.OPTIMUM  # (E, Lambda) [m]: the paper's optimum, E = 3 cm, Lambda = 4 cm
+DELAYS = (0.05, 0.10, 0.15)  # s: the paper's "up to 100 ms", and 50 ms either side
+TAU = 0.10  # s: the delay of the critical gain ranges
+names = list(model.geometry.cor_names)
+print(
+    f"preset {preset!r}; reflex gains {model.reflex.gains!r}: gain factor g = {model.reflex.gain_factor:g}, "
+    f"damping ratio {model.reflex.damping_ratio:g}"
+)
+
+# %% [markdown]
+# ## Co-contraction below the self-stable minimum
+#
+# At $E = 3$ cm, $\Lambda = 4$ cm, the activation falls from 1 (the minimum PCSA of Figure 3) to 0. Everything
+# muscular is linear in the PCSA, so the stiffness of each joint is affine in $a$, and each joint turns
+# self-stable at its own activation.
+
+# %%
+optimum = optimise.solve_point(model, *POSITION)
+coeffs = spinectl.segment_coefficients(model, *POSITION)
+activation = np.linspace(0.0, 1.0, 101)
+pcsa = activation[:, None] * optimum.pcsa  # (activation, muscle) [m^2]
+S, D = coeffs.stiffness(pcsa), coeffs.damping(pcsa)  # (activation, segment)
+theta = np.broadcast_to(coeffs.inertia, S.shape)
+kp, kd = reflex.resolve_gains(S, D, theta, model.reflex)
+exact = reflex.delay_margin(S, D, theta, kp, kd)
+kp_low, kp_high = reflex.critical_gains(S, D, theta, kd, TAU)
+
+s_none, s_full = coeffs.stiffness(0.0 * optimum.pcsa), coeffs.stiffness(optimum.pcsa)
+self_stable_from = np.clip(s_none / (s_none - s_full), 0.0, None)  # the activation where S_k = 0
+onsets = ", ".join(f"{name} {a:.3f}" for name, a in zip(names, self_stable_from, strict=True))
+print(f"self-stable from activation a = {onsets}")
+
+# %%
+fig, axes = plt.subplots(2, 2, figsize=(11, 7.5), sharex=True, layout="constrained")
+colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+for k, name in enumerate(names):
+    c = colours[k]
+    axes[0, 0].plot(activation, np.maximum(S[:, k], 0.0), color=c, label=name)
+    axes[0, 0].plot(activation, kp[:, k], "--", color=c)
+    axes[0, 1].plot(activation, kd[:, k], color=c, label=name)
+    margin = np.where(np.isinf(exact.margin[:, k]), np.nan, exact.margin[:, k])
+    axes[1, 0].semilogy(activation, margin, color=c, label=name)
+    axes[1, 0].axvline(self_stable_from[k], color=c, ls=":", lw=1)
+    axes[1, 1].plot(activation, kp_high[:, k], color=c, label=name)
+    axes[1, 1].plot(activation, kp_low[:, k], ":", color=c)
+    axes[1, 1].plot(activation, kp[:, k], "--", color=c)
+for tau in DELAYS:
+    axes[1, 0].axhline(tau, color="grey", lw=0.8)
+    axes[1, 0].annotate(f"{tau * 1e3:g} ms", (0.0, tau), xytext=(2, 2), textcoords="offset points", fontsize=8)
+axes[0, 0].set_title("stiffness deficit max(S, 0) (solid) and reflex gain k_p (dashed)", fontsize=10)
+axes[0, 0].set_ylabel("[N m/rad]")
+axes[0, 1].set_title("derivative gain k_d of the rule", fontsize=10)
+axes[0, 1].set_ylabel("k_d [N m s/rad]")
+axes[1, 0].set_title("delay margin τ_m; dotted: self-stable from here on, τ_m = ∞", fontsize=10)
+axes[1, 0].set_ylabel("τ_m [s]")
+axes[1, 1].set_title(f"stabilising k_p at τ = {TAU * 1e3:g} ms: from (dotted) to (solid); rule (dashed)", fontsize=10)
+axes[1, 1].set_ylabel("k_p [N m/rad]")
+for ax in axes[1]:
+    ax.set_xlabel("activation a [fraction of the minimum PCSA]")
+axes[0, 0].legend(fontsize=8)
+plt.show()
+
+# %% [markdown]
+# The same at five activations, joint by joint: the gains the reflex needs, the delay it tolerates, and the range
+# of $k_p$ that keeps the joint stable at 100 ms (its lower end is always $S_k$: the reflex must at least make up
+# the deficit).
+
+# %%
+rows = []
+for a in (0.0, 0.25, 0.5, 0.75, 1.0):
+    i = int(np.argmin(abs(activation - a)))
+    for k, name in enumerate(names):
+        rows.append(
+            {
+                "activation": activation[i],
+                "segment": name,
+                "S [N m/rad]": S[i, k],
+                "deficit [N m/rad]": max(S[i, k], 0.0),
+                "k_p [N m/rad]": kp[i, k],
+                "k_d [N m s/rad]": kd[i, k],
+                "τ_m [ms]": exact.margin[i, k] * 1e3,
+                "status": exact.status_names[i, k],
+                f"k_p min at {TAU * 1e3:g} ms [N m/rad]": kp_low[i, k],
+                f"k_p max at {TAU * 1e3:g} ms [N m/rad]": kp_high[i, k],
+            }
+        )
+pd.DataFrame(rows).set_index(["activation", "segment"]).round(2)
+
+# %% [markdown]
+# How much co-contraction does each delay need, when the reflex does the rest? The spine tolerates the smallest
+# delay margin of its five joints.
+
+# %%
+spine_margin = exact.margin.min(axis=1)
+for tau in DELAYS:
+    enough = spine_margin > tau
+    needed = f"a = {activation[np.argmax(enough)]:.2f}" if enough.any() else "none up to a = 1"
+    print(f"delay {tau * 1e3:3.0f} ms: least activation with the whole spine stable: {needed} (steps of 0.01)")
+print(f"reflex only (a = 0): the spine tolerates {spine_margin[0] * 1e3:.0f} ms")
+print(f"every joint self-stable, so any delay is tolerated: a >= {self_stable_from.max():.3f}")
+
+# %% [markdown]
+# ## Delay-margin maps over E × Λ
+#
+# Every sweep carries the delay margins of every joint at the model's reflex settings (`delay_margin_s`) and the
+# spine's, the least over the joints (`spine_delay_margin_s`). The margin does not depend on the delay itself, so
+# one sweep per activation answers "stable at delay $\tau$?" for every $\tau$: `spine_delay_margin_s > tau`.
+# Below, three activations (rows) and the three delays of the Discussion (columns).
+
+# %%
+axis = np.linspace(0.0, 0.08, GRID)  # E and Lambda [m]
+ACTIVATIONS = (0.0, 0.25, 0.5)
+maps = {a: sweep.sweep(config.set_parameter(model, "reflex.activation", a), axis, axis) for a in ACTIVATIONS}
+
+palette = ListedColormap(["#d95f02", "#1b9e77", "#bbbbbb"])  # unstable, stable, no self-stable optimum
+fig, axes = plt.subplots(
+    len(ACTIVATIONS), len(DELAYS), figsize=(10, 10), sharex=True, sharey=True, layout="constrained"
+)
+for row, (a, ds) in enumerate(maps.items()):
+    margin = ds["spine_delay_margin_s"].transpose("Lambda", "E").values
+    for col, tau in enumerate(DELAYS):
+        code = np.where(np.isnan(margin), 2, (margin > tau).astype(int))
+        ax = axes[row, col]
+        ax.pcolormesh(axis * 100, axis * 100, code, cmap=palette, vmin=0, vmax=2, shading="nearest")
+        share = np.mean(margin[~np.isnan(margin)] > tau)
+        ax.set_title(f"a = {a:g}, τ = {tau * 1e3:g} ms: {share:.0%} stable", fontsize=10)
+        ax.set_aspect("equal")
+    axes[row, 0].set_ylabel("lordosis Λ [cm]")
+for ax in axes[-1]:
+    ax.set_xlabel("eccentricity E [cm]")
+fig.legend(
+    handles=[Patch(color=palette(i), label=t) for i, t in enumerate(["unstable", "stable", "no optimum"])],
+    loc="outside lower center",
+    ncols=3,
+)
+plt.show()
+
+# %% [markdown]
+# The same sweeps as continuous maps: the spine's delay margin, with the three delays as contours.
+
+# %%
+fig, axes = plt.subplots(1, len(ACTIVATIONS), figsize=(12, 3.9), sharey=True, layout="constrained")
+for ax, (a, ds) in zip(axes, maps.items(), strict=True):
+    margin_ms = ds["spine_delay_margin_s"].transpose("Lambda", "E").values * 1e3
+    filled = ax.contourf(axis * 100, axis * 100, np.ma.masked_invalid(margin_ms), levels=12, cmap="viridis")
+    fig.colorbar(filled, ax=ax, label="spine delay margin [ms]")
+    if np.nanmin(margin_ms) < max(DELAYS) * 1e3 and np.nanmax(margin_ms) > min(DELAYS) * 1e3:
+        lines = ax.contour(axis * 100, axis * 100, margin_ms, levels=[t * 1e3 for t in DELAYS], colors="white")
+        ax.clabel(lines, fmt="%g ms", fontsize=8)
+    ax.set_title(f"activation a = {a:g}", fontsize=10)
+    ax.set_xlabel("eccentricity E [cm]")
+    ax.set_aspect("equal")
+axes[0].set_ylabel("lordosis Λ [cm]")
+plt.show()
+
+# %%
+pd.DataFrame(
+    {
+        "spine τ_m, least [ms]": [float(ds.spine_delay_margin_s.min()) * 1e3 for ds in maps.values()],
+        "spine τ_m, largest [ms]": [float(ds.spine_delay_margin_s.max()) * 1e3 for ds in maps.values()],
+        **{
+            f"stable at {tau * 1e3:g} ms [% of grid]": [
+                100 * float((ds.spine_delay_margin_s > tau).mean()) for ds in maps.values()
+            ]
+            for tau in DELAYS
+        },
+    },
+    index=pd.Index(ACTIVATIONS, name="activation"),
+).round(1)
+
+# %% [markdown]
+# ## Time-domain responses
+#
+# The nonlinear equation of motion of one joint (paper, Methods) with the reflex and its true delay, released from
+# a small tilt. At half the minimum PCSA, the joint with the least delay margin. Left: below self-stability, with
+# the reflex at 0.8 $\tau_m$ and at 1.2 $\tau_m$, and without it. Right: the same joint with the muscles a quarter
+# above the self-stable minimum, with the same reflex at the longer delay, and without it.
+
+# %%
+HALF = 0.5  # activation [fraction of the minimum PCSA]
+report = margins.analyse(config.set_parameter(model, "reflex.activation", HALF), *POSITION)
+limiting = min(report.segments, key=lambda s: s.delay_margin)
+tau_m = limiting.delay_margin
+low_plant = simulate.segment_plant(model, *POSITION, limiting.name, report.point.pcsa)
+high_plant = simulate.segment_plant(model, *POSITION, limiting.name, 1.25 * optimum.pcsa)
+gains = ([limiting.kp, limiting.kp, 0.0], [limiting.kd, limiting.kd, 0.0])
+low = simulate.simulate(low_plant, *gains, [0.8 * tau_m, 1.2 * tau_m, 0.0], model.reflex)
+high = simulate.simulate(high_plant, limiting.kp, limiting.kd, [1.2 * tau_m, 0.0], model.reflex)
+high_no_reflex = simulate.simulate(high_plant, 0.0, 0.0, 0.0, model.reflex)
+
+labels = [f"reflex, τ = 0.8 τ_m = {0.8 * tau_m * 1e3:.0f} ms", f"reflex, τ = 1.2 τ_m = {1.2 * tau_m * 1e3:.0f} ms"]
+fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4), sharey=True, layout="constrained")
+for i, label in enumerate([*labels, "no reflex"]):
+    left.plot(low.time, low.alpha[i] * 1e3, label=f"{label} ({'stable' if low.stable[i] else 'unstable'})")
+right.plot(high.time, high.alpha[1] * 1e3, label=f"{labels[1]} ({'stable' if high.stable[1] else 'unstable'})")
+right.plot(
+    high_no_reflex.time,
+    high_no_reflex.alpha[0] * 1e3,
+    label=f"no reflex ({'stable' if high_no_reflex.stable[0] else 'unstable'})",
+)
+limit = 3 * model.reflex.sim_perturbation * 1e3
+left.set_title(f"{limiting.name}, a = {report.point.activation:g}: τ_m = {tau_m * 1e3:.0f} ms", fontsize=10)
+right.set_title(f"{limiting.name}, 1.25 × minimum PCSA (self-stable)", fontsize=10)
+left.set_ylabel("tilt α [mrad]")
+for ax in (left, right):
+    ax.set_ylim(-limit, limit)
+    ax.set_xlabel("time [s]")
+    ax.legend(fontsize=8, loc="lower right")
+plt.show()
+
+# %% [markdown]
+# ## The loop in the frequency domain
+#
+# The same joint as a python-control system: the loop $L(s) = (k_p + k_d s)\,e^{-s\tau}\,G(s)$ with the delay as a
+# Padé approximant, at the model's delay. Below self-stability $G$ has a pole in the right half plane, so by the
+# Nyquist criterion the closed loop is stable when the curve circles $-1$ once counter-clockwise; a longer delay
+# turns the curve further, until at $\tau_m$ it passes through $-1$.
+
+# %%
+delay = model.reflex.delay
+loop = systems.loop_transfer(
+    limiting.stiffness, limiting.damping, limiting.inertia, limiting.kp, limiting.kd, delay, model.reflex.pade_order
+)
+bode = ct.bode_plot(loop, omega_limits=(0.1, 100.0), title=f"{limiting.name}: L(jω), τ = {delay * 1e3:g} ms")
+bode.axes[0, 0].set_ylabel("|L(jω)| [1]")
+plt.show()
+nyquist = ct.nyquist_plot(loop, title=f"{limiting.name}: Nyquist plot of L, τ = {delay * 1e3:g} ms")
+nyquist.axes[0, 0].set_xlabel("Re L(jω) [1]")
+nyquist.axes[0, 0].set_ylabel("Im L(jω) [1]")
+plt.show()
+
+# %% [markdown]
+# Every joint's margins at this configuration (`spinectl margins` prints the same): the exact delay margin and its
+# Padé estimate, the phase margin at the delay, the range of a common factor on both gains that keeps the loop
+# stable (python-control's gain margins, read for an open-loop unstable plant), and the stabilising $k_p$.
+
+# %%
+pd.DataFrame(
+    {
+        "S [N m/rad]": s.stiffness,
+        "D [N m s/rad]": s.damping,
+        "θ [kg m²]": s.inertia,
+        "k_p [N m/rad]": s.kp,
+        "k_d [N m s/rad]": s.kd,
+        "τ_m [ms]": s.delay_margin * 1e3,
+        "τ_m, Padé [ms]": s.delay_margin_pade * 1e3,
+        f"phase margin at {delay * 1e3:g} ms [°]": s.phase_margin_deg,
+        "gain factor, lower [1]": s.gain_margin_lower,
+        "gain factor, upper [1]": s.gain_margin,
+        f"k_p range at {delay * 1e3:g} ms [N m/rad]": f"{s.kp_min:.1f} to {s.kp_max:.1f}",
+        "stable": s.stable_at_delay,
+    }
+    for s in report.segments
+).set_index(pd.Index(names, name="segment")).round(3)

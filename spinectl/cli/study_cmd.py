@@ -1,0 +1,76 @@
+"""``spinectl study``: a parameter study from a study file, chunk by chunk on Dask, into a Zarr store."""
+
+from __future__ import annotations
+
+import argparse
+
+
+def register(sub) -> None:
+    """Add the ``study`` sub-command to the ``spinectl`` parser.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The sub-command action of :func:`spinectl.cli.build_parser`.
+    """
+    parser = sub.add_parser(
+        "study",
+        help="a parameter study (axes, samples) on Dask into a resumable Zarr store",
+        description="Solve the sweep's problems over the E x Lambda grid and every parameter axis and "
+        "Monte-Carlo draw of STUDY.toml (docs/studies.md), chunk by chunk, on a local Dask cluster or an "
+        "existing one, writing each chunk to a Zarr store as it finishes.",
+    )
+    parser.add_argument("study", metavar="STUDY.toml", help="the study file")
+    parser.add_argument("--out", required=True, metavar="STORE.zarr", help="the Zarr store (a folder)")
+    parser.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        help="an existing dask.distributed scheduler, e.g. tcp://host:8786, or 'synchronous' for "
+        "in-process (default: a local cluster on 127.0.0.1, started and closed by the command)",
+    )
+    parser.add_argument("--workers", type=_positive_int, metavar="N", help="local worker processes (default: cores)")
+    parser.add_argument("--resume", action="store_true", help="continue the study in --out, skipping chunks done")
+    parser.add_argument(
+        "--max-chunks", type=_count, metavar="N", help="stop after N chunks (continue later with --resume)"
+    )
+    parser.set_defaults(func=run)
+
+
+def _integer(text: str, low: int, name: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{name} must be an integer (got {text!r})") from None
+    if value < low:
+        raise argparse.ArgumentTypeError(f"{name} must be >= {low} (got {text!r})")
+    return value
+
+
+def _positive_int(text: str) -> int:
+    return _integer(text, 1, "--workers")
+
+
+def _count(text: str) -> int:
+    return _integer(text, 0, "--max-chunks")
+
+
+def run(args) -> int:
+    """Run ``spinectl study``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments (see :func:`register`).
+
+    Returns
+    -------
+    int
+        Exit code 0 (also when ``--max-chunks`` stopped the study early).
+    """
+    from .. import study  # dask and zarr only for this command
+
+    spec = study.load_study(args.study)
+    options = {"scheduler": args.scheduler, "workers": args.workers, "resume": args.resume}
+    result = study.run_study(spec, args.out, max_chunks=args.max_chunks, **options)
+    print(study.describe(result))
+    return 0
