@@ -216,6 +216,8 @@ def run_study(
             for index, outputs in executor.run(tasks(study, todo), f"spinectl-{study.digest()[:16]}"):
                 writer.write(study.chunk(index), outputs)
                 bar.update()
+    if np.all(done > 0):
+        store.consolidate(out)
     seconds = time.perf_counter() - start
     return StudyResult(Path(out), study.n_chunks, done_before, todo.size, seconds, executor.where, executor.addresses)
 
