@@ -396,3 +396,21 @@ def test_cli_bad_study_file_is_one_line(tmp_path, capsys):
     assert main(["study", str(tmp_path / "missing.toml"), "--out", str(tmp_path / "s.zarr")]) == 2
     assert "study: file not found" in capsys.readouterr().err
     assert not (tmp_path / "s.zarr").exists()
+
+
+def test_a_finished_store_opens_with_plain_xarray_without_warnings(tmp_path):
+    """After the last chunk the metadata is consolidated: xarray.open_zarr needs no options."""
+    import warnings
+
+    from spinectl.study import load_study, run_study
+
+    path = tmp_path / "s.toml"
+    path.write_text(
+        '[study]\npreset = "default"\noutputs = ["min_pcsa_cm2"]\n'
+        "[axes]\nE = { start = 0.0, stop = 0.08, num = 3 }\nLambda = { start = 0.0, stop = 0.08, num = 3 }\n"
+    )
+    run_study(load_study(path), tmp_path / "s.zarr", scheduler="synchronous", progress=False)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        ds = xr.open_zarr(tmp_path / "s.zarr")
+    assert ds.min_pcsa_cm2.shape == (3, 3)

@@ -46,7 +46,7 @@ ADDRESS = re.compile(r"^(tcp|tls|ucx|inproc|ws|wss)://\S+$")
 CONNECT_TIMEOUT = 10.0
 """Seconds to wait for a remote scheduler before giving up [s]."""
 
-KEEP_MALLOC = "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_"
+MALLOC_TRIM_SETTING = "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_"
 """Dask sets ``MALLOC_TRIM_THRESHOLD_=65536`` in its workers so that glibc hands freed memory back at
 once; the fast path allocates and frees many arrays of a few hundred kB per chunk and then runs about
 15 % slower (measured on one chunk of 4010 points). Local workers keep glibc's own threshold; a chunk's
@@ -216,6 +216,8 @@ def run_study(
             for index, outputs in executor.run(tasks(study, todo), f"spinectl-{study.digest()[:16]}"):
                 writer.write(study.chunk(index), outputs)
                 bar.update()
+    if np.all(done > 0):
+        store.consolidate(out)
     seconds = time.perf_counter() - start
     return StudyResult(Path(out), study.n_chunks, done_before, todo.size, seconds, executor.where, executor.addresses)
 
@@ -297,11 +299,15 @@ def _executor(scheduler: str | None, workers: int | None, n_todo: int, connect_t
     from distributed import Client, LocalCluster
 
     if scheduler is not None:
-        with _connected(Client, scheduler, connect_timeout) as client:
+        try:
+            client = Client(scheduler, timeout=connect_timeout, set_as_default=False)
+        except (OSError, TimeoutError) as exc:
+            raise ParameterError("scheduler", f"cannot connect to {scheduler}: {exc}") from None
+        with client:
             yield _Distributed(client, scheduler)
         return
     n = min(workers or _cores(), n_todo)
-    with dask.config.set({KEEP_MALLOC: None}):  # unset in the workers' environment, see KEEP_MALLOC
+    with dask.config.set({MALLOC_TRIM_SETTING: None}):  # unset in the workers' environment, see MALLOC_TRIM_SETTING
         cluster = LocalCluster(
             n_workers=n,
             threads_per_worker=1,  # cvxpy is not thread-safe; one process per worker
@@ -318,16 +324,6 @@ def _executor(scheduler: str | None, workers: int | None, n_todo: int, connect_t
 def _ignore_interrupts() -> None:
     """In a local worker: leave Ctrl-C to the command, which closes the cluster (no worker tracebacks)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-
-
-@contextlib.contextmanager
-def _connected(client_class, address: str, timeout: float):
-    try:
-        client = client_class(address, timeout=timeout, set_as_default=False)
-    except (OSError, TimeoutError) as exc:
-        raise ParameterError("scheduler", f"cannot connect to {address}: {exc}") from None
-    with client:
-        yield client
 
 
 def describe(result: StudyResult) -> str:

@@ -270,7 +270,7 @@ class Study:
     outputs : tuple of str
         Variables of :data:`spinectl.sweep.VARIABLES` to keep (default: all).
     chunk_size : int
-        Grid points per chunk (whole rows of E where a row fits).
+        Grid points per chunk: tiles of whole rows (every Lambda of some E) where a row fits.
     description : str
         Free text, stored with the results.
     text : str
@@ -290,6 +290,11 @@ class Study:
     def __post_init__(self):
         if not isinstance(self.model, Model):
             raise ParameterError("study.model", f"must be a Model (got {show(self.model)})")
+        if self.samples is not None and not isinstance(self.samples, Samples):
+            raise ParameterError("study.samples", f"must be Samples or None (got {show(self.samples)})")
+        if not all(isinstance(a, Axis) for a in self.axes):
+            raise ParameterError("study.axes", f"must be a sequence of Axis (got {show(self.axes)})")
+        object.__setattr__(self, "axes", tuple(self.axes))
         for name, axis in zip(GRID, (self.eccentricity, self.lordosis), strict=True):
             object.__setattr__(self, "eccentricity" if name == "E" else "lordosis", self._grid_axis(name, axis))
         if len(self.eccentricity) * len(self.lordosis) > sweep.MAX_GRID_POINTS:
@@ -316,7 +321,7 @@ class Study:
         if not names:
             raise ParameterError("study.outputs", "must name at least one variable")
         for i, name in enumerate(names):
-            if name not in sweep.VARIABLES:
+            if not isinstance(name, str) or name not in sweep.VARIABLES:
                 raise ConfigError(f"study.outputs[{i}]", _unknown_message(str(name), sweep.VARIABLES))
         return tuple(dict.fromkeys(names))
 

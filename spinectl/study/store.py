@@ -235,6 +235,21 @@ class Writer:
         self._flags[chunk.index] = self.done[chunk.index]
 
 
+def consolidate(path: str | Path) -> None:
+    """Consolidate the metadata of a finished store.
+
+    Chunks are written with ``consolidated=False`` (region writes); once every
+    chunk is done nothing changes the metadata again, so consolidating lets a
+    plain ``xarray.open_zarr(path)`` open the store quickly and without a warning.
+
+    Parameters
+    ----------
+    path : str or Path
+        The store.
+    """
+    zarr.consolidate_metadata(str(path))
+
+
 def open_store(path: str | Path) -> xr.Dataset:
     """A study store as a lazy Dataset (dask arrays; nothing read until asked).
 
