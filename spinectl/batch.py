@@ -174,15 +174,20 @@ def feasible_points(data: ProblemData) -> np.ndarray | None:
     return v[:, -1] <= optimise.SLAB_FACTOR * tol * (1.0 + np.abs(data.stability_bound).max(axis=-1))
 
 
-def _stages(data: ProblemData, ct_tolerance: float, first=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _stages(
+    data: ProblemData, ct_tolerance: float, first=None, min_pcsa_only: bool = False
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Stages 1-3 for a block of feasible points: minimum total, chosen x [cm^2], mask of good points.
 
     ``first``: the result of stage 1 for this block, if already solved.
+    ``min_pcsa_only``: stop after stage 1 (x is then a minimum-PCSA activation).
     """
     failed = (*_unsolved(data), np.zeros(len(data.stability), bool))
     status, x, good = _stage(data, "min_pcsa") if first is None else first
     if not good.any():
         return failed
+    if min_pcsa_only:
+        return x @ data.weights, np.maximum(x, 0.0), good
     total = x @ data.weights
     limit = np.where(good, total, 0.0) * (1.0 + ct_tolerance)  # keeps bad points finite for the solver
     status, x_ct, good_ct = _stage(data, "counter_torque", limit)
@@ -192,7 +197,7 @@ def _stages(data: ProblemData, ct_tolerance: float, first=None) -> tuple[np.ndar
     return total, np.maximum(x, 0.0), good & good_ct & good_tie
 
 
-def solve_stacked(data: ProblemData, ct_tolerance: float) -> BlockOptimum:
+def solve_stacked(data: ProblemData, ct_tolerance: float, *, min_pcsa_only: bool = False) -> BlockOptimum:
     """Stages 1-3 for a block of points (leading dimension P), stacked; the fast path.
 
     Only a block whose stage 1 is infeasible pays for :func:`feasible_points`.
@@ -206,6 +211,11 @@ def solve_stacked(data: ProblemData, ct_tolerance: float) -> BlockOptimum:
         A block of points (leading dimension P).
     ct_tolerance : float
         Relative band on the minimum total PCSA [1].
+    min_pcsa_only : bool
+        Solve stage 1 only (about a fifth of the time): ``min_pcsa`` is exact, but
+        ``pcsa`` and ``counter_torque`` belong to a minimum-PCSA activation, not
+        to the one of least ||CT|| (the calibration's K = 15 landscapes need
+        only the minimum).
     """
     n_points = len(data.stability)
     status = np.full(n_points, "optimal", dtype=object)
@@ -219,7 +229,7 @@ def solve_stacked(data: ProblemData, ct_tolerance: float) -> BlockOptimum:
             status[~mask] = "infeasible"
     good = np.zeros(n_points, bool)
     if feasible.size:
-        total[feasible], x[feasible], good[feasible] = _stages(data.point(feasible), ct_tolerance, first)
+        total[feasible], x[feasible], good[feasible] = _stages(data.point(feasible), ct_tolerance, first, min_pcsa_only)
     redo = np.flatnonzero(~good & (status != "infeasible"))
     if redo.size:
         status[redo], total[redo], x[redo] = _per_point(data.point(redo), ct_tolerance)

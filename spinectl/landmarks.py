@@ -29,6 +29,15 @@ Figure 4, position C") and puts C on the ridge Lambda ~ 1.7 E (Results), which
 the corner (8 cm, 8 cm) is not on; the C-ratios are therefore reported for both readings.
 """
 
+RIDGE_SLOPE = 1.7
+"""Slope of the paper's ridge of minimum PCSA, Lambda = 1.7 E (paper, Results)."""
+
+RIDGE_C = (POSITIONS["C"][1] / RIDGE_SLOPE, POSITIONS["C"][1])
+"""(E, Lambda) [m] of position C read on the ridge line: where Lambda = 1.7 E reaches the top
+edge of the grid, Lambda = 8 cm (paper, Results: the line runs "crossing the locations marked
+with A and C", which the corner (8 cm, 8 cm) is not on). A third reading of C, beside the corner
+and the text's optimum (:data:`OPTIMUM`)."""
+
 CT_LIMIT = 30.0
 """Realistic maximum of the local muscles' counter torque [N m] (paper, Discussion: +-30 N m)."""
 
@@ -221,7 +230,7 @@ LANDMARKS: tuple[Landmark, ...] = (
     ),
     Landmark(
         "ridge_slope",
-        1.7,
+        RIDGE_SLOPE,
         "~",
         "1",
         "Lambda/E of the per-E maximum of the minimum PCSA (fit through 0)",
@@ -301,6 +310,24 @@ LANDMARKS: tuple[Landmark, ...] = (
         _ct_ratio(POSITIONS["B"], OPTIMUM),
     ),
     Landmark(
+        "ct_D_over_C_ridge",
+        2.0,
+        "~",
+        "1",
+        "‖CT‖ at D / at C read on the ridge line (E = 8/1.7, Lambda = 8 cm)",
+        "Results, with C where the line Lambda = 1.7 E 'crossing the locations marked with A and C' leaves the grid",
+        _ct_ratio(POSITIONS["D"], RIDGE_C),
+    ),
+    Landmark(
+        "ct_B_over_C_ridge",
+        3.0,
+        "~",
+        "1",
+        "‖CT‖ at B / at C read on the ridge line (E = 8/1.7, Lambda = 8 cm)",
+        "Results, with C on the ridge line as above",
+        _ct_ratio(POSITIONS["B"], RIDGE_C),
+    ),
+    Landmark(
         "optimum_lordosis",
         4.0,
         "~",
@@ -347,7 +374,7 @@ LANDMARKS: tuple[Landmark, ...] = (
     ),
     Landmark(
         "ridge_slope_K15",
-        1.7,
+        RIDGE_SLOPE,
         "~",
         "1",
         "ridge slope as above, K = 15 N m/rad",

@@ -9,13 +9,11 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-import numpy as np
-
-from . import landmarks
+from . import landmarks, reproduction
 from .landmarks import Measurement
+from .reproduction import RELATION
+from .reproduction import format_number as _number
 from .units import m2_to_cm2
-
-RELATION = {"~": "≈", "=": "=", "<": "<", ">": ">"}
 
 
 @dataclass(frozen=True)
@@ -37,6 +35,8 @@ class Run:
         Files written, relative to the output folder.
     specific_tension : float
         f_iso per PCSA [N/m^2], for the local-muscle equivalent of CT.
+    calibrated : bool
+        Whether the parameters are the calibrated preset of docs/reproduction.md.
     """
 
     preset: str
@@ -46,18 +46,14 @@ class Run:
     seconds: float
     files: tuple[str, ...]
     specific_tension: float
-
-
-def _number(value: float) -> str:
-    if not np.isfinite(value):
-        return "n/a"
-    if value != 0 and (abs(value) < 1e-3 or abs(value) >= 1e4):
-        return f"{value:.2e}"
-    return f"{value:.3g}"
+    calibrated: bool = False
 
 
 def landmark_table(measurements: Sequence[Measurement]) -> str:
-    """The landmark table as Markdown: name, paper, spinectl, unit, agrees, how measured, where in the paper.
+    """The landmark table as Markdown: name, paper, spinectl, unit, agrees, verdict, how measured, where.
+
+    The verdict is that of docs/reproduction.md for the calibrated preset
+    (:func:`spinectl.reproduction.verdict_cell`), flagged where this run's value differs.
 
     Parameters
     ----------
@@ -65,14 +61,15 @@ def landmark_table(measurements: Sequence[Measurement]) -> str:
         From :func:`spinectl.landmarks.measure`.
     """
     lines = [
-        "| landmark | paper | spinectl | unit | agrees | how spinectl measures it | where the paper says it |",
-        "| --- | --- | --- | --- | --- | --- | --- |",
+        f"| landmark | paper | spinectl | unit | agrees | verdict for `{reproduction.PRESET}` "
+        "(docs/reproduction.md) | how spinectl measures it | where the paper says it |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
     for m in measurements:
         mark = m.landmark
         lines.append(
             f"| `{mark.name}` | {RELATION[mark.relation]} {_number(mark.paper)} | {_number(m.value)} | {mark.unit} "
-            f"| {'yes' if m.agrees else '**no**'} | {mark.how} | {mark.where} |"
+            f"| {'yes' if m.agrees else '**no**'} | {reproduction.verdict_cell(m)} | {mark.how} | {mark.where} |"
         )
     return "\n".join(lines)
 
@@ -102,8 +99,26 @@ def _halving(measurements: Sequence[Measurement], run: Run) -> str:
         f"With K = {landmarks.PAPER_STIFFNESS:g} N m/rad the largest minimum PCSA falls to "
         f"{_number(own)} of its K = 0 value with the model's `{run.convention}` convention and to "
         f"{_number(other)} with the `{run.other_convention}` convention; the paper reports a halving (0.5). "
-        f"With these parameters `{closer}` comes closer; which convention reproduces the halving is "
-        "for the calibration to settle, since both ratios depend on the uncalibrated parameters."
+        f"With these parameters `{closer}` comes closer; docs/errata.md (eq. 2) compares the conventions "
+        "after calibrating with each."
+    )
+
+
+def _provenance(run: Run) -> str:
+    if run.calibrated:
+        return (
+            "The parameters the paper does not state (upper-body mass, muscle attachment\n"
+            "points, fibre spread) are **calibrated** against the landmarks below in this\n"
+            "preset (`spinectl calibrate`; docs/reproduction.md gives the loss, the anatomical\n"
+            "bounds and the reason for every verdict). A landmark that does not agree is\n"
+            "either a compromise of the fit or one the model cannot reproduce whatever its\n"
+            "parameters; the verdict column says which."
+        )
+    return (
+        "These parameters are **not** the calibrated preset: the landmarks below are\n"
+        "reported as they are, not tuned, and the verdict column (which documents the\n"
+        f"calibrated `{reproduction.PRESET}` preset) flags every value that differs from it.\n"
+        f"`spinectl reproduce` without `--preset` or `--config` runs `{reproduction.PRESET}`."
     )
 
 
@@ -128,11 +143,7 @@ Parameters: {run.preset}. Wall time: {run.seconds:.1f} s.
 
 ## Read this first
 
-The parameters the paper does not state (upper-body mass, muscle attachment
-points, fibre spread) are set from anatomy in the `default` preset and are
-**not yet calibrated** against the paper's landmarks. Many landmarks below
-therefore do not match yet; they are reported as they are, not tuned. The
-calibration issue fits those parameters to this table.
+{_provenance(run)}
 
 **{agree} of {len(measurements)} landmarks agree** with the paper.
 

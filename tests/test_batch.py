@@ -57,6 +57,19 @@ def test_fast_path_equals_the_reference(model, variant):
         assert "infeasible" in set(fast.status) and "optimal" in set(fast.status)
 
 
+@pytest.mark.parametrize("variant", ["paired", "bounded"])
+def test_min_pcsa_only_gives_the_same_minimum(model, variant):
+    """Stage 1 alone (the calibration's K = 15 landscapes) gives the full path's minimum PCSA, infeasible
+    points included; its activation is a minimum-PCSA one (total equal to the minimum)."""
+    m = _variants(model)[variant]
+    data = _data(m)
+    full = batch.solve_stacked(data, m.optimisation.ct_tolerance)
+    first = batch.solve_stacked(data, m.optimisation.ct_tolerance, min_pcsa_only=True)
+    assert list(first.status) == list(full.status)
+    np.testing.assert_allclose(first.min_pcsa, full.min_pcsa, rtol=RTOL, equal_nan=True)
+    np.testing.assert_allclose(first.pcsa.sum(axis=1), first.min_pcsa, rtol=RTOL, equal_nan=True)
+
+
 def test_a_failing_block_falls_back_to_the_reference(model, monkeypatch):
     data = _data(model)
     ref = batch.solve_points(data, model.optimisation.ct_tolerance)

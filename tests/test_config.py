@@ -85,6 +85,17 @@ def test_set_parameter(model):
         config.set_parameter(model, "body.mass", math.nan)
 
 
+def test_set_parameters_validates_once_at_the_end(model):
+    """Moving a muscle wholly above its old upper attachment: one path at a time would pass through a
+    muscle whose lower end lies above its upper end (invalid); all at once it is valid."""
+    moved = {"muscles.0.lower.1": 0.30, "muscles.0.upper.1": 0.40}
+    m = config.set_parameters(model, moved)
+    assert m.muscles[0].lower == (0.12, 0.30) and m.muscles[0].upper == (0.12, 0.40)
+    with pytest.raises(ParameterError, match="must lie above lower"):
+        config.set_parameter(model, "muscles.0.lower.1", 0.30)
+    assert config.set_parameters(model, {"body.mass": 30.0}) == config.set_parameter(model, "body.mass", 30.0)
+
+
 def _parameter_fields():
     model = Model()
     for section in dataclasses.fields(Model):

@@ -10,7 +10,7 @@ from spinectl.config import to_dict
 from spinectl.params import Model
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "docs" / "_ext"))
-from spinectl_docs import api, cli, guide, notebooks, parameters, write_if_changed  # noqa: E402
+from spinectl_docs import api, cli, guide, notebooks, parameters, reproduction, write_if_changed  # noqa: E402
 
 
 def test_parameters_page_lists_every_parameter_with_its_unit():
@@ -84,3 +84,17 @@ def test_the_notebooks_page_is_a_guide_page_with_their_toctree():
     docs = Path(__file__).resolve().parents[1] / "docs"
     assert "notebooks" in guide.guide_pages(docs)
     assert "```{include} _generated/notebooks-toctree.md" in (docs / "notebooks.md").read_text()
+
+
+def test_reproduction_tables_list_every_landmark_and_free_parameter():
+    """docs/reproduction.md's tables: one row per landmark (with its verdict) and per free parameter
+    (with its bounds and the preset's value, read from the preset file)."""
+    from spinectl import calibration, landmarks
+    from spinectl import reproduction as verdicts
+
+    table = reproduction.landmark_table()
+    for mark in landmarks.LANDMARKS:
+        row = next(line for line in table.splitlines() if line.startswith(f"| `{mark.name}` |"))
+        assert verdicts.VERDICTS[mark.name].verdict in row
+    params = reproduction.parameter_table()
+    assert all(f"| `{p.name}` | {p.unit} | {p.lower:g} | {p.upper:g} |" in params for p in calibration.FREE_PARAMETERS)

@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import xarray as xr
 
-from spinectl import landmarks, report
+from spinectl import landmarks, report, reproduction
 
 AXIS = np.linspace(0.0, 0.08, 9)
 
@@ -26,12 +28,25 @@ RUN = report.Run("preset `default`", "physical", "paper", 9, 1.0, ("landscapes.n
 def test_report_is_honest_and_complete():
     measured = _measurements()
     text = report.render(measured, RUN)
-    assert "not yet calibrated" in text
+    assert "are **not** the calibrated preset" in text and "**calibrated**" not in text
     assert f"{sum(m.agrees for m in measured)} of {len(measured)} landmarks agree" in text
     rows = [line for line in text.splitlines() if line.startswith("| `")]
     assert len(rows) == len(landmarks.LANDMARKS)
-    assert all(row.count("|") == 8 for row in rows)  # no stray pipes (e.g. ||CT||) breaking the table
+    assert all(row.count("|") == 9 for row in rows)  # no stray pipes (e.g. ||CT||) breaking the table
     assert "`physical`" in text and "`paper`" in text and "[`report.md`](report.md)" in text
+
+
+def test_report_of_the_calibrated_preset_gives_the_documented_verdicts():
+    """Each row carries the verdict of docs/reproduction.md; a value that differs from the documented one
+    is flagged (these constructed landscapes are not the preset)."""
+    measured = _measurements()
+    text = report.render(measured, dataclasses.replace(RUN, calibrated=True))
+    assert "**calibrated**" in text
+    for m in measured:
+        row = next(line for line in text.splitlines() if line.startswith(f"| `{m.landmark.name}` |"))
+        documented = reproduction.VERDICTS[m.landmark.name]
+        assert documented.verdict in row
+        assert ("documented for `wagner2012`" in row) == (not documented.holds(m.value))
 
 
 def test_halving_names_the_closer_convention():

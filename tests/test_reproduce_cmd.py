@@ -7,9 +7,12 @@ import pytest
 from spinectl import plotting, sweep
 from spinectl.cli import main
 
+OTHER = "landscape_K15_physical.nc"
+"""The K = 15 landscape of the convention that the default preset, wagner2012 (convention 'paper'), does not use."""
+
 EXPECTED = {
     "landscapes.nc",
-    "landscape_K15_paper.nc",
+    OTHER,
     "fig3_min_pcsa.png",
     "fig4_counter_torque.png",
     "figS1_min_pcsa_K15.png",
@@ -28,10 +31,11 @@ def test_reproduce_writes_everything(tmp_path, capsys):
     ds = sweep.load(out / "landscapes.nc")
     assert list(ds["K"].values) == [0.0, 15.0] and ds.sizes["E"] == 5
     assert float(ds["counter_torque_norm_Nm"].sel(K=0.0, E=0.0, Lambda=0.0)) < 1e-9  # CT = 0 at A (paired)
-    assert "| `min_pcsa_A` |" in (out / "report.md").read_text()
+    text = (out / "report.md").read_text()
+    assert "| `min_pcsa_A` |" in text and "Parameters: preset `wagner2012`" in text and "**calibrated**" in text
     assert [p.split("/")[-1] for p in capsys.readouterr().out.split()] == [
         "landscapes.nc",
-        "landscape_K15_paper.nc",
+        OTHER,
         *plotting.figure_names(0.0),
         *plotting.figure_names(15.0),
         "report.md",
@@ -53,3 +57,10 @@ def test_a_failure_leaves_the_output_folder_untouched(tmp_path, monkeypatch, cap
 def test_reproduce_rejects_a_degenerate_grid(tmp_path, capsys):
     assert main(["reproduce", "--out", str(tmp_path), "--points", "1"]) == 2
     assert "--points: must be >= 3" in capsys.readouterr().err
+
+
+def test_reproduce_of_another_preset_says_it_is_not_calibrated(tmp_path, capsys):
+    assert main(["reproduce", "--out", str(tmp_path), "--points", "3", "--preset", "default"]) == 0
+    text = (tmp_path / "report.md").read_text()
+    assert "Parameters: preset `default`" in text and "are **not** the calibrated preset" in text
+    assert (tmp_path / "landscape_K15_paper.nc").exists()  # default uses the physical convention

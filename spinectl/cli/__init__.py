@@ -23,6 +23,7 @@ COMMANDS = (
     "plot_cmd",
     "reproduce_cmd",
     "study_cmd",
+    "calibrate_cmd",
 )
 """Modules of :mod:`spinectl.cli` that each register one sub-command."""
 

@@ -13,28 +13,34 @@ from ..io import atomic_write_text
 from ..params import Model
 
 
-def add_model_options(parser: argparse.ArgumentParser) -> None:
+def add_model_options(parser: argparse.ArgumentParser, default_preset: str = "default") -> None:
     """``--config FILE`` and ``--preset NAME``, on every command.
 
     Parameters
     ----------
     parser : argparse.ArgumentParser
         The (sub-)command's parser; the options go into a group named "model".
+    default_preset : str
+        The preset used when neither option is given (named in the help).
     """
     group = parser.add_argument_group("model")
     group.add_argument("--config", metavar="FILE", help="TOML file overriding the preset's parameters")
-    group.add_argument("--preset", metavar="NAME", help="built-in parameter preset (default: 'default')")
+    group.add_argument("--preset", metavar="NAME", help=f"built-in parameter preset (default: {default_preset!r})")
 
 
-def load_model(args: argparse.Namespace) -> Model:
+def load_model(args: argparse.Namespace, default_preset: str = "default") -> Model:
     """The model named by ``--preset`` and ``--config``.
 
     Parameters
     ----------
     args : argparse.Namespace
         Parsed arguments with ``config`` and ``preset`` (see :func:`add_model_options`).
+    default_preset : str
+        The preset when neither option is given; a ``--config`` file without
+        ``--preset`` keeps its own base preset (its ``preset`` key, else 'default').
     """
-    return load_config(args.config, preset=args.preset)
+    preset = args.preset or (None if args.config else default_preset)
+    return load_config(args.config, preset=preset)
 
 
 def finite_float(name: str):

@@ -12,22 +12,15 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-import numpy as np
-
-from .. import landmarks, plotting, report, sweep
-from ..config import set_parameter
+from .. import calibration, landmarks, plotting, report, reproduction, sweep
+from ..calibration import PAPER_POINTS
 from ..errors import ParameterError
 from ..io import staged_directory
 from ..params import Model
 from ._common import add_model_options, load_model
 
-PAPER_RANGE = (0.0, 0.08)
-"""E and Lambda [m] of the paper's grid (paper, Methods)."""
-
-PAPER_POINTS = 81
-"""Grid points per axis: 1 mm steps (paper, Methods; design page)."""
-
-CONVENTIONS = ("physical", "paper")
+DEFAULT_PRESET = reproduction.PRESET
+"""The calibrated preset (docs/reproduction.md): what ``reproduce`` runs unless told otherwise."""
 
 LANDSCAPES = "landscapes.nc"
 
@@ -50,7 +43,7 @@ def register(sub) -> None:
     parser.add_argument(
         "--points", type=int, default=PAPER_POINTS, help=f"grid points per axis (default {PAPER_POINTS}: 1 mm)"
     )
-    add_model_options(parser)
+    add_model_options(parser, default_preset=DEFAULT_PRESET)
     parser.set_defaults(func=run)
 
 
@@ -69,14 +62,19 @@ def run(args) -> int:
     """
     if args.points < 3:
         raise ParameterError("--points", f"must be >= 3 (got {args.points})")
-    source = f"config file {args.config}" if args.config else f"preset `{args.preset or 'default'}`"
-    paths = reproduce(load_model(args), args.out, points=args.points, source=source)
+    preset = args.preset or DEFAULT_PRESET
+    source = f"config file {args.config}" if args.config else f"preset `{preset}`"
+    calibrated = args.config is None and preset == reproduction.PRESET
+    model = load_model(args, default_preset=DEFAULT_PRESET)
+    paths = reproduce(model, args.out, points=args.points, source=source, calibrated=calibrated)
     for path in paths:
         print(path)
     return 0
 
 
-def reproduce(model: Model, out_dir, *, points: int = PAPER_POINTS, source: str = "", progress=None) -> list[Path]:
+def reproduce(
+    model: Model, out_dir, *, points: int = PAPER_POINTS, source: str = "", calibrated: bool = False, progress=None
+) -> list[Path]:
     """Run the study and write it into ``out_dir``; return the files written.
 
     Parameters
@@ -88,16 +86,15 @@ def reproduce(model: Model, out_dir, *, points: int = PAPER_POINTS, source: str 
         Grid points per axis.
     source : str
         Where the parameters came from, for the report.
+    calibrated : bool
+        Whether they are the calibrated preset (the report says so).
     progress : bool or None
         Progress bars (None: on a terminal only).
     """
     start = time.perf_counter()
-    axis = np.linspace(*PAPER_RANGE, points)
     k15 = landmarks.PAPER_STIFFNESS
-    both = sweep.stiffness_sweep(model, [0.0, k15], axis, axis, progress=progress)
-    other_convention = next(c for c in CONVENTIONS if c != model.passive.convention)
-    other_model = set_parameter(set_parameter(model, "passive.convention", other_convention), "passive.stiffness", k15)
-    other = sweep.sweep(other_model, axis, axis, progress=progress)
+    both, other = calibration.paper_landscapes(model, points, progress)
+    other_convention = calibration.other_convention(model)
     measured = landmarks.measure(landmarks.Landmarks(both.sel(K=0.0), both.sel(K=k15), other))
     other_name = f"landscape_K{k15:g}_{other_convention}.nc"
     with staged_directory(out_dir) as stage:
@@ -113,6 +110,7 @@ def reproduce(model: Model, out_dir, *, points: int = PAPER_POINTS, source: str 
             seconds=time.perf_counter() - start,
             files=names,
             specific_tension=model.fibre.specific_tension,
+            calibrated=calibrated,
         )
         (stage / "report.md").write_text(report.render(measured, run_facts))
     return [Path(out_dir) / name for name in names]

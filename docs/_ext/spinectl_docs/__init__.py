@@ -13,10 +13,12 @@ text changed, so that incremental builds stay incremental):
   top-level page except the index and the reference pages;
 - ``notebooks/*.ipynb`` and ``_generated/notebooks-toctree.md``: copies of the
   notebooks of the repository's ``notebooks/`` and their toctree, included by
-  ``notebooks.md`` (myst-nb executes them).
+  ``notebooks.md`` (myst-nb executes them);
+- ``_generated/calibration-parameters.md`` and ``_generated/landmark-verdicts.md``:
+  the tables of ``reproduction.md`` (free parameters, verdict of every landmark).
 
 ``_generated/`` is excluded from the sources (its files are included by
-``parameters.md``, ``cli.md``, ``api.md``, ``index.md`` and ``notebooks.md``);
+``parameters.md``, ``cli.md``, ``api.md``, ``index.md``, ``notebooks.md`` and ``reproduction.md``);
 ``api/``, ``notebooks/`` and ``_generated/`` are not in git. At ``autodoc-process-docstring`` it adds a
 numpydoc "Parameters" section built from the same metadata to the parameter
 dataclasses, so that their API pages document every field.
@@ -26,7 +28,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from . import api, cli, fields, guide, notebooks, parameters
+from . import api, cli, fields, guide, notebooks, parameters, reproduction
 
 GENERATED = "_generated"
 
@@ -55,6 +57,8 @@ def generate(app) -> None:
     write_if_changed(out / "guide-toctree.md", guide.toctree_markdown(src))
     pages = notebooks.copy_notebooks(notebooks.sources(src.parent), src, write_if_changed)
     write_if_changed(out / "notebooks-toctree.md", notebooks.toctree_markdown(pages))
+    write_if_changed(out / "calibration-parameters.md", reproduction.parameter_table())
+    write_if_changed(out / "landmark-verdicts.md", reproduction.landmark_table())
 
 
 def setup(app):

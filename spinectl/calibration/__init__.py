@@ -1,0 +1,101 @@
+"""Calibration of the parameters the paper does not state, against the paper's landmarks.
+
+The paper (Wagner et al. 2012) gives neither the upper-body mass, nor the
+muscle attachment coordinates, nor the fibre spread. This package fits them,
+within anatomically plausible bounds, to the landmarks of
+:mod:`spinectl.landmarks` (design page, "What the paper reports"), and reports
+the residual of every landmark (docs/reproduction.md):
+
+- :mod:`~spinectl.calibration.parameters`: the free parameters, their bounds
+  with sources, and the map between a parameter vector and a model;
+- :mod:`~spinectl.calibration.targets`: the landmarks as targets, and the loss;
+- :mod:`~spinectl.calibration.landscapes`: coarse landscapes for fitting, the
+  paper's 81 x 81 grid for verifying;
+- :mod:`~spinectl.calibration.fit`: :func:`calibrate`, differential evolution
+  then Nelder-Mead, with both passive-stiffness conventions;
+- :mod:`~spinectl.calibration.sensitivity`: what the landmarks identify;
+- :mod:`~spinectl.calibration.output`: the summary, the preset TOML, the loss history.
+"""
+
+from .fit import (
+    GENERATIONS,
+    POPSIZE,
+    REFINE_EVALUATIONS,
+    REFINE_STEP,
+    CalibrationResult,
+    Fit,
+    calibrate,
+)
+from .landscapes import (
+    CONVENTIONS,
+    FIT_POINTS,
+    PAPER_POINTS,
+    PAPER_RANGE,
+    coarse_landmarks,
+    coarse_landscape,
+    measure_model,
+    other_convention,
+    paper_axis,
+    paper_landscapes,
+    with_stiffness,
+)
+from .output import history_csv, preset_toml, summary
+from .parameters import FREE_PARAMETERS, FreeParameter, bounds, from_model, parameter_set, to_model
+from .sensitivity import STEP_LANDMARKS, Sensitivity, sensitivity
+from .targets import (
+    C_READINGS,
+    MISSING_PENALTY,
+    STRICT_MARGIN,
+    WEIGHTS,
+    Residual,
+    Target,
+    loss,
+    paper_targets,
+    penalty,
+    residuals,
+    synthetic_targets,
+)
+
+__all__ = [
+    "C_READINGS",
+    "CONVENTIONS",
+    "FIT_POINTS",
+    "FREE_PARAMETERS",
+    "GENERATIONS",
+    "MISSING_PENALTY",
+    "PAPER_POINTS",
+    "PAPER_RANGE",
+    "POPSIZE",
+    "REFINE_EVALUATIONS",
+    "REFINE_STEP",
+    "STEP_LANDMARKS",
+    "STRICT_MARGIN",
+    "WEIGHTS",
+    "CalibrationResult",
+    "Fit",
+    "FreeParameter",
+    "Residual",
+    "Sensitivity",
+    "Target",
+    "bounds",
+    "calibrate",
+    "coarse_landmarks",
+    "coarse_landscape",
+    "from_model",
+    "history_csv",
+    "loss",
+    "measure_model",
+    "other_convention",
+    "paper_axis",
+    "paper_landscapes",
+    "paper_targets",
+    "parameter_set",
+    "penalty",
+    "preset_toml",
+    "residuals",
+    "sensitivity",
+    "summary",
+    "synthetic_targets",
+    "to_model",
+    "with_stiffness",
+]
