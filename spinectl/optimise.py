@@ -1,9 +1,10 @@
 """Minimum PCSA and counter torques at one configuration: the readable reference.
 
 Design page, "The optimisation at each grid point". With the decision
-variables x [cm^2], the self-stable set F = {S x <= b, 0 <= x <= pcsa_max}
-(S_k(x) = dM_k/dalpha affine in x, b = -margin - gravity + passive
-stiffness) and the counter torques CT(x) = -(T x + g), affine in x:
+variables x [cm^2], the self-stable set F = {S x <= b, D x <= -damping_margin,
+0 <= x <= pcsa_max} (S_k(x) = dM_k/dalpha and D_k(x) = dM_k/domega affine in x,
+b = -stability_margin - gravity + passive stiffness; :class:`ProblemData`) and
+the counter torques CT(x) = -(T x + g), affine in x:
 
 1. minimum PCSA (Figure 3), the LP  t* = min w.x over F;
 2. counter torques (Figure 4), the SOCP  min ||CT(x)||_2 over F within the
