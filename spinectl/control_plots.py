@@ -18,6 +18,7 @@ import matplotlib.pyplot as plt  # noqa: E402 - after selecting the backend
 
 from .io import atomic_path  # noqa: E402
 from .simulate import Simulation  # noqa: E402
+from .systems import ignoring_underflow  # noqa: E402
 
 
 def _save(figure, path: Path) -> Path:
@@ -41,9 +42,10 @@ def bode(loops: Mapping[str, ct.TransferFunction], path, omega_limits=None, titl
     title : str, optional
         Figure title.
     """
-    plot = ct.bode_plot(
-        list(loops.values()), omega_limits=omega_limits, label=list(loops), title=title or "Reflex loop L(jw)"
-    )
+    with ignoring_underflow():
+        plot = ct.bode_plot(
+            list(loops.values()), omega_limits=omega_limits, label=list(loops), title=title or "Reflex loop L(jw)"
+        )
     return _save(plot.figure, path)
 
 
@@ -59,7 +61,8 @@ def nyquist(loops: Mapping[str, ct.TransferFunction], path, title: str = "") -> 
     title : str, optional
         Figure title.
     """
-    plot = ct.nyquist_plot(list(loops.values()), label=list(loops), title=title or "Nyquist plot of L(jw)")
+    with ignoring_underflow():
+        plot = ct.nyquist_plot(list(loops.values()), label=list(loops), title=title or "Nyquist plot of L(jw)")
     return _save(plot.figure, path)
 
 

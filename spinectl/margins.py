@@ -8,6 +8,7 @@ python-control's margins of the Padé loop (:mod:`spinectl.systems`).
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -191,11 +192,15 @@ def _python_control_margins(s, d, theta, kp, kd, delay, order, stable):
 
     Its Padé coefficients grow like (1/tau)^n, so very short delays at high orders
     overflow in ``stability_margins``; the exact margins do not depend on it.
+    python-control evaluates L(jw) under its own ``np.errstate(all="warn")``, so its
+    trouble arrives as RuntimeWarnings (underflow aside, see
+    :func:`spinectl.systems.ignoring_underflow`) and makes its reading undefined too.
     """
     try:
-        with np.errstate(over="raise", divide="raise", invalid="raise"):
+        with np.errstate(over="raise", divide="raise", invalid="raise"), warnings.catch_warnings():
+            warnings.simplefilter("error", RuntimeWarning)
             return systems.loop_margins(systems.loop_transfer(s, d, theta, kp, kd, delay, order), stable)
-    except FloatingPointError:
+    except (FloatingPointError, RuntimeWarning):
         return None
 
 

@@ -22,7 +22,7 @@ from .errors import ParameterError
 from .io import atomic_path
 from .optimise import problem_data
 from .params import Model
-from .stability import checked_coefficients
+from .stability import arithmetic_guard, checked_coefficients
 from .units import M2_PER_CM2, m2_to_cm2
 
 METHODS = ("fast", "per-point")
@@ -163,7 +163,9 @@ def point_columns(
         else:
             result = batch.solve_points(data, tol, progress=update)
         per_point += result.per_point
-        for name, values in _chunk_columns(result, coeffs, model).items():
+        with arithmetic_guard(e_grid[part], l_grid[part]):  # e.g. K = 1e154 overflows S^2 in the reflex roots
+            columns = _chunk_columns(result, coeffs, model)
+        for name, values in columns.items():
             if name not in arrays:
                 arrays[name] = np.empty((e_grid.size,) + values.shape[1:], values.dtype)
             arrays[name][part] = values

@@ -9,11 +9,14 @@ sweeps use the vectorised :mod:`spinectl.reflex` instead.
 - :func:`reflex_controller`, :func:`loop_transfer`: C(s) = kp + kd s and
   L(s) = C(s) e^{-s tau} G(s), G(s) = 1 / (theta s^2 - D s - S);
 - :func:`closed_loop`: the segment under the delayed reflex, from a disturbing torque to alpha;
-- :func:`loop_margins`: python-control's margins of L, read for an open-loop unstable plant.
+- :func:`loop_margins`: python-control's margins of L, read for an open-loop unstable plant;
+- :func:`ignoring_underflow`: python-control's frequency responses without underflow warnings.
 """
 
 from __future__ import annotations
 
+import contextlib
+import warnings
 from dataclasses import dataclass
 
 import control as ct
@@ -173,8 +176,9 @@ def loop_margins(loop: ct.TransferFunction, stable: bool) -> LoopMargins:
         Whether the closed loop is stable at k = 1 (decide it exactly, with
         :func:`spinectl.reflex.stable_at_delay`); if not, the gain interval is NaN.
     """
-    gm, pm, _, wpc, wgc, _ = ct.stability_margins(loop)
-    all_gm = np.asarray(ct.stability_margins(loop, returnall=True)[0], float)
+    with ignoring_underflow():
+        gm, pm, _, wpc, wgc, _ = ct.stability_margins(loop)
+        all_gm = np.asarray(ct.stability_margins(loop, returnall=True)[0], float)
     below, above = all_gm[all_gm < 1.0], all_gm[all_gm > 1.0]
     lower = float(below.max()) if below.size else 0.0
     upper = float(above.min()) if above.size else np.inf
@@ -189,3 +193,17 @@ def loop_margins(loop: ct.TransferFunction, stable: bool) -> LoopMargins:
         phase_crossover_rad_s=float(wpc),
         stable=bool(stable),
     )
+
+
+@contextlib.contextmanager
+def ignoring_underflow():
+    """Silence underflow warnings from python-control's evaluation of L(jw) in the ``with`` block.
+
+    python-control evaluates transfer functions under ``np.errstate(all="warn")``, so a
+    subnormal coefficient (e.g. the damping at an activation of 1e-308) warns
+    "underflow encountered"; the term is flushed to zero, which changes no result. numpy's
+    own default ignores underflow too. Overflow and invalid operations still warn.
+    """
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", "underflow encountered", RuntimeWarning)
+        yield

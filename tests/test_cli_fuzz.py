@@ -191,3 +191,19 @@ def test_random_arguments_to_the_analysis_commands_never_raise(analysis_folder, 
     """margins, sweep and plot: the same contract, fewer examples (each runs a solver or draws)."""
     with contextlib.chdir(analysis_folder):
         check(argv)
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        # python-control evaluates L(jw) under np.errstate(all="warn"): a subnormal
+        # activation made it warn "underflow encountered in divide" on stderr.
+        ["margins", "--E", "0.0", "--delay", "0.0", "--activation", "1.1125369292536007e-308"],
+        # K = 1.3e154 N m/rad: S^2 overflowed in the sweep's reflex columns, a numpy warning.
+        ["sweep", "--out", "out.nc", "--E", "0:0.0625:1", "--Lambda", "0:0.0625:1", "--K", "1.3407807929942597e+154"],
+    ],
+)
+def test_analysis_arguments_that_used_to_escape(analysis_folder, argv):
+    """Each of these once printed a warning or a traceback from the analysis commands."""
+    with contextlib.chdir(analysis_folder):
+        check(argv)

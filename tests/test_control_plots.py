@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from spinectl import control_plots, simulate, systems
@@ -21,3 +23,14 @@ def test_plots_are_pngs_and_leave_no_temporaries(tmp_path, model):
     ]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bode.png", "nyquist.png", "response.png"]
     assert all(p.read_bytes()[:8] == PNG for p in written)
+
+
+def test_frequency_plots_of_subnormal_coefficients_are_silent(tmp_path):
+    """python-control evaluates L(jw) under np.errstate(all="warn"); a subnormal damping
+    (activation 1e-308 in ``spinectl margins --plot``) printed underflow warnings."""
+    loops = {"L1L2": systems.loop_transfer(71.0, -1.1e-308, 1.31, 106.5, 13.6, 0.0, 5)}
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        control_plots.bode(loops, tmp_path / "bode.png")
+        control_plots.nyquist(loops, tmp_path / "nyquist.png")
+    assert (tmp_path / "bode.png").read_bytes()[:8] == PNG

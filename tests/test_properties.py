@@ -166,13 +166,17 @@ def test_min_pcsa_is_proportional_to_mass_without_passive_stiffness(model, posit
 def test_the_optimum_is_self_stable(model, position):
     """The optimum satisfies dM_k/dalpha <= -margin < 0 at every CoR and has D < 0, so both
     eigenvalues of every segment have negative real part (paper, eq. 1): check it with the
-    independent eigenvalue computation of segment_stability, or the status is not optimal."""
+    independent eigenvalue computation of segment_stability, or the point has no answer (NaN).
+
+    'optimal_inaccurate' (Clarabel's AlmostSolved, e.g. two identical pairs) is an answer too:
+    its reduced tolerance (~1e-4 of N m/rad-sized rows) is far inside the margins of 0.1 N m/rad
+    and 0.01 N m s/rad, so it must be self-stable as well.
+    """
     E, L = position
     optimum = solve_point(model, E, L)
     if optimum.status in OK_STATUSES:
         assert np.all(np.isfinite(optimum.pcsa)) and optimum.min_pcsa >= -1e-9
-    if optimum.status == "optimal":
         result = segment_stability(model, E, L, optimum.pcsa)
-        assert result.self_stable.all(), (result.stiffness, result.eigenvalues)
+        assert result.self_stable.all(), (optimum.status, result.stiffness, result.eigenvalues)
     else:
         assert np.isnan(optimum.min_pcsa) and np.isnan(optimum.pcsa).all()

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import warnings
+
 import control as ct
 import numpy as np
 import pytest
@@ -95,3 +97,15 @@ def test_zero_reflex_has_no_crossover():
     margins = systems.loop_margins(systems.loop_transfer(-20.0, -5.0, 2.0, 0.0, 0.0, 0.1, 5), stable=True)
     assert margins.phase_margin_deg == np.inf and np.isnan(margins.crossover_rad_s)
     assert margins.gain_margin_lower == 0.0 and margins.gain_margin_upper == np.inf
+
+
+def test_subnormal_coefficients_give_the_margins_of_zero_without_warnings():
+    """A damping of 1e-308 N m s/rad (e.g. an activation of 1e-308) is subnormal: python-control's
+    evaluation under np.errstate(all="warn") warned "underflow". The margins must be those of
+    D = 0 exactly (the term is below any double's resolution of the others), and silent."""
+    s, theta, kp, kd, tau = 71.0, 1.31, 106.5, 13.6, 0.0
+    exact = systems.loop_margins(systems.loop_transfer(s, 0.0, theta, kp, kd, tau, 5), stable=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        tiny = systems.loop_margins(systems.loop_transfer(s, -1.1e-308, theta, kp, kd, tau, 5), stable=True)
+    assert tiny == exact
