@@ -33,6 +33,7 @@ extensions = [
     "numpydoc",
     "sphinx.ext.autodoc",
     "sphinx.ext.mathjax",
+    "sphinx-mathjax-offline",  # MathJax 3 from _static/, so equations render without a network
     "sphinx.ext.viewcode",
     "spinectl_docs",
 ]
