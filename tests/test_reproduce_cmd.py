@@ -54,9 +54,13 @@ def test_a_failure_leaves_the_output_folder_untouched(tmp_path, monkeypatch, cap
     assert not out.exists() and list(tmp_path.iterdir()) == []
 
 
-def test_reproduce_rejects_a_degenerate_grid(tmp_path, capsys):
-    assert main(["reproduce", "--out", str(tmp_path), "--points", "1"]) == 2
-    assert "--points: must be >= 3" in capsys.readouterr().err
+@pytest.mark.parametrize("points", ["1", "1001", "4" * 400])
+def test_reproduce_rejects_a_degenerate_or_oversized_grid(tmp_path, capsys, points):
+    """1001 x 1001 exceeds sweep.MAX_GRID_POINTS (10^6); 4...4 (400 digits) once crashed numpy's linspace."""
+    assert main(["reproduce", "--out", str(tmp_path), "--points", points]) == 2
+    err = capsys.readouterr().err
+    assert "--points: must be 3 to 1000 per axis" in err and err.count("\n") == 1
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_reproduce_of_another_preset_says_it_is_not_calibrated(tmp_path, capsys):

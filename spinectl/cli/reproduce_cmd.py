@@ -9,6 +9,7 @@ staged and moved into ``--out`` at the end (:func:`spinectl.io.staged_directory`
 
 from __future__ import annotations
 
+import math
 import time
 from pathlib import Path
 
@@ -60,8 +61,9 @@ def run(args) -> int:
     int
         Exit code 0.
     """
-    if args.points < 3:
-        raise ParameterError("--points", f"must be >= 3 (got {args.points})")
+    largest = math.isqrt(sweep.MAX_GRID_POINTS)  # points x points, the limit of one sweep
+    if not 3 <= args.points <= largest:
+        raise ParameterError("--points", f"must be 3 to {largest} per axis (got {args.points})")
     preset = args.preset or DEFAULT_PRESET
     source = f"config file {args.config}" if args.config else f"preset `{preset}`"
     calibrated = args.config is None and preset == reproduction.PRESET
