@@ -212,7 +212,13 @@ def test_cli_writes_a_loadable_preset(tmp_path, capsys):
 
 @pytest.mark.parametrize(
     ("option", "value", "message"),
-    [("--starts", "0", "--starts: must be >= 1"), ("--grid", "2", "--grid: must be 3 to 161")],
+    [
+        ("--starts", "0", "--starts: must be >= 1"),
+        ("--grid", "2", "--grid: must be 3 to 161"),
+        ("--seed", "-2", "seed: must be an integer >= 0"),  # numpy's traceback before
+        ("--parameters", "mass,mass", "parameters: must be distinct names among mass,"),  # fitted twice before
+        ("--conventions", "paper,paper", "conventions: must be distinct names among physical, paper"),
+    ],
 )
 def test_cli_rejects_bad_settings(option, value, message, capsys):
     assert main(["calibrate", option, value]) == 2
@@ -221,4 +227,4 @@ def test_cli_rejects_bad_settings(option, value, message, capsys):
 
 def test_cli_rejects_an_unknown_convention(capsys):
     assert main(["calibrate", "--conventions", "physical,nope", "--grid", "3"]) == 2
-    assert "conventions: must be among physical, paper" in capsys.readouterr().err
+    assert "conventions: must be distinct names among physical, paper" in capsys.readouterr().err

@@ -290,7 +290,11 @@ def calibrate(
     targets = paper_targets() if targets is None else tuple(targets)
     unknown = [c for c in conventions if c not in CONVENTIONS]
     if unknown or not conventions or len(set(conventions)) != len(conventions):
-        raise ParameterError("conventions", f"must be among {', '.join(CONVENTIONS)} (got {list(conventions)})")
+        raise ParameterError(
+            "conventions", f"must be distinct names among {', '.join(CONVENTIONS)} (got {list(conventions)})"
+        )
+    if int(seed) != seed or seed < 0:  # numpy's generators take non-negative integers only
+        raise ParameterError("seed", f"must be an integer >= 0 (got {seed!r})")
     objective = _Objective(base, parameters, targets, points, conventions)
     say = progress or (lambda line: None)
     budget = {"seed": seed, "starts": starts, "popsize": popsize, "generations": generations}

@@ -156,8 +156,8 @@ def parameter_set(names: Sequence[str] | None = None) -> tuple[FreeParameter, ..
         return FREE_PARAMETERS
     known = {p.name: p for p in FREE_PARAMETERS}
     unknown = [n for n in names if n not in known]
-    if unknown or not names:
-        raise ParameterError("parameters", f"must be names among {', '.join(known)} (got {list(names)})")
+    if unknown or not names or len(set(names)) != len(names):
+        raise ParameterError("parameters", f"must be distinct names among {', '.join(known)} (got {list(names)})")
     return tuple(known[n] for n in names)
 
 
