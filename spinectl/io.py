@@ -7,6 +7,7 @@ half-written file.
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import shutil
 import tempfile
@@ -99,6 +100,28 @@ def _replace(tmp: Path, target: Path, directory: bool) -> None:
         os.replace(old, target)
         raise
     shutil.rmtree(old, ignore_errors=True)
+
+
+def check_writable(target: str | Path) -> Path:
+    """Raise :class:`OutputError` now if ``target`` could not be written later.
+
+    Long jobs call it before they start, so that a typo in ``--out`` costs a
+    second, not the run. It makes the missing parent folders (as
+    :func:`atomic_path` would) and a temporary file beside ``target``, then
+    removes the file; ``target`` itself is not touched.
+
+    Parameters
+    ----------
+    target : str or Path
+        The file a job will write with :func:`atomic_path`.
+    """
+    target = Path(target)
+    with _output_errors(target):
+        if target.is_dir():
+            raise IsADirectoryError(errno.EISDIR, "Is a directory")
+        target.parent.mkdir(parents=True, exist_ok=True)
+        _temporary(target, directory=False).unlink()
+    return target
 
 
 def atomic_write_text(target: str | Path, text: str) -> Path:

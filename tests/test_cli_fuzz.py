@@ -207,3 +207,47 @@ def test_analysis_arguments_that_used_to_escape(analysis_folder, argv):
     """Each of these once printed a warning or a traceback from the analysis commands."""
     with contextlib.chdir(analysis_folder):
         check(argv)
+
+
+JOB_VALUES = {
+    "--points": mostly(st.integers(3, 4).map(str), st.sampled_from(["2", "-1", "1001", "4" * 400, "x"])),
+    "--starts": mostly(st.integers(1, 2).map(str)),
+    "--seed": mostly(st.integers(-2, 5).map(str)),
+    "--grid": mostly(st.integers(3, 4).map(str)),
+    "--verify-grid": mostly(st.integers(3, 4).map(str)),
+    "--popsize": mostly(st.integers(1, 2).map(str)),
+    "--refine": mostly(st.integers(0, 2).map(str)),
+    "--activation": st.sampled_from(["paired", "independent", "x"]),
+    "--conventions": st.sampled_from(["physical", "paper", "physical,paper", "phys", "", ",", "paper,paper"]),
+    "--parameters": st.sampled_from(["mass", "spread", "mass,spread", "mas", "", "mass,mass"]),
+    "--history": st.sampled_from(["h.csv", "sub/h.csv", "/proc/x.csv"]),
+    "--config": st.sampled_from(sorted(CONFIG_FILES)),
+    "--preset": st.sampled_from(["default", "wagner2012", "nope"]),
+}
+JOB_COMMANDS = {
+    "reproduce --out rep --points 3": ["--points", "--config", "--preset"],
+    "calibrate --grid 3 --verify-grid 3 --generations 1 --popsize 1 --refine 0 --parameters mass": sorted(
+        set(JOB_VALUES) - {"--points"}
+    ),
+}
+"""The long jobs, kept to seconds: tiny grids and budgets unless an option overrides them."""
+
+
+@st.composite
+def job_arguments(draw) -> list[str]:
+    argv = draw(st.sampled_from(sorted(JOB_COMMANDS))).split()
+    for name in draw(st.lists(st.sampled_from(JOB_COMMANDS[" ".join(argv)]), unique=True, max_size=3)):
+        argv += [name, draw(JOB_VALUES[name])]
+    return argv
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(job_arguments())
+def test_random_arguments_to_reproduce_and_calibrate_never_raise(analysis_folder, argv):
+    """The same contract, except that a run that succeeds may report its progress on stderr."""
+    with contextlib.chdir(analysis_folder):
+        code, _, err = run(argv)
+    assert code in (0, 2), (argv, code, err)
+    assert "Traceback" not in err and "Warning" not in err, (argv, err)
+    if code == 2:
+        assert err.endswith("\n") and err.count("\n") == 1, (argv, err)

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import dataclasses
 import datetime
+import importlib
 import math
 import os
 import warnings
@@ -18,8 +19,9 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from spinectl import config, geometry, muscle
+from spinectl.cli import main
 from spinectl.errors import ConfigError, ModelError, OutputError, ParameterError, SpinectlError
-from spinectl.io import atomic_path, atomic_write_text
+from spinectl.io import atomic_path, atomic_write_text, check_writable
 from spinectl.optimise import OK_STATUSES, solve_point
 from spinectl.params import MAX_FIBRES, Model, MusclePair
 from spinectl.stability import segment_stability, validate_position
@@ -559,3 +561,34 @@ def test_an_unwritable_target_is_an_output_error(tmp_path):
     assert (tmp_path / "taken" / "inside").read_text() == "keep"
     assert (tmp_path / "a_file").read_text() == "keep"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a_file", "taken"]
+
+
+def test_check_writable_fails_where_the_write_would_and_leaves_nothing(tmp_path):
+    """The pre-flight of long jobs: the same OutputError as atomic_write_text above, before any work."""
+    (tmp_path / "taken").mkdir()
+    (tmp_path / "a_file").write_text("keep")
+    for target in (tmp_path / "taken", tmp_path / "a_file" / "below.json"):
+        with pytest.raises(OutputError, match="cannot write"):
+            check_writable(target)
+    assert check_writable(tmp_path / "new" / "out.nc") == tmp_path / "new" / "out.nc"
+    assert check_writable(tmp_path / "a_file") == tmp_path / "a_file"
+    assert (tmp_path / "a_file").read_text() == "keep"
+    assert sorted(p.name for p in tmp_path.rglob("*")) == ["a_file", "new", "taken"]  # no file made
+
+
+@pytest.mark.parametrize(
+    ("argv", "job"),
+    [
+        (["sweep", "--E", "0:0.08:3", "--Lambda", "0:0.08:3", "--out", "taken"], ("spinectl.sweep", "sweep")),
+        (["calibrate", "--grid", "3", "--history", "a_file/h.csv"], ("spinectl.calibration", "calibrate")),
+    ],
+)
+def test_long_jobs_check_their_outputs_before_they_start(tmp_path, monkeypatch, capsys, argv, job):
+    """A typo in --out costs a second, not the run: the job itself is never called."""
+    (tmp_path / "taken").mkdir()
+    (tmp_path / "a_file").write_text("keep")
+    monkeypatch.setattr(importlib.import_module(job[0]), job[1], lambda *a, **k: pytest.fail("the job ran"))
+    monkeypatch.chdir(tmp_path)
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("spinectl: error: cannot write") and err.count("\n") == 1

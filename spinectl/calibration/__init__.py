@@ -18,9 +18,11 @@ the residual of every landmark (docs/reproduction.md):
 """
 
 from .fit import (
+    BUDGET_RANGES,
     GENERATIONS,
     POPSIZE,
     REFINE_EVALUATIONS,
+    REFINE_RANGE,
     REFINE_STEP,
     CalibrationResult,
     Fit,
@@ -57,6 +59,7 @@ from .targets import (
 )
 
 __all__ = [
+    "BUDGET_RANGES",
     "C_READINGS",
     "CONVENTIONS",
     "FIT_POINTS",
@@ -67,6 +70,7 @@ __all__ = [
     "PAPER_RANGE",
     "POPSIZE",
     "REFINE_EVALUATIONS",
+    "REFINE_RANGE",
     "REFINE_STEP",
     "STEP_LANDMARKS",
     "STRICT_MARGIN",

@@ -41,6 +41,17 @@ REFINE_EVALUATIONS = 120
 """Loss evaluations of the local refinement (Nelder-Mead) per convention. With :data:`POPSIZE`
 and :data:`GENERATIONS` about 950 evaluations in all: 2-4 minutes on one core (docs/reproduction.md)."""
 
+BUDGET_RANGES = {"seed": (0, 2**31 - 1), "starts": (1, 100), "popsize": (1, 1000), "generations": (1, 100_000)}
+"""Allowed [low, high] of the run's integer settings.
+
+Seeds: scipy seeds numpy's legacy generator, which takes 0 <= seed + start < 2^32.
+The other highs are far beyond any useful run (a population of 1000 per parameter
+already costs about 10^4 losses a generation) and reject a typo before it asks for
+terabytes (popsize 10^12)."""
+
+REFINE_RANGE = (0, 1_000_000)
+"""Allowed [low, high] of ``refine``, the local refinement's loss evaluations per convention."""
+
 REFINE_STEP = 0.05
 """Size of the refinement's initial simplex, as a fraction of each bound's width."""
 
@@ -234,6 +245,20 @@ def _refine(objective: _Objective, parameters, convention: str, evaluations: int
     )
 
 
+def _check_settings(conventions: Sequence[str], **settings: int) -> None:
+    """Raise :class:`ParameterError` for unknown or repeated conventions or a setting out of range."""
+    unknown = [c for c in conventions if c not in CONVENTIONS]
+    if unknown or not conventions or len(set(conventions)) != len(conventions):
+        raise ParameterError(
+            "conventions", f"must be distinct names among {', '.join(CONVENTIONS)} (got {list(conventions)})"
+        )
+    ranges = BUDGET_RANGES | {"refine": REFINE_RANGE}
+    for name, value in settings.items():
+        low, high = ranges[name]
+        if isinstance(value, bool) or not isinstance(value, int | np.integer) or not low <= value <= high:
+            raise ParameterError(name, f"must be an integer in [{low}, {high:,}] (got {value!r})")
+
+
 def calibrate(
     base: Model,
     parameters: Sequence[FreeParameter] = FREE_PARAMETERS,
@@ -288,13 +313,7 @@ def calibrate(
     started = time.perf_counter()
     parameters = tuple(parameters)
     targets = paper_targets() if targets is None else tuple(targets)
-    unknown = [c for c in conventions if c not in CONVENTIONS]
-    if unknown or not conventions or len(set(conventions)) != len(conventions):
-        raise ParameterError(
-            "conventions", f"must be distinct names among {', '.join(CONVENTIONS)} (got {list(conventions)})"
-        )
-    if int(seed) != seed or seed < 0:  # numpy's generators take non-negative integers only
-        raise ParameterError("seed", f"must be an integer >= 0 (got {seed!r})")
+    _check_settings(conventions, seed=seed, starts=starts, popsize=popsize, generations=generations, refine=refine)
     objective = _Objective(base, parameters, targets, points, conventions)
     say = progress or (lambda line: None)
     budget = {"seed": seed, "starts": starts, "popsize": popsize, "generations": generations}

@@ -14,7 +14,7 @@ import sys
 
 from .. import calibration
 from ..config import set_parameter
-from ..io import atomic_write_text
+from ..io import atomic_write_text, check_writable
 from ._common import add_model_options, load_model, require
 
 
@@ -90,16 +90,14 @@ def run(args) -> int:
     int
         Exit code 0.
     """
-    require(args.starts >= 1, "--starts", f"must be >= 1 (got {args.starts})")
     require(3 <= args.grid <= 161, "--grid", f"must be 3 to 161 (got {args.grid})")
     require(3 <= args.verify_grid <= 161, "--verify-grid", f"must be 3 to 161 (got {args.verify_grid})")
-    require(args.generations >= 1, "--generations", f"must be >= 1 (got {args.generations})")
-    require(args.popsize >= 1, "--popsize", f"must be >= 1 (got {args.popsize})")
-    require(args.refine >= 0, "--refine", f"must be >= 0 (got {args.refine})")
     names = [n.strip() for n in args.parameters.split(",")] if args.parameters else None
     parameters = calibration.parameter_set(names)
     conventions = [c.strip() for c in args.conventions.split(",") if c.strip()]
     base = load_model(args)
+    for path in filter(None, (args.out, args.history)):
+        check_writable(path)  # before minutes of fitting
     if args.activation:
         base = set_parameter(base, "optimisation.activation", args.activation)
     result = calibration.calibrate(

@@ -8,6 +8,7 @@ import numpy as np
 
 from .. import sweep
 from ..config import set_parameter
+from ..io import check_writable
 from ._common import add_model_options, float_list, load_model
 
 DEFAULT_AXIS = "0:0.08:81"
@@ -59,6 +60,7 @@ def run(args) -> int:
     model = load_model(args)
     e_axis, l_axis = sweep.parse_grid(args.E, "--E"), sweep.parse_grid(args.Lambda, "--Lambda")
     options = {"method": args.method, "chunk_size": args.chunk_size}
+    check_writable(args.out)  # before the solves
     start = time.perf_counter()
     stiffnesses = args.K or [model.passive.stiffness]
     if len(stiffnesses) == 1:
