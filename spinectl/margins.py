@@ -200,7 +200,7 @@ def _python_control_margins(s, d, theta, kp, kd, delay, order, stable):
         with np.errstate(over="raise", divide="raise", invalid="raise"), warnings.catch_warnings():
             warnings.simplefilter("error", RuntimeWarning)
             return systems.loop_margins(systems.loop_transfer(s, d, theta, kp, kd, delay, order), stable)
-    except (FloatingPointError, RuntimeWarning):
+    except (FloatingPointError, RuntimeWarning, np.linalg.LinAlgError):  # LinAlgError: poles of NaN coefficients
         return None
 
 

@@ -37,6 +37,12 @@ MAX_PADE_ORDER = 10
 spine's loops (docs/reflex.md); from order 9 python-control's polynomial margins overflow
 for delays of a few microseconds, its coefficients growing like (1/tau)^n."""
 
+MAX_DELAY = 10.0
+"""Longest reflex delay [s]: fifty times the slowest loop the paper names (100 ms plus
+50-100 ms of force generation). A delay of 1e62 s, a unit typo, made the Padé
+coefficients (tau^n) overflow and python-control's Nyquist plot warn; the exact delay
+margin does not depend on tau, so nothing of interest lies beyond."""
+
 MAX_ACTIVATION = 10.0
 """Largest activation of the reflex section, a sanity bound: ten times the co-contraction that
 self-stability needs (a larger value is more likely a PCSA typed in place of a fraction)."""
@@ -346,7 +352,7 @@ class Reflex:
         0.1,
         "s",
         "Reflex delay tau. The paper's Discussion: reflexes follow a perturbation by up to 100 ms "
-        "(force generation adds another 50-100 ms).",
+        f"(force generation adds another 50-100 ms). 0 to {MAX_DELAY:g} s.",
     )
     pade_order: int = param(
         5, "1", f"Order of the Pade approximant of exp(-s tau) in the python-control models, 1 to {MAX_PADE_ORDER}."
@@ -411,7 +417,7 @@ class Reflex:
             raise ParameterError("sim_perturbation", f"must be < sim_divergence = {limit:g} rad (got {kick:g})")
         _store(
             self,
-            delay=v.non_negative("delay", self.delay),
+            delay=v.in_range("delay", self.delay, 0.0, MAX_DELAY),
             pade_order=v.integer("pade_order", self.pade_order, 1, MAX_PADE_ORDER),
             activation=v.in_range("activation", self.activation, 0.0, MAX_ACTIVATION),
             gain_factor=factor,

@@ -171,7 +171,7 @@ def _delayed(t_query, step, k, alpha, omega, acc, start):
     (start, 0), the segment held still.
     """
     pos = t_query / step
-    i = np.clip(np.floor(pos).astype(int), 0, max(k - 1, 0))
+    i = np.floor(np.clip(pos, 0, max(k - 1, 0))).astype(int)  # clip first: a delay of 1e62 s casts badly
     j = np.minimum(i + 1, k)
     u = np.clip(pos - i, 0.0, 1.0)
     runs = np.arange(alpha.shape[1])

@@ -114,7 +114,8 @@ def test_every_parameter_has_a_unit_and_documentation():
 @pytest.mark.parametrize(
     ("text", "field", "needle"),
     [
-        ("[reflex]\ndelay = -0.1\n", "reflex.delay", ">= 0"),
+        ("[reflex]\ndelay = -0.1\n", "reflex.delay", "in [0, 10]"),
+        ("[reflex]\ndelay = 11.0\n", "reflex.delay", "in [0, 10]"),
         ("[reflex]\npade_order = 0\n", "reflex.pade_order", "in [1, 10]"),
         ("[reflex]\npade_order = 11\n", "reflex.pade_order", "in [1, 10]"),
         ("[reflex]\nsim_divergence = 2.0\n", "reflex.sim_divergence", "<= pi/2"),

@@ -161,7 +161,7 @@ OUT_OF_RANGE = {
     "optimisation.pcsa_max": [0.0, -1.0, -math.inf],
     "optimisation.ct_tolerance": [-1e-3],
     "optimisation.solver_tolerance": [0.0, 1e-13, 1e-3],
-    "reflex.delay": [-0.1],
+    "reflex.delay": [-0.1, 10.5],
     "reflex.pade_order": [0, 11],
     "reflex.activation": [-0.1, 10.5],
     "reflex.gain_factor": [1.0, 0.5],
