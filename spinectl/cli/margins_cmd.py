@@ -116,7 +116,7 @@ def write_plots(model, report: MarginsReport, folder: Path) -> list[Path]:
     where = (
         f"E = {point.eccentricity * 100:g} cm, Lambda = {point.lordosis * 100:g} cm, activation {point.activation:g}"
     )
-    loops = {  # python_control None: its Pade model cannot be evaluated (e.g. tau = 1e62 s overflows)
+    loops = {  # python_control None: python-control cannot evaluate its Pade model (microsecond delays, high orders)
         s.name: systems.loop_transfer(s.stiffness, s.damping, s.inertia, s.kp, s.kd, report.delay, report.pade_order)
         for _, s in usable
         if (s.kp > 0 or s.kd > 0) and s.python_control is not None
