@@ -15,6 +15,7 @@ import numpy as np
 import scipy.optimize
 import scipy.stats
 
+from .. import _validate as v
 from .. import landmarks
 from ..errors import ModelError, ParameterError
 from ..landmarks import Landmarks
@@ -254,9 +255,7 @@ def _check_settings(conventions: Sequence[str], **settings: int) -> None:
         )
     ranges = BUDGET_RANGES | {"refine": REFINE_RANGE}
     for name, value in settings.items():
-        low, high = ranges[name]
-        if isinstance(value, bool) or not isinstance(value, int | np.integer) or not low <= value <= high:
-            raise ParameterError(name, f"must be an integer in [{low}, {high:,}] (got {value!r})")
+        v.integer(name, value, *ranges[name])
 
 
 def calibrate(
