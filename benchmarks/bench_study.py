@@ -42,7 +42,7 @@ import xarray as xr
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from spinectl import study  # noqa: E402
+from spinectl.landscape import study  # noqa: E402
 
 STUDY = """[study]
 description = "benchmark: {n} x {n} grid, 0 to 8 cm"

@@ -27,7 +27,8 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from spinectl import config, sweep  # noqa: E402
+from spinectl.landscape import sweep  # noqa: E402
+from spinectl.model import config  # noqa: E402
 
 
 def timed(function, repeats: int = 1):

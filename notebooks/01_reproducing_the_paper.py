@@ -35,7 +35,11 @@ import pandas as pd
 from IPython.display import display
 
 import spinectl
-from spinectl import config, landmarks, muscle, optimise, plotting, report, simulate, sweep
+from spinectl import optimise
+from spinectl.landscape import sweep
+from spinectl.model import config, muscle
+from spinectl.paper import figures, grid, landmarks, report
+from spinectl.reflex import simulate
 from spinectl.units import m2_to_cm2
 
 preset = PRESET or ("wagner2012" if "wagner2012" in spinectl.list_presets() else "default")
@@ -54,7 +58,7 @@ print(f"preset {preset!r}; E and Lambda from 0 to 8 cm, {GRID} points each ({(ax
 # match, so spinectl also solves $K = 15$ with the other reading of $K$ (the erratum section below).
 
 # %%
-K_PAPER = landmarks.PAPER_STIFFNESS  # N m/rad, the paper's ref. 26
+K_PAPER = grid.PAPER_STIFFNESS  # N m/rad, the paper's ref. 26
 other_convention = "paper" if model.passive.convention == "physical" else "physical"
 
 start = time.perf_counter()
@@ -75,7 +79,7 @@ print("solver statuses (K = 0):", dict(zip(*np.unique(k0["status"].values, retur
 # approximately 40 cm²." The positions A-D are the corners of the figure.
 
 # %%
-display(plotting.min_pcsa_figure(k0))
+display(figures.min_pcsa_figure(k0))
 
 # %% [markdown]
 # ### Figure 4: local counter torques
@@ -87,7 +91,7 @@ display(plotting.min_pcsa_figure(k0))
 # and a lumbar lordosis of $\Lambda \approx 4$ cm".
 
 # %%
-display(plotting.counter_torque_figure(k0, model.fibre.specific_tension))
+display(figures.counter_torque_figure(k0, model.fibre.specific_tension))
 
 # %% [markdown]
 # ### Figure S1: with the passive stiffness of the ligamentous sheath
@@ -97,7 +101,7 @@ display(plotting.counter_torque_figure(k0, model.fibre.specific_tension))
 # the required PCSA qualitatively".
 
 # %%
-display(plotting.min_pcsa_figure(k15))
+display(figures.min_pcsa_figure(k15))
 
 # %% [markdown]
 # ## The positions A-D
@@ -107,7 +111,7 @@ display(plotting.min_pcsa_figure(k15))
 # as the paper does: "Assuming [...] a lever arm of 7.0 cm", a counter torque is the PCSA of a local muscle.
 
 # %%
-positions = {**landmarks.POSITIONS, "optimum (E 3, Λ 4 cm)": landmarks.OPTIMUM}
+positions = {**grid.POSITIONS, "optimum (E 3, Λ 4 cm)": landmarks.OPTIMUM}
 rows = []
 for name, position in positions.items():
     ct_norm = landmarks.at(k0, "counter_torque_norm_Nm", position)
@@ -128,7 +132,7 @@ pd.DataFrame(rows).set_index("position").round(2)
 # %% [markdown]
 # ## The landmarks
 #
-# Every number the paper reports about these figures, beside spinectl's (`spinectl.landmarks`, the same table as
+# Every number the paper reports about these figures, beside spinectl's (`spinectl.paper.landmarks`, the same table as
 # in the `report.md` of `spinectl reproduce`). "About" is read as ±20 %, values being read off contour plots.
 
 # %%
@@ -284,7 +288,7 @@ plt.show()
 # Figure S1 with the other reading of $K$:
 
 # %%
-display(plotting.min_pcsa_figure(k15_other))
+display(figures.min_pcsa_figure(k15_other))
 
 # %% [markdown]
 # ### What each erratum changes, in one table

@@ -42,7 +42,11 @@ from matplotlib.colors import ListedColormap
 from matplotlib.patches import Patch
 
 import spinectl
-from spinectl import config, landmarks, margins, optimise, reflex, simulate, sweep, systems
+from spinectl import optimise, reflex
+from spinectl.landscape import sweep
+from spinectl.model import config
+from spinectl.paper import landmarks
+from spinectl.reflex import loops, margins, simulate
 
 preset = PRESET or ("wagner2012" if "wagner2012" in spinectl.list_presets() else "default")
 model = spinectl.load_preset(preset)
@@ -266,7 +270,7 @@ plt.show()
 
 # %%
 delay = model.reflex.delay
-loop = systems.loop_transfer(
+loop = loops.loop_transfer(
     limiting.stiffness, limiting.damping, limiting.inertia, limiting.kp, limiting.kd, delay, model.reflex.pade_order
 )
 bode = ct.bode_plot(loop, omega_limits=(0.1, 100.0), title=f"{limiting.name}: L(jω), τ = {delay * 1e3:g} ms")

@@ -30,7 +30,9 @@ import pandas as pd
 from IPython.display import display
 
 import spinectl
-from spinectl import config, landmarks, sweep
+from spinectl.landscape import sweep
+from spinectl.model import config
+from spinectl.paper import landmarks
 
 preset = PRESET or ("wagner2012" if "wagner2012" in spinectl.list_presets() else "default")
 model = config.set_parameter(spinectl.load_preset(preset), "passive.stiffness", 0.0)  # K = 0, as in Figure 3
@@ -42,6 +44,7 @@ print(
     f"preset {preset!r}: mass {model.body.mass:g} kg, K convention {model.passive.convention!r}, "
     f"activation {model.optimisation.activation!r}"
 )
+from spinectl.paper import grid
 
 # %% [markdown]
 # One function measures a model: a landscape over $E \times \Lambda$ for A, B, the ridge and the two slopes
@@ -56,8 +59,8 @@ def measure(variant):
     at_e = sweep.sweep(variant, [E_OPT], line).isel(E=0)
     ct, pcsa = at_e["counter_torque_norm_Nm"].values, at_e["min_pcsa_cm2"].values
     return {
-        "min PCSA at A [cm²]": landmarks.at(land, "min_pcsa_cm2", landmarks.POSITIONS["A"]),
-        "min PCSA at B [cm²]": landmarks.at(land, "min_pcsa_cm2", landmarks.POSITIONS["B"]),
+        "min PCSA at A [cm²]": landmarks.at(land, "min_pcsa_cm2", grid.POSITIONS["A"]),
+        "min PCSA at B [cm²]": landmarks.at(land, "min_pcsa_cm2", grid.POSITIONS["B"]),
         "ridge height [cm²]": float(land["min_pcsa_cm2"].max()),
         "ridge slope Λ/E [1]": landmarks.line_slope(land, "min_pcsa_cm2", "max"),
         "valley slope Λ/E [1]": landmarks.line_slope(land, "counter_torque_norm_Nm", "min"),
@@ -126,8 +129,8 @@ no_margins = config.set_parameter(no_margins, "optimisation.damping_margin", 0.0
 settings = {
     "K = 0, no margins": no_margins,
     "K = 0, default margins": model,
-    f"K = {landmarks.PAPER_STIFFNESS:g} N m/rad": config.set_parameter(
-        model, "passive.stiffness", landmarks.PAPER_STIFFNESS
+    f"K = {grid.PAPER_STIFFNESS:g} N m/rad": config.set_parameter(
+        model, "passive.stiffness", grid.PAPER_STIFFNESS
     ),
 }
 

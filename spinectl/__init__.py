@@ -2,30 +2,29 @@
 
 Implements the lumbar spine model of Wagner, Liebetrau, Schinowski, Wulf and
 de Lussanet (2012), *Spinal lordosis optimizes the requirements for a stable
-erect posture*, Theor Biol Med Model 9:13, with the reading and errata of
-``docs/model.md``.
+erect posture*, Theor Biol Med Model 9:13 (doi:10.1186/1742-4682-9-13), with
+the reading and errata of ``docs/model.md``. The map of the package, one idea
+per subpackage, is in CONTRIBUTING.md ("Architecture"):
 
-Layers (each depends only on those above it in this list):
-
-- parameters: :mod:`spinectl.params`, :mod:`spinectl.config`
-- physics: :mod:`spinectl.geometry`, :mod:`spinectl.muscle`, :mod:`spinectl.mechanics`
-- analysis: :mod:`spinectl.stability`, :mod:`spinectl.optimise` (per-point
-  reference), :mod:`spinectl.polish`, :mod:`spinectl.batch` (fast path),
-  :mod:`spinectl.reflex`, :mod:`spinectl.systems`, :mod:`spinectl.simulate`,
-  :mod:`spinectl.margins`
-- edges: :mod:`spinectl.sweep`, :mod:`spinectl.landmarks`, :mod:`spinectl.plotting`,
-  :mod:`spinectl.report`, :mod:`spinectl.io`, :mod:`spinectl.control_plots`,
-  :mod:`spinectl.cli`
+- :mod:`spinectl.model`: parameters, configuration, the physics and eq. 1;
+- :mod:`spinectl.optimise`: minimum PCSA and counter torques at every point;
+- :mod:`spinectl.reflex`: delayed reflexes and their margins;
+- :mod:`spinectl.landscape`: sweeps, NetCDF and parameter studies;
+- :mod:`spinectl.paper`: the paper's study, its landmarks and verdicts;
+- :mod:`spinectl.cli`: the ``spinectl`` command.
 
 The optimiser and the edges are not imported here (cvxpy, matplotlib and
-xarray take a second to import); ``from spinectl import optimise, sweep``.
+xarray take a second to import): ``from spinectl import optimise``.
 """
 
-from .config import dump_toml, list_presets, load_config, load_preset
+import importlib
+import warnings
+
 from .errors import ConfigError, ModelError, ParameterError, SpinectlError
-from .mechanics import SegmentCoefficients, segment_coefficients
-from .params import Model
-from .stability import StabilityResult, segment_stability
+from .model.config import dump_toml, list_presets, load_config, load_preset
+from .model.mechanics import SegmentCoefficients, segment_coefficients
+from .model.params import Model
+from .model.stability import StabilityResult, segment_stability
 
 __version__ = "0.1.0"
 
@@ -44,3 +43,45 @@ __all__ = [
     "segment_coefficients",
     "segment_stability",
 ]
+
+MOVED = {
+    "params": "spinectl.model.params",
+    "config": "spinectl.model.config",
+    "geometry": "spinectl.model.geometry",
+    "muscle": "spinectl.model.muscle",
+    "mechanics": "spinectl.model.mechanics",
+    "stability": "spinectl.model.stability",
+    "batch": "spinectl.optimise.stacked",
+    "polish": "spinectl.optimise.polish",
+    "systems": "spinectl.reflex.loops",
+    "simulate": "spinectl.reflex.simulate",
+    "margins": "spinectl.reflex.margins",
+    "control_plots": "spinectl.reflex.plots",
+    "sweep": "spinectl.landscape.sweep",
+    "study": "spinectl.landscape.study",
+    "landmarks": "spinectl.paper.landmarks",
+    "reproduction": "spinectl.paper.verdicts",
+    "plotting": "spinectl.paper.figures",
+    "report": "spinectl.paper.report",
+    "calibration": "spinectl.paper.calibration",
+    "io": "spinectl.atomic",
+}
+"""Modules of spinectl 0.1's flat layout and where they live now (CHANGELOG, 0.2).
+
+``from spinectl import sweep`` still works for one release, with a
+:class:`DeprecationWarning` naming the new module. Names that moved between
+modules when one was split (e.g. ``sweep.save``, now
+:func:`spinectl.landscape.netcdf.save`) are found in the new module only.
+"""
+
+
+def __getattr__(name: str):
+    """The moved modules of :data:`MOVED`, with a :class:`DeprecationWarning` (PEP 562)."""
+    if name not in MOVED:
+        raise AttributeError(f"module 'spinectl' has no attribute {name!r}")
+    warnings.warn(
+        f"spinectl.{name} has moved to {MOVED[name]}; the old name goes in the next release",
+        DeprecationWarning,
+        stacklevel=2,
+    )
+    return importlib.import_module(MOVED[name])

@@ -1,5 +1,5 @@
 """``python -m spinectl``: the command-line interface."""
 
-from spinectl.cli import main
+from .cli import main
 
 raise SystemExit(main())

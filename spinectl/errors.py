@@ -47,7 +47,7 @@ class ConfigError(ParameterError):
 class ModelError(SpinectlError, ValueError):
     """A configuration is valid parameter by parameter but not as a whole.
 
-    Raised where E and Lambda are known (:func:`spinectl.stability.validate_position`):
+    Raised where E and Lambda are known (:func:`spinectl.model.checks.validate_position`):
     a fibre attachment on a centre of rotation, or parameters so far off that
     the arithmetic overflows.
     """
@@ -57,5 +57,5 @@ class OutputError(SpinectlError, OSError):
     """An output cannot be written (folder not writable, a folder in the way, ...).
 
     Raised before anything is renamed onto the target, so the previous output
-    is left intact (see :func:`spinectl.io.atomic_path`).
+    is left intact (see :func:`spinectl.atomic.atomic_path`).
     """

@@ -7,10 +7,10 @@ import json
 import math
 import sys
 
-from ..config import load_config
+from ..atomic import atomic_write_text
 from ..errors import ParameterError
-from ..io import atomic_write_text
-from ..params import Model
+from ..model.config import load_config
+from ..model.params import Model
 
 
 def add_model_options(parser: argparse.ArgumentParser, default_preset: str = "default") -> None:

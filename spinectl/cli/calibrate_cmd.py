@@ -1,7 +1,7 @@
 """``spinectl calibrate``: fit the parameters the paper does not state to its landmarks.
 
 Differential evolution on a coarse grid with both passive-stiffness
-conventions (:func:`spinectl.calibration.calibrate`), progress on stderr, the
+conventions (:func:`spinectl.paper.calibration.calibrate`), progress on stderr, the
 residual of every landmark on stdout, and the calibrated model as a preset
 TOML written atomically (``--out``). This is how ``spinectl/presets/wagner2012.toml``
 was made; docs/reproduction.md describes the loss and the bounds.
@@ -12,9 +12,9 @@ from __future__ import annotations
 import shlex
 import sys
 
-from .. import calibration
-from ..config import set_parameter
-from ..io import atomic_write_text, check_writable
+from ..atomic import atomic_write_text, check_writable
+from ..model.config import set_parameter
+from ..paper import calibration, grid
 from ._common import add_model_options, load_model, require
 
 
@@ -42,7 +42,7 @@ def register(sub) -> None:
     parser.add_argument(
         "--verify-grid",
         type=int,
-        default=calibration.PAPER_POINTS,
+        default=grid.PAPER_POINTS,
         help="grid points per axis of the final measurement (default 81: the paper's 1 mm)",
     )
     parser.add_argument("--generations", type=int, default=calibration.GENERATIONS, help="generations per run")
@@ -60,7 +60,7 @@ def register(sub) -> None:
     )
     parser.add_argument(
         "--conventions",
-        default=",".join(calibration.CONVENTIONS),
+        default=",".join(grid.CONVENTIONS),
         metavar="NAME,...",
         help="passive-stiffness conventions to fit (default: physical,paper)",
     )

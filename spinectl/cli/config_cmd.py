@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import sys
 
-from ..config import dump_toml, list_presets
+from ..model.config import dump_toml, list_presets
 from ._common import add_model_options, load_model
 
 

@@ -7,8 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..config import set_parameter
-from ..margins import MarginsReport, SegmentMargins, analyse
+from ..model.config import set_parameter
+from ..reflex.margins import MarginsReport, SegmentMargins, analyse
 from ..units import m2_to_cm2
 from ._common import add_model_options, emit_json, finite_float, load_model
 from .stability_cmd import add_position_options
@@ -105,11 +105,11 @@ def write_plots(model, report: MarginsReport, folder: Path) -> list[Path]:
     model : Model
         The model of the report (simulation settings, geometry).
     report : MarginsReport
-        Output of :func:`spinectl.margins.analyse`.
+        Output of :func:`spinectl.reflex.margins.analyse`.
     folder : Path
         Folder for the PNGs (created if missing).
     """
-    from .. import control_plots, simulate, systems  # matplotlib only when plotting
+    from ..reflex import loops, plots, simulate  # matplotlib only when plotting
 
     point, settings = report.point, model.reflex
     usable = [(k, s) for k, s in enumerate(report.segments) if np.isfinite(s.stiffness)]  # NaN: infeasible
@@ -117,7 +117,7 @@ def write_plots(model, report: MarginsReport, folder: Path) -> list[Path]:
         f"E = {point.eccentricity * 100:g} cm, Lambda = {point.lordosis * 100:g} cm, activation {point.activation:g}"
     )
     loops = {  # python_control None: python-control cannot evaluate its Pade model (microsecond delays, high orders)
-        s.name: systems.loop_transfer(s.stiffness, s.damping, s.inertia, s.kp, s.kd, report.delay, report.pade_order)
+        s.name: loops.loop_transfer(s.stiffness, s.damping, s.inertia, s.kp, s.kd, report.delay, report.pade_order)
         for _, s in usable
         if (s.kp > 0 or s.kd > 0) and s.python_control is not None
     }
@@ -134,12 +134,12 @@ def write_plots(model, report: MarginsReport, folder: Path) -> list[Path]:
     written = []
     if loops:
         title = f"Reflex loops, Pade {report.pade_order}; {where}"
-        written.append(control_plots.bode(loops, folder / "bode.png", frequency_range(report), title))
+        written.append(plots.bode(loops, folder / "bode.png", frequency_range(report), title))
         title = f"Nyquist, tau = {report.delay:g} s; {where}"
-        written.append(control_plots.nyquist(loops, folder / "nyquist.png", title))
+        written.append(plots.nyquist(loops, folder / "nyquist.png", title))
     if responses:
         title = f"Response to a perturbation; {where}"
-        written.append(control_plots.time_response(responses, folder / "response.png", title))
+        written.append(plots.time_response(responses, folder / "response.png", title))
     skipped = sorted({"bode.png", "nyquist.png", "response.png"} - {p.name for p in written})
     if skipped:
         print(f"spinectl: note: not written (nothing to draw): {', '.join(skipped)}", file=sys.stderr)
@@ -202,7 +202,7 @@ def report_to_json(model, report: MarginsReport) -> dict:
     model : Model
         The model of the report (muscle names, gain mode).
     report : MarginsReport
-        Output of :func:`spinectl.margins.analyse`.
+        Output of :func:`spinectl.reflex.margins.analyse`.
     """
     point = report.point
     return {
@@ -231,7 +231,7 @@ def format_table(model, report: MarginsReport) -> str:
     model : Model
         The model of the report (gain mode).
     report : MarginsReport
-        Output of :func:`spinectl.margins.analyse`.
+        Output of :func:`spinectl.reflex.margins.analyse`.
     """
     point = report.point
     lines = [

@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from .. import plotting, sweep
+from ..landscape import netcdf
+from ..paper import figures
 
 
 def register(sub) -> None:
@@ -37,8 +38,8 @@ def run(args) -> int:
     int
         Exit code 0.
     """
-    dataset = sweep.load(args.results)
-    model = sweep.model_of(dataset)
-    for path in plotting.draw_figures(dataset, args.out, model.fibre.specific_tension):
+    dataset = netcdf.load(args.results)
+    model = netcdf.model_of(dataset)
+    for path in figures.draw_figures(dataset, args.out, model.fibre.specific_tension):
         print(path)
     return 0

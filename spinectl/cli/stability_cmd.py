@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-from ..config import set_parameter
 from ..errors import ModelError
-from ..optimise import solve_point
-from ..stability import StabilityResult, segment_stability
+from ..model.config import set_parameter
+from ..model.stability import StabilityResult, segment_stability
+from ..optimise.reference import solve_point
 from ..units import cm2_to_m2, m2_to_cm2
 from ._common import add_model_options, emit_json, finite_float, float_list, load_model
 
@@ -88,7 +88,7 @@ def run(args) -> int:
 
 
 def minimum_stabilising_pcsa(model, eccentricity: float, lordosis: float):
-    """The chosen activation of :func:`spinectl.optimise.solve_point` [m^2]; an error if there is none.
+    """The chosen activation of :func:`spinectl.optimise.reference.solve_point` [m^2]; an error if there is none.
 
     Parameters
     ----------
@@ -118,7 +118,7 @@ def result_to_json(model, result: StabilityResult, given: bool = True) -> dict:
     model : Model
         The model the result was computed with (muscle names, K).
     result : StabilityResult
-        Output of :func:`~spinectl.stability.segment_stability`.
+        Output of :func:`~spinectl.model.stability.segment_stability`.
     given : bool
         Whether the PCSA was given (``--pcsa``); ``pcsa_source`` is then 'given',
         else 'min_pcsa' (the optimiser's chosen activation).
@@ -161,7 +161,7 @@ def format_table(model, result: StabilityResult, given: bool = True) -> str:
     model : Model
         The model the result was computed with (muscle names, K).
     result : StabilityResult
-        Output of :func:`~spinectl.stability.segment_stability`.
+        Output of :func:`~spinectl.model.stability.segment_stability`.
     given : bool
         Whether the PCSA was given (``--pcsa``) or is the minimum stabilising one.
     """

@@ -67,7 +67,7 @@ def run(args) -> int:
     int
         Exit code 0 (also when ``--max-chunks`` stopped the study early).
     """
-    from .. import study  # dask and zarr only for this command
+    from ..landscape import study  # dask and zarr only for this command
 
     spec = study.load_study(args.study)
     options = {"scheduler": args.scheduler, "workers": args.workers, "resume": args.resume}

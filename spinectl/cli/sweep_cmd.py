@@ -6,9 +6,9 @@ import time
 
 import numpy as np
 
-from .. import sweep
-from ..config import set_parameter
-from ..io import check_writable
+from ..atomic import check_writable
+from ..landscape import netcdf, sweep
+from ..model.config import set_parameter
 from ._common import add_model_options, float_list, load_model
 
 DEFAULT_AXIS = "0:0.08:81"
@@ -68,7 +68,7 @@ def run(args) -> int:
         dataset = sweep.sweep(model, e_axis, l_axis, **options)
     else:
         dataset = sweep.stiffness_sweep(model, stiffnesses, e_axis, l_axis, **options)
-    sweep.save(dataset, args.out)
+    netcdf.save(dataset, args.out)
     print(summary(dataset, args.out, time.perf_counter() - start))
     return 0
 

@@ -1,1 +1,1 @@
-"""Built-in parameter presets, one TOML file each (see :mod:`spinectl.config`)."""
+"""Built-in parameter presets, one TOML file each (see :mod:`spinectl.model.config`)."""

@@ -4,7 +4,7 @@ At ``builder-inited`` it writes, beside the hand-written pages (only when a
 text changed, so that incremental builds stay incremental):
 
 - ``_generated/parameters.md``: every parameter with unit, default and
-  documentation, from the field metadata of :mod:`spinectl.params`;
+  documentation, from the field metadata of :mod:`spinectl.model.params`;
 - ``_generated/cli.md``: every command and sub-command of
   :func:`spinectl.cli.build_parser`;
 - ``_generated/api-modules.md`` and ``api/<module>.rst``: one autodoc page per

@@ -1,11 +1,11 @@
-"""The parameter tables of ``docs/parameters.md``, from the metadata of :mod:`spinectl.params`."""
+"""The parameter tables of ``docs/parameters.md``, from the metadata of :mod:`spinectl.model.params`."""
 
 from __future__ import annotations
 
 import dataclasses
 import inspect
 
-from spinectl.params import Model
+from spinectl.model.params import Model
 
 from .markup import first_paragraph, literal, md_escape, rst_to_myst
 

@@ -1,4 +1,4 @@
-"""The tables of ``docs/reproduction.md``, from :mod:`spinectl.calibration` and :mod:`spinectl.reproduction`.
+"""The tables of ``docs/reproduction.md``, from :mod:`spinectl.paper.calibration` and :mod:`spinectl.paper.verdicts`.
 
 The free parameters with their bounds, sources and calibrated values (read
 from the ``wagner2012`` preset), and the documented verdict of every landmark.
@@ -8,17 +8,17 @@ a fresh measurement of the preset (tests/test_reproduction.py).
 
 from __future__ import annotations
 
-from spinectl import calibration, reproduction
-from spinectl.config import load_preset
+from spinectl.model.config import load_preset
+from spinectl.paper import calibration, verdicts
 
 from .markup import md_escape
 
 
 def parameter_table() -> str:
     """The free parameters: name, unit, bounds, the calibrated value, what it is and where the bounds come from."""
-    fitted = load_preset(reproduction.PRESET)
+    fitted = load_preset(verdicts.PRESET)
     lines = [
-        f"| parameter | unit | lower | upper | `{reproduction.PRESET}` | what it is | source of the bounds |",
+        f"| parameter | unit | lower | upper | `{verdicts.PRESET}` | what it is | source of the bounds |",
         "| --- | --- | --- | --- | --- | --- | --- |",
     ]
     for p in calibration.FREE_PARAMETERS:
@@ -30,5 +30,5 @@ def parameter_table() -> str:
 
 
 def landmark_table() -> str:
-    """The documented verdict of every landmark (:func:`spinectl.reproduction.documented_table`)."""
-    return reproduction.documented_table()
+    """The documented verdict of every landmark (:func:`spinectl.paper.verdicts.documented_table`)."""
+    return verdicts.documented_table()

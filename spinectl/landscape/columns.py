@@ -1,0 +1,115 @@
+"""The landscape's variables at a list of points, solved chunk by chunk.
+
+The grid is solved in chunks of points (working memory stays flat however fine the grid),
+each chunk by the fast path (:mod:`spinectl.optimise.stacked`) or the per-point reference
+(:mod:`spinectl.optimise.reference`); the reflex columns follow from the chosen activation
+(:mod:`spinectl.reflex.maps`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..model.checks import arithmetic_guard, checked_coefficients
+from ..model.params import Model
+from ..optimise import stacked
+from ..optimise.problem import problem_data
+from ..reflex.delay import STATUS
+from ..reflex.maps import landscape
+from ..units import M2_PER_CM2, m2_to_cm2
+
+DEFAULT_CHUNK = 1024
+"""Grid points per stacked problem: large enough that Python overheads vanish, small enough to keep memory flat."""
+
+
+
+def point_columns(
+    model: Model, eccentricity, lordosis, *, method: str = "fast", chunk_size: int = DEFAULT_CHUNK, update=None
+) -> tuple[dict[str, np.ndarray], int]:
+    """Every variable of :data:`VARIABLES` at the points (E_i, Lambda_i), solved chunk by chunk.
+
+    The fast path solves each chunk of ``chunk_size`` consecutive points as one
+    stacked problem, so the answer depends on the chunking only through the
+    solver's tolerance; the same points in the same chunks give the same bits.
+
+    Parameters
+    ----------
+    model : Model
+        The parameters; ``passive.stiffness`` is K.
+    eccentricity, lordosis : array_like, shape (P,)
+        E and Lambda of each point [m].
+    method : {'fast', 'per-point'}
+    chunk_size : int
+        Points per chunk.
+    update : callable, optional
+        Called with the number of points solved, after each chunk (fast) or point (per-point).
+
+    Returns
+    -------
+    columns : dict of str to numpy.ndarray
+        Each variable with leading dimension P, in the units of its name.
+    per_point : int
+        Points that the per-point reference solved (all of them with ``method='per-point'``).
+    """
+    e_grid, l_grid = np.asarray(eccentricity, float), np.asarray(lordosis, float)
+    update = update or (lambda n: None)
+    arrays: dict[str, np.ndarray] = {}  # filled chunk by chunk: no copies of the answer beyond the answer
+    per_point = 0
+    for start in range(0, e_grid.size, int(chunk_size)):
+        part = slice(start, start + int(chunk_size))
+        coeffs = checked_coefficients(model, e_grid[part], l_grid[part])  # raises for bad input
+        data = problem_data(model, coeffs)
+        tol = model.optimisation.ct_tolerance
+        if method == "fast":
+            result = stacked.solve_stacked(data, tol)
+            update(len(data.stability))
+        else:
+            result = stacked.solve_points(data, tol, progress=update)
+        per_point += result.per_point
+        with arithmetic_guard(e_grid[part], l_grid[part]):  # e.g. K = 1e154 overflows S^2 in the reflex roots
+            columns = _chunk_columns(result, coeffs, model)
+        for name, values in columns.items():
+            if name not in arrays:
+                arrays[name] = np.empty((e_grid.size,) + values.shape[1:], values.dtype)
+            arrays[name][part] = values
+    return arrays, per_point
+
+
+def _chunk_columns(result: stacked.BlockOptimum, coeffs, model: Model) -> dict[str, np.ndarray]:
+    """The Dataset's variables for one chunk, in the units of their names."""
+    return _reflex_columns(model, coeffs, result.pcsa) | {
+        "min_pcsa_cm2": m2_to_cm2(result.min_pcsa),
+        "pcsa_cm2": m2_to_cm2(result.pcsa),
+        "counter_torque_Nm": result.counter_torque,
+        "counter_torque_norm_Nm": np.linalg.norm(result.counter_torque, axis=-1),
+        "status": result.status.astype(object),
+        "stiffness_per_cm2": coeffs.stiffness_per_pcsa * M2_PER_CM2,
+        "damping_per_cm2": coeffs.damping_per_pcsa * M2_PER_CM2,
+        "torque_per_cm2": coeffs.torque_per_pcsa * M2_PER_CM2,
+        "gravity_stiffness_Nm_per_rad": coeffs.gravity_stiffness,
+        "gravity_torque_Nm": coeffs.gravity_torque,
+        "passive_stiffness_Nm_per_rad": coeffs.passive_stiffness,
+        "inertia_kgm2": coeffs.inertia,
+    }
+
+
+def _reflex_columns(model: Model, coeffs, pcsa) -> dict[str, np.ndarray]:
+    """Delayed PD reflex at every point and segment (docs/reflex.md), vectorised.
+
+    The global muscles are active at ``reflex.activation`` times the chosen
+    activation (1: self-stable, no reflex needed; 0: reflex only); the gains
+    follow ``reflex``. The delay margin does not depend on the delay, so
+    ``delay_margin_s > tau`` answers "stable at delay tau" for any tau.
+    Infeasible points (NaN PCSA) get NaN and status 'undefined'.
+    """
+    active = model.reflex.activation * pcsa
+    maps = landscape(coeffs.stiffness(active), coeffs.damping(active), coeffs.inertia, model.reflex)
+    return {
+        "reflex_kp_Nm_per_rad": maps.kp,
+        "reflex_kd_Nms_per_rad": maps.kd,
+        "delay_margin_s": maps.delay_margin,
+        "delay_margin_pade_s": maps.delay_margin_pade,
+        "delay_margin_status": np.asarray(STATUS, dtype=object)[maps.delay_margin_status],
+        "stable_at_delay": maps.stable_at_delay,
+        "spine_delay_margin_s": np.min(maps.delay_margin, axis=-1),
+    }

@@ -1,0 +1,117 @@
+"""The landscape Dataset: its variables with units and long names, dimensions, coordinates and attributes.
+
+The schema is listed in docs/optimisation.md; sweeps (:mod:`spinectl.landscape.sweep`) and studies
+(:mod:`spinectl.landscape.study`) write the same variables.
+"""
+
+from __future__ import annotations
+
+import xarray as xr
+
+from .. import __version__
+from ..model import config
+from ..model.params import Model
+
+PAPER_REFERENCE = (
+    "Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012) Spinal lordosis optimizes "
+    "the requirements for a stable erect posture. Theor Biol Med Model 9:13"
+)
+
+
+VARIABLES = {
+    "min_pcsa_cm2": ("cm2", "minimum total PCSA of the global muscles for self-stability of all segments (Fig. 3)"),
+    "pcsa_cm2": ("cm2", "chosen activation: PCSA of each muscle (least ||CT|| within ct_tolerance of the minimum)"),
+    "counter_torque_Nm": ("N m", "local counter torque CT_k at the chosen activation"),
+    "counter_torque_norm_Nm": ("N m", "Euclidean norm ||CT|| of the local counter torques (Fig. 4)"),
+    "status": ("", "solver status: optimal, optimal_inaccurate, infeasible, infeasible_inaccurate, solver_error"),
+    "stiffness_per_cm2": ("N m rad-1 cm-2", "dM_k/dalpha of each muscle per cm2 of its PCSA"),
+    "damping_per_cm2": ("N m s rad-1 cm-2", "dM_k/domega of each muscle per cm2 of its PCSA"),
+    "torque_per_cm2": ("N m cm-2", "torque of each muscle about CoR k per cm2 of its PCSA, upright"),
+    "gravity_stiffness_Nm_per_rad": ("N m rad-1", "dM_ext/dalpha of the point mass (destabilising if > 0)"),
+    "gravity_torque_Nm": ("N m", "torque M_ext of the point mass about CoR k, upright"),
+    "passive_stiffness_Nm_per_rad": ("N m rad-1", "passive stiffness K as a torque stiffness (enters dM/dalpha as -K)"),
+    "inertia_kgm2": ("kg m2", "moment of inertia theta_k of the upper body about CoR k"),
+    "reflex_kp_Nm_per_rad": ("N m rad-1", "proportional gain kp of the delayed reflex (reflex settings)"),
+    "reflex_kd_Nms_per_rad": ("N m s rad-1", "derivative gain kd of the delayed reflex (reflex settings)"),
+    "delay_margin_s": ("s", "exact delay margin of the reflex loop at reflex.activation x chosen PCSA"),
+    "delay_margin_pade_s": ("s", "Pade estimate of the delay margin at reflex.pade_order"),
+    "delay_margin_status": ("", "finite, delay_independent (inf), unstable_without_delay (0) or undefined (NaN)"),
+    "stable_at_delay": ("", "closed loop stable with the delay reflex.delay (exact)"),
+    "spine_delay_margin_s": ("s", "smallest delay margin over the segments: the delay the whole spine tolerates"),
+}
+"""Every data variable: units (UDUNITS) and long name."""
+
+
+def dims_of(name: str, ndim: int) -> tuple[str, ...]:
+    """Dimensions of the variable ``name`` on the grid, from the number of its dimensions.
+
+    Parameters
+    ----------
+    name : str
+        A key of :data:`VARIABLES`.
+    ndim : int
+        2 (E, Lambda), 3 (plus segment, or muscle for ``pcsa_cm2``) or 4 (plus segment and muscle).
+    """
+    extra = {3: ("muscle",) if name == "pcsa_cm2" else ("segment",), 4: ("segment", "muscle")}
+    return ("E", "Lambda") + extra.get(ndim, ())
+
+
+def grid_coordinates(model: Model, e_axis, l_axis) -> dict:
+    """The coordinates ``E``, ``Lambda``, ``segment`` and ``muscle`` of a landscape, with units and names.
+
+    Parameters
+    ----------
+    model : Model
+        Supplies the names of the segments and muscles.
+    e_axis, l_axis : array_like, 1-D
+        Grid axes E and Lambda [m].
+    """
+    return {
+        "E": ("E", e_axis, {"units": "m", "long_name": "eccentricity of the spine"}),
+        "Lambda": ("Lambda", l_axis, {"units": "m", "long_name": "lordosis: horizontal offset of P3"}),
+        "segment": ("segment", list(model.geometry.cor_names), {"long_name": "centre of rotation"}),
+        "muscle": ("muscle", list(model.muscle_names), {"long_name": "global muscle"}),
+    }
+
+
+def landscape_dataset(model: Model, e_axis, l_axis, arrays: dict, method: str, per_point: int) -> xr.Dataset:
+    """The landscape Dataset of a sweep: variables with units, coordinates and the model as attributes.
+
+    Parameters
+    ----------
+    model : Model
+        The resolved model, written into the ``config_toml`` attribute.
+    e_axis, l_axis : array_like, 1-D
+        Grid axes E and Lambda [m].
+    arrays : dict of str to numpy.ndarray
+        Keys of :data:`VARIABLES`, each of shape (len(e_axis), len(l_axis), ...).
+    method : str
+        How the grid was solved ('fast' or 'per-point').
+    per_point : int
+        Points that the per-point reference solved.
+
+    Returns
+    -------
+    xarray.Dataset
+        Dimensions ``E``, ``Lambda``, ``segment``, ``muscle``; a scalar coordinate ``K``.
+    """
+    data_vars = {
+        name: xr.Variable(dims_of(name, arr.ndim), arr, {"units": VARIABLES[name][0], "long_name": VARIABLES[name][1]})
+        for name, arr in arrays.items()
+    }
+    coords = grid_coordinates(model, e_axis, l_axis) | {
+        "K": ((), model.passive.stiffness, {"units": "N m rad-1", "long_name": "passive stiffness K"}),
+    }
+    attrs = {
+        "title": "spinectl landscapes of minimum PCSA and counter torques",
+        "source": f"spinectl {__version__}",
+        "references": PAPER_REFERENCE,
+        "method": method,
+        "points_solved_per_point": per_point,
+        "passive_convention": model.passive.convention,
+        "activation": model.optimisation.activation,
+        "reflex_delay_s": model.reflex.delay,
+        "reflex_activation": model.reflex.activation,
+        "config_toml": config.dump_toml(model),
+    }
+    return xr.Dataset(data_vars, coords, attrs)

@@ -1,0 +1,33 @@
+"""Parameter studies: the sweep of :mod:`spinectl.landscape.sweep` over more axes, chunked, on Dask, into Zarr.
+
+A study file (``docs/studies.md``) names a base model, the E x Lambda grid, any
+number of parameter axes and Monte-Carlo draws, and the outputs.
+:func:`load_study` validates it into a :class:`Study`; :func:`run_study` solves
+it chunk by chunk (in-process, on a local Dask cluster or on an existing one)
+into a Zarr store that it can resume; :func:`load` reads the store back.
+
+- :mod:`spinectl.landscape.study.spec`: the study file, its validation and the plan of chunks;
+- :mod:`spinectl.landscape.study.store`: the Zarr store's layout, creation, resume check and writes;
+- :mod:`spinectl.landscape.study.run`: the chunks on a scheduler, written as they finish.
+"""
+
+from __future__ import annotations
+
+from .run import StudyResult, describe, run_study
+from .spec import Axis, Chunk, Sampled, Samples, Study, load_study, parse_study
+from .store import load, open_store
+
+__all__ = [
+    "Axis",
+    "Chunk",
+    "Sampled",
+    "Samples",
+    "Study",
+    "StudyResult",
+    "describe",
+    "load",
+    "load_study",
+    "open_store",
+    "parse_study",
+    "run_study",
+]

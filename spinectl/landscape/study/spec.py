@@ -1,0 +1,604 @@
+"""The study file: a validated :class:`Study` and its plan of chunks.
+
+A study file (TOML, format in ``docs/studies.md``) names a base model, the
+E x Lambda grid, any number of parameter axes (any dotted parameter, e.g.
+``body.mass``, ``passive.stiffness``, ``reflex.delay``) and Monte-Carlo draws
+of parameters (one ``sample`` dimension). It becomes a :class:`Study`, a frozen
+dataclass that validates every value through :func:`spinectl.model.config.set_parameters`
+before any work starts.
+
+The work is cut into chunks: one combination of the parameter axes (and
+sample) times a tile of the grid, each solved as one stacked problem by the
+fast path (:func:`spinectl.landscape.columns.point_columns`). The chunks are fixed by the
+study alone, never by the workers, so every worker count gives the same bits.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import math
+import numbers
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ... import _validate as v
+from ..._validate import escaped, show
+from ...errors import ConfigError, ParameterError, SpinectlError
+from ...model import config
+from ...model._toml import child, parse, read_text, unknown_message
+from ...model.checks import validate_position
+from ...model.params import Model
+from .. import schema, sweep
+
+ALIASES = {"K": "passive.stiffness", "delay": "reflex.delay"}
+"""Short axis names: the dimension keeps the short name (``K``, as in ``spinectl sweep --K``)."""
+
+GRID = ("E", "Lambda")
+"""The grid axes, always the last two dimensions before ``segment`` and ``muscle``."""
+
+SAMPLE = "sample"
+"""The dimension of the Monte-Carlo draws."""
+
+DISTRIBUTIONS = {"normal": ("mean", "std"), "uniform": ("low", "high"), "lognormal": ("median", "sigma")}
+"""Distributions of ``[samples.parameters]`` and their arguments, in the parameter's unit
+(``sigma``: of the logarithm). A draw is mean + std z, low + (high - low) u, median exp(sigma z)
+with z standard normal, u uniform on [0, 1)."""
+
+DEFAULT_CHUNK_POINTS = 4096
+"""Grid points per chunk: one stacked problem of this size takes about 1.5 s and 65 MB of working
+memory, so Python and scheduling overheads vanish and a killed study loses little."""
+
+MAX_CHUNK_POINTS = 65536
+"""Largest chunk: the stacked problem's working memory grows linearly, about 16 kB a point
+(tracemalloc peak of ``columns.point_columns``), so about 1 GB at this size."""
+
+MAX_COMBINATIONS = 10_000
+"""Most combinations of the parameter axes and samples: each is validated before any work
+starts (a few ms each: half a minute at most), and each needs at least one chunk."""
+
+SECTIONS = ("study", "model", "axes", "samples")
+STUDY_KEYS = ("preset", "config", "outputs", "chunk_size", "description")
+SAMPLE_KEYS = ("count", "seed", "parameters")
+RANGE_KEYS = ("start", "stop", "num")
+
+
+STORE_FORMAT = 1
+"""Version of the store layout (:mod:`spinectl.landscape.study.store`); part of :meth:`Study.digest`."""
+
+
+def _quoted(section: str, name: str) -> str:
+    """A study field as written in TOML: ``axes."body.mass"`` (a dotted key must be quoted)."""
+    return f'{section}."{escaped(name)}"' if "." in name else f"{section}.{escaped(name)}"
+
+
+def _scalars(where: str, values) -> tuple:
+    """Coordinate values: all finite numbers (ints stay ints) or all strings, distinct, at least one."""
+    items = v._sequence(where, values, "a list of numbers or strings")
+    if not items:
+        raise ParameterError(where, "must have at least one value")
+    if any(isinstance(x, str) for x in items) and not all(isinstance(x, str) for x in items):
+        raise ParameterError(where, f"must be all numbers or all strings (got {show(list(items))})")
+    out = tuple(_scalar(f"{where}[{i}]", x) for i, x in enumerate(items))
+    if len(set(out)) != len(out):
+        raise ParameterError(where, f"must not repeat a value (got {show(list(out))})")
+    return out
+
+
+def _scalar(where: str, value):
+    if isinstance(value, str):
+        return v.label(where, value)
+    number = v.real(where, value)  # rejects bools, NaN, inf and ints too large for a float
+    return int(value) if isinstance(value, numbers.Integral) else number
+
+
+def _check_name(where: str, parameter: str, model: Model) -> None:
+    """``parameter`` must name one value of the model: a ConfigError ("did you mean") otherwise."""
+    node = config.to_dict(model)
+    for key in parameter.split("."):
+        try:
+            node = child(node, key, parameter)
+        except ConfigError as exc:
+            raise ConfigError(where, exc.message) from None
+    if isinstance(node, (dict, list)) and node:
+        example = f"{parameter}.{next(iter(node)) if isinstance(node, dict) else 0}"
+        raise ParameterError(where, f"{parameter} is a table or a list: name one of its values, e.g. {example}")
+
+
+@dataclass(frozen=True)
+class Axis:
+    """One parameter axis of a study: a dimension of the results.
+
+    Parameters
+    ----------
+    name : str
+        Dotted parameter (``"body.mass"``, ``"muscles.0.spread"``) or an alias of :data:`ALIASES`;
+        the name of the dimension.
+    values : tuple
+        The parameter's values (numbers or strings), in its unit; distinct.
+    """
+
+    name: str
+    values: tuple
+
+    def __post_init__(self):
+        object.__setattr__(self, "values", _scalars(_quoted("axes", self.name), self.values))
+
+    @property
+    def parameter(self) -> str:
+        """The dotted parameter that this axis sets."""
+        return ALIASES.get(self.name, self.name)
+
+
+@dataclass(frozen=True)
+class Sampled:
+    """Monte-Carlo draws of one parameter, fixed by the seed of :class:`Samples`.
+
+    Parameters
+    ----------
+    parameter : str
+        Dotted parameter, e.g. ``"body.mass"``.
+    distribution : str
+        A key of :data:`DISTRIBUTIONS`.
+    arguments : tuple of (str, float)
+        The distribution's arguments by name, e.g. ``(("mean", 40.0), ("std", 4.0))``.
+    """
+
+    parameter: str
+    distribution: str
+    arguments: tuple
+
+    def __post_init__(self):
+        where = _quoted("samples.parameters", self.parameter)
+        v.choice(f"{where}.distribution", self.distribution, tuple(DISTRIBUTIONS))
+        names = DISTRIBUTIONS[self.distribution]
+        given = dict(self.arguments)
+        for key in given:
+            if key not in names:
+                raise ConfigError(f"{where}.{escaped(key)}", unknown_message(key, names))
+        missing = [n for n in names if n not in given]
+        if missing:
+            raise ParameterError(where, f"a {self.distribution} distribution needs {', '.join(missing)}")
+        args = {n: v.real(f"{where}.{n}", given[n]) for n in names}
+        if self.distribution == "uniform" and not args["low"] < args["high"]:
+            raise ParameterError(f"{where}.high", f"must be > low = {args['low']:g} (got {args['high']:g})")
+        if self.distribution == "lognormal":
+            v.positive(f"{where}.median", args["median"])
+        if self.distribution != "uniform":
+            v.non_negative(f"{where}.{names[1]}", args[names[1]])
+        object.__setattr__(self, "arguments", tuple(args.items()))
+
+    def draw(self, count: int, seed: int) -> np.ndarray:
+        """``count`` draws [the parameter's unit], from a stream of their own.
+
+        Each parameter's stream is seeded by ``seed`` and its name, so adding or
+        removing another sampled parameter leaves these draws unchanged.
+
+        Parameters
+        ----------
+        count : int
+            Number of draws.
+        seed : int
+            Seed of the study's samples.
+        """
+        rng = np.random.default_rng([seed, *self.parameter.encode()])
+        a, b = (value for _, value in self.arguments)
+        if self.distribution == "uniform":
+            return a + (b - a) * rng.random(count)
+        z = rng.standard_normal(count)
+        return a + b * z if self.distribution == "normal" else a * np.exp(b * z)
+
+
+@dataclass(frozen=True)
+class Samples:
+    """Monte-Carlo draws: one ``sample`` dimension of ``count`` draws of several parameters.
+
+    Parameters
+    ----------
+    count : int
+        Number of draws (the length of the ``sample`` dimension).
+    seed : int
+        Seed (>= 0): the same seed gives the same draws, so a resumed study sees the same ones.
+    parameters : tuple of Sampled
+        The parameters drawn, each independently.
+    """
+
+    count: int
+    seed: int
+    parameters: tuple[Sampled, ...]
+
+    def __post_init__(self):
+        object.__setattr__(self, "count", v.integer("samples.count", self.count, 1, MAX_COMBINATIONS))
+        object.__setattr__(self, "seed", v.integer("samples.seed", self.seed, 0))
+        if not self.parameters:
+            raise ParameterError("samples.parameters", "must name at least one parameter to draw")
+        names = [p.parameter for p in self.parameters]
+        for name in {n for n in names if names.count(n) > 1}:
+            raise ParameterError(_quoted("samples.parameters", name), "is given twice")
+        draws = {p.parameter: p.draw(self.count, self.seed) for p in self.parameters}
+        for values in draws.values():
+            values.flags.writeable = False
+        object.__setattr__(self, "_draws", draws)  # drawn once: every combination reads them
+
+    def values(self) -> dict[str, np.ndarray]:
+        """The draws of every parameter by name, shape (count,) each (read-only)."""
+        return dict(self._draws)
+
+
+@dataclass(frozen=True)
+class Chunk:
+    """One unit of work: a combination of the parameter axes times a tile of the grid.
+
+    Attributes
+    ----------
+    index : int
+        Position in the study's chunk order (combinations outer, tiles inner, C order).
+    combination : tuple of int
+        Index along each parameter dimension (:attr:`Study.dims`).
+    eccentricity, lordosis : slice
+        The tile: indices into the E and Lambda axes.
+    """
+
+    index: int
+    combination: tuple[int, ...]
+    eccentricity: slice
+    lordosis: slice
+
+
+@dataclass(frozen=True)
+class Study:
+    """A validated parameter study: base model, grid, parameter axes, samples, outputs, chunking.
+
+    Construction validates everything a worker will need, so that a bad value
+    stops the study before any work: every axis value and every draw through
+    :func:`spinectl.model.config.set_parameters`, then every combination together,
+    at the corners of the grid (:func:`spinectl.model.checks.validate_position`).
+    Field names in errors are those of the study file (``axes."body.mass"[2]``).
+
+    Parameters
+    ----------
+    model : Model
+        The base model; axes and samples replace some of its parameters.
+    eccentricity, lordosis : tuple of float
+        The grid axes E and Lambda [m].
+    axes : tuple of Axis
+        Parameter axes, one dimension each, in this order.
+    samples : Samples or None
+        Monte-Carlo draws (a ``sample`` dimension after the axes), or none.
+    outputs : tuple of str
+        Variables of :data:`spinectl.landscape.schema.VARIABLES` to keep (default: all).
+    chunk_size : int
+        Grid points per chunk: tiles of whole rows (every Lambda of some E) where a row fits.
+    description : str
+        Free text, stored with the results.
+    text : str
+        The study file as written, stored with the results.
+    """
+
+    model: Model
+    eccentricity: tuple
+    lordosis: tuple
+    axes: tuple[Axis, ...] = ()
+    samples: Samples | None = None
+    outputs: tuple[str, ...] = tuple(schema.VARIABLES)
+    chunk_size: int = DEFAULT_CHUNK_POINTS
+    description: str = ""
+    text: str = field(default="", compare=False)
+
+    def __post_init__(self):
+        if not isinstance(self.model, Model):
+            raise ParameterError("study.model", f"must be a Model (got {show(self.model)})")
+        if self.samples is not None and not isinstance(self.samples, Samples):
+            raise ParameterError("study.samples", f"must be Samples or None (got {show(self.samples)})")
+        if not all(isinstance(a, Axis) for a in self.axes):
+            raise ParameterError("study.axes", f"must be a sequence of Axis (got {show(self.axes)})")
+        object.__setattr__(self, "axes", tuple(self.axes))
+        for name, axis in zip(GRID, (self.eccentricity, self.lordosis), strict=True):
+            object.__setattr__(self, "eccentricity" if name == "E" else "lordosis", self._grid_axis(name, axis))
+        if len(self.eccentricity) * len(self.lordosis) > sweep.MAX_GRID_POINTS:
+            raise ParameterError("axes", f"the E x Lambda grid must have at most {sweep.MAX_GRID_POINTS:,} points")
+        object.__setattr__(self, "outputs", self._outputs(self.outputs))
+        chunk = v.integer("study.chunk_size", self.chunk_size, 1, MAX_CHUNK_POINTS)
+        object.__setattr__(self, "chunk_size", chunk)
+        if not isinstance(self.description, str):
+            raise ParameterError("study.description", f"must be a string (got {show(self.description)})")
+        self._check_parameters()
+        if math.prod(self.shape) > MAX_COMBINATIONS:
+            raise ParameterError("axes", f"at most {MAX_COMBINATIONS:,} combinations of axes and samples")
+        for combination in np.ndindex(*self.shape):
+            self._check_combination(combination)
+
+    @staticmethod
+    def _grid_axis(name: str, values) -> tuple[float, ...]:
+        values = _scalars(f"axes.{name}", values)
+        return tuple(v.real(f"axes.{name}[{i}]", x) for i, x in enumerate(values))
+
+    @staticmethod
+    def _outputs(outputs) -> tuple[str, ...]:
+        names = v._sequence("study.outputs", outputs, "a list of variable names")
+        if not names:
+            raise ParameterError("study.outputs", "must name at least one variable")
+        for i, name in enumerate(names):
+            if not isinstance(name, str) or name not in schema.VARIABLES:
+                raise ConfigError(f"study.outputs[{i}]", unknown_message(str(name), schema.VARIABLES))
+        return tuple(dict.fromkeys(names))
+
+    def _check_parameters(self) -> None:
+        """Each axis value and draw alone; no parameter twice; no change of the outputs' shape."""
+        seen: dict[str, str] = {}
+        drawn = self.samples.values() if self.samples else {}
+        named = [(_quoted("axes", a.name), a.parameter, a.values) for a in self.axes]
+        named += [(_quoted("samples.parameters", p), p, d.tolist()) for p, d in drawn.items()]
+        shape = (self.model.geometry.cor_names, self.model.muscle_names)
+        for where, parameter, values in named:
+            _check_name(where, parameter, self.model)
+            if parameter in seen:
+                raise ParameterError(where, f"sets {parameter}, which {seen[parameter]} sets already")
+            seen[parameter] = where
+            for i, value in enumerate(values):
+                try:
+                    model = config.set_parameters(self.model, {parameter: value})
+                except ParameterError as exc:
+                    raise type(exc)(f"{where}[{i}]", f"{exc.field}: {exc.message}") from None
+                if (model.geometry.cor_names, model.muscle_names) != shape:
+                    raise ParameterError(where, "must not rename the segments or muscles: outputs need one shape")
+
+    def _check_combination(self, combination) -> None:
+        """One combination of values together, at the corners of the grid; errors name the combination."""
+        overrides = self.overrides(combination)
+        values = ", ".join(f"{k} = {show(x)}" for k, x in overrides.items())
+        where = f" (study combination {values})" if values else ""
+        e_range, l_range = (min(self.eccentricity), max(self.eccentricity)), (min(self.lordosis), max(self.lordosis))
+        try:
+            validate_position(config.set_parameters(self.model, overrides), *np.meshgrid(e_range, l_range))
+        except ParameterError as exc:
+            raise type(exc)(exc.field, exc.message + where) from None
+        except SpinectlError as exc:
+            raise type(exc)(str(exc) + where) from None
+
+    @property
+    def dims(self) -> tuple[str, ...]:
+        """The parameter dimensions: the axes in order, then ``sample`` if there are samples."""
+        return tuple(a.name for a in self.axes) + ((SAMPLE,) if self.samples else ())
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        """Length of each of :attr:`dims`."""
+        return tuple(len(a.values) for a in self.axes) + ((self.samples.count,) if self.samples else ())
+
+    def overrides(self, combination) -> dict:
+        """The parameters that one combination sets, by dotted name, as plain Python values.
+
+        Parameters
+        ----------
+        combination : tuple of int
+            Index along each of :attr:`dims`.
+        """
+        out = {a.parameter: a.values[i] for a, i in zip(self.axes, combination, strict=False)}
+        if self.samples:
+            k = combination[len(self.axes)]
+            out |= {name: values[k].item() for name, values in self.samples.values().items()}
+        return out
+
+    @property
+    def tile(self) -> tuple[int, int]:
+        """Grid points of a chunk along E and Lambda: whole rows of Lambda while ``chunk_size`` allows."""
+        n_lambda = min(len(self.lordosis), self.chunk_size)
+        return max(1, min(len(self.eccentricity), self.chunk_size // n_lambda)), n_lambda
+
+    @property
+    def tiles(self) -> tuple[int, int]:
+        """Number of tiles along E and Lambda."""
+        return tuple(-(-n // t) for n, t in zip(self.grid_shape, self.tile, strict=True))
+
+    @property
+    def grid_shape(self) -> tuple[int, int]:
+        """Points along E and Lambda."""
+        return len(self.eccentricity), len(self.lordosis)
+
+    @property
+    def n_chunks(self) -> int:
+        """Number of chunks of the study."""
+        return math.prod(self.shape) * math.prod(self.tiles)
+
+    def chunk(self, index: int) -> Chunk:
+        """The chunk at position ``index`` of the study's order.
+
+        Parameters
+        ----------
+        index : int
+            0 <= index < :attr:`n_chunks`.
+        """
+        combination, tile = divmod(int(index), math.prod(self.tiles))
+        i_e, i_l = divmod(tile, self.tiles[1])
+        (b_e, b_l), (n_e, n_l) = self.tile, self.grid_shape
+        return Chunk(
+            index=int(index),
+            combination=tuple(int(i) for i in np.unravel_index(combination, self.shape)) if self.shape else (),
+            eccentricity=slice(i_e * b_e, min((i_e + 1) * b_e, n_e)),
+            lordosis=slice(i_l * b_l, min((i_l + 1) * b_l, n_l)),
+        )
+
+    def digest(self) -> str:
+        """SHA-256 of everything that fixes the numbers and the layout of the results.
+
+        The resolved base model, the grid, the axes, the drawn values, the
+        outputs and the tiling, not the file's text: comments and spacing may
+        change between a run and its resume, a value may not.
+        """
+        content = {
+            "format": STORE_FORMAT,
+            "model": config.dump_toml(self.model),
+            "grid": [list(self.eccentricity), list(self.lordosis)],
+            "axes": [[a.name, a.parameter, list(a.values)] for a in self.axes],
+            "samples": {k: d.tolist() for k, d in self.samples.values().items()} if self.samples else None,
+            "outputs": list(self.outputs),
+            "tile": list(self.tile),
+        }
+        return hashlib.sha256(json.dumps(content, sort_keys=True).encode()).hexdigest()
+
+
+# --- the study file --------------------------------------------------------------------------
+
+
+def load_study(path: str | Path) -> Study:
+    """Read and validate a study file (TOML; ``docs/studies.md``).
+
+    Parameters
+    ----------
+    path : str or Path
+        The study file; a ``config`` it names is relative to its folder.
+
+    Raises
+    ------
+    ConfigError
+        The file cannot be read, is not TOML, or has an unknown key ("did you mean").
+    ParameterError
+        A value is invalid; the field is named as in the file, e.g. ``axes."body.mass"[2]``.
+    """
+    path = Path(path)
+    try:
+        text = read_text(path)
+    except ConfigError as exc:
+        raise ConfigError("study", exc.message) from None
+    return parse_study(text, base_dir=path.parent, source=str(path))
+
+
+def parse_study(text: str, base_dir: str | Path = ".", source: str = "study") -> Study:
+    """A :class:`Study` from the text of a study file.
+
+    Parameters
+    ----------
+    text : str
+        TOML with the sections ``[study]``, ``[model]``, ``[axes]``, ``[samples]``.
+    base_dir : str or Path
+        Folder against which ``study.config`` is resolved.
+    source : str
+        Where the text came from, for messages.
+    """
+    try:
+        data = parse(text, source)
+    except ConfigError as exc:
+        raise ConfigError("study", exc.message) from None
+    for key in data:
+        if key not in SECTIONS:
+            raise ConfigError(escaped(key), unknown_message(key, SECTIONS))
+        if not isinstance(data[key], dict):
+            raise ConfigError(escaped(key), f"must be a table (got {show(data[key])})")
+    head = data.get("study", {})
+    _known_keys(head, STUDY_KEYS, "study")
+    axes = _flatten("axes", data.get("axes", {}), lambda x: any(k in x for k in RANGE_KEYS))
+    for name in GRID:
+        if name not in axes:
+            raise ParameterError(f"axes.{name}", "is required: a list of values or { start, stop, num } [m]")
+    options = {k: head[k] for k in ("outputs", "chunk_size", "description") if k in head}
+    return Study(
+        model=_base_model(head, data.get("model"), Path(base_dir)),
+        eccentricity=_values("axes.E", axes.pop("E")),
+        lordosis=_values("axes.Lambda", axes.pop("Lambda")),
+        axes=tuple(Axis(name, _values(_quoted("axes", name), value)) for name, value in axes.items()),
+        samples=_samples(data["samples"]) if "samples" in data else None,
+        text=text,
+        **options,
+    )
+
+
+def _known_keys(table: dict, allowed, where: str) -> None:
+    for key in table:
+        if key not in allowed:
+            raise ConfigError(f"{where}.{escaped(key)}", unknown_message(key, allowed))
+
+
+def _flatten(section: str, table: dict, is_leaf, prefix: str = "") -> dict:
+    """Dotted keys from nested tables: ``body.mass = [...]`` unquoted is ``{"body": {"mass": [...]}}`` in TOML."""
+    out: dict = {}
+    for key, value in table.items():
+        name = f"{prefix}{key}"
+        parts = _flatten(section, value, is_leaf, f"{name}.") if _is_table(value, is_leaf) else {name: value}
+        for dotted in parts:
+            if dotted in out:  # "body.mass" quoted and body.mass unquoted are two keys to TOML
+                raise ParameterError(_quoted(section, dotted), "is given twice")
+        out |= parts
+    return out
+
+
+def _is_table(value, is_leaf) -> bool:
+    return isinstance(value, dict) and bool(value) and not is_leaf(value)
+
+
+def _values(where: str, value) -> tuple:
+    """An axis: ``{ start, stop, num }`` (inclusive, evenly spaced), a list, or one value."""
+    if not isinstance(value, dict):
+        return tuple(value) if isinstance(value, list) else (value,)
+    _known_keys(value, RANGE_KEYS, where)
+    missing = [k for k in RANGE_KEYS if k not in value]
+    if missing:
+        raise ParameterError(where, f"a range needs start, stop and num (missing {', '.join(missing)})")
+    start, stop = v.real(f"{where}.start", value["start"]), v.real(f"{where}.stop", value["stop"])
+    num = v.integer(f"{where}.num", value["num"], 1, sweep.MAX_GRID_POINTS)
+    if start > stop:
+        raise ParameterError(f"{where}.stop", f"must be >= start = {start:g} (got {stop:g})")
+    return tuple(np.linspace(start, stop, num).tolist())
+
+
+def _base_model(head: dict, overrides, base_dir: Path) -> Model:
+    """The preset or configuration named in ``[study]``, with the ``[model]`` section on top."""
+    preset = head.get("preset")
+    try:
+        if "config" in head:
+            if not isinstance(head["config"], str):
+                raise ParameterError("config", f"must be a file name (got {show(head['config'])})")
+            model = config.load_config(base_dir / head["config"], preset=preset)
+        else:
+            model = config.load_preset("default" if preset is None else preset)
+    except ConfigError as exc:
+        if exc.field not in ("config", "preset"):
+            raise
+        raise ConfigError(f"study.{exc.field}", exc.message) from None
+    if overrides is None:
+        return model
+    try:
+        return config.merge(model, overrides)
+    except ParameterError as exc:
+        raise exc.under("model") from None
+
+
+def _samples(table: dict) -> Samples:
+    _known_keys(table, SAMPLE_KEYS, "samples")
+    for key in ("count", "parameters"):
+        if key not in table:
+            raise ParameterError(f"samples.{key}", "is required")
+    drawn = table["parameters"]
+    if not isinstance(drawn, dict):
+        raise ParameterError("samples.parameters", f"must be a table of distributions (got {show(drawn)})")
+    parameters = []
+    for name, spec in _flatten("samples.parameters", drawn, lambda x: "distribution" in x).items():
+        where = _quoted("samples.parameters", name)
+        if not isinstance(spec, dict) or "distribution" not in spec:
+            raise ParameterError(where, "must be { distribution = ..., <its arguments> }, see docs/studies.md")
+        arguments = tuple((k, x) for k, x in spec.items() if k != "distribution")
+        parameters.append(Sampled(name, spec["distribution"], arguments))
+    return Samples(table["count"], table.get("seed", 0), tuple(parameters))
+
+
+def fields_of(model: Model, dotted: str) -> dict[str, str]:
+    """``units`` and ``long_name`` of a parameter, from its field metadata (for coordinates).
+
+    Parameters
+    ----------
+    model : Model
+        Any model (only its structure is read).
+    dotted : str
+        Dotted parameter, e.g. ``"body.mass"`` or ``"muscles.0.upper.1"``.
+    """
+    node, meta = model, {}
+    for key in dotted.split("."):
+        if isinstance(node, tuple):
+            node = node[int(key)]
+            continue
+        meta = {f.name: f.metadata for f in dataclasses.fields(node)}[key]
+        node = getattr(node, key)
+    return {"units": meta.get("unit", ""), "long_name": meta.get("doc", dotted)}

@@ -1,0 +1,293 @@
+"""The Zarr store of a study: layout, creation, the resume check, chunk writes and reading back.
+
+Layout (``docs/studies.md``): every output of the study is one array with the
+study's parameter dimensions, then ``E``, ``Lambda`` and the output's own
+(``segment``, ``muscle``); its Zarr chunks are exactly the study's chunks, so
+that no two chunks of work ever share a file. ``chunk_done`` counts, per chunk,
+how often its results were written: 0 not yet (floats read NaN there), 1 done,
+never more. The attributes hold the study file, its digest and the base model.
+
+Zarr format 2: its specification covers the fixed-width strings of the status
+variables and coordinates; zarr-python 3.1 writes those in format 3 only with a
+warning that format 3 has no specification for them yet. Every Zarr file is
+written atomically (zarr's local store writes a temporary and renames it), so a
+killed run leaves whole chunks or none.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+import zarr
+
+from ... import __version__
+from ...atomic import atomic_path
+from ...errors import OutputError, ParameterError
+from ...model import config
+from .. import schema
+from .spec import SAMPLE, STORE_FORMAT, Chunk, Study, fields_of
+
+DONE = "chunk_done"
+"""The per-chunk counter of writes."""
+
+STRING_WIDTH = 32
+"""Characters of the fixed-width status strings; the longest status has 22."""
+
+ZARR_FORMAT = 2
+
+OPEN_ERRORS = (zarr.errors.BaseZarrError, OSError, ValueError, KeyError)
+"""What opening something that is not a Zarr store raises."""
+
+
+def encode(columns: dict, outputs, tile: tuple[int, int]) -> dict[str, np.ndarray]:
+    """The chosen outputs of :func:`~spinectl.landscape.columns.point_columns` as stored.
+
+    On the tile, strings fixed-width.
+
+    Parameters
+    ----------
+    columns : dict of str to numpy.ndarray
+        Leading dimension: the tile's points, E-major.
+    outputs : sequence of str
+        Names to keep.
+    tile : tuple of int
+        Points of the tile along E and Lambda.
+    """
+    out = {}
+    for name in outputs:
+        values = columns[name].reshape(tuple(tile) + columns[name].shape[1:])
+        if values.dtype == object:
+            text = values.astype(str)
+            if text.dtype.itemsize // 4 > STRING_WIDTH:  # numpy would truncate silently
+                raise ValueError(f"{name}: a value longer than {STRING_WIDTH} characters")
+            values = text.astype(f"<U{STRING_WIDTH}")
+        out[name] = values
+    return out
+
+
+def _fill(dtype: np.dtype):
+    return {"f": np.nan, "U": "", "b": False}.get(dtype.kind, 0)
+
+
+def template(study: Study, probe: dict[str, np.ndarray]) -> xr.Dataset:
+    """The whole store as a lazy Dataset: fill values, coordinates, attributes; nothing computed.
+
+    Parameters
+    ----------
+    study : Study
+        Its dimensions, coordinates and tiling.
+    probe : dict of str to numpy.ndarray
+        One point's outputs as :func:`encode` gives them (tile 1 x 1): their dtypes and trailing shapes.
+    """
+    import dask.array as da  # only where a store is made: the other commands need no dask
+
+    lead = study.shape + study.grid_shape
+    chunks = (1,) * len(study.shape) + study.tile
+    data_vars = {}
+    for name, values in probe.items():
+        dims = study.dims + schema.dims_of(name, values.ndim)
+        shape, fill = lead + values.shape[2:], _fill(values.dtype)
+        array = da.full(shape, fill, dtype=values.dtype, chunks=chunks + values.shape[2:])
+        units, long_name = schema.VARIABLES[name]
+        data_vars[name] = xr.Variable(dims, array, {"units": units, "long_name": long_name})
+    done = da.zeros(study.n_chunks, dtype="int16", chunks=1)
+    data_vars[DONE] = xr.Variable(("chunk",), done, {"long_name": "times the chunk was written: 0 not yet, 1 done"})
+    return xr.Dataset(data_vars, _coordinates(study), _attributes(study))
+
+
+def _coordinates(study: Study) -> dict:
+    model = study.model
+    coords = {
+        a.name: (a.name, list(a.values), fields_of(model, a.parameter) | {"parameter": a.parameter}) for a in study.axes
+    }
+    if study.samples:
+        coords[SAMPLE] = (SAMPLE, np.arange(study.samples.count), {"long_name": "Monte-Carlo draw"})
+        for name, values in study.samples.values().items():
+            coords[name] = (SAMPLE, values, fields_of(model, name) | {"parameter": name})
+    return coords | schema.grid_coordinates(model, list(study.eccentricity), list(study.lordosis))
+
+
+def _attributes(study: Study) -> dict:
+    return {
+        "title": "spinectl parameter study",
+        "description": study.description,
+        "source": f"spinectl {__version__}",
+        "references": schema.PAPER_REFERENCE,
+        "method": "fast",
+        "store_format": STORE_FORMAT,
+        "study_digest": study.digest(),
+        "study_toml": study.text,
+        "config_toml": config.dump_toml(study.model),
+        "chunk_tile": list(study.tile),
+    }
+
+
+def existing(study: Study, path: str | Path, resume: bool) -> np.ndarray | None:
+    """The write count of every chunk of an existing store; None if there is none yet.
+
+    An existing store is never replaced: it is filled in place, chunk by chunk
+    (that is what makes it resumable), so replacing it would discard every
+    finished chunk. Without ``resume`` it is refused; the user removes it deliberately.
+
+    Parameters
+    ----------
+    study : Study
+        The study to run.
+    path : str or Path
+        The store (a folder).
+    resume : bool
+        Continue an existing store.
+
+    Raises
+    ------
+    OutputError
+        The store exists and ``resume`` is false.
+    ParameterError
+        ``resume`` and the path holds no study store, or one of another study (field ``store``).
+    """
+    path = Path(path)
+    if not (path.exists() or path.is_symlink()):
+        return None
+    if not resume:
+        raise OutputError(
+            f"{str(path)!r} exists: add --resume to continue the study it holds, or remove it to start "
+            "afresh (a study store is filled in place and never replaced, which would discard its chunks)"
+        )
+    return _done_counts(study, path)
+
+
+def create(study: Study, path: str | Path, probe: dict) -> np.ndarray:
+    """Create the store atomically (:func:`spinectl.atomic.atomic_path`): complete or absent; return zero counts.
+
+    Parameters
+    ----------
+    study : Study
+        The study to run.
+    path : str or Path
+        The store (a folder) to create.
+    probe : dict
+        See :func:`template`.
+
+    Raises
+    ------
+    OutputError
+        The store cannot be created.
+    """
+    with atomic_path(path, directory=True) as tmp:
+        template(study, probe).to_zarr(tmp, mode="w", compute=False, zarr_format=ZARR_FORMAT, consolidated=False)
+    return np.zeros(study.n_chunks, dtype=int)
+
+
+def _done_counts(study: Study, path: Path) -> np.ndarray:
+    try:
+        group = zarr.open_group(path, mode="r", zarr_format=ZARR_FORMAT)
+        digest = group.attrs.get("study_digest")
+        counts = group[DONE][:] if digest else None
+    except OPEN_ERRORS:
+        digest = None
+    if digest is None:
+        raise ParameterError("store", f"{str(path)!r} is not a spinectl study store")
+    if digest != study.digest():
+        raise ParameterError(
+            "store",
+            f"{str(path)!r} holds another study (digest {digest[:12]}, this file {study.digest()[:12]}): resume "
+            "with the study file that made it, or write to another store",
+        )
+    return counts.astype(int)
+
+
+class Writer:
+    """Writes finished chunks into their own regions, then counts them done.
+
+    Parameters
+    ----------
+    study : Study
+        The study of the store.
+    path : str or Path
+        The store, as made by :func:`create`.
+    done : numpy.ndarray of int
+        The write counts read by :func:`existing` or :func:`create`; updated in place.
+    """
+
+    def __init__(self, study: Study, path: str | Path, done: np.ndarray):
+        self.study, self.path, self.done = study, Path(path), done
+        self._flags = zarr.open_group(self.path, mode="r+", zarr_format=ZARR_FORMAT)[DONE]
+
+    def write(self, chunk: Chunk, outputs: dict[str, np.ndarray]) -> None:
+        """Write one chunk's outputs (from :func:`encode`), then raise its count.
+
+        The data first, the count after: a run killed in between leaves the
+        chunk counted 0, and a resume writes it again, whole.
+
+        Parameters
+        ----------
+        chunk : Chunk
+            Where the outputs go.
+        outputs : dict of str to numpy.ndarray
+            On the chunk's tile.
+        """
+        lead = (np.newaxis,) * len(self.study.dims)
+        part = xr.Dataset(
+            {name: (self.study.dims + schema.dims_of(name, x.ndim), x[lead]) for name, x in outputs.items()}
+        )
+        region = {dim: slice(i, i + 1) for dim, i in zip(self.study.dims, chunk.combination, strict=True)}
+        region |= {"E": chunk.eccentricity, "Lambda": chunk.lordosis}
+        part.to_zarr(self.path, region=region, consolidated=False, zarr_format=ZARR_FORMAT)
+        self.done[chunk.index] += 1
+        self._flags[chunk.index] = self.done[chunk.index]
+
+
+def consolidate(path: str | Path) -> None:
+    """Consolidate the metadata of a finished store.
+
+    Chunks are written with ``consolidated=False`` (region writes); once every
+    chunk is done nothing changes the metadata again, so consolidating lets a
+    plain ``xarray.open_zarr(path)`` open the store quickly and without a warning.
+
+    Parameters
+    ----------
+    path : str or Path
+        The store.
+    """
+    zarr.consolidate_metadata(str(path))
+
+
+def open_store(path: str | Path) -> xr.Dataset:
+    """A study store as a lazy Dataset (dask arrays; nothing read until asked).
+
+    Parameters
+    ----------
+    path : str or Path
+        The store.
+
+    Raises
+    ------
+    ParameterError
+        Not a spinectl study store (field ``store``).
+    """
+    try:
+        dataset = xr.open_zarr(path, consolidated=False, zarr_format=ZARR_FORMAT)
+    except OPEN_ERRORS:
+        dataset = None
+    if dataset is None or "study_digest" not in dataset.attrs:
+        raise ParameterError("store", f"{str(path)!r} is not a spinectl study store")
+    return dataset
+
+
+def load(path: str | Path) -> xr.Dataset:
+    """A study store fully in memory, statuses as Python strings as in :func:`spinectl.landscape.sweep.sweep`.
+
+    Points of chunks not yet done read NaN (numbers), ``''`` (statuses), False, see ``chunk_done``.
+
+    Parameters
+    ----------
+    path : str or Path
+        The store.
+    """
+    dataset = open_store(path).load()
+    for name, variable in dataset.data_vars.items():
+        if variable.dtype.kind == "U":
+            dataset[name] = variable.astype(object)
+    return dataset

@@ -1,0 +1,131 @@
+"""Sweeps over the (E, Lambda) grid: the paper's landscapes as an xarray Dataset.
+
+The grid is solved in chunks of points (working memory stays flat however
+fine the grid), each chunk by the fast path (:mod:`spinectl.optimise.stacked`) or the
+per-point reference (:mod:`spinectl.optimise`). The Dataset carries the
+answers, the per-segment coefficients that define every problem (so that
+later analyses, e.g. delay margins, need not recompute them) and the
+resolved configuration; docs/optimisation.md lists the schema with units.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+from tqdm import tqdm
+
+from ..errors import ParameterError
+from ..model import config
+from ..model.params import Model
+from .columns import DEFAULT_CHUNK, point_columns
+from .schema import landscape_dataset
+
+METHODS = ("fast", "per-point")
+"""'fast': stacked blocks (:func:`spinectl.optimise.stacked.solve_stacked`); 'per-point': the cvxpy reference."""
+
+MAX_GRID_POINTS = 1_000_000
+"""Largest grid of one sweep: the answer alone takes about 1.2 kB a point (1.2 GB here),
+and at about 0.2 ms a point the fast path needs some minutes. A larger request is more
+likely a typo (a step count in place of a point count) than a plan."""
+
+
+def parse_grid(spec: str, name: str) -> np.ndarray:
+    """A grid axis from ``"start:stop:num"`` (inclusive, metres) or a single value.
+
+    Parameters
+    ----------
+    spec : str
+        E.g. ``"0:0.08:81"`` or ``"0.03"``.
+    name : str
+        The option, for the error message.
+
+    Raises
+    ------
+    ParameterError
+        Naming ``name`` (e.g. ``"--E"``) and the allowed form.
+    """
+    parts = spec.split(":")
+    try:
+        if len(parts) == 1:
+            return np.array([float(parts[0])])
+        start, stop, num = float(parts[0]), float(parts[1]), int(parts[2])
+    except (ValueError, IndexError):
+        raise ParameterError(name, f"must be START:STOP:NUM in metres, e.g. 0:0.08:81 (got {spec!r})") from None
+    if len(parts) != 3 or not 1 <= num <= MAX_GRID_POINTS or not start <= stop or not np.isfinite([start, stop]).all():
+        raise ParameterError(
+            name, f"must be START:STOP:NUM with START <= STOP and 1 <= NUM <= {MAX_GRID_POINTS:,} (got {spec!r})"
+        )
+    return np.linspace(start, stop, num)
+
+
+def sweep(
+    model: Model,
+    eccentricity,
+    lordosis,
+    *,
+    method: str = "fast",
+    chunk_size: int = DEFAULT_CHUNK,
+    progress: bool | None = None,
+) -> xr.Dataset:
+    """Minimum PCSA and counter torques on the grid E x Lambda (Figures 3 and 4).
+
+    Parameters
+    ----------
+    model : Model
+        Its ``passive.stiffness`` is the K of this landscape.
+    eccentricity, lordosis : array_like, 1-D
+        Grid axes E and Lambda [m].
+    method : {'fast', 'per-point'}
+    chunk_size : int
+        Grid points per chunk.
+    progress : bool or None
+        Show a progress bar on stderr; None: only on a terminal.
+
+    Returns
+    -------
+    xarray.Dataset
+        Dimensions ``E``, ``Lambda``, ``segment``, ``muscle``; schema in docs/optimisation.md.
+    """
+    if method not in METHODS:
+        raise ParameterError("method", f"must be one of {', '.join(map(repr, METHODS))} (got {method!r})")
+    if int(chunk_size) < 1:
+        raise ParameterError("chunk_size", f"must be >= 1 (got {chunk_size})")
+    e_axis = np.atleast_1d(np.asarray(eccentricity, float))
+    l_axis = np.atleast_1d(np.asarray(lordosis, float))
+    if e_axis.ndim != 1 or l_axis.ndim != 1 or e_axis.size * l_axis.size > MAX_GRID_POINTS:
+        raise ParameterError("grid", f"must be two 1-D axes with at most {MAX_GRID_POINTS:,} points in all")
+    e_grid, l_grid = (a.ravel() for a in np.meshgrid(e_axis, l_axis, indexing="ij"))
+    disable = None if progress is None else not progress  # None: tqdm shows it on a terminal only
+    with tqdm(total=e_grid.size, disable=disable, unit="pt", desc="sweep") as bar:
+        options = {"method": method, "chunk_size": chunk_size, "update": bar.update}
+        arrays, per_point = point_columns(model, e_grid, l_grid, **options)
+    shape = (e_axis.size, l_axis.size)
+    arrays = {name: values.reshape(shape + values.shape[1:]) for name, values in arrays.items()}
+    return landscape_dataset(model, e_axis, l_axis, arrays, method, per_point)
+
+
+def stiffness_sweep(model: Model, stiffnesses, eccentricity, lordosis, **options) -> xr.Dataset:
+    """:func:`sweep` for several passive stiffnesses K [N m/rad], stacked along a ``K`` dimension.
+
+    ``config_toml`` is then the model of the first K; the ``K`` coordinate gives each one's
+    ``passive.stiffness`` (convention: ``passive_convention``).
+
+    Parameters
+    ----------
+    model : Model
+    stiffnesses : sequence of float
+        K values [N m/rad].
+    eccentricity, lordosis : array_like, 1-D
+        Grid axes [m].
+    **options
+        Passed to :func:`sweep`.
+    """
+    parts = [
+        sweep(config.set_parameter(model, "passive.stiffness", float(k)), eccentricity, lordosis, **options)
+        for k in stiffnesses
+    ]
+    combined = xr.concat(parts, dim="K", data_vars="all", coords="minimal", compat="override", combine_attrs="override")
+    combined.attrs["points_solved_per_point"] = sum(p.attrs["points_solved_per_point"] for p in parts)
+    return combined
+
+

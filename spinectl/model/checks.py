@@ -1,0 +1,163 @@
+"""Guarded evaluation of the model: positions, PCSA vectors and arithmetic checked before use.
+
+Every analysis evaluates the coefficients of :mod:`spinectl.model.mechanics` through
+:func:`checked_coefficients`, which rejects positions outside the model's range or with
+attachments the spline cannot reach, and turns floating-point overflow into a
+:class:`~spinectl.errors.ModelError` naming the position.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+
+import numpy as np
+
+from ..errors import ModelError, ParameterError
+from . import geometry
+from .mechanics import SegmentCoefficients, segment_coefficients
+from .params import Model
+
+
+def validate_position(model: Model, eccentricity, lordosis) -> None:
+    """Raise unless the model can be evaluated at (E, Lambda); see :func:`checked_coefficients`.
+
+    Parameters
+    ----------
+    model : Model
+        Supplies the modelled ranges, the geometry and every parameter.
+    eccentricity, lordosis : array_like
+        E and Lambda [m]; broadcast together (a whole grid may be checked at once).
+
+    Raises
+    ------
+    ParameterError
+        E or Lambda is not finite or outside ``geometry.eccentricity_range`` or
+        ``geometry.lordosis_range`` [m].
+    ModelError
+        A fibre attachment lies on a centre of rotation there, or the
+        parameters overflow the arithmetic (a value orders of magnitude off).
+    """
+    checked_coefficients(model, eccentricity, lordosis)
+
+
+def checked_coefficients(model: Model, eccentricity, lordosis) -> SegmentCoefficients:
+    """:func:`~spinectl.mechanics.segment_coefficients` after every check of :func:`validate_position`.
+
+    Floating-point overflow, division by zero and invalid operations become a
+    :class:`ModelError`, never a numpy warning or a NaN passed on to a solver.
+
+    Parameters
+    ----------
+    model : Model
+        The parameters.
+    eccentricity, lordosis : array_like
+        E and Lambda [m]; broadcast together.
+    """
+    _check_range(model, eccentricity, lordosis)
+    with arithmetic_guard(eccentricity, lordosis):
+        _check_attachments(model, eccentricity, lordosis)
+        coeffs = segment_coefficients(model, eccentricity, lordosis)
+        values = [getattr(coeffs, f.name) for f in dataclasses.fields(coeffs)]
+        if not all(np.all(np.isfinite(x)) for x in values) or np.any(coeffs.inertia <= 0):
+            raise FloatingPointError("non-finite segment coefficients or zero inertia")
+    return coeffs
+
+
+def _where(eccentricity, lordosis) -> str:
+    e, lam = np.broadcast_arrays(np.asarray(eccentricity, float), np.asarray(lordosis, float))
+    if e.size == 1:
+        return f"at E = {e.flat[0]:g} m, Lambda = {lam.flat[0]:g} m"
+    return f"on the grid E in [{e.min():g}, {e.max():g}] m, Lambda in [{lam.min():g}, {lam.max():g}] m"
+
+
+@contextlib.contextmanager
+def arithmetic_guard(eccentricity, lordosis):
+    """Raise :class:`ModelError` for floating-point trouble inside the ``with`` block.
+
+    Validated parameters are finite, so overflow, division by zero or an
+    invalid operation mean that some values are orders of magnitude off (a
+    unit typo); the user gets that, not a numpy warning and NaN results.
+
+    Parameters
+    ----------
+    eccentricity, lordosis : array_like
+        E and Lambda [m] being evaluated, named in the message.
+    """
+    try:
+        with np.errstate(over="raise", divide="raise", invalid="raise"):
+            yield
+    except (FloatingPointError, OverflowError, ZeroDivisionError) as exc:
+        reason = str(exc) if isinstance(exc, FloatingPointError) else type(exc).__name__  # numpy's say where
+        raise ModelError(
+            f"the model's arithmetic fails {_where(eccentricity, lordosis)} ({reason}); "
+            "is a parameter or an input orders of magnitude off? (units are SI: m, kg, N, s)"
+        ) from None
+
+
+def _check_attachments(model: Model, eccentricity, lordosis) -> None:
+    """Raise :class:`ModelError` if a fibre attachment lies on a centre of rotation.
+
+    A fibre's line of action may pass through a CoR (a zero lever arm is a
+    valid answer), but an attachment on the CoR leaves no arm between the
+    joint and the muscle: the fibre has zero length on one side of the joint.
+    "On" means equal up to round-off of the coordinates.
+    """
+    cor = geometry.cor_positions(eccentricity, lordosis, model.geometry)  # (..., K, 2)
+    upper, lower, share = geometry.all_fibres(model)  # (F, 2), (F, 2), (F, M)
+    tolerance = 4 * np.finfo(float).eps
+    for end, points in (("upper", upper), ("lower", lower)):
+        offset = cor[..., :, None, :] - points  # (..., K, F, 2)
+        scale = np.abs(cor[..., :, None, :]).sum(-1) + np.abs(points).sum(-1)
+        on_cor = np.abs(offset).sum(-1) <= tolerance * scale
+        if on_cor.any():
+            *at, k, f = np.argwhere(on_cor)[0]
+            muscle = int(np.argmax(share[f]))
+            pair = muscle // 2
+            e, lam = (
+                np.broadcast_to(np.asarray(x, float), on_cor.shape[:-2])[tuple(at)] for x in (eccentricity, lordosis)
+            )
+            raise ModelError(
+                f"muscles.{pair}.{end}: the {end} attachment of a fibre of {model.muscle_names[muscle]} lies on the "
+                f"centre of rotation {model.geometry.cor_names[k]} {_where(e, lam)}; a fibre needs a non-zero "
+                "arm between the joint and each attachment"
+            )
+
+
+def _check_range(model: Model, eccentricity, lordosis) -> None:
+    for name, value, (lo, hi) in (
+        ("E", eccentricity, model.geometry.eccentricity_range),
+        ("Lambda", lordosis, model.geometry.lordosis_range),
+    ):
+        arr = np.asarray(value, float)
+        if not np.all(np.isfinite(arr)):
+            raise ParameterError(name, "must be finite")
+        if np.any(arr < lo) or np.any(arr > hi):
+            bad = arr[(arr < lo) | (arr > hi)].flat[0]
+            raise ParameterError(name, f"must be in [{lo:g}, {hi:g}] m, the modelled range (got {bad:g})")
+
+
+def expand_pcsa(model: Model, pcsa) -> np.ndarray:
+    """Per-muscle PCSA [m^2] from per-muscle (2 n values) or per-pair (n values, each side) input.
+
+    With n values, both muscles of pair j get ``pcsa[j]`` (paired activation).
+
+    Parameters
+    ----------
+    model : Model
+        Supplies the muscle pairs.
+    pcsa : array_like, shape (..., n) or (..., 2 n)
+        PCSA [m^2], finite and >= 0.
+    """
+    pcsa = np.asarray(pcsa, float)
+    n_pairs = len(model.muscles)
+    if pcsa.shape[-1:] == (n_pairs,):
+        pcsa = pcsa @ geometry.pairing_matrix(n_pairs).T
+    elif pcsa.shape[-1:] != (2 * n_pairs,):
+        raise ParameterError(
+            "pcsa",
+            f"must have {n_pairs} values (one per pair) or {2 * n_pairs} (one per muscle); got {pcsa.shape[-1:]}",
+        )
+    if not np.all(np.isfinite(pcsa)) or np.any(pcsa < 0):
+        raise ParameterError("pcsa", "must be finite and >= 0")
+    return pcsa

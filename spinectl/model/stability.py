@@ -1,0 +1,159 @@
+"""Self-stability of each lumbar segment for a given PCSA vector.
+
+For CoR k, with all other CoRs fixed (paper, Methods), the linearised equation
+of motion about the upright equilibrium is alpha' = omega,
+omega' = (S_k alpha + D_k omega) / theta_k, with S_k = dM/dalpha (muscles,
+gravity and passive stiffness) and D_k = dM/domega. The segment is self-stable
+iff both eigenvalues of its Jacobian have negative real part (paper, eq. 1).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .checks import arithmetic_guard, checked_coefficients, expand_pcsa
+from .mechanics import SegmentCoefficients
+from .params import Model
+
+
+def jacobian(stiffness, damping, inertia):
+    """Jacobian of (alpha', omega') at the equilibrium, shape (..., 2, 2) [1/s^2, 1/s].
+
+    J = [[0, 1], [S/theta, D/theta]] (paper, Stability analysis).
+
+    Parameters
+    ----------
+    stiffness : array_like
+        S = dM/dalpha [N m/rad].
+    damping : array_like
+        D = dM/domega [N m s/rad].
+    inertia : array_like
+        theta [kg m^2].
+    """
+    s, d, theta = np.broadcast_arrays(*(np.asarray(x, float) for x in (stiffness, damping, inertia)))
+    jac = np.zeros(s.shape + (2, 2))
+    jac[..., 0, 1] = 1.0
+    jac[..., 1, 0] = s / theta
+    jac[..., 1, 1] = d / theta
+    return jac
+
+
+def eigenvalues(stiffness, damping, inertia):
+    """Eigenvalues of :func:`jacobian` in closed form, shape (..., 2) complex [1/s].
+
+    lambda_{1,2} = D/(2 theta) +- sqrt(D^2/(4 theta^2) + S/theta) (paper, eq. 1,
+    with d(omega')/d(omega) = D/theta and d(omega')/d(alpha) = S/theta).
+    The root with the larger real part comes first.
+
+    Parameters
+    ----------
+    stiffness : array_like
+        S = dM/dalpha [N m/rad].
+    damping : array_like
+        D = dM/domega [N m s/rad].
+    inertia : array_like
+        theta [kg m^2].
+    """
+    s, d, theta = (np.asarray(x, float) for x in (stiffness, damping, inertia))
+    half = d / (2.0 * theta)
+    root = np.sqrt((half**2 + s / theta).astype(complex))
+    return np.stack([half + root, half - root], axis=-1)
+
+
+def self_stable(eigs, margin: float = 0.0):
+    """True where every eigenvalue has real part < -margin [1/s].
+
+    Parameters
+    ----------
+    eigs : array_like, shape (..., 2)
+        Eigenvalues [1/s], e.g. from :func:`eigenvalues`.
+    margin : float
+        Required distance of the real parts from zero [1/s].
+    """
+    return np.all(np.real(eigs) < -margin, axis=-1)
+
+
+@dataclass(frozen=True)
+class StabilityResult:
+    """Stability of every segment at one (E, Lambda) for one PCSA vector.
+
+    Attributes
+    ----------
+    eccentricity, lordosis : float
+        E and Lambda [m].
+    pcsa : numpy.ndarray, shape (n_muscles,)
+        PCSA of each muscle [m^2].
+    segment_names : tuple of str
+    stiffness, damping, inertia : numpy.ndarray, shape (n_cor,)
+        S [N m/rad], D [N m s/rad], theta [kg m^2].
+    eigenvalues : numpy.ndarray, shape (n_cor, 2), complex
+        [1/s].
+    self_stable : numpy.ndarray of bool, shape (n_cor,)
+    counter_torque : numpy.ndarray, shape (n_cor,)
+        CT_k [N m].
+    coefficients : SegmentCoefficients
+        The per-unit-PCSA problem data the result was computed from.
+    """
+
+    eccentricity: float
+    lordosis: float
+    pcsa: np.ndarray
+    segment_names: tuple[str, ...]
+    stiffness: np.ndarray
+    damping: np.ndarray
+    inertia: np.ndarray
+    eigenvalues: np.ndarray
+    self_stable: np.ndarray
+    counter_torque: np.ndarray
+    coefficients: SegmentCoefficients
+
+    @property
+    def counter_torque_norm(self) -> float:
+        """Euclidean norm ||CT|| [N m] (paper, Stability analysis)."""
+        return float(np.linalg.norm(self.counter_torque))
+
+    @property
+    def all_self_stable(self) -> bool:
+        """True if every segment is self-stable."""
+        return bool(np.all(self.self_stable))
+
+
+def segment_stability(model: Model, eccentricity: float, lordosis: float, pcsa) -> StabilityResult:
+    """Jacobian eigenvalues, self-stability and counter torque of every segment.
+
+    Parameters
+    ----------
+    model : Model
+    eccentricity, lordosis : float
+        E and Lambda [m], inside the modelled range.
+    pcsa : array_like
+        PCSA [m^2], per pair (n values) or per muscle (2 n values); see :func:`expand_pcsa`.
+
+    Returns
+    -------
+    StabilityResult
+    """
+    coeffs = checked_coefficients(model, float(eccentricity), float(lordosis))
+    pcsa = expand_pcsa(model, pcsa)
+    with arithmetic_guard(eccentricity, lordosis):  # e.g. a PCSA of 1e300 cm^2
+        stiffness = coeffs.stiffness(pcsa)
+        damping = coeffs.damping(pcsa)
+        eigs = eigenvalues(stiffness, damping, coeffs.inertia)
+        counter_torque = coeffs.counter_torque(pcsa)
+        if not all(np.all(np.isfinite(x)) for x in (stiffness, damping, eigs, counter_torque)):
+            raise FloatingPointError("non-finite stiffness, damping, eigenvalues or counter torque")
+    return StabilityResult(
+        eccentricity=float(eccentricity),
+        lordosis=float(lordosis),
+        pcsa=pcsa,
+        segment_names=model.geometry.cor_names,
+        stiffness=stiffness,
+        damping=damping,
+        inertia=coeffs.inertia,
+        eigenvalues=eigs,
+        self_stable=self_stable(eigs),
+        counter_torque=counter_torque,
+        coefficients=coeffs,
+    )

@@ -1,0 +1,74 @@
+"""The optimisation at every grid point: minimum PCSA, least counter torque, least-norm activation.
+
+docs/model.md, "The optimisation", and docs/optimisation.md. One formulation
+(:mod:`~spinectl.optimise.problem`) is solved two ways: per point with cvxpy, the
+readable reference (:mod:`~spinectl.optimise.reference`), and for blocks of points
+as one stacked Clarabel problem, the fast path (:mod:`~spinectl.optimise.stacked`);
+both answers are polished to the exact optimum (:mod:`~spinectl.optimise.polish`).
+
+The per-point API is re-exported here: ``optimise.solve_point(model, E, Lambda)``.
+"""
+
+from .problem import (
+    DEFAULT_TOLERANCE,
+    INFEASIBLE_STATUSES,
+    OK_STATUSES,
+    RANK_RTOL,
+    SLAB_FACTOR,
+    SOLVER_ERROR,
+    STAGES,
+    PointOptimum,
+    ProblemData,
+    ct_slab,
+    inequalities,
+    objective,
+    polished,
+    problem_data,
+    solver_options,
+    to_si,
+    worst_status,
+)
+from .reference import (
+    SOLVERS,
+    ParetoFront,
+    least_norm_activation_qp,
+    least_total_pcsa_lp,
+    min_counter_torque_socp,
+    min_norm_activation,
+    min_pcsa_lp,
+    optimum,
+    pareto_front,
+    point_optimum,
+    solve_point,
+)
+
+__all__ = [
+    "DEFAULT_TOLERANCE",
+    "INFEASIBLE_STATUSES",
+    "OK_STATUSES",
+    "RANK_RTOL",
+    "SLAB_FACTOR",
+    "SOLVERS",
+    "SOLVER_ERROR",
+    "STAGES",
+    "ParetoFront",
+    "PointOptimum",
+    "ProblemData",
+    "ct_slab",
+    "inequalities",
+    "least_norm_activation_qp",
+    "least_total_pcsa_lp",
+    "min_counter_torque_socp",
+    "min_norm_activation",
+    "min_pcsa_lp",
+    "objective",
+    "optimum",
+    "pareto_front",
+    "point_optimum",
+    "polished",
+    "problem_data",
+    "solve_point",
+    "solver_options",
+    "to_si",
+    "worst_status",
+]

@@ -1,0 +1,91 @@
+"""Calibration of the parameters the paper does not state, against the paper's landmarks.
+
+The paper (Wagner et al. 2012) gives neither the upper-body mass, nor the
+muscle attachment coordinates, nor the fibre spread. This package fits them,
+within anatomically plausible bounds, to the landmarks of
+:mod:`spinectl.paper.landmarks` (design page, "What the paper reports"), and reports
+the residual of every landmark (docs/reproduction.md):
+
+- :mod:`~spinectl.paper.calibration.parameters`: the free parameters, their bounds
+  with sources, and the map between a parameter vector and a model;
+- :mod:`~spinectl.paper.calibration.targets`: the landmarks as targets, and the loss;
+- :mod:`~spinectl.paper.calibration.landscapes`: coarse landscapes for fitting, the
+  paper's 81 x 81 grid for verifying;
+- :mod:`~spinectl.paper.calibration.fit`: :func:`calibrate`, differential evolution
+  then Nelder-Mead, with both passive-stiffness conventions;
+- :mod:`~spinectl.paper.calibration.sensitivity`: what the landmarks identify;
+- :mod:`~spinectl.paper.calibration.output`: the summary, the preset TOML, the loss history.
+"""
+
+from .fit import (
+    BUDGET_RANGES,
+    GENERATIONS,
+    POPSIZE,
+    REFINE_EVALUATIONS,
+    REFINE_RANGE,
+    REFINE_STEP,
+    CalibrationResult,
+    Fit,
+    calibrate,
+)
+from .landscapes import (
+    FIT_POINTS,
+    coarse_landmarks,
+    coarse_landscape,
+    measure_model,
+)
+from .output import history_csv, preset_toml, summary
+from .parameters import FREE_PARAMETERS, FreeParameter, bounds, from_model, parameter_set, to_model
+from .sensitivity import STEP_LANDMARKS, Sensitivity, sensitivity
+from .targets import (
+    C_READINGS,
+    MISSING_PENALTY,
+    STRICT_MARGIN,
+    WEIGHTS,
+    Residual,
+    Target,
+    loss,
+    paper_targets,
+    penalty,
+    residuals,
+    synthetic_targets,
+)
+
+__all__ = [
+    "BUDGET_RANGES",
+    "C_READINGS",
+    "FIT_POINTS",
+    "FREE_PARAMETERS",
+    "GENERATIONS",
+    "MISSING_PENALTY",
+    "POPSIZE",
+    "REFINE_EVALUATIONS",
+    "REFINE_RANGE",
+    "REFINE_STEP",
+    "STEP_LANDMARKS",
+    "STRICT_MARGIN",
+    "WEIGHTS",
+    "CalibrationResult",
+    "Fit",
+    "FreeParameter",
+    "Residual",
+    "Sensitivity",
+    "Target",
+    "bounds",
+    "calibrate",
+    "coarse_landmarks",
+    "coarse_landscape",
+    "from_model",
+    "history_csv",
+    "loss",
+    "measure_model",
+    "paper_targets",
+    "parameter_set",
+    "penalty",
+    "preset_toml",
+    "residuals",
+    "sensitivity",
+    "summary",
+    "synthetic_targets",
+    "to_model",
+]

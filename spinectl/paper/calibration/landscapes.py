@@ -1,0 +1,92 @@
+"""The landscapes the landmarks are measured on: coarse ones for fitting, the paper's grid for verifying.
+
+The fitting landscapes are coarse (17 x 17 by default) and use the fast path
+(:mod:`spinectl.optimise.stacked`); the K = 15 N m/rad landscape needs only the minimum
+PCSA (stage 1). The fitted model is measured again on the paper's 81 x 81 grid
+with full sweeps (:func:`measure_model`), as ``spinectl reproduce`` does.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from ...model.checks import checked_coefficients
+from ...model.params import Model
+from ...optimise import stacked
+from ...optimise.problem import problem_data
+from ...units import m2_to_cm2
+from .. import grid, landmarks
+from ..landmarks import Landmarks, Measurement
+
+FIT_POINTS = 17
+"""Grid points per axis while fitting: 5 mm steps, which contain the paper's positions
+A-D and its optimum (E = 3 cm, Lambda = 4 cm)."""
+
+
+def coarse_landscape(model: Model, axis, *, counter_torque: bool = True) -> xr.Dataset:
+    """Minimum PCSA (and ‖CT‖) on the grid axis x axis by the fast path, for fitting.
+
+    The variables that :func:`spinectl.paper.landmarks.measure` reads, without the rest
+    of a :func:`spinectl.landscape.sweep.sweep` Dataset. Without ``counter_torque`` only
+    stage 1 is solved (:func:`spinectl.optimise.stacked.solve_stacked`), and
+    ``counter_torque_norm_Nm`` is absent.
+
+    Parameters
+    ----------
+    model : Model
+    axis : array_like, 1-D
+        E and Lambda axis [m].
+    counter_torque : bool
+        Also solve for the least counter torques.
+    """
+    axis = np.asarray(axis, float)
+    e, lam = (a.ravel() for a in np.meshgrid(axis, axis, indexing="ij"))
+    data = problem_data(model, checked_coefficients(model, e, lam))
+    result = stacked.solve_stacked(data, model.optimisation.ct_tolerance, min_pcsa_only=not counter_torque)
+    shape, dims = (axis.size, axis.size), ("E", "Lambda")
+    variables = {"min_pcsa_cm2": (dims, m2_to_cm2(result.min_pcsa).reshape(shape))}
+    if counter_torque:
+        variables["counter_torque_norm_Nm"] = (dims, np.linalg.norm(result.counter_torque, axis=-1).reshape(shape))
+    return xr.Dataset(variables, coords={"E": axis, "Lambda": axis})
+
+
+def coarse_landmarks(model: Model, points: int = FIT_POINTS, *, other: bool = False) -> Landmarks:
+    """The landscapes the landmarks need, on a coarse grid (:func:`coarse_landscape`).
+
+    K = 0 with counter torques; K = 15 N m/rad with the model's convention; with
+    ``other``, K = 15 with the other convention too.
+
+    Parameters
+    ----------
+    model : Model
+    points : int
+        Grid points per axis.
+    other : bool
+        Also the K = 15 landscape of the other convention.
+    """
+    axis = grid.paper_axis(points)
+    k15 = grid.PAPER_STIFFNESS
+    k0 = coarse_landscape(grid.with_stiffness(model, 0.0), axis)
+    own = coarse_landscape(grid.with_stiffness(model, k15), axis, counter_torque=False)
+    alt = None
+    if other:
+        other_model = grid.with_stiffness(model, k15, grid.other_convention(model))
+        alt = coarse_landscape(other_model, axis, counter_torque=False)
+    return Landmarks(k0, own, alt)
+
+
+def measure_model(model: Model, points: int = grid.PAPER_POINTS, progress=None) -> list[Measurement]:
+    """Every landmark of ``model`` measured afresh on the paper's grid (:func:`grid.paper_landscapes`).
+
+    Parameters
+    ----------
+    model : Model
+    points : int
+        Grid points per axis.
+    progress : bool or None
+        Progress bars.
+    """
+    both, other = grid.paper_landscapes(model, points, progress)
+    k15 = grid.PAPER_STIFFNESS
+    return landmarks.measure(Landmarks(both.sel(K=0.0), both.sel(K=k15), other))

@@ -1,0 +1,86 @@
+"""A calibration as text: the summary ``spinectl calibrate`` prints, the preset TOML, the loss history."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from ...model.config import dump_toml
+from ..verdicts import RELATION
+from .fit import CalibrationResult
+
+
+def _number(value: float) -> str:
+    return f"{value:.4g}" if np.isfinite(value) else "n/a"
+
+
+def summary(result: CalibrationResult) -> str:
+    """The calibration as text: the parameters with their bounds, each convention's loss, every landmark.
+
+    Parameters
+    ----------
+    result : CalibrationResult
+    """
+    best = result.best
+    lines = [f"calibrated in {result.seconds:.0f} s, {result.evaluations} evaluations; convention {best.convention}"]
+    lines += ["", f"{'parameter':18} {'value':>9} {'lower':>8} {'upper':>8}  unit"]
+    for p, v in zip(result.parameters, best.vector, strict=True):
+        lines.append(f"{p.name:18} {v:9.4g} {p.lower:8.4g} {p.upper:8.4g}  {p.unit}")
+    lines += ["", "convention   loss (fit grid)   loss (verification grid)"]
+    for fit in result.fits.values():
+        lines.append(f"{fit.convention:12} {fit.fit_loss:15.4g}   {fit.loss:.4g}")
+    lines += ["", f"{'landmark':22} {'paper':>9} {'spinectl':>10} {'log-ratio':>10} {'penalty':>8}  agrees"]
+    for r in best.residuals:
+        paper = f"{RELATION[r.relation]} {r.paper:.3g}"
+        lines.append(
+            f"{r.name:22} {paper:>9} {_number(r.value):>10} {_number(r.log_ratio):>10} {r.penalty:8.3g}  "
+            f"{'yes' if r.agrees else 'no'}"
+        )
+    return "\n".join(lines)
+
+
+def preset_toml(result: CalibrationResult, command: str, date: str | None = None) -> str:
+    """The calibrated model as a preset TOML, with a header saying how it was produced.
+
+    Parameters
+    ----------
+    result : CalibrationResult
+    command : str
+        The command line that produced it.
+    date : str, optional
+        ISO date; default today.
+    """
+    date = date or time.strftime("%Y-%m-%d")
+    best = result.best
+    header = [
+        "# spinectl preset calibrated against the landmarks of Wagner et al. (2012); docs/reproduction.md.",
+        f"# Produced by: {command}",
+        f"# Date: {date}; wall time {result.seconds:.0f} s, {result.evaluations} loss evaluations.",
+        f"# Loss: {best.loss:.4g} on the {result.settings['verify_points']}-point grid "
+        f"({best.fit_loss:.4g} on the {result.settings['points']}-point fitting grid); "
+        f"{sum(r.agrees for r in best.residuals)} of {len(best.residuals)} landmarks agree.",
+        f"# Passive-stiffness convention: {best.convention} (losses: "
+        + ", ".join(f"{f.convention} {f.loss:.4g}" for f in result.fits.values())
+        + ").",
+        "# Free parameters (value; bounds):",
+    ]
+    for p, v in zip(result.parameters, best.vector, strict=True):
+        header.append(f"#   {p.name} = {v:.6g} {p.unit}; [{p.lower:g}, {p.upper:g}]")
+    return "\n".join(header) + "\n" + dump_toml(result.model)
+
+
+def history_csv(result: CalibrationResult) -> str:
+    """Every loss evaluation as CSV: the parameter vector, then the loss with each convention.
+
+    Parameters
+    ----------
+    result : CalibrationResult
+    """
+    names = [f"{p.name}_{p.unit}" for p in result.parameters]
+    header = ",".join(["evaluation", *names, *(f"loss_{c}" for c in result.settings["conventions"])])
+    rows = [
+        ",".join([str(i), *(f"{v:.10g}" for v in vector), *(f"{v:.10g}" for v in losses)])
+        for i, (vector, losses) in enumerate(zip(result.vectors, result.history, strict=True))
+    ]
+    return "\n".join([header, *rows]) + "\n"

@@ -1,0 +1,147 @@
+"""The main job: the paper's study end to end, written into one folder.
+
+E and Lambda from 0 to 8 cm at 1 mm, K = 0 and K = 15 N m/rad with the
+model's convention for K, and K = 15 with the other convention (for the
+halving landmark; :mod:`spinectl.paper.grid`); the landscapes as NetCDF,
+Figures 3, 4 and S1 as PNG, and a Markdown report with the paper's landmarks
+beside spinectl's and a verdict for each (docs/reproduction.md). Everything is
+staged and moved into the folder at the end (:func:`spinectl.atomic.staged_directory`).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from pathlib import Path
+
+from ..atomic import staged_directory
+from ..errors import ParameterError
+from ..landscape import netcdf, sweep
+from ..model.config import load_config
+from ..model.params import Model
+from . import figures, grid, landmarks, report, verdicts
+
+DEFAULT_PRESET = verdicts.PRESET
+"""The calibrated preset (docs/reproduction.md): what the study runs unless told otherwise."""
+
+LANDSCAPES = "landscapes.nc"
+"""File name of the K = 0 and K = 15 N m/rad landscapes in the output folder."""
+
+MIN_POINTS = 3
+"""Fewest grid points per axis: the corners A-D and one point between them."""
+
+MAX_POINTS = math.isqrt(sweep.MAX_GRID_POINTS)
+"""Most grid points per axis: points x points is the limit of one sweep."""
+
+
+def reproduce(
+    out_dir,
+    *,
+    preset: str | None = None,
+    config=None,
+    points: int = grid.PAPER_POINTS,
+    progress: bool | None = None,
+) -> list[Path]:
+    """Run the paper's study with a preset or a configuration file and write it into ``out_dir``.
+
+    Parameters
+    ----------
+    out_dir : str or Path
+        The output folder; replaced as a whole when the study has finished.
+    preset : str, optional
+        A built-in preset; default :data:`DEFAULT_PRESET` (the calibrated ``wagner2012``).
+    config : str or Path, optional
+        A TOML file with any subset of the parameters; without ``preset`` it keeps
+        its own base preset.
+    points : int
+        Grid points per axis, :data:`MIN_POINTS` to :data:`MAX_POINTS` (81: the paper's 1 mm).
+    progress : bool or None
+        Progress bars on stderr (None: on a terminal only).
+
+    Returns
+    -------
+    list of Path
+        The files written: the landscapes, the figures and ``report.md``.
+
+    Raises
+    ------
+    ParameterError
+        ``points`` out of range.
+    ConfigError
+        An unknown preset or a bad configuration file.
+    """
+    check_points(points)
+    if config is None:
+        preset = preset or DEFAULT_PRESET
+    model = load_config(config, preset=preset)
+    source = f"config file {config}" if config else f"preset `{preset}`"
+    calibrated = config is None and preset == verdicts.PRESET
+    return reproduce_model(model, out_dir, points=points, source=source, calibrated=calibrated, progress=progress)
+
+
+def check_points(points: int) -> None:
+    """Raise :class:`~spinectl.errors.ParameterError` unless ``points`` per axis is a grid the study can run.
+
+    Parameters
+    ----------
+    points : int
+        Grid points per axis.
+    """
+    if not MIN_POINTS <= points <= MAX_POINTS:
+        raise ParameterError("--points", f"must be {MIN_POINTS} to {MAX_POINTS} per axis (got {points})")
+
+
+def reproduce_model(
+    model: Model,
+    out_dir,
+    *,
+    points: int = grid.PAPER_POINTS,
+    source: str = "",
+    calibrated: bool = False,
+    progress: bool | None = None,
+) -> list[Path]:
+    """Run the study for a given model and write it into ``out_dir``.
+
+    Parameters
+    ----------
+    model : Model
+        Its passive stiffness is replaced by 0 and by :data:`spinectl.paper.grid.PAPER_STIFFNESS`.
+    out_dir : str or Path
+        The output folder; replaced as a whole when the study has finished.
+    points : int
+        Grid points per axis.
+    source : str
+        Where the parameters came from, for the report.
+    calibrated : bool
+        Whether they are the calibrated preset (the report says so).
+    progress : bool or None
+        Progress bars (None: on a terminal only).
+
+    Returns
+    -------
+    list of Path
+        The files written, inside ``out_dir``.
+    """
+    start = time.perf_counter()
+    k15 = grid.PAPER_STIFFNESS
+    both, other = grid.paper_landscapes(model, points, progress)
+    other_convention = grid.other_convention(model)
+    measured = landmarks.measure(landmarks.Landmarks(both.sel(K=0.0), both.sel(K=k15), other))
+    other_name = f"landscape_K{k15:g}_{other_convention}.nc"
+    with staged_directory(out_dir) as stage:
+        netcdf.save(both, stage / LANDSCAPES)
+        netcdf.save(other, stage / other_name)
+        drawn = figures.draw_figures(both, stage, model.fibre.specific_tension)
+        names = (LANDSCAPES, other_name, *(f.name for f in drawn), "report.md")
+        run_facts = report.Run(
+            preset=source or "the given model",
+            convention=model.passive.convention,
+            other_convention=other_convention,
+            points=points,
+            seconds=time.perf_counter() - start,
+            files=names,
+            specific_tension=model.fibre.specific_tension,
+            calibrated=calibrated,
+        )
+        (stage / "report.md").write_text(report.render(measured, run_facts))
+    return [Path(out_dir) / name for name in names]

@@ -1,0 +1,59 @@
+"""Delayed reflexes: the PD reflex loop of each segment, its delay margins, simulation and plots.
+
+docs/reflex.md. Pure vectorised numpy functions for the exact delay margin
+(:mod:`~spinectl.reflex.delay`), its Padé estimates (:mod:`~spinectl.reflex.pade`),
+the gains (:mod:`~spinectl.reflex.gains`) and their maps over a landscape
+(:mod:`~spinectl.reflex.maps`); above them the python-control objects
+(:mod:`~spinectl.reflex.loops`), the nonlinear simulation (:mod:`~spinectl.reflex.simulate`),
+the report of one configuration (:mod:`~spinectl.reflex.margins`) and its plots
+(:mod:`~spinectl.reflex.plots`).
+
+The vectorised functions are re-exported here (``reflex.delay_margin(S, D, theta, kp, kd)``);
+python-control and matplotlib are imported only by the modules that need them.
+"""
+
+from .delay import (
+    DELAY_INDEPENDENT,
+    FINITE,
+    STATUS,
+    UNDEFINED,
+    UNSTABLE_WITHOUT_DELAY,
+    Crossings,
+    DelayMargin,
+    critical_gains,
+    crossings,
+    delay_margin,
+    phase_margin,
+    right_half_plane_roots,
+    stable_at_delay,
+    stable_without_delay,
+)
+from .gains import default_gains, resolve_gains
+from .maps import ReflexLandscape, landscape
+from .pade import pade_coefficients, pade_convergence, pade_delay_margin, pade_inverse_lag, pade_phase_lag
+
+__all__ = [
+    "DELAY_INDEPENDENT",
+    "FINITE",
+    "STATUS",
+    "UNDEFINED",
+    "UNSTABLE_WITHOUT_DELAY",
+    "Crossings",
+    "DelayMargin",
+    "ReflexLandscape",
+    "critical_gains",
+    "crossings",
+    "default_gains",
+    "delay_margin",
+    "landscape",
+    "pade_coefficients",
+    "pade_convergence",
+    "pade_delay_margin",
+    "pade_inverse_lag",
+    "pade_phase_lag",
+    "phase_margin",
+    "resolve_gains",
+    "right_half_plane_roots",
+    "stable_at_delay",
+    "stable_without_delay",
+]

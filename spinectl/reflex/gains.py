@@ -1,0 +1,64 @@
+"""Reflex gains: the default rule from the segment's stiffness and inertia, or gains given by the user.
+
+The rule and its reasons are in docs/reflex.md, "The default reflex".
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .delay import as_arrays
+
+
+def default_gains(stiffness, damping, inertia, gain_factor, damping_ratio):
+    """The default reflex rule (``docs/reflex.md``, "The default reflex").
+
+    kp = gain_factor * max(S, 0): the stiffness deficit below self-stability
+    times a factor > 1, so that the reflexive stiffness kp - S = (gain_factor - 1) S
+    replaces the missing one; a self-stable segment (S < 0) gets no proportional
+    reflex. kd = max(0, 2 zeta sqrt(theta (kp - S)) + D): the delay-free closed loop
+    theta s^2 + (kd - D) s + (kp - S) gets the damping ratio zeta, counting the
+    muscles' own damping -D >= 0 first (kd = 0 when they already damp enough).
+
+    Parameters
+    ----------
+    stiffness, damping, inertia : array_like
+        S [N m/rad], D [N m s/rad], theta [kg m^2].
+    gain_factor : float
+        Factor on the stiffness deficit [1], > 1.
+    damping_ratio : float
+        zeta [1], > 0.
+
+    Returns
+    -------
+    kp, kd : numpy.ndarray
+        [N m/rad], [N m s/rad]; NaN where an input is NaN.
+    """
+    s, d, theta = as_arrays(stiffness, damping, inertia)
+    kp = gain_factor * np.maximum(s, 0.0)
+    net = np.maximum(kp - s, 0.0)
+    kd = np.maximum(2.0 * damping_ratio * np.sqrt(theta * net) + d, 0.0)
+    return kp, kd
+
+
+def resolve_gains(stiffness, damping, inertia, reflex, kp=None, kd=None):
+    """Gains per segment from the reflex settings, each optionally overridden.
+
+    Parameters
+    ----------
+    stiffness, damping, inertia : array_like
+        S [N m/rad], D [N m s/rad], theta [kg m^2].
+    reflex : spinectl.params.Reflex
+        ``gains = "rule"`` uses :func:`default_gains`, ``"explicit"`` its ``kp`` and ``kd``.
+    kp, kd : float, optional
+        Explicit gains [N m/rad], [N m s/rad] that replace the configured ones.
+    """
+    s, d, theta = as_arrays(stiffness, damping, inertia)
+    if reflex.gains == "rule":
+        kp0, kd0 = default_gains(s, d, theta, reflex.gain_factor, reflex.damping_ratio)
+    else:
+        kp0, kd0 = np.full(s.shape, reflex.kp), np.full(s.shape, reflex.kd)
+    kp_out = kp0 if kp is None else np.full(s.shape, float(kp))
+    kd_out = kd0 if kd is None else np.full(s.shape, float(kd))
+    nan = np.isnan(s) | np.isnan(d) | np.isnan(theta)
+    return np.where(nan, np.nan, kp_out), np.where(nan, np.nan, kd_out)

@@ -1,0 +1,209 @@
+"""Segments and reflex loops as python-control systems (design page, Reflex with delay).
+
+One python-control object per segment, for the command line, plots and checks;
+sweeps use the vectorised :mod:`spinectl.reflex` instead.
+
+- :func:`segment_system`: the linearised segment as a ``StateSpace``, states
+  (alpha, omega), input a torque [N m], output alpha [rad];
+- :func:`pade_delay`: exp(-s tau) as python-control's Padé approximant;
+- :func:`reflex_controller`, :func:`loop_transfer`: C(s) = kp + kd s and
+  L(s) = C(s) e^{-s tau} G(s), G(s) = 1 / (theta s^2 - D s - S);
+- :func:`closed_loop`: the segment under the delayed reflex, from a disturbing torque to alpha;
+- :func:`loop_margins`: python-control's margins of L, read for an open-loop unstable plant;
+- :func:`ignoring_underflow`: python-control's frequency responses without underflow warnings.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import warnings
+from dataclasses import dataclass
+
+import control as ct
+import numpy as np
+
+from ..model.stability import jacobian
+
+STATES = ("alpha", "omega")
+"""State names of a segment: angle [rad] and angular velocity [rad/s]."""
+
+
+def segment_system(stiffness: float, damping: float, inertia: float, name: str | None = None) -> ct.StateSpace:
+    """The segment linearised at the upright equilibrium (paper, Stability analysis).
+
+    x = (alpha, omega), x' = J x + (0, 1/theta) u, y = alpha, with the Jacobian
+    J = [[0, 1], [S/theta, D/theta]] of :func:`spinectl.model.stability.jacobian`; so its
+    poles are the eigenvalues of paper eq. (1).
+
+    Parameters
+    ----------
+    stiffness, damping, inertia : float
+        S [N m/rad], D [N m s/rad], theta [kg m^2].
+    name : str, optional
+        System name, e.g. the CoR ("L3L4").
+    """
+    a = jacobian(stiffness, damping, inertia)
+    b = np.array([[0.0], [1.0 / inertia]])
+    c = np.array([[1.0, 0.0]])
+    return ct.ss(a, b, c, 0.0, inputs=["torque"], outputs=["alpha"], states=list(STATES), name=name)
+
+
+def pade_delay(delay: float, order: int) -> ct.TransferFunction:
+    """exp(-s delay) as python-control's [order/order] Padé approximant (1 for no delay).
+
+    Parameters
+    ----------
+    delay : float
+        tau [s].
+    order : int
+        Order of the approximant.
+    """
+    num, den = ct.pade(delay, order)
+    return ct.tf(num, den, inputs=["u"], outputs=["u_delayed"])
+
+
+def reflex_controller(kp: float, kd: float) -> ct.TransferFunction:
+    """C(s) = kp + kd s [N m/rad], from alpha to the reflex torque (before the delay and sign).
+
+    Parameters
+    ----------
+    kp, kd : float
+        Reflex gains [N m/rad], [N m s/rad].
+    """
+    return ct.tf([kd, kp], [1.0], inputs=["alpha"], outputs=["reflex"])
+
+
+def loop_transfer(stiffness, damping, inertia, kp, kd, delay: float, order: int) -> ct.TransferFunction:
+    """Loop transfer function L(s) = C(s) Pade(s) G(s), the delay as a Padé approximant.
+
+    The closed loop is 1 + L = 0. G(s) = 1 / (theta s^2 - D s - S) is the transfer
+    function of :func:`segment_system`, written from its coefficients (design page,
+    Reflex with delay) rather than converted, which is exact.
+
+    Parameters
+    ----------
+    stiffness, damping, inertia : float
+        S [N m/rad], D [N m s/rad], theta [kg m^2].
+    kp, kd : float
+        Reflex gains [N m/rad], [N m s/rad].
+    delay : float
+        tau [s].
+    order : int
+        Order of the Padé approximant (:func:`pade_delay`).
+    """
+    plant = ct.tf([1.0], [inertia, -damping, -stiffness], inputs=["torque"], outputs=["alpha"])
+    return reflex_controller(kp, kd) * pade_delay(delay, order) * plant
+
+
+def closed_loop(stiffness, damping, inertia, kp, kd, delay: float, order: int, name=None) -> ct.StateSpace:
+    """The segment under the delayed reflex u = -(kp alpha + kd omega)(t - tau), Padé delay.
+
+    Built in state space (the PD acts on the states, so nothing improper is
+    realised): the plant with both states as outputs, fed back through the gain
+    row [kp, kd] and the Padé system. Input: a disturbing torque [N m]; output: alpha.
+    Its poles converge to the rightmost roots of the quasi-polynomial as the order grows.
+
+    Parameters
+    ----------
+    stiffness, damping, inertia : float
+        S [N m/rad], D [N m s/rad], theta [kg m^2].
+    kp, kd : float
+        Reflex gains [N m/rad], [N m s/rad].
+    delay : float
+        tau [s].
+    order : int
+        Order of the Padé approximant.
+    name : str, optional
+        System name.
+    """
+    plant = segment_system(stiffness, damping, inertia)
+    full = ct.ss(plant.A, plant.B, np.eye(2), np.zeros((2, 1)))
+    feedback_path = ct.tf2ss(pade_delay(delay, order)) * np.array([[kp, kd]])
+    loop = ct.feedback(full, feedback_path, sign=-1)
+    return ct.ss(loop.A, loop.B, loop.C[:1], loop.D[:1], inputs=["torque"], outputs=["alpha"], name=name)
+
+
+@dataclass(frozen=True)
+class LoopMargins:
+    """Margins of a loop transfer function from python-control's ``stability_margins``.
+
+    ``stability_margins`` does not know how many open-loop poles are unstable: it
+    reports the gain margin nearest to 1 (in dB), whichever side. For a segment below
+    self-stability (one open-loop pole in Re s > 0) the Nyquist curve must circle -1
+    once counter-clockwise, and the loop gain k is only stable in an interval
+    (gain_margin_lower, gain_margin_upper) around 1, the lower end > 0 (at least S/kp:
+    too weak a reflex cannot hold the segment). Both ends are the phase crossovers'
+    1/abs(L) nearest to 1 from below and above; they are meaningful only if the closed
+    loop is stable (``stable``), else NaN.
+
+    Attributes
+    ----------
+    gain_margin : float
+        python-control's gain margin [1] (nearest to 1 in dB; < 1 means a lower margin).
+    gain_margin_lower, gain_margin_upper : float
+        Stable range of a factor on both gains [1]; 0 and inf where unbounded.
+    phase_margin_deg : float
+        python-control's phase margin [deg], smallest in magnitude; inf without crossover.
+    crossover_rad_s : float
+        Gain crossover frequency of that phase margin [rad/s]; NaN without crossover.
+    phase_crossover_rad_s : float
+        Phase crossover frequency of ``gain_margin`` [rad/s].
+    stable : bool
+        Closed loop stable, as decided by the caller (exactly, from the quasi-polynomial).
+    """
+
+    gain_margin: float
+    gain_margin_lower: float
+    gain_margin_upper: float
+    phase_margin_deg: float
+    crossover_rad_s: float
+    phase_crossover_rad_s: float
+    stable: bool
+
+
+def loop_margins(loop: ct.TransferFunction, stable: bool) -> LoopMargins:
+    """python-control's margins of ``loop`` with the lower/upper reading of :class:`LoopMargins`.
+
+    The closed-loop stability only changes with a gain factor k where k L(jw) = -1,
+    i.e. at k = 1/abs(L(jw)) on the phase crossovers (``stability_margins(returnall=True)``),
+    so a stable loop stays stable for k between the nearest of these below and above 1.
+
+    Parameters
+    ----------
+    loop : control.TransferFunction
+        L(s), e.g. from :func:`loop_transfer`.
+    stable : bool
+        Whether the closed loop is stable at k = 1 (decide it exactly, with
+        :func:`spinectl.reflex.delay.stable_at_delay`); if not, the gain interval is NaN.
+    """
+    with ignoring_underflow():
+        gm, pm, _, wpc, wgc, _ = ct.stability_margins(loop)
+        all_gm = np.asarray(ct.stability_margins(loop, returnall=True)[0], float)
+    below, above = all_gm[all_gm < 1.0], all_gm[all_gm > 1.0]
+    lower = float(below.max()) if below.size else 0.0
+    upper = float(above.min()) if above.size else np.inf
+    if not stable:
+        lower = upper = np.nan
+    return LoopMargins(
+        gain_margin=float(gm),
+        gain_margin_lower=lower,
+        gain_margin_upper=upper,
+        phase_margin_deg=float(pm),
+        crossover_rad_s=float(wgc),
+        phase_crossover_rad_s=float(wpc),
+        stable=bool(stable),
+    )
+
+
+@contextlib.contextmanager
+def ignoring_underflow():
+    """Silence underflow warnings from python-control's evaluation of L(jw) in the ``with`` block.
+
+    python-control evaluates transfer functions under ``np.errstate(all="warn")``, so a
+    subnormal coefficient (e.g. the damping at an activation of 1e-308) warns
+    "underflow encountered"; the term is flushed to zero, which changes no result. numpy's
+    own default ignores underflow too. Overflow and invalid operations still warn.
+    """
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", "underflow encountered", RuntimeWarning)
+        yield

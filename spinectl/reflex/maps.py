@@ -1,0 +1,74 @@
+"""The delayed reflex at every point and segment of a landscape, vectorised.
+
+Gains (:mod:`spinectl.reflex.gains`), exact and Padé delay margins (:mod:`spinectl.reflex.delay`,
+:mod:`spinectl.reflex.pade`) and stability at the model's delay, as arrays of any shape.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .delay import as_arrays, delay_margin, stable_at_delay
+from .gains import resolve_gains
+from .pade import pade_delay_margin
+
+
+@dataclass(frozen=True)
+class ReflexLandscape:
+    """Reflex gains and delay margins over a grid of segments (any shape).
+
+    Attributes
+    ----------
+    kp, kd : numpy.ndarray
+        Reflex gains [N m/rad], [N m s/rad].
+    delay_margin : numpy.ndarray
+        Exact delay margin [s] (:func:`delay_margin`).
+    delay_margin_status : numpy.ndarray of int
+        Index into :data:`STATUS`.
+    crossing_frequency : numpy.ndarray
+        Frequency at which stability is lost [rad/s].
+    delay_margin_pade : numpy.ndarray
+        Padé estimate of the delay margin at the configured order [s].
+    stable_at_delay : numpy.ndarray of bool
+        Closed loop stable with the configured delay (exact).
+    """
+
+    kp: np.ndarray
+    kd: np.ndarray
+    delay_margin: np.ndarray
+    delay_margin_status: np.ndarray
+    crossing_frequency: np.ndarray
+    delay_margin_pade: np.ndarray
+    stable_at_delay: np.ndarray
+
+
+def landscape(stiffness, damping, inertia, reflex, kp=None, kd=None) -> ReflexLandscape:
+    """Gains, exact and Padé delay margins and the stability verdict for arrays of segments.
+
+    The vectorised entry point for sweeps over E x Lambda: pass S, D, theta of every
+    segment at every grid point (already scaled by the activation), any shape.
+
+    Parameters
+    ----------
+    stiffness, damping, inertia : array_like
+        S [N m/rad], D [N m s/rad], theta [kg m^2]; NaN (infeasible) gives NaN and status 'undefined'.
+    reflex : spinectl.params.Reflex
+        Delay, Padé order and gains.
+    kp, kd : float, optional
+        Explicit gains overriding ``reflex``.
+    """
+    s, d, theta = as_arrays(stiffness, damping, inertia)
+    kp_, kd_ = resolve_gains(s, d, theta, reflex, kp, kd)
+    exact = delay_margin(s, d, theta, kp_, kd_)
+    pade = pade_delay_margin(s, d, theta, kp_, kd_, reflex.pade_order)
+    return ReflexLandscape(
+        kp=kp_,
+        kd=kd_,
+        delay_margin=exact.margin,
+        delay_margin_status=exact.status,
+        crossing_frequency=exact.frequency,
+        delay_margin_pade=pade.margin,
+        stable_at_delay=stable_at_delay(s, d, theta, kp_, kd_, reflex.delay),
+    )

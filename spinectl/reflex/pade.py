@@ -1,0 +1,132 @@
+"""Padé estimates of the delay margin: the rational approximation of the delay, its phase lag and its margin.
+
+The Padé approximant of order n of exp(-s tau) has unit gain on the imaginary axis and
+the phase lag -2 sum arctan(...) of its poles; replacing the exact lag w tau by it gives the
+delay margin that a Padé loop predicts (docs/reflex.md, "Padé estimates"), vectorised like
+:mod:`spinectl.reflex.delay`.
+"""
+
+from __future__ import annotations
+
+from fractions import Fraction
+from math import factorial
+
+import numpy as np
+
+from .delay import (
+    BISECTIONS,
+    DelayMargin,
+    crossings,
+    delay_margin,
+    margin_from_delays,
+    stable_without_delay,
+    undefined_inputs,
+)
+
+
+def pade_coefficients(order: int) -> np.ndarray:
+    """Coefficients c_0..c_n of the [n/n] Padé approximant exp(-x) ~ q(-x) / q(x), q(x) = sum c_k x^k.
+
+    c_k = (2n - k)! n! / ((2n)! k! (n - k)!) (Baker and Graves-Morris, Padé Approximants,
+    1996; e.g. n = 1: q = 1 + x/2; n = 2: q = 1 + x/2 + x^2/12), lowest power first, c_0 = 1.
+
+    Parameters
+    ----------
+    order : int
+        n >= 1.
+    """
+    n = int(order)
+    return np.array(
+        [
+            float(Fraction(factorial(2 * n - k) * factorial(n), factorial(2 * n) * factorial(k) * factorial(n - k)))
+            for k in range(n + 1)
+        ]
+    )
+
+
+def pade_phase_lag(y, order: int):
+    """Phase lag [rad] of the Padé all-pass q(-jy)/q(jy) at y = w tau, unwrapped.
+
+    Equals 2 arg q(jy) = 2 sum_i atan((y - Im r_i) / -Re r_i) over the roots r_i of q
+    (all in Re < 0, so every term is continuous): increases from 0 to n pi, where the
+    true delay's lag y grows without bound. Its magnitude is exactly 1: the Padé
+    loop has the same crossover frequencies as the true one.
+
+    Parameters
+    ----------
+    y : array_like
+        w tau [rad].
+    order : int
+        Order n of the approximant.
+    """
+    roots = np.roots(pade_coefficients(order)[::-1])
+    y = np.asarray(y, float)[..., None]
+    return 2.0 * np.sum(np.arctan((y - roots.imag) / -roots.real), axis=-1)
+
+
+def pade_inverse_lag(phase, order: int):
+    """The y >= 0 with :func:`pade_phase_lag` (y) = ``phase`` [rad]; inf where phase >= n pi.
+
+    Vectorised bisection on u = (2/pi) atan(y) in [0, 1), where the lag is monotone.
+
+    Parameters
+    ----------
+    phase : array_like
+        Lag to reach [rad].
+    order : int
+        Order n of the approximant.
+    """
+    phase = np.asarray(phase, float)
+    lo, hi = np.zeros_like(phase), np.ones_like(phase)
+    for _ in range(BISECTIONS):
+        mid = 0.5 * (lo + hi)
+        below = pade_phase_lag(np.tan(0.5 * np.pi * mid), order) < phase
+        lo, hi = np.where(below, mid, lo), np.where(below, hi, mid)
+    y = np.tan(0.5 * np.pi * 0.5 * (lo + hi))
+    return np.where(phase < order * np.pi, y, np.inf)
+
+
+def pade_delay_margin(stiffness, damping, inertia, kp, kd, order: int) -> DelayMargin:
+    """Delay margin of the loop with the delay replaced by its [n/n] Padé approximant.
+
+    Same crossings as the exact loop (the approximant is all-pass); only the phase
+    differs, so the critical delay of a crossing is y/w with lag(y) = phi, and none
+    when phi >= n pi. Converges to :func:`delay_margin` as the order grows.
+
+    Parameters
+    ----------
+    stiffness, damping, inertia : array_like
+        S [N m/rad], D [N m s/rad], theta [kg m^2].
+    kp, kd : array_like
+        Reflex gains [N m/rad], [N m s/rad].
+    order : int
+        Order n of the approximant.
+    """
+    cr = crossings(stiffness, damping, inertia, kp, kd)
+    first = pade_inverse_lag(cr.phase, order) / cr.frequency
+    stable0 = stable_without_delay(stiffness, damping, kp, kd)
+    return margin_from_delays(first, cr.frequency, stable0, undefined_inputs(stiffness, damping, inertia, kp, kd))
+
+
+def pade_convergence(stiffness, damping, inertia, kp, kd, orders):
+    """Padé delay margins and their errors against the exact margin, for several orders.
+
+    Parameters
+    ----------
+    stiffness, damping, inertia : array_like
+        S [N m/rad], D [N m s/rad], theta [kg m^2].
+    kp, kd : array_like
+        Reflex gains [N m/rad], [N m s/rad].
+    orders : sequence of int
+        Orders n of the approximants.
+
+    Returns
+    -------
+    margins, errors : numpy.ndarray, shape (len(orders), ...)
+        Padé delay margin [s] and its error (Padé - exact) [s]; 0 where both are inf.
+    """
+    exact = delay_margin(stiffness, damping, inertia, kp, kd).margin
+    margins = np.stack([pade_delay_margin(stiffness, damping, inertia, kp, kd, n).margin for n in orders])
+    with np.errstate(invalid="ignore"):
+        errors = np.where(margins == exact, 0.0, margins - exact)
+    return margins, errors

@@ -1,0 +1,310 @@
+"""Nonlinear time-domain simulation of one segment under a reflex with the true delay.
+
+The plant is the paper's equation of motion for CoR k (Methods):
+
+    theta alpha'' = sum_i PCSA_i M_i(alpha, omega) + M_ext(alpha) + CT_k - K alpha + u(t),
+
+with the muscle torques of :func:`spinectl.model.mechanics.muscle_torque_per_pcsa`, gravity
+from :func:`spinectl.model.mechanics.gravity_torque`, the passive stiffness K of
+:func:`spinectl.model.mechanics.passive_stiffness` and the constant counter torque CT_k that
+makes upright an equilibrium. The reflex is u(t) = -(kp alpha + kd omega)(t - tau)
+(design page, Reflex with delay).
+
+Integration: classical Runge-Kutta with a fixed step and a history buffer; delayed
+states between grid points come from cubic Hermite interpolation (alpha with slope
+omega, omega with slope omega'), which keeps the scheme fourth order. The step is cut
+to the delay when the delay is shorter, so every delayed time is already computed.
+Before t = 0 the segment is held at the perturbation angle at rest, then released.
+Runs are batched: every array argument broadcasts to a batch of independent runs.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..model import geometry, mechanics
+from ..model.params import Model, Reflex
+
+MAX_STEPS = 1_000_000
+"""Most time steps of one simulation: four arrays of this many rows per run, about a minute of work."""
+
+_NOISE = np.sqrt(np.finfo(float).eps)
+"""A response that decays below this fraction of its perturbation is in rounding noise: stable."""
+
+
+@dataclass(frozen=True)
+class SegmentPlant:
+    """The nonlinear mechanics of one segment at a fixed activation.
+
+    Attributes
+    ----------
+    model : Model
+    cor : numpy.ndarray, shape (2,)
+        Position of the CoR [m].
+    pcsa : numpy.ndarray, shape (n_muscles,)
+        PCSA of each muscle [m^2].
+    inertia : float
+        theta_k [kg m^2].
+    passive_stiffness : float
+        K as a physical stiffness [N m/rad].
+    name : str
+        Name of the CoR.
+    counter_torque : float
+        CT_k = -(sum_i M_i + M_ext) upright [N m] (paper, Methods).
+    fibres : tuple of numpy.ndarray
+        Upper and lower attachments of every fibre [m] and its isometric force f_iso [N]
+        (:func:`spinectl.model.geometry.all_fibres`, PCSA shares times the specific tension).
+    """
+
+    model: Model
+    cor: np.ndarray
+    pcsa: np.ndarray
+    inertia: float
+    passive_stiffness: float
+    name: str
+    counter_torque: float
+    fibres: tuple
+
+    def torque(self, alpha, omega):
+        """Net torque without the reflex [N m], the counter torque included: zero upright.
+
+        sum_i M_i + M_ext + CT_k - K alpha (paper, Methods). The counter torque is
+        computed with the same expression at (0, 0) (see :func:`segment_plant`), so
+        the equilibrium is exact to rounding and small responses are not swamped by
+        a constant offset.
+
+        Parameters
+        ----------
+        alpha, omega : array_like
+            Angle [rad] and angular velocity [rad/s] of the segment.
+        """
+        return _torque_without_ct(self, alpha, omega) + self.counter_torque
+
+
+def _torque_without_ct(plant: SegmentPlant, alpha, omega):
+    """sum_i M_i + M_ext - K alpha [N m]: M_i = h_i f_l f_H per unit f_iso times each fibre's f_iso."""
+    upper, lower, f_iso = plant.fibres
+    alpha, omega = np.asarray(alpha, float), np.asarray(omega, float)
+    m = plant.model
+    per_fiso = mechanics.fibre_torque(alpha[..., None], omega[..., None], upper, lower, plant.cor, m.fibre, m.errata)
+    gravity = mechanics.gravity_torque(alpha, plant.cor, m)
+    return per_fiso @ f_iso + gravity - plant.passive_stiffness * alpha
+
+
+def segment_plant(model: Model, eccentricity: float, lordosis: float, segment, pcsa) -> SegmentPlant:
+    """The :class:`SegmentPlant` of one CoR at a configuration and activation.
+
+    Parameters
+    ----------
+    model : Model
+    eccentricity, lordosis : float
+        E and Lambda [m].
+    segment : int or str
+        Index or name of the CoR.
+    pcsa : array_like, shape (n_muscles,)
+        PCSA of each muscle [m^2].
+    """
+    names = model.geometry.cor_names
+    if isinstance(segment, str):
+        if segment not in names:
+            raise ParameterError("segment", f"must be one of {', '.join(names)} (got {segment!r})")
+        segment = names.index(segment)
+    cor = geometry.cor_positions(eccentricity, lordosis, model.geometry)[segment]
+    theta = float(mechanics.inertia(cor, model))
+    pcsa = np.asarray(pcsa, float)
+    upper, lower, share = geometry.all_fibres(model)
+    plant = SegmentPlant(
+        model=model,
+        cor=cor,
+        pcsa=pcsa,
+        inertia=theta,
+        passive_stiffness=float(mechanics.passive_stiffness(model, theta)),
+        name=names[segment],
+        counter_torque=0.0,
+        fibres=(upper, lower, model.fibre.specific_tension * share @ pcsa),
+    )
+    return dataclasses.replace(plant, counter_torque=float(-_torque_without_ct(plant, 0.0, 0.0)))
+
+
+@dataclass(frozen=True)
+class Simulation:
+    """A batch of simulated responses.
+
+    Attributes
+    ----------
+    time : numpy.ndarray, shape (n,)
+        [s].
+    alpha, omega, reflex_torque : numpy.ndarray, shape (batch, n)
+        Angle [rad], angular velocity [rad/s], reflex torque u [N m]; frozen after divergence.
+    delay, kp, kd : numpy.ndarray, shape (batch,)
+        [s], [N m/rad], [N m s/rad].
+    diverged : numpy.ndarray of bool, shape (batch,)
+        abs(alpha) exceeded ``sim_divergence``.
+    growth_rate : numpy.ndarray, shape (batch,)
+        Growth of the peak abs(alpha) from the middle to the last third [1/s]; inf if diverged.
+    """
+
+    time: np.ndarray
+    alpha: np.ndarray
+    omega: np.ndarray
+    reflex_torque: np.ndarray
+    delay: np.ndarray
+    kp: np.ndarray
+    kd: np.ndarray
+    diverged: np.ndarray
+    growth_rate: np.ndarray
+
+    @property
+    def stable(self) -> np.ndarray:
+        """The verdict: the response shrinks (growth rate < 0) and never diverged."""
+        return self.growth_rate < 0
+
+
+def _delayed(t_query, step, k, alpha, omega, acc, start):
+    """(alpha, omega) at t_query per run, by cubic Hermite between grid points 0..k.
+
+    alpha uses the slope omega, omega the slope omega'; before t = 0 the history is
+    (start, 0), the segment held still.
+    """
+    pos = t_query / step
+    i = np.floor(np.clip(pos, 0, max(k - 1, 0))).astype(int)  # clip first: a delay of 1e62 s casts badly
+    j = np.minimum(i + 1, k)
+    u = np.clip(pos - i, 0.0, 1.0)
+    runs = np.arange(alpha.shape[1])
+    h00, h10, h01, h11 = 2 * u**3 - 3 * u**2 + 1, u**3 - 2 * u**2 + u, -2 * u**3 + 3 * u**2, u**3 - u**2
+    w_i, w_j = omega[i, runs], omega[j, runs]
+    a = h00 * alpha[i, runs] + h10 * step * w_i + h01 * alpha[j, runs] + h11 * step * w_j
+    w = h00 * w_i + h10 * step * acc[i, runs] + h01 * w_j + h11 * step * acc[j, runs]
+    before = t_query <= 0
+    return np.where(before, start, a), np.where(before, 0.0, w)
+
+
+def growth_rate(time, alpha, perturbation: float):
+    """Growth rate [1/s] of the peak abs(alpha) from the middle to the last third of the run.
+
+    ln(max over the last third / max over the middle third) / (duration / 3): the
+    transient of the first third is skipped; the windows should span an oscillation
+    period. A response below sqrt(machine epsilon) times the perturbation is rounding
+    noise and counts as decayed (-inf).
+
+    Parameters
+    ----------
+    time : numpy.ndarray, shape (n,)
+        [s].
+    alpha : numpy.ndarray, shape (batch, n)
+        Angles [rad].
+    perturbation : float
+        Initial angle [rad].
+    """
+    n = time.size
+    a, b = n // 3, 2 * n // 3
+    middle = np.max(np.abs(alpha[:, a:b]), axis=-1)
+    last = np.max(np.abs(alpha[:, b:]), axis=-1)
+    span = time[-1] - time[b - 1] if n > 3 else time[-1]
+    with np.errstate(divide="ignore"):
+        rate = np.log(last / middle) / span
+    return np.where(last < _NOISE * perturbation, -np.inf, rate)
+
+
+def simulate(plant: SegmentPlant, kp, kd, delay, settings: Reflex, perturbation=None) -> Simulation:
+    """Simulate the segment under the delayed reflex; arrays broadcast to a batch of runs.
+
+    Parameters
+    ----------
+    plant : SegmentPlant
+    kp, kd, delay : array_like
+        Reflex gains [N m/rad], [N m s/rad] and delay [s]; kp = kd = 0 is "no reflex".
+    settings : Reflex
+        ``sim_duration``, ``sim_time_step``, ``sim_perturbation``, ``sim_divergence``.
+    perturbation : float, optional
+        Initial angle [rad] instead of ``settings.sim_perturbation``.
+
+    Returns
+    -------
+    Simulation
+    """
+    kp, kd, tau = (
+        np.ravel(x) for x in np.broadcast_arrays(*(np.atleast_1d(np.asarray(v, float)) for v in (kp, kd, delay)))
+    )
+    if np.any(tau < 0) or not np.all(np.isfinite(tau)):
+        raise ParameterError("delay", "must be finite and >= 0")
+    start = settings.sim_perturbation if perturbation is None else float(perturbation)
+    positive = tau[tau > 0]
+    step = min(settings.sim_time_step, positive.min()) if positive.size else settings.sim_time_step
+    n = int(np.ceil(settings.sim_duration / step))
+    if n > MAX_STEPS:
+        raise ParameterError(
+            "reflex.delay",
+            f"a simulation of {settings.sim_duration:g} s with steps of at most the delay {step:g} s needs "
+            f"{n} steps, more than {MAX_STEPS}; use a longer delay or a shorter sim_duration",
+        )
+    time = np.arange(n + 1) * step
+    alpha, omega, acc, u_hist = (np.zeros((n + 1, tau.size)) for _ in range(4))
+    alpha[0] = start
+    diverged = np.zeros(tau.size, bool)
+
+    def accel(t, a, w, k):
+        delayed_a, delayed_w = _delayed(t - tau, step, k, alpha, omega, acc, start)
+        now = tau == 0  # no delay: the reflex sees the stage's own state
+        u = -(kp * np.where(now, a, delayed_a) + kd * np.where(now, w, delayed_w))
+        return (plant.torque(a, w) + u) / plant.inertia, u
+
+    for k in range(n):
+        t, a, w = time[k], alpha[k], omega[k]
+        acc[k], u_hist[k] = accel(t, a, w, k)
+        a2, w2 = a + 0.5 * step * w, w + 0.5 * step * acc[k]
+        k2 = accel(t + 0.5 * step, a2, w2, k)[0]
+        a3, w3 = a + 0.5 * step * w2, w + 0.5 * step * k2
+        k3 = accel(t + 0.5 * step, a3, w3, k)[0]
+        a4, w4 = a + step * w3, w + step * k3
+        k4 = accel(t + step, a4, w4, k)[0]
+        new_a = a + step / 6 * (w + 2 * w2 + 2 * w3 + w4)
+        new_w = w + step / 6 * (acc[k] + 2 * k2 + 2 * k3 + k4)
+        diverged |= np.abs(new_a) > settings.sim_divergence
+        alpha[k + 1] = np.where(diverged, a, new_a)
+        omega[k + 1] = np.where(diverged, w, new_w)
+        if diverged.all():
+            alpha[k + 2 :], omega[k + 2 :], u_hist[k + 1 :] = alpha[k + 1], omega[k + 1], u_hist[k]
+            break
+    else:
+        u_hist[n] = accel(time[n], alpha[n], omega[n], n)[1]
+    rate = np.where(diverged, np.inf, growth_rate(time, alpha.T, start))
+    return Simulation(time, alpha.T, omega.T, u_hist.T, tau, kp, kd, diverged, rate)
+
+
+def simulated_delay_margin(plant: SegmentPlant, kp, kd, settings: Reflex, low, high, batch=8, rounds=3):
+    """Bracket the delay where the simulated closed loop turns unstable.
+
+    Each round simulates ``batch`` delays spread evenly inside [low, high] in one
+    batched run and keeps the interval between the last stable and the first unstable
+    one; ``batch = 1`` is plain bisection. The bracket shrinks by batch + 1 per round.
+
+    Parameters
+    ----------
+    plant : SegmentPlant
+    kp, kd : float
+        Reflex gains [N m/rad], [N m s/rad].
+    settings : Reflex
+        Simulation settings (see :func:`simulate`).
+    low, high : float
+        Initial bracket of delays [s]: stable at ``low``, unstable at ``high``.
+    batch, rounds : int
+        Delays simulated per round, and rounds.
+
+    Returns
+    -------
+    low, high : float
+        Delays [s] with the simulation stable at ``low`` and unstable at ``high``
+        (the initial bracket must be so).
+    """
+    for _ in range(rounds):
+        delays = np.linspace(low, high, batch + 2)[1:-1]
+        stable = simulate(plant, kp, kd, delays, settings).stable
+        first_unstable = int(np.argmin(stable)) if not stable.all() else batch
+        grid = np.concatenate([[low], delays, [high]])
+        low, high = grid[first_unstable], grid[first_unstable + 1]
+    return float(low), float(high)

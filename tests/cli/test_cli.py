@@ -1,0 +1,116 @@
+"""The command line: output formats and clean failures."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import tomllib
+
+import pytest
+
+from spinectl import optimise
+from spinectl.cli import main
+from spinectl.model import config
+
+
+def run(argv, capsys):
+    code = main(argv)
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_stability_table(capsys):
+    code, out, _ = run(["stability", "--E", "0.03", "--Lambda", "0.04", "--pcsa", "10,10,10"], capsys)
+    assert code == 0
+    assert "L5S1" in out and "||CT||" in out
+
+
+def test_stability_json_schema(capsys):
+    code, out, _ = run(
+        ["stability", "--E", "0.03", "--Lambda", "0.04", "--pcsa", "10,10,10", "--K", "15", "--json"], capsys
+    )
+    assert code == 0
+    doc = json.loads(out)
+    assert doc["E_m"] == 0.03 and doc["Lambda_m"] == 0.04 and doc["K_Nm_per_rad"] == 15
+    assert len(doc["pcsa_cm2"]) == 6 and doc["total_pcsa_cm2"] == pytest.approx(60)
+    seg = doc["segments"][0]
+    for key in (
+        "name",
+        "stiffness_Nm_per_rad",
+        "damping_Nms_per_rad",
+        "inertia_kgm2",
+        "eigenvalues",
+        "self_stable",
+        "counter_torque_Nm",
+    ):
+        assert key in seg
+    assert len(seg["eigenvalues"]) == 2 and len(seg["eigenvalues"][0]) == 2
+    norm = sum(s["counter_torque_Nm"] ** 2 for s in doc["segments"]) ** 0.5
+    assert doc["counter_torque_norm_Nm"] == pytest.approx(norm)
+
+
+def test_config_show_is_loadable_toml(capsys, tmp_path):
+    code, out, _ = run(["config", "show"], capsys)
+    assert code == 0
+    tomllib.loads(out)
+    path = tmp_path / "shown.toml"
+    path.write_text(out)
+    assert config.load_config(path) == config.load_preset("default")
+
+
+@pytest.mark.parametrize(
+    ("argv", "needle"),
+    [
+        (["stability", "--E", "0.5", "--pcsa", "1,1,1"], "E: must be in"),
+        (["stability", "--E", "nan", "--pcsa", "1,1,1"], "--E must be finite"),
+        (["stability", "--pcsa", "1,1"], "pcsa: must have 3 values"),
+        (["stability", "--pcsa", "a"], "--pcsa must be a number"),
+        (["stability", "--pcsa", "1,1,1", "--config", "/no/such.toml"], "file not found"),
+        (["stability", "--pcsa", "1,1,1", "--preset", "nope"], "preset: must be one of"),
+        (["stability", "--pcsa", "1,1,1", "--K", "-1"], "passive.stiffness: must be >= 0"),
+        (["frobnicate"], "invalid choice"),
+    ],
+)
+def test_bad_input_is_one_line_exit_2(argv, needle, capsys):
+    code, out, err = run(argv, capsys)
+    assert code == 2
+    assert needle in err
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+
+
+def test_stability_defaults_to_the_minimum_stabilising_pcsa(capsys):
+    """Without --pcsa the optimiser's chosen activation is used: self-stable, total = solve_point's."""
+    code, out, _ = run(["stability", "--E", "0.03", "--Lambda", "0.04", "--json"], capsys)
+    assert code == 0
+    doc = json.loads(out)
+    assert doc["pcsa_source"] == "min_pcsa" and doc["all_self_stable"]
+    expected = optimise.solve_point(config.load_preset("default"), 0.03, 0.04)
+    assert doc["total_pcsa_cm2"] == pytest.approx(expected.total_pcsa * 1e4, rel=1e-9)
+    code, out, _ = run(["stability", "--E", "0.03", "--Lambda", "0.04"], capsys)
+    assert code == 0 and "minimum stabilising" in out
+
+
+def test_stability_without_a_stabilising_pcsa_is_exit_2(tmp_path, capsys):
+    """At most 1 cm^2 per muscle cannot hold the upright body: no default PCSA exists."""
+    path = tmp_path / "weak.toml"
+    path.write_text("[optimisation]\npcsa_max = 1e-4\n")
+    code, _, err = run(["stability", "--config", str(path)], capsys)
+    assert code == 2 and "no activation stabilises" in err and len(err.strip().splitlines()) == 1
+
+
+def test_bad_config_values_from_file(tmp_path, capsys):
+    path = tmp_path / "bad.toml"
+    path.write_text("[body]\nmass = -1.0\n")
+    code, _, err = run(["stability", "--pcsa", "1,1,1", "--config", str(path)], capsys)
+    assert code == 2 and err.strip() == "spinectl: error: body.mass: must be > 0 (got -1)"
+
+
+def test_module_entry_point_runs_in_a_subprocess():
+    proc = subprocess.run(
+        [sys.executable, "-m", "spinectl", "stability", "--E", "1", "--pcsa", "1,1,1"],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr and proc.stderr.count("\n") == 1

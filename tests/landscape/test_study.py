@@ -1,0 +1,417 @@
+"""Parameter studies: the study file's validation, the chunk plan, the Zarr store, Dask runs, kill and resume.
+
+The reference for every result is :func:`spinectl.landscape.sweep.sweep` of the same
+model, with ``chunk_size`` equal to a chunk of whole rows, so that both solve
+the very same stacked problems: the answers must agree bit for bit.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import psutil
+import pytest
+import xarray as xr
+import zarr
+
+from spinectl.cli import main
+from spinectl.errors import ConfigError, ModelError, OutputError, ParameterError
+from spinectl.landscape import study, sweep
+from spinectl.landscape.study import spec
+from spinectl.landscape.study import store as study_store
+from spinectl.model import config
+
+ROOT = Path(__file__).resolve().parents[2]
+
+GRID = "E = { start = 0.0, stop = 0.08, num = 6 }\nLambda = { start = 0.0, stop = 0.08, num = 10 }\n"
+STUDY = f"""# four combinations x 3 tiles of 2 rows = 12 chunks of 20 points
+[study]
+chunk_size = 20
+description = "test study"
+
+[axes]
+{GRID}K = [0.0, 15.0]
+"body.mass" = [35.0, 45.0]
+"""
+TILE_POINTS = 20
+
+
+def write(tmp_path: Path, text: str = STUDY, name: str = "study.toml") -> Path:
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory):
+    """The study run in-process, uninterrupted: the results every other run must reproduce."""
+    folder = tmp_path_factory.mktemp("reference")
+    result = study.run_study(study.parse_study(STUDY), folder / "ref.zarr", scheduler="synchronous", progress=False)
+    assert result.complete and result.computed == 12 and result.where == "in-process"
+    return study.load(folder / "ref.zarr")
+
+
+# --- the study file ----------------------------------------------------------------------------
+
+
+def study_with(axes: str = "", head: str = "", more: str = "") -> str:
+    return f"[study]\n{head}\n[axes]\n{GRID}{axes}\n{more}"
+
+
+NORMAL_MASS = '[samples]\ncount = 3\nseed = 1\n[samples.parameters]\n"body.mass" = {{ {} }}\n'
+
+BAD_STUDIES = [
+    ("[studyy]\n", ConfigError, "studyy", "did you mean 'study'"),
+    (study_with(head="chunksize = 8"), ConfigError, "study.chunksize", "did you mean 'chunk_size'"),
+    (study_with(head='outputs = ["min_pcsa"]'), ConfigError, "study.outputs[0]", "did you mean 'min_pcsa_cm2'"),
+    (study_with(head="chunk_size = 0"), ParameterError, "study.chunk_size", "must be an integer in [1, 65536]"),
+    (study_with(head='preset = "nope"'), ConfigError, "study.preset", "must be one of"),
+    (study_with(more="[model]\nbody.mass = -1.0\n"), ParameterError, "model.body.mass", "must be > 0"),
+    (study_with('"body.mas" = [40.0]'), ConfigError, 'axes."body.mas"', "did you mean 'mass'"),
+    (study_with('"body.mass" = [40.0, -1.0]'), ParameterError, 'axes."body.mass"[1]', "body.mass: must be > 0"),
+    (study_with("K = [-1.0]"), ParameterError, "axes.K[0]", "passive.stiffness: must be >= 0"),
+    (study_with('"body.mass" = [40.0, 40.0]'), ParameterError, 'axes."body.mass"', "must not repeat a value"),
+    (study_with('"body.mass" = []'), ParameterError, 'axes."body.mass"', "at least one value"),
+    (study_with('"body.mass" = [40.0, "a"]'), ParameterError, 'axes."body.mass"', "all numbers or all strings"),
+    (study_with('"muscles.0.upper" = [0.1]'), ParameterError, 'axes."muscles.0.upper"', "name one of its values"),
+    (study_with('"muscles.0.name" = ["a"]'), ParameterError, 'axes."muscles.0.name"', "must not rename"),
+    (study_with('K = [0.0]\n"passive.stiffness" = [1.0]'), ParameterError, 'axes."passive.stiffness"', "axes.K sets"),
+    (study_with('"body.mass" = [1.0]\nbody.mass = [2.0]'), ParameterError, 'axes."body.mass"', "is given twice"),
+    ("[axes]\nLambda = [0.0]\n", ParameterError, "axes.E", "is required"),
+    ("[axes]\nE = { start = 0.0, stop = 0.08 }\nLambda = [0.0]\n", ParameterError, "axes.E", "missing num"),
+    ("[axes]\nE = { start = 0.08, stop = 0.0, num = 3 }\nLambda = [0.0]\n", ParameterError, "axes.E.stop", ">= start"),
+    ("[axes]\nE = [0.5]\nLambda = [0.0]\n", ParameterError, "E", "must be in [-0.1, 0.1] m"),
+    (study_with(more=NORMAL_MASS.format('distribution = "gauss", mean = 40.0, std = 1.0')), ParameterError,
+     'samples.parameters."body.mass".distribution', "must be one of 'normal'"),
+    (study_with(more=NORMAL_MASS.format('distribution = "normal", mean = 40.0')), ParameterError,
+     'samples.parameters."body.mass"', "needs std"),
+    (study_with(more=NORMAL_MASS.format('distribution = "normal", mean = 40.0, sd = 1.0')), ConfigError,
+     'samples.parameters."body.mass".sd', "did you mean 'std'"),
+    (study_with(more="[samples]\nseed = 1\n"), ParameterError, "samples.count", "is required"),
+    (study_with(more="[samples]\ncount = 2\nsed = 1\nparameters = {}\n"), ConfigError, "samples.sed", "'seed'"),
+]  # fmt: skip
+"""(file, error class, field, part of the message): each class of mistake in a study file."""
+
+
+@pytest.mark.parametrize(("text", "kind", "field", "needle"), BAD_STUDIES)
+def test_study_file_errors_name_the_field(text, kind, field, needle):
+    with pytest.raises(kind) as info:
+        study.parse_study(text)
+    assert info.value.field == field and needle in info.value.message
+
+
+def test_a_draw_out_of_range_is_caught_before_any_work():
+    """A normal mass with std = mean draws a negative mass now and then: which draw says so."""
+    text = study_with(
+        more=NORMAL_MASS.replace("count = 3", "count = 50").format('distribution = "normal", mean = 40.0, std = 40.0')
+    )
+    with pytest.raises(ParameterError) as info:
+        study.parse_study(text)
+    draws = spec.Sampled("body.mass", "normal", (("mean", 40.0), ("std", 40.0))).draw(50, 1)
+    first_bad = int(np.flatnonzero(draws <= 0)[0])
+    assert info.value.field == f'samples.parameters."body.mass"[{first_bad}]'
+
+
+def test_values_valid_alone_but_not_together_name_the_combination():
+    """mass_height 0.15 m lies above the default top CoR (0.145 m), a top CoR at 0.16 m lies below the
+    default mass height (0.326 m); together the mass sits below the joint (params.Model)."""
+    text = study_with('"body.mass_height" = [0.15, 0.3]\n"geometry.cor_heights.0" = [0.16]')
+    with pytest.raises(ParameterError) as info:
+        study.parse_study(text)
+    assert info.value.field == "body.mass_height"
+    assert "study combination body.mass_height = 0.15, geometry.cor_heights.0 = 0.16" in info.value.message
+
+
+def test_too_many_combinations_are_refused():
+    text = study_with(
+        '"body.mass" = { start = 30.0, stop = 50.0, num = 101 }\nK = { start = 0.0, stop = 15.0, num = 100 }'
+    )
+    with pytest.raises(ParameterError, match="at most 10,000 combinations"):
+        study.parse_study(text)
+
+
+def test_unquoted_dotted_keys_and_aliases_read_as_parameters(tmp_path):
+    """TOML reads ``body.mass = [..]`` as a nested table; it names the same axis as ``"body.mass"``."""
+    (tmp_path / "model.toml").write_text("[body]\nmass = 50.0\n")
+    text = study_with("body.mass = [35, 45]\ndelay = [0.05]", head='config = "model.toml"')
+    parsed = study.parse_study(text, base_dir=tmp_path)
+    assert parsed.dims == ("body.mass", "delay") and parsed.axes[1].parameter == "reflex.delay"
+    assert parsed.axes[0].values == (35, 45) and parsed.model.body.mass == 50.0
+    assert parsed.overrides((1, 0)) == {"body.mass": 45, "reflex.delay": 0.05}
+
+
+def test_the_example_in_the_docs_is_a_valid_study():
+    page = (ROOT / "docs" / "studies.md").read_text()
+    example = study.parse_study(page.split("```toml\n", 1)[1].split("```", 1)[0])
+    assert example.dims == ("body.mass", "K", "delay", "sample") and example.shape == (3, 2, 3, 20)
+    assert example.model.reflex.activation == 0.5 and example.tile == (50, 81) and example.n_chunks == 720
+
+
+def test_digest_ignores_comments_and_follows_values():
+    base = study.parse_study(STUDY).digest()
+    assert study.parse_study("# another comment\n" + STUDY.replace(" = ", "=")).digest() == base
+    assert study.parse_study(STUDY.replace("45.0", "46.0")).digest() != base
+
+
+# --- samples -----------------------------------------------------------------------------------
+
+
+def test_draws_are_fixed_by_the_seed_and_independent_of_other_parameters():
+    mass = '"body.mass" = { distribution = "uniform", low = 30.0, high = 50.0 }\n'
+    height = '"body.mass_height" = { distribution = "normal", mean = 0.326, std = 0.01 }\n'
+    head = "[samples]\ncount = 4\nseed = {}\n[samples.parameters]\n"
+    one = study.parse_study(study_with(more=head.format(7) + mass))
+    two = study.parse_study(study_with(more=head.format(7) + mass + height))
+    other_seed = study.parse_study(study_with(more=head.format(8) + mass))
+    draws = one.samples.values()["body.mass"]
+    np.testing.assert_array_equal(two.samples.values()["body.mass"], draws)
+    assert not np.array_equal(other_seed.samples.values()["body.mass"], draws)
+    assert one.dims == ("sample",) and one.overrides((2,)) == {"body.mass": draws[2]}
+    assert np.all((draws >= 30.0) & (draws < 50.0))
+
+
+@pytest.mark.parametrize(
+    ("distribution", "arguments", "transform", "mean", "std"),
+    [
+        ("normal", (("mean", 40.0), ("std", 4.0)), lambda x: x, 40.0, 4.0),
+        ("lognormal", (("median", 40.0), ("sigma", 0.1)), np.log, np.log(40.0), 0.1),
+        ("uniform", (("low", 30.0), ("high", 50.0)), lambda x: x, 40.0, 20.0 / np.sqrt(12.0)),
+    ],
+)
+def test_draws_follow_their_distribution(distribution, arguments, transform, mean, std):
+    """Sample mean within 4 standard errors of the distribution's (of log x for lognormal); the standard
+    deviation within 10 % (uniform: (high - low) / sqrt(12))."""
+    n = 4000
+    x = transform(spec.Sampled("body.mass", distribution, arguments).draw(n, 2012))
+    assert abs(x.mean() - mean) < 4 * std / np.sqrt(n)
+    assert x.std() == pytest.approx(std, rel=0.1)
+
+
+# --- the chunk plan ----------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(("chunk_size", "tile"), [(20, (2, 10)), (25, (2, 10)), (7, (1, 7)), (1000, (6, 10))])
+def test_chunks_cover_every_point_once(chunk_size, tile):
+    plan = study.parse_study(STUDY.replace("chunk_size = 20", f"chunk_size = {chunk_size}"))
+    assert plan.tile == tile
+    covered = np.zeros(plan.shape + plan.grid_shape, int)
+    for i in range(plan.n_chunks):
+        chunk = plan.chunk(i)
+        assert chunk.index == i
+        covered[chunk.combination + (chunk.eccentricity, chunk.lordosis)] += 1
+    assert np.all(covered == 1)
+
+
+# --- results ------------------------------------------------------------------------------------
+
+
+def assert_equals_sweep(dataset: xr.Dataset, parsed: study.Study) -> None:
+    """Every combination bit for bit equal to the sweep of its model, solved in the same blocks."""
+    for combination in np.ndindex(*parsed.shape):
+        model = config.set_parameters(parsed.model, parsed.overrides(combination))
+        expected = sweep.sweep(model, parsed.eccentricity, parsed.lordosis, chunk_size=TILE_POINTS, progress=False)
+        got = dataset.isel(dict(zip(parsed.dims, combination, strict=True)))
+        for name in parsed.outputs:
+            xr.testing.assert_identical(got[name].reset_coords(drop=True), expected[name].reset_coords(drop=True))
+
+
+def test_in_process_study_equals_the_sweep(reference):
+    assert_equals_sweep(reference, study.parse_study(STUDY))
+    assert reference["K"].attrs["parameter"] == "passive.stiffness" and reference["K"].attrs["units"] == "N m/rad"
+    assert reference["body.mass"].attrs["units"] == "kg" and reference.attrs["description"] == "test study"
+    assert np.all(reference["chunk_done"].values == 1)
+
+
+def test_one_chunk_runs_in_process_without_a_cluster(tmp_path):
+    one = study.parse_study(f"[study]\noutputs = ['min_pcsa_cm2', 'status']\n[axes]\n{GRID}")
+    result = study.run_study(one, tmp_path / "one.zarr", progress=False)
+    assert one.n_chunks == 1 and result.where == "in-process" and result.addresses == ()
+    expected = sweep.sweep(one.model, one.eccentricity, one.lordosis, chunk_size=60, progress=False)
+    got = study.load(tmp_path / "one.zarr")
+    assert set(got.data_vars) == {"min_pcsa_cm2", "status", "chunk_done"}
+    xr.testing.assert_identical(got["status"].reset_coords(drop=True), expected["status"].reset_coords(drop=True))
+
+
+def test_two_local_workers_on_loopback_give_the_same_bits(reference, tmp_path, monkeypatch):
+    """A LocalCluster of two worker processes: same store as in-process; it listens on 127.0.0.1 only."""
+    listening: list[str] = []
+    write = study_store.Writer.write
+
+    def spy(self, chunk, outputs):  # the cluster is up while chunks are written
+        if not listening:
+            processes = [psutil.Process(), *psutil.Process().children(recursive=True)]
+            listening.extend(c.laddr.ip for p in processes for c in p.net_connections("inet") if c.status == "LISTEN")
+        write(self, chunk, outputs)
+
+    monkeypatch.setattr(study_store.Writer, "write", spy)
+    result = study.run_study(study.parse_study(STUDY), tmp_path / "two.zarr", workers=2, progress=False)
+    assert result.where == "2 local workers" and len(result.addresses) == 3
+    assert all(a.startswith("tcp://127.0.0.1:") for a in result.addresses)
+    assert listening and set(listening) == {"127.0.0.1"}
+    xr.testing.assert_identical(study.load(tmp_path / "two.zarr"), reference)
+
+
+def test_an_existing_cluster_by_its_address(reference, tmp_path):
+    """``scheduler='tcp://...'``: the study connects to a cluster it did not start, and leaves it running."""
+    from distributed import LocalCluster
+
+    with LocalCluster(n_workers=1, threads_per_worker=1, host="127.0.0.1", dashboard_address=None) as cluster:
+        address = cluster.scheduler_address
+        result = study.run_study(study.parse_study(STUDY), tmp_path / "s.zarr", scheduler=address, progress=False)
+        assert result.where == address and len(cluster.scheduler_info["workers"]) == 1
+    xr.testing.assert_identical(study.load(tmp_path / "s.zarr"), reference)
+
+
+# --- interruption and resume ---------------------------------------------------------------------
+
+
+def test_stopped_study_resumes_to_the_same_bits(reference, tmp_path):
+    parsed, out = study.parse_study(STUDY), tmp_path / "s.zarr"
+    first = study.run_study(parsed, out, scheduler="synchronous", max_chunks=5, progress=False)
+    assert (first.computed, first.complete) == (5, False)
+    partial = study.load(out)
+    np.testing.assert_array_equal(partial["chunk_done"].values, [1] * 5 + [0] * 7)
+    assert np.isnan(partial["min_pcsa_cm2"].values).sum() == 7 * TILE_POINTS  # unwritten chunks read NaN
+    second = study.run_study(parsed, out, scheduler="synchronous", resume=True, progress=False)
+    assert (second.done_before, second.computed, second.complete) == (5, 7, True)
+    xr.testing.assert_identical(study.load(out), reference)  # every chunk written exactly once
+
+
+def test_killed_study_resumes_without_computing_a_chunk_twice(reference, tmp_path):
+    """SIGKILL a study run by the CLI once two chunks are done, then resume it.
+
+    ``chunk_done`` counts the writes of each chunk: after the resume every count
+    is 1, so the chunks finished before the kill were not computed again.
+    """
+    path, out = write(tmp_path), tmp_path / "killed.zarr"
+    command = [sys.executable, "-m", "spinectl", "study", str(path), "--out", str(out), "--scheduler", "synchronous"]
+    env = os.environ | {"PYTHONPATH": str(ROOT)}
+    proc = subprocess.Popen(command, cwd=ROOT, env=env, start_new_session=True, stderr=subprocess.DEVNULL)
+    try:
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline and proc.poll() is None and done_chunks(out) < 2:
+            time.sleep(0.005)
+    finally:
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait()
+    before = study.load(out)["chunk_done"].values
+    assert 2 <= before.sum() < 12, "the kill must land mid-study"
+    result = study.run_study(study.parse_study(STUDY), out, scheduler="synchronous", resume=True, progress=False)
+    assert (result.done_before, result.computed) == (before.sum(), 12 - before.sum())
+    xr.testing.assert_identical(study.load(out), reference)
+
+
+def done_chunks(out: Path) -> int:
+    try:
+        return int(zarr.open_group(out, mode="r")["chunk_done"][:].sum())
+    except (OSError, KeyError, ValueError, zarr.errors.BaseZarrError):
+        return 0  # not created yet
+
+
+# --- the store's guards ----------------------------------------------------------------------------
+
+
+def test_existing_store_is_refused_without_resume(tmp_path):
+    parsed, out = study.parse_study(STUDY), tmp_path / "s.zarr"
+    study.run_study(parsed, out, scheduler="synchronous", max_chunks=1, progress=False)
+    files = sorted(p.relative_to(out) for p in out.rglob("*"))
+    with pytest.raises(OutputError, match="add --resume"):
+        study.run_study(parsed, out, scheduler="synchronous", progress=False)
+    assert sorted(p.relative_to(out) for p in out.rglob("*")) == files
+    other = study.parse_study(STUDY.replace("45.0", "46.0"))
+    with pytest.raises(ParameterError, match="holds another study") as info:
+        study.run_study(other, out, scheduler="synchronous", resume=True, progress=False)
+    assert info.value.field == "store"
+    with pytest.raises(ParameterError, match="not a spinectl study store"):
+        study.run_study(parsed, tmp_path, scheduler="synchronous", resume=True, progress=False)
+
+
+def test_resume_without_a_store_starts_one(tmp_path):
+    parsed = study.parse_study(STUDY)
+    result = study.run_study(parsed, tmp_path / "new.zarr", scheduler="synchronous", resume=True, max_chunks=0)
+    assert (result.done_before, result.computed) == (0, 0)
+    assert study.load(tmp_path / "new.zarr")["chunk_done"].sum() == 0
+
+
+def test_unreachable_scheduler_leaves_no_store(tmp_path):
+    with pytest.raises(ParameterError, match="cannot connect") as info:
+        study.run_study(
+            study.parse_study(STUDY), tmp_path / "s.zarr", scheduler="tcp://127.0.0.1:1", connect_timeout=0.5
+        )
+    assert info.value.field == "scheduler" and not (tmp_path / "s.zarr").exists()
+
+
+def test_open_store_rejects_other_folders(tmp_path):
+    with pytest.raises(ParameterError, match="not a spinectl study store"):
+        study.open_store(tmp_path)
+
+
+def test_an_attachment_on_a_centre_of_rotation_stops_the_study_before_work(tmp_path):
+    """A lower attachment at (0, 0.005) is L5S1 itself at E = Lambda = 0 (tests/test_robustness.py)."""
+    text = study_with('"muscles.0.lower.0" = [0.12, 0.0]\n"muscles.0.lower.1" = [0.005]\n"muscles.0.spread" = [0.0]')
+    text = text.replace(GRID, "E = [0.0]\nLambda = [0.0]\n")
+    with pytest.raises(ModelError, match="study combination muscles.0.lower.0 = 0.0"):
+        study.parse_study(text)
+
+
+# --- the command line ------------------------------------------------------------------------------
+
+
+def test_cli_runs_and_resumes_a_study(tmp_path, capsys):
+    path, out = write(tmp_path), tmp_path / "s.zarr"
+    assert main(["study", str(path), "--out", str(out), "--scheduler", "synchronous", "--max-chunks", "4"]) == 0
+    line = capsys.readouterr().out.strip()
+    assert line.startswith("study: 4 of 12 chunks done") and "run again with --resume" in line and str(out) in line
+    assert main(["study", str(path), "--out", str(out), "--scheduler", "synchronous", "--resume"]) == 0
+    assert "12 of 12 chunks done (8 computed now, 4 before)" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("arguments", "needle"),
+    [
+        (["--workers", "2", "--scheduler", "tcp://127.0.0.1:1"], "workers: sets the size of the local cluster"),
+        (["--scheduler", "localhost"], "scheduler: must be 'synchronous' or a dask.distributed address"),
+        (["--workers", "0"], "--workers must be >= 1"),
+        (["--workers", "100000"], "workers: must be an integer in [1,"),
+        (["--max-chunks", "-1"], "--max-chunks must be >= 0"),
+    ],
+)
+def test_cli_bad_options_are_one_line(tmp_path, capsys, arguments, needle):
+    code = main(["study", str(write(tmp_path)), "--out", str(tmp_path / "s.zarr"), *arguments])
+    err = capsys.readouterr().err
+    assert code == 2 and needle in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "s.zarr").exists()
+
+
+def test_cli_bad_study_file_is_one_line(tmp_path, capsys):
+    path = write(tmp_path, STUDY.replace("35.0", "-35.0"))
+    code = main(["study", str(path), "--out", str(tmp_path / "s.zarr")])
+    err = capsys.readouterr().err
+    assert code == 2 and 'axes."body.mass"[0]: body.mass: must be > 0' in err and len(err.strip().splitlines()) == 1
+    assert main(["study", str(tmp_path / "missing.toml"), "--out", str(tmp_path / "s.zarr")]) == 2
+    assert "study: file not found" in capsys.readouterr().err
+    assert not (tmp_path / "s.zarr").exists()
+
+
+def test_a_finished_store_opens_with_plain_xarray_without_warnings(tmp_path):
+    """After the last chunk the metadata is consolidated: xarray.open_zarr needs no options."""
+    import warnings
+
+    from spinectl.landscape.study import load_study, run_study
+
+    path = tmp_path / "s.toml"
+    path.write_text(
+        '[study]\npreset = "default"\noutputs = ["min_pcsa_cm2"]\n'
+        "[axes]\nE = { start = 0.0, stop = 0.08, num = 3 }\nLambda = { start = 0.0, stop = 0.08, num = 3 }\n"
+    )
+    run_study(load_study(path), tmp_path / "s.zarr", scheduler="synchronous", progress=False)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        ds = xr.open_zarr(tmp_path / "s.zarr")
+    assert ds.min_pcsa_cm2.shape == (3, 3)

@@ -1,0 +1,133 @@
+"""Sweeps: grid orientation, chunking, the per-point method, NetCDF round trip and the CLI."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from spinectl import optimise
+from spinectl.cli import main
+from spinectl.errors import ParameterError
+from spinectl.landscape import netcdf, schema, sweep
+from spinectl.model.mechanics import segment_coefficients
+from spinectl.model.params import Model
+
+E_AXIS = np.array([0.0, 0.04, 0.08])
+L_AXIS = np.array([0.0, 0.03, 0.05, 0.08])  # a different length, so that a transposed grid would fail
+
+
+@pytest.fixture(scope="module")
+def landscape():
+    return sweep.sweep(Model(), E_AXIS, L_AXIS, progress=False)
+
+
+def test_schema_units_and_orientation(landscape, model):
+    assert landscape["min_pcsa_cm2"].dims == ("E", "Lambda")
+    assert landscape["pcsa_cm2"].dims == ("E", "Lambda", "muscle")
+    assert landscape["counter_torque_Nm"].dims == ("E", "Lambda", "segment")
+    assert landscape["stiffness_per_cm2"].dims == ("E", "Lambda", "segment", "muscle")
+    assert landscape["E"].attrs["units"] == "m" and landscape["Lambda"].attrs["units"] == "m"
+    for name in schema.VARIABLES:
+        assert name in landscape and "units" in landscape[name].attrs
+    opt = optimise.solve_point(model, 0.04, 0.03)  # the reference at one grid point, by name
+    here = landscape.sel(E=0.04, Lambda=0.03)
+    assert float(here["min_pcsa_cm2"]) == pytest.approx(opt.min_pcsa * 1e4, rel=1e-6)
+    np.testing.assert_allclose(here["counter_torque_Nm"], opt.counter_torque, rtol=1e-6, atol=1e-6)
+    assert float(here["counter_torque_norm_Nm"]) == pytest.approx(opt.counter_torque_norm, rel=1e-6)
+
+
+def test_coefficients_are_those_of_the_mechanics(landscape, model):
+    coeffs = segment_coefficients(model, 0.08, 0.05)
+    here = landscape.sel(E=0.08, Lambda=0.05)
+    np.testing.assert_allclose(here["stiffness_per_cm2"], coeffs.stiffness_per_pcsa * 1e-4)
+    np.testing.assert_allclose(here["inertia_kgm2"], coeffs.inertia)
+
+
+def test_chunks_and_methods_give_the_same_dataset(landscape, model):
+    chunked = sweep.sweep(model, E_AXIS, L_AXIS, chunk_size=5, progress=False)
+    xr.testing.assert_allclose(chunked.drop_vars("status"), landscape.drop_vars("status"), rtol=1e-12)
+    reference = sweep.sweep(model, E_AXIS, L_AXIS, method="per-point", progress=False)
+    assert reference.attrs["points_solved_per_point"] == E_AXIS.size * L_AXIS.size
+    for name in ("min_pcsa_cm2", "pcsa_cm2", "counter_torque_Nm"):
+        np.testing.assert_allclose(reference[name], landscape[name], rtol=1e-6, atol=1e-6)
+
+
+def test_netcdf_round_trip(landscape, model, tmp_path):
+    path = netcdf.save(landscape, tmp_path / "r.nc")
+    back = netcdf.load(path)
+    xr.testing.assert_identical(back, landscape)
+    assert netcdf.model_of(back) == model
+
+
+def test_stiffness_lowers_the_minimum(model):
+    """-K adds to dM/dalpha, so the stable set only grows: the minimum PCSA can only fall."""
+    both = sweep.stiffness_sweep(model, [0.0, 15.0], E_AXIS, L_AXIS, progress=False)
+    assert both["min_pcsa_cm2"].dims == ("K", "E", "Lambda")
+    assert (both["min_pcsa_cm2"].sel(K=15.0) < both["min_pcsa_cm2"].sel(K=0.0)).all()
+
+
+@pytest.mark.parametrize(
+    ("spec", "expected"), [("0:0.08:81", np.linspace(0, 0.08, 81)), ("0.03", [0.03]), ("0:0:1", [0.0])]
+)
+def test_parse_grid(spec, expected):
+    np.testing.assert_allclose(sweep.parse_grid(spec, "--E"), expected)
+
+
+@pytest.mark.parametrize("spec", ["0:0.08", "a:b:c", "0.08:0:5", "0:1:0", "0:nan:3", "0:0.08:1000000000"])
+def test_parse_grid_rejects(spec):
+    with pytest.raises(ParameterError) as info:
+        sweep.parse_grid(spec, "--E")
+    assert info.value.field == "--E"
+
+
+def test_cli_sweep_writes_netcdf(tmp_path, capsys):
+    out = tmp_path / "r.nc"
+    code = main(["sweep", "--E", "0:0.08:3", "--Lambda", "0:0.08:2", "--K", "0,15", "--out", str(out)])
+    assert code == 0 and "12 points (12 solved" in capsys.readouterr().out
+    ds = netcdf.load(out)
+    assert ds.sizes["K"] == 2 and ds.sizes["E"] == 3 and ds.sizes["Lambda"] == 2
+
+
+def test_cli_sweep_bad_input(tmp_path, capsys):
+    code = main(["sweep", "--E", "0:0.5:3", "--out", str(tmp_path / "r.nc")])
+    err = capsys.readouterr().err
+    assert code == 2 and "E: must be in" in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "r.nc").exists()
+
+
+def test_load_rejects_what_is_not_a_sweep(tmp_path):
+    other = tmp_path / "other.nc"
+    xr.Dataset({"x": ("t", [1.0])}).to_netcdf(other)
+    text = tmp_path / "text.nc"
+    text.write_text("not netcdf")
+    for path, needle in ((other, "not a spinectl sweep"), (text, "not a spinectl NetCDF file")):
+        with pytest.raises(ParameterError) as info:
+            netcdf.load(path)
+        assert info.value.field == "results" and needle in str(info.value)
+
+
+def test_an_absurd_grid_is_refused_before_any_work(model):
+    axis = np.zeros(1001)
+    with pytest.raises(ParameterError) as info:
+        sweep.sweep(model, axis, axis)
+    assert info.value.field == "grid"
+
+
+def test_delay_margins_in_the_sweep_equal_the_margins_report():
+    """Second path: the per-point ``margins.analyse`` (per-point optimum, python-control
+    alongside) gives the same gains, delay margins and verdicts as the vectorised sweep."""
+    from spinectl.reflex import margins
+
+    model = Model()
+    E, L = np.array([0.0, 0.03]), np.array([0.04, 0.08])
+    ds = sweep.sweep(model, E, L, progress=False)
+    for e in E:
+        for lam in L:
+            report = margins.analyse(model, float(e), float(lam))
+            point = ds.sel(E=e, Lambda=lam)
+            for k, seg in enumerate(report.segments):
+                assert point.reflex_kp_Nm_per_rad.values[k] == pytest.approx(seg.kp, rel=1e-6)
+                assert point.delay_margin_s.values[k] == pytest.approx(seg.delay_margin, rel=1e-6)
+                assert bool(point.stable_at_delay.values[k]) == seg.stable_at_delay
+            assert float(point.spine_delay_margin_s) == pytest.approx(min(s.delay_margin for s in report.segments))

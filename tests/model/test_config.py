@@ -1,0 +1,132 @@
+"""Parameters: presets, TOML round trip, validation, documentation."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import pytest
+
+from spinectl.errors import ConfigError, ParameterError
+from spinectl.model import config
+from spinectl.model.params import Model
+
+
+def test_default_preset_equals_dataclass_defaults():
+    """presets/default.toml must not drift from the documented dataclass defaults."""
+    assert config.load_preset("default") == Model()
+
+
+def test_dump_and_load_round_trip(tmp_path, model):
+    path = tmp_path / "m.toml"
+    path.write_text(config.dump_toml(model))
+    assert config.load_config(path) == model
+
+
+def test_partial_file_overrides_the_preset(tmp_path):
+    path = tmp_path / "m.toml"
+    path.write_text("[body]\nmass = 55.0\n[passive]\nstiffness = 15.0\n")
+    m = config.load_config(path)
+    assert m.body.mass == 55.0 and m.passive.stiffness == 15.0
+    assert m.geometry == Model().geometry
+
+
+def _error_for(tmp_path, text, exc=ParameterError):
+    path = tmp_path / "bad.toml"
+    path.write_text(text)
+    with pytest.raises(exc) as info:
+        config.load_config(path)
+    return info.value
+
+
+def test_negative_mass_names_the_field(tmp_path):
+    err = _error_for(tmp_path, "[body]\nmass = -3.0\n")
+    assert err.field == "body.mass" and "> 0" in str(err)
+
+
+def test_nan_is_rejected(tmp_path):
+    err = _error_for(tmp_path, "[fibre]\nk1 = nan\n")
+    assert err.field == "fibre.k1" and "finite" in str(err)
+
+
+def test_unknown_key_suggests_the_right_one(tmp_path):
+    err = _error_for(tmp_path, "[body]\nmas = 3.0\n", ConfigError)
+    assert err.field == "body.mas" and "did you mean 'mass'" in str(err)
+
+
+def test_unknown_section_is_rejected(tmp_path):
+    err = _error_for(tmp_path, "[bodyy]\nmass = 3.0\n", ConfigError)
+    assert "did you mean 'body'" in str(err)
+
+
+def test_errors_inside_muscle_list_name_the_index(tmp_path):
+    err = _error_for(tmp_path, '[[muscles]]\nname = "x"\nupper = [0.1, 0.0]\nlower = [0.1, 0.2]\n')
+    assert err.field == "muscles.0.upper"
+
+
+def test_missing_file_and_bad_toml(tmp_path):
+    with pytest.raises(ConfigError, match="not found"):
+        config.load_config(tmp_path / "nope.toml")
+    err = _error_for(tmp_path, "[body\n", ConfigError)
+    assert "not valid TOML" in str(err)
+
+
+def test_unknown_preset():
+    with pytest.raises(ConfigError, match="must be one of"):
+        config.load_preset("nope")
+
+
+def test_set_parameter(model):
+    m = config.set_parameter(model, "muscles.1.spread", 0.05)
+    assert m.muscles[1].spread == 0.05 and m.muscles[0] == model.muscles[0]
+    with pytest.raises(ConfigError, match="did you mean 'mass'"):
+        config.set_parameter(model, "body.masss", 1.0)
+    with pytest.raises(ParameterError):
+        config.set_parameter(model, "body.mass", math.nan)
+
+
+def test_set_parameters_validates_once_at_the_end(model):
+    """Moving a muscle wholly above its old upper attachment: one path at a time would pass through a
+    muscle whose lower end lies above its upper end (invalid); all at once it is valid."""
+    moved = {"muscles.0.lower.1": 0.30, "muscles.0.upper.1": 0.40}
+    m = config.set_parameters(model, moved)
+    assert m.muscles[0].lower == (0.12, 0.30) and m.muscles[0].upper == (0.12, 0.40)
+    with pytest.raises(ParameterError, match="must lie above lower"):
+        config.set_parameter(model, "muscles.0.lower.1", 0.30)
+    assert config.set_parameters(model, {"body.mass": 30.0}) == config.set_parameter(model, "body.mass", 30.0)
+
+
+def _parameter_fields():
+    model = Model()
+    for section in dataclasses.fields(Model):
+        value = getattr(model, section.name)
+        cls = type(value[0]) if isinstance(value, tuple) else type(value)
+        for f in dataclasses.fields(cls):
+            yield f"{section.name}.{f.name}", f
+
+
+def test_every_parameter_has_a_unit_and_documentation():
+    """Fails on an undocumented parameter (python-control's convention)."""
+    undocumented = [name for name, f in _parameter_fields() if not f.metadata.get("doc") or "unit" not in f.metadata]
+    assert undocumented == []
+
+
+@pytest.mark.parametrize(
+    ("text", "field", "needle"),
+    [
+        ("[reflex]\ndelay = -0.1\n", "reflex.delay", "in [0, 10]"),
+        ("[reflex]\ndelay = 11.0\n", "reflex.delay", "in [0, 10]"),
+        ("[reflex]\npade_order = 0\n", "reflex.pade_order", "in [1, 10]"),
+        ("[reflex]\npade_order = 11\n", "reflex.pade_order", "in [1, 10]"),
+        ("[reflex]\nsim_divergence = 2.0\n", "reflex.sim_divergence", "<= pi/2"),
+        ("[reflex]\npade_order = 5.0\n", "reflex.pade_order", "must be an integer"),
+        ("[reflex]\nactivation = -0.5\n", "reflex.activation", "in [0, 10]"),
+        ("[reflex]\ngain_factor = 1.0\n", "reflex.gain_factor", "> 1"),
+        ("[reflex]\ngains = 'auto'\n", "reflex.gains", "one of"),
+        ("[reflex]\nsim_perturbation = 0.3\n", "reflex.sim_perturbation", "< sim_divergence"),
+        ("[reflex]\nsim_time_step = 20.0\n", "reflex.sim_time_step", "< sim_duration"),
+    ],
+)
+def test_reflex_section_is_validated(tmp_path, text, field, needle):
+    err = _error_for(tmp_path, text)
+    assert err.field == field and needle in str(err)

@@ -1,0 +1,112 @@
+"""Self-stability of segments: known-stable and known-unstable configurations."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from spinectl.errors import ParameterError
+from spinectl.model import mechanics, muscle
+from spinectl.model.params import Errata, Passive
+from spinectl.model.stability import eigenvalues, jacobian, segment_stability, self_stable
+
+ZERO = np.zeros(3)
+
+
+def test_closed_form_eigenvalues_equal_numerical_eigenvalues(rng):
+    s = rng.normal(0, 50, 20)
+    d = -rng.uniform(0, 20, 20)
+    theta = rng.uniform(0.5, 5, 20)
+    closed = np.sort_complex(eigenvalues(s, d, theta))
+    numeric = np.sort_complex(np.linalg.eigvals(jacobian(s, d, theta)))
+    np.testing.assert_allclose(closed, numeric, atol=1e-9)
+
+
+def test_gravity_alone_destabilises_every_segment(model):
+    """No muscle, K = 0: an inverted pendulum at every CoR, lambda = +-sqrt(g / r).
+
+    At E = Lambda = 0 the mass is straight above CoR k at r_k = 0.326 - y_k, and
+    theta_k = m r_k^2, so S/theta = g / r_k (design page, gravity erratum).
+    """
+    result = segment_stability(model, 0.0, 0.0, ZERO)
+    assert not result.self_stable.any()
+    r = model.body.mass_height - np.asarray(model.geometry.cor_heights)
+    np.testing.assert_allclose(result.eigenvalues[:, 0].real, np.sqrt(model.body.gravity / r), rtol=1e-12)
+
+
+def test_printed_gravity_sign_makes_a_centre_not_self_stable(model):
+    """With the printed sign and no muscle, S = -m g r, D = 0: eigenvalues +-j sqrt(g/r).
+
+    Real parts are 0, so the segments are not (asymptotically) self-stable; yet
+    the paper needs 35 cm^2 at A, which is why the sign must be an erratum.
+    """
+    printed = model.replace(errata=Errata(gravity_sign="printed"))
+    result = segment_stability(printed, 0.0, 0.0, ZERO)
+    np.testing.assert_allclose(result.eigenvalues.real, 0.0, atol=1e-12)
+    assert not result.self_stable.any()
+
+
+def test_stiff_ligaments_stabilise_without_much_muscle(model):
+    """K = 1000 N m/rad exceeds gravity (m g r <= 40 * 9.81 * 0.321 = 126 N m/rad)
+    plus any muscle term at 1 cm^2 per muscle (|dM/dalpha| < 10 N m/rad per cm^2
+    for lever arms below 0.2 m), and 1 cm^2 gives D < 0: stable at every CoR."""
+    stiff = model.replace(passive=Passive(stiffness=1000.0))
+    result = segment_stability(stiff, 0.04, 0.02, np.full(3, 1e-4))
+    assert result.self_stable.all()
+
+
+def _vertical_threshold(m):
+    """PCSA per muscle [m^2] at which S_k = 0 for the single-vertical-fibre pair, by hand.
+
+    S_k = m g r_k + 2 p sigma (f_l a b/(a+b) - d^2 f_l'), see test_mechanics.
+    """
+    d, top = 0.12, 0.24
+    y = np.asarray(m.geometry.cor_heights)
+    a, b, l0 = top - y, y, top
+    f_l = muscle.force_length(l0, 1.2 * l0, m.fibre)
+    f_l_slope = muscle.force_length_slope(l0, 1.2 * l0, m.fibre)
+    per_pcsa = 2 * m.fibre.specific_tension * (f_l * a * b / (a + b) - d**2 * f_l_slope)
+    gravity = m.body.mass * m.body.gravity * (m.body.mass_height - y)
+    return np.where(per_pcsa < 0, -gravity / per_pcsa, np.inf)
+
+
+def test_vertical_pair_is_stable_just_above_its_hand_threshold(vertical_model):
+    threshold = _vertical_threshold(vertical_model)
+    k = int(np.argmin(threshold))  # most favourable CoR with a finite threshold
+    assert np.isfinite(threshold[k])
+    above = segment_stability(vertical_model, 0.0, 0.0, [1.01 * threshold[k]])
+    below = segment_stability(vertical_model, 0.0, 0.0, [0.99 * threshold[k]])
+    assert above.self_stable[k] and not below.self_stable[k]
+    # CoRs whose hand threshold is infinite (buckling term wins) are never stable.
+    hopeless = ~np.isfinite(threshold)
+    assert not segment_stability(vertical_model, 0.0, 0.0, [1.0]).self_stable[hopeless].any()
+
+
+def test_passive_stiffness_conventions(model):
+    """'physical' subtracts K from dM/dalpha; 'paper' subtracts K theta_k (eq. 2 as printed)."""
+    base = mechanics.segment_coefficients(model, 0.02, 0.03)
+    phys = mechanics.segment_coefficients(model.replace(passive=Passive(15.0, "physical")), 0.02, 0.03)
+    paper = mechanics.segment_coefficients(model.replace(passive=Passive(15.0, "paper")), 0.02, 0.03)
+    np.testing.assert_allclose(base.stiffness(np.zeros(6)) - phys.stiffness(np.zeros(6)), 15.0)
+    np.testing.assert_allclose(base.stiffness(np.zeros(6)) - paper.stiffness(np.zeros(6)), 15.0 * base.inertia)
+
+
+def test_self_stable_margin():
+    eigs = np.array([[-0.5 + 1j, -0.5 - 1j]])
+    assert self_stable(eigs)[0] and not self_stable(eigs, margin=1.0)[0]
+
+
+@pytest.mark.parametrize(
+    ("E", "L", "pcsa", "field"),
+    [
+        (0.5, 0.0, ZERO, "E"),
+        (0.0, -0.2, ZERO, "Lambda"),
+        (np.nan, 0.0, ZERO, "E"),
+        (0.0, 0.0, [1, 2], "pcsa"),
+        (0.0, 0.0, [-1, 0, 0], "pcsa"),
+    ],
+)
+def test_bad_input_names_the_field(model, E, L, pcsa, field):
+    with pytest.raises(ParameterError) as info:
+        segment_stability(model, E, L, pcsa)
+    assert info.value.field == field
