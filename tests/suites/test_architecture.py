@@ -1,6 +1,7 @@
 """The architecture of spinectl, read from its source: layers depend only downward, and no import cycle.
 
-The layers and their order are those of CONTRIBUTING.md ("Architecture"):
+The layers and their order are those of CONTRIBUTING.md ("Architecture", "Layers"; a test
+checks that its table and :data:`LAYERS` agree, and that its tree names every module):
 
     errors units _validate atomic presets  <  model  <  optimise  <  reflex  <  landscape  <  paper  <  cli
 
@@ -15,21 +16,24 @@ Every module is parsed with :mod:`ast`, nothing is imported: relative and
 absolute imports are resolved to modules of spinectl, those inside functions
 included for the layers. Imports by :func:`importlib.import_module` are not
 seen; the package has two, both by design: its deprecated aliases of 0.1's
-module names (``spinectl/__init__.py``) and the CLI's sub-commands. The cycle check uses the imports that run when a
-module is imported (those outside functions): a cycle there means a module can
-be half-initialised when another reads it.
+module names (``spinectl/__init__.py``) and the CLI's sub-commands. The cycle
+check uses the imports that run when a module is imported (those outside
+functions): a cycle there means a module can be half-initialised when another
+reads it.
 """
 
 from __future__ import annotations
 
 import ast
 import graphlib
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
 
-PACKAGE = Path(__file__).resolve().parents[2] / "spinectl"
+ROOT = Path(__file__).resolve().parents[2]
+PACKAGE = ROOT / "spinectl"
 
 LAYERS = (
     ("errors", "units", "_validate", "atomic", "presets"),
@@ -188,6 +192,25 @@ def test_no_module_imports_a_higher_layer(spinectl_imports):
 def test_no_import_cycle(spinectl_imports):
     cycle = import_cycle(spinectl_imports)
     assert cycle is None, "import cycle: " + " -> ".join(cycle)
+
+
+def contributing_section(title: str) -> str:
+    """The text of one "###" section of CONTRIBUTING.md."""
+    return (ROOT / "CONTRIBUTING.md").read_text().split(f"### {title}\n")[1].split("\n##")[0]
+
+
+def test_the_layers_are_those_of_contributing():
+    cells = [line.split("|")[1] for line in contributing_section("Layers").splitlines() if line.startswith("|")]
+    rows = [cell for cell in cells if "`" in cell]  # the table's first column, without header and rule
+    assert [tuple(re.findall(r"`(\w+)`", row)) for row in rows] == list(LAYERS)
+
+
+def test_the_map_in_contributing_names_every_module():
+    tree = contributing_section("The tree")
+    names = {path.name for path in PACKAGE.rglob("*.py")} | {f"{p.name}/" for p in PACKAGE.rglob("*") if p.is_dir()}
+    missing = [n for n in names - {"__pycache__/"} if not re.search(rf"(^|\s){re.escape(n)}(\s|$)", tree, re.M)]
+    assert [n for n in missing if not n.endswith("_cmd.py")] == []  # cli's commands: one line, <name>_cmd.py
+    assert "<name>_cmd.py" in tree
 
 
 def _package(tmp_path: Path, files: dict[str, str]) -> Path:
