@@ -287,6 +287,13 @@ def field_metadata(obj, dotted: str) -> dict:
     -------
     dict
         The metadata of the last field on the way (empty if it has none).
+
+    Raises
+    ------
+    KeyError
+        A part of ``dotted`` names no field (check names first, e.g. with :func:`locate`).
+    IndexError
+        An index beyond its tuple.
     """
     node, meta = obj, {}
     for key in dotted.split("."):

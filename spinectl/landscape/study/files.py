@@ -94,7 +94,7 @@ def parse_study(text: str, base_dir: str | Path = ".", source: str = "study") ->
         data = parse(text, source)
     except ConfigError as exc:
         raise ConfigError("study", exc.message) from None
-    for key, value in data.items():
+    for key, value in data.items():  # key by key: the first section that is wrong is the one named
         check_keys((key,), SECTIONS)
         check_table(value, escaped(key))
     head = data.get("study", {})
