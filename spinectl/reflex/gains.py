@@ -1,6 +1,6 @@
 """Reflex gains: the default rule from the segment's stiffness and inertia, or gains given by the user.
 
-The rule and its reasons are in docs/reflex.md, "The default reflex".
+The rule and its reasons are in docs/reflex.md, "The default reflex, and the activation level".
 """
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from .delay import as_arrays
 
 
 def default_gains(stiffness, damping, inertia, gain_factor, damping_ratio):
-    """The default reflex rule (``docs/reflex.md``, "The default reflex").
+    """The default reflex rule (docs/reflex.md, "The default reflex, and the activation level").
 
     kp = gain_factor * max(S, 0): the stiffness deficit below self-stability
     times a factor > 1, so that the reflexive stiffness kp - S = (gain_factor - 1) S
@@ -48,10 +48,16 @@ def resolve_gains(stiffness, damping, inertia, reflex, kp=None, kd=None):
     ----------
     stiffness, damping, inertia : array_like
         S [N m/rad], D [N m s/rad], theta [kg m^2].
-    reflex : spinectl.params.Reflex
+    reflex : spinectl.model.params.Reflex
         ``gains = "rule"`` uses :func:`default_gains`, ``"explicit"`` its ``kp`` and ``kd``.
     kp, kd : float, optional
         Explicit gains [N m/rad], [N m s/rad] that replace the configured ones.
+
+    Returns
+    -------
+    kp, kd : numpy.ndarray
+        [N m/rad], [N m s/rad], each of the broadcast shape of S, D and theta; NaN where
+        one of them is NaN.
     """
     s, d, theta = as_arrays(stiffness, damping, inertia)
     if reflex.gains == "rule":
