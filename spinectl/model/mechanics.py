@@ -251,7 +251,7 @@ def inertia(cor, model: Model):
 def passive_stiffness(model: Model, inertia_k):
     """Passive stiffness K as a physical torque stiffness [N m/rad], per CoR.
 
-    'physical': K itself. 'paper': eq. 2 subtracts K from d(omega')/dalpha,
+    'physical': K itself. 'paper': eq. 2 of the paper [1]_ subtracts K from d(omega')/dalpha,
     i.e. K theta_k from dM/dalpha (docs/model.md, "Passive stiffness: two
     conventions" and "Units of eq. 2").
 
@@ -266,6 +266,12 @@ def passive_stiffness(model: Model, inertia_k):
     -------
     numpy.ndarray
         K_k [N m/rad], the shape of ``inertia_k``; enters dM_k/dalpha as -K_k.
+
+    References
+    ----------
+    .. [1] Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012). Spinal
+       lordosis optimizes the requirements for a stable erect posture. Theor Biol Med
+       Model 9:13. doi:10.1186/1742-4682-9-13
     """
     k = model.passive.stiffness
     if model.passive.convention == "paper":

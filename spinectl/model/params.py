@@ -7,9 +7,15 @@ otherwise. Instances validate themselves on construction and raise
 :class:`~spinectl.errors.ParameterError` naming the field.
 
 Reading and writing TOML lives in :mod:`spinectl.model.config`; this module does no
-I/O. docs/model.md sets out the reading of the paper (Wagner et al. 2012,
-"the paper") that these defaults encode; docs/parameters.md lists every field
-with its unit, default and source, and docs/glossary.md the symbols.
+I/O. docs/model.md sets out the reading of the paper [1]_ ("the paper") that
+these defaults encode; docs/parameters.md lists every field with its unit,
+default and source, and docs/glossary.md the symbols.
+
+References
+----------
+.. [1] Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012). Spinal
+   lordosis optimizes the requirements for a stable erect posture. Theor Biol Med
+   Model 9:13. doi:10.1186/1742-4682-9-13
 """
 
 from __future__ import annotations

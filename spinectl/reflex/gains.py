@@ -19,6 +19,9 @@ def default_gains(stiffness, damping, inertia, gain_factor, damping_ratio):
     reflex. kd = max(0, 2 zeta sqrt(theta (kp - S)) + D): the delay-free closed loop
     theta s^2 + (kd - D) s + (kp - S) gets the damping ratio zeta, counting the
     muscles' own damping -D >= 0 first (kd = 0 when they already damp enough).
+    The factor 1.5 and zeta = 1 were chosen against Stépán's bound sqrt(2 theta / S),
+    the longest delay any delayed PD can balance the reflex-only segment with [1]_ [2]_
+    (docs/reflex.md).
 
     Parameters
     ----------
@@ -33,6 +36,13 @@ def default_gains(stiffness, damping, inertia, gain_factor, damping_ratio):
     -------
     kp, kd : numpy.ndarray
         [N m/rad], [N m s/rad]; NaN where an input is NaN.
+
+    References
+    ----------
+    .. [1] Stépán G (1989). Retarded Dynamical Systems: Stability and Characteristic
+       Functions. Longman Scientific & Technical, Harlow.
+    .. [2] Stépán G, Kollár L (2000). Balancing with reflex delay. Math Comput Model
+       31:199-205.
     """
     s, d, theta = as_arrays(stiffness, damping, inertia)
     kp = gain_factor * np.maximum(s, 0.0)
