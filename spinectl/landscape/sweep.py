@@ -39,6 +39,11 @@ def parse_grid(spec: str, name: str) -> np.ndarray:
     name : str
         The option, for the error message.
 
+    Returns
+    -------
+    numpy.ndarray, shape (num,)
+        The axis [m], ``numpy.linspace(start, stop, num)``, or the single value.
+
     Raises
     ------
     ParameterError
@@ -119,6 +124,12 @@ def stiffness_sweep(model: Model, stiffnesses, eccentricity, lordosis, **options
         Grid axes [m].
     **options
         Passed to :func:`sweep`.
+
+    Returns
+    -------
+    xarray.Dataset
+        The landscapes of :func:`sweep` stacked along ``K`` [N m/rad], in the order of
+        ``stiffnesses``.
     """
     parts = [
         sweep(config.set_parameter(model, "passive.stiffness", float(k)), eccentricity, lordosis, **options)

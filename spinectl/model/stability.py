@@ -4,7 +4,14 @@ For CoR k, with all other CoRs fixed (paper, Methods), the linearised equation
 of motion about the upright equilibrium is alpha' = omega,
 omega' = (S_k alpha + D_k omega) / theta_k, with S_k = dM/dalpha (muscles,
 gravity and passive stiffness) and D_k = dM/domega. The segment is self-stable
-iff both eigenvalues of its Jacobian have negative real part (paper, eq. 1).
+iff both eigenvalues of its Jacobian have negative real part (paper [1]_, eq. 1;
+docs/model.md, "One segment: the Jacobian and eq. 1").
+
+References
+----------
+.. [1] Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012). Spinal
+   lordosis optimizes the requirements for a stable erect posture. Theor Biol Med
+   Model 9:13. doi:10.1186/1742-4682-9-13
 """
 
 from __future__ import annotations
@@ -31,6 +38,12 @@ def jacobian(stiffness, damping, inertia):
         D = dM/domega [N m s/rad].
     inertia : array_like
         theta [kg m^2].
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 2, 2)
+        J; its second row is [S/theta [1/s^2], D/theta [1/s]]. ``...`` is the
+        broadcast shape of the three inputs.
     """
     s, d, theta = np.broadcast_arrays(*(np.asarray(x, float) for x in (stiffness, damping, inertia)))
     jac = np.zeros(s.shape + (2, 2))
@@ -43,7 +56,7 @@ def jacobian(stiffness, damping, inertia):
 def eigenvalues(stiffness, damping, inertia):
     """Eigenvalues of :func:`jacobian` in closed form, shape (..., 2) complex [1/s].
 
-    lambda_{1,2} = D/(2 theta) +- sqrt(D^2/(4 theta^2) + S/theta) (paper, eq. 1,
+    lambda_{1,2} = D/(2 theta) +- sqrt(D^2/(4 theta^2) + S/theta) (paper [1]_, eq. 1,
     with d(omega')/d(omega) = D/theta and d(omega')/d(alpha) = S/theta).
     The root with the larger real part comes first.
 
@@ -55,6 +68,17 @@ def eigenvalues(stiffness, damping, inertia):
         D = dM/domega [N m s/rad].
     inertia : array_like
         theta [kg m^2].
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 2), complex
+        lambda_1, lambda_2 [1/s]; ``...`` is the broadcast shape of the inputs.
+
+    References
+    ----------
+    .. [1] Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012). Spinal
+       lordosis optimizes the requirements for a stable erect posture. Theor Biol Med
+       Model 9:13. doi:10.1186/1742-4682-9-13
     """
     s, d, theta = (np.asarray(x, float) for x in (stiffness, damping, inertia))
     half = d / (2.0 * theta)
@@ -71,6 +95,11 @@ def self_stable(eigs, margin: float = 0.0):
         Eigenvalues [1/s], e.g. from :func:`eigenvalues`.
     margin : float
         Required distance of the real parts from zero [1/s].
+
+    Returns
+    -------
+    numpy.ndarray of bool, shape (...)
+        True where both eigenvalues have real part < -margin.
     """
     return np.all(np.real(eigs) < -margin, axis=-1)
 
@@ -123,6 +152,9 @@ class StabilityResult:
 def segment_stability(model: Model, eccentricity: float, lordosis: float, pcsa) -> StabilityResult:
     """Jacobian eigenvalues, self-stability and counter torque of every segment.
 
+    The analysis of the paper [1]_ (Methods, Stability analysis and calculation of
+    counter torques): eq. 1 per CoR, and the counter torques CT_k.
+
     Parameters
     ----------
     model : Model
@@ -134,6 +166,23 @@ def segment_stability(model: Model, eccentricity: float, lordosis: float, pcsa) 
     Returns
     -------
     StabilityResult
+        Per segment (shape (n_cor,)): S [N m/rad], D [N m s/rad], theta [kg m^2], the
+        eigenvalues [1/s], the self-stability verdict and CT_k [N m]; with the
+        per-muscle PCSA [m^2] used and the coefficients it came from.
+
+    Raises
+    ------
+    ParameterError
+        E or Lambda outside the modelled range, or a PCSA vector of the wrong length
+        or with negative or non-finite entries.
+    ModelError
+        The model cannot be evaluated there (see :func:`~spinectl.model.checks.validate_position`).
+
+    References
+    ----------
+    .. [1] Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012). Spinal
+       lordosis optimizes the requirements for a stable erect posture. Theor Biol Med
+       Model 9:13. doi:10.1186/1742-4682-9-13
     """
     coeffs = checked_coefficients(model, float(eccentricity), float(lordosis))
     pcsa = expand_pcsa(model, pcsa)

@@ -26,7 +26,7 @@ def test_gravity_alone_destabilises_every_segment(model):
     """No muscle, K = 0: an inverted pendulum at every CoR, lambda = +-sqrt(g / r).
 
     At E = Lambda = 0 the mass is straight above CoR k at r_k = 0.326 - y_k, and
-    theta_k = m r_k^2, so S/theta = g / r_k (design page, gravity erratum).
+    theta_k = m r_k^2, so S/theta = g / r_k (docs/model.md, "Gravity sign").
     """
     result = segment_stability(model, 0.0, 0.0, ZERO)
     assert not result.self_stable.any()

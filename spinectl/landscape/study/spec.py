@@ -183,6 +183,11 @@ class Sampled:
             Number of draws.
         seed : int
             Seed of the study's samples.
+
+        Returns
+        -------
+        numpy.ndarray, shape (count,)
+            The draws, in the unit of the parameter.
         """
         rng = np.random.default_rng([seed, *self.parameter.encode()])
         a, b = (value for _, value in self.arguments)
@@ -224,7 +229,14 @@ class Samples:
         object.__setattr__(self, "_draws", draws)  # drawn once: every combination reads them
 
     def values(self) -> dict[str, np.ndarray]:
-        """The draws of every parameter by name, shape (count,) each (read-only)."""
+        """The draws of every parameter by name, shape (count,) each (read-only).
+
+        Returns
+        -------
+        dict of str to numpy.ndarray
+            ``{dotted parameter: draws}``, each of shape (count,) in the parameter's unit;
+            a new dict, the arrays read-only.
+        """
         return dict(self._draws)
 
 
@@ -376,6 +388,12 @@ class Study:
         ----------
         combination : tuple of int
             Index along each of :attr:`dims`.
+
+        Returns
+        -------
+        dict
+            ``{dotted parameter: value}`` in each parameter's unit, ready for
+            :func:`spinectl.model.config.set_parameters`; empty without axes or samples.
         """
         out = {a.parameter: a.values[i] for a, i in zip(self.axes, combination, strict=False)}
         if self.samples:
@@ -411,6 +429,12 @@ class Study:
         ----------
         index : int
             0 <= index < :attr:`n_chunks`.
+
+        Returns
+        -------
+        Chunk
+            Its index, the combination of the parameter axes and the slices of the E and
+            Lambda axes that make its tile.
         """
         combination, tile = divmod(int(index), math.prod(self.tiles))
         i_e, i_l = divmod(tile, self.tiles[1])
@@ -428,6 +452,11 @@ class Study:
         The resolved base model, the grid, the axes, the drawn values, the
         outputs and the tiling, not the file's text: comments and spacing may
         change between a run and its resume, a value may not.
+
+        Returns
+        -------
+        str
+            64 hexadecimal digits.
         """
         content = {
             "format": STORE_FORMAT,
@@ -451,6 +480,11 @@ def load_study(path: str | Path) -> Study:
     ----------
     path : str or Path
         The study file; a ``config`` it names is relative to its folder.
+
+    Returns
+    -------
+    Study
+        The validated study.
 
     Raises
     ------
@@ -478,6 +512,18 @@ def parse_study(text: str, base_dir: str | Path = ".", source: str = "study") ->
         Folder against which ``study.config`` is resolved.
     source : str
         Where the text came from, for messages.
+
+    Returns
+    -------
+    Study
+        The validated study.
+
+    Raises
+    ------
+    ConfigError
+        Not TOML, or an unknown section or key.
+    ParameterError
+        A value is invalid, or the E or Lambda axis is missing.
     """
     try:
         data = parse(text, source)
@@ -593,6 +639,12 @@ def fields_of(model: Model, dotted: str) -> dict[str, str]:
         Any model (only its structure is read).
     dotted : str
         Dotted parameter, e.g. ``"body.mass"`` or ``"muscles.0.upper.1"``.
+
+    Returns
+    -------
+    dict of str to str
+        ``{"units": ..., "long_name": ...}``: the field's ``unit`` metadata ("" if none)
+        and its ``doc`` (``dotted`` if none).
     """
     node, meta = model, {}
     for key in dotted.split("."):
