@@ -64,9 +64,9 @@ def run(args) -> int:
         Exit code 0.
     """
     model = model_with_overrides(args)
-    pcsa = cm2_to_m2(args.pcsa) if args.pcsa is not None else None
-    result = stability_at(model, args.E, args.Lambda, pcsa)
-    source = "given" if args.pcsa is not None else "min_pcsa"
+    given = args.pcsa is not None  # else the minimum stabilising PCSA
+    result = stability_at(model, args.E, args.Lambda, cm2_to_m2(args.pcsa) if given else None)
+    source = "given" if given else "min_pcsa"
     if args.json:
         emit_json(result.to_dict(model, pcsa_source=source))
     else:
