@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..units import m2_to_cm2
 from .checks import arithmetic_guard, checked_coefficients, expand_pcsa
 from .mechanics import SegmentCoefficients
 from .params import Model
@@ -147,6 +148,98 @@ class StabilityResult:
     def all_self_stable(self) -> bool:
         """True if every segment is self-stable."""
         return bool(np.all(self.self_stable))
+
+    def to_dict(self, model: Model, pcsa_source: str = "given") -> dict:
+        """The result as a JSON-ready dict: the document of ``spinectl stability --json``.
+
+        Parameters
+        ----------
+        model : Model
+            The model the result was computed with (muscle names, K and its convention).
+        pcsa_source : {'given', 'min_pcsa'}
+            Where the PCSA came from: given by the caller, or the minimum stabilising
+            PCSA (the optimiser's chosen activation,
+            :func:`spinectl.optimise.reference.minimum_stabilising_pcsa`).
+
+        Returns
+        -------
+        dict
+            ``E_m``, ``Lambda_m``, ``K_Nm_per_rad``, ``K_convention``, ``pcsa_source``,
+            ``pcsa_cm2`` (muscle name -> PCSA [cm^2]), ``total_pcsa_cm2``, ``segments`` (each
+            with ``name``, ``stiffness_Nm_per_rad``, ``damping_Nms_per_rad``, ``inertia_kgm2``,
+            ``eigenvalues`` as [real, imaginary] pairs [1/s], ``self_stable``,
+            ``counter_torque_Nm``), ``all_self_stable`` and ``counter_torque_norm_Nm``; the
+            unit is in each key's name.
+        """
+        pcsa = m2_to_cm2(self.pcsa)
+        return {
+            "E_m": self.eccentricity,
+            "Lambda_m": self.lordosis,
+            "K_Nm_per_rad": model.passive.stiffness,
+            "K_convention": model.passive.convention,
+            "pcsa_source": pcsa_source,
+            "pcsa_cm2": dict(zip(model.muscle_names, pcsa.tolist(), strict=False)),
+            "total_pcsa_cm2": float(pcsa.sum()),
+            "segments": [
+                {
+                    "name": name,
+                    "stiffness_Nm_per_rad": float(self.stiffness[k]),
+                    "damping_Nms_per_rad": float(self.damping[k]),
+                    "inertia_kgm2": float(self.inertia[k]),
+                    "eigenvalues": [[float(z.real), float(z.imag)] for z in self.eigenvalues[k]],
+                    "self_stable": bool(self.self_stable[k]),
+                    "counter_torque_Nm": float(self.counter_torque[k]),
+                }
+                for k, name in enumerate(self.segment_names)
+            ],
+            "all_self_stable": self.all_self_stable,
+            "counter_torque_norm_Nm": self.counter_torque_norm,
+        }
+
+    def table(self, model: Model, pcsa_source: str = "given") -> str:
+        """The result as a readable table, one row a segment, with the PCSA and ||CT|| around it.
+
+        Parameters
+        ----------
+        model : Model
+            The model the result was computed with (muscle names, K and its convention).
+        pcsa_source : {'given', 'min_pcsa'}
+            Where the PCSA came from (see :meth:`to_dict`); 'min_pcsa' says so in the PCSA line.
+
+        Returns
+        -------
+        str
+            The text ``spinectl stability`` prints (no final newline).
+        """
+
+        def complex_column(z: complex) -> str:
+            return f"{z.real:9.3f}{z.imag:+9.3f}j"
+
+        pcsa = m2_to_cm2(self.pcsa)
+        given = pcsa_source == "given"
+        lines = [
+            f"E = {self.eccentricity * 100:.2f} cm, Lambda = {self.lordosis * 100:.2f} cm, "
+            f"K = {model.passive.stiffness:g} N m/rad ({model.passive.convention})",
+            ("PCSA [cm^2]: " if given else "PCSA [cm^2] (minimum stabilising, chosen activation): ")
+            + ", ".join(f"{n} {p:.2f}" for n, p in zip(model.muscle_names, pcsa, strict=False))
+            + f"  (total {pcsa.sum():.2f})",
+            "",
+            f"{'segment':8} {'S [N m/rad]':>12} {'D [N m s/rad]':>14} {'theta [kg m2]':>14} "
+            f"{'lambda_1 [1/s]':>20} {'lambda_2 [1/s]':>20} {'stable':>7} {'CT [N m]':>10}",
+        ]
+        for k, name in enumerate(self.segment_names):
+            eig = self.eigenvalues[k]
+            lines.append(
+                f"{name:8} {self.stiffness[k]:12.3f} {self.damping[k]:14.4f} {self.inertia[k]:14.4f} "
+                f"{complex_column(eig[0]):>20} {complex_column(eig[1]):>20} "
+                f"{'yes' if self.self_stable[k] else 'NO':>7} {self.counter_torque[k]:10.3f}"
+            )
+        lines += [
+            "",
+            f"||CT|| = {self.counter_torque_norm:.3f} N m; "
+            f"self-stable: {'all segments' if self.all_self_stable else 'NOT all segments'}",
+        ]
+        return "\n".join(lines)
 
 
 def segment_stability(model: Model, eccentricity: float, lordosis: float, pcsa) -> StabilityResult:

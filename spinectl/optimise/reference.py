@@ -37,8 +37,10 @@ from dataclasses import dataclass
 import cvxpy as cp
 import numpy as np
 
+from ..errors import ModelError
 from ..model.checks import checked_coefficients
 from ..model.params import Model
+from ..model.stability import StabilityResult, segment_stability
 from ..units import M2_PER_CM2
 from .problem import (
     INFEASIBLE_STATUSES,
@@ -384,3 +386,62 @@ def pareto_front(model: Model, eccentricity: float, lordosis: float, n_points: i
             norm = np.linalg.norm(data.counter_torque(polished(data, "counter_torque", x.value, value)[0]))
         norms.append(norm)
     return ParetoFront(float(eccentricity), float(lordosis), budgets * M2_PER_CM2, np.asarray(norms), tuple(statuses))
+
+
+def minimum_stabilising_pcsa(model: Model, eccentricity: float, lordosis: float) -> np.ndarray:
+    """The chosen activation of :func:`solve_point`: the minimum stabilising PCSA [m^2].
+
+    Parameters
+    ----------
+    model : Model
+        ``optimisation`` sets activation mode, margin, bounds and tolerances.
+    eccentricity, lordosis : float
+        E and Lambda [m].
+
+    Returns
+    -------
+    numpy.ndarray, shape (n_muscles,)
+        PCSA of each muscle [m^2] that makes every segment self-stable.
+
+    Raises
+    ------
+    ModelError
+        No activation within the bounds stabilises every segment, or the solver failed
+        (the message names the optimiser's status and suggests giving ``--pcsa``).
+    """
+    optimum = solve_point(model, eccentricity, lordosis)
+    if not optimum.ok:
+        raise ModelError(
+            f"pcsa: no activation stabilises every segment at E = {eccentricity:g} m, Lambda = {lordosis:g} m "
+            f"(optimiser status {optimum.status}); give --pcsa"
+        )
+    return optimum.pcsa
+
+
+def stability_at(model: Model, eccentricity: float, lordosis: float, pcsa=None) -> StabilityResult:
+    """Stability of every segment for a PCSA, by default the minimum stabilising one.
+
+    Parameters
+    ----------
+    model : Model
+    eccentricity, lordosis : float
+        E and Lambda [m].
+    pcsa : array_like, optional
+        PCSA [m^2], per pair or per muscle (:func:`spinectl.model.checks.expand_pcsa`);
+        default :func:`minimum_stabilising_pcsa`.
+
+    Returns
+    -------
+    StabilityResult
+        :func:`spinectl.model.stability.segment_stability` at that PCSA.
+
+    Raises
+    ------
+    ModelError
+        ``pcsa`` not given and no activation stabilises every segment.
+    ParameterError
+        E, Lambda or ``pcsa`` out of range.
+    """
+    if pcsa is None:
+        pcsa = minimum_stabilising_pcsa(model, eccentricity, lordosis)
+    return segment_stability(model, eccentricity, lordosis, pcsa)
