@@ -51,6 +51,11 @@ def model_with_overrides(args):
     ----------
     args : argparse.Namespace
         Parsed arguments; ``delay`` [s], ``activation``, ``pade_order``, ``kp``, ``kd`` are optional.
+
+    Returns
+    -------
+    Model
+        The validated model.
     """
     model = load_model(args)
     for option, dotted in OVERRIDES:

@@ -43,6 +43,11 @@ def model_with_overrides(args):
     ----------
     args : argparse.Namespace
         Parsed arguments; ``K`` [N m/rad] is optional.
+
+    Returns
+    -------
+    Model
+        The validated model.
     """
     model = load_model(args)
     if getattr(args, "K", None) is not None:

@@ -8,7 +8,7 @@ from ..landscape import sweep
 from ._common import add_model_options, float_list, load_model
 
 DEFAULT_AXIS = "0:0.08:81"
-"""The paper's grid: 0 to 8 cm in 1 mm steps (design page, What the paper reports)."""
+"""The paper's grid: 0 to 8 cm in 1 mm steps (paper, Methods)."""
 
 
 def register(sub) -> None:

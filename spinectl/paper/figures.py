@@ -162,6 +162,11 @@ def figure_names(stiffness: float) -> tuple[str, str]:
     ----------
     stiffness : float
         Passive stiffness K [N m/rad]; 0 gives Figures 3 and 4, else S1 and 4 with K in the name.
+
+    Returns
+    -------
+    tuple of str
+        The PNG names of the minimum-PCSA and the counter-torque figure.
     """
     if stiffness == 0:
         return "fig3_min_pcsa.png", "fig4_counter_torque.png"

@@ -78,6 +78,11 @@ def operating_point(model: Model, eccentricity: float, lordosis: float, activati
         E and Lambda [m].
     activation : float
         Fraction of the minimum stabilising PCSA [1]; 0 skips the optimiser.
+
+    Returns
+    -------
+    OperatingPoint
+        The PCSA [m^2] and each segment's S [N m/rad], D [N m s/rad] and theta [kg m^2] there.
     """
     coeffs = checked_coefficients(model, float(eccentricity), float(lordosis))
     if activation == 0:
@@ -211,6 +216,11 @@ def segment_margins(name, stiffness, damping, inertia, kp, kd, delay: float, ord
         tau [s].
     order : int
         Order of the Padé approximant.
+
+    Returns
+    -------
+    SegmentMargins
+        Exact and Padé delay margins [s], phase margin [deg], stabilising gain range and verdict.
     """
     s, d, theta, kp, kd = (float(x) for x in (stiffness, damping, inertia, kp, kd))
     exact = delay_margin(s, d, theta, kp, kd)
@@ -358,6 +368,11 @@ def analyse(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None
         E and Lambda [m].
     kp, kd : float, optional
         Explicit gains for every segment [N m/rad], [N m s/rad], each replacing the configured one.
+
+    Returns
+    -------
+    MarginsReport
+        The operating point and one :class:`SegmentMargins` per segment.
     """
     settings = model.reflex
     point = operating_point(model, eccentricity, lordosis, settings.activation)
