@@ -44,7 +44,7 @@ from spinectl.units import m2_to_cm2
 
 preset = PRESET or ("wagner2012" if "wagner2012" in spinectl.list_presets() else "default")
 model = config.set_parameter(spinectl.load_preset(preset), "passive.stiffness", 0.0)  # K = 0, as in Figures 3, 4
-axis = np.linspace(0.0, 0.08, GRID)  # E and Lambda [m]
+axis = grid.paper_axis(GRID)  # E and Lambda [m], the paper's 0 to 8 cm
 CM = 100.0  # cm per m, for axes and tables
 print(f"preset {preset!r}; E and Lambda from 0 to 8 cm, {GRID} points each ({(axis[1] - axis[0]) * 1e3:.3g} mm apart)")
 
@@ -59,13 +59,11 @@ print(f"preset {preset!r}; E and Lambda from 0 to 8 cm, {GRID} points each ({(ax
 
 # %%
 K_PAPER = grid.PAPER_STIFFNESS  # N m/rad, the paper's ref. 26
-other_convention = "paper" if model.passive.convention == "physical" else "physical"
+other_convention = grid.other_convention(model)
 
 start = time.perf_counter()
-both = sweep.stiffness_sweep(model, [0.0, K_PAPER], axis, axis)
+both, k15_other = grid.paper_landscapes(model, GRID)  # K = 0 and 15, and K = 15 with the other convention
 k0, k15 = both.sel(K=0.0), both.sel(K=K_PAPER)
-other_model = config.set_parameter(model, "passive.convention", other_convention)
-k15_other = sweep.sweep(config.set_parameter(other_model, "passive.stiffness", K_PAPER), axis, axis)
 print(f"3 landscapes of {GRID}x{GRID} points in {time.perf_counter() - start:.1f} s")
 print("solver statuses (K = 0):", dict(zip(*np.unique(k0["status"].values, return_counts=True), strict=True)))
 

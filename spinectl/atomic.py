@@ -21,6 +21,10 @@ from .errors import OutputError
 def atomic_path(target: str | Path, *, directory: bool = False) -> Iterator[Path]:
     """Yield a temporary path in the target's folder; rename it onto ``target`` on success.
 
+    On an exception the temporary is removed and ``target`` is left untouched.
+    The new output gets the previous one's permissions, or the usual ones of a
+    new file (the umask), not the private mode of a temporary.
+
     Parameters
     ----------
     target : str or Path
@@ -28,9 +32,11 @@ def atomic_path(target: str | Path, *, directory: bool = False) -> Iterator[Path
     directory : bool
         Create the temporary as a folder.
 
-    On an exception the temporary is removed and ``target`` is left untouched.
-    The new output gets the previous one's permissions, or the usual ones of a
-    new file (the umask), not the private mode of a temporary.
+    Yields
+    ------
+    Path
+        The temporary to write, beside ``target``: an empty file, or an empty folder
+        with ``directory=True``.
 
     Raises
     ------
@@ -114,6 +120,16 @@ def check_writable(target: str | Path) -> Path:
     ----------
     target : str or Path
         The file a job will write with :func:`atomic_path`.
+
+    Returns
+    -------
+    Path
+        ``target`` as a :class:`~pathlib.Path`.
+
+    Raises
+    ------
+    OutputError
+        ``target`` is a folder, or its folder cannot be created or written.
     """
     target = Path(target)
     with _output_errors(target):
@@ -133,6 +149,11 @@ def atomic_write_text(target: str | Path, text: str) -> Path:
         Final file.
     text : str
         Its whole content.
+
+    Returns
+    -------
+    Path
+        ``target`` as a :class:`~pathlib.Path`, now holding ``text``.
     """
     with atomic_path(target) as tmp:
         tmp.write_text(text, encoding="utf-8")
@@ -151,6 +172,11 @@ def staged_directory(target: str | Path) -> Iterator[Path]:
     ----------
     target : str or Path
         The output folder (created if missing).
+
+    Yields
+    ------
+    Path
+        The empty staging folder, beside ``target``; write the outputs into it.
 
     Raises
     ------

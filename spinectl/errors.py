@@ -36,6 +36,11 @@ class ParameterError(SpinectlError, ValueError):
         ----------
         prefix : str
             Dotted path of the section, e.g. ``"body"``; empty leaves the name unchanged.
+
+        Returns
+        -------
+        ParameterError
+            A new error of the same class, its field ``prefix.field``.
         """
         return type(self)(f"{prefix}.{self.field}" if prefix else self.field, self.message)
 

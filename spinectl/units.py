@@ -18,6 +18,11 @@ def cm2_to_m2(value):
     ----------
     value : array_like
         PCSA [cm^2].
+
+    Returns
+    -------
+    numpy.ndarray
+        PCSA [m^2], the shape of ``value``.
     """
     return np.asarray(value, float) * M2_PER_CM2
 
@@ -29,5 +34,10 @@ def m2_to_cm2(value):
     ----------
     value : array_like
         PCSA [m^2].
+
+    Returns
+    -------
+    numpy.ndarray
+        PCSA [cm^2], the shape of ``value``.
     """
     return np.asarray(value, float) / M2_PER_CM2

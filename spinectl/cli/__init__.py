@@ -53,7 +53,13 @@ class _ParserExit(Exception):
 
 
 def build_parser() -> argparse.ArgumentParser:
-    """The full argument parser with every registered sub-command."""
+    """The full argument parser with every registered sub-command.
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        ``spinectl`` with the sub-commands of :data:`COMMANDS`; its errors raise instead of exiting.
+    """
     from .. import __version__
 
     parser = _Parser(
@@ -75,6 +81,11 @@ def main(argv: list[str] | None = None) -> int:
     ----------
     argv : list of str, optional
         The arguments after ``spinectl``; default ``sys.argv[1:]``.
+
+    Returns
+    -------
+    int
+        0 on success, 2 for an error the user can fix (one line on stderr), 130 on Ctrl-C.
     """
     try:
         args = build_parser().parse_args(argv)

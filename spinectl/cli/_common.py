@@ -28,6 +28,18 @@ def add_model_options(parser: argparse.ArgumentParser, default_preset: str = "de
     group.add_argument("--preset", metavar="NAME", help=f"built-in parameter preset (default: {default_preset!r})")
 
 
+def add_position_options(parser: argparse.ArgumentParser) -> None:
+    """``--E`` and ``--Lambda`` in metres.
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        The sub-command's parser.
+    """
+    parser.add_argument("--E", type=finite_float("--E"), default=0.0, help="eccentricity E [m] (default 0)")
+    parser.add_argument("--Lambda", type=finite_float("--Lambda"), default=0.0, help="lordosis Lambda [m] (default 0)")
+
+
 def load_model(args: argparse.Namespace, default_preset: str = "default") -> Model:
     """The model named by ``--preset`` and ``--config``.
 

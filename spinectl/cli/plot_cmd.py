@@ -38,8 +38,6 @@ def run(args) -> int:
     int
         Exit code 0.
     """
-    dataset = netcdf.load(args.results)
-    model = netcdf.model_of(dataset)
-    for path in figures.draw_figures(dataset, args.out, model.fibre.specific_tension):
+    for path in figures.draw_figures(netcdf.load(args.results), args.out):
         print(path)
     return 0

@@ -4,15 +4,11 @@ from __future__ import annotations
 
 import time
 
-import numpy as np
-
-from ..atomic import check_writable
-from ..landscape import netcdf, sweep
-from ..model.config import set_parameter
+from ..landscape import sweep
 from ._common import add_model_options, float_list, load_model
 
 DEFAULT_AXIS = "0:0.08:81"
-"""The paper's grid: 0 to 8 cm in 1 mm steps (design page, What the paper reports)."""
+"""The paper's grid: 0 to 8 cm in 1 mm steps (paper, Methods)."""
 
 
 def register(sub) -> None:
@@ -59,42 +55,8 @@ def run(args) -> int:
     """
     model = load_model(args)
     e_axis, l_axis = sweep.parse_grid(args.E, "--E"), sweep.parse_grid(args.Lambda, "--Lambda")
-    options = {"method": args.method, "chunk_size": args.chunk_size}
-    check_writable(args.out)  # before the solves
+    options = {"stiffnesses": args.K, "method": args.method, "chunk_size": args.chunk_size}
     start = time.perf_counter()
-    stiffnesses = args.K or [model.passive.stiffness]
-    if len(stiffnesses) == 1:
-        model = set_parameter(model, "passive.stiffness", stiffnesses[0])
-        dataset = sweep.sweep(model, e_axis, l_axis, **options)
-    else:
-        dataset = sweep.stiffness_sweep(model, stiffnesses, e_axis, l_axis, **options)
-    netcdf.save(dataset, args.out)
-    print(summary(dataset, args.out, time.perf_counter() - start))
+    dataset = sweep.write_sweep(model, e_axis, l_axis, args.out, **options)
+    print(f"wrote {args.out}: {sweep.describe(dataset)} in {time.perf_counter() - start:.1f} s")
     return 0
-
-
-def summary(dataset, path, seconds: float) -> str:
-    """One line: what was written, how many points solved, the ranges of both landscapes.
-
-    Parameters
-    ----------
-    dataset : xarray.Dataset
-        The sweep.
-    path : str or Path
-        Where it was written.
-    seconds : float
-        Wall time [s].
-    """
-    status = dataset["status"].values
-    pcsa, torque = dataset["min_pcsa_cm2"].values, dataset["counter_torque_norm_Nm"].values
-    ok = np.isfinite(pcsa)
-    ranges = ""
-    if ok.any():
-        ranges = (
-            f"; min PCSA {np.nanmin(pcsa):.1f}-{np.nanmax(pcsa):.1f} cm2, "
-            f"||CT|| {np.nanmin(torque):.1f}-{np.nanmax(torque):.1f} N m"
-        )
-    return (
-        f"wrote {path}: {status.size} points ({int(ok.sum())} solved, {int((~ok).sum())} infeasible or failed)"
-        f"{ranges} in {seconds:.1f} s"
-    )

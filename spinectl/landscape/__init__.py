@@ -5,4 +5,6 @@ docs/optimisation.md (the schema) and docs/studies.md. The variables and their u
 (:mod:`~spinectl.landscape.columns`), the sweep over a grid
 (:mod:`~spinectl.landscape.sweep`), NetCDF files (:mod:`~spinectl.landscape.netcdf`)
 and parameter studies on Dask in a Zarr store (:mod:`~spinectl.landscape.study`).
+
+Symbols and units: docs/glossary.md.
 """

@@ -23,18 +23,28 @@ def model_of(dataset: xr.Dataset) -> Model:
     Parameters
     ----------
     dataset : xarray.Dataset
-        From :func:`sweep` or :func:`load`.
+        From :func:`~spinectl.landscape.sweep.sweep` or :func:`load`.
+
+    Returns
+    -------
+    Model
+        The parameters of the sweep, validated.
     """
     return config.from_dict(Model, tomllib.loads(dataset.attrs["config_toml"]))
 
 
 def save(dataset: xr.Dataset, path: str | Path) -> Path:
-    """Write a Dataset to NetCDF atomically (:func:`spinectl.io.atomic_path`).
+    """Write a Dataset to NetCDF atomically (:func:`spinectl.atomic.atomic_path`).
 
     Parameters
     ----------
     dataset : xarray.Dataset
     path : str or Path
+
+    Returns
+    -------
+    Path
+        ``path`` as a :class:`~pathlib.Path`, now holding the NetCDF file.
     """
     with atomic_path(path) as tmp:
         dataset.to_netcdf(tmp, engine="netcdf4")
@@ -47,6 +57,12 @@ def load(path: str | Path) -> xr.Dataset:
     Parameters
     ----------
     path : str or Path
+
+    Returns
+    -------
+    xarray.Dataset
+        The landscape, loaded into memory, with at least :data:`REQUIRED`, ``E``,
+        ``Lambda`` and the ``config_toml`` attribute.
 
     Raises
     ------

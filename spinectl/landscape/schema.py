@@ -51,6 +51,11 @@ def dims_of(name: str, ndim: int) -> tuple[str, ...]:
         A key of :data:`VARIABLES`.
     ndim : int
         2 (E, Lambda), 3 (plus segment, or muscle for ``pcsa_cm2``) or 4 (plus segment and muscle).
+
+    Returns
+    -------
+    tuple of str
+        Dimension names, ``("E", "Lambda", ...)``.
     """
     extra = {3: ("muscle",) if name == "pcsa_cm2" else ("segment",), 4: ("segment", "muscle")}
     return ("E", "Lambda") + extra.get(ndim, ())
@@ -65,6 +70,12 @@ def grid_coordinates(model: Model, e_axis, l_axis) -> dict:
         Supplies the names of the segments and muscles.
     e_axis, l_axis : array_like, 1-D
         Grid axes E and Lambda [m].
+
+    Returns
+    -------
+    dict
+        ``{name: (dimension, values, attributes)}`` for ``E`` [m], ``Lambda`` [m],
+        ``segment`` and ``muscle``, as xarray takes coordinates.
     """
     return {
         "E": ("E", e_axis, {"units": "m", "long_name": "eccentricity of the spine"}),

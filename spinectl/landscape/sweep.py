@@ -14,9 +14,11 @@ import numpy as np
 import xarray as xr
 from tqdm import tqdm
 
+from ..atomic import check_writable
 from ..errors import ParameterError
 from ..model import config
 from ..model.params import Model
+from . import netcdf
 from .columns import DEFAULT_CHUNK, point_columns
 from .schema import landscape_dataset
 
@@ -38,6 +40,11 @@ def parse_grid(spec: str, name: str) -> np.ndarray:
         E.g. ``"0:0.08:81"`` or ``"0.03"``.
     name : str
         The option, for the error message.
+
+    Returns
+    -------
+    numpy.ndarray, shape (num,)
+        The axis [m], ``numpy.linspace(start, stop, num)``, or the single value.
 
     Raises
     ------
@@ -119,6 +126,12 @@ def stiffness_sweep(model: Model, stiffnesses, eccentricity, lordosis, **options
         Grid axes [m].
     **options
         Passed to :func:`sweep`.
+
+    Returns
+    -------
+    xarray.Dataset
+        The landscapes of :func:`sweep` stacked along ``K`` [N m/rad], in the order of
+        ``stiffnesses``.
     """
     parts = [
         sweep(config.set_parameter(model, "passive.stiffness", float(k)), eccentricity, lordosis, **options)
@@ -129,3 +142,67 @@ def stiffness_sweep(model: Model, stiffnesses, eccentricity, lordosis, **options
     return combined
 
 
+def write_sweep(model: Model, eccentricity, lordosis, path, *, stiffnesses=None, **options) -> xr.Dataset:
+    """:func:`sweep` for one K, :func:`stiffness_sweep` for several, saved as NetCDF: ``spinectl sweep``.
+
+    Parameters
+    ----------
+    model : Model
+    eccentricity, lordosis : array_like, 1-D
+        Grid axes E and Lambda [m].
+    path : str or Path
+        NetCDF file, written atomically (:func:`spinectl.landscape.netcdf.save`); checked
+        before the solves, so that a typo costs a second, not the sweep.
+    stiffnesses : sequence of float, optional
+        Passive stiffnesses K [N m/rad]; one gives a landscape with a scalar ``K``, several a
+        ``K`` dimension. Default (None or empty): the model's K.
+    **options
+        Passed to :func:`sweep` (``method``, ``chunk_size``, ``progress``).
+
+    Returns
+    -------
+    xarray.Dataset
+        What was written.
+
+    Raises
+    ------
+    OutputError
+        ``path`` cannot be written.
+    ParameterError
+        A bad option or K.
+    """
+    check_writable(path)
+    stiffnesses = list(stiffnesses or [model.passive.stiffness])
+    if len(stiffnesses) == 1:
+        model = config.set_parameter(model, "passive.stiffness", stiffnesses[0])
+        dataset = sweep(model, eccentricity, lordosis, **options)
+    else:
+        dataset = stiffness_sweep(model, stiffnesses, eccentricity, lordosis, **options)
+    netcdf.save(dataset, path)
+    return dataset
+
+
+def describe(dataset: xr.Dataset) -> str:
+    """How many points a sweep solved, and the ranges of both landscapes, in one line.
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        Output of :func:`sweep` or :func:`stiffness_sweep`.
+
+    Returns
+    -------
+    str
+        E.g. ``"25 points (25 solved, 0 infeasible or failed); min PCSA 10.2-40.3 cm2, ||CT|| 0.0-31.5 N m"``;
+        the ranges only if some point was solved.
+    """
+    status = dataset["status"].values
+    pcsa, torque = dataset["min_pcsa_cm2"].values, dataset["counter_torque_norm_Nm"].values
+    ok = np.isfinite(pcsa)
+    ranges = ""
+    if ok.any():
+        ranges = (
+            f"; min PCSA {np.nanmin(pcsa):.1f}-{np.nanmax(pcsa):.1f} cm2, "
+            f"||CT|| {np.nanmin(torque):.1f}-{np.nanmax(torque):.1f} N m"
+        )
+    return f"{status.size} points ({int(ok.sum())} solved, {int((~ok).sum())} infeasible or failed){ranges}"

@@ -6,5 +6,13 @@ from TOML with presets (:mod:`~spinectl.model.config`, on the schema engine
 the spine's geometry (:mod:`~spinectl.model.geometry`), the Hill-type muscles
 (:mod:`~spinectl.model.muscle`), the torques and their derivatives per unit PCSA
 (:mod:`~spinectl.model.mechanics`); :mod:`~spinectl.model.checks` guards their
-evaluation and :mod:`~spinectl.model.stability` applies the paper's eq. 1.
+evaluation and :mod:`~spinectl.model.stability` applies the paper's eq. 1 [1]_.
+
+Symbols and units: docs/glossary.md.
+
+References
+----------
+.. [1] Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012). Spinal
+   lordosis optimizes the requirements for a stable erect posture. Theor Biol Med
+   Model 9:13. doi:10.1186/1742-4682-9-13
 """

@@ -311,7 +311,7 @@ def to_dict(obj) -> dict:
     Parameters
     ----------
     obj : dataclass instance
-        A :class:`~spinectl.params.Model` or one of its sections.
+        A :class:`~spinectl.model.params.Model` or one of its sections.
 
     Returns
     -------
@@ -337,7 +337,7 @@ def from_dict(cls, data: dict, path: str = ""):
     Parameters
     ----------
     cls : type
-        A parameter dataclass, e.g. :class:`~spinectl.params.Model`.
+        A parameter dataclass, e.g. :class:`~spinectl.model.params.Model`.
     data : dict
         Its fields, nested as in TOML (SI units).
     path : str

@@ -42,7 +42,7 @@ def validate_position(model: Model, eccentricity, lordosis) -> None:
 
 
 def checked_coefficients(model: Model, eccentricity, lordosis) -> SegmentCoefficients:
-    """:func:`~spinectl.mechanics.segment_coefficients` after every check of :func:`validate_position`.
+    """:func:`~spinectl.model.mechanics.segment_coefficients` after every check of :func:`validate_position`.
 
     Floating-point overflow, division by zero and invalid operations become a
     :class:`ModelError`, never a numpy warning or a NaN passed on to a solver.
@@ -53,6 +53,19 @@ def checked_coefficients(model: Model, eccentricity, lordosis) -> SegmentCoeffic
         The parameters.
     eccentricity, lordosis : array_like
         E and Lambda [m]; broadcast together.
+
+    Returns
+    -------
+    SegmentCoefficients
+        As :func:`~spinectl.model.mechanics.segment_coefficients`, every entry finite
+        and every inertia > 0.
+
+    Raises
+    ------
+    ParameterError
+        E or Lambda not finite or outside the modelled range [m].
+    ModelError
+        A fibre attachment on a centre of rotation, or floating-point trouble.
     """
     _check_range(model, eccentricity, lordosis)
     with arithmetic_guard(eccentricity, lordosis):
@@ -83,6 +96,17 @@ def arithmetic_guard(eccentricity, lordosis):
     ----------
     eccentricity, lordosis : array_like
         E and Lambda [m] being evaluated, named in the message.
+
+    Yields
+    ------
+    None
+        Control returns to the ``with`` block under ``numpy.errstate(over, divide,
+        invalid = "raise")``.
+
+    Raises
+    ------
+    ModelError
+        On overflow, division by zero or an invalid operation inside the block.
     """
     try:
         with np.errstate(over="raise", divide="raise", invalid="raise"):
@@ -148,6 +172,17 @@ def expand_pcsa(model: Model, pcsa) -> np.ndarray:
         Supplies the muscle pairs.
     pcsa : array_like, shape (..., n) or (..., 2 n)
         PCSA [m^2], finite and >= 0.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 2 n)
+        PCSA of each muscle [m^2], in the order of
+        :attr:`~spinectl.model.params.Model.muscle_names`.
+
+    Raises
+    ------
+    ParameterError
+        Neither n nor 2 n values, or a value negative or not finite.
     """
     pcsa = np.asarray(pcsa, float)
     n_pairs = len(model.muscles)

@@ -21,7 +21,13 @@ PRESET_PACKAGE = "spinectl.presets"
 
 
 def list_presets() -> list[str]:
-    """Names of the built-in presets (TOML files shipped in :mod:`spinectl.presets`)."""
+    """Names of the built-in presets (TOML files shipped in :mod:`spinectl.presets`).
+
+    Returns
+    -------
+    list of str
+        Preset names without ``.toml``, sorted, e.g. ``["default", "wagner2012"]``.
+    """
     files = resources.files(PRESET_PACKAGE).iterdir()
     return sorted(f.name.removesuffix(".toml") for f in files if f.name.endswith(".toml"))
 
@@ -33,6 +39,16 @@ def load_preset(name: str = "default") -> Model:
     ----------
     name : str
         One of :func:`list_presets`.
+
+    Returns
+    -------
+    Model
+        The preset's parameters, validated.
+
+    Raises
+    ------
+    ConfigError
+        ``name`` is not a built-in preset.
     """
     presets = list_presets()
     if not isinstance(name, str) or name not in presets:
@@ -51,6 +67,11 @@ def load_config(path: str | Path | None = None, preset: str | None = None) -> Mo
         preset with ``preset = "NAME"``.
     preset : str, optional
         Base preset; overrides the file's own ``preset`` key. Default ``"default"``.
+
+    Returns
+    -------
+    Model
+        The base preset with the file's values in place of its own, validated.
     """
     if path is None:
         return load_preset("default" if preset is None else preset)
@@ -78,6 +99,11 @@ def merge(base: Model, data: dict) -> Model:
         The parameters to start from.
     data : dict
         Nested parameters as read from TOML, e.g. ``{"body": {"mass": 50.0}}`` (SI units).
+
+    Returns
+    -------
+    Model
+        A new, validated model; ``base`` is unchanged.
     """
     merged = _deep_merge(to_dict(base), data)
     return from_dict(Model, merged)
@@ -104,6 +130,11 @@ def set_parameter(model: Model, dotted: str, value) -> Model:
         Dotted path of the parameter; list items by index.
     value : object
         The new value, in the parameter's unit (see ``docs/parameters.md``); validated.
+
+    Returns
+    -------
+    Model
+        A new, validated model; ``model`` is unchanged.
     """
     return set_parameters(model, {dotted: value})
 
@@ -120,6 +151,11 @@ def set_parameters(model: Model, values: dict) -> Model:
         The parameters to start from.
     values : dict
         New values by dotted path, as in :func:`set_parameter`.
+
+    Returns
+    -------
+    Model
+        A new, validated model; ``model`` is unchanged.
     """
     data = to_dict(model)
     for dotted, value in values.items():
@@ -135,6 +171,12 @@ def dump_toml(model: Model) -> str:
     ----------
     model : Model
         The parameters to write.
+
+    Returns
+    -------
+    str
+        TOML text that :func:`load_config` reads back to ``model``; every field is
+        preceded by a comment with its unit in brackets and its ``doc`` metadata.
     """
     lines = ["# spinectl model parameters (SI units unless a comment says otherwise)", ""]
     for f in dataclasses.fields(model):

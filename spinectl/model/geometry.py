@@ -1,6 +1,6 @@
 """Geometry: the spine line, the centres of rotation, the muscle fibres.
 
-Pure array functions, SI units, no I/O. Frame (design page, Frame and units):
+Pure array functions, SI units, no I/O. Frame (docs/model.md, "Frame and units"):
 x horizontal, positive ventral (sagittal) or right (coronal); y vertical, up;
 the body's symmetry axis is x = 0; P2 (pelvic joint) at y = 0.
 """
@@ -29,7 +29,7 @@ def lordosis_shape(geometry: Geometry) -> np.ndarray:
     """Horizontal offset of each CoR per unit lordosis, phi_k [1].
 
     The spine line is a cubic spline through P2 (y = 0), P3 (y = L/2) and P1
-    (y = L), L the spine length (paper, Methods; design page, Geometry). The
+    (y = L), L the spine length (paper, Methods; docs/model.md, "The spine line"). The
     spline is linear in its data, so with P1 and P2 at x = -E and P3 at
     x = -E + Lambda the line is x(y) = -E + Lambda phi(y), phi being the spline
     through (0, 0), (L/2, 1), (L, 0). For natural end conditions
@@ -51,7 +51,8 @@ def lordosis_shape(geometry: Geometry) -> np.ndarray:
 def cor_positions(eccentricity, lordosis, geometry: Geometry) -> np.ndarray:
     """Positions of the centres of rotation for an eccentricity and a lordosis.
 
-    x_k = -E + Lambda phi_k, y_k = the CoR heights (design page, Geometry).
+    x_k = -E + Lambda phi_k, y_k = the CoR heights (docs/model.md, "Centres of
+    rotation and the point mass").
 
     Parameters
     ----------
@@ -80,6 +81,11 @@ def mass_position(model: Model) -> np.ndarray:
     ----------
     model : Model
         Supplies ``body.mass_height`` [m].
+
+    Returns
+    -------
+    numpy.ndarray, shape (2,)
+        (x, y) of the point mass [m].
     """
     return np.array([0.0, model.body.mass_height])
 
@@ -96,6 +102,11 @@ def fibre_offsets(n: int, spread: float) -> np.ndarray:
         Number of fibres [1].
     spread : float
         Width of the attachment surface [m].
+
+    Returns
+    -------
+    numpy.ndarray, shape (n,)
+        Offset of each fibre from the line of action along its unit normal [m].
     """
     if n == 1:
         return np.zeros(1)
@@ -164,13 +175,19 @@ def all_fibres(model: Model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 def pairing_matrix(n_pairs: int) -> np.ndarray:
     """Map pair PCSAs to muscle PCSAs: pcsa_muscles = P @ pcsa_pairs, shape (2 n, n).
 
-    Paired activation gives both sides of a pair the same PCSA (design page,
-    The optimisation), so each pair's total PCSA is twice its per-side value;
+    Paired activation gives both sides of a pair the same PCSA (docs/model.md,
+    "The muscles"), so each pair's total PCSA is twice its per-side value;
     the decision variable here is the per-side PCSA.
 
     Parameters
     ----------
     n_pairs : int
         Number of antagonistic pairs.
+
+    Returns
+    -------
+    numpy.ndarray, shape (2 n_pairs, n_pairs)
+        P[2 j + side, j] = 1, else 0 [1]; rows in the order of
+        :attr:`~spinectl.model.params.Model.muscle_names`.
     """
     return np.repeat(np.eye(n_pairs), 2, axis=0)

@@ -10,7 +10,15 @@ counter-clockwise.
 Everything muscular is linear in PCSA, so the linearisation is stored per unit
 PCSA [per m^2]: :func:`segment_coefficients` returns the torque, stiffness
 dM/dalpha and damping dM/domega of every muscle about every CoR, and the
-gravity terms, which together define every problem spinectl solves.
+gravity terms, which together define every problem spinectl solves. The
+formulas are the paper's [1]_ (Methods), as read in docs/model.md ("Lever arms"
+to "Passive stiffness: two conventions").
+
+References
+----------
+.. [1] Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012). Spinal
+   lordosis optimizes the requirements for a stable erect posture. Theor Biol Med
+   Model 9:13. doi:10.1186/1742-4682-9-13
 """
 
 from __future__ import annotations
@@ -32,6 +40,12 @@ def rotate(vectors, alpha):
         (x, y) components [any length unit].
     alpha : array_like
         Angle [rad], counter-clockwise positive.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 2)
+        The rotated vectors, in the unit of ``vectors``; the broadcast shape of
+        ``vectors`` and ``alpha``.
     """
     vectors = np.asarray(vectors, float)
     cos, sin = np.cos(alpha), np.sin(alpha)
@@ -46,6 +60,11 @@ def cross2(a, b):
     ----------
     a, b : numpy.ndarray, shape (..., 2)
         The vectors; broadcast together.
+
+    Returns
+    -------
+    numpy.ndarray, shape (...)
+        a x b, in the product of the units of ``a`` and ``b`` (e.g. [m^2]).
     """
     return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
 
@@ -90,6 +109,12 @@ def lever_arm_slope(upper, lower, cor):
         Attachment points in the upright configuration [m].
     cor : array_like, shape (..., 2)
         Centre of rotation [m].
+
+    Returns
+    -------
+    numpy.ndarray, shape (...)
+        dh/dalpha at the upright posture [m/rad]; the broadcast shape of the points
+        without their last axis.
     """
     u = np.asarray(upper) - cor
     p = np.asarray(lower) - cor
@@ -113,6 +138,12 @@ def fibre_torque(alpha, omega, upper, lower, cor, fibre_params, errata):
         Upright attachment points and CoR [m].
     fibre_params : Fibre
     errata : Errata
+
+    Returns
+    -------
+    numpy.ndarray
+        M_i / f_iso [m] of every fibre; the broadcast shape of ``alpha``, ``omega``
+        and the points without their last axis.
     """
     l0 = np.linalg.norm(np.asarray(lower) - np.asarray(upper), axis=-1)
     l_opt = fibre_params.optimal_length_ratio * l0
@@ -141,6 +172,7 @@ def muscle_torque_per_pcsa(model: Model, cor, alpha, omega):
     Returns
     -------
     numpy.ndarray, shape (..., n_muscles)
+        Torque of each muscle per unit of its PCSA [N m / m^2].
     """
     upper, lower, share = geometry.all_fibres(model)
     c = np.asarray(cor, float)[..., None, :]
@@ -157,6 +189,11 @@ def gravity_sign(model: Model) -> float:
     ----------
     model : Model
         Supplies ``errata.gravity_sign``.
+
+    Returns
+    -------
+    float
+        +1.0 ('destabilising') or -1.0 ('printed') [1].
     """
     return 1.0 if model.errata.gravity_sign == "destabilising" else -1.0
 
@@ -167,8 +204,9 @@ def gravity_torque(alpha, cor, model: Model):
     With r = R(alpha)(m_pos - c), the torque of the weight (0, -m g) is
     -m g r_x. For a mass above the CoR this is m g norm(r) sin(angle from
     vertical), an inverted pendulum: dM_ext/dalpha = m g r_y > 0. This is the
-    design page's gravity erratum; the paper prints M_ext = -m g r sin(alpha)
-    (``errata.gravity_sign = "printed"`` negates the whole torque).
+    corrected sign (docs/model.md, "Gravity sign"); the paper prints
+    M_ext = -m g r sin(alpha) (``errata.gravity_sign = "printed"`` negates the whole
+    torque).
 
     Parameters
     ----------
@@ -177,6 +215,11 @@ def gravity_torque(alpha, cor, model: Model):
     cor : array_like, shape (..., 2)
         CoR position [m].
     model : Model
+
+    Returns
+    -------
+    numpy.ndarray, shape (...)
+        M_ext [N m]; the broadcast shape of ``alpha`` and ``cor`` without its last axis.
     """
     r = rotate(geometry.mass_position(model) - np.asarray(cor), alpha)
     weight = model.body.mass * model.body.gravity
@@ -187,7 +230,7 @@ def inertia(cor, model: Model):
     """Moment of inertia of the upper body about a CoR, theta_k [kg m^2].
 
     theta_k = m (r_k^2 + rho^2), r_k the CoR-to-mass distance and rho the
-    radius of gyration (design page, One segment: default m r_k^2).
+    radius of gyration (docs/model.md, "Gravity": default rho = 0, m r_k^2).
 
     Parameters
     ----------
@@ -195,6 +238,11 @@ def inertia(cor, model: Model):
         CoR position [m].
     model : Model
         Supplies the mass [kg], its height [m] and the radius of gyration [m].
+
+    Returns
+    -------
+    numpy.ndarray, shape (...)
+        theta_k [kg m^2]; the shape of ``cor`` without its last axis.
     """
     r = geometry.mass_position(model) - np.asarray(cor)
     return model.body.mass * (np.sum(r**2, axis=-1) + model.body.radius_of_gyration**2)
@@ -203,8 +251,9 @@ def inertia(cor, model: Model):
 def passive_stiffness(model: Model, inertia_k):
     """Passive stiffness K as a physical torque stiffness [N m/rad], per CoR.
 
-    'physical': K itself. 'paper': eq. 2 subtracts K from d(omega')/dalpha,
-    i.e. K theta_k from dM/dalpha (design page, erratum eq. 2).
+    'physical': K itself. 'paper': eq. 2 of the paper [1]_ subtracts K from d(omega')/dalpha,
+    i.e. K theta_k from dM/dalpha (docs/model.md, "Passive stiffness: two
+    conventions" and "Units of eq. 2").
 
     Parameters
     ----------
@@ -212,6 +261,17 @@ def passive_stiffness(model: Model, inertia_k):
         Supplies ``passive.stiffness`` and ``passive.convention``.
     inertia_k : array_like
         theta_k of each CoR [kg m^2]; sets the output shape.
+
+    Returns
+    -------
+    numpy.ndarray
+        K_k [N m/rad], the shape of ``inertia_k``; enters dM_k/dalpha as -K_k.
+
+    References
+    ----------
+    .. [1] Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012). Spinal
+       lordosis optimizes the requirements for a stable erect posture. Theor Biol Med
+       Model 9:13. doi:10.1186/1742-4682-9-13
     """
     k = model.passive.stiffness
     if model.passive.convention == "paper":
@@ -260,6 +320,11 @@ class SegmentCoefficients:
         ----------
         pcsa : array_like, shape (..., n_muscles)
             PCSA of each muscle [m^2].
+
+        Returns
+        -------
+        numpy.ndarray, shape (..., n_cor)
+            S_k [N m/rad]; negative is stabilising.
         """
         muscular = np.einsum("...km,...m->...k", self.stiffness_per_pcsa, np.asarray(pcsa, float))
         return muscular + self.gravity_stiffness - self.passive_stiffness
@@ -271,6 +336,11 @@ class SegmentCoefficients:
         ----------
         pcsa : array_like, shape (..., n_muscles)
             PCSA of each muscle [m^2].
+
+        Returns
+        -------
+        numpy.ndarray, shape (..., n_cor)
+            D_k [N m s/rad], <= 0.
         """
         return np.einsum("...km,...m->...k", self.damping_per_pcsa, np.asarray(pcsa, float))
 
@@ -278,12 +348,17 @@ class SegmentCoefficients:
         """Local counter torques CT_k [N m] making the upright posture an equilibrium.
 
         CT_k = -(sum_i M_i + M_ext) at alpha = 0, omega = 0 (paper, Methods;
-        design page, One segment). Affine in PCSA.
+        docs/model.md, "The counter torques"). Affine in PCSA.
 
         Parameters
         ----------
         pcsa : array_like, shape (..., n_muscles)
             PCSA of each muscle [m^2].
+
+        Returns
+        -------
+        numpy.ndarray, shape (..., n_cor)
+            CT_k [N m].
         """
         muscular = np.einsum("...km,...m->...k", self.torque_per_pcsa, np.asarray(pcsa, float))
         return -(muscular + self.gravity_torque)
@@ -299,6 +374,9 @@ def segment_coefficients(model: Model, eccentricity, lordosis) -> SegmentCoeffic
     - stiffness: dM/dalpha = h' f_l - h^2 f_l'         (h' from :func:`lever_arm_slope`, dl/dalpha = -h)
     - damping:   dM/domega = h^2 f_l f_H'(0)           (v = h omega)
 
+    These are the partial derivatives that enter the Jacobian of the paper's eq. 1
+    [1]_ (docs/model.md, "Stiffness and damping per unit PCSA").
+
     Parameters
     ----------
     model : Model
@@ -308,6 +386,16 @@ def segment_coefficients(model: Model, eccentricity, lordosis) -> SegmentCoeffic
     Returns
     -------
     SegmentCoefficients
+        Per unit PCSA, shape (..., n_cor, n_muscles): torque [N m / m^2], stiffness
+        [N m/rad / m^2], damping [N m s/rad / m^2]; per CoR, shape (..., n_cor): gravity
+        torque [N m] and stiffness [N m/rad], passive stiffness [N m/rad], inertia
+        [kg m^2]. ``...`` is the broadcast shape of E and Lambda.
+
+    References
+    ----------
+    .. [1] Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012). Spinal
+       lordosis optimizes the requirements for a stable erect posture. Theor Biol Med
+       Model 9:13. doi:10.1186/1742-4682-9-13
     """
     cor = geometry.cor_positions(eccentricity, lordosis, model.geometry)  # (..., K, 2)
     upper, lower, share = geometry.all_fibres(model)  # (F, 2), (F, 2), (F, M)

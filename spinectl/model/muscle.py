@@ -1,8 +1,19 @@
 """Muscle fibre mechanics: force-length and Hill force-velocity relations.
 
 Pure array functions. Forces are returned per unit isometric force (divide by
-f_iso = specific_tension * PCSA), so every quantity is linear in PCSA (design
-page, Muscle). Velocities are *shortening* velocities: v >= 0 concentric.
+f_iso = specific_tension * PCSA), so every quantity is linear in PCSA
+(docs/model.md, "Force-velocity"). Velocities are *shortening* velocities:
+v >= 0 concentric. The relations are the paper's [1]_ (Methods), with the eccentric
+constant C corrected (docs/model.md, "Eccentric Hill constant C"); the hyperbolic
+force-velocity relation is Hill's [2]_.
+
+References
+----------
+.. [1] Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012). Spinal
+   lordosis optimizes the requirements for a stable erect posture. Theor Biol Med
+   Model 9:13. doi:10.1186/1742-4682-9-13
+.. [2] Hill AV (1938). The heat of shortening and the dynamic constants of muscle.
+   Proc R Soc Lond B 126:136-195.
 """
 
 from __future__ import annotations
@@ -17,7 +28,8 @@ from .params import Errata, Fibre
 def force_length(length, optimal_length, fibre: Fibre):
     """Force-length factor f_l [1] (paper, Methods; its refs 17, 18).
 
-    f_l = exp(-(((l / l_opt)^k1 - 1) / k2)^2)
+    f_l = exp(-(((l / l_opt)^k1 - 1) / k2)^2), the paper's force-length relation [1]_
+    (docs/model.md, "Force-length").
 
     Parameters
     ----------
@@ -27,6 +39,18 @@ def force_length(length, optimal_length, fibre: Fibre):
         Optimal fibre length l_opt [m] (paper: 1.2 l0).
     fibre : Fibre
         Supplies k1 and k2 [1].
+
+    Returns
+    -------
+    numpy.ndarray
+        f_l [1], in (0, 1], 1 at l = l_opt; the broadcast shape of ``length`` and
+        ``optimal_length``.
+
+    References
+    ----------
+    .. [1] Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012). Spinal
+       lordosis optimizes the requirements for a stable erect posture. Theor Biol Med
+       Model 9:13. doi:10.1186/1742-4682-9-13
     """
     u = ((np.asarray(length) / optimal_length) ** fibre.k1 - 1.0) / fibre.k2
     return np.exp(-(u**2))
@@ -46,6 +70,11 @@ def force_length_slope(length, optimal_length, fibre: Fibre):
         Optimal fibre length l_opt [m].
     fibre : Fibre
         Supplies k1 and k2 [1].
+
+    Returns
+    -------
+    numpy.ndarray
+        df_l/dl [1/m]; the broadcast shape of ``length`` and ``optimal_length``.
     """
     ratio = np.asarray(length) / optimal_length
     u = (ratio**fibre.k1 - 1.0) / fibre.k2
@@ -93,12 +122,20 @@ def max_velocity(optimal_length, fibre: Fibre):
         l_opt [m].
     fibre : Fibre
         Supplies vmax_slow, vmax_fast_gain [l_opt/s] and fast_twitch [1].
+
+    Returns
+    -------
+    numpy.ndarray
+        v_max [m/s], the shape of ``optimal_length``.
     """
     return (fibre.vmax_slow + fibre.vmax_fast_gain * fibre.fast_twitch) * np.asarray(optimal_length)
 
 
 def hill_constants(optimal_length, fibre: Fibre, errata: Errata) -> HillConstants:
     """Hill constants per unit f_iso for fibres of optimal length ``optimal_length`` [m].
+
+    The paper's constants [1]_ (Methods; docs/model.md, "Force-velocity") of the
+    Hill-type force-velocity relation [2]_.
 
     Parameters
     ----------
@@ -108,7 +145,21 @@ def hill_constants(optimal_length, fibre: Fibre, errata: Errata) -> HillConstant
         hill_a, hill_b, vmax_*, fast_twitch, eccentric_enhancement.
     errata : Errata
         ``eccentric_constant``: 'corrected' C = (A - 1) B or 'printed' C = (A - 1) b
-        (design page, erratum C).
+        (docs/model.md, "Eccentric Hill constant C").
+
+    Returns
+    -------
+    HillConstants
+        a, A [1] and c, C [m/s] per unit f_iso; b, B [m/s]; each of the shape of
+        ``optimal_length`` (a and A are scalars).
+
+    References
+    ----------
+    .. [1] Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012). Spinal
+       lordosis optimizes the requirements for a stable erect posture. Theor Biol Med
+       Model 9:13. doi:10.1186/1742-4682-9-13
+    .. [2] Hill AV (1938). The heat of shortening and the dynamic constants of muscle.
+       Proc R Soc Lond B 126:136-195.
     """
     a = fibre.hill_a
     b = fibre.hill_b * max_velocity(optimal_length, fibre)
@@ -130,6 +181,12 @@ def force_velocity(velocity, hill: HillConstants):
     velocity : array_like
         Shortening velocity v [m/s].
     hill : HillConstants
+
+    Returns
+    -------
+    numpy.ndarray
+        f_H / f_iso [1], 1 at v = 0; the broadcast shape of ``velocity`` and the
+        constants.
     """
     v = np.asarray(velocity, float)
     concentric = hill.c / (np.where(v >= 0, v, 0.0) + hill.b) - hill.a
@@ -148,6 +205,12 @@ def force_velocity_slope(velocity, hill: HillConstants):
     velocity : array_like
         Shortening velocity v [m/s].
     hill : HillConstants
+
+    Returns
+    -------
+    numpy.ndarray
+        d(f_H/f_iso)/dv [s/m], negative on both branches; the broadcast shape of
+        ``velocity`` and the constants.
     """
     v = np.asarray(velocity, float)
     concentric = -hill.c / (np.where(v >= 0, v, 0.0) + hill.b) ** 2

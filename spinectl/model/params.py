@@ -7,8 +7,15 @@ otherwise. Instances validate themselves on construction and raise
 :class:`~spinectl.errors.ParameterError` naming the field.
 
 Reading and writing TOML lives in :mod:`spinectl.model.config`; this module does no
-I/O. The design page (``shared/design/model.md``) fixes the reading of the
-paper (Wagner et al. 2012, "the paper") that these defaults encode.
+I/O. docs/model.md sets out the reading of the paper [1]_ ("the paper") that
+these defaults encode; docs/parameters.md lists every field with its unit,
+default and source, and docs/glossary.md the symbols.
+
+References
+----------
+.. [1] Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012). Spinal
+   lordosis optimizes the requirements for a stable erect posture. Theor Biol Med
+   Model 9:13. doi:10.1186/1742-4682-9-13
 """
 
 from __future__ import annotations
@@ -59,6 +66,12 @@ def param(default, unit: str, doc: str):
         Unit of the value, e.g. ``"N m/rad"``; ``"1"`` for a ratio, ``""`` for text.
     doc : str
         What the parameter is and where its value comes from.
+
+    Returns
+    -------
+    dataclasses.Field
+        A field with ``metadata = {"unit": unit, "doc": doc}`` and the default (or
+        default factory).
     """
     kwargs = {"default_factory": lambda: default} if isinstance(default, (list, dict)) else {"default": default}
     return field(metadata={"unit": unit, "doc": doc}, **kwargs)
@@ -92,7 +105,7 @@ class Body:
         0.0,
         "m",
         "Radius of gyration of the upper body about the point mass; the inertia about CoR k "
-        "is m (r_k^2 + rho^2). 0 reproduces the paper's point mass (design page, One segment).",
+        "is m (r_k^2 + rho^2). 0 reproduces the paper's point mass (docs/model.md, Gravity).",
     )
 
     def __post_init__(self):
@@ -107,7 +120,7 @@ class Body:
 
 @dataclass(frozen=True)
 class Geometry:
-    """Spine line and centres of rotation (paper, Methods; design page, Geometry)."""
+    """Spine line and centres of rotation (paper, Methods; docs/model.md, "Geometry")."""
 
     cor_names: tuple[str, ...] = param(
         ("L1L2", "L2L3", "L3L4", "L4L5", "L5S1"), "", "Names of the centres of rotation, top to bottom."
@@ -121,7 +134,7 @@ class Geometry:
     spline_bc: str = param(
         "natural",
         "",
-        "End conditions of the cubic spline through P2, P3, P1: 'natural' (design default), "
+        "End conditions of the cubic spline through P2, P3, P1: 'natural' (the default), "
         "'clamped' (zero slope at both ends) or 'not-a-knot' (a parabola for three points).",
     )
     eccentricity_range: tuple[float, ...] = param(
@@ -209,7 +222,8 @@ class MusclePair:
     the upper body) to the pelvis (``lower``, fixed) as ``fibres`` parallel
     fibres spread over ``spread`` across the line of action (paper, Methods).
     The paper gives no coordinates; the defaults are anatomical estimates
-    (see ``docs/parameters.md``) to be calibrated (issue: calibration).
+    (see ``docs/parameters.md``), which the calibration fits to the paper's landmarks
+    (docs/reproduction.md, "The calibration").
     """
 
     name: str = param("straight", "", "Name of the pair.")
@@ -260,7 +274,7 @@ class Passive:
         "physical",
         "",
         "'physical': K adds -K to dM/dalpha (i.e. -K/theta to d(omega')/dalpha). 'paper': eq. 2 as "
-        "printed, -K subtracted from d(omega')/dalpha itself (K then read in 1/s^2). Design page, erratum eq. 2.",
+        "printed, -K subtracted from d(omega')/dalpha itself (K then read in 1/s^2). docs/model.md, Units of eq. 2.",
     )
 
     def __post_init__(self):
@@ -270,7 +284,7 @@ class Passive:
 
 @dataclass(frozen=True)
 class Errata:
-    """Choices between the paper's printed formulas and their corrections (design page)."""
+    """Choices between the paper's printed formulas and their corrections (docs/model.md, "Errata")."""
 
     gravity_sign: str = param(
         "destabilising",
@@ -292,7 +306,7 @@ class Errata:
 
 @dataclass(frozen=True)
 class Optimisation:
-    """Settings of the minimum-PCSA and counter-torque problems (design page, The optimisation)."""
+    """Settings of the minimum-PCSA and counter-torque problems (docs/model.md, "The optimisation")."""
 
     activation: str = param(
         "paired", "", "'paired': one PCSA per antagonistic pair (both sides equal); 'independent': one per muscle."
@@ -340,7 +354,7 @@ class Optimisation:
 
 @dataclass(frozen=True)
 class Reflex:
-    """Delayed PD reflex per segment and its time-domain simulation (design page, Reflex with delay).
+    """Delayed PD reflex per segment and its time-domain simulation (docs/reflex.md, "The loop").
 
     Beyond the paper, which discusses reflexes in words only (Discussion: "reflexes are
     delayed by up to 100 ms ... the force generation of the muscles takes another
@@ -464,7 +478,7 @@ class Model:
         _store(self, muscles=tuple(muscles))
         top = self.geometry.cor_heights[0]
         if self.body.mass_height <= top:
-            # every segment is an inverted pendulum: the mass above the joint (design page, One segment)
+            # every segment is an inverted pendulum: the mass above the joint (docs/model.md, Gravity)
             raise ParameterError(
                 "body.mass_height",
                 f"must lie above the top centre of rotation {self.geometry.cor_names[0]} at {top:g} m "
@@ -482,5 +496,11 @@ class Model:
         return tuple(m.name for m in self.muscles)
 
     def replace(self, **changes) -> Model:
-        """Return a copy with top-level sections replaced (see :func:`dataclasses.replace`)."""
+        """Return a copy with top-level sections replaced (see :func:`dataclasses.replace`).
+
+        Returns
+        -------
+        Model
+            A new, validated model; ``self`` is unchanged.
+        """
         return dataclasses.replace(self, **changes)

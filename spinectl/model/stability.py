@@ -4,7 +4,14 @@ For CoR k, with all other CoRs fixed (paper, Methods), the linearised equation
 of motion about the upright equilibrium is alpha' = omega,
 omega' = (S_k alpha + D_k omega) / theta_k, with S_k = dM/dalpha (muscles,
 gravity and passive stiffness) and D_k = dM/domega. The segment is self-stable
-iff both eigenvalues of its Jacobian have negative real part (paper, eq. 1).
+iff both eigenvalues of its Jacobian have negative real part (paper [1]_, eq. 1;
+docs/model.md, "One segment: the Jacobian and eq. 1").
+
+References
+----------
+.. [1] Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012). Spinal
+   lordosis optimizes the requirements for a stable erect posture. Theor Biol Med
+   Model 9:13. doi:10.1186/1742-4682-9-13
 """
 
 from __future__ import annotations
@@ -13,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..units import m2_to_cm2
 from .checks import arithmetic_guard, checked_coefficients, expand_pcsa
 from .mechanics import SegmentCoefficients
 from .params import Model
@@ -31,6 +39,12 @@ def jacobian(stiffness, damping, inertia):
         D = dM/domega [N m s/rad].
     inertia : array_like
         theta [kg m^2].
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 2, 2)
+        J; its second row is [S/theta [1/s^2], D/theta [1/s]]. ``...`` is the
+        broadcast shape of the three inputs.
     """
     s, d, theta = np.broadcast_arrays(*(np.asarray(x, float) for x in (stiffness, damping, inertia)))
     jac = np.zeros(s.shape + (2, 2))
@@ -43,7 +57,7 @@ def jacobian(stiffness, damping, inertia):
 def eigenvalues(stiffness, damping, inertia):
     """Eigenvalues of :func:`jacobian` in closed form, shape (..., 2) complex [1/s].
 
-    lambda_{1,2} = D/(2 theta) +- sqrt(D^2/(4 theta^2) + S/theta) (paper, eq. 1,
+    lambda_{1,2} = D/(2 theta) +- sqrt(D^2/(4 theta^2) + S/theta) (paper [1]_, eq. 1,
     with d(omega')/d(omega) = D/theta and d(omega')/d(alpha) = S/theta).
     The root with the larger real part comes first.
 
@@ -55,6 +69,17 @@ def eigenvalues(stiffness, damping, inertia):
         D = dM/domega [N m s/rad].
     inertia : array_like
         theta [kg m^2].
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 2), complex
+        lambda_1, lambda_2 [1/s]; ``...`` is the broadcast shape of the inputs.
+
+    References
+    ----------
+    .. [1] Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012). Spinal
+       lordosis optimizes the requirements for a stable erect posture. Theor Biol Med
+       Model 9:13. doi:10.1186/1742-4682-9-13
     """
     s, d, theta = (np.asarray(x, float) for x in (stiffness, damping, inertia))
     half = d / (2.0 * theta)
@@ -71,6 +96,11 @@ def self_stable(eigs, margin: float = 0.0):
         Eigenvalues [1/s], e.g. from :func:`eigenvalues`.
     margin : float
         Required distance of the real parts from zero [1/s].
+
+    Returns
+    -------
+    numpy.ndarray of bool, shape (...)
+        True where both eigenvalues have real part < -margin.
     """
     return np.all(np.real(eigs) < -margin, axis=-1)
 
@@ -119,9 +149,104 @@ class StabilityResult:
         """True if every segment is self-stable."""
         return bool(np.all(self.self_stable))
 
+    def to_dict(self, model: Model, pcsa_source: str = "given") -> dict:
+        """The result as a JSON-ready dict: the document of ``spinectl stability --json``.
+
+        Parameters
+        ----------
+        model : Model
+            The model the result was computed with (muscle names, K and its convention).
+        pcsa_source : {'given', 'min_pcsa'}
+            Where the PCSA came from: given by the caller, or the minimum stabilising
+            PCSA (the optimiser's chosen activation,
+            :func:`spinectl.optimise.reference.minimum_stabilising_pcsa`).
+
+        Returns
+        -------
+        dict
+            ``E_m``, ``Lambda_m``, ``K_Nm_per_rad``, ``K_convention``, ``pcsa_source``,
+            ``pcsa_cm2`` (muscle name -> PCSA [cm^2]), ``total_pcsa_cm2``, ``segments`` (each
+            with ``name``, ``stiffness_Nm_per_rad``, ``damping_Nms_per_rad``, ``inertia_kgm2``,
+            ``eigenvalues`` as [real, imaginary] pairs [1/s], ``self_stable``,
+            ``counter_torque_Nm``), ``all_self_stable`` and ``counter_torque_norm_Nm``; the
+            unit is in each key's name.
+        """
+        pcsa = m2_to_cm2(self.pcsa)
+        return {
+            "E_m": self.eccentricity,
+            "Lambda_m": self.lordosis,
+            "K_Nm_per_rad": model.passive.stiffness,
+            "K_convention": model.passive.convention,
+            "pcsa_source": pcsa_source,
+            "pcsa_cm2": dict(zip(model.muscle_names, pcsa.tolist(), strict=False)),
+            "total_pcsa_cm2": float(pcsa.sum()),
+            "segments": [
+                {
+                    "name": name,
+                    "stiffness_Nm_per_rad": float(self.stiffness[k]),
+                    "damping_Nms_per_rad": float(self.damping[k]),
+                    "inertia_kgm2": float(self.inertia[k]),
+                    "eigenvalues": [[float(z.real), float(z.imag)] for z in self.eigenvalues[k]],
+                    "self_stable": bool(self.self_stable[k]),
+                    "counter_torque_Nm": float(self.counter_torque[k]),
+                }
+                for k, name in enumerate(self.segment_names)
+            ],
+            "all_self_stable": self.all_self_stable,
+            "counter_torque_norm_Nm": self.counter_torque_norm,
+        }
+
+    def table(self, model: Model, pcsa_source: str = "given") -> str:
+        """The result as a readable table, one row a segment, with the PCSA and ||CT|| around it.
+
+        Parameters
+        ----------
+        model : Model
+            The model the result was computed with (muscle names, K and its convention).
+        pcsa_source : {'given', 'min_pcsa'}
+            Where the PCSA came from (see :meth:`to_dict`); 'min_pcsa' says so in the PCSA line.
+
+        Returns
+        -------
+        str
+            The text ``spinectl stability`` prints (no final newline).
+        """
+
+        def complex_column(z: complex) -> str:
+            return f"{z.real:9.3f}{z.imag:+9.3f}j"
+
+        pcsa = m2_to_cm2(self.pcsa)
+        given = pcsa_source == "given"
+        lines = [
+            f"E = {self.eccentricity * 100:.2f} cm, Lambda = {self.lordosis * 100:.2f} cm, "
+            f"K = {model.passive.stiffness:g} N m/rad ({model.passive.convention})",
+            ("PCSA [cm^2]: " if given else "PCSA [cm^2] (minimum stabilising, chosen activation): ")
+            + ", ".join(f"{n} {p:.2f}" for n, p in zip(model.muscle_names, pcsa, strict=False))
+            + f"  (total {pcsa.sum():.2f})",
+            "",
+            f"{'segment':8} {'S [N m/rad]':>12} {'D [N m s/rad]':>14} {'theta [kg m2]':>14} "
+            f"{'lambda_1 [1/s]':>20} {'lambda_2 [1/s]':>20} {'stable':>7} {'CT [N m]':>10}",
+        ]
+        for k, name in enumerate(self.segment_names):
+            eig = self.eigenvalues[k]
+            lines.append(
+                f"{name:8} {self.stiffness[k]:12.3f} {self.damping[k]:14.4f} {self.inertia[k]:14.4f} "
+                f"{complex_column(eig[0]):>20} {complex_column(eig[1]):>20} "
+                f"{'yes' if self.self_stable[k] else 'NO':>7} {self.counter_torque[k]:10.3f}"
+            )
+        lines += [
+            "",
+            f"||CT|| = {self.counter_torque_norm:.3f} N m; "
+            f"self-stable: {'all segments' if self.all_self_stable else 'NOT all segments'}",
+        ]
+        return "\n".join(lines)
+
 
 def segment_stability(model: Model, eccentricity: float, lordosis: float, pcsa) -> StabilityResult:
     """Jacobian eigenvalues, self-stability and counter torque of every segment.
+
+    The analysis of the paper [1]_ (Methods, Stability analysis and calculation of
+    counter torques): eq. 1 per CoR, and the counter torques CT_k.
 
     Parameters
     ----------
@@ -134,6 +259,23 @@ def segment_stability(model: Model, eccentricity: float, lordosis: float, pcsa) 
     Returns
     -------
     StabilityResult
+        Per segment (shape (n_cor,)): S [N m/rad], D [N m s/rad], theta [kg m^2], the
+        eigenvalues [1/s], the self-stability verdict and CT_k [N m]; with the
+        per-muscle PCSA [m^2] used and the coefficients it came from.
+
+    Raises
+    ------
+    ParameterError
+        E or Lambda outside the modelled range, or a PCSA vector of the wrong length
+        or with negative or non-finite entries.
+    ModelError
+        The model cannot be evaluated there (see :func:`~spinectl.model.checks.validate_position`).
+
+    References
+    ----------
+    .. [1] Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012). Spinal
+       lordosis optimizes the requirements for a stable erect posture. Theor Biol Med
+       Model 9:13. doi:10.1186/1742-4682-9-13
     """
     coeffs = checked_coefficients(model, float(eccentricity), float(lordosis))
     pcsa = expand_pcsa(model, pcsa)

@@ -7,6 +7,8 @@ as one stacked Clarabel problem, the fast path (:mod:`~spinectl.optimise.stacked
 both answers are polished to the exact optimum (:mod:`~spinectl.optimise.polish`).
 
 The per-point API is re-exported here: ``optimise.solve_point(model, E, Lambda)``.
+
+Symbols and units: docs/glossary.md.
 """
 
 from .problem import (

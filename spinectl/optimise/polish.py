@@ -8,9 +8,15 @@ Polishing guesses the active constraints from the answer's slacks, solves the
 KKT system of the equality-constrained problem exactly, and keeps the result
 only if it is a verified KKT point (feasible, complementary, stationary with
 multipliers >= 0), which for a convex problem proves it optimal. Otherwise the
-solver's answer stands. The same idea as OSQP's solution polishing,
+solver's answer stands. The same idea as OSQP's solution polishing [1]_,
 vectorised over any number of independent problems; the per-point reference
 and the fast path both use it, so both report the exact optimum.
+
+References
+----------
+.. [1] Stellato B, Banjac G, Goulart P, Bemporad A, Boyd S (2020). OSQP: an operator
+   splitting solver for quadratic programs. Math Program Comput 12:637-672.
+   doi:10.1007/s12532-020-00179-2
 """
 
 from __future__ import annotations

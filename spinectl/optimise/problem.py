@@ -103,6 +103,12 @@ class ProblemData:
         ----------
         index : int, slice or array of int
             Index into the leading dimensions.
+
+        Returns
+        -------
+        ProblemData
+            The same problem with the grid-point arrays indexed; ``weights``,
+            ``to_muscles``, ``upper`` and ``tolerance`` unchanged.
         """
         return replace(
             self,
@@ -120,6 +126,11 @@ class ProblemData:
         ----------
         x : array_like, shape (..., n_var)
             Decision variables [cm^2].
+
+        Returns
+        -------
+        numpy.ndarray, shape (..., n_cor)
+            CT_k [N m].
         """
         return -(np.einsum("...kn,...n->...k", self.torque, np.asarray(x, float)) + self.gravity_torque)
 
@@ -135,7 +146,13 @@ def problem_data(model: Model, coeffs: SegmentCoefficients) -> ProblemData:
     model : Model
         Supplies the ``optimisation`` settings.
     coeffs : SegmentCoefficients
-        Per-unit-PCSA mechanics from :func:`~spinectl.mechanics.segment_coefficients`.
+        Per-unit-PCSA mechanics from :func:`~spinectl.model.mechanics.segment_coefficients`.
+
+    Returns
+    -------
+    ProblemData
+        The constraints and torques per cm^2 of each decision variable, with the
+        leading shape of ``coeffs``.
     """
     n_muscles = coeffs.stiffness_per_pcsa.shape[-1]
     if model.optimisation.activation == "paired":
@@ -210,6 +227,13 @@ def solver_options(solver: str, tolerance: float | None) -> dict:
         cvxpy's name of the solver, e.g. 'CLARABEL'.
     tolerance : float or None
         [1]; None: the solver's defaults.
+
+    Returns
+    -------
+    dict
+        Options to pass to ``cvxpy.Problem.solve``: absolute and relative gap and
+        feasibility tolerances for 'CLARABEL' and 'SCS'; empty for other solvers or
+        without a tolerance.
     """
     if tolerance is None:
         return {}
@@ -277,6 +301,15 @@ def objective(data: ProblemData, stage: str):
     data : ProblemData
     stage : str
         One of :data:`STAGES`.
+
+    Returns
+    -------
+    hessian : numpy.ndarray or None, shape (..., n_var, n_var)
+        H; None for the linear objective of 'min_pcsa'. [N^2 m^2 per cm^4] for
+        'counter_torque', [1] for 'least_norm'.
+    linear : numpy.ndarray, shape (..., n_var)
+        q; the weights [1] for 'min_pcsa', [N^2 m^2 per cm^2] for 'counter_torque',
+        0 for 'least_norm'.
     """
     lead, n = data.stability.shape[:-2], data.weights.size
     if stage == "min_pcsa":
@@ -288,7 +321,7 @@ def objective(data: ProblemData, stage: str):
 
 
 def polished(data: ProblemData, stage: str, x0, total_max=np.inf, x_ct=None):
-    """The exact optimum of ``stage`` from the solver's answer ``x0`` (:func:`spinectl.polish.polish`).
+    """The exact optimum of ``stage`` from the solver's answer ``x0`` (:func:`spinectl.optimise.polish.polish`).
 
     Polishing imposes CT(x) = CT(x_ct) exactly, as equalities on the row space
     of T, where the solver had the slab of :func:`ct_slab`. Returns x [cm^2]
@@ -305,6 +338,13 @@ def polished(data: ProblemData, stage: str, x0, total_max=np.inf, x_ct=None):
         The band of the stage [cm^2], as for :func:`inequalities`.
     x_ct : array_like, optional
         The stage-2 optimum whose counter torques stage 3 keeps [cm^2].
+
+    Returns
+    -------
+    x : numpy.ndarray, shape (..., n_var)
+        The polished optimum [cm^2].
+    verified : numpy.ndarray of bool, shape (...)
+        True where ``x`` passed the KKT check.
     """
     hessian, linear = objective(data, stage)
     lhs, rhs = inequalities(data, total_max)
@@ -317,7 +357,18 @@ def polished(data: ProblemData, stage: str, x0, total_max=np.inf, x_ct=None):
 
 
 def worst_status(*statuses: str) -> str:
-    """'optimal_inaccurate' if any stage was inaccurate, else 'optimal' (for optimal stages)."""
+    """'optimal_inaccurate' if any stage was inaccurate, else 'optimal' (for optimal stages).
+
+    Parameters
+    ----------
+    *statuses : str
+        cvxpy statuses of the stages, each 'optimal' or 'optimal_inaccurate'.
+
+    Returns
+    -------
+    str
+        The status of the point.
+    """
     return cp.OPTIMAL_INACCURATE if cp.OPTIMAL_INACCURATE in statuses else cp.OPTIMAL
 
 
@@ -376,6 +427,15 @@ def to_si(data: ProblemData, total, x) -> tuple[np.ndarray, np.ndarray, np.ndarr
         Minimum total PCSA [cm^2].
     x : array_like, shape (..., n_var)
         Chosen decision variables [cm^2].
+
+    Returns
+    -------
+    min_pcsa : numpy.ndarray, shape (...)
+        [m^2].
+    pcsa : numpy.ndarray, shape (..., n_muscles)
+        PCSA of each muscle [m^2].
+    counter_torque : numpy.ndarray, shape (..., n_cor)
+        CT_k [N m].
     """
     x = np.asarray(x, float)
     pcsa = np.einsum("mn,...n->...m", data.to_muscles, x) * M2_PER_CM2

@@ -1,6 +1,6 @@
 """Minimum PCSA and counter torques at one configuration: the readable reference.
 
-Design page, "The optimisation at each grid point". With the decision
+docs/model.md, "The optimisation", and docs/optimisation.md, "Formulation". With the decision
 variables x [cm^2], the self-stable set F = {S x <= b, D x <= -damping_margin,
 0 <= x <= pcsa_max} (S_k(x) = dM_k/dalpha and D_k(x) = dM_k/domega affine in x,
 b = -stability_margin - gravity + passive stiffness; :class:`ProblemData`) and
@@ -37,8 +37,10 @@ from dataclasses import dataclass
 import cvxpy as cp
 import numpy as np
 
+from ..errors import ModelError
 from ..model.checks import checked_coefficients
 from ..model.params import Model
+from ..model.stability import StabilityResult, segment_stability
 from ..units import M2_PER_CM2
 from .problem import (
     INFEASIBLE_STATUSES,
@@ -122,8 +124,8 @@ def min_pcsa_lp(data: ProblemData) -> tuple[str, np.ndarray | None]:
 def min_counter_torque_socp(data: ProblemData, total_max: float) -> tuple[str, np.ndarray | None]:
     """Stage 2: least ||CT||_2 over self-stable activations with total PCSA <= ``total_max`` [cm^2].
 
-    CT = -(torque @ x + gravity_torque) (paper, Methods; design page, The
-    optimisation). Solved as the SOCP min ||CT||_2, then polished.
+    CT = -(torque @ x + gravity_torque) (paper, Methods; docs/model.md, "The
+    counter torques"). Solved as the SOCP min ||CT||_2, then polished.
 
     Parameters
     ----------
@@ -159,6 +161,7 @@ def least_norm_activation_qp(data: ProblemData, total_max: float, x_ct) -> tuple
     Returns
     -------
     status : str
+        As for :func:`min_pcsa_lp`.
     x : numpy.ndarray or None
         [cm^2], None unless optimal.
     """
@@ -181,6 +184,7 @@ def least_total_pcsa_lp(data: ProblemData, x_ct) -> tuple[str, np.ndarray | None
     Returns
     -------
     status : str
+        As for :func:`min_pcsa_lp`.
     x : numpy.ndarray or None
         [cm^2], None unless optimal.
     """
@@ -200,6 +204,16 @@ def optimum(data: ProblemData, ct_tolerance: float) -> tuple[str, float, np.ndar
         The problem at one (E, Lambda).
     ct_tolerance : float
         Relative band on the minimum total PCSA [1].
+
+    Returns
+    -------
+    status : str
+        The worst status of the three stages ('optimal' or 'optimal_inaccurate'), or
+        the first stage's that failed ('infeasible', 'solver_error', ...).
+    min_pcsa : float
+        Minimum total PCSA t* [cm^2]; NaN unless every stage is optimal.
+    x : numpy.ndarray or None, shape (n_var,)
+        The chosen decision variables [cm^2], >= 0; None unless every stage is optimal.
     """
     status, x = min_pcsa_lp(data)
     if x is None:
@@ -229,6 +243,12 @@ def point_optimum(data: ProblemData, ct_tolerance: float, eccentricity=np.nan, l
         Relative band on the minimum total PCSA [1]; inf: the minimum-norm activation.
     eccentricity, lordosis : float
         E and Lambda [m], recorded in the result.
+
+    Returns
+    -------
+    PointOptimum
+        Status, minimum total PCSA [m^2], per-muscle PCSA [m^2] and CT_k [N m]; NaN
+        values unless optimal.
     """
     status, total, x = optimum(data, ct_tolerance)
     if x is None:
@@ -244,6 +264,10 @@ def _point_data(model: Model, eccentricity: float, lordosis: float) -> ProblemDa
 def solve_point(model: Model, eccentricity: float, lordosis: float) -> PointOptimum:
     """Minimum PCSA and least counter torque at one configuration (per-point cvxpy reference).
 
+    The paper's two questions [1]_: the minimum PCSA for self-stability of every
+    segment by eq. 1 (its Figure 3) and the counter torques at that activation (its
+    Figure 4), as the convex problems of docs/model.md, "The optimisation".
+
     Parameters
     ----------
     model : Model
@@ -254,6 +278,22 @@ def solve_point(model: Model, eccentricity: float, lordosis: float) -> PointOpti
     Returns
     -------
     PointOptimum
+        Status ('optimal', 'optimal_inaccurate', 'infeasible' or 'solver_error'), the
+        minimum total PCSA [m^2], the chosen PCSA of each muscle [m^2] and CT_k [N m]
+        (shape (n_cor,)); NaN values unless optimal.
+
+    Raises
+    ------
+    ParameterError
+        E or Lambda outside the modelled range.
+    ModelError
+        The model cannot be evaluated there (see :func:`~spinectl.model.checks.validate_position`).
+
+    References
+    ----------
+    .. [1] Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012). Spinal
+       lordosis optimizes the requirements for a stable erect posture. Theor Biol Med
+       Model 9:13. doi:10.1186/1742-4682-9-13
     """
     data = _point_data(model, eccentricity, lordosis)
     return point_optimum(data, model.optimisation.ct_tolerance, eccentricity, lordosis)
@@ -262,8 +302,8 @@ def solve_point(model: Model, eccentricity: float, lordosis: float) -> PointOpti
 def min_norm_activation(model: Model, eccentricity: float, lordosis: float) -> PointOptimum:
     """The minimum-norm activation: least ||CT||_2 over all self-stable activations.
 
-    No budget on the total PCSA (design page: "also offer minimum-norm
-    activations"); ties broken by least total PCSA. ``min_pcsa`` is still the
+    No budget on the total PCSA (docs/optimisation.md, "Formulation": minimum-norm
+    activations); ties broken by least total PCSA. ``min_pcsa`` is still the
     minimum total PCSA of stage 1, ``total_pcsa`` what this activation uses.
 
     Parameters
@@ -271,6 +311,11 @@ def min_norm_activation(model: Model, eccentricity: float, lordosis: float) -> P
     model : Model
     eccentricity, lordosis : float
         E and Lambda [m].
+
+    Returns
+    -------
+    PointOptimum
+        As :func:`solve_point`, with the minimum-norm activation as ``pcsa`` [m^2].
     """
     data = _point_data(model, eccentricity, lordosis)
     return point_optimum(data, np.inf, eccentricity, lordosis)
@@ -300,7 +345,7 @@ class ParetoFront:
 
 
 def pareto_front(model: Model, eccentricity: float, lordosis: float, n_points: int = 21) -> ParetoFront:
-    """The Pareto front between total PCSA and ||CT||_2 (design page, The optimisation).
+    """The Pareto front between total PCSA and ||CT||_2 (docs/optimisation.md, "Formulation").
 
     Stage 2 with the budget as a cvxpy Parameter, for ``n_points`` budgets
     evenly spaced from the minimum total PCSA to the total of the minimum-norm
@@ -313,6 +358,12 @@ def pareto_front(model: Model, eccentricity: float, lordosis: float, n_points: i
         E and Lambda [m].
     n_points : int
         Number of budgets.
+
+    Returns
+    -------
+    ParetoFront
+        Budgets on the total PCSA [m^2], shape (n_points,), the least ||CT||_2 within
+        each [N m] and the status per budget.
     """
     data = _point_data(model, eccentricity, lordosis)
     far = point_optimum(data, np.inf)
@@ -335,3 +386,62 @@ def pareto_front(model: Model, eccentricity: float, lordosis: float, n_points: i
             norm = np.linalg.norm(data.counter_torque(polished(data, "counter_torque", x.value, value)[0]))
         norms.append(norm)
     return ParetoFront(float(eccentricity), float(lordosis), budgets * M2_PER_CM2, np.asarray(norms), tuple(statuses))
+
+
+def minimum_stabilising_pcsa(model: Model, eccentricity: float, lordosis: float) -> np.ndarray:
+    """The chosen activation of :func:`solve_point`: the minimum stabilising PCSA [m^2].
+
+    Parameters
+    ----------
+    model : Model
+        ``optimisation`` sets activation mode, margin, bounds and tolerances.
+    eccentricity, lordosis : float
+        E and Lambda [m].
+
+    Returns
+    -------
+    numpy.ndarray, shape (n_muscles,)
+        PCSA of each muscle [m^2] that makes every segment self-stable.
+
+    Raises
+    ------
+    ModelError
+        No activation within the bounds stabilises every segment, or the solver failed
+        (the message names the optimiser's status and suggests giving ``--pcsa``).
+    """
+    optimum = solve_point(model, eccentricity, lordosis)
+    if not optimum.ok:
+        raise ModelError(
+            f"pcsa: no activation stabilises every segment at E = {eccentricity:g} m, Lambda = {lordosis:g} m "
+            f"(optimiser status {optimum.status}); give --pcsa"
+        )
+    return optimum.pcsa
+
+
+def stability_at(model: Model, eccentricity: float, lordosis: float, pcsa=None) -> StabilityResult:
+    """Stability of every segment for a PCSA, by default the minimum stabilising one.
+
+    Parameters
+    ----------
+    model : Model
+    eccentricity, lordosis : float
+        E and Lambda [m].
+    pcsa : array_like, optional
+        PCSA [m^2], per pair or per muscle (:func:`spinectl.model.checks.expand_pcsa`);
+        default :func:`minimum_stabilising_pcsa`.
+
+    Returns
+    -------
+    StabilityResult
+        :func:`spinectl.model.stability.segment_stability` at that PCSA.
+
+    Raises
+    ------
+    ModelError
+        ``pcsa`` not given and no activation stabilises every segment.
+    ParameterError
+        E, Lambda or ``pcsa`` out of range.
+    """
+    if pcsa is None:
+        pcsa = minimum_stabilising_pcsa(model, eccentricity, lordosis)
+    return segment_stability(model, eccentricity, lordosis, pcsa)

@@ -54,7 +54,7 @@ _STATUS = {
 
 @dataclass(frozen=True)
 class BlockOptimum:
-    """Results for a block of points, the arrays of :class:`~spinectl.PointOptimum`.
+    """Results for a block of points, the arrays of :class:`~spinectl.optimise.problem.PointOptimum`.
 
     Attributes
     ----------
@@ -168,6 +168,12 @@ def feasible_points(data: ProblemData) -> np.ndarray | None:
     ----------
     data : ProblemData
         A block of points (leading dimension P).
+
+    Returns
+    -------
+    numpy.ndarray of bool, shape (P,) or None
+        True where some activation within the bounds makes every segment self-stable;
+        None if the phase-1 problem failed.
     """
     n_points, n_rows, n = data.stability.shape
     lhs, rhs = inequalities(data)
@@ -228,6 +234,12 @@ def solve_stacked(data: ProblemData, ct_tolerance: float, *, min_pcsa_only: bool
         ``pcsa`` and ``counter_torque`` belong to a minimum-PCSA activation, not
         to the one of least ||CT|| (the calibration's K = 15 landscapes need
         only the minimum).
+
+    Returns
+    -------
+    BlockOptimum
+        Status, minimum total PCSA [m^2], per-muscle PCSA [m^2] and CT_k [N m] of every
+        point (leading dimension P), and how many points the per-point reference solved.
     """
     n_points = len(data.stability)
     status = np.full(n_points, "optimal", dtype=object)
@@ -259,6 +271,11 @@ def solve_points(data: ProblemData, ct_tolerance: float, progress=None) -> Block
         Relative band on the minimum total PCSA [1].
     progress : callable, optional
         Called with 1 after every point (e.g. a tqdm bar's ``update``).
+
+    Returns
+    -------
+    BlockOptimum
+        As :func:`solve_stacked`, every point solved by the reference (``per_point = P``).
     """
     status, total, x = _per_point(data, ct_tolerance, progress)
     return _block_optimum(data, status, total, x, per_point=len(total))

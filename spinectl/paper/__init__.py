@@ -6,6 +6,8 @@ on each (:mod:`~spinectl.paper.verdicts`), Figures 3, 4 and S1
 (:mod:`~spinectl.paper.figures`), the report (:mod:`~spinectl.paper.report`), the
 calibration of the unstated parameters (:mod:`~spinectl.paper.calibration`) and the
 main job, :func:`spinectl.paper.reproduce` (:mod:`~spinectl.paper.reproduction`).
+
+Symbols and units: docs/glossary.md.
 """
 
 from .reproduction import reproduce

@@ -3,8 +3,10 @@
 Filled contours over E (abscissa) and Lambda (ordinate), both in cm, with
 positions A-D labelled at the corners (:data:`spinectl.paper.landmarks.POSITIONS`).
 Figure 4 adds the +-30 N m limit of the local muscles as a contour and the
-paper's optimum. Matplotlib's object API with the Agg canvas: no global
-backend state, no display needed. Every file is written atomically.
+paper's optimum. Each figure function draws on a new figure with the Agg
+canvas (:func:`spinectl.canvas.new_figure`: no global backend state, no display
+needed) and returns it, writing nothing; :func:`save_figure` writes one
+atomically, and :func:`draw_figures` draws and saves the set.
 """
 
 from __future__ import annotations
@@ -13,10 +15,10 @@ from pathlib import Path
 
 import numpy as np
 import xarray as xr
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from ..atomic import atomic_path
+from ..canvas import new_figure, save_png
+from ..landscape import netcdf
 from ..units import M2_PER_CM2
 from . import grid, landmarks
 
@@ -32,8 +34,7 @@ _CORNER_OFFSET = {"A": (6, 6), "B": (-16, 6), "C": (-16, -16), "D": (6, -16)}
 
 
 def _axes(title: str):
-    fig = Figure(figsize=FIGURE_SIZE, layout="constrained")
-    FigureCanvasAgg(fig)
+    fig = new_figure(figsize=FIGURE_SIZE, layout="constrained")
     ax = fig.add_subplot()
     ax.set_xlabel("eccentricity E [cm]")
     ax.set_ylabel("lordosis Λ [cm]")
@@ -88,6 +89,11 @@ def min_pcsa_figure(dataset: xr.Dataset) -> Figure:
     ----------
     dataset : xarray.Dataset
         One landscape (scalar K).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Filled contours over E and Lambda [cm]; nothing is written.
     """
     name = "Fig. 3" if float(dataset["K"]) == 0 else "Fig. S1"
     title = f"{name}: minimum PCSA for self-stability, {_k_label(dataset)}"
@@ -107,6 +113,11 @@ def counter_torque_figure(dataset: xr.Dataset, specific_tension: float) -> Figur
         One landscape (scalar K).
     specific_tension : float
         f_iso per PCSA [N/m^2].
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Filled contours over E and Lambda [cm]; nothing is written.
     """
     title = f"Fig. 4: local counter torques ‖CT‖, {_k_label(dataset)}"
     field = dataset["counter_torque_norm_Nm"]
@@ -127,16 +138,21 @@ def counter_torque_figure(dataset: xr.Dataset, specific_tension: float) -> Figur
 
 
 def save_figure(fig: Figure, path: str | Path) -> Path:
-    """Write a figure as PNG atomically.
+    """The save step: :func:`spinectl.canvas.save_png` at this module's :data:`DPI`.
 
     Parameters
     ----------
     fig : matplotlib.figure.Figure
+        A figure of this module.
     path : str or Path
+        The PNG file, written atomically.
+
+    Returns
+    -------
+    Path
+        ``path``.
     """
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=DPI)
-    return Path(path)
+    return save_png(fig, path, DPI)
 
 
 def figure_names(stiffness: float) -> tuple[str, str]:
@@ -146,14 +162,19 @@ def figure_names(stiffness: float) -> tuple[str, str]:
     ----------
     stiffness : float
         Passive stiffness K [N m/rad]; 0 gives Figures 3 and 4, else S1 and 4 with K in the name.
+
+    Returns
+    -------
+    tuple of str
+        The PNG names of the minimum-PCSA and the counter-torque figure.
     """
     if stiffness == 0:
         return "fig3_min_pcsa.png", "fig4_counter_torque.png"
     return f"figS1_min_pcsa_K{stiffness:g}.png", f"fig4_counter_torque_K{stiffness:g}.png"
 
 
-def draw_figures(dataset: xr.Dataset, out_dir: str | Path, specific_tension: float) -> list[Path]:
-    """Draw Figures 3 and 4 for every K of ``dataset`` (Figure S1 for K > 0) into ``out_dir``.
+def draw_figures(dataset: xr.Dataset, out_dir: str | Path, specific_tension: float | None = None) -> list[Path]:
+    """Draw Figures 3 and 4 for every K of ``dataset`` (Figure S1 for K > 0) and save them into ``out_dir``.
 
     Parameters
     ----------
@@ -161,14 +182,25 @@ def draw_figures(dataset: xr.Dataset, out_dir: str | Path, specific_tension: flo
         From :func:`~spinectl.landscape.sweep.sweep` (scalar K) or
         :func:`~spinectl.landscape.sweep.stiffness_sweep` (a K dimension).
     out_dir : str or Path
-    specific_tension : float
-        f_iso per PCSA [N/m^2], for the local-PCSA scale of Figure 4.
+        Folder for the PNG files (created if missing), named by :func:`figure_names`.
+    specific_tension : float, optional
+        f_iso per PCSA [N/m^2], for the local-PCSA scale of Figure 4; default: that of
+        the model the dataset was computed with (:func:`spinectl.landscape.netcdf.model_of`).
 
     Returns
     -------
     list of Path
         The PNG files written.
+
+    Raises
+    ------
+    ConfigError, ParameterError
+        ``specific_tension`` not given and the dataset's ``config_toml`` is not a valid model.
+    OutputError
+        A file cannot be written.
     """
+    if specific_tension is None:
+        specific_tension = netcdf.model_of(dataset).fibre.specific_tension
     out_dir = Path(out_dir)
     parts = [dataset.sel(K=k) for k in dataset["K"].values] if "K" in dataset.dims else [dataset]
     written = []

@@ -1,8 +1,8 @@
 """The paper's study, defined once: its grid, positions A-D, stiffnesses and conventions.
 
 Wagner et al. (2012), Methods: E and Lambda from 0 to 8 cm in 1 mm steps (81 x 81 points),
-the passive stiffness K = 0 and K = 15 N m/rad; docs/model.md, "Passive stiffness", for the
-two readings of K in eq. 2. :func:`paper_landscapes` solves the study's landscapes; the
+the passive stiffness K = 0 and K = 15 N m/rad; docs/model.md, "Passive stiffness: two
+conventions", for the two readings of K in eq. 2. :func:`paper_landscapes` solves the study's landscapes; the
 main job (:func:`spinectl.paper.reproduce`), the calibration and the notebooks
 all start from here.
 """
@@ -17,7 +17,9 @@ from ..model.config import set_parameters
 from ..model.params import Model
 
 POSITIONS = {"A": (0.0, 0.0), "B": (0.08, 0.0), "C": (0.08, 0.08), "D": (0.0, 0.08)}
-"""(E, Lambda) [m] of positions A-D, the corners of Figures 3 and 4 (design page)."""
+"""(E, Lambda) [m] of positions A-D, the corners of Figures 3 and 4.
+
+docs/optimisation.md, "Reading of the positions", and docs/glossary.md."""
 
 
 PAPER_STIFFNESS = 15.0
@@ -27,7 +29,7 @@ STIFFNESSES = (0.0, PAPER_STIFFNESS)
 """The passive stiffnesses K [N m/rad] of the paper's landscapes: Figure 3 (K = 0) and Figure S1 (K = 15)."""
 
 CONVENTIONS = ("physical", "paper")
-"""The two readings of the passive stiffness K in eq. 2 (design page, erratum eq. 2)."""
+"""The two readings of the passive stiffness K in eq. 2 (docs/model.md, "Passive stiffness: two conventions")."""
 
 
 PAPER_RANGE = (0.0, 0.08)
@@ -35,8 +37,9 @@ PAPER_RANGE = (0.0, 0.08)
 
 
 PAPER_POINTS = 81
-"""Grid points per axis of the paper's grid (1 mm steps; paper, Methods; design page), on which
-the calibrated model is measured."""
+"""Grid points per axis of the paper's grid, on which the calibrated model is measured: 1 mm steps
+(paper, Methods, Stability analysis and calculation of counter torques; its section on the
+musculoskeletal model speaks of 100 equidistant steps instead)."""
 
 
 def paper_axis(points: int) -> np.ndarray:
@@ -46,6 +49,11 @@ def paper_axis(points: int) -> np.ndarray:
     ----------
     points : int
         Number of grid points (81: 1 mm steps).
+
+    Returns
+    -------
+    numpy.ndarray, shape (points,)
+        The axis [m], evenly spaced from 0 to 0.08.
     """
     return np.linspace(*PAPER_RANGE, int(points))
 
@@ -56,6 +64,11 @@ def other_convention(model: Model) -> str:
     Parameters
     ----------
     model : Model
+
+    Returns
+    -------
+    str
+        'paper' for a 'physical' model and vice versa.
     """
     return next(c for c in CONVENTIONS if c != model.passive.convention)
 
@@ -70,6 +83,11 @@ def with_stiffness(model: Model, stiffness: float, convention: str | None = None
         K [N m/rad].
     convention : str, optional
         'physical' or 'paper'.
+
+    Returns
+    -------
+    Model
+        A new, validated model; ``model`` is unchanged.
     """
     values = {"passive.stiffness": float(stiffness)}
     if convention is not None:

@@ -2,8 +2,9 @@
 
 A table (:data:`LANDMARKS`) of the values the paper reports, each with its
 unit, how spinectl measures it from the K = 0 and K = 15 N m/rad landscapes
-(:func:`measure`) and where the paper says it (design page, "What the paper
-reports"). Shared by the reproduction report and the calibration of the
+(:func:`measure`) and where the paper says it (its Results, Discussion and
+Additional file 1; docs/reproduction.md, "The claims one by one", gives the verdict
+on each). Shared by the reproduction report and the calibration of the
 unstated parameters.
 
 "About" in the paper is read as +-20 % (values read off contour plots);
@@ -106,6 +107,11 @@ class Landmark:
         ----------
         value : float
             spinectl's measurement, in :attr:`unit`.
+
+        Returns
+        -------
+        bool
+            False for a value that is not finite.
         """
         if not np.isfinite(value):
             return False
@@ -129,6 +135,11 @@ def at(dataset: xr.Dataset, name: str, position) -> float:
         Variable name.
     position : tuple of float
         (E, Lambda) [m].
+
+    Returns
+    -------
+    float
+        The value, in the variable's unit (NaN at an infeasible point).
     """
     e, lam = position
     return float(dataset[name].sel(E=e, Lambda=lam, method="nearest"))
@@ -150,6 +161,11 @@ def line_slope(dataset: xr.Dataset, name: str, pick: str) -> float:
         Variable name.
     pick : {'max', 'min'}
         Ridge or valley.
+
+    Returns
+    -------
+    float
+        s = Lambda / E [1]; NaN if no column counts.
     """
     field = dataset[name].transpose("E", "Lambda").values
     sign = 1.0 if pick == "max" else -1.0
@@ -366,7 +382,7 @@ LANDMARKS: tuple[Landmark, ...] = (
         "~",
         "1",
         "the same with the other K convention",
-        "Discussion; design page, erratum eq. 2: which convention halves it?",
+        "Discussion; docs/errata.md, 'The units of eq. 2': which convention halves it?",
         _halving(other=True),
     ),
     Landmark(
@@ -405,6 +421,12 @@ def measure(landmarks: Landmarks) -> list[Measurement]:
     Parameters
     ----------
     landmarks : Landmarks
+
+    Returns
+    -------
+    list of Measurement
+        One per landmark, in the order of :data:`LANDMARKS`: the value in the
+        landmark's unit (NaN where a landscape it needs is missing) and whether it agrees.
     """
     out = []
     for mark in LANDMARKS:
@@ -427,5 +449,10 @@ def local_pcsa_equivalent(counter_torque, specific_tension: float, lever_arm: fl
         f_iso per PCSA [N/m^2].
     lever_arm : float
         Lever arm of the local muscle [m].
+
+    Returns
+    -------
+    numpy.ndarray
+        PCSA [m^2], the shape of ``counter_torque``.
     """
     return np.abs(counter_torque) / (lever_arm * specific_tension)

@@ -59,6 +59,11 @@ def landmark_table(measurements: Sequence[Measurement]) -> str:
     ----------
     measurements : sequence of Measurement
         From :func:`spinectl.paper.landmarks.measure`.
+
+    Returns
+    -------
+    str
+        A Markdown table, one row per measurement, without a trailing newline.
     """
     lines = [
         f"| landmark | paper | spinectl | unit | agrees | verdict for `{verdicts.PRESET}` "
@@ -131,6 +136,12 @@ def render(measurements: Sequence[Measurement], run: Run) -> str:
         From :func:`spinectl.paper.landmarks.measure`.
     run : Run
         Facts about the run.
+
+    Returns
+    -------
+    str
+        The whole ``report.md``: the run's facts, the landmark table, the halving by K,
+        the local-muscle equivalent of the counter torques and the files written.
     """
     agree = sum(m.agrees for m in measurements)
     files = "\n".join(f"- [`{name}`]({name})" for name in run.files)

@@ -63,6 +63,12 @@ class Verdict:
         ----------
         value : float
             A fresh measurement, in the landmark's unit.
+
+        Returns
+        -------
+        bool
+            True if finite and within :data:`RELATIVE` of the documented value (within
+            :data:`spinectl.paper.landmarks.ZERO_TORQUE` of a documented 0).
         """
         if self.value == 0.0:
             return bool(np.isfinite(value) and abs(value) <= landmarks.ZERO_TORQUE)
@@ -125,6 +131,11 @@ def verdict(name: str) -> Verdict | None:
     ----------
     name : str
         Landmark name.
+
+    Returns
+    -------
+    Verdict or None
+        The entry of :data:`VERDICTS`.
     """
     return VERDICTS.get(name)
 
@@ -135,6 +146,11 @@ def format_number(value: float) -> str:
     Parameters
     ----------
     value : float
+
+    Returns
+    -------
+    str
+        E.g. ``"36.3"``, ``"1.20e-05"`` or ``"n/a"``.
     """
     if not np.isfinite(value):
         return "n/a"
@@ -151,6 +167,12 @@ def documented_table() -> str:
     """The documented table as Markdown: landmark, paper, spinectl (documented), verdict, reason.
 
     For docs/reproduction.md (generated at each docs build).
+
+    Returns
+    -------
+    str
+        A Markdown table, one row per landmark of :data:`spinectl.paper.landmarks.LANDMARKS`,
+        ending in a newline.
     """
     lines = [
         "| landmark | what | paper | spinectl | unit | verdict | why |",
@@ -176,6 +198,12 @@ def verdict_cell(measurement: Measurement) -> str:
     ----------
     measurement : Measurement
         From :func:`spinectl.paper.landmarks.measure`.
+
+    Returns
+    -------
+    str
+        "verdict: reason", with the documented value appended where the fresh one
+        differs; "n/a" for a landmark without a documented verdict.
     """
     v = VERDICTS.get(measurement.landmark.name)
     if v is None:

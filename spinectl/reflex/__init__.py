@@ -10,6 +10,8 @@ the report of one configuration (:mod:`~spinectl.reflex.margins`) and its plots
 
 The vectorised functions are re-exported here (``reflex.delay_margin(S, D, theta, kp, kd)``);
 python-control and matplotlib are imported only by the modules that need them.
+
+Symbols and units: docs/glossary.md.
 """
 
 from .delay import (

@@ -3,8 +3,9 @@
 Pure vectorised numpy functions of arrays (any broadcastable shapes) of the
 segment's stiffness S = dM/dalpha [N m/rad], damping D = dM/domega
 [N m s/rad], inertia theta [kg m^2] and the reflex gains kp [N m/rad],
-kd [N m s/rad]; no python-control object per point (design page, Reflex with
-delay; the derivations are in ``docs/reflex.md``).
+kd [N m s/rad]; no python-control object per point (the loop and the derivations
+are in docs/reflex.md, "The loop" and "Crossing frequencies and the exact delay
+margin"). The reflex is beyond the paper, which discusses it in words only.
 
 The linearised segment theta alpha'' = S alpha + D alpha' + u with the delayed
 reflex u(t) = -(kp alpha + kd alpha')(t - tau) has the characteristic
@@ -15,13 +16,20 @@ quasi-polynomial
 A root crosses the imaginary axis at s = j w only where abs(Q(jw)) = abs(P(jw)), i.e.
 F(w^2) = 0 with F(x) = theta^2 x^2 + (2 S theta + D^2 - kd^2) x + S^2 - kp^2,
 and then only at the delays tau = (phi + 2 pi k) / w, phi = arg(-Q/P) mod 2 pi.
-The sign of F'(w^2) is the direction of the crossing (Cooke and Grossman 1982;
-Cooke and van den Driessche 1986): + destabilising, - stabilising.
+The sign of F'(w^2) is the direction of the crossing (Cooke and Grossman 1982 [1]_;
+Cooke and van den Driessche 1986 [2]_): + destabilising, - stabilising.
 
 theta = 0 with kd = 0 is accepted by :func:`delay_margin` and :func:`phase_margin`
 too: the first-order-plus-delay loop of the textbooks (a retarded equation);
 theta = 0 with kd != 0 would be of neutral type and is not covered, and the root
 counting (:func:`right_half_plane_roots`, :func:`critical_gains`) assumes theta > 0.
+
+References
+----------
+.. [1] Cooke KL, Grossman Z (1982). Discrete delay, distributed delay and stability
+   switches. J Math Anal Appl 86:592-627.
+.. [2] Cooke KL, van den Driessche P (1986). On zeroes of some transcendental
+   equations. Funkcialaj Ekvacioj 29:77-90.
 """
 
 from __future__ import annotations
@@ -72,6 +80,12 @@ def stable_without_delay(stiffness, damping, kp, kd):
         S [N m/rad], D [N m s/rad].
     kp, kd : array_like
         Reflex gains [N m/rad], [N m s/rad].
+
+    Returns
+    -------
+    numpy.ndarray of bool
+        True where the delay-free closed loop is asymptotically stable; the broadcast
+        shape of the inputs.
     """
     s, d, kp, kd = as_arrays(stiffness, damping, kp, kd)
     return (kd > d) & (kp > s)
@@ -110,6 +124,7 @@ def crossings(stiffness, damping, inertia, kp, kd) -> Crossings:
     Solves F(x) = theta^2 x^2 + (2 S theta + D^2 - kd^2) x + (S^2 - kp^2) = 0,
     from abs(kp + j kd w)^2 = (S + theta w^2)^2 + D^2 w^2 (``docs/reflex.md``), for x = w^2 > 0.
     w = 0 is never a crossing for kp != S: there exp(0) = 1 and Delta(0) = kp - S.
+    The direction of a crossing is sign F'(w^2) [1]_ [2]_.
 
     Parameters
     ----------
@@ -121,6 +136,15 @@ def crossings(stiffness, damping, inertia, kp, kd) -> Crossings:
     Returns
     -------
     Crossings
+        Frequency [rad/s], phase [rad] and direction [1], each of shape (..., 2) with
+        ``...`` the broadcast shape of the inputs; NaN in empty slots.
+
+    References
+    ----------
+    .. [1] Cooke KL, Grossman Z (1982). Discrete delay, distributed delay and stability
+       switches. J Math Anal Appl 86:592-627.
+    .. [2] Cooke KL, van den Driessche P (1986). On zeroes of some transcendental
+       equations. Funkcialaj Ekvacioj 29:77-90.
     """
     s, d, theta, kp, kd = as_arrays(stiffness, damping, inertia, kp, kd)
     a, b, c = theta**2, 2.0 * s * theta + d**2 - kd**2, s**2 - kp**2
@@ -185,7 +209,8 @@ def margin_from_delays(first_delays, frequency, stable0, undefined) -> DelayMarg
     Returns
     -------
     DelayMargin
-        The margin, the frequency at it and the status code of each point.
+        The margin [s], the frequency at it [rad/s] and the status code of each point,
+        each of shape (...).
     """
     delays = np.where(np.isnan(first_delays), np.inf, first_delays)
     slot = np.argmin(delays, axis=-1)
@@ -210,12 +235,13 @@ def undefined_inputs(*values):
     Returns
     -------
     numpy.ndarray of bool
+        True where any input is NaN; the broadcast shape of the inputs.
     """
     return np.any(np.isnan(np.stack(as_arrays(*values))), axis=0)
 
 
 def delay_margin(stiffness, damping, inertia, kp, kd) -> DelayMargin:
-    """Exact delay margin from the quasi-polynomial (``docs/reflex.md``, "Delay margin").
+    """Exact delay margin from the quasi-polynomial (docs/reflex.md, "Crossing frequencies and the exact delay margin").
 
     If the loop is stable at tau = 0 the first root to reach the imaginary axis as
     tau grows does so at the smallest critical delay phi/w over the crossings;
@@ -229,6 +255,20 @@ def delay_margin(stiffness, damping, inertia, kp, kd) -> DelayMargin:
     Returns
     -------
     DelayMargin
+        tau_m [s] (inf, 0 or NaN by :data:`STATUS`), the frequency at which stability
+        is lost [rad/s] and the status code, each of the broadcast shape of the inputs.
+
+    Notes
+    -----
+    The crossings and their directions are those of :func:`crossings`, after Cooke
+    and Grossman [1]_ and Cooke and van den Driessche [2]_.
+
+    References
+    ----------
+    .. [1] Cooke KL, Grossman Z (1982). Discrete delay, distributed delay and stability
+       switches. J Math Anal Appl 86:592-627.
+    .. [2] Cooke KL, van den Driessche P (1986). On zeroes of some transcendental
+       equations. Funkcialaj Ekvacioj 29:77-90.
     """
     cr = crossings(stiffness, damping, inertia, kp, kd)
     stable0 = stable_without_delay(stiffness, damping, kp, kd)
@@ -282,6 +322,12 @@ def stable_at_delay(stiffness, damping, inertia, kp, kd, delay):
         Reflex gains [N m/rad], [N m s/rad].
     delay : array_like
         tau [s].
+
+    Returns
+    -------
+    numpy.ndarray of bool
+        True where the closed loop with delay tau is asymptotically stable; the broadcast
+        shape of the inputs (False where an input is NaN).
     """
     s, d, theta, kp, kd, tau = as_arrays(stiffness, damping, inertia, kp, kd, delay)
     count = right_half_plane_roots(s, d, theta, kp, kd, tau)
@@ -309,7 +355,7 @@ def phase_margin(stiffness, damping, inertia, kp, kd, delay):
     Returns
     -------
     phase_margin, crossover : numpy.ndarray
-        PM [rad] and w_c [rad/s].
+        PM [rad] and w_c [rad/s], each of the broadcast shape of the inputs.
     """
     cr = crossings(stiffness, damping, inertia, kp, kd)
     tau = np.asarray(delay, float)
@@ -365,7 +411,7 @@ def critical_gains(stiffness, damping, inertia, kd, delay, lobes: int = 8, point
     Returns
     -------
     kp_min, kp_max : numpy.ndarray
-        [N m/rad]; kp_max = inf at tau = 0.
+        [N m/rad], each of the broadcast shape of the inputs; kp_max = inf at tau = 0.
     """
     s, d, theta, kd, tau = as_arrays(stiffness, damping, inertia, kd, delay)
     y = np.linspace(0.0, lobes * np.pi, lobes * points_per_lobe + 1)

@@ -1,6 +1,6 @@
 """Reflex gains: the default rule from the segment's stiffness and inertia, or gains given by the user.
 
-The rule and its reasons are in docs/reflex.md, "The default reflex".
+The rule and its reasons are in docs/reflex.md, "The default reflex, and the activation level".
 """
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from .delay import as_arrays
 
 
 def default_gains(stiffness, damping, inertia, gain_factor, damping_ratio):
-    """The default reflex rule (``docs/reflex.md``, "The default reflex").
+    """The default reflex rule (docs/reflex.md, "The default reflex, and the activation level").
 
     kp = gain_factor * max(S, 0): the stiffness deficit below self-stability
     times a factor > 1, so that the reflexive stiffness kp - S = (gain_factor - 1) S
@@ -19,6 +19,9 @@ def default_gains(stiffness, damping, inertia, gain_factor, damping_ratio):
     reflex. kd = max(0, 2 zeta sqrt(theta (kp - S)) + D): the delay-free closed loop
     theta s^2 + (kd - D) s + (kp - S) gets the damping ratio zeta, counting the
     muscles' own damping -D >= 0 first (kd = 0 when they already damp enough).
+    The factor 1.5 and zeta = 1 were chosen against Stépán's bound sqrt(2 theta / S),
+    the longest delay any delayed PD can balance the reflex-only segment with [1]_ [2]_
+    (docs/reflex.md).
 
     Parameters
     ----------
@@ -33,6 +36,13 @@ def default_gains(stiffness, damping, inertia, gain_factor, damping_ratio):
     -------
     kp, kd : numpy.ndarray
         [N m/rad], [N m s/rad]; NaN where an input is NaN.
+
+    References
+    ----------
+    .. [1] Stépán G (1989). Retarded Dynamical Systems: Stability and Characteristic
+       Functions. Longman Scientific & Technical, Harlow.
+    .. [2] Stépán G, Kollár L (2000). Balancing with reflex delay. Math Comput Model
+       31:199-205.
     """
     s, d, theta = as_arrays(stiffness, damping, inertia)
     kp = gain_factor * np.maximum(s, 0.0)
@@ -48,10 +58,16 @@ def resolve_gains(stiffness, damping, inertia, reflex, kp=None, kd=None):
     ----------
     stiffness, damping, inertia : array_like
         S [N m/rad], D [N m s/rad], theta [kg m^2].
-    reflex : spinectl.params.Reflex
+    reflex : spinectl.model.params.Reflex
         ``gains = "rule"`` uses :func:`default_gains`, ``"explicit"`` its ``kp`` and ``kd``.
     kp, kd : float, optional
         Explicit gains [N m/rad], [N m s/rad] that replace the configured ones.
+
+    Returns
+    -------
+    kp, kd : numpy.ndarray
+        [N m/rad], [N m s/rad], each of the broadcast shape of S, D and theta; NaN where
+        one of them is NaN.
     """
     s, d, theta = as_arrays(stiffness, damping, inertia)
     if reflex.gains == "rule":

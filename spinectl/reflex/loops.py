@@ -1,4 +1,4 @@
-"""Segments and reflex loops as python-control systems (design page, Reflex with delay).
+"""Segments and reflex loops as python-control systems (docs/reflex.md, "The loop").
 
 One python-control object per segment, for the command line, plots and checks;
 sweeps use the vectorised :mod:`spinectl.reflex` instead.
@@ -33,7 +33,7 @@ def segment_system(stiffness: float, damping: float, inertia: float, name: str |
 
     x = (alpha, omega), x' = J x + (0, 1/theta) u, y = alpha, with the Jacobian
     J = [[0, 1], [S/theta, D/theta]] of :func:`spinectl.model.stability.jacobian`; so its
-    poles are the eigenvalues of paper eq. (1).
+    poles are the eigenvalues of paper eq. (1) [1]_.
 
     Parameters
     ----------
@@ -41,6 +41,17 @@ def segment_system(stiffness: float, damping: float, inertia: float, name: str |
         S [N m/rad], D [N m s/rad], theta [kg m^2].
     name : str, optional
         System name, e.g. the CoR ("L3L4").
+
+    Returns
+    -------
+    control.StateSpace
+        Two states (alpha [rad], omega [rad/s]), input "torque" [N m], output "alpha" [rad].
+
+    References
+    ----------
+    .. [1] Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012). Spinal
+       lordosis optimizes the requirements for a stable erect posture. Theor Biol Med
+       Model 9:13. doi:10.1186/1742-4682-9-13
     """
     a = jacobian(stiffness, damping, inertia)
     b = np.array([[0.0], [1.0 / inertia]])
@@ -57,6 +68,11 @@ def pade_delay(delay: float, order: int) -> ct.TransferFunction:
         tau [s].
     order : int
         Order of the approximant.
+
+    Returns
+    -------
+    control.TransferFunction
+        The all-pass [order/order] rational function [1], input "u", output "u_delayed".
     """
     num, den = ct.pade(delay, order)
     return ct.tf(num, den, inputs=["u"], outputs=["u_delayed"])
@@ -69,6 +85,11 @@ def reflex_controller(kp: float, kd: float) -> ct.TransferFunction:
     ----------
     kp, kd : float
         Reflex gains [N m/rad], [N m s/rad].
+
+    Returns
+    -------
+    control.TransferFunction
+        C(s) [N m/rad], input "alpha", output "reflex".
     """
     return ct.tf([kd, kp], [1.0], inputs=["alpha"], outputs=["reflex"])
 
@@ -77,8 +98,8 @@ def loop_transfer(stiffness, damping, inertia, kp, kd, delay: float, order: int)
     """Loop transfer function L(s) = C(s) Pade(s) G(s), the delay as a Padé approximant.
 
     The closed loop is 1 + L = 0. G(s) = 1 / (theta s^2 - D s - S) is the transfer
-    function of :func:`segment_system`, written from its coefficients (design page,
-    Reflex with delay) rather than converted, which is exact.
+    function of :func:`segment_system`, written from its coefficients (docs/reflex.md,
+    "The loop") rather than converted, which is exact.
 
     Parameters
     ----------
@@ -90,6 +111,11 @@ def loop_transfer(stiffness, damping, inertia, kp, kd, delay: float, order: int)
         tau [s].
     order : int
         Order of the Padé approximant (:func:`pade_delay`).
+
+    Returns
+    -------
+    control.TransferFunction
+        L(s) [1], the delay replaced by its Padé approximant.
     """
     plant = ct.tf([1.0], [inertia, -damping, -stiffness], inputs=["torque"], outputs=["alpha"])
     return reflex_controller(kp, kd) * pade_delay(delay, order) * plant
@@ -115,6 +141,11 @@ def closed_loop(stiffness, damping, inertia, kp, kd, delay: float, order: int, n
         Order of the Padé approximant.
     name : str, optional
         System name.
+
+    Returns
+    -------
+    control.StateSpace
+        2 + ``order`` states, input "torque" [N m], output "alpha" [rad].
     """
     plant = segment_system(stiffness, damping, inertia)
     full = ct.ss(plant.A, plant.B, np.eye(2), np.zeros((2, 1)))
@@ -175,6 +206,11 @@ def loop_margins(loop: ct.TransferFunction, stable: bool) -> LoopMargins:
     stable : bool
         Whether the closed loop is stable at k = 1 (decide it exactly, with
         :func:`spinectl.reflex.delay.stable_at_delay`); if not, the gain interval is NaN.
+
+    Returns
+    -------
+    LoopMargins
+        Gain margins [1], phase margin [deg], crossover frequencies [rad/s] and ``stable``.
     """
     with ignoring_underflow():
         gm, pm, _, wpc, wgc, _ = ct.stability_margins(loop)
@@ -203,6 +239,11 @@ def ignoring_underflow():
     subnormal coefficient (e.g. the damping at an activation of 1e-308) warns
     "underflow encountered"; the term is flushed to zero, which changes no result. numpy's
     own default ignores underflow too. Overflow and invalid operations still warn.
+
+    Yields
+    ------
+    None
+        Control returns to the ``with`` block with the underflow warnings filtered.
     """
     with warnings.catch_warnings():
         warnings.filterwarnings("ignore", "underflow encountered", RuntimeWarning)

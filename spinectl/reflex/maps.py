@@ -54,10 +54,17 @@ def landscape(stiffness, damping, inertia, reflex, kp=None, kd=None) -> ReflexLa
     ----------
     stiffness, damping, inertia : array_like
         S [N m/rad], D [N m s/rad], theta [kg m^2]; NaN (infeasible) gives NaN and status 'undefined'.
-    reflex : spinectl.params.Reflex
+    reflex : spinectl.model.params.Reflex
         Delay, Padé order and gains.
     kp, kd : float, optional
         Explicit gains overriding ``reflex``.
+
+    Returns
+    -------
+    ReflexLandscape
+        Gains [N m/rad], [N m s/rad], exact and Padé delay margins [s], their status,
+        the crossing frequency [rad/s] and the verdict at ``reflex.delay``, each of the
+        broadcast shape of S, D and theta.
     """
     s, d, theta = as_arrays(stiffness, damping, inertia)
     kp_, kd_ = resolve_gains(s, d, theta, reflex, kp, kd)

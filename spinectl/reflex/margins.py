@@ -4,6 +4,10 @@ Combines the operating point (an activation level of the minimum stabilising PCS
 :func:`spinectl.optimise.reference.solve_point`), the reflex gains (:mod:`spinectl.reflex`),
 the exact margins from the quasi-polynomial (:mod:`spinectl.reflex`) and
 python-control's margins of the Padé loop (:mod:`spinectl.reflex.loops`).
+
+A :class:`MarginsReport` presents itself: :meth:`MarginsReport.to_dict` (the JSON of
+``spinectl margins --json``, units in the key names) and :meth:`MarginsReport.table`.
+:func:`report_responses` computes what its plots show (:func:`spinectl.reflex.plots.write_plots`).
 """
 
 from __future__ import annotations
@@ -17,7 +21,8 @@ from ..model import stability
 from ..model.checks import arithmetic_guard, checked_coefficients
 from ..model.params import Model
 from ..optimise.reference import solve_point
-from . import gains, loops, pade
+from ..units import m2_to_cm2
+from . import gains, loops, pade, simulate
 from .delay import critical_gains, delay_margin, phase_margin, stable_at_delay
 
 SKIPPED = "skipped"
@@ -41,6 +46,8 @@ class OperatingPoint:
         activation x the optimum's PCSA [m^2].
     stiffness, damping, inertia : numpy.ndarray, shape (n_cor,)
         S [N m/rad], D [N m s/rad], theta [kg m^2] per segment.
+    muscle_names : tuple of str
+        The muscle of each entry of ``pcsa`` (:attr:`spinectl.model.params.Model.muscle_names`).
     """
 
     eccentricity: float
@@ -51,6 +58,7 @@ class OperatingPoint:
     stiffness: np.ndarray
     damping: np.ndarray
     inertia: np.ndarray
+    muscle_names: tuple[str, ...]
 
     @property
     def ok(self) -> bool:
@@ -70,6 +78,11 @@ def operating_point(model: Model, eccentricity: float, lordosis: float, activati
         E and Lambda [m].
     activation : float
         Fraction of the minimum stabilising PCSA [1]; 0 skips the optimiser.
+
+    Returns
+    -------
+    OperatingPoint
+        The PCSA [m^2] and each segment's S [N m/rad], D [N m s/rad] and theta [kg m^2] there.
     """
     coeffs = checked_coefficients(model, float(eccentricity), float(lordosis))
     if activation == 0:
@@ -86,6 +99,7 @@ def operating_point(model: Model, eccentricity: float, lordosis: float, activati
         stiffness=coeffs.stiffness(pcsa),
         damping=coeffs.damping(pcsa),
         inertia=coeffs.inertia,
+        muscle_names=model.muscle_names,
     )
 
 
@@ -143,6 +157,49 @@ class SegmentMargins:
     kp_max: float
     stable_at_delay: bool
 
+    def to_dict(self) -> dict:
+        """This segment as a JSON-ready dict, the unit in each key's name.
+
+        Returns
+        -------
+        dict
+            ``name``, ``stiffness_Nm_per_rad``, ``damping_Nms_per_rad``, ``inertia_kgm2``,
+            ``self_stable``, ``kp_Nm_per_rad``, ``kd_Nms_per_rad``, ``gain_margin``,
+            ``gain_margin_lower``, ``phase_margin_deg``, ``crossover_rad_s``, ``delay_margin_s``,
+            ``delay_margin_status``, ``delay_margin_pade_s``, ``kp_min_Nm_per_rad``,
+            ``kp_max_Nm_per_rad``, ``stable_at_delay`` and ``python_control`` (None, or its
+            ``gain_margin``, ``phase_margin_deg``, ``crossover_rad_s``, ``phase_crossover_rad_s``).
+            Infinite and NaN values stay floats (``Infinity``, ``NaN`` in JSON).
+        """
+        pc = self.python_control
+        return {
+            "name": self.name,
+            "stiffness_Nm_per_rad": self.stiffness,
+            "damping_Nms_per_rad": self.damping,
+            "inertia_kgm2": self.inertia,
+            "self_stable": self.self_stable,
+            "kp_Nm_per_rad": self.kp,
+            "kd_Nms_per_rad": self.kd,
+            "gain_margin": self.gain_margin,
+            "gain_margin_lower": self.gain_margin_lower,
+            "phase_margin_deg": self.phase_margin_deg,
+            "crossover_rad_s": self.crossover_rad_s,
+            "delay_margin_s": self.delay_margin,
+            "delay_margin_status": self.delay_margin_status,
+            "delay_margin_pade_s": self.delay_margin_pade,
+            "kp_min_Nm_per_rad": self.kp_min,
+            "kp_max_Nm_per_rad": self.kp_max,
+            "stable_at_delay": self.stable_at_delay,
+            "python_control": None
+            if pc is None
+            else {
+                "gain_margin": pc.gain_margin,
+                "phase_margin_deg": pc.phase_margin_deg,
+                "crossover_rad_s": pc.crossover_rad_s,
+                "phase_crossover_rad_s": pc.phase_crossover_rad_s,
+            },
+        }
+
 
 def segment_margins(name, stiffness, damping, inertia, kp, kd, delay: float, order: int) -> SegmentMargins:
     """All margins of one segment's reflex loop (see :class:`SegmentMargins`).
@@ -159,6 +216,11 @@ def segment_margins(name, stiffness, damping, inertia, kp, kd, delay: float, ord
         tau [s].
     order : int
         Order of the Padé approximant.
+
+    Returns
+    -------
+    SegmentMargins
+        Exact and Padé delay margins [s], phase margin [deg], stabilising gain range and verdict.
     """
     s, d, theta, kp, kd = (float(x) for x in (stiffness, damping, inertia, kp, kd))
     exact = delay_margin(s, d, theta, kp, kd)
@@ -217,12 +279,82 @@ class MarginsReport:
         Reflex delay tau [s].
     pade_order : int
     segments : tuple of SegmentMargins
+    gains : str
+        How the gains were chosen: 'rule' or 'explicit' (:attr:`spinectl.model.params.Reflex.gains`).
     """
 
     point: OperatingPoint
     delay: float
     pade_order: int
     segments: tuple[SegmentMargins, ...]
+    gains: str
+
+    @property
+    def all_stable_at_delay(self) -> bool:
+        """True if the closed loop of every segment is stable at the delay (exact)."""
+        return all(s.stable_at_delay for s in self.segments)
+
+    def to_dict(self) -> dict:
+        """The report as a JSON-ready dict: the document of ``spinectl margins --json``.
+
+        Returns
+        -------
+        dict
+            ``E_m``, ``Lambda_m``, ``delay_s``, ``pade_order``, ``activation``, ``optimum_status``,
+            ``gains``, ``pcsa_cm2`` (muscle name -> PCSA [cm^2]), ``segments`` (one
+            :meth:`SegmentMargins.to_dict` each) and ``all_stable_at_delay``; the unit is in each
+            key's name.
+        """
+        point = self.point
+        return {
+            "E_m": point.eccentricity,
+            "Lambda_m": point.lordosis,
+            "delay_s": self.delay,
+            "pade_order": self.pade_order,
+            "activation": point.activation,
+            "optimum_status": point.status,
+            "gains": self.gains,
+            "pcsa_cm2": dict(zip(point.muscle_names, m2_to_cm2(point.pcsa).tolist(), strict=True)),
+            "segments": [s.to_dict() for s in self.segments],
+            "all_stable_at_delay": self.all_stable_at_delay,
+        }
+
+    def table(self) -> str:
+        """The report as a readable table, one row a segment, with a header and a key to the columns.
+
+        Returns
+        -------
+        str
+            The text ``spinectl margins`` prints (no final newline).
+        """
+        point = self.point
+        lines = [
+            f"E = {point.eccentricity * 100:.2f} cm, Lambda = {point.lordosis * 100:.2f} cm, "
+            f"activation {point.activation:g} x minimum PCSA (optimum: {point.status}), "
+            f"delay {self.delay:g} s, Pade order {self.pade_order}, gains: {self.gains}",
+            "",
+            f"{'segment':8} {'S':>8} {'D':>8} {'theta':>6} {'kp':>8} {'kd':>7} {'GM low':>7} {'GM up':>7} "
+            f"{'PM[deg]':>8} {'w_c':>7} {'tau_m[s]':>9} {'Pade[s]':>9} {'kp range at tau':>19} {'stable':>6}",
+        ]
+        for s in self.segments:
+            lines.append(
+                f"{s.name:8} {_num(s.stiffness, 8, 2)} {_num(s.damping, 8, 2)} {_num(s.inertia, 6, 3)} "
+                f"{_num(s.kp, 8, 2)} {_num(s.kd, 7, 2)} {_num(s.gain_margin_lower, 7, 3)} "
+                f"{_num(s.gain_margin, 7, 3)} {_num(s.phase_margin_deg, 8, 2)} {_num(s.crossover_rad_s, 7, 3)} "
+                f"{_num(s.delay_margin, 9, 4)} {_num(s.delay_margin_pade, 9, 4)} "
+                f"[{_num(s.kp_min, 8, 1)},{_num(s.kp_max, 8, 1)}] {'yes' if s.stable_at_delay else 'NO':>6}"
+            )
+        lines += [
+            "",
+            "S, kp in N m/rad; D, kd in N m s/rad; theta in kg m^2; w_c in rad/s. GM: stable range of a common",
+            "factor on kp and kd. tau_m: exact delay margin (inf: any delay; 0: unstable without delay).",
+        ]
+        return "\n".join(lines)
+
+
+def _num(value: float, width: int, digits: int) -> str:
+    """``value`` in a column of ``width`` with ``digits`` decimals; inf and NaN as words."""
+    return f"{value:{width}.{digits}f}" if value == value and abs(value) != float("inf") else f"{value!s:>{width}}"
 
 
 def analyse(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None) -> MarginsReport:
@@ -236,12 +368,19 @@ def analyse(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None
         E and Lambda [m].
     kp, kd : float, optional
         Explicit gains for every segment [N m/rad], [N m s/rad], each replacing the configured one.
+
+    Returns
+    -------
+    MarginsReport
+        The operating point and one :class:`SegmentMargins` per segment.
     """
     settings = model.reflex
     point = operating_point(model, eccentricity, lordosis, settings.activation)
     with arithmetic_guard(eccentricity, lordosis):  # absurd gains or delays: a ModelError, not NaN and warnings
         segments = _segments(model, point, settings, kp, kd)
-    return MarginsReport(point=point, delay=settings.delay, pade_order=settings.pade_order, segments=segments)
+    return MarginsReport(
+        point=point, delay=settings.delay, pade_order=settings.pade_order, segments=segments, gains=settings.gains
+    )
 
 
 def _segments(model, point, settings, kp, kd) -> tuple[SegmentMargins, ...]:
@@ -259,3 +398,66 @@ def _segments(model, point, settings, kp, kd) -> tuple[SegmentMargins, ...]:
         )
         for k, name in enumerate(model.geometry.cor_names)
     )
+
+
+@dataclass(frozen=True)
+class ReportResponses:
+    """What the plots of a :class:`MarginsReport` show, computed (:func:`report_responses`).
+
+    Attributes
+    ----------
+    loops : dict of str to control.TransferFunction
+        Segment name -> its Padé loop L(s) (:func:`spinectl.reflex.loops.loop_transfer`), for each
+        segment with a reflex (kp > 0 or kd > 0) whose loop python-control can evaluate.
+    simulations : dict of str to Simulation
+        Segment name -> two simulated runs, with the reflex (run 0) and without it (run 1)
+        (:func:`spinectl.reflex.simulate.simulate`), for each segment with a finite stiffness.
+    """
+
+    loops: dict
+    simulations: dict
+
+
+def report_responses(model: Model, report: MarginsReport) -> ReportResponses:
+    """The loops and the simulated responses of every segment of ``report``: the compute step of its plots.
+
+    A segment without reflex (kp = kd = 0, e.g. self-stable under the default rule) has
+    no loop; one whose Padé loop python-control cannot evaluate (``python_control`` None:
+    microsecond delays at high orders) neither. A segment of an infeasible optimum (NaN
+    stiffness) has neither a loop nor a simulation.
+
+    Parameters
+    ----------
+    model : Model
+        The model of the report (geometry and the simulation settings of ``model.reflex``).
+    report : MarginsReport
+        Output of :func:`analyse` for ``model``.
+
+    Returns
+    -------
+    ReportResponses
+
+    Raises
+    ------
+    ParameterError
+        The simulation cannot run at the report's delay (too many time steps, see
+        :func:`spinectl.reflex.simulate.simulate`).
+    """
+    point = report.point
+    usable = [(k, s) for k, s in enumerate(report.segments) if np.isfinite(s.stiffness)]  # NaN: infeasible
+    transfer = {
+        s.name: loops.loop_transfer(s.stiffness, s.damping, s.inertia, s.kp, s.kd, report.delay, report.pade_order)
+        for _, s in usable
+        if (s.kp > 0 or s.kd > 0) and s.python_control is not None
+    }
+    simulations = {
+        s.name: simulate.simulate(
+            simulate.segment_plant(model, point.eccentricity, point.lordosis, k, point.pcsa),
+            [s.kp, 0.0],
+            [s.kd, 0.0],
+            report.delay,
+            model.reflex,
+        )
+        for k, s in usable
+    }
+    return ReportResponses(loops=transfer, simulations=simulations)

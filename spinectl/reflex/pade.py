@@ -2,8 +2,13 @@
 
 The Padé approximant of order n of exp(-s tau) has unit gain on the imaginary axis and
 the phase lag -2 sum arctan(...) of its poles; replacing the exact lag w tau by it gives the
-delay margin that a Padé loop predicts (docs/reflex.md, "Padé estimates"), vectorised like
-:mod:`spinectl.reflex.delay`.
+delay margin that a Padé loop predicts (docs/reflex.md, "Padé estimate"), vectorised like
+:mod:`spinectl.reflex.delay`. The approximant's coefficients are the classical ones [1]_.
+
+References
+----------
+.. [1] Baker GA Jr, Graves-Morris P (1996). Padé Approximants, 2nd ed. Encyclopedia of
+   Mathematics and its Applications 59. Cambridge University Press.
 """
 
 from __future__ import annotations
@@ -27,13 +32,23 @@ from .delay import (
 def pade_coefficients(order: int) -> np.ndarray:
     """Coefficients c_0..c_n of the [n/n] Padé approximant exp(-x) ~ q(-x) / q(x), q(x) = sum c_k x^k.
 
-    c_k = (2n - k)! n! / ((2n)! k! (n - k)!) (Baker and Graves-Morris, Padé Approximants,
-    1996; e.g. n = 1: q = 1 + x/2; n = 2: q = 1 + x/2 + x^2/12), lowest power first, c_0 = 1.
+    c_k = (2n - k)! n! / ((2n)! k! (n - k)!) (Baker and Graves-Morris [1]_; e.g. n = 1:
+    q = 1 + x/2; n = 2: q = 1 + x/2 + x^2/12), lowest power first, c_0 = 1.
 
     Parameters
     ----------
     order : int
         n >= 1.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n + 1,)
+        c_0..c_n [1], lowest power first.
+
+    References
+    ----------
+    .. [1] Baker GA Jr, Graves-Morris P (1996). Padé Approximants, 2nd ed. Encyclopedia of
+       Mathematics and its Applications 59. Cambridge University Press.
     """
     n = int(order)
     return np.array(
@@ -58,6 +73,11 @@ def pade_phase_lag(y, order: int):
         w tau [rad].
     order : int
         Order n of the approximant.
+
+    Returns
+    -------
+    numpy.ndarray
+        The lag [rad], in [0, n pi); the shape of ``y``.
     """
     roots = np.roots(pade_coefficients(order)[::-1])
     y = np.asarray(y, float)[..., None]
@@ -75,6 +95,11 @@ def pade_inverse_lag(phase, order: int):
         Lag to reach [rad].
     order : int
         Order n of the approximant.
+
+    Returns
+    -------
+    numpy.ndarray
+        y = w tau [rad], the shape of ``phase``; inf where ``phase`` >= n pi.
     """
     phase = np.asarray(phase, float)
     lo, hi = np.zeros_like(phase), np.ones_like(phase)
@@ -101,6 +126,12 @@ def pade_delay_margin(stiffness, damping, inertia, kp, kd, order: int) -> DelayM
         Reflex gains [N m/rad], [N m s/rad].
     order : int
         Order n of the approximant.
+
+    Returns
+    -------
+    DelayMargin
+        As :func:`~spinectl.reflex.delay.delay_margin`, with the Padé loop's critical
+        delays [s]; inf (delay-independent) also where every crossing's phase is >= n pi.
     """
     cr = crossings(stiffness, damping, inertia, kp, kd)
     first = pade_inverse_lag(cr.phase, order) / cr.frequency

@@ -8,7 +8,7 @@ with the muscle torques of :func:`spinectl.model.mechanics.muscle_torque_per_pcs
 from :func:`spinectl.model.mechanics.gravity_torque`, the passive stiffness K of
 :func:`spinectl.model.mechanics.passive_stiffness` and the constant counter torque CT_k that
 makes upright an equilibrium. The reflex is u(t) = -(kp alpha + kd omega)(t - tau)
-(design page, Reflex with delay).
+(docs/reflex.md, "The loop" and "Nonlinear simulation with the true delay").
 
 Integration: classical Runge-Kutta with a fixed step and a history buffer; delayed
 states between grid points come from cubic Hermite interpolation (alpha with slope
@@ -81,6 +81,12 @@ class SegmentPlant:
         ----------
         alpha, omega : array_like
             Angle [rad] and angular velocity [rad/s] of the segment.
+
+        Returns
+        -------
+        numpy.ndarray
+            The torque [N m], the broadcast shape of ``alpha`` and ``omega``; 0 (to
+            rounding) at alpha = omega = 0.
         """
         return _torque_without_ct(self, alpha, omega) + self.counter_torque
 
@@ -107,6 +113,12 @@ def segment_plant(model: Model, eccentricity: float, lordosis: float, segment, p
         Index or name of the CoR.
     pcsa : array_like, shape (n_muscles,)
         PCSA of each muscle [m^2].
+
+    Returns
+    -------
+    SegmentPlant
+        The CoR [m], its inertia [kg m^2] and passive stiffness [N m/rad], each fibre's
+        f_iso [N] and the counter torque [N m] that makes upright an equilibrium.
     """
     names = model.geometry.cor_names
     if isinstance(segment, str):
@@ -199,6 +211,11 @@ def growth_rate(time, alpha, perturbation: float):
         Angles [rad].
     perturbation : float
         Initial angle [rad].
+
+    Returns
+    -------
+    numpy.ndarray, shape (batch,)
+        The growth rate [1/s]; -inf where the response is rounding noise.
     """
     n = time.size
     a, b = n // 3, 2 * n // 3
@@ -226,6 +243,8 @@ def simulate(plant: SegmentPlant, kp, kd, delay, settings: Reflex, perturbation=
     Returns
     -------
     Simulation
+        Time [s], alpha [rad], omega [rad/s] and the reflex torque [N m] of every run,
+        shape (batch, n), with the divergence flags and growth rates [1/s].
     """
     kp, kd, tau = (
         np.ravel(x) for x in np.broadcast_arrays(*(np.atleast_1d(np.asarray(v, float)) for v in (kp, kd, delay)))

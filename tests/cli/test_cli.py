@@ -12,6 +12,7 @@ import pytest
 from spinectl import optimise
 from spinectl.cli import main
 from spinectl.model import config
+from spinectl.model.stability import segment_stability
 
 
 def run(argv, capsys):
@@ -26,28 +27,16 @@ def test_stability_table(capsys):
     assert "L5S1" in out and "||CT||" in out
 
 
-def test_stability_json_schema(capsys):
-    code, out, _ = run(
-        ["stability", "--E", "0.03", "--Lambda", "0.04", "--pcsa", "10,10,10", "--K", "15", "--json"], capsys
-    )
-    assert code == 0
-    doc = json.loads(out)
-    assert doc["E_m"] == 0.03 and doc["Lambda_m"] == 0.04 and doc["K_Nm_per_rad"] == 15
-    assert len(doc["pcsa_cm2"]) == 6 and doc["total_pcsa_cm2"] == pytest.approx(60)
-    seg = doc["segments"][0]
-    for key in (
-        "name",
-        "stiffness_Nm_per_rad",
-        "damping_Nms_per_rad",
-        "inertia_kgm2",
-        "eigenvalues",
-        "self_stable",
-        "counter_torque_Nm",
-    ):
-        assert key in seg
-    assert len(seg["eigenvalues"]) == 2 and len(seg["eigenvalues"][0]) == 2
-    norm = sum(s["counter_torque_Nm"] ** 2 for s in doc["segments"]) ** 0.5
-    assert doc["counter_torque_norm_Nm"] == pytest.approx(norm)
+def test_stability_prints_the_results_dict_and_table(capsys):
+    """``--json`` prints :meth:`StabilityResult.to_dict`, the table :meth:`StabilityResult.table`
+    (their schema and values: tests/model/test_stability.py)."""
+    argv = ["stability", "--E", "0.03", "--Lambda", "0.04", "--pcsa", "10,10,10", "--K", "15"]
+    model = config.set_parameter(config.load_preset("default"), "passive.stiffness", 15.0)
+    result = segment_stability(model, 0.03, 0.04, [10e-4, 10e-4, 10e-4])
+    code, out, _ = run([*argv, "--json"], capsys)
+    assert code == 0 and out == json.dumps(result.to_dict(model), indent=2) + "\n"
+    code, out, _ = run(argv, capsys)
+    assert code == 0 and out == result.table(model) + "\n"
 
 
 def test_config_show_is_loadable_toml(capsys, tmp_path):

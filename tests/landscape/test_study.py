@@ -353,7 +353,7 @@ def test_open_store_rejects_other_folders(tmp_path):
 
 
 def test_an_attachment_on_a_centre_of_rotation_stops_the_study_before_work(tmp_path):
-    """A lower attachment at (0, 0.005) is L5S1 itself at E = Lambda = 0 (tests/test_robustness.py)."""
+    """A lower attachment at (0, 0.005) is L5S1 itself at E = Lambda = 0 (tests/suites/test_robustness.py)."""
     text = study_with('"muscles.0.lower.0" = [0.12, 0.0]\n"muscles.0.lower.1" = [0.005]\n"muscles.0.spread" = [0.0]')
     text = text.replace(GRID, "E = [0.0]\nLambda = [0.0]\n")
     with pytest.raises(ModelError, match="study combination muscles.0.lower.0 = 0.0"):

@@ -8,7 +8,7 @@ import xarray as xr
 
 from spinectl import optimise
 from spinectl.cli import main
-from spinectl.errors import ParameterError
+from spinectl.errors import OutputError, ParameterError
 from spinectl.landscape import netcdf, schema, sweep
 from spinectl.model.mechanics import segment_coefficients
 from spinectl.model.params import Model
@@ -131,3 +131,32 @@ def test_delay_margins_in_the_sweep_equal_the_margins_report():
                 assert point.delay_margin_s.values[k] == pytest.approx(seg.delay_margin, rel=1e-6)
                 assert bool(point.stable_at_delay.values[k]) == seg.stable_at_delay
             assert float(point.spine_delay_margin_s) == pytest.approx(min(s.delay_margin for s in report.segments))
+
+
+def test_write_sweep_one_k_is_a_scalar_landscape(model, tmp_path):
+    """One K: the plain sweep with that K (a scalar coordinate), written and returned."""
+    out = tmp_path / "one.nc"
+    dataset = sweep.write_sweep(model, [0.0, 0.08], [0.0], out, stiffnesses=[15.0], progress=False)
+    assert "K" not in dataset.dims and float(dataset["K"]) == 15.0
+    assert netcdf.load(out).identical(dataset)
+    default = sweep.write_sweep(model, [0.0], [0.0], tmp_path / "default.nc", progress=False)
+    assert float(default["K"]) == model.passive.stiffness
+
+
+def test_write_sweep_checks_its_file_before_solving(model, tmp_path, monkeypatch):
+    (tmp_path / "taken").mkdir()
+    monkeypatch.setattr(sweep, "sweep", lambda *a, **k: pytest.fail("the sweep ran"))
+    with pytest.raises(OutputError, match="cannot write"):
+        sweep.write_sweep(model, [0.0], [0.0], tmp_path / "taken")
+
+
+def test_describe(landscape):
+    """12 points, all feasible on the default model's grid; ranges as the data's own extremes."""
+    pcsa, torque = landscape["min_pcsa_cm2"].values, landscape["counter_torque_norm_Nm"].values
+    assert sweep.describe(landscape) == (
+        f"12 points (12 solved, 0 infeasible or failed); min PCSA {pcsa.min():.1f}-{pcsa.max():.1f} cm2, "
+        f"||CT|| {torque.min():.1f}-{torque.max():.1f} N m"
+    )
+    nothing = landscape.copy()
+    nothing["min_pcsa_cm2"] = nothing["min_pcsa_cm2"] * np.nan
+    assert sweep.describe(nothing) == "12 points (0 solved, 12 infeasible or failed)"

@@ -1,4 +1,4 @@
-"""An interrupted sweep leaves the previous output intact (issue 8: atomic outputs)."""
+"""An interrupted sweep leaves the previous output intact: outputs are written atomically (docs/robustness.md)."""
 
 from __future__ import annotations
 

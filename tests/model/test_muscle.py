@@ -1,4 +1,7 @@
-"""Force-length and Hill force-velocity (paper, Methods; design page, erratum C)."""
+"""Force-length and Hill force-velocity (paper, Methods).
+
+docs/model.md, "The muscle fibre" and "Eccentric Hill constant C".
+"""
 
 from __future__ import annotations
 

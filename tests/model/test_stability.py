@@ -26,7 +26,7 @@ def test_gravity_alone_destabilises_every_segment(model):
     """No muscle, K = 0: an inverted pendulum at every CoR, lambda = +-sqrt(g / r).
 
     At E = Lambda = 0 the mass is straight above CoR k at r_k = 0.326 - y_k, and
-    theta_k = m r_k^2, so S/theta = g / r_k (design page, gravity erratum).
+    theta_k = m r_k^2, so S/theta = g / r_k (docs/model.md, "Gravity sign").
     """
     result = segment_stability(model, 0.0, 0.0, ZERO)
     assert not result.self_stable.any()
@@ -110,3 +110,47 @@ def test_bad_input_names_the_field(model, E, L, pcsa, field):
     with pytest.raises(ParameterError) as info:
         segment_stability(model, E, L, pcsa)
     assert info.value.field == field
+
+
+SEGMENT_KEYS = (
+    "name",
+    "stiffness_Nm_per_rad",
+    "damping_Nms_per_rad",
+    "inertia_kgm2",
+    "eigenvalues",
+    "self_stable",
+    "counter_torque_Nm",
+)
+"""Every key of a segment in ``spinectl stability --json``: the unit in the name."""
+
+
+def test_to_dict_schema_and_values(model):
+    """Units in the key names; PCSA in cm^2 by muscle; ||CT|| the norm of the listed torques."""
+    stiff = model.replace(passive=Passive(15.0, "paper"))
+    result = segment_stability(stiff, 0.03, 0.04, [10e-4, 10e-4, 10e-4])
+    doc = result.to_dict(stiff)
+    assert doc["E_m"] == 0.03 and doc["Lambda_m"] == 0.04
+    assert doc["K_Nm_per_rad"] == 15 and doc["K_convention"] == "paper" and doc["pcsa_source"] == "given"
+    assert doc["pcsa_cm2"] == dict.fromkeys(model.muscle_names, pytest.approx(10.0))
+    assert doc["total_pcsa_cm2"] == pytest.approx(60)
+    assert [s["name"] for s in doc["segments"]] == list(result.segment_names)
+    for k, seg in enumerate(doc["segments"]):
+        assert tuple(seg) == SEGMENT_KEYS
+        assert seg["eigenvalues"] == [[z.real, z.imag] for z in result.eigenvalues[k]]
+        assert seg["self_stable"] == all(re < 0 for re, _ in seg["eigenvalues"])
+    norm = sum(s["counter_torque_Nm"] ** 2 for s in doc["segments"]) ** 0.5
+    assert doc["counter_torque_norm_Nm"] == pytest.approx(norm)
+    assert doc["all_self_stable"] == all(s["self_stable"] for s in doc["segments"])
+    assert result.to_dict(stiff, pcsa_source="min_pcsa")["pcsa_source"] == "min_pcsa"
+
+
+def test_table(model):
+    result = segment_stability(model, 0.03, 0.04, [10e-4, 10e-4, 10e-4])
+    lines = result.table(model).splitlines()
+    assert lines[0] == "E = 3.00 cm, Lambda = 4.00 cm, K = 0 N m/rad (physical)"
+    assert lines[1].startswith("PCSA [cm^2]: ") and lines[1].endswith("(total 60.00)")
+    rows = lines[4 : 4 + len(result.segment_names)]
+    assert [row.split()[0] for row in rows] == list(result.segment_names)
+    assert [float(row.split()[-1]) for row in rows] == pytest.approx(result.counter_torque, abs=5e-4)
+    assert lines[-1].startswith(f"||CT|| = {result.counter_torque_norm:.3f} N m; self-stable: ")
+    assert "(minimum stabilising, chosen activation)" in result.table(model, pcsa_source="min_pcsa")

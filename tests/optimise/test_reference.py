@@ -9,9 +9,11 @@ import numpy as np
 import pytest
 
 from spinectl import optimise
+from spinectl.errors import ModelError
 from spinectl.model import geometry
 from spinectl.model.mechanics import segment_coefficients
 from spinectl.model.stability import segment_stability
+from spinectl.optimise import reference
 
 POINTS = [(0.0, 0.0), (0.08, 0.0), (0.08, 0.08), (0.0, 0.08), (0.03, 0.04)]
 """Positions A, B, C, D of the paper's figures and its optimum (E, Lambda) [m]."""
@@ -149,3 +151,25 @@ def test_passive_stiffness_alone_still_needs_muscle_damping(model):
     result = segment_stability(stiff, 0.03, 0.04, opt.pcsa)
     assert np.all(result.damping <= -stiff.optimisation.damping_margin * (1 - 1e-6))
     assert result.self_stable.all()
+
+
+def test_minimum_stabilising_pcsa_is_the_chosen_activation(model):
+    pcsa = reference.minimum_stabilising_pcsa(model, 0.03, 0.04)
+    np.testing.assert_array_equal(pcsa, optimise.solve_point(model, 0.03, 0.04).pcsa)
+    assert segment_stability(model, 0.03, 0.04, pcsa).all_self_stable
+
+
+def test_no_minimum_stabilising_pcsa_is_a_model_error(model):
+    """At most 1 cm^2 per muscle: infeasible (as above), an error naming the status and the way out."""
+    with pytest.raises(ModelError, match=r"no activation stabilises every segment at E = 0 m, Lambda = 0 m"):
+        reference.minimum_stabilising_pcsa(_with(model, pcsa_max=1e-4), 0.0, 0.0)
+
+
+def test_stability_at_defaults_to_the_minimum_stabilising_pcsa(model):
+    default = reference.stability_at(model, 0.03, 0.04)
+    np.testing.assert_array_equal(default.pcsa, optimise.solve_point(model, 0.03, 0.04).pcsa)
+    given = reference.stability_at(model, 0.03, 0.04, [10e-4, 10e-4, 10e-4])
+    expected = segment_stability(model, 0.03, 0.04, [10e-4, 10e-4, 10e-4])
+    np.testing.assert_array_equal(given.eigenvalues, expected.eigenvalues)
+    with pytest.raises(ModelError):
+        reference.stability_at(_with(model, pcsa_max=1e-4), 0.0, 0.0)

@@ -14,7 +14,8 @@ from spinectl.model.params import Passive
 from spinectl.optimise import stacked
 
 RTOL = 1e-6
-"""The issue's agreement: 1e-6 relative (to each point's total PCSA or ||CT||, at least 1 N m)."""
+"""The agreement the fast path promises (docs/optimisation.md, "Benchmark"): 1e-6 relative (to each point's
+total PCSA or ||CT||, at least 1 N m)."""
 
 GRID = np.linspace(0.0, 0.08, 5)
 

@@ -1,9 +1,12 @@
-"""Figures: produced, non-trivial, named after the paper's figures; the plot command."""
+"""Figures: returned without writing, saved as a separate step, non-trivial, named after the paper's figures;
+the plot command."""
 
 from __future__ import annotations
 
+import matplotlib.pyplot as plt
 import numpy as np
 import pytest
+from matplotlib.figure import Figure
 from matplotlib.image import imread
 
 from spinectl.cli import main
@@ -34,6 +37,25 @@ def test_figures_3_4_and_s1_are_drawn(results, tmp_path):
     assert names == sorted([*figures.figure_names(0.0), *figures.figure_names(15.0)])
     assert "figS1_min_pcsa_K15.png" in names
     assert all(_non_trivial(p) for p in written)
+
+
+def test_figure_functions_return_figures_and_write_nothing(results, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    k0 = netcdf.load(results).sel(K=0.0)
+    drawn = [figures.min_pcsa_figure(k0), figures.counter_torque_figure(k0, Model().fibre.specific_tension)]
+    assert all(isinstance(f, Figure) for f in drawn) and [len(f.axes) for f in drawn] == [2, 2]  # with colour bars
+    assert drawn[0].axes[0].get_title().startswith("Fig. 3: minimum PCSA")
+    assert list(tmp_path.iterdir()) == [] and plt.get_fignums() == []
+    path = figures.save_figure(drawn[0], tmp_path / "f.png")
+    assert _non_trivial(path) and [p.name for p in tmp_path.iterdir()] == ["f.png"]
+
+
+def test_draw_figures_reads_the_specific_tension_of_the_dataset(results, tmp_path):
+    """Without it, Figure 4's scale is that of the model the sweep ran with: the same PNG bytes."""
+    dataset = netcdf.load(results).sel(K=0.0)
+    given = figures.draw_figures(dataset, tmp_path / "given", Model().fibre.specific_tension)
+    default = figures.draw_figures(dataset, tmp_path / "default")
+    assert [p.read_bytes() for p in default] == [p.read_bytes() for p in given]
 
 
 def test_plot_command(results, tmp_path, capsys):

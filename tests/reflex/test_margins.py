@@ -1,4 +1,5 @@
-"""Per-segment reflex margins at one configuration: activation levels, explicit gains, infeasibility."""
+"""Per-segment reflex margins at one configuration: activation levels, explicit gains, infeasibility;
+the report as a dict and a table, and the responses its plots show."""
 
 from __future__ import annotations
 
@@ -70,3 +71,117 @@ def test_python_control_overflow_leaves_the_exact_margins(model):
     for seg in report.segments:
         assert seg.python_control is None and np.isnan(seg.gain_margin)
         assert 0.1 < seg.delay_margin < 0.2 and seg.stable_at_delay
+
+
+JSON_KEYS = (
+    "name",
+    "stiffness_Nm_per_rad",
+    "damping_Nms_per_rad",
+    "inertia_kgm2",
+    "self_stable",
+    "kp_Nm_per_rad",
+    "kd_Nms_per_rad",
+    "gain_margin",
+    "gain_margin_lower",
+    "phase_margin_deg",
+    "crossover_rad_s",
+    "delay_margin_s",
+    "delay_margin_status",
+    "delay_margin_pade_s",
+    "kp_min_Nm_per_rad",
+    "kp_max_Nm_per_rad",
+    "stable_at_delay",
+    "python_control",
+)
+"""Every key of a segment in ``spinectl margins --json``: the unit in the name."""
+
+
+def test_to_dict_schema_and_values(model):
+    """The document's numbers are the exact analysis of its own S, D, theta, kp, kd (reflex.delay_margin)."""
+    report = margins.analyse(_with_reflex(model, activation=0.0, delay=0.1, pade_order=3), E, LAMBDA)
+    doc = report.to_dict()
+    assert doc["E_m"] == E and doc["Lambda_m"] == LAMBDA and doc["activation"] == 0.0
+    assert doc["delay_s"] == 0.1 and doc["pade_order"] == 3 and doc["optimum_status"] == "skipped"
+    assert doc["gains"] == "rule" and doc["pcsa_cm2"] == dict.fromkeys(model.muscle_names, 0.0)
+    assert [s["name"] for s in doc["segments"]] == ["L1L2", "L2L3", "L3L4", "L4L5", "L5S1"]
+    for seg in doc["segments"]:
+        assert tuple(seg) == JSON_KEYS
+        exact = reflex.delay_margin(
+            seg["stiffness_Nm_per_rad"],
+            seg["damping_Nms_per_rad"],
+            seg["inertia_kgm2"],
+            seg["kp_Nm_per_rad"],
+            seg["kd_Nms_per_rad"],
+        )
+        assert seg["delay_margin_s"] == pytest.approx(float(exact.margin), rel=1e-12)
+        assert seg["stable_at_delay"] == (0.1 < seg["delay_margin_s"])
+        assert set(seg["python_control"]) == {
+            "gain_margin",
+            "phase_margin_deg",
+            "crossover_rad_s",
+            "phase_crossover_rad_s",
+        }
+    assert doc["all_stable_at_delay"] == all(s["stable_at_delay"] for s in doc["segments"])
+
+
+def test_to_dict_pcsa_in_cm2_by_muscle(model):
+    report = margins.analyse(_with_reflex(model, activation=0.5), E, LAMBDA)
+    doc = report.to_dict()
+    assert list(doc["pcsa_cm2"]) == list(model.muscle_names)
+    np.testing.assert_allclose(list(doc["pcsa_cm2"].values()), report.point.pcsa * 1e4, rtol=1e-12)
+
+
+def test_self_stable_margins_are_infinite_in_the_dict(model):
+    doc = margins.analyse(_with_reflex(model, activation=1.0), E, LAMBDA).to_dict()
+    assert all(
+        s["delay_margin_s"] == float("inf") and s["delay_margin_status"] == "delay_independent" for s in doc["segments"]
+    )
+
+
+def test_undefined_python_control_reading_is_none_in_the_dict(model):
+    report = margins.analyse(_with_reflex(model, activation=0.0, delay=1e-6, pade_order=10), E, LAMBDA)
+    assert all(s["python_control"] is None for s in report.to_dict()["segments"])
+
+
+def test_table(model):
+    report = margins.analyse(_with_reflex(model, activation=0.0), E, LAMBDA, kp=150.0, kd=20.0)
+    lines = report.table().splitlines()
+    assert lines[0].startswith("E = 3.00 cm, Lambda = 4.00 cm, activation 0 x minimum PCSA (optimum: skipped)")
+    rows = [line for line in lines if line.split()[:1] in (["L1L2"], ["L2L3"], ["L3L4"], ["L4L5"], ["L5S1"])]
+    assert len(rows) == 5 and all(row.split()[4:6] == ["150.00", "20.00"] for row in rows)
+    assert "tau_m: exact delay margin" in lines[-1]
+
+
+def test_table_writes_inf_and_nan_as_words(model):
+    self_stable = margins.analyse(_with_reflex(model, activation=1.0), E, LAMBDA).table()
+    assert " inf " in self_stable
+    infeasible = model.replace(optimisation=Optimisation(pcsa_max=1e-8))
+    assert " nan " in margins.analyse(_with_reflex(infeasible, activation=0.5), E, LAMBDA).table()
+
+
+def test_report_responses_of_a_reflex_only_report(model):
+    """Activation 0: every segment has a loop (the Pade loop of its own gains) and a simulation."""
+    model = _with_reflex(model, activation=0.0, sim_duration=0.3)
+    report = margins.analyse(model, E, LAMBDA)
+    responses = margins.report_responses(model, report)
+    names = [s.name for s in report.segments]
+    assert list(responses.loops) == names and list(responses.simulations) == names
+    s = report.segments[2]
+    w = np.array([0.5, 5.0, 50.0])
+    expected = (s.kp + s.kd * 1j * w) / (s.inertia * (1j * w) ** 2 - s.damping * 1j * w - s.stiffness)
+    pade = reflex.pade_coefficients(report.pade_order)  # e^{-x} ~ q(-x)/q(x), x = s tau
+    x = 1j * w * report.delay
+    q = sum(c * x**k for k, c in enumerate(pade))
+    q_minus = sum(c * (-x) ** k for k, c in enumerate(pade))
+    np.testing.assert_allclose(responses.loops[s.name](1j * w), expected * q_minus / q, rtol=1e-9)
+    run = responses.simulations[s.name]
+    assert list(run.kp) == [s.kp, 0.0] and list(run.kd) == [s.kd, 0.0]  # with the reflex, then without
+
+
+def test_report_responses_without_reflex_or_optimum(model):
+    """Self-stable segments (kp = kd = 0) have no loop but a simulation; an infeasible optimum has neither."""
+    stable = _with_reflex(model, activation=1.0, sim_duration=0.3)
+    responses = margins.report_responses(stable, margins.analyse(stable, E, LAMBDA))
+    assert responses.loops == {} and len(responses.simulations) == 5
+    tiny = _with_reflex(model.replace(optimisation=Optimisation(pcsa_max=1e-8)), activation=0.5)
+    assert margins.report_responses(tiny, margins.analyse(tiny, E, LAMBDA)) == margins.ReportResponses({}, {})

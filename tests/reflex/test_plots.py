@@ -1,28 +1,103 @@
-"""Bode, Nyquist and time-response plots: written atomically as PNG files."""
+"""Bode, Nyquist and time-response figures: drawn and returned, written only by the save step."""
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
 
+import matplotlib.pyplot as plt
 import numpy as np
+import pytest
+from matplotlib.figure import Figure
 
-from spinectl.model.params import Reflex
-from spinectl.reflex import loops, plots, simulate
+from spinectl.model.params import Optimisation, Reflex
+from spinectl.reflex import loops, margins, plots, simulate
 
 PNG = b"\x89PNG\r\n\x1a\n"
 
 
-def test_plots_are_pngs_and_leave_no_temporaries(tmp_path, model):
-    transfer = {"L3L4": loops.loop_transfer(50.0, -15.0, 2.6, 75.0, 1.3, 0.1, 5)}
+def _loop():
+    return {"L3L4": loops.loop_transfer(50.0, -15.0, 2.6, 75.0, 1.3, 0.1, 5)}
+
+
+def _runs(model):
     plant = simulate.segment_plant(model, 0.03, 0.04, 2, np.array([15, 15, 0, 0, 0.2, 0.2]) * 1e-4)
-    runs = {"L3L4": simulate.simulate(plant, [75.0, 0.0], [1.3, 0.0], 0.1, Reflex(sim_duration=0.3))}
+    return {"L3L4": simulate.simulate(plant, [75.0, 0.0], [1.3, 0.0], 0.1, Reflex(sim_duration=0.3))}
+
+
+def _reflex(model, **changes):
+    return model.replace(reflex=dataclasses.replace(model.reflex, **changes))
+
+
+def test_figure_functions_return_figures_and_write_nothing(tmp_path, monkeypatch, model):
+    monkeypatch.chdir(tmp_path)
+    figures = [
+        plots.bode_figure(_loop(), omega_limits=(0.1, 100.0)),
+        plots.nyquist_figure(_loop()),
+        plots.response_figure(_runs(model)),
+    ]
+    assert all(isinstance(f, Figure) for f in figures)
+    assert list(tmp_path.iterdir()) == []
+    assert plt.get_fignums() == []  # drawn on their own canvas: pyplot holds none of them
+    assert [len(f.axes) for f in figures] == [2, 1, 1]  # magnitude and phase; one Nyquist axes; one segment
+    assert [f.get_suptitle() for f in figures] == [
+        "Reflex loop L(jw)",
+        "Nyquist plot of L(jw)",
+        "Response to a perturbation (nonlinear segment, true delay)",
+    ]
+
+
+def test_bode_magnitude_is_that_of_the_loop():
+    """The curve python-control draws on our axes is |L(jw)|, evaluated here by the transfer function itself."""
+    loop = _loop()
+    w, magnitude = plots.bode_figure(loop, omega_limits=(0.1, 100.0)).axes[0].get_lines()[0].get_data()
+    assert w.min() == pytest.approx(0.1) and w.max() == pytest.approx(100.0)
+    np.testing.assert_allclose(magnitude, abs(loop["L3L4"](1j * w)), rtol=1e-9)
+
+
+def test_save_figure_writes_pngs_and_leaves_no_temporaries(tmp_path, model):
     written = [
-        plots.bode(transfer, tmp_path / "bode.png", omega_limits=(0.1, 100.0)),
-        plots.nyquist(transfer, tmp_path / "nyquist.png"),
-        plots.time_response(runs, tmp_path / "response.png"),
+        plots.save_figure(plots.bode_figure(_loop()), tmp_path / "bode.png"),
+        plots.save_figure(plots.nyquist_figure(_loop()), tmp_path / "nyquist.png"),
+        plots.save_figure(plots.response_figure(_runs(model)), tmp_path / "response.png"),
     ]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bode.png", "nyquist.png", "response.png"]
     assert all(p.read_bytes()[:8] == PNG for p in written)
+
+
+def test_write_plots_of_a_reflex_only_report(tmp_path, model):
+    """Activation 0: every segment needs its reflex, so every plot has something to draw."""
+    model = _reflex(model, activation=0.0, sim_duration=0.3)
+    report = margins.analyse(model, 0.03, 0.04)
+    written = plots.write_plots(report, tmp_path / "p", model)
+    assert [p.name for p in written] == list(plots.PLOT_FILES)
+    assert sorted(p.name for p in (tmp_path / "p").iterdir()) == sorted(plots.PLOT_FILES)
+    assert all(p.read_bytes()[:8] == PNG for p in written)
+
+
+def test_write_plots_without_a_loop_writes_the_response_only(tmp_path, model):
+    """Activation 1: self-stable, the rule gives kp = kd = 0, so there is no loop to draw."""
+    model = _reflex(model, activation=1.0, sim_duration=0.3)
+    written = plots.write_plots(margins.analyse(model, 0.03, 0.04), tmp_path, model)
+    assert [p.name for p in written] == ["response.png"]
+
+
+def test_report_figures_draw_the_responses_they_are_given(model):
+    model = _reflex(model, activation=0.0, sim_duration=0.3)
+    report = margins.analyse(model, 0.03, 0.04)
+    figures = plots.report_figures(report, margins.ReportResponses(loops={}, simulations=_runs(model)))
+    assert list(figures) == ["response.png"] and "E = 3 cm, Lambda = 4 cm" in figures["response.png"].get_suptitle()
+
+
+def test_frequency_range_spans_the_loops_rates(model):
+    """A decade around every crossover and the Pade corner order/tau; (0.1, 10) rad/s when no rate is known."""
+    report = margins.analyse(_reflex(model, activation=0.0), 0.03, 0.04)
+    low, high = plots.frequency_range(report)
+    crossovers = [s.crossover_rad_s for s in report.segments]
+    assert low <= min(crossovers) / 10 and high >= report.pade_order / report.delay * 10
+    infeasible = model.replace(optimisation=Optimisation(pcsa_max=1e-8))
+    nothing = margins.analyse(_reflex(infeasible, activation=0.5, delay=0.0), 0.03, 0.04)
+    assert plots.frequency_range(nothing) == pytest.approx((0.1, 10.0))
 
 
 def test_frequency_plots_of_subnormal_coefficients_are_silent(tmp_path):
@@ -31,6 +106,6 @@ def test_frequency_plots_of_subnormal_coefficients_are_silent(tmp_path):
     transfer = {"L1L2": loops.loop_transfer(71.0, -1.1e-308, 1.31, 106.5, 13.6, 0.0, 5)}
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        plots.bode(transfer, tmp_path / "bode.png")
-        plots.nyquist(transfer, tmp_path / "nyquist.png")
+        plots.save_figure(plots.bode_figure(transfer), tmp_path / "bode.png")
+        plots.save_figure(plots.nyquist_figure(transfer), tmp_path / "nyquist.png")
     assert (tmp_path / "bode.png").read_bytes()[:8] == PNG

@@ -3,7 +3,7 @@
 The layers and their order are those of CONTRIBUTING.md ("Architecture", "Layers"; a test
 checks that its table and :data:`LAYERS` agree, and that its tree names every module):
 
-    errors units _validate atomic presets  <  model  <  optimise  <  reflex  <  landscape  <  paper  <  cli
+    errors units _validate atomic canvas presets  <  model  <  optimise  <  reflex  <  landscape  <  paper  <  cli
 
 A module may import modules of its own layer and of the layers before it, never
 of a later one (:data:`LAYERS`). ``spinectl/__init__.py`` is exempt as an
@@ -36,7 +36,7 @@ ROOT = Path(__file__).resolve().parents[2]
 PACKAGE = ROOT / "spinectl"
 
 LAYERS = (
-    ("errors", "units", "_validate", "atomic", "presets"),
+    ("errors", "units", "_validate", "atomic", "canvas", "presets"),
     ("model",),
     ("optimise",),
     ("reflex",),

@@ -146,7 +146,8 @@ def test_reexported_names_link_to_their_home():
 
 
 def test_guide_pages_leave_out_the_index_and_the_references(tmp_path):
-    for name in ("index.md", "model.md", "api.md", "cli.md", "parameters.md", "reflex.md", "optimisation.md"):
+    names = ("index.md", "model.md", "api.md", "cli.md", "parameters.md", "glossary.md", "reflex.md", "optimisation.md")
+    for name in names:
         (tmp_path / name).write_text("# x\n")
     (tmp_path / "_generated").mkdir()
     assert guide.guide_pages(tmp_path) == ["model", "optimisation", "reflex"]

@@ -21,7 +21,7 @@ from nbclient import NotebookClient
 ROOT = Path(__file__).resolve().parents[2]
 NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))
 EXPECTED = ("01_reproducing_the_paper", "02_reflex_versus_self_stability", "03_sensitivity")
-"""The notebooks of issue 6: reproduction, delayed reflex, sensitivity."""
+"""The notebooks docs/notebooks.md lists: reproduction, delayed reflex, sensitivity."""
 
 CI_GRID = "17"
 """Grid points per axis in the tests (5 mm): each notebook runs in well under a minute."""
@@ -33,6 +33,7 @@ by_name = pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.stem)
 
 
 def test_the_issue_notebooks_are_there():
+    """The three notebooks of :data:`EXPECTED` are in ``notebooks/``; others may be added."""
     assert {p.stem for p in NOTEBOOKS} >= set(EXPECTED)
 
 

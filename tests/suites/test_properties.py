@@ -80,7 +80,8 @@ def test_mirror_symmetry(model, position):
     """E, Lambda -> -E, -Lambda mirrors x -> -x: CoR x_k = -E + Lambda phi_k changes sign,
     and the dorsal muscle is the mirror image of the ventral one. A mirror reverses the
     sense of rotation, so torques change sign and the sides swap, while stiffness and
-    damping (torque per angle, both reversed) keep theirs (design page, Geometry)."""
+    damping (torque per angle, both reversed) keep theirs (docs/model.md, "The muscles": the
+    dorsal muscle is the mirror image x -> -x of the ventral one)."""
     E, L = position
     a = checked_coefficients(model, E, L)
     b = checked_coefficients(model, -E, -L)
@@ -122,7 +123,7 @@ def test_stiffness_and_damping_are_central_differences_of_the_torque(model, posi
 @given(models(), positions, _between(0.1, 10.0))
 def test_gravity_scales_with_mass_and_nothing_else_does(model, position, factor):
     """Gravity stiffness m g r_y, gravity torque -m g r_x and inertia m (r^2 + rho^2) are
-    linear in m (design page, One segment); the muscular coefficients do not involve m."""
+    linear in m (docs/model.md, "Gravity"); the muscular coefficients do not involve m."""
     E, L = position
     heavy = model.replace(body=dataclasses.replace(model.body, mass=model.body.mass * factor))
     a, b = checked_coefficients(model, E, L), checked_coefficients(heavy, E, L)
@@ -141,8 +142,8 @@ def test_min_pcsa_is_proportional_to_mass_without_passive_stiffness(model, posit
     """min PCSA(c m) = c min PCSA(m) at K = 0, with no margin and no upper bound.
 
     Why: the LP is  min w.x  s.t.  A x <= -(m g r_y - K) - margin,  0 <= x <= pcsa_max,
-    every constraint linear in the PCSA x (design page, Muscle: everything muscular is
-    linear in PCSA). With K = 0, margin = 0 and pcsa_max = inf the constant term is
+    every constraint linear in the PCSA x (docs/model.md, "Force-velocity": everything
+    muscular is linear in PCSA). With K = 0, margin = 0 and pcsa_max = inf the constant term is
     -m g r_y (and the damping rows' bound is -damping_margin = 0), so x is feasible for m iff c x
     is feasible for c m, and the optimum scales
     by c. The counter torque CT = -(T x + M_ext) is then c times as large as well.

@@ -8,8 +8,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-NOT_GUIDE = ("index", "parameters", "cli", "api")
-"""Top-level pages that are not guide pages: the index and the reference pages."""
+NOT_GUIDE = ("index", "parameters", "glossary", "cli", "api")
+"""Top-level pages that are not guide pages: the index and the reference pages (their toctree is in index.md)."""
 
 FIRST = ("model",)
 """Guide pages listed first, in this order; the others follow alphabetically."""

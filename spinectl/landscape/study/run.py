@@ -117,6 +117,12 @@ def tasks(study: Study, indices) -> Iterator[Task]:
         The study.
     indices : iterable of int
         Chunks, in the order to run them.
+
+    Yields
+    ------
+    Task
+        One chunk: its index, the base model, the parameter overrides of its
+        combination, its tile of the E and Lambda axes [m] and the outputs to compute.
     """
     e_axis, l_axis = np.asarray(study.eccentricity), np.asarray(study.lordosis)
     for index in indices:
@@ -194,6 +200,12 @@ def run_study(
         A progress bar of chunks on stderr; None: only on a terminal.
     connect_timeout : float
         Seconds to wait for a remote ``scheduler`` [s].
+
+    Returns
+    -------
+    StudyResult
+        The store, the chunks of the study, those done before and now, the wall time
+        [s] and where the chunks ran.
 
     Raises
     ------
@@ -334,6 +346,11 @@ def describe(result: StudyResult) -> str:
     ----------
     result : StudyResult
         From :func:`run_study`.
+
+    Returns
+    -------
+    str
+        The line, without a newline; it ends with how to resume if chunks are left.
     """
     done = result.done_before + result.computed
     tail = "" if result.complete else f"; {result.chunks - done} left: run again with --resume"

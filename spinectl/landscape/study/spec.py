@@ -171,8 +171,8 @@ class Sampled:
 
         Returns
         -------
-        numpy.ndarray
-            Shape (count,).
+        numpy.ndarray, shape (count,)
+            The draws, in the unit of the parameter.
         """
         rng = np.random.default_rng([seed, *self.parameter.encode()])
         a, b = (value for _, value in self.arguments)
@@ -214,7 +214,14 @@ class Samples:
         object.__setattr__(self, "_draws", draws)  # drawn once: every combination reads them
 
     def values(self) -> dict[str, np.ndarray]:
-        """The draws of every parameter by name, shape (count,) each (read-only)."""
+        """The draws of every parameter by name, shape (count,) each (read-only).
+
+        Returns
+        -------
+        dict of str to numpy.ndarray
+            ``{dotted parameter: draws}``, each of shape (count,) in the parameter's unit;
+            a new dict, the arrays read-only.
+        """
         return dict(self._draws)
 
 
@@ -380,7 +387,8 @@ class Study:
         Returns
         -------
         dict
-            Value by dotted parameter: the axes' values, then the draws.
+            ``{dotted parameter: value}`` in each parameter's unit, ready for
+            :func:`spinectl.model.config.set_parameters`; empty without axes or samples.
         """
         out = {a.parameter: a.values[i] for a, i in zip(self.axes, combination, strict=False)}
         if self.samples:
@@ -420,7 +428,8 @@ class Study:
         Returns
         -------
         Chunk
-            Its combination and tile.
+            Its index, the combination of the parameter axes and the slices of the E and
+            Lambda axes that make its tile.
         """
         combination, tile = divmod(int(index), math.prod(self.tiles))
         i_e, i_l = divmod(tile, self.tiles[1])

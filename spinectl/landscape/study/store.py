@@ -55,6 +55,17 @@ def encode(columns: dict, outputs, tile: tuple[int, int]) -> dict[str, np.ndarra
         Names to keep.
     tile : tuple of int
         Points of the tile along E and Lambda.
+
+    Returns
+    -------
+    dict of str to numpy.ndarray
+        Each of ``outputs``, shape ``tile`` + its trailing shape (segment, muscle);
+        strings as fixed-width unicode of :data:`STRING_WIDTH` characters.
+
+    Raises
+    ------
+    ValueError
+        A string longer than :data:`STRING_WIDTH` characters.
     """
     out = {}
     for name in outputs:
@@ -81,6 +92,13 @@ def template(study: Study, probe: dict[str, np.ndarray]) -> xr.Dataset:
         Its dimensions, coordinates and tiling.
     probe : dict of str to numpy.ndarray
         One point's outputs as :func:`encode` gives them (tile 1 x 1): their dtypes and trailing shapes.
+
+    Returns
+    -------
+    xarray.Dataset
+        Every output over the study's dimensions and the grid, as dask arrays of fill
+        values chunked by the study's tiles, the chunk counts (``chunk_done``), the
+        coordinates with units and the study's attributes.
     """
     import dask.array as da  # only where a store is made: the other commands need no dask
 
@@ -145,6 +163,11 @@ def existing(study: Study, path: str | Path, resume: bool) -> np.ndarray | None:
     resume : bool
         Continue an existing store.
 
+    Returns
+    -------
+    numpy.ndarray of int, shape (n_chunks,) or None
+        How many times each chunk was written (0: not yet); None if ``path`` does not exist.
+
     Raises
     ------
     OutputError
@@ -174,6 +197,11 @@ def create(study: Study, path: str | Path, probe: dict) -> np.ndarray:
         The store (a folder) to create.
     probe : dict
         See :func:`template`.
+
+    Returns
+    -------
+    numpy.ndarray of int, shape (n_chunks,)
+        Zeros: no chunk written yet.
 
     Raises
     ------
@@ -267,6 +295,11 @@ def open_store(path: str | Path) -> xr.Dataset:
     path : str or Path
         The store.
 
+    Returns
+    -------
+    xarray.Dataset
+        The store's variables as dask arrays, with its coordinates and attributes.
+
     Raises
     ------
     ParameterError
@@ -290,6 +323,16 @@ def load(path: str | Path) -> xr.Dataset:
     ----------
     path : str or Path
         The store.
+
+    Returns
+    -------
+    xarray.Dataset
+        As :func:`open_store`, loaded into memory, string variables as object arrays.
+
+    Raises
+    ------
+    ParameterError
+        Not a spinectl study store (field ``store``).
     """
     dataset = open_store(path).load()
     for name, variable in dataset.data_vars.items():

@@ -3,8 +3,8 @@
 The paper (Wagner et al. 2012) gives neither the upper-body mass, nor the
 muscle attachment coordinates, nor the fibre spread. This package fits them,
 within anatomically plausible bounds, to the landmarks of
-:mod:`spinectl.paper.landmarks` (design page, "What the paper reports"), and reports
-the residual of every landmark (docs/reproduction.md):
+:mod:`spinectl.paper.landmarks` (what the paper's Results and Discussion report), and
+reports the residual of every landmark (docs/reproduction.md, "The calibration"):
 
 - :mod:`~spinectl.paper.calibration.parameters`: the free parameters, their bounds
   with sources, and the map between a parameter vector and a model;

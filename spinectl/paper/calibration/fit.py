@@ -1,8 +1,9 @@
 """The fit: differential evolution, then Nelder-Mead, then verification on the paper's grid.
 
 :func:`calibrate` is the routine behind ``spinectl calibrate``
-(docs/reproduction.md, The optimiser). The passive-stiffness convention
-(design page, erratum eq. 2) is a discrete choice, fitted both ways and reported.
+(docs/reproduction.md, "The optimiser"). The passive-stiffness convention
+(docs/model.md, "Passive stiffness: two conventions") is a discrete choice, fitted
+both ways and reported.
 """
 
 from __future__ import annotations
@@ -271,11 +272,11 @@ def calibrate(
 ) -> CalibrationResult:
     """Fit the free parameters of ``base`` to the landmarks, with each passive-stiffness convention.
 
-    Two stages on the coarse grid. Global: differential evolution
+    Two stages on the coarse grid. Global: differential evolution [1]_
     (:func:`scipy.optimize.differential_evolution`, seeded) ``starts`` times with
     seeds ``seed``, ``seed + 1``, ..., minimising the least loss over the
     conventions; each initial population contains the base model's own vector,
-    so the fit is never worse than the start. Local: Nelder-Mead from the best
+    so the fit is never worse than the start. Local: Nelder-Mead [2]_ from the best
     vector of each convention (``refine`` evaluations each). Then the best
     vector of each convention is measured on the verification grid, and the
     least loss there wins.
@@ -304,6 +305,21 @@ def calibrate(
         Loss evaluations of the local refinement per convention (0: none).
     progress : callable, optional
         Called with a line of text as the run proceeds.
+
+    Returns
+    -------
+    CalibrationResult
+        The calibrated model (passive stiffness 0, the winning convention), the fit of
+        each convention with its losses and residuals, every evaluated vector and its
+        losses, the optimiser's reports, the wall time [s] and the settings.
+
+    References
+    ----------
+    .. [1] Storn R, Price K (1997). Differential evolution - a simple and efficient
+       heuristic for global optimization over continuous spaces. J Global Optim
+       11:341-359.
+    .. [2] Nelder JA, Mead R (1965). A simplex method for function minimization.
+       Comput J 7:308-313.
     """
     started = time.perf_counter()
     parameters = tuple(parameters)

@@ -39,6 +39,12 @@ def coarse_landscape(model: Model, axis, *, counter_torque: bool = True) -> xr.D
         E and Lambda axis [m].
     counter_torque : bool
         Also solve for the least counter torques.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``min_pcsa_cm2`` [cm^2] (and ``counter_torque_norm_Nm`` [N m]) over ``E``, ``Lambda``
+        [m]; NaN at infeasible points.
     """
     axis = np.asarray(axis, float)
     e, lam = (a.ravel() for a in np.meshgrid(axis, axis, indexing="ij"))
@@ -64,6 +70,12 @@ def coarse_landmarks(model: Model, points: int = FIT_POINTS, *, other: bool = Fa
         Grid points per axis.
     other : bool
         Also the K = 15 landscape of the other convention.
+
+    Returns
+    -------
+    Landmarks
+        K = 0 with ‖CT‖, K = 15 N m/rad (minimum PCSA only) and, with ``other``, K = 15
+        in the other convention (else None).
     """
     axis = grid.paper_axis(points)
     k15 = grid.PAPER_STIFFNESS
@@ -77,7 +89,7 @@ def coarse_landmarks(model: Model, points: int = FIT_POINTS, *, other: bool = Fa
 
 
 def measure_model(model: Model, points: int = grid.PAPER_POINTS, progress=None) -> list[Measurement]:
-    """Every landmark of ``model`` measured afresh on the paper's grid (:func:`grid.paper_landscapes`).
+    """Every landmark of ``model`` measured afresh on the paper's grid (:func:`spinectl.paper.grid.paper_landscapes`).
 
     Parameters
     ----------
@@ -86,6 +98,11 @@ def measure_model(model: Model, points: int = grid.PAPER_POINTS, progress=None) 
         Grid points per axis.
     progress : bool or None
         Progress bars.
+
+    Returns
+    -------
+    list of Measurement
+        As :func:`spinectl.paper.landmarks.measure`, one per landmark.
     """
     both, other = grid.paper_landscapes(model, points, progress)
     k15 = grid.PAPER_STIFFNESS

@@ -21,6 +21,12 @@ def summary(result: CalibrationResult) -> str:
     Parameters
     ----------
     result : CalibrationResult
+
+    Returns
+    -------
+    str
+        Lines of plain text without a trailing newline: time and evaluations, a table of
+        the parameters, the loss of each convention and the residual of every landmark.
     """
     best = result.best
     lines = [f"calibrated in {result.seconds:.0f} s, {result.evaluations} evaluations; convention {best.convention}"]
@@ -50,6 +56,12 @@ def preset_toml(result: CalibrationResult, command: str, date: str | None = None
         The command line that produced it.
     date : str, optional
         ISO date; default today.
+
+    Returns
+    -------
+    str
+        Comment lines (command, date, loss, convention, the free parameters with their
+        bounds), then :func:`spinectl.model.config.dump_toml` of the calibrated model.
     """
     date = date or time.strftime("%Y-%m-%d")
     best = result.best
@@ -76,6 +88,11 @@ def history_csv(result: CalibrationResult) -> str:
     Parameters
     ----------
     result : CalibrationResult
+
+    Returns
+    -------
+    str
+        A header row and one row per evaluation, ending in a newline.
     """
     names = [f"{p.name}_{p.unit}" for p in result.parameters]
     header = ",".join(["evaluation", *names, *(f"loss_{c}" for c in result.settings["conventions"])])

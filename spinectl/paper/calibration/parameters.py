@@ -52,6 +52,11 @@ class FreeParameter:
         Parameters
         ----------
         model : Model
+
+        Returns
+        -------
+        float
+            The value, in :attr:`unit`.
         """
         node = model
         for key in self.paths[0].split("."):
@@ -151,6 +156,16 @@ def parameter_set(names: Sequence[str] | None = None) -> tuple[FreeParameter, ..
     ----------
     names : sequence of str, optional
         Subset of the names of :data:`FREE_PARAMETERS`, in the order wanted.
+
+    Returns
+    -------
+    tuple of FreeParameter
+        In the order of ``names``.
+
+    Raises
+    ------
+    ParameterError
+        An unknown or repeated name, or an empty list (field ``parameters``).
     """
     if names is None:
         return FREE_PARAMETERS
@@ -171,6 +186,11 @@ def to_model(base: Model, vector, parameters: Sequence[FreeParameter] = FREE_PAR
     vector : array_like, shape (n,)
         Values of ``parameters``, each in its unit.
     parameters : sequence of FreeParameter
+
+    Returns
+    -------
+    Model
+        A new, validated model with every path of every free parameter set.
     """
     values = {path: float(v) for p, v in zip(parameters, vector, strict=True) for path in p.paths}
     return set_parameters(base, values)
@@ -183,6 +203,11 @@ def from_model(model: Model, parameters: Sequence[FreeParameter] = FREE_PARAMETE
     ----------
     model : Model
     parameters : sequence of FreeParameter
+
+    Returns
+    -------
+    numpy.ndarray, shape (n,)
+        One value per free parameter, each in its unit.
     """
     return np.array([p.value(model) for p in parameters])
 
@@ -193,5 +218,10 @@ def bounds(parameters: Sequence[FreeParameter] = FREE_PARAMETERS) -> list[tuple[
     Parameters
     ----------
     parameters : sequence of FreeParameter
+
+    Returns
+    -------
+    list of tuple of float
+        ``[(lower, upper), ...]``, as :func:`scipy.optimize.differential_evolution` takes them.
     """
     return [(p.lower, p.upper) for p in parameters]

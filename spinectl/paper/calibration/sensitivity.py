@@ -62,6 +62,12 @@ def sensitivity(
         Grid points per axis of the landscapes.
     step : float
         Half step, as a fraction of each bound's width (clipped to the bounds).
+
+    Returns
+    -------
+    Sensitivity
+        The landmarks used, the Jacobian [1], shape (n_landmarks, n_parameters), its
+        singular values and right singular vectors.
     """
     parameters = tuple(parameters)
     centre = from_model(model, parameters)

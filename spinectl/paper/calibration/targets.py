@@ -1,4 +1,4 @@
-"""The paper's landmarks as fitting targets, and the loss (docs/reproduction.md, The loss).
+"""The paper's landmarks as fitting targets, and the loss (docs/reproduction.md, "The loss").
 
 A weighted sum over the landmarks: squared log-ratio residuals log(value /
 paper) for the "about" landmarks, one-sided (hinge) squared log-ratios for "<"
@@ -73,6 +73,12 @@ def paper_targets(weights: dict[str, float] | None = None) -> tuple[Target, ...]
     ----------
     weights : dict, optional
         Landmark name to weight; unlisted landmarks weigh 1.
+
+    Returns
+    -------
+    tuple of Target
+        The landmarks with a positive value and a positive weight, in the order of
+        :data:`spinectl.paper.landmarks.LANDMARKS`.
     """
     weights = WEIGHTS if weights is None else weights
     return tuple(
@@ -92,6 +98,11 @@ def synthetic_targets(measurements: Sequence[Measurement], names: Sequence[str] 
     names : sequence of str, optional
         Landmarks to use; default every one with a finite positive value. Exact zeros
         (relation '=', e.g. ‖CT‖ at A, whose measured value is rounding) are left out.
+
+    Returns
+    -------
+    tuple of Target
+        One '~' target of weight 1 per chosen landmark, its value the measured one.
     """
     chosen = [m for m in measurements if (names is None or m.landmark.name in names) and m.landmark.relation != "="]
     return tuple(Target(m.landmark.name, m.value, "~") for m in chosen if np.isfinite(m.value) and m.value > 0)
@@ -109,6 +120,11 @@ def penalty(target: Target, value: float) -> float:
     target : Target
     value : float
         spinectl's measurement, in the landmark's unit.
+
+    Returns
+    -------
+    float
+        The term [1], >= 0.
     """
     if not (np.isfinite(value) and value > 0):
         return target.weight * MISSING_PENALTY
@@ -128,6 +144,11 @@ def loss(measurements: Sequence[Measurement], targets: Sequence[Target]) -> floa
     measurements : sequence of Measurement
         From :func:`spinectl.paper.landmarks.measure`.
     targets : sequence of Target
+
+    Returns
+    -------
+    float
+        The loss [1], >= 0.
     """
     values = {m.landmark.name: m.value for m in measurements}
     return float(sum(penalty(t, values[t.name]) for t in targets))
@@ -175,6 +196,11 @@ def residuals(measurements: Sequence[Measurement], targets: Sequence[Target]) ->
         From :func:`spinectl.paper.landmarks.measure`.
     targets : sequence of Target
         The fitted landmarks; the others get penalty 0.
+
+    Returns
+    -------
+    tuple of Residual
+        One per measurement, in their order.
     """
     by_name = {t.name: t for t in targets}
     out = []
