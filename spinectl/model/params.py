@@ -281,9 +281,9 @@ class Local:
         10.0,
         "1",
         "Dimensionless q of the muscle stiffness k = q F / l (Bergmark 1989, doi:10.3109/17453678909154177; "
-        "used for spine stability by Cholewicki & McGill 1996, doi:10.1016/0268-0033(95)00035-6). 10 is a "
-        "value common in that literature, not a measurement: Brown & McGill 2010 "
-        "(doi:10.1080/10255841003630652) find q falling with activation. Local PCSAs scale with 1/q.",
+        "used for spine stability by Cholewicki & McGill 1996, doi:10.1016/0268-0033(95)00035-6). 10 is "
+        "spinectl's assumption, not a measurement: Brown et al. 2010 (doi:10.1080/10255841003630652) find "
+        "q falling with activation. Local PCSAs scale with 1/q.",
     )
     lever_arm: float = param(
         0.07,
