@@ -237,6 +237,12 @@ def chain_coefficients(model: Model, eccentricity, lordosis) -> ChainCoefficient
     Returns
     -------
     ChainCoefficients
+
+    References
+    ----------
+    Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012). Spinal lordosis
+    optimizes the requirements for a stable erect posture. Theor Biol Med Model 9:13.
+    doi:10.1186/1742-4682-9-13.
     """
     cor = geometry.cor_positions(eccentricity, lordosis, model.geometry)  # (..., n, 2)
     upper, lower, to_muscle, l0, l_opt, hill = _fibre_constants(model)
@@ -281,6 +287,11 @@ def coupled_margin(stiffness):
     -------
     numpy.ndarray, shape (...)
         [N m/rad]; > 0 stable.
+
+    References
+    ----------
+    Bergmark A (1989). Stability of the lumbar spine. A study in mechanical engineering.
+    Acta Orthop Scand Suppl 230:1-54. doi:10.3109/17453678909154177.
     """
     return np.linalg.eigvalsh(-np.asarray(stiffness, float))[..., 0]
 
@@ -296,6 +307,11 @@ def local_stiffness_per_pcsa(model: Model) -> float:
     ----------
     model : Model
         Supplies ``local`` (q, r [m], l [m]) and ``fibre.specific_tension`` sigma [N/m^2].
+
+    Returns
+    -------
+    float
+        kappa [N m/rad / m^2].
 
     References
     ----------
@@ -318,5 +334,10 @@ def local_pcsa(local_stiffness, model: Model):
     local_stiffness : array_like
         k [N m/rad].
     model : Model
+
+    Returns
+    -------
+    numpy.ndarray
+        A [m^2], the shape of ``local_stiffness``.
     """
     return np.asarray(local_stiffness, float) / local_stiffness_per_pcsa(model)

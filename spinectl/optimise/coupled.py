@@ -306,6 +306,13 @@ def least_local_stiffness(model: Model, eccentricity: float, lordosis: float, pc
     ParameterError
         ``pcsa`` has the wrong length or a negative or non-finite entry; E or Lambda is
         outside the modelled range.
+    ModelError
+        A fibre attachment lies on a CoR, or the arithmetic overflows.
+
+    References
+    ----------
+    Bergmark A (1989). Stability of the lumbar spine. A study in mechanical engineering.
+    Acta Orthop Scand Suppl 230:1-54. doi:10.3109/17453678909154177.
     """
     given = model.replace(optimisation=dataclasses.replace(model.optimisation, activation="independent"))
     data = coupled_data(given, eccentricity, lordosis)  # one variable per muscle: x = pcsa in cm^2
@@ -327,6 +334,18 @@ def min_global_pcsa(model: Model, eccentricity: float, lordosis: float) -> Coupl
     -------
     CoupledOptimum
         ``local_stiffness`` is zero; NaN and status 'infeasible' where no activation can.
+
+    Raises
+    ------
+    ParameterError
+        E or Lambda is outside the modelled range.
+    ModelError
+        A fibre attachment lies on a CoR, or the arithmetic overflows.
+
+    References
+    ----------
+    Bergmark A (1989). Stability of the lumbar spine. A study in mechanical engineering.
+    Acta Orthop Scand Suppl 230:1-54. doi:10.3109/17453678909154177.
     """
     data = coupled_data(model, eccentricity, lordosis)
     status, x = min_global_pcsa_sdp(data)
@@ -346,6 +365,18 @@ def joint_optimum(model: Model, eccentricity: float, lordosis: float) -> Coupled
     Returns
     -------
     CoupledOptimum
+
+    Raises
+    ------
+    ParameterError
+        E or Lambda is outside the modelled range.
+    ModelError
+        A fibre attachment lies on a CoR, or the arithmetic overflows.
+
+    References
+    ----------
+    Bergmark A (1989). Stability of the lumbar spine. A study in mechanical engineering.
+    Acta Orthop Scand Suppl 230:1-54. doi:10.3109/17453678909154177.
     """
     data = coupled_data(model, eccentricity, lordosis)
     status, x, k = joint_optimum_sdp(data)
