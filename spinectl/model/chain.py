@@ -199,6 +199,11 @@ class ChainCoefficients:
             PCSA of each global muscle [m^2].
         local_stiffness : array_like, shape (..., n_cor)
             Stiffness k_j >= 0 of the local muscles at each joint [N m/rad]; 0: none.
+
+        Returns
+        -------
+        numpy.ndarray, shape (..., n_cor, n_cor)
+            Symmetric [N m/rad]; its diagonal is S_k - k_k.
         """
         muscular = np.einsum("...jkm,...m->...jk", self.stiffness_per_pcsa, np.asarray(pcsa, float))
         diagonal = self.passive_stiffness + np.asarray(local_stiffness, float)
@@ -211,6 +216,11 @@ class ChainCoefficients:
         ----------
         pcsa : array_like, shape (..., n_muscles)
             PCSA of each global muscle [m^2].
+
+        Returns
+        -------
+        numpy.ndarray, shape (..., n_cor, n_cor)
+            Symmetric, negative semidefinite [N m s/rad]; its diagonal is D_k.
         """
         return np.einsum("...jkm,...m->...jk", self.damping_per_pcsa, np.asarray(pcsa, float))
 

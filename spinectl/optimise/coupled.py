@@ -87,6 +87,11 @@ class CoupledData:
             Decision variables [cm^2].
         local_stiffness : array_like, shape (n_cor,)
             k [N m/rad]; 0: none.
+
+        Returns
+        -------
+        numpy.ndarray, shape (n_cor, n_cor)
+            [N m/rad].
         """
         k = np.broadcast_to(np.asarray(local_stiffness, float), self.stiffness_offset.shape[:1])
         return self.stiffness_offset + self.stiffness @ np.asarray(x, float) - np.diag(k)
@@ -101,6 +106,10 @@ def coupled_data(model: Model, eccentricity: float, lordosis: float) -> CoupledD
         ``optimisation`` (activation, margins, bounds, tolerance) and ``local``.
     eccentricity, lordosis : float
         E and Lambda [m], inside the modelled range.
+
+    Returns
+    -------
+    CoupledData
 
     Raises
     ------
