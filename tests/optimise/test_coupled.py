@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from spinectl import load_preset, optimise
+from spinectl.errors import ParameterError
 from spinectl.model import chain
 from spinectl.model.mechanics import segment_coefficients
 from spinectl.model.params import Body, Passive
@@ -212,7 +213,6 @@ def test_totals_scale_with_the_mass(solve):
 
 
 def test_outside_the_modelled_range_is_an_error(model):
-    from spinectl.errors import ParameterError
-
+    """E = 0.5 m lies outside geometry.eccentricity_range (+-0.1 m): an error naming E, not a NaN."""
     with pytest.raises(ParameterError):
         coupled.joint_optimum(model, 0.5, 0.0)
