@@ -45,7 +45,7 @@ from ..model.checks import arithmetic_guard, checked_coefficients, expand_pcsa
 from ..model.params import Model
 from ..units import M2_PER_CM2
 from .problem import OK_STATUSES, ProblemData, inequalities, problem_data, to_si
-from .reference import _solve
+from .reference import solve_with_fallback
 
 
 @dataclass(frozen=True)
@@ -173,7 +173,7 @@ def least_local_stiffness_sdp(data: CoupledData, x) -> tuple[str, np.ndarray | N
     k = cp.Variable(data.stiffness_offset.shape[0], nonneg=True)
     x = np.asarray(x, float)
     problem = cp.Problem(cp.Minimize(cp.sum(k)), [_lmi(data, x, k)])
-    status = _solve(problem, data.problem.tolerance)
+    status = solve_with_fallback(problem, data.problem.tolerance)
     if status not in OK_STATUSES:
         return status, None
     return status, _feasible_local(data, x, k.value)
@@ -196,7 +196,7 @@ def min_global_pcsa_sdp(data: CoupledData) -> tuple[str, np.ndarray | None]:
     lhs, rhs = inequalities(data.problem)
     x = cp.Variable(data.problem.weights.size)
     problem = cp.Problem(cp.Minimize(data.problem.weights @ x), [lhs @ x <= rhs, _lmi(data, x)])
-    status = _solve(problem, data.problem.tolerance)
+    status = solve_with_fallback(problem, data.problem.tolerance)
     if status not in OK_STATUSES:
         return status, None
     return status, np.maximum(x.value, 0.0)
@@ -228,7 +228,7 @@ def joint_optimum_sdp(data: CoupledData) -> tuple[str, np.ndarray | None, np.nda
     k = cp.Variable(n_cor, nonneg=True)
     cost = data.problem.weights @ x + data.cost_weight * cp.sum(k) / data.local_per_cm2
     problem = cp.Problem(cp.Minimize(cost), [lhs @ x <= rhs, _lmi(data, x, k)])
-    status = _solve(problem, data.problem.tolerance)
+    status = solve_with_fallback(problem, data.problem.tolerance)
     if status not in OK_STATUSES:
         return status, None, None
     x_opt = np.maximum(x.value, 0.0)
