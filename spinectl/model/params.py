@@ -283,6 +283,52 @@ class Passive:
 
 
 @dataclass(frozen=True)
+class Local:
+    """Local (intersegmental) muscles as a joint stiffness of the coupled chain (docs/chain.md).
+
+    A local muscle of PCSA A at full activation pulls with F = specific_tension * A at the
+    lever arm r of one joint; its short-range stiffness q F / l (Bergmark 1989,
+    doi:10.3109/17453678909154177) gives the joint the rotational stiffness q F r^2 / l.
+    """
+
+    stiffness_gain: float = param(
+        10.0,
+        "1",
+        "Dimensionless q of the muscle stiffness k = q F / l (Bergmark 1989, doi:10.3109/17453678909154177; "
+        "used for spine stability by Cholewicki & McGill 1996, doi:10.1016/0268-0033(95)00035-6). 10 is "
+        "spinectl's assumption, not a measurement: Brown et al. 2010 (doi:10.1080/10255841003630652) find "
+        "q falling with activation. Local PCSAs scale with 1/q.",
+    )
+    lever_arm: float = param(
+        0.07,
+        "m",
+        "Lever arm r of a local muscle about its joint (paper, Discussion: a conservative 7.0 cm, so that "
+        "its +-30 N m limit is a PCSA of 17 cm^2).",
+    )
+    length: float = param(
+        0.035,
+        "m",
+        "Length l of a local muscle in k = q F / l: one motion segment, the mean spacing of the paper's "
+        "centres of rotation, (145 - 5 mm) / 4 = 35 mm.",
+    )
+    cost_weight: float = param(
+        1.0,
+        "1",
+        "Weight w of the local PCSA against the global PCSA in the joint optimum of the coupled chain "
+        "(docs/chain.md): 1 counts a cm^2 of local muscle like a cm^2 of global muscle.",
+    )
+
+    def __post_init__(self):
+        _store(
+            self,
+            stiffness_gain=v.positive("stiffness_gain", self.stiffness_gain),
+            lever_arm=v.positive("lever_arm", self.lever_arm),
+            length=v.positive("length", self.length),
+            cost_weight=v.non_negative("cost_weight", self.cost_weight),
+        )
+
+
+@dataclass(frozen=True)
 class Errata:
     """Choices between the paper's printed formulas and their corrections (docs/model.md, "Errata")."""
 
@@ -456,6 +502,7 @@ class Model:
         default_factory=_default_muscles, metadata={"doc": "The antagonistic pairs of global muscles."}
     )
     passive: Passive = field(default_factory=Passive, metadata={"doc": "Passive stiffness K."})
+    local: Local = field(default_factory=Local, metadata={"doc": "Local muscles of the coupled chain."})
     errata: Errata = field(default_factory=Errata, metadata={"doc": "Printed formula or correction."})
     optimisation: Optimisation = field(default_factory=Optimisation, metadata={"doc": "Optimiser settings."})
     reflex: Reflex = field(default_factory=Reflex, metadata={"doc": "Delayed reflex and its simulation."})

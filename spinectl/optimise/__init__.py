@@ -42,6 +42,7 @@ from .reference import (
     pareto_front,
     point_optimum,
     solve_point,
+    solve_with_fallback,
 )
 
 __all__ = [
@@ -70,6 +71,7 @@ __all__ = [
     "polished",
     "problem_data",
     "solve_point",
+    "solve_with_fallback",
     "solver_options",
     "to_si",
     "worst_status",

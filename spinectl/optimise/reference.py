@@ -60,13 +60,26 @@ SOLVERS = ("CLARABEL", "SCS")
 """Solvers tried in order: Clarabel, then SCS as the fallback when Clarabel fails."""
 
 
-def _solve(problem: cp.Problem, tolerance: float | None = None) -> str:
+def solve_with_fallback(problem: cp.Problem, tolerance: float | None = None) -> str:
     """Solve with the first solver that answers; return the cvxpy status or 'solver_error'.
 
     An 'optimal' status without finite values for the variables (a broken
     solver) does not count as an answer. cvxpy's warnings (e.g. "Solution may
     be inaccurate") are silenced: the status records them, and a command-line
-    user must see one line, not solver chatter.
+    user must see one line, not solver chatter. The per-point reference and the
+    coupled chain's semidefinite programs (:mod:`spinectl.optimise.coupled`) share it.
+
+    Parameters
+    ----------
+    problem : cvxpy.Problem
+        The problem; its variables hold the answer afterwards.
+    tolerance : float, optional
+        Feasibility and gap tolerance (:func:`~spinectl.optimise.problem.solver_options`).
+
+    Returns
+    -------
+    str
+        cvxpy's status ('optimal', 'optimal_inaccurate', 'infeasible', ...) or 'solver_error'.
     """
     for solver in SOLVERS:
         try:
@@ -92,7 +105,7 @@ def _stage(data: ProblemData, stage: str, cost, total_max=np.inf, x_ct=None) -> 
     lhs, rhs = inequalities(data, total_max, x_ct)
     x = cp.Variable(data.weights.size)
     problem = cp.Problem(cp.Minimize(cost(x)), [lhs @ x <= rhs])
-    status = _solve(problem, data.tolerance)
+    status = solve_with_fallback(problem, data.tolerance)
     if status not in OK_STATUSES:
         return status, None
     x_opt, verified = polished(data, stage, x.value, total_max, x_ct)
@@ -379,7 +392,7 @@ def pareto_front(model: Model, eccentricity: float, lordosis: float, n_points: i
     problem = cp.Problem(cp.Minimize(cp.norm(_ct_expression(data, x), 2)), constraints)
     for value in budgets:
         budget.value = value
-        status = _solve(problem, data.tolerance)
+        status = solve_with_fallback(problem, data.tolerance)
         statuses.append(status)
         norm = np.nan
         if status in OK_STATUSES:

@@ -109,6 +109,7 @@ KINDS = {
     "muscles.fibres": INT,
     "passive.stiffness": REAL,
     "passive.convention": CHOICE,
+    **{f"local.{f.name}": REAL for f in dataclasses.fields(Model().local)},
     "errata.gravity_sign": CHOICE,
     "errata.eccentric_constant": CHOICE,
     "optimisation.activation": CHOICE,
@@ -158,6 +159,10 @@ OUT_OF_RANGE = {
     "muscles.spread": [-0.01, 0.24, 1.0],  # the default straight fibre is 0.24 m long
     "muscles.fibres": [0, -1, MAX_FIBRES + 1, 10**30],
     "passive.stiffness": [-1.0],
+    "local.stiffness_gain": [0.0, -10.0],
+    "local.lever_arm": [0.0, -0.07],
+    "local.length": [0.0, -0.035],
+    "local.cost_weight": [-1.0],
     "optimisation.stability_margin": [-0.1],
     "optimisation.damping_margin": [-0.1],
     "optimisation.pcsa_max": [0.0, -1.0, -math.inf],

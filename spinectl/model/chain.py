@@ -1,0 +1,353 @@
+"""The coupled chain: every centre of rotation free at once (docs/chain.md).
+
+The paper tests each CoR alone, all others fixed (:mod:`spinectl.model.mechanics`). Here
+the generalised coordinates are q = (alpha_1, ..., alpha_n), one rotation per CoR in the
+order of ``geometry.cor_heights`` (top to bottom), with the pelvis fixed. Rotating joint k
+carries everything above it: the higher CoRs, the thoracic attachments of the global
+muscles and the point mass. Every global muscle runs from thorax to pelvis, so it spans
+all joints.
+
+Linearised at the upright equilibrium, tau(q, q') ~ tau_0 + K q + D q' with symmetric
+n x n matrices, linear in the PCSA like everything muscular: per unit PCSA of muscle i,
+K_i[j, k] = -f'_i h_ij h_ik - f_i d2l_i/dq_j dq_k and D_i[j, k] = (df_i/dv) h_ij h_ik;
+gravity K_g[j, k] = m g (y_m - y of the higher of CoRs j and k); the passive stiffness
+-K_pas on the diagonal. The diagonal is the per-segment analysis: K[k, k] = S_k and
+D[k, k] = D_k (:func:`spinectl.model.mechanics.segment_coefficients`). tau_0 is the
+per-segment torque, so the counter torques are those of the per-segment model.
+
+The nonlinear generalised torques (:func:`chain_muscle_torque_per_pcsa`,
+:func:`chain_gravity_torque`) are what K and D linearise; the tests differentiate them.
+Pure array functions, SI units, vectorised over leading (grid) dimensions.
+
+References
+----------
+Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012). Spinal lordosis
+optimizes the requirements for a stable erect posture. Theor Biol Med Model 9:13.
+doi:10.1186/1742-4682-9-13.
+
+Bergmark A (1989). Stability of the lumbar spine. A study in mechanical engineering.
+Acta Orthop Scand Suppl 230:1-54. doi:10.3109/17453678909154177.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import geometry, muscle
+from .mechanics import fibre_length_and_lever_arm, gravity_sign, inertia, passive_stiffness, rotate
+from .params import Model
+
+
+def chain_positions(q, cor):
+    """Positions of the centres of rotation, and the thorax's rotation, for joint angles ``q``.
+
+    Joint j is carried by every joint below it: with the bottom CoR fixed on the pelvis,
+    c_j(q) = c_{j+1}(q) + R(q_{j+1} + ... + q_n)(c_j - c_{j+1}). The thorax, above the top
+    joint, turns by the sum of all angles.
+
+    Parameters
+    ----------
+    q : array_like, shape (..., n_cor)
+        Rotation of each joint [rad], counter-clockwise, top to bottom.
+    cor : array_like, shape (..., n_cor, 2)
+        Upright positions of the CoRs [m], top to bottom.
+
+    Returns
+    -------
+    moved : numpy.ndarray, shape (..., n_cor, 2)
+        CoR positions in the rotated chain [m].
+    thorax_angle : numpy.ndarray, shape (...)
+        Rotation of the thorax, sum of ``q`` [rad].
+    """
+    q = np.asarray(q, float)
+    cor = np.asarray(cor, float)
+    n = cor.shape[-2]
+    moved = np.array(np.broadcast_to(cor, np.broadcast_shapes(q.shape + (2,), cor.shape)))
+    angle = np.zeros(moved.shape[:-2])
+    for j in range(n - 2, -1, -1):
+        angle = angle + q[..., j + 1]
+        moved[..., j, :] = moved[..., j + 1, :] + rotate(cor[..., j, :] - cor[..., j + 1, :], angle)
+    return moved, angle + q[..., 0]
+
+
+def carried_points(points, q, cor):
+    """Positions of points fixed to the thorax (above every joint) in the rotated chain.
+
+    P(q) = c_1(q) + R(q_1 + ... + q_n)(P - c_1), c_1 the top CoR (:func:`chain_positions`).
+
+    Parameters
+    ----------
+    points : array_like, shape (n_points, 2)
+        Upright positions [m], e.g. the upper attachments of the fibres.
+    q : array_like, shape (..., n_cor)
+        Joint rotations [rad].
+    cor : array_like, shape (..., n_cor, 2)
+        Upright CoR positions [m].
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., n_points, 2)
+        [m].
+    """
+    moved, angle = chain_positions(q, cor)
+    top = np.asarray(cor, float)[..., 0, None, :]
+    return moved[..., 0, None, :] + rotate(np.asarray(points, float) - top, angle[..., None])
+
+
+def _fibre_constants(model: Model):
+    """Attachments, fibre-to-muscle matrix per unit PCSA, upright length, l_opt and Hill constants."""
+    upper, lower, share = geometry.all_fibres(model)
+    l0 = np.linalg.norm(lower - upper, axis=-1)
+    l_opt = model.fibre.optimal_length_ratio * l0
+    hill = muscle.hill_constants(l_opt, model.fibre, model.errata)
+    return upper, lower, model.fibre.specific_tension * share, l0, l_opt, hill
+
+
+def chain_muscle_torque_per_pcsa(model: Model, cor, q, qdot):
+    """Nonlinear generalised torques of every muscle on every joint per unit PCSA [N m / m^2].
+
+    tau_j = sum over fibres of h_j f_l(l) f_H(v) (paper, Methods: M_i = h_i f_li f_Hi), with
+    the fibre's length l(q), its lever arm about the moved CoR j, h_j = -dl/dq_j, and its
+    shortening velocity v = sum_j h_j q'_j. With one joint free this is
+    :func:`spinectl.model.mechanics.muscle_torque_per_pcsa`.
+
+    Parameters
+    ----------
+    model : Model
+    cor : array_like, shape (..., n_cor, 2)
+        Upright CoR positions [m].
+    q : array_like, shape (..., n_cor)
+        Joint rotations [rad].
+    qdot : array_like, shape (..., n_cor)
+        Joint angular velocities [rad/s].
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., n_cor, n_muscles)
+    """
+    upper, lower, to_muscle, _, l_opt, hill = _fibre_constants(model)
+    moved, _ = chain_positions(q, cor)
+    tops = carried_points(upper, q, cor)  # (..., F, 2)
+    length, h = fibre_length_and_lever_arm(tops[..., None, :, :], lower, moved[..., :, None, :])  # (..., n, F)
+    velocity = np.einsum("...jf,...j->...f", h, np.asarray(qdot, float))
+    tension = muscle.force_length(length[..., 0, :], l_opt, model.fibre) * muscle.force_velocity(velocity, hill)
+    return (h * tension[..., None, :]) @ to_muscle
+
+
+def chain_gravity_torque(model: Model, cor, q):
+    """Nonlinear generalised torque of the point mass on every joint [N m].
+
+    tau_j = -dV/dq_j with V = m g y_m(q): tau_j = -m g (m(q) - c_j(q))_x, the torque of the
+    weight about the moved CoR j (:func:`spinectl.model.mechanics.gravity_torque` when one
+    joint is free, with its sign convention, ``errata.gravity_sign``).
+
+    Parameters
+    ----------
+    model : Model
+    cor : array_like, shape (..., n_cor, 2)
+        Upright CoR positions [m].
+    q : array_like, shape (..., n_cor)
+        Joint rotations [rad].
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., n_cor)
+    """
+    moved, _ = chain_positions(q, cor)
+    mass = carried_points(geometry.mass_position(model)[None, :], q, cor)  # (..., 1, 2)
+    weight = model.body.mass * model.body.gravity
+    return gravity_sign(model) * (-weight * (mass - moved)[..., 0])
+
+
+@dataclass(frozen=True)
+class ChainCoefficients:
+    """The linearised chain at one or many (E, Lambda): tau ~ tau_0 + K q + D q'.
+
+    Muscular terms are per unit PCSA of each muscle [per m^2], as in
+    :class:`~spinectl.model.mechanics.SegmentCoefficients`; leading dimensions are those
+    of the broadcast (E, Lambda). Every matrix is symmetric, and its diagonal is the
+    per-segment coefficient of that CoR.
+
+    Attributes
+    ----------
+    stiffness_per_pcsa : numpy.ndarray, shape (..., n_cor, n_cor, n_muscles)
+        K_i = dtau/dq per unit PCSA of muscle i [N m/rad / m^2].
+    damping_per_pcsa : numpy.ndarray, shape (..., n_cor, n_cor, n_muscles)
+        D_i = dtau/dq' per unit PCSA [N m s/rad / m^2]; negative semidefinite.
+    gravity_stiffness : numpy.ndarray, shape (..., n_cor, n_cor)
+        K_g [N m/rad]: m g (y_m - y of the higher CoR), positive definite with the corrected sign.
+    passive_stiffness : numpy.ndarray, shape (..., n_cor)
+        K_pas per joint as a physical stiffness [N m/rad], entering K as -diag(K_pas).
+    length_gradient : numpy.ndarray, shape (..., n_fibres, n_cor)
+        dl/dq of every fibre [m/rad], = -h; rank <= 3 for fibres from thorax to pelvis.
+    """
+
+    stiffness_per_pcsa: np.ndarray
+    damping_per_pcsa: np.ndarray
+    gravity_stiffness: np.ndarray
+    passive_stiffness: np.ndarray
+    length_gradient: np.ndarray
+
+    def stiffness(self, pcsa, local_stiffness=0.0):
+        """K - diag(k) [N m/rad]: muscles, gravity, passive and local stiffness.
+
+        Parameters
+        ----------
+        pcsa : array_like, shape (..., n_muscles)
+            PCSA of each global muscle [m^2].
+        local_stiffness : array_like, shape (..., n_cor)
+            Stiffness k_j >= 0 of the local muscles at each joint [N m/rad]; 0: none.
+
+        Returns
+        -------
+        numpy.ndarray, shape (..., n_cor, n_cor)
+            Symmetric [N m/rad]; its diagonal is S_k - k_k.
+        """
+        muscular = np.einsum("...jkm,...m->...jk", self.stiffness_per_pcsa, np.asarray(pcsa, float))
+        diagonal = self.passive_stiffness + np.asarray(local_stiffness, float)
+        return muscular + self.gravity_stiffness - diagonal[..., None] * np.eye(diagonal.shape[-1])
+
+    def damping(self, pcsa):
+        """D [N m s/rad] of the global muscles.
+
+        Parameters
+        ----------
+        pcsa : array_like, shape (..., n_muscles)
+            PCSA of each global muscle [m^2].
+
+        Returns
+        -------
+        numpy.ndarray, shape (..., n_cor, n_cor)
+            Symmetric, negative semidefinite [N m s/rad]; its diagonal is D_k.
+        """
+        return np.einsum("...jkm,...m->...jk", self.damping_per_pcsa, np.asarray(pcsa, float))
+
+
+def chain_coefficients(model: Model, eccentricity, lordosis) -> ChainCoefficients:
+    """Stiffness and damping matrices of the chain at the upright equilibrium, per unit PCSA.
+
+    With u_j = U - c_j (upper attachment from CoR j), e = P - U (the fibre) and
+    h_j = (u_j x e) / l the lever arm about CoR j, the fibre length has the Hessian
+
+        d2l/dq_j dq_k = (u_j . u_k + e . u_hi - h_j h_k) / l,
+
+    hi the higher of CoRs j and k (the second derivative of the carried point U is
+    -u_hi); its diagonal is -dh/dalpha of :func:`~spinectl.model.mechanics.lever_arm_slope`.
+    Per unit f_iso of a fibre, K = -f_l' h h' - f_l d2l and D = f_l f_H'(0) h h'
+    (docs/chain.md); gravity and the passive stiffness as in the per-segment model.
+
+    Parameters
+    ----------
+    model : Model
+    eccentricity, lordosis : array_like
+        E and Lambda [m]; broadcast together.
+
+    Returns
+    -------
+    ChainCoefficients
+
+    References
+    ----------
+    Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012). Spinal lordosis
+    optimizes the requirements for a stable erect posture. Theor Biol Med Model 9:13.
+    doi:10.1186/1742-4682-9-13.
+    """
+    cor = geometry.cor_positions(eccentricity, lordosis, model.geometry)  # (..., n, 2)
+    upper, lower, to_muscle, l0, l_opt, hill = _fibre_constants(model)
+    f_l = muscle.force_length(l0, l_opt, model.fibre)
+    f_l_slope = muscle.force_length_slope(l0, l_opt, model.fibre)
+    f_h_slope = muscle.force_velocity_slope(np.zeros_like(l0), hill)
+
+    _, h = fibre_length_and_lever_arm(upper, lower, cor[..., :, None, :])  # (..., n, F)
+    u = upper - cor[..., :, None, :]  # (..., n, F, 2)
+    n = cor.shape[-2]
+    higher = np.minimum.outer(np.arange(n), np.arange(n))  # CoRs are ordered top to bottom
+    e_dot_u = np.einsum("fd,...jfd->...jf", lower - upper, u)
+    hh = h[..., :, None, :] * h[..., None, :, :]  # (..., n, n, F)
+    hessian = (np.einsum("...jfd,...kfd->...jkf", u, u) + e_dot_u[..., higher, :] - hh) / l0
+
+    y = cor[..., 1]
+    weight = model.body.mass * model.body.gravity
+    return ChainCoefficients(
+        stiffness_per_pcsa=(-f_l_slope * hh - f_l * hessian) @ to_muscle,
+        damping_per_pcsa=(f_l * f_h_slope * hh) @ to_muscle,
+        gravity_stiffness=gravity_sign(model) * weight * (model.body.mass_height - y[..., higher]),
+        passive_stiffness=passive_stiffness(model, inertia(cor, model)),
+        length_gradient=-np.swapaxes(h, -1, -2),
+    )
+
+
+def coupled_margin(stiffness):
+    """Smallest eigenvalue of -K [N m/rad]: the static stability margin of the chain.
+
+    The upright chain is statically stable (Bergmark 1989: the potential energy has a
+    minimum) iff -K is positive definite; spinectl's sign convention is that of S_k,
+    stable for negative stiffness. Its diagonal entries are -S_k, so the margin is at
+    most min_k(-S_k), the per-segment margin.
+
+    Parameters
+    ----------
+    stiffness : array_like, shape (..., n_cor, n_cor)
+        Symmetric K, or K - diag(k) with local stiffness k [N m/rad]
+        (:meth:`ChainCoefficients.stiffness`).
+
+    Returns
+    -------
+    numpy.ndarray, shape (...)
+        [N m/rad]; > 0 stable.
+
+    References
+    ----------
+    Bergmark A (1989). Stability of the lumbar spine. A study in mechanical engineering.
+    Acta Orthop Scand Suppl 230:1-54. doi:10.3109/17453678909154177.
+    """
+    return np.linalg.eigvalsh(-np.asarray(stiffness, float))[..., 0]
+
+
+def local_stiffness_per_pcsa(model: Model) -> float:
+    """Joint stiffness of a local muscle per unit PCSA at full activation [N m/rad / m^2].
+
+    kappa = q sigma r^2 / l: the muscle's short-range stiffness q F / l (Bergmark 1989;
+    Cholewicki & McGill 1996) with F = sigma A, acting at the lever arm r of its joint
+    (``local``; docs/chain.md). The geometric stiffness of its tension is neglected.
+
+    Parameters
+    ----------
+    model : Model
+        Supplies ``local`` (q, r [m], l [m]) and ``fibre.specific_tension`` sigma [N/m^2].
+
+    Returns
+    -------
+    float
+        kappa [N m/rad / m^2].
+
+    References
+    ----------
+    Cholewicki J, McGill SM (1996). Mechanical stability of the in vivo lumbar spine:
+    implications for injury and chronic low back pain. Clin Biomech 11(1):1-15.
+    doi:10.1016/0268-0033(95)00035-6.
+    """
+    local = model.local
+    return local.stiffness_gain * model.fibre.specific_tension * local.lever_arm**2 / local.length
+
+
+def local_pcsa(local_stiffness, model: Model):
+    """The least local-muscle PCSA that gives a joint the stiffness ``local_stiffness`` [m^2].
+
+    A = k / kappa (:func:`local_stiffness_per_pcsa`), at full activation; compare with the
+    paper's 17 cm^2 (30 N m at 7 cm).
+
+    Parameters
+    ----------
+    local_stiffness : array_like
+        k [N m/rad].
+    model : Model
+
+    Returns
+    -------
+    numpy.ndarray
+        A [m^2], the shape of ``local_stiffness``.
+    """
+    return np.asarray(local_stiffness, float) / local_stiffness_per_pcsa(model)

@@ -1,0 +1,392 @@
+"""Coupled stability of the lumbar chain: semidefinite programmes per point (docs/chain.md).
+
+The paper tests each centre of rotation alone. With all five free at once
+(:mod:`spinectl.model.chain`), the upright chain is statically stable when its stiffness
+matrix is negative definite (Bergmark 1989), here with the margin mu
+(``optimisation.stability_margin``, the per-segment margin):
+
+    diag(k) - K(x) >= mu I   (a linear matrix inequality, LMI),
+
+K(x) = K_g - diag(K_pas) + sum_i x_i K_i affine in the global PCSA x [cm^2] (the decision
+variables of :class:`~spinectl.optimise.problem.ProblemData`, paired or independent), k >= 0
+the stiffness of local muscles at each joint [N m/rad]. Three questions, each an SDP
+solved with cvxpy and Clarabel (PSD cone; SCS as the fallback):
+
+(a) :func:`least_local_stiffness`: at a given global activation, the least sum of k;
+(b) :func:`min_global_pcsa`: global muscles only (k = 0), the least total PCSA;
+(c) :func:`joint_optimum`: the least total global PCSA + w * local PCSA, with the local
+    PCSA k / kappa of :func:`spinectl.model.chain.local_pcsa` and w ``local.cost_weight``.
+
+(b) and (c) keep the per-segment problem's rows (:func:`~spinectl.optimise.problem.inequalities`):
+the damping rows D_k <= -damping_margin and the bounds on x; (b) also its stiffness rows
+S_k <= -mu, which the LMI implies (they are its diagonal). So the coupled feasible set lies
+inside the per-segment one and the coupled minimum is never below the paper's. A point where
+no activation stabilises the chain is an answer: NaN values and the solver's status.
+
+The solver's k is made exactly feasible by a uniform shift, k + max(0, mu - margin): adding
+c to every k_j adds c I to the matrix. The reported margin is that of numpy's eigvalsh.
+
+References
+----------
+Bergmark A (1989). Stability of the lumbar spine. A study in mechanical engineering.
+Acta Orthop Scand Suppl 230:1-54. doi:10.3109/17453678909154177.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+import cvxpy as cp
+import numpy as np
+
+from ..model import chain
+from ..model.checks import arithmetic_guard, checked_coefficients, expand_pcsa
+from ..model.params import Model
+from ..units import M2_PER_CM2
+from .problem import OK_STATUSES, ProblemData, inequalities, problem_data, to_si
+from .reference import solve_with_fallback
+
+
+@dataclass(frozen=True)
+class CoupledData:
+    """The data of the coupled problems at one (E, Lambda), decision variables x in cm^2.
+
+    Attributes
+    ----------
+    problem : ProblemData
+        The per-segment formulation: weights, bounds, damping rows, x -> muscles, CT.
+    coefficients : ChainCoefficients
+        The chain's matrices per unit PCSA (SI), :func:`spinectl.model.chain.chain_coefficients`.
+    stiffness : numpy.ndarray, shape (n_cor, n_cor, n_var)
+        K per unit x [N m/rad per cm^2].
+    stiffness_offset : numpy.ndarray, shape (n_cor, n_cor)
+        K at x = 0: gravity and passive stiffness [N m/rad].
+    margin : float
+        mu [N m/rad] (``optimisation.stability_margin``).
+    local_per_cm2 : float
+        kappa, joint stiffness per cm^2 of local muscle [N m/rad per cm^2].
+    cost_weight : float
+        w, the cost of a cm^2 of local muscle in cm^2 of global muscle [1] (``local.cost_weight``).
+    """
+
+    problem: ProblemData
+    coefficients: chain.ChainCoefficients
+    stiffness: np.ndarray
+    stiffness_offset: np.ndarray
+    margin: float
+    local_per_cm2: float
+    cost_weight: float
+
+    def matrix(self, x, local_stiffness=0.0) -> np.ndarray:
+        """K(x) - diag(k) [N m/rad] for decision variables ``x`` [cm^2].
+
+        Parameters
+        ----------
+        x : array_like, shape (n_var,)
+            Decision variables [cm^2].
+        local_stiffness : array_like, shape (n_cor,)
+            k [N m/rad]; 0: none.
+
+        Returns
+        -------
+        numpy.ndarray, shape (n_cor, n_cor)
+            [N m/rad].
+        """
+        k = np.broadcast_to(np.asarray(local_stiffness, float), self.stiffness_offset.shape[:1])
+        return self.stiffness_offset + self.stiffness @ np.asarray(x, float) - np.diag(k)
+
+
+def coupled_data(model: Model, eccentricity: float, lordosis: float) -> CoupledData:
+    """Assemble :class:`CoupledData` at one configuration.
+
+    Parameters
+    ----------
+    model : Model
+        ``optimisation`` (activation, margins, bounds, tolerance) and ``local``.
+    eccentricity, lordosis : float
+        E and Lambda [m], inside the modelled range.
+
+    Returns
+    -------
+    CoupledData
+
+    Raises
+    ------
+    ParameterError
+        E or Lambda is outside the modelled range (:func:`~spinectl.model.checks.validate_position`).
+    ModelError
+        A fibre attachment lies on a CoR, or the arithmetic overflows.
+    """
+    e, lam = float(eccentricity), float(lordosis)
+    data = problem_data(model, checked_coefficients(model, e, lam))
+    with arithmetic_guard(e, lam):
+        coeffs = chain.chain_coefficients(model, e, lam)
+    per_var = data.to_muscles * M2_PER_CM2  # m^2 of each muscle per cm^2 of x
+    return CoupledData(
+        problem=data,
+        coefficients=coeffs,
+        stiffness=coeffs.stiffness_per_pcsa @ per_var,
+        stiffness_offset=coeffs.stiffness(np.zeros(per_var.shape[0])),
+        margin=model.optimisation.stability_margin,
+        local_per_cm2=chain.local_stiffness_per_pcsa(model) * M2_PER_CM2,
+        cost_weight=model.local.cost_weight,
+    )
+
+
+def _lmi(data: CoupledData, x, k=None) -> cp.Constraint:
+    """diag(k) - K(x) - mu I >> 0 as a cvxpy constraint; x a cvxpy variable or fixed values [cm^2]."""
+    n = data.stiffness_offset.shape[0]
+    if isinstance(x, cp.Expression):
+        stiffness = data.stiffness_offset + sum(x[i] * data.stiffness[:, :, i] for i in range(data.stiffness.shape[-1]))
+    else:
+        stiffness = data.matrix(x)
+    matrix = -stiffness - data.margin * np.eye(n)
+    return (matrix if k is None else matrix + cp.diag(k)) >> 0
+
+
+def _feasible_local(data: CoupledData, x, k) -> np.ndarray:
+    """k >= 0 shifted so that diag(k) - K(x) >= mu I holds to rounding (adds c I to the matrix)."""
+    k = np.maximum(np.asarray(k, float), 0.0)
+    shortfall = data.margin - chain.coupled_margin(data.matrix(x, k))
+    return k + max(shortfall, 0.0)
+
+
+def least_local_stiffness_sdp(data: CoupledData, x) -> tuple[str, np.ndarray | None]:
+    """(a) The least total local stiffness sum(k) with diag(k) - K(x) >= mu I, k >= 0.
+
+    Always feasible (large k); the dual is max <Z, K(x) + mu I> over Z >= 0, diag(Z) <= 1.
+
+    Parameters
+    ----------
+    data : CoupledData
+    x : array_like, shape (n_var,)
+        Global activation as decision variables [cm^2].
+
+    Returns
+    -------
+    status : str
+        'optimal', 'optimal_inaccurate' or 'solver_error'.
+    k : numpy.ndarray or None
+        Local stiffness per joint [N m/rad], None unless optimal.
+    """
+    k = cp.Variable(data.stiffness_offset.shape[0], nonneg=True)
+    x = np.asarray(x, float)
+    problem = cp.Problem(cp.Minimize(cp.sum(k)), [_lmi(data, x, k)])
+    status = solve_with_fallback(problem, data.problem.tolerance)
+    if status not in OK_STATUSES:
+        return status, None
+    return status, _feasible_local(data, x, k.value)
+
+
+def min_global_pcsa_sdp(data: CoupledData) -> tuple[str, np.ndarray | None]:
+    """(b) The least total global PCSA w.x with -K(x) >= mu I and the per-segment rows, k = 0.
+
+    Parameters
+    ----------
+    data : CoupledData
+
+    Returns
+    -------
+    status : str
+        'optimal', 'optimal_inaccurate', 'infeasible', 'infeasible_inaccurate' or 'solver_error'.
+    x : numpy.ndarray or None
+        Decision variables [cm^2], None unless optimal.
+    """
+    lhs, rhs = inequalities(data.problem)
+    x = cp.Variable(data.problem.weights.size)
+    problem = cp.Problem(cp.Minimize(data.problem.weights @ x), [lhs @ x <= rhs, _lmi(data, x)])
+    status = solve_with_fallback(problem, data.problem.tolerance)
+    if status not in OK_STATUSES:
+        return status, None
+    return status, np.maximum(x.value, 0.0)
+
+
+def joint_optimum_sdp(data: CoupledData) -> tuple[str, np.ndarray | None, np.ndarray | None]:
+    """(c) The least w.x + cost_weight * sum(k) / kappa with diag(k) - K(x) >= mu I, k >= 0.
+
+    The per-segment damping rows and bounds on x hold; the per-segment stiffness rows do not
+    apply, local stiffness entering each joint (the LMI's diagonal is S_k - k_k <= -mu).
+
+    Parameters
+    ----------
+    data : CoupledData
+
+    Returns
+    -------
+    status : str
+        As for :func:`min_global_pcsa_sdp`.
+    x : numpy.ndarray or None
+        Global decision variables [cm^2], None unless optimal.
+    k : numpy.ndarray or None
+        Local stiffness per joint [N m/rad], None unless optimal.
+    """
+    n_cor = data.stiffness_offset.shape[0]
+    lhs, rhs = inequalities(data.problem)
+    lhs, rhs = lhs[n_cor:], rhs[n_cor:]  # drop the per-segment stiffness rows (the first n_cor)
+    x = cp.Variable(data.problem.weights.size)
+    k = cp.Variable(n_cor, nonneg=True)
+    cost = data.problem.weights @ x + data.cost_weight * cp.sum(k) / data.local_per_cm2
+    problem = cp.Problem(cp.Minimize(cost), [lhs @ x <= rhs, _lmi(data, x, k)])
+    status = solve_with_fallback(problem, data.problem.tolerance)
+    if status not in OK_STATUSES:
+        return status, None, None
+    x_opt = np.maximum(x.value, 0.0)
+    return status, x_opt, _feasible_local(data, x_opt, k.value)
+
+
+@dataclass(frozen=True)
+class CoupledOptimum:
+    """Result of a coupled problem at one (E, Lambda), in SI units; NaN unless optimal.
+
+    Attributes
+    ----------
+    eccentricity, lordosis : float
+        E and Lambda [m].
+    status : str
+        The solver's status: 'optimal' (or 'optimal_inaccurate'), 'infeasible' (no activation
+        within the bounds stabilises the chain) or 'solver_error'.
+    pcsa : numpy.ndarray, shape (n_muscles,)
+        Global PCSA of each muscle [m^2].
+    local_stiffness : numpy.ndarray, shape (n_cor,)
+        k_j of the local muscles at each joint [N m/rad].
+    local_pcsa : numpy.ndarray, shape (n_cor,)
+        The least local-muscle PCSA giving k_j [m^2] (:func:`spinectl.model.chain.local_pcsa`).
+    counter_torque : numpy.ndarray, shape (n_cor,)
+        CT_k at the global activation [N m], as in the per-segment model.
+    margin : float
+        Smallest eigenvalue of -(K - diag(k)) [N m/rad]; >= stability_margin up to the solver tolerance.
+    """
+
+    eccentricity: float
+    lordosis: float
+    status: str
+    pcsa: np.ndarray
+    local_stiffness: np.ndarray
+    local_pcsa: np.ndarray
+    counter_torque: np.ndarray
+    margin: float
+
+    @property
+    def total_pcsa(self) -> float:
+        """Total global PCSA [m^2]."""
+        return float(np.sum(self.pcsa))
+
+    @property
+    def total_local_pcsa(self) -> float:
+        """Total local PCSA over the joints [m^2]."""
+        return float(np.sum(self.local_pcsa))
+
+    @property
+    def ok(self) -> bool:
+        """True if the optimum was found."""
+        return self.status in OK_STATUSES
+
+
+def _result(model: Model, data: CoupledData, e: float, lam: float, status: str, x, k) -> CoupledOptimum:
+    """A :class:`CoupledOptimum` from decision variables x [cm^2] and k [N m/rad] (None: NaN)."""
+    n_cor = data.stiffness_offset.shape[0]
+    x = np.full(data.problem.weights.size, np.nan) if x is None else x
+    k = np.full(n_cor, np.nan) if k is None else k
+    _, pcsa, counter_torque = to_si(data.problem, np.nan, x)
+    margin = np.nan if np.isnan(x).any() or np.isnan(k).any() else float(chain.coupled_margin(data.matrix(x, k)))
+    return CoupledOptimum(e, lam, status, pcsa, k, chain.local_pcsa(k, model), counter_torque, margin)
+
+
+def least_local_stiffness(model: Model, eccentricity: float, lordosis: float, pcsa) -> CoupledOptimum:
+    """(a) The least local stiffness that makes the chain stable at a global activation.
+
+    Parameters
+    ----------
+    model : Model
+    eccentricity, lordosis : float
+        E and Lambda [m].
+    pcsa : array_like
+        Global PCSA [m^2], one value per pair (both sides) or per muscle, whatever
+        ``optimisation.activation`` says.
+
+    Returns
+    -------
+    CoupledOptimum
+        ``pcsa`` is the given activation, ``local_stiffness`` the least k.
+
+    Raises
+    ------
+    ParameterError
+        ``pcsa`` has the wrong length or a negative or non-finite entry; E or Lambda is
+        outside the modelled range.
+    ModelError
+        A fibre attachment lies on a CoR, or the arithmetic overflows.
+
+    References
+    ----------
+    Bergmark A (1989). Stability of the lumbar spine. A study in mechanical engineering.
+    Acta Orthop Scand Suppl 230:1-54. doi:10.3109/17453678909154177.
+    """
+    given = model.replace(optimisation=dataclasses.replace(model.optimisation, activation="independent"))
+    data = coupled_data(given, eccentricity, lordosis)  # one variable per muscle: x = pcsa in cm^2
+    x = expand_pcsa(model, pcsa) / M2_PER_CM2
+    status, k = least_local_stiffness_sdp(data, x)
+    return _result(model, data, float(eccentricity), float(lordosis), status, x, k)
+
+
+def min_global_pcsa(model: Model, eccentricity: float, lordosis: float) -> CoupledOptimum:
+    """(b) The least global PCSA that makes the chain stable without local muscles.
+
+    Parameters
+    ----------
+    model : Model
+    eccentricity, lordosis : float
+        E and Lambda [m].
+
+    Returns
+    -------
+    CoupledOptimum
+        ``local_stiffness`` is zero; NaN and status 'infeasible' where no activation can.
+
+    Raises
+    ------
+    ParameterError
+        E or Lambda is outside the modelled range.
+    ModelError
+        A fibre attachment lies on a CoR, or the arithmetic overflows.
+
+    References
+    ----------
+    Bergmark A (1989). Stability of the lumbar spine. A study in mechanical engineering.
+    Acta Orthop Scand Suppl 230:1-54. doi:10.3109/17453678909154177.
+    """
+    data = coupled_data(model, eccentricity, lordosis)
+    status, x = min_global_pcsa_sdp(data)
+    k = None if x is None else np.zeros(data.stiffness_offset.shape[0])
+    return _result(model, data, float(eccentricity), float(lordosis), status, x, k)
+
+
+def joint_optimum(model: Model, eccentricity: float, lordosis: float) -> CoupledOptimum:
+    """(c) The least total global PCSA plus ``local.cost_weight`` times the local PCSA.
+
+    Parameters
+    ----------
+    model : Model
+    eccentricity, lordosis : float
+        E and Lambda [m].
+
+    Returns
+    -------
+    CoupledOptimum
+
+    Raises
+    ------
+    ParameterError
+        E or Lambda is outside the modelled range.
+    ModelError
+        A fibre attachment lies on a CoR, or the arithmetic overflows.
+
+    References
+    ----------
+    Bergmark A (1989). Stability of the lumbar spine. A study in mechanical engineering.
+    Acta Orthop Scand Suppl 230:1-54. doi:10.3109/17453678909154177.
+    """
+    data = coupled_data(model, eccentricity, lordosis)
+    status, x, k = joint_optimum_sdp(data)
+    return _result(model, data, float(eccentricity), float(lordosis), status, x, k)

@@ -1,0 +1,184 @@
+"""The coupled chain: kinematics, nonlinear torques and their linearisation (docs/chain.md)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from spinectl import load_preset
+from spinectl.model import chain, geometry, mechanics, muscle
+from spinectl.model.params import Errata, Local, Model, Passive
+
+STEP = 1e-6
+N_COR = 5
+
+
+def _random_positions(rng, n=4):
+    return rng.uniform(-0.08, 0.08, n), rng.uniform(-0.08, 0.08, n)
+
+
+def _central_difference(func, n=N_COR, step=STEP):
+    """d func / d z_k by central differences, stacked on a new axis after the joint axis."""
+    columns = [(func(step * np.eye(n)[k]) - func(-step * np.eye(n)[k])) / (2 * step) for k in range(n)]
+    return np.stack(columns, axis=-1)
+
+
+def test_one_free_joint_is_the_per_segment_model(model, rng):
+    """Only joint k turning (alpha, omega) is the paper's segment k with all other CoRs fixed:
+    the chain's torque on joint k is mechanics' nonlinear torque about CoR k, muscles and gravity."""
+    E, L = _random_positions(rng)
+    cor = geometry.cor_positions(E, L, model.geometry)
+    for k in range(N_COR):
+        alpha, omega = rng.uniform(-0.2, 0.2), rng.uniform(-1.0, 1.0)
+        q, qdot = alpha * np.eye(N_COR)[k], omega * np.eye(N_COR)[k]
+        muscles = chain.chain_muscle_torque_per_pcsa(model, cor, q, qdot)[..., k, :]
+        segment = mechanics.muscle_torque_per_pcsa(model, cor[..., k, :], alpha, omega)
+        np.testing.assert_allclose(muscles, segment, rtol=1e-10, atol=1e-9 * np.abs(segment).max())
+        gravity = chain.chain_gravity_torque(model, cor, q)[..., k]
+        np.testing.assert_allclose(gravity, mechanics.gravity_torque(alpha, cor[..., k, :], model), rtol=1e-12)
+
+
+@pytest.mark.parametrize("convention", ["physical", "paper"])
+def test_diagonal_is_the_per_segment_stiffness_and_damping(rng, convention):
+    """K[k, k] = S_k and D[k, k] = D_k of segment_coefficients, every muscle, gravity and passive."""
+    model = Model(passive=Passive(stiffness=15.0, convention=convention))
+    E, L = _random_positions(rng)
+    coupled = chain.chain_coefficients(model, E, L)
+    segment = mechanics.segment_coefficients(model, E, L)
+    per_muscle = np.diagonal(coupled.stiffness_per_pcsa, axis1=-3, axis2=-2).swapaxes(-1, -2)
+    np.testing.assert_allclose(per_muscle, segment.stiffness_per_pcsa, rtol=1e-12, atol=1e-9)
+    damping = np.diagonal(coupled.damping_per_pcsa, axis1=-3, axis2=-2).swapaxes(-1, -2)
+    np.testing.assert_allclose(damping, segment.damping_per_pcsa, rtol=1e-12, atol=1e-9)
+    pcsa = rng.uniform(0, 20e-4, 6)
+    np.testing.assert_allclose(
+        np.diagonal(coupled.stiffness(pcsa), axis1=-2, axis2=-1), segment.stiffness(pcsa), rtol=1e-12, atol=1e-9
+    )
+    np.testing.assert_allclose(
+        np.diagonal(coupled.damping(pcsa), axis1=-2, axis2=-1), segment.damping(pcsa), rtol=1e-12, atol=1e-12
+    )
+
+
+def test_matrices_are_symmetric(model, rng):
+    coupled = chain.chain_coefficients(model, *_random_positions(rng))
+    for matrix in (coupled.stiffness_per_pcsa, coupled.damping_per_pcsa):
+        np.testing.assert_array_equal(matrix, np.swapaxes(matrix, -3, -2))
+    np.testing.assert_array_equal(coupled.gravity_stiffness, np.swapaxes(coupled.gravity_stiffness, -1, -2))
+
+
+@pytest.mark.parametrize("preset", ["default", "wagner2012"])
+def test_stiffness_is_central_difference_of_nonlinear_chain_torques(rng, preset):
+    """dtau_j/dq_k of chain_muscle_torque_per_pcsa (q' = 0), every muscle and pair of joints."""
+    model = load_preset(preset)
+    E, L = _random_positions(rng)
+    cor = geometry.cor_positions(E, L, model.geometry)
+    zero = np.zeros(N_COR)
+    fd = _central_difference(lambda q: chain.chain_muscle_torque_per_pcsa(model, cor, q, zero))  # (..., j, M, k)
+    fd = np.moveaxis(fd, -1, -2)
+    expected = chain.chain_coefficients(model, E, L).stiffness_per_pcsa
+    np.testing.assert_allclose(expected, fd, atol=1e-6 * np.abs(fd).max())
+
+
+def test_damping_is_central_difference_of_nonlinear_chain_torques(model, rng):
+    """dtau_j/dq'_k; the Hill curve has a kink in its second derivative at v = 0, hence 1e-6."""
+    E, L = _random_positions(rng)
+    cor = geometry.cor_positions(E, L, model.geometry)
+    zero = np.zeros(N_COR)
+    fd = np.moveaxis(_central_difference(lambda w: chain.chain_muscle_torque_per_pcsa(model, cor, zero, w)), -1, -2)
+    damping = chain.chain_coefficients(model, E, L).damping_per_pcsa
+    np.testing.assert_allclose(damping, fd, atol=1e-6 * np.abs(fd).max())
+    # negative semidefinite for every muscle: sum of f_l f_H'(0) h h' with f_H'(0) < 0
+    eigs = np.linalg.eigvalsh(np.moveaxis(damping, -1, -3))
+    assert np.all(eigs <= 1e-9 * np.abs(eigs).max())
+
+
+@pytest.mark.parametrize("sign", ["destabilising", "printed"])
+def test_gravity_stiffness_is_central_difference_and_closed_form(rng, sign):
+    """K_g = dtau_g/dq by differences, and by hand: m g (y_m - y of the higher CoR)."""
+    model = Model(errata=Errata(gravity_sign=sign))
+    E, L = _random_positions(rng)
+    cor = geometry.cor_positions(E, L, model.geometry)
+    fd = _central_difference(lambda q: chain.chain_gravity_torque(model, cor, q))
+    coupled = chain.chain_coefficients(model, E, L)
+    np.testing.assert_allclose(coupled.gravity_stiffness, fd, rtol=1e-7)
+    y = np.asarray(model.geometry.cor_heights)
+    weight = model.body.mass * model.body.gravity * (1 if sign == "destabilising" else -1)
+    # L1L2 (row 0) is the higher CoR of every pair it is in; L5S1 (4) with L4L5 (3): L4L5
+    np.testing.assert_allclose(coupled.gravity_stiffness[..., 0, 4], weight * (0.326 - y[0]), rtol=1e-12)
+    np.testing.assert_allclose(coupled.gravity_stiffness[..., 4, 3], weight * (0.326 - y[3]), rtol=1e-12)
+    # the matrix min(s_j, s_k), s = y_m - y > 0 distinct: a Brownian-motion covariance, positive definite
+    eigs = np.linalg.eigvalsh(coupled.gravity_stiffness * (1 if sign == "destabilising" else -1))
+    assert np.all(eigs > 0)
+
+
+def test_single_vertical_fibre_closed_form(vertical_model):
+    """U = (d, T), P = (d, 0): h_j = -d at every joint, and by hand
+    d2l/dq_j dq_k = ((T - y_j)(T - y_k) - T (T - y_hi)) / T, y_hi the higher of the two."""
+    m = vertical_model
+    coupled = chain.chain_coefficients(m, 0.0, 0.0)
+    d, top = 0.12, 0.24
+    y = np.asarray(m.geometry.cor_heights)
+    higher = np.maximum.outer(y, y)
+    hessian = (np.outer(top - y, top - y) - top * (top - higher)) / top
+    l_opt = 1.2 * top
+    f_l = muscle.force_length(top, l_opt, m.fibre)
+    f_l_slope = muscle.force_length_slope(top, l_opt, m.fibre)
+    expected = m.fibre.specific_tension * (-f_l_slope * d**2 - f_l * hessian)
+    np.testing.assert_allclose(coupled.stiffness_per_pcsa[..., 0], expected, rtol=1e-12)
+    np.testing.assert_allclose(coupled.stiffness_per_pcsa[..., 1], expected, rtol=1e-12)  # the mirror fibre
+    np.testing.assert_allclose(coupled.length_gradient[..., 0, :], d, rtol=1e-12)  # dl/dq = -h = d
+
+
+@pytest.mark.parametrize("preset", ["default", "wagner2012"])
+def test_length_gradient_has_rank_at_most_three(rng, preset):
+    """h_ij = (U_i - c_j) x e_i / l_i is affine in c_j: at most 3 independent columns (1, c_x, c_y),
+    2 when the CoRs lie on a vertical line (Lambda = 0, c_x = -E), so 2-3 joint modes get no f'."""
+    model = load_preset(preset)
+    E, L = _random_positions(rng, 6)
+    gradient = chain.chain_coefficients(model, E, L).length_gradient  # (6, F, 5)
+    assert list(np.linalg.matrix_rank(gradient)) == [3] * 6
+    straight = chain.chain_coefficients(model, E, 0.0).length_gradient
+    assert list(np.linalg.matrix_rank(straight)) == [2] * 6
+
+
+def test_chain_positions_are_a_rigid_chain(model, rng):
+    """Turning joint k moves the CoRs above it rigidly about c_k and none below; the thorax turns by sum(q)."""
+    cor = geometry.cor_positions(0.02, 0.05, model.geometry)
+    q = rng.uniform(-0.3, 0.3, N_COR)
+    moved, angle = chain.chain_positions(q, cor)
+    assert angle == pytest.approx(q.sum(), rel=1e-14)
+    np.testing.assert_array_equal(moved[-1], cor[-1])  # L5S1 sits on the pelvis
+    for j in range(N_COR - 1):  # link lengths are kept
+        assert np.linalg.norm(moved[j] - moved[j + 1]) == pytest.approx(np.linalg.norm(cor[j] - cor[j + 1]))
+    k = 2
+    one, _ = chain.chain_positions(0.1 * np.eye(N_COR)[k], cor)
+    np.testing.assert_allclose(one[k:], cor[k:], atol=1e-15)
+    np.testing.assert_allclose(one[:k], cor[k] + mechanics.rotate(cor[:k] - cor[k], 0.1), atol=1e-15)
+    upper, _, _ = geometry.all_fibres(model)
+    tops = chain.carried_points(upper, q, cor)
+    np.testing.assert_allclose(tops, moved[0] + mechanics.rotate(upper - cor[0], q.sum()), atol=1e-15)
+
+
+def test_coupled_margin_is_the_smallest_eigenvalue_of_minus_k():
+    """A diagonal K gives min(-S_k); a coupling lowers it below every -S_k (2 x 2 by hand)."""
+    assert chain.coupled_margin(np.diag([-3.0, -1.0, -2.0])) == pytest.approx(1.0)
+    # [[-2, 1], [1, -2]]: eigenvalues of -K are 1 and 3
+    assert chain.coupled_margin(np.array([[-2.0, 1.0], [1.0, -2.0]])) == pytest.approx(1.0)
+
+
+def test_local_muscle_stiffness_per_pcsa_by_hand():
+    """q sigma r^2 / l = 10 * 25 N/cm^2 * (7 cm)^2 / 3.5 cm = 350 N m/rad per 10 cm^2: the paper's
+    17 cm^2 local muscle (30 N m at 7 cm) is a joint stiffness of 595 N m/rad."""
+    model = Model()
+    assert chain.local_stiffness_per_pcsa(model) == pytest.approx(10 * 25e4 * 0.07**2 / 0.035)
+    assert float(chain.local_pcsa(595.0, model)) == pytest.approx(17e-4)
+    halved = Model(local=Local(stiffness_gain=5.0))
+    assert float(chain.local_pcsa(595.0, halved)) == pytest.approx(34e-4)
+
+
+def test_coefficients_broadcast_over_a_grid(model):
+    E, L = np.meshgrid(np.linspace(0, 0.08, 3), np.linspace(0, 0.08, 2), indexing="ij")
+    grid = chain.chain_coefficients(model, E, L)
+    assert grid.stiffness_per_pcsa.shape == (3, 2, 5, 5, 6)
+    assert grid.length_gradient.shape == (3, 2, 30, 5)
+    one = chain.chain_coefficients(model, E[2, 1], L[2, 1])
+    np.testing.assert_allclose(grid.stiffness_per_pcsa[2, 1], one.stiffness_per_pcsa, rtol=1e-12)

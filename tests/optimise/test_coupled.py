@@ -1,0 +1,218 @@
+"""Coupled stability of the chain: the issue's finding and the three SDPs (docs/chain.md)."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import cvxpy as cp
+import numpy as np
+import pytest
+
+from spinectl import load_preset, optimise
+from spinectl.errors import ParameterError
+from spinectl.model import chain
+from spinectl.model.mechanics import segment_coefficients
+from spinectl.model.params import Body, Passive
+from spinectl.optimise import coupled
+
+LOWER = 1 - 1e-4
+"""Lowering an optimum's objective by 1e-4 relative must leave the feasible set."""
+
+TOL = 1e-6
+"""Feasibility of the LMI [N m/rad], far above the solver's 1e-9 and far below any margin."""
+
+
+def _with(model, **settings):
+    return model.replace(optimisation=dataclasses.replace(model.optimisation, **settings))
+
+
+def _null_modes(coefficients):
+    """Orthonormal joint modes that change no fibre length to first order: null(dl/dq)."""
+    _, sing, rows = np.linalg.svd(coefficients.length_gradient)
+    return rows[np.sum(sing > 1e-10 * sing[0]) :].T
+
+
+def test_segment_optimum_leaves_four_chain_modes_unstable():
+    """The issue's claim, at preset wagner2012, position A (E = Lambda = 0), on the LP optimum:
+    the diagonal of K is S_k, all < 0 (self-stable segment by segment), yet K has 4 positive
+    eigenvalues; the issue reports -K's as about -58 ... +258 N m/rad."""
+    model = load_preset("wagner2012")
+    opt = optimise.solve_point(model, 0.0, 0.0)
+    stiffness = chain.chain_coefficients(model, 0.0, 0.0).stiffness(opt.pcsa)
+    per_segment = segment_coefficients(model, 0.0, 0.0).stiffness(opt.pcsa)
+    np.testing.assert_allclose(np.diag(stiffness), per_segment, rtol=1e-12, atol=1e-9)
+    assert np.all(per_segment <= -model.optimisation.stability_margin * (1 - 1e-6))
+    eigs = np.linalg.eigvalsh(-stiffness)
+    assert np.sum(eigs < 0) == 4
+    assert eigs[0] == pytest.approx(-58, abs=1) and eigs[-1] == pytest.approx(258, abs=1)
+    assert chain.coupled_margin(stiffness) == pytest.approx(eigs[0])
+
+
+@pytest.mark.parametrize("preset", ["default", "wagner2012"])
+@pytest.mark.parametrize(("E", "L"), [(0.0, 0.0), (0.03, 0.04)])
+def test_global_muscles_alone_cannot_stabilise_the_chain(preset, E, L):
+    """An independent certificate of (b)'s infeasibility: on the null modes N of dl/dq, every
+    muscle's K_i is positive definite (its tension buckles the chain; the f' term is zero there)
+    and so is gravity's, so N'K(x)N > 0 for every x >= 0 and -K(x) >= mu I is impossible."""
+    model = load_preset(preset)
+    coefficients = chain.chain_coefficients(model, E, L)
+    modes = _null_modes(coefficients)
+    assert modes.shape[1] >= 2  # rank(dl/dq) <= 3 of 5 joints
+    per_muscle = np.einsum("ja,jkm,kb->mab", modes, coefficients.stiffness_per_pcsa, modes)
+    assert np.all(np.linalg.eigvalsh(per_muscle) > 0)
+    assert np.all(np.linalg.eigvalsh(modes.T @ coefficients.stiffness(np.zeros(6)) @ modes) > 0)
+    result = coupled.min_global_pcsa(model, E, L)
+    assert result.status in optimise.INFEASIBLE_STATUSES and not result.ok
+    assert np.isnan(result.total_pcsa) and np.isnan(result.margin)
+
+
+def test_every_activation_leaves_as_many_unstable_modes_as_null_modes(rng):
+    """By Courant-Fischer, K > 0 on the null modes gives K at least dim(N) positive eigenvalues."""
+    model = load_preset("default")
+    coefficients = chain.chain_coefficients(model, 0.03, 0.04)
+    n_modes = _null_modes(coefficients).shape[1]
+    for pcsa in rng.uniform(0, 50e-4, (20, 6)):
+        assert np.sum(np.linalg.eigvalsh(coefficients.stiffness(pcsa)) > 0) >= n_modes
+
+
+def _dual_bound(stiffness, margin):
+    """max <Z, K + mu I> over Z >= 0, diag(Z) <= 1: by weak duality a lower bound on sum(k) of (a)."""
+    n = stiffness.shape[0]
+    z = cp.Variable((n, n), PSD=True)
+    problem = cp.Problem(cp.Maximize(cp.trace(z @ (stiffness + margin * np.eye(n)))), [cp.diag(z) <= 1])
+    problem.solve(solver="CLARABEL")
+    value = z.value
+    assert np.linalg.eigvalsh(value).min() >= -1e-7 and np.diag(value).max() <= 1 + 1e-7
+    return float(np.sum(value * (stiffness + margin * np.eye(n))))
+
+
+@pytest.mark.parametrize("preset", ["default", "wagner2012"])
+def test_least_local_stiffness_is_feasible_and_minimal(preset):
+    """(a) at the LP optimum: eigvalsh shows the LMI holds, a 1e-4 smaller k breaks it, and the
+    dual SDP's bound meets sum(k) (a second problem: the two are optimal together)."""
+    model = load_preset(preset)
+    E, L = 0.03, 0.04
+    opt = optimise.solve_point(model, E, L)
+    result = coupled.least_local_stiffness(model, E, L, opt.pcsa)
+    assert result.ok
+    mu = model.optimisation.stability_margin
+    stiffness = chain.chain_coefficients(model, E, L).stiffness(opt.pcsa)
+    k = result.local_stiffness
+    assert np.all(k >= 0)
+    assert chain.coupled_margin(stiffness - np.diag(k)) >= mu - 1e-12
+    assert result.margin == pytest.approx(chain.coupled_margin(stiffness - np.diag(k)))
+    assert chain.coupled_margin(stiffness - np.diag(LOWER * k)) < mu
+    assert _dual_bound(stiffness, mu) == pytest.approx(k.sum(), rel=1e-6)
+    np.testing.assert_allclose(result.local_pcsa, k / chain.local_stiffness_per_pcsa(model), rtol=1e-12)
+    np.testing.assert_allclose(result.pcsa, opt.pcsa, rtol=1e-12)
+    np.testing.assert_allclose(result.counter_torque, opt.counter_torque, rtol=1e-9, atol=1e-9)
+
+
+def test_no_local_stiffness_needed_where_the_chain_is_already_stable(model):
+    """A chain stabilised by a large passive stiffness alone needs k = 0 (a diagonal -K_pas > mu I)."""
+    stiff = model.replace(passive=Passive(stiffness=1e4))
+    result = coupled.least_local_stiffness(stiff, 0.0, 0.0, [0.0, 0.0, 0.0])
+    assert result.ok
+    np.testing.assert_allclose(result.local_stiffness, 0.0, atol=1e-6)
+
+
+@pytest.mark.parametrize("activation", ["paired", "independent"])
+def test_global_only_optimum_where_passive_stiffness_makes_it_feasible(activation):
+    """(b) with K = 100 N m/rad: feasible, LMI held by eigvalsh, a 1e-4 smaller x breaks it,
+    and never below the per-segment minimum (the LMI's diagonal is the per-segment rows)."""
+    model = _with(load_preset("default"), activation=activation)
+    model = model.replace(passive=Passive(stiffness=100.0))
+    result = coupled.min_global_pcsa(model, 0.0, 0.0)
+    assert result.ok
+    mu = model.optimisation.stability_margin
+    coefficients = chain.chain_coefficients(model, 0.0, 0.0)
+    assert chain.coupled_margin(coefficients.stiffness(result.pcsa)) >= mu - TOL
+    lowered = LOWER * result.pcsa
+    assert np.all(segment_coefficients(model, 0.0, 0.0).damping(lowered) < -model.optimisation.damping_margin)
+    assert chain.coupled_margin(coefficients.stiffness(lowered)) < mu  # so it is the LMI that breaks
+    assert result.total_pcsa >= optimise.solve_point(model, 0.0, 0.0).min_pcsa * (1 - 1e-6)
+    np.testing.assert_array_equal(result.local_stiffness, 0.0)
+
+
+@pytest.mark.parametrize("preset", ["default", "wagner2012"])
+def test_joint_optimum_is_feasible_minimal_and_below_the_sequential_answer(preset):
+    """(c): the LMI holds; x and k lowered together by 1e-4 break it; and its cost is at most that
+    of the LP optimum plus (a)'s local stiffness there, a feasible point of (c)."""
+    model = load_preset(preset)
+    E, L = 0.0, 0.0
+    result = coupled.joint_optimum(model, E, L)
+    assert result.ok
+    mu = model.optimisation.stability_margin
+    coefficients = chain.chain_coefficients(model, E, L)
+    k = result.local_stiffness
+    assert chain.coupled_margin(coefficients.stiffness(result.pcsa, k)) >= mu - TOL
+    assert chain.coupled_margin(coefficients.stiffness(LOWER * result.pcsa, LOWER * k)) < mu
+    w = model.local.cost_weight
+    cost = result.total_pcsa + w * result.total_local_pcsa
+    opt = optimise.solve_point(model, E, L)
+    sequential = coupled.least_local_stiffness(model, E, L, opt.pcsa)
+    assert cost <= opt.total_pcsa + w * sequential.total_local_pcsa
+    independent = coupled.joint_optimum(_with(model, activation="independent"), E, L)
+    assert independent.total_pcsa + w * independent.total_local_pcsa <= cost * (1 + 1e-6)
+
+
+@pytest.mark.parametrize("preset", ["default", "wagner2012"])
+def test_joint_optimum_meets_its_dual_bound(preset):
+    """(c) against the Lagrange dual, built here from the chain's matrices and the per-segment
+    rows without the stiffness rows (S_k - k_k <= -mu is the LMI's diagonal):
+    max <Z, K_0 + mu I> - lambda'h  s.t.  Z >= 0, diag(Z) <= w / kappa, lambda >= 0,
+    weights_i + <Z, K_i> + (G'lambda)_i = 0. Weak duality: any such (Z, lambda) bounds (c) below."""
+    model = load_preset(preset)
+    data = coupled.coupled_data(model, 0.0, 0.0)
+    x = np.array([1.0, 2.0, 3.0])  # the data's matrices are the chain's, per cm^2 of x
+    pcsa = data.problem.to_muscles @ x * 1e-4
+    np.testing.assert_allclose(data.matrix(x), data.coefficients.stiffness(pcsa), rtol=1e-12, atol=1e-9)
+    n_cor, mu = 5, model.optimisation.stability_margin
+    lhs, rhs = optimise.inequalities(data.problem)
+    lhs, rhs = lhs[n_cor:], rhs[n_cor:]
+    z = cp.Variable((n_cor, n_cor), PSD=True)
+    lam = cp.Variable(rhs.size, nonneg=True)
+    price = model.local.cost_weight / data.local_per_cm2
+    stationary = [
+        data.problem.weights[i] + cp.trace(z @ data.stiffness[:, :, i]) + lhs[:, i] @ lam == 0 for i in range(x.size)
+    ]
+    dual = cp.Problem(
+        cp.Maximize(cp.trace(z @ (data.stiffness_offset + mu * np.eye(n_cor))) - rhs @ lam),
+        [cp.diag(z) <= price, *stationary],
+    )
+    dual.solve(solver="CLARABEL")
+    assert dual.status == "optimal"
+    result = coupled.joint_optimum(model, 0.0, 0.0)
+    cost = (result.total_pcsa + model.local.cost_weight * result.total_local_pcsa) / 1e-4
+    assert dual.value == pytest.approx(cost, rel=1e-6)
+
+
+def test_joint_optimum_meets_the_per_segment_requirements(model):
+    """Segment k with its local stiffness is self-stable, S_k - k_k <= -mu (the LMI's diagonal)."""
+    result = coupled.joint_optimum(model, 0.03, 0.04)
+    segment = segment_coefficients(model, 0.03, 0.04)
+    mu = model.optimisation.stability_margin
+    assert np.all(segment.stiffness(result.pcsa) - result.local_stiffness <= -mu + TOL)
+    assert np.all(segment.damping(result.pcsa) <= -model.optimisation.damping_margin * (1 - 1e-6))
+
+
+@pytest.mark.parametrize("solve", ["least_local", "joint"])
+def test_totals_scale_with_the_mass(solve):
+    """With K_pas = 0 and no margins, K_g is proportional to m and K_i to x: doubling m doubles
+    x and k at the optimum (the LMI and the damping rows are homogeneous)."""
+    base = _with(load_preset("wagner2012"), stability_margin=0.0, damping_margin=0.0)
+    heavy = base.replace(body=Body(mass=2 * base.body.mass))
+    if solve == "joint":
+        light_result, heavy_result = (coupled.joint_optimum(m, 0.03, 0.04) for m in (base, heavy))
+        assert heavy_result.total_pcsa == pytest.approx(2 * light_result.total_pcsa, rel=1e-5)
+    else:
+        pcsa = optimise.solve_point(base, 0.03, 0.04).pcsa
+        light_result = coupled.least_local_stiffness(base, 0.03, 0.04, pcsa)
+        heavy_result = coupled.least_local_stiffness(heavy, 0.03, 0.04, 2 * pcsa)
+    assert heavy_result.local_stiffness.sum() == pytest.approx(2 * light_result.local_stiffness.sum(), rel=1e-5)
+
+
+def test_outside_the_modelled_range_is_an_error(model):
+    """E = 0.5 m lies outside geometry.eccentricity_range (+-0.1 m): an error naming E, not a NaN."""
+    with pytest.raises(ParameterError):
+        coupled.joint_optimum(model, 0.5, 0.0)
