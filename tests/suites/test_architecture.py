@@ -180,16 +180,19 @@ def spinectl_imports() -> list[Import]:
 
 
 def test_every_module_is_in_a_layer():
+    """Every module of spinectl belongs to a layer of LAYERS (a new top-level name fails here first)."""
     for module in module_files(PACKAGE):
         layer_of(module, 0)
 
 
 def test_no_module_imports_a_higher_layer(spinectl_imports):
+    """No module imports a module of a later layer, at module level or inside a function."""
     assert len(spinectl_imports) > 100  # the walk found the package's imports
     assert upward_imports(spinectl_imports, "spinectl") == []
 
 
 def test_no_import_cycle(spinectl_imports):
+    """The imports that run when a module is imported form no cycle."""
     cycle = import_cycle(spinectl_imports)
     assert cycle is None, "import cycle: " + " -> ".join(cycle)
 
@@ -200,12 +203,14 @@ def contributing_section(title: str) -> str:
 
 
 def test_the_layers_are_those_of_contributing():
+    """CONTRIBUTING.md's layer table lists the layers of LAYERS, in the same order."""
     cells = [line.split("|")[1] for line in contributing_section("Layers").splitlines() if line.startswith("|")]
     rows = [cell for cell in cells if "`" in cell]  # the table's first column, without header and rule
     assert [tuple(re.findall(r"`(\w+)`", row)) for row in rows] == list(LAYERS)
 
 
 def test_the_map_in_contributing_names_every_module():
+    """CONTRIBUTING.md's tree has a line for every file and folder of the package."""
     tree = contributing_section("The tree")
     names = {path.name for path in PACKAGE.rglob("*.py")} | {f"{p.name}/" for p in PACKAGE.rglob("*") if p.is_dir()}
     missing = [n for n in names - {"__pycache__/"} if not re.search(rf"(^|\s){re.escape(n)}(\s|$)", tree, re.M)]
@@ -247,6 +252,7 @@ def test_the_checks_find_upward_imports_of_every_form(tmp_path):
 
 
 def test_the_cycle_check_ignores_imports_inside_functions(tmp_path):
+    """An import inside a function breaks no cycle check; the same import at module level does."""
     package = _package(
         tmp_path,
         {

@@ -109,6 +109,7 @@ def command_paths(parser: argparse.ArgumentParser, prefix: str = "spinectl") -> 
 
 
 def test_cli_page_has_a_section_for_every_command(reference_site):
+    """The built CLI page has a section for every command and sub-command of the parser, with its options."""
     page = (reference_site / "cli.txt").read_text()
     headings = {line.strip() for line in page.splitlines()}
     paths = command_paths(build_parser())
@@ -118,6 +119,7 @@ def test_cli_page_has_a_section_for_every_command(reference_site):
 
 
 def test_api_pages_one_per_module_internal_ones_marked(reference_site):
+    """One API page per module; internal modules are marked on their page and listed apart on their package's."""
     pages = {p.stem: p.read_text() for p in (reference_site / "api").glob("*.txt")}
     assert {"spinectl.model", "spinectl.model.params", "spinectl.model._toml"} <= set(pages)
     assert "Internal module" in pages["spinectl.model._toml"]
@@ -129,6 +131,7 @@ def test_api_pages_one_per_module_internal_ones_marked(reference_site):
 
 
 def test_api_pages_of_modules_that_are_gone_are_pruned(tmp_path):
+    """Pages of modules that no longer exist are removed; the others stay."""
     pages = ["spinectl.model.params", "spinectl.model.gone", "spinectl.gone.module"]
     (tmp_path / API_FOLDER).mkdir()
     for name in pages:
@@ -138,6 +141,7 @@ def test_api_pages_of_modules_that_are_gone_are_pruned(tmp_path):
 
 
 def test_reexported_names_link_to_their_home():
+    """A re-exported name resolves to the module that defines it; others resolve to nothing."""
     assert reexports.canonical("spinectl.Model") == "spinectl.model.params.Model"
     assert reexports.canonical("spinectl.optimise.pareto_front") == "spinectl.optimise.reference.pareto_front"
     assert reexports.canonical("spinectl.model.params.Model") is None  # already its home
