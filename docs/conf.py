@@ -5,10 +5,12 @@ Build from the repository root (warnings are errors, as in CI)::
     python -m sphinx -W --keep-going -b html docs docs/_build/html
 
 Markdown pages go through MyST (myst-nb, which also executes and renders the
-notebooks); docstrings through autodoc and numpydoc. The reference pages
-(parameters, command line, API) are generated from the code at each build by
-the local extension in ``_ext/spinectl_docs``, which also copies the notebooks
-of ``notebooks/`` into ``docs/notebooks/``.
+notebooks); docstrings through autodoc and numpydoc. The reference pages are
+generated from the code at each build: the API by autosummary (one page per
+module, ``api/``, from ``_templates/autosummary/module.rst``), the command line
+by sphinx-argparse-cli (``cli.md``), the parameters and the tables of the
+reproduction page by the local extension in ``_ext/spinectl_docs``, which also
+copies the notebooks of ``notebooks/`` into ``docs/notebooks/``.
 """
 
 import os
@@ -32,6 +34,8 @@ extensions = [
     "myst_nb",  # MyST Markdown pages, and notebooks
     "numpydoc",
     "sphinx.ext.autodoc",
+    "sphinx.ext.autosummary",  # the API pages, docs/api.md
+    "sphinx_argparse_cli",  # the command-line reference, docs/cli.md
     "sphinx.ext.mathjax",
     "sphinx-mathjax-offline",  # MathJax 3 from _static/, so equations render without a network
     "sphinx.ext.viewcode",
@@ -39,6 +43,7 @@ extensions = [
 ]
 
 root_doc = "index"
+templates_path = ["_templates"]
 exclude_patterns = ["_build", "_generated", "**/.ipynb_checkpoints"]
 
 # MyST: $...$ and $$...$$ math, \begin{align} environments
@@ -58,6 +63,11 @@ autodoc_member_order = "bysource"
 autodoc_typehints = "signature"
 numpydoc_show_class_members = False  # autodoc lists the members itself
 numpydoc_xref_param_type = False
+
+# autosummary: a page per module, walking the package from docs/api.md (:recursive:);
+# a package's tables list what its __all__ exports, re-exported names included
+autosummary_generate = True
+autosummary_ignore_module_all = False
 
 # no intersphinx: the build runs without network
 

@@ -1,7 +1,10 @@
 """The schema engine for TOML files: reading, parsing, dotted keys, dataclasses from tables and back.
 
-Model files (:mod:`spinectl.model.config`) and study files (:mod:`spinectl.landscape.study.spec`)
-share it, so both report the same errors in the same words.
+Model files (:mod:`spinectl.model.config`) and study files (:mod:`spinectl.landscape.study.files`)
+share it, so both report the same errors in the same words: an unknown key with the allowed
+ones and a "did you mean" (:func:`check_keys`), a value that should be a table
+(:func:`check_table`), a dotted key that leads nowhere (:func:`locate`) or is given twice
+(:func:`flatten`), each field named as it is written in the file (:func:`quoted_key`).
 """
 
 from __future__ import annotations
@@ -118,6 +121,35 @@ def _index(node: list, key: str, dotted: str) -> int:
     return int(key)
 
 
+def locate(data, dotted: str) -> tuple:
+    """The table or array that holds the value at a dotted key, and the value's key in it.
+
+    Parameters
+    ----------
+    data : dict
+        Nested tables and arrays, as :func:`parse` or :func:`to_dict` give them.
+    dotted : str
+        A dotted key such as ``"body.mass"`` or ``"muscles.0.spread"`` (array items by index).
+
+    Returns
+    -------
+    tuple of (dict or list, str or int)
+        The holder and the key (an int in an array): ``holder[key]`` is the value.
+
+    Raises
+    ------
+    ConfigError
+        A part of ``dotted`` is unknown (with a "did you mean"), not an index of its array,
+        or follows a value that is not a table (field ``dotted``), as :func:`child` says.
+    """
+    node = data
+    *parents, last = dotted.split(".")
+    for key in parents:
+        node = child(node, key, dotted)
+    child(node, last, dotted)  # the last key must exist too: same checks, same messages
+    return node, int(last) if isinstance(node, list) else last
+
+
 def unknown_message(key: str, allowed) -> str:
     """The message for an unknown key: the allowed keys and the closest one.
 
@@ -138,6 +170,141 @@ def unknown_message(key: str, allowed) -> str:
     return f"unknown key {show(key)} (allowed: {', '.join(sorted(allowed))}){hint}"
 
 
+def check_keys(keys, allowed, where: str = "") -> None:
+    """Reject the first key that is not allowed, with :func:`unknown_message`.
+
+    Parameters
+    ----------
+    keys : iterable of str
+        The keys given, e.g. a table (its keys).
+    allowed : iterable of str
+        The keys allowed there.
+    where : str
+        The field of the table, as written in the file (``"samples"``, ``'axes."body.mass"'``);
+        empty at the top of the file.
+
+    Raises
+    ------
+    ConfigError
+        For the first unknown key; the field is ``where.key`` (the key escaped, since a quoted
+        TOML key may hold a line break).
+    """
+    allowed = list(allowed)
+    for key in keys:
+        if key not in allowed:
+            shown = escaped(key)
+            raise ConfigError(f"{where}.{shown}" if where else shown, unknown_message(key, allowed))
+
+
+def check_table(value, where: str) -> None:
+    """Reject a value that should be a table.
+
+    Parameters
+    ----------
+    value : object
+        The value given.
+    where : str
+        Its field, as written in the file.
+
+    Raises
+    ------
+    ConfigError
+        ``value`` is not a table (a dict).
+    """
+    if not isinstance(value, dict):
+        raise ConfigError(where, f"must be a table (got {show(value)})")
+
+
+def quoted_key(section: str, name: str) -> str:
+    """A key of ``section`` as written in TOML: ``axes."body.mass"`` (a dotted key is quoted).
+
+    Parameters
+    ----------
+    section : str
+        The field of the table that holds the key, e.g. ``"axes"``.
+    name : str
+        The key, possibly dotted.
+
+    Returns
+    -------
+    str
+        ``section.name``, with ``name`` quoted if it holds a dot, escaped either way.
+    """
+    return f'{section}."{escaped(name)}"' if "." in name else f"{section}.{escaped(name)}"
+
+
+def flatten(table: dict, section: str, is_leaf) -> dict:
+    """The dotted keys of nested tables: ``body.mass = 1`` unquoted is ``{"body": {"mass": 1}}`` in TOML.
+
+    Parameters
+    ----------
+    table : dict
+        A table whose keys may be dotted, quoted or not.
+    section : str
+        The field of the table, for messages.
+    is_leaf : callable
+        ``is_leaf(value)`` for a non-empty table: true if it is a value (e.g. ``{ start, stop,
+        num }``) rather than the next level of a dotted key. Other values are leaves anyway.
+
+    Returns
+    -------
+    dict
+        Each leaf by its dotted key, in the order of the file.
+
+    Raises
+    ------
+    ParameterError
+        A key is given twice: ``"body.mass"`` quoted and ``body.mass`` unquoted are two keys to TOML.
+    """
+    return _flatten(table, section, is_leaf, "")
+
+
+def _flatten(table: dict, section: str, is_leaf, prefix: str) -> dict:
+    out: dict = {}
+    for key, value in table.items():
+        name = f"{prefix}{key}"
+        nested = isinstance(value, dict) and bool(value) and not is_leaf(value)
+        parts = _flatten(value, section, is_leaf, f"{name}.") if nested else {name: value}
+        for dotted in parts:
+            if dotted in out:
+                raise ParameterError(quoted_key(section, dotted), "is given twice")
+        out |= parts
+    return out
+
+
+def field_metadata(obj, dotted: str) -> dict:
+    """The metadata (``unit``, ``doc``) of the dataclass field that holds a dotted parameter.
+
+    Parameters
+    ----------
+    obj : dataclass instance
+        E.g. a :class:`~spinectl.model.params.Model` (only its structure is read).
+    dotted : str
+        A dotted parameter, e.g. ``"body.mass"``; items of a tuple by index
+        (``"muscles.0.upper.1"`` is a coordinate of the field ``upper``).
+
+    Returns
+    -------
+    dict
+        The metadata of the last field on the way (empty if it has none).
+
+    Raises
+    ------
+    KeyError
+        A part of ``dotted`` names no field (check names first, e.g. with :func:`locate`).
+    IndexError
+        An index beyond its tuple.
+    """
+    node, meta = obj, {}
+    for key in dotted.split("."):
+        if isinstance(node, tuple):
+            node = node[int(key)]
+            continue
+        meta = {f.name: f.metadata for f in dataclasses.fields(node)}[key]
+        node = getattr(node, key)
+    return dict(meta)
+
+
 def to_dict(obj) -> dict:
     """Nested plain dict (lists for tuples) of a parameter dataclass.
 
@@ -145,6 +312,11 @@ def to_dict(obj) -> dict:
     ----------
     obj : dataclass instance
         A :class:`~spinectl.model.params.Model` or one of its sections.
+
+    Returns
+    -------
+    dict
+        Its fields by name; nested dataclasses as dicts, tuples of them as lists of dicts.
     """
     out = {}
     for f in dataclasses.fields(obj):
@@ -171,6 +343,11 @@ def from_dict(cls, data: dict, path: str = ""):
     path : str
         Dotted path of ``cls`` inside the model, prefixed to error field names.
 
+    Returns
+    -------
+    object
+        An instance of ``cls``.
+
     Raises
     ------
     ConfigError
@@ -178,13 +355,8 @@ def from_dict(cls, data: dict, path: str = ""):
     ParameterError
         For a value that fails validation; the field is named with its full path.
     """
-    if not isinstance(data, dict):
-        raise ConfigError(path or "config", f"must be a table (got {show(data)})")
-    fields = {f.name: f for f in dataclasses.fields(cls)}
-    for key in data:
-        if key not in fields:
-            shown = escaped(key)  # a quoted TOML key may hold a newline
-            raise ConfigError(f"{path}.{shown}" if path else shown, unknown_message(key, fields))
+    check_table(data, path or "config")
+    check_keys(data, [f.name for f in dataclasses.fields(cls)], path)
     hints = typing.get_type_hints(cls)
     kwargs = {}
     for name, value in data.items():
@@ -211,7 +383,24 @@ def _convert(hint, value, path: str):
     return value
 
 
-def _fields_toml(obj) -> list[str]:
+def table_lines(obj) -> list[str]:
+    """The fields of a dataclass as the lines of a TOML table, each after a comment with its unit and doc.
+
+    Parameters
+    ----------
+    obj : dataclass instance
+        One section of a model, e.g. its ``body``.
+
+    Returns
+    -------
+    list of str
+        ``# [unit] doc`` and ``name = value`` for each field (without the table's header).
+
+    Raises
+    ------
+    TypeError
+        A value that TOML cannot hold (a ``None``, an object).
+    """
     lines = []
     for f in dataclasses.fields(obj):
         unit = f.metadata.get("unit", "")

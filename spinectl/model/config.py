@@ -14,7 +14,7 @@ from pathlib import Path
 
 from .._validate import show
 from ..errors import ConfigError
-from ._toml import _fields_toml, child, from_dict, parse, read_text, to_dict
+from ._toml import from_dict, locate, parse, read_text, table_lines, to_dict
 from .params import Model
 
 PRESET_PACKAGE = "spinectl.presets"
@@ -159,12 +159,8 @@ def set_parameters(model: Model, values: dict) -> Model:
     """
     data = to_dict(model)
     for dotted, value in values.items():
-        node = data
-        *parents, last = dotted.split(".")
-        for key in parents:
-            node = child(node, key, dotted)
-        child(node, last, dotted)  # the last key must exist too: same checks, same messages
-        node[int(last) if isinstance(node, list) else last] = value
+        holder, key = locate(data, dotted)
+        holder[key] = value
     return from_dict(Model, data)
 
 
@@ -187,9 +183,9 @@ def dump_toml(model: Model) -> str:
         value = getattr(model, f.name)
         if isinstance(value, tuple):
             for item in value:
-                lines += [f"[[{f.name}]]", *_fields_toml(item), ""]
+                lines += [f"[[{f.name}]]", *table_lines(item), ""]
         else:
-            lines += [f"[{f.name}]", *_fields_toml(value), ""]
+            lines += [f"[{f.name}]", *table_lines(value), ""]
     return "\n".join(lines)
 
 

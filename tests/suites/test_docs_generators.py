@@ -1,16 +1,37 @@
-"""The generators of the reference pages in docs/_ext (the Sphinx build itself runs in .ci/run)."""
+"""The reference pages: spinectl's generators in docs/_ext, and the pages that maintained extensions make.
+
+The whole Sphinx build runs in .ci/run; :func:`reference_site` builds the
+command-line page and the API pages of one subpackage, as plain text, with the
+settings of docs/conf.py, so that a test can read what they list.
+"""
 
 from __future__ import annotations
 
 import argparse
+import shutil
+import subprocess
 import sys
 from pathlib import Path
+from types import SimpleNamespace
 
+import pytest
+
+from spinectl.cli import build_parser
 from spinectl.model.config import to_dict
 from spinectl.model.params import Model
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "docs" / "_ext"))
-from spinectl_docs import api, cli, guide, notebooks, parameters, reproduction, write_if_changed  # noqa: E402
+DOCS = Path(__file__).resolve().parents[2] / "docs"
+sys.path.insert(0, str(DOCS / "_ext"))
+from spinectl_docs import (  # noqa: E402
+    API_FOLDER,
+    guide,
+    notebooks,
+    parameters,
+    prune_api_pages,
+    reexports,
+    reproduction,
+    write_if_changed,
+)
 
 
 def test_parameters_page_lists_every_parameter_with_its_unit():
@@ -30,30 +51,102 @@ def test_parameters_page_lists_every_parameter_with_its_unit():
     assert "| `body.mass` | kg | `40.0` |" in page
 
 
-def test_cli_page_walks_sub_sub_commands_and_skips_aliases():
-    parser = argparse.ArgumentParser(prog="tool")
-    sub = parser.add_subparsers(dest="command")
-    group = sub.add_parser("group", help="a group", aliases=["g"])
-    inner = group.add_subparsers(dest="action")
-    leaf = inner.add_parser("leaf", help="the leaf")
-    leaf.add_argument("--width", type=float, default=2.5, help="width [m], default %(default)s")
-    page = cli.markdown(parser)
-    assert "## `tool`" in page and "### `tool group`" in page and "#### `tool group leaf`" in page
-    assert page.count("### `tool group`") == 1  # the alias g is the same parser
-    assert "| `--width WIDTH` | 2.5 | width \\[m\\], default 2.5 |" in page
+SITE_CONF = f"""
+import runpy
+
+globals().update(runpy.run_path({str(DOCS / "conf.py")!r}))
+extensions = [name for name in extensions if name != "spinectl_docs"]  # no notebooks, no generated pages
+templates_path = [{str(DOCS / "_templates")!r}]
+exclude_patterns = ["_build"]
+"""
+
+SITE_INDEX = """# Reference
+
+```{toctree}
+cli
+api
+```
+"""
+
+SITE_API = """API
+===
+
+.. autosummary::
+   :toctree: api
+   :recursive:
+
+   spinectl.model
+"""
 
 
-def test_cli_page_has_every_spinectl_command():
-    page = cli.markdown()
-    for command in ("spinectl config show", "spinectl config presets", "spinectl stability"):
-        assert f"`{command}`" in page
+@pytest.fixture(scope="module")
+def reference_site(tmp_path_factory) -> Path:
+    """docs/cli.md and the API pages of spinectl.model, built as text (in a subprocess: the
+    argparse extension removes spinectl.cli from ``sys.modules`` after reading its parser)."""
+    pytest.importorskip("sphinx_argparse_cli", reason="the docs extra is not installed")
+    src = tmp_path_factory.mktemp("site")
+    (src / "conf.py").write_text(SITE_CONF)
+    (src / "index.md").write_text(SITE_INDEX)
+    (src / "api.rst").write_text(SITE_API)
+    shutil.copy(DOCS / "cli.md", src / "cli.md")
+    command = [sys.executable, "-m", "sphinx", "-q", "-b", "text", str(src), str(src / "_build")]
+    done = subprocess.run(command, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    return src / "_build"
 
 
-def test_api_stub_per_module_and_reexports():
-    names = api.module_names()
-    assert "spinectl.model.mechanics" in names and "spinectl.__main__" not in names
-    assert ".. automodule:: spinectl.model.mechanics" in api.stub("spinectl.model.mechanics")
-    assert ":py:obj:`~spinectl.model.params.Model`" in api.stub("spinectl")
+def command_paths(parser: argparse.ArgumentParser, prefix: str = "spinectl") -> list[str]:
+    """Every sub-command below ``parser``, as typed (``spinectl config show``), aliases once."""
+    paths = []
+    for action in parser._actions:  # argparse has no public walk of its sub-commands
+        if isinstance(action, argparse._SubParsersAction):
+            seen = set()
+            for name, sub in action.choices.items():
+                if id(sub) not in seen:
+                    seen.add(id(sub))
+                    paths += [f"{prefix} {name}", *command_paths(sub, f"{prefix} {name}")]
+    return paths
+
+
+def test_cli_page_has_a_section_for_every_command(reference_site):
+    """The built CLI page has a section for every command and sub-command of the parser, with its options."""
+    page = (reference_site / "cli.txt").read_text()
+    headings = {line.strip() for line in page.splitlines()}
+    paths = command_paths(build_parser())
+    assert {"spinectl config show", "spinectl config presets", "spinectl study"} <= set(paths)
+    assert [path for path in paths if path not in headings] == []
+    assert "--preset NAME" in page and "--pcsa CM2,..." in page  # the options, with their metavars
+
+
+def test_api_pages_one_per_module_internal_ones_marked(reference_site):
+    """One API page per module; internal modules are marked on their page and listed apart on their package's."""
+    pages = {p.stem: p.read_text() for p in (reference_site / "api").glob("*.txt")}
+    assert {"spinectl.model", "spinectl.model.params", "spinectl.model._toml"} <= set(pages)
+    assert "Internal module" in pages["spinectl.model._toml"]
+    assert "Internal module" not in pages["spinectl.model.params"]
+    package = pages["spinectl.model"]  # tables of its modules, public first: "| "params" | Model parameters ..."
+    public, internal = package.split("-[ Modules ]-")[1].split("-[ Internal modules ]-")
+    assert '| "params"' in public and '"_toml"' not in public
+    assert '| "_toml"' in internal.split("-[")[0]
+
+
+def test_api_pages_of_modules_that_are_gone_are_pruned(tmp_path):
+    """Pages of modules that no longer exist are removed; the others stay."""
+    pages = ["spinectl.model.params", "spinectl.model.gone", "spinectl.gone.module"]
+    (tmp_path / API_FOLDER).mkdir()
+    for name in pages:
+        (tmp_path / API_FOLDER / f"{name}.rst").write_text(name)
+    prune_api_pages(SimpleNamespace(srcdir=tmp_path))
+    assert [p.stem for p in (tmp_path / API_FOLDER).iterdir()] == ["spinectl.model.params"]
+
+
+def test_reexported_names_link_to_their_home():
+    """A re-exported name resolves to the module that defines it; others resolve to nothing."""
+    assert reexports.canonical("spinectl.Model") == "spinectl.model.params.Model"
+    assert reexports.canonical("spinectl.optimise.pareto_front") == "spinectl.optimise.reference.pareto_front"
+    assert reexports.canonical("spinectl.model.params.Model") is None  # already its home
+    assert reexports.canonical("spinectl.no_such_name") is None
+    assert reexports.canonical("numpy.ndarray") is None  # not spinectl's
 
 
 def test_guide_pages_leave_out_the_index_and_the_references(tmp_path):

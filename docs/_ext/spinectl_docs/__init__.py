@@ -1,14 +1,12 @@
-"""Sphinx extension: spinectl's reference pages, generated from the code at build time.
+"""Sphinx extension: spinectl's own reference pages, generated from the code at build time.
 
-At ``builder-inited`` it writes, beside the hand-written pages (only when a
-text changed, so that incremental builds stay incremental):
+The API pages (autosummary) and the command line (sphinx-argparse-cli) come
+from maintained extensions (``conf.py``); what is particular to spinectl is
+here. At ``builder-inited`` it writes, beside the hand-written pages (only when
+a text changed, so that incremental builds stay incremental):
 
 - ``_generated/parameters.md``: every parameter with unit, default and
   documentation, from the field metadata of :mod:`spinectl.model.params`;
-- ``_generated/cli.md``: every command and sub-command of
-  :func:`spinectl.cli.build_parser`;
-- ``_generated/api-modules.md`` and ``api/<module>.rst``: one autodoc page per
-  module of the package, found by walking it;
 - ``_generated/guide-toctree.md``: the toctree of the guide pages, every
   top-level page except the index and the reference pages;
 - ``notebooks/*.ipynb`` and ``_generated/notebooks-toctree.md``: copies of the
@@ -18,19 +16,27 @@ text changed, so that incremental builds stay incremental):
   the tables of ``reproduction.md`` (free parameters, verdict of every landmark).
 
 ``_generated/`` is excluded from the sources (its files are included by
-``parameters.md``, ``cli.md``, ``api.md``, ``index.md``, ``notebooks.md`` and ``reproduction.md``);
-``api/``, ``notebooks/`` and ``_generated/`` are not in git. At ``autodoc-process-docstring`` it adds a
-numpydoc "Parameters" section built from the same metadata to the parameter
-dataclasses, so that their API pages document every field.
+``parameters.md``, ``index.md``, ``notebooks.md`` and ``reproduction.md``);
+``notebooks/``, ``_generated/`` and autosummary's ``api/`` are not in git.
+
+At ``autodoc-process-docstring`` it adds a numpydoc "Parameters" section built
+from the same metadata to the parameter dataclasses, so that their API pages
+document every field. At ``missing-reference`` it sends a reference to a
+re-exported name (``spinectl.Model``, listed on the package's page) to where
+the name is documented.
 """
 
 from __future__ import annotations
 
+import importlib.util
 from pathlib import Path
 
-from . import api, cli, fields, guide, notebooks, parameters, reproduction
+from . import fields, guide, notebooks, parameters, reexports, reproduction
 
 GENERATED = "_generated"
+
+API_FOLDER = "api"
+"""The folder of autosummary's module pages (``:toctree: api`` in ``api.md``)."""
 
 
 def write_if_changed(path: Path, text: str) -> None:
@@ -45,15 +51,6 @@ def generate(app) -> None:
     src = Path(app.srcdir)
     out = src / GENERATED
     write_if_changed(out / "parameters.md", parameters.markdown())
-    write_if_changed(out / "cli.md", cli.markdown())
-    modules = api.module_names()
-    write_if_changed(out / "api-modules.md", api.index_markdown(modules, folder=api.FOLDER))
-    stubs = {f"{name}.rst": api.stub(name) for name in modules}
-    for name, text in stubs.items():
-        write_if_changed(src / api.FOLDER / name, text)
-    for old in (src / api.FOLDER).glob("*.rst"):
-        if old.name not in stubs:  # a module that was removed or renamed
-            old.unlink()
     write_if_changed(out / "guide-toctree.md", guide.toctree_markdown(src))
     pages = notebooks.copy_notebooks(notebooks.sources(src.parent), src, write_if_changed)
     write_if_changed(out / "notebooks-toctree.md", notebooks.toctree_markdown(pages))
@@ -61,8 +58,25 @@ def generate(app) -> None:
     write_if_changed(out / "landmark-verdicts.md", reproduction.landmark_table())
 
 
+def prune_api_pages(app) -> None:
+    """Remove the pages that autosummary wrote for modules that are gone (renamed or removed).
+
+    autosummary writes ``api/<module>.rst`` but never removes one, and a page in
+    no toctree fails the build (``-W``); a fresh checkout has none of them.
+    """
+    for page in (Path(app.srcdir) / API_FOLDER).glob("*.rst"):
+        try:
+            gone = importlib.util.find_spec(page.stem) is None
+        except ModuleNotFoundError:  # its package is gone too
+            gone = True
+        if gone:
+            page.unlink()
+
+
 def setup(app):
     app.connect("builder-inited", generate)
+    app.connect("builder-inited", prune_api_pages, priority=600)  # after autosummary's (500)
     # before numpydoc (priority 500) turns the sections into reST
     app.connect("autodoc-process-docstring", fields.add_parameters_section, priority=400)
+    app.connect("missing-reference", reexports.resolve)
     return {"version": "1", "parallel_read_safe": True, "parallel_write_safe": True}

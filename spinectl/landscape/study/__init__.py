@@ -6,15 +6,17 @@ number of parameter axes and Monte-Carlo draws, and the outputs.
 it chunk by chunk (in-process, on a local Dask cluster or on an existing one)
 into a Zarr store that it can resume; :func:`load` reads the store back.
 
-- :mod:`spinectl.landscape.study.spec`: the study file, its validation and the plan of chunks;
+- :mod:`spinectl.landscape.study.spec`: the study, its validation and the plan of chunks;
+- :mod:`spinectl.landscape.study.files`: the study file, read and checked against its schema;
 - :mod:`spinectl.landscape.study.store`: the Zarr store's layout, creation, resume check and writes;
 - :mod:`spinectl.landscape.study.run`: the chunks on a scheduler, written as they finish.
 """
 
 from __future__ import annotations
 
+from .files import load_study, parse_study
 from .run import StudyResult, describe, run_study
-from .spec import Axis, Chunk, Sampled, Samples, Study, load_study, parse_study
+from .spec import Axis, Chunk, Sampled, Samples, Study
 from .store import load, open_store
 
 __all__ = [

@@ -1,11 +1,12 @@
-"""The study file: a validated :class:`Study` and its plan of chunks.
+"""The study: a validated :class:`Study` and its plan of chunks.
 
-A study file (TOML, format in ``docs/studies.md``) names a base model, the
-E x Lambda grid, any number of parameter axes (any dotted parameter, e.g.
-``body.mass``, ``passive.stiffness``, ``reflex.delay``) and Monte-Carlo draws
-of parameters (one ``sample`` dimension). It becomes a :class:`Study`, a frozen
-dataclass that validates every value through :func:`spinectl.model.config.set_parameters`
-before any work starts.
+A study names a base model, the E x Lambda grid, any number of parameter axes
+(any dotted parameter, e.g. ``body.mass``, ``passive.stiffness``,
+``reflex.delay``) and Monte-Carlo draws of parameters (one ``sample``
+dimension). A :class:`Study` is a frozen dataclass that validates every value
+through :func:`spinectl.model.config.set_parameters` before any work starts;
+:mod:`spinectl.landscape.study.files` reads it from a study file (TOML, format
+in ``docs/studies.md``), and errors name the fields as that file writes them.
 
 The work is cut into chunks: one combination of the parameter axes (and
 sample) times a tile of the grid, each solved as one stacked problem by the
@@ -15,21 +16,19 @@ study alone, never by the workers, so every worker count gives the same bits.
 
 from __future__ import annotations
 
-import dataclasses
 import hashlib
 import json
 import math
 import numbers
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
 from ... import _validate as v
-from ..._validate import escaped, show
+from ..._validate import show
 from ...errors import ConfigError, ParameterError, SpinectlError
 from ...model import config
-from ...model._toml import child, parse, read_text, unknown_message
+from ...model._toml import check_keys, locate, quoted_key, unknown_message
 from ...model.checks import validate_position
 from ...model.params import Model
 from .. import schema, sweep
@@ -60,19 +59,8 @@ MAX_COMBINATIONS = 10_000
 """Most combinations of the parameter axes and samples: each is validated before any work
 starts (a few ms each: half a minute at most), and each needs at least one chunk."""
 
-SECTIONS = ("study", "model", "axes", "samples")
-STUDY_KEYS = ("preset", "config", "outputs", "chunk_size", "description")
-SAMPLE_KEYS = ("count", "seed", "parameters")
-RANGE_KEYS = ("start", "stop", "num")
-
-
 STORE_FORMAT = 1
 """Version of the store layout (:mod:`spinectl.landscape.study.store`); part of :meth:`Study.digest`."""
-
-
-def _quoted(section: str, name: str) -> str:
-    """A study field as written in TOML: ``axes."body.mass"`` (a dotted key must be quoted)."""
-    return f'{section}."{escaped(name)}"' if "." in name else f"{section}.{escaped(name)}"
 
 
 def _scalars(where: str, values) -> tuple:
@@ -97,12 +85,11 @@ def _scalar(where: str, value):
 
 def _check_name(where: str, parameter: str, model: Model) -> None:
     """``parameter`` must name one value of the model: a ConfigError ("did you mean") otherwise."""
-    node = config.to_dict(model)
-    for key in parameter.split("."):
-        try:
-            node = child(node, key, parameter)
-        except ConfigError as exc:
-            raise ConfigError(where, exc.message) from None
+    try:
+        holder, key = locate(config.to_dict(model), parameter)
+    except ConfigError as exc:
+        raise ConfigError(where, exc.message) from None
+    node = holder[key]
     if isinstance(node, (dict, list)) and node:
         example = f"{parameter}.{next(iter(node)) if isinstance(node, dict) else 0}"
         raise ParameterError(where, f"{parameter} is a table or a list: name one of its values, e.g. {example}")
@@ -125,7 +112,7 @@ class Axis:
     values: tuple
 
     def __post_init__(self):
-        object.__setattr__(self, "values", _scalars(_quoted("axes", self.name), self.values))
+        object.__setattr__(self, "values", _scalars(quoted_key("axes", self.name), self.values))
 
     @property
     def parameter(self) -> str:
@@ -152,13 +139,11 @@ class Sampled:
     arguments: tuple
 
     def __post_init__(self):
-        where = _quoted("samples.parameters", self.parameter)
+        where = quoted_key("samples.parameters", self.parameter)
         v.choice(f"{where}.distribution", self.distribution, tuple(DISTRIBUTIONS))
         names = DISTRIBUTIONS[self.distribution]
         given = dict(self.arguments)
-        for key in given:
-            if key not in names:
-                raise ConfigError(f"{where}.{escaped(key)}", unknown_message(key, names))
+        check_keys(given, names, where)
         missing = [n for n in names if n not in given]
         if missing:
             raise ParameterError(where, f"a {self.distribution} distribution needs {', '.join(missing)}")
@@ -222,7 +207,7 @@ class Samples:
             raise ParameterError("samples.parameters", "must name at least one parameter to draw")
         names = [p.parameter for p in self.parameters]
         for name in {n for n in names if names.count(n) > 1}:
-            raise ParameterError(_quoted("samples.parameters", name), "is given twice")
+            raise ParameterError(quoted_key("samples.parameters", name), "is given twice")
         draws = {p.parameter: p.draw(self.count, self.seed) for p in self.parameters}
         for values in draws.values():
             values.flags.writeable = False
@@ -288,6 +273,16 @@ class Study:
         Free text, stored with the results.
     text : str
         The study file as written, stored with the results.
+
+    Raises
+    ------
+    ConfigError
+        An axis or draw names no parameter of the model ("did you mean"), or an unknown output.
+    ParameterError
+        A value is invalid alone, or with the others of its combination; too many points or
+        combinations.
+    ModelError
+        A combination cannot be evaluated at a corner of the grid.
     """
 
     model: Model
@@ -342,8 +337,8 @@ class Study:
         """Each axis value and draw alone; no parameter twice; no change of the outputs' shape."""
         seen: dict[str, str] = {}
         drawn = self.samples.values() if self.samples else {}
-        named = [(_quoted("axes", a.name), a.parameter, a.values) for a in self.axes]
-        named += [(_quoted("samples.parameters", p), p, d.tolist()) for p, d in drawn.items()]
+        named = [(quoted_key("axes", a.name), a.parameter, a.values) for a in self.axes]
+        named += [(quoted_key("samples.parameters", p), p, d.tolist()) for p, d in drawn.items()]
         shape = (self.model.geometry.cor_names, self.model.muscle_names)
         for where, parameter, values in named:
             _check_name(where, parameter, self.model)
@@ -468,189 +463,3 @@ class Study:
             "tile": list(self.tile),
         }
         return hashlib.sha256(json.dumps(content, sort_keys=True).encode()).hexdigest()
-
-
-# --- the study file --------------------------------------------------------------------------
-
-
-def load_study(path: str | Path) -> Study:
-    """Read and validate a study file (TOML; ``docs/studies.md``).
-
-    Parameters
-    ----------
-    path : str or Path
-        The study file; a ``config`` it names is relative to its folder.
-
-    Returns
-    -------
-    Study
-        The validated study.
-
-    Raises
-    ------
-    ConfigError
-        The file cannot be read, is not TOML, or has an unknown key ("did you mean").
-    ParameterError
-        A value is invalid; the field is named as in the file, e.g. ``axes."body.mass"[2]``.
-    """
-    path = Path(path)
-    try:
-        text = read_text(path)
-    except ConfigError as exc:
-        raise ConfigError("study", exc.message) from None
-    return parse_study(text, base_dir=path.parent, source=str(path))
-
-
-def parse_study(text: str, base_dir: str | Path = ".", source: str = "study") -> Study:
-    """A :class:`Study` from the text of a study file.
-
-    Parameters
-    ----------
-    text : str
-        TOML with the sections ``[study]``, ``[model]``, ``[axes]``, ``[samples]``.
-    base_dir : str or Path
-        Folder against which ``study.config`` is resolved.
-    source : str
-        Where the text came from, for messages.
-
-    Returns
-    -------
-    Study
-        The validated study.
-
-    Raises
-    ------
-    ConfigError
-        Not TOML, or an unknown section or key.
-    ParameterError
-        A value is invalid, or the E or Lambda axis is missing.
-    """
-    try:
-        data = parse(text, source)
-    except ConfigError as exc:
-        raise ConfigError("study", exc.message) from None
-    for key in data:
-        if key not in SECTIONS:
-            raise ConfigError(escaped(key), unknown_message(key, SECTIONS))
-        if not isinstance(data[key], dict):
-            raise ConfigError(escaped(key), f"must be a table (got {show(data[key])})")
-    head = data.get("study", {})
-    _known_keys(head, STUDY_KEYS, "study")
-    axes = _flatten("axes", data.get("axes", {}), lambda x: any(k in x for k in RANGE_KEYS))
-    for name in GRID:
-        if name not in axes:
-            raise ParameterError(f"axes.{name}", "is required: a list of values or { start, stop, num } [m]")
-    options = {k: head[k] for k in ("outputs", "chunk_size", "description") if k in head}
-    return Study(
-        model=_base_model(head, data.get("model"), Path(base_dir)),
-        eccentricity=_values("axes.E", axes.pop("E")),
-        lordosis=_values("axes.Lambda", axes.pop("Lambda")),
-        axes=tuple(Axis(name, _values(_quoted("axes", name), value)) for name, value in axes.items()),
-        samples=_samples(data["samples"]) if "samples" in data else None,
-        text=text,
-        **options,
-    )
-
-
-def _known_keys(table: dict, allowed, where: str) -> None:
-    for key in table:
-        if key not in allowed:
-            raise ConfigError(f"{where}.{escaped(key)}", unknown_message(key, allowed))
-
-
-def _flatten(section: str, table: dict, is_leaf, prefix: str = "") -> dict:
-    """Dotted keys from nested tables: ``body.mass = [...]`` unquoted is ``{"body": {"mass": [...]}}`` in TOML."""
-    out: dict = {}
-    for key, value in table.items():
-        name = f"{prefix}{key}"
-        parts = _flatten(section, value, is_leaf, f"{name}.") if _is_table(value, is_leaf) else {name: value}
-        for dotted in parts:
-            if dotted in out:  # "body.mass" quoted and body.mass unquoted are two keys to TOML
-                raise ParameterError(_quoted(section, dotted), "is given twice")
-        out |= parts
-    return out
-
-
-def _is_table(value, is_leaf) -> bool:
-    return isinstance(value, dict) and bool(value) and not is_leaf(value)
-
-
-def _values(where: str, value) -> tuple:
-    """An axis: ``{ start, stop, num }`` (inclusive, evenly spaced), a list, or one value."""
-    if not isinstance(value, dict):
-        return tuple(value) if isinstance(value, list) else (value,)
-    _known_keys(value, RANGE_KEYS, where)
-    missing = [k for k in RANGE_KEYS if k not in value]
-    if missing:
-        raise ParameterError(where, f"a range needs start, stop and num (missing {', '.join(missing)})")
-    start, stop = v.real(f"{where}.start", value["start"]), v.real(f"{where}.stop", value["stop"])
-    num = v.integer(f"{where}.num", value["num"], 1, sweep.MAX_GRID_POINTS)
-    if start > stop:
-        raise ParameterError(f"{where}.stop", f"must be >= start = {start:g} (got {stop:g})")
-    return tuple(np.linspace(start, stop, num).tolist())
-
-
-def _base_model(head: dict, overrides, base_dir: Path) -> Model:
-    """The preset or configuration named in ``[study]``, with the ``[model]`` section on top."""
-    preset = head.get("preset")
-    try:
-        if "config" in head:
-            if not isinstance(head["config"], str):
-                raise ParameterError("config", f"must be a file name (got {show(head['config'])})")
-            model = config.load_config(base_dir / head["config"], preset=preset)
-        else:
-            model = config.load_preset("default" if preset is None else preset)
-    except ConfigError as exc:
-        if exc.field not in ("config", "preset"):
-            raise
-        raise ConfigError(f"study.{exc.field}", exc.message) from None
-    if overrides is None:
-        return model
-    try:
-        return config.merge(model, overrides)
-    except ParameterError as exc:
-        raise exc.under("model") from None
-
-
-def _samples(table: dict) -> Samples:
-    _known_keys(table, SAMPLE_KEYS, "samples")
-    for key in ("count", "parameters"):
-        if key not in table:
-            raise ParameterError(f"samples.{key}", "is required")
-    drawn = table["parameters"]
-    if not isinstance(drawn, dict):
-        raise ParameterError("samples.parameters", f"must be a table of distributions (got {show(drawn)})")
-    parameters = []
-    for name, spec in _flatten("samples.parameters", drawn, lambda x: "distribution" in x).items():
-        where = _quoted("samples.parameters", name)
-        if not isinstance(spec, dict) or "distribution" not in spec:
-            raise ParameterError(where, "must be { distribution = ..., <its arguments> }, see docs/studies.md")
-        arguments = tuple((k, x) for k, x in spec.items() if k != "distribution")
-        parameters.append(Sampled(name, spec["distribution"], arguments))
-    return Samples(table["count"], table.get("seed", 0), tuple(parameters))
-
-
-def fields_of(model: Model, dotted: str) -> dict[str, str]:
-    """``units`` and ``long_name`` of a parameter, from its field metadata (for coordinates).
-
-    Parameters
-    ----------
-    model : Model
-        Any model (only its structure is read).
-    dotted : str
-        Dotted parameter, e.g. ``"body.mass"`` or ``"muscles.0.upper.1"``.
-
-    Returns
-    -------
-    dict of str to str
-        ``{"units": ..., "long_name": ...}``: the field's ``unit`` metadata ("" if none)
-        and its ``doc`` (``dotted`` if none).
-    """
-    node, meta = model, {}
-    for key in dotted.split("."):
-        if isinstance(node, tuple):
-            node = node[int(key)]
-            continue
-        meta = {f.name: f.metadata for f in dataclasses.fields(node)}[key]
-        node = getattr(node, key)
-    return {"units": meta.get("unit", ""), "long_name": meta.get("doc", dotted)}

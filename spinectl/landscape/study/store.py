@@ -26,8 +26,9 @@ from ... import __version__
 from ...atomic import atomic_path
 from ...errors import OutputError, ParameterError
 from ...model import config
+from ...model._toml import field_metadata
 from .. import schema
-from .spec import SAMPLE, STORE_FORMAT, Chunk, Study, fields_of
+from .spec import SAMPLE, STORE_FORMAT, Chunk, Study
 
 DONE = "chunk_done"
 """The per-chunk counter of writes."""
@@ -117,14 +118,18 @@ def template(study: Study, probe: dict[str, np.ndarray]) -> xr.Dataset:
 
 def _coordinates(study: Study) -> dict:
     model = study.model
-    coords = {
-        a.name: (a.name, list(a.values), fields_of(model, a.parameter) | {"parameter": a.parameter}) for a in study.axes
-    }
+    coords = {a.name: (a.name, list(a.values), _parameter_attributes(model, a.parameter)) for a in study.axes}
     if study.samples:
         coords[SAMPLE] = (SAMPLE, np.arange(study.samples.count), {"long_name": "Monte-Carlo draw"})
         for name, values in study.samples.values().items():
-            coords[name] = (SAMPLE, values, fields_of(model, name) | {"parameter": name})
+            coords[name] = (SAMPLE, values, _parameter_attributes(model, name))
     return coords | schema.grid_coordinates(model, list(study.eccentricity), list(study.lordosis))
+
+
+def _parameter_attributes(model, dotted: str) -> dict[str, str]:
+    """``units``, ``long_name`` and ``parameter`` of a parameter's coordinate, from its field metadata."""
+    meta = field_metadata(model, dotted)
+    return {"units": meta.get("unit", ""), "long_name": meta.get("doc", dotted), "parameter": dotted}
 
 
 def _attributes(study: Study) -> dict:

@@ -1,0 +1,171 @@
+"""The study file: TOML read, checked against its schema and turned into a :class:`~.spec.Study`.
+
+The format is that of ``docs/studies.md``: the sections ``[study]`` (base
+model, outputs, chunking), ``[model]`` (parameters over the base model),
+``[axes]`` (the grid and the parameter axes: a list, one value or
+``{ start, stop, num }``) and ``[samples]`` (Monte-Carlo draws). Keys are
+checked by the engine of the model files (:mod:`spinectl.model._toml`), so a
+study file and a model file report the same mistakes in the same words; the
+values are validated by the dataclasses of :mod:`spinectl.landscape.study.spec`.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ... import _validate as v
+from ..._validate import escaped, show
+from ...errors import ConfigError, ParameterError
+from ...model import config
+from ...model._toml import check_keys, check_table, flatten, parse, quoted_key, read_text
+from ...model.params import Model
+from .. import sweep
+from .spec import GRID, Axis, Sampled, Samples, Study
+
+SECTIONS = ("study", "model", "axes", "samples")
+"""The sections of a study file."""
+
+STUDY_KEYS = ("preset", "config", "outputs", "chunk_size", "description")
+"""The keys of ``[study]``."""
+
+SAMPLE_KEYS = ("count", "seed", "parameters")
+"""The keys of ``[samples]``."""
+
+RANGE_KEYS = ("start", "stop", "num")
+"""The keys of a range of values, ``{ start, stop, num }``."""
+
+
+def load_study(path: str | Path) -> Study:
+    """Read and validate a study file (TOML; ``docs/studies.md``).
+
+    Parameters
+    ----------
+    path : str or Path
+        The study file; a ``config`` it names is relative to its folder.
+
+    Returns
+    -------
+    Study
+        The validated study, with the file's text.
+
+    Raises
+    ------
+    ConfigError
+        The file cannot be read, is not TOML, or has an unknown key ("did you mean").
+    ParameterError
+        A value is invalid; the field is named as in the file, e.g. ``axes."body.mass"[2]``.
+    """
+    path = Path(path)
+    try:
+        text = read_text(path)
+    except ConfigError as exc:
+        raise ConfigError("study", exc.message) from None
+    return parse_study(text, base_dir=path.parent, source=str(path))
+
+
+def parse_study(text: str, base_dir: str | Path = ".", source: str = "study") -> Study:
+    """A :class:`~.spec.Study` from the text of a study file.
+
+    Parameters
+    ----------
+    text : str
+        TOML with the sections ``[study]``, ``[model]``, ``[axes]``, ``[samples]``.
+    base_dir : str or Path
+        Folder against which ``study.config`` is resolved.
+    source : str
+        Where the text came from, for messages.
+
+    Returns
+    -------
+    Study
+        The validated study, with ``text``.
+
+    Raises
+    ------
+    ConfigError
+        Not TOML, an unknown section or key ("did you mean"), a section that is not a table,
+        or a base model that cannot be loaded.
+    ParameterError
+        A value is invalid, or ``axes.E`` or ``axes.Lambda`` is missing.
+    """
+    try:
+        data = parse(text, source)
+    except ConfigError as exc:
+        raise ConfigError("study", exc.message) from None
+    for key, value in data.items():  # key by key: the first section that is wrong is the one named
+        check_keys((key,), SECTIONS)
+        check_table(value, escaped(key))
+    head = data.get("study", {})
+    check_keys(head, STUDY_KEYS, "study")
+    axes = flatten(data.get("axes", {}), "axes", lambda x: any(k in x for k in RANGE_KEYS))
+    for name in GRID:
+        if name not in axes:
+            raise ParameterError(f"axes.{name}", "is required: a list of values or { start, stop, num } [m]")
+    options = {k: head[k] for k in ("outputs", "chunk_size", "description") if k in head}
+    return Study(
+        model=_base_model(head, data.get("model"), Path(base_dir)),
+        eccentricity=_axis_values("axes.E", axes.pop("E")),
+        lordosis=_axis_values("axes.Lambda", axes.pop("Lambda")),
+        axes=tuple(Axis(name, _axis_values(quoted_key("axes", name), value)) for name, value in axes.items()),
+        samples=_samples(data["samples"]) if "samples" in data else None,
+        text=text,
+        **options,
+    )
+
+
+def _axis_values(where: str, value) -> tuple:
+    """An axis: ``{ start, stop, num }`` (inclusive, evenly spaced), a list, or one value."""
+    if not isinstance(value, dict):
+        return tuple(value) if isinstance(value, list) else (value,)
+    check_keys(value, RANGE_KEYS, where)
+    missing = [k for k in RANGE_KEYS if k not in value]
+    if missing:
+        raise ParameterError(where, f"a range needs start, stop and num (missing {', '.join(missing)})")
+    start, stop = v.real(f"{where}.start", value["start"]), v.real(f"{where}.stop", value["stop"])
+    num = v.integer(f"{where}.num", value["num"], 1, sweep.MAX_GRID_POINTS)
+    if start > stop:
+        raise ParameterError(f"{where}.stop", f"must be >= start = {start:g} (got {stop:g})")
+    return tuple(np.linspace(start, stop, num).tolist())
+
+
+def _base_model(head: dict, overrides, base_dir: Path) -> Model:
+    """The preset or configuration named in ``[study]``, with the ``[model]`` section on top."""
+    preset = head.get("preset")
+    try:
+        if "config" in head:
+            if not isinstance(head["config"], str):
+                raise ParameterError("config", f"must be a file name (got {show(head['config'])})")
+            model = config.load_config(base_dir / head["config"], preset=preset)
+        else:
+            model = config.load_preset("default" if preset is None else preset)
+    except ConfigError as exc:
+        if exc.field not in ("config", "preset"):
+            raise
+        raise ConfigError(f"study.{exc.field}", exc.message) from None
+    if overrides is None:
+        return model
+    try:
+        return config.merge(model, overrides)
+    except ParameterError as exc:
+        raise exc.under("model") from None
+
+
+def _samples(table: dict) -> Samples:
+    """The ``[samples]`` section: its count, seed and one distribution per (dotted) parameter."""
+    check_keys(table, SAMPLE_KEYS, "samples")
+    for key in ("count", "parameters"):
+        if key not in table:
+            raise ParameterError(f"samples.{key}", "is required")
+    drawn = table["parameters"]
+    if not isinstance(drawn, dict):
+        raise ParameterError("samples.parameters", f"must be a table of distributions (got {show(drawn)})")
+    parameters = []
+    for name, spec in flatten(drawn, "samples.parameters", lambda x: "distribution" in x).items():
+        where = quoted_key("samples.parameters", name)
+        if not isinstance(spec, dict) or "distribution" not in spec:
+            raise ParameterError(where, "must be { distribution = ..., <its arguments> }, see docs/studies.md")
+        arguments = tuple((k, x) for k, x in spec.items() if k != "distribution")
+        parameters.append(Sampled(name, spec["distribution"], arguments))
+    return Samples(table["count"], table.get("seed", 0), tuple(parameters))
