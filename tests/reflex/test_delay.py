@@ -142,8 +142,11 @@ def test_root_count_through_stability_switches():
     regains stability as the delay grows. The exact count agrees with the python-control Padé poles."""
     s, d, theta, kp, kd = -100.0, -1.0, 1.0, 50.0, 0.0
     np.testing.assert_allclose(
-        reflex.crossings(s, d, theta, kp, kd).frequency ** 2, (199 + np.array([1, -1]) * np.sqrt(9601)) / 2, rtol=1e-12
+        reflex.crossings(s, d, theta, kp, kd).frequency[:2] ** 2,
+        (199 + np.array([1, -1]) * np.sqrt(9601)) / 2,
+        rtol=1e-12,
     )
+    assert np.isnan(reflex.crossings(s, d, theta, kp, kd).frequency[2])  # F is quadratic without the lag
     delays = np.linspace(0.0, 0.6, 61)[1:]
     exact = reflex.stable_at_delay(s, d, theta, kp, kd, delays)
     pade = np.array([_rightmost_pole(s, d, theta, kp, kd, tau, order=16) < 0 for tau in delays])
