@@ -191,5 +191,3 @@ def dump_toml(model: Model) -> str:
         else:
             lines += [f"[{f.name}]", *_fields_toml(value), ""]
     return "\n".join(lines)
-
-

@@ -381,7 +381,7 @@ class Reflex:
         "Default 50 ms: the contraction time constants (tau1 = tau2 = 50 ms) of active human muscle at "
         "about 20 % of maximum effort (Zahalak GI, Heyman SJ 1979, J Biomech Eng 101:28-37, "
         "doi:10.1115/1.3426220); spinectl keeps one of the two. 0 is the pure delay; at most "
-        f"{MAX_ACTIVATION_TIME_CONSTANT:g} s (docs/reflex.md, \"Force generation: the activation lag\").",
+        f'{MAX_ACTIVATION_TIME_CONSTANT:g} s (docs/reflex.md, "Force generation: the activation lag").',
     )
     pade_order: int = param(
         5, "1", f"Order of the Pade approximant of exp(-s tau) in the python-control models, 1 to {MAX_PADE_ORDER}."
