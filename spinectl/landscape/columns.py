@@ -22,6 +22,7 @@ DEFAULT_CHUNK = 1024
 """Grid points per stacked problem: large enough that Python overheads vanish, small enough to keep memory flat."""
 
 
+
 def point_columns(
     model: Model, eccentricity, lordosis, *, method: str = "fast", chunk_size: int = DEFAULT_CHUNK, update=None
 ) -> tuple[dict[str, np.ndarray], int]:

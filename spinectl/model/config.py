@@ -191,3 +191,5 @@ def dump_toml(model: Model) -> str:
         else:
             lines += [f"[{f.name}]", *_fields_toml(value), ""]
     return "\n".join(lines)
+
+
