@@ -17,9 +17,9 @@
 #
 # with the stiffness $S_k = \partial M/\partial\alpha$ (muscles, gravity, passive $K$), the Hill damping
 # $D_k = \partial M/\partial\omega \le 0$ and a delayed PD reflex whose torque builds up with the force generation
-# of the muscles, a lag of time constant $T_a$ (50 ms by default; see the section on force generation). Without the reflex the joint is self-stable
-# when $S_k < 0$ (paper, eq. 1). The global muscles work at an **activation** $a$, a fraction of the minimum
-# stabilising PCSA of Figure 3: $a = 0$ is no co-contraction (reflex only), $a = 1$ is self-stable. The reflex
+# of the muscles, a lag of time constant $T_a$ (50 ms by default; see the section on force generation). Without
+# the reflex the joint is self-stable when $S_k < 0$ (paper, eq. 1). The global muscles work at an
+# **activation** $a$, a fraction of the minimum stabilising PCSA of Figure 3: $a = 0$ is no co-contraction (reflex only), $a = 1$ is self-stable. The reflex
 # follows spinectl's default rule: $k_p = g\max(S_k, 0)$, the stiffness deficit times a gain factor $g > 1$ so
 # that some stiffness is left to spare, and $k_d$ for a given damping ratio of the loop without delay (docs:
 # *Delayed reflexes*; `reflex.gain_factor`, `reflex.damping_ratio`). The **delay margin** $\tau_m$ is
@@ -332,9 +332,9 @@ plt.show()
 # ## The loop in the frequency domain
 #
 # The same joint as a python-control system: the loop $L(s) = (k_p + k_d s)\,e^{-s\tau}\,G(s)/(T_a s + 1)$ with the
-# delay as a Padé approximant, at the model's delay and activation lag. Below self-stability $G$ has a pole in the right half plane, so by the
-# Nyquist criterion the closed loop is stable when the curve circles $-1$ once counter-clockwise; a longer delay
-# turns the curve further, until at $\tau_m$ it passes through $-1$.
+# delay as a Padé approximant, at the model's delay and activation lag. Below self-stability $G$ has a pole in the
+# right half plane, so by the Nyquist criterion the closed loop is stable when the curve circles $-1$ once
+# counter-clockwise; a longer delay turns the curve further, until at $\tau_m$ it passes through $-1$.
 
 # %%
 delay = model.reflex.delay
