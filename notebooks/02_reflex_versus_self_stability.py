@@ -19,11 +19,11 @@
 # $D_k = \partial M/\partial\omega \le 0$ and a delayed PD reflex whose torque builds up with the force generation
 # of the muscles, a lag of time constant $T_a$ (50 ms by default; see the section on force generation). Without
 # the reflex the joint is self-stable when $S_k < 0$ (paper, eq. 1). The global muscles work at an
-# **activation** $a$, a fraction of the minimum stabilising PCSA of Figure 3: $a = 0$ is no co-contraction (reflex only), $a = 1$ is self-stable. The reflex
-# follows spinectl's default rule: $k_p = g\max(S_k, 0)$, the stiffness deficit times a gain factor $g > 1$ so
-# that some stiffness is left to spare, and $k_d$ for a given damping ratio of the loop without delay (docs:
-# *Delayed reflexes*; `reflex.gain_factor`, `reflex.damping_ratio`). The **delay margin** $\tau_m$ is
-# the largest delay with the loop stable for every delay below it, computed exactly from the characteristic
+# **activation** $a$, a fraction of the minimum stabilising PCSA of Figure 3: $a = 0$ is no co-contraction (reflex
+# only), $a = 1$ is self-stable. The reflex follows spinectl's default rule: $k_p = g\max(S_k, 0)$, the stiffness
+# deficit times a gain factor $g > 1$ so that some stiffness is left to spare, and $k_d$ for a given damping ratio of
+# the loop without delay (docs: *Delayed reflexes*; `reflex.gain_factor`, `reflex.damping_ratio`). The **delay margin**
+# $\tau_m$ is the largest delay with the loop stable for every delay below it, computed exactly from the characteristic
 # quasi-polynomial; it is infinite where no delay can destabilise the joint.
 
 # %% tags=["parameters"]
