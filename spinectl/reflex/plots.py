@@ -174,8 +174,8 @@ def response_figure(responses: Mapping[str, Simulation], title: str = "") -> Fig
 def frequency_range(report: MarginsReport) -> tuple[float, float]:
     """A decade below the slowest and above the fastest rate of the loops [rad/s].
 
-    The rates: each segment's sqrt(abs(S)/theta), abs(D)/theta and crossover, and
-    order/tau, beyond which the Padé phase saturates.
+    The rates: each segment's sqrt(abs(S)/theta), abs(D)/theta and crossover, the corner
+    1/T_a of the activation lag, and order/tau, beyond which the Padé phase saturates.
 
     Parameters
     ----------
@@ -188,6 +188,7 @@ def frequency_range(report: MarginsReport) -> tuple[float, float]:
         Lowest and highest frequency [rad/s]; (0.1, 10) if no rate is finite and positive.
     """
     rates = [report.pade_order / report.delay] if report.delay > 0 else []
+    rates += [1.0 / report.activation_time_constant] if report.activation_time_constant > 0 else []
     for s in report.segments:
         rates += [np.sqrt(abs(s.stiffness) / s.inertia), abs(s.damping) / s.inertia, s.crossover_rad_s]
     rates = [r for r in rates if np.isfinite(r) and r > 0] or [1.0]
