@@ -90,13 +90,16 @@ def test_report_figures_draw_the_responses_they_are_given(model):
 
 
 def test_frequency_range_spans_the_loops_rates(model):
-    """A decade around every crossover and the Pade corner order/tau; (0.1, 10) rad/s when no rate is known."""
+    """A decade around every crossover, the Pade corner order/tau and the lag's corner 1/T_a; (0.1, 10) rad/s
+    when no rate is known (no segment, no delay, no lag)."""
     report = margins.analyse(_reflex(model, activation=0.0), 0.03, 0.04)
     low, high = plots.frequency_range(report)
     crossovers = [s.crossover_rad_s for s in report.segments]
     assert low <= min(crossovers) / 10 and high >= report.pade_order / report.delay * 10
     infeasible = model.replace(optimisation=Optimisation(pcsa_max=1e-8))
-    nothing = margins.analyse(_reflex(infeasible, activation=0.5, delay=0.0), 0.03, 0.04)
+    lagged = margins.analyse(_reflex(infeasible, activation=0.5, delay=0.0), 0.03, 0.04)
+    assert plots.frequency_range(lagged) == pytest.approx((2.0, 200.0))  # 1/T_a = 20 rad/s alone
+    nothing = margins.analyse(_reflex(infeasible, activation=0.5, delay=0.0, activation_time_constant=0.0), 0.03, 0.04)
     assert plots.frequency_range(nothing) == pytest.approx((0.1, 10.0))
 
 
