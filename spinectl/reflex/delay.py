@@ -338,7 +338,7 @@ def _cubic_roots(f3, f2, f1, f0):
     x = np.where(real, x, np.nan)
     close = np.abs(x[..., :, None] - x[..., None, :]) <= _TANGENT * np.abs(x[..., :, None])
     twins = np.sum(close, axis=-1) > 1
-    first = np.argmax(close, axis=-1) == np.arange(3)  # keep one of each double root
+    first = np.argmax(close, axis=-1) == np.arange(SLOTS)  # keep one of each double root
     return np.where(twins & ~first, np.nan, x), twins
 
 
