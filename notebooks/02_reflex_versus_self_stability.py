@@ -12,17 +12,18 @@
 #
 # $$
 # \theta_k\,\ddot\alpha = S_k\,\alpha + D_k\,\dot\alpha + u, \qquad
-# u(t) = -\bigl(k_p\,\alpha + k_d\,\dot\alpha\bigr)(t - \tau),
+# T_a\,\dot u + u = -\bigl(k_p\,\alpha + k_d\,\dot\alpha\bigr)(t - \tau),
 # $$
 #
 # with the stiffness $S_k = \partial M/\partial\alpha$ (muscles, gravity, passive $K$), the Hill damping
-# $D_k = \partial M/\partial\omega \le 0$ and a delayed PD reflex. Without the reflex the joint is self-stable
-# when $S_k < 0$ (paper, eq. 1). The global muscles work at an **activation** $a$, a fraction of the minimum
-# stabilising PCSA of Figure 3: $a = 0$ is no co-contraction (reflex only), $a = 1$ is self-stable. The reflex
-# follows spinectl's default rule: $k_p = g\max(S_k, 0)$, the stiffness deficit times a gain factor $g > 1$ so
-# that some stiffness is left to spare, and $k_d$ for a given damping ratio of the loop without delay (docs:
-# *Delayed reflexes*; `reflex.gain_factor`, `reflex.damping_ratio`). The **delay margin** $\tau_m$ is
-# the largest delay with the loop stable for every delay below it, computed exactly from the characteristic
+# $D_k = \partial M/\partial\omega \le 0$ and a delayed PD reflex whose torque builds up with the force generation
+# of the muscles, a lag of time constant $T_a$ (50 ms by default; see the section on force generation). Without
+# the reflex the joint is self-stable when $S_k < 0$ (paper, eq. 1). The global muscles work at an
+# **activation** $a$, a fraction of the minimum stabilising PCSA of Figure 3: $a = 0$ is no co-contraction (reflex
+# only), $a = 1$ is self-stable. The reflex follows spinectl's default rule: $k_p = g\max(S_k, 0)$, the stiffness
+# deficit times a gain factor $g > 1$ so that some stiffness is left to spare, and $k_d$ for a given damping ratio of
+# the loop without delay (docs: *Delayed reflexes*; `reflex.gain_factor`, `reflex.damping_ratio`). The **delay margin**
+# $\tau_m$ is the largest delay with the loop stable for every delay below it, computed exactly from the characteristic
 # quasi-polynomial; it is infinite where no delay can destabilise the joint.
 
 # %% tags=["parameters"]
@@ -56,7 +57,7 @@ TAU = 0.10  # s: the delay of the critical gain ranges
 names = list(model.geometry.cor_names)
 print(
     f"preset {preset!r}; reflex gains {model.reflex.gains!r}: gain factor g = {model.reflex.gain_factor:g}, "
-    f"damping ratio {model.reflex.damping_ratio:g}"
+    f"damping ratio {model.reflex.damping_ratio:g}; force generation lag {model.reflex.activation_time_constant:g} s"
 )
 
 # %% [markdown]
@@ -73,9 +74,10 @@ activation = np.linspace(0.0, 1.0, 101)
 pcsa = activation[:, None] * optimum.pcsa  # (activation, muscle) [m^2]
 S, D = coeffs.stiffness(pcsa), coeffs.damping(pcsa)  # (activation, segment)
 theta = np.broadcast_to(coeffs.inertia, S.shape)
+LAG = model.reflex.activation_time_constant  # s: force generation after the delay (see the section below)
 kp, kd = reflex.resolve_gains(S, D, theta, model.reflex)
-exact = reflex.delay_margin(S, D, theta, kp, kd)
-kp_low, kp_high = reflex.critical_gains(S, D, theta, kd, TAU)
+exact = reflex.delay_margin(S, D, theta, kp, kd, LAG)
+kp_low, kp_high = reflex.critical_gains(S, D, theta, kd, TAU, lag=LAG)
 
 s_none, s_full = coeffs.stiffness(0.0 * optimum.pcsa), coeffs.stiffness(optimum.pcsa)
 self_stable_from = np.clip(s_none / (s_none - s_full), 0.0, None)  # the activation where S_k = 0
@@ -221,6 +223,72 @@ pd.DataFrame(
 ).round(1)
 
 # %% [markdown]
+# ## Force generation: how the activation lag moves the regimes
+#
+# The Discussion adds that "the force generation of the muscles takes another 50-100 ms". spinectl models it as
+# a first-order lag $1/(T_a s + 1)$ between the delayed reflex command and the torque
+# (`reflex.activation_time_constant`, default 50 ms; 0 is the pure delay above). For every point of the grid:
+# the least activation $a$ (in steps of 0.05) at which every joint is stable with a 100 ms delay and the lag
+# $T_a$. Where it is 0 the reflex alone suffices; where it reaches the activation at which every joint is
+# self-stable, only self-stability works. Everything muscular is linear in the PCSA, so one sweep's
+# coefficients give the joints at every activation.
+
+# %%
+ds = maps[0.0]
+pcsa_cm2 = ds["pcsa_cm2"].values  # (E, Lambda, muscle): the chosen activation of Figure 3
+muscular = np.einsum("elkm,elm->elk", ds["stiffness_per_cm2"].values, pcsa_cm2)
+damping_full = np.einsum("elkm,elm->elk", ds["damping_per_cm2"].values, pcsa_cm2)
+rigid = ds["gravity_stiffness_Nm_per_rad"].values - ds["passive_stiffness_Nm_per_rad"].values
+inertia = ds["inertia_kgm2"].values
+LEVELS = np.round(np.arange(0.0, 1.0001, 0.05), 2)
+LAGS = (0.0, 0.05, 0.10)  # s
+TAU_LAG = 0.10  # s: the delay of the regime maps
+self_stable_at = np.full(rigid.shape[:2], np.nan)
+for a in LEVELS[::-1]:
+    self_stable_at = np.where(np.all(a * muscular + rigid < 0, axis=-1), a, self_stable_at)
+least = {}
+for lag in LAGS:
+    settings = config.set_parameter(model, "reflex.activation_time_constant", lag).reflex
+    settings = config.set_parameter(model.replace(reflex=settings), "reflex.delay", TAU_LAG).reflex
+    found = np.full(rigid.shape[:2], np.nan)
+    for a in LEVELS[::-1]:  # from the top down: the last level that holds is the least
+        grid = reflex.landscape(a * muscular + rigid, a * damping_full, inertia, settings)
+        found = np.where(np.all(grid.stable_at_delay, axis=-1), a, found)
+    least[lag] = found
+
+fig, axes = plt.subplots(1, len(LAGS), figsize=(12, 4), sharey=True, layout="constrained")
+for ax, (lag, found) in zip(axes, least.items(), strict=True):
+    shown = ax.pcolormesh(
+        axis * 100, axis * 100, found.T, cmap="viridis", vmin=0, vmax=1, shading="nearest"
+    )
+    ax.contour(axis * 100, axis * 100, (found >= self_stable_at).T.astype(float), levels=[0.5], colors="white")
+    reflex_only = np.mean(found == 0)
+    ax.set_title(f"T_a = {lag * 1e3:g} ms: reflex alone at {reflex_only:.0%} of the grid", fontsize=10)
+    ax.set_xlabel("eccentricity E [cm]")
+    ax.set_aspect("equal")
+axes[0].set_ylabel("lordosis Λ [cm]")
+fig.colorbar(shown, ax=axes, label=f"least activation stable at τ = {TAU_LAG * 1e3:g} ms (white: self-stable needed)")
+plt.show()
+
+# %%
+pd.DataFrame(
+    {
+        "reflex alone suffices [% of grid]": [100 * np.mean(f == 0) for f in least.values()],
+        "needs co-contraction [% of grid]": [100 * np.mean((f > 0) & (f < self_stable_at)) for f in least.values()],
+        "only self-stable [% of grid]": [100 * np.mean(f >= self_stable_at) for f in least.values()],
+        "median least activation": [float(np.nanmedian(f)) for f in least.values()],
+    },
+    index=pd.Index([lag * 1e3 for lag in LAGS], name="activation lag T_a [ms]"),
+).round(2)
+
+# %% [markdown]
+# With the pure delay the reflex alone holds the spine at 100 ms wherever its margin is just above 100 ms; 50 ms
+# of force generation lowers the reflex-only margin by about a third, so the reflex-only regime shrinks or
+# vanishes, co-contraction is needed instead, and the least activation grows with the lag. The self-stable
+# activation does not depend on the lag: the closer the needed activation comes to it, the more the paper's
+# argument holds, that a self-stable spine makes the reflex delays "much less problematic".
+
+# %% [markdown]
 # ## Time-domain responses
 #
 # The nonlinear equation of motion of one joint (paper, Methods) with the reflex and its true delay, released from
@@ -263,15 +331,22 @@ plt.show()
 # %% [markdown]
 # ## The loop in the frequency domain
 #
-# The same joint as a python-control system: the loop $L(s) = (k_p + k_d s)\,e^{-s\tau}\,G(s)$ with the delay as a
-# Padé approximant, at the model's delay. Below self-stability $G$ has a pole in the right half plane, so by the
-# Nyquist criterion the closed loop is stable when the curve circles $-1$ once counter-clockwise; a longer delay
-# turns the curve further, until at $\tau_m$ it passes through $-1$.
+# The same joint as a python-control system: the loop $L(s) = (k_p + k_d s)\,e^{-s\tau}\,G(s)/(T_a s + 1)$ with the
+# delay as a Padé approximant, at the model's delay and activation lag. Below self-stability $G$ has a pole in the
+# right half plane, so by the Nyquist criterion the closed loop is stable when the curve circles $-1$ once
+# counter-clockwise; a longer delay turns the curve further, until at $\tau_m$ it passes through $-1$.
 
 # %%
 delay = model.reflex.delay
 loop = loops.loop_transfer(
-    limiting.stiffness, limiting.damping, limiting.inertia, limiting.kp, limiting.kd, delay, model.reflex.pade_order
+    limiting.stiffness,
+    limiting.damping,
+    limiting.inertia,
+    limiting.kp,
+    limiting.kd,
+    delay,
+    model.reflex.pade_order,
+    model.reflex.activation_time_constant,
 )
 bode = ct.bode_plot(loop, omega_limits=(0.1, 100.0), title=f"{limiting.name}: L(jω), τ = {delay * 1e3:g} ms")
 bode.axes[0, 0].set_ylabel("|L(jω)| [1]")

@@ -8,7 +8,8 @@ per subpackage, is in CONTRIBUTING.md ("Architecture"):
 
 - :mod:`spinectl.model`: parameters, configuration, the physics and eq. 1;
 - :mod:`spinectl.optimise`: minimum PCSA and counter torques at every point;
-- :mod:`spinectl.reflex`: delayed reflexes and their margins;
+- :mod:`spinectl.reflex`: delayed reflexes and their margins; :func:`delay_margin`, the exact
+  delay margin of any SISO python-control loop, is here at the top;
 - :mod:`spinectl.landscape`: sweeps, NetCDF and parameter studies;
 - :mod:`spinectl.paper`: the paper's study, its landmarks and verdicts;
 - :mod:`spinectl.cli`: the ``spinectl`` command.
@@ -25,17 +26,20 @@ from .model.config import dump_toml, list_presets, load_config, load_preset
 from .model.mechanics import SegmentCoefficients, segment_coefficients
 from .model.params import Model
 from .model.stability import StabilityResult, segment_stability
+from .reflex.siso import LoopDelayMargin, delay_margin
 
 __version__ = "0.1.0"
 
 __all__ = [
     "ConfigError",
+    "LoopDelayMargin",
     "Model",
     "ModelError",
     "ParameterError",
     "SegmentCoefficients",
     "SpinectlError",
     "StabilityResult",
+    "delay_margin",
     "dump_toml",
     "list_presets",
     "load_config",

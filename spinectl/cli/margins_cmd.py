@@ -20,12 +20,20 @@ def register(sub) -> None:
     parser = sub.add_parser(
         "margins",
         help="delay, gain and phase margins of a delayed PD reflex at each segment",
-        description="Close each segment's loop with a delayed PD reflex u = -(kp alpha + kd omega)(t - tau) "
-        "and report the exact delay margin (quasi-polynomial), its Pade estimate, gain and phase margins, "
+        description="Close each segment's loop with a delayed PD reflex -(kp alpha + kd omega)(t - tau), "
+        "its torque lagged by the force generation 1/(T_a s + 1), and report the exact delay margin "
+        "(quasi-polynomial), its Pade estimate, gain and phase margins, "
         "the stabilising range of kp and whether the loop is stable at the delay. See docs/reflex.md.",
     )
     add_position_options(parser)
     parser.add_argument("--delay", type=finite_float("--delay"), help="reflex delay tau [s] (default: config, 0.1)")
+    parser.add_argument(
+        "--activation-lag",
+        type=finite_float("--activation-lag"),
+        metavar="T_A",
+        help="time constant T_a [s] of the force generation after the delay, a lag 1/(T_a s + 1) "
+        "(default: config, 0.05; 0: the pure delay)",
+    )
     parser.add_argument("--kp", type=finite_float("--kp"), help="proportional gain [N m/rad] (default: the rule)")
     parser.add_argument("--kd", type=finite_float("--kd"), help="derivative gain [N m s/rad] (default: the rule)")
     parser.add_argument(
@@ -40,7 +48,12 @@ def register(sub) -> None:
     parser.set_defaults(func=run)
 
 
-OVERRIDES = (("delay", "reflex.delay"), ("activation", "reflex.activation"), ("pade_order", "reflex.pade_order"))
+OVERRIDES = (
+    ("delay", "reflex.delay"),
+    ("activation_lag", "reflex.activation_time_constant"),
+    ("activation", "reflex.activation"),
+    ("pade_order", "reflex.pade_order"),
+)
 """Command-line options that replace a parameter of the ``reflex`` section."""
 
 
@@ -50,7 +63,8 @@ def model_with_overrides(args):
     Parameters
     ----------
     args : argparse.Namespace
-        Parsed arguments; ``delay`` [s], ``activation``, ``pade_order``, ``kp``, ``kd`` are optional.
+        Parsed arguments; ``delay`` [s], ``activation_lag`` [s], ``activation``, ``pade_order``, ``kp``,
+        ``kd`` are optional.
 
     Returns
     -------

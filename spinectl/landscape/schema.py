@@ -33,10 +33,14 @@ VARIABLES = {
     "inertia_kgm2": ("kg m2", "moment of inertia theta_k of the upper body about CoR k"),
     "reflex_kp_Nm_per_rad": ("N m rad-1", "proportional gain kp of the delayed reflex (reflex settings)"),
     "reflex_kd_Nms_per_rad": ("N m s rad-1", "derivative gain kd of the delayed reflex (reflex settings)"),
-    "delay_margin_s": ("s", "exact delay margin of the reflex loop at reflex.activation x chosen PCSA"),
+    "delay_margin_s": (
+        "s",
+        "exact delay margin of the reflex loop (with the activation lag reflex.activation_time_constant) "
+        "at reflex.activation x chosen PCSA",
+    ),
     "delay_margin_pade_s": ("s", "Pade estimate of the delay margin at reflex.pade_order"),
     "delay_margin_status": ("", "finite, delay_independent (inf), unstable_without_delay (0) or undefined (NaN)"),
-    "stable_at_delay": ("", "closed loop stable with the delay reflex.delay (exact)"),
+    "stable_at_delay": ("", "closed loop stable with the delay reflex.delay and the activation lag (exact)"),
     "spine_delay_margin_s": ("s", "smallest delay margin over the segments: the delay the whole spine tolerates"),
 }
 """Every data variable: units (UDUNITS) and long name."""
@@ -122,6 +126,7 @@ def landscape_dataset(model: Model, e_axis, l_axis, arrays: dict, method: str, p
         "passive_convention": model.passive.convention,
         "activation": model.optimisation.activation,
         "reflex_delay_s": model.reflex.delay,
+        "reflex_activation_time_constant_s": model.reflex.activation_time_constant,
         "reflex_activation": model.reflex.activation,
         "config_toml": config.dump_toml(model),
     }

@@ -50,6 +50,10 @@ MAX_DELAY = 10.0
 coefficients (tau^n) overflow and python-control's Nyquist plot warn; the exact delay
 margin does not depend on tau, so nothing of interest lies beyond."""
 
+MAX_ACTIVATION_TIME_CONSTANT = 1.0
+"""Longest force-generation time constant of the reflex [s]: ten times the 100 ms the paper names as
+the upper end of force generation; a value beyond it is more likely milliseconds typed as seconds."""
+
 MAX_ACTIVATION = 10.0
 """Largest activation of the reflex section, a sanity bound: ten times the co-contraction that
 self-stability needs (a larger value is more likely a PCSA typed in place of a fraction)."""
@@ -404,7 +408,8 @@ class Reflex:
 
     Beyond the paper, which discusses reflexes in words only (Discussion: "reflexes are
     delayed by up to 100 ms ... the force generation of the muscles takes another
-    50-100 ms"). The reflex torque is u = -(kp alpha + kd omega)(t - delay); see
+    50-100 ms"). The reflex command -(kp alpha + kd omega)(t - delay) becomes the torque u
+    through the force-generation lag T_a u' + u = command (``activation_time_constant``); see
     ``docs/reflex.md`` for the default gain rule and the margins.
     """
 
@@ -413,6 +418,16 @@ class Reflex:
         "s",
         "Reflex delay tau. The paper's Discussion: reflexes follow a perturbation by up to 100 ms "
         f"(force generation adds another 50-100 ms). 0 to {MAX_DELAY:g} s.",
+    )
+    activation_time_constant: float = param(
+        0.05,
+        "s",
+        "Force generation (excitation-contraction dynamics) of the reflex torque as a first-order lag "
+        "1/(T_a s + 1) after the delay. The paper's Discussion: force generation takes another 50-100 ms. "
+        "Default 50 ms: the contraction time constants (tau1 = tau2 = 50 ms) of active human muscle at "
+        "about 20 % of maximum effort (Zahalak GI, Heyman SJ 1979, J Biomech Eng 101:28-37, "
+        "doi:10.1115/1.3426220); spinectl keeps one of the two. 0 is the pure delay; at most "
+        f'{MAX_ACTIVATION_TIME_CONSTANT:g} s (docs/reflex.md, "Force generation: the activation lag").',
     )
     pade_order: int = param(
         5, "1", f"Order of the Pade approximant of exp(-s tau) in the python-control models, 1 to {MAX_PADE_ORDER}."
@@ -478,6 +493,9 @@ class Reflex:
         _store(
             self,
             delay=v.in_range("delay", self.delay, 0.0, MAX_DELAY),
+            activation_time_constant=v.in_range(
+                "activation_time_constant", self.activation_time_constant, 0.0, MAX_ACTIVATION_TIME_CONSTANT
+            ),
             pade_order=v.integer("pade_order", self.pade_order, 1, MAX_PADE_ORDER),
             activation=v.in_range("activation", self.activation, 0.0, MAX_ACTIVATION),
             gain_factor=factor,

@@ -4,7 +4,9 @@ docs/reflex.md. Pure vectorised numpy functions for the exact delay margin
 (:mod:`~spinectl.reflex.delay`), its Padé estimates (:mod:`~spinectl.reflex.pade`),
 the gains (:mod:`~spinectl.reflex.gains`) and their maps over a landscape
 (:mod:`~spinectl.reflex.maps`); above them the python-control objects
-(:mod:`~spinectl.reflex.loops`), the nonlinear simulation (:mod:`~spinectl.reflex.simulate`),
+(:mod:`~spinectl.reflex.loops`), the exact delay margin of any SISO loop
+(:mod:`~spinectl.reflex.siso`, also ``spinectl.delay_margin``), the nonlinear simulation
+(:mod:`~spinectl.reflex.simulate`),
 the report of one configuration (:mod:`~spinectl.reflex.margins`) and its plots
 (:mod:`~spinectl.reflex.plots`).
 
@@ -22,6 +24,7 @@ from .delay import (
     UNSTABLE_WITHOUT_DELAY,
     Crossings,
     DelayMargin,
+    WithoutDelay,
     critical_gains,
     crossings,
     delay_margin,
@@ -29,6 +32,7 @@ from .delay import (
     right_half_plane_roots,
     stable_at_delay,
     stable_without_delay,
+    without_delay,
 )
 from .gains import default_gains, resolve_gains
 from .maps import ReflexLandscape, landscape
@@ -42,6 +46,7 @@ __all__ = [
     "UNSTABLE_WITHOUT_DELAY",
     "Crossings",
     "DelayMargin",
+    "WithoutDelay",
     "ReflexLandscape",
     "critical_gains",
     "crossings",
@@ -58,4 +63,5 @@ __all__ = [
     "right_half_plane_roots",
     "stable_at_delay",
     "stable_without_delay",
+    "without_delay",
 ]

@@ -1,28 +1,33 @@
-"""Delayed PD reflex of one segment: default gains, exact and Padé delay margins, critical gains.
+"""Delayed, lagged PD reflex of one segment: exact delay margins, root counting, critical gains.
 
 Pure vectorised numpy functions of arrays (any broadcastable shapes) of the
 segment's stiffness S = dM/dalpha [N m/rad], damping D = dM/domega
 [N m s/rad], inertia theta [kg m^2] and the reflex gains kp [N m/rad],
-kd [N m s/rad]; no python-control object per point (the loop and the derivations
-are in docs/reflex.md, "The loop" and "Crossing frequencies and the exact delay
-margin"). The reflex is beyond the paper, which discusses it in words only.
+kd [N m s/rad], and the activation time constant T_a [s] of the force generation
+(``lag``, 0 by default: the pure delay); no python-control object per point (the loop
+and the derivations are in docs/reflex.md, "The loop", "Force generation: the
+activation lag" and "Crossing frequencies and the exact delay margin"). The reflex
+is beyond the paper, which discusses it in words only.
 
-The linearised segment theta alpha'' = S alpha + D alpha' + u with the delayed
-reflex u(t) = -(kp alpha + kd alpha')(t - tau) has the characteristic
-quasi-polynomial
+The linearised segment theta alpha'' = S alpha + D alpha' + u with the delayed reflex
+command -(kp alpha + kd alpha')(t - tau), turned into the torque u by the lag
+T_a u' + u = command, has the characteristic quasi-polynomial
 
-    Delta(s, tau) = P(s) + Q(s) exp(-s tau),  P(s) = theta s^2 - D s - S,  Q(s) = kp + kd s.
+    Delta(s, tau) = P(s) + Q(s) exp(-s tau),  P(s) = (T_a s + 1)(theta s^2 - D s - S),  Q(s) = kp + kd s.
 
 A root crosses the imaginary axis at s = j w only where abs(Q(jw)) = abs(P(jw)), i.e.
-F(w^2) = 0 with F(x) = theta^2 x^2 + (2 S theta + D^2 - kd^2) x + S^2 - kp^2,
-and then only at the delays tau = (phi + 2 pi k) / w, phi = arg(-Q/P) mod 2 pi.
-The sign of F'(w^2) is the direction of the crossing (Cooke and Grossman 1982 [1]_;
-Cooke and van den Driessche 1986 [2]_): + destabilising, - stabilising.
+F(w^2) = 0 with F(x) = (1 + T_a^2 x)(theta^2 x^2 + (2 S theta + D^2) x + S^2) - kp^2 - kd^2 x
+(quadratic in x for T_a = 0, cubic otherwise), and then only at the delays
+tau = (phi + 2 pi k) / w, phi = arg(-Q/P) mod 2 pi. The sign of F'(w^2) is the direction
+of the crossing (Cooke and Grossman 1982 [1]_; Cooke and van den Driessche 1986 [2]_):
++ destabilising, - stabilising. With T_a = 0 every function returns what it did before
+the lag existed, bit for bit.
 
-theta = 0 with kd = 0 is accepted by :func:`delay_margin` and :func:`phase_margin`
-too: the first-order-plus-delay loop of the textbooks (a retarded equation);
-theta = 0 with kd != 0 would be of neutral type and is not covered, and the root
-counting (:func:`right_half_plane_roots`, :func:`critical_gains`) assumes theta > 0.
+Boundary cases (docs/reflex.md, "Boundary cases"): the delay-free loop is classified from
+the signs of its coefficients after making the leading one positive, so a first-order
+loop (theta = 0) does not depend on the sign convention; a pair on the imaginary axis at
+tau = 0 (kd = D) is followed to the side it leaves to; the pure gain (theta = D = T_a =
+kd = 0) has a closed form; loops of neutral type (kd != 0 with deg P <= 1) are refused.
 
 References
 ----------
@@ -38,6 +43,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import ParameterError
+
 STATUS = ("finite", "delay_independent", "unstable_without_delay", "undefined")
 """Meaning of :attr:`DelayMargin.status` codes 0..3.
 
@@ -45,14 +52,20 @@ STATUS = ("finite", "delay_independent", "unstable_without_delay", "undefined")
 - ``delay_independent``: stable without delay and no root can reach the imaginary
   axis (abs(Q(jw)) != abs(P(jw)) for every w > 0): stable for every delay, margin = inf.
   This is where self-stability makes the delay irrelevant.
-- ``unstable_without_delay``: not stable even at tau = 0 (kp <= S or kd <= D):
-  margin = 0, the largest tau_m with stability on all of [0, tau_m) being none.
+- ``unstable_without_delay``: not asymptotically stable even at tau = 0 (a root in
+  Re s >= 0 of P + Q): margin = 0, the largest tau_m with stability on all of [0, tau_m) being none.
 - ``undefined``: an input is NaN (e.g. an infeasible optimum): margin = NaN.
 """
 FINITE, DELAY_INDEPENDENT, UNSTABLE_WITHOUT_DELAY, UNDEFINED = range(len(STATUS))
 
 BISECTIONS = 60
 """Halvings of a bracket in the vectorised root finders: 2^-60 of the bracket, below float resolution."""
+
+SLOTS = 3
+"""Crossing slots per point: F is at most cubic in w^2 (quadratic without the activation lag)."""
+
+_TANGENT = 1e-7
+"""Relative distance below which two roots of the cubic F are one double root (a tangency, direction 0)."""
 
 
 def as_arrays(*values):
@@ -71,15 +84,156 @@ def as_arrays(*values):
     return np.broadcast_arrays(*(np.asarray(x, float) for x in values))
 
 
-def stable_without_delay(stiffness, damping, kp, kd):
-    """True where theta s^2 + (kd - D) s + (kp - S) is Hurwitz: kd > D and kp > S (theta > 0).
+def check_retarded(inertia, damping, kd, lag=0.0) -> None:
+    """Refuse the loops that are not of retarded type: deg Q >= deg P (docs/reflex.md, "Boundary cases").
+
+    deg P = 2 (theta > 0), 1 (theta = 0, D != 0) or 0 (theta = D = 0), plus 1 with the
+    activation lag; deg Q = 1 where kd != 0. deg Q = deg P >= 1 is of neutral type (roots
+    can come from infinity), deg Q > deg P advanced: neither is covered. The pure gain
+    (deg P = deg Q = 0) is, in closed form (:func:`delay_margin`).
 
     Parameters
     ----------
-    stiffness, damping : array_like
-        S [N m/rad], D [N m s/rad].
+    inertia, damping, kd, lag : array_like
+        theta [kg m^2], D [N m s/rad], kd [N m s/rad], T_a [s].
+
+    Raises
+    ------
+    ParameterError
+        Naming ``kd``, where some point has kd != 0 and deg P <= 1.
+    """
+    theta, d, kd, lag = as_arrays(inertia, damping, kd, lag)
+    degree_p = np.where(theta != 0, 2, np.where(d != 0, 1, 0)) + (lag != 0)
+    if np.any((kd != 0) & (degree_p <= 1)):
+        raise ParameterError(
+            "kd",
+            "must be 0 where inertia = 0 and activation_time_constant = 0: with a derivative reflex the loop "
+            "is then of neutral type, which the delay margin does not cover",
+        )
+
+
+def without_delay_coefficients(stiffness, damping, inertia, kp, kd, lag=0.0):
+    """Coefficients of the delay-free closed loop R(s) = (T_a s + 1)(theta s^2 - D s - S) + kp + kd s.
+
+    Parameters
+    ----------
+    stiffness, damping, inertia, kp, kd, lag : array_like
+        S [N m/rad], D [N m s/rad], theta [kg m^2], kp [N m/rad], kd [N m s/rad], T_a [s].
+
+    Returns
+    -------
+    r3, r2, r1, r0 : numpy.ndarray
+        theta T_a, theta - D T_a, kd - D - S T_a, kp - S [N m/rad times s^k]; with T_a = 0 exactly
+        0, theta, kd - D and kp - S.
+    """
+    s, d, theta, kp, kd, lag = as_arrays(stiffness, damping, inertia, kp, kd, lag)
+    return theta * lag, theta - d * lag, kd - d - s * lag, kp - s
+
+
+@dataclass(frozen=True)
+class WithoutDelay:
+    """The delay-free closed loop R(s) of :func:`without_delay_coefficients`, per point.
+
+    Attributes
+    ----------
+    unstable : numpy.ndarray
+        Roots of R in Re s > 0, counted exactly from the signs of its coefficients (Routh).
+    axis_frequency : numpy.ndarray
+        w0 > 0 where R has the pair +-j w0 on the imaginary axis [rad/s]; NaN elsewhere.
+    zero_root : numpy.ndarray of bool
+        R(0) = kp - S = 0: s = 0 is a root for every delay.
+    departure : numpy.ndarray
+        Where the axis pair leaves to as tau grows from 0: +1 right, -1 left, 0 it stays on
+        the axis (no reflex); NaN without an axis pair.
+    """
+
+    unstable: np.ndarray
+    axis_frequency: np.ndarray
+    zero_root: np.ndarray
+    departure: np.ndarray
+
+    @property
+    def stable(self) -> np.ndarray:
+        """Every root of R in Re s < 0."""
+        return (self.unstable == 0) & np.isnan(self.axis_frequency) & ~self.zero_root
+
+
+def _routh(r3, r2, r1, r0):
+    """Roots in Re s > 0 and the axis pair of r3 s^3 + r2 s^2 + r1 s + r0 (any leading zeros), exactly."""
+    lead = np.where(r3 != 0, r3, np.where(r2 != 0, r2, np.where(r1 != 0, r1, 1.0)))
+    r3, r2, r1, r0 = (np.sign(lead) * c for c in (r3, r2, r1, r0))  # leading coefficient > 0
+    nan = np.full(np.shape(r0), np.nan)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        # degree 1 and 2
+        linear = (r0 < 0).astype(float)
+        quadratic = np.where(r0 < 0, 1.0, np.where(r0 == 0, (r1 < 0) * 1.0, np.where(r1 < 0, 2.0, 0.0)))
+        axis2 = np.where((r1 == 0) & (r0 > 0), np.sqrt(r0 / r2), nan)
+        # degree 3: Routh's first column r3, r2, h / r2, r0 with h = r2 r1 - r3 r0
+        h = r2 * r1 - r3 * r0
+        column = np.sign(np.stack([r3, r2, h / r2, r0]))
+        changes = np.sum(column[1:] != column[:-1], axis=0).astype(float)
+        zero = np.where(r1 < 0, 1.0, np.where(r2 < 0, np.where(r1 > 0, 2.0, 1.0), 0.0))  # s (r3 s^2 + r2 s + r1)
+        split = (r2 < 0) * 1.0 + (r1 < 0) * 1.0  # h = 0: R = (r3 s + r2)(s^2 + r1 / r3)
+        cubic = np.where(r0 == 0, zero, np.where(r2 == 0, np.where(r0 > 0, 2.0, 1.0), np.where(h == 0, split, changes)))
+        axis3 = np.where((h == 0) & (r2 != 0) & (r1 > 0) & (r0 != 0), np.sqrt(r1 / r3), nan)
+    unstable = np.where(r3 != 0, cubic, np.where(r2 != 0, quadratic, np.where(r1 != 0, linear, 0.0)))
+    axis = np.where(r3 != 0, axis3, np.where(r2 != 0, axis2, nan))
+    return unstable, axis
+
+
+def without_delay(stiffness, damping, inertia, kp, kd, lag=0.0) -> WithoutDelay:
+    """The delay-free closed loop: its unstable roots, an axis pair and where that pair goes as tau grows.
+
+    An axis pair +-j w0 of R (e.g. kd = D and kp > S without the lag) is a crossing at tau = 0.
+    It leaves to the side of Re ds/dtau = Re s0 Q(s0) / R'(s0) (the first order of
+    Delta(s(tau), tau) = 0 in tau, which has the sign of F'(w0^2)); where that vanishes (a
+    tangency, e.g. kp = 0, kd = D) the second order decides,
+    s2 = [(sQ)'(s0) s1 - R''(s0) s1^2 / 2 - s0^2 Q(s0) / 2] / R'(s0), and with Q = 0 (no reflex)
+    the pair stays on the axis for every delay (docs/reflex.md, "Boundary cases").
+
+    Parameters
+    ----------
+    stiffness, damping, inertia, kp, kd, lag : array_like
+        S [N m/rad], D [N m s/rad], theta [kg m^2], kp [N m/rad], kd [N m s/rad], T_a [s].
+
+    Returns
+    -------
+    WithoutDelay
+        Counts, axis frequency [rad/s], zero-root flags and departures, each of the
+        broadcast shape of the inputs.
+    """
+    s, d, theta, kp, kd, lag = as_arrays(stiffness, damping, inertia, kp, kd, lag)
+    unstable, w0 = _routh(*without_delay_coefficients(s, d, theta, kp, kd, lag))
+    axis = np.isfinite(w0)
+    s0 = 1j * np.where(axis, w0, 0.0)
+    with np.errstate(all="ignore"):  # only the points with an axis pair are read
+        p2, dp2 = theta * s0**2 - d * s0 - s, 2.0 * theta * s0 - d
+        r1 = lag * p2 + (lag * s0 + 1.0) * dp2 + kd  # R'(s0)
+        r2 = 2.0 * lag * dp2 + 2.0 * theta * (lag * s0 + 1.0)  # R''(s0)
+        q0, sq1 = kp + kd * s0, kp + 2.0 * kd * s0
+        s1 = s0 * q0 / r1
+        s2 = (sq1 * s1 - 0.5 * r2 * s1**2 - 0.5 * s0**2 * q0) / r1
+        first = np.where(np.abs(s1.real) > 1e-12 * np.abs(s1), np.sign(s1.real), 0.0)
+        second = np.where(np.abs(s2.real) > 1e-12 * np.abs(s2), np.sign(s2.real), 0.0)
+    departure = np.where(axis, np.where(first != 0, first, second), np.nan)
+    return WithoutDelay(unstable=unstable, axis_frequency=w0, zero_root=kp == s, departure=departure)
+
+
+def stable_without_delay(stiffness, damping, inertia, kp, kd, lag=0.0):
+    """True where the delay-free closed loop R(s) of :func:`without_delay_coefficients` is Hurwitz.
+
+    Without the lag and with theta > 0: kd > D and kp > S. Decided from the signs of
+    R's coefficients after making the leading one positive, so that a first-order loop
+    (theta = 0) does not depend on the sign convention of P and Q.
+
+    Parameters
+    ----------
+    stiffness, damping, inertia : array_like
+        S [N m/rad], D [N m s/rad], theta [kg m^2].
     kp, kd : array_like
         Reflex gains [N m/rad], [N m s/rad].
+    lag : array_like, optional
+        Activation time constant T_a [s].
 
     Returns
     -------
@@ -87,24 +241,25 @@ def stable_without_delay(stiffness, damping, kp, kd):
         True where the delay-free closed loop is asymptotically stable; the broadcast
         shape of the inputs.
     """
-    s, d, kp, kd = as_arrays(stiffness, damping, kp, kd)
-    return (kd > d) & (kp > s)
+    return without_delay(stiffness, damping, inertia, kp, kd, lag).stable
 
 
 @dataclass(frozen=True)
 class Crossings:
-    """Where roots of the closed loop can cross the imaginary axis; two slots per point.
+    """Where roots of the closed loop can cross the imaginary axis; :data:`SLOTS` slots per point.
 
-    Slot 0 holds the larger root x+ of F (destabilising), slot 1 the smaller x-
-    (stabilising); empty slots are NaN.
+    Slots hold the positive roots x = w^2 of F, largest first; empty slots are NaN.
+    Without the lag F is quadratic: slot 0 holds x+ (destabilising), slot 1 x-
+    (stabilising) and slot 2 is empty.
 
     Attributes
     ----------
-    frequency : numpy.ndarray, shape (..., 2)
+    frequency : numpy.ndarray, shape (..., 3)
         w > 0 with abs(Q(jw)) = abs(P(jw)), the gain crossover of the loop [rad/s].
-    phase : numpy.ndarray, shape (..., 2)
-        phi = arg(-Q(jw)/P(jw)) in [0, 2 pi) [rad]: the delay must add w tau = phi (mod 2 pi).
-    direction : numpy.ndarray, shape (..., 2)
+    phase : numpy.ndarray, shape (..., 3)
+        phi = arg(-Q(jw)/P(jw)) in [0, 2 pi) [rad]: the delay must add w tau = phi (mod 2 pi);
+        exactly 0 for a pair that sits on the axis at tau = 0.
+    direction : numpy.ndarray, shape (..., 3)
         sign F'(w^2): +1 roots move right as tau grows, -1 left, 0 a tangency.
     """
 
@@ -114,17 +269,87 @@ class Crossings:
 
     @property
     def first_delay(self) -> np.ndarray:
-        """The smallest critical delay of each crossing, phi / w [s], shape (..., 2)."""
+        """The smallest critical delay of each crossing, phi / w [s], shape (..., 3)."""
         return self.phase / self.frequency
 
 
-def crossings(stiffness, damping, inertia, kp, kd) -> Crossings:
-    """Crossing frequencies, phases and directions of the delayed reflex loop.
+def crossing_polynomial(stiffness, damping, inertia, kp, kd, lag=0.0):
+    """Coefficients of F(x) = abs(P(jw))^2 - abs(Q(jw))^2 in x = w^2, P = (T_a s + 1)(theta s^2 - D s - S).
 
-    Solves F(x) = theta^2 x^2 + (2 S theta + D^2 - kd^2) x + (S^2 - kp^2) = 0,
-    from abs(kp + j kd w)^2 = (S + theta w^2)^2 + D^2 w^2 (``docs/reflex.md``), for x = w^2 > 0.
-    w = 0 is never a crossing for kp != S: there exp(0) = 1 and Delta(0) = kp - S.
-    The direction of a crossing is sign F'(w^2) [1]_ [2]_.
+    F(x) = (1 + T_a^2 x)(theta^2 x^2 + (2 S theta + D^2) x + S^2) - kp^2 - kd^2 x (docs/reflex.md,
+    "Crossing frequencies and the exact delay margin").
+
+    Parameters
+    ----------
+    stiffness, damping, inertia, kp, kd, lag : array_like
+        S [N m/rad], D [N m s/rad], theta [kg m^2], kp [N m/rad], kd [N m s/rad], T_a [s].
+
+    Returns
+    -------
+    f3, f2, f1, f0 : numpy.ndarray
+        The coefficients of x^3 .. x^0; f3 = 0 and f2 = theta^2 without the lag.
+    """
+    s, d, theta, kp, kd, lag = as_arrays(stiffness, damping, inertia, kp, kd, lag)
+    t2 = lag**2
+    middle = 2.0 * s * theta + d**2
+    return t2 * theta**2, theta**2 + t2 * middle, middle - kd**2 + t2 * s**2, s**2 - kp**2
+
+
+def _positive_roots(f3, f2, f1, f0):
+    """Positive roots x of F, largest first, :data:`SLOTS` slots, and sign F'(x) at each (0: double root)."""
+    a, b, c = f2, f1, f0
+    disc = b**2 - 4.0 * a * c
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        # quadratic (f3 = 0): the cancellation-free pair of roots; a = 0 (first order) leaves x = c / q only
+        q = -0.5 * (b + np.copysign(np.sqrt(np.where(disc >= 0, disc, np.nan)), b))
+        quad = np.stack([q / a, c / q, np.full(q.shape, np.nan)], axis=-1)
+        cubic, cubic_tangent = _cubic_roots(f3, f2, f1, f0)
+    cubic_points = f3 != 0
+    x = np.where(cubic_points[..., None], cubic, quad)
+    x = np.where(np.isfinite(x) & (x > 0), x, np.nan)
+    order = np.argsort(-np.nan_to_num(x, nan=-np.inf), axis=-1, kind="stable")  # larger first, NaN last
+    x = np.take_along_axis(x, order, axis=-1)
+    tangent = np.where(cubic_points[..., None], np.take_along_axis(cubic_tangent, order, axis=-1), disc[..., None] == 0)
+    with np.errstate(invalid="ignore", over="ignore"):
+        slope = 2.0 * f2[..., None] * x + f1[..., None] + 3.0 * f3[..., None] * x**2
+    return x, np.where(tangent, 0.0, np.sign(slope))
+
+
+def _cubic_roots(f3, f2, f1, f0):
+    """Real roots of f3 x^3 + f2 x^2 + f1 x + f0 (f3 != 0; NaN where not real), and double-root flags.
+
+    The eigenvalues of the companion matrix, batched, then polished by Newton's method;
+    two roots within :data:`_TANGENT` of each other are one double root (a tangency).
+    """
+    lead = np.where(f3 != 0, f3, 1.0)
+    companion = np.zeros(f3.shape + (3, 3))
+    companion[..., 0, :] = -np.stack([f2, f1, f0], axis=-1) / lead[..., None]
+    companion[..., 1, 0] = companion[..., 2, 1] = 1.0
+    companion = np.where(np.isfinite(companion), companion, 0.0)
+    roots = np.linalg.eigvals(companion)
+    real = np.abs(roots.imag) <= _TANGENT * np.maximum(np.abs(roots), np.finfo(float).tiny)
+    x = roots.real
+    cf = [c[..., None] for c in (f3, f2, f1, f0)]
+    for _ in range(3):
+        value = ((cf[0] * x + cf[1]) * x + cf[2]) * x + cf[3]
+        slope = (3.0 * cf[0] * x + 2.0 * cf[1]) * x + cf[2]
+        step = np.where(slope != 0, value / np.where(slope != 0, slope, 1.0), 0.0)
+        x = x - np.where(np.abs(step) < 0.1 * np.abs(x) + 1e-300, step, 0.0)
+    x = np.where(real, x, np.nan)
+    close = np.abs(x[..., :, None] - x[..., None, :]) <= _TANGENT * np.abs(x[..., :, None])
+    twins = np.sum(close, axis=-1) > 1
+    first = np.argmax(close, axis=-1) == np.arange(SLOTS)  # keep one of each double root
+    return np.where(twins & ~first, np.nan, x), twins
+
+
+def crossings(stiffness, damping, inertia, kp, kd, lag=0.0) -> Crossings:
+    """Crossing frequencies, phases and directions of the delayed, lagged reflex loop.
+
+    The positive roots x = w^2 of F (:func:`crossing_polynomial`): without the lag a quadratic,
+    solved in closed form; with it a cubic (eigenvalues of its companion matrix, polished).
+    w = 0 is never a crossing for kp != S: there exp(0) = 1 and Delta(0) = kp - S. The direction
+    of a crossing is sign F'(w^2) [1]_ [2]_. A pair on the imaginary axis at tau = 0 (e.g.
+    kd = D) crosses there: its phase is set to exactly 0.
 
     Parameters
     ----------
@@ -132,11 +357,13 @@ def crossings(stiffness, damping, inertia, kp, kd) -> Crossings:
         S [N m/rad], D [N m s/rad], theta [kg m^2].
     kp, kd : array_like
         Reflex gains [N m/rad], [N m s/rad].
+    lag : array_like, optional
+        Activation time constant T_a [s]; 0 is the pure delay.
 
     Returns
     -------
     Crossings
-        Frequency [rad/s], phase [rad] and direction [1], each of shape (..., 2) with
+        Frequency [rad/s], phase [rad] and direction [1], each of shape (..., 3) with
         ``...`` the broadcast shape of the inputs; NaN in empty slots.
 
     References
@@ -146,25 +373,27 @@ def crossings(stiffness, damping, inertia, kp, kd) -> Crossings:
     .. [2] Cooke KL, van den Driessche P (1986). On zeroes of some transcendental
        equations. Funkcialaj Ekvacioj 29:77-90.
     """
-    s, d, theta, kp, kd = as_arrays(stiffness, damping, inertia, kp, kd)
-    a, b, c = theta**2, 2.0 * s * theta + d**2 - kd**2, s**2 - kp**2
-    disc = b**2 - 4.0 * a * c
-    with np.errstate(divide="ignore", invalid="ignore"):
-        # the cancellation-free pair of roots; a = 0 (first order) leaves x = c / q only
-        q = -0.5 * (b + np.copysign(np.sqrt(np.where(disc >= 0, disc, np.nan)), b))
-        x = np.stack([q / a, c / q], axis=-1)
-        x = np.where(np.isfinite(x) & (x > 0), x, np.nan)
-        x = -np.sort(-x, axis=-1)  # larger first, NaN last
+    s, d, theta, kp, kd, lag = as_arrays(stiffness, damping, inertia, kp, kd, lag)
+    x, direction = _positive_roots(*crossing_polynomial(s, d, theta, kp, kd, lag))
+    with np.errstate(invalid="ignore"):
         w = np.sqrt(x)
-        slope = 2.0 * a[..., None] * x + b[..., None]
-    direction = np.where(disc[..., None] == 0, 0.0, np.sign(slope))
     jw = 1j * np.nan_to_num(w)
     p = theta[..., None] * jw**2 - d[..., None] * jw - s[..., None]
+    p = np.where(lag[..., None] == 0, p, p * (1.0 + lag[..., None] * jw))
     qq = kp[..., None] + kd[..., None] * jw
     with np.errstate(divide="ignore", invalid="ignore"):
         phase = np.mod(np.angle(-qq / p), 2.0 * np.pi)
     phase = np.where(np.isnan(w), np.nan, phase)
+    phase = np.where(_axis_slot(w, without_delay(s, d, theta, kp, kd, lag).axis_frequency), 0.0, phase)
     return Crossings(frequency=w, phase=phase, direction=np.where(np.isnan(w), np.nan, direction))
+
+
+def _axis_slot(frequency, axis_frequency):
+    """The slot of each point whose crossing is the delay-free axis pair (at tau = 0), as a mask."""
+    gap = np.abs(frequency - axis_frequency[..., None])
+    gap = np.where(np.isnan(gap), np.inf, gap)
+    nearest = np.argmin(gap, axis=-1)[..., None] == np.arange(frequency.shape[-1])
+    return nearest & (gap <= 1e-6 * axis_frequency[..., None])
 
 
 @dataclass(frozen=True)
@@ -240,23 +469,53 @@ def undefined_inputs(*values):
     return np.any(np.isnan(np.stack(as_arrays(*values))), axis=0)
 
 
-def delay_margin(stiffness, damping, inertia, kp, kd) -> DelayMargin:
+def pure_gain(inertia, damping, kd, lag):
+    """Where the loop is a pure gain with delay, 1 + K exp(-s tau), K = -kp/S.
+
+    P = -S is then a constant (theta = D = T_a = 0) and so is Q = kp (kd = 0); its roots lie at
+    Re s = ln abs(K) / tau for every tau > 0 (docs/reflex.md, "Boundary cases").
+
+    Parameters
+    ----------
+    inertia, damping, kd, lag : array_like
+        theta [kg m^2], D [N m s/rad], kd [N m s/rad], T_a [s].
+
+    Returns
+    -------
+    numpy.ndarray of bool
+        The broadcast shape of the inputs.
+    """
+    theta, d, kd, lag = as_arrays(inertia, damping, kd, lag)
+    return (theta == 0) & (d == 0) & (kd == 0) & (lag == 0)
+
+
+def delay_margin(stiffness, damping, inertia, kp, kd, lag=0.0) -> DelayMargin:
     """Exact delay margin from the quasi-polynomial (docs/reflex.md, "Crossing frequencies and the exact delay margin").
 
     If the loop is stable at tau = 0 the first root to reach the imaginary axis as
     tau grows does so at the smallest critical delay phi/w over the crossings;
-    without crossings the loop is stable for every delay (margin inf).
+    without crossings the loop is stable for every delay (margin inf). The pure gain
+    (theta = D = T_a = kd = 0), 1 + K exp(-s tau) with K = -kp/S, has its roots at
+    Re s = ln abs(K) / tau: margin inf if abs(K) < 1, else 0 (status ``finite``: stable at
+    tau = 0, unstable for every tau > 0).
 
     Parameters
     ----------
     stiffness, damping, inertia, kp, kd : array_like
         S [N m/rad], D [N m s/rad], theta [kg m^2], kp [N m/rad], kd [N m s/rad].
+    lag : array_like, optional
+        Activation time constant T_a [s] of the force generation after the delay; 0 is the pure delay.
 
     Returns
     -------
     DelayMargin
         tau_m [s] (inf, 0 or NaN by :data:`STATUS`), the frequency at which stability
         is lost [rad/s] and the status code, each of the broadcast shape of the inputs.
+
+    Raises
+    ------
+    ParameterError
+        Naming ``kd``, for a loop of neutral type (:func:`check_retarded`).
 
     Notes
     -----
@@ -270,18 +529,32 @@ def delay_margin(stiffness, damping, inertia, kp, kd) -> DelayMargin:
     .. [2] Cooke KL, van den Driessche P (1986). On zeroes of some transcendental
        equations. Funkcialaj Ekvacioj 29:77-90.
     """
-    cr = crossings(stiffness, damping, inertia, kp, kd)
-    stable0 = stable_without_delay(stiffness, damping, kp, kd)
-    undefined = undefined_inputs(stiffness, damping, inertia, kp, kd)
-    return margin_from_delays(cr.first_delay, cr.frequency, stable0, undefined)
+    check_retarded(inertia, damping, kd, lag)
+    cr = crossings(stiffness, damping, inertia, kp, kd, lag)
+    stable0 = stable_without_delay(stiffness, damping, inertia, kp, kd, lag)
+    undefined = undefined_inputs(stiffness, damping, inertia, kp, kd, lag)
+    result = margin_from_delays(cr.first_delay, cr.frequency, stable0, undefined)
+    gain = pure_gain(inertia, damping, kd, lag) & ~undefined & stable0
+    if not np.any(gain):
+        return result
+    s, kp = as_arrays(stiffness, kp)
+    small = np.abs(kp) < np.abs(s)
+    return DelayMargin(
+        margin=np.where(gain, np.where(small, np.inf, 0.0), result.margin),
+        frequency=np.where(gain, np.nan, result.frequency),
+        status=np.where(gain, np.where(small, DELAY_INDEPENDENT, FINITE), result.status).astype(np.int8),
+    )
 
 
-def right_half_plane_roots(stiffness, damping, inertia, kp, kd, delay):
+def right_half_plane_roots(stiffness, damping, inertia, kp, kd, delay, lag=0.0):
     """Number of closed-loop roots with Re s > 0 at the delay ``delay`` [s], exactly.
 
     N(tau) = N(0) + 2 sum over crossings of direction * #{k >= 0: phi/w + 2 pi k/w < tau}:
     every crossing moves a conjugate pair (retarded type: no root comes from
-    infinity). N(0) counts the roots of theta s^2 + (kd - D) s + (kp - S).
+    infinity). N(0) counts the roots of the delay-free loop R(s) in Re s > 0. A pair on
+    the axis at tau = 0 counts 2 for tau > 0 if it leaves to the right, else 0
+    (:func:`without_delay`); without a reflex the roots do not move. The pure gain
+    (theta = D = T_a = kd = 0) has infinitely many (inf) for tau > 0 where abs(kp) > abs(S).
 
     Parameters
     ----------
@@ -291,28 +564,45 @@ def right_half_plane_roots(stiffness, damping, inertia, kp, kd, delay):
         Reflex gains [N m/rad], [N m s/rad].
     delay : array_like
         tau [s].
+    lag : array_like, optional
+        Activation time constant T_a [s].
 
     Returns
     -------
     numpy.ndarray
         The count, as floats (NaN where an input is NaN).
+
+    Raises
+    ------
+    ParameterError
+        Naming ``kd``, for a loop of neutral type (:func:`check_retarded`).
     """
-    s, d, theta, kp, kd, tau = as_arrays(stiffness, damping, inertia, kp, kd, delay)
-    c0, c1 = kp - s, kd - d
-    n0 = np.where(c0 < 0, 1.0, np.where(c1 < 0, 2.0, 0.0))
-    cr = crossings(s, d, theta, kp, kd)
+    check_retarded(inertia, damping, kd, lag)
+    s, d, theta, kp, kd, tau, lag = as_arrays(stiffness, damping, inertia, kp, kd, delay, lag)
+    free = without_delay(s, d, theta, kp, kd, lag)
+    cr = crossings(s, d, theta, kp, kd, lag)
     with np.errstate(invalid="ignore"):
         passed = np.floor((tau[..., None] - cr.first_delay) * cr.frequency / (2.0 * np.pi)) + 1.0
     passed = np.where(np.isnan(passed), 0.0, np.maximum(passed, 0.0))
-    count = n0 + 2.0 * np.sum(np.nan_to_num(cr.direction) * passed, axis=-1)
-    return np.where(undefined_inputs(s, d, theta, kp, kd, tau), np.nan, count)
+    direction = np.nan_to_num(cr.direction)
+    count = free.unstable + 2.0 * np.sum(direction * passed, axis=-1)
+    # the axis pair's crossing at tau = 0 counts by where it goes, not by sign F'
+    at_zero = _axis_slot(cr.frequency, free.axis_frequency)
+    count -= 2.0 * np.sum(np.where(at_zero, direction, 0.0), axis=-1)
+    count += 2.0 * np.where((tau > 0) & ~np.isnan(free.axis_frequency), np.maximum(free.departure, 0.0), 0.0)
+    count = np.where((kp == 0) & (kd == 0), free.unstable, count)  # no reflex: Delta = P for every delay
+    infinite = pure_gain(theta, d, kd, lag) & (tau > 0) & (np.abs(kp) > np.abs(s))
+    count = np.where(infinite, np.inf, count)
+    return np.where(undefined_inputs(s, d, theta, kp, kd, tau, lag), np.nan, count)
 
 
-def stable_at_delay(stiffness, damping, inertia, kp, kd, delay):
+def stable_at_delay(stiffness, damping, inertia, kp, kd, delay, lag=0.0):
     """True where the closed loop with the true delay [s] has every root in Re s < 0.
 
     Exact for every delay, also beyond the delay margin (stability switches). A root
-    fixed at s = 0 (kp = S) or on the axis at tau = 0 (kd = D) counts as unstable.
+    fixed at s = 0 (kp = S), a pair on the axis at tau = 0, and a pair that stays on the
+    axis for every delay (no reflex on an undamped segment, S < 0 and D = 0) count as unstable;
+    so does the pure gain with abs(kp) = abs(S) for tau > 0 (roots on the axis).
 
     Parameters
     ----------
@@ -322,20 +612,29 @@ def stable_at_delay(stiffness, damping, inertia, kp, kd, delay):
         Reflex gains [N m/rad], [N m s/rad].
     delay : array_like
         tau [s].
+    lag : array_like, optional
+        Activation time constant T_a [s].
 
     Returns
     -------
     numpy.ndarray of bool
         True where the closed loop with delay tau is asymptotically stable; the broadcast
         shape of the inputs (False where an input is NaN).
+
+    Raises
+    ------
+    ParameterError
+        Naming ``kd``, for a loop of neutral type (:func:`check_retarded`).
     """
-    s, d, theta, kp, kd, tau = as_arrays(stiffness, damping, inertia, kp, kd, delay)
-    count = right_half_plane_roots(s, d, theta, kp, kd, tau)
-    on_axis = (kp == s) | ((tau == 0) & (kd <= d))
-    return (count == 0) & ~on_axis
+    s, d, theta, kp, kd, tau, lag = as_arrays(stiffness, damping, inertia, kp, kd, delay, lag)
+    count = right_half_plane_roots(s, d, theta, kp, kd, tau, lag)
+    free = without_delay(s, d, theta, kp, kd, lag)
+    axis = ~np.isnan(free.axis_frequency) & ((tau == 0) | (free.departure == 0))
+    marginal_gain = pure_gain(theta, d, kd, lag) & (tau > 0) & (np.abs(kp) == np.abs(s))
+    return (count == 0) & ~free.zero_root & ~axis & ~marginal_gain
 
 
-def phase_margin(stiffness, damping, inertia, kp, kd, delay):
+def phase_margin(stiffness, damping, inertia, kp, kd, delay, lag=0.0):
     """Exact phase margin [rad] and gain crossover [rad/s] of the loop with the true delay.
 
     At the crossover w_c that limits the delay margin (smallest phi/w),
@@ -351,13 +650,15 @@ def phase_margin(stiffness, damping, inertia, kp, kd, delay):
         Reflex gains [N m/rad], [N m s/rad].
     delay : array_like
         tau [s].
+    lag : array_like, optional
+        Activation time constant T_a [s]; its phase is part of L.
 
     Returns
     -------
     phase_margin, crossover : numpy.ndarray
         PM [rad] and w_c [rad/s], each of the broadcast shape of the inputs.
     """
-    cr = crossings(stiffness, damping, inertia, kp, kd)
+    cr = crossings(stiffness, damping, inertia, kp, kd, lag)
     tau = np.asarray(delay, float)
     delays = np.where(np.isnan(cr.first_delay), np.inf, cr.first_delay)
     slot = np.argmin(delays, axis=-1)[..., None]
@@ -365,9 +666,6 @@ def phase_margin(stiffness, damping, inertia, kp, kd, delay):
     phi = np.take_along_axis(cr.phase, slot, axis=-1)[..., 0]
     pm = np.mod(phi - w * tau + np.pi, 2.0 * np.pi) - np.pi
     return np.where(np.isnan(w), np.inf, pm), w
-
-
-# --- Padé approximants of the delay ----------------------------------------------------------
 
 
 # --- critical gains ------------------------------------------------------------------------
@@ -390,13 +688,14 @@ def _bracketed_roots(func, grid):
     return np.where(has, 0.5 * (lo + hi), np.nan)
 
 
-def critical_gains(stiffness, damping, inertia, kd, delay, lobes: int = 8, points_per_lobe: int = 48):
+def critical_gains(stiffness, damping, inertia, kd, delay, lobes: int = 8, points_per_lobe: int = 48, lag=0.0):
     """Range (kp_min, kp_max) of proportional gains that stabilise the segment at ``delay``, given kd.
 
     D-subdivision (``docs/reflex.md``, "Critical gains"): stability can change only at
     kp = S (a root at s = 0) or where a root sits at s = j w, i.e. where
-    h(w) = (theta w^2 + S) sin(w tau) + D w cos(w tau) - kd w = 0, at
-    kp(w) = (theta w^2 + S) cos(w tau) - D w sin(w tau). The roots of h are searched for
+    h(w) = A sin(w tau) + B cos(w tau) - kd w = 0, at kp(w) = A cos(w tau) - B sin(w tau), with
+    A + j B = (1 + j w T_a)((theta w^2 + S) + j D w) (A = theta w^2 + S, B = D w without the lag).
+    The roots of h are searched for
     w tau in (0, lobes pi]; between consecutive candidate gains the number of unstable
     roots is constant and :func:`right_half_plane_roots` tells which interval is stable.
     The lowest stable interval is returned; NaN, NaN where none is.
@@ -407,23 +706,36 @@ def critical_gains(stiffness, damping, inertia, kd, delay, lobes: int = 8, point
         S [N m/rad], D [N m s/rad], theta [kg m^2], kd [N m s/rad], tau [s].
     lobes, points_per_lobe : int
         Search range (in half-periods of the delay) and its sampling.
+    lag : array_like, optional
+        Activation time constant T_a [s].
 
     Returns
     -------
     kp_min, kp_max : numpy.ndarray
         [N m/rad], each of the broadcast shape of the inputs; kp_max = inf at tau = 0.
+
+    Raises
+    ------
+    ParameterError
+        Naming ``kd``, for a loop of neutral type (:func:`check_retarded`).
     """
-    s, d, theta, kd, tau = as_arrays(stiffness, damping, inertia, kd, delay)
+    check_retarded(inertia, damping, kd, lag)
+    s, d, theta, kd, tau, lag = as_arrays(stiffness, damping, inertia, kd, delay, lag)
     y = np.linspace(0.0, lobes * np.pi, lobes * points_per_lobe + 1)
     t = np.where(tau > 0, tau, 1.0)[..., None]
-    s_, d_, th_, kd_ = (x[..., None] for x in (s, d, theta, kd))
+    s_, d_, th_, kd_, lag_ = (x[..., None] for x in (s, d, theta, kd, lag))
+
+    def parts(a, w):  # A and B / w from a = theta w^2 + S; B / w stays finite at w = 0
+        return a - d_ * lag_ * w**2, d_ + lag_ * a
 
     def h_over_w(yy):  # h(w) / w as a function of y = w tau, finite at y = 0 (sinc), so the grid starts there
-        return (th_ * yy**2 / t**2 + s_) * t * np.sinc(yy / np.pi) + d_ * np.cos(yy) - kd_
+        big_a, b_over_w = parts(th_ * yy**2 / t**2 + s_, yy / t)
+        return big_a * t * np.sinc(yy / np.pi) + b_over_w * np.cos(yy) - kd_
 
     roots = _bracketed_roots(h_over_w, np.broadcast_to(y, s.shape + y.shape))
     w = roots / t
-    kp_roots = (th_ * w**2 + s_) * np.cos(roots) - d_ * w * np.sin(roots)
+    big_a, b_over_w = parts(th_ * w**2 + s_, w)
+    kp_roots = big_a * np.cos(roots) - b_over_w * w * np.sin(roots)
     candidates = np.sort(np.concatenate([s[..., None], kp_roots], axis=-1), axis=-1)  # NaN last
     finite = np.where(np.isnan(candidates), np.inf, candidates)
     lows = np.concatenate([np.full(s.shape + (1,), -np.inf), finite], axis=-1)
@@ -431,17 +743,15 @@ def critical_gains(stiffness, damping, inertia, kd, delay, lobes: int = 8, point
     # a gain inside each interval: the middle, or one step beyond the end of an unbounded one
     low_f, high_f = np.where(np.isinf(lows), highs - 1.0, lows), np.where(np.isinf(highs), np.nan, highs)
     probe = np.where(np.isnan(high_f), low_f + np.abs(low_f) + 1.0, 0.5 * (low_f + high_f))
-    ok = stable_at_delay(s_, d_, th_, probe, kd_, tau[..., None]) & (lows < highs)
+    ok = stable_at_delay(s_, d_, th_, probe, kd_, tau[..., None], lag_) & (lows < highs)
     first = np.argmax(ok, axis=-1)[..., None]
     found = np.any(ok, axis=-1)
     kp_min = np.where(found, np.take_along_axis(lows, first, axis=-1)[..., 0], np.nan)
     kp_max = np.where(found, np.take_along_axis(highs, first, axis=-1)[..., 0], np.nan)
-    no_delay = tau == 0
+    no_delay = (tau == 0) & (lag == 0)  # with the lag even tau = 0 bounds kp: the cubic's Hurwitz condition
     kp_min = np.where(no_delay, np.where(kd > d, s, np.nan), kp_min)
     kp_max = np.where(no_delay, np.where(kd > d, np.inf, np.nan), kp_max)
     return kp_min, kp_max
 
 
 # --- the landscape over a grid ---------------------------------------------------------------
-
-

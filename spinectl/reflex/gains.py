@@ -10,7 +10,7 @@ import numpy as np
 from .delay import as_arrays
 
 
-def default_gains(stiffness, damping, inertia, gain_factor, damping_ratio):
+def default_gains(stiffness, damping, inertia, gain_factor, damping_ratio, lag=0.0):
     """The default reflex rule (docs/reflex.md, "The default reflex, and the activation level").
 
     kp = gain_factor * max(S, 0): the stiffness deficit below self-stability
@@ -19,6 +19,9 @@ def default_gains(stiffness, damping, inertia, gain_factor, damping_ratio):
     reflex. kd = max(0, 2 zeta sqrt(theta (kp - S)) + D): the delay-free closed loop
     theta s^2 + (kd - D) s + (kp - S) gets the damping ratio zeta, counting the
     muscles' own damping -D >= 0 first (kd = 0 when they already damp enough).
+    The activation lag 1/(T_a s + 1) is compensated to first order: kd gains kp T_a, so
+    that (kp + kd s)/(T_a s + 1) = kp + (kd - kp T_a) s + O(s^2) is the lag-free rule's
+    reflex at low frequency (docs/reflex.md, "The default reflex, and the activation level").
     The factor 1.5 and zeta = 1 were chosen against Stépán's bound sqrt(2 theta / S),
     the longest delay any delayed PD can balance the reflex-only segment with [1]_ [2]_
     (docs/reflex.md).
@@ -31,6 +34,8 @@ def default_gains(stiffness, damping, inertia, gain_factor, damping_ratio):
         Factor on the stiffness deficit [1], > 1.
     damping_ratio : float
         zeta [1], > 0.
+    lag : array_like, optional
+        Activation time constant T_a [s]; 0 leaves the rule as without the lag, bit for bit.
 
     Returns
     -------
@@ -44,10 +49,10 @@ def default_gains(stiffness, damping, inertia, gain_factor, damping_ratio):
     .. [2] Stépán G, Kollár L (2000). Balancing with reflex delay. Math Comput Model
        31:199-205.
     """
-    s, d, theta = as_arrays(stiffness, damping, inertia)
+    s, d, theta, lag = as_arrays(stiffness, damping, inertia, lag)
     kp = gain_factor * np.maximum(s, 0.0)
     net = np.maximum(kp - s, 0.0)
-    kd = np.maximum(2.0 * damping_ratio * np.sqrt(theta * net) + d, 0.0)
+    kd = np.maximum(2.0 * damping_ratio * np.sqrt(theta * net) + d, 0.0) + kp * lag
     return kp, kd
 
 
@@ -59,7 +64,8 @@ def resolve_gains(stiffness, damping, inertia, reflex, kp=None, kd=None):
     stiffness, damping, inertia : array_like
         S [N m/rad], D [N m s/rad], theta [kg m^2].
     reflex : spinectl.model.params.Reflex
-        ``gains = "rule"`` uses :func:`default_gains`, ``"explicit"`` its ``kp`` and ``kd``.
+        ``gains = "rule"`` uses :func:`default_gains` (with its ``activation_time_constant``),
+        ``"explicit"`` its ``kp`` and ``kd``.
     kp, kd : float, optional
         Explicit gains [N m/rad], [N m s/rad] that replace the configured ones.
 
@@ -71,7 +77,7 @@ def resolve_gains(stiffness, damping, inertia, reflex, kp=None, kd=None):
     """
     s, d, theta = as_arrays(stiffness, damping, inertia)
     if reflex.gains == "rule":
-        kp0, kd0 = default_gains(s, d, theta, reflex.gain_factor, reflex.damping_ratio)
+        kp0, kd0 = default_gains(s, d, theta, reflex.gain_factor, reflex.damping_ratio, reflex.activation_time_constant)
     else:
         kp0, kd0 = np.full(s.shape, reflex.kp), np.full(s.shape, reflex.kd)
     kp_out = kp0 if kp is None else np.full(s.shape, float(kp))

@@ -6,8 +6,9 @@ sweeps use the vectorised :mod:`spinectl.reflex` instead.
 - :func:`segment_system`: the linearised segment as a ``StateSpace``, states
   (alpha, omega), input a torque [N m], output alpha [rad];
 - :func:`pade_delay`: exp(-s tau) as python-control's Padé approximant;
+- :func:`activation_lag`: the force generation 1/(T_a s + 1) after the delay;
 - :func:`reflex_controller`, :func:`loop_transfer`: C(s) = kp + kd s and
-  L(s) = C(s) e^{-s tau} G(s), G(s) = 1 / (theta s^2 - D s - S);
+  L(s) = C(s) e^{-s tau} A(s) G(s), A(s) = 1/(T_a s + 1), G(s) = 1 / (theta s^2 - D s - S);
 - :func:`closed_loop`: the segment under the delayed reflex, from a disturbing torque to alpha;
 - :func:`loop_margins`: python-control's margins of L, read for an open-loop unstable plant;
 - :func:`ignoring_underflow`: python-control's frequency responses without underflow warnings.
@@ -78,6 +79,22 @@ def pade_delay(delay: float, order: int) -> ct.TransferFunction:
     return ct.tf(num, den, inputs=["u"], outputs=["u_delayed"])
 
 
+def activation_lag(lag: float) -> ct.TransferFunction:
+    """A(s) = 1/(T_a s + 1): the force generation of the reflex torque (docs/reflex.md, "Force generation").
+
+    Parameters
+    ----------
+    lag : float
+        Activation time constant T_a [s]; 0 gives A = 1.
+
+    Returns
+    -------
+    control.TransferFunction
+        A(s) [1], input "u_delayed", output "u_force".
+    """
+    return ct.tf([1.0], [lag, 1.0] if lag > 0 else [1.0], inputs=["u_delayed"], outputs=["u_force"])
+
+
 def reflex_controller(kp: float, kd: float) -> ct.TransferFunction:
     """C(s) = kp + kd s [N m/rad], from alpha to the reflex torque (before the delay and sign).
 
@@ -94,8 +111,10 @@ def reflex_controller(kp: float, kd: float) -> ct.TransferFunction:
     return ct.tf([kd, kp], [1.0], inputs=["alpha"], outputs=["reflex"])
 
 
-def loop_transfer(stiffness, damping, inertia, kp, kd, delay: float, order: int) -> ct.TransferFunction:
-    """Loop transfer function L(s) = C(s) Pade(s) G(s), the delay as a Padé approximant.
+def loop_transfer(
+    stiffness, damping, inertia, kp, kd, delay: float, order: int, lag: float = 0.0
+) -> ct.TransferFunction:
+    """Loop transfer function L(s) = C(s) Pade(s) A(s) G(s), the delay as a Padé approximant.
 
     The closed loop is 1 + L = 0. G(s) = 1 / (theta s^2 - D s - S) is the transfer
     function of :func:`segment_system`, written from its coefficients (docs/reflex.md,
@@ -111,6 +130,8 @@ def loop_transfer(stiffness, damping, inertia, kp, kd, delay: float, order: int)
         tau [s].
     order : int
         Order of the Padé approximant (:func:`pade_delay`).
+    lag : float, optional
+        Activation time constant T_a [s] (:func:`activation_lag`); 0 leaves it out.
 
     Returns
     -------
@@ -118,15 +139,19 @@ def loop_transfer(stiffness, damping, inertia, kp, kd, delay: float, order: int)
         L(s) [1], the delay replaced by its Padé approximant.
     """
     plant = ct.tf([1.0], [inertia, -damping, -stiffness], inputs=["torque"], outputs=["alpha"])
-    return reflex_controller(kp, kd) * pade_delay(delay, order) * plant
+    loop = reflex_controller(kp, kd) * pade_delay(delay, order)
+    return (loop * activation_lag(lag) if lag > 0 else loop) * plant
 
 
-def closed_loop(stiffness, damping, inertia, kp, kd, delay: float, order: int, name=None) -> ct.StateSpace:
-    """The segment under the delayed reflex u = -(kp alpha + kd omega)(t - tau), Padé delay.
+def closed_loop(
+    stiffness, damping, inertia, kp, kd, delay: float, order: int, name=None, lag: float = 0.0
+) -> ct.StateSpace:
+    """The segment under the delayed, lagged reflex T_a u' + u = -(kp alpha + kd omega)(t - tau), Padé delay.
 
     Built in state space (the PD acts on the states, so nothing improper is
     realised): the plant with both states as outputs, fed back through the gain
-    row [kp, kd] and the Padé system. Input: a disturbing torque [N m]; output: alpha.
+    row [kp, kd], the Padé system and the activation lag. Input: a disturbing torque [N m];
+    output: alpha.
     Its poles converge to the rightmost roots of the quasi-polynomial as the order grows.
 
     Parameters
@@ -141,15 +166,20 @@ def closed_loop(stiffness, damping, inertia, kp, kd, delay: float, order: int, n
         Order of the Padé approximant.
     name : str, optional
         System name.
+    lag : float, optional
+        Activation time constant T_a [s]; 0 leaves the lag out.
 
     Returns
     -------
     control.StateSpace
-        2 + ``order`` states, input "torque" [N m], output "alpha" [rad].
+        2 + ``order`` states (one more with the lag), input "torque" [N m], output "alpha" [rad].
     """
     plant = segment_system(stiffness, damping, inertia)
     full = ct.ss(plant.A, plant.B, np.eye(2), np.zeros((2, 1)))
-    feedback_path = ct.tf2ss(pade_delay(delay, order)) * np.array([[kp, kd]])
+    delayed = ct.tf2ss(pade_delay(delay, order))
+    if lag > 0:
+        delayed = ct.tf2ss(activation_lag(lag)) * delayed
+    feedback_path = delayed * np.array([[kp, kd]])
     loop = ct.feedback(full, feedback_path, sign=-1)
     return ct.ss(loop.A, loop.B, loop.C[:1], loop.D[:1], inputs=["torque"], outputs=["alpha"], name=name)
 

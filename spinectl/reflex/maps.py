@@ -1,6 +1,7 @@
-"""The delayed reflex at every point and segment of a landscape, vectorised.
+"""The delayed, lagged reflex at every point and segment of a landscape, vectorised.
 
-Gains (:mod:`spinectl.reflex.gains`), exact and Padé delay margins (:mod:`spinectl.reflex.delay`,
+The activation time constant of ``reflex`` enters every column. Gains (:mod:`spinectl.reflex.gains`),
+exact and Padé delay margins (:mod:`spinectl.reflex.delay`,
 :mod:`spinectl.reflex.pade`) and stability at the model's delay, as arrays of any shape.
 """
 
@@ -55,7 +56,7 @@ def landscape(stiffness, damping, inertia, reflex, kp=None, kd=None) -> ReflexLa
     stiffness, damping, inertia : array_like
         S [N m/rad], D [N m s/rad], theta [kg m^2]; NaN (infeasible) gives NaN and status 'undefined'.
     reflex : spinectl.model.params.Reflex
-        Delay, Padé order and gains.
+        Delay, activation time constant, Padé order and gains.
     kp, kd : float, optional
         Explicit gains overriding ``reflex``.
 
@@ -67,9 +68,10 @@ def landscape(stiffness, damping, inertia, reflex, kp=None, kd=None) -> ReflexLa
         broadcast shape of S, D and theta.
     """
     s, d, theta = as_arrays(stiffness, damping, inertia)
+    lag = reflex.activation_time_constant
     kp_, kd_ = resolve_gains(s, d, theta, reflex, kp, kd)
-    exact = delay_margin(s, d, theta, kp_, kd_)
-    pade = pade_delay_margin(s, d, theta, kp_, kd_, reflex.pade_order)
+    exact = delay_margin(s, d, theta, kp_, kd_, lag)
+    pade = pade_delay_margin(s, d, theta, kp_, kd_, reflex.pade_order, lag)
     return ReflexLandscape(
         kp=kp_,
         kd=kd_,
@@ -77,5 +79,5 @@ def landscape(stiffness, damping, inertia, reflex, kp=None, kd=None) -> ReflexLa
         delay_margin_status=exact.status,
         crossing_frequency=exact.frequency,
         delay_margin_pade=pade.margin,
-        stable_at_delay=stable_at_delay(s, d, theta, kp_, kd_, reflex.delay),
+        stable_at_delay=stable_at_delay(s, d, theta, kp_, kd_, reflex.delay, lag),
     )

@@ -12,6 +12,7 @@ A :class:`MarginsReport` presents itself: :meth:`MarginsReport.to_dict` (the JSO
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
 from dataclasses import dataclass
 
@@ -116,6 +117,9 @@ class SegmentMargins:
         Reflex gains [N m/rad], [N m s/rad].
     self_stable : bool
         Stable without reflex (:func:`spinectl.model.stability.self_stable`): no open-loop pole in Re s >= 0.
+    slowest_time_constant : float
+        -1 / max Re lambda over the eigenvalues of paper eq. (1) [s]: how slowly the segment without
+        reflex settles; NaN unless self-stable.
     delay_margin : float
         Exact delay margin [s] (inf: any delay; 0: unstable without delay; NaN: undefined).
     delay_margin_status : str
@@ -145,6 +149,7 @@ class SegmentMargins:
     kp: float
     kd: float
     self_stable: bool
+    slowest_time_constant: float
     delay_margin: float
     delay_margin_status: str
     delay_margin_pade: float
@@ -164,7 +169,7 @@ class SegmentMargins:
         -------
         dict
             ``name``, ``stiffness_Nm_per_rad``, ``damping_Nms_per_rad``, ``inertia_kgm2``,
-            ``self_stable``, ``kp_Nm_per_rad``, ``kd_Nms_per_rad``, ``gain_margin``,
+            ``self_stable``, ``slowest_time_constant_s``, ``kp_Nm_per_rad``, ``kd_Nms_per_rad``, ``gain_margin``,
             ``gain_margin_lower``, ``phase_margin_deg``, ``crossover_rad_s``, ``delay_margin_s``,
             ``delay_margin_status``, ``delay_margin_pade_s``, ``kp_min_Nm_per_rad``,
             ``kp_max_Nm_per_rad``, ``stable_at_delay`` and ``python_control`` (None, or its
@@ -178,6 +183,7 @@ class SegmentMargins:
             "damping_Nms_per_rad": self.damping,
             "inertia_kgm2": self.inertia,
             "self_stable": self.self_stable,
+            "slowest_time_constant_s": self.slowest_time_constant,
             "kp_Nm_per_rad": self.kp,
             "kd_Nms_per_rad": self.kd,
             "gain_margin": self.gain_margin,
@@ -201,7 +207,9 @@ class SegmentMargins:
         }
 
 
-def segment_margins(name, stiffness, damping, inertia, kp, kd, delay: float, order: int) -> SegmentMargins:
+def segment_margins(
+    name, stiffness, damping, inertia, kp, kd, delay: float, order: int, lag: float = 0.0
+) -> SegmentMargins:
     """All margins of one segment's reflex loop (see :class:`SegmentMargins`).
 
     Parameters
@@ -216,6 +224,8 @@ def segment_margins(name, stiffness, damping, inertia, kp, kd, delay: float, ord
         tau [s].
     order : int
         Order of the Padé approximant.
+    lag : float, optional
+        Activation time constant T_a [s].
 
     Returns
     -------
@@ -223,12 +233,14 @@ def segment_margins(name, stiffness, damping, inertia, kp, kd, delay: float, ord
         Exact and Padé delay margins [s], phase margin [deg], stabilising gain range and verdict.
     """
     s, d, theta, kp, kd = (float(x) for x in (stiffness, damping, inertia, kp, kd))
-    exact = delay_margin(s, d, theta, kp, kd)
-    pm, w_c = phase_margin(s, d, theta, kp, kd, delay)
-    stable = bool(stable_at_delay(s, d, theta, kp, kd, delay))
-    kp_min, kp_max = critical_gains(s, d, theta, kd, delay)
+    exact = delay_margin(s, d, theta, kp, kd, lag)
+    pm, w_c = phase_margin(s, d, theta, kp, kd, delay, lag)
+    stable = bool(stable_at_delay(s, d, theta, kp, kd, delay, lag))
+    kp_min, kp_max = critical_gains(s, d, theta, kd, delay, lag=lag)
     defined = all(np.isfinite(x) for x in (s, d, theta, kp, kd))
-    pc = _python_control_margins(s, d, theta, kp, kd, delay, order, stable) if defined else None
+    pc = _python_control_margins(s, d, theta, kp, kd, delay, order, stable, lag) if defined else None
+    poles = stability.eigenvalues(s, d, theta)
+    self_stable = bool(stability.self_stable(poles))
     return SegmentMargins(
         name=name,
         stiffness=s,
@@ -236,10 +248,11 @@ def segment_margins(name, stiffness, damping, inertia, kp, kd, delay: float, ord
         inertia=theta,
         kp=kp,
         kd=kd,
-        self_stable=bool(stability.self_stable(stability.eigenvalues(s, d, theta))),
+        self_stable=self_stable,
+        slowest_time_constant=float(-1.0 / np.max(np.real(poles))) if self_stable else np.nan,
         delay_margin=float(exact.margin),
         delay_margin_status=str(exact.status_names),
-        delay_margin_pade=float(pade.pade_delay_margin(s, d, theta, kp, kd, order).margin),
+        delay_margin_pade=float(pade.pade_delay_margin(s, d, theta, kp, kd, order, lag).margin),
         phase_margin_deg=float(np.degrees(pm)),
         crossover_rad_s=float(w_c),
         gain_margin=pc.gain_margin_upper if pc else np.nan,
@@ -251,7 +264,7 @@ def segment_margins(name, stiffness, damping, inertia, kp, kd, delay: float, ord
     )
 
 
-def _python_control_margins(s, d, theta, kp, kd, delay, order, stable):
+def _python_control_margins(s, d, theta, kp, kd, delay, order, stable, lag):
     """python-control's margins of the Padé loop, or None where its polynomial arithmetic overflows.
 
     Its Padé coefficients grow like (1/tau)^n, so very short delays at high orders
@@ -263,7 +276,7 @@ def _python_control_margins(s, d, theta, kp, kd, delay, order, stable):
     try:
         with np.errstate(over="raise", divide="raise", invalid="raise"), warnings.catch_warnings():
             warnings.simplefilter("error", RuntimeWarning)
-            return loops.loop_margins(loops.loop_transfer(s, d, theta, kp, kd, delay, order), stable)
+            return loops.loop_margins(loops.loop_transfer(s, d, theta, kp, kd, delay, order, lag), stable)
     except (FloatingPointError, RuntimeWarning, np.linalg.LinAlgError):  # LinAlgError: poles of NaN coefficients
         return None
 
@@ -277,6 +290,8 @@ class MarginsReport:
     point : OperatingPoint
     delay : float
         Reflex delay tau [s].
+    activation_time_constant : float
+        T_a [s] of the force generation after the delay (:attr:`spinectl.model.params.Reflex.activation_time_constant`).
     pade_order : int
     segments : tuple of SegmentMargins
     gains : str
@@ -285,6 +300,7 @@ class MarginsReport:
 
     point: OperatingPoint
     delay: float
+    activation_time_constant: float
     pade_order: int
     segments: tuple[SegmentMargins, ...]
     gains: str
@@ -300,8 +316,8 @@ class MarginsReport:
         Returns
         -------
         dict
-            ``E_m``, ``Lambda_m``, ``delay_s``, ``pade_order``, ``activation``, ``optimum_status``,
-            ``gains``, ``pcsa_cm2`` (muscle name -> PCSA [cm^2]), ``segments`` (one
+            ``E_m``, ``Lambda_m``, ``delay_s``, ``activation_time_constant_s``, ``pade_order``,
+            ``activation``, ``optimum_status``, ``gains``, ``pcsa_cm2`` (muscle name -> PCSA [cm^2]), ``segments`` (one
             :meth:`SegmentMargins.to_dict` each) and ``all_stable_at_delay``; the unit is in each
             key's name.
         """
@@ -310,6 +326,7 @@ class MarginsReport:
             "E_m": point.eccentricity,
             "Lambda_m": point.lordosis,
             "delay_s": self.delay,
+            "activation_time_constant_s": self.activation_time_constant,
             "pade_order": self.pade_order,
             "activation": point.activation,
             "optimum_status": point.status,
@@ -322,6 +339,10 @@ class MarginsReport:
     def table(self) -> str:
         """The report as a readable table, one row a segment, with a header and a key to the columns.
 
+        Where an infinite or missing value has a meaning it is written as a word: "unbounded"
+        (a delay margin, gain factor or kp range without limit), "none" (no crossover, no
+        stabilising range, not self-stable); "n/a" for a segment without an optimum.
+
         Returns
         -------
         str
@@ -331,30 +352,47 @@ class MarginsReport:
         lines = [
             f"E = {point.eccentricity * 100:.2f} cm, Lambda = {point.lordosis * 100:.2f} cm, "
             f"activation {point.activation:g} x minimum PCSA (optimum: {point.status}), "
-            f"delay {self.delay:g} s, Pade order {self.pade_order}, gains: {self.gains}",
+            f"delay {self.delay:g} s, activation lag {self.activation_time_constant:g} s, "
+            f"Pade order {self.pade_order}, gains: {self.gains}",
             "",
-            f"{'segment':8} {'S':>8} {'D':>8} {'theta':>6} {'kp':>8} {'kd':>7} {'GM low':>7} {'GM up':>7} "
-            f"{'PM[deg]':>8} {'w_c':>7} {'tau_m[s]':>9} {'Pade[s]':>9} {'kp range at tau':>19} {'stable':>6}",
+            f"{'segment':8} {'S':>8} {'D':>8} {'theta':>6} {'self-stable':>11} {'T_slow[s]':>9} {'kp':>8} "
+            f"{'kd':>7} {'GM low':>7} {'GM up':>9} {'PM[deg]':>8} {'w_c':>7} {'tau_m[s]':>9} {'Pade[s]':>9} "
+            f"{'kp range at tau':>21} {'stable':>6}",
         ]
-        for s in self.segments:
-            lines.append(
-                f"{s.name:8} {_num(s.stiffness, 8, 2)} {_num(s.damping, 8, 2)} {_num(s.inertia, 6, 3)} "
-                f"{_num(s.kp, 8, 2)} {_num(s.kd, 7, 2)} {_num(s.gain_margin_lower, 7, 3)} "
-                f"{_num(s.gain_margin, 7, 3)} {_num(s.phase_margin_deg, 8, 2)} {_num(s.crossover_rad_s, 7, 3)} "
-                f"{_num(s.delay_margin, 9, 4)} {_num(s.delay_margin_pade, 9, 4)} "
-                f"[{_num(s.kp_min, 8, 1)},{_num(s.kp_max, 8, 1)}] {'yes' if s.stable_at_delay else 'NO':>6}"
-            )
+        lines += [_row(s) for s in self.segments]
         lines += [
             "",
-            "S, kp in N m/rad; D, kd in N m s/rad; theta in kg m^2; w_c in rad/s. GM: stable range of a common",
-            "factor on kp and kd. tau_m: exact delay margin (inf: any delay; 0: unstable without delay).",
+            "S, kp in N m/rad; D, kd in N m s/rad; theta in kg m^2; w_c in rad/s. T_slow: slowest time constant",
+            "of the segment without reflex. GM: stable range of a common factor on kp and kd. tau_m: exact delay",
+            "margin (unbounded: any delay; 0: unstable without delay).",
         ]
         return "\n".join(lines)
 
 
-def _num(value: float, width: int, digits: int) -> str:
-    """``value`` in a column of ``width`` with ``digits`` decimals; inf and NaN as words."""
-    return f"{value:{width}.{digits}f}" if value == value and abs(value) != float("inf") else f"{value!s:>{width}}"
+def _row(s: SegmentMargins) -> str:
+    """One segment's line of :meth:`MarginsReport.table`."""
+    na = "n/a" if np.isnan(s.stiffness) else "none"  # no optimum: nothing is known
+
+    def num(value, width, digits, inf="unbounded"):
+        return _num(value, width, digits, inf=inf, nan=na)
+
+    self_stable = "n/a" if na == "n/a" else ("yes" if s.self_stable else "no")
+    return (
+        f"{s.name:8} {num(s.stiffness, 8, 2)} {num(s.damping, 8, 2)} {num(s.inertia, 6, 3)} {self_stable:>11} "
+        f"{num(s.slowest_time_constant, 9, 3)} {num(s.kp, 8, 2)} {num(s.kd, 7, 2)} "
+        f"{num(s.gain_margin_lower, 7, 3)} {num(s.gain_margin, 9, 3)} {num(s.phase_margin_deg, 8, 2, inf='none')} "
+        f"{num(s.crossover_rad_s, 7, 3)} {num(s.delay_margin, 9, 4)} {num(s.delay_margin_pade, 9, 4)} "
+        f"[{num(s.kp_min, 9, 1)},{num(s.kp_max, 9, 1)}] {'yes' if s.stable_at_delay else 'NO':>6}"
+    )
+
+
+def _num(value: float, width: int, digits: int, inf: str = "unbounded", nan: str = "none") -> str:
+    """``value`` in a column of ``width`` with ``digits`` decimals; infinite and NaN values as the words given."""
+    if np.isnan(value):
+        return f"{nan:>{width}}"
+    if np.isinf(value):
+        return f"{('-' if value < 0 else '') + inf:>{width}}"
+    return f"{value:{width}.{digits}f}"
 
 
 def analyse(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None) -> MarginsReport:
@@ -379,7 +417,12 @@ def analyse(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None
     with arithmetic_guard(eccentricity, lordosis):  # absurd gains or delays: a ModelError, not NaN and warnings
         segments = _segments(model, point, settings, kp, kd)
     return MarginsReport(
-        point=point, delay=settings.delay, pade_order=settings.pade_order, segments=segments, gains=settings.gains
+        point=point,
+        delay=settings.delay,
+        activation_time_constant=settings.activation_time_constant,
+        pade_order=settings.pade_order,
+        segments=segments,
+        gains=settings.gains,
     )
 
 
@@ -395,6 +438,7 @@ def _segments(model, point, settings, kp, kd) -> tuple[SegmentMargins, ...]:
             kds[k],
             settings.delay,
             settings.pade_order,
+            settings.activation_time_constant,
         )
         for k, name in enumerate(model.geometry.cor_names)
     )
@@ -418,13 +462,78 @@ class ReportResponses:
     simulations: dict
 
 
+RESPONSE_SPAN = 5.0
+"""Slowest time constants a simulated response of ``spinectl margins --plot`` spans."""
+
+RESPONSE_SHORTEST = 1.0
+"""Shortest simulated response [s]: a few periods of the fastest loops of the spine."""
+
+
+def slowest_time_constant(segment: SegmentMargins, delay: float, order: int, lag: float) -> float:
+    """1 / abs(Re s) of the rightmost root of the segment with its reflex, or without it if it has none [s].
+
+    The rightmost pole of python-control's Padé closed loop (:func:`spinectl.reflex.loops.closed_loop`)
+    and of the segment alone (paper, eq. 1): the slower of the two runs that a response plot shows.
+    A decaying response settles, and a growing one grows by e, in one such time constant; inf at a
+    root on the axis.
+
+    Parameters
+    ----------
+    segment : SegmentMargins
+        A segment with a finite stiffness.
+    delay : float
+        tau [s].
+    order : int
+        Order of the Padé approximant.
+    lag : float
+        Activation time constant T_a [s].
+
+    Returns
+    -------
+    float
+        The time constant [s].
+    """
+    s, d, theta = segment.stiffness, segment.damping, segment.inertia
+    rates = [np.max(np.real(stability.eigenvalues(s, d, theta)))]
+    if (segment.kp > 0 or segment.kd > 0) and segment.python_control is not None:
+        poles = loops.closed_loop(s, d, theta, segment.kp, segment.kd, delay, order, lag=lag).poles()
+        rates.append(np.max(np.real(poles)))
+    with np.errstate(divide="ignore"):
+        return float(np.max(1.0 / np.abs(rates)))
+
+
+def response_duration(segment: SegmentMargins, report: MarginsReport, settings) -> float:
+    """How long to simulate a segment for its response plot: :data:`RESPONSE_SPAN` slowest time constants [s].
+
+    Between :data:`RESPONSE_SHORTEST` (or ten time steps) and ``settings.sim_duration`` (the longest simulation).
+
+    Parameters
+    ----------
+    segment : SegmentMargins
+        A segment of ``report`` with a finite stiffness.
+    report : MarginsReport
+        Its report (delay, activation lag, Padé order).
+    settings : spinectl.model.params.Reflex
+        ``sim_duration`` bounds the result.
+
+    Returns
+    -------
+    float
+        The duration [s].
+    """
+    slow = slowest_time_constant(segment, report.delay, report.pade_order, report.activation_time_constant)
+    shortest = min(max(RESPONSE_SHORTEST, 10 * settings.sim_time_step), settings.sim_duration)
+    return float(np.clip(RESPONSE_SPAN * slow, shortest, settings.sim_duration))
+
+
 def report_responses(model: Model, report: MarginsReport) -> ReportResponses:
     """The loops and the simulated responses of every segment of ``report``: the compute step of its plots.
 
-    A segment without reflex (kp = kd = 0, e.g. self-stable under the default rule) has
-    no loop; one whose Padé loop python-control cannot evaluate (``python_control`` None:
-    microsecond delays at high orders) neither. A segment of an infeasible optimum (NaN
-    stiffness) has neither a loop nor a simulation.
+    Each simulation spans :data:`RESPONSE_SPAN` of the slowest time constants of its two runs
+    (:func:`response_duration`), at most ``sim_duration``. A segment without reflex (kp = kd = 0,
+    e.g. self-stable under the default rule) has no loop; one whose Padé loop python-control
+    cannot evaluate (``python_control`` None: microsecond delays at high orders) neither. A
+    segment of an infeasible optimum (NaN stiffness) has neither a loop nor a simulation.
 
     Parameters
     ----------
@@ -446,7 +555,16 @@ def report_responses(model: Model, report: MarginsReport) -> ReportResponses:
     point = report.point
     usable = [(k, s) for k, s in enumerate(report.segments) if np.isfinite(s.stiffness)]  # NaN: infeasible
     transfer = {
-        s.name: loops.loop_transfer(s.stiffness, s.damping, s.inertia, s.kp, s.kd, report.delay, report.pade_order)
+        s.name: loops.loop_transfer(
+            s.stiffness,
+            s.damping,
+            s.inertia,
+            s.kp,
+            s.kd,
+            report.delay,
+            report.pade_order,
+            report.activation_time_constant,
+        )
         for _, s in usable
         if (s.kp > 0 or s.kd > 0) and s.python_control is not None
     }
@@ -456,7 +574,7 @@ def report_responses(model: Model, report: MarginsReport) -> ReportResponses:
             [s.kp, 0.0],
             [s.kd, 0.0],
             report.delay,
-            model.reflex,
+            dataclasses.replace(model.reflex, sim_duration=response_duration(s, report, model.reflex)),
         )
         for k, s in usable
     }

@@ -21,9 +21,11 @@ import numpy as np
 from .delay import (
     BISECTIONS,
     DelayMargin,
+    check_retarded,
     crossings,
     delay_margin,
     margin_from_delays,
+    pure_gain,
     stable_without_delay,
     undefined_inputs,
 )
@@ -111,7 +113,7 @@ def pade_inverse_lag(phase, order: int):
     return np.where(phase < order * np.pi, y, np.inf)
 
 
-def pade_delay_margin(stiffness, damping, inertia, kp, kd, order: int) -> DelayMargin:
+def pade_delay_margin(stiffness, damping, inertia, kp, kd, order: int, lag=0.0) -> DelayMargin:
     """Delay margin of the loop with the delay replaced by its [n/n] Padé approximant.
 
     Same crossings as the exact loop (the approximant is all-pass); only the phase
@@ -126,20 +128,35 @@ def pade_delay_margin(stiffness, damping, inertia, kp, kd, order: int) -> DelayM
         Reflex gains [N m/rad], [N m s/rad].
     order : int
         Order n of the approximant.
+    lag : array_like, optional
+        Activation time constant T_a [s]; its phase is part of phi.
 
     Returns
     -------
     DelayMargin
         As :func:`~spinectl.reflex.delay.delay_margin`, with the Padé loop's critical
         delays [s]; inf (delay-independent) also where every crossing's phase is >= n pi.
+
+    Raises
+    ------
+    ParameterError
+        Naming ``kd``, for a loop of neutral type (:func:`~spinectl.reflex.delay.check_retarded`).
     """
-    cr = crossings(stiffness, damping, inertia, kp, kd)
+    check_retarded(inertia, damping, kd, lag)
+    cr = crossings(stiffness, damping, inertia, kp, kd, lag)
     first = pade_inverse_lag(cr.phase, order) / cr.frequency
-    stable0 = stable_without_delay(stiffness, damping, kp, kd)
-    return margin_from_delays(first, cr.frequency, stable0, undefined_inputs(stiffness, damping, inertia, kp, kd))
+    stable0 = stable_without_delay(stiffness, damping, inertia, kp, kd, lag)
+    undefined = undefined_inputs(stiffness, damping, inertia, kp, kd, lag)
+    pade = margin_from_delays(first, cr.frequency, stable0, undefined)
+    gain = pure_gain(inertia, damping, kd, lag) & ~undefined
+    if not np.any(gain):
+        return pade
+    exact = delay_margin(stiffness, damping, inertia, kp, kd, lag)  # no crossings: the closed form holds for Padé too
+    fields = ("margin", "frequency", "status")
+    return DelayMargin(*(np.where(gain, getattr(exact, f), getattr(pade, f)) for f in fields))
 
 
-def pade_convergence(stiffness, damping, inertia, kp, kd, orders):
+def pade_convergence(stiffness, damping, inertia, kp, kd, orders, lag=0.0):
     """Padé delay margins and their errors against the exact margin, for several orders.
 
     Parameters
@@ -150,14 +167,16 @@ def pade_convergence(stiffness, damping, inertia, kp, kd, orders):
         Reflex gains [N m/rad], [N m s/rad].
     orders : sequence of int
         Orders n of the approximants.
+    lag : array_like, optional
+        Activation time constant T_a [s].
 
     Returns
     -------
     margins, errors : numpy.ndarray, shape (len(orders), ...)
         Padé delay margin [s] and its error (Padé - exact) [s]; 0 where both are inf.
     """
-    exact = delay_margin(stiffness, damping, inertia, kp, kd).margin
-    margins = np.stack([pade_delay_margin(stiffness, damping, inertia, kp, kd, n).margin for n in orders])
+    exact = delay_margin(stiffness, damping, inertia, kp, kd, lag).margin
+    margins = np.stack([pade_delay_margin(stiffness, damping, inertia, kp, kd, n, lag).margin for n in orders])
     with np.errstate(invalid="ignore"):
         errors = np.where(margins == exact, 0.0, margins - exact)
     return margins, errors

@@ -43,8 +43,15 @@ def _control_figure(rows: int, **subplots):
     return fig, axes
 
 
-def bode_figure(loops: Mapping[str, ct.TransferFunction], omega_limits=None, title: str = "") -> Figure:
-    """Bode plot of the loop transfer functions L(s) = C(s) Pade(s) G(s), one curve per segment.
+def bode_figure(
+    loops: Mapping[str, ct.TransferFunction], omega_limits=None, title: str = "", margins: Mapping | None = None
+) -> Figure:
+    """Bode plot of the loop transfer functions L(s) = C(s) Pade(s) A(s) G(s), one curve per segment.
+
+    With ``margins`` each curve carries its margins: a dot where abs(L) = 1 (the crossover that
+    limits the delay margin) and, below it, the phase margin as a bar from the phase curve to
+    -180 deg; a bar from abs(L) up to 1 at the phase crossover of the upper gain margin; and the
+    exact delay margin tau_m, the phase margin and the upper gain margin in the legend.
 
     Parameters
     ----------
@@ -54,18 +61,57 @@ def bode_figure(loops: Mapping[str, ct.TransferFunction], omega_limits=None, tit
         Frequency range [rad/s]; python-control's default otherwise.
     title : str, optional
         Figure title.
+    margins : mapping of str to SegmentMargins, optional
+        Segment name -> its margins (:class:`spinectl.reflex.margins.SegmentMargins`).
 
     Returns
     -------
     matplotlib.figure.Figure
         Magnitude above phase; nothing is written.
     """
+    margins = margins or {}
+    labels = [_margin_label(name, margins.get(name)) for name in loops]
     fig, axes = _control_figure(2, sharex=True)
     with ignoring_underflow():
-        plot = ct.bode_plot(list(loops.values()), omega_limits=omega_limits, label=list(loops), ax=axes)
+        plot = ct.bode_plot(list(loops.values()), omega_limits=omega_limits, label=labels, ax=axes)
+    for i, name in enumerate(loops):
+        if name in margins:
+            _mark_margins(axes[0, 0], axes[1, 0], i, margins[name])
     plot.set_plot_title(title or "Reflex loop L(jw)", frame="figure")
     fig.align_labels()
     return fig
+
+
+def _margin_label(name: str, seg) -> str:
+    """The legend entry of a segment: its name and, if known, its delay, phase and upper gain margins."""
+    if seg is None or np.isnan(seg.delay_margin):
+        return name
+    parts = [f"tau_m {'unbounded' if np.isinf(seg.delay_margin) else f'{seg.delay_margin:.3g} s'}"]
+    if np.isfinite(seg.phase_margin_deg):
+        parts.append(f"PM {seg.phase_margin_deg:.0f} deg")
+    if np.isfinite(seg.gain_margin):
+        parts.append(f"GM {seg.gain_margin:.2f}")
+    return f"{name}: " + ", ".join(parts)
+
+
+def _mark_margins(magnitude_ax, phase_ax, index: int, seg) -> None:
+    """Mark one curve's margins: the phase margin as a bar from the phase at the crossover (a dot on
+    abs(L) = 1) to -180 deg, the upper gain margin as a bar from abs(L) to 1 at its phase crossover."""
+    w, mag = magnitude_ax.get_lines()[index].get_data()
+    phase = phase_ax.get_lines()[index].get_ydata()
+    colour = magnitude_ax.get_lines()[index].get_color()
+    w_c, pm = seg.crossover_rad_s, seg.phase_margin_deg
+    if np.isfinite(w_c) and np.isfinite(pm) and w.min() <= w_c <= w.max():
+        at = float(np.interp(np.log(w_c), np.log(w), phase))  # python-control's branch of the phase
+        magnitude_ax.plot([w_c], [1.0], "o", color=colour, ms=4)
+        phase_ax.plot([w_c, w_c], [at, at - pm], "-", color=colour, lw=3, alpha=0.6)
+    if np.isfinite(seg.gain_margin):
+        # the phase crossovers of the drawn curve (phase = -180 deg mod 360); the one with abs(L) = 1/GM
+        wrapped = np.mod(np.asarray(phase) + 180.0, 360.0)
+        jumps = np.flatnonzero(np.abs(np.diff(wrapped)) > 180.0)
+        if jumps.size:
+            i = jumps[np.argmin(np.abs(np.log(mag[jumps] * seg.gain_margin)))]
+            magnitude_ax.plot([w[i], w[i]], [mag[i], 1.0], "-", color=colour, lw=3, alpha=0.6)
 
 
 def nyquist_figure(loops: Mapping[str, ct.TransferFunction], title: str = "") -> Figure:
@@ -128,8 +174,8 @@ def response_figure(responses: Mapping[str, Simulation], title: str = "") -> Fig
 def frequency_range(report: MarginsReport) -> tuple[float, float]:
     """A decade below the slowest and above the fastest rate of the loops [rad/s].
 
-    The rates: each segment's sqrt(abs(S)/theta), abs(D)/theta and crossover, and
-    order/tau, beyond which the Padé phase saturates.
+    The rates: each segment's sqrt(abs(S)/theta), abs(D)/theta and crossover, the corner
+    1/T_a of the activation lag, and order/tau, beyond which the Padé phase saturates.
 
     Parameters
     ----------
@@ -142,6 +188,7 @@ def frequency_range(report: MarginsReport) -> tuple[float, float]:
         Lowest and highest frequency [rad/s]; (0.1, 10) if no rate is finite and positive.
     """
     rates = [report.pade_order / report.delay] if report.delay > 0 else []
+    rates += [1.0 / report.activation_time_constant] if report.activation_time_constant > 0 else []
     for s in report.segments:
         rates += [np.sqrt(abs(s.stiffness) / s.inertia), abs(s.damping) / s.inertia, s.crossover_rad_s]
     rates = [r for r in rates if np.isfinite(r) and r > 0] or [1.0]
@@ -173,7 +220,8 @@ def report_figures(report: MarginsReport, responses: ReportResponses) -> dict[st
     figures = {}
     if responses.loops:
         title = f"Reflex loops, Pade {report.pade_order}; {where}"
-        figures["bode.png"] = bode_figure(responses.loops, frequency_range(report), title)
+        by_name = {seg.name: seg for seg in report.segments}
+        figures["bode.png"] = bode_figure(responses.loops, frequency_range(report), title, by_name)
         figures["nyquist.png"] = nyquist_figure(responses.loops, f"Nyquist, tau = {report.delay:g} s; {where}")
     if responses.simulations:
         figures["response.png"] = response_figure(responses.simulations, f"Response to a perturbation; {where}")

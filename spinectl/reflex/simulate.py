@@ -7,8 +7,9 @@ The plant is the paper's equation of motion for CoR k (Methods):
 with the muscle torques of :func:`spinectl.model.mechanics.muscle_torque_per_pcsa`, gravity
 from :func:`spinectl.model.mechanics.gravity_torque`, the passive stiffness K of
 :func:`spinectl.model.mechanics.passive_stiffness` and the constant counter torque CT_k that
-makes upright an equilibrium. The reflex is u(t) = -(kp alpha + kd omega)(t - tau)
-(docs/reflex.md, "The loop" and "Nonlinear simulation with the true delay").
+makes upright an equilibrium. The reflex command -(kp alpha + kd omega)(t - tau) becomes the
+torque u through the activation lag T_a u' + u = command (docs/reflex.md, "The loop", "Force
+generation: the activation lag" and "Nonlinear simulation with the true delay").
 
 Integration: classical Runge-Kutta with a fixed step and a history buffer; delayed
 states between grid points come from cubic Hermite interpolation (alpha with slope
@@ -228,7 +229,11 @@ def growth_rate(time, alpha, perturbation: float):
 
 
 def simulate(plant: SegmentPlant, kp, kd, delay, settings: Reflex, perturbation=None) -> Simulation:
-    """Simulate the segment under the delayed reflex; arrays broadcast to a batch of runs.
+    """Simulate the segment under the delayed, lagged reflex; arrays broadcast to a batch of runs.
+
+    The reflex command -(kp alpha + kd omega)(t - tau) becomes the torque u through the
+    activation lag T_a u' + u = command (``settings.activation_time_constant``; u is the
+    command itself for T_a = 0). The lag starts at rest on the held history, u(0) = -kp alpha(0).
 
     Parameters
     ----------
@@ -236,7 +241,8 @@ def simulate(plant: SegmentPlant, kp, kd, delay, settings: Reflex, perturbation=
     kp, kd, delay : array_like
         Reflex gains [N m/rad], [N m s/rad] and delay [s]; kp = kd = 0 is "no reflex".
     settings : Reflex
-        ``sim_duration``, ``sim_time_step``, ``sim_perturbation``, ``sim_divergence``.
+        ``sim_duration``, ``sim_time_step``, ``sim_perturbation``, ``sim_divergence`` and
+        ``activation_time_constant``.
     perturbation : float, optional
         Initial angle [rad] instead of ``settings.sim_perturbation``.
 
@@ -245,6 +251,12 @@ def simulate(plant: SegmentPlant, kp, kd, delay, settings: Reflex, perturbation=
     Simulation
         Time [s], alpha [rad], omega [rad/s] and the reflex torque [N m] of every run,
         shape (batch, n), with the divergence flags and growth rates [1/s].
+
+    Raises
+    ------
+    ParameterError
+        A negative or non-finite delay, or more than :data:`MAX_STEPS` steps (the step is cut
+        to the delay and to half the activation time constant).
     """
     kp, kd, tau = (
         np.ravel(x) for x in np.broadcast_arrays(*(np.atleast_1d(np.asarray(v, float)) for v in (kp, kd, delay)))
@@ -252,37 +264,35 @@ def simulate(plant: SegmentPlant, kp, kd, delay, settings: Reflex, perturbation=
     if np.any(tau < 0) or not np.all(np.isfinite(tau)):
         raise ParameterError("delay", "must be finite and >= 0")
     start = settings.sim_perturbation if perturbation is None else float(perturbation)
-    positive = tau[tau > 0]
-    step = min(settings.sim_time_step, positive.min()) if positive.size else settings.sim_time_step
-    n = int(np.ceil(settings.sim_duration / step))
-    if n > MAX_STEPS:
-        raise ParameterError(
-            "reflex.delay",
-            f"a simulation of {settings.sim_duration:g} s with steps of at most the delay {step:g} s needs "
-            f"{n} steps, more than {MAX_STEPS}; use a longer delay or a shorter sim_duration",
-        )
+    lag = settings.activation_time_constant
+    step, n = _steps(settings, tau, lag)
     time = np.arange(n + 1) * step
     alpha, omega, acc, u_hist = (np.zeros((n + 1, tau.size)) for _ in range(4))
     alpha[0] = start
+    force = -kp * start  # the lag at rest on the held history (unused without the lag)
     diverged = np.zeros(tau.size, bool)
 
-    def accel(t, a, w, k):
+    def accel(t, a, w, f, k):
+        """omega' and the torque applied; with the lag, f is the torque and the command drives f'."""
         delayed_a, delayed_w = _delayed(t - tau, step, k, alpha, omega, acc, start)
         now = tau == 0  # no delay: the reflex sees the stage's own state
         u = -(kp * np.where(now, a, delayed_a) + kd * np.where(now, w, delayed_w))
-        return (plant.torque(a, w) + u) / plant.inertia, u
+        if lag > 0:
+            return (plant.torque(a, w) + f) / plant.inertia, f, (u - f) / lag
+        return (plant.torque(a, w) + u) / plant.inertia, u, 0.0
 
     for k in range(n):
         t, a, w = time[k], alpha[k], omega[k]
-        acc[k], u_hist[k] = accel(t, a, w, k)
-        a2, w2 = a + 0.5 * step * w, w + 0.5 * step * acc[k]
-        k2 = accel(t + 0.5 * step, a2, w2, k)[0]
-        a3, w3 = a + 0.5 * step * w2, w + 0.5 * step * k2
-        k3 = accel(t + 0.5 * step, a3, w3, k)[0]
-        a4, w4 = a + step * w3, w + step * k3
-        k4 = accel(t + step, a4, w4, k)[0]
+        acc[k], u_hist[k], df1 = accel(t, a, w, force, k)
+        a2, w2, f2 = a + 0.5 * step * w, w + 0.5 * step * acc[k], force + 0.5 * step * df1
+        k2, _, df2 = accel(t + 0.5 * step, a2, w2, f2, k)
+        a3, w3, f3 = a + 0.5 * step * w2, w + 0.5 * step * k2, force + 0.5 * step * df2
+        k3, _, df3 = accel(t + 0.5 * step, a3, w3, f3, k)
+        a4, w4, f4 = a + step * w3, w + step * k3, force + step * df3
+        k4, _, df4 = accel(t + step, a4, w4, f4, k)
         new_a = a + step / 6 * (w + 2 * w2 + 2 * w3 + w4)
         new_w = w + step / 6 * (acc[k] + 2 * k2 + 2 * k3 + k4)
+        force = force + step / 6 * (df1 + 2 * df2 + 2 * df3 + df4)
         diverged |= np.abs(new_a) > settings.sim_divergence
         alpha[k + 1] = np.where(diverged, a, new_a)
         omega[k + 1] = np.where(diverged, w, new_w)
@@ -290,9 +300,27 @@ def simulate(plant: SegmentPlant, kp, kd, delay, settings: Reflex, perturbation=
             alpha[k + 2 :], omega[k + 2 :], u_hist[k + 1 :] = alpha[k + 1], omega[k + 1], u_hist[k]
             break
     else:
-        u_hist[n] = accel(time[n], alpha[n], omega[n], n)[1]
+        u_hist[n] = accel(time[n], alpha[n], omega[n], force, n)[1]
     rate = np.where(diverged, np.inf, growth_rate(time, alpha.T, start))
     return Simulation(time, alpha.T, omega.T, u_hist.T, tau, kp, kd, diverged, rate)
+
+
+def _steps(settings: Reflex, tau, lag: float) -> tuple[float, int]:
+    """The fixed step [s], at most the shortest positive delay and half the lag, and the number of steps."""
+    positive = tau[tau > 0]
+    step = min(settings.sim_time_step, positive.min()) if positive.size else settings.sim_time_step
+    limit = "reflex.delay"
+    if 0 < lag < 2 * step:  # explicit RK4 on u' = (command - u) / T_a needs a step below about 2.8 T_a
+        step, limit = 0.5 * lag, "reflex.activation_time_constant"
+    n = int(np.ceil(settings.sim_duration / step))
+    if n > MAX_STEPS:
+        raise ParameterError(
+            limit,
+            f"a simulation of {settings.sim_duration:g} s with steps of {step:g} s (at most the delay, and half "
+            f"the activation time constant) needs {n} steps, more than {MAX_STEPS}; use a longer delay or "
+            "activation time constant, or a shorter sim_duration",
+        )
+    return step, n
 
 
 def simulated_delay_margin(plant: SegmentPlant, kp, kd, settings: Reflex, low, high, batch=8, rounds=3):

@@ -116,3 +116,24 @@ def test_plot_writes_nothing_when_the_simulation_cannot_run(tmp_path, capsys):
     """A 1 ns delay needs 1.2e10 steps: refused before any PNG is written."""
     code, _, err = run(["margins", "--delay", "1e-9", "--plot", str(tmp_path / "p")], capsys)
     assert code == 2 and "reflex.delay" in err and not (tmp_path / "p").exists()
+
+
+def test_activation_lag_option_and_toml_key(tmp_path, capsys):
+    """--activation-lag sets reflex.activation_time_constant (echoed as activation_time_constant_s), as the TOML
+    key does; 0 is the pure delay, whose margins are those of reflex.delay_margin without the lag."""
+    code, out, _ = run(["margins", "--activation", "0", "--activation-lag", "0", "--json"], capsys)
+    doc = json.loads(out)
+    assert code == 0 and doc["activation_time_constant_s"] == 0.0
+    from spinectl import reflex
+
+    seg = doc["segments"][2]
+    exact = reflex.delay_margin(
+        seg["stiffness_Nm_per_rad"], 0.0, seg["inertia_kgm2"], seg["kp_Nm_per_rad"], seg["kd_Nms_per_rad"]
+    )
+    assert seg["delay_margin_s"] == float(exact.margin)
+    config_file = tmp_path / "lag.toml"
+    config_file.write_text("[reflex]\nactivation_time_constant = 0.08\n")
+    code, out, _ = run(["margins", "--config", str(config_file), "--json"], capsys)
+    assert code == 0 and json.loads(out)["activation_time_constant_s"] == 0.08
+    code, _, err = run(["margins", "--activation-lag", "5"], capsys)
+    assert code == 2 and "activation_time_constant" in err and len(err.strip().splitlines()) == 1

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from spinectl import reflex
+from spinectl.errors import ParameterError
 from spinectl.model.params import Reflex
 from spinectl.reflex.loops import closed_loop
 
@@ -142,8 +143,11 @@ def test_root_count_through_stability_switches():
     regains stability as the delay grows. The exact count agrees with the python-control Padé poles."""
     s, d, theta, kp, kd = -100.0, -1.0, 1.0, 50.0, 0.0
     np.testing.assert_allclose(
-        reflex.crossings(s, d, theta, kp, kd).frequency ** 2, (199 + np.array([1, -1]) * np.sqrt(9601)) / 2, rtol=1e-12
+        reflex.crossings(s, d, theta, kp, kd).frequency[:2] ** 2,
+        (199 + np.array([1, -1]) * np.sqrt(9601)) / 2,
+        rtol=1e-12,
     )
+    assert np.isnan(reflex.crossings(s, d, theta, kp, kd).frequency[2])  # F is quadratic without the lag
     delays = np.linspace(0.0, 0.6, 61)[1:]
     exact = reflex.stable_at_delay(s, d, theta, kp, kd, delays)
     pade = np.array([_rightmost_pole(s, d, theta, kp, kd, tau, order=16) < 0 for tau in delays])
@@ -249,3 +253,96 @@ def test_critical_gains_for_a_tiny_delay():
     assert lo == pytest.approx(S0) and 1e6 * S0 > hi > 1e3 * S0
     inside_outside = reflex.stable_at_delay(S0, D0, THETA0, np.array([0.999, 1.001]) * hi, kd, 1e-6)
     assert inside_outside.tolist() == [True, False]
+
+
+# --- boundary cases ------------------------------------------------------------------------------
+
+
+def _rightmost_root(s, d, theta, kp, kd, tau, guess):
+    """A root of theta s^2 - D s - S + (kp + kd s) e^{-s tau}, by Newton from ``guess`` (an independent route)."""
+    z = complex(guess)
+    for _ in range(50):
+        e = np.exp(-z * tau)
+        f = theta * z * z - d * z - s + (kp + kd * z) * e
+        df = 2 * theta * z - d + kd * e - tau * (kp + kd * z) * e
+        z -= f / df
+    return z
+
+
+def test_axis_pair_at_zero_delay_that_moves_left():
+    """S = -1, D = 0, theta = 1, kp = -0.5, kd = 0 (kd = D): s^2 + 0.5 = 0 puts +-0.707j on the axis at tau = 0,
+    and sign F'(0.5) = -1 sends them left. At tau = 1 no root is in Re s > 0: the rightmost pair is
+    -0.306 +- 0.782j (Newton on the quasi-polynomial; python-control's order-16 Padé loop agrees)."""
+    assert reflex.right_half_plane_roots(-1, 0, 1, -0.5, 0, 1.0) == 0
+    assert reflex.stable_at_delay(-1, 0, 1, -0.5, 0, 1.0)
+    assert not reflex.stable_at_delay(-1, 0, 1, -0.5, 0, 0.0)  # on the axis at tau = 0
+    root = _rightmost_root(-1, 0, 1, -0.5, 0, 1.0, -0.3 + 0.78j)
+    assert root.real == pytest.approx(-0.306, abs=1e-3) and abs(root.imag) == pytest.approx(0.782, abs=1e-3)
+    assert _rightmost_pole(-1, 0, 1, -0.5, 0, 1.0, order=16) == pytest.approx(root.real, abs=1e-6)
+
+
+@pytest.mark.parametrize(("kp", "count"), [(0.5, 2), (-2.0, 1)])
+def test_axis_boundary_for_the_other_signs_of_kp(kp, count):
+    """kd = D = 0, S = -1: kp = 0.5 > S puts the pair on the axis with sign F' = +1, so it moves right (two
+    roots in Re s > 0 for every small delay, as python-control's Padé poles say); kp = -2 < S gives the real
+    pair +-1 of s^2 - 1, one in the right half plane at tau = 0 and after."""
+    for tau in (0.05, 0.3):
+        assert reflex.right_half_plane_roots(-1, 0, 1, kp, 0, tau) == count
+        assert not reflex.stable_at_delay(-1, 0, 1, kp, 0, tau)
+        poles = closed_loop(-1, 0, 1, kp, 0, tau, 12).poles()
+        assert np.sum(poles.real > 1e-9) == count
+
+
+def test_tangent_axis_pair_follows_the_second_order():
+    """kp = 0, kd = D = -0.5, S = -1, theta = 1: F = (x - 1)^2 touches 0 at w = 1 (no first-order motion). The
+    second order of Delta(s(tau), tau) = 0 gives Re s'' = D w^2 / (4 theta) < 0: the pair leaves to the left,
+    as the order-16 Padé poles show at tau = 0.2."""
+    assert reflex.right_half_plane_roots(-1, -0.5, 1, 0, -0.5, 0.2) == 0
+    assert reflex.stable_at_delay(-1, -0.5, 1, 0, -0.5, 0.2)
+    assert _rightmost_pole(-1, -0.5, 1, 0, -0.5, 0.2, order=16) < 0
+
+
+def test_undamped_segment_without_reflex_is_never_asymptotically_stable():
+    """S < 0, D = 0, kp = kd = 0: Delta = theta s^2 - S has the pair +-j sqrt(-S/theta) for every delay."""
+    delays = np.array([0.0, 0.1, 1.0, 10.0])
+    assert not reflex.stable_at_delay(-4.0, 0.0, 1.0, 0.0, 0.0, delays).any()
+    assert np.all(reflex.right_half_plane_roots(-4.0, 0.0, 1.0, 0.0, 0.0, delays) == 0)
+    assert reflex.delay_margin(-4.0, 0.0, 1.0, 0.0, 0.0).status_names == "unstable_without_delay"
+
+
+def test_root_at_zero_with_a_root_on_the_right():
+    """kp = S, kd < D: theta s^2 + (kd - D) s has the roots 0 and (D - kd)/theta > 0: one in Re s > 0, not two."""
+    assert reflex.right_half_plane_roots(10.0, 0.0, 1.0, 10.0, -1.0, 0.0) == 1
+
+
+def test_first_order_loop_does_not_depend_on_the_sign_convention():
+    """theta = 0: (S, D, kp) = (0, 1, -1) and (0, -1, 1) are the same loop s + e^{-s tau} = 0, stable for
+    tau < pi/2 (the classical result: the root pair crosses at w = 1, where w tau = pi/2)."""
+    for args in ((0.0, 1.0, 0.0, -1.0, 0.0), (0.0, -1.0, 0.0, 1.0, 0.0)):
+        result = reflex.delay_margin(*args)
+        assert result.status_names == "finite" and result.margin == pytest.approx(np.pi / 2, rel=1e-12)
+        assert reflex.stable_at_delay(*args, 1.5) and not reflex.stable_at_delay(*args, 1.6)
+
+
+def test_pure_gain_with_delay_has_its_closed_form():
+    """theta = D = kd = 0: -S + kp e^{-s tau} = 0, i.e. 1 + K e^{-s tau} with K = -kp/S, has the roots
+    s = (ln|K| + j(2k + 1) pi) / tau (K > 0): stable for every delay if |K| < 1, for none > 0 if |K| > 1."""
+    small, large = reflex.delay_margin(-2.0, 0.0, 0.0, 1.0, 0.0), reflex.delay_margin(-1.0, 0.0, 0.0, 2.0, 0.0)
+    assert small.margin == np.inf and small.status_names == "delay_independent"
+    assert large.margin == 0.0 and large.status_names == "finite"  # stable at tau = 0 (no root), not after
+    tau = 0.7
+    root = (np.log(2.0) + 1j * np.pi) / tau
+    assert abs(1.0 + 2.0 * np.exp(-root * tau)) < 1e-12 and root.real > 0
+    assert reflex.right_half_plane_roots(-1.0, 0.0, 0.0, 2.0, 0.0, tau) == np.inf
+    assert reflex.stable_at_delay(-2.0, 0.0, 0.0, 1.0, 0.0, tau) and not reflex.stable_at_delay(
+        -1.0, 0.0, 0.0, 2.0, 0.0, tau
+    )
+    assert reflex.pade_delay_margin(-1.0, 0.0, 0.0, 2.0, 0.0, 5).margin == 0.0
+
+
+@pytest.mark.parametrize("args", [(0.0, -1.0, 0.0, 1.0, 0.5), (-1.0, 0.0, 0.0, 1.0, 0.2)])
+def test_neutral_loops_are_refused_naming_kd(args):
+    """theta = 0 with kd != 0: deg Q = deg P (neutral type) or more; not covered, a one-line ParameterError."""
+    with pytest.raises(ParameterError, match="kd") as info:
+        reflex.delay_margin(*args)
+    assert info.value.field == "kd" and "\n" not in str(info.value)

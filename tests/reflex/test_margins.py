@@ -32,14 +32,15 @@ def test_activation_one_is_self_stable_and_needs_no_reflex(model):
 
 
 def test_activation_zero_is_reflex_only(model):
-    """No co-contraction: S = m g r_y (gravity alone) and D = 0 at every segment; the optimiser is skipped."""
-    report = margins.analyse(_with_reflex(model, activation=0.0), E, LAMBDA)
+    """No co-contraction: S = m g r_y (gravity alone) and D = 0 at every segment; the optimiser is skipped.
+    At 50 ms (with the default 50 ms activation lag the reflex-only margins are 63-95 ms) every loop is stable."""
+    report = margins.analyse(_with_reflex(model, activation=0.0, delay=0.05), E, LAMBDA)
     assert report.point.status == margins.SKIPPED and not report.point.pcsa.any()
     coeffs = segment_coefficients(model, E, LAMBDA)
     np.testing.assert_allclose([s.stiffness for s in report.segments], coeffs.gravity_stiffness)
     for seg in report.segments:
         assert not seg.self_stable and 0 < seg.delay_margin < np.inf
-        assert seg.stable_at_delay == (model.reflex.delay < seg.delay_margin)
+        assert seg.stable_at_delay == (report.delay < seg.delay_margin)
         assert seg.delay_margin_pade == pytest.approx(seg.delay_margin, rel=1e-6)  # order 5, w tau < 1
         # a segment that needs its reflex is open-loop unstable: the gain may fall to S / kp only
         assert seg.gain_margin_lower == pytest.approx(seg.stiffness / seg.kp)
@@ -49,7 +50,8 @@ def test_explicit_gains_replace_the_rule(model):
     report = margins.analyse(_with_reflex(model, activation=0.0), E, LAMBDA, kp=200.0)
     assert all(s.kp == 200.0 for s in report.segments)
     s = report.segments[2]
-    assert s.kd == pytest.approx(float(reflex.default_gains(s.stiffness, 0.0, s.inertia, 1.5, 1.0)[1]))
+    lag = model.reflex.activation_time_constant
+    assert s.kd == pytest.approx(float(reflex.default_gains(s.stiffness, 0.0, s.inertia, 1.5, 1.0, lag)[1]))
     configured = margins.analyse(_with_reflex(model, activation=0.0, gains="explicit", kp=150.0, kd=20.0), E, LAMBDA)
     assert all((s.kp, s.kd) == (150.0, 20.0) for s in configured.segments)
 
@@ -67,7 +69,8 @@ def test_infeasible_optimum_is_an_answer_not_an_exception(model):
 def test_python_control_overflow_leaves_the_exact_margins(model):
     """Padé order 10 at a 1 us delay: python-control's polynomial margins overflow (coefficients
     ~ (1/tau)^10); its reading is dropped (None, NaN gain margins), the exact analysis stands."""
-    report = margins.analyse(_with_reflex(model, activation=0.0, delay=1e-6, pade_order=10), E, LAMBDA)
+    model = _with_reflex(model, activation=0.0, delay=1e-6, pade_order=10, activation_time_constant=0.0)
+    report = margins.analyse(model, E, LAMBDA)
     for seg in report.segments:
         assert seg.python_control is None and np.isnan(seg.gain_margin)
         assert 0.1 < seg.delay_margin < 0.2 and seg.stable_at_delay
@@ -79,6 +82,7 @@ JSON_KEYS = (
     "damping_Nms_per_rad",
     "inertia_kgm2",
     "self_stable",
+    "slowest_time_constant_s",
     "kp_Nm_per_rad",
     "kd_Nms_per_rad",
     "gain_margin",
@@ -102,6 +106,8 @@ def test_to_dict_schema_and_values(model):
     doc = report.to_dict()
     assert doc["E_m"] == E and doc["Lambda_m"] == LAMBDA and doc["activation"] == 0.0
     assert doc["delay_s"] == 0.1 and doc["pade_order"] == 3 and doc["optimum_status"] == "skipped"
+    lag = doc["activation_time_constant_s"]
+    assert lag == model.reflex.activation_time_constant == 0.05
     assert doc["gains"] == "rule" and doc["pcsa_cm2"] == dict.fromkeys(model.muscle_names, 0.0)
     assert [s["name"] for s in doc["segments"]] == ["L1L2", "L2L3", "L3L4", "L4L5", "L5S1"]
     for seg in doc["segments"]:
@@ -112,6 +118,7 @@ def test_to_dict_schema_and_values(model):
             seg["inertia_kgm2"],
             seg["kp_Nm_per_rad"],
             seg["kd_Nms_per_rad"],
+            lag,
         )
         assert seg["delay_margin_s"] == pytest.approx(float(exact.margin), rel=1e-12)
         assert seg["stable_at_delay"] == (0.1 < seg["delay_margin_s"])
@@ -148,15 +155,24 @@ def test_table(model):
     lines = report.table().splitlines()
     assert lines[0].startswith("E = 3.00 cm, Lambda = 4.00 cm, activation 0 x minimum PCSA (optimum: skipped)")
     rows = [line for line in lines if line.split()[:1] in (["L1L2"], ["L2L3"], ["L3L4"], ["L4L5"], ["L5S1"])]
-    assert len(rows) == 5 and all(row.split()[4:6] == ["150.00", "20.00"] for row in rows)
-    assert "tau_m: exact delay margin" in lines[-1]
+    assert len(rows) == 5 and all(row.split()[6:8] == ["150.00", "20.00"] for row in rows)
+    assert all(row.split()[4:6] == ["no", "none"] for row in rows)  # gravity alone: not self-stable
+    assert "tau_m: exact delay" in lines[-2]
 
 
 def test_table_writes_inf_and_nan_as_words(model):
-    self_stable = margins.analyse(_with_reflex(model, activation=1.0), E, LAMBDA).table()
-    assert " inf " in self_stable
+    """Self-stable without reflex: delay margins and gain factors are "unbounded", the phase margin and
+    crossover "none", and the slowest time constant is -1/max Re lambda of paper eq. (1); no optimum: "n/a"."""
+    report = margins.analyse(_with_reflex(model, activation=1.0), E, LAMBDA)
+    table = report.table()
+    assert " unbounded " in table and " none " in table and "inf" not in table and "nan" not in table
+    seg = report.segments[0]
+    slow = -1.0 / np.roots([seg.inertia, -seg.damping, -seg.stiffness]).real.max()
+    row = next(line for line in table.splitlines() if line.startswith(seg.name)).split()
+    assert row[4] == "yes" and float(row[5]) == pytest.approx(slow, abs=1e-3)
     infeasible = model.replace(optimisation=Optimisation(pcsa_max=1e-8))
-    assert " nan " in margins.analyse(_with_reflex(infeasible, activation=0.5), E, LAMBDA).table()
+    table = margins.analyse(_with_reflex(infeasible, activation=0.5), E, LAMBDA).table()
+    assert " n/a " in table and "nan" not in table
 
 
 def test_report_responses_of_a_reflex_only_report(model):
@@ -168,7 +184,8 @@ def test_report_responses_of_a_reflex_only_report(model):
     assert list(responses.loops) == names and list(responses.simulations) == names
     s = report.segments[2]
     w = np.array([0.5, 5.0, 50.0])
-    expected = (s.kp + s.kd * 1j * w) / (s.inertia * (1j * w) ** 2 - s.damping * 1j * w - s.stiffness)
+    lag = 1.0 / (1.0 + report.activation_time_constant * 1j * w)  # force generation 1/(T_a s + 1)
+    expected = lag * (s.kp + s.kd * 1j * w) / (s.inertia * (1j * w) ** 2 - s.damping * 1j * w - s.stiffness)
     pade = reflex.pade_coefficients(report.pade_order)  # e^{-x} ~ q(-x)/q(x), x = s tau
     x = 1j * w * report.delay
     q = sum(c * x**k for k, c in enumerate(pade))

@@ -90,13 +90,16 @@ def test_report_figures_draw_the_responses_they_are_given(model):
 
 
 def test_frequency_range_spans_the_loops_rates(model):
-    """A decade around every crossover and the Pade corner order/tau; (0.1, 10) rad/s when no rate is known."""
+    """A decade around every crossover, the Pade corner order/tau and the lag's corner 1/T_a; (0.1, 10) rad/s
+    when no rate is known (no segment, no delay, no lag)."""
     report = margins.analyse(_reflex(model, activation=0.0), 0.03, 0.04)
     low, high = plots.frequency_range(report)
     crossovers = [s.crossover_rad_s for s in report.segments]
     assert low <= min(crossovers) / 10 and high >= report.pade_order / report.delay * 10
     infeasible = model.replace(optimisation=Optimisation(pcsa_max=1e-8))
-    nothing = margins.analyse(_reflex(infeasible, activation=0.5, delay=0.0), 0.03, 0.04)
+    lagged = margins.analyse(_reflex(infeasible, activation=0.5, delay=0.0), 0.03, 0.04)
+    assert plots.frequency_range(lagged) == pytest.approx((2.0, 200.0))  # 1/T_a = 20 rad/s alone
+    nothing = margins.analyse(_reflex(infeasible, activation=0.5, delay=0.0, activation_time_constant=0.0), 0.03, 0.04)
     assert plots.frequency_range(nothing) == pytest.approx((0.1, 10.0))
 
 
@@ -109,3 +112,39 @@ def test_frequency_plots_of_subnormal_coefficients_are_silent(tmp_path):
         plots.save_figure(plots.bode_figure(transfer), tmp_path / "bode.png")
         plots.save_figure(plots.nyquist_figure(transfer), tmp_path / "nyquist.png")
     assert (tmp_path / "bode.png").read_bytes()[:8] == PNG
+
+
+def test_bode_marks_the_margins_of_a_report(model):
+    """Half activation: every loop gets a legend entry with its exact delay margin, a dot at (w_c, 1) and a phase
+    bar of length PM at w_c, from the drawn phase at w_c to -180 deg (mod 360)."""
+    model = _reflex(model, activation=0.5, sim_duration=0.3)
+    report = margins.analyse(model, 0.03, 0.04)
+    responses = margins.report_responses(model, report)
+    fig = plots.report_figures(report, responses)["bode.png"]
+    magnitude, phase = fig.axes[:2]
+    labels = [text.get_text() for text in magnitude.get_legend().get_texts()]
+    assert all(f"tau_m {s.delay_margin:.3g} s" in label for s, label in zip(report.segments, labels, strict=True))
+    n = len(report.segments)
+    bars = phase.get_lines()[n:]
+    assert len(bars) == n
+    for seg, bar in zip(report.segments, bars, strict=True):
+        w, y = bar.get_data()
+        assert w[0] == w[1] == pytest.approx(seg.crossover_rad_s)
+        assert y[0] - y[1] == pytest.approx(seg.phase_margin_deg)
+        assert np.mod(y[1], 360.0) == pytest.approx(180.0, abs=0.5)  # the bar ends on -180 deg (mod 360)
+
+
+def test_responses_span_five_slowest_time_constants(model):
+    """The simulated response of a segment lasts 5 / |Re p| of its slowest root (Padé closed loop or, without
+    reflex, paper eq. 1), between 1 s and sim_duration: not a fixed length."""
+    model = _reflex(model, activation=0.5)
+    report = margins.analyse(model, 0.03, 0.04)
+    seg = report.segments[2]
+    poles = loops.closed_loop(
+        seg.stiffness, seg.damping, seg.inertia, seg.kp, seg.kd, report.delay, report.pade_order, lag=0.05
+    ).poles()
+    open_loop = np.roots([seg.inertia, -seg.damping, -seg.stiffness])
+    slow = max(1 / abs(poles.real.max()), 1 / abs(open_loop.real.max()))
+    duration = margins.response_duration(seg, report, model.reflex)
+    assert duration == pytest.approx(min(max(5 * slow, 1.0), model.reflex.sim_duration), rel=1e-9)
+    assert 1.0 < duration < model.reflex.sim_duration  # here neither bound applies

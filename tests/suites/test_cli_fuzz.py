@@ -149,6 +149,7 @@ ANALYSIS_VALUES = {
     "--E": mostly(st.floats(-0.12, 0.12).map(repr)),
     "--Lambda": mostly(st.floats(-0.12, 0.12).map(repr)),
     "--delay": mostly(st.floats(0, 0.5).map(repr)),
+    "--activation-lag": mostly(st.floats(0, 0.2).map(repr)),
     "--kp": mostly(st.floats(0, 500).map(repr)),
     "--kd": mostly(st.floats(0, 50).map(repr)),
     "--activation": mostly(st.floats(0, 1.5).map(repr)),
@@ -159,7 +160,17 @@ ANALYSIS_VALUES = {
     "--config": st.sampled_from(sorted(CONFIG_FILES)),
 }
 ANALYSIS_COMMANDS = {
-    "margins": ["--E", "--Lambda", "--delay", "--kp", "--kd", "--activation", "--pade-order", "--config"],
+    "margins": [
+        "--E",
+        "--Lambda",
+        "--delay",
+        "--activation-lag",
+        "--kp",
+        "--kd",
+        "--activation",
+        "--pade-order",
+        "--config",
+    ],
     "sweep --out out.nc": ["--K", "--method", "--chunk-size", "--config"],
     "plot tiny.nc --out figures": ["--E"],  # plot takes no such option: an argparse error
 }

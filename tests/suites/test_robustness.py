@@ -119,6 +119,7 @@ KINDS = {
     "optimisation.ct_tolerance": REAL,
     "optimisation.solver_tolerance": REAL,
     "reflex.delay": REAL,
+    "reflex.activation_time_constant": REAL,
     "reflex.pade_order": INT,
     "reflex.activation": REAL,
     "reflex.gains": CHOICE,
@@ -169,6 +170,7 @@ OUT_OF_RANGE = {
     "optimisation.ct_tolerance": [-1e-3],
     "optimisation.solver_tolerance": [0.0, 1e-13, 1e-3],
     "reflex.delay": [-0.1, 10.5],
+    "reflex.activation_time_constant": [-0.05, 50.0],  # 50: milliseconds typed as seconds
     "reflex.pade_order": [0, 11],
     "reflex.activation": [-0.1, 10.5],
     "reflex.gain_factor": [1.0, 0.5],
