@@ -72,7 +72,9 @@ counter torques ``"counter torque <CoR>"``, dimensions ``"dimension E"`` and ``"
 
 def _line_geometry(model: Model, heights):
     heights = tuple(float(h) for h in heights)
-    return dataclasses.replace(model.geometry, cor_heights=heights, cor_names=tuple(f"y{i}" for i in range(len(heights))))
+    return dataclasses.replace(
+        model.geometry, cor_heights=heights, cor_names=tuple(f"y{i}" for i in range(len(heights)))
+    )
 
 
 def spine_line(model: Model, eccentricity: float, lordosis: float, samples: int = LINE_SAMPLES) -> np.ndarray:
@@ -107,7 +109,7 @@ def _vertebrae(model: Model, eccentricity: float, lordosis: float) -> list[tuple
     """
     edges = (model.geometry.spine_length, *model.geometry.cor_heights)
     bodies = []
-    for name, top, bottom in zip(model.geometry.cor_names, edges[:-1], edges[1:]):
+    for name, top, bottom in zip(model.geometry.cor_names, edges[:-1], edges[1:], strict=True):
         middle, half = (top + bottom) / 2, VERTEBRA_FILL * (top - bottom) / 2
         upper, centre, lower = geometry.cor_positions(
             eccentricity, lordosis, _line_geometry(model, (middle + half, middle, middle - half))
@@ -125,7 +127,9 @@ def _upper_vertebra(cor_name: str) -> str:
     return match.group(0) if match else f"above {cor_name}"
 
 
-def activation(model: Model, eccentricity: float, lordosis: float, pcsa=None) -> tuple[np.ndarray | None, np.ndarray | None, str]:
+def activation(
+    model: Model, eccentricity: float, lordosis: float, pcsa=None
+) -> tuple[np.ndarray | None, np.ndarray | None, str]:
     """The PCSA and counter torques to draw, and a phrase that says where they come from.
 
     Parameters
@@ -155,7 +159,11 @@ def activation(model: Model, eccentricity: float, lordosis: float, pcsa=None) ->
         best = solve_point(model, eccentricity, lordosis)
         if not best.ok:
             return None, None, f"optimum: none (status {best.status}); geometry only"
-        return best.pcsa, best.counter_torque, f"activation: the optimum (solve_point), {_cm2(best.pcsa.sum())} cm² in all"
+        return (
+            best.pcsa,
+            best.counter_torque,
+            f"activation: the optimum (solve_point), {_cm2(best.pcsa.sum())} cm² in all",
+        )
     per_muscle = expand_pcsa(model, pcsa)
     result = segment_stability(model, eccentricity, lordosis, per_muscle)
     return result.pcsa, result.counter_torque, f"activation: given, {_cm2(per_muscle.sum())} cm² in all"
@@ -181,7 +189,7 @@ def _draw_fibres(ax, model: Model, pcsa: np.ndarray | None) -> None:
         for side, side_name in enumerate(SIDES):
             muscle = 2 * p + side
             idle = pcsa is not None and widths[muscle] == 0
-            for i, (up, low) in enumerate(zip(ups[side], lows[side])):
+            for i, (up, low) in enumerate(zip(ups[side], lows[side], strict=True)):
                 ax.plot(
                     [up[0] * CM_PER_M, low[0] * CM_PER_M],
                     [up[1] * CM_PER_M, low[1] * CM_PER_M],
@@ -216,7 +224,7 @@ def _draw_counter_torques(ax, model: Model, cors: np.ndarray, counter_torque: np
     (docs/model.md, "Frame and units"), so it points to -x; its length is
     TORQUE_SCALE per N m.
     """
-    for name, (x, y), torque in zip(model.geometry.cor_names, cors, counter_torque):
+    for name, (x, y), torque in zip(model.geometry.cor_names, cors, counter_torque, strict=True):
         dx = -torque * TORQUE_SCALE * CM_PER_M
         ax.annotate(
             "",
@@ -227,8 +235,14 @@ def _draw_counter_torques(ax, model: Model, cors: np.ndarray, counter_torque: np
             zorder=3,
         )
         ax.annotate(
-            f"{torque:+.1f} N m", (x + dx / 2, y), xytext=(0, 3), textcoords="offset points", ha="center", va="bottom",
-            fontsize=6, color="crimson",
+            f"{torque:+.1f} N m",
+            (x + dx / 2, y),
+            xytext=(0, 3),
+            textcoords="offset points",
+            ha="center",
+            va="bottom",
+            fontsize=6,
+            color="crimson",
         )
 
 
@@ -243,12 +257,19 @@ def _draw_spine(ax, model: Model, eccentricity: float, lordosis: float, annotate
     cors = geometry.cor_positions(eccentricity, lordosis, model.geometry)
     ax.plot(*(cors * CM_PER_M).T, "o", mfc="white", mec="k", ms=5 if annotate else 3, gid=GIDS["cor"], zorder=4)
     if annotate:
-        for name, (x, y) in zip(model.geometry.cor_names, cors * CM_PER_M):
+        for name, (x, y) in zip(model.geometry.cor_names, cors * CM_PER_M, strict=True):
             ax.annotate(
-                name, (x, y), xytext=(-8, 0), textcoords="offset points", ha="right", va="center", fontsize=7,
-                bbox=_LABEL_BOX, zorder=5,
+                name,
+                (x, y),
+                xytext=(-8, 0),
+                textcoords="offset points",
+                ha="right",
+                va="center",
+                fontsize=7,
+                bbox=_LABEL_BOX,
+                zorder=5,
             )
-        for label, (x, y) in zip(("P1", "P3", "P2"), points * CM_PER_M):
+        for label, (x, y) in zip(("P1", "P3", "P2"), points * CM_PER_M, strict=True):
             ax.annotate(label, (x, y), xytext=(6, 0), textcoords="offset points", va="center", fontsize=7)
     return cors
 
@@ -278,7 +299,15 @@ def _limits(ax, model: Model, cors: np.ndarray) -> None:
     ax.set_aspect("equal")
 
 
-def draw_model(model: Model, eccentricity: float, lordosis: float, pcsa=None, counter_torque: bool = False, ax=None, annotate: bool = True) -> Figure:
+def draw_model(
+    model: Model,
+    eccentricity: float,
+    lordosis: float,
+    pcsa=None,
+    counter_torque: bool = False,
+    ax=None,
+    annotate: bool = True,
+) -> Figure:
     """Draw the model at one (E, Lambda): the paper's Figure 2, to scale [cm].
 
     Parameters
