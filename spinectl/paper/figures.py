@@ -154,6 +154,7 @@ def _mark_positions(ax, e: np.ndarray, lam: np.ndarray) -> None:
             fontweight="bold" if len(name) == 1 else "normal",
             fontsize=9 if len(name) == 1 else 7,
             bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": "k", "lw": 0.5},
+            gid=f"label {name}",
         )
 
 
@@ -223,7 +224,8 @@ def _landscape(field: xr.DataArray, title: str, label: str, vmin=None, vmax=None
         fig.colorbar(filled, ax=ax).set_label(label)
         if values.max() > values.min():
             lines = ax.contour(e, lam, values, levels=filled.levels[1:-1:3], colors="k", linewidths=0.4, alpha=0.6)
-            ax.clabel(lines, fmt="%.3g", fontsize=6)
+            for text in ax.clabel(lines, fmt="%.3g", fontsize=6):
+                text.set_clip_on(True)  # a label near the edge is cut, never drawn outside the axes
     _shape(ax, e_m, lam_m)
     _mark_positions(ax, e_m, lam_m)
     _mark_readings(ax, e_m, lam_m)
