@@ -161,7 +161,8 @@ ANALYSIS_VALUES = {
 ANALYSIS_COMMANDS = {
     "margins": ["--E", "--Lambda", "--delay", "--kp", "--kd", "--activation", "--pade-order", "--config"],
     "sweep --out out.nc": ["--K", "--method", "--chunk-size", "--config"],
-    "plot tiny.nc --out figures": ["--E"],  # plot takes no such option: an argparse error
+    "plot tiny.nc --out figures": ["--E", "--vmin", "--vmax"],  # plot takes no --E: an argparse error
+    "draw --out model.png": ["--E", "--Lambda", "--pcsa", "--config"],
 }
 
 
@@ -188,7 +189,7 @@ def analysis_folder(fuzz_folder):
 @settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(analysis_arguments())
 def test_random_arguments_to_the_analysis_commands_never_raise(analysis_folder, argv):
-    """margins, sweep and plot: the same contract, fewer examples (each runs a solver or draws)."""
+    """margins, sweep, plot and draw: the same contract, fewer examples (each runs a solver or draws)."""
     with contextlib.chdir(analysis_folder):
         check(argv)
 
