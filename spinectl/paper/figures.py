@@ -327,7 +327,7 @@ def ratio_figure(dataset: xr.Dataset, stiffness: float = grid.PAPER_STIFFNESS) -
     if values.count() and values.min() < HALVING < values.max():
         e, lam = ratio["E"].values * CM_PER_M, ratio["Lambda"].values * CM_PER_M
         half = ax.contour(e, lam, values, levels=[HALVING], colors="white", linewidths=1.5)
-        ax.clabel(half, fmt=lambda _: "0.5: halved", fontsize=8)
+        ax.clabel(half, fmt=lambda _: f"{HALVING:g}: halved", fontsize=8)
     return fig
 
 
