@@ -281,7 +281,9 @@ def _draw_body(ax, model: Model, eccentricity: float, lordosis: float, annotate:
     ax.plot(*mass, "o", color="k", ms=10 if annotate else 5, gid=GIDS["mass"])
     if not annotate:
         return
-    ax.annotate(f"m = {model.body.mass:g} kg", mass, xytext=(9, 0), textcoords="offset points", va="center", fontsize=8)
+    ax.annotate(
+        f"m = {model.body.mass:.3g} kg", mass, xytext=(9, 0), textcoords="offset points", va="center", fontsize=8
+    )
     length = model.geometry.spine_length * CM_PER_M
     e, lam = eccentricity * CM_PER_M, lordosis * CM_PER_M
     ax.plot([-e, -e], [0.0, length], color="0.5", lw=0.6, ls=":", gid=GIDS["chord"])
