@@ -21,6 +21,7 @@ COMMANDS = (
     "margins_cmd",
     "sweep_cmd",
     "plot_cmd",
+    "draw_cmd",
     "reproduce_cmd",
     "study_cmd",
     "calibrate_cmd",

@@ -1,9 +1,10 @@
-"""``spinectl plot``: the paper's Figures 3, 4 and S1 from a sweep's NetCDF file."""
+"""``spinectl plot``: the paper's Figures 3, 4 and S1 (and their ratio) from a sweep's NetCDF file."""
 
 from __future__ import annotations
 
 from ..landscape import netcdf
 from ..paper import figures
+from ._common import finite_float
 
 
 def register(sub) -> None:
@@ -18,10 +19,29 @@ def register(sub) -> None:
         "plot",
         help="draw Figures 3, 4 (and S1 for K > 0) from a sweep's NetCDF file",
         description="Filled contours of the minimum PCSA (Fig. 3; Fig. S1 for K > 0) and of ||CT|| "
-        "(Fig. 4, with the +-30 N m limit), positions A-D marked, as PNG files.",
+        "(Fig. 4, with the +-30 N m limit), on any grid: positions A-D where they lie inside it, the "
+        "grid's other corners by their coordinates, the ridge Lambda = 1.7 E and the paper's optimum; "
+        "as PNG, PDF or SVG files.",
     )
     parser.add_argument("results", metavar="RESULTS.nc", help="a file written by 'spinectl sweep' or 'reproduce'")
-    parser.add_argument("--out", required=True, metavar="DIR", help="folder for the PNG files")
+    parser.add_argument("--out", required=True, metavar="DIR", help="folder for the figure files")
+    parser.add_argument("--format", choices=figures.FORMATS, default="png", help="file format (default png)")
+    parser.add_argument(
+        "--dpi", type=finite_float("--dpi"), default=figures.DPI, help=f"PNG resolution (default {figures.DPI})"
+    )
+    scale = parser.add_argument_group("colour scale of the minimum-PCSA figures")
+    scale.add_argument("--vmin", type=finite_float("--vmin"), help="lower end [cm^2] (default: the data's)")
+    scale.add_argument("--vmax", type=finite_float("--vmax"), help="upper end [cm^2] (default: the data's)")
+    scale.add_argument(
+        "--shared-scale", action="store_true", help="Figures 3 and S1 on one scale, the range over every K"
+    )
+    extra = parser.add_argument_group("extra figures")
+    extra.add_argument(
+        "--ratio", action="store_true", help="also the minimum PCSA at K > 0 over K = 0 (the paper's halving)"
+    )
+    extra.add_argument(
+        "--insets", action="store_true", help="the model drawn at the grid's corners around Figures 3 and S1"
+    )
     parser.set_defaults(func=run)
 
 
@@ -38,6 +58,15 @@ def run(args) -> int:
     int
         Exit code 0.
     """
-    for path in figures.draw_figures(netcdf.load(args.results), args.out):
+    options = figures.FigureOptions(
+        format=args.format,
+        dpi=args.dpi,
+        vmin=args.vmin,
+        vmax=args.vmax,
+        shared_scale=args.shared_scale,
+        ratio=args.ratio,
+        insets=args.insets,
+    )
+    for path in figures.draw_figures(netcdf.load(args.results), args.out, options=options):
         print(path)
     return 0

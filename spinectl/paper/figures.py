@@ -1,64 +1,213 @@
-"""The paper's figures from a sweep Dataset: Figures 3, 4 and S1.
+"""The paper's figures from a sweep Dataset: Figures 3, 4 and S1, and the ratio S1 / 3.
 
-Filled contours over E (abscissa) and Lambda (ordinate), both in cm, with
-positions A-D labelled at the corners (:data:`spinectl.paper.landmarks.POSITIONS`).
-Figure 4 adds the +-30 N m limit of the local muscles as a contour and the
-paper's optimum. Each figure function draws on a new figure with the Agg
+Filled contours over E (abscissa) and Lambda (ordinate), both in cm, on any
+grid: labelled contour lines, positions A-D (:data:`spinectl.paper.grid.POSITIONS`)
+where they lie inside the grid and the grid's other corners by their
+coordinates, the paper's ridge Lambda = 1.7 E and its optimum (E ~ 3, Lambda ~ 4 cm,
+which its Discussion calls position C, beside the corner C). Figure 4 adds the
++-30 N m limit of the local muscles as a contour; Figure 3 optionally the model
+drawn at the grid's corners (:mod:`spinectl.paper.drawing`), as the paper's corner panels.
+Each figure function draws on a new figure with the Agg
 canvas (:func:`spinectl.canvas.new_figure`: no global backend state, no display
 needed) and returns it, writing nothing; :func:`save_figure` writes one
-atomically, and :func:`draw_figures` draws and saves the set.
+atomically as PNG, PDF or SVG, and :func:`draw_figures` draws and saves the set
+(:class:`FigureOptions`: format, resolution, colour range, shared scale, ratio map, insets).
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import xarray as xr
 from matplotlib.figure import Figure
 
+from ..atomic import atomic_path
 from ..canvas import new_figure, save_png
+from ..errors import ParameterError
 from ..landscape import netcdf
 from ..units import M2_PER_CM2
-from . import grid, landmarks
+from . import drawing, grid, landmarks
 
 CM_PER_M = 100.0
 FIGURE_SIZE = (6.4, 5.2)
 """Inches."""
+INSET_FIGURE_SIZE = (8.4, 8.0)
+"""Inches, Figure 3 with the model drawn at its four corners."""
 DPI = 150
+MIN_DPI, MAX_DPI = 10, 1200
+"""Resolutions [dots per inch] that :func:`save_figure` accepts: legible, and an image of tens of megapixels at most."""
+FORMATS = ("png", "pdf", "svg")
+"""File formats of :func:`save_figure`, named by the file's suffix."""
 LEVELS = 16
 """Number of filled contour levels."""
+EQUAL_ASPECT = 2.0
+"""E and Lambda share one scale unless one axis spans more than this many times the other."""
+HALVING = 0.5
+"""The paper's ratio of minimum PCSA with and without K = 15 N m/rad (Additional file 1: "halves")."""
+_TOLERANCE = 1e-9
+"""[m] A position on a grid's edge counts as inside."""
 
-_CORNER_OFFSET = {"A": (6, 6), "B": (-16, 6), "C": (-16, -16), "D": (6, -16)}
-"""Label offsets [points] that keep the corner labels inside the axes."""
+_CONVENTION = {"paper": "eq. 2 as printed", "physical": "physical, -K in dM/dα"}
+"""How a title names the passive-stiffness convention (docs/model.md, "Passive stiffness: two conventions")."""
 
 
-def _axes(title: str):
-    fig = new_figure(figsize=FIGURE_SIZE, layout="constrained")
-    ax = fig.add_subplot()
+@dataclass(frozen=True)
+class FigureOptions:
+    """How :func:`draw_figures` draws and saves.
+
+    Attributes
+    ----------
+    format : str
+        One of :data:`FORMATS`.
+    dpi : float
+        Resolution of PNG files [dots per inch].
+    vmin, vmax : float, optional
+        Colour range of the minimum-PCSA figures [cm²]; default each figure's own.
+    shared_scale : bool
+        Figures 3 and S1 on one colour scale, the range over every K.
+    ratio : bool
+        Also the map of minimum PCSA at K > 0 over K = 0 (the paper's "halving").
+    insets : bool
+        The model drawn at the grid's four corners around Figure 3 and S1.
+    """
+
+    format: str = "png"
+    dpi: float = DPI
+    vmin: float | None = None
+    vmax: float | None = None
+    shared_scale: bool = False
+    ratio: bool = False
+    insets: bool = False
+
+    def __post_init__(self):
+        if self.format not in FORMATS:
+            raise ParameterError("--format", f"must be one of {', '.join(FORMATS)} (got {self.format!r})")
+        check_dpi(self.dpi)
+
+
+def check_dpi(dpi: float) -> None:
+    """Raise :class:`~spinectl.errors.ParameterError` unless ``dpi`` is a resolution matplotlib can render.
+
+    Parameters
+    ----------
+    dpi : float
+        Dots per inch: finite, 10 to :data:`MAX_DPI`.
+    """
+    if not (np.isfinite(dpi) and MIN_DPI <= dpi <= MAX_DPI):
+        raise ParameterError("--dpi", f"must be {MIN_DPI} to {MAX_DPI} dots per inch (got {dpi:g})")
+
+
+def _axes(title: str, fig=None, spec=None):
+    fig = fig or new_figure(figsize=FIGURE_SIZE, layout="constrained")
+    ax = fig.add_subplot(spec) if spec is not None else fig.add_subplot()
     ax.set_xlabel("eccentricity E [cm]")
     ax.set_ylabel("lordosis Λ [cm]")
-    ax.set_title(title, fontsize=10)
-    ax.set_aspect("equal")
+    ax.set_title(title, fontsize=9)
     return fig, ax
 
 
-def _mark_positions(ax) -> None:
-    for name, (e, lam) in grid.POSITIONS.items():
-        x, y = e * CM_PER_M, lam * CM_PER_M
-        ax.plot(x, y, "o", color="k", markersize=4, clip_on=False)
+def _inside(position, e: np.ndarray, lam: np.ndarray) -> bool:
+    x, y = position
+    return e.min() - _TOLERANCE <= x <= e.max() + _TOLERANCE and lam.min() - _TOLERANCE <= y <= lam.max() + _TOLERANCE
+
+
+def grid_marks(e: np.ndarray, lam: np.ndarray) -> list[tuple[str, tuple[float, float]]]:
+    """The labelled points of a landscape: positions A-D inside the grid, and its other corners.
+
+    Parameters
+    ----------
+    e, lam : numpy.ndarray
+        The grid's E and Lambda axes [m].
+
+    Returns
+    -------
+    list of (str, (float, float))
+        Label and (E, Lambda) [m]: a letter for a position of
+        :data:`spinectl.paper.grid.POSITIONS` inside the grid, "E, Λ = ... cm" for a
+        corner of the grid that is none of them.
+    """
+    marks = [(name, p) for name, p in grid.POSITIONS.items() if _inside(p, e, lam)]
+    for corner in ((e.min(), lam.min()), (e.max(), lam.min()), (e.max(), lam.max()), (e.min(), lam.max())):
+        if not any(np.allclose(corner, p, atol=_TOLERANCE) for _, p in marks):
+            marks.append((f"{corner[0] * CM_PER_M:g}, {corner[1] * CM_PER_M:g} cm", corner))
+    return marks
+
+
+def _mark_positions(ax, e: np.ndarray, lam: np.ndarray) -> None:
+    """Positions A-D where they lie inside the grid, the grid's other corners by their coordinates.
+
+    Each label sits on the side of its point that faces the middle of the grid, so it stays inside the axes.
+    """
+    middle = ((e.min() + e.max()) / 2, (lam.min() + lam.max()) / 2)
+    for name, (x, y) in grid_marks(e, lam):
+        right, up = x <= middle[0], y <= middle[1]
+        ax.plot(x * CM_PER_M, y * CM_PER_M, "o", color="k", markersize=4, clip_on=False, gid=f"position {name}")
         ax.annotate(
             name,
-            (x, y),
-            xytext=_CORNER_OFFSET[name],
+            (x * CM_PER_M, y * CM_PER_M),
+            xytext=(6 if right else -6, 6 if up else -6),
             textcoords="offset points",
-            fontweight="bold",
+            ha="left" if right else "right",
+            va="bottom" if up else "top",
+            fontweight="bold" if len(name) == 1 else "normal",
+            fontsize=9 if len(name) == 1 else 7,
             bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": "k", "lw": 0.5},
+            gid=f"label {name}",
         )
 
 
-def _landscape(field: xr.DataArray, title: str, label: str):
-    """A filled contour of ``field`` (dims E, Lambda) with A-D marked; returns (figure, axes).
+def _mark_readings(ax, e: np.ndarray, lam: np.ndarray) -> None:
+    """The paper's ridge Lambda = 1.7 E and its optimum (position C as its Discussion reads it), inside the grid."""
+    lo, hi = max(e.min(), lam.min() / landmarks.RIDGE_SLOPE), min(e.max(), lam.max() / landmarks.RIDGE_SLOPE)
+    if lo < hi:
+        ridge_e = np.array([lo, hi])
+        ax.plot(
+            ridge_e * CM_PER_M,
+            landmarks.RIDGE_SLOPE * ridge_e * CM_PER_M,
+            color="white",
+            lw=1.0,
+            ls=(0, (4, 2)),
+            label=f"Λ = {landmarks.RIDGE_SLOPE:g} E (the paper's ridge)",
+            gid="ridge",
+        )
+    if _inside(landmarks.OPTIMUM, e, lam):
+        ax.plot(
+            *(np.array(landmarks.OPTIMUM) * CM_PER_M),
+            "*",
+            color="red",
+            markersize=10,
+            gid="optimum",
+            label="the paper's optimum, C in its Discussion (E ≈ 3, Λ ≈ 4 cm)",
+        )
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(loc="upper center", fontsize=7, framealpha=0.8)
+
+
+def _shape(ax, e: np.ndarray, lam: np.ndarray) -> None:
+    """Limits at the grid; equal scales unless that would squeeze one axis (:data:`EQUAL_ASPECT`)."""
+    ax.set_xlim(e.min() * CM_PER_M, e.max() * CM_PER_M)
+    ax.set_ylim(lam.min() * CM_PER_M, lam.max() * CM_PER_M)
+    spans = np.ptp(e), np.ptp(lam)
+    if min(spans) > 0 and max(spans) <= EQUAL_ASPECT * min(spans):
+        ax.set_aspect("equal")
+
+
+def _levels(values: np.ma.MaskedArray, vmin: float | None, vmax: float | None):
+    """Filled levels: LEVELS steps over the data, or over [vmin, vmax] (extended past it)."""
+    if vmin is None and vmax is None:
+        return LEVELS, "neither"
+    low = values.min() if vmin is None else vmin
+    high = values.max() if vmax is None else vmax
+    if not high > low:
+        raise ParameterError("--vmin/--vmax", f"need vmin < vmax (got {low:g} and {high:g})")
+    extend = {(False, False): "neither", (True, False): "min", (False, True): "max", (True, True): "both"}
+    return np.linspace(low, high, LEVELS + 1), extend[(bool(values.min() < low), bool(values.max() > high))]
+
+
+def _landscape(field: xr.DataArray, title: str, label: str, vmin=None, vmax=None, fig=None, spec=None):
+    """A filled contour of ``field`` (dims E, Lambda), contour lines labelled, A-D marked; returns (figure, axes).
 
     Infeasible points (NaN) stay white, and the title says how many there are.
     """
@@ -66,38 +215,119 @@ def _landscape(field: xr.DataArray, title: str, label: str):
     infeasible = int(values.mask.sum()) if np.ma.is_masked(values) else 0
     if infeasible:
         title += f"\nwhite: no self-stable activation within the bounds ({infeasible} of {values.size} points)"
-    fig, ax = _axes(title)
-    e = field["E"].values * CM_PER_M
-    lam = field["Lambda"].values * CM_PER_M
+    fig, ax = _axes(title, fig, spec)
+    e_m, lam_m = field["E"].values, field["Lambda"].values
+    e, lam = e_m * CM_PER_M, lam_m * CM_PER_M
     if infeasible < values.size:
-        filled = ax.contourf(e, lam, values, levels=LEVELS, cmap="viridis")
+        levels, extend = _levels(values, vmin, vmax)
+        filled = ax.contourf(e, lam, values, levels=levels, cmap="viridis", extend=extend)
         fig.colorbar(filled, ax=ax).set_label(label)
-    ax.set_xlim(e.min(), e.max())
-    ax.set_ylim(lam.min(), lam.max())
-    _mark_positions(ax)
+        if values.max() > values.min():
+            lines = ax.contour(e, lam, values, levels=filled.levels[1:-1:3], colors="k", linewidths=0.4, alpha=0.6)
+            for text in ax.clabel(lines, fmt="%.3g", fontsize=6):
+                text.set_clip_on(True)  # a label near the edge is cut, never drawn outside the axes
+    _shape(ax, e_m, lam_m)
+    _mark_positions(ax, e_m, lam_m)
+    _mark_readings(ax, e_m, lam_m)
     return fig, ax
 
 
 def _k_label(dataset: xr.Dataset) -> str:
-    return f"K = {float(dataset['K']):g} N m/rad ({dataset.attrs.get('passive_convention', '?')})"
+    stiffness = float(dataset["K"])
+    if stiffness == 0:
+        return "K = 0"
+    convention = dataset.attrs.get("passive_convention", "?")
+    return f"K = {stiffness:g} N m/rad (K convention: {_CONVENTION.get(convention, convention)})"
 
 
-def min_pcsa_figure(dataset: xr.Dataset) -> Figure:
+def min_pcsa_figure(
+    dataset: xr.Dataset, vmin: float | None = None, vmax: float | None = None, insets: bool = False
+) -> Figure:
     """Figure 3 (K = 0) or S1 (K > 0): minimum PCSA for self-stability of every segment.
 
     Parameters
     ----------
     dataset : xarray.Dataset
         One landscape (scalar K).
+    vmin, vmax : float, optional
+        Colour range [cm²]; default the data's.
+    insets : bool
+        The model drawn at the grid's four corners (:func:`spinectl.paper.drawing.draw_model`),
+        the fibres' widths the chosen activation there (the paper's small corner panels).
 
     Returns
     -------
     matplotlib.figure.Figure
         Filled contours over E and Lambda [cm]; nothing is written.
+
+    Raises
+    ------
+    ParameterError
+        ``vmin`` not below ``vmax``.
     """
     name = "Fig. 3" if float(dataset["K"]) == 0 else "Fig. S1"
     title = f"{name}: minimum PCSA for self-stability, {_k_label(dataset)}"
-    fig, _ = _landscape(dataset["min_pcsa_cm2"], title, "minimum PCSA [cm²]")
+    if not insets:
+        fig, _ = _landscape(dataset["min_pcsa_cm2"], title, "minimum PCSA [cm²]", vmin, vmax)
+        return fig
+    fig = new_figure(figsize=INSET_FIGURE_SIZE, layout="constrained")
+    spec = fig.add_gridspec(3, 3, width_ratios=(1, 2.4, 1), height_ratios=(1, 2.4, 1))
+    _landscape(dataset["min_pcsa_cm2"], title, "minimum PCSA [cm²]", vmin, vmax, fig, spec[1, 1])
+    _draw_corners(fig, spec, dataset)
+    return fig
+
+
+def _draw_corners(fig, spec, dataset: xr.Dataset) -> None:
+    """The model at each corner of the grid, in the figure's corner cells, with its chosen activation."""
+    model = netcdf.model_of(dataset)
+    e, lam = dataset["E"].values, dataset["Lambda"].values
+    labels = {p: name for name, p in grid_marks(e, lam)}
+    cells = {(0, 0): (2, 0), (1, 0): (2, 2), (1, 1): (0, 2), (0, 1): (0, 0)}
+    for (i, j), (row, col) in cells.items():
+        position = ((e.min(), e.max())[i], (lam.min(), lam.max())[j])
+        pcsa = dataset["pcsa_cm2"].sel(E=position[0], Lambda=position[1], method="nearest").values * M2_PER_CM2
+        ax = fig.add_subplot(spec[row, col])
+        drawing.draw_model(model, *position, pcsa=pcsa if np.all(np.isfinite(pcsa)) else None, ax=ax, annotate=False)
+        label = next(name for p, name in labels.items() if np.allclose(p, position, atol=_TOLERANCE))
+        coordinates = f"E = {position[0] * CM_PER_M:g}, Λ = {position[1] * CM_PER_M:g} cm"
+        ax.set_title(coordinates if label[0].isdigit() else f"{label}: {coordinates}", fontsize=7)
+
+
+def ratio_figure(dataset: xr.Dataset, stiffness: float = grid.PAPER_STIFFNESS) -> Figure:
+    """Minimum PCSA at K = ``stiffness`` over that at K = 0: the paper's "halving" (Additional file 1) as a map.
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        With a K dimension holding 0 and ``stiffness``
+        (:func:`~spinectl.landscape.sweep.stiffness_sweep`).
+    stiffness : float
+        K [N m/rad] of the numerator.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Filled contours of the ratio [1] on a 0 to 1 scale over E and Lambda [cm], the paper's 0.5 as a contour;
+        white where either landscape is infeasible or the K = 0 minimum is 0.
+
+    Raises
+    ------
+    ParameterError
+        ``dataset`` lacks K = 0 or K = ``stiffness``.
+    """
+    if "K" not in dataset.dims or not {0.0, float(stiffness)} <= {float(k) for k in dataset["K"].values}:
+        raise ParameterError("K", f"the ratio map needs landscapes at K = 0 and K = {stiffness:g} N m/rad")
+    pcsa = dataset["min_pcsa_cm2"]
+    base = pcsa.sel(K=0.0)
+    ratio = (pcsa.sel(K=float(stiffness)) / base).where(base > 0)
+    part = dataset.sel(K=float(stiffness))
+    title = f"Fig. S1 / Fig. 3: minimum PCSA at {_k_label(part)}\nover that at K = 0 (the paper: 0.5, a halving)"
+    fig, ax = _landscape(ratio, title, "ratio of minimum PCSA [1]", 0.0, 1.0)
+    values = np.ma.masked_invalid(ratio.transpose("Lambda", "E").values)
+    if values.count() and values.min() < HALVING < values.max():
+        e, lam = ratio["E"].values * CM_PER_M, ratio["Lambda"].values * CM_PER_M
+        half = ax.contour(e, lam, values, levels=[HALVING], colors="white", linewidths=1.5)
+        ax.clabel(half, fmt=lambda _: f"{HALVING:g}: halved", fontsize=8)
     return fig
 
 
@@ -132,48 +362,107 @@ def counter_torque_figure(dataset: xr.Dataset, specific_tension: float) -> Figur
     if values.count() and values.min() < landmarks.CT_LIMIT < values.max():
         limit = ax.contour(e, lam, values, levels=[landmarks.CT_LIMIT], colors="white", linestyles="--")
         ax.clabel(limit, fmt=lambda _: f"±{landmarks.CT_LIMIT:g} N m", fontsize=8)
-    ax.plot(*(np.array(landmarks.OPTIMUM) * CM_PER_M), "*", color="red", markersize=10, label="paper's optimum")
-    ax.legend(loc="upper center", fontsize=8, framealpha=0.8)
     return fig
 
 
-def save_figure(fig: Figure, path: str | Path) -> Path:
-    """The save step: :func:`spinectl.canvas.save_png` at this module's :data:`DPI`.
+def save_figure(fig: Figure, path: str | Path, dpi: float = DPI) -> Path:
+    """The save step: write ``fig`` atomically (:func:`spinectl.atomic.atomic_path`), its format named by the suffix.
 
     Parameters
     ----------
     fig : matplotlib.figure.Figure
-        A figure of this module.
+        A figure of this module or of :mod:`spinectl.paper.drawing`.
     path : str or Path
-        The PNG file, written atomically.
+        The file: ``.png``, ``.pdf`` or ``.svg`` (:data:`FORMATS`).
+    dpi : float
+        Resolution of a PNG [dots per inch]; default :data:`DPI`.
 
     Returns
     -------
     Path
         ``path``.
+
+    Raises
+    ------
+    ParameterError
+        Another suffix, or ``dpi`` out of range (:func:`check_dpi`).
+    OutputError
+        The file cannot be written; a previous file of that name is left as it was.
     """
-    return save_png(fig, path, DPI)
+    check_dpi(dpi)
+    suffix = Path(path).suffix.lower().lstrip(".")
+    if suffix not in FORMATS:
+        raise ParameterError("--out", f"must end in .png, .pdf or .svg (got {str(path)!r})")
+    if suffix == "png":
+        return save_png(fig, path, dpi)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format=suffix, dpi=dpi)
+    return Path(path)
 
 
-def figure_names(stiffness: float) -> tuple[str, str]:
+def figure_names(stiffness: float, format: str = "png") -> tuple[str, str]:
     """File names of the minimum-PCSA and counter-torque figures.
 
     Parameters
     ----------
     stiffness : float
         Passive stiffness K [N m/rad]; 0 gives Figures 3 and 4, else S1 and 4 with K in the name.
+    format : str
+        The suffix, one of :data:`FORMATS`.
 
     Returns
     -------
     tuple of str
-        The PNG names of the minimum-PCSA and the counter-torque figure.
+        The names of the minimum-PCSA and the counter-torque figure.
     """
     if stiffness == 0:
-        return "fig3_min_pcsa.png", "fig4_counter_torque.png"
-    return f"figS1_min_pcsa_K{stiffness:g}.png", f"fig4_counter_torque_K{stiffness:g}.png"
+        return f"fig3_min_pcsa.{format}", f"fig4_counter_torque.{format}"
+    return f"figS1_min_pcsa_K{stiffness:g}.{format}", f"fig4_counter_torque_K{stiffness:g}.{format}"
 
 
-def draw_figures(dataset: xr.Dataset, out_dir: str | Path, specific_tension: float | None = None) -> list[Path]:
+def ratio_name(stiffness: float, format: str = "png") -> str:
+    """File name of :func:`ratio_figure`.
+
+    Parameters
+    ----------
+    stiffness : float
+        K [N m/rad] of the numerator.
+    format : str
+        The suffix, one of :data:`FORMATS`.
+
+    Returns
+    -------
+    str
+        E.g. ``figS1_over_fig3_K15.png``.
+    """
+    return f"figS1_over_fig3_K{stiffness:g}.{format}"
+
+
+def _pcsa_range(dataset: xr.Dataset, options: FigureOptions) -> tuple[float | None, float | None]:
+    """The colour range of the minimum-PCSA figures: the options', else with shared_scale that over every K."""
+    vmin, vmax = options.vmin, options.vmax
+    if options.shared_scale:
+        values = dataset["min_pcsa_cm2"].values
+        if np.isfinite(values).any():
+            vmin = float(np.nanmin(values)) if vmin is None else vmin
+            vmax = float(np.nanmax(values)) if vmax is None else vmax
+    return vmin, vmax
+
+
+def _ratio_stiffnesses(dataset: xr.Dataset) -> list[float]:
+    """The K > 0 of a dataset that also holds K = 0; checked before anything is drawn."""
+    stiffnesses = [float(k) for k in np.atleast_1d(dataset["K"].values)]
+    if "K" not in dataset.dims or 0.0 not in stiffnesses or max(stiffnesses) <= 0:
+        raise ParameterError("--ratio", "needs a landscape with K = 0 and a K > 0 (spinectl sweep --K 0,15)")
+    return [k for k in stiffnesses if k > 0]
+
+
+def draw_figures(
+    dataset: xr.Dataset,
+    out_dir: str | Path,
+    specific_tension: float | None = None,
+    options: FigureOptions | None = None,
+) -> list[Path]:
     """Draw Figures 3 and 4 for every K of ``dataset`` (Figure S1 for K > 0) and save them into ``out_dir``.
 
     Parameters
@@ -182,30 +471,39 @@ def draw_figures(dataset: xr.Dataset, out_dir: str | Path, specific_tension: flo
         From :func:`~spinectl.landscape.sweep.sweep` (scalar K) or
         :func:`~spinectl.landscape.sweep.stiffness_sweep` (a K dimension).
     out_dir : str or Path
-        Folder for the PNG files (created if missing), named by :func:`figure_names`.
+        Folder for the files (created if missing), named by :func:`figure_names` (and :func:`ratio_name`).
     specific_tension : float, optional
         f_iso per PCSA [N/m^2], for the local-PCSA scale of Figure 4; default: that of
         the model the dataset was computed with (:func:`spinectl.landscape.netcdf.model_of`).
+    options : FigureOptions, optional
+        Format, resolution, colour range, ratio map, insets; default PNG at :data:`DPI`.
 
     Returns
     -------
     list of Path
-        The PNG files written.
+        The files written.
 
     Raises
     ------
     ConfigError, ParameterError
-        ``specific_tension`` not given and the dataset's ``config_toml`` is not a valid model.
+        ``specific_tension`` not given and the dataset's ``config_toml`` is not a valid model;
+        a bad colour range, or the ratio map without K = 0 and a K > 0.
     OutputError
         A file cannot be written.
     """
+    options = options or FigureOptions()
     if specific_tension is None:
         specific_tension = netcdf.model_of(dataset).fibre.specific_tension
     out_dir = Path(out_dir)
     parts = [dataset.sel(K=k) for k in dataset["K"].values] if "K" in dataset.dims else [dataset]
+    vmin, vmax = _pcsa_range(dataset, options)
+    stiffnesses = _ratio_stiffnesses(dataset) if options.ratio else []
     written = []
     for part in parts:
-        pcsa_name, ct_name = figure_names(float(part["K"]))
-        written.append(save_figure(min_pcsa_figure(part), out_dir / pcsa_name))
-        written.append(save_figure(counter_torque_figure(part, specific_tension), out_dir / ct_name))
+        pcsa_name, ct_name = figure_names(float(part["K"]), options.format)
+        pcsa_fig = min_pcsa_figure(part, vmin, vmax, options.insets)
+        written.append(save_figure(pcsa_fig, out_dir / pcsa_name, options.dpi))
+        written.append(save_figure(counter_torque_figure(part, specific_tension), out_dir / ct_name, options.dpi))
+    for k in stiffnesses:
+        written.append(save_figure(ratio_figure(dataset, k), out_dir / ratio_name(k, options.format), options.dpi))
     return written

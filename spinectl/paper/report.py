@@ -127,6 +127,28 @@ def _provenance(run: Run) -> str:
     )
 
 
+IMAGE_SUFFIXES = (".png", ".svg")
+"""Files that the report shows as images, beside its link to them."""
+
+
+def figures_section(files: Sequence[str]) -> str:
+    """The figures of a run embedded as Markdown images, each under its file name.
+
+    Parameters
+    ----------
+    files : sequence of str
+        Files written, relative to the output folder (the report's own folder).
+
+    Returns
+    -------
+    str
+        One ``### name`` heading and ``![name](name)`` per image file, in the order given;
+        an empty string without images.
+    """
+    images = [name for name in files if name.lower().endswith(IMAGE_SUFFIXES)]
+    return "\n\n".join(f"### {name}\n\n![{name}]({name})" for name in images)
+
+
 def render(measurements: Sequence[Measurement], run: Run) -> str:
     """The Markdown report of a reproduction run.
 
@@ -141,7 +163,7 @@ def render(measurements: Sequence[Measurement], run: Run) -> str:
     -------
     str
         The whole ``report.md``: the run's facts, the landmark table, the halving by K,
-        the local-muscle equivalent of the counter torques and the files written.
+        the local-muscle equivalent of the counter torques, the figures (embedded) and the files written.
     """
     agree = sum(m.agrees for m in measurements)
     files = "\n".join(f"- [`{name}`]({name})" for name in run.files)
@@ -170,6 +192,10 @@ so the C-ratios are given for both readings.
 {_local_pcsa(measurements, run.specific_tension)}
 
 {_halving(measurements, run)}
+
+## Figures
+
+{figures_section(run.files) or "No figures were written."}
 
 ## Files
 

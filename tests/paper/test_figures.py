@@ -3,6 +3,8 @@ the plot command."""
 
 from __future__ import annotations
 
+import xml.etree.ElementTree as ET
+
 import matplotlib.pyplot as plt
 import numpy as np
 import pytest
@@ -10,6 +12,7 @@ from matplotlib.figure import Figure
 from matplotlib.image import imread
 
 from spinectl.cli import main
+from spinectl.errors import ParameterError
 from spinectl.landscape import netcdf, sweep
 from spinectl.model.params import Model
 from spinectl.paper import figures
@@ -67,3 +70,129 @@ def test_plot_command(results, tmp_path, capsys):
 def test_plot_command_missing_file(tmp_path, capsys):
     assert main(["plot", str(tmp_path / "none.nc"), "--out", str(tmp_path)]) == 2
     assert "results: file not found" in capsys.readouterr().err
+
+
+GRIDS = {
+    "partial": (np.linspace(0.02, 0.06, 3), np.linspace(0.01, 0.05, 3)),
+    "offset": (np.linspace(0.02, 0.10, 4), np.linspace(-0.03, 0.01, 3)),
+    "non-square": (np.linspace(0.0, 0.08, 4), np.linspace(0.0, 0.01, 3)),
+}
+"""Grids that are not the paper's 0-8 cm: inside it, shifted past its edges, and 8:1."""
+
+
+@pytest.fixture(scope="module")
+def other_grids():
+    return {name: sweep.sweep(Model(), e, lam, progress=False) for name, (e, lam) in GRIDS.items()}
+
+
+def _inside_axes(fig):
+    """Whether every marker lies inside the axes' limits and the (at least 4) labels of the positions and corners
+    inside the axes' box, once drawn (the contour lines' labels are clipped to the axes)."""
+    fig.canvas.draw()
+    ax = fig.axes[0]
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    for line in ax.lines:
+        if line.get_gid() and (line.get_gid().startswith("position") or line.get_gid() == "optimum"):
+            x, y = np.asarray(line.get_xdata()), np.asarray(line.get_ydata())
+            if not (np.all((x0 - 1e-9 <= x) & (x <= x1 + 1e-9)) and np.all((y0 - 1e-9 <= y) & (y <= y1 + 1e-9))):
+                return False
+    box = ax.get_window_extent()
+    labels = [t.get_window_extent() for t in ax.texts if (t.get_gid() or "").startswith("label")]
+    return len(labels) >= 4 and all(
+        box.x0 - 1 <= b.x0 and b.x1 <= box.x1 + 1 and box.y0 - 1 <= b.y0 and b.y1 <= box.y1 + 1 for b in labels
+    )
+
+
+@pytest.mark.parametrize("name", sorted(GRIDS))
+def test_any_grid_keeps_every_marker_inside_and_the_axes_unsqueezed(other_grids, name):
+    """Positions A-D only where inside (B = (8, 0) cm lies in the offset and the non-square grid), the other corners
+    by their coordinates; equal scales unless one axis spans more than twice the other (8:1 here)."""
+    dataset = other_grids[name]
+    for fig in (figures.min_pcsa_figure(dataset), figures.counter_torque_figure(dataset, 2.5e5)):
+        assert _inside_axes(fig)
+        ax = fig.axes[0]
+        assert (ax.get_aspect() == 1.0) == (name != "non-square")
+        e, lam = GRIDS[name]
+        assert ax.get_xlim() == pytest.approx((e[0] * 100, e[-1] * 100))
+        assert ax.get_ylim() == pytest.approx((lam[0] * 100, lam[-1] * 100))
+    labels = [label for label, _ in figures.grid_marks(*GRIDS[name])]
+    assert ("B" in labels) == (name != "partial") and "A" not in labels[1:] and len(labels) >= 4
+    if name == "offset":
+        assert labels == ["B", "2, -3 cm", "10, -3 cm", "10, 1 cm", "2, 1 cm"]
+
+
+def test_the_paper_grid_marks_a_to_d_at_its_corners_the_ridge_and_the_optimum(results):
+    """On 0-8 cm: A-D at the corners (paper, Results), Lambda = 1.7 E from (0, 0) to (8/1.7, 8) cm, the star
+    at (3, 4) cm (paper, Discussion)."""
+    fig = figures.min_pcsa_figure(netcdf.load(results).sel(K=0.0))
+    assert _inside_axes(fig)
+    lines = {line.get_gid(): line for line in fig.axes[0].lines if line.get_gid()}
+    assert {g for g in lines if g.startswith("position")} == {f"position {p}" for p in "ABCD"}
+    np.testing.assert_allclose(lines["ridge"].get_xdata(), [0.0, 8 / 1.7])
+    np.testing.assert_allclose(lines["ridge"].get_ydata(), [0.0, 8.0])
+    np.testing.assert_allclose(np.ravel(lines["optimum"].get_xydata()), [3.0, 4.0])
+    assert fig.axes[0].texts  # the contour lines' labels and A-D
+
+
+def test_titles_name_the_convention_not_a_bare_word(results):
+    dataset = netcdf.load(results)
+    k0 = figures.min_pcsa_figure(dataset.sel(K=0.0)).axes[0].get_title()
+    k15 = figures.min_pcsa_figure(dataset.sel(K=15.0)).axes[0].get_title()
+    assert "K = 0" in k0 and "convention" not in k0
+    assert "K convention: physical" in k15 and "(physical)" not in k15 and "(paper)" not in k15
+    printed = figures.min_pcsa_figure(dataset.sel(K=15.0).assign_attrs(passive_convention="paper"))
+    assert "K convention: eq. 2 as printed" in printed.axes[0].get_title()
+
+
+def test_shared_scale_and_given_range(results, tmp_path, monkeypatch):
+    """With shared_scale both minimum-PCSA figures get the range over K = 0 and 15 (numpy's nanmin, nanmax);
+    a given vmin/vmax sets the colour bar's ends."""
+    dataset = netcdf.load(results)
+    seen = []
+    original = figures.min_pcsa_figure
+
+    def spy(part, vmin=None, vmax=None, insets=False):
+        seen.append((vmin, vmax))
+        return original(part, vmin, vmax, insets)
+
+    monkeypatch.setattr(figures, "min_pcsa_figure", spy)
+    figures.draw_figures(dataset, tmp_path, options=figures.FigureOptions(shared_scale=True))
+    values = dataset["min_pcsa_cm2"].values
+    assert seen == [(np.nanmin(values), np.nanmax(values))] * 2
+    fig = original(dataset.sel(K=0.0), 20.0, 80.0)
+    assert fig.axes[1].get_ylim() == pytest.approx((20.0, 80.0))
+    with pytest.raises(ParameterError, match="vmin"):
+        original(dataset.sel(K=0.0), 50.0, 40.0)
+
+
+def test_ratio_map_and_insets(results, tmp_path, other_grids):
+    """The ratio S1 / 3 on a 0-1 scale; insets: four model drawings around Figure 3; both need what they need."""
+    dataset = netcdf.load(results)
+    ratio = figures.ratio_figure(dataset)
+    assert ratio.axes[1].get_ylim() == pytest.approx((0.0, 1.0)) and "halving" in ratio.axes[0].get_title()
+    inset = figures.min_pcsa_figure(dataset.sel(K=0.0), insets=True)
+    titles = sorted(ax.get_title() for ax in inset.axes[2:])
+    assert titles == ["A: E = 0, Λ = 0 cm", "B: E = 8, Λ = 0 cm", "C: E = 8, Λ = 8 cm", "D: E = 0, Λ = 8 cm"]
+    with pytest.raises(ParameterError, match="K = 0"):
+        figures.ratio_figure(other_grids["partial"])
+    with pytest.raises(ParameterError, match="--ratio"):
+        figures.draw_figures(other_grids["partial"], tmp_path, options=figures.FigureOptions(ratio=True))
+    assert list(tmp_path.iterdir()) == []  # checked before anything is written
+    path = figures.save_figure(inset, tmp_path / "inset.png")
+    assert _non_trivial(path)
+
+
+def test_plot_command_options_write_vector_files(results, tmp_path, capsys):
+    """--format svg/pdf: SVG parses as XML, PDF starts with its header; --ratio adds the ratio map."""
+    assert main(["plot", str(results), "--out", str(tmp_path / "svg"), "--format", "svg", "--ratio"]) == 0
+    svgs = sorted((tmp_path / "svg").iterdir())
+    assert [p.name for p in svgs] == sorted(
+        [*figures.figure_names(0, "svg"), *figures.figure_names(15, "svg"), figures.ratio_name(15, "svg")]
+    )
+    assert all(ET.parse(p).getroot().tag.endswith("svg") for p in svgs)
+    argv = ["plot", str(results), "--out", str(tmp_path / "pdf"), "--format", "pdf", "--vmin", "0", "--vmax", "80"]
+    assert main(argv) == 0
+    assert all(p.read_bytes().startswith(b"%PDF-") for p in (tmp_path / "pdf").iterdir())
+    capsys.readouterr()
+    assert main(["plot", str(results), "--out", str(tmp_path / "x"), "--dpi", "0"]) == 2
+    assert "--dpi" in capsys.readouterr().err and not (tmp_path / "x").exists()

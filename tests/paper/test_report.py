@@ -54,3 +54,13 @@ def test_halving_names_the_closer_convention():
     text = report.render(_measurements(), RUN)
     assert "0.5 of its K = 0 value with the model's `physical` convention" in text
     assert "`physical` comes closer" in text
+
+
+def test_report_embeds_the_figures_it_links():
+    """Every PNG (or SVG) of the run appears as a Markdown image and as a link; other files only as links."""
+    files = ("landscapes.nc", "fig3_min_pcsa.png", "figS1_min_pcsa_K15.svg", "report.md")
+    text = report.render(_measurements(), dataclasses.replace(RUN, files=files))
+    for name in files[1:3]:
+        assert f"![{name}]({name})" in text and f"[`{name}`]({name})" in text
+    assert "![landscapes.nc]" not in text and "![report.md]" not in text
+    assert "No figures were written." in report.render(_measurements(), RUN)

@@ -172,7 +172,8 @@ ANALYSIS_COMMANDS = {
         "--config",
     ],
     "sweep --out out.nc": ["--K", "--method", "--chunk-size", "--config"],
-    "plot tiny.nc --out figures": ["--E"],  # plot takes no such option: an argparse error
+    "plot tiny.nc --out figures": ["--E", "--vmin", "--vmax"],  # plot takes no --E: an argparse error
+    "draw --out model.png": ["--E", "--Lambda", "--pcsa", "--config"],
 }
 
 
@@ -199,7 +200,7 @@ def analysis_folder(fuzz_folder):
 @settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(analysis_arguments())
 def test_random_arguments_to_the_analysis_commands_never_raise(analysis_folder, argv):
-    """margins, sweep and plot: the same contract, fewer examples (each runs a solver or draws)."""
+    """margins, sweep, plot and draw: the same contract, fewer examples (each runs a solver or draws)."""
     with contextlib.chdir(analysis_folder):
         check(argv)
 

@@ -1,0 +1,64 @@
+"""``spinectl draw``: the model drawn at one (E, Lambda), as PNG, PDF or SVG."""
+
+from __future__ import annotations
+
+from ..paper import drawing, figures
+from ..units import cm2_to_m2
+from ._common import add_model_options, add_position_options, finite_float, float_list, load_model
+
+
+def register(sub) -> None:
+    """Add the ``draw`` sub-command to the ``spinectl`` parser.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The sub-command action of :func:`spinectl.cli.build_parser`.
+    """
+    parser = sub.add_parser(
+        "draw",
+        help="draw the model at one E and Lambda (spine, CoRs, fibres, point mass)",
+        description="The planar model to scale in cm: the spine line through P1, P3, P2 with the "
+        "centres of rotation and vertebrae, the symmetry axis, E and Lambda dimensioned, every muscle "
+        "fibre (width proportional to its muscle's PCSA), the point mass and its line of gravity, and "
+        "optionally the counter torque at each CoR.",
+    )
+    add_position_options(parser)
+    activation = parser.add_mutually_exclusive_group()
+    activation.add_argument(
+        "--pcsa",
+        type=float_list("--pcsa"),
+        metavar="CM2,...",
+        help="PCSA [cm^2], one value per pair or one per muscle (default: the optimum of solve_point)",
+    )
+    activation.add_argument("--geometry-only", action="store_true", help="no activation: every fibre drawn alike")
+    parser.add_argument(
+        "--counter-torque", action="store_true", help="arrows for the counter torques CT_k [N m] at the CoRs"
+    )
+    parser.add_argument("--out", required=True, metavar="FILE", help="the figure: .png, .pdf or .svg")
+    parser.add_argument(
+        "--dpi", type=finite_float("--dpi"), default=figures.DPI, help=f"PNG resolution (default {figures.DPI})"
+    )
+    add_model_options(parser)
+    parser.set_defaults(func=run)
+
+
+def run(args) -> int:
+    """Run ``spinectl draw``: draw, save, print the file's path.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments: ``E``, ``Lambda`` [m], ``pcsa`` [cm^2], ``geometry_only``,
+        ``counter_torque``, ``out``, ``dpi`` and the model options.
+
+    Returns
+    -------
+    int
+        Exit code 0.
+    """
+    model = load_model(args)
+    pcsa = None if args.geometry_only else ("optimum" if args.pcsa is None else cm2_to_m2(args.pcsa))
+    fig = drawing.draw_model(model, args.E, args.Lambda, pcsa=pcsa, counter_torque=args.counter_torque)
+    print(figures.save_figure(fig, args.out, args.dpi))
+    return 0

@@ -1,0 +1,149 @@
+"""The model drawing: its geometry read back from the Figure's artists, mirrored models, widths, torques, files."""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+
+import matplotlib.pyplot as plt
+import numpy as np
+import pytest
+from matplotlib.figure import Figure
+from matplotlib.image import imread
+
+from spinectl.canvas import new_figure
+from spinectl.errors import ParameterError
+from spinectl.model import geometry
+from spinectl.model.params import Model
+from spinectl.model.stability import segment_stability
+from spinectl.paper import drawing, figures
+
+CM = 100.0
+
+
+def _artists(fig: Figure) -> dict:
+    """Every artist of the figure's first axes that has a gid, by gid."""
+    ax = fig.axes[0]
+    found = {}
+    for artist in [*ax.lines, *ax.patches, *ax.texts]:
+        if artist.get_gid():
+            found[artist.get_gid()] = artist
+    return found
+
+
+def _xy(line) -> np.ndarray:
+    return np.column_stack([line.get_xdata(), line.get_ydata()]) / CM
+
+
+def _fibres(fig: Figure, model: Model) -> tuple[np.ndarray, np.ndarray]:
+    """Upper and lower ends [m] of every fibre, in the order of geometry.all_fibres."""
+    artists = _artists(fig)
+    ends = [
+        _xy(artists[f"fibre {name} {i}"])
+        for pair, names in zip(model.muscles, np.reshape(model.muscle_names, (-1, 2)), strict=True)
+        for name in names
+        for i in range(pair.fibres)
+    ]
+    return np.array([e[0] for e in ends]), np.array([e[1] for e in ends])
+
+
+@pytest.mark.parametrize(("e", "lam"), [(0.03, 0.04), (0.08, 0.0), (0.0, 0.08), (-0.02, 0.05)])
+def test_cors_and_attachments_read_back_match_the_geometry(model, e, lam):
+    """CoRs against geometry.cor_positions and the closed form x = -E + Lambda phi (docs/model.md,
+    phi = 1.5 s - 0.5 s^3 with natural ends); fibre ends against geometry.all_fibres; mass at (0, 0.326 m)."""
+    fig = drawing.draw_model(model, e, lam)
+    artists = _artists(fig)
+    cors = _xy(artists[drawing.GIDS["cor"]])
+    np.testing.assert_allclose(cors, geometry.cor_positions(e, lam, model.geometry), rtol=0, atol=1e-12)
+    y = np.array([0.145, 0.106, 0.072, 0.035, 0.005])
+    s = 1 - np.abs(y - 0.088) / 0.088
+    np.testing.assert_allclose(cors[:, 0], -e + lam * (1.5 * s - 0.5 * s**3), rtol=0, atol=1e-12)
+    upper, lower = _fibres(fig, model)
+    want_upper, want_lower, _ = geometry.all_fibres(model)
+    np.testing.assert_allclose(upper, want_upper, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(lower, want_lower, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(_xy(artists[drawing.GIDS["mass"]]), [[0.0, 0.326]], rtol=0, atol=1e-12)
+    spline = _xy(artists[drawing.GIDS["spline"]])  # P1, P3, P2 from the paper's definition of E and Lambda
+    np.testing.assert_allclose(spline, [[-e, 0.176], [-e + lam, 0.088], [-e, 0.0]], rtol=0, atol=1e-12)
+
+
+def test_the_straight_pair_in_closed_form(model):
+    """Default straight pair: vertical fibres at x = +-(0.12 + linspace(-0.015, 0.015, 5)) m from y = 0.24 to 0 m."""
+    upper, lower = _fibres(drawing.draw_model(model, 0.03, 0.04), model)
+    x = 0.12 + np.linspace(-0.015, 0.015, 5)
+    np.testing.assert_allclose(np.sort(upper[:10, 0]), np.sort(np.concatenate([x, -x])), atol=1e-12)
+    np.testing.assert_allclose(upper[:10, 1], 0.24, atol=1e-12)
+    np.testing.assert_allclose(lower[:10, 1], 0.0, atol=1e-12)
+    np.testing.assert_allclose(upper[:10, 0], lower[:10, 0], atol=1e-12)
+
+
+def _mirror_of(a: np.ndarray) -> np.ndarray:
+    return a * np.array([-1.0, 1.0])
+
+
+@pytest.mark.parametrize(("e", "lam"), [(0.03, 0.04), (0.0, 0.05)])
+def test_mirrored_models_give_mirrored_drawings(model, e, lam):
+    """(E, Lambda) and (-E, -Lambda) are mirror images in x = 0 (the muscles are symmetric, docs/model.md);
+    with E = 0 (the coronal plane) a scoliosis to the left mirrors one to the right."""
+    one, other = _artists(drawing.draw_model(model, e, lam)), _artists(drawing.draw_model(model, -e, -lam))
+    for gid in (drawing.GIDS["spine"], drawing.GIDS["cor"], drawing.GIDS["spline"]):
+        np.testing.assert_allclose(_xy(other[gid]), _mirror_of(_xy(one[gid])), atol=1e-12)
+    vertebrae = [gid for gid in one if gid.startswith("vertebra")]
+    assert len(vertebrae) == 5
+    for gid in vertebrae:  # a mirrored rectangle: the same corners, x negated (in reversed order)
+        mine, theirs = one[gid].get_xy()[:4] / CM, other[gid].get_xy()[:4] / CM
+        np.testing.assert_allclose(sorted(map(tuple, theirs)), sorted(map(tuple, _mirror_of(mine))), atol=1e-12)
+
+
+def test_line_widths_are_proportional_to_the_given_pcsa(model):
+    """PCSA 10, 5, 0 cm² per pair: the straight pair at MAX_WIDTH, the outer oblique at half of it, the inner idle."""
+    fig = drawing.draw_model(model, 0.03, 0.04, pcsa=np.array([10.0, 5.0, 0.0]) * 1e-4)
+    artists = _artists(fig)
+    for side in ("ventral", "dorsal"):
+        assert artists[f"fibre straight_{side} 0"].get_linewidth() == pytest.approx(drawing.MAX_WIDTH)
+        assert artists[f"fibre oblique_outer_{side} 4"].get_linewidth() == pytest.approx(drawing.MAX_WIDTH / 2)
+        assert artists[f"fibre oblique_inner_{side} 2"].get_linestyle() == ":"
+
+
+def test_counter_torque_arrows_are_scaled_in_newton_metres(model):
+    """Each arrow runs from its CoR, TORQUE_SCALE m per N m of CT_k (segment_stability) towards -x for CT_k > 0."""
+    pcsa = np.array([10.0, 5.0, 1.0]) * 1e-4
+    fig = drawing.draw_model(model, 0.03, 0.04, pcsa=pcsa, counter_torque=True)
+    torques = segment_stability(model, 0.03, 0.04, pcsa).counter_torque
+    cors = geometry.cor_positions(0.03, 0.04, model.geometry)
+    artists = _artists(fig)
+    for name, cor, torque in zip(model.geometry.cor_names, cors, torques, strict=True):
+        arrow = artists[f"counter torque {name}"]
+        start, end = np.array(arrow.xyann) / CM, np.array(arrow.xy) / CM
+        np.testing.assert_allclose(start, cor, atol=1e-12)
+        np.testing.assert_allclose(end - start, [-torque * drawing.TORQUE_SCALE, 0.0], atol=1e-12)
+
+
+def test_the_optimum_is_the_default_activation_of_the_cli_and_is_named(model):
+    fig = drawing.draw_model(model, 0.03, 0.04, pcsa="optimum")
+    assert "the optimum (solve_point)" in fig.axes[0].get_title()
+    assert "no activation" in drawing.draw_model(model, 0.03, 0.04).axes[0].get_title()
+
+
+def test_draws_into_given_axes_and_refuses_torques_without_activation(model):
+    fig = new_figure()
+    ax = fig.add_subplot()
+    assert drawing.draw_model(model, 0.0, 0.0, ax=ax, annotate=False) is fig and ax.get_xticks().size == 0
+    assert ax.get_aspect() == 1.0 and plt.get_fignums() == []
+    with pytest.raises(ParameterError, match="counter_torque"):
+        drawing.draw_model(model, 0.0, 0.0, counter_torque=True)
+    with pytest.raises(ParameterError, match="pcsa"):
+        drawing.draw_model(model, 0.0, 0.0, pcsa="best")
+
+
+def test_png_pdf_and_svg_files(model, tmp_path):
+    """PNG: many colours, not blank; SVG parses as XML; PDF: its header and one page."""
+    fig = drawing.draw_model(model, 0.03, 0.04, pcsa="optimum", counter_torque=True)
+    png, pdf, svg = (figures.save_figure(fig, tmp_path / f"model.{kind}") for kind in ("png", "pdf", "svg"))
+    image = imread(png)
+    assert image.std() > 0.05 and len(np.unique(image.reshape(-1, image.shape[-1]), axis=0)) > 20
+    assert ET.parse(svg).getroot().tag.endswith("svg")
+    data = pdf.read_bytes()
+    assert data.startswith(b"%PDF-") and data.count(b"/Type /Page\n") + data.count(b"/Type /Page ") == 1
+    with pytest.raises(ParameterError, match="--out"):
+        figures.save_figure(fig, tmp_path / "model.txt")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["model.pdf", "model.png", "model.svg"]
