@@ -143,5 +143,5 @@ def reproduce_model(
             specific_tension=model.fibre.specific_tension,
             calibrated=calibrated,
         )
-        (stage / "report.md").write_text(report.render(measured, run_facts))
+        (stage / "report.md").write_text(report.render(measured, run_facts), encoding="utf-8")
     return [Path(out_dir) / name for name in names]

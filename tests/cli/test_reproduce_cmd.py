@@ -69,3 +69,18 @@ def test_reproduce_of_another_preset_says_it_is_not_calibrated(tmp_path, capsys)
     text = (tmp_path / "report.md").read_text()
     assert "Parameters: preset `default`" in text and "are **not** the calibrated preset" in text
     assert (tmp_path / "landscape_K15_paper.nc").exists()  # default uses the physical convention
+
+
+def test_reproduce_writes_utf8_under_a_latin1_locale(tmp_path, monkeypatch, capsys):
+    """Under an ISO-8859-1 locale the report (with Λ, ≙, cm²) is still written, as UTF-8.
+
+    pathlib asks ``io.text_encoding`` for the encoding of a call without one; under
+    an ISO-8859-1 locale it answers 'locale', i.e. latin-1, which cannot encode Λ.
+    """
+    import io
+
+    real = io.text_encoding
+    monkeypatch.setattr(io, "text_encoding", lambda encoding, *a: real(encoding, *a) if encoding else "iso-8859-1")
+    out = tmp_path / "results"
+    assert main(["reproduce", "--out", str(out), "--points", "3"]) == 0
+    assert "Λ" in (out / "report.md").read_bytes().decode("utf-8")

@@ -599,3 +599,31 @@ def test_long_jobs_check_their_outputs_before_they_start(tmp_path, monkeypatch, 
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert err.startswith("spinectl: error: cannot write") and err.count("\n") == 1
+
+
+def test_every_text_file_is_opened_with_an_explicit_encoding():
+    """Every ``open``, ``read_text``, ``write_text`` in spinectl names its encoding (issue 18, class 13).
+
+    Without one Python uses the locale's encoding, e.g. ISO-8859-1, which cannot
+    write the report's Λ; binary modes ('rb', 'wb') need none.
+    """
+    import ast
+    import pathlib
+
+    import spinectl
+
+    missing = []
+    for path in pathlib.Path(spinectl.__file__).parent.rglob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if not isinstance(node, ast.Call):
+                continue
+            name = getattr(node.func, "attr", getattr(node.func, "id", None))
+            if name not in {"open", "read_text", "write_text"}:
+                continue
+            if isinstance(node.func, ast.Name) and name != "open":
+                continue  # spinectl's own read_text (model/_toml.py), which names the encoding
+            modes = [a.value for a in node.args[1:2] + [k.value for k in node.keywords if k.arg == "mode"]]
+            binary = any(isinstance(m, ast.Constant) and "b" in str(m.value) for m in modes)
+            if not binary and not any(k.arg == "encoding" for k in node.keywords):
+                missing.append(f"{path.name}:{node.lineno}")
+    assert missing == []
