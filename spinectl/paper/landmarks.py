@@ -469,13 +469,15 @@ class Measurement:
     value : float
         spinectl's value, in the landmark's unit (NaN if not measurable).
     agrees : bool
+    off_grid : tuple of ((float, float or None), (float, float or None))
+        (position named, grid point read) [m] for each position of the landmark that is
+        not a grid point (:func:`grid_point`).
     """
 
     landmark: Landmark
     value: float
     agrees: bool
     off_grid: tuple = ()
-    """(position, grid point) pairs [m] where the landmark's position is not on the grid."""
 
     @property
     def how(self) -> str:

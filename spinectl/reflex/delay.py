@@ -38,6 +38,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .inputs import validated
+
 STATUS = ("finite", "delay_independent", "unstable_without_delay", "undefined")
 """Meaning of :attr:`DelayMargin.status` codes 0..3.
 
@@ -71,6 +73,7 @@ def as_arrays(*values):
     return np.broadcast_arrays(*(np.asarray(x, float) for x in values))
 
 
+@validated
 def stable_without_delay(stiffness, damping, kp, kd):
     """True where theta s^2 + (kd - D) s + (kp - S) is Hurwitz: kd > D and kp > S (theta > 0).
 
@@ -118,6 +121,7 @@ class Crossings:
         return self.phase / self.frequency
 
 
+@validated(zero_inertia=True)
 def crossings(stiffness, damping, inertia, kp, kd) -> Crossings:
     """Crossing frequencies, phases and directions of the delayed reflex loop.
 
@@ -240,6 +244,7 @@ def undefined_inputs(*values):
     return np.any(np.isnan(np.stack(as_arrays(*values))), axis=0)
 
 
+@validated(zero_inertia=True)
 def delay_margin(stiffness, damping, inertia, kp, kd) -> DelayMargin:
     """Exact delay margin from the quasi-polynomial (docs/reflex.md, "Crossing frequencies and the exact delay margin").
 
@@ -276,6 +281,7 @@ def delay_margin(stiffness, damping, inertia, kp, kd) -> DelayMargin:
     return margin_from_delays(cr.first_delay, cr.frequency, stable0, undefined)
 
 
+@validated
 def right_half_plane_roots(stiffness, damping, inertia, kp, kd, delay):
     """Number of closed-loop roots with Re s > 0 at the delay ``delay`` [s], exactly.
 
@@ -308,6 +314,7 @@ def right_half_plane_roots(stiffness, damping, inertia, kp, kd, delay):
     return np.where(undefined_inputs(s, d, theta, kp, kd, tau), np.nan, count)
 
 
+@validated
 def stable_at_delay(stiffness, damping, inertia, kp, kd, delay):
     """True where the closed loop with the true delay [s] has every root in Re s < 0.
 
@@ -335,6 +342,7 @@ def stable_at_delay(stiffness, damping, inertia, kp, kd, delay):
     return (count == 0) & ~on_axis
 
 
+@validated(zero_inertia=True)
 def phase_margin(stiffness, damping, inertia, kp, kd, delay):
     """Exact phase margin [rad] and gain crossover [rad/s] of the loop with the true delay.
 
@@ -390,6 +398,7 @@ def _bracketed_roots(func, grid):
     return np.where(has, 0.5 * (lo + hi), np.nan)
 
 
+@validated
 def critical_gains(stiffness, damping, inertia, kd, delay, lobes: int = 8, points_per_lobe: int = 48):
     """Range (kp_min, kp_max) of proportional gains that stabilise the segment at ``delay``, given kd.
 

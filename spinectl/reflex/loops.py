@@ -23,11 +23,13 @@ import control as ct
 import numpy as np
 
 from ..model.stability import jacobian
+from .inputs import validated
 
 STATES = ("alpha", "omega")
 """State names of a segment: angle [rad] and angular velocity [rad/s]."""
 
 
+@validated
 def segment_system(stiffness: float, damping: float, inertia: float, name: str | None = None) -> ct.StateSpace:
     """The segment linearised at the upright equilibrium (paper, Stability analysis).
 
@@ -59,6 +61,7 @@ def segment_system(stiffness: float, damping: float, inertia: float, name: str |
     return ct.ss(a, b, c, 0.0, inputs=["torque"], outputs=["alpha"], states=list(STATES), name=name)
 
 
+@validated
 def pade_delay(delay: float, order: int) -> ct.TransferFunction:
     """exp(-s delay) as python-control's [order/order] Padé approximant (1 for no delay).
 
@@ -78,6 +81,7 @@ def pade_delay(delay: float, order: int) -> ct.TransferFunction:
     return ct.tf(num, den, inputs=["u"], outputs=["u_delayed"])
 
 
+@validated
 def reflex_controller(kp: float, kd: float) -> ct.TransferFunction:
     """C(s) = kp + kd s [N m/rad], from alpha to the reflex torque (before the delay and sign).
 
@@ -94,6 +98,7 @@ def reflex_controller(kp: float, kd: float) -> ct.TransferFunction:
     return ct.tf([kd, kp], [1.0], inputs=["alpha"], outputs=["reflex"])
 
 
+@validated
 def loop_transfer(stiffness, damping, inertia, kp, kd, delay: float, order: int) -> ct.TransferFunction:
     """Loop transfer function L(s) = C(s) Pade(s) G(s), the delay as a Padé approximant.
 
@@ -121,6 +126,7 @@ def loop_transfer(stiffness, damping, inertia, kp, kd, delay: float, order: int)
     return reflex_controller(kp, kd) * pade_delay(delay, order) * plant
 
 
+@validated
 def closed_loop(stiffness, damping, inertia, kp, kd, delay: float, order: int, name=None) -> ct.StateSpace:
     """The segment under the delayed reflex u = -(kp alpha + kd omega)(t - tau), Padé delay.
 

@@ -24,6 +24,7 @@ from ..optimise.reference import solve_point
 from ..units import m2_to_cm2
 from . import gains, loops, pade, simulate
 from .delay import critical_gains, delay_margin, phase_margin, stable_at_delay
+from .inputs import validated
 
 SKIPPED = "skipped"
 """Optimum status when activation = 0: the optimiser is not consulted (no co-contraction)."""
@@ -201,6 +202,7 @@ class SegmentMargins:
         }
 
 
+@validated
 def segment_margins(name, stiffness, damping, inertia, kp, kd, delay: float, order: int) -> SegmentMargins:
     """All margins of one segment's reflex loop (see :class:`SegmentMargins`).
 

@@ -27,8 +27,10 @@ from .delay import (
     stable_without_delay,
     undefined_inputs,
 )
+from .inputs import validated
 
 
+@validated
 def pade_coefficients(order: int) -> np.ndarray:
     """Coefficients c_0..c_n of the [n/n] Padé approximant exp(-x) ~ q(-x) / q(x), q(x) = sum c_k x^k.
 
@@ -59,6 +61,7 @@ def pade_coefficients(order: int) -> np.ndarray:
     )
 
 
+@validated
 def pade_phase_lag(y, order: int):
     """Phase lag [rad] of the Padé all-pass q(-jy)/q(jy) at y = w tau, unwrapped.
 
@@ -84,6 +87,7 @@ def pade_phase_lag(y, order: int):
     return 2.0 * np.sum(np.arctan((y - roots.imag) / -roots.real), axis=-1)
 
 
+@validated
 def pade_inverse_lag(phase, order: int):
     """The y >= 0 with :func:`pade_phase_lag` (y) = ``phase`` [rad]; inf where phase >= n pi.
 
@@ -111,6 +115,7 @@ def pade_inverse_lag(phase, order: int):
     return np.where(phase < order * np.pi, y, np.inf)
 
 
+@validated
 def pade_delay_margin(stiffness, damping, inertia, kp, kd, order: int) -> DelayMargin:
     """Delay margin of the loop with the delay replaced by its [n/n] Padé approximant.
 
@@ -139,6 +144,7 @@ def pade_delay_margin(stiffness, damping, inertia, kp, kd, order: int) -> DelayM
     return margin_from_delays(first, cr.frequency, stable0, undefined_inputs(stiffness, damping, inertia, kp, kd))
 
 
+@validated
 def pade_convergence(stiffness, damping, inertia, kp, kd, orders):
     """Padé delay margins and their errors against the exact margin, for several orders.
 
