@@ -41,8 +41,9 @@ def atomic_path(target: str | Path, *, directory: bool = False) -> Iterator[Path
     Raises
     ------
     OutputError
-        The folder cannot be created or written, or ``target`` cannot be
-        replaced (e.g. a folder where a file should go). Exceptions of the
+        The folder cannot be created or written, the writer meets a full disk
+        (an ``OSError`` of :data:`DEVICE_ERRORS`), or ``target`` cannot be
+        replaced (e.g. a folder where a file should go). Other exceptions of the
         writer itself propagate unchanged.
     """
     target = Path(target)
@@ -50,7 +51,8 @@ def atomic_path(target: str | Path, *, directory: bool = False) -> Iterator[Path
         target.parent.mkdir(parents=True, exist_ok=True)
         tmp = _temporary(target, directory)
     try:
-        yield tmp
+        with _output_errors(target, errnos=DEVICE_ERRORS):  # the writer meets a full disk
+            yield tmp
         with _output_errors(target):
             _set_mode(tmp, target, directory)
             _replace(tmp, target, directory)
@@ -62,11 +64,21 @@ def atomic_path(target: str | Path, *, directory: bool = False) -> Iterator[Path
         raise
 
 
+DEVICE_ERRORS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EROFS, errno.EIO})
+"""Error numbers of an output's file system refusing the bytes (full, over quota, file too
+large, read-only, failing): a writer's ``OSError`` with one of these is an :class:`OutputError`;
+its other exceptions (e.g. a missing input) propagate unchanged."""
+
+
 @contextlib.contextmanager
-def _output_errors(target: Path):
+def _output_errors(target: Path, errnos=None):
     try:
         yield
+    except OutputError:
+        raise  # already one line, naming its own target
     except OSError as exc:
+        if errnos is not None and exc.errno not in errnos:
+            raise
         reason = exc.strerror or exc.__class__.__name__
         raise OutputError(f"cannot write {str(target)!r}: {reason}") from None
 

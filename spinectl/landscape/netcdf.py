@@ -8,8 +8,9 @@ from pathlib import Path
 
 import xarray as xr
 
+from .._validate import printable
 from ..atomic import atomic_path
-from ..errors import ParameterError
+from ..errors import OutputError, ParameterError, SpinectlError
 from ..model import config
 from ..model.params import Model
 
@@ -45,9 +46,19 @@ def save(dataset: xr.Dataset, path: str | Path) -> Path:
     -------
     Path
         ``path`` as a :class:`~pathlib.Path`, now holding the NetCDF file.
+
+    Raises
+    ------
+    OutputError
+        ``path`` cannot be written (a folder in the way, a full disk); the previous file is left intact.
     """
     with atomic_path(path) as tmp:
-        dataset.to_netcdf(tmp, engine="netcdf4")
+        try:
+            dataset.to_netcdf(tmp, engine="netcdf4")
+        except (OSError, RuntimeError) as exc:  # netCDF-C reports a full disk as e.g. "NetCDF: HDF error"
+            if isinstance(exc, SpinectlError):
+                raise
+            raise OutputError(f"cannot write {str(path)!r}: {printable(str(exc))}") from None
     return Path(path)
 
 

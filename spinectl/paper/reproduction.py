@@ -14,7 +14,7 @@ import math
 import time
 from pathlib import Path
 
-from ..atomic import staged_directory
+from ..atomic import atomic_write_text, staged_directory
 from ..errors import ParameterError
 from ..landscape import netcdf, sweep
 from ..model.config import load_config
@@ -143,5 +143,5 @@ def reproduce_model(
             specific_tension=model.fibre.specific_tension,
             calibrated=calibrated,
         )
-        (stage / "report.md").write_text(report.render(measured, run_facts), encoding="utf-8")
+        atomic_write_text(stage / "report.md", report.render(measured, run_facts))  # UTF-8; a full disk: OutputError
     return [Path(out_dir) / name for name in names]
