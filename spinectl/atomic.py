@@ -172,6 +172,54 @@ def atomic_write_text(target: str | Path, text: str) -> Path:
     return Path(target)
 
 
+def _stage(target: Path) -> Path:
+    """A new, empty staging folder for ``target`` on its file system: inside it, or beside it if it does not exist."""
+    if target.is_dir():
+        return Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".tmp", dir=target))
+    target.parent.mkdir(parents=True, exist_ok=True)
+    return _temporary(target, directory=True)
+
+
+def check_staged_directory(target: str | Path) -> Path:
+    """Raise :class:`OutputError` now if :func:`staged_directory` could not fill ``target`` later.
+
+    Long jobs call it before they start: it makes the staging folder, moves a file
+    from it into ``target`` by a rename (as the end of the job will) and removes both;
+    a mount point that refuses the rename, a file where the folder should be or a
+    read-only folder fail here, not after the run. ``target`` keeps its contents; its
+    missing parent folders are created.
+
+    Parameters
+    ----------
+    target : str or Path
+        The output folder.
+
+    Returns
+    -------
+    Path
+        ``target`` as a :class:`~pathlib.Path`.
+
+    Raises
+    ------
+    OutputError
+        ``target`` is a file, or its folder cannot be written or take a rename from the staging folder.
+    """
+    target = Path(target)
+    with _output_errors(target):
+        if target.exists() and not target.is_dir():
+            raise NotADirectoryError(errno.ENOTDIR, "Not a directory")
+        stage = _stage(target)
+        try:
+            probe = stage / "probe"
+            probe.touch()
+            landed = (target if target.is_dir() else stage.parent) / f".{stage.name}.probe"
+            os.replace(probe, landed)
+            landed.unlink()
+        finally:
+            shutil.rmtree(stage, ignore_errors=True)
+    return target
+
+
 @contextlib.contextmanager
 def staged_directory(target: str | Path) -> Iterator[Path]:
     """Yield an empty staging folder; on success move each of its files into ``target``.
@@ -188,7 +236,9 @@ def staged_directory(target: str | Path) -> Iterator[Path]:
     Yields
     ------
     Path
-        The empty staging folder, beside ``target``; write the outputs into it.
+        The empty staging folder, on ``target``'s file system (inside ``target`` if it
+        exists, beside it if not: a mount point cannot take renames from its parent);
+        write the outputs into it.
 
     Raises
     ------
@@ -197,8 +247,7 @@ def staged_directory(target: str | Path) -> Iterator[Path]:
     """
     target = Path(target)
     with _output_errors(target):
-        target.parent.mkdir(parents=True, exist_ok=True)
-        stage = _temporary(target, directory=True)
+        stage = _stage(target)
     try:
         yield stage
         with _output_errors(target):
