@@ -14,6 +14,7 @@ import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
+from ._validate import show
 from .errors import OutputError
 
 
@@ -46,7 +47,7 @@ def atomic_path(target: str | Path, *, directory: bool = False) -> Iterator[Path
         replaced (e.g. a folder where a file should go). Other exceptions of the
         writer itself propagate unchanged.
     """
-    target = Path(target)
+    target = _named(target)
     with _output_errors(target):
         target.parent.mkdir(parents=True, exist_ok=True)
         tmp = _temporary(target, directory)
@@ -62,6 +63,18 @@ def atomic_path(target: str | Path, *, directory: bool = False) -> Iterator[Path
         else:
             tmp.unlink(missing_ok=True)
         raise
+
+
+def _named(target: str | Path) -> Path:
+    """``target`` as a Path, or :class:`OutputError` if its name has a line break or control character.
+
+    Such a name is valid on POSIX, but it breaks the one-line listings and messages
+    that name the outputs, and the command line that a preset's header records.
+    """
+    text = str(target)
+    if not text.isprintable():
+        raise OutputError(f"cannot write {show(text)}: the name must be printable (no line breaks or control codes)")
+    return Path(target)
 
 
 DEVICE_ERRORS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EROFS, errno.EIO})
@@ -141,9 +154,10 @@ def check_writable(target: str | Path) -> Path:
     Raises
     ------
     OutputError
-        ``target`` is a folder, or its folder cannot be created or written.
+        ``target`` is a folder or has a name that is not printable, or its folder cannot be
+        created or written.
     """
-    target = Path(target)
+    target = _named(target)
     with _output_errors(target):
         if target.is_dir():
             raise IsADirectoryError(errno.EISDIR, "Is a directory")
@@ -204,7 +218,7 @@ def check_staged_directory(target: str | Path) -> Path:
     OutputError
         ``target`` is a file, or its folder cannot be written or take a rename from the staging folder.
     """
-    target = Path(target)
+    target = _named(target)
     with _output_errors(target):
         if target.exists() and not target.is_dir():
             raise NotADirectoryError(errno.ENOTDIR, "Not a directory")

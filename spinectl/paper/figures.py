@@ -18,6 +18,7 @@ import xarray as xr
 from matplotlib.figure import Figure
 
 from ..canvas import new_figure, save_png
+from ..errors import ParameterError
 from ..landscape import netcdf
 from ..units import M2_PER_CM2
 from . import grid, landmarks
@@ -62,6 +63,12 @@ def _landscape(field: xr.DataArray, title: str, label: str):
 
     Infeasible points (NaN) stay white, and the title says how many there are.
     """
+    if field.sizes["E"] < 2 or field.sizes["Lambda"] < 2:  # a contour needs an area
+        raise ParameterError(
+            "grid",
+            f"a landscape figure needs at least 2 values of E and 2 of Lambda (got {field.sizes['E']} x "
+            f"{field.sizes['Lambda']})",
+        )
     values = np.ma.masked_invalid(field.transpose("Lambda", "E").values)
     infeasible = int(values.mask.sum()) if np.ma.is_masked(values) else 0
     if infeasible:
@@ -195,7 +202,8 @@ def draw_figures(dataset: xr.Dataset, out_dir: str | Path, specific_tension: flo
     Raises
     ------
     ConfigError, ParameterError
-        ``specific_tension`` not given and the dataset's ``config_toml`` is not a valid model.
+        ``specific_tension`` not given and the dataset's ``config_toml`` is not a valid model;
+        fewer than 2 values of E or of Lambda (field ``grid``), before any file is written.
     OutputError
         A file cannot be written.
     """
