@@ -221,7 +221,9 @@ def describe(dataset: xr.Dataset) -> str:
     -------
     str
         E.g. ``"25 points (25 solved, 0 infeasible or failed); min PCSA 10.2-40.3 cm2, ||CT|| 0.0-31.5 N m"``;
-        the ranges only if some point was solved.
+        the ranges only if some point was solved, and a warning naming the points whose
+        status is ``optimal_inaccurate`` (the solver did not meet its tolerances: their
+        numbers may be far off) if there are any.
     """
     status = dataset["status"].values
     pcsa, torque = dataset["min_pcsa_cm2"].values, dataset["counter_torque_norm_Nm"].values
@@ -232,4 +234,7 @@ def describe(dataset: xr.Dataset) -> str:
             f"; min PCSA {np.nanmin(pcsa):.1f}-{np.nanmax(pcsa):.1f} cm2, "
             f"||CT|| {np.nanmin(torque):.1f}-{np.nanmax(torque):.1f} N m"
         )
+    inaccurate = int(np.sum(status == "optimal_inaccurate"))
+    if inaccurate:
+        ranges += f"; WARNING: {inaccurate} inaccurate (status optimal_inaccurate: values may be far off)"
     return f"{status.size} points ({int(ok.sum())} solved, {int((~ok).sum())} infeasible or failed){ranges}"
