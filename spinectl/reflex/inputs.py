@@ -12,6 +12,7 @@ allowed (an infeasible point: the answer is NaN with status ``undefined``).
 
 from __future__ import annotations
 
+import contextlib
 import contextvars
 import functools
 import inspect
@@ -74,13 +75,31 @@ def validated(func=None, *, zero_inertia: bool = False):
             check_order(given["order"])
         for order in given.get("orders", ()):
             check_order(order, "orders")
-        token = _INSIDE.set(True)
-        try:
+        with guarded():
             return func(*args, **kwargs)
-        finally:
-            _INSIDE.reset(token)
 
     return checked
+
+
+@contextlib.contextmanager
+def guarded():
+    """Skip the checks of :func:`validated` inside the block: for library callers under their own guard.
+
+    A sweep's reflex columns come from a validated model and run under
+    :func:`spinectl.model.checks.arithmetic_guard`, which names the position and the
+    likely unit typo when the arithmetic overflows; their S and D are not the user's
+    to correct, so a bound on them would only blur that message.
+
+    Yields
+    ------
+    None
+        Inside the block the public reflex functions run unchecked.
+    """
+    token = _INSIDE.set(True)
+    try:
+        yield
+    finally:
+        _INSIDE.reset(token)
 
 
 def check_arrays(given: dict, *, zero_inertia: bool = False) -> None:

@@ -8,7 +8,7 @@ import pytest
 from spinectl import reflex
 from spinectl.errors import ParameterError
 from spinectl.reflex import loops
-from spinectl.reflex.inputs import MAX_MAGNITUDE
+from spinectl.reflex.inputs import MAX_MAGNITUDE, guarded
 
 S, D, THETA, KP, KD = 5.0, -10.0, 0.5, 20.0, 3.0
 """An unstable segment with a stabilising reflex (kp > S, kd > D): a finite delay margin."""
@@ -51,3 +51,12 @@ def test_limits_and_nan_stay_answers():
     reflex.delay_margin(S, D, THETA, MAX_MAGNITUDE, KD)
     kp_min, _ = reflex.critical_gains(-100.0, -1.0, 1.0, 0.0, 0.1)  # probes kp = inf inside: not refused
     assert np.isfinite(kp_min)
+
+
+def test_library_callers_under_their_own_guard_are_not_checked_again():
+    """A sweep's reflex columns run under arithmetic_guard (its message names the grid); inside
+    ``guarded()`` a magnitude beyond MAX_MAGNITUDE reaches the arithmetic, as it did before."""
+    with guarded():
+        reflex.delay_margin(S, D, THETA, 1e100, KD)
+    with pytest.raises(ParameterError):
+        reflex.delay_margin(S, D, THETA, 1e100, KD)
