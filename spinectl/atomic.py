@@ -14,6 +14,7 @@ import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
+from ._validate import show
 from .errors import OutputError
 
 
@@ -41,16 +42,18 @@ def atomic_path(target: str | Path, *, directory: bool = False) -> Iterator[Path
     Raises
     ------
     OutputError
-        The folder cannot be created or written, or ``target`` cannot be
-        replaced (e.g. a folder where a file should go). Exceptions of the
+        The folder cannot be created or written, the writer meets a full disk
+        (an ``OSError`` of :data:`DEVICE_ERRORS`), or ``target`` cannot be
+        replaced (e.g. a folder where a file should go). Other exceptions of the
         writer itself propagate unchanged.
     """
-    target = Path(target)
+    target = _named(target)
     with _output_errors(target):
         target.parent.mkdir(parents=True, exist_ok=True)
         tmp = _temporary(target, directory)
     try:
-        yield tmp
+        with _output_errors(target, errnos=DEVICE_ERRORS):  # the writer meets a full disk
+            yield tmp
         with _output_errors(target):
             _set_mode(tmp, target, directory)
             _replace(tmp, target, directory)
@@ -62,11 +65,33 @@ def atomic_path(target: str | Path, *, directory: bool = False) -> Iterator[Path
         raise
 
 
+def _named(target: str | Path) -> Path:
+    """``target`` as a Path, or :class:`OutputError` if its name has a line break or control character.
+
+    Such a name is valid on POSIX, but it breaks the one-line listings and messages
+    that name the outputs, and the command line that a preset's header records.
+    """
+    text = str(target)
+    if not text.isprintable():
+        raise OutputError(f"cannot write {show(text)}: the name must be printable (no line breaks or control codes)")
+    return Path(target)
+
+
+DEVICE_ERRORS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EROFS, errno.EIO})
+"""Error numbers of an output's file system refusing the bytes (full, over quota, file too
+large, read-only, failing): a writer's ``OSError`` with one of these is an :class:`OutputError`;
+its other exceptions (e.g. a missing input) propagate unchanged."""
+
+
 @contextlib.contextmanager
-def _output_errors(target: Path):
+def _output_errors(target: Path, errnos=None):
     try:
         yield
+    except OutputError:
+        raise  # already one line, naming its own target
     except OSError as exc:
+        if errnos is not None and exc.errno not in errnos:
+            raise
         reason = exc.strerror or exc.__class__.__name__
         raise OutputError(f"cannot write {str(target)!r}: {reason}") from None
 
@@ -129,9 +154,10 @@ def check_writable(target: str | Path) -> Path:
     Raises
     ------
     OutputError
-        ``target`` is a folder, or its folder cannot be created or written.
+        ``target`` is a folder or has a name that is not printable, or its folder cannot be
+        created or written.
     """
-    target = Path(target)
+    target = _named(target)
     with _output_errors(target):
         if target.is_dir():
             raise IsADirectoryError(errno.EISDIR, "Is a directory")
@@ -160,6 +186,54 @@ def atomic_write_text(target: str | Path, text: str) -> Path:
     return Path(target)
 
 
+def _stage(target: Path) -> Path:
+    """A new, empty staging folder for ``target`` on its file system: inside it, or beside it if it does not exist."""
+    if target.is_dir():
+        return Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".tmp", dir=target))
+    target.parent.mkdir(parents=True, exist_ok=True)
+    return _temporary(target, directory=True)
+
+
+def check_staged_directory(target: str | Path) -> Path:
+    """Raise :class:`OutputError` now if :func:`staged_directory` could not fill ``target`` later.
+
+    Long jobs call it before they start: it makes the staging folder, moves a file
+    from it into ``target`` by a rename (as the end of the job will) and removes both;
+    a mount point that refuses the rename, a file where the folder should be or a
+    read-only folder fail here, not after the run. ``target`` keeps its contents; its
+    missing parent folders are created.
+
+    Parameters
+    ----------
+    target : str or Path
+        The output folder.
+
+    Returns
+    -------
+    Path
+        ``target`` as a :class:`~pathlib.Path`.
+
+    Raises
+    ------
+    OutputError
+        ``target`` is a file, or its folder cannot be written or take a rename from the staging folder.
+    """
+    target = _named(target)
+    with _output_errors(target):
+        if target.exists() and not target.is_dir():
+            raise NotADirectoryError(errno.ENOTDIR, "Not a directory")
+        stage = _stage(target)
+        try:
+            probe = stage / "probe"
+            probe.touch()
+            landed = (target if target.is_dir() else stage.parent) / f".{stage.name}.probe"
+            os.replace(probe, landed)
+            landed.unlink()
+        finally:
+            shutil.rmtree(stage, ignore_errors=True)
+    return target
+
+
 @contextlib.contextmanager
 def staged_directory(target: str | Path) -> Iterator[Path]:
     """Yield an empty staging folder; on success move each of its files into ``target``.
@@ -176,7 +250,9 @@ def staged_directory(target: str | Path) -> Iterator[Path]:
     Yields
     ------
     Path
-        The empty staging folder, beside ``target``; write the outputs into it.
+        The empty staging folder, on ``target``'s file system (inside ``target`` if it
+        exists, beside it if not: a mount point cannot take renames from its parent);
+        write the outputs into it.
 
     Raises
     ------
@@ -185,8 +261,7 @@ def staged_directory(target: str | Path) -> Iterator[Path]:
     """
     target = Path(target)
     with _output_errors(target):
-        target.parent.mkdir(parents=True, exist_ok=True)
-        stage = _temporary(target, directory=True)
+        stage = _stage(target)
     try:
         yield stage
         with _output_errors(target):

@@ -15,6 +15,7 @@ from ..model.params import Model
 from ..optimise import stacked
 from ..optimise.problem import problem_data
 from ..reflex.delay import STATUS
+from ..reflex.inputs import guarded
 from ..reflex.maps import landscape
 from ..units import M2_PER_CM2, m2_to_cm2
 
@@ -66,7 +67,7 @@ def point_columns(
         else:
             result = stacked.solve_points(data, tol, progress=update)
         per_point += result.per_point
-        with arithmetic_guard(e_grid[part], l_grid[part]):  # e.g. K = 1e154 overflows S^2 in the reflex roots
+        with arithmetic_guard(e_grid[part], l_grid[part]), guarded():  # e.g. K = 1e154 overflows S^2 in the reflex
             columns = _chunk_columns(result, coeffs, model)
         for name, values in columns.items():
             if name not in arrays:

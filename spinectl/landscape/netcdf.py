@@ -6,10 +6,12 @@ from __future__ import annotations
 import tomllib
 from pathlib import Path
 
+import numpy as np
 import xarray as xr
 
+from .._validate import printable, show
 from ..atomic import atomic_path
-from ..errors import ParameterError
+from ..errors import OutputError, ParameterError, SpinectlError
 from ..model import config
 from ..model.params import Model
 
@@ -29,8 +31,22 @@ def model_of(dataset: xr.Dataset) -> Model:
     -------
     Model
         The parameters of the sweep, validated.
+
+    Raises
+    ------
+    ParameterError
+        No ``config_toml``, or one that is not TOML or not a valid model (an edited or
+        foreign file; field ``config_toml``, the model's own field named in the message).
     """
-    return config.from_dict(Model, tomllib.loads(dataset.attrs["config_toml"]))
+    text = dataset.attrs.get("config_toml")
+    if not isinstance(text, str):
+        raise ParameterError("config_toml", f"must be the model as TOML text (got {show(text)})")
+    try:
+        return config.from_dict(Model, tomllib.loads(text))
+    except tomllib.TOMLDecodeError as exc:
+        raise ParameterError("config_toml", f"is not valid TOML ({printable(str(exc))})") from None
+    except ParameterError as exc:  # ConfigError too
+        raise ParameterError("config_toml", f"is not a valid model ({printable(str(exc))})") from None
 
 
 def save(dataset: xr.Dataset, path: str | Path) -> Path:
@@ -45,9 +61,19 @@ def save(dataset: xr.Dataset, path: str | Path) -> Path:
     -------
     Path
         ``path`` as a :class:`~pathlib.Path`, now holding the NetCDF file.
+
+    Raises
+    ------
+    OutputError
+        ``path`` cannot be written (a folder in the way, a full disk); the previous file is left intact.
     """
     with atomic_path(path) as tmp:
-        dataset.to_netcdf(tmp, engine="netcdf4")
+        try:
+            dataset.to_netcdf(tmp, engine="netcdf4")
+        except (OSError, RuntimeError) as exc:  # netCDF-C reports a full disk as e.g. "NetCDF: HDF error"
+            if isinstance(exc, SpinectlError):
+                raise
+            raise OutputError(f"cannot write {str(path)!r}: {printable(str(exc))}") from None
     return Path(path)
 
 
@@ -67,7 +93,9 @@ def load(path: str | Path) -> xr.Dataset:
     Raises
     ------
     ParameterError
-        The file is missing, not NetCDF or not a sweep (field ``results``).
+        The file is missing, not NetCDF or not a sweep (field ``results``): a required
+        variable, the dimensions E and Lambda (and K when K is a dimension),
+        finite coordinates with no value repeated, or a ``config_toml`` that is a valid model.
     """
     path = Path(path)
     if not path.is_file():
@@ -80,4 +108,34 @@ def load(path: str | Path) -> xr.Dataset:
     if missing or "config_toml" not in dataset.attrs:
         what = ", ".join(missing) or "attribute config_toml"
         raise ParameterError("results", f"{path} is not a spinectl sweep (missing {what})")
+    problem = _layout_problem(dataset)
+    if problem is None:
+        try:
+            model_of(dataset)
+        except ParameterError as exc:
+            problem = str(exc)
+    if problem:
+        raise ParameterError("results", f"{show(str(path))} is not a spinectl sweep as written ({printable(problem)})")
     return dataset
+
+
+def _layout_problem(dataset: xr.Dataset) -> str | None:
+    """What is wrong with the dimensions and coordinates that a sweep writes, or None.
+
+    A sweep's landscapes have dimensions E and Lambda, and K when several
+    stiffnesses were swept; E, Lambda and K are finite numbers, none repeated
+    (what :func:`~spinectl.landscape.sweep.write_sweep` makes).
+    """
+    grid = ("K", "E", "Lambda") if "K" in dataset.dims else ("E", "Lambda")
+    for name in REQUIRED[:-1]:
+        if sorted(dataset[name].dims) != sorted(grid):  # in any order: readers select by name
+            return f"{name} has dimensions {dataset[name].dims}, expected {grid}"
+    for name in ("K", "E", "Lambda"):
+        values = dataset[name].values
+        if dataset[name].ndim != (1 if name in grid else 0) or values.dtype.kind not in "iuf":
+            return f"coordinate {name} must be numbers along its own dimension"
+        if not np.all(np.isfinite(values)):
+            return f"coordinate {name} must be finite (got {show(values.tolist())})"
+        if np.unique(values).size != values.size:
+            return f"coordinate {name} must not repeat a value (got {show(values.tolist())})"
+    return None

@@ -101,6 +101,8 @@ def sweep(
     l_axis = np.atleast_1d(np.asarray(lordosis, float))
     if e_axis.ndim != 1 or l_axis.ndim != 1 or e_axis.size * l_axis.size > MAX_GRID_POINTS:
         raise ParameterError("grid", f"must be two 1-D axes with at most {MAX_GRID_POINTS:,} points in all")
+    for name, axis in (("E", e_axis), ("Lambda", l_axis)):
+        distinct(name, axis)
     e_grid, l_grid = (a.ravel() for a in np.meshgrid(e_axis, l_axis, indexing="ij"))
     disable = None if progress is None else not progress  # None: tqdm shows it on a terminal only
     with tqdm(total=e_grid.size, disable=disable, unit="pt", desc="sweep") as bar:
@@ -109,6 +111,25 @@ def sweep(
     shape = (e_axis.size, l_axis.size)
     arrays = {name: values.reshape(shape + values.shape[1:]) for name, values in arrays.items()}
     return landscape_dataset(model, e_axis, l_axis, arrays, method, per_point)
+
+
+def distinct(name: str, axis: np.ndarray) -> None:
+    """Raise :class:`ParameterError` if ``axis`` repeats a value: a coordinate must pick one point.
+
+    A repeated E, Lambda or K (``--K 15,15``, ``--E 0:0:3``) would be written, and then
+    no reader could select one landscape by it.
+
+    Parameters
+    ----------
+    name : str
+        The axis, for the message.
+    axis : numpy.ndarray, 1-D
+        Its values, in its unit.
+    """
+    values, counts = np.unique(axis, return_counts=True)
+    if np.any(counts > 1):
+        repeated = ", ".join(f"{x:g}" for x in values[counts > 1])
+        raise ParameterError(name, f"must not repeat a value (repeated: {repeated})")
 
 
 def stiffness_sweep(model: Model, stiffnesses, eccentricity, lordosis, **options) -> xr.Dataset:
@@ -132,7 +153,13 @@ def stiffness_sweep(model: Model, stiffnesses, eccentricity, lordosis, **options
     xarray.Dataset
         The landscapes of :func:`sweep` stacked along ``K`` [N m/rad], in the order of
         ``stiffnesses``.
+
+    Raises
+    ------
+    ParameterError
+        A K repeated (:func:`distinct`), or as :func:`sweep`.
     """
+    distinct("K", np.asarray(stiffnesses, float))
     parts = [
         sweep(config.set_parameter(model, "passive.stiffness", float(k)), eccentricity, lordosis, **options)
         for k in stiffnesses
@@ -194,7 +221,9 @@ def describe(dataset: xr.Dataset) -> str:
     -------
     str
         E.g. ``"25 points (25 solved, 0 infeasible or failed); min PCSA 10.2-40.3 cm2, ||CT|| 0.0-31.5 N m"``;
-        the ranges only if some point was solved.
+        the ranges only if some point was solved, and a warning naming the points whose
+        status is ``optimal_inaccurate`` (the solver did not meet its tolerances: their
+        numbers may be far off) if there are any.
     """
     status = dataset["status"].values
     pcsa, torque = dataset["min_pcsa_cm2"].values, dataset["counter_torque_norm_Nm"].values
@@ -205,4 +234,7 @@ def describe(dataset: xr.Dataset) -> str:
             f"; min PCSA {np.nanmin(pcsa):.1f}-{np.nanmax(pcsa):.1f} cm2, "
             f"||CT|| {np.nanmin(torque):.1f}-{np.nanmax(torque):.1f} N m"
         )
+    inaccurate = int(np.sum(status == "optimal_inaccurate"))
+    if inaccurate:
+        ranges += f"; WARNING: {inaccurate} inaccurate (status optimal_inaccurate: values may be far off)"
     return f"{status.size} points ({int(ok.sum())} solved, {int((~ok).sum())} infeasible or failed){ranges}"

@@ -41,6 +41,46 @@ def validate_position(model: Model, eccentricity, lordosis) -> None:
     checked_coefficients(model, eccentricity, lordosis)
 
 
+def validate_grid(model: Model, eccentricity, lordosis, chunk_points: int, *, attachments: bool = True) -> None:
+    """Raise unless the model can be evaluated at every point of the grid E x Lambda, before any work.
+
+    The modelled range is a box, so its check and the arithmetic's (:func:`validate_position`)
+    are made at the grid's corners; an attachment on a centre of rotation can happen at any
+    point, so that check covers the whole grid, ``chunk_points`` points at a time (its
+    arrays grow with points x centres x fibres).
+
+    Parameters
+    ----------
+    model : Model
+        The parameters.
+    eccentricity, lordosis : array_like, 1-d
+        The grid's axes E and Lambda [m].
+    chunk_points : int
+        Most grid points checked at once (e.g. a study's chunk size), >= 1.
+    attachments : bool
+        Check the attachments at every point; False when a model with the same geometry
+        and muscles has passed already (they alone decide it).
+
+    Raises
+    ------
+    ParameterError
+        E or Lambda not finite or outside the modelled range [m].
+    ModelError
+        A fibre attachment on a centre of rotation at some grid point (named), or
+        floating-point trouble at a corner.
+    """
+    e_axis, l_axis = np.ravel(np.asarray(eccentricity, float)), np.ravel(np.asarray(lordosis, float))
+    _check_range(model, e_axis, l_axis)
+    validate_position(model, *np.meshgrid([e_axis.min(), e_axis.max()], [l_axis.min(), l_axis.max()]))
+    if not attachments:
+        return
+    rows = max(1, chunk_points // l_axis.size)  # whole rows of Lambda, as the study's tiles
+    for start in range(0, e_axis.size, rows):
+        e_grid, l_grid = np.meshgrid(e_axis[start : start + rows], l_axis, indexing="ij")
+        with arithmetic_guard(e_grid, l_grid):
+            _check_attachments(model, e_grid, l_grid)
+
+
 def checked_coefficients(model: Model, eccentricity, lordosis) -> SegmentCoefficients:
     """:func:`~spinectl.model.mechanics.segment_coefficients` after every check of :func:`validate_position`.
 

@@ -53,7 +53,7 @@ def load_preset(name: str = "default") -> Model:
     presets = list_presets()
     if not isinstance(name, str) or name not in presets:
         raise ConfigError("preset", f"must be one of {', '.join(map(repr, presets))} (got {show(name)})")
-    text = resources.files(PRESET_PACKAGE).joinpath(f"{name}.toml").read_text()
+    text = resources.files(PRESET_PACKAGE).joinpath(f"{name}.toml").read_text(encoding="utf-8")
     return _model_from_text(text, source=f"preset {name!r}", is_preset=True)
 
 

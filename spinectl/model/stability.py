@@ -55,11 +55,14 @@ def jacobian(stiffness, damping, inertia):
 
 
 def eigenvalues(stiffness, damping, inertia):
-    """Eigenvalues of :func:`jacobian` in closed form, shape (..., 2) complex [1/s].
+    """Eigenvalues of :func:`jacobian`, the roots of theta s^2 - D s - S, shape (..., 2) complex [1/s].
 
     lambda_{1,2} = D/(2 theta) +- sqrt(D^2/(4 theta^2) + S/theta) (paper [1]_, eq. 1,
-    with d(omega')/d(omega) = D/theta and d(omega')/d(alpha) = S/theta).
-    The root with the larger real part comes first.
+    with d(omega')/d(omega) = D/theta and d(omega')/d(alpha) = S/theta), computed
+    without cancellation: for real roots q = (D + sign(D) sqrt(D^2 + 4 theta S)) / 2
+    gives lambda = q/theta and -S/q (Press et al. [2]_, section 5.6), so the small
+    root keeps its precision when theta -> 0 or S -> 0 (the textbook form returns 0
+    there). The root with the larger real part comes first.
 
     Parameters
     ----------
@@ -68,7 +71,7 @@ def eigenvalues(stiffness, damping, inertia):
     damping : array_like
         D = dM/domega [N m s/rad].
     inertia : array_like
-        theta [kg m^2].
+        theta [kg m^2], > 0.
 
     Returns
     -------
@@ -80,11 +83,48 @@ def eigenvalues(stiffness, damping, inertia):
     .. [1] Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012). Spinal
        lordosis optimizes the requirements for a stable erect posture. Theor Biol Med
        Model 9:13. doi:10.1186/1742-4682-9-13
+    .. [2] Press WH, Teukolsky SA, Vetterling WT, Flannery BP (2007). Numerical Recipes,
+       3rd ed., section 5.6, "Quadratic and Cubic Equations". Cambridge University Press.
     """
-    s, d, theta = (np.asarray(x, float) for x in (stiffness, damping, inertia))
-    half = d / (2.0 * theta)
-    root = np.sqrt((half**2 + s / theta).astype(complex))
-    return np.stack([half + root, half - root], axis=-1)
+    s, d, theta = np.broadcast_arrays(*(np.asarray(x, float) for x in (stiffness, damping, inertia)))
+    disc = d * d + 4.0 * theta * s  # theta^2 times (D/(2 theta))^2 + S/theta, times 4
+    real = disc >= 0
+    root = np.sqrt(np.abs(disc))
+    q = 0.5 * (d + np.where(d < 0, -root, root))  # |q| = (|D| + root) / 2: no cancellation
+    nonzero = q != 0  # q = 0 only for D = S = 0: a double root at 0
+    big = np.where(nonzero, q / theta, 0.0)
+    small = np.where(nonzero, -s / np.where(nonzero, q, 1.0), 0.0)
+    first = np.where(real, np.maximum(big, small), d / (2.0 * theta) + 1j * root / (2.0 * theta))
+    second = np.where(real, np.minimum(big, small), d / (2.0 * theta) - 1j * root / (2.0 * theta))
+    return np.stack([first, second], axis=-1).astype(complex)
+
+
+def hurwitz_stable(stiffness, damping):
+    """Self-stability of eq. 1 from the signs of S and D alone (Routh-Hurwitz), shape (...) bool.
+
+    theta s^2 - D s - S with theta > 0 has both roots in Re s < 0 iff -D > 0 and
+    -S > 0 (the Routh-Hurwitz criterion of a quadratic, Ogata [1]_, section 5-6): an
+    exact verdict, however small theta or S, where the eigenvalues' real parts may
+    round to 0.
+
+    Parameters
+    ----------
+    stiffness : array_like
+        S = dM/dalpha [N m/rad].
+    damping : array_like
+        D = dM/domega [N m s/rad].
+
+    Returns
+    -------
+    numpy.ndarray of bool
+        True where S < 0 and D < 0; broadcast shape of the inputs.
+
+    References
+    ----------
+    .. [1] Ogata K (2010). Modern Control Engineering, 5th ed., section 5-6,
+       "Routh's Stability Criterion". Prentice Hall.
+    """
+    return (np.asarray(stiffness, float) < 0) & (np.asarray(damping, float) < 0)
 
 
 def self_stable(eigs, margin: float = 0.0):
@@ -295,7 +335,7 @@ def segment_stability(model: Model, eccentricity: float, lordosis: float, pcsa) 
         damping=damping,
         inertia=coeffs.inertia,
         eigenvalues=eigs,
-        self_stable=self_stable(eigs),
+        self_stable=hurwitz_stable(stiffness, damping),
         counter_torque=counter_torque,
         coefficients=coeffs,
     )

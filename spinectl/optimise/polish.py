@@ -117,7 +117,8 @@ def _kkt_step(hess, q, lhs, rhs, x0, active, cutoff):
     kkt[..., n:, :n] = g_active
     residual = np.concatenate([-(_mv(hess, x0) + q), (rhs - _mv(lhs, x0)) * active], axis=-1)
     u, sing, vt = np.linalg.svd(kkt)
-    inverse = np.where(sing > cutoff[..., None], 1.0 / np.where(sing > 0, sing, 1.0), 0.0)
+    kept = sing > cutoff[..., None]
+    inverse = np.where(kept, 1.0 / np.where(kept, sing, 1.0), 0.0)  # not 1/subnormal: it overflows
     step = _mv(_t(vt), inverse * _mv(_t(u), residual))
     return x0 + step[..., :n], step[..., n:] * active
 

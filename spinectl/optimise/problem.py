@@ -271,7 +271,8 @@ def inequalities(data: ProblemData, total_max=np.inf, x_ct=None) -> tuple[np.nda
     """
     lead, n = data.stability.shape[:-2], data.weights.size
     eye = np.broadcast_to(np.eye(n), lead + (n, n))
-    lhs, rhs = [data.stability, -eye], [data.stability_bound, np.zeros(lead + (n,))]
+    stability, bound = equilibrated(data.stability, data.stability_bound)
+    lhs, rhs = [stability, -eye], [bound, np.zeros(lead + (n,))]
     if np.isfinite(data.upper):
         lhs.append(eye)
         rhs.append(np.full(lead + (n,), data.upper))
@@ -285,6 +286,39 @@ def inequalities(data: ProblemData, total_max=np.inf, x_ct=None) -> tuple[np.nda
         lhs += [rows, -rows]
         rhs += [centre + half_width[..., None], half_width[..., None] - centre]
     return np.concatenate(lhs, axis=-2), np.concatenate(rhs, axis=-1)
+
+
+def equilibrated(rows, bound):
+    """The stability rows and their bounds divided by their largest magnitude: the same set, scaled to 1.
+
+    A row S_k x <= -margin - (gravity - passive stiffness) has coefficients of a few
+    N m/rad per cm^2 but a bound of the size of K; with an absurd K (1e12 N m/rad) the
+    solver's tolerances, relative to the data, no longer resolve the coefficients and it
+    reports 'optimal_inaccurate' answers far off the optimum, or 'infeasible'. Dividing
+    each row and its bound by max(max_j abs(G_ij), abs(h_i)) keeps the feasible set and
+    gives every row a largest entry of 1 (row equilibration, e.g. Gill, Murray and Wright
+    1981 [1]_, section 8.7).
+
+    Parameters
+    ----------
+    rows : numpy.ndarray, shape (..., r, n_var)
+        G [N m/rad or N m s/rad per cm^2].
+    bound : numpy.ndarray, shape (..., r)
+        h [N m/rad or N m s/rad].
+
+    Returns
+    -------
+    rows, bound : numpy.ndarray
+        G and h divided row by row by their largest magnitude [1 and cm^2 per unit]; a zero row is kept.
+
+    References
+    ----------
+    .. [1] Gill PE, Murray W, Wright MH (1981). Practical Optimization, section 8.7, "Scaling".
+       Academic Press.
+    """
+    scale = np.maximum(np.abs(rows).max(axis=-1), np.abs(bound))
+    scale = np.where(scale > 0, scale, 1.0)
+    return rows / scale[..., None], bound / scale
 
 
 STAGES = ("min_pcsa", "counter_torque", "least_norm")

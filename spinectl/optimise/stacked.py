@@ -177,6 +177,7 @@ def feasible_points(data: ProblemData) -> np.ndarray | None:
     """
     n_points, n_rows, n = data.stability.shape
     lhs, rhs = inequalities(data)
+    bound = rhs[:, :n_rows]  # the stability bounds as the solver sees them (equilibrated, problem.equilibrated)
     violation = np.zeros(lhs.shape[:2] + (1,))
     violation[:, :n_rows] = -1.0
     floor = np.zeros((n_points, 1, n + 1))
@@ -189,7 +190,7 @@ def feasible_points(data: ProblemData) -> np.ndarray | None:
     if status != "optimal":
         return None
     tol = DEFAULT_TOLERANCE if data.tolerance is None else data.tolerance
-    return v[:, -1] <= SLAB_FACTOR * tol * (1.0 + np.abs(data.stability_bound).max(axis=-1))
+    return v[:, -1] <= SLAB_FACTOR * tol * (1.0 + np.abs(bound).max(axis=-1))
 
 
 def _stages(

@@ -211,6 +211,12 @@ def _landscape(field: xr.DataArray, title: str, label: str, vmin=None, vmax=None
 
     Infeasible points (NaN) stay white, and the title says how many there are.
     """
+    if field.sizes["E"] < 2 or field.sizes["Lambda"] < 2:  # a contour needs an area
+        raise ParameterError(
+            "grid",
+            f"a landscape figure needs at least 2 values of E and 2 of Lambda (got {field.sizes['E']} x "
+            f"{field.sizes['Lambda']})",
+        )
     values = np.ma.masked_invalid(field.transpose("Lambda", "E").values)
     infeasible = int(values.mask.sum()) if np.ma.is_masked(values) else 0
     if infeasible:
@@ -487,7 +493,8 @@ def draw_figures(
     ------
     ConfigError, ParameterError
         ``specific_tension`` not given and the dataset's ``config_toml`` is not a valid model;
-        a bad colour range, or the ratio map without K = 0 and a K > 0.
+        a bad colour range, or the ratio map without K = 0 and a K > 0; fewer than 2 values
+        of E or of Lambda (field ``grid``), before any file is written.
     OutputError
         A file cannot be written.
     """

@@ -90,6 +90,9 @@ class Landmark:
         Where the paper says it.
     measure : callable
         ``measure(landmarks) -> float``; NaN when a landscape it needs is missing.
+    positions : tuple of (float, float or None)
+        The (E, Lambda) [m] it reads at the nearest grid point (Lambda None: the
+        whole column at E); :func:`measure` reports the grid points used where they differ.
     """
 
     name: str
@@ -99,6 +102,7 @@ class Landmark:
     how: str
     where: str
     measure: Callable[[Landmarks], float]
+    positions: tuple = ()
 
     def agrees(self, value: float) -> bool:
         """Whether ``value`` matches the paper's value under :attr:`relation`.
@@ -143,6 +147,43 @@ def at(dataset: xr.Dataset, name: str, position) -> float:
     """
     e, lam = position
     return float(dataset[name].sel(E=e, Lambda=lam, method="nearest"))
+
+
+def grid_point(dataset: xr.Dataset, position) -> tuple[float, float | None]:
+    """The grid point that :func:`at` reads for ``position``: the nearest E and Lambda [m].
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        A landscape with dimensions E and Lambda.
+    position : tuple of (float, float or None)
+        (E, Lambda) [m]; Lambda None for a whole column.
+
+    Returns
+    -------
+    tuple of (float, float or None)
+        The coordinates of the nearest grid point [m] (Lambda None if not asked).
+    """
+    e, lam = position
+    near_e = float(dataset["E"].sel(E=e, method="nearest"))
+    return near_e, None if lam is None else float(dataset["Lambda"].sel(Lambda=lam, method="nearest"))
+
+
+def label(position) -> str:
+    """A position as the report writes it, e.g. ``"E = 3, Λ = 4 cm"``.
+
+    Parameters
+    ----------
+    position : tuple of (float, float or None)
+        (E, Lambda) [m]; Lambda None for a whole column.
+
+    Returns
+    -------
+    str
+        E and Lambda in cm, to 0.01 mm.
+    """
+    e, lam = position
+    return f"E = {e * 100:.4g} cm" if lam is None else f"E = {e * 100:.4g}, Λ = {lam * 100:.4g} cm"
 
 
 def line_slope(dataset: xr.Dataset, name: str, pick: str) -> float:
@@ -212,7 +253,14 @@ def _halving(other: bool) -> Callable[[Landmarks], float]:
 
 LANDMARKS: tuple[Landmark, ...] = (
     Landmark(
-        "min_pcsa_A", 35.0, "~", "cm2", "minimum PCSA at A", "Results, Fig. 3: 'about 35 cm2 (position A)'", _pcsa("A")
+        "min_pcsa_A",
+        35.0,
+        "~",
+        "cm2",
+        "minimum PCSA at A",
+        "Results, Fig. 3: 'about 35 cm2 (position A)'",
+        _pcsa("A"),
+        positions=(POSITIONS["A"],),
     ),
     Landmark(
         "min_pcsa_D_over_A",
@@ -222,6 +270,7 @@ LANDMARKS: tuple[Landmark, ...] = (
         "minimum PCSA at D / at A",
         "Results: 'Increasing the spinal curvature slightly reduces the required PCSA (position D)'",
         lambda d: _ratio(_pcsa("D")(d), _pcsa("A")(d)),
+        positions=(POSITIONS["D"], POSITIONS["A"]),
     ),
     Landmark(
         "min_pcsa_B",
@@ -231,6 +280,7 @@ LANDMARKS: tuple[Landmark, ...] = (
         "minimum PCSA at B",
         "Results: 'less than 15 cm2 for E = 8 cm, Lambda = 0'",
         _pcsa("B"),
+        positions=(POSITIONS["B"],),
     ),
     Landmark(
         "min_pcsa_ridge",
@@ -258,6 +308,7 @@ LANDMARKS: tuple[Landmark, ...] = (
         "largest minimum PCSA / minimum PCSA at B",
         "Results: 'this threefold reduction in minimum PCSA with an increasing eccentricity'",
         lambda d: _ratio(_ridge(d.k0), _pcsa("B")(d)),
+        positions=(POSITIONS["B"],),
     ),
     Landmark(
         "ct_A",
@@ -267,6 +318,7 @@ LANDMARKS: tuple[Landmark, ...] = (
         "‖CT‖ at A",
         "Discussion: 'no local counter torques are necessary' (position A)",
         _ct(POSITIONS["A"]),
+        positions=(POSITIONS["A"],),
     ),
     Landmark(
         "ct_valley_slope",
@@ -285,6 +337,7 @@ LANDMARKS: tuple[Landmark, ...] = (
         "‖CT‖ at B",
         "Discussion: 'local counter torques ... exceed +-70 Nm' (B)",
         _ct(POSITIONS["B"]),
+        positions=(POSITIONS["B"],),
     ),
     Landmark(
         "ct_D_over_C",
@@ -294,6 +347,7 @@ LANDMARKS: tuple[Landmark, ...] = (
         "‖CT‖ at D / at C (C = corner 8, 8 cm)",
         "Results: 'the required local torques in position D are twice those of position C'",
         _ct_ratio(POSITIONS["D"], POSITIONS["C"]),
+        positions=(POSITIONS["D"], POSITIONS["C"]),
     ),
     Landmark(
         "ct_B_over_C",
@@ -303,6 +357,7 @@ LANDMARKS: tuple[Landmark, ...] = (
         "‖CT‖ at B / at C (C = corner 8, 8 cm)",
         "Results: 'in position B ... three times as high'",
         _ct_ratio(POSITIONS["B"], POSITIONS["C"]),
+        positions=(POSITIONS["B"], POSITIONS["C"]),
     ),
     Landmark(
         "ct_D_over_C_text",
@@ -312,6 +367,7 @@ LANDMARKS: tuple[Landmark, ...] = (
         "‖CT‖ at D / at C read as E = 3, Lambda = 4 cm",
         "Results, with C as the Discussion places it",
         _ct_ratio(POSITIONS["D"], OPTIMUM),
+        positions=(POSITIONS["D"], OPTIMUM),
     ),
     Landmark(
         "ct_B_over_C_text",
@@ -321,6 +377,7 @@ LANDMARKS: tuple[Landmark, ...] = (
         "‖CT‖ at B / at C read as E = 3, Lambda = 4 cm",
         "Results, with C as the Discussion places it",
         _ct_ratio(POSITIONS["B"], OPTIMUM),
+        positions=(POSITIONS["B"], OPTIMUM),
     ),
     Landmark(
         "ct_D_over_C_ridge",
@@ -330,6 +387,7 @@ LANDMARKS: tuple[Landmark, ...] = (
         "‖CT‖ at D / at C read on the ridge line (E = 8/1.7, Lambda = 8 cm)",
         "Results, with C where the line Lambda = 1.7 E 'crossing the locations marked with A and C' leaves the grid",
         _ct_ratio(POSITIONS["D"], RIDGE_C),
+        positions=(POSITIONS["D"], RIDGE_C),
     ),
     Landmark(
         "ct_B_over_C_ridge",
@@ -339,6 +397,7 @@ LANDMARKS: tuple[Landmark, ...] = (
         "‖CT‖ at B / at C read on the ridge line (E = 8/1.7, Lambda = 8 cm)",
         "Results, with C on the ridge line as above",
         _ct_ratio(POSITIONS["B"], RIDGE_C),
+        positions=(POSITIONS["B"], RIDGE_C),
     ),
     Landmark(
         "optimum_lordosis",
@@ -348,6 +407,7 @@ LANDMARKS: tuple[Landmark, ...] = (
         "Lambda of least ‖CT‖ at E = 3 cm",
         "Discussion: 'require an eccentricity of E ~ 3 cm and a lumbar lordosis of Lambda ~ 4 cm'",
         _best_lordosis,
+        positions=((OPTIMUM[0], None),),
     ),
     Landmark(
         "ct_optimum",
@@ -357,6 +417,7 @@ LANDMARKS: tuple[Landmark, ...] = (
         "‖CT‖ at E = 3, Lambda = 4 cm",
         "Discussion: the optimum lies inside the +-30 N m limit (Fig. 4 contour)",
         _ct(OPTIMUM),
+        positions=(OPTIMUM,),
     ),
     Landmark(
         "min_pcsa_ridge_K15",
@@ -408,11 +469,21 @@ class Measurement:
     value : float
         spinectl's value, in the landmark's unit (NaN if not measurable).
     agrees : bool
+    off_grid : tuple of ((float, float or None), (float, float or None))
+        (position named, grid point read) [m] for each position of the landmark that is
+        not a grid point (:func:`grid_point`).
     """
 
     landmark: Landmark
     value: float
     agrees: bool
+    off_grid: tuple = ()
+
+    @property
+    def how(self) -> str:
+        """How it was measured: the landmark's :attr:`Landmark.how`, plus the grid points used off its positions."""
+        notes = [f"{label(used)} for {label(named)}" for named, used in self.off_grid]
+        return self.landmark.how + (f" (nearest grid point: {'; '.join(notes)})" if notes else "")
 
 
 def measure(landmarks: Landmarks) -> list[Measurement]:
@@ -431,8 +502,14 @@ def measure(landmarks: Landmarks) -> list[Measurement]:
     out = []
     for mark in LANDMARKS:
         value = float(mark.measure(landmarks))
-        out.append(Measurement(mark, value, mark.agrees(value)))
+        used = ((named, grid_point(landmarks.k0, named)) for named in mark.positions)
+        off_grid = tuple((named, near) for named, near in used if not _same(named, near))
+        out.append(Measurement(mark, value, mark.agrees(value), off_grid))
     return out
+
+
+def _same(position, near) -> bool:
+    return all(a is None or np.isclose(a, b, rtol=0.0, atol=1e-9) for a, b in zip(position, near, strict=True))
 
 
 def local_pcsa_equivalent(counter_torque, specific_tension: float, lever_arm: float = LOCAL_LEVER_ARM):

@@ -74,19 +74,26 @@ def landmark_table(measurements: Sequence[Measurement]) -> str:
         mark = m.landmark
         lines.append(
             f"| `{mark.name}` | {RELATION[mark.relation]} {_number(mark.paper)} | {_number(m.value)} | {mark.unit} "
-            f"| {'yes' if m.agrees else '**no**'} | {verdicts.verdict_cell(m)} | {mark.how} | {mark.where} |"
+            f"| {'yes' if m.agrees else '**no**'} | {verdicts.verdict_cell(m)} | {m.how} | {mark.where} |"
         )
     return "\n".join(lines)
 
 
+def _find(measurements: Sequence[Measurement], name: str) -> Measurement:
+    return next(m for m in measurements if m.landmark.name == name)
+
+
 def _value(measurements: Sequence[Measurement], name: str) -> float:
-    return next(m.value for m in measurements if m.landmark.name == name)
+    return _find(measurements, name).value
 
 
 def _local_pcsa(measurements: Sequence[Measurement], specific_tension: float) -> str:
     parts = []
-    for name, label in (("ct_B", "B"), ("ct_optimum", "E = 3, Λ = 4 cm")):
-        torque = _value(measurements, name)
+    for name, label in (("ct_B", "B"), ("ct_optimum", landmarks.label(landmarks.OPTIMUM))):
+        m = _find(measurements, name)
+        torque = m.value
+        if m.off_grid:  # the point actually read, not the one named
+            label = f"{landmarks.label(m.off_grid[0][1])} (nearest grid point to {label})"
         pcsa = m2_to_cm2(landmarks.local_pcsa_equivalent(torque, specific_tension))
         parts.append(f"{label}: {_number(torque)} N m ≙ {_number(float(pcsa))} cm²")
     limit = m2_to_cm2(landmarks.local_pcsa_equivalent(landmarks.CT_LIMIT, specific_tension))

@@ -14,7 +14,7 @@ import math
 import time
 from pathlib import Path
 
-from ..atomic import staged_directory
+from ..atomic import atomic_write_text, check_staged_directory, staged_directory
 from ..errors import ParameterError
 from ..landscape import netcdf, sweep
 from ..model.config import load_config
@@ -69,6 +69,8 @@ def reproduce(
         ``points`` out of range.
     ConfigError
         An unknown preset or a bad configuration file.
+    OutputError
+        ``out_dir`` cannot be filled (:func:`spinectl.atomic.check_staged_directory`), before any solve.
     """
     check_points(points)
     if config is None:
@@ -121,7 +123,13 @@ def reproduce_model(
     -------
     list of Path
         The files written, inside ``out_dir``.
+
+    Raises
+    ------
+    OutputError
+        ``out_dir`` cannot be filled (:func:`spinectl.atomic.check_staged_directory`), before any solve.
     """
+    check_staged_directory(out_dir)  # before minutes of solving: a mount point, a file in the way
     start = time.perf_counter()
     k15 = grid.PAPER_STIFFNESS
     both, other = grid.paper_landscapes(model, points, progress)
@@ -143,5 +151,5 @@ def reproduce_model(
             specific_tension=model.fibre.specific_tension,
             calibrated=calibrated,
         )
-        (stage / "report.md").write_text(report.render(measured, run_facts))
+        atomic_write_text(stage / "report.md", report.render(measured, run_facts))  # UTF-8; a full disk: OutputError
     return [Path(out_dir) / name for name in names]

@@ -44,6 +44,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
+from .inputs import validated
 
 STATUS = ("finite", "delay_independent", "unstable_without_delay", "undefined")
 """Meaning of :attr:`DelayMargin.status` codes 0..3.
@@ -219,6 +220,7 @@ def without_delay(stiffness, damping, inertia, kp, kd, lag=0.0) -> WithoutDelay:
     return WithoutDelay(unstable=unstable, axis_frequency=w0, zero_root=kp == s, departure=departure)
 
 
+@validated(zero_inertia=True)
 def stable_without_delay(stiffness, damping, inertia, kp, kd, lag=0.0):
     """True where the delay-free closed loop R(s) of :func:`without_delay_coefficients` is Hurwitz.
 
@@ -342,6 +344,7 @@ def _cubic_roots(f3, f2, f1, f0):
     return np.where(twins & ~first, np.nan, x), twins
 
 
+@validated(zero_inertia=True)
 def crossings(stiffness, damping, inertia, kp, kd, lag=0.0) -> Crossings:
     """Crossing frequencies, phases and directions of the delayed, lagged reflex loop.
 
@@ -489,6 +492,7 @@ def pure_gain(inertia, damping, kd, lag):
     return (theta == 0) & (d == 0) & (kd == 0) & (lag == 0)
 
 
+@validated(zero_inertia=True)
 def delay_margin(stiffness, damping, inertia, kp, kd, lag=0.0) -> DelayMargin:
     """Exact delay margin from the quasi-polynomial (docs/reflex.md, "Crossing frequencies and the exact delay margin").
 
@@ -546,6 +550,7 @@ def delay_margin(stiffness, damping, inertia, kp, kd, lag=0.0) -> DelayMargin:
     )
 
 
+@validated(zero_inertia=True)
 def right_half_plane_roots(stiffness, damping, inertia, kp, kd, delay, lag=0.0):
     """Number of closed-loop roots with Re s > 0 at the delay ``delay`` [s], exactly.
 
@@ -596,6 +601,7 @@ def right_half_plane_roots(stiffness, damping, inertia, kp, kd, delay, lag=0.0):
     return np.where(undefined_inputs(s, d, theta, kp, kd, tau, lag), np.nan, count)
 
 
+@validated(zero_inertia=True)
 def stable_at_delay(stiffness, damping, inertia, kp, kd, delay, lag=0.0):
     """True where the closed loop with the true delay [s] has every root in Re s < 0.
 
@@ -634,6 +640,7 @@ def stable_at_delay(stiffness, damping, inertia, kp, kd, delay, lag=0.0):
     return (count == 0) & ~free.zero_root & ~axis & ~marginal_gain
 
 
+@validated(zero_inertia=True)
 def phase_margin(stiffness, damping, inertia, kp, kd, delay, lag=0.0):
     """Exact phase margin [rad] and gain crossover [rad/s] of the loop with the true delay.
 
@@ -688,6 +695,7 @@ def _bracketed_roots(func, grid):
     return np.where(has, 0.5 * (lo + hi), np.nan)
 
 
+@validated
 def critical_gains(stiffness, damping, inertia, kd, delay, lobes: int = 8, points_per_lobe: int = 48, lag=0.0):
     """Range (kp_min, kp_max) of proportional gains that stabilise the segment at ``delay``, given kd.
 

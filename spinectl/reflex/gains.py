@@ -8,8 +8,10 @@ from __future__ import annotations
 import numpy as np
 
 from .delay import as_arrays
+from .inputs import validated
 
 
+@validated
 def default_gains(stiffness, damping, inertia, gain_factor, damping_ratio, lag=0.0):
     """The default reflex rule (docs/reflex.md, "The default reflex, and the activation level").
 
@@ -56,6 +58,7 @@ def default_gains(stiffness, damping, inertia, gain_factor, damping_ratio, lag=0
     return kp, kd
 
 
+@validated
 def resolve_gains(stiffness, damping, inertia, reflex, kp=None, kd=None):
     """Gains per segment from the reflex settings, each optionally overridden.
 

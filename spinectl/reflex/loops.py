@@ -24,11 +24,13 @@ import control as ct
 import numpy as np
 
 from ..model.stability import jacobian
+from .inputs import validated
 
 STATES = ("alpha", "omega")
 """State names of a segment: angle [rad] and angular velocity [rad/s]."""
 
 
+@validated
 def segment_system(stiffness: float, damping: float, inertia: float, name: str | None = None) -> ct.StateSpace:
     """The segment linearised at the upright equilibrium (paper, Stability analysis).
 
@@ -60,6 +62,7 @@ def segment_system(stiffness: float, damping: float, inertia: float, name: str |
     return ct.ss(a, b, c, 0.0, inputs=["torque"], outputs=["alpha"], states=list(STATES), name=name)
 
 
+@validated
 def pade_delay(delay: float, order: int) -> ct.TransferFunction:
     """exp(-s delay) as python-control's [order/order] Padé approximant (1 for no delay).
 
@@ -111,6 +114,7 @@ def reflex_controller(kp: float, kd: float) -> ct.TransferFunction:
     return ct.tf([kd, kp], [1.0], inputs=["alpha"], outputs=["reflex"])
 
 
+@validated
 def loop_transfer(
     stiffness, damping, inertia, kp, kd, delay: float, order: int, lag: float = 0.0
 ) -> ct.TransferFunction:
@@ -143,6 +147,7 @@ def loop_transfer(
     return (loop * activation_lag(lag) if lag > 0 else loop) * plant
 
 
+@validated
 def closed_loop(
     stiffness, damping, inertia, kp, kd, delay: float, order: int, name=None, lag: float = 0.0
 ) -> ct.StateSpace:

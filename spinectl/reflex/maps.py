@@ -13,6 +13,7 @@ import numpy as np
 
 from .delay import as_arrays, delay_margin, stable_at_delay
 from .gains import resolve_gains
+from .inputs import validated
 from .pade import pade_delay_margin
 
 
@@ -45,6 +46,7 @@ class ReflexLandscape:
     stable_at_delay: np.ndarray
 
 
+@validated
 def landscape(stiffness, damping, inertia, reflex, kp=None, kd=None) -> ReflexLandscape:
     """Gains, exact and Padé delay margins and the stability verdict for arrays of segments.
 

@@ -25,6 +25,7 @@ from ..optimise.reference import solve_point
 from ..units import m2_to_cm2
 from . import gains, loops, pade, simulate
 from .delay import critical_gains, delay_margin, phase_margin, stable_at_delay
+from .inputs import validated
 
 SKIPPED = "skipped"
 """Optimum status when activation = 0: the optimiser is not consulted (no co-contraction)."""
@@ -207,6 +208,7 @@ class SegmentMargins:
         }
 
 
+@validated
 def segment_margins(
     name, stiffness, damping, inertia, kp, kd, delay: float, order: int, lag: float = 0.0
 ) -> SegmentMargins:

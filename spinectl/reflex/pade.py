@@ -29,8 +29,10 @@ from .delay import (
     stable_without_delay,
     undefined_inputs,
 )
+from .inputs import validated
 
 
+@validated
 def pade_coefficients(order: int) -> np.ndarray:
     """Coefficients c_0..c_n of the [n/n] Padé approximant exp(-x) ~ q(-x) / q(x), q(x) = sum c_k x^k.
 
@@ -61,6 +63,7 @@ def pade_coefficients(order: int) -> np.ndarray:
     )
 
 
+@validated
 def pade_phase_lag(y, order: int):
     """Phase lag [rad] of the Padé all-pass q(-jy)/q(jy) at y = w tau, unwrapped.
 
@@ -86,6 +89,7 @@ def pade_phase_lag(y, order: int):
     return 2.0 * np.sum(np.arctan((y - roots.imag) / -roots.real), axis=-1)
 
 
+@validated
 def pade_inverse_lag(phase, order: int):
     """The y >= 0 with :func:`pade_phase_lag` (y) = ``phase`` [rad]; inf where phase >= n pi.
 
@@ -113,6 +117,7 @@ def pade_inverse_lag(phase, order: int):
     return np.where(phase < order * np.pi, y, np.inf)
 
 
+@validated(zero_inertia=True)
 def pade_delay_margin(stiffness, damping, inertia, kp, kd, order: int, lag=0.0) -> DelayMargin:
     """Delay margin of the loop with the delay replaced by its [n/n] Padé approximant.
 
@@ -156,6 +161,7 @@ def pade_delay_margin(stiffness, damping, inertia, kp, kd, order: int, lag=0.0) 
     return DelayMargin(*(np.where(gain, getattr(exact, f), getattr(pade, f)) for f in fields))
 
 
+@validated(zero_inertia=True)
 def pade_convergence(stiffness, damping, inertia, kp, kd, orders, lag=0.0):
     """Padé delay margins and their errors against the exact margin, for several orders.
 

@@ -2,11 +2,15 @@
 
 from __future__ import annotations
 
+import errno
+import os
+import pathlib
+
 import pytest
 
 from spinectl.cli import main
 from spinectl.landscape import netcdf
-from spinectl.paper import figures
+from spinectl.paper import figures, grid
 
 OTHER = "landscape_K15_physical.nc"
 """The K = 15 landscape of the convention that the default preset, wagner2012 (convention 'paper'), does not use."""
@@ -69,3 +73,68 @@ def test_reproduce_of_another_preset_says_it_is_not_calibrated(tmp_path, capsys)
     text = (tmp_path / "report.md").read_text()
     assert "Parameters: preset `default`" in text and "are **not** the calibrated preset" in text
     assert (tmp_path / "landscape_K15_paper.nc").exists()  # default uses the physical convention
+
+
+def test_reproduce_writes_utf8_under_a_latin1_locale(tmp_path, monkeypatch, capsys):
+    """Under an ISO-8859-1 locale the report (with Λ, ≙, cm²) is still written, as UTF-8.
+
+    pathlib asks ``io.text_encoding`` for the encoding of a call without one; under
+    an ISO-8859-1 locale it answers 'locale', i.e. latin-1, which cannot encode Λ.
+    """
+    import io
+
+    real = io.text_encoding
+    monkeypatch.setattr(io, "text_encoding", lambda encoding, *a: real(encoding, *a) if encoding else "iso-8859-1")
+    out = tmp_path / "results"
+    assert main(["reproduce", "--out", str(out), "--points", "3"]) == 0
+    assert "Λ" in (out / "report.md").read_bytes().decode("utf-8")
+
+
+def _mount_point(target):
+    """os.replace as if ``target`` were a mount point: a rename from outside it into it fails with EXDEV."""
+    real = os.replace
+
+    def replace(src, dst):
+        src, dst = pathlib.Path(src), pathlib.Path(dst)
+        if dst.parent == target and not src.is_relative_to(target):
+            raise OSError(errno.EXDEV, os.strerror(errno.EXDEV))
+        return real(src, dst)
+
+    return replace
+
+
+def test_reproduce_into_a_mount_point(tmp_path, monkeypatch, capsys):
+    """The output folder is a mount point (simulated: renames into it from its parent fail with EXDEV).
+
+    The staging folder is made inside it, so every file lands by a rename on its own
+    file system (before: "Invalid cross-device link" after the whole run).
+    """
+    out = tmp_path / "mnt"
+    out.mkdir()
+    monkeypatch.setattr(os, "replace", _mount_point(out))
+    assert main(["reproduce", "--out", str(out), "--points", "3"]) == 0
+    assert {p.name for p in out.iterdir()} == EXPECTED
+
+
+def test_an_output_folder_that_refuses_renames_fails_before_the_work(tmp_path, monkeypatch, capsys):
+    """A folder that takes no rename at all (simulated EROFS) is refused before any landscape is solved."""
+    out = tmp_path / "mnt"
+    out.mkdir()
+    monkeypatch.setattr(os, "replace", _refuse_all(out))
+    monkeypatch.setattr(grid, "paper_landscapes", lambda *a: pytest.fail("solved before checking the output"))
+    assert main(["reproduce", "--out", str(out), "--points", "3"]) == 2
+    err = capsys.readouterr().err
+    assert "Read-only file system" in err and err.count("\n") == 1
+    assert list(out.iterdir()) == [] and [p.name for p in tmp_path.iterdir()] == ["mnt"]
+
+
+def _refuse_all(target):
+    """os.replace as if ``target`` were read-only: no rename into it."""
+    real = os.replace
+
+    def replace(src, dst):
+        if pathlib.Path(dst).parent == target:
+            raise OSError(errno.EROFS, os.strerror(errno.EROFS))
+        return real(src, dst)
+
+    return replace

@@ -415,3 +415,16 @@ def test_a_finished_store_opens_with_plain_xarray_without_warnings(tmp_path):
         warnings.simplefilter("error")
         ds = xr.open_zarr(tmp_path / "s.zarr")
     assert ds.min_pcsa_cm2.shape == (3, 3)
+
+
+def test_an_attachment_on_a_centre_of_rotation_inside_the_grid_stops_the_study_before_work(tmp_path):
+    """The same attachment, at L5S1 for E = Lambda = 0, now the middle of a 3 x 3 grid, not a corner.
+
+    Before, only the corners were checked: the study made its store, solved the chunks
+    before the bad point and could never finish.
+    """
+    text = study_with('"muscles.0.lower.0" = [0.12, 0.0]\n"muscles.0.lower.1" = [0.005]\n"muscles.0.spread" = [0.0]')
+    text = text.replace(GRID, "E = [-0.01, 0.0, 0.01]\nLambda = [-0.01, 0.0, 0.01]\n")
+    with pytest.raises(ModelError, match="at E = 0 m, Lambda = 0 m.*study combination muscles.0.lower.0 = 0.0"):
+        study.parse_study(text)
+    assert list(tmp_path.iterdir()) == []

@@ -160,3 +160,26 @@ def test_describe(landscape):
     nothing = landscape.copy()
     nothing["min_pcsa_cm2"] = nothing["min_pcsa_cm2"] * np.nan
     assert sweep.describe(nothing) == "12 points (0 solved, 12 infeasible or failed)"
+
+
+def test_an_absurd_stiffness_gets_the_true_minimum_with_status_optimal():
+    """K = 1e12 N m/rad: the stiffness rows are slack, so the minimum PCSA is that of any K large
+    enough to make them slack, e.g. K = 1e4 (solved well-scaled, status 'optimal' before the fix too),
+    about 0.02 cm^2 (the damping rows alone). Before: 'optimal_inaccurate' or 'infeasible'
+    (issue 18: 4e10 cm^2 reported)."""
+    from spinectl.model.config import set_parameter
+
+    axes = ([0.0, 0.04], [0.0, 0.04])
+    absurd = sweep.sweep(set_parameter(Model(), "passive.stiffness", 1e12), *axes)
+    stiff = sweep.sweep(set_parameter(Model(), "passive.stiffness", 1e4), *axes)
+    assert np.all(stiff["status"].values == "optimal") and np.all(absurd["status"].values == "optimal")
+    np.testing.assert_allclose(absurd["min_pcsa_cm2"], stiff["min_pcsa_cm2"], rtol=1e-6)
+    assert np.all(absurd["min_pcsa_cm2"].values < 0.05)
+
+
+def test_describe_warns_of_inaccurate_points():
+    """A number whose status is optimal_inaccurate is never printed without a warning."""
+    ds = sweep.sweep(Model(), [0.0, 0.04], [0.0])
+    assert "WARNING" not in sweep.describe(ds)
+    ds["status"][0] = "optimal_inaccurate"
+    assert "WARNING: 1 inaccurate (status optimal_inaccurate" in sweep.describe(ds)

@@ -7,8 +7,9 @@ import pytest
 
 from spinectl.errors import ParameterError
 from spinectl.model import mechanics, muscle
+from spinectl.model.config import set_parameter
 from spinectl.model.params import Errata, Passive
-from spinectl.model.stability import eigenvalues, jacobian, segment_stability, self_stable
+from spinectl.model.stability import eigenvalues, hurwitz_stable, jacobian, segment_stability, self_stable
 
 ZERO = np.zeros(3)
 
@@ -20,6 +21,46 @@ def test_closed_form_eigenvalues_equal_numerical_eigenvalues(rng):
     closed = np.sort_complex(eigenvalues(s, d, theta))
     numeric = np.sort_complex(np.linalg.eigvals(jacobian(s, d, theta)))
     np.testing.assert_allclose(closed, numeric, atol=1e-9)
+
+
+def test_eigenvalues_keep_the_small_root_when_theta_is_tiny():
+    """theta -> 0: the roots of theta s^2 - D s - S are about D/theta and -S/D.
+
+    From Vieta: lambda_1 lambda_2 = -S/theta and lambda_1 + lambda_2 = D/theta, so
+    for theta S << D^2 the small root is -S/D (1 + O(theta S / D^2)); with
+    S = -17.7, D = -5.78 (the segment of issue 18, mass 1 nm above L1L2) it is
+    -3.062. The textbook form D/(2 theta) + sqrt(...) cancels to 0.
+    """
+    s, d, theta = -17.7, -5.78, 1e-20
+    eigs = eigenvalues(s, d, theta)
+    np.testing.assert_allclose(eigs[0].real, -s / d, rtol=1e-12)
+    np.testing.assert_allclose(eigs[1].real, d / theta, rtol=1e-12)
+    assert self_stable(eigs) and hurwitz_stable(s, d)
+
+
+def test_hurwitz_verdict_agrees_with_numerical_eigenvalues(rng):
+    """Routh-Hurwitz (S < 0 and D < 0) against numpy's eigenvalues of the Jacobian, both signs of S and D."""
+    s = rng.normal(0, 50, 200)
+    d = rng.normal(0, 10, 200)
+    theta = rng.uniform(0.01, 5, 200)
+    numeric = np.all(np.linalg.eigvals(jacobian(s, d, theta)).real < 0, axis=-1)
+    np.testing.assert_array_equal(hurwitz_stable(s, d), numeric)
+
+
+def test_mass_just_above_the_top_joint_is_judged_by_eq_1(model):
+    """Mass 1 nm above L1L2: theta_1 ~ 1e-18 kg m^2, yet the verdict follows the signs of S and D.
+
+    The segment's S and D do not depend on theta; where both are negative it is
+    self-stable by eq. 1 (Routh-Hurwitz), and its slow eigenvalue is -S/D (see above).
+    """
+    top = model.geometry.cor_heights[0]
+    near = set_parameter(model, "body.mass_height", top + 1e-9)
+    pcsa = np.array([0.13, 0.0, 9.96]) * 1e-4  # the minimum stabilising PCSA of this model [m^2]
+    result = segment_stability(near, 0.0, 0.0, pcsa)
+    s, d = result.stiffness[0], result.damping[0]
+    assert s < 0 and d < 0 and result.inertia[0] < 1e-12
+    assert result.self_stable[0]
+    np.testing.assert_allclose(result.eigenvalues[0, 0].real, -s / d, rtol=1e-6)
 
 
 def test_gravity_alone_destabilises_every_segment(model):

@@ -62,3 +62,26 @@ def test_infeasible_columns_do_not_break_the_measurements():
     empty = ds.copy(data={k: np.full(v.shape, np.nan) for k, v in ds.data_vars.items()})
     measured = landmarks.measure(landmarks.Landmarks(empty, empty, empty))
     assert all(np.isnan(m.value) and not m.agrees for m in measured)
+
+
+def test_a_landmark_off_the_grid_names_the_grid_point_it_read():
+    """11 points (8 mm steps): E = 3 cm is read at 3.2 cm, and the measurement says so.
+
+    ‖CT‖ = 1000 E [N m] here, so the value read is 1000 * 0.032 = 32 N m (not 30);
+    on the 1 mm grid 3 cm is a grid point and nothing is added to the label.
+    """
+    axis = np.linspace(0.0, 0.08, 11)  # 0, 0.8, ..., 8 cm: the grid of reproduce --points 11
+    e, lam = np.meshgrid(axis, axis, indexing="ij")
+    ds = xr.Dataset(
+        {"min_pcsa_cm2": (("E", "Lambda"), 0 * e + 30), "counter_torque_norm_Nm": (("E", "Lambda"), 1e3 * e + 0 * lam)},
+        coords={"E": axis, "Lambda": axis},
+    )
+    coarse = {m.landmark.name: m for m in landmarks.measure(landmarks.Landmarks(ds))}
+    optimum = coarse["ct_optimum"]
+    assert optimum.value == pytest.approx(32.0)
+    assert optimum.off_grid == (((0.03, 0.04), (pytest.approx(0.032), pytest.approx(0.04))),)
+    assert "nearest grid point: E = 3.2, Λ = 4 cm for E = 3, Λ = 4 cm" in optimum.how
+    assert "E = 3.2 cm for E = 3 cm" in coarse["optimum_lordosis"].how
+    assert coarse["ct_A"].off_grid == () and coarse["ct_A"].how == coarse["ct_A"].landmark.how
+    fine = landmarks.measure(landmarks.Landmarks(_landscape(lambda e, lam: e, lambda e, lam: e)))
+    assert next(m for m in fine if m.landmark.name == "ct_optimum").off_grid == ()

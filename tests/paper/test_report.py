@@ -12,11 +12,11 @@ from spinectl.paper import landmarks, report, verdicts
 AXIS = np.linspace(0.0, 0.08, 9)
 
 
-def _measurements():
-    e, lam = np.meshgrid(AXIS, AXIS, indexing="ij")
+def _measurements(axis=AXIS):
+    e, lam = np.meshgrid(axis, axis, indexing="ij")
     ds = xr.Dataset(
         {"min_pcsa_cm2": (("E", "Lambda"), 60 - 100 * e), "counter_torque_norm_Nm": (("E", "Lambda"), 1e3 * e)},
-        coords={"E": AXIS, "Lambda": AXIS},
+        coords={"E": axis, "Lambda": axis},
     )
     half = ds.assign(min_pcsa_cm2=ds["min_pcsa_cm2"] / 2)
     return landmarks.measure(landmarks.Landmarks(ds, half, ds))
@@ -64,3 +64,16 @@ def test_report_embeds_the_figures_it_links():
         assert f"![{name}]({name})" in text and f"[`{name}`]({name})" in text
     assert "![landscapes.nc]" not in text and "![report.md]" not in text
     assert "No figures were written." in report.render(_measurements(), RUN)
+
+
+def test_report_names_the_grid_point_of_an_off_grid_landmark():
+    """On a 9-point grid (1 cm steps) C on the ridge line, E = 8/1.7 = 4.71 cm, is read at E = 5 cm.
+
+    The report's row says so, and the optimum (3, 4 cm: a grid point) is labelled as it is.
+    """
+    text = report.render(_measurements(), RUN)
+    row = next(line for line in text.splitlines() if line.startswith("| `ct_D_over_C_ridge` |"))
+    assert "nearest grid point: E = 5, Λ = 8 cm for E = 4.706, Λ = 8 cm" in row
+    assert "E = 3, Λ = 4 cm: 30 N m" in text  # ‖CT‖ = 1000 E at E = 3 cm
+    coarse = report.render(_measurements(np.linspace(0.0, 0.08, 11)), RUN)  # reproduce --points 11
+    assert "E = 3.2, Λ = 4 cm (nearest grid point to E = 3, Λ = 4 cm): 32 N m" in coarse

@@ -601,3 +601,82 @@ def test_long_jobs_check_their_outputs_before_they_start(tmp_path, monkeypatch, 
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert err.startswith("spinectl: error: cannot write") and err.count("\n") == 1
+
+
+def test_every_text_file_is_opened_with_an_explicit_encoding():
+    """Every ``open``, ``read_text``, ``write_text`` in spinectl names its encoding (issue 18, class 13).
+
+    Without one Python uses the locale's encoding, e.g. ISO-8859-1, which cannot
+    write the report's Λ; binary modes ('rb', 'wb') need none.
+    """
+    import ast
+    import pathlib
+
+    import spinectl
+
+    missing = []
+    for path in pathlib.Path(spinectl.__file__).parent.rglob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if not isinstance(node, ast.Call):
+                continue
+            name = getattr(node.func, "attr", getattr(node.func, "id", None))
+            if name not in {"open", "read_text", "write_text"}:
+                continue
+            if isinstance(node.func, ast.Name) and name != "open":
+                continue  # spinectl's own read_text (model/_toml.py), which names the encoding
+            modes = [a.value for a in node.args[1:2] + [k.value for k in node.keywords if k.arg == "mode"]]
+            binary = any(isinstance(m, ast.Constant) and "b" in str(m.value) for m in modes)
+            if not binary and not any(k.arg == "encoding" for k in node.keywords):
+                missing.append(f"{path.name}:{node.lineno}")
+    assert missing == []
+
+
+def _full_disk(*args, **kwargs):
+    import errno
+
+    raise OSError(errno.ENOSPC, "No space left on device")
+
+
+@pytest.mark.parametrize(
+    ("command", "patched"),
+    [
+        (["sweep", "--E", "0:0.08:3", "--Lambda", "0:0.08:3", "--out", "{out}/old.nc"], "xarray.Dataset.to_netcdf"),
+        (["plot", "{out}/old.nc", "--out", "{out}"], "matplotlib.figure.Figure.savefig"),
+        (["reproduce", "--points", "3", "--out", "{out}"], "matplotlib.figure.Figure.savefig"),
+        (["margins", "--plot", "{out}"], "matplotlib.figure.Figure.savefig"),
+        (["study", "{out}/study.toml", "--out", "{out}/s.zarr", "--scheduler", "synchronous"],
+         "xarray.Dataset.to_zarr"),
+    ],
+)
+def test_a_full_disk_is_one_line_and_keeps_the_previous_files(tmp_path, monkeypatch, capsys, command, patched):
+    """OSError(ENOSPC) from the writer (simulated: the disk cannot be filled in a test) is an OutputError:
+    one line naming the file, exit 2, the previous output intact, no temporary left (issue 18, class 16)."""
+    from spinectl.landscape import sweep
+
+    sweep.write_sweep(Model(), [0.0, 0.08], [0.0, 0.08], tmp_path / "old.nc")  # a previous output, and plot's input
+    (tmp_path / "study.toml").write_text("[axes]\nE = [0.0, 0.08]\nLambda = [0.0]\n", encoding="utf-8")
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    argv = [a.format(out=tmp_path) for a in command]
+    monkeypatch.setattr(patched, _full_disk)
+    code = main(argv)
+    err = capsys.readouterr().err
+    assert code == 2 and "No space left on device" in err and err.count("\n") == 1 and "Traceback" not in err
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+
+
+def test_a_full_disk_while_writing_text_is_an_output_error(tmp_path, monkeypatch):
+    """atomic_write_text (calibrate's preset and history, JSON outputs) on a full disk: OutputError, old text kept."""
+    target = tmp_path / "preset.toml"
+    target.write_text("old", encoding="utf-8")
+    monkeypatch.setattr("pathlib.Path.write_text", _full_disk)
+    with pytest.raises(OutputError, match="preset.toml'.*No space left on device"):
+        atomic_write_text(target, "new")
+    assert target.read_bytes() == b"old" and [p.name for p in tmp_path.iterdir()] == ["preset.toml"]
+
+
+def test_other_errors_of_a_writer_are_not_called_output_errors(tmp_path):
+    """Only the file system's refusals (atomic.DEVICE_ERRORS) become OutputError; a writer's own bug stays itself."""
+    with pytest.raises(FileNotFoundError), atomic_path(tmp_path / "x") as tmp:
+        tmp.write_text("x", encoding="utf-8")
+        (tmp_path / "missing-input").read_text(encoding="utf-8")
+    assert list(tmp_path.iterdir()) == []

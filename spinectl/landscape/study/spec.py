@@ -29,7 +29,7 @@ from ..._validate import show
 from ...errors import ConfigError, ParameterError, SpinectlError
 from ...model import config
 from ...model._toml import check_keys, locate, quoted_key, unknown_message
-from ...model.checks import validate_position
+from ...model.checks import validate_grid
 from ...model.params import Model
 from .. import schema, sweep
 
@@ -252,7 +252,7 @@ class Study:
     Construction validates everything a worker will need, so that a bad value
     stops the study before any work: every axis value and every draw through
     :func:`spinectl.model.config.set_parameters`, then every combination together,
-    at the corners of the grid (:func:`spinectl.model.checks.validate_position`).
+    on the whole grid (:func:`spinectl.model.checks.validate_grid`).
     Field names in errors are those of the study file (``axes."body.mass"[2]``).
 
     Parameters
@@ -282,7 +282,7 @@ class Study:
         A value is invalid alone, or with the others of its combination; too many points or
         combinations.
     ModelError
-        A combination cannot be evaluated at a corner of the grid.
+        A combination cannot be evaluated at a point of the grid.
     """
 
     model: Model
@@ -315,8 +315,9 @@ class Study:
         self._check_parameters()
         if math.prod(self.shape) > MAX_COMBINATIONS:
             raise ParameterError("axes", f"at most {MAX_COMBINATIONS:,} combinations of axes and samples")
+        checked_shapes: set = set()  # geometry and muscles whose attachments passed on the whole grid
         for combination in np.ndindex(*self.shape):
-            self._check_combination(combination)
+            self._check_combination(combination, checked_shapes)
 
     @staticmethod
     def _grid_axis(name: str, values) -> tuple[float, ...]:
@@ -353,14 +354,22 @@ class Study:
                 if (model.geometry.cor_names, model.muscle_names) != shape:
                     raise ParameterError(where, "must not rename the segments or muscles: outputs need one shape")
 
-    def _check_combination(self, combination) -> None:
-        """One combination of values together, at the corners of the grid; errors name the combination."""
+    def _check_combination(self, combination, checked_shapes: set) -> None:
+        """One combination of values together, on the whole grid (:func:`validate_grid`); errors name the combination.
+
+        ``checked_shapes`` holds the (geometry, muscles) whose attachments passed already:
+        they alone decide that check, so it runs once per distinct pair, not per combination.
+        """
         overrides = self.overrides(combination)
         values = ", ".join(f"{k} = {show(x)}" for k, x in overrides.items())
         where = f" (study combination {values})" if values else ""
-        e_range, l_range = (min(self.eccentricity), max(self.eccentricity)), (min(self.lordosis), max(self.lordosis))
         try:
-            validate_position(config.set_parameters(self.model, overrides), *np.meshgrid(e_range, l_range))
+            model = config.set_parameters(self.model, overrides)
+            shape = (model.geometry, model.muscles)
+            validate_grid(
+                model, self.eccentricity, self.lordosis, self.chunk_size, attachments=shape not in checked_shapes
+            )
+            checked_shapes.add(shape)
         except ParameterError as exc:
             raise type(exc)(exc.field, exc.message + where) from None
         except SpinectlError as exc:
