@@ -46,12 +46,12 @@ def atomic_path(target: str | Path, *, directory: bool = False) -> Iterator[Path
         writer itself propagate unchanged.
     """
     target = Path(target)
-    with _output_errors(target):
+    with output_errors(target):
         target.parent.mkdir(parents=True, exist_ok=True)
         tmp = _temporary(target, directory)
     try:
         yield tmp
-        with _output_errors(target):
+        with output_errors(target):
             _set_mode(tmp, target, directory)
             _replace(tmp, target, directory)
     except BaseException:
@@ -63,9 +63,22 @@ def atomic_path(target: str | Path, *, directory: bool = False) -> Iterator[Path
 
 
 @contextlib.contextmanager
-def _output_errors(target: Path):
+def output_errors(target: str | Path) -> Iterator[None]:
+    """Turn an :class:`OSError` of the block into an :class:`OutputError` naming ``target``.
+
+    Parameters
+    ----------
+    target : str or Path
+        The output, as named in the message.
+
+    Yields
+    ------
+    None
+    """
     try:
         yield
+    except OutputError:
+        raise  # already says what and why
     except OSError as exc:
         reason = exc.strerror or exc.__class__.__name__
         raise OutputError(f"cannot write {str(target)!r}: {reason}") from None
@@ -132,7 +145,7 @@ def check_writable(target: str | Path) -> Path:
         ``target`` is a folder, or its folder cannot be created or written.
     """
     target = Path(target)
-    with _output_errors(target):
+    with output_errors(target):
         if target.is_dir():
             raise IsADirectoryError(errno.EISDIR, "Is a directory")
         target.parent.mkdir(parents=True, exist_ok=True)
@@ -184,12 +197,12 @@ def staged_directory(target: str | Path) -> Iterator[Path]:
         The folders cannot be created or the files not moved into ``target``.
     """
     target = Path(target)
-    with _output_errors(target):
+    with output_errors(target):
         target.parent.mkdir(parents=True, exist_ok=True)
         stage = _temporary(target, directory=True)
     try:
         yield stage
-        with _output_errors(target):
+        with output_errors(target):
             target.mkdir(exist_ok=True)
             for item in sorted(stage.iterdir()):
                 _set_mode(item, target / item.name, item.is_dir())
