@@ -14,7 +14,7 @@ import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
-from .errors import OutputError
+from .errors import OutputError, ParameterError
 
 
 @contextlib.contextmanager
@@ -153,6 +153,49 @@ def check_writable(target: str | Path) -> Path:
     return target
 
 
+def check_distinct(outputs: dict, inputs: dict | None = None) -> None:
+    """Raise :class:`ParameterError` if an output is one of the inputs or another of the outputs.
+
+    Paths are compared resolved (after symlinks, ``..``), and as files where they exist
+    (hard links), so that no spelling of a path lets a command replace its own input
+    (``calibrate --config x.toml --out x.toml``) or write two outputs onto one file.
+
+    Parameters
+    ----------
+    outputs : dict
+        Option name (e.g. ``"--out"``) -> the path it writes, a list of paths (the files of
+        an output folder), or None (not given).
+    inputs : dict, optional
+        Option name -> the path it reads, or None.
+
+    Raises
+    ------
+    ParameterError
+        Named after the later of the two options, e.g. ``--history: is the same file as --out ('x')``.
+    """
+    seen: list[tuple[str, Path]] = []
+    for kind, given in (("input", inputs or {}), ("output", outputs)):
+        for field, paths in given.items():
+            for path in [paths] if isinstance(paths, str | Path) else paths or ():
+                for other, earlier in seen:
+                    if kind == "output" and _same_file(path, earlier):
+                        raise ParameterError(
+                            field,
+                            f"is the same file as {other} ({str(earlier)!r}): an output must not replace "
+                            "an input or another output",
+                        )
+                seen.append((field, Path(path)))
+
+
+def _same_file(a: str | Path, b: str | Path) -> bool:
+    if os.path.realpath(a) == os.path.realpath(b):
+        return True
+    try:
+        return os.path.samefile(a, b)
+    except (OSError, ValueError):  # one of them does not exist (yet), or cannot be a path
+        return False
+
+
 def atomic_write_text(target: str | Path, text: str) -> Path:
     """Write ``text`` to ``target`` atomically (UTF-8); return the target path.
 
@@ -173,18 +216,67 @@ def atomic_write_text(target: str | Path, text: str) -> Path:
     return Path(target)
 
 
-@contextlib.contextmanager
-def staged_directory(target: str | Path) -> Iterator[Path]:
-    """Yield an empty staging folder; on success move each of its files into ``target``.
+def check_folder(target: str | Path, names=()) -> Path:
+    """Raise :class:`OutputError` now if the folder ``target`` could not take the files ``names`` later.
 
-    Every file lands by an atomic rename, all at the end: an interrupted run
-    leaves ``target`` as it was, and files already in ``target`` that the run
-    does not write are kept. On an exception the staging folder is removed.
+    Long jobs call it before they start (:func:`staged_directory` calls it too): it
+    makes the missing parent folders and a temporary folder beside ``target``, then
+    removes it; ``target`` itself is not touched.
+
+    Parameters
+    ----------
+    target : str or Path
+        The output folder, written with :func:`staged_directory`.
+    names : iterable of str
+        The files the job will write into it.
+
+    Returns
+    -------
+    Path
+        ``target`` as a :class:`~pathlib.Path`.
+
+    Raises
+    ------
+    OutputError
+        ``target`` is a file, the working directory or a folder above it (it could not be
+        replaced as a whole), one of ``names`` is a folder in it, or its folder cannot be
+        created or written.
+    """
+    target = Path(target)
+    with output_errors(target):
+        if (target.exists() or target.is_symlink()) and not target.is_dir():
+            raise NotADirectoryError(errno.ENOTDIR, "Not a directory")
+        if Path.cwd().resolve().is_relative_to(target.resolve()):
+            raise OutputError(
+                f"cannot write {str(target)!r}: it is the working directory or holds it, and an output folder "
+                "is replaced as a whole: name a folder for the output"
+            )
+        target.parent.mkdir(parents=True, exist_ok=True)
+        _temporary(target, directory=True).rmdir()
+    for name in names:
+        with output_errors(target / name):
+            if (target / name).is_dir():
+                raise IsADirectoryError(errno.EISDIR, "Is a directory")
+    return target
+
+
+@contextlib.contextmanager
+def staged_directory(target: str | Path, names=()) -> Iterator[Path]:
+    """Yield an empty staging folder; on success it replaces the folder ``target`` as a whole.
+
+    The files already in ``target`` that the run does not write are kept: they are
+    hard-linked into the staging folder (copied where the file system cannot link), and
+    the staging folder then takes the place of ``target`` by renames (the old folder
+    moved aside, the new one in, the old one removed; put back if the new one cannot go
+    in). So ``target`` holds the old set of files or the new one, never a mix: an
+    interruption, a full disk or a blocked name before the renames leaves it as it was.
 
     Parameters
     ----------
     target : str or Path
         The output folder (created if missing).
+    names : iterable of str
+        The files the run will write, checked first (:func:`check_folder`).
 
     Yields
     ------
@@ -194,18 +286,43 @@ def staged_directory(target: str | Path) -> Iterator[Path]:
     Raises
     ------
     OutputError
-        The folders cannot be created or the files not moved into ``target``.
+        ``target`` cannot take the output (:func:`check_folder`), or a file written is a
+        folder in ``target`` (or the other way round), or the folders cannot be written.
     """
-    target = Path(target)
+    target = check_folder(target, names)
     with output_errors(target):
-        target.parent.mkdir(parents=True, exist_ok=True)
         stage = _temporary(target, directory=True)
     try:
         yield stage
         with output_errors(target):
-            target.mkdir(exist_ok=True)
-            for item in sorted(stage.iterdir()):
-                _set_mode(item, target / item.name, item.is_dir())
-                os.replace(item, target / item.name)
+            if target.is_dir():
+                _keep_the_others(target, stage)
+            _set_mode(stage, target, directory=True)
+            _replace(stage, target, directory=True)
     finally:
         shutil.rmtree(stage, ignore_errors=True)
+
+
+def _keep_the_others(target: Path, stage: Path) -> None:
+    """Hard-link (or copy) into ``stage`` every entry of ``target`` that the run did not write."""
+    for item in target.iterdir():
+        new = stage / item.name
+        if new.exists() or new.is_symlink():
+            if new.is_dir() != item.is_dir():
+                kind = "a folder" if item.is_dir() else "a file"
+                raise OutputError(f"cannot write {str(item)!r}: {kind} of that name is in the way")
+            continue
+        if item.is_dir() and not item.is_symlink():
+            shutil.copytree(item, new, symlinks=True, copy_function=_link_or_copy)
+        else:
+            _link_or_copy(item, new)
+
+
+def _link_or_copy(source, destination) -> None:
+    if os.path.islink(source):
+        os.symlink(os.readlink(source), destination)
+        return
+    try:
+        os.link(source, destination)
+    except OSError:  # no hard links on this file system
+        shutil.copy2(source, destination)

@@ -1,7 +1,8 @@
 """Matplotlib figures without pyplot: drawn on the Agg canvas, saved atomically as PNG.
 
 The figure functions of :mod:`spinectl.reflex.plots` and :mod:`spinectl.paper.figures`
-draw on a :func:`new_figure` and return it; :func:`save_png` is the separate save step.
+draw on a :func:`new_figure` and return it; :func:`save_png` is the separate save step,
+:func:`save_pngs` that of a set of figures into one folder, swapped in as a whole.
 Nothing here selects a backend or touches pyplot's global figure list, so a figure is
 garbage-collected like any object, works without a display, and shows itself in a
 notebook (``display(fig)``).
@@ -14,7 +15,7 @@ from pathlib import Path
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from .atomic import atomic_path
+from .atomic import atomic_path, staged_directory
 
 
 def new_figure(**options) -> Figure:
@@ -60,3 +61,35 @@ def save_png(figure: Figure, path: str | Path, dpi: float) -> Path:
     with atomic_path(path) as tmp:
         figure.savefig(tmp, format="png", dpi=dpi)
     return Path(path)
+
+
+def save_pngs(figures: dict[str, Figure], folder: str | Path, dpi: float) -> list[Path]:
+    """Write a set of figures as PNG files into ``folder``: all of them or none.
+
+    They are written into a staging folder that then replaces ``folder`` as a whole
+    (:func:`spinectl.atomic.staged_directory`; the other files of ``folder`` are kept), so
+    an interruption or a full disk half-way leaves no mix of new and old figures.
+
+    Parameters
+    ----------
+    figures : dict of str to matplotlib.figure.Figure
+        File name -> figure.
+    folder : str or Path
+        The output folder; created if missing.
+    dpi : float
+        Resolution [dots per inch].
+
+    Returns
+    -------
+    list of Path
+        The files written, in the order of ``figures``.
+
+    Raises
+    ------
+    OutputError
+        ``folder`` cannot take the files (checked before the first is written); nothing is written.
+    """
+    with staged_directory(folder, figures) as stage:
+        for name, figure in figures.items():
+            save_png(figure, stage / name, dpi)
+    return [Path(folder) / name for name in figures]

@@ -6,7 +6,7 @@ Figure 4 adds the +-30 N m limit of the local muscles as a contour and the
 paper's optimum. Each figure function draws on a new figure with the Agg
 canvas (:func:`spinectl.canvas.new_figure`: no global backend state, no display
 needed) and returns it, writing nothing; :func:`save_figure` writes one
-atomically, and :func:`draw_figures` draws and saves the set.
+atomically, :func:`figure_set` draws the set and :func:`draw_figures` saves it (as a whole).
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ import numpy as np
 import xarray as xr
 from matplotlib.figure import Figure
 
-from ..canvas import new_figure, save_png
+from ..canvas import new_figure, save_png, save_pngs
 from ..landscape import netcdf
 from ..units import M2_PER_CM2
 from . import grid, landmarks
@@ -166,26 +166,62 @@ def figure_names(stiffness: float) -> tuple[str, str]:
     Returns
     -------
     tuple of str
-        The PNG names of the minimum-PCSA and the counter-torque figure.
+        The PNG names of the minimum-PCSA and the counter-torque figure: K short (``K15``)
+        where that reads back as K, else every digit of K (``K15.000001``), so that
+        distinct stiffnesses never share a file.
     """
     if stiffness == 0:
         return "fig3_min_pcsa.png", "fig4_counter_torque.png"
-    return f"figS1_min_pcsa_K{stiffness:g}.png", f"fig4_counter_torque_K{stiffness:g}.png"
+    short = f"{stiffness:g}"
+    k = short if float(short) == stiffness else repr(float(stiffness))
+    return f"figS1_min_pcsa_K{k}.png", f"fig4_counter_torque_K{k}.png"
 
 
-def draw_figures(dataset: xr.Dataset, out_dir: str | Path, specific_tension: float | None = None) -> list[Path]:
-    """Draw Figures 3 and 4 for every K of ``dataset`` (Figure S1 for K > 0) and save them into ``out_dir``.
+def figure_set(dataset: xr.Dataset, specific_tension: float | None = None) -> dict[str, Figure]:
+    """Figures 3 and 4 for every K of ``dataset`` (Figure S1 for K > 0), by file name; nothing written.
 
     Parameters
     ----------
     dataset : xarray.Dataset
         From :func:`~spinectl.landscape.sweep.sweep` (scalar K) or
         :func:`~spinectl.landscape.sweep.stiffness_sweep` (a K dimension).
-    out_dir : str or Path
-        Folder for the PNG files (created if missing), named by :func:`figure_names`.
     specific_tension : float, optional
         f_iso per PCSA [N/m^2], for the local-PCSA scale of Figure 4; default: that of
         the model the dataset was computed with (:func:`spinectl.landscape.netcdf.model_of`).
+
+    Returns
+    -------
+    dict of str to matplotlib.figure.Figure
+        :func:`figure_names` of each K -> its figure, K in the dataset's order.
+
+    Raises
+    ------
+    ConfigError, ParameterError
+        ``specific_tension`` not given and the dataset's ``config_toml`` is not a valid model.
+    """
+    if specific_tension is None:
+        specific_tension = netcdf.model_of(dataset).fibre.specific_tension
+    parts = [dataset.sel(K=k) for k in dataset["K"].values] if "K" in dataset.dims else [dataset]
+    drawn = {}
+    for part in parts:
+        pcsa_name, ct_name = figure_names(float(part["K"]))
+        drawn[pcsa_name] = min_pcsa_figure(part)
+        drawn[ct_name] = counter_torque_figure(part, specific_tension)
+    return drawn
+
+
+def draw_figures(dataset: xr.Dataset, out_dir: str | Path, specific_tension: float | None = None) -> list[Path]:
+    """Draw :func:`figure_set` and save it into ``out_dir``: every figure or none (:func:`spinectl.canvas.save_pngs`).
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        As for :func:`figure_set`.
+    out_dir : str or Path
+        Folder for the PNG files (created if missing), named by :func:`figure_names`; its
+        other files are kept.
+    specific_tension : float, optional
+        As for :func:`figure_set`.
 
     Returns
     -------
@@ -197,15 +233,6 @@ def draw_figures(dataset: xr.Dataset, out_dir: str | Path, specific_tension: flo
     ConfigError, ParameterError
         ``specific_tension`` not given and the dataset's ``config_toml`` is not a valid model.
     OutputError
-        A file cannot be written.
+        ``out_dir`` cannot take the files; nothing is written.
     """
-    if specific_tension is None:
-        specific_tension = netcdf.model_of(dataset).fibre.specific_tension
-    out_dir = Path(out_dir)
-    parts = [dataset.sel(K=k) for k in dataset["K"].values] if "K" in dataset.dims else [dataset]
-    written = []
-    for part in parts:
-        pcsa_name, ct_name = figure_names(float(part["K"]))
-        written.append(save_figure(min_pcsa_figure(part), out_dir / pcsa_name))
-        written.append(save_figure(counter_torque_figure(part, specific_tension), out_dir / ct_name))
-    return written
+    return save_pngs(figure_set(dataset, specific_tension), out_dir, DPI)

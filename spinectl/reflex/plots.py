@@ -21,7 +21,7 @@ import matplotlib
 import numpy as np
 from matplotlib.figure import Figure
 
-from ..canvas import new_figure, save_png
+from ..canvas import new_figure, save_png, save_pngs
 from ..model.params import Model
 from .loops import ignoring_underflow
 from .margins import MarginsReport, ReportResponses, report_responses
@@ -203,7 +203,8 @@ def write_plots(report: MarginsReport, folder: str | Path, model: Model) -> list
 
     response.png of every segment with a finite stiffness; bode.png and nyquist.png of
     every non-zero reflex loop. Everything is computed and drawn before the first file
-    is written, so a failure (e.g. a delay too short to simulate) writes nothing.
+    is written, so a failure (e.g. a delay too short to simulate) writes nothing; the
+    files then replace the old ones together (:func:`spinectl.canvas.save_pngs`).
 
     Parameters
     ----------
@@ -224,7 +225,6 @@ def write_plots(report: MarginsReport, folder: str | Path, model: Model) -> list
     ParameterError
         The simulation cannot run at the report's delay.
     OutputError
-        A file cannot be written.
+        A file cannot be written (nothing is written then).
     """
-    figures = report_figures(report, report_responses(model, report))
-    return [save_figure(fig, Path(folder) / name) for name, fig in figures.items()]
+    return save_pngs(report_figures(report, report_responses(model, report)), folder, DPI)

@@ -48,7 +48,7 @@ def test_a_failure_leaves_the_output_folder_untouched(tmp_path, monkeypatch, cap
     def broken(*args, **kwargs):
         raise RuntimeError("simulated crash while drawing")
 
-    monkeypatch.setattr(figures, "draw_figures", broken)
+    monkeypatch.setattr(figures, "figure_set", broken)
     out = tmp_path / "results"
     with pytest.raises(RuntimeError):
         main(["reproduce", "--out", str(out), "--points", "3"])
@@ -69,3 +69,28 @@ def test_reproduce_of_another_preset_says_it_is_not_calibrated(tmp_path, capsys)
     text = (tmp_path / "report.md").read_text()
     assert "Parameters: preset `default`" in text and "are **not** the calibrated preset" in text
     assert (tmp_path / "landscape_K15_paper.nc").exists()  # default uses the physical convention
+
+
+def test_a_blocked_name_in_the_output_folder_stops_before_the_work(tmp_path, monkeypatch, capsys):
+    """``report.md`` is a folder: exit 2 before any sweep, every old file as it was.
+
+    Before, the files were moved in one by one at the end, and 6 of the 7 were already
+    the new ones when the seventh failed.
+    """
+    from spinectl.paper import grid
+
+    out = tmp_path / "results"
+    (out / "report.md").mkdir(parents=True)
+    old = {name: f"old {name}".encode() for name in EXPECTED - {"report.md"}}
+    for name, content in old.items():
+        (out / name).write_bytes(content)
+
+    def no_sweep(*args, **kwargs):
+        raise AssertionError("the sweeps must not start")
+
+    monkeypatch.setattr(grid, "paper_landscapes", no_sweep)
+    assert main(["reproduce", "--out", str(out), "--points", "3"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "report.md': Is a directory" in err
+    assert {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()} == old
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["results"]
