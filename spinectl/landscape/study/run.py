@@ -54,7 +54,7 @@ ADDRESS = re.compile(r"^tcp://\S+$")
 UNUSABLE_SCHEMES = {
     "tls": "needs certificates, which spinectl does not configure",
     "wss": "needs certificates, which spinectl does not configure",
-    "ws": "is not tested with spinectl",
+    "ws": "is not tested with spinectl (its listener binds every interface): use tcp://",
     "ucx": "needs ucx-py, which spinectl does not install",
     "inproc": "reaches only a scheduler inside this process",
 }
