@@ -1,7 +1,9 @@
 """Atomic output: write to a temporary name beside the target, then rename.
 
 An interrupted run leaves either the previous file or the new one, never a
-half-written file.
+half-written file. A folder replaces a folder in one step where the OS can
+(Linux's ``renameat2`` with ``RENAME_EXCHANGE``), else in two (the old one moved
+aside, the new one in), so that a set of files changes as a whole.
 """
 
 from __future__ import annotations
@@ -108,6 +110,9 @@ def _replace(tmp: Path, target: Path, directory: bool) -> None:
     if not (directory and target.exists()):
         os.replace(tmp, target)
         return
+    if _exchange(tmp, target):  # one step: the new folder at target, the old one at tmp
+        shutil.rmtree(tmp, ignore_errors=True)
+        return
     # A folder cannot be renamed over a non-empty one: move the old aside first,
     # and put it back if the new one cannot take its place.
     old = target.with_name(f".{target.name}.old")
@@ -119,6 +124,29 @@ def _replace(tmp: Path, target: Path, directory: bool) -> None:
         os.replace(old, target)
         raise
     shutil.rmtree(old, ignore_errors=True)
+
+
+RENAME_EXCHANGE = 2
+"""Linux's ``renameat2`` flag that swaps two paths in one step (<linux/fs.h>)."""
+
+
+def _exchange(a: Path, b: Path) -> bool:
+    """Swap the paths ``a`` and ``b`` atomically (Linux >= 3.15); False where the OS or file system cannot."""
+    import ctypes
+    import ctypes.util
+
+    try:
+        libc = ctypes.CDLL(ctypes.util.find_library("c"), use_errno=True)
+        renameat2 = libc.renameat2
+    except (OSError, AttributeError, TypeError):  # no C library by that name, or no renameat2 in it
+        return False
+    at_cwd = -100  # AT_FDCWD: paths relative to the working directory
+    if renameat2(at_cwd, os.fsencode(a), at_cwd, os.fsencode(b), RENAME_EXCHANGE) == 0:
+        return True
+    error = ctypes.get_errno()
+    if error in (errno.ENOSYS, errno.EINVAL, errno.ENOTSUP):
+        return False  # not supported here: the caller renames in two steps
+    raise OSError(error, os.strerror(error), str(b))
 
 
 def check_writable(target: str | Path) -> Path:
