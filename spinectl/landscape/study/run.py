@@ -242,18 +242,15 @@ def run_study(
     OutputError
         ``out`` exists and ``resume`` is false, it cannot be written, or another run holds it.
     """
-    _check_options(scheduler, workers, max_chunks)
-    for name, seconds in (("connect_timeout", connect_timeout), ("worker_timeout", worker_timeout)):
-        if isinstance(seconds, bool) or not isinstance(seconds, int | float) or not 0 < seconds < math.inf:
-            raise ParameterError(name, f"must be a number of seconds > 0 (got {seconds!r})")
+    timeouts = {"connect_timeout": connect_timeout, "worker_timeout": worker_timeout}
+    _check_options(scheduler, workers, max_chunks, timeouts)
     start = time.perf_counter()
     notify = notify or (lambda line: None)
     with store.locked(out):  # before the existence check: two runs cannot both pass it
         done = store.existing(study, out, resume, notify)  # before the cluster starts: a refusal costs nothing
         indices = np.arange(study.n_chunks) if done is None else np.flatnonzero(done == 0)
         todo = indices[: None if max_chunks is None else max_chunks]
-        timeouts = (connect_timeout, worker_timeout)
-        with _executor(scheduler, workers, todo.size, timeouts, notify) as executor:
+        with _executor(scheduler, workers, todo.size, tuple(timeouts.values()), notify) as executor:
             if done is None:  # after connecting: an unreachable scheduler leaves no store behind
                 done = store.create(study, out, _probe(study))
             done_before = int(np.count_nonzero(done))
@@ -285,7 +282,7 @@ def _disabled(progress: bool | None) -> bool | None:
     return None if progress is None else not progress  # None: tqdm shows it on a terminal only
 
 
-def _check_options(scheduler, workers, max_chunks) -> None:
+def _check_options(scheduler, workers, max_chunks, timeouts: dict) -> None:
     if scheduler is not None and not (scheduler == SYNCHRONOUS or ADDRESS.match(str(scheduler))):
         allowed = f"{SYNCHRONOUS!r} or a dask.distributed address such as tcp://host:8786"
         scheme = str(scheduler).partition("://")[0]
@@ -300,6 +297,9 @@ def _check_options(scheduler, workers, max_chunks) -> None:
             raise ParameterError("workers", f"must be {allowed} (got {workers!r})")
     if max_chunks is not None and (isinstance(max_chunks, bool) or not isinstance(max_chunks, int) or max_chunks < 0):
         raise ParameterError("max_chunks", f"must be an integer >= 0 (got {max_chunks!r})")
+    for name, seconds in timeouts.items():
+        if isinstance(seconds, bool) or not isinstance(seconds, int | float) or not 0 < seconds < math.inf:
+            raise ParameterError(name, f"must be a number of seconds > 0 (got {seconds!r})")
 
 
 def _cores() -> int:
@@ -353,26 +353,8 @@ def _executor(scheduler: str | None, workers: int | None, n_todo: int, timeouts:
         with _remote(scheduler, *timeouts, notify) as client:
             yield _Distributed(client, _where(scheduler, len(client.scheduler_info()["workers"])))
         return
-    import dask
-    from distributed import Client, LocalCluster
-
     n = min(workers or _cores(), n_todo)
-    with contextlib.ExitStack() as stack:
-        # Ctrl-C waits until the cluster has started, then closes it: the worker processes
-        # inherit the blocked signal (no tracebacks of theirs), and a half-started cluster
-        # is never closed (distributed asserts then).
-        with _interrupts_deferred(), dask.config.set({MALLOC_TRIM_SETTING: None}):  # see MALLOC_TRIM_SETTING
-            cluster = stack.enter_context(
-                LocalCluster(
-                    n_workers=n,
-                    threads_per_worker=1,  # cvxpy is not thread-safe; one process per worker
-                    processes=True,
-                    host="127.0.0.1",  # loopback only: nothing listens on another address
-                    dashboard_address=None,
-                    silence_logs=logging.ERROR,
-                )
-            )
-            client = stack.enter_context(Client(cluster, set_as_default=False))
+    with _local_cluster(n) as client:
         yield _Distributed(client, f"{n} local worker{'s' * (n != 1)}")
 
 
@@ -381,15 +363,53 @@ def _where(scheduler: str, n_workers: int) -> str:
 
 
 @contextlib.contextmanager
-def _interrupts_deferred():
-    """Block SIGINT in this thread (and so in the threads and processes started meanwhile); deliver it after."""
-    if not hasattr(signal, "pthread_sigmask"):
-        yield
-        return
-    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+def _local_cluster(n: int):
+    """A client of a new local cluster of ``n`` single-threaded worker processes on 127.0.0.1, closed after.
+
+    Ctrl-C is held (SIGINT blocked) while the cluster starts and while it closes, and acts
+    in between: the worker processes inherit the blocked signal, so they print no
+    tracebacks of their own, and distributed is never asked to close a half-started
+    cluster (it asserts then).
+    """
+    import dask
+    from distributed import Client, LocalCluster
+
+    previous = _block_interrupts()
     try:
-        yield
+        with dask.config.set({MALLOC_TRIM_SETTING: None}):  # unset in the workers' environment, see there
+            cluster = LocalCluster(
+                n_workers=n,
+                threads_per_worker=1,  # cvxpy is not thread-safe; one process per worker
+                processes=True,
+                host="127.0.0.1",  # loopback only: nothing listens on another address
+                dashboard_address=None,
+                # no dashboard, but the scheduler's HTTP server (health routes) would take port 8787 and
+                # warn on stderr when another cluster has it: a free loopback port instead
+                scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
+                silence_logs=logging.ERROR,
+            )
+        try:
+            client = Client(cluster, set_as_default=False)
+            try:
+                _restore_interrupts(previous)  # a Ctrl-C of the start-up acts here
+                yield client
+            finally:
+                _block_interrupts()
+                client.close()
+        finally:
+            cluster.close()
     finally:
+        _restore_interrupts(previous)
+
+
+def _block_interrupts():
+    """Block SIGINT in this thread (and so in the threads and processes it starts); return the previous mask."""
+    return signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT}) if hasattr(signal, "pthread_sigmask") else None
+
+
+def _restore_interrupts(previous) -> None:
+    """Restore the mask from :func:`_block_interrupts`: a SIGINT that came meanwhile is delivered now."""
+    if previous is not None:
         signal.pthread_sigmask(signal.SIG_SETMASK, previous)
 
 
