@@ -289,10 +289,11 @@ def check_folder(target: str | Path, names=()) -> Path:
 
 
 @contextlib.contextmanager
-def staged_directory(target: str | Path, names=()) -> Iterator[Path]:
+def staged_directory(target: str | Path, names=(), replaces=()) -> Iterator[Path]:
     """Yield an empty staging folder; on success it replaces the folder ``target`` as a whole.
 
-    The files already in ``target`` that the run does not write are kept: they are
+    The files already in ``target`` that the run does not write are kept (but those
+    named in ``replaces``, earlier outputs of the same kind, go): they are
     hard-linked into the staging folder (copied where the file system cannot link), and
     the staging folder then takes the place of ``target`` by renames (the old folder
     moved aside, the new one in, the old one removed; put back if the new one cannot go
@@ -305,6 +306,9 @@ def staged_directory(target: str | Path, names=()) -> Iterator[Path]:
         The output folder (created if missing).
     names : iterable of str
         The files the run will write, checked first (:func:`check_folder`).
+    replaces : iterable of str
+        Files that the new output replaces as a set: not kept where the run does not
+        write them (e.g. a Bode plot of an earlier run, beside a new response plot).
 
     Yields
     ------
@@ -324,17 +328,19 @@ def staged_directory(target: str | Path, names=()) -> Iterator[Path]:
         yield stage
         with output_errors(target):
             if target.is_dir():
-                _keep_the_others(target, stage)
+                _keep_the_others(target, stage, set(replaces))
             _set_mode(stage, target, directory=True)
             _replace(stage, target, directory=True)
     finally:
         shutil.rmtree(stage, ignore_errors=True)
 
 
-def _keep_the_others(target: Path, stage: Path) -> None:
-    """Hard-link (or copy) into ``stage`` every entry of ``target`` that the run did not write."""
+def _keep_the_others(target: Path, stage: Path, replaced: set[str]) -> None:
+    """Hard-link (or copy) into ``stage`` every entry of ``target`` that the run did not write, but ``replaced``."""
     for item in target.iterdir():
         new = stage / item.name
+        if item.name in replaced and not (new.exists() or new.is_symlink()):
+            continue
         if new.exists() or new.is_symlink():
             if new.is_dir() != item.is_dir():
                 kind = "a folder" if item.is_dir() else "a file"

@@ -63,7 +63,7 @@ def save_png(figure: Figure, path: str | Path, dpi: float) -> Path:
     return Path(path)
 
 
-def save_pngs(figures: dict[str, Figure], folder: str | Path, dpi: float) -> list[Path]:
+def save_pngs(figures: dict[str, Figure], folder: str | Path, dpi: float, replaces=()) -> list[Path]:
     """Write a set of figures as PNG files into ``folder``: all of them or none.
 
     They are written into a staging folder that then replaces ``folder`` as a whole
@@ -78,6 +78,8 @@ def save_pngs(figures: dict[str, Figure], folder: str | Path, dpi: float) -> lis
         The output folder; created if missing.
     dpi : float
         Resolution [dots per inch].
+    replaces : iterable of str
+        Names of earlier figures of the set that go even where ``figures`` has none of that name.
 
     Returns
     -------
@@ -89,7 +91,7 @@ def save_pngs(figures: dict[str, Figure], folder: str | Path, dpi: float) -> lis
     OutputError
         ``folder`` cannot take the files (checked before the first is written); nothing is written.
     """
-    with staged_directory(folder, figures) as stage:
+    with staged_directory(folder, figures, replaces) as stage:
         for name, figure in figures.items():
             save_png(figure, stage / name, dpi)
     return [Path(folder) / name for name in figures]

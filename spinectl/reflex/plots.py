@@ -204,7 +204,9 @@ def write_plots(report: MarginsReport, folder: str | Path, model: Model) -> list
     response.png of every segment with a finite stiffness; bode.png and nyquist.png of
     every non-zero reflex loop. Everything is computed and drawn before the first file
     is written, so a failure (e.g. a delay too short to simulate) writes nothing; the
-    files then replace the old ones together (:func:`spinectl.canvas.save_pngs`).
+    files then replace the old ones together (:func:`spinectl.canvas.save_pngs`), and a
+    plot of an earlier run that this one does not draw goes with them: the folder never
+    shows a Bode plot of one configuration beside the response of another.
 
     Parameters
     ----------
@@ -227,4 +229,4 @@ def write_plots(report: MarginsReport, folder: str | Path, model: Model) -> list
     OutputError
         A file cannot be written (nothing is written then).
     """
-    return save_pngs(report_figures(report, report_responses(model, report)), folder, DPI)
+    return save_pngs(report_figures(report, report_responses(model, report)), folder, DPI, replaces=PLOT_FILES)
