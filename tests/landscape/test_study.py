@@ -486,6 +486,10 @@ def test_a_lost_chunk_file_is_refused_on_load_and_recomputed_on_resume(reference
     result = study.run_study(parsed, out, scheduler="synchronous", resume=True, progress=False, notify=notes.append)
     assert (result.done_before, result.computed) == (11, 1) and "computing it again" in notes[0]
     xr.testing.assert_identical(study.load(out), reference)
+    group = zarr.open_group(out, mode="r+")  # a store made before every chunk was a file: not checked
+    del group.attrs[study_store.CHUNK_FILES]
+    delete_chunk_file(out, "min_pcsa_cm2", "0.1.2.0")
+    assert np.isnan(study.open_store(out)["min_pcsa_cm2"].values).sum() == TILE_POINTS
 
 
 def test_an_all_nan_chunk_is_still_a_file(tmp_path):

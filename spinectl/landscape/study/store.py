@@ -44,6 +44,10 @@ from .spec import SAMPLE, STORE_FORMAT, Chunk, Study
 DONE = "chunk_done"
 """The per-chunk counter of writes."""
 
+CHUNK_FILES = "every_chunk_a_file"
+"""The attribute that says every chunk written is a file (``write_empty_chunks``); stores made before
+it may lack the files of chunks of fill values only, so their chunks are not checked (:func:`missing_chunks`)."""
+
 STRING_WIDTH = 32
 """Characters of the fixed-width status strings; the longest status has 22."""
 
@@ -155,6 +159,7 @@ def _attributes(study: Study) -> dict:
         "study_toml": study.text,
         "config_toml": config.dump_toml(study.model),
         "chunk_tile": list(study.tile),
+        CHUNK_FILES: True,
     }
 
 
@@ -385,11 +390,14 @@ def missing_chunks(path: str | Path, counts: np.ndarray) -> np.ndarray:
     Returns
     -------
     numpy.ndarray of int
-        Indices of the chunks counted done with a chunk file missing, ascending.
+        Indices of the chunks counted done with a chunk file missing, ascending; none
+        in a store made without :data:`CHUNK_FILES` (it cannot tell).
     """
     group = zarr.open_group(path, mode="r", zarr_format=ZARR_FORMAT)
     done = np.flatnonzero(np.asarray(counts) > 0)
     missing = np.zeros(len(counts), dtype=bool)
+    if group.attrs.get(CHUNK_FILES) is not True:
+        return np.flatnonzero(missing)  # an older store: a chunk of fill values only may lack its file
     for name, array in group.arrays():
         if not {"E", "Lambda"} <= set(array.attrs.get("_ARRAY_DIMENSIONS", ())):
             continue  # the chunk counts, the coordinates
