@@ -321,7 +321,7 @@ def staged_directory(target: str | Path, names=(), replaces=()) -> Iterator[Path
         ``target`` cannot take the output (:func:`check_folder`), or a file written is a
         folder in ``target`` (or the other way round), or the folders cannot be written.
     """
-    target = check_folder(target, names)
+    target = Path(os.path.realpath(check_folder(target, names)))  # a link to a folder: replace the folder
     with output_errors(target):
         stage = _temporary(target, directory=True)
     try:

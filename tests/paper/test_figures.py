@@ -112,6 +112,15 @@ def test_plot_into_a_folder_with_a_folder_in_a_figure_s_place_writes_nothing(res
     assert (out / "fig3_min_pcsa.png").read_bytes() == b"old" and sorted(tmp_path.iterdir()) == [out]
 
 
+def test_a_link_to_the_output_folder_stays_a_link(results, tmp_path):
+    """``--out link`` with link -> real: the figures go into real, the link is left as it is."""
+    (tmp_path / "real").mkdir()
+    (tmp_path / "link").symlink_to(tmp_path / "real")
+    assert main(["plot", str(results), "--out", str(tmp_path / "link")]) == 0
+    assert (tmp_path / "link").is_symlink() and (tmp_path / "real" / "fig3_min_pcsa.png").is_file()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["link", "real"]
+
+
 def test_the_working_directory_is_not_replaced_as_an_output_folder(results, tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     assert main(["plot", str(results), "--out", "."]) == 2
