@@ -1,7 +1,9 @@
 """Atomic output: write to a temporary name beside the target, then rename.
 
 An interrupted run leaves either the previous file or the new one, never a
-half-written file.
+half-written file. A folder replaces a folder in one step where the OS can
+(Linux's ``renameat2`` with ``RENAME_EXCHANGE``), else in two (the old one moved
+aside, the new one in), so that a set of files changes as a whole.
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from ._validate import show
-from .errors import OutputError
+from .errors import OutputError, ParameterError
 
 
 @contextlib.contextmanager
@@ -42,19 +44,18 @@ def atomic_path(target: str | Path, *, directory: bool = False) -> Iterator[Path
     Raises
     ------
     OutputError
-        The folder cannot be created or written, the writer meets a full disk
-        (an ``OSError`` of :data:`DEVICE_ERRORS`), or ``target`` cannot be
-        replaced (e.g. a folder where a file should go). Other exceptions of the
+        The folder cannot be created or written, or ``target`` cannot be
+        replaced (e.g. a folder where a file should go). Exceptions of the
         writer itself propagate unchanged.
     """
     target = _named(target)
-    with _output_errors(target):
+    with output_errors(target):
         target.parent.mkdir(parents=True, exist_ok=True)
         tmp = _temporary(target, directory)
     try:
-        with _output_errors(target, errnos=DEVICE_ERRORS):  # the writer meets a full disk
+        with output_errors(target, errnos=DEVICE_ERRORS):  # the writer meets a full disk
             yield tmp
-        with _output_errors(target):
+        with output_errors(target):
             _set_mode(tmp, target, directory)
             _replace(tmp, target, directory)
     except BaseException:
@@ -84,11 +85,24 @@ its other exceptions (e.g. a missing input) propagate unchanged."""
 
 
 @contextlib.contextmanager
-def _output_errors(target: Path, errnos=None):
+def output_errors(target: str | Path, errnos=None) -> Iterator[None]:
+    """Turn an :class:`OSError` of the block into an :class:`OutputError` naming ``target``.
+
+    Parameters
+    ----------
+    target : str or Path
+        The output, as named in the message.
+    errnos : collection of int, optional
+        Convert only these error numbers (e.g. :data:`DEVICE_ERRORS`); others propagate.
+
+    Yields
+    ------
+    None
+    """
     try:
         yield
     except OutputError:
-        raise  # already one line, naming its own target
+        raise  # already says what and why
     except OSError as exc:
         if errnos is not None and exc.errno not in errnos:
             raise
@@ -120,6 +134,9 @@ def _replace(tmp: Path, target: Path, directory: bool) -> None:
     if not (directory and target.exists()):
         os.replace(tmp, target)
         return
+    if _exchange(tmp, target):  # one step: the new folder at target, the old one at tmp
+        shutil.rmtree(tmp, ignore_errors=True)
+        return
     # A folder cannot be renamed over a non-empty one: move the old aside first,
     # and put it back if the new one cannot take its place.
     old = target.with_name(f".{target.name}.old")
@@ -131,6 +148,29 @@ def _replace(tmp: Path, target: Path, directory: bool) -> None:
         os.replace(old, target)
         raise
     shutil.rmtree(old, ignore_errors=True)
+
+
+RENAME_EXCHANGE = 2
+"""Linux's ``renameat2`` flag that swaps two paths in one step (<linux/fs.h>)."""
+
+
+def _exchange(a: Path, b: Path) -> bool:
+    """Swap the paths ``a`` and ``b`` atomically (Linux >= 3.15); False where the OS or file system cannot."""
+    import ctypes
+    import ctypes.util
+
+    try:
+        libc = ctypes.CDLL(ctypes.util.find_library("c"), use_errno=True)
+        renameat2 = libc.renameat2
+    except (OSError, AttributeError, TypeError):  # no C library by that name, or no renameat2 in it
+        return False
+    at_cwd = -100  # AT_FDCWD: paths relative to the working directory
+    if renameat2(at_cwd, os.fsencode(a), at_cwd, os.fsencode(b), RENAME_EXCHANGE) == 0:
+        return True
+    error = ctypes.get_errno()
+    if error in (errno.ENOSYS, errno.EINVAL, errno.ENOTSUP):
+        return False  # not supported here: the caller renames in two steps
+    raise OSError(error, os.strerror(error), str(b))
 
 
 def check_writable(target: str | Path) -> Path:
@@ -154,16 +194,58 @@ def check_writable(target: str | Path) -> Path:
     Raises
     ------
     OutputError
-        ``target`` is a folder or has a name that is not printable, or its folder cannot be
-        created or written.
+        ``target`` is a folder, or its folder cannot be created or written.
     """
     target = _named(target)
-    with _output_errors(target):
+    with output_errors(target):
         if target.is_dir():
             raise IsADirectoryError(errno.EISDIR, "Is a directory")
         target.parent.mkdir(parents=True, exist_ok=True)
         _temporary(target, directory=False).unlink()
     return target
+
+
+def check_distinct(outputs: dict, inputs: dict | None = None) -> None:
+    """Raise :class:`ParameterError` if an output is one of the inputs or another of the outputs.
+
+    Paths are compared resolved (after symlinks, ``..``), and as files where they exist
+    (hard links), so that no spelling of a path lets a command replace its own input
+    (``calibrate --config x.toml --out x.toml``) or write two outputs onto one file.
+
+    Parameters
+    ----------
+    outputs : dict
+        Option name (e.g. ``"--out"``) -> the path it writes, a list of paths (the files of
+        an output folder), or None (not given).
+    inputs : dict, optional
+        Option name -> the path it reads, or None.
+
+    Raises
+    ------
+    ParameterError
+        Named after the later of the two options, e.g. ``--history: is the same file as --out ('x')``.
+    """
+    seen: list[tuple[str, Path]] = []
+    for kind, given in (("input", inputs or {}), ("output", outputs)):
+        for field, paths in given.items():
+            for path in [paths] if isinstance(paths, str | Path) else paths or ():
+                for other, earlier in seen:
+                    if kind == "output" and _same_file(path, earlier):
+                        raise ParameterError(
+                            field,
+                            f"is the same file as {other} ({str(earlier)!r}): an output must not replace "
+                            "an input or another output",
+                        )
+                seen.append((field, Path(path)))
+
+
+def _same_file(a: str | Path, b: str | Path) -> bool:
+    if os.path.realpath(a) == os.path.realpath(b):
+        return True
+    try:
+        return os.path.samefile(a, b)
+    except (OSError, ValueError):  # one of them does not exist (yet), or cannot be a path
+        return False
 
 
 def atomic_write_text(target: str | Path, text: str) -> Path:
@@ -186,27 +268,19 @@ def atomic_write_text(target: str | Path, text: str) -> Path:
     return Path(target)
 
 
-def _stage(target: Path) -> Path:
-    """A new, empty staging folder for ``target`` on its file system: inside it, or beside it if it does not exist."""
-    if target.is_dir():
-        return Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".tmp", dir=target))
-    target.parent.mkdir(parents=True, exist_ok=True)
-    return _temporary(target, directory=True)
+def check_folder(target: str | Path, names=()) -> Path:
+    """Raise :class:`OutputError` now if the folder ``target`` could not take the files ``names`` later.
 
-
-def check_staged_directory(target: str | Path) -> Path:
-    """Raise :class:`OutputError` now if :func:`staged_directory` could not fill ``target`` later.
-
-    Long jobs call it before they start: it makes the staging folder, moves a file
-    from it into ``target`` by a rename (as the end of the job will) and removes both;
-    a mount point that refuses the rename, a file where the folder should be or a
-    read-only folder fail here, not after the run. ``target`` keeps its contents; its
-    missing parent folders are created.
+    Long jobs call it before they start (:func:`staged_directory` calls it too): it
+    makes the missing parent folders and a temporary folder beside ``target``, then
+    removes it; ``target`` itself is not touched.
 
     Parameters
     ----------
     target : str or Path
-        The output folder.
+        The output folder, written with :func:`staged_directory`.
+    names : iterable of str
+        The files the job will write into it.
 
     Returns
     -------
@@ -216,56 +290,144 @@ def check_staged_directory(target: str | Path) -> Path:
     Raises
     ------
     OutputError
-        ``target`` is a file, or its folder cannot be written or take a rename from the staging folder.
+        ``target`` is a file, the working directory or a folder above it (it could not be
+        replaced as a whole), one of ``names`` is a folder in it, or its folder cannot be
+        created or written.
     """
     target = _named(target)
-    with _output_errors(target):
-        if target.exists() and not target.is_dir():
+    with output_errors(target):
+        if (target.exists() or target.is_symlink()) and not target.is_dir():
             raise NotADirectoryError(errno.ENOTDIR, "Not a directory")
-        stage = _stage(target)
-        try:
-            probe = stage / "probe"
-            probe.touch()
-            landed = (target if target.is_dir() else stage.parent) / f".{stage.name}.probe"
-            os.replace(probe, landed)
-            landed.unlink()
-        finally:
-            shutil.rmtree(stage, ignore_errors=True)
+        if _is_mount(target):
+            _probe_inside(target)
+            return target
+        if Path.cwd().resolve().is_relative_to(target.resolve()):
+            raise OutputError(
+                f"cannot write {str(target)!r}: it is the working directory or holds it, and an output folder "
+                "is replaced as a whole: name a folder for the output"
+            )
+        target.parent.mkdir(parents=True, exist_ok=True)
+        _temporary(target, directory=True).rmdir()
+    for name in names:
+        with output_errors(target / name):
+            if (target / name).is_dir():
+                raise IsADirectoryError(errno.EISDIR, "Is a directory")
     return target
 
 
 @contextlib.contextmanager
-def staged_directory(target: str | Path) -> Iterator[Path]:
-    """Yield an empty staging folder; on success move each of its files into ``target``.
+def staged_directory(target: str | Path, names=(), replaces=()) -> Iterator[Path]:
+    """Yield an empty staging folder; on success it replaces the folder ``target`` as a whole.
 
-    Every file lands by an atomic rename, all at the end: an interrupted run
-    leaves ``target`` as it was, and files already in ``target`` that the run
-    does not write are kept. On an exception the staging folder is removed.
+    The files already in ``target`` that the run does not write are kept (but those
+    named in ``replaces``, earlier outputs of the same kind, go): they are
+    hard-linked into the staging folder (copied where the file system cannot link), and
+    the staging folder then takes the place of ``target`` by renames (the old folder
+    moved aside, the new one in, the old one removed; put back if the new one cannot go
+    in). So ``target`` holds the old set of files or the new one, never a mix: an
+    interruption, a full disk or a blocked name before the renames leaves it as it was.
+    A mount point (a container's bind mount) cannot be replaced: there the staging
+    folder is inside ``target`` and its files land one by one at the end, each by an
+    atomic rename (``replaces`` does not apply).
 
     Parameters
     ----------
     target : str or Path
         The output folder (created if missing).
+    names : iterable of str
+        The files the run will write, checked first (:func:`check_folder`).
+    replaces : iterable of str
+        Files that the new output replaces as a set: not kept where the run does not
+        write them (e.g. a Bode plot of an earlier run, beside a new response plot).
 
     Yields
     ------
     Path
-        The empty staging folder, on ``target``'s file system (inside ``target`` if it
-        exists, beside it if not: a mount point cannot take renames from its parent);
-        write the outputs into it.
+        The empty staging folder, beside ``target`` (inside a mount point); write the outputs into it.
 
     Raises
     ------
     OutputError
-        The folders cannot be created or the files not moved into ``target``.
+        ``target`` cannot take the output (:func:`check_folder`), or a file written is a
+        folder in ``target`` (or the other way round), or the folders cannot be written.
     """
-    target = Path(target)
-    with _output_errors(target):
-        stage = _stage(target)
+    target = Path(os.path.realpath(check_folder(target, names)))  # a link to a folder: replace the folder
+    if _is_mount(target):
+        with _filled_in_place(target) as stage:
+            yield stage
+        return
+    with output_errors(target):
+        stage = _temporary(target, directory=True)
     try:
         yield stage
-        with _output_errors(target):
-            target.mkdir(exist_ok=True)
+        with output_errors(target):
+            if target.is_dir():
+                _keep_the_others(target, stage, set(replaces))
+            _set_mode(stage, target, directory=True)
+            _replace(stage, target, directory=True)
+    finally:
+        shutil.rmtree(stage, ignore_errors=True)
+
+
+def _keep_the_others(target: Path, stage: Path, replaced: set[str]) -> None:
+    """Hard-link (or copy) into ``stage`` every entry of ``target`` that the run did not write, but ``replaced``."""
+    for item in target.iterdir():
+        new = stage / item.name
+        if item.name in replaced and not (new.exists() or new.is_symlink()):
+            continue
+        if new.exists() or new.is_symlink():
+            if new.is_dir() != item.is_dir():
+                kind = "a folder" if item.is_dir() else "a file"
+                raise OutputError(f"cannot write {str(item)!r}: {kind} of that name is in the way")
+            continue
+        if item.is_dir() and not item.is_symlink():
+            shutil.copytree(item, new, symlinks=True, copy_function=_link_or_copy)
+        else:
+            _link_or_copy(item, new)
+
+
+def _link_or_copy(source, destination) -> None:
+    if os.path.islink(source):
+        os.symlink(os.readlink(source), destination)
+        return
+    try:
+        os.link(source, destination)
+    except OSError:  # no hard links on this file system
+        shutil.copy2(source, destination)
+
+
+def _is_mount(target: Path) -> bool:
+    """A folder that is a mount point (e.g. a container's bind mount): it cannot be renamed or replaced."""
+    return target.is_dir() and os.path.ismount(target)
+
+
+def _probe_inside(target: Path) -> None:
+    """Make a staging folder inside ``target`` and move a file from it into ``target``, as the end of a job will."""
+    stage = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".tmp", dir=target))
+    try:
+        probe = stage / "probe"
+        probe.touch()
+        landed = target / f".{stage.name}.probe"
+        os.replace(probe, landed)
+        landed.unlink()
+    finally:
+        shutil.rmtree(stage, ignore_errors=True)
+
+
+@contextlib.contextmanager
+def _filled_in_place(target: Path) -> Iterator[Path]:
+    """Stage inside a mount point and move each file into it at the end.
+
+    A mount point cannot be replaced as a whole, and renames from its parent's file
+    system fail (EXDEV); the files then land one by one, each by an atomic rename, all
+    after the job has finished, and the files already there that the job does not
+    write are kept.
+    """
+    with output_errors(target):
+        stage = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".tmp", dir=target))
+    try:
+        yield stage
+        with output_errors(target):
             for item in sorted(stage.iterdir()):
                 _set_mode(item, target / item.name, item.is_dir())
                 os.replace(item, target / item.name)

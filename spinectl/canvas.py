@@ -1,7 +1,8 @@
-"""Matplotlib figures without pyplot: drawn on the Agg canvas, saved atomically as PNG.
+"""Matplotlib figures without pyplot: drawn on the Agg canvas, saved atomically.
 
 The figure functions of :mod:`spinectl.reflex.plots` and :mod:`spinectl.paper.figures`
-draw on a :func:`new_figure` and return it; :func:`save_png` is the separate save step.
+draw on a :func:`new_figure` and return it; :func:`save_file` (or :func:`save_png`) is the separate save step,
+:func:`save_figures` that of a set of figures into one folder, swapped in as a whole.
 Nothing here selects a backend or touches pyplot's global figure list, so a figure is
 garbage-collected like any object, works without a display, and shows itself in a
 notebook (``display(fig)``).
@@ -14,7 +15,7 @@ from pathlib import Path
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from .atomic import atomic_path
+from .atomic import atomic_path, staged_directory
 
 
 def new_figure(**options) -> Figure:
@@ -36,7 +37,7 @@ def new_figure(**options) -> Figure:
 
 
 def save_png(figure: Figure, path: str | Path, dpi: float) -> Path:
-    """Write ``figure`` as a PNG file atomically (:func:`spinectl.atomic.atomic_path`).
+    """Write ``figure`` as a PNG file atomically (:func:`save_file` for a ``.png`` path).
 
     Parameters
     ----------
@@ -60,3 +61,64 @@ def save_png(figure: Figure, path: str | Path, dpi: float) -> Path:
     with atomic_path(path) as tmp:
         figure.savefig(tmp, format="png", dpi=dpi)
     return Path(path)
+
+
+def save_file(figure: Figure, path: str | Path, dpi: float) -> Path:
+    """Write ``figure`` atomically in the format its suffix names (``.png``, ``.pdf``, ``.svg``, ...).
+
+    Parameters
+    ----------
+    figure : matplotlib.figure.Figure
+        The figure to write.
+    path : str or Path
+        The file; its folder is created if missing.
+    dpi : float
+        Resolution of raster output [dots per inch].
+
+    Returns
+    -------
+    Path
+        ``path``.
+
+    Raises
+    ------
+    OutputError
+        The file cannot be written; a previous file of that name is left as it was.
+    """
+    with atomic_path(path) as tmp:
+        figure.savefig(tmp, format=Path(path).suffix.lower().lstrip(".") or "png", dpi=dpi)
+    return Path(path)
+
+
+def save_figures(figures: dict[str, Figure], folder: str | Path, dpi: float, replaces=()) -> list[Path]:
+    """Write a set of figures into ``folder``, each in the format of its name's suffix: all of them or none.
+
+    They are written into a staging folder that then replaces ``folder`` as a whole
+    (:func:`spinectl.atomic.staged_directory`; the other files of ``folder`` are kept), so
+    an interruption or a full disk half-way leaves no mix of new and old figures.
+
+    Parameters
+    ----------
+    figures : dict of str to matplotlib.figure.Figure
+        File name -> figure.
+    folder : str or Path
+        The output folder; created if missing.
+    dpi : float
+        Resolution of raster output [dots per inch].
+    replaces : iterable of str
+        Names of earlier figures of the set that go even where ``figures`` has none of that name.
+
+    Returns
+    -------
+    list of Path
+        The files written, in the order of ``figures``.
+
+    Raises
+    ------
+    OutputError
+        ``folder`` cannot take the files (checked before the first is written); nothing is written.
+    """
+    with staged_directory(folder, figures, replaces) as stage:
+        for name, figure in figures.items():
+            save_file(figure, stage / name, dpi)
+    return [Path(folder) / name for name in figures]

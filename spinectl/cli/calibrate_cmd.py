@@ -12,7 +12,7 @@ from __future__ import annotations
 import shlex
 import sys
 
-from ..atomic import atomic_write_text, check_writable
+from ..atomic import atomic_write_text, check_distinct, check_writable
 from ..model.config import set_parameter
 from ..paper import calibration, grid
 from ._common import add_model_options, load_model, require
@@ -95,6 +95,7 @@ def run(args) -> int:
     names = [n.strip() for n in args.parameters.split(",")] if args.parameters else None
     parameters = calibration.parameter_set(names)
     conventions = [c.strip() for c in args.conventions.split(",") if c.strip()]
+    check_distinct({"--out": args.out, "--history": args.history}, {"--config": args.config})
     base = load_model(args)
     for path in filter(None, (args.out, args.history)):
         check_writable(path)  # before minutes of fitting

@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import sys
+from pathlib import Path
 
+from ..atomic import check_distinct
 from ..model.config import set_parameter
 from ..reflex.margins import analyse
 from ._common import add_model_options, add_position_options, emit_json, finite_float, load_model
@@ -97,6 +99,10 @@ def run(args) -> int:
     int
         Exit code 0 (also for an infeasible optimum, reported as a status).
     """
+    if args.plot:
+        from ..reflex.plots import PLOT_FILES
+
+        check_distinct({"--plot": [Path(args.plot, name) for name in PLOT_FILES]}, {"--config": args.config})
     model = model_with_overrides(args)
     report = analyse(model, args.E, args.Lambda, kp=args.kp, kd=args.kd)
     if args.plot:

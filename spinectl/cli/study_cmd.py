@@ -3,6 +3,9 @@
 from __future__ import annotations
 
 import argparse
+import sys
+
+from ._common import finite_float
 
 
 def register(sub) -> None:
@@ -27,6 +30,13 @@ def register(sub) -> None:
         metavar="ADDRESS",
         help="an existing dask.distributed scheduler, e.g. tcp://host:8786, or 'synchronous' for "
         "in-process (default: a local cluster on 127.0.0.1, started and closed by the command)",
+    )
+    parser.add_argument(
+        "--worker-timeout",
+        type=finite_float("--worker-timeout"),
+        metavar="SECONDS",
+        help="with --scheduler: how long to wait for a first worker if it has none "
+        "(default: spinectl.landscape.study.run.WORKER_TIMEOUT)",
     )
     parser.add_argument("--workers", type=_positive_int, metavar="N", help="local worker processes (default: cores)")
     parser.add_argument("--resume", action="store_true", help="continue the study in --out, skipping chunks done")
@@ -71,6 +81,9 @@ def run(args) -> int:
 
     spec = study.load_study(args.study)
     options = {"scheduler": args.scheduler, "workers": args.workers, "resume": args.resume}
+    options["notify"] = lambda line: print(line, file=sys.stderr)
+    if args.worker_timeout is not None:
+        options["worker_timeout"] = args.worker_timeout
     result = study.run_study(spec, args.out, max_chunks=args.max_chunks, **options)
     print(study.describe(result))
     return 0

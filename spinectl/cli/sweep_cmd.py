@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import time
 
+from ..atomic import check_distinct
 from ..landscape import sweep
 from ._common import add_model_options, float_list, load_model
 
@@ -53,6 +54,7 @@ def run(args) -> int:
     int
         Exit code 0.
     """
+    check_distinct({"--out": args.out}, {"--config": args.config})
     model = load_model(args)
     e_axis, l_axis = sweep.parse_grid(args.E, "--E"), sweep.parse_grid(args.Lambda, "--Lambda")
     options = {"stiffnesses": args.K, "method": args.method, "chunk_size": args.chunk_size}

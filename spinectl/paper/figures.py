@@ -10,8 +10,9 @@ drawn at the grid's corners (:mod:`spinectl.paper.drawing`), as the paper's corn
 Each figure function draws on a new figure with the Agg
 canvas (:func:`spinectl.canvas.new_figure`: no global backend state, no display
 needed) and returns it, writing nothing; :func:`save_figure` writes one
-atomically as PNG, PDF or SVG, and :func:`draw_figures` draws and saves the set
-(:class:`FigureOptions`: format, resolution, colour range, shared scale, ratio map, insets).
+atomically as PNG, PDF or SVG, :func:`figure_set` draws the set (:class:`FigureOptions`:
+format, colour range, shared scale, ratio map, insets) and :func:`draw_figures` saves it
+as a whole.
 """
 
 from __future__ import annotations
@@ -23,8 +24,7 @@ import numpy as np
 import xarray as xr
 from matplotlib.figure import Figure
 
-from ..atomic import atomic_path
-from ..canvas import new_figure, save_png
+from ..canvas import new_figure, save_figures, save_file
 from ..errors import ParameterError
 from ..landscape import netcdf
 from ..units import M2_PER_CM2
@@ -399,11 +399,7 @@ def save_figure(fig: Figure, path: str | Path, dpi: float = DPI) -> Path:
     suffix = Path(path).suffix.lower().lstrip(".")
     if suffix not in FORMATS:
         raise ParameterError("--out", f"must end in .png, .pdf or .svg (got {str(path)!r})")
-    if suffix == "png":
-        return save_png(fig, path, dpi)
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format=suffix, dpi=dpi)
-    return Path(path)
+    return save_file(fig, path, dpi)
 
 
 def figure_names(stiffness: float, format: str = "png") -> tuple[str, str]:
@@ -419,11 +415,20 @@ def figure_names(stiffness: float, format: str = "png") -> tuple[str, str]:
     Returns
     -------
     tuple of str
-        The names of the minimum-PCSA and the counter-torque figure.
+        The names of the minimum-PCSA and the counter-torque figure: K short (``K15``)
+        where that reads back as K, else every digit of K (``K15.000001``), so that
+        distinct stiffnesses never share a file.
     """
     if stiffness == 0:
         return f"fig3_min_pcsa.{format}", f"fig4_counter_torque.{format}"
-    return f"figS1_min_pcsa_K{stiffness:g}.{format}", f"fig4_counter_torque_K{stiffness:g}.{format}"
+    k = _k_in_name(stiffness)
+    return f"figS1_min_pcsa_K{k}.{format}", f"fig4_counter_torque_K{k}.{format}"
+
+
+def _k_in_name(stiffness: float) -> str:
+    """K as file names write it: short where that reads back as K, else every digit."""
+    short = f"{stiffness:g}"
+    return short if float(short) == stiffness else repr(float(stiffness))
 
 
 def ratio_name(stiffness: float, format: str = "png") -> str:
@@ -441,7 +446,7 @@ def ratio_name(stiffness: float, format: str = "png") -> str:
     str
         E.g. ``figS1_over_fig3_K15.png``.
     """
-    return f"figS1_over_fig3_K{stiffness:g}.{format}"
+    return f"figS1_over_fig3_K{_k_in_name(stiffness)}.{format}"
 
 
 def _pcsa_range(dataset: xr.Dataset, options: FigureOptions) -> tuple[float | None, float | None]:
@@ -463,26 +468,67 @@ def _ratio_stiffnesses(dataset: xr.Dataset) -> list[float]:
     return [k for k in stiffnesses if k > 0]
 
 
-def draw_figures(
-    dataset: xr.Dataset,
-    out_dir: str | Path,
-    specific_tension: float | None = None,
-    options: FigureOptions | None = None,
-) -> list[Path]:
-    """Draw Figures 3 and 4 for every K of ``dataset`` (Figure S1 for K > 0) and save them into ``out_dir``.
+def figure_set(
+    dataset: xr.Dataset, specific_tension: float | None = None, options: FigureOptions | None = None
+) -> dict[str, Figure]:
+    """Figures 3 and 4 for every K of ``dataset`` (Figure S1 for K > 0), by file name; nothing written.
 
     Parameters
     ----------
     dataset : xarray.Dataset
         From :func:`~spinectl.landscape.sweep.sweep` (scalar K) or
         :func:`~spinectl.landscape.sweep.stiffness_sweep` (a K dimension).
-    out_dir : str or Path
-        Folder for the files (created if missing), named by :func:`figure_names` (and :func:`ratio_name`).
     specific_tension : float, optional
         f_iso per PCSA [N/m^2], for the local-PCSA scale of Figure 4; default: that of
         the model the dataset was computed with (:func:`spinectl.landscape.netcdf.model_of`).
     options : FigureOptions, optional
         Format, resolution, colour range, ratio map, insets; default PNG at :data:`DPI`.
+
+    Returns
+    -------
+    dict of str to matplotlib.figure.Figure
+        :func:`figure_names` of each K -> its figure, K in the dataset's order.
+
+    Raises
+    ------
+    ConfigError, ParameterError
+        ``specific_tension`` not given and the dataset's ``config_toml`` is not a valid model.
+    """
+    options = options or FigureOptions()
+    if specific_tension is None:
+        specific_tension = netcdf.model_of(dataset).fibre.specific_tension
+    parts = [dataset.sel(K=k) for k in dataset["K"].values] if "K" in dataset.dims else [dataset]
+    vmin, vmax = _pcsa_range(dataset, options)
+    stiffnesses = _ratio_stiffnesses(dataset) if options.ratio else []
+    drawn = {}
+    for part in parts:
+        pcsa_name, ct_name = figure_names(float(part["K"]), options.format)
+        drawn[pcsa_name] = min_pcsa_figure(part, vmin, vmax, options.insets)
+        drawn[ct_name] = counter_torque_figure(part, specific_tension)
+    for k in stiffnesses:
+        drawn[ratio_name(k, options.format)] = ratio_figure(dataset, k)
+    return drawn
+
+
+def draw_figures(
+    dataset: xr.Dataset,
+    out_dir: str | Path,
+    specific_tension: float | None = None,
+    options: FigureOptions | None = None,
+) -> list[Path]:
+    """Draw :func:`figure_set` and save it into ``out_dir``: all or none (:func:`spinectl.canvas.save_figures`).
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        As for :func:`figure_set`.
+    out_dir : str or Path
+        Folder for the files (created if missing), named by :func:`figure_names` (and
+        :func:`ratio_name`); its other files are kept.
+    specific_tension : float, optional
+        As for :func:`figure_set`.
+    options : FigureOptions, optional
+        As for :func:`figure_set`; its ``dpi`` is the resolution of PNG files.
 
     Returns
     -------
@@ -496,21 +542,7 @@ def draw_figures(
         a bad colour range, or the ratio map without K = 0 and a K > 0; fewer than 2 values
         of E or of Lambda (field ``grid``), before any file is written.
     OutputError
-        A file cannot be written.
+        ``out_dir`` cannot take the files; nothing is written.
     """
     options = options or FigureOptions()
-    if specific_tension is None:
-        specific_tension = netcdf.model_of(dataset).fibre.specific_tension
-    out_dir = Path(out_dir)
-    parts = [dataset.sel(K=k) for k in dataset["K"].values] if "K" in dataset.dims else [dataset]
-    vmin, vmax = _pcsa_range(dataset, options)
-    stiffnesses = _ratio_stiffnesses(dataset) if options.ratio else []
-    written = []
-    for part in parts:
-        pcsa_name, ct_name = figure_names(float(part["K"]), options.format)
-        pcsa_fig = min_pcsa_figure(part, vmin, vmax, options.insets)
-        written.append(save_figure(pcsa_fig, out_dir / pcsa_name, options.dpi))
-        written.append(save_figure(counter_torque_figure(part, specific_tension), out_dir / ct_name, options.dpi))
-    for k in stiffnesses:
-        written.append(save_figure(ratio_figure(dataset, k), out_dir / ratio_name(k, options.format), options.dpi))
-    return written
+    return save_figures(figure_set(dataset, specific_tension, options), out_dir, options.dpi)

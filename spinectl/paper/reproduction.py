@@ -4,8 +4,9 @@ E and Lambda from 0 to 8 cm at 1 mm, K = 0 and K = 15 N m/rad with the
 model's convention for K, and K = 15 with the other convention (for the
 halving landmark; :mod:`spinectl.paper.grid`); the landscapes as NetCDF,
 Figures 3, 4 and S1 as PNG, and a Markdown report with the paper's landmarks
-beside spinectl's and a verdict for each (docs/reproduction.md). Everything is
-staged and moved into the folder at the end (:func:`spinectl.atomic.staged_directory`).
+beside spinectl's and a verdict for each (docs/reproduction.md). The folder is
+checked before the work, everything is staged, and the staging folder replaces
+the output folder as a whole at the end (:func:`spinectl.atomic.staged_directory`).
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ import math
 import time
 from pathlib import Path
 
-from ..atomic import atomic_write_text, check_staged_directory, staged_directory
+from ..atomic import atomic_write_text, check_distinct, check_folder, staged_directory
 from ..errors import ParameterError
 from ..landscape import netcdf, sweep
 from ..model.config import load_config
@@ -26,6 +27,9 @@ DEFAULT_PRESET = verdicts.PRESET
 
 LANDSCAPES = "landscapes.nc"
 """File name of the K = 0 and K = 15 N m/rad landscapes in the output folder."""
+
+REPORT = "report.md"
+"""File name of the landmarks report in the output folder."""
 
 MIN_POINTS = 3
 """Fewest grid points per axis: the corners A-D and one point between them."""
@@ -70,12 +74,13 @@ def reproduce(
     ConfigError
         An unknown preset or a bad configuration file.
     OutputError
-        ``out_dir`` cannot be filled (:func:`spinectl.atomic.check_staged_directory`), before any solve.
+        ``out_dir`` cannot take the output (:func:`spinectl.atomic.check_folder`), before any solve.
     """
     check_points(points)
     if config is None:
         preset = preset or DEFAULT_PRESET
     model = load_config(config, preset=preset)
+    check_distinct({"--out": [Path(out_dir, name) for name in output_names(model)]}, {"--config": config})
     source = f"config file {config}" if config else f"preset `{preset}`"
     calibrated = config is None and preset == verdicts.PRESET
     return reproduce_model(model, out_dir, points=points, source=source, calibrated=calibrated, progress=progress)
@@ -91,6 +96,26 @@ def check_points(points: int) -> None:
     """
     if not MIN_POINTS <= points <= MAX_POINTS:
         raise ParameterError("--points", f"must be {MIN_POINTS} to {MAX_POINTS} per axis (got {points})")
+
+
+def output_names(model: Model) -> tuple[str, ...]:
+    """The files that the study of ``model`` writes into its folder, in the order :func:`reproduce_model` returns them.
+
+    Parameters
+    ----------
+    model : Model
+        Its passive-stiffness convention names the landscape of the other convention.
+
+    Returns
+    -------
+    tuple of str
+        The landscapes, the other convention's landscape, Figures 3, 4 (K = 0) and S1, 4
+        (K = 15 N m/rad), the report.
+    """
+    k15 = grid.PAPER_STIFFNESS
+    other_name = f"landscape_K{k15:g}_{grid.other_convention(model)}.nc"
+    figure_names = [name for k in (0.0, k15) for name in figures.figure_names(k)]
+    return (LANDSCAPES, other_name, *figure_names, REPORT)
 
 
 def reproduce_model(
@@ -127,29 +152,31 @@ def reproduce_model(
     Raises
     ------
     OutputError
-        ``out_dir`` cannot be filled (:func:`spinectl.atomic.check_staged_directory`), before any solve.
+        ``out_dir`` cannot take the output (:func:`spinectl.atomic.check_folder`), before any solve.
     """
-    check_staged_directory(out_dir)  # before minutes of solving: a mount point, a file in the way
     start = time.perf_counter()
     k15 = grid.PAPER_STIFFNESS
-    both, other = grid.paper_landscapes(model, points, progress)
     other_convention = grid.other_convention(model)
+    names = output_names(model)
+    other_name = names[1]
+    check_folder(out_dir, names)  # before minutes of solving
+    both, other = grid.paper_landscapes(model, points, progress)
     measured = landmarks.measure(landmarks.Landmarks(both.sel(K=0.0), both.sel(K=k15), other))
-    other_name = f"landscape_K{k15:g}_{other_convention}.nc"
-    with staged_directory(out_dir) as stage:
+    drawn = figures.figure_set(both, model.fibre.specific_tension)
+    run_facts = report.Run(
+        preset=source or "the given model",
+        convention=model.passive.convention,
+        other_convention=other_convention,
+        points=points,
+        seconds=time.perf_counter() - start,
+        files=names,
+        specific_tension=model.fibre.specific_tension,
+        calibrated=calibrated,
+    )
+    with staged_directory(out_dir, names) as stage:
         netcdf.save(both, stage / LANDSCAPES)
         netcdf.save(other, stage / other_name)
-        drawn = figures.draw_figures(both, stage, model.fibre.specific_tension)
-        names = (LANDSCAPES, other_name, *(f.name for f in drawn), "report.md")
-        run_facts = report.Run(
-            preset=source or "the given model",
-            convention=model.passive.convention,
-            other_convention=other_convention,
-            points=points,
-            seconds=time.perf_counter() - start,
-            files=names,
-            specific_tension=model.fibre.specific_tension,
-            calibrated=calibrated,
-        )
-        atomic_write_text(stage / "report.md", report.render(measured, run_facts))  # UTF-8; a full disk: OutputError
+        for name, figure in drawn.items():
+            figures.save_figure(figure, stage / name)
+        atomic_write_text(stage / REPORT, report.render(measured, run_facts))  # UTF-8; a full disk: OutputError
     return [Path(out_dir) / name for name in names]

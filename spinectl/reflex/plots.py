@@ -21,7 +21,7 @@ import matplotlib
 import numpy as np
 from matplotlib.figure import Figure
 
-from ..canvas import new_figure, save_png
+from ..canvas import new_figure, save_figures, save_png
 from ..model.params import Model
 from .loops import ignoring_underflow
 from .margins import MarginsReport, ReportResponses, report_responses
@@ -251,7 +251,10 @@ def write_plots(report: MarginsReport, folder: str | Path, model: Model) -> list
 
     response.png of every segment with a finite stiffness; bode.png and nyquist.png of
     every non-zero reflex loop. Everything is computed and drawn before the first file
-    is written, so a failure (e.g. a delay too short to simulate) writes nothing.
+    is written, so a failure (e.g. a delay too short to simulate) writes nothing; the
+    files then replace the old ones together (:func:`spinectl.canvas.save_figures`), and a
+    plot of an earlier run that this one does not draw goes with them: the folder never
+    shows a Bode plot of one configuration beside the response of another.
 
     Parameters
     ----------
@@ -272,7 +275,6 @@ def write_plots(report: MarginsReport, folder: str | Path, model: Model) -> list
     ParameterError
         The simulation cannot run at the report's delay.
     OutputError
-        A file cannot be written.
+        A file cannot be written (nothing is written then).
     """
-    figures = report_figures(report, report_responses(model, report))
-    return [save_figure(fig, Path(folder) / name) for name, fig in figures.items()]
+    return save_figures(report_figures(report, report_responses(model, report)), folder, DPI, replaces=PLOT_FILES)

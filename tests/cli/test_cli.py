@@ -103,3 +103,39 @@ def test_module_entry_point_runs_in_a_subprocess():
         check=False,
     )
     assert proc.returncode == 2 and "Traceback" not in proc.stderr and proc.stderr.count("\n") == 1
+
+
+def _preset_file(tmp_path):
+    path = tmp_path / "mine.toml"
+    path.write_text('preset = "default"\n[body]\nmass = 41.0\n')
+    return path
+
+
+@pytest.mark.parametrize(
+    ("argv", "needle"),
+    [
+        (["calibrate", "--out", "{d}/x.toml", "--history", "{d}/x.toml"], "--history: is the same file as --out"),
+        (["calibrate", "--config", "{c}", "--out", "{c}"], "--out: is the same file as --config"),
+        (["calibrate", "--config", "{c}", "--history", "{d}/link.toml"], "--history: is the same file as --config"),
+        (["calibrate", "--out", "{d}/x.toml", "--history", "{d}/sub/../x.toml"], "--history: is the same file as"),
+        (["sweep", "--config", "{c}", "--out", "{d}/link.toml", "--E", "0:0:1", "--Lambda", "0:0:1"], "--out: is"),
+        (["margins", "--config", "{d}/bode.png", "--plot", "{d}"], "--plot: is the same file as --config"),
+        (["reproduce", "--config", "{d}/report.md", "--out", "{d}"], "--out: is the same file as --config"),
+    ],
+)
+def test_an_output_never_replaces_an_input_or_another_output(tmp_path, capsys, argv, needle):
+    """Every spelling of one file (the same name, a symlink, ``sub/..``) is refused before any work, one line.
+
+    Before, ``calibrate --out X --history X`` replaced the preset with the CSV, and
+    ``--config X --out X`` the input with the output.
+    """
+    config = _preset_file(tmp_path)
+    (tmp_path / "link.toml").symlink_to(config)
+    (tmp_path / "sub").mkdir()
+    for name in ("bode.png", "report.md"):
+        (tmp_path / name).write_text(config.read_text())
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir() if p.is_file()}
+    assert main([a.format(d=tmp_path, c=config) for a in argv]) == 2
+    err = capsys.readouterr().err
+    assert needle in err and err.count("\n") == 1
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir() if p.is_file()} == before

@@ -8,6 +8,7 @@ import pathlib
 
 import pytest
 
+from spinectl import atomic
 from spinectl.cli import main
 from spinectl.landscape import netcdf
 from spinectl.paper import figures, grid
@@ -52,7 +53,7 @@ def test_a_failure_leaves_the_output_folder_untouched(tmp_path, monkeypatch, cap
     def broken(*args, **kwargs):
         raise RuntimeError("simulated crash while drawing")
 
-    monkeypatch.setattr(figures, "draw_figures", broken)
+    monkeypatch.setattr(figures, "figure_set", broken)
     out = tmp_path / "results"
     with pytest.raises(RuntimeError):
         main(["reproduce", "--out", str(out), "--points", "3"])
@@ -104,13 +105,15 @@ def _mount_point(target):
 
 
 def test_reproduce_into_a_mount_point(tmp_path, monkeypatch, capsys):
-    """The output folder is a mount point (simulated: renames into it from its parent fail with EXDEV).
+    """The output folder is a mount point (simulated: ``os.path.ismount`` says so, and renames into it
+    from its parent fail with EXDEV).
 
     The staging folder is made inside it, so every file lands by a rename on its own
     file system (before: "Invalid cross-device link" after the whole run).
     """
     out = tmp_path / "mnt"
     out.mkdir()
+    monkeypatch.setattr(atomic, "_is_mount", lambda target: pathlib.Path(target) == out)
     monkeypatch.setattr(os, "replace", _mount_point(out))
     assert main(["reproduce", "--out", str(out), "--points", "3"]) == 0
     assert {p.name for p in out.iterdir()} == EXPECTED
@@ -120,6 +123,7 @@ def test_an_output_folder_that_refuses_renames_fails_before_the_work(tmp_path, m
     """A folder that takes no rename at all (simulated EROFS) is refused before any landscape is solved."""
     out = tmp_path / "mnt"
     out.mkdir()
+    monkeypatch.setattr(atomic, "_is_mount", lambda target: pathlib.Path(target) == out)
     monkeypatch.setattr(os, "replace", _refuse_all(out))
     monkeypatch.setattr(grid, "paper_landscapes", lambda *a: pytest.fail("solved before checking the output"))
     assert main(["reproduce", "--out", str(out), "--points", "3"]) == 2
@@ -138,3 +142,28 @@ def _refuse_all(target):
         return real(src, dst)
 
     return replace
+
+
+def test_a_blocked_name_in_the_output_folder_stops_before_the_work(tmp_path, monkeypatch, capsys):
+    """``report.md`` is a folder: exit 2 before any sweep, every old file as it was.
+
+    Before, the files were moved in one by one at the end, and 6 of the 7 were already
+    the new ones when the seventh failed.
+    """
+    from spinectl.paper import grid
+
+    out = tmp_path / "results"
+    (out / "report.md").mkdir(parents=True)
+    old = {name: f"old {name}".encode() for name in EXPECTED - {"report.md"}}
+    for name, content in old.items():
+        (out / name).write_bytes(content)
+
+    def no_sweep(*args, **kwargs):
+        raise AssertionError("the sweeps must not start")
+
+    monkeypatch.setattr(grid, "paper_landscapes", no_sweep)
+    assert main(["reproduce", "--out", str(out), "--points", "3"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "report.md': Is a directory" in err
+    assert {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()} == old
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["results"]

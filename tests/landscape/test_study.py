@@ -7,6 +7,7 @@ the very same stacked problems: the answers must agree bit for bit.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import subprocess
@@ -264,7 +265,7 @@ def test_an_existing_cluster_by_its_address(reference, tmp_path):
     with LocalCluster(n_workers=1, threads_per_worker=1, host="127.0.0.1", dashboard_address=None) as cluster:
         address = cluster.scheduler_address
         result = study.run_study(study.parse_study(STUDY), tmp_path / "s.zarr", scheduler=address, progress=False)
-        assert result.where == address and len(cluster.scheduler_info["workers"]) == 1
+        assert result.where == f"{address} (1 worker)" and len(cluster.scheduler_info["workers"]) == 1
     xr.testing.assert_identical(study.load(tmp_path / "s.zarr"), reference)
 
 
@@ -428,3 +429,165 @@ def test_an_attachment_on_a_centre_of_rotation_inside_the_grid_stops_the_study_b
     with pytest.raises(ModelError, match="at E = 0 m, Lambda = 0 m.*study combination muscles.0.lower.0 = 0.0"):
         study.parse_study(text)
     assert list(tmp_path.iterdir()) == []
+
+
+# --- faults: one store per run, lost chunks, schedulers that are not (tests of docs/robustness.md) -----------
+
+
+def test_a_second_run_on_the_same_store_is_refused_while_the_first_runs(reference, tmp_path):
+    """Two fresh runs on one store: the second starts while the first is past its existence check.
+
+    The second is started from inside the first's ``store.create`` (the moment at which both
+    used to have passed the check); it must stop at once naming the first, and the first
+    must finish its store whole (every chunk of the reference, written once).
+    """
+    parsed, out = study.parse_study(STUDY), tmp_path / "s.zarr"
+    create, refusals = study_store.create, []
+
+    def create_with_a_rival(*args):
+        with pytest.raises(OutputError, match=f"in use by another study run \\(process {os.getpid()} ") as info:
+            study.run_study(parsed, out, scheduler="synchronous", progress=False)
+        refusals.append(str(info.value))
+        return create(*args)
+
+    study_store.create = create_with_a_rival
+    try:
+        study.run_study(parsed, out, scheduler="synchronous", progress=False)
+    finally:
+        study_store.create = create
+    assert len(refusals) == 1 and len(refusals[0].splitlines()) == 1
+    xr.testing.assert_identical(study.load(out), reference)
+    assert not Path(f"{out}.lock").exists()
+
+
+def test_a_stale_lock_of_a_dead_process_is_taken_over(tmp_path):
+    """A lock of a process that has ended (on this host) is taken over; one of another host is not."""
+    import socket
+
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()  # its pid is free now (reuse within the test is astronomically unlikely)
+    out = tmp_path / "s.zarr"
+    lock = Path(f"{out}.lock")
+    lock.write_text(f"{dead.pid} {socket.gethostname()}\n")
+    parsed = study.parse_study(STUDY)
+    result = study.run_study(parsed, out, scheduler="synchronous", max_chunks=1, progress=False)
+    assert result.computed == 1 and not lock.exists()
+    lock.write_text(f"{dead.pid} another-host.invalid\n")
+    with pytest.raises(OutputError, match=f"process {dead.pid} on host another-host.invalid"):
+        study.run_study(parsed, out, scheduler="synchronous", resume=True, progress=False)
+    assert lock.read_text() == f"{dead.pid} another-host.invalid\n"  # not the refused run's to remove
+
+
+def delete_chunk_file(out: Path, name: str, key: str) -> None:
+    """Remove one chunk file of a finished store (and the consolidated metadata is left as it was)."""
+    (out / name / key).unlink()
+
+
+def test_a_lost_chunk_file_is_refused_on_load_and_recomputed_on_resume(reference, tmp_path):
+    """Chunk 5 of STUDY (combination (0, 1), third tile of E) is key 0.1.2.0 of min_pcsa_cm2.
+
+    The key follows from the layout: combinations outer (K index 0, mass index 1), the
+    three tiles of two E rows inner (5 = 1 * 3 + 2, so E tile 2: rows 4 and 5), one Lambda tile.
+    """
+    parsed, out = study.parse_study(STUDY), tmp_path / "s.zarr"
+    study.run_study(parsed, out, scheduler="synchronous", progress=False)
+    assert parsed.chunk(5).combination == (0, 1) and parsed.chunk(5).eccentricity == slice(4, 6)
+    delete_chunk_file(out, "min_pcsa_cm2", "0.1.2.0")
+    with pytest.raises(ParameterError, match=r"1 chunk\(s\) counted done have lost their data \(chunk 5\)"):
+        study.load(out)
+    notes = []
+    result = study.run_study(parsed, out, scheduler="synchronous", resume=True, progress=False, notify=notes.append)
+    assert (result.done_before, result.computed) == (11, 1) and "computing it again" in notes[0]
+    xr.testing.assert_identical(study.load(out), reference)
+    group = zarr.open_group(out, mode="r+")  # a store made before every chunk was a file: not checked
+    del group.attrs[study_store.CHUNK_FILES]
+    delete_chunk_file(out, "min_pcsa_cm2", "0.1.2.0")
+    assert np.isnan(study.open_store(out)["min_pcsa_cm2"].values).sum() == TILE_POINTS
+
+
+def test_an_all_nan_chunk_is_still_a_file(tmp_path):
+    """A chunk whose values are all fill values (every point infeasible: pcsa_max tiny) is written as a file.
+
+    Without ``write_empty_chunks`` zarr would skip it, and the check of lost chunks could
+    not tell it from a deleted one.
+    """
+    text = f"[study]\noutputs = ['min_pcsa_cm2']\n[model]\nbody.mass = 40.0\n[axes]\n{GRID}"
+    parsed = study.parse_study(text.replace("[model]\n", "[model]\noptimisation.pcsa_max = 1e-6\n"))
+    out = tmp_path / "s.zarr"
+    study.run_study(parsed, out, scheduler="synchronous", progress=False)
+    loaded = study.load(out)
+    assert np.isnan(loaded["min_pcsa_cm2"].values).all() and (out / "min_pcsa_cm2" / "0.0").is_file()
+
+
+@pytest.fixture
+def http_server():
+    """A plain HTTP server on 127.0.0.1 (something that listens but is no Dask scheduler), closed after."""
+    import http.server
+    import threading
+
+    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), http.server.BaseHTTPRequestHandler)
+    thread = threading.Thread(target=server.serve_forever, daemon=True)
+    thread.start()
+    yield f"tcp://127.0.0.1:{server.server_address[1]}"
+    server.shutdown()
+    server.server_close()
+
+
+def test_something_else_than_a_scheduler_gives_up_in_time(http_server, tmp_path):
+    """An HTTP server at the address: one ParameterError after ``connect_timeout``, no store, no lock."""
+    start = time.monotonic()
+    with pytest.raises(ParameterError, match="cannot connect to .*no answer of a Dask scheduler within 1 s"):
+        study.run_study(study.parse_study(STUDY), tmp_path / "s.zarr", scheduler=http_server, connect_timeout=1.0)
+    assert time.monotonic() - start < 10
+    assert not (tmp_path / "s.zarr").exists() and not (tmp_path / "s.zarr.lock").exists()
+
+
+def test_a_scheduler_without_workers_stops_after_the_worker_timeout(tmp_path, capsys):
+    """A scheduler with no worker: the CLI says so, waits --worker-timeout, then one line, exit 2, no store."""
+    from distributed import LocalCluster
+
+    options = {"processes": False, "protocol": "tcp://", "host": "127.0.0.1", "dashboard_address": None}
+    with LocalCluster(n_workers=0, **options) as cluster:
+        address = cluster.scheduler_address
+        arguments = ["study", str(write(tmp_path)), "--out", str(tmp_path / "s.zarr"), "--scheduler", address]
+        start = time.monotonic()
+        code = main([*arguments, "--worker-timeout", "0.5"])
+        elapsed = time.monotonic() - start
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and elapsed < 10
+    assert err[0] == f"study: {address} (0 workers)" and "waiting up to 0.5 s" in err[1]
+    assert err[-1].startswith(f"spinectl: error: scheduler: {address} has no worker, and none joined within 0.5 s")
+    assert not (tmp_path / "s.zarr").exists()
+
+
+@pytest.mark.parametrize("scheme", ["ucx", "inproc", "tls", "ws", "wss"])
+def test_schemes_spinectl_cannot_use_are_refused_with_the_reason(tmp_path, capsys, scheme):
+    address = f"{scheme}://127.0.0.1:8786"
+    code = main(["study", str(write(tmp_path)), "--out", str(tmp_path / "s.zarr"), "--scheduler", address])
+    err = capsys.readouterr().err
+    assert code == 2 and len(err.strip().splitlines()) == 1
+    assert f"(got '{address}'): {scheme}:// {study.run.UNUSABLE_SCHEMES[scheme]}" in err
+
+
+def test_ctrl_c_while_the_local_cluster_starts_is_one_line(tmp_path):
+    """SIGINT to the whole process group (as a terminal's Ctrl-C) once the first worker process exists.
+
+    Its worker processes used to print their own KeyboardInterrupt tracebacks, and
+    closing the half-started cluster raised an AssertionError.
+    """
+    out = tmp_path / "s.zarr"
+    command = [sys.executable, "-m", "spinectl", "study", str(write(tmp_path)), "--out", str(out), "--workers", "2"]
+    env = os.environ | {"PYTHONPATH": str(ROOT)}
+    proc = subprocess.Popen(command, cwd=ROOT, env=env, start_new_session=True, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline and proc.poll() is None and not psutil.Process(proc.pid).children():
+            time.sleep(0.01)
+        os.killpg(proc.pid, signal.SIGINT)
+        err = proc.communicate(timeout=60)[1]
+    finally:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait()
+    assert (proc.returncode, err) == (130, "spinectl: interrupted\n")
+    assert not Path(f"{out}.lock").exists()

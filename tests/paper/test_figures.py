@@ -196,3 +196,75 @@ def test_plot_command_options_write_vector_files(results, tmp_path, capsys):
     capsys.readouterr()
     assert main(["plot", str(results), "--out", str(tmp_path / "x"), "--dpi", "0"]) == 2
     assert "--dpi" in capsys.readouterr().err and not (tmp_path / "x").exists()
+
+
+def test_an_interrupted_plot_leaves_the_old_figures_not_a_mix(results, tmp_path, monkeypatch, capsys):
+    """Ctrl-C while the third of four figures is saved: the folder holds the old four, byte for byte.
+
+    Before, the first two were already the new ones. A file of the user's in the folder is kept
+    by the run that finishes, and no staging folder is left beside it.
+    """
+    from spinectl import canvas
+
+    out = tmp_path / "figs"
+    assert main(["plot", str(results), "--out", str(out)]) == 0
+    (out / "notes.txt").write_text("mine")
+    for name in figures.figure_names(0.0) + figures.figure_names(15.0):
+        (out / name).write_bytes(b"old " + name.encode())  # old figures that a new run would change
+    old = {p.name: p.read_bytes() for p in out.iterdir()}
+    save, calls = canvas.save_file, []
+
+    def interrupted(figure, path, dpi):
+        calls.append(path)
+        if len(calls) == 3:
+            raise KeyboardInterrupt
+        return save(figure, path, dpi)
+
+    monkeypatch.setattr(canvas, "save_file", interrupted)
+    assert main(["plot", str(results), "--out", str(out)]) == 130
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == old
+    assert [p.name for p in tmp_path.iterdir()] == ["figs"]
+    monkeypatch.setattr(canvas, "save_file", save)
+    assert main(["plot", str(results), "--out", str(out)]) == 0
+    assert (out / "notes.txt").read_text() == "mine" and _non_trivial(out / "fig3_min_pcsa.png")
+    assert [p.name for p in tmp_path.iterdir()] == ["figs"]
+
+
+def test_plot_into_a_folder_with_a_folder_in_a_figure_s_place_writes_nothing(results, tmp_path, capsys):
+    """``fig4_counter_torque.png`` is a folder: refused before drawing, one line, the folder as it was."""
+    out = tmp_path / "figs"
+    (out / "fig4_counter_torque.png").mkdir(parents=True)
+    (out / "fig3_min_pcsa.png").write_bytes(b"old")
+    assert main(["plot", str(results), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "fig4_counter_torque.png': Is a directory" in err
+    assert (out / "fig3_min_pcsa.png").read_bytes() == b"old" and sorted(tmp_path.iterdir()) == [out]
+
+
+def test_a_link_to_the_output_folder_stays_a_link(results, tmp_path):
+    """``--out link`` with link -> real: the figures go into real, the link is left as it is."""
+    (tmp_path / "real").mkdir()
+    (tmp_path / "link").symlink_to(tmp_path / "real")
+    assert main(["plot", str(results), "--out", str(tmp_path / "link")]) == 0
+    assert (tmp_path / "link").is_symlink() and (tmp_path / "real" / "fig3_min_pcsa.png").is_file()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["link", "real"]
+
+
+def test_the_working_directory_is_not_replaced_as_an_output_folder(results, tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    assert main(["plot", str(results), "--out", "."]) == 2
+    assert "it is the working directory or holds it" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(("stiffness", "near"), [(15.0, 15.000001), (1e-7, 1.0000001e-7), (123456.0, 123456.5)])
+def test_distinct_stiffnesses_give_distinct_figure_names(stiffness, near):
+    """``f"{K:g}"`` keeps 6 digits: 15 and 15.000001 (and 123456 and 123456.5) used to share a file name.
+
+    The names must also read back as their K: the part after 'K' parses to the float given.
+    """
+    names = [figures.figure_names(k) for k in (stiffness, near)]
+    assert len(set(names[0]) | set(names[1])) == 4
+    for k, (pcsa, _) in zip((stiffness, near), names, strict=True):
+        assert float(pcsa.removeprefix("figS1_min_pcsa_K").removesuffix(".png")) == k
+    assert figures.figure_names(15.0) == ("figS1_min_pcsa_K15.png", "fig4_counter_torque_K15.png")

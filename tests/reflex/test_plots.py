@@ -76,10 +76,18 @@ def test_write_plots_of_a_reflex_only_report(tmp_path, model):
 
 
 def test_write_plots_without_a_loop_writes_the_response_only(tmp_path, model):
-    """Activation 1: self-stable, the rule gives kp = kd = 0, so there is no loop to draw."""
+    """Activation 1: self-stable, the rule gives kp = kd = 0, so there is no loop to draw.
+
+    Into a folder with the plots of an earlier run (activation 0) and a file of the
+    user's: the earlier Bode and Nyquist plots go (they showed another configuration),
+    the user's file stays.
+    """
+    plots.write_plots(margins.analyse(_reflex(model, activation=0.0, sim_duration=0.3), 0.03, 0.04), tmp_path, model)
+    (tmp_path / "notes.txt").write_text("mine")
     model = _reflex(model, activation=1.0, sim_duration=0.3)
     written = plots.write_plots(margins.analyse(model, 0.03, 0.04), tmp_path, model)
     assert [p.name for p in written] == ["response.png"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["notes.txt", "response.png"]
 
 
 def test_report_figures_draw_the_responses_they_are_given(model):

@@ -8,6 +8,12 @@ Where the chunks run (:func:`run_study`):
   whatever happens. A study with at most one chunk left runs in-process.
 - ``scheduler="synchronous"``: in-process, one chunk after another.
 - ``scheduler="tcp://host:port"``: an existing cluster; its workers need the same spinectl.
+  The connection and the handshake give up after ``connect_timeout`` (anything that
+  listens there but is no Dask scheduler included), and the run waits at most
+  ``worker_timeout`` for a first worker, before the store is made.
+
+The store is locked for the run (:func:`spinectl.landscape.study.store.locked`): a
+second run on the same store stops at once with a line naming the first.
 
 The client writes every finished chunk (:class:`spinectl.landscape.study.store.Writer`) and
 keeps at most two chunks per worker thread submitted, so neither the
@@ -20,11 +26,12 @@ from __future__ import annotations
 import contextlib
 import itertools
 import logging
+import math
 import os
 import re
 import signal
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -41,11 +48,23 @@ from .spec import Study
 SYNCHRONOUS = "synchronous"
 """The ``scheduler`` that runs every chunk in this process, one after another."""
 
-ADDRESS = re.compile(r"^(tcp|tls|ucx|inproc|ws|wss)://\S+$")
-"""A ``dask.distributed`` scheduler address."""
+ADDRESS = re.compile(r"^tcp://\S+$")
+"""A ``dask.distributed`` scheduler address that spinectl can use: plain TCP."""
+
+UNUSABLE_SCHEMES = {
+    "tls": "needs certificates, which spinectl does not configure",
+    "wss": "needs certificates, which spinectl does not configure",
+    "ws": "is not tested with spinectl (its listener binds every interface): use tcp://",
+    "ucx": "needs ucx-py, which spinectl does not install",
+    "inproc": "reaches only a scheduler inside this process",
+}
+"""The other schemes of ``dask.distributed`` addresses, and why a study cannot use them."""
 
 CONNECT_TIMEOUT = 10.0
-"""Seconds to wait for a remote scheduler before giving up [s]."""
+"""Seconds to wait for a remote scheduler's answer (connection and handshake) before giving up [s]."""
+
+WORKER_TIMEOUT = 60.0
+"""Seconds to wait for the first worker of a remote scheduler that has none [s]."""
 
 MALLOC_TRIM_SETTING = "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_"
 """Dask sets ``MALLOC_TRIM_THRESHOLD_=65536`` in its workers so that glibc hands freed memory back at
@@ -178,6 +197,8 @@ def run_study(
     max_chunks: int | None = None,
     progress: bool | None = None,
     connect_timeout: float = CONNECT_TIMEOUT,
+    worker_timeout: float = WORKER_TIMEOUT,
+    notify: Callable[[str], None] | None = None,
 ) -> StudyResult:
     """Run ``study`` into the Zarr store ``out``: every chunk not yet done, written as it finishes.
 
@@ -199,7 +220,12 @@ def run_study(
     progress : bool or None
         A progress bar of chunks on stderr; None: only on a terminal.
     connect_timeout : float
-        Seconds to wait for a remote ``scheduler`` [s].
+        Seconds to wait for a remote ``scheduler``'s answer, connection and handshake [s].
+    worker_timeout : float
+        Seconds to wait for the first worker of a remote ``scheduler`` that has none [s].
+    notify : callable or None
+        Called with a line of text for what the user should know while it runs (a
+        remote scheduler's worker count, a wait for a worker, chunks found missing).
 
     Returns
     -------
@@ -210,29 +236,39 @@ def run_study(
     Raises
     ------
     ParameterError
-        Bad ``scheduler``, ``workers`` or ``max_chunks``; an unreachable scheduler; ``resume`` of a foreign store.
+        Bad ``scheduler``, ``workers`` or ``max_chunks``; an unreachable scheduler, something
+        else than a scheduler at its address, or no worker within ``worker_timeout``;
+        ``resume`` of a foreign store.
     OutputError
-        ``out`` exists and ``resume`` is false, or it cannot be written.
+        ``out`` exists and ``resume`` is false, it cannot be written, or another run holds it.
     """
-    _check_options(scheduler, workers, max_chunks)
+    timeouts = {"connect_timeout": connect_timeout, "worker_timeout": worker_timeout}
+    _check_options(scheduler, workers, max_chunks, timeouts)
     start = time.perf_counter()
-    done = store.existing(study, out, resume)  # before the cluster starts: a refusal costs nothing
-    indices = np.arange(study.n_chunks) if done is None else np.flatnonzero(done == 0)
-    todo = indices[: None if max_chunks is None else max_chunks]
-    with _executor(scheduler, workers, todo.size, connect_timeout) as executor:
-        if done is None:  # after connecting: an unreachable scheduler leaves no store behind
-            done = store.create(study, out, _probe(study))
-        done_before = int(np.count_nonzero(done))
-        writer = store.Writer(study, out, done)
-        bar = tqdm(total=study.n_chunks, initial=done_before, unit="chunk", desc="study", disable=_disabled(progress))
-        with bar:
-            for index, outputs in executor.run(tasks(study, todo), f"spinectl-{study.digest()[:16]}"):
-                writer.write(study.chunk(index), outputs)
-                bar.update()
-    if np.all(done > 0):
-        store.consolidate(out)
+    notify = notify or (lambda line: None)
+    with store.locked(out):  # before the existence check: two runs cannot both pass it
+        done = store.existing(study, out, resume, notify)  # before the cluster starts: a refusal costs nothing
+        indices = np.arange(study.n_chunks) if done is None else np.flatnonzero(done == 0)
+        todo = indices[: None if max_chunks is None else max_chunks]
+        with _executor(scheduler, workers, todo.size, tuple(timeouts.values()), notify) as executor:
+            if done is None:  # after connecting: an unreachable scheduler leaves no store behind
+                done = store.create(study, out, _probe(study))
+            done_before = int(np.count_nonzero(done))
+            _run_chunks(study, out, done, executor.run(tasks(study, todo), f"spinectl-{study.digest()[:16]}"), progress)
+        if np.all(done > 0):
+            store.consolidate(out)
     seconds = time.perf_counter() - start
     return StudyResult(Path(out), study.n_chunks, done_before, todo.size, seconds, executor.where, executor.addresses)
+
+
+def _run_chunks(study: Study, out, done: np.ndarray, results, progress: bool | None) -> None:
+    """Write each chunk of ``results`` as it comes, with a progress bar of the whole study."""
+    writer = store.Writer(study, out, done)
+    initial = int(np.count_nonzero(done))
+    with tqdm(total=study.n_chunks, initial=initial, unit="chunk", desc="study", disable=_disabled(progress)) as bar:
+        for index, outputs in results:
+            writer.write(study.chunk(index), outputs)
+            bar.update()
 
 
 def _probe(study: Study) -> dict[str, np.ndarray]:
@@ -246,10 +282,12 @@ def _disabled(progress: bool | None) -> bool | None:
     return None if progress is None else not progress  # None: tqdm shows it on a terminal only
 
 
-def _check_options(scheduler, workers, max_chunks) -> None:
+def _check_options(scheduler, workers, max_chunks, timeouts: dict) -> None:
     if scheduler is not None and not (scheduler == SYNCHRONOUS or ADDRESS.match(str(scheduler))):
         allowed = f"{SYNCHRONOUS!r} or a dask.distributed address such as tcp://host:8786"
-        raise ParameterError("scheduler", f"must be {allowed} (got {scheduler!r})")
+        scheme = str(scheduler).partition("://")[0]
+        why = f": {scheme}:// {UNUSABLE_SCHEMES[scheme]}" if scheme in UNUSABLE_SCHEMES else ""
+        raise ParameterError("scheduler", f"must be {allowed} (got {scheduler!r}){why}")
     if workers is not None:
         if scheduler is not None:
             raise ParameterError("workers", "sets the size of the local cluster: not with a scheduler")
@@ -259,6 +297,9 @@ def _check_options(scheduler, workers, max_chunks) -> None:
             raise ParameterError("workers", f"must be {allowed} (got {workers!r})")
     if max_chunks is not None and (isinstance(max_chunks, bool) or not isinstance(max_chunks, int) or max_chunks < 0):
         raise ParameterError("max_chunks", f"must be an integer >= 0 (got {max_chunks!r})")
+    for name, seconds in timeouts.items():
+        if isinstance(seconds, bool) or not isinstance(seconds, int | float) or not 0 < seconds < math.inf:
+            raise ParameterError(name, f"must be a number of seconds > 0 (got {seconds!r})")
 
 
 def _cores() -> int:
@@ -304,39 +345,124 @@ class _Distributed:
 
 
 @contextlib.contextmanager
-def _executor(scheduler: str | None, workers: int | None, n_todo: int, connect_timeout: float):
+def _executor(scheduler: str | None, workers: int | None, n_todo: int, timeouts: tuple[float, float], notify):
     if scheduler == SYNCHRONOUS or (scheduler is None and n_todo <= 1):
         yield _InProcess()
         return
-    import dask
-    from distributed import Client, LocalCluster
-
     if scheduler is not None:
-        try:
-            client = Client(scheduler, timeout=connect_timeout, set_as_default=False)
-        except (OSError, TimeoutError) as exc:
-            raise ParameterError("scheduler", f"cannot connect to {scheduler}: {exc}") from None
-        with client:
-            yield _Distributed(client, scheduler)
+        with _remote(scheduler, *timeouts, notify) as client:
+            yield _Distributed(client, _where(scheduler, len(client.scheduler_info()["workers"])))
         return
     n = min(workers or _cores(), n_todo)
-    with dask.config.set({MALLOC_TRIM_SETTING: None}):  # unset in the workers' environment, see MALLOC_TRIM_SETTING
-        cluster = LocalCluster(
-            n_workers=n,
-            threads_per_worker=1,  # cvxpy is not thread-safe; one process per worker
-            processes=True,
-            host="127.0.0.1",  # loopback only: nothing listens on another address
-            dashboard_address=None,
-            silence_logs=logging.ERROR,
-        )
-    with cluster, Client(cluster, set_as_default=False) as client:
-        client.run(_ignore_interrupts)
+    with _local_cluster(n) as client:
         yield _Distributed(client, f"{n} local worker{'s' * (n != 1)}")
 
 
-def _ignore_interrupts() -> None:
-    """In a local worker: leave Ctrl-C to the command, which closes the cluster (no worker tracebacks)."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
+def _where(scheduler: str, n_workers: int) -> str:
+    return f"{scheduler} ({n_workers} worker{'s' * (n_workers != 1)})"
+
+
+@contextlib.contextmanager
+def _local_cluster(n: int):
+    """A client of a new local cluster of ``n`` single-threaded worker processes on 127.0.0.1, closed after.
+
+    Ctrl-C is held (SIGINT blocked) while the cluster starts and while it closes, and acts
+    in between: the worker processes inherit the blocked signal, so they print no
+    tracebacks of their own, and distributed is never asked to close a half-started
+    cluster (it asserts then).
+    """
+    import dask
+    from distributed import Client, LocalCluster
+
+    previous = _block_interrupts()
+    try:
+        with dask.config.set({MALLOC_TRIM_SETTING: None}):  # unset in the workers' environment, see there
+            cluster = LocalCluster(
+                n_workers=n,
+                threads_per_worker=1,  # cvxpy is not thread-safe; one process per worker
+                processes=True,
+                host="127.0.0.1",  # loopback only: nothing listens on another address
+                dashboard_address=None,
+                # no dashboard, but the scheduler's HTTP server (health routes) would take port 8787 and
+                # warn on stderr when another cluster has it: a free loopback port instead
+                scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
+                silence_logs=logging.ERROR,
+            )
+        try:
+            client = Client(cluster, set_as_default=False)
+            try:
+                _restore_interrupts(previous)  # a Ctrl-C of the start-up acts here
+                yield client
+            finally:
+                _block_interrupts()
+                client.close()
+        finally:
+            cluster.close()
+    finally:
+        _restore_interrupts(previous)
+
+
+def _block_interrupts():
+    """Block SIGINT in this thread (and so in the threads and processes it starts); return the previous mask."""
+    return signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT}) if hasattr(signal, "pthread_sigmask") else None
+
+
+def _restore_interrupts(previous) -> None:
+    """Restore the mask from :func:`_block_interrupts`: a SIGINT that came meanwhile is delivered now."""
+    if previous is not None:
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+
+
+@contextlib.contextmanager
+def _remote(scheduler: str, connect_timeout: float, worker_timeout: float, notify):
+    """A client of the scheduler at ``scheduler``, once it has answered and has a worker."""
+    from distributed import Client
+
+    n_workers = _handshake(scheduler, connect_timeout)
+    notify(f"study: {_where(scheduler, n_workers)}")
+    try:
+        client = Client(scheduler, timeout=connect_timeout, set_as_default=False)
+    except (OSError, TimeoutError) as exc:
+        raise ParameterError("scheduler", f"cannot connect to {scheduler}: {exc}") from None
+    with client:
+        if not n_workers:
+            notify(f"study: waiting up to {worker_timeout:g} s for a worker of {scheduler}")
+            try:
+                client.wait_for_workers(1, timeout=worker_timeout)
+            except TimeoutError:
+                raise ParameterError(
+                    "scheduler",
+                    f"{scheduler} has no worker, and none joined within {worker_timeout:g} s: start one "
+                    f"(dask worker {scheduler}) or wait longer (--worker-timeout)",
+                ) from None
+        yield client
+
+
+def _handshake(scheduler: str, timeout: float) -> int:
+    """Ask the scheduler who it is, within ``timeout`` [s] in all; return its number of workers.
+
+    ``distributed.Client`` bounds the TCP connection but not every read of the
+    handshake after it: something that listens but is no Dask scheduler (an HTTP
+    server) would keep it waiting for ever.
+    """
+    import asyncio
+
+    from distributed.core import rpc
+
+    async def identity():
+        async with rpc(scheduler, timeout=timeout) as remote:
+            return await remote.identity()
+
+    try:
+        info = asyncio.run(asyncio.wait_for(identity(), timeout))
+    except TimeoutError:
+        reason = f"no answer of a Dask scheduler within {timeout:g} s (is it one?)"
+        raise ParameterError("scheduler", f"cannot connect to {scheduler}: {reason}") from None
+    except (OSError, ValueError, TypeError) as exc:  # refused, unreachable, garbage instead of a handshake
+        raise ParameterError("scheduler", f"cannot connect to {scheduler}: {exc}") from None
+    if not isinstance(info, dict) or info.get("type") != "Scheduler":
+        raise ParameterError("scheduler", f"cannot connect to {scheduler}: it answers, but is no Dask scheduler")
+    return int(info.get("n_workers", len(info.get("workers", ()))))
 
 
 def describe(result: StudyResult) -> str:

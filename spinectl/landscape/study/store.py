@@ -11,11 +11,22 @@ Zarr format 2: its specification covers the fixed-width strings of the status
 variables and coordinates; zarr-python 3.1 writes those in format 3 only with a
 warning that format 3 has no specification for them yet. Every Zarr file is
 written atomically (zarr's local store writes a temporary and renames it), so a
-killed run leaves whole chunks or none.
+killed run leaves whole chunks or none. Every chunk is written as a file, also
+one of fill values only (``write_empty_chunks``), so that a chunk counted done
+has a file of each output: a resume and :func:`open_store` check that it does
+(:func:`missing_chunks`).
+
+A run holds the store's lock file (:func:`locked`), ``<store>.lock`` beside it,
+from before the existence check to its end: a second run on the same store is
+refused at once, naming the first.
 """
 
 from __future__ import annotations
 
+import contextlib
+import os
+import socket
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import numpy as np
@@ -23,7 +34,7 @@ import xarray as xr
 import zarr
 
 from ... import __version__
-from ...atomic import atomic_path
+from ...atomic import atomic_path, output_errors
 from ...errors import OutputError, ParameterError
 from ...model import config
 from ...model._toml import field_metadata
@@ -32,6 +43,10 @@ from .spec import SAMPLE, STORE_FORMAT, Chunk, Study
 
 DONE = "chunk_done"
 """The per-chunk counter of writes."""
+
+CHUNK_FILES = "every_chunk_a_file"
+"""The attribute that says every chunk written is a file (``write_empty_chunks``); stores made before
+it may lack the files of chunks of fill values only, so their chunks are not checked (:func:`missing_chunks`)."""
 
 STRING_WIDTH = 32
 """Characters of the fixed-width status strings; the longest status has 22."""
@@ -144,10 +159,13 @@ def _attributes(study: Study) -> dict:
         "study_toml": study.text,
         "config_toml": config.dump_toml(study.model),
         "chunk_tile": list(study.tile),
+        CHUNK_FILES: True,
     }
 
 
-def existing(study: Study, path: str | Path, resume: bool) -> np.ndarray | None:
+def existing(
+    study: Study, path: str | Path, resume: bool, notify: Callable[[str], None] = lambda line: None
+) -> np.ndarray | None:
     """The write count of every chunk of an existing store; None if there is none yet.
 
     An existing store is never replaced: it is filled in place, chunk by chunk
@@ -162,11 +180,14 @@ def existing(study: Study, path: str | Path, resume: bool) -> np.ndarray | None:
         The store (a folder).
     resume : bool
         Continue an existing store.
+    notify : callable
+        Told (a line of text) of chunks counted done whose data is missing: they count 0, to be computed again.
 
     Returns
     -------
     numpy.ndarray of int, shape (n_chunks,) or None
-        How many times each chunk was written (0: not yet); None if ``path`` does not exist.
+        How many times each chunk was written (0: not yet, or counted done but its data is
+        missing, :func:`missing_chunks`); None if ``path`` does not exist.
 
     Raises
     ------
@@ -183,7 +204,12 @@ def existing(study: Study, path: str | Path, resume: bool) -> np.ndarray | None:
             f"{str(path)!r} exists: add --resume to continue the study it holds, or remove it to start "
             "afresh (a study store is filled in place and never replaced, which would discard its chunks)"
         )
-    return _done_counts(study, path)
+    counts = _done_counts(study, path)
+    missing = missing_chunks(path, counts)
+    if missing.size:
+        notify(f"study: {_missing_text(path, missing)}; computing {'it' if missing.size == 1 else 'them'} again")
+        counts[missing] = 0
+    return counts
 
 
 def create(study: Study, path: str | Path, probe: dict) -> np.ndarray:
@@ -209,7 +235,9 @@ def create(study: Study, path: str | Path, probe: dict) -> np.ndarray:
         The store cannot be created.
     """
     with atomic_path(path, directory=True) as tmp:
-        template(study, probe).to_zarr(tmp, mode="w", compute=False, zarr_format=ZARR_FORMAT, consolidated=False)
+        template(study, probe).to_zarr(
+            tmp, mode="w", compute=False, zarr_format=ZARR_FORMAT, consolidated=False, write_empty_chunks=True
+        )
     return np.zeros(study.n_chunks, dtype=int)
 
 
@@ -267,7 +295,7 @@ class Writer:
         )
         region = {dim: slice(i, i + 1) for dim, i in zip(self.study.dims, chunk.combination, strict=True)}
         region |= {"E": chunk.eccentricity, "Lambda": chunk.lordosis}
-        part.to_zarr(self.path, region=region, consolidated=False, zarr_format=ZARR_FORMAT)
+        part.to_zarr(self.path, region=region, consolidated=False, zarr_format=ZARR_FORMAT, write_empty_chunks=True)
         self.done[chunk.index] += 1
         self._flags[chunk.index] = self.done[chunk.index]
 
@@ -303,7 +331,7 @@ def open_store(path: str | Path) -> xr.Dataset:
     Raises
     ------
     ParameterError
-        Not a spinectl study store (field ``store``).
+        Not a spinectl study store, or a chunk counted done has lost its data (field ``store``).
     """
     try:
         dataset = xr.open_zarr(path, consolidated=False, zarr_format=ZARR_FORMAT)
@@ -311,6 +339,9 @@ def open_store(path: str | Path) -> xr.Dataset:
         dataset = None
     if dataset is None or "study_digest" not in dataset.attrs:
         raise ParameterError("store", f"{str(path)!r} is not a spinectl study store")
+    missing = missing_chunks(path, dataset[DONE].values)
+    if missing.size:
+        raise ParameterError("store", f"{_missing_text(path, missing)}: run the study again with --resume")
     return dataset
 
 
@@ -339,3 +370,143 @@ def load(path: str | Path) -> xr.Dataset:
         if variable.dtype.kind == "U":
             dataset[name] = variable.astype(object)
     return dataset
+
+
+def missing_chunks(path: str | Path, counts: np.ndarray) -> np.ndarray:
+    """The chunks counted done of which an output has no file (deleted, or lost by a copy).
+
+    Every output array is chunked as the study (parameter dimensions one by one, then
+    the tile of E and Lambda, the trailing dimensions whole), so chunk ``i`` of the study is
+    the ``i``-th of the leading chunk grid in C order; and every chunk written is a file
+    (``write_empty_chunks``). One listing per output: cheap beside reading the data.
+
+    Parameters
+    ----------
+    path : str or Path
+        The store.
+    counts : numpy.ndarray of int, shape (n_chunks,)
+        Its ``chunk_done``.
+
+    Returns
+    -------
+    numpy.ndarray of int
+        Indices of the chunks counted done with a chunk file missing, ascending; none
+        in a store made without :data:`CHUNK_FILES` (it cannot tell).
+    """
+    group = zarr.open_group(path, mode="r", zarr_format=ZARR_FORMAT)
+    done = np.flatnonzero(np.asarray(counts) > 0)
+    missing = np.zeros(len(counts), dtype=bool)
+    if group.attrs.get(CHUNK_FILES) is not True:
+        return np.flatnonzero(missing)  # an older store: a chunk of fill values only may lack its file
+    for name, array in group.arrays():
+        if not {"E", "Lambda"} <= set(array.attrs.get("_ARRAY_DIMENSIONS", ())):
+            continue  # the chunk counts, the coordinates
+        lead = array.attrs["_ARRAY_DIMENSIONS"].index("Lambda") + 1
+        grid = tuple(-(-n // c) for n, c in zip(array.shape, array.chunks, strict=True))
+        separator = array.metadata.dimension_separator
+        folder = Path(path, name)
+        present = {str(p.relative_to(folder)) for p in folder.rglob("*") if p.is_file()}
+        for index in done:
+            position = np.unravel_index(index, grid[:lead]) + (0,) * (len(grid) - lead)
+            missing[index] |= separator.join(str(int(i)) for i in position) not in present
+    return np.flatnonzero(missing)
+
+
+def _missing_text(path, missing: np.ndarray) -> str:
+    shown = ", ".join(str(i) for i in missing[:5]) + (", ..." if missing.size > 5 else "")
+    return f"{str(path)!r}: {missing.size} chunk(s) counted done have lost their data (chunk {shown})"
+
+
+LOCK_SUFFIX = ".lock"
+"""The lock file of a store ``s.zarr`` is ``s.zarr.lock``, beside it."""
+
+
+@contextlib.contextmanager
+def locked(path: str | Path) -> Iterator[Path]:
+    """Hold the lock of the store ``path`` while the block runs: no second run can use it meanwhile.
+
+    The lock is a file beside the store, created exclusively (``O_EXCL``), holding the
+    process id and host name of its holder; it is removed at the end, whatever happens.
+    A lock left by a run that is gone (killed: its process id no longer runs on this
+    host) is taken over; one of another host is never (its process cannot be checked):
+    remove it by hand once that run has ended.
+
+    Parameters
+    ----------
+    path : str or Path
+        The store (it need not exist yet).
+
+    Yields
+    ------
+    Path
+        The lock file.
+
+    Raises
+    ------
+    OutputError
+        Another run holds the lock (its process id and host are named), or the lock cannot be written.
+    """
+    lock = Path(f"{path}{LOCK_SUFFIX}")
+    with output_errors(lock):
+        lock.parent.mkdir(parents=True, exist_ok=True)
+        _acquire(lock)
+    try:
+        yield lock
+    finally:
+        lock.unlink(missing_ok=True)
+
+
+def _acquire(lock: Path, attempts: int = 3) -> None:
+    me = f"{os.getpid()} {socket.gethostname()}\n"
+    for _ in range(attempts):  # a stale lock that another run took over meanwhile: look again
+        try:
+            fd = os.open(lock, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644)
+        except FileExistsError:
+            holder = _holder(lock)
+            if holder is None or not _gone(*holder):
+                who = "unknown" if holder is None else f"process {holder[0]} on host {holder[1]}"
+                raise OutputError(
+                    f"{str(lock)[: -len(LOCK_SUFFIX)]!r} is in use by another study run ({who}, lock file "
+                    f"{str(lock)!r}): wait for it to end, or remove the lock file if that run has ended"
+                ) from None
+            _take_over(lock, holder)
+            continue
+        with os.fdopen(fd, "w") as file:
+            file.write(me)
+        return
+    raise OutputError(f"cannot lock {str(lock)!r}: other runs keep taking it")
+
+
+def _holder(lock: Path) -> tuple[int, str] | None:
+    """(pid, host) of a lock file, or None if it is unreadable or half-written (then it counts as held)."""
+    try:
+        pid, host = lock.read_text(encoding="utf-8").split()
+        return int(pid), host
+    except (OSError, ValueError, UnicodeDecodeError):
+        return None
+
+
+def _gone(pid: int, host: str) -> bool:
+    """Whether the holder has ended: only decidable for a process of this host."""
+    if host != socket.gethostname():
+        return False
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return True
+    except PermissionError:  # runs, as another user
+        return False
+    return False
+
+
+def _take_over(lock: Path, holder: tuple[int, str]) -> None:
+    """Remove a stale lock, unless another run replaced it meanwhile (then it is put back)."""
+    aside = lock.with_name(f"{lock.name}.{os.getpid()}.stale")
+    try:
+        os.replace(lock, aside)
+    except FileNotFoundError:
+        return  # removed by its holder or by another run: try again
+    if _holder(aside) != holder:  # a live lock of another run, taken over meanwhile
+        with contextlib.suppress(FileExistsError):
+            os.link(aside, lock)
+    aside.unlink(missing_ok=True)
