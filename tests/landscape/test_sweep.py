@@ -10,6 +10,7 @@ from spinectl import optimise
 from spinectl.cli import main
 from spinectl.errors import OutputError, ParameterError
 from spinectl.landscape import netcdf, schema, sweep
+from spinectl.model import chain
 from spinectl.model.mechanics import segment_coefficients
 from spinectl.model.params import Model
 
@@ -160,3 +161,14 @@ def test_describe(landscape):
     nothing = landscape.copy()
     nothing["min_pcsa_cm2"] = nothing["min_pcsa_cm2"] * np.nan
     assert sweep.describe(nothing) == "12 points (0 solved, 12 infeasible or failed)"
+
+
+def test_coupled_margin_is_that_of_the_chain_at_the_chosen_activation(landscape, model):
+    """coupled_margin_Nm_per_rad: the smallest eigenvalue of -K of model.chain at the point's PCSA,
+    by numpy's eigvalsh on the matrix assembled here; negative (unstable chain) everywhere on this grid."""
+    here = landscape.sel(E=0.04, Lambda=0.03)
+    stiffness = chain.chain_coefficients(model, 0.04, 0.03).stiffness(here["pcsa_cm2"].values * 1e-4)
+    expected = np.linalg.eigvalsh(-stiffness)[0]
+    assert float(here["coupled_margin_Nm_per_rad"]) == pytest.approx(expected, rel=1e-6)
+    assert landscape["coupled_margin_Nm_per_rad"].dims == ("E", "Lambda")
+    assert float(landscape["coupled_margin_Nm_per_rad"].max()) < 0
