@@ -197,7 +197,7 @@ def state_matrix(mass, stiffness, damping):
 
     M q'' = K q + D q' (spinectl's tau = K q + D q', the per-segment eq. 1 with theta -> M), so
     A = [[0, I], [M^-1 K, M^-1 D]]. One joint (n = 1) is
-    :func:`spinectl.model.stability.jacobian`. Where M is singular (no levels, rho = 0), A is NaN.
+    :func:`spinectl.model.stability.jacobian`. Where M is singular (levels without mass), A is NaN.
 
     Parameters
     ----------
@@ -249,7 +249,7 @@ def dynamic_eigenvalues(mass, stiffness, damping):
     finite = np.all(np.isfinite(a), axis=(-2, -1))
     eigs = np.linalg.eigvals(np.where(finite[..., None, None], a, 0.0)).astype(complex)
     eigs = np.take_along_axis(eigs, np.argsort(-eigs.real, axis=-1, kind="stable"), axis=-1)
-    return np.where(finite[..., None], eigs, np.nan)
+    return np.where(finite[..., None], eigs, complex(np.nan, np.nan))
 
 
 def _fibre_constants(model: Model):

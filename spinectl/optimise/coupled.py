@@ -542,8 +542,13 @@ class CoupledStability:
             f"static margin (smallest eigenvalue of -K) = {self.margin:.3f} N m/rad "
             f"({'stable' if self.margin > 0 else 'UNSTABLE'})",
             "eigenvalues [1/s]: " + ", ".join(f"{z.real:.3f}{z.imag:+.3f}j" for z in self.eigenvalues),
-            f"global muscles alone: {'dynamically stable' if self.self_stable else 'NOT stable'} "
-            f"({int(np.sum(self.eigenvalues.real >= 0))} of {self.eigenvalues.size} eigenvalues with Re >= 0)",
+            "global muscles alone: "
+            + (
+                "eigenvalues undefined, the mass matrix is singular (levels.mass = 0)"
+                if np.isnan(self.eigenvalues).any()
+                else f"{'dynamically stable' if self.self_stable else 'NOT stable'} "
+                f"({int(np.sum(self.eigenvalues.real >= 0))} of {self.eigenvalues.size} eigenvalues with Re >= 0)"
+            ),
             "least local stiffness [N m/rad]: "
             + ", ".join(f"{n} {k:.2f}" for n, k in zip(names, local, strict=True))
             + f"  (total {np.sum(local):.2f}; local PCSA {m2_to_cm2(self.local.total_local_pcsa):.2f} cm^2; "
@@ -593,12 +598,12 @@ def coupled_stability_at(model: Model, eccentricity: float, lordosis: float, pcs
     pcsa = minimum_stabilising_pcsa(model, e, lam) if pcsa is None else expand_pcsa(model, pcsa)
     data = coupled_data(model, e, lam)
     coefficients = data.coefficients
+    local = least_local_stiffness(model, e, lam, pcsa)  # the SDP, outside numpy's guard
     with arithmetic_guard(e, lam):
         stiffness = coefficients.stiffness(pcsa)
         damping = coefficients.damping(pcsa)
         mass = chain.mass_matrix(model, geometry.cor_positions(e, lam, model.geometry))
         eigenvalues = chain.dynamic_eigenvalues(mass, stiffness, damping)
-        local = least_local_stiffness(model, e, lam, pcsa)
         with_local = chain.dynamic_eigenvalues(mass, stiffness - np.diag(local.local_stiffness), damping)
     paired = model.optimisation.activation == "paired"
     return CoupledStability(

@@ -30,3 +30,17 @@ def test_coupled_table_with_a_given_pcsa(capsys):
     model = config.set_parameter(config.load_preset("default"), "passive.stiffness", 15.0)
     result = coupled_stability_at(model, 0.0, 0.0, np.full(3, 10e-4))
     assert f"static margin (smallest eigenvalue of -K) = {result.margin:.3f} N m/rad" in out
+
+
+def test_massless_levels_leave_the_eigenvalues_undefined(tmp_path, capsys):
+    """levels.mass = 0: M = m J'J has rank 2 (1 at E = 0, the CoRs right below the mass), so no
+    eigenvalues (NaN, not stable); the statics stand."""
+    path = tmp_path / "m.toml"
+    path.write_text("[levels]\nmass = 0.0\n")
+    assert main(["stability", "--coupled", "--config", str(path)]) == 0
+    assert "eigenvalues undefined, the mass matrix is singular" in capsys.readouterr().out
+    assert main(["stability", "--coupled", "--config", str(path), "--E", "0.03", "--json"]) == 0
+    document = json.loads(capsys.readouterr().out)["coupled"]
+    assert np.all(np.isnan(document["eigenvalues"])) and document["self_stable"] is False
+    assert np.linalg.matrix_rank(np.array(document["mass_matrix_kgm2"])) == 2
+    assert document["margin_Nm_per_rad"] < 0  # the static analysis does not need M

@@ -9,7 +9,7 @@ from spinectl import load_preset, optimise
 from spinectl.errors import ModelError
 from spinectl.model import chain, geometry
 from spinectl.model.params import Levels, Model
-from spinectl.reflex.chain import chain_system
+from spinectl.reflex.chain_system import chain_system
 from spinectl.reflex.loops import segment_system
 
 
