@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from ..model.config import set_parameter
+from ..optimise.coupled import coupled_stability_at
 from ..optimise.reference import stability_at
 from ..units import cm2_to_m2
 from ._common import add_model_options, add_position_options, emit_json, finite_float, float_list, load_model
@@ -31,6 +32,12 @@ def register(sub) -> None:
         "(default: the minimum stabilising PCSA, the optimiser's chosen activation)",
     )
     parser.add_argument("--K", type=finite_float("--K"), help="passive stiffness K [N m/rad] (overrides the model)")
+    parser.add_argument(
+        "--coupled",
+        action="store_true",
+        help="free all CoRs at once: the chain's stiffness, damping and mass matrices, its static margin, "
+        "dynamic eigenvalues and least local stiffness (docs/chain.md)",
+    )
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     add_model_options(parser)
     parser.set_defaults(func=run)
@@ -61,7 +68,8 @@ def run(args) -> int:
     Parameters
     ----------
     args : argparse.Namespace
-        Parsed arguments: ``E``, ``Lambda`` [m], ``pcsa`` [cm^2], ``K``, ``json`` and the model options.
+        Parsed arguments: ``E``, ``Lambda`` [m], ``pcsa`` [cm^2], ``K``, ``coupled``, ``json`` and the
+        model options.
 
     Returns
     -------
@@ -70,7 +78,8 @@ def run(args) -> int:
     """
     model = model_with_overrides(args)
     given = args.pcsa is not None  # else the minimum stabilising PCSA
-    result = stability_at(model, args.E, args.Lambda, cm2_to_m2(args.pcsa) if given else None)
+    analysis = coupled_stability_at if args.coupled else stability_at
+    result = analysis(model, args.E, args.Lambda, cm2_to_m2(args.pcsa) if given else None)
     source = "given" if given else "min_pcsa"
     if args.json:
         emit_json(result.to_dict(model, pcsa_source=source))

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..model import chain
 from ..model.checks import arithmetic_guard, checked_coefficients
 from ..model.params import Model
 from ..optimise import stacked
@@ -69,6 +70,7 @@ def point_columns(
         per_point += result.per_point
         with arithmetic_guard(e_grid[part], l_grid[part]), guarded():  # e.g. K = 1e154 overflows S^2 in the reflex
             columns = _chunk_columns(result, coeffs, model)
+            columns["coupled_margin_Nm_per_rad"] = _coupled_margin(model, e_grid[part], l_grid[part], result.pcsa)
         for name, values in columns.items():
             if name not in arrays:
                 arrays[name] = np.empty((e_grid.size,) + values.shape[1:], values.dtype)
@@ -92,6 +94,12 @@ def _chunk_columns(result: stacked.BlockOptimum, coeffs, model: Model) -> dict[s
         "passive_stiffness_Nm_per_rad": coeffs.passive_stiffness,
         "inertia_kgm2": coeffs.inertia,
     }
+
+
+def _coupled_margin(model: Model, eccentricity, lordosis, pcsa) -> np.ndarray:
+    """Static margin of the coupled chain at the chosen activation [N m/rad], NaN where infeasible (docs/chain.md)."""
+    stiffness = chain.chain_coefficients(model, eccentricity, lordosis).stiffness(np.nan_to_num(pcsa))
+    return np.where(np.isnan(pcsa).any(axis=-1), np.nan, chain.coupled_margin(stiffness))
 
 
 def _reflex_columns(model: Model, coeffs, pcsa) -> dict[str, np.ndarray]:

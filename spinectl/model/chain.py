@@ -96,6 +96,162 @@ def carried_points(points, q, cor):
     return moved[..., 0, None, :] + rotate(np.asarray(points, float) - top, angle[..., None])
 
 
+def _carried_by(n: int) -> np.ndarray:
+    """carried[b, j]: body b is carried by joint j (b = 0 the upper body, b = i + 1 the level below CoR i)."""
+    return (np.arange(n)[None, :] >= np.arange(n)[:, None]).astype(float)
+
+
+def level_positions(q, cor):
+    """Centres of mass of the lumbar levels in the rotated chain [m] (docs/chain.md, "The mass matrix").
+
+    Level i lies between CoRs i and i + 1 (L2 between L1L2 and L2L3, ...); upright, its centre
+    of mass is on the line of gravity (x = 0, like the upper body's point mass), halfway up
+    between the two CoRs. It is carried by the joints below it, i + 1, ..., n - 1:
+    P_i(q) = c_{i+1}(q) + R(q_{i+1} + ... + q_n)(P_i - c_{i+1}).
+
+    Parameters
+    ----------
+    q : array_like, shape (..., n_cor)
+        Joint rotations [rad].
+    cor : array_like, shape (..., n_cor, 2)
+        Upright CoR positions [m], top to bottom.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., n_cor - 1, 2)
+        [m].
+    """
+    q = np.asarray(q, float)
+    cor = np.asarray(cor, float)
+    moved, _ = chain_positions(q, cor)
+    upright = np.stack([np.zeros(cor.shape[:-2] + (cor.shape[-2] - 1,)), (cor[..., :-1, 1] + cor[..., 1:, 1]) / 2], -1)
+    angle = np.cumsum(q[..., ::-1], axis=-1)[..., ::-1][..., 1:]  # q_{i+1} + ... + q_n
+    return moved[..., 1:, :] + rotate(upright - cor[..., 1:, :], angle)
+
+
+def level_weight(model: Model) -> float:
+    """The weight of one lumbar level that enters gravity [N]: ``levels.weight_in_gravity`` m_level g.
+
+    Parameters
+    ----------
+    model : Model
+
+    Returns
+    -------
+    float
+        [N]; 0 by default (the levels carry inertia only; docs/chain.md, "The weight of the levels").
+    """
+    return model.levels.weight_in_gravity * model.levels.mass * model.body.gravity
+
+
+def mass_matrix(model: Model, cor):
+    """Mass matrix of the chain at the upright posture [kg m^2] (docs/chain.md, "The mass matrix").
+
+    M = sum over the bodies b of m_b J_v,b' J_v,b + I_b J_w,b' J_w,b, with the upper body (the
+    point mass m at (0, ``body.mass_height``), I = m rho^2, rho ``body.radius_of_gyration``)
+    carried by every joint and each lumbar level (:func:`level_positions`; ``levels.mass``,
+    I = m rho_level^2) by the joints below it. A body carried by joint j moves with
+    dP/dq_j = J (P - c_j) (J the quarter turn) and turns with dphi/dq_j = 1, so
+
+        M[j, k] = sum over b carried by j and k of m_b ((P_b - c_j) . (P_b - c_k) + rho_b^2).
+
+    M[k, k] without the levels is theta_k of :func:`spinectl.model.mechanics.inertia`.
+
+    Parameters
+    ----------
+    model : Model
+        ``body`` (mass, height, radius of gyration) and ``levels`` (mass, radius of gyration).
+    cor : array_like, shape (..., n_cor, 2)
+        Upright CoR positions [m], top to bottom.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., n_cor, n_cor)
+        Symmetric [kg m^2]; positive definite when the levels have mass.
+
+    References
+    ----------
+    Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012). Spinal lordosis
+    optimizes the requirements for a stable erect posture. Theor Biol Med Model 9:13.
+    doi:10.1186/1742-4682-9-13.
+    """
+    cor = np.asarray(cor, float)
+    n = cor.shape[-2]
+    body, levels = model.body, model.levels
+    positions = np.concatenate(
+        [np.broadcast_to(geometry.mass_position(model), cor.shape[:-2] + (1, 2)), level_positions(np.zeros(n), cor)],
+        axis=-2,
+    )  # (..., n, 2): the upper body, then the n - 1 levels
+    masses = np.array([body.mass] + [levels.mass] * (n - 1))
+    gyration = np.array([body.radius_of_gyration] + [levels.radius_of_gyration] * (n - 1)) ** 2
+    carried = _carried_by(n)
+    arm = (positions[..., :, None, :] - cor[..., None, :, :]) * carried[..., None]  # (..., b, j, 2)
+    mass = np.einsum("b,...bjd,...bkd->...jk", masses, arm, arm) + np.einsum(
+        "b,bj,bk->jk", masses * gyration, carried, carried
+    )
+    return (mass + np.swapaxes(mass, -1, -2)) / 2  # symmetric to the last bit, not just to rounding
+
+
+def state_matrix(mass, stiffness, damping):
+    """The linearised chain as a first-order system: x' = A x, x = (q, q') [1/s^2, 1/s].
+
+    M q'' = K q + D q' (spinectl's tau = K q + D q', the per-segment eq. 1 with theta -> M), so
+    A = [[0, I], [M^-1 K, M^-1 D]]. One joint (n = 1) is
+    :func:`spinectl.model.stability.jacobian`. Where M is singular (levels without mass), A is NaN.
+
+    Parameters
+    ----------
+    mass : array_like, shape (..., n, n)
+        M [kg m^2] (:func:`mass_matrix`).
+    stiffness : array_like, shape (..., n, n)
+        K [N m/rad], possibly K - diag(k) with local stiffness.
+    damping : array_like, shape (..., n, n)
+        D [N m s/rad].
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 2 n, 2 n)
+        A; NaN where M is singular to working precision.
+    """
+    mass, stiffness, damping = np.broadcast_arrays(*(np.asarray(x, float) for x in (mass, stiffness, damping)))
+    n = mass.shape[-1]
+    singular = np.linalg.cond(mass) > 1.0 / np.finfo(float).eps
+    regular = np.where(singular[..., None, None], np.eye(n), mass)
+    lower = np.linalg.solve(regular, np.concatenate([stiffness, damping], axis=-1))  # (..., n, 2 n)
+    upper = np.broadcast_to(np.concatenate([np.zeros((n, n)), np.eye(n)], axis=-1), lower.shape)
+    a = np.concatenate([upper, lower], axis=-2)
+    return np.where(singular[..., None, None], np.nan, a)
+
+
+def dynamic_eigenvalues(mass, stiffness, damping):
+    """Eigenvalues of :func:`state_matrix` [1/s], the largest real part first.
+
+    The chain is dynamically stable iff all lie in the left half-plane
+    (:func:`spinectl.model.stability.self_stable` applies to them as to a segment's two).
+
+    Parameters
+    ----------
+    mass, stiffness, damping : array_like, shape (..., n, n)
+        M [kg m^2], K [N m/rad], D [N m s/rad].
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 2 n), complex
+        [1/s]; NaN where M is singular.
+
+    References
+    ----------
+    Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012). Spinal lordosis
+    optimizes the requirements for a stable erect posture. Theor Biol Med Model 9:13.
+    doi:10.1186/1742-4682-9-13.
+    """
+    a = state_matrix(mass, stiffness, damping)
+    finite = np.all(np.isfinite(a), axis=(-2, -1))
+    eigs = np.linalg.eigvals(np.where(finite[..., None, None], a, 0.0)).astype(complex)
+    eigs = np.take_along_axis(eigs, np.argsort(-eigs.real, axis=-1, kind="stable"), axis=-1)
+    return np.where(finite[..., None], eigs, complex(np.nan, np.nan))
+
+
 def _fibre_constants(model: Model):
     """Attachments, fibre-to-muscle matrix per unit PCSA, upright length, l_opt and Hill constants."""
     upper, lower, share = geometry.all_fibres(model)
@@ -137,11 +293,13 @@ def chain_muscle_torque_per_pcsa(model: Model, cor, q, qdot):
 
 
 def chain_gravity_torque(model: Model, cor, q):
-    """Nonlinear generalised torque of the point mass on every joint [N m].
+    """Nonlinear generalised torque of the weights on every joint [N m].
 
     tau_j = -dV/dq_j with V = m g y_m(q): tau_j = -m g (m(q) - c_j(q))_x, the torque of the
     weight about the moved CoR j (:func:`spinectl.model.mechanics.gravity_torque` when one
-    joint is free, with its sign convention, ``errata.gravity_sign``).
+    joint is free, with its sign convention, ``errata.gravity_sign``); plus the fraction
+    ``levels.weight_in_gravity`` of the lumbar levels' weights (:func:`level_weight`), each on
+    the joints that carry it (0 by default; docs/chain.md, "The weight of the levels").
 
     Parameters
     ----------
@@ -158,7 +316,11 @@ def chain_gravity_torque(model: Model, cor, q):
     moved, _ = chain_positions(q, cor)
     mass = carried_points(geometry.mass_position(model)[None, :], q, cor)  # (..., 1, 2)
     weight = model.body.mass * model.body.gravity
-    return gravity_sign(model) * (-weight * (mass - moved)[..., 0])
+    torque = -weight * (mass - moved)[..., 0]
+    levels = level_positions(q, cor)  # (..., n - 1, 2); level i is carried by joints i + 1, ...
+    arm = (levels[..., :, None, 0] - moved[..., None, :, 0]) * _carried_by(moved.shape[-2])[1:]
+    torque = torque - level_weight(model) * arm.sum(axis=-2)
+    return gravity_sign(model) * torque
 
 
 @dataclass(frozen=True)
@@ -177,7 +339,8 @@ class ChainCoefficients:
     damping_per_pcsa : numpy.ndarray, shape (..., n_cor, n_cor, n_muscles)
         D_i = dtau/dq' per unit PCSA [N m s/rad / m^2]; negative semidefinite.
     gravity_stiffness : numpy.ndarray, shape (..., n_cor, n_cor)
-        K_g [N m/rad]: m g (y_m - y of the higher CoR), positive definite with the corrected sign.
+        K_g [N m/rad]: m g (y_m - y of the higher CoR), positive definite with the corrected sign;
+        plus the levels' weight on the joints that carry them, if ``levels.weight_in_gravity`` > 0.
     passive_stiffness : numpy.ndarray, shape (..., n_cor)
         K_pas per joint as a physical stiffness [N m/rad], entering K as -diag(K_pas).
     length_gradient : numpy.ndarray, shape (..., n_fibres, n_cor)
@@ -270,10 +433,14 @@ def chain_coefficients(model: Model, eccentricity, lordosis) -> ChainCoefficient
 
     y = cor[..., 1]
     weight = model.body.mass * model.body.gravity
+    # a level at height y_b carried by joints b+1, ...: w (y_b - y_hi) on those rows and columns
+    carried = _carried_by(n)[1:]  # (n - 1, n)
+    height = level_positions(np.zeros(n), cor)[..., :, None, None, 1] - y[..., None, higher]
+    levels = level_weight(model) * np.sum(height * carried[:, :, None] * carried[:, None, :], axis=-3)
     return ChainCoefficients(
         stiffness_per_pcsa=(-f_l_slope * hh - f_l * hessian) @ to_muscle,
         damping_per_pcsa=(f_l * f_h_slope * hh) @ to_muscle,
-        gravity_stiffness=gravity_sign(model) * weight * (model.body.mass_height - y[..., higher]),
+        gravity_stiffness=gravity_sign(model) * (weight * (model.body.mass_height - y[..., higher]) + levels),
         passive_stiffness=passive_stiffness(model, inertia(cor, model)),
         length_gradient=-np.swapaxes(h, -1, -2),
     )

@@ -333,6 +333,47 @@ class Local:
 
 
 @dataclass(frozen=True)
+class Levels:
+    """The lumbar levels as bodies of the coupled chain: their inertia and weight (docs/chain.md).
+
+    One body per vertebral level between two neighbouring centres of rotation (L2 to L5
+    for the paper's five CoRs), a slice of the trunk with its centre of mass on the line
+    of gravity (x = 0, like the upper body's point mass) halfway up between its CoRs. The
+    per-segment analysis (eq. 1) has no such bodies; they make the chain's mass matrix
+    regular (the point mass alone gives it rank 2).
+    """
+
+    mass: float = param(
+        1.8,
+        "kg",
+        "Mass of each lumbar level (a slice of the trunk between two CoRs). 2.5 % of a 73 kg body, within "
+        "the per-vertebral-level masses measured by CT (1.1 % at T1 rising to 2.6 % at L5; Pearsall, Reid "
+        "and Livingston 1996, doi:10.1007/BF02667349). 0 removes the levels (the paper's point mass alone).",
+    )
+    radius_of_gyration: float = param(
+        0.06,
+        "m",
+        "Radius of gyration of a level about its centre of mass for sagittal rotation: a uniform slab of "
+        "the abdomen's sagittal depth d of about 0.2 m, sqrt(d^2 / 12) = 0.058 m; spinectl's estimate.",
+    )
+    weight_in_gravity: float = param(
+        0.0,
+        "1",
+        "Fraction of the levels' weight that enters the chain's gravity stiffness K_g (docs/chain.md, "
+        "'The weight of the levels'). 0 (default): the levels carry inertia only, so the diagonal of K stays "
+        "the paper's S_k; 1: their full weight, each level an inverted pendulum on the joints below it.",
+    )
+
+    def __post_init__(self):
+        _store(
+            self,
+            mass=v.non_negative("mass", self.mass),
+            radius_of_gyration=v.non_negative("radius_of_gyration", self.radius_of_gyration),
+            weight_in_gravity=v.in_range("weight_in_gravity", self.weight_in_gravity, 0.0, 1.0),
+        )
+
+
+@dataclass(frozen=True)
 class Errata:
     """Choices between the paper's printed formulas and their corrections (docs/model.md, "Errata")."""
 
@@ -521,6 +562,7 @@ class Model:
     )
     passive: Passive = field(default_factory=Passive, metadata={"doc": "Passive stiffness K."})
     local: Local = field(default_factory=Local, metadata={"doc": "Local muscles of the coupled chain."})
+    levels: Levels = field(default_factory=Levels, metadata={"doc": "Lumbar levels of the coupled chain."})
     errata: Errata = field(default_factory=Errata, metadata={"doc": "Printed formula or correction."})
     optimisation: Optimisation = field(default_factory=Optimisation, metadata={"doc": "Optimiser settings."})
     reflex: Reflex = field(default_factory=Reflex, metadata={"doc": "Delayed reflex and its simulation."})

@@ -10,6 +10,7 @@ from spinectl import optimise
 from spinectl.cli import main
 from spinectl.errors import OutputError, ParameterError
 from spinectl.landscape import netcdf, schema, sweep
+from spinectl.model import chain
 from spinectl.model.mechanics import segment_coefficients
 from spinectl.model.params import Model
 
@@ -166,7 +167,7 @@ def test_an_absurd_stiffness_gets_the_true_minimum_with_status_optimal():
     """K = 1e12 N m/rad: the stiffness rows are slack, so the minimum PCSA is that of any K large
     enough to make them slack, e.g. K = 1e4 (solved well-scaled, status 'optimal' before the fix too),
     about 0.02 cm^2 (the damping rows alone). Before: 'optimal_inaccurate' or 'infeasible'
-    (issue 18: 4e10 cm^2 reported)."""
+    (4e10 cm^2 was reported)."""
     from spinectl.model.config import set_parameter
 
     axes = ([0.0, 0.04], [0.0, 0.04])
@@ -183,3 +184,14 @@ def test_describe_warns_of_inaccurate_points():
     assert "WARNING" not in sweep.describe(ds)
     ds["status"][0] = "optimal_inaccurate"
     assert "WARNING: 1 inaccurate (status optimal_inaccurate" in sweep.describe(ds)
+
+
+def test_coupled_margin_is_that_of_the_chain_at_the_chosen_activation(landscape, model):
+    """coupled_margin_Nm_per_rad: the smallest eigenvalue of -K of model.chain at the point's PCSA,
+    by numpy's eigvalsh on the matrix assembled here; negative (unstable chain) everywhere on this grid."""
+    here = landscape.sel(E=0.04, Lambda=0.03)
+    stiffness = chain.chain_coefficients(model, 0.04, 0.03).stiffness(here["pcsa_cm2"].values * 1e-4)
+    expected = np.linalg.eigvalsh(-stiffness)[0]
+    assert float(here["coupled_margin_Nm_per_rad"]) == pytest.approx(expected, rel=1e-6)
+    assert landscape["coupled_margin_Nm_per_rad"].dims == ("E", "Lambda")
+    assert float(landscape["coupled_margin_Nm_per_rad"].max()) < 0

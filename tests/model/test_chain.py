@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from spinectl import load_preset
-from spinectl.model import chain, geometry, mechanics, muscle
-from spinectl.model.params import Errata, Local, Model, Passive
+from spinectl.model import chain, geometry, mechanics, muscle, stability
+from spinectl.model.params import Body, Errata, Levels, Local, Model, Passive
 
 STEP = 1e-6
 N_COR = 5
@@ -182,3 +182,107 @@ def test_coefficients_broadcast_over_a_grid(model):
     assert grid.length_gradient.shape == (3, 2, 30, 5)
     one = chain.chain_coefficients(model, E[2, 1], L[2, 1])
     np.testing.assert_allclose(grid.stiffness_per_pcsa[2, 1], one.stiffness_per_pcsa, rtol=1e-12)
+
+
+# --- inertia and dynamic stability -------------------------------------------------------------
+
+
+def _bodies_by_rotations(model, q, cor):
+    """Upper-body point and level centres in the rotated chain, built joint by joint from the pelvis:
+    turning joint j (bottom first) rotates every body and CoR above it about the current c_j."""
+    n = cor.shape[0]
+    y = cor[:, 1]
+    points = [np.array([0.0, model.body.mass_height])] + [np.array([0.0, (y[i] + y[i + 1]) / 2]) for i in range(n - 1)]
+    base = [0] + [i + 1 for i in range(n - 1)]  # the highest joint carrying each body
+    points, cors = [p.copy() for p in points], cor.copy()
+    for j in range(n - 1, -1, -1):
+        centre = cors[j].copy()
+        points = [
+            centre + mechanics.rotate(p - centre, q[j]) if j >= b else p for p, b in zip(points, base, strict=True)
+        ]
+        cors[:j] = centre + mechanics.rotate(cors[:j] - centre, q[j])
+    angles = [q[b:].sum() for b in base]
+    return np.array(points), np.array(angles)
+
+
+@pytest.mark.parametrize("preset", ["default", "wagner2012"])
+def test_mass_matrix_is_the_hessian_of_the_kinetic_energy(rng, preset):
+    """T(q') = 1/2 sum m |v|^2 + 1/2 m rho^2 phi'^2 with v and phi' by central differences of the
+    bodies' positions and angles (built rotation by rotation); M[j, k] = T(e_j + e_k) - T(e_j) - T(e_k)
+    (T is quadratic), and M is symmetric positive definite."""
+    model = load_preset(preset)
+    model = model.replace(body=Body(mass=model.body.mass, mass_height=model.body.mass_height, radius_of_gyration=0.05))
+    E, L = _random_positions(rng, 1)
+    cor = geometry.cor_positions(E[0], L[0], model.geometry)
+    masses = np.array([model.body.mass] + [model.levels.mass] * (N_COR - 1))
+    gyration = np.array([0.05] + [model.levels.radius_of_gyration] * (N_COR - 1))
+
+    def kinetic(qdot, h=1e-6):
+        (p_plus, a_plus), (p_minus, a_minus) = (_bodies_by_rotations(model, s * h * qdot, cor) for s in (1, -1))
+        v, w = (p_plus - p_minus) / (2 * h), (a_plus - a_minus) / (2 * h)
+        return 0.5 * np.sum(masses * (np.sum(v**2, axis=-1) + gyration**2 * w**2))
+
+    eye = np.eye(N_COR)
+    hessian = np.array(
+        [[kinetic(eye[j] + eye[k]) - kinetic(eye[j]) - kinetic(eye[k]) for k in range(N_COR)] for j in range(N_COR)]
+    )
+    mass = chain.mass_matrix(model, cor)
+    np.testing.assert_allclose(mass, hessian, rtol=1e-7, atol=1e-9 * np.abs(mass).max())
+    np.testing.assert_array_equal(mass, mass.T)
+    assert np.all(np.linalg.eigvalsh(mass) > 0)
+
+
+def test_mass_matrix_diagonal_is_theta_without_levels(rng):
+    """With massless levels, M[k, k] is the per-segment theta_k = m (r_k^2 + rho^2) of mechanics.inertia,
+    and M = m J'J + m rho^2 1 1' has rank 3: singular, so the state matrix is NaN."""
+    model = Model(body=Body(radius_of_gyration=0.1), levels=Levels(mass=0.0))
+    E, L = _random_positions(rng)
+    cor = geometry.cor_positions(E, L, model.geometry)
+    mass = chain.mass_matrix(model, cor)
+    np.testing.assert_allclose(np.diagonal(mass, axis1=-2, axis2=-1), mechanics.inertia(cor, model), rtol=1e-12)
+    assert list(np.linalg.matrix_rank(mass)) == [3] * len(E)
+    assert np.all(np.isnan(chain.dynamic_eigenvalues(mass, -np.eye(N_COR), -np.eye(N_COR))))
+
+
+def test_decoupled_chain_has_the_per_segment_eigenvalues(rng):
+    """Diagonal M, K and D: the 2n eigenvalues of the state matrix are the segments' eq. 1 roots
+    (stability.eigenvalues, closed form), stable and unstable, real and complex."""
+    theta = rng.uniform(0.5, 4.0, N_COR)
+    stiffness = np.array([-30.0, 20.0, -5.0, -100.0, 0.5])
+    damping = np.array([-2.0, -1.0, -0.1, -30.0, 0.0])
+    eigs = chain.dynamic_eigenvalues(np.diag(theta), np.diag(stiffness), np.diag(damping))
+    expected = stability.eigenvalues(stiffness, damping, theta).ravel()
+    np.testing.assert_allclose(np.sort_complex(eigs), np.sort_complex(expected), atol=1e-10)
+    assert np.all(np.diff(eigs.real) <= 0)  # the largest real part first
+    # one joint: the state matrix is the segment's Jacobian
+    np.testing.assert_allclose(
+        chain.state_matrix([[theta[0]]], [[stiffness[0]]], [[damping[0]]]),
+        stability.jacobian(stiffness[0], damping[0], theta[0]),
+        rtol=1e-14,
+    )
+
+
+@pytest.mark.parametrize("sign", ["destabilising", "printed"])
+def test_level_weight_in_gravity(rng, sign):
+    """With levels.weight_in_gravity = 1, K_g is the central difference of the nonlinear gravity
+    torques (point mass and levels), and by hand each level b adds m_l g (y_b - y_hi) on the joints
+    below it; upright, their weight loads the joints below them (beyond the per-segment CT)."""
+    base = Model(errata=Errata(gravity_sign=sign))
+    model = base.replace(levels=Levels(weight_in_gravity=1.0))
+    E, L = _random_positions(rng)
+    cor = geometry.cor_positions(E, L, model.geometry)
+    fd = _central_difference(lambda q: chain.chain_gravity_torque(model, cor, q))
+    gravity = chain.chain_coefficients(model, E, L).gravity_stiffness
+    np.testing.assert_allclose(gravity, fd, rtol=1e-7)
+    # upright, a level on the line of gravity (x = 0) loads each joint below it with w x_j (w its weight)
+    zero = np.zeros(N_COR)
+    loading = chain.chain_gravity_torque(model, cor, zero) - chain.chain_gravity_torque(base, cor, zero)
+    signed = model.levels.mass * model.body.gravity * (1 if sign == "destabilising" else -1)
+    np.testing.assert_allclose(loading, signed * np.arange(N_COR) * cor[..., 0], rtol=1e-12, atol=1e-12)
+    y = np.asarray(model.geometry.cor_heights)
+    w = model.levels.mass * model.body.gravity * (1 if sign == "destabilising" else -1)
+    extra = gravity - chain.chain_coefficients(base, E, L).gravity_stiffness
+    # joint L5S1 (4) carries all four levels, at heights (y_i + y_{i+1}) / 2 above y_4
+    by_hand = w * sum((y[i] + y[i + 1]) / 2 - y[4] for i in range(4))
+    np.testing.assert_allclose(extra[..., 4, 4], by_hand, rtol=1e-12)
+    np.testing.assert_allclose(extra[..., 0, :], 0.0, atol=1e-12)  # L1L2 carries no level

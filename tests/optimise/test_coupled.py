@@ -7,12 +7,14 @@ import dataclasses
 import cvxpy as cp
 import numpy as np
 import pytest
+import scipy.linalg
 
 from spinectl import load_preset, optimise
 from spinectl.errors import ParameterError
 from spinectl.model import chain
 from spinectl.model.mechanics import segment_coefficients
 from spinectl.model.params import Body, Passive
+from spinectl.model.stability import segment_stability
 from spinectl.optimise import coupled
 
 LOWER = 1 - 1e-4
@@ -216,3 +218,52 @@ def test_outside_the_modelled_range_is_an_error(model):
     """E = 0.5 m lies outside geometry.eccentricity_range (+-0.1 m): an error naming E, not a NaN."""
     with pytest.raises(ParameterError):
         coupled.joint_optimum(model, 0.5, 0.0)
+
+
+# --- the coupled chain at the per-segment optimum (spinectl stability --coupled) ---------------
+
+
+@pytest.mark.parametrize("preset", ["default", "wagner2012"])
+def test_coupled_stability_at_the_segment_optimum(preset):
+    """At position A and the LP optimum: K = K_g - diag(K_pas) + sum_i x_i dK/dx_i rebuilt from the
+    per-variable matrices (x the paired PCSA in cm^2); its diagonal and D's are eq. 1's S_k and D_k;
+    the eigenvalues are those of the quadratic eigenproblem det(lambda^2 M - lambda D - K) = 0 solved
+    as a generalised eigenproblem by scipy; four grow (the four unstable static modes), and the least
+    local stiffness of (a) makes every one decay."""
+    model = load_preset(preset)
+    result = coupled.coupled_stability_at(model, 0.0, 0.0)
+    opt = optimise.solve_point(model, 0.0, 0.0)
+    np.testing.assert_allclose(result.pcsa, opt.pcsa, rtol=1e-12)
+    x = opt.pcsa[::2] * 1e4  # paired: one variable per pair, cm^2 (both sides equal)
+    rebuilt = result.gravity_stiffness - model.passive.stiffness * np.eye(5)
+    rebuilt = rebuilt + np.einsum("i,ijk->jk", x, result.stiffness_per_variable)
+    np.testing.assert_allclose(result.stiffness, rebuilt, rtol=1e-9, atol=1e-9)
+    segment = segment_stability(model, 0.0, 0.0, opt.pcsa)
+    np.testing.assert_allclose(np.diag(result.stiffness), segment.stiffness, rtol=1e-12, atol=1e-9)
+    np.testing.assert_allclose(np.diag(result.damping), segment.damping, rtol=1e-12)
+    a = np.block([[np.zeros((5, 5)), np.eye(5)], [result.stiffness, result.damping]])
+    b = np.block([[np.eye(5), np.zeros((5, 5))], [np.zeros((5, 5)), result.mass]])
+    np.testing.assert_allclose(
+        np.sort_complex(result.eigenvalues), np.sort_complex(scipy.linalg.eig(a, b, right=False)), rtol=1e-7
+    )
+    assert np.sum(result.eigenvalues.real > 0) == 4 and not result.self_stable
+    assert result.margin == pytest.approx(np.linalg.eigvalsh(-result.stiffness)[0])
+    least = coupled.least_local_stiffness(model, 0.0, 0.0, opt.pcsa)
+    np.testing.assert_allclose(result.local.local_stiffness, least.local_stiffness, rtol=1e-9)
+    assert result.stable_with_local and np.all(result.local_eigenvalues.real < 0)
+
+
+def test_coupled_stability_dict_has_the_units_in_its_keys():
+    """The JSON document: matrices as nested lists of the right shapes, SI with units in the names."""
+    model = load_preset("default")
+    result = coupled.coupled_stability_at(model, 0.03, 0.04, [10e-4, 10e-4, 10e-4])
+    document = result.to_dict(model, pcsa_source="given")["coupled"]
+    for key in ("stiffness_matrix_Nm_per_rad", "gravity_stiffness_matrix_Nm_per_rad", "damping_matrix_Nms_per_rad"):
+        assert np.shape(document[key]) == (5, 5)
+    assert np.shape(document["mass_matrix_kgm2"]) == (5, 5)
+    assert np.shape(document["stiffness_matrix_per_cm2"]) == (3, 5, 5)
+    assert document["decision_variables"] == list(model.pair_names)
+    assert document["pcsa_cm2"] == pytest.approx(dict.fromkeys(model.muscle_names, 10.0))
+    assert np.shape(document["eigenvalues"]) == (10, 2) and document["self_stable"] is False
+    assert document["local_stiffness_total_Nm_per_rad"] == pytest.approx(sum(document["local_stiffness_Nm_per_rad"]))
+    assert document["margin_Nm_per_rad"] == pytest.approx(result.margin)

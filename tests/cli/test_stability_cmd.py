@@ -1,0 +1,46 @@
+"""``spinectl stability --coupled``: the chain's document and table (docs/chain.md)."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+
+from spinectl.cli import main
+from spinectl.model import config
+from spinectl.optimise.coupled import coupled_stability_at
+
+
+def test_coupled_json_is_the_results_dict(capsys):
+    """--coupled --json prints CoupledStability.to_dict of the library call (values: tests/optimise)."""
+    argv = ["stability", "--coupled", "--E", "0.03", "--Lambda", "0.04", "--preset", "wagner2012", "--json"]
+    assert main(argv) == 0
+    printed = json.loads(capsys.readouterr().out)
+    model = config.load_preset("wagner2012")
+    expected = coupled_stability_at(model, 0.03, 0.04).to_dict(model, pcsa_source="min_pcsa")
+    assert printed == json.loads(json.dumps(expected))
+    assert printed["coupled"]["self_stable"] is False and printed["coupled"]["stable_with_local"] is True
+
+
+def test_coupled_table_with_a_given_pcsa(capsys):
+    """--pcsa is the global activation; the table names the matrices and the verdicts."""
+    assert main(["stability", "--coupled", "--pcsa", "10,10,10", "--K", "15"]) == 0
+    out = capsys.readouterr().out
+    assert "mass M [kg m^2]" in out and "static margin" in out and "least local stiffness" in out
+    model = config.set_parameter(config.load_preset("default"), "passive.stiffness", 15.0)
+    result = coupled_stability_at(model, 0.0, 0.0, np.full(3, 10e-4))
+    assert f"static margin (smallest eigenvalue of -K) = {result.margin:.3f} N m/rad" in out
+
+
+def test_massless_levels_leave_the_eigenvalues_undefined(tmp_path, capsys):
+    """levels.mass = 0: M = m J'J has rank 2 (1 at E = 0, the CoRs right below the mass), so no
+    eigenvalues (NaN, not stable); the statics stand."""
+    path = tmp_path / "m.toml"
+    path.write_text("[levels]\nmass = 0.0\n")
+    assert main(["stability", "--coupled", "--config", str(path)]) == 0
+    assert "eigenvalues undefined, the mass matrix is singular" in capsys.readouterr().out
+    assert main(["stability", "--coupled", "--config", str(path), "--E", "0.03", "--json"]) == 0
+    document = json.loads(capsys.readouterr().out)["coupled"]
+    assert np.all(np.isnan(document["eigenvalues"])) and document["self_stable"] is False
+    assert np.linalg.matrix_rank(np.array(document["mass_matrix_kgm2"])) == 2
+    assert document["margin_Nm_per_rad"] < 0  # the static analysis does not need M
