@@ -39,7 +39,7 @@ def test_plot_of_a_bad_dataset_is_one_line(tmp_path, monkeypatch, capsys, comman
     assert not (tmp_path / "figs").exists()
 
 
-# --- valid or foreign inputs that crashed the readers (issue 18, class 17) ---------------------------
+# --- valid or foreign inputs that crashed the readers (docs/robustness.md) ---------------------------
 
 
 @pytest.fixture(scope="module")

@@ -28,7 +28,7 @@ def test_eigenvalues_keep_the_small_root_when_theta_is_tiny():
 
     From Vieta: lambda_1 lambda_2 = -S/theta and lambda_1 + lambda_2 = D/theta, so
     for theta S << D^2 the small root is -S/D (1 + O(theta S / D^2)); with
-    S = -17.7, D = -5.78 (the segment of issue 18, mass 1 nm above L1L2) it is
+    S = -17.7, D = -5.78 (the segment of docs/robustness.md, mass 1 nm above L1L2) it is
     -3.062. The textbook form D/(2 theta) + sqrt(...) cancels to 0.
     """
     s, d, theta = -17.7, -5.78, 1e-20

@@ -1,4 +1,4 @@
-"""The shared formulation: row equilibration keeps the feasible set (issue 18, class 7)."""
+"""The shared formulation: row equilibration keeps the feasible set (docs/robustness.md, absurd K)."""
 
 from __future__ import annotations
 

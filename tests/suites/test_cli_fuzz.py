@@ -213,7 +213,7 @@ def test_random_arguments_to_the_analysis_commands_never_raise(analysis_folder, 
         ["margins", "--E", "0.0", "--delay", "0.0", "--activation", "1.1125369292536007e-308"],
         # K = 1.3e154 N m/rad: S^2 overflowed in the sweep's reflex columns, a numpy warning.
         ["sweep", "--out", "out.nc", "--E", "0:0.0625:1", "--Lambda", "0:0.0625:1", "--K", "1.3407807929942597e+154"],
-        # equilibrated stability rows (issue 18): a subnormal singular value of the polishing's KKT
+        # equilibrated stability rows (docs/robustness.md): a subnormal singular value of the polishing's KKT
         # system made 1/sigma overflow, "overflow encountered in divide" (optimise/polish.py).
         ["sweep", "--out", "out.nc", "--E", "0.03125:0.0625:1", "--Lambda", "0.0:0.0625:1", "--K", "127.0",
          "--config", "on_cor.toml"],
