@@ -608,7 +608,9 @@ def test_long_jobs_check_their_outputs_before_they_start(tmp_path, monkeypatch, 
 
 
 def test_every_text_file_is_opened_with_an_explicit_encoding():
-    """Every ``open``, ``read_text``, ``write_text`` in spinectl names its encoding (docs/robustness.md, a locale that is not UTF-8).
+    """Every ``open``, ``read_text``, ``write_text`` in spinectl names its encoding.
+
+    docs/robustness.md, "a locale that is not UTF-8".
 
     Without one Python uses the locale's encoding, e.g. ISO-8859-1, which cannot
     write the report's Λ; binary modes ('rb', 'wb') need none.
@@ -654,7 +656,7 @@ def _full_disk(*args, **kwargs):
 )
 def test_a_full_disk_is_one_line_and_keeps_the_previous_files(tmp_path, monkeypatch, capsys, command, patched):
     """OSError(ENOSPC) from the writer (simulated: the disk cannot be filled in a test) is an OutputError:
-    one line naming the file, exit 2, the previous output intact, no temporary left (docs/robustness.md, a full disk)."""
+    one line naming the file, exit 2, the previous output intact, no temporary left (docs/robustness.md)."""
     from spinectl.landscape import sweep
 
     sweep.write_sweep(Model(), [0.0, 0.08], [0.0, 0.08], tmp_path / "old.nc")  # a previous output, and plot's input
