@@ -19,6 +19,9 @@ xarray take a second to import): ``from spinectl import optimise``.
 """
 
 import importlib
+import importlib.abc
+import importlib.util
+import sys
 import warnings
 
 from .errors import ConfigError, ModelError, ParameterError, SpinectlError
@@ -72,20 +75,64 @@ MOVED = {
 }
 """Modules of spinectl 0.1's flat layout and where they live now (CHANGELOG, 0.2).
 
-``from spinectl import sweep`` still works for one release, with a
+``from spinectl import sweep``, ``import spinectl.sweep`` and
+``from spinectl.config import load_preset`` still work for one release, with a
 :class:`DeprecationWarning` naming the new module. Names that moved between
 modules when one was split (e.g. ``sweep.save``, now
 :func:`spinectl.landscape.netcdf.save`) are found in the new module only.
 """
 
 
+def _moved(old: str, stacklevel: int):
+    """The module that the 0.1 name ``spinectl.<old>`` (or a module inside it) now is, with a warning."""
+    head, _, rest = old.partition(".")
+    new = MOVED[head] + (f".{rest}" if rest else "")
+    warnings.warn(
+        f"spinectl.{old} has moved to {new}; the old name goes in the next release",
+        DeprecationWarning,
+        stacklevel=stacklevel,
+    )
+    return importlib.import_module(new)
+
+
 def __getattr__(name: str):
-    """The moved modules of :data:`MOVED`, with a :class:`DeprecationWarning` (PEP 562)."""
+    """The moved modules of :data:`MOVED`, with a :class:`DeprecationWarning` (PEP 562).
+
+    Parameters
+    ----------
+    name : str
+        An attribute of the package, e.g. ``"sweep"``.
+
+    Returns
+    -------
+    module
+        The module that ``spinectl.<name>`` now is.
+
+    Raises
+    ------
+    AttributeError
+        ``name`` is neither an attribute nor a moved module.
+    """
     if name not in MOVED:
         raise AttributeError(f"module 'spinectl' has no attribute {name!r}")
-    warnings.warn(
-        f"spinectl.{name} has moved to {MOVED[name]}; the old name goes in the next release",
-        DeprecationWarning,
-        stacklevel=2,
-    )
-    return importlib.import_module(MOVED[name])
+    return _moved(name, stacklevel=3)
+
+
+class _MovedModules(importlib.abc.MetaPathFinder, importlib.abc.Loader):
+    """``import spinectl.sweep`` and ``from spinectl.config import ...`` of 0.1: the new module, with a warning."""
+
+    def find_spec(self, fullname, path=None, target=None):
+        old = fullname.removeprefix(f"{__name__}.")
+        if old != fullname and old.partition(".")[0] in MOVED:
+            return importlib.util.spec_from_loader(fullname, self)
+        return None
+
+    def create_module(self, spec):
+        return _moved(spec.name.removeprefix(f"{__name__}."), stacklevel=8)
+
+    def exec_module(self, module):
+        pass  # the new module is imported already
+
+
+if not any(isinstance(finder, _MovedModules) for finder in sys.meta_path):
+    sys.meta_path.insert(0, _MovedModules())  # before the path finder, which would load old paths twice

@@ -3,12 +3,18 @@
 from __future__ import annotations
 
 import importlib
+import os
 import re
+import subprocess
+import sys
 import warnings
+from pathlib import Path
 
 import pytest
 
 import spinectl
+
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def test_top_level_api_is_importable():
@@ -45,3 +51,29 @@ def test_the_new_packages_need_no_warning():
 def test_an_unknown_name_is_an_attribute_error():
     with pytest.raises(AttributeError, match="no attribute 'nonsense'"):
         spinectl.nonsense  # noqa: B018
+
+
+def _python(code: str, *flags: str) -> subprocess.CompletedProcess:
+    """``code`` in a fresh interpreter (the import system's caches start empty), this checkout first."""
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    return subprocess.run([sys.executable, *flags, "-c", code], capture_output=True, text=True, env=env, check=False)
+
+
+@pytest.mark.parametrize(
+    ("statement", "new"),
+    [
+        ("import spinectl.sweep as m", "spinectl.landscape.sweep"),
+        ("from spinectl.config import load_preset as m", "spinectl.model.config"),
+        ("from spinectl.study.spec import Study as m", "spinectl.landscape.study.spec"),
+        ("import spinectl.calibration.fit as m", "spinectl.paper.calibration.fit"),
+    ],
+)
+def test_import_statements_of_old_names_give_the_new_module_with_a_warning(statement, new):
+    """0.1's import statements: the same objects as the new module's (one module, not a second copy
+    loaded under the old name), and a DeprecationWarning naming the new module."""
+    check = f"{statement}; import sys, importlib; n = importlib.import_module('{new}')"
+    check += "; assert m is n or getattr(n, m.__name__, None) is m, m"
+    ok = _python(check, "-W", "ignore::DeprecationWarning")
+    assert ok.returncode == 0, ok.stderr
+    warned = _python(statement, "-W", "error::DeprecationWarning")
+    assert warned.returncode != 0 and f"has moved to {new.rsplit('.', 1)[0]}" in warned.stderr
