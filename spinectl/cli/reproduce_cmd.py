@@ -18,8 +18,9 @@ def register(sub) -> None:
     parser = sub.add_parser(
         "reproduce",
         help="run the paper's study: landscapes, figures and a landmark report",
-        description="Reproduce Figures 3, 4 and S1 of Wagner et al. (2012) at 1 mm resolution for "
-        "K = 0 and 15 N m/rad and compare the paper's landmarks with spinectl's in report.md.",
+        description="Reproduce Figures 3, 4 and S1 of Wagner et al. (2012) (E and Lambda from 0 to 8 cm; "
+        "1 mm steps by default, see --points) for K = 0 and 15 N m/rad and compare the paper's landmarks "
+        "with spinectl's in report.md.",
     )
     parser.add_argument("--out", default="results", metavar="DIR", help="output folder (default: results)")
     parser.add_argument(
