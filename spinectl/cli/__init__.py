@@ -88,6 +88,7 @@ def main(argv: list[str] | None = None) -> int:
     int
         0 on success, 2 for an error the user can fix (one line on stderr), 130 on Ctrl-C.
     """
+    _printable_streams()
     try:
         args = build_parser().parse_args(argv)
         return int(args.func(args) or 0)
@@ -104,3 +105,15 @@ def main(argv: list[str] | None = None) -> int:
         return 130
     except BrokenPipeError:
         return 0
+
+
+def _printable_streams() -> None:
+    """Let stdout and stderr print any path: characters their encoding lacks come out escaped.
+
+    An output named ``Λ.nc`` on an ASCII terminal (``PYTHONIOENCODING=ascii``, the C locale)
+    is written; printing its name must not then fail with a traceback.
+    """
+    for stream in (sys.stdout, sys.stderr):
+        reconfigure = getattr(stream, "reconfigure", None)  # absent on replaced streams (pytest's capture)
+        if reconfigure is not None:
+            reconfigure(errors="backslashreplace")

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from ..atomic import check_distinct
 from ..paper import drawing, figures
 from ..units import cm2_to_m2
 from ._common import add_model_options, add_position_options, finite_float, float_list, load_model
@@ -57,6 +58,7 @@ def run(args) -> int:
     int
         Exit code 0.
     """
+    check_distinct({"--out": args.out}, {"--config": args.config})  # before the work: never the input
     model = load_model(args)
     pcsa = None if args.geometry_only else ("optimum" if args.pcsa is None else cm2_to_m2(args.pcsa))
     fig = drawing.draw_model(model, args.E, args.Lambda, pcsa=pcsa, counter_torque=args.counter_torque)

@@ -45,3 +45,28 @@ def test_draw_errors_are_one_line_and_write_nothing(tmp_path, capsys):
         err = capsys.readouterr().err
         assert message in err and err.count("\n") == 1
     assert list(tmp_path.iterdir()) == []
+
+
+def test_draw_never_replaces_its_own_config(tmp_path, capsys):
+    """``--out`` naming the ``--config`` file (whatever its suffix): one line, exit 2, the config intact."""
+    config = tmp_path / "c.svg"
+    config.write_text('preset = "default"\n', encoding="utf-8")
+    code = main(["draw", "--E", "0.03", "--Lambda", "0.04", "--config", str(config), "--out", str(config)])
+    assert code == 2 and "is the same file as --config" in capsys.readouterr().err
+    assert config.read_text(encoding="utf-8") == 'preset = "default"\n'
+
+
+def test_a_non_ascii_output_name_on_an_ascii_terminal(tmp_path):
+    """``PYTHONIOENCODING=ascii``: the file Λ.png is written and its name printed escaped, exit 0."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2]
+    env = {**os.environ, "PYTHONIOENCODING": "ascii", "PYTHONPATH": str(root)}
+    out = tmp_path / "Λ.png"
+    command = [sys.executable, "-m", "spinectl", "draw", "--E", "0.03", "--Lambda", "0.04", "--geometry-only"]
+    done = subprocess.run([*command, "--out", str(out)], capture_output=True, text=True, env=env, check=False)
+    assert done.returncode == 0, done.stderr
+    assert out.exists() and "\\u039b.png" in done.stdout

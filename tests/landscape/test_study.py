@@ -591,3 +591,31 @@ def test_ctrl_c_while_the_local_cluster_starts_is_one_line(tmp_path):
         proc.wait()
     assert (proc.returncode, err) == (130, "spinectl: interrupted\n")
     assert not Path(f"{out}.lock").exists()
+
+
+def test_a_server_announcing_an_exabyte_frame_is_no_scheduler(tmp_path):
+    """A server on 127.0.0.1 that answers with a frame length of 2**62 bytes: Dask's reader tries to
+    allocate it (MemoryError); that is one ParameterError, not a traceback, and no store or lock."""
+    import socket
+    import struct
+    import threading
+
+    listener = socket.socket()
+    listener.bind(("127.0.0.1", 0))
+    listener.listen(1)
+
+    def answer():
+        connection, _ = listener.accept()
+        with connection:
+            connection.sendall(struct.pack("<Q", 2**62))  # the length of the frames that would follow
+            connection.recv(1024)
+
+    thread = threading.Thread(target=answer, daemon=True)
+    thread.start()
+    address = f"tcp://127.0.0.1:{listener.getsockname()[1]}"
+    try:
+        with pytest.raises(ParameterError, match="cannot connect to"):
+            study.run_study(study.parse_study(STUDY), tmp_path / "s.zarr", scheduler=address, connect_timeout=2.0)
+    finally:
+        listener.close()
+    assert not (tmp_path / "s.zarr").exists() and not (tmp_path / "s.zarr.lock").exists()

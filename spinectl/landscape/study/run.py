@@ -446,6 +446,7 @@ def _handshake(scheduler: str, timeout: float) -> int:
     server) would keep it waiting for ever.
     """
     import asyncio
+    import struct
 
     from distributed.core import rpc
 
@@ -458,8 +459,10 @@ def _handshake(scheduler: str, timeout: float) -> int:
     except TimeoutError:
         reason = f"no answer of a Dask scheduler within {timeout:g} s (is it one?)"
         raise ParameterError("scheduler", f"cannot connect to {scheduler}: {reason}") from None
-    except (OSError, ValueError, TypeError) as exc:  # refused, unreachable, garbage instead of a handshake
+    except (OSError, ValueError, TypeError, struct.error) as exc:  # refused, unreachable, garbage for a handshake
         raise ParameterError("scheduler", f"cannot connect to {scheduler}: {exc}") from None
+    except MemoryError:  # a frame length of exabytes: something else's protocol
+        info = None
     if not isinstance(info, dict) or info.get("type") != "Scheduler":
         raise ParameterError("scheduler", f"cannot connect to {scheduler}: it answers, but is no Dask scheduler")
     return int(info.get("n_workers", len(info.get("workers", ()))))
