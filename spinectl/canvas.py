@@ -1,7 +1,7 @@
 """Matplotlib figures without pyplot: drawn on the Agg canvas, saved atomically.
 
 The figure functions of :mod:`spinectl.reflex.plots` and :mod:`spinectl.paper.figures`
-draw on a :func:`new_figure` and return it; :func:`save_file` (or :func:`save_png`) is the separate save step,
+draw on a :func:`new_figure` and return it; :func:`save_file` is the separate save step,
 :func:`save_figures` that of a set of figures into one folder, swapped in as a whole.
 Nothing here selects a backend or touches pyplot's global figure list, so a figure is
 garbage-collected like any object, works without a display, and shows itself in a
@@ -34,33 +34,6 @@ def new_figure(**options) -> Figure:
     figure = Figure(**options)
     FigureCanvasAgg(figure)
     return figure
-
-
-def save_png(figure: Figure, path: str | Path, dpi: float) -> Path:
-    """Write ``figure`` as a PNG file atomically (:func:`save_file` for a ``.png`` path).
-
-    Parameters
-    ----------
-    figure : matplotlib.figure.Figure
-        The figure to write.
-    path : str or Path
-        The PNG file; its folder is created if missing.
-    dpi : float
-        Resolution [dots per inch].
-
-    Returns
-    -------
-    Path
-        ``path``.
-
-    Raises
-    ------
-    OutputError
-        The file cannot be written; a previous file of that name is left as it was.
-    """
-    with atomic_path(path) as tmp:
-        figure.savefig(tmp, format="png", dpi=dpi)
-    return Path(path)
 
 
 def save_file(figure: Figure, path: str | Path, dpi: float) -> Path:

@@ -40,6 +40,19 @@ def add_position_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--Lambda", type=finite_float("--Lambda"), default=0.0, help="lordosis Lambda [m] (default 0)")
 
 
+def add_dpi_option(parser: argparse.ArgumentParser) -> None:
+    """``--dpi``, the resolution of PNG figures, on the commands that draw (:data:`spinectl.paper.figures.DPI`).
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        The sub-command's parser.
+    """
+    from ..paper.figures import DPI  # only the drawing commands pay for matplotlib
+
+    parser.add_argument("--dpi", type=finite_float("--dpi"), default=DPI, help=f"PNG resolution (default {DPI})")
+
+
 def load_model(args: argparse.Namespace, default_preset: str = "default") -> Model:
     """The model named by ``--preset`` and ``--config``.
 

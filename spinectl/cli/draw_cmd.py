@@ -5,7 +5,7 @@ from __future__ import annotations
 from ..atomic import check_distinct
 from ..paper import drawing, figures
 from ..units import cm2_to_m2
-from ._common import add_model_options, add_position_options, finite_float, float_list, load_model
+from ._common import add_dpi_option, add_model_options, add_position_options, float_list, load_model
 
 
 def register(sub) -> None:
@@ -37,9 +37,7 @@ def register(sub) -> None:
         "--counter-torque", action="store_true", help="arrows for the counter torques CT_k [N m] at the CoRs"
     )
     parser.add_argument("--out", required=True, metavar="FILE", help="the figure: .png, .pdf or .svg")
-    parser.add_argument(
-        "--dpi", type=finite_float("--dpi"), default=figures.DPI, help=f"PNG resolution (default {figures.DPI})"
-    )
+    add_dpi_option(parser)
     add_model_options(parser)
     parser.set_defaults(func=run)
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from ..landscape import netcdf
 from ..paper import figures
-from ._common import finite_float
+from ._common import add_dpi_option, finite_float
 
 
 def register(sub) -> None:
@@ -26,9 +26,7 @@ def register(sub) -> None:
     parser.add_argument("results", metavar="RESULTS.nc", help="a file written by 'spinectl sweep' or 'reproduce'")
     parser.add_argument("--out", required=True, metavar="DIR", help="folder for the figure files")
     parser.add_argument("--format", choices=figures.FORMATS, default="png", help="file format (default png)")
-    parser.add_argument(
-        "--dpi", type=finite_float("--dpi"), default=figures.DPI, help=f"PNG resolution (default {figures.DPI})"
-    )
+    add_dpi_option(parser)
     scale = parser.add_argument_group("colour scale of the minimum-PCSA figures")
     scale.add_argument("--vmin", type=finite_float("--vmin"), help="lower end [cm^2] (default: the data's)")
     scale.add_argument("--vmax", type=finite_float("--vmax"), help="upper end [cm^2] (default: the data's)")

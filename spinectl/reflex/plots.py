@@ -21,7 +21,7 @@ import matplotlib
 import numpy as np
 from matplotlib.figure import Figure
 
-from ..canvas import new_figure, save_figures, save_png
+from ..canvas import new_figure, save_figures, save_file
 from ..model.params import Model
 from .loops import ignoring_underflow
 from .margins import MarginsReport, ReportResponses, report_responses
@@ -229,7 +229,7 @@ def report_figures(report: MarginsReport, responses: ReportResponses) -> dict[st
 
 
 def save_figure(fig: Figure, path: str | Path) -> Path:
-    """The save step: :func:`spinectl.canvas.save_png` at this module's :data:`DPI`.
+    """The save step: :func:`spinectl.canvas.save_file` at this module's :data:`DPI`.
 
     Parameters
     ----------
@@ -243,7 +243,7 @@ def save_figure(fig: Figure, path: str | Path) -> Path:
     Path
         ``path``.
     """
-    return save_png(fig, path, DPI)
+    return save_file(fig, path, DPI)
 
 
 def write_plots(report: MarginsReport, folder: str | Path, model: Model) -> list[Path]:

@@ -11,7 +11,7 @@ import matplotlib.pyplot as plt
 import pytest
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 
-from spinectl.canvas import new_figure, save_png
+from spinectl.canvas import new_figure, save_file
 from spinectl.errors import OutputError
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -45,9 +45,9 @@ def test_new_figure_is_not_pyplots():
     assert tuple(fig.get_size_inches()) == (2, 1)
 
 
-def test_save_png_writes_a_png_and_no_temporary(tmp_path):
+def test_save_file_writes_a_png_and_no_temporary(tmp_path):
     fig = new_figure(figsize=(2, 1))
-    path = save_png(fig, tmp_path / "sub" / "f.png", dpi=50)
+    path = save_file(fig, tmp_path / "sub" / "f.png", dpi=50)
     assert path == tmp_path / "sub" / "f.png"
     assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert [p.name for p in path.parent.iterdir()] == ["f.png"]
@@ -63,7 +63,7 @@ def test_a_failed_save_leaves_the_previous_file(tmp_path, monkeypatch):
 
     monkeypatch.setattr(fig, "savefig", broken)
     with pytest.raises(RuntimeError):
-        save_png(fig, target, dpi=50)
+        save_file(fig, target, dpi=50)
     assert target.read_bytes() == b"previous" and [p.name for p in tmp_path.iterdir()] == ["f.png"]
     with pytest.raises(OutputError, match="cannot write"):
-        save_png(new_figure(), target / "below.png", dpi=50)  # a file where a folder should be
+        save_file(new_figure(), target / "below.png", dpi=50)  # a file where a folder should be
