@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import contextlib
 import errno
+import functools
 import os
 import shutil
 import tempfile
@@ -154,15 +155,24 @@ RENAME_EXCHANGE = 2
 """Linux's ``renameat2`` flag that swaps two paths in one step (<linux/fs.h>)."""
 
 
-def _exchange(a: Path, b: Path) -> bool:
-    """Swap the paths ``a`` and ``b`` atomically (Linux >= 3.15); False where the OS or file system cannot."""
+@functools.cache
+def _renameat2():
+    """The C library's ``renameat2``, or None; looked up once (``find_library`` may start ``ldconfig``)."""
     import ctypes
     import ctypes.util
 
     try:
-        libc = ctypes.CDLL(ctypes.util.find_library("c"), use_errno=True)
-        renameat2 = libc.renameat2
+        return ctypes.CDLL(ctypes.util.find_library("c"), use_errno=True).renameat2
     except (OSError, AttributeError, TypeError):  # no C library by that name, or no renameat2 in it
+        return None
+
+
+def _exchange(a: Path, b: Path) -> bool:
+    """Swap the paths ``a`` and ``b`` atomically (Linux >= 3.15); False where the OS or file system cannot."""
+    import ctypes
+
+    renameat2 = _renameat2()
+    if renameat2 is None:
         return False
     at_cwd = -100  # AT_FDCWD: paths relative to the working directory
     if renameat2(at_cwd, os.fsencode(a), at_cwd, os.fsencode(b), RENAME_EXCHANGE) == 0:
@@ -322,10 +332,12 @@ def staged_directory(target: str | Path, names=(), replaces=()) -> Iterator[Path
     The files already in ``target`` that the run does not write are kept (but those
     named in ``replaces``, earlier outputs of the same kind, go): they are
     hard-linked into the staging folder (copied where the file system cannot link), and
-    the staging folder then takes the place of ``target`` by renames (the old folder
-    moved aside, the new one in, the old one removed; put back if the new one cannot go
-    in). So ``target`` holds the old set of files or the new one, never a mix: an
-    interruption, a full disk or a blocked name before the renames leaves it as it was.
+    the staging folder then takes the place of ``target``: in one step where Linux's
+    ``renameat2`` exchanges them, else by renames (the old folder moved aside, the new one
+    in, the old one removed; put back if the new one cannot go in). So ``target`` holds
+    the old set of files or the new one, never a mix: an interruption, a full disk or a
+    blocked name before the renames leaves it as it was. The other files are linked anew on
+    every write: cheap for a folder of figures, not for one that also holds a large store.
     A mount point (a container's bind mount) cannot be replaced: there the staging
     folder is inside ``target`` and its files land one by one at the end, each by an
     atomic rename (``replaces`` does not apply).

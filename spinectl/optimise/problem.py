@@ -265,9 +265,10 @@ def inequalities(data: ProblemData, total_max=np.inf, x_ct=None) -> tuple[np.nda
     Returns
     -------
     lhs : numpy.ndarray, shape (..., r, n_var)
-        G [N m/rad per cm^2 for stiffness rows, 1 otherwise].
+        G: the stability rows equilibrated (:func:`equilibrated`: each row and its bound divided
+        by the row's largest magnitude, so [1 per cm^2]); the bound rows [1].
     rhs : numpy.ndarray, shape (..., r)
-        h [N m/rad or cm^2].
+        h: the equilibrated stability bounds [1], the bounds on x [cm^2].
     """
     lead, n = data.stability.shape[:-2], data.weights.size
     eye = np.broadcast_to(np.eye(n), lead + (n, n))

@@ -1,4 +1,4 @@
-"""Coupled stability of the chain: the issue's finding and the three SDPs (docs/chain.md)."""
+"""Coupled stability of the chain: the unstable modes at the per-segment optimum and the three SDPs (docs/chain.md)."""
 
 from __future__ import annotations
 
@@ -35,9 +35,9 @@ def _null_modes(coefficients):
 
 
 def test_segment_optimum_leaves_four_chain_modes_unstable():
-    """The issue's claim, at preset wagner2012, position A (E = Lambda = 0), on the LP optimum:
+    """The claim of docs/chain.md ("The finding"), at preset wagner2012, position A (E = Lambda = 0), on the LP optimum:
     the diagonal of K is S_k, all < 0 (self-stable segment by segment), yet K has 4 positive
-    eigenvalues; the issue reports -K's as about -58 ... +258 N m/rad."""
+    eigenvalues; docs/chain.md reports -K's as about -58 ... +258 N m/rad."""
     model = load_preset("wagner2012")
     opt = optimise.solve_point(model, 0.0, 0.0)
     stiffness = chain.chain_coefficients(model, 0.0, 0.0).stiffness(opt.pcsa)

@@ -36,6 +36,11 @@ def test_chain_system_poles_and_static_gain(preset):
         rtol=1e-8,
     )
     np.testing.assert_allclose(system.dcgain(), -np.linalg.inv(stiffness), rtol=1e-8)
+    # independent of the state matrix: each pole s solves det(M s^2 - D s - K) = 0 (the chain's
+    # characteristic equation, tau = K q + D q' = M q''), checked as the smallest singular value
+    for s in system.poles():
+        singular = np.linalg.svd(mass * s**2 - damping * s - stiffness, compute_uv=False)
+        assert singular[-1] <= 1e-7 * singular[0]
 
 
 def test_one_joint_is_the_segment_system():
