@@ -46,7 +46,7 @@ import spinectl
 from spinectl import optimise, reflex
 from spinectl.landscape import sweep
 from spinectl.model import config
-from spinectl.paper import landmarks
+from spinectl.paper import grid, landmarks
 from spinectl.reflex import loops, margins, simulate
 
 preset = PRESET or ("wagner2012" if "wagner2012" in spinectl.list_presets() else "default")
@@ -162,7 +162,7 @@ print(f"every joint self-stable, so any delay is tolerated: a >= {self_stable_fr
 # Below, three activations (rows) and the three delays of the Discussion (columns).
 
 # %%
-axis = np.linspace(0.0, 0.08, GRID)  # E and Lambda [m]
+axis = grid.paper_axis(GRID)  # E and Lambda [m], the paper's 0 to 8 cm
 ACTIVATIONS = (0.0, 0.25, 0.5)
 maps = {a: sweep.sweep(config.set_parameter(model, "reflex.activation", a), axis, axis) for a in ACTIVATIONS}
 

@@ -32,11 +32,11 @@ from IPython.display import display
 import spinectl
 from spinectl.landscape import sweep
 from spinectl.model import config
-from spinectl.paper import landmarks
+from spinectl.paper import grid, landmarks
 
 preset = PRESET or ("wagner2012" if "wagner2012" in spinectl.list_presets() else "default")
 model = config.set_parameter(spinectl.load_preset(preset), "passive.stiffness", 0.0)  # K = 0, as in Figure 3
-axis = np.linspace(0.0, 0.08, GRID)  # E and Lambda of the landscapes [m]
+axis = grid.paper_axis(GRID)  # E and Lambda of the landscapes [m], the paper's 0 to 8 cm
 E_OPT = landmarks.OPTIMUM[0]  # m: the paper's eccentricity, 3 cm
 line = np.linspace(0.0, 0.08, 161)  # Lambda [m] at E = 3 cm, 0.5 mm apart: cheap, so finer than the landscapes
 CM = 100.0  # cm per m
@@ -44,7 +44,6 @@ print(
     f"preset {preset!r}: mass {model.body.mass:g} kg, K convention {model.passive.convention!r}, "
     f"activation {model.optimisation.activation!r}"
 )
-from spinectl.paper import grid
 
 # %% [markdown]
 # One function measures a model: a landscape over $E \times \Lambda$ for A, B, the ridge and the two slopes

@@ -10,6 +10,9 @@ import numpy as np
 M2_PER_CM2 = 1e-4
 """Square metres per square centimetre."""
 
+CM_PER_M = 100.0
+"""Centimetres per metre: lengths on the figures' axes."""
+
 
 def cm2_to_m2(value):
     """PCSA [cm^2] -> [m^2].

@@ -48,7 +48,7 @@ def add_dpi_option(parser: argparse.ArgumentParser) -> None:
     parser : argparse.ArgumentParser
         The sub-command's parser.
     """
-    from ..paper.figures import DPI  # only the drawing commands pay for matplotlib
+    from ..paper.figures import DPI
 
     parser.add_argument("--dpi", type=finite_float("--dpi"), default=DPI, help=f"PNG resolution (default {DPI})")
 

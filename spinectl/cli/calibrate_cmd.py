@@ -37,13 +37,16 @@ def register(sub) -> None:
     parser.add_argument("--starts", type=int, default=1, help="independent optimiser runs, seeds SEED, SEED+1, ...")
     parser.add_argument("--seed", type=int, default=0, help="seed of the first run (default 0)")
     parser.add_argument(
-        "--grid", type=int, default=calibration.FIT_POINTS, help="grid points per axis while fitting (default 17)"
+        "--grid",
+        type=int,
+        default=calibration.FIT_POINTS,
+        help=f"grid points per axis while fitting (default {calibration.FIT_POINTS})",
     )
     parser.add_argument(
         "--verify-grid",
         type=int,
         default=grid.PAPER_POINTS,
-        help="grid points per axis of the final measurement (default 81: the paper's 1 mm)",
+        help=f"grid points per axis of the final measurement (default {grid.PAPER_POINTS}: the paper's 1 mm)",
     )
     parser.add_argument("--generations", type=int, default=calibration.GENERATIONS, help="generations per run")
     parser.add_argument("--popsize", type=int, default=calibration.POPSIZE, help="population per free parameter")

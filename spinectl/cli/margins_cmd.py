@@ -106,7 +106,7 @@ def run(args) -> int:
     model = model_with_overrides(args)
     report = analyse(model, args.E, args.Lambda, kp=args.kp, kd=args.kd)
     if args.plot:
-        from ..reflex import plots  # python-control's plotting and matplotlib only when plotting
+        from ..reflex import plots
 
         written = plots.write_plots(report, args.plot, model)
         skipped = sorted(set(plots.PLOT_FILES) - {p.name for p in written})

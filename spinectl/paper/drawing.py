@@ -30,8 +30,8 @@ from ..model.checks import expand_pcsa
 from ..model.params import SIDES, Model
 from ..model.stability import segment_stability
 from ..optimise.reference import solve_point
+from ..units import CM_PER_M, m2_to_cm2
 
-CM_PER_M = 100.0
 FIGURE_SIZE = (5.6, 6.4)
 """Inches."""
 PAIR_COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:purple", "tab:brown", "tab:pink")
@@ -170,7 +170,7 @@ def activation(
 
 
 def _cm2(area: float) -> str:
-    return f"{area * 1e4:.3g}"
+    return f"{m2_to_cm2(area):.3g}"
 
 
 def _widths(pcsa: np.ndarray | None, n_muscles: int) -> np.ndarray:

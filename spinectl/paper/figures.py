@@ -27,10 +27,9 @@ from matplotlib.figure import Figure
 from ..canvas import new_figure, save_figures, save_file
 from ..errors import ParameterError
 from ..landscape import netcdf
-from ..units import M2_PER_CM2
+from ..units import CM_PER_M, M2_PER_CM2
 from . import drawing, grid, landmarks
 
-CM_PER_M = 100.0
 FIGURE_SIZE = (6.4, 5.2)
 """Inches."""
 INSET_FIGURE_SIZE = (8.4, 8.0)

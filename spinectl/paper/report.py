@@ -1,7 +1,7 @@
 """The reproduction report: the paper's landmarks beside spinectl's, as Markdown.
 
 Pure text from measurements and a few facts about the run; writing the file
-is the caller's job (:mod:`spinectl.cli.reproduce_cmd`).
+is the caller's job (:func:`spinectl.paper.reproduce`).
 """
 
 from __future__ import annotations

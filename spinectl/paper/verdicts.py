@@ -124,22 +124,6 @@ VERDICTS: dict[str, Verdict] = {
 """Landmark name to its documented :class:`Verdict`: the ``wagner2012`` preset on the paper's 81 x 81 grid."""
 
 
-def verdict(name: str) -> Verdict | None:
-    """The documented verdict of landmark ``name``, or None if it has none.
-
-    Parameters
-    ----------
-    name : str
-        Landmark name.
-
-    Returns
-    -------
-    Verdict or None
-        The entry of :data:`VERDICTS`.
-    """
-    return VERDICTS.get(name)
-
-
 def format_number(value: float) -> str:
     """A value as the reports print it: 3 significant digits, exponent form when tiny or huge, 'n/a' if NaN.
 
