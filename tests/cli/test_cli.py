@@ -31,7 +31,7 @@ def test_stability_prints_the_results_dict_and_table(capsys):
     """``--json`` prints :meth:`StabilityResult.to_dict`, the table :meth:`StabilityResult.table`
     (their schema and values: tests/model/test_stability.py)."""
     argv = ["stability", "--E", "0.03", "--Lambda", "0.04", "--pcsa", "10,10,10", "--K", "15"]
-    model = config.set_parameter(config.load_preset("default"), "passive.stiffness", 15.0)
+    model = config.set_parameter(config.load_preset(config.DEFAULT_PRESET), "passive.stiffness", 15.0)
     result = segment_stability(model, 0.03, 0.04, [10e-4, 10e-4, 10e-4])
     code, out, _ = run([*argv, "--json"], capsys)
     assert code == 0 and out == json.dumps(result.to_dict(model), indent=2) + "\n"
@@ -45,7 +45,7 @@ def test_config_show_is_loadable_toml(capsys, tmp_path):
     tomllib.loads(out)
     path = tmp_path / "shown.toml"
     path.write_text(out)
-    assert config.load_config(path) == config.load_preset("default")
+    assert config.load_config(path) == config.load_preset(config.DEFAULT_PRESET)
 
 
 @pytest.mark.parametrize(
@@ -74,8 +74,14 @@ def test_stability_defaults_to_the_minimum_stabilising_pcsa(capsys):
     assert code == 0
     doc = json.loads(out)
     assert doc["pcsa_source"] == "min_pcsa" and doc["all_self_stable"]
-    expected = optimise.solve_point(config.load_preset("default"), 0.03, 0.04)
-    assert doc["total_pcsa_cm2"] == pytest.approx(expected.total_pcsa * 1e4, rel=1e-9)
+    assert doc["preset"] == config.DEFAULT_PRESET
+    expected = optimise.solve_point(config.load_preset(config.DEFAULT_PRESET), 0.03, 0.04)
+    assert doc["chosen_pcsa_total_cm2"] == pytest.approx(expected.total_pcsa * 1e4, rel=1e-9)
+    assert doc["total_pcsa_cm2"] == doc["chosen_pcsa_total_cm2"]  # the old key, kept for one release
+    assert doc["min_pcsa_cm2"] == pytest.approx(expected.min_pcsa * 1e4, rel=1e-9)  # the LP's own minimum
+    # the chosen activation lies within ct_tolerance above the LP minimum (docs/optimisation.md)
+    tolerance = config.load_preset(config.DEFAULT_PRESET).optimisation.ct_tolerance
+    assert doc["min_pcsa_cm2"] <= doc["chosen_pcsa_total_cm2"] <= doc["min_pcsa_cm2"] * (1 + tolerance) + 1e-9
     code, out, _ = run(["stability", "--E", "0.03", "--Lambda", "0.04"], capsys)
     assert code == 0 and "minimum stabilising" in out
 

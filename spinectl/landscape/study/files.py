@@ -139,7 +139,7 @@ def _base_model(head: dict, overrides, base_dir: Path) -> Model:
                 raise ParameterError("config", f"must be a file name (got {show(head['config'])})")
             model = config.load_config(base_dir / head["config"], preset=preset)
         else:
-            model = config.load_preset("default" if preset is None else preset)
+            model = config.load_preset(config.DEFAULT_PRESET if preset is None else preset)
     except ConfigError as exc:
         if exc.field not in ("config", "preset"):
             raise
