@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import sys
 
-from ..model.config import diff_models, dump_toml, list_presets, load_model_spec
+from ..model.config import diff_models, list_presets, load_model_spec, show_toml
 from ..model.source import header
 from ._common import add_model_options, load_model
 
@@ -37,7 +37,7 @@ def register(sub) -> None:
 
 
 def _show(args) -> int:
-    sys.stdout.write(dump_toml(load_model(args)))
+    sys.stdout.write(show_toml(load_model(args)))
     return 0
 
 

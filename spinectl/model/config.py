@@ -319,19 +319,12 @@ def dump_toml(model: Model) -> str:
     Returns
     -------
     str
-        TOML text that :func:`load_config` reads back to ``model`` (when its pairs include the
-        preset's, as every loaded model's do); a header comment names the model's source and how
-        ``[[muscles]]`` combine; every field is preceded by a comment with its unit in brackets
-        and its ``doc`` metadata.
+        TOML text that :func:`~spinectl.model._toml.from_dict` reads back to ``model`` (and
+        :func:`load_config` when its pairs include the preset's); every field is preceded by a
+        comment with its unit in brackets and its ``doc`` metadata. It names no source, so that
+        what it identifies (a study's digest) depends on the parameters alone.
     """
-    lines = [
-        "# spinectl model parameters (SI units unless a comment says otherwise)",
-        f"# model: {header(model)}",
-        "# A --config file gives any subset of these. Its [[muscles]] tables merge with the preset's",
-        "# pairs by name: a known name changes the keys given, a new name adds a pair. With",
-        '# muscles_mode = "replace" at the top of the file, its pairs replace the preset\'s (with a warning).',
-        "",
-    ]
+    lines = ["# spinectl model parameters (SI units unless a comment says otherwise)", ""]
     for f in dataclasses.fields(model):
         value = getattr(model, f.name)
         if isinstance(value, tuple):
@@ -440,3 +433,32 @@ def load_model_spec(spec: str) -> Model:
         presets = ", ".join(map(repr, list_presets()))
         raise ConfigError("config", f"{show(spec)} is neither a preset ({presets}) nor an existing file")
     return load_config(spec)
+
+
+def show_toml(model: Model) -> str:
+    """``spinectl config show``: :func:`dump_toml` under comments naming the model and how files combine.
+
+    Parameters
+    ----------
+    model : Model
+        The parameters to show.
+
+    Returns
+    -------
+    str
+        A complete model file: the :func:`~spinectl.model.source.header` line and the rules of
+        ``[[muscles]]`` as comments, ``muscles_mode = "replace"`` (its pairs are the whole set, so
+        :func:`load_config` reads it back to ``model``), then :func:`dump_toml`.
+    """
+    return "\n".join(
+        [
+            f"# model: {header(model)}",
+            '# A --config file gives any subset of these parameters, over its preset (preset = "NAME").',
+            "# Its [[muscles]] tables merge with the preset's pairs by name: a known name changes the keys",
+            '# given, a new name adds a pair. muscles_mode = "replace" (as here, where every pair is listed)',
+            "# puts the file's pairs in place of the preset's; spinectl warns if that drops a preset's pair.",
+            'muscles_mode = "replace"',
+            "",
+            dump_toml(model),
+        ]
+    )
