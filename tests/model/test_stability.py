@@ -197,3 +197,18 @@ def test_table(model):
     assert [float(row.split()[-1]) for row in rows] == pytest.approx(result.counter_torque, abs=5e-4)
     assert lines[-1].startswith(f"||CT|| = {result.counter_torque_norm:.3f} N m; self-stable: ")
     assert "(minimum stabilising, chosen activation)" in result.table(model, pcsa_source="min_pcsa")
+
+
+def test_a_result_has_no_truth_value(model):
+    """``if result:`` is ambiguous (every segment or any?): a TypeError naming all_self_stable."""
+    result = segment_stability(model, 0.03, 0.04, [10e-4, 10e-4, 10e-4])
+    with pytest.raises(TypeError, match="use result.all_self_stable"):
+        bool(result)
+    assert result.all_self_stable == bool(np.all(result.self_stable))
+
+
+def test_a_pcsa_in_cm2_given_as_m2_is_refused(model):
+    """pcsa=[10, 10, 10] (cm^2 out of habit) is 10 m^2 per muscle: refused, naming the cm^2 slip and the fix."""
+    with pytest.raises(ParameterError, match=r"if you meant 10 cm\^2, pass 0.001"):
+        segment_stability(model, 0.03, 0.04, [10, 10, 10])
+    segment_stability(model, 0.03, 0.04, [MAX_PLAUSIBLE_PCSA] * 3)  # the bound itself is allowed

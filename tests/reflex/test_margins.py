@@ -205,3 +205,18 @@ def test_report_responses_without_reflex_or_optimum(model):
     assert responses.loops == {} and len(responses.simulations) == 5
     tiny = _with_reflex(model.replace(optimisation=Optimisation(pcsa_max=1e-8)), activation=0.5)
     assert margins.report_responses(tiny, margins.analyse(tiny, E, LAMBDA)) == margins.ReportResponses({}, {})
+
+
+@pytest.mark.parametrize(
+    ("kp", "kd", "label"),
+    [
+        (None, None, "rule"),
+        (150.0, 20.0, "explicit"),
+        (150.0, None, "explicit kp, rule kd"),
+        (None, 5.0, "rule kp, explicit kd"),
+    ],
+)
+def test_gains_say_how_they_were_chosen(model, kp, kd, label):
+    """Gains given to analyse are explicit in the report, also where the model's setting is 'rule'."""
+    report = margins.analyse(_with_reflex(model, activation=0.0), E, LAMBDA, kp=kp, kd=kd)
+    assert report.gains == label and report.to_dict()["gains"] == label

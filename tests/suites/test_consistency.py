@@ -49,6 +49,4 @@ def test_every_command_reports_the_same_model_and_numbers(tmp_path, capsys):
     # margins runs at a fraction of the chosen activation (reflex.activation): its PCSA over that
     # fraction is the chosen activation, whose total stability reports
     activation = margins["activation"]
-    assert sum(margins["pcsa_cm2"].values()) / activation == pytest.approx(
-        stability["chosen_pcsa_total_cm2"], rel=1e-6
-    )
+    assert sum(margins["pcsa_cm2"].values()) / activation == pytest.approx(stability["chosen_pcsa_total_cm2"], rel=1e-6)
