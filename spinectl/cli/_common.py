@@ -28,6 +28,17 @@ def add_model_options(parser: argparse.ArgumentParser) -> None:
         help="TOML file overriding the preset's parameters ([[muscles]] merge with the preset's by name)",
     )
     group.add_argument("--preset", metavar="NAME", help=f"built-in parameter preset (default: {DEFAULT_PRESET!r})")
+    add_set_option(group)
+
+
+def add_set_option(group) -> None:
+    """``--set SECTION.FIELD=VALUE`` (repeatable) into ``args.assignments``; in :func:`add_model_options`.
+
+    Parameters
+    ----------
+    group : argparse.ArgumentParser or argparse._ArgumentGroup
+        Where the option goes (``spinectl study`` takes it alone: its file names the preset).
+    """
     group.add_argument(
         "--set",
         dest="assignments",

@@ -7,6 +7,7 @@ from pathlib import Path
 import pytest
 
 from spinectl.cli import main
+from spinectl.landscape import study
 from spinectl.model import config
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
@@ -16,7 +17,9 @@ def test_the_study_runs_and_plot_draws_its_slices(tmp_path, capsys):
     """2 masses x 2 stiffnesses: 4 slices, each drawn as minimum PCSA and ||CT|| (8 files)."""
     store = tmp_path / "study.zarr"
     argv = ["study", str(EXAMPLES / "study.toml"), "--out", str(store), "--scheduler", "synchronous"]
-    assert main(argv) == 0
+    assert main([*argv, "--set", "optimisation.ct_tolerance=0.002"]) == 0
+    attrs = study.load(store).attrs  # the store names its model, --set included
+    assert attrs["preset"] == "wagner2012" and attrs["overridden"] == "optimisation.ct_tolerance"
     assert main(["plot", str(store), "--out", str(tmp_path / "figures")]) == 0
     written = sorted(Path(line).name for line in capsys.readouterr().out.split() if line.endswith(".png"))
     assert len(written) == 8
