@@ -110,7 +110,8 @@ def load_config(path: str | Path | None = None, preset: str | None = None) -> Mo
     data = parse(read_text(path), str(path))
     base_name = data.pop("preset", None)
     mode = data.pop("muscles_mode", "merge")
-    preset = preset or (DEFAULT_PRESET if base_name is None else base_name)
+    if preset is None:  # an empty name is an error of load_preset, not the default
+        preset = DEFAULT_PRESET if base_name is None else base_name
     model = merge(load_preset(preset), data, muscles_mode=mode, source=str(path))
     digest = hashlib.sha256(path.read_bytes()).hexdigest()
     return with_source(model, ModelSource(preset=preset, config=str(path), config_sha256=digest))
