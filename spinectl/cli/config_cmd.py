@@ -31,8 +31,8 @@ def register(sub) -> None:
         description="Compare two models, each a preset name or a TOML model file (on its own preset): one line "
         "per differing parameter, 'name [unit]: first -> second'; muscle pairs matched by name.",
     )
-    diff.add_argument("first", metavar="PRESET_OR_FILE")
-    diff.add_argument("second", metavar="PRESET_OR_FILE")
+    diff.add_argument("first", metavar="FIRST", help="a preset name or a model file (TOML)")
+    diff.add_argument("second", metavar="SECOND", help="a preset name or a model file (TOML)")
     diff.set_defaults(func=_diff)
 
 

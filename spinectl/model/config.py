@@ -266,7 +266,7 @@ def _pair_index(data: dict, dotted: str) -> str:
 
 
 def apply_overrides(model: Model, assignments) -> Model:
-    """``model`` with ``SECTION.FIELD=VALUE`` assignments applied (``spinectl ... --set``), validated together.
+    """``model`` with ``SECTION.FIELD=VALUE`` assignments applied and validated together, as ``--set`` does.
 
     VALUE is read as a TOML value (``15``, ``1e-3``, ``inf``, ``[0.04, 0.26]``, ``"paper"``); text
     that is no TOML value is a string, so ``passive.convention=paper`` needs no quotes. A pair is
