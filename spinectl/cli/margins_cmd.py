@@ -6,6 +6,7 @@ import sys
 from pathlib import Path
 
 from ..atomic import check_distinct
+from ..model.config import set_parameters
 from ..reflex.margins import analyse
 from ._common import add_model_options, add_position_options, emit_json, finite_float, load_model
 
@@ -73,8 +74,8 @@ def model_with_overrides(args):
         The validated model.
     """
     model = load_model(args, {dotted: getattr(args, option) for option, dotted in OVERRIDES})
-    gains = {f"reflex.{option}": getattr(args, option) for option in ("kp", "kd")}
-    load_model(args, gains)  # validates: a gain must be >= 0; analyse() takes them as explicit gains
+    gains = {f"reflex.{option}": getattr(args, option) for option in ("kp", "kd") if getattr(args, option) is not None}
+    set_parameters(model, gains)  # validates: a gain must be >= 0; analyse() takes them as explicit gains
     return model
 
 
