@@ -23,7 +23,7 @@
 import os
 
 GRID = int(os.environ.get("SPINECTL_NB_GRID", "81"))  # points per axis over 0-8 cm: 81 is the paper's 1 mm step
-PRESET = os.environ.get("SPINECTL_NB_PRESET", "")  # "": the calibrated "wagner2012" if installed, else "default"
+PRESET = os.environ.get("SPINECTL_NB_PRESET", "")  # "": spinectl's default preset, the calibrated "wagner2012"
 
 # %%
 # %matplotlib inline
@@ -42,7 +42,7 @@ from spinectl.paper import figures, grid, landmarks, report
 from spinectl.reflex import simulate
 from spinectl.units import m2_to_cm2
 
-preset = PRESET or ("wagner2012" if "wagner2012" in spinectl.list_presets() else "default")
+preset = PRESET or spinectl.DEFAULT_PRESET  # the preset of every command and of spinectl.load_preset()
 model = config.set_parameter(spinectl.load_preset(preset), "passive.stiffness", 0.0)  # K = 0, as in Figures 3, 4
 axis = grid.paper_axis(GRID)  # E and Lambda [m], the paper's 0 to 8 cm
 CM = 100.0  # cm per m, for axes and tables

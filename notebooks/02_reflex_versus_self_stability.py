@@ -30,7 +30,7 @@
 import os
 
 GRID = int(os.environ.get("SPINECTL_NB_GRID", "81"))  # points per axis over 0-8 cm: 81 is the paper's 1 mm step
-PRESET = os.environ.get("SPINECTL_NB_PRESET", "")  # "": the calibrated "wagner2012" if installed, else "default"
+PRESET = os.environ.get("SPINECTL_NB_PRESET", "")  # "": spinectl's default preset, the calibrated "wagner2012"
 
 # %%
 # %matplotlib inline
@@ -49,7 +49,7 @@ from spinectl.model import config
 from spinectl.paper import grid, landmarks
 from spinectl.reflex import loops, margins, simulate
 
-preset = PRESET or ("wagner2012" if "wagner2012" in spinectl.list_presets() else "default")
+preset = PRESET or spinectl.DEFAULT_PRESET  # the preset of every command and of spinectl.load_preset()
 model = spinectl.load_preset(preset)
 POSITION = landmarks.OPTIMUM  # (E, Lambda) [m]: the paper's optimum, E = 3 cm, Lambda = 4 cm
 DELAYS = (0.05, 0.10, 0.15)  # s: the paper's "up to 100 ms", and 50 ms either side

@@ -19,7 +19,7 @@
 import os
 
 GRID = int(os.environ.get("SPINECTL_NB_GRID", "81"))  # points per axis over 0-8 cm: 81 is the paper's 1 mm step
-PRESET = os.environ.get("SPINECTL_NB_PRESET", "")  # "": the calibrated "wagner2012" if installed, else "default"
+PRESET = os.environ.get("SPINECTL_NB_PRESET", "")  # "": spinectl's default preset, the calibrated "wagner2012"
 
 # %%
 # %matplotlib inline
@@ -34,7 +34,7 @@ from spinectl.landscape import sweep
 from spinectl.model import config
 from spinectl.paper import grid, landmarks
 
-preset = PRESET or ("wagner2012" if "wagner2012" in spinectl.list_presets() else "default")
+preset = PRESET or spinectl.DEFAULT_PRESET  # the preset of every command and of spinectl.load_preset()
 model = config.set_parameter(spinectl.load_preset(preset), "passive.stiffness", 0.0)  # K = 0, as in Figure 3
 axis = grid.paper_axis(GRID)  # E and Lambda of the landscapes [m], the paper's 0 to 8 cm
 E_OPT = landmarks.OPTIMUM[0]  # m: the paper's eccentricity, 3 cm

@@ -25,7 +25,7 @@ import sys
 import warnings
 
 from .errors import ConfigError, ModelError, ParameterError, SpinectlError
-from .model.config import dump_toml, list_presets, load_config, load_preset
+from .model.config import DEFAULT_PRESET, apply_overrides, dump_toml, list_presets, load_config, load_preset
 from .model.mechanics import SegmentCoefficients, segment_coefficients
 from .model.params import Model
 from .model.stability import StabilityResult, segment_stability
@@ -34,6 +34,7 @@ from .reflex.siso import LoopDelayMargin, delay_margin
 __version__ = "0.1.0"
 
 __all__ = [
+    "DEFAULT_PRESET",
     "ConfigError",
     "LoopDelayMargin",
     "Model",
@@ -42,6 +43,7 @@ __all__ = [
     "SegmentCoefficients",
     "SpinectlError",
     "StabilityResult",
+    "apply_overrides",
     "delay_margin",
     "dump_toml",
     "list_presets",

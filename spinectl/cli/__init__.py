@@ -10,7 +10,9 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import re
 import sys
+import warnings
 
 from .._validate import printable
 from ..errors import SpinectlError
@@ -32,7 +34,15 @@ EXIT_USAGE = 2
 
 
 class _Parser(argparse.ArgumentParser):
-    """ArgumentParser whose errors are one line and exit 2, and that never calls ``sys.exit``."""
+    """ArgumentParser whose errors are one line and exit 2, and that never calls ``sys.exit``.
+
+    A word that starts with a minus and a digit is a value, not an option: ``--E -0.02:0.1:25``
+    (argparse 3.11 takes only plain negative numbers so, Python 3.13 any such word).
+    """
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = re.compile(r"^-\.?\d")
 
     def error(self, message):  # noqa: D401 - argparse API
         raise _UsageError(f"{self.prog}: {message}")
@@ -90,8 +100,10 @@ def main(argv: list[str] | None = None) -> int:
     """
     _printable_streams()
     try:
-        args = build_parser().parse_args(argv)
-        return int(args.func(args) or 0)
+        with warnings.catch_warnings():
+            warnings.showwarning = _one_line_warning
+            args = build_parser().parse_args(argv)
+            return int(args.func(args) or 0)
     except _ParserExit as exc:
         return exc.status
     except _UsageError as exc:
@@ -105,6 +117,11 @@ def main(argv: list[str] | None = None) -> int:
         return 130
     except BrokenPipeError:
         return 0
+
+
+def _one_line_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """A warning as one line on stderr, ``spinectl: warning: ...``, without the source line."""
+    print(f"spinectl: warning: {printable(str(message))}", file=sys.stderr)
 
 
 def _printable_streams() -> None:

@@ -9,23 +9,45 @@ import sys
 
 from ..atomic import atomic_write_text
 from ..errors import ParameterError
-from ..model.config import load_config
+from ..model.config import DEFAULT_PRESET, apply_overrides, load_config, set_parameters
 from ..model.params import Model
 
 
-def add_model_options(parser: argparse.ArgumentParser, default_preset: str = "default") -> None:
-    """``--config FILE`` and ``--preset NAME``, on every command.
+def add_model_options(parser: argparse.ArgumentParser) -> None:
+    """``--config FILE``, ``--preset NAME`` and ``--set SECTION.FIELD=VALUE``, on every command that takes a model.
 
     Parameters
     ----------
     parser : argparse.ArgumentParser
         The (sub-)command's parser; the options go into a group named "model".
-    default_preset : str
-        The preset used when neither option is given (named in the help).
     """
     group = parser.add_argument_group("model")
-    group.add_argument("--config", metavar="FILE", help="TOML file overriding the preset's parameters")
-    group.add_argument("--preset", metavar="NAME", help=f"built-in parameter preset (default: {default_preset!r})")
+    group.add_argument(
+        "--config",
+        metavar="FILE",
+        help="TOML file overriding the preset's parameters ([[muscles]] merge with the preset's by name)",
+    )
+    group.add_argument("--preset", metavar="NAME", help=f"built-in parameter preset (default: {DEFAULT_PRESET!r})")
+    add_set_option(group)
+
+
+def add_set_option(group) -> None:
+    """``--set SECTION.FIELD=VALUE`` (repeatable) into ``args.assignments``; in :func:`add_model_options`.
+
+    Parameters
+    ----------
+    group : argparse.ArgumentParser or argparse._ArgumentGroup
+        Where the option goes (``spinectl study`` takes it alone: its file names the preset).
+    """
+    group.add_argument(
+        "--set",
+        dest="assignments",
+        action="append",
+        default=[],
+        metavar="SECTION.FIELD=VALUE",
+        help="set one parameter, validated as in a TOML file, e.g. --set passive.stiffness=15 "
+        "or --set muscles.straight.spread=0.02 (repeatable; 'spinectl config show' lists every field)",
+    )
 
 
 def add_position_options(parser: argparse.ArgumentParser) -> None:
@@ -53,19 +75,25 @@ def add_dpi_option(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--dpi", type=finite_float("--dpi"), default=DPI, help=f"PNG resolution (default {DPI})")
 
 
-def load_model(args: argparse.Namespace, default_preset: str = "default") -> Model:
-    """The model named by ``--preset`` and ``--config``.
+def load_model(args: argparse.Namespace, aliases: dict | None = None) -> Model:
+    """The model named by ``--preset``, ``--config`` and ``--set``, with a command's own options on top.
 
     Parameters
     ----------
     args : argparse.Namespace
-        Parsed arguments with ``config`` and ``preset`` (see :func:`add_model_options`).
-    default_preset : str
-        The preset when neither option is given; a ``--config`` file without
-        ``--preset`` keeps its own base preset (its ``preset`` key, else 'default').
+        Parsed arguments with ``config``, ``preset`` and ``assignments`` (see :func:`add_model_options`).
+    aliases : dict, optional
+        A command's options that are aliases of ``--set`` (e.g. ``--K`` for ``passive.stiffness``):
+        value by dotted field; None values (options not given) are skipped. Applied after ``--set``.
+
+    Returns
+    -------
+    Model
+        The validated model; its source names the preset, the file and every overridden field.
     """
-    preset = args.preset or (None if args.config else default_preset)
-    return load_config(args.config, preset=preset)
+    model = apply_overrides(load_config(args.config, preset=args.preset), getattr(args, "assignments", []))
+    given = {dotted: value for dotted, value in (aliases or {}).items() if value is not None}
+    return set_parameters(model, given) if given else model
 
 
 def finite_float(name: str):

@@ -13,7 +13,6 @@ import shlex
 import sys
 
 from ..atomic import atomic_write_text, check_distinct, check_writable
-from ..model.config import set_parameter
 from ..paper import calibration, grid
 from ._common import add_model_options, load_model, require
 
@@ -99,11 +98,9 @@ def run(args) -> int:
     parameters = calibration.parameter_set(names)
     conventions = [c.strip() for c in args.conventions.split(",") if c.strip()]
     check_distinct({"--out": args.out, "--history": args.history}, {"--config": args.config})
-    base = load_model(args)
+    base = load_model(args, {"optimisation.activation": args.activation})
     for path in filter(None, (args.out, args.history)):
         check_writable(path)  # before minutes of fitting
-    if args.activation:
-        base = set_parameter(base, "optimisation.activation", args.activation)
     result = calibration.calibrate(
         base,
         parameters,
@@ -133,6 +130,8 @@ def _command(args) -> str:
     for option in ("config", "preset", "activation", "parameters"):
         if getattr(args, option):
             words += [f"--{option}", getattr(args, option)]
+    for assignment in args.assignments:
+        words += ["--set", assignment]
     words += ["--seed", str(args.seed), "--starts", str(args.starts), "--grid", str(args.grid)]
     words += ["--verify-grid", str(args.verify_grid), "--generations", str(args.generations)]
     words += ["--popsize", str(args.popsize), "--refine", str(args.refine), "--conventions", args.conventions]

@@ -6,7 +6,7 @@ import sys
 from pathlib import Path
 
 from ..atomic import check_distinct
-from ..model.config import set_parameter
+from ..model.config import set_parameters
 from ..reflex.margins import analyse
 from ._common import add_model_options, add_position_options, emit_json, finite_float, load_model
 
@@ -56,11 +56,11 @@ OVERRIDES = (
     ("activation", "reflex.activation"),
     ("pade_order", "reflex.pade_order"),
 )
-"""Command-line options that replace a parameter of the ``reflex`` section."""
+"""Command-line options that are aliases of ``--set reflex.FIELD=VALUE``."""
 
 
 def model_with_overrides(args):
-    """The model of ``--preset``/``--config`` with the reflex options applied (validated there).
+    """The model of ``--preset``/``--config``/``--set`` with the reflex options applied (validated there).
 
     Parameters
     ----------
@@ -73,15 +73,9 @@ def model_with_overrides(args):
     Model
         The validated model.
     """
-    model = load_model(args)
-    for option, dotted in OVERRIDES:
-        value = getattr(args, option)
-        if value is not None:
-            model = set_parameter(model, dotted, value)
-    for option in ("kp", "kd"):
-        value = getattr(args, option)
-        if value is not None:
-            set_parameter(model, f"reflex.{option}", value)  # validates: a gain must be >= 0
+    model = load_model(args, {dotted: getattr(args, option) for option, dotted in OVERRIDES})
+    gains = {f"reflex.{option}": getattr(args, option) for option in ("kp", "kd") if getattr(args, option) is not None}
+    set_parameters(model, gains)  # validates: a gain must be >= 0; analyse() takes them as explicit gains
     return model
 
 

@@ -1,6 +1,8 @@
-"""``spinectl plot``: the paper's Figures 3, 4 and S1 (and their ratio) from a sweep's NetCDF file."""
+"""``spinectl plot``: Figures 3, 4 and S1 from a sweep's NetCDF file; two landscapes compared; a study's slices."""
 
 from __future__ import annotations
+
+from pathlib import Path
 
 from ..landscape import netcdf
 from ..paper import figures
@@ -23,7 +25,17 @@ def register(sub) -> None:
         "grid's other corners by their coordinates, the ridge Lambda = 1.7 E and the paper's optimum; "
         "as PNG, PDF or SVG files.",
     )
-    parser.add_argument("results", metavar="RESULTS.nc", help="a file written by 'spinectl sweep' or 'reproduce'")
+    parser.add_argument(
+        "results",
+        metavar="RESULTS",
+        help="a NetCDF file written by 'spinectl sweep' or 'reproduce', or a study's Zarr store (a folder: "
+        "each E x Lambda slice's minimum PCSA and ||CT||)",
+    )
+    parser.add_argument(
+        "--vs",
+        metavar="OTHER.nc",
+        help="compare with this landscape on the same grid: difference and ratio maps (RESULTS minus, over, OTHER)",
+    )
     parser.add_argument("--out", required=True, metavar="DIR", help="folder for the figure files")
     parser.add_argument("--format", choices=figures.FORMATS, default="png", help="file format (default png)")
     add_dpi_option(parser)
@@ -56,6 +68,22 @@ def run(args) -> int:
     int
         Exit code 0.
     """
+    if args.vs:
+        from ..paper.comparison import draw_comparison
+
+        written = draw_comparison(args.results, args.vs, args.out, args.format, args.dpi)
+    elif Path(args.results).is_dir():
+        from ..paper.slices import draw_study
+
+        written = draw_study(args.results, args.out, args.format, args.dpi)
+    else:
+        written = _draw_figures(args)
+    for path in written:
+        print(path)
+    return 0
+
+
+def _draw_figures(args):
     options = figures.FigureOptions(
         format=args.format,
         dpi=args.dpi,
@@ -65,6 +93,4 @@ def run(args) -> int:
         ratio=args.ratio,
         insets=args.insets,
     )
-    for path in figures.draw_figures(netcdf.load(args.results), args.out, options=options):
-        print(path)
-    return 0
+    return figures.draw_figures(netcdf.load(args.results), args.out, options=options)

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from ..paper import grid
-from ..paper.reproduction import DEFAULT_PRESET, reproduce
+from ..paper.reproduction import reproduce
 from ._common import add_model_options
 
 
@@ -29,7 +29,7 @@ def register(sub) -> None:
         default=grid.PAPER_POINTS,
         help=f"grid points per axis (default {grid.PAPER_POINTS}: 1 mm)",
     )
-    add_model_options(parser, default_preset=DEFAULT_PRESET)
+    add_model_options(parser)
     parser.set_defaults(func=run)
 
 
@@ -46,6 +46,8 @@ def run(args) -> int:
     int
         Exit code 0.
     """
-    for path in reproduce(args.out, preset=args.preset, config=args.config, points=args.points):
+    for path in reproduce(
+        args.out, preset=args.preset, config=args.config, overrides=args.assignments, points=args.points
+    ):
         print(path)
     return 0

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from ..model.config import set_parameter
 from ..optimise.coupled import coupled_stability_at
 from ..optimise.reference import stability_at
 from ..units import cm2_to_m2
@@ -31,7 +30,9 @@ def register(sub) -> None:
         help="PCSA [cm^2]: one value per pair (each muscle of the pair) or one per muscle "
         "(default: the minimum stabilising PCSA, the optimiser's chosen activation)",
     )
-    parser.add_argument("--K", type=finite_float("--K"), help="passive stiffness K [N m/rad] (overrides the model)")
+    parser.add_argument(
+        "--K", type=finite_float("--K"), help="passive stiffness K [N m/rad] (alias of --set passive.stiffness=K)"
+    )
     parser.add_argument(
         "--coupled",
         action="store_true",
@@ -41,25 +42,6 @@ def register(sub) -> None:
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     add_model_options(parser)
     parser.set_defaults(func=run)
-
-
-def model_with_overrides(args):
-    """The model of ``--preset``/``--config`` with ``--K`` applied.
-
-    Parameters
-    ----------
-    args : argparse.Namespace
-        Parsed arguments; ``K`` [N m/rad] is optional.
-
-    Returns
-    -------
-    Model
-        The validated model.
-    """
-    model = load_model(args)
-    if getattr(args, "K", None) is not None:
-        model = set_parameter(model, "passive.stiffness", args.K)
-    return model
 
 
 def run(args) -> int:
@@ -76,7 +58,7 @@ def run(args) -> int:
     int
         Exit code 0.
     """
-    model = model_with_overrides(args)
+    model = load_model(args, {"passive.stiffness": args.K})
     given = args.pcsa is not None  # else the minimum stabilising PCSA
     analysis = coupled_stability_at if args.coupled else stability_at
     result = analysis(model, args.E, args.Lambda, cm2_to_m2(args.pcsa) if given else None)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ._common import finite_float
+from ._common import add_set_option, finite_float
 
 
 def register(sub) -> None:
@@ -43,6 +43,7 @@ def register(sub) -> None:
     parser.add_argument(
         "--max-chunks", type=_count, metavar="N", help="stop after N chunks (continue later with --resume)"
     )
+    add_set_option(parser.add_argument_group("model (the study file names its preset or config)"))
     parser.set_defaults(func=run)
 
 
@@ -79,7 +80,7 @@ def run(args) -> int:
     """
     from ..landscape import study  # dask and zarr only for this command
 
-    spec = study.load_study(args.study)
+    spec = study.load_study(args.study, overrides=args.assignments)
     options = {"scheduler": args.scheduler, "workers": args.workers, "resume": args.resume}
     options["notify"] = lambda line: print(line, file=sys.stderr)
     if args.worker_timeout is not None:

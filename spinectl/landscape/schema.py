@@ -9,7 +9,7 @@ from __future__ import annotations
 import xarray as xr
 
 from .. import __version__
-from ..model import config
+from ..model import config, source
 from ..model.params import Model
 
 PAPER_REFERENCE = (
@@ -133,5 +133,5 @@ def landscape_dataset(model: Model, e_axis, l_axis, arrays: dict, method: str, p
         "reflex_activation_time_constant_s": model.reflex.activation_time_constant,
         "reflex_activation": model.reflex.activation,
         "config_toml": config.dump_toml(model),
-    }
+    } | source.attributes(model)
     return xr.Dataset(data_vars, coords, attrs)

@@ -201,7 +201,8 @@ def write_sweep(model: Model, eccentricity, lordosis, path, *, stiffnesses=None,
     check_writable(path)
     stiffnesses = list(stiffnesses or [model.passive.stiffness])
     if len(stiffnesses) == 1:
-        model = config.set_parameter(model, "passive.stiffness", stiffnesses[0])
+        if stiffnesses[0] != model.passive.stiffness:  # else the model's own K, not an override
+            model = config.set_parameter(model, "passive.stiffness", stiffnesses[0])
         dataset = sweep(model, eccentricity, lordosis, **options)
     else:
         dataset = stiffness_sweep(model, stiffnesses, eccentricity, lordosis, **options)
@@ -220,7 +221,8 @@ def describe(dataset: xr.Dataset) -> str:
     Returns
     -------
     str
-        E.g. ``"25 points (25 solved, 0 infeasible or failed); min PCSA 10.2-40.3 cm2, ||CT|| 0.0-31.5 N m"``;
+        E.g. ``"preset wagner2012, K = 0 N m/rad, convention paper: 25 points (25 solved, 0 infeasible or
+        failed); min PCSA 10.2-40.3 cm2, ||CT|| 0.0-31.5 N m"`` (the model's line from the ``model`` attribute);
         the ranges only if some point was solved, and a warning naming the points whose
         status is ``optimal_inaccurate`` (the solver did not meet its tolerances: their
         numbers may be far off) if there are any.
@@ -237,4 +239,5 @@ def describe(dataset: xr.Dataset) -> str:
     inaccurate = int(np.sum(status == "optimal_inaccurate"))
     if inaccurate:
         ranges += f"; WARNING: {inaccurate} inaccurate (status optimal_inaccurate: values may be far off)"
-    return f"{status.size} points ({int(ok.sum())} solved, {int((~ok).sum())} infeasible or failed){ranges}"
+    model = f"{dataset.attrs['model']}: " if "model" in dataset.attrs else ""
+    return f"{model}{status.size} points ({int(ok.sum())} solved, {int((~ok).sum())} infeasible or failed){ranges}"

@@ -201,6 +201,13 @@ def _check_range(model: Model, eccentricity, lordosis) -> None:
             raise ParameterError(name, f"must be in [{lo:g}, {hi:g}] m, the modelled range (got {bad:g})")
 
 
+MAX_PLAUSIBLE_PCSA = 0.1
+"""Largest PCSA of one muscle [m^2] that :func:`expand_pcsa` accepts: 1000 cm^2, four times the
+largest human muscle's (the soleus, about 230 cm^2; Ward SR et al. 2009, Clin Orthop Relat Res
+467:1074-1082, doi:10.1007/s11999-008-0594-8). A larger value is almost surely cm^2 typed where the
+API means m^2 (``pcsa=[10, 10, 10]``)."""
+
+
 def expand_pcsa(model: Model, pcsa) -> np.ndarray:
     """Per-muscle PCSA [m^2] from per-muscle (2 n values) or per-pair (n values, each side) input.
 
@@ -222,7 +229,8 @@ def expand_pcsa(model: Model, pcsa) -> np.ndarray:
     Raises
     ------
     ParameterError
-        Neither n nor 2 n values, or a value negative or not finite.
+        Neither n nor 2 n values, a value negative or not finite, or one above
+        :data:`MAX_PLAUSIBLE_PCSA` (most likely cm^2 given where m^2 are meant).
     """
     pcsa = np.asarray(pcsa, float)
     n_pairs = len(model.muscles)
@@ -235,4 +243,11 @@ def expand_pcsa(model: Model, pcsa) -> np.ndarray:
         )
     if not np.all(np.isfinite(pcsa)) or np.any(pcsa < 0):
         raise ParameterError("pcsa", "must be finite and >= 0")
+    if np.any(pcsa > MAX_PLAUSIBLE_PCSA):
+        largest = float(pcsa.max())
+        raise ParameterError(
+            "pcsa",
+            f"must be at most {MAX_PLAUSIBLE_PCSA:g} m^2 per muscle (got {largest:g} m^2): the Python API takes "
+            f"m^2; if you meant {largest:g} cm^2, pass {largest * 1e-4:g} (spinectl.units.cm2_to_m2)",
+        )
     return pcsa

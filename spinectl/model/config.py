@@ -1,23 +1,44 @@
 """Reading and writing model parameters as TOML, and the built-in presets.
 
 A configuration file may give any subset of the parameters; the rest come from
-the preset it names with ``preset = "NAME"`` (default ``"default"``). Unknown
-keys are rejected with a "did you mean" hint. :func:`dump_toml` writes the
-fully resolved set with each field's unit and documentation as comments.
+the preset it names with ``preset = "NAME"`` (default :data:`DEFAULT_PRESET`). Unknown
+keys are rejected with a "did you mean" hint. ``[[muscles]]`` tables are merged with the
+preset's pairs by name (:data:`MUSCLES_MODES`). :func:`dump_toml` writes the
+fully resolved set with each field's unit and documentation as comments. Every model
+loaded or changed here carries its :class:`~spinectl.model.source.ModelSource`.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import hashlib
+import tomllib
+import warnings
 from importlib import resources
 from pathlib import Path
 
 from .._validate import show
-from ..errors import ConfigError
+from ..errors import ConfigError, ParameterError
 from ._toml import from_dict, locate, parse, read_text, table_lines, to_dict
-from .params import Model
+from .params import Model, MusclePair
+from .source import ModelSource, header, source_of, with_source
 
 PRESET_PACKAGE = "spinectl.presets"
+
+DEFAULT_PRESET = "wagner2012"
+"""The preset of every command and API entry point when none is named: the calibrated one that
+``spinectl reproduce`` runs, so that every answer belongs to the model whose landmarks
+docs/reproduction.md checks (docs/model.md, "The default model"). ``"default"``, the
+anatomical, uncalibrated estimate, stays selectable by name."""
+
+MUSCLES_MODES = ("merge", "replace")
+"""How a file's ``[[muscles]]`` tables combine with the preset's pairs (its key ``muscles_mode``):
+``"merge"`` (the default) updates the pair of the same ``name`` with the keys given and appends a
+pair whose name is new; ``"replace"`` puts the file's pairs in place of the preset's, with a warning."""
+
+
+class ConfigWarning(UserWarning):
+    """A configuration that is valid but may not do what its author meant (e.g. replaces the muscle set)."""
 
 
 def list_presets() -> list[str]:
@@ -32,18 +53,18 @@ def list_presets() -> list[str]:
     return sorted(f.name.removesuffix(".toml") for f in files if f.name.endswith(".toml"))
 
 
-def load_preset(name: str = "default") -> Model:
+def load_preset(name: str = DEFAULT_PRESET) -> Model:
     """The built-in preset ``name`` as a :class:`~spinectl.model.params.Model`.
 
     Parameters
     ----------
     name : str
-        One of :func:`list_presets`.
+        One of :func:`list_presets`; default :data:`DEFAULT_PRESET`.
 
     Returns
     -------
     Model
-        The preset's parameters, validated.
+        The preset's parameters, validated, its source the preset.
 
     Raises
     ------
@@ -54,7 +75,8 @@ def load_preset(name: str = "default") -> Model:
     if not isinstance(name, str) or name not in presets:
         raise ConfigError("preset", f"must be one of {', '.join(map(repr, presets))} (got {show(name)})")
     text = resources.files(PRESET_PACKAGE).joinpath(f"{name}.toml").read_text(encoding="utf-8")
-    return _model_from_text(text, source=f"preset {name!r}", is_preset=True)
+    model = from_dict(Model, parse(text, f"preset {name!r}"))
+    return with_source(model, ModelSource(preset=name))
 
 
 def load_config(path: str | Path | None = None, preset: str | None = None) -> Model:
@@ -64,34 +86,41 @@ def load_config(path: str | Path | None = None, preset: str | None = None) -> Mo
     ----------
     path : str or Path, optional
         A TOML file with any subset of the parameters. It may name its base
-        preset with ``preset = "NAME"``.
+        preset with ``preset = "NAME"`` and how its ``[[muscles]]`` combine with the
+        preset's with ``muscles_mode`` (:data:`MUSCLES_MODES`).
     preset : str, optional
-        Base preset; overrides the file's own ``preset`` key. Default ``"default"``.
+        Base preset; overrides the file's own ``preset`` key. Default :data:`DEFAULT_PRESET`.
 
     Returns
     -------
     Model
-        The base preset with the file's values in place of its own, validated.
+        The base preset with the file's values in place of its own, validated; its source
+        names the preset, the file and the file's SHA-256.
+
+    Raises
+    ------
+    ConfigError
+        The file cannot be read or parsed, or names an unknown key, preset or muscles mode.
+    ParameterError
+        A value is out of range.
     """
     if path is None:
-        return load_preset("default" if preset is None else preset)
-    return _model_from_text(read_text(Path(path)), source=str(path), preset=preset)
-
-
-def _model_from_text(text: str, source: str, preset: str | None = None, is_preset: bool = False) -> Model:
-    data = parse(text, source)
+        return load_preset(DEFAULT_PRESET if preset is None else preset)
+    path = Path(path)
+    data = parse(read_text(path), str(path))
     base_name = data.pop("preset", None)
-    if is_preset:
-        return from_dict(Model, data)
-    if preset is None:
-        preset = "default" if base_name is None else base_name
-    return merge(load_preset(preset), data)
+    mode = data.pop("muscles_mode", "merge")
+    if preset is None:  # an empty name is an error of load_preset, not the default
+        preset = DEFAULT_PRESET if base_name is None else base_name
+    model = merge(load_preset(preset), data, muscles_mode=mode, source=str(path))
+    digest = hashlib.sha256(path.read_bytes()).hexdigest()
+    return with_source(model, ModelSource(preset=preset, config=str(path), config_sha256=digest))
 
 
-def merge(base: Model, data: dict) -> Model:
+def merge(base: Model, data: dict, muscles_mode: str = "merge", source: str = "config") -> Model:
     """``base`` with the (partial, nested) parameters in ``data`` replacing its own.
 
-    ``muscles``, a list, replaces the whole list when given.
+    Sections merge key by key; ``muscles`` merge by name or replace the set (``muscles_mode``).
 
     Parameters
     ----------
@@ -99,14 +128,70 @@ def merge(base: Model, data: dict) -> Model:
         The parameters to start from.
     data : dict
         Nested parameters as read from TOML, e.g. ``{"body": {"mass": 50.0}}`` (SI units).
+    muscles_mode : {'merge', 'replace'}
+        See :data:`MUSCLES_MODES`.
+    source : str
+        Where ``data`` came from, named in the warning when it replaces the muscle set.
 
     Returns
     -------
     Model
-        A new, validated model; ``base`` is unchanged.
+        A new, validated model with ``base``'s source; ``base`` is unchanged.
+
+    Raises
+    ------
+    ConfigError
+        ``muscles_mode`` unknown, or a merged ``[[muscles]]`` table without a ``name``.
+
+    Warns
+    -----
+    ConfigWarning
+        ``muscles_mode = "replace"`` drops some of the preset's pairs.
     """
-    merged = _deep_merge(to_dict(base), data)
-    return from_dict(Model, merged)
+    if muscles_mode not in MUSCLES_MODES:
+        allowed = ", ".join(map(repr, MUSCLES_MODES))
+        raise ConfigError("muscles_mode", f"must be one of {allowed} (got {show(muscles_mode)})")
+    merged = _deep_merge(to_dict(base), {k: v for k, v in data.items() if k != "muscles"})
+    if "muscles" in data:
+        merged["muscles"] = _muscles(merged["muscles"], data["muscles"], muscles_mode, source)
+    return with_source(from_dict(Model, merged), source_of(base))
+
+
+def _muscles(base: list, given, mode: str, source: str) -> list:
+    """The muscle pairs of ``base`` combined with a file's ``[[muscles]]`` (:data:`MUSCLES_MODES`)."""
+    if not isinstance(given, list) or not given:
+        return given  # from_dict names the error: must be an array of tables, with at least one pair
+    if mode == "replace":
+        kept = {pair.get("name") for pair in given if isinstance(pair, dict)}
+        dropped = [pair["name"] for pair in base if pair["name"] not in kept]
+        if dropped:  # a complete file (config show's output) keeps every name: no warning
+            warnings.warn(
+                f"{source} replaces the preset's muscle pairs (muscles_mode = 'replace'): "
+                f"{', '.join(dropped)} dropped, {len(given)} pair(s) given",
+                ConfigWarning,
+                stacklevel=3,
+            )
+        return given
+    out = [dict(pair) for pair in base]
+    names = [pair["name"] for pair in out]
+    for i, pair in enumerate(given):
+        if not isinstance(pair, dict):
+            return given  # from_dict names the error
+        if "name" not in pair:
+            raise ConfigError(
+                f"muscles.{i}.name",
+                "is required: pairs merge with the preset's by name (or set muscles_mode = 'replace')",
+            )
+        if pair["name"] in [p.get("name") for p in given[:i]]:
+            repeated = show(pair["name"])
+            raise ParameterError(f"muscles.{i}.name", f"must be unique among the pairs (repeated: {repeated})")
+        if pair["name"] in names:
+            out[names.index(pair["name"])].update(pair)
+        else:
+            out.append(dict(pair))
+            names.append(pair["name"])
+        from_dict(MusclePair, out[names.index(pair["name"])], f"muscles.{i}")  # errors name the file's table
+    return out
 
 
 def _deep_merge(base: dict, new: dict) -> dict:
@@ -155,13 +240,73 @@ def set_parameters(model: Model, values: dict) -> Model:
     Returns
     -------
     Model
-        A new, validated model; ``model`` is unchanged.
+        A new, validated model whose source lists these fields as overridden; ``model`` is unchanged.
+
+    Raises
+    ------
+    ConfigError
+        A dotted path that names no parameter (with a "did you mean"), as in a TOML file.
+    ParameterError
+        A value out of range.
     """
     data = to_dict(model)
     for dotted, value in values.items():
-        holder, key = locate(data, dotted)
+        holder, key = locate(data, _pair_index(data, dotted))
         holder[key] = value
-    return from_dict(Model, data)
+    return with_source(from_dict(Model, data), source_of(model).with_overridden(values))
+
+
+def _pair_index(data: dict, dotted: str) -> str:
+    """``muscles.straight.spread`` as ``muscles.0.spread``: a pair by its name as well as its index."""
+    parts = dotted.split(".")
+    names = [pair.get("name") for pair in data.get("muscles", [])]
+    if len(parts) > 1 and parts[0] == "muscles" and parts[1] in names:
+        parts[1] = str(names.index(parts[1]))
+    return ".".join(parts)
+
+
+def apply_overrides(model: Model, assignments) -> Model:
+    """``model`` with ``SECTION.FIELD=VALUE`` assignments applied and validated together, as ``--set`` does.
+
+    VALUE is read as a TOML value (``15``, ``1e-3``, ``inf``, ``[0.04, 0.26]``, ``"paper"``); text
+    that is no TOML value is a string, so ``passive.convention=paper`` needs no quotes. A pair is
+    named by index or by name (``muscles.straight.spread=0.02``).
+
+    Parameters
+    ----------
+    model : Model
+        The parameters to start from.
+    assignments : iterable of str
+        E.g. ``["passive.stiffness=15", "reflex.delay=0.05"]``.
+
+    Returns
+    -------
+    Model
+        A new model whose source lists the fields as overridden (:func:`set_parameters`).
+
+    Raises
+    ------
+    ParameterError
+        An assignment without ``=`` (field ``set``), or a value out of range.
+    ConfigError
+        A field that does not exist, with the same message as in a TOML file.
+    """
+    values = {}
+    for text in assignments:
+        dotted, sep, value = text.partition("=")
+        if not sep or not dotted.strip():
+            raise ParameterError("set", f"must be SECTION.FIELD=VALUE, e.g. passive.stiffness=15 (got {show(text)})")
+        values[dotted.strip()] = _toml_value(value.strip())
+    return set_parameters(model, values) if values else model
+
+
+def _toml_value(text: str):
+    """``text`` read as one TOML value, or as a string if it is none."""
+    try:
+        data = tomllib.loads(f"value = {text}")
+    except tomllib.TOMLDecodeError:
+        return text
+    return data["value"] if list(data) == ["value"] else text
 
 
 def dump_toml(model: Model) -> str:
@@ -175,8 +320,10 @@ def dump_toml(model: Model) -> str:
     Returns
     -------
     str
-        TOML text that :func:`load_config` reads back to ``model``; every field is
-        preceded by a comment with its unit in brackets and its ``doc`` metadata.
+        TOML text that :func:`~spinectl.model._toml.from_dict` reads back to ``model`` (and
+        :func:`load_config` when its pairs include the preset's); every field is preceded by a
+        comment with its unit in brackets and its ``doc`` metadata. It names no source, so that
+        what it identifies (a study's digest) depends on the parameters alone.
     """
     lines = ["# spinectl model parameters (SI units unless a comment says otherwise)", ""]
     for f in dataclasses.fields(model):
@@ -189,3 +336,130 @@ def dump_toml(model: Model) -> str:
     return "\n".join(lines)
 
 
+@dataclasses.dataclass(frozen=True)
+class Difference:
+    """One parameter in which two models differ (:func:`diff_models`).
+
+    Attributes
+    ----------
+    name : str
+        Dotted parameter; a muscle pair by its name (``muscles.straight.spread``).
+    unit : str
+        Its unit as in ``docs/parameters.md`` (``"1"`` a ratio, ``""`` text).
+    first, second : object
+        Its value in each model; None where the model has no such pair.
+    """
+
+    name: str
+    unit: str
+    first: object
+    second: object
+
+    def line(self) -> str:
+        """The difference as one line: ``body.mass [kg]: 24.06 -> 40``.
+
+        Returns
+        -------
+        str
+        """
+        unit = f" [{self.unit}]" if self.unit and self.unit != "1" else ""
+        return f"{self.name}{unit}: {_shown(self.first)} -> {_shown(self.second)}"
+
+
+def _shown(value) -> str:
+    if value is None:
+        return "(absent)"
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_shown(x) for x in value) + "]"
+    return f"{value:.6g}" if isinstance(value, float) else str(value)
+
+
+def diff_models(first: Model, second: Model) -> list[Difference]:
+    """Every parameter whose value differs between two models, with its unit.
+
+    Muscle pairs are matched by name, so a pair missing from one model is listed field by field
+    with None on that side.
+
+    Parameters
+    ----------
+    first, second : Model
+
+    Returns
+    -------
+    list of Difference
+        In the order of the model's sections and fields; empty if the models are equal.
+    """
+    a, b = _parameters(first), _parameters(second)
+    out = []
+    for name in list(a) + [n for n in b if n not in a]:
+        unit = (a.get(name) or b[name])[0]
+        x, y = (a[name][1] if name in a else None), (b[name][1] if name in b else None)
+        if x != y:
+            out.append(Difference(name, unit, x, y))
+    return out
+
+
+def _parameters(model: Model) -> dict:
+    """(unit, value) of every parameter by dotted name; muscle pairs by their names."""
+    out = {}
+    for section in dataclasses.fields(model):
+        value = getattr(model, section.name)
+        pairs = section.name == "muscles"
+        for prefix, obj in [(f"muscles.{p.name}", p) for p in value] if pairs else [(section.name, value)]:
+            for f in dataclasses.fields(obj):
+                out[f"{prefix}.{f.name}"] = (f.metadata.get("unit", ""), getattr(obj, f.name))
+    return out
+
+
+def load_model_spec(spec: str) -> Model:
+    """A preset by name, or a model file by path: the argument of ``spinectl config diff``.
+
+    Parameters
+    ----------
+    spec : str
+        A name of :func:`list_presets`, else a path to a TOML model file.
+
+    Returns
+    -------
+    Model
+
+    Raises
+    ------
+    ConfigError
+        Neither a preset nor a readable model file (the message names both).
+    """
+    if spec in list_presets():
+        return load_preset(spec)
+    if not Path(spec).exists():
+        presets = ", ".join(map(repr, list_presets()))
+        raise ConfigError("config", f"{show(spec)} is neither a preset ({presets}) nor an existing file")
+    return load_config(spec)
+
+
+def show_toml(model: Model) -> str:
+    """``spinectl config show``: :func:`dump_toml` under comments naming the model and how files combine.
+
+    Parameters
+    ----------
+    model : Model
+        The parameters to show.
+
+    Returns
+    -------
+    str
+        A complete model file: the :func:`~spinectl.model.source.header` line and the rules of
+        ``[[muscles]]`` as comments, ``muscles_mode = "replace"`` (its pairs are the whole set, so
+        :func:`load_config` reads it back to ``model``), then :func:`dump_toml`.
+    """
+    return "\n".join(
+        [
+            f"# model: {header(model)}",
+            '# A --config file gives any subset of these parameters, over its preset (preset = "NAME").',
+            "# Its [[muscles]] tables merge with the preset's pairs by name: a known name changes the keys",
+            '# given, a new name adds a pair. muscles_mode = "replace" (as here, where every pair is listed)',
+            "# puts the file's pairs in place of the preset's; spinectl warns if that drops a preset's pair.",
+            'muscles_mode = "replace"',
+            "",
+            dump_toml(model),
+        ]
+    )

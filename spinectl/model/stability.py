@@ -16,6 +16,7 @@ References
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -24,6 +25,7 @@ from ..units import m2_to_cm2
 from .checks import arithmetic_guard, checked_coefficients, expand_pcsa
 from .mechanics import SegmentCoefficients
 from .params import Model
+from .source import header, provenance
 
 
 def jacobian(stiffness, damping, inertia):
@@ -165,6 +167,13 @@ class StabilityResult:
         CT_k [N m].
     coefficients : SegmentCoefficients
         The per-unit-PCSA problem data the result was computed from.
+    min_pcsa : float
+        The minimum total PCSA [m^2] of the LP (paper, Figure 3) when the PCSA is the optimiser's
+        chosen activation (:func:`spinectl.optimise.reference.stability_at`); NaN when the PCSA was given.
+        The chosen activation's total lies within ``optimisation.ct_tolerance`` above it.
+
+    Use :attr:`all_self_stable` for one verdict: the truth value of a result is ambiguous
+    (every segment, or any?) and raises a :class:`TypeError` that says so.
     """
 
     eccentricity: float
@@ -178,6 +187,13 @@ class StabilityResult:
     self_stable: np.ndarray
     counter_torque: np.ndarray
     coefficients: SegmentCoefficients
+    min_pcsa: float = math.nan
+
+    def __bool__(self):
+        raise TypeError(
+            "the truth value of a StabilityResult is ambiguous: use result.all_self_stable (every segment) "
+            "or result.self_stable (one bool per segment)"
+        )
 
     @property
     def counter_torque_norm(self) -> float:
@@ -204,21 +220,25 @@ class StabilityResult:
         Returns
         -------
         dict
-            ``E_m``, ``Lambda_m``, ``K_Nm_per_rad``, ``K_convention``, ``pcsa_source``,
-            ``pcsa_cm2`` (muscle name -> PCSA [cm^2]), ``total_pcsa_cm2``, ``segments`` (each
+            The model's :func:`~spinectl.model.source.provenance` (``preset``, ``config``,
+            ``config_sha256``, ``overridden``, ``K_Nm_per_rad``, ``K_convention``), ``E_m``,
+            ``Lambda_m``, ``pcsa_source``, ``pcsa_cm2`` (muscle name -> PCSA [cm^2]),
+            ``chosen_pcsa_total_cm2`` (the total of that PCSA), ``min_pcsa_cm2`` (the LP minimum,
+            NaN for a given PCSA), ``total_pcsa_cm2`` (deprecated name of ``chosen_pcsa_total_cm2``,
+            kept for one release), ``segments`` (each
             with ``name``, ``stiffness_Nm_per_rad``, ``damping_Nms_per_rad``, ``inertia_kgm2``,
             ``eigenvalues`` as [real, imaginary] pairs [1/s], ``self_stable``,
             ``counter_torque_Nm``), ``all_self_stable`` and ``counter_torque_norm_Nm``; the
             unit is in each key's name.
         """
         pcsa = m2_to_cm2(self.pcsa)
-        return {
+        return provenance(model) | {
             "E_m": self.eccentricity,
             "Lambda_m": self.lordosis,
-            "K_Nm_per_rad": model.passive.stiffness,
-            "K_convention": model.passive.convention,
             "pcsa_source": pcsa_source,
             "pcsa_cm2": dict(zip(model.muscle_names, pcsa.tolist(), strict=False)),
+            "chosen_pcsa_total_cm2": float(pcsa.sum()),
+            "min_pcsa_cm2": float(m2_to_cm2(self.min_pcsa)),
             "total_pcsa_cm2": float(pcsa.sum()),
             "segments": [
                 {
@@ -257,12 +277,13 @@ class StabilityResult:
 
         pcsa = m2_to_cm2(self.pcsa)
         given = pcsa_source == "given"
+        minimum = "" if math.isnan(self.min_pcsa) else f"; LP minimum {m2_to_cm2(self.min_pcsa):.2f}"
         lines = [
-            f"E = {self.eccentricity * 100:.2f} cm, Lambda = {self.lordosis * 100:.2f} cm, "
-            f"K = {model.passive.stiffness:g} N m/rad ({model.passive.convention})",
+            header(model),
+            f"E = {self.eccentricity * 100:.2f} cm, Lambda = {self.lordosis * 100:.2f} cm",
             ("PCSA [cm^2]: " if given else "PCSA [cm^2] (minimum stabilising, chosen activation): ")
             + ", ".join(f"{n} {p:.2f}" for n, p in zip(model.muscle_names, pcsa, strict=False))
-            + f"  (total {pcsa.sum():.2f})",
+            + f"  (total {pcsa.sum():.2f}{minimum})",
             "",
             f"{'segment':8} {'S [N m/rad]':>12} {'D [N m s/rad]':>14} {'theta [kg m2]':>14} "
             f"{'lambda_1 [1/s]':>20} {'lambda_2 [1/s]':>20} {'stable':>7} {'CT [N m]':>10}",

@@ -43,6 +43,7 @@ import numpy as np
 from ..model import chain, geometry
 from ..model.checks import arithmetic_guard, checked_coefficients, expand_pcsa
 from ..model.params import Model
+from ..model.source import header, provenance
 from ..model.stability import self_stable
 from ..units import M2_PER_CM2, m2_to_cm2
 from .problem import OK_STATUSES, ProblemData, inequalities, problem_data, to_si
@@ -466,7 +467,8 @@ class CoupledStability:
         Returns
         -------
         dict
-            ``E_m``, ``Lambda_m``, ``K_Nm_per_rad``, ``K_convention``, ``pcsa_source`` and
+            The model's :func:`~spinectl.model.source.provenance` (``preset``, ``config``, ``config_sha256``,
+            ``overridden``, ``K_Nm_per_rad``, ``K_convention``), ``E_m``, ``Lambda_m``, ``pcsa_source`` and
             ``coupled``: ``segments``, ``decision_variables``, ``pcsa_cm2`` (muscle -> cm^2),
             ``stiffness_matrix_Nm_per_rad``, ``gravity_stiffness_matrix_Nm_per_rad``,
             ``stiffness_matrix_per_cm2`` (n_var x n_cor x n_cor, N m/rad per cm^2),
@@ -477,11 +479,9 @@ class CoupledStability:
             ``eigenvalues_with_local`` and ``stable_with_local`` (with the least local stiffness).
         """
         local = self.local
-        return {
+        return provenance(model) | {
             "E_m": self.eccentricity,
             "Lambda_m": self.lordosis,
-            "K_Nm_per_rad": model.passive.stiffness,
-            "K_convention": model.passive.convention,
             "pcsa_source": pcsa_source,
             "coupled": {
                 "segments": list(self.segment_names),
@@ -523,8 +523,8 @@ class CoupledStability:
         given = pcsa_source == "given"
         names = self.segment_names
         lines = [
-            f"Coupled chain at E = {self.eccentricity * 100:.2f} cm, Lambda = {self.lordosis * 100:.2f} cm, "
-            f"K = {model.passive.stiffness:g} N m/rad ({model.passive.convention})",
+            header(model),
+            f"Coupled chain at E = {self.eccentricity * 100:.2f} cm, Lambda = {self.lordosis * 100:.2f} cm",
             ("PCSA [cm^2]: " if given else "PCSA [cm^2] (minimum stabilising per segment): ")
             + ", ".join(f"{n} {p:.2f}" for n, p in zip(model.muscle_names, pcsa, strict=True))
             + f"  (total {pcsa.sum():.2f})",

@@ -31,6 +31,7 @@ same problems for a block of points at once and is checked against this module.
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
 from dataclasses import dataclass
 
@@ -422,13 +423,18 @@ def minimum_stabilising_pcsa(model: Model, eccentricity: float, lordosis: float)
         No activation within the bounds stabilises every segment, or the solver failed
         (the message names the optimiser's status and suggests giving ``--pcsa``).
     """
+    return _stabilising_optimum(model, eccentricity, lordosis).pcsa
+
+
+def _stabilising_optimum(model: Model, eccentricity: float, lordosis: float) -> PointOptimum:
+    """:func:`solve_point`, or the :class:`ModelError` of :func:`minimum_stabilising_pcsa` unless it is optimal."""
     optimum = solve_point(model, eccentricity, lordosis)
     if not optimum.ok:
         raise ModelError(
             f"pcsa: no activation stabilises every segment at E = {eccentricity:g} m, Lambda = {lordosis:g} m "
             f"(optimiser status {optimum.status}); give --pcsa"
         )
-    return optimum.pcsa
+    return optimum
 
 
 def stability_at(model: Model, eccentricity: float, lordosis: float, pcsa=None) -> StabilityResult:
@@ -446,7 +452,8 @@ def stability_at(model: Model, eccentricity: float, lordosis: float, pcsa=None) 
     Returns
     -------
     StabilityResult
-        :func:`spinectl.model.stability.segment_stability` at that PCSA.
+        :func:`spinectl.model.stability.segment_stability` at that PCSA; with the optimiser's
+        PCSA, its ``min_pcsa`` is the LP minimum [m^2].
 
     Raises
     ------
@@ -455,6 +462,8 @@ def stability_at(model: Model, eccentricity: float, lordosis: float, pcsa=None) 
     ParameterError
         E, Lambda or ``pcsa`` out of range.
     """
-    if pcsa is None:
-        pcsa = minimum_stabilising_pcsa(model, eccentricity, lordosis)
-    return segment_stability(model, eccentricity, lordosis, pcsa)
+    if pcsa is not None:
+        return segment_stability(model, eccentricity, lordosis, pcsa)
+    optimum = _stabilising_optimum(model, eccentricity, lordosis)
+    result = segment_stability(model, eccentricity, lordosis, optimum.pcsa)
+    return dataclasses.replace(result, min_pcsa=optimum.min_pcsa)

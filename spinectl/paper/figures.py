@@ -237,6 +237,31 @@ def _landscape(field: xr.DataArray, title: str, label: str, vmin=None, vmax=None
     return fig, ax
 
 
+def landscape_figure(field: xr.DataArray, title: str, label: str) -> Figure:
+    """Any variable over E and Lambda drawn as the landscape figures are: filled contours, A-D marked.
+
+    Parameters
+    ----------
+    field : xarray.DataArray
+        Dimensions ``E`` and ``Lambda`` [m], at least 2 values each; NaN points stay white.
+    title : str
+        The figure's title.
+    label : str
+        The colour bar's label, with the unit.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Nothing is written.
+
+    Raises
+    ------
+    ParameterError
+        Fewer than 2 values of E or of Lambda (field ``grid``).
+    """
+    return _landscape(field, title, label)[0]
+
+
 def _k_label(dataset: xr.Dataset) -> str:
     stiffness = float(dataset["K"])
     if stiffness == 0:
@@ -420,12 +445,23 @@ def figure_names(stiffness: float, format: str = "png") -> tuple[str, str]:
     """
     if stiffness == 0:
         return f"fig3_min_pcsa.{format}", f"fig4_counter_torque.{format}"
-    k = _k_in_name(stiffness)
+    k = k_in_name(stiffness)
     return f"figS1_min_pcsa_K{k}.{format}", f"fig4_counter_torque_K{k}.{format}"
 
 
-def _k_in_name(stiffness: float) -> str:
-    """K as file names write it: short where that reads back as K, else every digit."""
+def k_in_name(stiffness: float) -> str:
+    """K as file names write it: short where that reads back as K, else every digit.
+
+    Parameters
+    ----------
+    stiffness : float
+        K [N m/rad].
+
+    Returns
+    -------
+    str
+        E.g. ``"15"``, or ``"15.000000000000002"``.
+    """
     short = f"{stiffness:g}"
     return short if float(short) == stiffness else repr(float(stiffness))
 
@@ -445,7 +481,7 @@ def ratio_name(stiffness: float, format: str = "png") -> str:
     str
         E.g. ``figS1_over_fig3_K15.png``.
     """
-    return f"figS1_over_fig3_K{_k_in_name(stiffness)}.{format}"
+    return f"figS1_over_fig3_K{k_in_name(stiffness)}.{format}"
 
 
 def _pcsa_range(dataset: xr.Dataset, options: FigureOptions) -> tuple[float | None, float | None]:

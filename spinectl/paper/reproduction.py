@@ -18,12 +18,12 @@ from pathlib import Path
 from ..atomic import atomic_write_text, check_distinct, check_folder, staged_directory
 from ..errors import ParameterError
 from ..landscape import netcdf, sweep
-from ..model.config import load_config
+from ..model.config import DEFAULT_PRESET, apply_overrides, load_config
 from ..model.params import Model
+from ..model.source import header, source_of
 from . import figures, grid, landmarks, report, verdicts
 
-DEFAULT_PRESET = verdicts.PRESET
-"""The calibrated preset (docs/reproduction.md): what the study runs unless told otherwise."""
+__all__ = ["DEFAULT_PRESET", "reproduce", "reproduce_model"]
 
 LANDSCAPES = "landscapes.nc"
 """File name of the K = 0 and K = 15 N m/rad landscapes in the output folder."""
@@ -43,6 +43,7 @@ def reproduce(
     *,
     preset: str | None = None,
     config=None,
+    overrides=(),
     points: int = grid.PAPER_POINTS,
     progress: bool | None = None,
 ) -> list[Path]:
@@ -53,10 +54,12 @@ def reproduce(
     out_dir : str or Path
         The output folder; replaced as a whole when the study has finished.
     preset : str, optional
-        A built-in preset; default :data:`DEFAULT_PRESET` (the calibrated ``wagner2012``).
+        A built-in preset; default :data:`~spinectl.model.config.DEFAULT_PRESET` (the calibrated ``wagner2012``).
     config : str or Path, optional
         A TOML file with any subset of the parameters; without ``preset`` it keeps
         its own base preset.
+    overrides : sequence of str
+        ``SECTION.FIELD=VALUE`` assignments on top (:func:`spinectl.model.config.apply_overrides`).
     points : int
         Grid points per axis, :data:`MIN_POINTS` to :data:`MAX_POINTS` (81: the paper's 1 mm).
     progress : bool or None
@@ -77,13 +80,11 @@ def reproduce(
         ``out_dir`` cannot take the output (:func:`spinectl.atomic.check_folder`), before any solve.
     """
     check_points(points)
-    if config is None:
-        preset = preset or DEFAULT_PRESET
-    model = load_config(config, preset=preset)
+    model = apply_overrides(load_config(config, preset=preset), overrides)
     check_distinct({"--out": [Path(out_dir, name) for name in output_names(model)]}, {"--config": config})
-    source = f"config file {config}" if config else f"preset `{preset}`"
-    calibrated = config is None and preset == verdicts.PRESET
-    return reproduce_model(model, out_dir, points=points, source=source, calibrated=calibrated, progress=progress)
+    origin = source_of(model)
+    calibrated = origin.preset == verdicts.PRESET and not (origin.config or origin.overridden)
+    return reproduce_model(model, out_dir, points=points, calibrated=calibrated, progress=progress)
 
 
 def check_points(points: int) -> None:
@@ -123,7 +124,6 @@ def reproduce_model(
     out_dir,
     *,
     points: int = grid.PAPER_POINTS,
-    source: str = "",
     calibrated: bool = False,
     progress: bool | None = None,
 ) -> list[Path]:
@@ -137,8 +137,6 @@ def reproduce_model(
         The output folder; replaced as a whole when the study has finished.
     points : int
         Grid points per axis.
-    source : str
-        Where the parameters came from, for the report.
     calibrated : bool
         Whether they are the calibrated preset (the report says so).
     progress : bool or None
@@ -164,7 +162,7 @@ def reproduce_model(
     measured = landmarks.measure(landmarks.Landmarks(both.sel(K=0.0), both.sel(K=k15), other))
     drawn = figures.figure_set(both, model.fibre.specific_tension)
     run_facts = report.Run(
-        preset=source or "the given model",
+        preset=header(model),
         convention=model.passive.convention,
         other_convention=other_convention,
         points=points,

@@ -14,13 +14,14 @@ from __future__ import annotations
 
 import dataclasses
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..model import stability
 from ..model.checks import arithmetic_guard, checked_coefficients
 from ..model.params import Model
+from ..model.source import header, provenance
 from ..optimise.reference import solve_point
 from ..units import m2_to_cm2
 from . import gains, loops, pade, simulate
@@ -297,7 +298,11 @@ class MarginsReport:
     pade_order : int
     segments : tuple of SegmentMargins
     gains : str
-        How the gains were chosen: 'rule' or 'explicit' (:attr:`spinectl.model.params.Reflex.gains`).
+        How the gains were chosen: 'rule' or 'explicit' (:attr:`spinectl.model.params.Reflex.gains`),
+        'explicit' when both were given to :func:`analyse`, e.g. 'explicit kp, rule kd' when one was.
+    model : dict
+        The model's :func:`~spinectl.model.source.provenance` and its :func:`~spinectl.model.source.header`
+        line (key ``header``).
     """
 
     point: OperatingPoint
@@ -306,6 +311,7 @@ class MarginsReport:
     pade_order: int
     segments: tuple[SegmentMargins, ...]
     gains: str
+    model: dict = field(default_factory=dict)
 
     @property
     def all_stable_at_delay(self) -> bool:
@@ -318,13 +324,16 @@ class MarginsReport:
         Returns
         -------
         dict
+            The model's :func:`~spinectl.model.source.provenance` (``preset``, ``config``,
+            ``config_sha256``, ``overridden``, ``K_Nm_per_rad``, ``K_convention``),
             ``E_m``, ``Lambda_m``, ``delay_s``, ``activation_time_constant_s``, ``pade_order``,
             ``activation``, ``optimum_status``, ``gains``, ``pcsa_cm2`` (muscle name -> PCSA [cm^2]), ``segments`` (one
             :meth:`SegmentMargins.to_dict` each) and ``all_stable_at_delay``; the unit is in each
             key's name.
         """
         point = self.point
-        return {
+        model = {k: v for k, v in self.model.items() if k != "header"}
+        return model | {
             "E_m": point.eccentricity,
             "Lambda_m": point.lordosis,
             "delay_s": self.delay,
@@ -352,6 +361,7 @@ class MarginsReport:
         """
         point = self.point
         lines = [
+            self.model.get("header", "preset unknown"),
             f"E = {point.eccentricity * 100:.2f} cm, Lambda = {point.lordosis * 100:.2f} cm, "
             f"activation {point.activation:g} x minimum PCSA (optimum: {point.status}), "
             f"delay {self.delay:g} s, activation lag {self.activation_time_constant:g} s, "
@@ -424,8 +434,18 @@ def analyse(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None
         activation_time_constant=settings.activation_time_constant,
         pade_order=settings.pade_order,
         segments=segments,
-        gains=settings.gains,
+        gains=_gains_label(settings.gains, kp, kd),
+        model=provenance(model) | {"header": header(model)},
     )
+
+
+def _gains_label(configured: str, kp, kd) -> str:
+    """How the gains were chosen: the configured way, 'explicit' when both were given, or a mix."""
+    if kp is None and kd is None:
+        return configured
+    if kp is not None and kd is not None:
+        return "explicit"
+    return f"explicit kp, {configured} kd" if kp is not None else f"{configured} kp, explicit kd"
 
 
 def _segments(model, point, settings, kp, kd) -> tuple[SegmentMargins, ...]:

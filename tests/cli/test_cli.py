@@ -31,7 +31,7 @@ def test_stability_prints_the_results_dict_and_table(capsys):
     """``--json`` prints :meth:`StabilityResult.to_dict`, the table :meth:`StabilityResult.table`
     (their schema and values: tests/model/test_stability.py)."""
     argv = ["stability", "--E", "0.03", "--Lambda", "0.04", "--pcsa", "10,10,10", "--K", "15"]
-    model = config.set_parameter(config.load_preset("default"), "passive.stiffness", 15.0)
+    model = config.set_parameter(config.load_preset(config.DEFAULT_PRESET), "passive.stiffness", 15.0)
     result = segment_stability(model, 0.03, 0.04, [10e-4, 10e-4, 10e-4])
     code, out, _ = run([*argv, "--json"], capsys)
     assert code == 0 and out == json.dumps(result.to_dict(model), indent=2) + "\n"
@@ -45,7 +45,7 @@ def test_config_show_is_loadable_toml(capsys, tmp_path):
     tomllib.loads(out)
     path = tmp_path / "shown.toml"
     path.write_text(out)
-    assert config.load_config(path) == config.load_preset("default")
+    assert config.load_config(path) == config.load_preset(config.DEFAULT_PRESET)
 
 
 @pytest.mark.parametrize(
@@ -74,8 +74,14 @@ def test_stability_defaults_to_the_minimum_stabilising_pcsa(capsys):
     assert code == 0
     doc = json.loads(out)
     assert doc["pcsa_source"] == "min_pcsa" and doc["all_self_stable"]
-    expected = optimise.solve_point(config.load_preset("default"), 0.03, 0.04)
-    assert doc["total_pcsa_cm2"] == pytest.approx(expected.total_pcsa * 1e4, rel=1e-9)
+    assert doc["preset"] == config.DEFAULT_PRESET
+    expected = optimise.solve_point(config.load_preset(config.DEFAULT_PRESET), 0.03, 0.04)
+    assert doc["chosen_pcsa_total_cm2"] == pytest.approx(expected.total_pcsa * 1e4, rel=1e-9)
+    assert doc["total_pcsa_cm2"] == doc["chosen_pcsa_total_cm2"]  # the old key, kept for one release
+    assert doc["min_pcsa_cm2"] == pytest.approx(expected.min_pcsa * 1e4, rel=1e-9)  # the LP's own minimum
+    # the chosen activation lies within ct_tolerance above the LP minimum (docs/optimisation.md)
+    tolerance = config.load_preset(config.DEFAULT_PRESET).optimisation.ct_tolerance
+    assert doc["min_pcsa_cm2"] <= doc["chosen_pcsa_total_cm2"] <= doc["min_pcsa_cm2"] * (1 + tolerance) + 1e-9
     code, out, _ = run(["stability", "--E", "0.03", "--Lambda", "0.04"], capsys)
     assert code == 0 and "minimum stabilising" in out
 
@@ -139,3 +145,52 @@ def test_an_output_never_replaces_an_input_or_another_output(tmp_path, capsys, a
     err = capsys.readouterr().err
     assert needle in err and err.count("\n") == 1
     assert {p.name: p.read_bytes() for p in tmp_path.iterdir() if p.is_file()} == before
+
+
+def test_a_negative_grid_start_is_a_value(tmp_path, capsys):
+    """--E -0.02:0.02:3 parses as the axis (argparse alone took it for an option)."""
+    out = tmp_path / "n.nc"
+    assert main(["sweep", "--E", "-0.02:0.02:3", "--Lambda", "0.03", "--out", str(out)]) == 0
+    from spinectl.landscape import netcdf
+
+    assert netcdf.load(out)["E"].values.tolist() == [-0.02, 0.0, 0.02]
+
+
+def test_set_errors_are_one_line_as_in_a_file(tmp_path, capsys):
+    """--set body.mas=3 and a file with [body] mas = 3 print the same line (exit 2)."""
+    path = tmp_path / "bad.toml"
+    path.write_text("[body]\nmas = 3\n")
+    code, _, from_file = run(["stability", "--config", str(path)], capsys)
+    assert code == 2
+    code, _, from_set = run(["stability", "--set", "body.mas=3"], capsys)
+    assert code == 2 and from_set == from_file and "did you mean 'mass'" in from_set and from_set.count("\n") == 1
+
+
+def test_set_reaches_every_command_and_is_marked(capsys):
+    """The table's first line marks the overridden field; --K is an alias applied after --set."""
+    code, out, _ = run(["stability", "--pcsa", "10,10,10", "--set", "passive.stiffness=15", "--K", "10"], capsys)
+    assert code == 0 and out.splitlines()[0].endswith("K = 10 N m/rad, convention paper; overridden: passive.stiffness")
+    for argv in (["margins"], ["config", "show"], ["draw", "--geometry-only", "--out", "/nonexistent/x.png"]):
+        code, _, err = run([*argv, "--set", "reflex.delay=-1"], capsys)
+        assert code == 2 and "reflex.delay: must be" in err
+
+
+def test_config_diff_prints_every_difference_with_its_unit(capsys):
+    code, out, _ = run(["config", "diff", "wagner2012", "default"], capsys)
+    assert code == 0
+    lines = out.splitlines()
+    assert lines[0].startswith("--- preset wagner2012") and lines[1].startswith("+++ preset default")
+    assert "body.mass [kg]: 24.0566 -> 40" in lines and "passive.convention: paper -> physical" in lines
+    code, out, _ = run(["config", "diff", "default", "default"], capsys)
+    assert code == 0 and out.splitlines()[-1] == "no parameter differs"
+
+
+def test_a_file_that_replaces_the_muscles_warns_in_one_line(tmp_path, capsys):
+    path = tmp_path / "one.toml"
+    path.write_text('muscles_mode = "replace"\n[[muscles]]\nname = "only"\nupper = [0.1, 0.25]\nlower = [0.1, 0.0]\n')
+    code, _, err = run(["config", "show", "--config", str(path)], capsys)
+    assert code == 0
+    assert (
+        err == f"spinectl: warning: {path} replaces the preset's muscle pairs (muscles_mode = 'replace'): "
+        "straight, oblique_outer, oblique_inner dropped, 1 pair(s) given\n"
+    )

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import dataclasses
 import json
 
 import pytest
@@ -34,13 +33,15 @@ def run(argv, capsys):
 
 
 def _model(**reflex):
-    model = config.load_preset("default")
-    return model.replace(reflex=dataclasses.replace(model.reflex, **reflex))
+    """The CLI's model for ``--preset default`` and these reflex options (overridden fields, as the CLI sets them)."""
+    return config.set_parameters(config.load_preset("default"), {f"reflex.{k}": v for k, v in reflex.items()})
 
 
 def test_json_is_the_reports_dict(capsys):
     """``--json`` prints :meth:`MarginsReport.to_dict` (its schema and values: tests/reflex/test_margins.py)."""
-    code, out, _ = run(["margins", "--delay", "0.1", "--activation", "0", "--pade-order", "3", "--json"], capsys)
+    code, out, _ = run(
+        ["margins", "--preset", "default", "--delay", "0.1", "--activation", "0", "--pade-order", "3", "--json"], capsys
+    )
     assert code == 0
     report = margins.analyse(_model(delay=0.1, activation=0.0, pade_order=3), 0.0, 0.0)
     assert out == json.dumps(report.to_dict(), indent=2) + "\n"
@@ -59,7 +60,7 @@ def test_self_stable_margins_are_infinite_in_json(capsys):
 
 
 def test_table_is_the_reports_table(capsys):
-    code, out, _ = run(["margins", "--activation", "0", "--kp", "150", "--kd", "20"], capsys)
+    code, out, _ = run(["margins", "--preset", "default", "--activation", "0", "--kp", "150", "--kd", "20"], capsys)
     assert code == 0 and "L5S1" in out and "tau_m" in out and "150.00" in out
     assert out == margins.analyse(_model(activation=0.0), 0.0, 0.0, kp=150.0, kd=20.0).table() + "\n"
 

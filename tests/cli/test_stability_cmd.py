@@ -24,7 +24,7 @@ def test_coupled_json_is_the_results_dict(capsys):
 
 def test_coupled_table_with_a_given_pcsa(capsys):
     """--pcsa is the global activation; the table names the matrices and the verdicts."""
-    assert main(["stability", "--coupled", "--pcsa", "10,10,10", "--K", "15"]) == 0
+    assert main(["stability", "--coupled", "--pcsa", "10,10,10", "--K", "15", "--preset", "default"]) == 0
     out = capsys.readouterr().out
     assert "mass M [kg m^2]" in out and "static margin" in out and "least local stiffness" in out
     model = config.set_parameter(config.load_preset("default"), "passive.stiffness", 15.0)

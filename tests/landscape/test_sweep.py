@@ -10,7 +10,7 @@ from spinectl import optimise
 from spinectl.cli import main
 from spinectl.errors import OutputError, ParameterError
 from spinectl.landscape import netcdf, schema, sweep
-from spinectl.model import chain
+from spinectl.model import chain, source
 from spinectl.model.mechanics import segment_coefficients
 from spinectl.model.params import Model
 
@@ -155,12 +155,13 @@ def test_describe(landscape):
     """12 points, all feasible on the default model's grid; ranges as the data's own extremes."""
     pcsa, torque = landscape["min_pcsa_cm2"].values, landscape["counter_torque_norm_Nm"].values
     assert sweep.describe(landscape) == (
-        f"12 points (12 solved, 0 infeasible or failed); min PCSA {pcsa.min():.1f}-{pcsa.max():.1f} cm2, "
+        f"{source.header(Model())}: 12 points (12 solved, 0 infeasible or failed); "
+        f"min PCSA {pcsa.min():.1f}-{pcsa.max():.1f} cm2, "
         f"||CT|| {torque.min():.1f}-{torque.max():.1f} N m"
     )
     nothing = landscape.copy()
     nothing["min_pcsa_cm2"] = nothing["min_pcsa_cm2"] * np.nan
-    assert sweep.describe(nothing) == "12 points (0 solved, 12 infeasible or failed)"
+    assert sweep.describe(nothing).endswith(": 12 points (0 solved, 12 infeasible or failed)")
 
 
 def test_an_absurd_stiffness_gets_the_true_minimum_with_status_optimal():

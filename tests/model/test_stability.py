@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from spinectl.errors import ParameterError
-from spinectl.model import mechanics, muscle
+from spinectl.model import mechanics, muscle, source
+from spinectl.model.checks import MAX_PLAUSIBLE_PCSA
 from spinectl.model.config import set_parameter
 from spinectl.model.params import Errata, Passive
 from spinectl.model.stability import eigenvalues, hurwitz_stable, jacobian, segment_stability, self_stable
@@ -120,7 +121,7 @@ def test_vertical_pair_is_stable_just_above_its_hand_threshold(vertical_model):
     assert above.self_stable[k] and not below.self_stable[k]
     # CoRs whose hand threshold is infinite (buckling term wins) are never stable.
     hopeless = ~np.isfinite(threshold)
-    assert not segment_stability(vertical_model, 0.0, 0.0, [1.0]).self_stable[hopeless].any()
+    assert not segment_stability(vertical_model, 0.0, 0.0, [MAX_PLAUSIBLE_PCSA]).self_stable[hopeless].any()
 
 
 def test_passive_stiffness_conventions(model):
@@ -188,10 +189,26 @@ def test_to_dict_schema_and_values(model):
 def test_table(model):
     result = segment_stability(model, 0.03, 0.04, [10e-4, 10e-4, 10e-4])
     lines = result.table(model).splitlines()
-    assert lines[0] == "E = 3.00 cm, Lambda = 4.00 cm, K = 0 N m/rad (physical)"
-    assert lines[1].startswith("PCSA [cm^2]: ") and lines[1].endswith("(total 60.00)")
-    rows = lines[4 : 4 + len(result.segment_names)]
+    assert lines[0] == source.header(model)
+    assert lines[1] == "E = 3.00 cm, Lambda = 4.00 cm"
+    assert lines[2].startswith("PCSA [cm^2]: ") and lines[2].endswith("(total 60.00)")  # 6 x 10 cm^2, given
+    rows = lines[5 : 5 + len(result.segment_names)]
     assert [row.split()[0] for row in rows] == list(result.segment_names)
     assert [float(row.split()[-1]) for row in rows] == pytest.approx(result.counter_torque, abs=5e-4)
     assert lines[-1].startswith(f"||CT|| = {result.counter_torque_norm:.3f} N m; self-stable: ")
     assert "(minimum stabilising, chosen activation)" in result.table(model, pcsa_source="min_pcsa")
+
+
+def test_a_result_has_no_truth_value(model):
+    """``if result:`` is ambiguous (every segment or any?): a TypeError naming all_self_stable."""
+    result = segment_stability(model, 0.03, 0.04, [10e-4, 10e-4, 10e-4])
+    with pytest.raises(TypeError, match="use result.all_self_stable"):
+        bool(result)
+    assert result.all_self_stable == bool(np.all(result.self_stable))
+
+
+def test_a_pcsa_in_cm2_given_as_m2_is_refused(model):
+    """pcsa=[10, 10, 10] (cm^2 out of habit) is 10 m^2 per muscle: refused, naming the cm^2 slip and the fix."""
+    with pytest.raises(ParameterError, match=r"if you meant 10 cm\^2, pass 0.001"):
+        segment_stability(model, 0.03, 0.04, [10, 10, 10])
+    segment_stability(model, 0.03, 0.04, [MAX_PLAUSIBLE_PCSA] * 3)  # the bound itself is allowed

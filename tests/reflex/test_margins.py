@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from spinectl import reflex
+from spinectl.model import source
 from spinectl.model.mechanics import segment_coefficients
 from spinectl.model.params import Optimisation
 from spinectl.reflex import margins
@@ -153,7 +154,9 @@ def test_undefined_python_control_reading_is_none_in_the_dict(model):
 def test_table(model):
     report = margins.analyse(_with_reflex(model, activation=0.0), E, LAMBDA, kp=150.0, kd=20.0)
     lines = report.table().splitlines()
-    assert lines[0].startswith("E = 3.00 cm, Lambda = 4.00 cm, activation 0 x minimum PCSA (optimum: skipped)")
+    assert lines[0] == source.header(model)  # the model's line first (docs/model.md, "The default model")
+    assert lines[1].startswith("E = 3.00 cm, Lambda = 4.00 cm, activation 0 x minimum PCSA (optimum: skipped)")
+    assert lines[1].endswith("gains: explicit")  # both gains given
     rows = [line for line in lines if line.split()[:1] in (["L1L2"], ["L2L3"], ["L3L4"], ["L4L5"], ["L5S1"])]
     assert len(rows) == 5 and all(row.split()[6:8] == ["150.00", "20.00"] for row in rows)
     assert all(row.split()[4:6] == ["no", "none"] for row in rows)  # gravity alone: not self-stable
@@ -202,3 +205,18 @@ def test_report_responses_without_reflex_or_optimum(model):
     assert responses.loops == {} and len(responses.simulations) == 5
     tiny = _with_reflex(model.replace(optimisation=Optimisation(pcsa_max=1e-8)), activation=0.5)
     assert margins.report_responses(tiny, margins.analyse(tiny, E, LAMBDA)) == margins.ReportResponses({}, {})
+
+
+@pytest.mark.parametrize(
+    ("kp", "kd", "label"),
+    [
+        (None, None, "rule"),
+        (150.0, 20.0, "explicit"),
+        (150.0, None, "explicit kp, rule kd"),
+        (None, 5.0, "rule kp, explicit kd"),
+    ],
+)
+def test_gains_say_how_they_were_chosen(model, kp, kd, label):
+    """Gains given to analyse are explicit in the report, also where the model's setting is 'rule'."""
+    report = margins.analyse(_with_reflex(model, activation=0.0), E, LAMBDA, kp=kp, kd=kd)
+    assert report.gains == label and report.to_dict()["gains"] == label

@@ -260,15 +260,19 @@ def test_an_invalid_value_is_a_parameter_error_naming_the_field(tmp_path, case):
         ('[[muscles]]\nname = "a"\n[[muscles]]\nname = "a"\n', "muscles.1.name", "unique"),
         ("[geometry]\ncor_heights = [0.145, 0.072]\n", "geometry.cor_names", "one name per entry of cor_heights"),
         ("[geometry]\nspine_length = 0.1\n", "geometry.cor_heights", "spine_length=0.1"),
-        ("[[muscles]]\nlower = [0.12, 0.3]\n", "muscles.0.upper", "must lie above lower"),
-        ("[[muscles]]\nupper = [1e308, 1.0]\nlower = [-1e308, 0.0]\n", "muscles.0.upper", "finite distance"),
+        ('[[muscles]]\nname = "straight"\nlower = [0.12, 0.3]\n', "muscles.0.upper", "must lie above lower"),
+        (
+            '[[muscles]]\nname = "straight"\nupper = [1e308, 1.0]\nlower = [-1e308, 0.0]\n',
+            "muscles.0.upper",
+            "finite distance",
+        ),
         ("[body]\nmass_height = 0.145\n", "body.mass_height", "above the top centre of rotation L1L2"),
         ("[geometry]\ncor_heights = [0.3, 0.1]\ncor_names = ['a', 'b']\n", "geometry.cor_heights", "on the spine"),
         ("body = 3\n", "body", "must be a table"),
         ("muscles = 3\n", "muscles", "array of tables"),
         ("muscles = []\n", "muscles", "at least one"),
         ("muscles = [1]\n", "muscles.0", "must be a table"),
-        ("[[muscles]]\nupper = { x = 1 }\n", "muscles.0.upper", "must be a list"),
+        ('[[muscles]]\nname = "straight"\nupper = { x = 1 }\n', "muscles.0.upper", "must be a list"),
         ('preset = "nope"\n', "preset", "must be one of"),
         ("preset = 3\n", "preset", "must be one of"),
         ('preset = ""\n', "preset", "must be one of"),
@@ -461,8 +465,9 @@ def test_overflow_is_a_model_error_or_a_solver_status(tmp_path, dotted, value):
             assert not optimum.ok and np.isnan(optimum.min_pcsa)
 
 
-def test_huge_pcsa_is_a_model_error(model):
-    with pytest.raises(ModelError, match="orders of magnitude"):
+def test_huge_pcsa_is_refused_before_any_arithmetic(model):
+    """1e300 m^2 once overflowed to a ModelError; now any PCSA above 0.1 m^2 is refused up front, naming cm^2."""
+    with pytest.raises(ParameterError, match="if you meant 1e\\+300 cm\\^2"):
         segment_stability(model, 0.0, 0.0, np.full(3, 1e300))
 
 
@@ -652,8 +657,10 @@ def _full_disk(*args, **kwargs):
         (["plot", "{out}/old.nc", "--out", "{out}"], "matplotlib.figure.Figure.savefig"),
         (["reproduce", "--points", "3", "--out", "{out}"], "matplotlib.figure.Figure.savefig"),
         (["margins", "--plot", "{out}"], "matplotlib.figure.Figure.savefig"),
-        (["study", "{out}/study.toml", "--out", "{out}/s.zarr", "--scheduler", "synchronous"],
-         "xarray.Dataset.to_zarr"),
+        (
+            ["study", "{out}/study.toml", "--out", "{out}/s.zarr", "--scheduler", "synchronous"],
+            "xarray.Dataset.to_zarr",
+        ),
     ],
 )
 def test_a_full_disk_is_one_line_and_keeps_the_previous_files(tmp_path, monkeypatch, capsys, command, patched):

@@ -11,6 +11,7 @@ values are validated by the dataclasses of :mod:`spinectl.landscape.study.spec`.
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 import numpy as np
@@ -37,13 +38,16 @@ RANGE_KEYS = ("start", "stop", "num")
 """The keys of a range of values, ``{ start, stop, num }``."""
 
 
-def load_study(path: str | Path) -> Study:
+def load_study(path: str | Path, overrides=()) -> Study:
     """Read and validate a study file (TOML; ``docs/studies.md``).
 
     Parameters
     ----------
     path : str or Path
         The study file; a ``config`` it names is relative to its folder.
+    overrides : sequence of str
+        ``SECTION.FIELD=VALUE`` assignments on the study's base model, after its ``[model]``
+        (``spinectl study --set``; :func:`spinectl.model.config.apply_overrides`).
 
     Returns
     -------
@@ -62,7 +66,10 @@ def load_study(path: str | Path) -> Study:
         text = read_text(path)
     except ConfigError as exc:
         raise ConfigError("study", exc.message) from None
-    return parse_study(text, base_dir=path.parent, source=str(path))
+    study = parse_study(text, base_dir=path.parent, source=str(path))
+    if not overrides:
+        return study
+    return dataclasses.replace(study, model=config.apply_overrides(study.model, overrides))
 
 
 def parse_study(text: str, base_dir: str | Path = ".", source: str = "study") -> Study:
@@ -139,7 +146,7 @@ def _base_model(head: dict, overrides, base_dir: Path) -> Model:
                 raise ParameterError("config", f"must be a file name (got {show(head['config'])})")
             model = config.load_config(base_dir / head["config"], preset=preset)
         else:
-            model = config.load_preset("default" if preset is None else preset)
+            model = config.load_preset(config.DEFAULT_PRESET if preset is None else preset)
     except ConfigError as exc:
         if exc.field not in ("config", "preset"):
             raise

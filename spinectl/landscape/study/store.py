@@ -36,7 +36,7 @@ import zarr
 from ... import __version__
 from ...atomic import atomic_path, output_errors
 from ...errors import OutputError, ParameterError
-from ...model import config
+from ...model import config, source
 from ...model._toml import field_metadata
 from .. import schema
 from .spec import SAMPLE, STORE_FORMAT, Chunk, Study
@@ -160,7 +160,7 @@ def _attributes(study: Study) -> dict:
         "config_toml": config.dump_toml(study.model),
         "chunk_tile": list(study.tile),
         CHUNK_FILES: True,
-    }
+    } | source.attributes(study.model)
 
 
 def existing(

@@ -1,0 +1,158 @@
+"""Where a model came from: its preset, its configuration file (path and SHA-256), its overridden fields.
+
+Every output names the model it used (docs/model.md, "The default model"): a table's header line
+(:func:`header`), a JSON document's keys (:func:`provenance`), a dataset's attributes and the
+reproduction report. The source rides on the :class:`~spinectl.model.params.Model` instance as a
+private attribute, outside its fields, so two equal parameter sets still compare equal however they
+were made; :mod:`spinectl.model.config` attaches it when it loads or changes a model.
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+from dataclasses import dataclass
+
+from .params import Model
+
+_ATTRIBUTE = "_spinectl_source"
+
+
+@dataclass(frozen=True)
+class ModelSource:
+    """How a model was assembled.
+
+    Attributes
+    ----------
+    preset : str or None
+        The built-in preset it starts from; None for a model built in Python (``Model()``).
+    config : str or None
+        The configuration file laid over the preset, as given.
+    config_sha256 : str or None
+        SHA-256 of that file's bytes (hex).
+    overridden : tuple of str
+        Dotted fields changed after loading (``--set``, ``--K``, :func:`~spinectl.model.config.set_parameters`).
+    """
+
+    preset: str | None = None
+    config: str | None = None
+    config_sha256: str | None = None
+    overridden: tuple[str, ...] = ()
+
+    def with_overridden(self, names) -> ModelSource:
+        """This source with ``names`` added to :attr:`overridden` (each once, in order).
+
+        Parameters
+        ----------
+        names : iterable of str
+            Dotted fields, e.g. ``"passive.stiffness"``.
+
+        Returns
+        -------
+        ModelSource
+            A new source.
+        """
+        added = tuple(n for n in dict.fromkeys(names) if n not in self.overridden)
+        return dataclasses.replace(self, overridden=self.overridden + added)
+
+
+def source_of(model: Model) -> ModelSource:
+    """The :class:`ModelSource` of ``model`` (an empty one for a model built in Python).
+
+    Parameters
+    ----------
+    model : Model
+
+    Returns
+    -------
+    ModelSource
+    """
+    return getattr(model, _ATTRIBUTE, ModelSource())
+
+
+def with_source(model: Model, source: ModelSource) -> Model:
+    """A shallow copy of ``model`` that carries ``source``; ``model`` is unchanged.
+
+    Parameters
+    ----------
+    model : Model
+    source : ModelSource
+
+    Returns
+    -------
+    Model
+        Equal to ``model`` (the source is no field).
+    """
+    out = copy.copy(model)
+    object.__setattr__(out, _ATTRIBUTE, source)  # frozen: the fields stay as validated
+    return out
+
+
+def header(model: Model) -> str:
+    """One line naming the model: ``preset wagner2012, K = 15 N m/rad, convention paper``, then the file and overrides.
+
+    Parameters
+    ----------
+    model : Model
+
+    Returns
+    -------
+    str
+        E.g. ``preset wagner2012, K = 0 N m/rad, convention paper; config my.toml (sha256 1a2b3c4d5e6f);
+        overridden: passive.stiffness``.
+    """
+    src = source_of(model)
+    name = src.preset or "none (a Model built in Python)"
+    parts = [f"preset {name}, K = {model.passive.stiffness:g} N m/rad, convention {model.passive.convention}"]
+    if src.config:
+        parts.append(f"config {src.config} (sha256 {src.config_sha256[:12]})")
+    if src.overridden:
+        parts.append(f"overridden: {', '.join(src.overridden)}")
+    return "; ".join(parts)
+
+
+def provenance(model: Model) -> dict:
+    """The model's source as JSON-ready keys (also the attributes of datasets and stores).
+
+    Parameters
+    ----------
+    model : Model
+
+    Returns
+    -------
+    dict
+        ``preset`` (str or None), ``config`` (path or None), ``config_sha256`` (hex or None),
+        ``overridden`` (list of dotted fields), ``K_Nm_per_rad`` and ``K_convention``.
+    """
+    src = source_of(model)
+    return {
+        "preset": src.preset,
+        "config": src.config,
+        "config_sha256": src.config_sha256,
+        "overridden": list(src.overridden),
+        "K_Nm_per_rad": model.passive.stiffness,
+        "K_convention": model.passive.convention,
+    }
+
+
+def attributes(model: Model) -> dict:
+    """The model's source as NetCDF/Zarr attributes: strings only (netCDF has no null).
+
+    Parameters
+    ----------
+    model : Model
+
+    Returns
+    -------
+    dict of str to str
+        ``model`` (the :func:`header` line), ``preset``, ``config``, ``config_sha256`` and
+        ``overridden`` (comma-separated); empty strings where there is none.
+    """
+    src = source_of(model)
+    return {
+        "model": header(model),
+        "preset": src.preset or "",
+        "config": src.config or "",
+        "config_sha256": src.config_sha256 or "",
+        "overridden": ", ".join(src.overridden),
+    }

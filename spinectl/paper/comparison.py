@@ -1,0 +1,144 @@
+"""Two landscapes on the same grid compared: difference and ratio maps (``spinectl plot a.nc --vs b.nc``).
+
+For each K the two files share, the minimum PCSA (Figure 3 / S1) and ||CT|| (Figure 4) of the first
+file minus, and over, those of the second, drawn as the landscape figures are
+(:mod:`spinectl.paper.figures`). Landscapes on different grids are not interpolated: the comparison
+names the axis that differs and stops.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+from matplotlib.figure import Figure
+
+from ..canvas import save_figures
+from ..errors import ParameterError
+from ..landscape import netcdf
+from . import figures
+
+COMPARED = (
+    ("min_pcsa_cm2", "minimum PCSA", "cm²", "min_pcsa"),
+    ("counter_torque_norm_Nm", "||CT||", "N m", "counter_torque"),
+)
+"""The variables compared: name in the dataset, what it is, unit, stem of the file name."""
+
+_TOLERANCE = 1e-9
+"""Coordinates [m or N m/rad] closer than this are the same grid point (rounding in a file)."""
+
+
+def stiffnesses(dataset: xr.Dataset) -> list[float]:
+    """The values of K [N m/rad] of a landscape, whether K is a dimension or a scalar coordinate.
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+
+    Returns
+    -------
+    list of float
+    """
+    return [float(k) for k in np.atleast_1d(dataset["K"].values)]
+
+
+def check_same_grid(first: xr.Dataset, second: xr.Dataset) -> None:
+    """Raise unless two landscapes share their E and Lambda axes and their values of K.
+
+    Parameters
+    ----------
+    first, second : xarray.Dataset
+
+    Raises
+    ------
+    ParameterError
+        Field ``--vs``: the axis that differs, with both files' ranges.
+    """
+    for name, unit in (("E", "m"), ("Lambda", "m"), ("K", "N m/rad")):
+        x, y = np.atleast_1d(first[name].values), np.atleast_1d(second[name].values)
+        if x.shape != y.shape or not np.allclose(x, y, rtol=0, atol=_TOLERANCE):
+            raise ParameterError(
+                "--vs",
+                f"the grids differ in {name}: {_axis(x)} {unit} in the first file, {_axis(y)} {unit} in the second; "
+                "sweep both on the same grid",
+            )
+
+
+def _axis(values: np.ndarray) -> str:
+    return f"{values.size} value(s) {values.min():g} to {values.max():g}"
+
+
+def _at(dataset: xr.Dataset, stiffness: float) -> xr.Dataset:
+    return dataset.sel(K=stiffness) if "K" in dataset.dims else dataset
+
+
+def comparison_set(first: xr.Dataset, second: xr.Dataset, labels=("first", "second"), format: str = "png") -> dict:
+    """Difference and ratio maps of the minimum PCSA and ||CT|| of two landscapes, by file name.
+
+    Parameters
+    ----------
+    first, second : xarray.Dataset
+        Landscapes on the same grid (:func:`check_same_grid`), e.g. two presets' sweeps.
+    labels : tuple of str
+        How the titles name the two (e.g. their file names).
+    format : str
+        File format of the names, one of :data:`spinectl.paper.figures.FORMATS`.
+
+    Returns
+    -------
+    dict of str to matplotlib.figure.Figure
+        ``{stem}_difference_K{K}.{format}`` (first minus second, in the variable's unit) and
+        ``{stem}_ratio_K{K}.{format}`` (first over second [1], white where the second is 0 or
+        either is infeasible) for each stem of :data:`COMPARED` and each K; nothing is written.
+
+    Raises
+    ------
+    ParameterError
+        The grids differ (field ``--vs``).
+    """
+    check_same_grid(first, second)
+    drawn: dict[str, Figure] = {}
+    for k in stiffnesses(first):
+        a, b = _at(first, k), _at(second, k)
+        for name, what, unit, stem in COMPARED:
+            where = f"K = {k:g} N m/rad"
+            suffix = f"_K{figures.k_in_name(k)}.{format}"
+            difference = a[name] - b[name]
+            title = f"{what}: {labels[0]} minus {labels[1]}, {where}"
+            drawn[f"{stem}_difference{suffix}"] = figures.landscape_figure(difference, title, f"difference [{unit}]")
+            ratio = (a[name] / b[name]).where(b[name] > 0)
+            title = f"{what}: {labels[0]} over {labels[1]}, {where}"
+            drawn[f"{stem}_ratio{suffix}"] = figures.landscape_figure(ratio, title, "ratio [1]")
+    return drawn
+
+
+def draw_comparison(first, second, out_dir, format: str = "png", dpi: float = figures.DPI) -> list:
+    """Load two sweep files, draw :func:`comparison_set` and save it into ``out_dir`` (all or none).
+
+    Parameters
+    ----------
+    first, second : str or Path
+        NetCDF files of ``spinectl sweep`` or ``reproduce`` (:func:`spinectl.landscape.netcdf.load`).
+    out_dir : str or Path
+        Folder for the figures.
+    format : str
+        One of :data:`spinectl.paper.figures.FORMATS`.
+    dpi : float
+        Resolution of PNG files.
+
+    Returns
+    -------
+    list of Path
+        The files written.
+
+    Raises
+    ------
+    ParameterError
+        A file that is no sweep (field ``results``), or grids that differ (field ``--vs``).
+    OutputError
+        ``out_dir`` cannot take the files; nothing is written.
+    """
+    labels = (Path(first).name, Path(second).name)
+    drawn = comparison_set(netcdf.load(first), netcdf.load(second), labels, format)
+    return save_figures(drawn, out_dir, dpi)

@@ -1,0 +1,99 @@
+"""A parameter study's E x Lambda slices drawn (``spinectl plot STORE.zarr``).
+
+A study store (:mod:`spinectl.landscape.study`) holds one landscape per value of each parameter axis
+and per Monte-Carlo draw. Each slice is drawn as the landscape figures are
+(:func:`spinectl.paper.figures.landscape_figure`): its minimum PCSA and its ||CT||, the title naming
+the slice's parameter values. A store with more slices than :data:`MAX_SLICES` is refused with the
+way to select from it.
+"""
+
+from __future__ import annotations
+
+import itertools
+from pathlib import Path
+
+import xarray as xr
+
+from ..canvas import save_figures
+from ..errors import ParameterError
+from . import comparison, figures
+
+MAX_SLICES = 24
+"""Most slices one ``spinectl plot`` of a store draws (two figures each)."""
+
+
+def slice_figures(dataset: xr.Dataset, format: str = "png") -> dict:
+    """The minimum PCSA and ||CT|| of every E x Lambda slice of a study, by file name.
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        A study store as :func:`spinectl.landscape.study.load` reads it.
+    format : str
+        One of :data:`spinectl.paper.figures.FORMATS`.
+
+    Returns
+    -------
+    dict of str to matplotlib.figure.Figure
+        ``{stem}_{dim}={value}_....{format}`` for each stem of
+        :data:`spinectl.paper.comparison.COMPARED` and each slice (``{stem}.{format}`` for a study
+        without axes); nothing is written.
+
+    Raises
+    ------
+    ParameterError
+        More than :data:`MAX_SLICES` slices (field ``results``), naming the dimensions.
+    """
+    dims = [d for d in dataset["min_pcsa_cm2"].dims if d not in ("E", "Lambda")]
+    count = 1
+    for d in dims:
+        count *= dataset.sizes[d]
+    if count > MAX_SLICES:
+        shape = " x ".join(f"{d} ({dataset.sizes[d]})" for d in dims)
+        raise ParameterError(
+            "results",
+            f"the study has {count} E x Lambda slices ({shape}); spinectl plot draws at most {MAX_SLICES}: "
+            "select some with spinectl.landscape.study.load(...).isel(...) and "
+            "spinectl.paper.figures.landscape_figure (docs/studies.md)",
+        )
+    drawn = {}
+    for index in itertools.product(*(range(dataset.sizes[d]) for d in dims)):
+        part = dataset.isel(dict(zip(dims, index, strict=True)))
+        values = [(d, part[d].values.item()) for d in dims]
+        where = ", ".join(f"{d} = {v:g}" for d, v in values) or "the study's model"
+        name = "".join(f"_{d}={v:g}" for d, v in values)
+        for variable, what, unit, stem in comparison.COMPARED:
+            title = f"{what} of the study, {where}"
+            drawn[f"{stem}{name}.{format}"] = figures.landscape_figure(part[variable], title, f"{what} [{unit}]")
+    return drawn
+
+
+def draw_study(path, out_dir, format: str = "png", dpi: float = figures.DPI) -> list[Path]:
+    """Read a study store and save :func:`slice_figures` into ``out_dir`` (all or none).
+
+    Parameters
+    ----------
+    path : str or Path
+        The store (a folder written by ``spinectl study``).
+    out_dir : str or Path
+        Folder for the figures.
+    format : str
+        One of :data:`spinectl.paper.figures.FORMATS`.
+    dpi : float
+        Resolution of PNG files.
+
+    Returns
+    -------
+    list of Path
+        The files written.
+
+    Raises
+    ------
+    ParameterError
+        Not a finished study store (field ``store``), or too many slices (field ``results``).
+    OutputError
+        ``out_dir`` cannot take the files; nothing is written.
+    """
+    from ..landscape.study import store  # zarr and dask only for a store
+
+    return save_figures(slice_figures(store.load(path), format), out_dir, dpi)

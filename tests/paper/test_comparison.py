@@ -1,0 +1,63 @@
+"""Two landscapes compared: difference and ratio maps on one grid, a clear error on two (spinectl plot --vs)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from spinectl.cli import main
+from spinectl.errors import ParameterError
+from spinectl.landscape import sweep
+from spinectl.model import config
+from spinectl.paper import comparison
+
+AXIS = np.linspace(0.0, 0.08, 3)
+
+
+@pytest.fixture(scope="module")
+def two():
+    """The calibrated and the anatomical preset on one 3 x 3 grid."""
+    return (
+        sweep.sweep(config.load_preset("wagner2012"), AXIS, AXIS),
+        sweep.sweep(config.load_preset("default"), AXIS, AXIS),
+    )
+
+
+def test_maps_are_the_difference_and_the_ratio(two, monkeypatch):
+    """The drawn fields are first - second and first / second, point by point (numpy on the same arrays)."""
+    drawn = {}
+    monkeypatch.setattr(
+        comparison.figures, "landscape_figure", lambda field, title, label: drawn.setdefault(title, field)
+    )
+    figures = comparison.comparison_set(*two, labels=("a.nc", "b.nc"))
+    assert sorted(figures) == [
+        "counter_torque_difference_K0.png",
+        "counter_torque_ratio_K0.png",
+        "min_pcsa_difference_K0.png",
+        "min_pcsa_ratio_K0.png",
+    ]
+    a, b = (ds["min_pcsa_cm2"].values for ds in two)
+    difference = drawn["minimum PCSA: a.nc minus b.nc, K = 0 N m/rad"]
+    ratio = drawn["minimum PCSA: a.nc over b.nc, K = 0 N m/rad"]
+    np.testing.assert_allclose(difference.values, a - b)
+    np.testing.assert_allclose(ratio.values, a / b)
+
+
+def test_different_grids_are_refused_naming_the_axis(two):
+    other = sweep.sweep(config.load_preset("default"), AXIS, AXIS[:2])
+    with pytest.raises(ParameterError, match="--vs: the grids differ in Lambda: 3 value"):
+        comparison.check_same_grid(two[0], other)
+
+
+def test_plot_vs_writes_four_maps_or_one_error_line(tmp_path, capsys):
+    for name, preset in (("a.nc", "wagner2012"), ("b.nc", "default"), ("c.nc", "default")):
+        grid = "0:0.08:3" if name != "c.nc" else "0:0.08:2"
+        assert (
+            main(["sweep", "--E", grid, "--Lambda", "0:0.08:3", "--preset", preset, "--out", str(tmp_path / name)]) == 0
+        )
+    capsys.readouterr()
+    assert main(["plot", str(tmp_path / "a.nc"), "--vs", str(tmp_path / "b.nc"), "--out", str(tmp_path / "f")]) == 0
+    assert len(capsys.readouterr().out.split()) == 4
+    assert main(["plot", str(tmp_path / "a.nc"), "--vs", str(tmp_path / "c.nc"), "--out", str(tmp_path / "g")]) == 2
+    err = capsys.readouterr().err
+    assert "the grids differ in E" in err and err.count("\n") == 1 and not (tmp_path / "g").exists()
