@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..model.checks import arithmetic_guard
 from ..model.params import Model
 from ..optimise.coupled import CoupledStability, coupled_stability_at
 from .chain_system import DiskMargins, chain_disk_margins, chain_loop
@@ -222,7 +223,8 @@ def coupled_margins(model: Model, eccentricity: float, lordosis: float, kp=None,
         kp0, kd0 = np.full(n, settings.kp), np.full(n, settings.kd)
     kp = kp0 if kp is None else np.full(n, float(kp))
     kd = kd0 if kd is None else np.full(n, float(kd))
-    exact = chain_delay_margin(chain.mass, chain.stiffness, chain.damping, kp, kd, lag)
+    with arithmetic_guard(eccentricity, lordosis):  # gains or delays orders of magnitude off: a ModelError
+        exact = chain_delay_margin(chain.mass, chain.stiffness, chain.damping, kp, kd, lag)
     stable = stable_at(exact, settings.delay)
     disk = None
     if stable:

@@ -32,9 +32,9 @@ References
 from __future__ import annotations
 
 import numpy as np
+import scipy.linalg
 
 from ..errors import ParameterError
-from ..model.chain import state_matrix
 from .delay import DELAY_INDEPENDENT, FINITE, STATUS, UNDEFINED, UNSTABLE_WITHOUT_DELAY
 from .pade import pade_inverse_lag
 from .siso import LoopDelayMargin
@@ -55,7 +55,8 @@ def _matrices(mass, stiffness, damping, kp, kd):
             raise ParameterError(name, f"must be a square matrix like mass, {n} x {n} (got shape {x.shape})")
     gains = []
     for name, x in (("kp", kp), ("kd", kd)):
-        x = np.broadcast_to(np.asarray(x, float), (n,)) if np.ndim(x) <= 1 else np.asarray(x, float)
+        x = np.asarray(x, float)
+        x = np.full(n, float(x)) if x.ndim == 0 else x
         if x.shape != (n,):
             raise ParameterError(name, f"must be one gain per joint, {n} values (got shape {np.shape(x)})")
         gains.append(np.diag(x))
@@ -90,7 +91,8 @@ def delay_free_poles(mass, stiffness, damping, kp, kd, lag=0.0):
     """Roots of det(P(s) + Q(s)) = 0: the closed loop without delay [1/s].
 
     States (q, q', u) with M q'' = K q + D q' + u and T_a u' = -u - K_p q - K_d q'; without the
-    lag the state matrix of :func:`spinectl.model.chain.state_matrix` with K - K_p and D - K_d.
+    lag (T_a = 0, u = -K_p q - K_d q') the eigenvalues of :func:`spinectl.model.chain.state_matrix`
+    with K - K_p and D - K_d.
 
     Parameters
     ----------
@@ -104,18 +106,16 @@ def delay_free_poles(mass, stiffness, damping, kp, kd, lag=0.0):
     Returns
     -------
     numpy.ndarray, shape (2 n,) or (3 n,), complex
-        [1/s]; NaN where M is singular.
+        [1/s]: the finite generalised eigenvalues of the pencil (A, E) of the descriptor form
+        E x' = A x, E = diag(I, M, T_a I), so that a tiny T_a needs no division by it.
     """
     mass, stiffness, damping, kp, kd = _matrices(mass, stiffness, damping, kp, kd)
     n = mass.shape[0]
-    a = state_matrix(mass, stiffness - kp, damping - kd) if lag == 0 else state_matrix(mass, stiffness, damping)
-    if not np.all(np.isfinite(a)):
-        return np.full((2 if lag == 0 else 3) * n, complex(np.nan, np.nan))
-    if lag == 0:
-        return np.linalg.eigvals(a)
-    top = np.concatenate([a, np.concatenate([np.zeros((n, n)), np.linalg.inv(mass)])], axis=1)
-    bottom = np.concatenate([-kp, -kd, -np.eye(n)], axis=1) / lag
-    return np.linalg.eigvals(np.concatenate([top, bottom]))
+    zero, one = np.zeros((n, n)), np.eye(n)
+    a = np.block([[zero, one, zero], [stiffness, damping, one], [-kp, -kd, -one]])
+    e = np.block([[one, zero, zero], [zero, mass, zero], [zero, zero, lag * one]])
+    roots = scipy.linalg.eigvals(a, e)  # T_a = 0: n infinite eigenvalues, the lag's absent states
+    return roots[np.isfinite(roots)]
 
 
 def highest_crossing(mass, stiffness, damping, kp, kd) -> float:
@@ -169,7 +169,7 @@ def _crossings(mass, stiffness, damping, kp, kd, lag):
         w = 0.5 * (lo + hi)
         p, q = characteristic_matrices(mass, stiffness, damping, kp, kd, [w], lag)
         inverse = _inverse_eigenvalues(p, q)[0]
-        near = np.abs(np.log(np.abs(inverse)))
+        near = np.abs(np.abs(inverse) - 1.0)
         # as many eigenvalues as the count changed by, nearest the circle first
         for j in np.argsort(near)[: max(1, abs(int(counts[i + 1]) - int(below)))]:
             found.append((w, 1.0 / inverse[j]))
