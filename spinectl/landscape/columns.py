@@ -13,7 +13,7 @@ import numpy as np
 from ..model import chain
 from ..model.checks import arithmetic_guard, checked_coefficients
 from ..model.params import Model
-from ..optimise import stacked
+from ..optimise import coupled, stacked
 from ..optimise.problem import problem_data
 from ..reflex.delay import STATUS
 from ..reflex.inputs import guarded
@@ -22,7 +22,6 @@ from ..units import M2_PER_CM2, m2_to_cm2
 
 DEFAULT_CHUNK = 1024
 """Grid points per stacked problem: large enough that Python overheads vanish, small enough to keep memory flat."""
-
 
 
 def point_columns(
@@ -70,7 +69,10 @@ def point_columns(
         per_point += result.per_point
         with arithmetic_guard(e_grid[part], l_grid[part]), guarded():  # e.g. K = 1e154 overflows S^2 in the reflex
             columns = _chunk_columns(result, coeffs, model)
-            columns["coupled_margin_Nm_per_rad"] = _coupled_margin(model, e_grid[part], l_grid[part], result.pcsa)
+            stiffness = _chain_stiffness(model, e_grid[part], l_grid[part], result.pcsa)
+            margin = chain.coupled_margin(np.nan_to_num(stiffness))
+            columns["coupled_margin_Nm_per_rad"] = np.where(np.isnan(stiffness[:, 0, 0]), np.nan, margin)
+        columns |= _local_stiffness(model, stiffness, method)  # an SDP: outside numpy's guard
         for name, values in columns.items():
             if name not in arrays:
                 arrays[name] = np.empty((e_grid.size,) + values.shape[1:], values.dtype)
@@ -96,10 +98,26 @@ def _chunk_columns(result: stacked.BlockOptimum, coeffs, model: Model) -> dict[s
     }
 
 
-def _coupled_margin(model: Model, eccentricity, lordosis, pcsa) -> np.ndarray:
-    """Static margin of the coupled chain at the chosen activation [N m/rad], NaN where infeasible (docs/chain.md)."""
+def _chain_stiffness(model: Model, eccentricity, lordosis, pcsa) -> np.ndarray:
+    """The coupled chain's K at the chosen activation [N m/rad], NaN where infeasible (docs/chain.md)."""
     stiffness = chain.chain_coefficients(model, eccentricity, lordosis).stiffness(np.nan_to_num(pcsa))
-    return np.where(np.isnan(pcsa).any(axis=-1), np.nan, chain.coupled_margin(stiffness))
+    return np.where(np.isnan(pcsa).any(axis=-1)[:, None, None], np.nan, stiffness)
+
+
+def _local_stiffness(model: Model, stiffness, method: str) -> dict[str, np.ndarray]:
+    """The least local stiffness at the chosen activation, problem (a) of docs/chain.md, per joint and total.
+
+    The fast path solves the chunk as one stacked SDP, the per-point method one cvxpy SDP per point.
+    """
+    opt = model.optimisation
+    if method == "fast":
+        _, k = coupled.least_local_stiffness_stacked(stiffness, opt.stability_margin, opt.solver_tolerance)
+    else:
+        k = np.full(stiffness.shape[:-1], np.nan)
+        for i in np.flatnonzero(np.isfinite(stiffness[:, 0, 0])):
+            status, found = coupled.least_local_stiffness_at(stiffness[i], opt.stability_margin, opt.solver_tolerance)
+            k[i] = np.nan if found is None else found
+    return {"local_stiffness_Nm_per_rad": k, "local_stiffness_total_Nm_per_rad": np.sum(k, axis=-1)}
 
 
 def _reflex_columns(model: Model, coeffs, pcsa) -> dict[str, np.ndarray]:

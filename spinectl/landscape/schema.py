@@ -46,6 +46,11 @@ VARIABLES = {
         "N m rad-1",
         "static margin of the coupled chain at the chosen activation: smallest eigenvalue of -K (> 0 stable)",
     ),
+    "local_stiffness_Nm_per_rad": (
+        "N m rad-1",
+        "least local-muscle stiffness k_j that makes the coupled chain stable at the chosen activation (SDP)",
+    ),
+    "local_stiffness_total_Nm_per_rad": ("N m rad-1", "sum over the joints of local_stiffness_Nm_per_rad"),
 }
 """Every data variable: units (UDUNITS) and long name."""
 

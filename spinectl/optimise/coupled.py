@@ -37,8 +37,10 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 
+import clarabel
 import cvxpy as cp
 import numpy as np
+import scipy.sparse as sp
 
 from ..model import chain, geometry
 from ..model.checks import arithmetic_guard, checked_coefficients, expand_pcsa
@@ -47,6 +49,7 @@ from ..model.stability import self_stable
 from ..units import M2_PER_CM2, m2_to_cm2
 from .problem import OK_STATUSES, ProblemData, inequalities, problem_data, to_si
 from .reference import minimum_stabilising_pcsa, solve_with_fallback
+from .stacked import CLARABEL_STATUS, stacked_settings
 
 
 @dataclass(frozen=True)
@@ -146,17 +149,55 @@ def _lmi(data: CoupledData, x, k=None) -> cp.Constraint:
     return (matrix if k is None else matrix + cp.diag(k)) >> 0
 
 
-def _feasible_local(data: CoupledData, x, k) -> np.ndarray:
-    """k >= 0 shifted so that diag(k) - K(x) >= mu I holds to rounding (adds c I to the matrix)."""
+def _shifted(stiffness, margin: float, k) -> np.ndarray:
+    """k >= 0 shifted so that diag(k) - K >= mu I holds to rounding (adding c to every k_j adds c I); vectorised."""
     k = np.maximum(np.asarray(k, float), 0.0)
-    shortfall = data.margin - chain.coupled_margin(data.matrix(x, k))
-    return k + max(shortfall, 0.0)
+    shortfall = margin - chain.coupled_margin(np.asarray(stiffness, float) - k[..., :, None] * np.eye(k.shape[-1]))
+    return k + np.maximum(shortfall, 0.0)[..., None]
+
+
+def _feasible_local(data: CoupledData, x, k) -> np.ndarray:
+    """:func:`_shifted` at K(x)."""
+    return _shifted(data.matrix(x), data.margin, k)
+
+
+def least_local_stiffness_at(stiffness, margin: float, tolerance: float | None = None):
+    """(a) The least total local stiffness sum(k) with diag(k) - K >= mu I, k >= 0, for one matrix K.
+
+    Always feasible (large k); the dual is max <Z, K + mu I> over Z >= 0, diag(Z) <= 1. The
+    per-point reference (cvxpy, Clarabel with SCS as the fallback) of
+    :func:`least_local_stiffness_stacked`.
+
+    Parameters
+    ----------
+    stiffness : array_like, shape (n, n)
+        K [N m/rad].
+    margin : float
+        mu [N m/rad].
+    tolerance : float, optional
+        The solver's gap and feasibility tolerance.
+
+    Returns
+    -------
+    status : str
+        'optimal', 'optimal_inaccurate' or 'solver_error'.
+    k : numpy.ndarray or None
+        Local stiffness per joint [N m/rad], None unless optimal; exactly feasible (a uniform shift).
+    """
+    stiffness = np.asarray(stiffness, float)
+    n = stiffness.shape[0]
+    k = cp.Variable(n, nonneg=True)
+    problem = cp.Problem(cp.Minimize(cp.sum(k)), [cp.diag(k) - stiffness - margin * np.eye(n) >> 0])
+    status = solve_with_fallback(problem, tolerance)
+    if status not in OK_STATUSES:
+        return status, None
+    return status, _shifted(stiffness, margin, k.value)
 
 
 def least_local_stiffness_sdp(data: CoupledData, x) -> tuple[str, np.ndarray | None]:
     """(a) The least total local stiffness sum(k) with diag(k) - K(x) >= mu I, k >= 0.
 
-    Always feasible (large k); the dual is max <Z, K(x) + mu I> over Z >= 0, diag(Z) <= 1.
+    :func:`least_local_stiffness_at` with K(x).
 
     Parameters
     ----------
@@ -171,13 +212,78 @@ def least_local_stiffness_sdp(data: CoupledData, x) -> tuple[str, np.ndarray | N
     k : numpy.ndarray or None
         Local stiffness per joint [N m/rad], None unless optimal.
     """
-    k = cp.Variable(data.stiffness_offset.shape[0], nonneg=True)
-    x = np.asarray(x, float)
-    problem = cp.Problem(cp.Minimize(cp.sum(k)), [_lmi(data, x, k)])
-    status = solve_with_fallback(problem, data.problem.tolerance)
+    return least_local_stiffness_at(data.matrix(np.asarray(x, float)), data.margin, data.problem.tolerance)
+
+
+def _svec(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Clarabel's PSD-triangle order: the upper triangle column by column, off-diagonals scaled by sqrt 2."""
+    rows, cols = np.triu_indices(n)
+    order = np.lexsort((rows, cols))  # column-major
+    rows, cols = rows[order], cols[order]
+    return rows, cols, np.where(rows == cols, 1.0, np.sqrt(2.0))
+
+
+def least_local_stiffness_stacked(stiffness, margin: float, tolerance: float | None = None):
+    """(a) at P points at once: one Clarabel problem with a 5 x 5 PSD cone per point.
+
+    The points' problems share no variable, so the stacked problem is block diagonal: for each
+    point p, min sum(k_p) s.t. diag(k_p) - K_p - mu I >= 0 (a PSD-triangle cone), k_p >= 0.
+    The solution is made exactly feasible per point like :func:`least_local_stiffness_sdp`'s.
+    The sum of the P objectives is minimised with the tolerance relative to it, so each point's
+    own optimum holds to about P times the tolerance relative to the total; the benchmark
+    (benchmarks/bench_local_stiffness.py) and the tests compare with the per-point SDP.
+
+    Parameters
+    ----------
+    stiffness : array_like, shape (P, n, n)
+        K at each point [N m/rad]; a point with a NaN gives NaN.
+    margin : float
+        mu [N m/rad].
+    tolerance : float, optional
+        Clarabel's gap and feasibility tolerance (``optimisation.solver_tolerance``).
+
+    Returns
+    -------
+    status : str
+        Clarabel's status in cvxpy's words ('optimal', 'optimal_inaccurate', 'solver_error').
+    k : numpy.ndarray, shape (P, n)
+        The least local stiffness at each point [N m/rad]; NaN unless optimal and finite.
+
+    References
+    ----------
+    Goulart PJ, Chen Y (2024). Clarabel: an interior-point solver for conic programs with
+    quadratic objectives. arXiv:2405.12762. doi:10.48550/arXiv.2405.12762.
+    """
+    a = np.asarray(stiffness, float)
+    points, n = a.shape[0], a.shape[-1]
+    k = np.full((points, n), np.nan)
+    finite = np.flatnonzero(np.all(np.isfinite(a), axis=(-2, -1)))
+    if finite.size == 0:
+        return "optimal", k
+    m = finite.size
+    rows, cols, scale = _svec(n)
+    width = rows.size
+    target = -(a[finite] + margin * np.eye(n))  # s = svec(diag(k) - K - mu I) = b - A k
+    b_psd = (target[:, rows, cols] * scale).ravel()
+    diagonal = np.flatnonzero(rows == cols)  # positions of (j, j) in a block, in j order
+    psd = sp.csc_matrix(
+        (np.full(m * n, -1.0), ((np.arange(m)[:, None] * width + diagonal).ravel(), np.arange(m * n))),
+        shape=(m * width, m * n),
+    )
+    lhs = sp.vstack([psd, -sp.identity(m * n, format="csc")]).tocsc()
+    rhs = np.concatenate([b_psd, np.zeros(m * n)])
+    cones = [clarabel.PSDTriangleConeT(n)] * m + [clarabel.NonnegativeConeT(m * n)]
+    try:
+        solution = clarabel.DefaultSolver(
+            sp.csc_matrix((m * n, m * n)), np.ones(m * n), lhs, rhs, cones, stacked_settings(tolerance)
+        ).solve()
+    except (ValueError, RuntimeError, ArithmeticError):  # a solver panic: unsolved
+        return "solver_error", k
+    status = CLARABEL_STATUS.get(solution.status, "solver_error")
     if status not in OK_STATUSES:
-        return status, None
-    return status, _feasible_local(data, x, k.value)
+        return status, k
+    k[finite] = _shifted(a[finite], margin, np.asarray(solution.x).reshape(m, n))
+    return status, k
 
 
 def min_global_pcsa_sdp(data: CoupledData) -> tuple[str, np.ndarray | None]:
