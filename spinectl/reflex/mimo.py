@@ -35,9 +35,9 @@ import numpy as np
 import scipy.linalg
 
 from ..errors import ParameterError
-from .delay import DELAY_INDEPENDENT, FINITE, STATUS, UNDEFINED, UNSTABLE_WITHOUT_DELAY
+from .delay import STATUS, UNDEFINED, UNSTABLE_WITHOUT_DELAY
 from .pade import pade_inverse_lag
-from .siso import LoopDelayMargin
+from .siso import LoopDelayMargin, from_crossings
 
 DECADES = 7
 """Decades of frequency the sweep spans below the highest possible crossing (:func:`highest_crossing`)."""
@@ -239,15 +239,7 @@ def chain_delay_margin(mass, stiffness, damping, kp, kd, lag=0.0) -> LoopDelayMa
     w = np.array([c[0] for c in found])
     phases = np.array([np.mod(-np.angle(c[1]), 2.0 * np.pi) for c in found])
     directions = np.array([_direction(mass, stiffness, damping, kp, kd, lag, *c) for c in found], float)
-    destabilising = directions > 0
-    if not stable:
-        margin, at, status = 0.0, np.nan, UNSTABLE_WITHOUT_DELAY
-    elif not destabilising.any():
-        margin, at, status = np.inf, np.nan, DELAY_INDEPENDENT
-    else:
-        first = np.where(destabilising, phases / np.where(w > 0, w, 1.0), np.inf)
-        margin, at, status = float(first.min()), float(w[np.argmin(first)]), FINITE
-    return LoopDelayMargin(margin, at, STATUS[status], w.reshape(-1), phases.reshape(-1), directions, stable)
+    return from_crossings(w, phases, directions, stable)
 
 
 def pade_margin(exact: LoopDelayMargin, order: int) -> float:
