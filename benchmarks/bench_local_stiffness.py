@@ -1,4 +1,4 @@
-"""Benchmark: the least local stiffness over the 81 x 81 landscape, stacked against per point.
+"""Benchmark: the coupled chain's SDPs over the 81 x 81 landscape, stacked against per point.
 
     python benchmarks/bench_local_stiffness.py                # 81 x 81, per-point reference on 200 points
     python benchmarks/bench_local_stiffness.py --points 41 --sample 100
@@ -10,7 +10,10 @@ per-point cvxpy reference (:func:`~spinectl.optimise.coupled.least_local_stiffne
 random sample of its points, its time extrapolated to the grid. Prints both times, their
 ratio and the largest relative difference of the totals on the sample. The per-segment
 optimum the SDPs start from is solved first and not timed. Target: <= 30 s for 81 x 81 on the
-project's 2-core machine. Timings on a shared machine are noisy: the ratio is what matters.
+project's 2-core machine. Then the same for the joint optimum of global and local muscle,
+problem (c) (:func:`~spinectl.optimise.coupled.joint_optimum_stacked` against
+:func:`~spinectl.optimise.coupled.joint_optimum_sdp`), compared by its objective.
+Timings on a shared machine are noisy: the ratio is what matters.
 """
 
 from __future__ import annotations
@@ -30,6 +33,7 @@ from spinectl.model import chain, config  # noqa: E402
 from spinectl.model.checks import checked_coefficients  # noqa: E402
 from spinectl.optimise import coupled, stacked  # noqa: E402
 from spinectl.optimise.problem import problem_data  # noqa: E402
+from spinectl.units import M2_PER_CM2  # noqa: E402
 
 
 def chain_stiffness(model, e, lam):
@@ -80,6 +84,36 @@ def main() -> None:
     print(f"  per point (cvxpy, {sample.size} points, extrapolated): {per_point:8.2f} s")
     print(f"  ratio per point / stacked:   {per_point / fast:8.1f}")
     print(f"  largest relative difference of the totals on the sample: {difference:.2e}")
+    joint(model, e, lam, sample)
+
+
+def joint(model, e, lam, sample) -> None:
+    """Problem (c): the stacked chunks on the whole grid, per point on the sample; the objectives compared."""
+    kappa = chain.local_stiffness_per_pcsa(model) * M2_PER_CM2
+    mu, weight = model.optimisation.stability_margin, model.local.cost_weight
+    start = time.perf_counter()
+    objective = []
+    for first in range(0, e.size, DEFAULT_CHUNK):
+        part = slice(first, first + DEFAULT_CHUNK)
+        data = problem_data(model, checked_coefficients(model, e[part], lam[part]))
+        coefficients = chain.chain_coefficients(model, e[part], lam[part])
+        _, x, k = coupled.joint_optimum_stacked(data, coefficients, mu, kappa, weight)
+        objective.append(x @ data.weights + weight * k.sum(axis=-1) / kappa)
+    fast = time.perf_counter() - start
+    objective = np.concatenate(objective)
+    start = time.perf_counter()
+    reference = []
+    for i in sample:
+        data = coupled.coupled_data(model, e[i], lam[i])
+        _, x, k = coupled.joint_optimum_sdp(data)
+        reference.append(data.problem.weights @ x + weight * k.sum() / kappa)
+    per_point = (time.perf_counter() - start) / sample.size * e.size
+    difference = np.nanmax(np.abs(objective[sample] - np.array(reference)) / np.array(reference))
+    print("joint optimum of global and local muscle")
+    print(f"  stacked (chunks of {DEFAULT_CHUNK}):  {fast:8.2f} s")
+    print(f"  per point (cvxpy, {sample.size} points, extrapolated): {per_point:8.2f} s")
+    print(f"  ratio per point / stacked:   {per_point / fast:8.1f}")
+    print(f"  largest relative difference of the objectives on the sample: {difference:.2e}")
 
 
 if __name__ == "__main__":

@@ -14,7 +14,7 @@ from ..model import chain
 from ..model.checks import arithmetic_guard, checked_coefficients
 from ..model.params import Model
 from ..optimise import coupled, stacked
-from ..optimise.problem import problem_data
+from ..optimise.problem import OK_STATUSES, problem_data
 from ..reflex.delay import STATUS
 from ..reflex.inputs import guarded
 from ..reflex.maps import landscape
@@ -72,7 +72,8 @@ def point_columns(
             stiffness = _chain_stiffness(model, e_grid[part], l_grid[part], result.pcsa)
             margin = chain.coupled_margin(np.nan_to_num(stiffness))
             columns["coupled_margin_Nm_per_rad"] = np.where(np.isnan(stiffness[:, 0, 0]), np.nan, margin)
-        columns |= _local_stiffness(model, stiffness, method)  # an SDP: outside numpy's guard
+        columns |= _local_stiffness(model, stiffness, method)  # SDPs: outside numpy's guard
+        columns |= _joint_optimum(model, e_grid[part], l_grid[part], data, method)
         for name, values in columns.items():
             if name not in arrays:
                 arrays[name] = np.empty((e_grid.size,) + values.shape[1:], values.dtype)
@@ -115,9 +116,36 @@ def _local_stiffness(model: Model, stiffness, method: str) -> dict[str, np.ndarr
     else:
         k = np.full(stiffness.shape[:-1], np.nan)
         for i in np.flatnonzero(np.isfinite(stiffness[:, 0, 0])):
-            status, found = coupled.least_local_stiffness_at(stiffness[i], opt.stability_margin, opt.solver_tolerance)
+            _, found = coupled.least_local_stiffness_at(stiffness[i], opt.stability_margin, opt.solver_tolerance)
             k[i] = np.nan if found is None else found
     return {"local_stiffness_Nm_per_rad": k, "local_stiffness_total_Nm_per_rad": np.sum(k, axis=-1)}
+
+
+def _joint_optimum(model: Model, eccentricity, lordosis, data, method: str) -> dict[str, np.ndarray]:
+    """The joint optimum of global and local muscle, problem (c) of docs/chain.md: its two totals [cm^2].
+
+    The fast path solves the chunk as one stacked SDP and falls back to one cvxpy SDP per point
+    where the stack fails as a whole (e.g. one infeasible point); the per-point method always does.
+    """
+    kappa = chain.local_stiffness_per_pcsa(model) * M2_PER_CM2  # N m/rad per cm^2
+    status = "per-point"
+    if method == "fast":
+        coefficients = chain.chain_coefficients(model, eccentricity, lordosis)
+        opt = model.optimisation
+        status, x, k = coupled.joint_optimum_stacked(
+            data, coefficients, opt.stability_margin, kappa, model.local.cost_weight
+        )
+    if status not in OK_STATUSES:
+        x = np.full((eccentricity.size, data.weights.size), np.nan)
+        k = np.full((eccentricity.size, len(model.geometry.cor_names)), np.nan)
+        for i, (e, lam) in enumerate(zip(eccentricity, lordosis, strict=True)):
+            _, x_i, k_i = coupled.joint_optimum_sdp(coupled.coupled_data(model, e, lam))
+            if x_i is not None:
+                x[i], k[i] = x_i, k_i
+    return {
+        "joint_global_pcsa_cm2": x @ data.to_muscles.sum(axis=0),
+        "joint_local_pcsa_cm2": k.sum(axis=-1) / kappa,
+    }
 
 
 def _reflex_columns(model: Model, coeffs, pcsa) -> dict[str, np.ndarray]:

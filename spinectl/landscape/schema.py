@@ -51,6 +51,8 @@ VARIABLES = {
         "least local-muscle stiffness k_j that makes the coupled chain stable at the chosen activation (SDP)",
     ),
     "local_stiffness_total_Nm_per_rad": ("N m rad-1", "sum over the joints of local_stiffness_Nm_per_rad"),
+    "joint_global_pcsa_cm2": ("cm2", "joint optimum of global and local muscle (coupled chain): total global PCSA"),
+    "joint_local_pcsa_cm2": ("cm2", "joint optimum of global and local muscle (coupled chain): total local PCSA"),
 }
 """Every data variable: units (UDUNITS) and long name."""
 

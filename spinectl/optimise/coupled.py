@@ -286,6 +286,76 @@ def least_local_stiffness_stacked(stiffness, margin: float, tolerance: float | N
     return status, k
 
 
+def joint_optimum_stacked(
+    data: ProblemData, coefficients: chain.ChainCoefficients, margin: float, local_per_cm2, cost_weight
+):
+    """(c) at P points at once: one Clarabel problem, per point a PSD cone, the LP rows and k >= 0.
+
+    Per point p, with z_p = (x_p, k_p): min w.x_p + cost_weight sum(k_p) / kappa subject to
+    diag(k_p) - K_p(x_p) - mu I >= 0 (a PSD-triangle cone), the per-segment rows of
+    :func:`joint_optimum_sdp` (damping rows, bounds on x) and k_p >= 0. The points share no
+    variable, so the problem is block diagonal; a chunk that fails as a whole (an infeasible
+    point spoils the stack) returns its status and NaN, for the caller to solve per point.
+
+    Parameters
+    ----------
+    data : ProblemData
+        The per-segment problem at the P points (leading dimension P).
+    coefficients : ChainCoefficients
+        The chain's matrices at the same points (:func:`spinectl.model.chain.chain_coefficients`).
+    margin : float
+        mu [N m/rad].
+    local_per_cm2 : float
+        kappa [N m/rad per cm^2] (:func:`spinectl.model.chain.local_stiffness_per_pcsa`).
+    cost_weight : float
+        w_local [1].
+
+    Returns
+    -------
+    status : str
+        Clarabel's status in cvxpy's words.
+    x : numpy.ndarray, shape (P, n_var)
+        Global decision variables [cm^2]; NaN unless optimal.
+    k : numpy.ndarray, shape (P, n_cor)
+        Local stiffness [N m/rad]; NaN unless optimal.
+    """
+    per_var = coefficients.stiffness_per_pcsa @ (data.to_muscles * M2_PER_CM2)  # (P, n, n, v)
+    offset = coefficients.stiffness(np.zeros(data.to_muscles.shape[0]))  # (P, n, n)
+    points, n, v = per_var.shape[0], per_var.shape[1], per_var.shape[-1]
+    lhs, rhs = inequalities(data)
+    lhs, rhs = lhs[:, n:], rhs[:, n:]  # drop the per-segment stiffness rows, as joint_optimum_sdp does
+    rows, cols, scale = _svec(n)
+    width = rows.size
+    psd = np.zeros((points, width, v + n))
+    psd[:, :, :v] = per_var[:, rows, cols, :] * scale[:, None]  # s = svec(-K0 - mu I - sum x_i K_i + diag k)
+    psd[:, np.flatnonzero(rows == cols), v + np.arange(n)] = -1.0
+    b_psd = (-(offset + margin * np.eye(n))[:, rows, cols] * scale).reshape(-1)
+    nonneg = np.concatenate([np.zeros((n, v)), -np.eye(n)], axis=1)  # s = k >= 0
+    linear = np.concatenate(
+        [np.concatenate([lhs, np.zeros(lhs.shape[:2] + (n,))], axis=-1), np.broadcast_to(nonneg, (points, n, v + n))],
+        axis=1,
+    )
+    b_linear = np.concatenate([rhs, np.zeros((points, n))], axis=1).reshape(-1)
+    lhs_matrix = sp.vstack([sp.block_diag(list(psd), format="csc"), sp.block_diag(list(linear), format="csc")]).tocsc()
+    cost = np.tile(np.concatenate([data.weights, np.full(n, cost_weight / local_per_cm2)]), points)
+    cones = [clarabel.PSDTriangleConeT(n)] * points + [clarabel.NonnegativeConeT(b_linear.size)]
+    x, k = np.full((points, v), np.nan), np.full((points, n), np.nan)
+    try:
+        solution = clarabel.DefaultSolver(
+            sp.csc_matrix((cost.size, cost.size)), cost, lhs_matrix, np.concatenate([b_psd, b_linear]), cones,
+            stacked_settings(data.tolerance),
+        ).solve()  # fmt: skip
+    except (ValueError, RuntimeError, ArithmeticError):
+        return "solver_error", x, k
+    status = CLARABEL_STATUS.get(solution.status, "solver_error")
+    if status not in OK_STATUSES:
+        return status, x, k
+    z = np.asarray(solution.x).reshape(points, v + n)
+    x = np.maximum(z[:, :v], 0.0)
+    matrix = offset + np.einsum("pjkv,pv->pjk", per_var, x)
+    return status, x, _shifted(matrix, margin, z[:, v:])
+
+
 def min_global_pcsa_sdp(data: CoupledData) -> tuple[str, np.ndarray | None]:
     """(b) The least total global PCSA w.x with -K(x) >= mu I and the per-segment rows, k = 0.
 
