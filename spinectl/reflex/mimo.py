@@ -122,9 +122,9 @@ def highest_crossing(mass, stiffness, damping, kp, kd) -> float:
     """An upper bound on every crossing frequency [rad/s].
 
     A crossing needs P(jw) v = -z Q(jw) v with abs(z) = 1, so sigma_min(P) <= sigma_max(Q);
-    with sigma_min(P) >= lambda_min(M) w^2 - |D| w - |K| (abs(T_a jw + 1) >= 1) and
-    sigma_max(Q) <= max k_p + max k_d w, no crossing lies above the positive root of
-    lambda_min(M) w^2 - (|D| + max k_d) w - (|K| + max k_p).
+    with sigma_min(P) >= lambda_min(M) w^2 - norm(D) w - norm(K) (spectral norms; abs(T_a jw + 1) >= 1)
+    and sigma_max(Q) <= max k_p + max k_d w, no crossing lies above the positive root of
+    lambda_min(M) w^2 - (norm(D) + max k_d) w - (norm(K) + max k_p).
 
     Parameters
     ----------
