@@ -113,9 +113,10 @@ def chain_loop(mass, stiffness, damping, kp, kd, delay: float, order: int, lag: 
     plant = chain_system(mass, stiffness, damping, names)
     state = ct.ss(plant.A, plant.B, np.eye(2 * n), np.zeros((2 * n, n)))
     gains = np.concatenate([np.diag(np.broadcast_to(kp, (n,))), np.diag(np.broadcast_to(kd, (n,)))], axis=1)
-    one = ct.ss(ct.tf(*ct.pade(delay, order))) if delay > 0 else _static([[1.0]])
+    # scipy's realisation, as in spinectl.reflex.loops (slycot, installed for AB13MD, would give another)
+    one = ct.tf2ss(ct.tf(*ct.pade(delay, order)), method="scipy") if delay > 0 else _static([[1.0]])
     if lag > 0:
-        one = ct.ss(ct.tf([1.0], [lag, 1.0])) * one
+        one = ct.tf2ss(ct.tf([1.0], [lag, 1.0]), method="scipy") * one
     delays = ct.append(*([one] * n))
     loop = delays * _static(gains) * state
     return ct.ss(
