@@ -161,11 +161,11 @@ class CoupledMargins:
             "",
             f"delayed reflex on the chain: activation {self.activation:g} x minimum PCSA, delay {self.delay:g} s, "
             f"activation lag {self.activation_time_constant:g} s, gains: {self.gains}",
-            f"{'joint':8} {'kp [N m/rad]':>13} {'kd [N m s/rad]':>15} {'disk alpha':>11} {'GM':>7} {'PM[deg]':>8}",
+            f"{'joint':8} {'kp [N m/rad]':>13} {'kd [N m s/rad]':>15} {'disk alpha':>11} {'GM':>9} {'PM[deg]':>8}",
         ]
         single = np.full((len(self.kp), 3), np.nan) if disk is None else disk.loop_at_a_time
         for name, kp, kd, (a, g, p) in zip(self.chain.segment_names, self.kp, self.kd, single, strict=True):
-            lines.append(f"{name:8} {kp:13.3f} {kd:15.4f} {a:11.3f} {g:7.3f} {p:8.2f}")
+            lines.append(f"{name:8} {kp:13.3f} {kd:15.4f} {a:11.3f} {g:9.4g} {p:8.2f}")
         lines += [
             f"exact delay margin {margin}{where} ({exact.status}); Pade order {self.pade_order}: "
             f"{self.delay_margin_pade * 1000:.4g} ms",
