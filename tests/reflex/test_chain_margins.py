@@ -72,3 +72,14 @@ def test_below_the_margin_the_loop_is_stable_with_disk_margins():
     assert 0 < result.disk.disk_margin < 2
     assert np.all(result.disk.loop_at_a_time[:, 0] >= result.disk.disk_margin * (1 - 1e-6))
     assert "exact delay margin" in result.table(model)
+
+
+def test_command_line_errors_are_one_line(capsys):
+    """--plot has no chain version; gains orders of magnitude off overflow: exit 2, one line, no traceback."""
+    for argv, field in (
+        (["margins", "--coupled", "--plot", "out"], "--plot"),
+        (["margins", "--coupled", "--kp", "1e300"], "arithmetic"),
+    ):
+        assert main(argv) == 2
+        err = capsys.readouterr().err
+        assert field in err and len(err.strip().splitlines()) == 1 and "Traceback" not in err
