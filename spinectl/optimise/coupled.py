@@ -23,6 +23,10 @@ S_k <= -mu, which the LMI implies (they are its diagonal). So the coupled feasib
 inside the per-segment one and the coupled minimum is never below the paper's. A point where
 no activation stabilises the chain is an answer: NaN values and the solver's status.
 
+For grids, (a) and (c) also come stacked: the points of a chunk share no variable, so one
+Clarabel problem with a PSD cone per point solves them all (:func:`least_local_stiffness_stacked`,
+:func:`joint_optimum_stacked`; the landscape's variables), the per-point SDPs the reference.
+
 The solver's k is made exactly feasible by a uniform shift, k + max(0, mu - margin): adding
 c to every k_j adds c I to the matrix. The reported margin is that of numpy's eigvalsh.
 
