@@ -89,11 +89,12 @@ plt.show()
 # ## 2. The local stiffness the chain needs, over the landscape
 #
 # The least local stiffness $\sum_j k_j$ with $\operatorname{diag}(k) - K \succeq \mu I$ is a small semidefinite
-# programme per point; the sweep solves a chunk of points as one (variables `local_stiffness_total_Nm_per_rad` and
-# `coupled_margin_Nm_per_rad`). Beside it, Figure 4's $\|CT\|$.
+# programme per point; `sweep(..., coupled=True)` (`spinectl sweep --coupled`) solves a chunk of points as one
+# (variables `local_stiffness_total_Nm_per_rad`, beside the static `coupled_margin_Nm_per_rad`). Beside it, Figure
+# 4's $\|CT\|$.
 
 # %%
-land = sweep.sweep(model, axis, axis, progress=False)
+land = sweep.sweep(model, axis, axis, progress=False, coupled=True)
 fig, axes = plt.subplots(1, 3, figsize=(13, 3.6), constrained_layout=True)
 extent = [axis[0] * CM, axis[-1] * CM, axis[0] * CM, axis[-1] * CM]
 for ax, (name, title) in zip(

@@ -25,9 +25,18 @@ DEFAULT_CHUNK = 1024
 
 
 def point_columns(
-    model: Model, eccentricity, lordosis, *, method: str = "fast", chunk_size: int = DEFAULT_CHUNK, update=None
+    model: Model,
+    eccentricity,
+    lordosis,
+    *,
+    method: str = "fast",
+    chunk_size: int = DEFAULT_CHUNK,
+    update=None,
+    coupled: bool = False,
 ) -> tuple[dict[str, np.ndarray], int]:
     """Every variable of :data:`VARIABLES` at the points (E_i, Lambda_i), solved chunk by chunk.
+
+    Those of :data:`~spinectl.landscape.schema.ON_REQUEST` only if ``coupled``.
 
     The fast path solves each chunk of ``chunk_size`` consecutive points as one
     stacked problem, so the answer depends on the chunking only through the
@@ -44,6 +53,8 @@ def point_columns(
         Points per chunk.
     update : callable, optional
         Called with the number of points solved, after each chunk (fast) or point (per-point).
+    coupled : bool
+        Also the coupled chain's SDP variables (:data:`~spinectl.landscape.schema.ON_REQUEST`).
 
     Returns
     -------
@@ -72,8 +83,9 @@ def point_columns(
             stiffness = _chain_stiffness(model, e_grid[part], l_grid[part], result.pcsa)
             margin = chain.coupled_margin(np.nan_to_num(stiffness))
             columns["coupled_margin_Nm_per_rad"] = np.where(np.isnan(stiffness[:, 0, 0]), np.nan, margin)
-        columns |= _local_stiffness(model, stiffness, method)  # SDPs: outside numpy's guard
-        columns |= _joint_optimum(model, e_grid[part], l_grid[part], data, method)
+        if coupled:  # SDPs: outside numpy's guard
+            columns |= _local_stiffness(model, stiffness, method)
+            columns |= _joint_optimum(model, e_grid[part], l_grid[part], data, method)
         for name, values in columns.items():
             if name not in arrays:
                 arrays[name] = np.empty((e_grid.size,) + values.shape[1:], values.dtype)

@@ -56,6 +56,15 @@ VARIABLES = {
 }
 """Every data variable: units (UDUNITS) and long name."""
 
+ON_REQUEST = (
+    "local_stiffness_Nm_per_rad",
+    "local_stiffness_total_Nm_per_rad",
+    "joint_global_pcsa_cm2",
+    "joint_local_pcsa_cm2",
+)
+"""Variables computed only when asked for (``sweep --coupled``, a study's ``outputs``): semidefinite
+programmes of the coupled chain, a few ms a point, ten times the rest of a landscape (docs/chain.md)."""
+
 
 def dims_of(name: str, ndim: int) -> tuple[str, ...]:
     """Dimensions of the variable ``name`` on the grid, from the number of its dimensions.

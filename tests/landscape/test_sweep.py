@@ -21,7 +21,7 @@ L_AXIS = np.array([0.0, 0.03, 0.05, 0.08])  # a different length, so that a tran
 
 @pytest.fixture(scope="module")
 def landscape():
-    return sweep.sweep(Model(), E_AXIS, L_AXIS, progress=False)
+    return sweep.sweep(Model(), E_AXIS, L_AXIS, progress=False, coupled=True)
 
 
 def test_schema_units_and_orientation(landscape, model):
@@ -47,7 +47,7 @@ def test_coefficients_are_those_of_the_mechanics(landscape, model):
 
 
 def test_chunks_and_methods_give_the_same_dataset(landscape, model):
-    chunked = sweep.sweep(model, E_AXIS, L_AXIS, chunk_size=5, progress=False)
+    chunked = sweep.sweep(model, E_AXIS, L_AXIS, chunk_size=5, progress=False, coupled=True)
     local = [  # the chain's SDPs: to the solver's tolerance, not polished
         "status",
         "local_stiffness_Nm_per_rad",
@@ -56,7 +56,7 @@ def test_chunks_and_methods_give_the_same_dataset(landscape, model):
         "joint_local_pcsa_cm2",
     ]
     xr.testing.assert_allclose(chunked.drop_vars(local), landscape.drop_vars(local), rtol=1e-12)
-    reference = sweep.sweep(model, E_AXIS, L_AXIS, method="per-point", progress=False)
+    reference = sweep.sweep(model, E_AXIS, L_AXIS, method="per-point", progress=False, coupled=True)
     assert reference.attrs["points_solved_per_point"] == E_AXIS.size * L_AXIS.size
     for name in ("min_pcsa_cm2", "pcsa_cm2", "counter_torque_Nm"):
         np.testing.assert_allclose(reference[name], landscape[name], rtol=1e-6, atol=1e-6)
@@ -219,6 +219,13 @@ def test_local_stiffness_is_the_chain_sdp_at_the_chosen_activation(landscape, mo
     assert margin >= model.optimisation.stability_margin * (1 - 1e-9)
     at_a = float(landscape["local_stiffness_total_Nm_per_rad"].sel(E=0.0, Lambda=0.0))
     assert at_a == pytest.approx(391, abs=0.5)
+
+
+def test_the_chains_sdps_only_on_request(landscape):
+    """Without coupled=True a sweep has every variable but the SDPs of schema.ON_REQUEST, the same values."""
+    plain = sweep.sweep(Model(), E_AXIS, L_AXIS, progress=False)
+    assert set(plain.data_vars) == set(schema.VARIABLES) - set(schema.ON_REQUEST)
+    xr.testing.assert_identical(plain, landscape.drop_vars(schema.ON_REQUEST))
 
 
 def test_joint_optimum_is_the_chain_sdp(landscape, model):
