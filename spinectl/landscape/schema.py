@@ -63,7 +63,7 @@ ON_REQUEST = (
     "joint_local_pcsa_cm2",
 )
 """Variables computed only when asked for (``sweep --coupled``, a study's ``outputs``): semidefinite
-programmes of the coupled chain, a few ms a point, ten times the rest of a landscape (docs/chain.md)."""
+programmes of the coupled chain, about 2.7 ms a point, seven times the rest of a landscape (docs/chain.md)."""
 
 
 def dims_of(name: str, ndim: int) -> tuple[str, ...]:
