@@ -6,6 +6,7 @@ import sys
 from pathlib import Path
 
 from ..atomic import check_distinct
+from ..errors import ParameterError
 from ..model.config import set_parameters
 from ..reflex.margins import analyse
 from ._common import add_model_options, add_position_options, emit_json, finite_float, load_model
@@ -44,6 +45,11 @@ def register(sub) -> None:
         help="fraction of the minimum stabilising PCSA: 0 reflex only, 1 self-stable (default: config, 0.5)",
     )
     parser.add_argument("--pade-order", type=int, help="order of the Pade delay in the python-control models")
+    parser.add_argument(
+        "--coupled",
+        action="store_true",
+        help="the whole chain under a diagonal reflex: exact delay margin, Pade margin, disk margins (docs/chain.md)",
+    )
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     parser.add_argument("--plot", metavar="DIR", help="write bode.png, nyquist.png and response.png into DIR")
     add_model_options(parser)
@@ -98,6 +104,8 @@ def run(args) -> int:
 
         check_distinct({"--plot": [Path(args.plot, name) for name in PLOT_FILES]}, {"--config": args.config})
     model = model_with_overrides(args)
+    if args.coupled:
+        return _coupled(model, args)
     report = analyse(model, args.E, args.Lambda, kp=args.kp, kd=args.kd)
     if args.plot:
         from ..reflex import plots
@@ -110,4 +118,18 @@ def run(args) -> int:
         emit_json(report.to_dict())
     else:
         print(report.table())
+    return 0
+
+
+def _coupled(model, args) -> int:
+    """``--coupled``: the chain's margins (:func:`spinectl.reflex.chain_margins.coupled_margins`)."""
+    if args.plot:
+        raise ParameterError("--plot", "is not available with --coupled")
+    from ..reflex.chain_margins import coupled_margins
+
+    result = coupled_margins(model, args.E, args.Lambda, kp=args.kp, kd=args.kd)
+    if args.json:
+        emit_json(result.to_dict(model))
+    else:
+        print(result.table(model))
     return 0

@@ -36,6 +36,9 @@ def register(sub) -> None:
     )
     parser.add_argument("--method", choices=sweep.METHODS, default="fast", help="solution path (default: fast)")
     parser.add_argument("--chunk-size", type=int, default=sweep.DEFAULT_CHUNK, help="grid points per stacked solve")
+    parser.add_argument(
+        "--coupled", action="store_true", help="also the coupled chain's least local stiffness and joint optimum (SDPs)"
+    )
     parser.add_argument("--out", required=True, metavar="FILE.nc", help="NetCDF file to write (atomically)")
     add_model_options(parser)
     parser.set_defaults(func=run)
@@ -57,7 +60,7 @@ def run(args) -> int:
     check_distinct({"--out": args.out}, {"--config": args.config})
     model = load_model(args)
     e_axis, l_axis = sweep.parse_grid(args.E, "--E"), sweep.parse_grid(args.Lambda, "--Lambda")
-    options = {"stiffnesses": args.K, "method": args.method, "chunk_size": args.chunk_size}
+    options = {"stiffnesses": args.K, "method": args.method, "chunk_size": args.chunk_size, "coupled": args.coupled}
     start = time.perf_counter()
     dataset = sweep.write_sweep(model, e_axis, l_axis, args.out, **options)
     print(f"wrote {args.out}: {sweep.describe(dataset)} in {time.perf_counter() - start:.1f} s")

@@ -13,8 +13,8 @@ import numpy as np
 from ..model import chain
 from ..model.checks import arithmetic_guard, checked_coefficients
 from ..model.params import Model
-from ..optimise import stacked
-from ..optimise.problem import problem_data
+from ..optimise import coupled, stacked
+from ..optimise.problem import OK_STATUSES, problem_data
 from ..reflex.delay import STATUS
 from ..reflex.inputs import guarded
 from ..reflex.maps import landscape
@@ -24,11 +24,19 @@ DEFAULT_CHUNK = 1024
 """Grid points per stacked problem: large enough that Python overheads vanish, small enough to keep memory flat."""
 
 
-
 def point_columns(
-    model: Model, eccentricity, lordosis, *, method: str = "fast", chunk_size: int = DEFAULT_CHUNK, update=None
+    model: Model,
+    eccentricity,
+    lordosis,
+    *,
+    method: str = "fast",
+    chunk_size: int = DEFAULT_CHUNK,
+    update=None,
+    coupled: bool = False,
 ) -> tuple[dict[str, np.ndarray], int]:
     """Every variable of :data:`VARIABLES` at the points (E_i, Lambda_i), solved chunk by chunk.
+
+    Those of :data:`~spinectl.landscape.schema.ON_REQUEST` only if ``coupled``.
 
     The fast path solves each chunk of ``chunk_size`` consecutive points as one
     stacked problem, so the answer depends on the chunking only through the
@@ -45,6 +53,8 @@ def point_columns(
         Points per chunk.
     update : callable, optional
         Called with the number of points solved, after each chunk (fast) or point (per-point).
+    coupled : bool
+        Also the coupled chain's SDP variables (:data:`~spinectl.landscape.schema.ON_REQUEST`).
 
     Returns
     -------
@@ -70,7 +80,12 @@ def point_columns(
         per_point += result.per_point
         with arithmetic_guard(e_grid[part], l_grid[part]), guarded():  # e.g. K = 1e154 overflows S^2 in the reflex
             columns = _chunk_columns(result, coeffs, model)
-            columns["coupled_margin_Nm_per_rad"] = _coupled_margin(model, e_grid[part], l_grid[part], result.pcsa)
+            stiffness = _chain_stiffness(model, e_grid[part], l_grid[part], result.pcsa)
+            margin = chain.coupled_margin(np.nan_to_num(stiffness))
+            columns["coupled_margin_Nm_per_rad"] = np.where(np.isnan(stiffness[:, 0, 0]), np.nan, margin)
+        if coupled:  # SDPs: outside numpy's guard
+            columns |= _local_stiffness(model, stiffness, method)
+            columns |= _joint_optimum(model, e_grid[part], l_grid[part], data, method)
         for name, values in columns.items():
             if name not in arrays:
                 arrays[name] = np.empty((e_grid.size,) + values.shape[1:], values.dtype)
@@ -96,10 +111,53 @@ def _chunk_columns(result: stacked.BlockOptimum, coeffs, model: Model) -> dict[s
     }
 
 
-def _coupled_margin(model: Model, eccentricity, lordosis, pcsa) -> np.ndarray:
-    """Static margin of the coupled chain at the chosen activation [N m/rad], NaN where infeasible (docs/chain.md)."""
+def _chain_stiffness(model: Model, eccentricity, lordosis, pcsa) -> np.ndarray:
+    """The coupled chain's K at the chosen activation [N m/rad], NaN where infeasible (docs/chain.md)."""
     stiffness = chain.chain_coefficients(model, eccentricity, lordosis).stiffness(np.nan_to_num(pcsa))
-    return np.where(np.isnan(pcsa).any(axis=-1), np.nan, chain.coupled_margin(stiffness))
+    return np.where(np.isnan(pcsa).any(axis=-1)[:, None, None], np.nan, stiffness)
+
+
+def _local_stiffness(model: Model, stiffness, method: str) -> dict[str, np.ndarray]:
+    """The least local stiffness at the chosen activation, problem (a) of docs/chain.md, per joint and total.
+
+    The fast path solves the chunk as one stacked SDP, the per-point method one cvxpy SDP per point.
+    """
+    opt = model.optimisation
+    if method == "fast":
+        _, k = coupled.least_local_stiffness_stacked(stiffness, opt.stability_margin, opt.solver_tolerance)
+    else:
+        k = np.full(stiffness.shape[:-1], np.nan)
+        for i in np.flatnonzero(np.isfinite(stiffness[:, 0, 0])):
+            _, found = coupled.least_local_stiffness_at(stiffness[i], opt.stability_margin, opt.solver_tolerance)
+            k[i] = np.nan if found is None else found
+    return {"local_stiffness_Nm_per_rad": k, "local_stiffness_total_Nm_per_rad": np.sum(k, axis=-1)}
+
+
+def _joint_optimum(model: Model, eccentricity, lordosis, data, method: str) -> dict[str, np.ndarray]:
+    """The joint optimum of global and local muscle, problem (c) of docs/chain.md: its two totals [cm^2].
+
+    The fast path solves the chunk as one stacked SDP and falls back to one cvxpy SDP per point
+    where the stack fails as a whole (e.g. one infeasible point); the per-point method always does.
+    """
+    kappa = chain.local_stiffness_per_pcsa(model) * M2_PER_CM2  # N m/rad per cm^2
+    status = "per-point"
+    if method == "fast":
+        coefficients = chain.chain_coefficients(model, eccentricity, lordosis)
+        opt = model.optimisation
+        status, x, k = coupled.joint_optimum_stacked(
+            data, coefficients, opt.stability_margin, kappa, model.local.cost_weight
+        )
+    if status not in OK_STATUSES:
+        x = np.full((eccentricity.size, data.weights.size), np.nan)
+        k = np.full((eccentricity.size, len(model.geometry.cor_names)), np.nan)
+        for i, (e, lam) in enumerate(zip(eccentricity, lordosis, strict=True)):
+            _, x_i, k_i = coupled.joint_optimum_sdp(coupled.coupled_data(model, e, lam))
+            if x_i is not None:
+                x[i], k[i] = x_i, k_i
+    return {
+        "joint_global_pcsa_cm2": x @ data.to_muscles.sum(axis=0),
+        "joint_local_pcsa_cm2": k.sum(axis=-1) / kappa,
+    }
 
 
 def _reflex_columns(model: Model, coeffs, pcsa) -> dict[str, np.ndarray]:

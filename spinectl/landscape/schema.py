@@ -46,8 +46,24 @@ VARIABLES = {
         "N m rad-1",
         "static margin of the coupled chain at the chosen activation: smallest eigenvalue of -K (> 0 stable)",
     ),
+    "local_stiffness_Nm_per_rad": (
+        "N m rad-1",
+        "least local-muscle stiffness k_j that makes the coupled chain stable at the chosen activation (SDP)",
+    ),
+    "local_stiffness_total_Nm_per_rad": ("N m rad-1", "sum over the joints of local_stiffness_Nm_per_rad"),
+    "joint_global_pcsa_cm2": ("cm2", "joint optimum of global and local muscle (coupled chain): total global PCSA"),
+    "joint_local_pcsa_cm2": ("cm2", "joint optimum of global and local muscle (coupled chain): total local PCSA"),
 }
 """Every data variable: units (UDUNITS) and long name."""
+
+ON_REQUEST = (
+    "local_stiffness_Nm_per_rad",
+    "local_stiffness_total_Nm_per_rad",
+    "joint_global_pcsa_cm2",
+    "joint_local_pcsa_cm2",
+)
+"""Variables computed only when asked for (``sweep --coupled``, a study's ``outputs``): semidefinite
+programmes of the coupled chain, about 2.7 ms a point, seven times the rest of a landscape (docs/chain.md)."""
 
 
 def dims_of(name: str, ndim: int) -> tuple[str, ...]:

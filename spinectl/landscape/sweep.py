@@ -73,6 +73,7 @@ def sweep(
     method: str = "fast",
     chunk_size: int = DEFAULT_CHUNK,
     progress: bool | None = None,
+    coupled: bool = False,
 ) -> xr.Dataset:
     """Minimum PCSA and counter torques on the grid E x Lambda (Figures 3 and 4).
 
@@ -87,6 +88,8 @@ def sweep(
         Grid points per chunk.
     progress : bool or None
         Show a progress bar on stderr; None: only on a terminal.
+    coupled : bool
+        Also the coupled chain's SDP variables (:data:`spinectl.landscape.schema.ON_REQUEST`, docs/chain.md).
 
     Returns
     -------
@@ -106,7 +109,7 @@ def sweep(
     e_grid, l_grid = (a.ravel() for a in np.meshgrid(e_axis, l_axis, indexing="ij"))
     disable = None if progress is None else not progress  # None: tqdm shows it on a terminal only
     with tqdm(total=e_grid.size, disable=disable, unit="pt", desc="sweep") as bar:
-        options = {"method": method, "chunk_size": chunk_size, "update": bar.update}
+        options = {"method": method, "chunk_size": chunk_size, "update": bar.update, "coupled": coupled}
         arrays, per_point = point_columns(model, e_grid, l_grid, **options)
     shape = (e_axis.size, l_axis.size)
     arrays = {name: values.reshape(shape + values.shape[1:]) for name, values in arrays.items()}

@@ -23,6 +23,10 @@ S_k <= -mu, which the LMI implies (they are its diagonal). So the coupled feasib
 inside the per-segment one and the coupled minimum is never below the paper's. A point where
 no activation stabilises the chain is an answer: NaN values and the solver's status.
 
+For grids, (a) and (c) also come stacked: the points of a chunk share no variable, so one
+Clarabel problem with a PSD cone per point solves them all (:func:`least_local_stiffness_stacked`,
+:func:`joint_optimum_stacked`; the landscape's variables), the per-point SDPs the reference.
+
 The solver's k is made exactly feasible by a uniform shift, k + max(0, mu - margin): adding
 c to every k_j adds c I to the matrix. The reported margin is that of numpy's eigvalsh.
 
@@ -37,8 +41,10 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 
+import clarabel
 import cvxpy as cp
 import numpy as np
+import scipy.sparse as sp
 
 from ..model import chain, geometry
 from ..model.checks import arithmetic_guard, checked_coefficients, expand_pcsa
@@ -48,6 +54,7 @@ from ..model.stability import self_stable
 from ..units import M2_PER_CM2, m2_to_cm2
 from .problem import OK_STATUSES, ProblemData, inequalities, problem_data, to_si
 from .reference import minimum_stabilising_pcsa, solve_with_fallback
+from .stacked import CLARABEL_STATUS, stacked_settings
 
 
 @dataclass(frozen=True)
@@ -147,17 +154,55 @@ def _lmi(data: CoupledData, x, k=None) -> cp.Constraint:
     return (matrix if k is None else matrix + cp.diag(k)) >> 0
 
 
-def _feasible_local(data: CoupledData, x, k) -> np.ndarray:
-    """k >= 0 shifted so that diag(k) - K(x) >= mu I holds to rounding (adds c I to the matrix)."""
+def _shifted(stiffness, margin: float, k) -> np.ndarray:
+    """k >= 0 shifted so that diag(k) - K >= mu I holds to rounding (adding c to every k_j adds c I); vectorised."""
     k = np.maximum(np.asarray(k, float), 0.0)
-    shortfall = data.margin - chain.coupled_margin(data.matrix(x, k))
-    return k + max(shortfall, 0.0)
+    shortfall = margin - chain.coupled_margin(np.asarray(stiffness, float) - k[..., :, None] * np.eye(k.shape[-1]))
+    return k + np.maximum(shortfall, 0.0)[..., None]
+
+
+def _feasible_local(data: CoupledData, x, k) -> np.ndarray:
+    """:func:`_shifted` at K(x)."""
+    return _shifted(data.matrix(x), data.margin, k)
+
+
+def least_local_stiffness_at(stiffness, margin: float, tolerance: float | None = None):
+    """(a) The least total local stiffness sum(k) with diag(k) - K >= mu I, k >= 0, for one matrix K.
+
+    Always feasible (large k); the dual is max <Z, K + mu I> over Z >= 0, diag(Z) <= 1. The
+    per-point reference (cvxpy, Clarabel with SCS as the fallback) of
+    :func:`least_local_stiffness_stacked`.
+
+    Parameters
+    ----------
+    stiffness : array_like, shape (n, n)
+        K [N m/rad].
+    margin : float
+        mu [N m/rad].
+    tolerance : float, optional
+        The solver's gap and feasibility tolerance.
+
+    Returns
+    -------
+    status : str
+        'optimal', 'optimal_inaccurate' or 'solver_error'.
+    k : numpy.ndarray or None
+        Local stiffness per joint [N m/rad], None unless optimal; exactly feasible (a uniform shift).
+    """
+    stiffness = np.asarray(stiffness, float)
+    n = stiffness.shape[0]
+    k = cp.Variable(n, nonneg=True)
+    problem = cp.Problem(cp.Minimize(cp.sum(k)), [cp.diag(k) - stiffness - margin * np.eye(n) >> 0])
+    status = solve_with_fallback(problem, tolerance)
+    if status not in OK_STATUSES:
+        return status, None
+    return status, _shifted(stiffness, margin, k.value)
 
 
 def least_local_stiffness_sdp(data: CoupledData, x) -> tuple[str, np.ndarray | None]:
     """(a) The least total local stiffness sum(k) with diag(k) - K(x) >= mu I, k >= 0.
 
-    Always feasible (large k); the dual is max <Z, K(x) + mu I> over Z >= 0, diag(Z) <= 1.
+    :func:`least_local_stiffness_at` with K(x).
 
     Parameters
     ----------
@@ -172,13 +217,148 @@ def least_local_stiffness_sdp(data: CoupledData, x) -> tuple[str, np.ndarray | N
     k : numpy.ndarray or None
         Local stiffness per joint [N m/rad], None unless optimal.
     """
-    k = cp.Variable(data.stiffness_offset.shape[0], nonneg=True)
-    x = np.asarray(x, float)
-    problem = cp.Problem(cp.Minimize(cp.sum(k)), [_lmi(data, x, k)])
-    status = solve_with_fallback(problem, data.problem.tolerance)
+    return least_local_stiffness_at(data.matrix(np.asarray(x, float)), data.margin, data.problem.tolerance)
+
+
+def _svec(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Clarabel's PSD-triangle order: the upper triangle column by column, off-diagonals scaled by sqrt 2."""
+    rows, cols = np.triu_indices(n)
+    order = np.lexsort((rows, cols))  # column-major
+    rows, cols = rows[order], cols[order]
+    return rows, cols, np.where(rows == cols, 1.0, np.sqrt(2.0))
+
+
+def least_local_stiffness_stacked(stiffness, margin: float, tolerance: float | None = None):
+    """(a) at P points at once: one Clarabel problem with a 5 x 5 PSD cone per point.
+
+    The points' problems share no variable, so the stacked problem is block diagonal: for each
+    point p, min sum(k_p) s.t. diag(k_p) - K_p - mu I >= 0 (a PSD-triangle cone), k_p >= 0.
+    The solution is made exactly feasible per point like :func:`least_local_stiffness_sdp`'s.
+    The sum of the P objectives is minimised with the tolerance relative to it, so each point's
+    own optimum holds to about P times the tolerance relative to the total; the benchmark
+    (benchmarks/bench_local_stiffness.py) and the tests compare with the per-point SDP.
+
+    Parameters
+    ----------
+    stiffness : array_like, shape (P, n, n)
+        K at each point [N m/rad]; a point with a NaN gives NaN.
+    margin : float
+        mu [N m/rad].
+    tolerance : float, optional
+        Clarabel's gap and feasibility tolerance (``optimisation.solver_tolerance``).
+
+    Returns
+    -------
+    status : str
+        Clarabel's status in cvxpy's words ('optimal', 'optimal_inaccurate', 'solver_error').
+    k : numpy.ndarray, shape (P, n)
+        The least local stiffness at each point [N m/rad]; NaN unless optimal and finite.
+
+    References
+    ----------
+    Goulart PJ, Chen Y (2024). Clarabel: an interior-point solver for conic programs with
+    quadratic objectives. arXiv:2405.12762. doi:10.48550/arXiv.2405.12762.
+    """
+    a = np.asarray(stiffness, float)
+    points, n = a.shape[0], a.shape[-1]
+    k = np.full((points, n), np.nan)
+    finite = np.flatnonzero(np.all(np.isfinite(a), axis=(-2, -1)))
+    if finite.size == 0:
+        return "optimal", k
+    m = finite.size
+    rows, cols, scale = _svec(n)
+    width = rows.size
+    target = -(a[finite] + margin * np.eye(n))  # s = svec(diag(k) - K - mu I) = b - A k
+    b_psd = (target[:, rows, cols] * scale).ravel()
+    diagonal = np.flatnonzero(rows == cols)  # positions of (j, j) in a block, in j order
+    psd = sp.csc_matrix(
+        (np.full(m * n, -1.0), ((np.arange(m)[:, None] * width + diagonal).ravel(), np.arange(m * n))),
+        shape=(m * width, m * n),
+    )
+    lhs = sp.vstack([psd, -sp.identity(m * n, format="csc")]).tocsc()
+    rhs = np.concatenate([b_psd, np.zeros(m * n)])
+    cones = [clarabel.PSDTriangleConeT(n)] * m + [clarabel.NonnegativeConeT(m * n)]
+    try:
+        solution = clarabel.DefaultSolver(
+            sp.csc_matrix((m * n, m * n)), np.ones(m * n), lhs, rhs, cones, stacked_settings(tolerance)
+        ).solve()
+    except (ValueError, RuntimeError, ArithmeticError):  # a solver panic: unsolved
+        return "solver_error", k
+    status = CLARABEL_STATUS.get(solution.status, "solver_error")
     if status not in OK_STATUSES:
-        return status, None
-    return status, _feasible_local(data, x, k.value)
+        return status, k
+    k[finite] = _shifted(a[finite], margin, np.asarray(solution.x).reshape(m, n))
+    return status, k
+
+
+def joint_optimum_stacked(
+    data: ProblemData, coefficients: chain.ChainCoefficients, margin: float, local_per_cm2, cost_weight
+):
+    """(c) at P points at once: one Clarabel problem, per point a PSD cone, the LP rows and k >= 0.
+
+    Per point p, with z_p = (x_p, k_p): min w.x_p + cost_weight sum(k_p) / kappa subject to
+    diag(k_p) - K_p(x_p) - mu I >= 0 (a PSD-triangle cone), the per-segment rows of
+    :func:`joint_optimum_sdp` (damping rows, bounds on x) and k_p >= 0. The points share no
+    variable, so the problem is block diagonal; a chunk that fails as a whole (an infeasible
+    point spoils the stack) returns its status and NaN, for the caller to solve per point.
+
+    Parameters
+    ----------
+    data : ProblemData
+        The per-segment problem at the P points (leading dimension P).
+    coefficients : ChainCoefficients
+        The chain's matrices at the same points (:func:`spinectl.model.chain.chain_coefficients`).
+    margin : float
+        mu [N m/rad].
+    local_per_cm2 : float
+        kappa [N m/rad per cm^2] (:func:`spinectl.model.chain.local_stiffness_per_pcsa`).
+    cost_weight : float
+        w_local [1].
+
+    Returns
+    -------
+    status : str
+        Clarabel's status in cvxpy's words.
+    x : numpy.ndarray, shape (P, n_var)
+        Global decision variables [cm^2]; NaN unless optimal.
+    k : numpy.ndarray, shape (P, n_cor)
+        Local stiffness [N m/rad]; NaN unless optimal.
+    """
+    per_var = coefficients.stiffness_per_pcsa @ (data.to_muscles * M2_PER_CM2)  # (P, n, n, v)
+    offset = coefficients.stiffness(np.zeros(data.to_muscles.shape[0]))  # (P, n, n)
+    points, n, v = per_var.shape[0], per_var.shape[1], per_var.shape[-1]
+    lhs, rhs = inequalities(data)
+    lhs, rhs = lhs[:, n:], rhs[:, n:]  # drop the per-segment stiffness rows, as joint_optimum_sdp does
+    rows, cols, scale = _svec(n)
+    width = rows.size
+    psd = np.zeros((points, width, v + n))
+    psd[:, :, :v] = per_var[:, rows, cols, :] * scale[:, None]  # s = svec(-K0 - mu I - sum x_i K_i + diag k)
+    psd[:, np.flatnonzero(rows == cols), v + np.arange(n)] = -1.0
+    b_psd = (-(offset + margin * np.eye(n))[:, rows, cols] * scale).reshape(-1)
+    nonneg = np.concatenate([np.zeros((n, v)), -np.eye(n)], axis=1)  # s = k >= 0
+    linear = np.concatenate(
+        [np.concatenate([lhs, np.zeros(lhs.shape[:2] + (n,))], axis=-1), np.broadcast_to(nonneg, (points, n, v + n))],
+        axis=1,
+    )
+    b_linear = np.concatenate([rhs, np.zeros((points, n))], axis=1).reshape(-1)
+    lhs_matrix = sp.vstack([sp.block_diag(list(psd), format="csc"), sp.block_diag(list(linear), format="csc")]).tocsc()
+    cost = np.tile(np.concatenate([data.weights, np.full(n, cost_weight / local_per_cm2)]), points)
+    cones = [clarabel.PSDTriangleConeT(n)] * points + [clarabel.NonnegativeConeT(b_linear.size)]
+    x, k = np.full((points, v), np.nan), np.full((points, n), np.nan)
+    try:
+        solution = clarabel.DefaultSolver(
+            sp.csc_matrix((cost.size, cost.size)), cost, lhs_matrix, np.concatenate([b_psd, b_linear]), cones,
+            stacked_settings(data.tolerance),
+        ).solve()  # fmt: skip
+    except (ValueError, RuntimeError, ArithmeticError):
+        return "solver_error", x, k
+    status = CLARABEL_STATUS.get(solution.status, "solver_error")
+    if status not in OK_STATUSES:
+        return status, x, k
+    z = np.asarray(solution.x).reshape(points, v + n)
+    x = np.maximum(z[:, :v], 0.0)
+    matrix = offset + np.einsum("pjkv,pv->pjk", per_var, x)
+    return status, x, _shifted(matrix, margin, z[:, v:])
 
 
 def min_global_pcsa_sdp(data: CoupledData) -> tuple[str, np.ndarray | None]:

@@ -43,7 +43,7 @@ from .problem import (
 )
 from .reference import optimum
 
-_STATUS = {
+CLARABEL_STATUS = {
     clarabel.SolverStatus.Solved: "optimal",
     clarabel.SolverStatus.AlmostSolved: "optimal_inaccurate",
     clarabel.SolverStatus.PrimalInfeasible: "infeasible",
@@ -95,7 +95,18 @@ def block_diagonal(blocks) -> sp.csc_matrix:
     return sp.csc_matrix((blocks.ravel(), (rows.ravel(), cols.ravel())), shape=(n * r, n * c))
 
 
-def _settings(tolerance: float | None) -> clarabel.DefaultSettings:
+def stacked_settings(tolerance: float | None) -> clarabel.DefaultSettings:
+    """Clarabel's settings, quiet, with the gap and feasibility tolerance of the per-point reference.
+
+    Parameters
+    ----------
+    tolerance : float or None
+        [1]; None: Clarabel's defaults (:func:`~spinectl.optimise.problem.solver_options`).
+
+    Returns
+    -------
+    clarabel.DefaultSettings
+    """
     settings = clarabel.DefaultSettings()
     settings.verbose = False
     for name, value in solver_options("CLARABEL", tolerance).items():
@@ -132,12 +143,14 @@ def stacked_qp(hessian, linear, lhs, rhs, tolerance: float | None) -> tuple[str,
     lhs_matrix = block_diagonal(lhs)
     cones = [clarabel.NonnegativeConeT(lhs_matrix.shape[0])]
     try:
-        solver = clarabel.DefaultSolver(quad, linear.ravel(), lhs_matrix, np.ravel(rhs), cones, _settings(tolerance))
+        solver = clarabel.DefaultSolver(
+            quad, linear.ravel(), lhs_matrix, np.ravel(rhs), cones, stacked_settings(tolerance)
+        )
         solution = solver.solve()
     except (ValueError, RuntimeError, ArithmeticError):  # bad data or a solver panic: the block is unsolved
         return SOLVER_ERROR, np.full((n_points, n), np.nan)
     x = np.asarray(solution.x, float).reshape(n_points, n)
-    status = _STATUS.get(solution.status, SOLVER_ERROR)
+    status = CLARABEL_STATUS.get(solution.status, SOLVER_ERROR)
     return (status if np.all(np.isfinite(x)) else SOLVER_ERROR), x
 
 

@@ -2,10 +2,14 @@
 
 The multi-input counterpart of :func:`spinectl.reflex.loops.segment_system`: all joints free
 at once, M q'' = K q + D q' + u (:func:`spinectl.model.chain.state_matrix`), one torque input
-and one angle output per joint. The delayed reflex on the chain is not built yet.
+and one angle output per joint; the loop of the diagonal delayed reflex with Padé delays
+(:func:`chain_loop`) and its disk margins (:func:`chain_disk_margins`, docs/chain.md,
+"The delayed reflex"). The exact delay margin is :func:`spinectl.reflex.mimo.chain_delay_margin`.
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import control as ct
 import numpy as np
@@ -69,3 +73,123 @@ def chain_system(mass, stiffness, damping, names) -> ct.StateSpace:
         states=[f"alpha_{k}" for k in names] + [f"omega_{k}" for k in names],
         name="chain",
     )
+
+
+def chain_loop(mass, stiffness, damping, kp, kd, delay: float, order: int, lag: float, names) -> ct.StateSpace:
+    """The loop broken at the joint torques: L(s) = A(s) R(s) [K_p K_d] G(s), negative feedback.
+
+    G maps the torques u to the state (q, q') of :func:`chain_system`; [K_p K_d] is the
+    diagonal reflex; R(s) the [order/order] Padé approximant of exp(-s tau) at every joint
+    (python-control's ``pade``) and A(s) = 1/(T_a s + 1) the force generation. The closed
+    loop is u = -L u, so (I + L)^-1 is the sensitivity at the plant input.
+
+    Parameters
+    ----------
+    mass, stiffness, damping : array_like, shape (n, n)
+        M [kg m^2], K [N m/rad], D [N m s/rad].
+    kp, kd : array_like, shape (n,)
+        Diagonal gains [N m/rad], [N m s/rad].
+    delay : float
+        tau [s].
+    order : int
+        Padé order.
+    lag : float
+        T_a [s]; 0 none.
+    names : sequence of str
+        The joints, top to bottom.
+
+    Returns
+    -------
+    control.StateSpace
+        n inputs ``torque_<name>`` [N m], n outputs ``reflex_<name>`` [N m].
+
+    Raises
+    ------
+    ModelError
+        As :func:`chain_system`.
+    """
+    names = list(names)
+    n = len(names)
+    plant = chain_system(mass, stiffness, damping, names)
+    state = ct.ss(plant.A, plant.B, np.eye(2 * n), np.zeros((2 * n, n)))
+    gains = np.concatenate([np.diag(np.broadcast_to(kp, (n,))), np.diag(np.broadcast_to(kd, (n,)))], axis=1)
+    # scipy's realisation, as in spinectl.reflex.loops (slycot, installed for AB13MD, would give another)
+    one = ct.tf2ss(ct.tf(*ct.pade(delay, order)), method="scipy") if delay > 0 else _static([[1.0]])
+    if lag > 0:
+        one = ct.tf2ss(ct.tf([1.0], [lag, 1.0]), method="scipy") * one
+    delays = ct.append(*([one] * n))
+    loop = delays * _static(gains) * state
+    return ct.ss(
+        loop.A, loop.B, loop.C, loop.D, inputs=[f"torque_{k}" for k in names], outputs=[f"reflex_{k}" for k in names]
+    )
+
+
+@dataclass(frozen=True)
+class DiskMargins:
+    """Balanced disk margins of the chain's loop (skew 0; Seiler, Packard and Gahinet 2020).
+
+    Attributes
+    ----------
+    disk_margin : float
+        alpha, the multiloop disk margin [1]: the loop tolerates simultaneous independent
+        gain-and-phase variations at every joint inside the disk of size alpha.
+    gain_margin : float
+        The gain factor it tolerates [1] ((1 + alpha/2)/(1 - alpha/2)); inf for alpha >= 2.
+    phase_margin_deg : float
+        The phase it tolerates [deg].
+    loop_at_a_time : numpy.ndarray, shape (n, 3)
+        The same three per joint, the other loops closed.
+    """
+
+    disk_margin: float
+    gain_margin: float
+    phase_margin_deg: float
+    loop_at_a_time: np.ndarray
+
+
+def _static(gain) -> ct.StateSpace:
+    """A static gain matrix as a python-control system without states."""
+    gain = np.atleast_2d(np.asarray(gain, float))
+    return ct.ss(np.zeros((0, 0)), np.zeros((0, gain.shape[1])), np.zeros((gain.shape[0], 0)), gain)
+
+
+def _factor(gain_db: float) -> float:
+    """python-control's disk gain margin [dB] as a factor [1]."""
+    return float(ct.db2mag(gain_db))
+
+
+def chain_disk_margins(loop: ct.StateSpace, omega) -> DiskMargins:
+    """Multiloop and loop-at-a-time disk margins of ``loop`` with ``control.disk_margins``.
+
+    The multiloop margin bounds the structured singular value of the balanced sensitivity
+    S - I/2 over diagonal complex perturbations (python-control's AB13MD upper bound, through
+    slycot); joint j alone sees L_j = L_jj - L_jr (I + L_rr)^-1 L_rj, r the other joints.
+    Meaningful only for a closed loop that is stable: the caller checks.
+
+    Parameters
+    ----------
+    loop : control.StateSpace
+        L of :func:`chain_loop`, n x n.
+    omega : array_like
+        Frequencies [rad/s].
+
+    Returns
+    -------
+    DiskMargins
+
+    References
+    ----------
+    Seiler P, Packard A, Gahinet P (2020). An introduction to disk margins. IEEE Control
+    Systems Magazine 40(5):78-95. doi:10.1109/MCS.2020.3005277.
+    """
+    omega = np.asarray(omega, float)
+    alpha, gain, phase = ct.disk_margins(loop, omega)
+    n = loop.ninputs
+    single = []
+    for j in range(n):
+        rest = [i for i in range(n) if i != j]
+        closed = ct.feedback(_static(np.eye(n - 1)), loop[rest, rest]) if rest else None
+        siso = loop[j, j] if closed is None else loop[j, j] - loop[[j], rest] * closed * loop[rest, [j]]
+        a_j, g_j, p_j = ct.disk_margins(siso, omega)
+        single.append((float(a_j), _factor(g_j), float(p_j)))
+    return DiskMargins(float(alpha), _factor(gain), float(phase), np.array(single))

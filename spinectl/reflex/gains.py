@@ -53,9 +53,47 @@ def default_gains(stiffness, damping, inertia, gain_factor, damping_ratio, lag=0
     """
     s, d, theta, lag = as_arrays(stiffness, damping, inertia, lag)
     kp = gain_factor * np.maximum(s, 0.0)
-    net = np.maximum(kp - s, 0.0)
-    kd = np.maximum(2.0 * damping_ratio * np.sqrt(theta * net) + d, 0.0) + kp * lag
-    return kp, kd
+    return kp, _derivative_gain(kp, s, d, theta, damping_ratio, lag)
+
+
+def _derivative_gain(kp, stiffness, damping, inertia, damping_ratio, lag):
+    """kd = max(0, 2 zeta sqrt(theta (kp - S)) + D) + kp T_a: the rule's damping (see :func:`default_gains`)."""
+    net = np.maximum(kp - stiffness, 0.0)
+    return np.maximum(2.0 * damping_ratio * np.sqrt(inertia * net) + damping, 0.0) + kp * lag
+
+
+def chain_gains(mass, stiffness, damping, local_stiffness, gain_factor, damping_ratio, lag=0.0):
+    """The default rule on the chain: diagonal gains from the chain's stiffness deficit (docs/chain.md).
+
+    A joint's deficit is the least local stiffness k_j of
+    :func:`spinectl.optimise.coupled.least_local_stiffness` (diag(k) - K >= mu I): what the
+    joint lacks for the whole chain to be stable, where the segment's deficit max(S, 0) is
+    what it lacks alone. kp_j = gain_factor k_j, and kd_j is the segment rule's
+    (:func:`default_gains`) with theta = M[j, j], S = K[j, j], D = D[j, j]. Without delay,
+    K_p - K >= mu I + (gain_factor - 1) diag(k) is positive definite; with K_d - D positive
+    definite too the delay-free chain is stable (a mechanical system with positive definite
+    stiffness and damping; Lyapunov function the energy).
+
+    Parameters
+    ----------
+    mass, stiffness, damping : array_like, shape (n, n)
+        M [kg m^2], K [N m/rad], D [N m s/rad].
+    local_stiffness : array_like, shape (n,)
+        k [N m/rad], the least local stiffness.
+    gain_factor, damping_ratio : float
+        As in :func:`default_gains` [1].
+    lag : float, optional
+        Activation time constant T_a [s].
+
+    Returns
+    -------
+    kp, kd : numpy.ndarray, shape (n,)
+        [N m/rad], [N m s/rad].
+    """
+    diagonal = (np.diagonal(np.asarray(x, float)) for x in (mass, stiffness, damping))
+    theta, s, d = diagonal
+    kp = gain_factor * np.maximum(np.asarray(local_stiffness, float), 0.0)
+    return kp, _derivative_gain(kp, s, d, theta, damping_ratio, lag)
 
 
 @validated

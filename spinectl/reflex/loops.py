@@ -181,9 +181,10 @@ def closed_loop(
     """
     plant = segment_system(stiffness, damping, inertia)
     full = ct.ss(plant.A, plant.B, np.eye(2), np.zeros((2, 1)))
-    delayed = ct.tf2ss(pade_delay(delay, order))
+    # scipy's realisation, not slycot's: the same matrices whether slycot is installed or not
+    delayed = ct.tf2ss(pade_delay(delay, order), method="scipy")
     if lag > 0:
-        delayed = ct.tf2ss(activation_lag(lag)) * delayed
+        delayed = ct.tf2ss(activation_lag(lag), method="scipy") * delayed
     feedback_path = delayed * np.array([[kp, kd]])
     loop = ct.feedback(full, feedback_path, sign=-1)
     return ct.ss(loop.A, loop.B, loop.C[:1], loop.D[:1], inputs=["torque"], outputs=["alpha"], name=name)

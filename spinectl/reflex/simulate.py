@@ -91,6 +91,21 @@ class SegmentPlant:
         """
         return _torque_without_ct(self, alpha, omega) + self.counter_torque
 
+    def acceleration(self, alpha, omega, torque):
+        """alpha'' = (net torque + reflex torque) / theta [rad/s^2] (paper, Methods).
+
+        Parameters
+        ----------
+        alpha, omega, torque : array_like
+            Angle [rad], angular velocity [rad/s] and reflex torque [N m], one entry per run.
+
+        Returns
+        -------
+        numpy.ndarray
+            [rad/s^2], the broadcast shape.
+        """
+        return (self.torque(alpha, omega) + torque) / self.inertia
+
 
 def _torque_without_ct(plant: SegmentPlant, alpha, omega):
     """sum_i M_i + M_ext - K alpha [N m]: M_i = h_i f_l f_H per unit f_iso times each fibre's f_iso."""
@@ -228,7 +243,7 @@ def growth_rate(time, alpha, perturbation: float):
     return np.where(last < _NOISE * perturbation, -np.inf, rate)
 
 
-def simulate(plant: SegmentPlant, kp, kd, delay, settings: Reflex, perturbation=None) -> Simulation:
+def simulate(plant, kp, kd, delay, settings: Reflex, perturbation=None) -> Simulation:
     """Simulate the segment under the delayed, lagged reflex; arrays broadcast to a batch of runs.
 
     The reflex command -(kp alpha + kd omega)(t - tau) becomes the torque u through the
@@ -237,14 +252,15 @@ def simulate(plant: SegmentPlant, kp, kd, delay, settings: Reflex, perturbation=
 
     Parameters
     ----------
-    plant : SegmentPlant
+    plant : SegmentPlant or ChainPlant
+        Anything with ``acceleration(alpha, omega, torque)`` over the runs.
     kp, kd, delay : array_like
         Reflex gains [N m/rad], [N m s/rad] and delay [s]; kp = kd = 0 is "no reflex".
     settings : Reflex
         ``sim_duration``, ``sim_time_step``, ``sim_perturbation``, ``sim_divergence`` and
         ``activation_time_constant``.
-    perturbation : float, optional
-        Initial angle [rad] instead of ``settings.sim_perturbation``.
+    perturbation : float or array_like, optional
+        Initial angle [rad] instead of ``settings.sim_perturbation``; one per run for a batch.
 
     Returns
     -------
@@ -263,7 +279,7 @@ def simulate(plant: SegmentPlant, kp, kd, delay, settings: Reflex, perturbation=
     )
     if np.any(tau < 0) or not np.all(np.isfinite(tau)):
         raise ParameterError("delay", "must be finite and >= 0")
-    start = settings.sim_perturbation if perturbation is None else float(perturbation)
+    start = settings.sim_perturbation if perturbation is None else np.asarray(perturbation, float)
     lag = settings.activation_time_constant
     step, n = _steps(settings, tau, lag)
     time = np.arange(n + 1) * step
@@ -278,8 +294,8 @@ def simulate(plant: SegmentPlant, kp, kd, delay, settings: Reflex, perturbation=
         now = tau == 0  # no delay: the reflex sees the stage's own state
         u = -(kp * np.where(now, a, delayed_a) + kd * np.where(now, w, delayed_w))
         if lag > 0:
-            return (plant.torque(a, w) + f) / plant.inertia, f, (u - f) / lag
-        return (plant.torque(a, w) + u) / plant.inertia, u, 0.0
+            return plant.acceleration(a, w, f), f, (u - f) / lag
+        return plant.acceleration(a, w, u), u, 0.0
 
     for k in range(n):
         t, a, w = time[k], alpha[k], omega[k]
@@ -355,3 +371,82 @@ def simulated_delay_margin(plant: SegmentPlant, kp, kd, settings: Reflex, low, h
         grid = np.concatenate([[low], delays, [high]])
         low, high = grid[first_unstable], grid[first_unstable + 1]
     return float(low), float(high)
+
+
+@dataclass(frozen=True)
+class ChainPlant:
+    """The linearised chain M q'' = K q + D q' + u (docs/chain.md, "Dynamic stability") for :func:`simulate`.
+
+    Its runs are the joints of a batch of chains, joint index fastest: run r is joint r mod n
+    of chain r // n, so that :func:`simulate` integrates every joint with the true delay and the
+    cubic Hermite history of a segment.
+
+    Attributes
+    ----------
+    mass, stiffness, damping : numpy.ndarray, shape (n, n)
+        M [kg m^2] (regular), K [N m/rad], D [N m s/rad].
+    """
+
+    mass: np.ndarray
+    stiffness: np.ndarray
+    damping: np.ndarray
+
+    def acceleration(self, alpha, omega, torque):
+        """q'' = M^-1 (K q + D q' + u) of every chain of the batch [rad/s^2].
+
+        Parameters
+        ----------
+        alpha, omega, torque : numpy.ndarray, shape (batch * n,)
+            Joint angles [rad], angular velocities [rad/s] and reflex torques [N m], joint fastest.
+
+        Returns
+        -------
+        numpy.ndarray, shape (batch * n,)
+            [rad/s^2].
+        """
+        n = self.mass.shape[0]
+        q, qdot, u = (np.broadcast_to(x, np.shape(alpha)).reshape(-1, n) for x in (alpha, omega, torque))
+        force = q @ self.stiffness.T + qdot @ self.damping.T + u
+        return np.linalg.solve(self.mass, force.T).T.reshape(-1)
+
+
+def simulate_chain(plant: ChainPlant, kp, kd, delay, settings: Reflex, perturbation):
+    """Simulate a batch of chains under the diagonal delayed reflex -(K_p q + K_d q')(t - tau).
+
+    Every joint is a run of :func:`simulate` (same integrator, history and activation lag);
+    a chain is stable when the largest joint angle shrinks (:func:`growth_rate` of
+    max_j abs(q_j)).
+
+    Parameters
+    ----------
+    plant : ChainPlant
+    kp, kd : array_like, shape (n,)
+        Gains per joint [N m/rad], [N m s/rad].
+    delay : array_like, shape (batch,)
+        One delay per chain [s].
+    settings : Reflex
+        The simulation settings (see :func:`simulate`).
+    perturbation : array_like, shape (n,)
+        Initial joint angles [rad], held before t = 0.
+
+    Returns
+    -------
+    simulation : Simulation
+        Per run (batch * n, joint fastest).
+    stable : numpy.ndarray of bool, shape (batch,)
+        The verdict per chain.
+
+    Raises
+    ------
+    ParameterError
+        As :func:`simulate`.
+    """
+    n = plant.mass.shape[0]
+    delay = np.atleast_1d(np.asarray(delay, float))
+    tile = np.tile  # joint fastest
+    start = tile(np.asarray(perturbation, float), delay.size)
+    run = simulate(plant, tile(kp, delay.size), tile(kd, delay.size), np.repeat(delay, n), settings, start)
+    largest = np.max(np.abs(run.alpha).reshape(delay.size, n, -1), axis=1)
+    rate = growth_rate(run.time, largest, float(np.max(np.abs(start))))
+    diverged = run.diverged.reshape(delay.size, n).any(axis=1)
+    return run, ~diverged & (rate < 0)

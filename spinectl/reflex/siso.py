@@ -247,6 +247,30 @@ def delay_margin(loop) -> LoopDelayMargin:
     x, directions = _positive_roots(crossover_polynomial(num, den))
     w = np.sqrt(x)
     phases = np.mod(np.angle(-np.polyval(num, 1j * w) / np.polyval(den, 1j * w)), 2.0 * np.pi)
+    return from_crossings(w, phases, directions, stable)
+
+
+def from_crossings(crossovers, phases, directions, stable: bool) -> LoopDelayMargin:
+    """The margin from the crossings: the first destabilising critical delay phi / w of a loop stable without delay.
+
+    Shared by the SISO loop and the chain (:func:`spinectl.reflex.mimo.chain_delay_margin`).
+
+    Parameters
+    ----------
+    crossovers : array_like, shape (m,)
+        Crossing frequencies w > 0 [rad/s].
+    phases : array_like, shape (m,)
+        w tau mod 2 pi at each [rad].
+    directions : array_like, shape (m,)
+        +1 destabilising, -1 stabilising, 0 tangent.
+    stable : bool
+        Stable without delay.
+
+    Returns
+    -------
+    LoopDelayMargin
+    """
+    w, phases, directions = (np.asarray(x, float).reshape(-1) for x in (crossovers, phases, directions))
     destabilising = directions > 0
     if not stable:
         margin, at, status = 0.0, np.nan, UNSTABLE_WITHOUT_DELAY

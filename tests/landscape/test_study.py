@@ -239,6 +239,19 @@ def test_one_chunk_runs_in_process_without_a_cluster(tmp_path):
     xr.testing.assert_identical(got["status"].reset_coords(drop=True), expected["status"].reset_coords(drop=True))
 
 
+def test_the_chains_sdps_are_outputs_on_request(tmp_path):
+    """Named in outputs, the coupled chain's SDP variables come out as in a sweep --coupled of the same chunk
+    (the same stacked problem, so the same bits); by default they are not computed."""
+    names = ["local_stiffness_Nm_per_rad", "joint_global_pcsa_cm2"]
+    one = study.parse_study(f"[study]\noutputs = {names}\n[axes]\n{GRID}")
+    study.run_study(one, tmp_path / "one.zarr", progress=False)
+    got = study.load(tmp_path / "one.zarr")
+    expected = sweep.sweep(one.model, one.eccentricity, one.lordosis, chunk_size=60, progress=False, coupled=True)
+    for name in names:
+        xr.testing.assert_identical(got[name].reset_coords(drop=True), expected[name].reset_coords(drop=True))
+    assert "local_stiffness_total_Nm_per_rad" not in study.parse_study(f"[axes]\n{GRID}").outputs
+
+
 def test_two_local_workers_on_loopback_give_the_same_bits(reference, tmp_path, monkeypatch):
     """A LocalCluster of two worker processes: same store as in-process; it listens on 127.0.0.1 only."""
     listening: list[str] = []

@@ -13,6 +13,7 @@ from spinectl.landscape import netcdf, schema, sweep
 from spinectl.model import chain, source
 from spinectl.model.mechanics import segment_coefficients
 from spinectl.model.params import Model
+from spinectl.optimise.coupled import joint_optimum, least_local_stiffness
 
 E_AXIS = np.array([0.0, 0.04, 0.08])
 L_AXIS = np.array([0.0, 0.03, 0.05, 0.08])  # a different length, so that a transposed grid would fail
@@ -20,7 +21,7 @@ L_AXIS = np.array([0.0, 0.03, 0.05, 0.08])  # a different length, so that a tran
 
 @pytest.fixture(scope="module")
 def landscape():
-    return sweep.sweep(Model(), E_AXIS, L_AXIS, progress=False)
+    return sweep.sweep(Model(), E_AXIS, L_AXIS, progress=False, coupled=True)
 
 
 def test_schema_units_and_orientation(landscape, model):
@@ -46,12 +47,30 @@ def test_coefficients_are_those_of_the_mechanics(landscape, model):
 
 
 def test_chunks_and_methods_give_the_same_dataset(landscape, model):
-    chunked = sweep.sweep(model, E_AXIS, L_AXIS, chunk_size=5, progress=False)
-    xr.testing.assert_allclose(chunked.drop_vars("status"), landscape.drop_vars("status"), rtol=1e-12)
-    reference = sweep.sweep(model, E_AXIS, L_AXIS, method="per-point", progress=False)
+    chunked = sweep.sweep(model, E_AXIS, L_AXIS, chunk_size=5, progress=False, coupled=True)
+    local = [  # the chain's SDPs: to the solver's tolerance, not polished
+        "status",
+        "local_stiffness_Nm_per_rad",
+        "local_stiffness_total_Nm_per_rad",
+        "joint_global_pcsa_cm2",
+        "joint_local_pcsa_cm2",
+    ]
+    xr.testing.assert_allclose(chunked.drop_vars(local), landscape.drop_vars(local), rtol=1e-12)
+    reference = sweep.sweep(model, E_AXIS, L_AXIS, method="per-point", progress=False, coupled=True)
     assert reference.attrs["points_solved_per_point"] == E_AXIS.size * L_AXIS.size
     for name in ("min_pcsa_cm2", "pcsa_cm2", "counter_torque_Nm"):
         np.testing.assert_allclose(reference[name], landscape[name], rtol=1e-6, atol=1e-6)
+    # the least local stiffness: the stacked SDP of each chunk against one cvxpy SDP per point; the
+    # optimum (the total) is unique, the minimiser need not be
+    for other in (chunked, reference):
+        total = other["local_stiffness_total_Nm_per_rad"]
+        np.testing.assert_allclose(total, landscape["local_stiffness_total_Nm_per_rad"], rtol=1e-6)
+        # the joint optimum: its objective (global + local, local.cost_weight = 1) is unique, its split
+        # between the two nearly flat (1e-5 relative between solvers)
+        cost = other["joint_global_pcsa_cm2"] + other["joint_local_pcsa_cm2"]
+        expected = landscape["joint_global_pcsa_cm2"] + landscape["joint_local_pcsa_cm2"]
+        np.testing.assert_allclose(cost, expected, rtol=1e-6)
+        np.testing.assert_allclose(other["joint_local_pcsa_cm2"], landscape["joint_local_pcsa_cm2"], rtol=1e-4)
 
 
 def test_netcdf_round_trip(landscape, model, tmp_path):
@@ -185,6 +204,41 @@ def test_describe_warns_of_inaccurate_points():
     assert "WARNING" not in sweep.describe(ds)
     ds["status"][0] = "optimal_inaccurate"
     assert "WARNING: 1 inaccurate (status optimal_inaccurate" in sweep.describe(ds)
+
+
+def test_local_stiffness_is_the_chain_sdp_at_the_chosen_activation(landscape, model):
+    """local_stiffness_Nm_per_rad: optimise.coupled.least_local_stiffness (cvxpy, per point) at the point's
+    PCSA; at A it is 391 N m/rad in total (docs/chain.md, the table of the finding), and every k makes
+    diag(k) - K >= mu I by numpy's eigvalsh."""
+    here = landscape.sel(E=0.04, Lambda=0.03)
+    pcsa = here["pcsa_cm2"].values * 1e-4
+    expected = least_local_stiffness(model, 0.04, 0.03, pcsa).local_stiffness
+    assert float(here["local_stiffness_total_Nm_per_rad"]) == pytest.approx(expected.sum(), rel=1e-6)
+    assert landscape["local_stiffness_Nm_per_rad"].dims == ("E", "Lambda", "segment")
+    stiffness = chain.chain_coefficients(model, 0.04, 0.03).stiffness(pcsa)
+    margin = np.linalg.eigvalsh(np.diag(here["local_stiffness_Nm_per_rad"].values) - stiffness)[0]
+    assert margin >= model.optimisation.stability_margin * (1 - 1e-9)
+    at_a = float(landscape["local_stiffness_total_Nm_per_rad"].sel(E=0.0, Lambda=0.0))
+    assert at_a == pytest.approx(391, abs=0.5)
+
+
+def test_the_chains_sdps_only_on_request(landscape):
+    """Without coupled=True a sweep has every variable but the SDPs of schema.ON_REQUEST, the same values."""
+    plain = sweep.sweep(Model(), E_AXIS, L_AXIS, progress=False)
+    assert set(plain.data_vars) == set(schema.VARIABLES) - set(schema.ON_REQUEST)
+    xr.testing.assert_identical(plain, landscape.drop_vars(schema.ON_REQUEST))
+
+
+def test_joint_optimum_is_the_chain_sdp(landscape, model):
+    """joint_*_pcsa_cm2: optimise.coupled.joint_optimum (cvxpy, per point); at A 33.0 cm^2 global and
+    13.2 cm^2 local (docs/chain.md, the finding), less in total than the paper's 63.7 cm^2 of global muscle."""
+    here = landscape.sel(E=0.0, Lambda=0.0)
+    expected = joint_optimum(model, 0.0, 0.0)
+    cost = float(here["joint_global_pcsa_cm2"] + here["joint_local_pcsa_cm2"])
+    assert cost == pytest.approx((expected.total_pcsa + expected.total_local_pcsa) * 1e4, rel=1e-6)
+    assert float(here["joint_global_pcsa_cm2"]) == pytest.approx(33.0, abs=0.05)
+    assert float(here["joint_local_pcsa_cm2"]) == pytest.approx(13.2, abs=0.05)
+    assert cost < float(here["min_pcsa_cm2"])
 
 
 def test_coupled_margin_is_that_of_the_chain_at_the_chosen_activation(landscape, model):

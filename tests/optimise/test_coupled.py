@@ -12,10 +12,12 @@ import scipy.linalg
 from spinectl import load_preset, optimise
 from spinectl.errors import ParameterError
 from spinectl.model import chain
+from spinectl.model.checks import checked_coefficients
 from spinectl.model.mechanics import segment_coefficients
 from spinectl.model.params import Body, Passive
 from spinectl.model.stability import segment_stability
 from spinectl.optimise import coupled
+from spinectl.optimise.problem import inequalities, problem_data
 
 LOWER = 1 - 1e-4
 """Lowering an optimum's objective by 1e-4 relative must leave the feasible set."""
@@ -267,3 +269,43 @@ def test_coupled_stability_dict_has_the_units_in_its_keys():
     assert np.shape(document["eigenvalues"]) == (10, 2) and document["self_stable"] is False
     assert document["local_stiffness_total_Nm_per_rad"] == pytest.approx(sum(document["local_stiffness_Nm_per_rad"]))
     assert document["margin_Nm_per_rad"] == pytest.approx(result.margin)
+
+
+def test_stacked_least_local_stiffness_is_the_per_point_sdp():
+    """The stacked Clarabel problem (one PSD cone per point) against one cvxpy SDP per point, on random
+    symmetric matrices of the chain's size and scale: the same optimum (total) to 1e-6 relative, every k
+    feasible by numpy's eigvalsh, and a NaN matrix gives NaN without disturbing the others."""
+    rng = np.random.default_rng(12)
+    a = rng.normal(scale=60.0, size=(12, 5, 5))
+    matrices = (a + np.swapaxes(a, -1, -2)) / 2
+    matrices[4] = np.nan
+    status, k = coupled.least_local_stiffness_stacked(matrices, 0.1, 1e-9)
+    assert status == "optimal" and np.isnan(k[4]).all()
+    for i in (0, 1, 2, 3, 5, 6, 7, 8, 9, 10, 11):
+        _, reference = coupled.least_local_stiffness_at(matrices[i], 0.1, 1e-9)
+        assert k[i].sum() == pytest.approx(reference.sum(), rel=1e-6)
+        assert np.linalg.eigvalsh(np.diag(k[i]) - matrices[i])[0] >= 0.1 * (1 - 1e-9)
+        assert np.all(k[i] >= 0)
+
+
+@pytest.mark.parametrize("activation", ["paired", "independent"])
+def test_stacked_joint_optimum_is_the_per_point_sdp(activation):
+    """Problem (c) for four points as one Clarabel problem against joint_optimum_sdp (cvxpy) per point:
+    the same objective to 1e-6, the LMI diag(k) - K(x) >= mu I by numpy's eigvalsh, x within its rows."""
+    model = load_preset("wagner2012")
+    model = model.replace(optimisation=dataclasses.replace(model.optimisation, activation=activation))
+    e, lam = np.array([0.0, 0.03, 0.08, 0.05]), np.array([0.0, 0.04, 0.0, 0.08])
+    data = problem_data(model, checked_coefficients(model, e, lam))
+    kappa = chain.local_stiffness_per_pcsa(model) * 1e-4
+    status, x, k = coupled.joint_optimum_stacked(
+        data, chain.chain_coefficients(model, e, lam), 0.1, kappa, model.local.cost_weight
+    )
+    assert status == "optimal"
+    lhs, rhs = inequalities(data)
+    for i in range(e.size):
+        point = coupled.coupled_data(model, e[i], lam[i])
+        _, x_ref, k_ref = coupled.joint_optimum_sdp(point)
+        cost = data.weights @ x[i] + k[i].sum() / kappa
+        assert cost == pytest.approx(data.weights @ x_ref + k_ref.sum() / kappa, rel=1e-6)
+        assert chain.coupled_margin(point.matrix(x[i], k[i])) >= 0.1 * (1 - 1e-9)
+        assert np.all(lhs[i, 5:] @ x[i] <= rhs[i, 5:] + 1e-6)

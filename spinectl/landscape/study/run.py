@@ -41,7 +41,7 @@ from tqdm import tqdm  # plain: tqdm.auto warns in kernels without ipywidgets (a
 from ...errors import ParameterError
 from ...model import config
 from ...model.params import Model
-from .. import columns
+from .. import columns, schema
 from . import store
 from .spec import Study
 
@@ -123,7 +123,8 @@ def solve_chunk(task: Task) -> tuple[int, dict[str, np.ndarray]]:
     """
     model = config.set_parameters(task.model, task.overrides)
     e_grid, l_grid = (a.ravel() for a in np.meshgrid(task.eccentricity, task.lordosis, indexing="ij"))
-    solved, _ = columns.point_columns(model, e_grid, l_grid, chunk_size=e_grid.size)
+    coupled = any(name in schema.ON_REQUEST for name in task.outputs)
+    solved, _ = columns.point_columns(model, e_grid, l_grid, chunk_size=e_grid.size, coupled=coupled)
     return task.index, store.encode(solved, task.outputs, (task.eccentricity.size, task.lordosis.size))
 
 

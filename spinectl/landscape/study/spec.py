@@ -266,7 +266,8 @@ class Study:
     samples : Samples or None
         Monte-Carlo draws (a ``sample`` dimension after the axes), or none.
     outputs : tuple of str
-        Variables of :data:`spinectl.landscape.schema.VARIABLES` to keep (default: all).
+        Variables of :data:`spinectl.landscape.schema.VARIABLES` to keep (default: all but
+        :data:`~spinectl.landscape.schema.ON_REQUEST`, the coupled chain's SDPs).
     chunk_size : int
         Grid points per chunk: tiles of whole rows (every Lambda of some E) where a row fits.
     description : str
@@ -290,7 +291,7 @@ class Study:
     lordosis: tuple
     axes: tuple[Axis, ...] = ()
     samples: Samples | None = None
-    outputs: tuple[str, ...] = tuple(schema.VARIABLES)
+    outputs: tuple[str, ...] = tuple(name for name in schema.VARIABLES if name not in schema.ON_REQUEST)
     chunk_size: int = DEFAULT_CHUNK_POINTS
     description: str = ""
     text: str = field(default="", compare=False)

@@ -1,0 +1,250 @@
+"""Reflex margins of the whole chain at one configuration: ``spinectl margins --coupled`` (docs/chain.md).
+
+The operating point is that of ``spinectl margins`` (``reflex.activation`` times the per-segment
+optimum, :func:`spinectl.reflex.margins.operating_point`); the chain's matrices there come from
+:func:`spinectl.optimise.coupled.coupled_stability_at`; the diagonal gains from the rule
+:func:`spinectl.reflex.gains.chain_gains` (or ``reflex.kp``, ``reflex.kd``, or the options); the
+exact delay margin from :func:`spinectl.reflex.mimo.chain_delay_margin`, its Padé estimate from
+:func:`~spinectl.reflex.mimo.pade_margin`, the disk margins of the Padé loop from
+:func:`spinectl.reflex.chain_system.chain_disk_margins`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..model.checks import arithmetic_guard
+from ..model.params import Model
+from ..optimise.coupled import CoupledStability, coupled_stability_at
+from .chain_system import DiskMargins, chain_disk_margins, chain_loop
+from .gains import chain_gains
+from .margins import operating_point
+from .mimo import chain_delay_margin, highest_crossing, pade_margin
+from .siso import LoopDelayMargin
+
+DISK_POINTS = 600
+"""Frequencies of the disk-margin sweep, log-spaced from 0.01 rad/s to ten times the highest crossing."""
+
+
+def stable_at(exact: LoopDelayMargin, delay: float) -> bool:
+    """Is the loop stable at ``delay``? Count the root pairs that crossed on [0, delay).
+
+    Each critical delay below ``delay`` moves a pair of roots across the imaginary axis in its
+    direction (:meth:`~spinectl.reflex.siso.LoopDelayMargin.critical_delays`); stable iff stable
+    without delay and none is left on the right.
+
+    Parameters
+    ----------
+    exact : LoopDelayMargin
+    delay : float
+        tau [s].
+
+    Returns
+    -------
+    bool
+    """
+    if not exact.stable_without_delay:
+        return False
+    if exact.margin == np.inf:
+        return True
+    return sum(d for t, _, d in exact.critical_delays(delay) if t < delay) == 0 and exact.margin != delay
+
+
+@dataclass(frozen=True)
+class CoupledMargins:
+    """The chain under the diagonal delayed reflex at one configuration.
+
+    Attributes
+    ----------
+    chain : CoupledStability
+        The matrices, the least local stiffness and the eigenvalues at the operating point.
+    activation : float
+        Fraction of the per-segment minimum PCSA [1].
+    delay : float
+        tau [s].
+    activation_time_constant : float
+        T_a [s].
+    pade_order : int
+    gains : str
+        'rule' (:func:`spinectl.reflex.gains.chain_gains`) or 'explicit'.
+    kp, kd : numpy.ndarray, shape (n_cor,)
+        [N m/rad], [N m s/rad].
+    exact : LoopDelayMargin
+        The exact delay margin and the crossings (:func:`spinectl.reflex.mimo.chain_delay_margin`).
+    delay_margin_pade : float
+        The Padé loop's delay margin [s].
+    stable_at_delay : bool
+        The true-delay loop is stable at ``delay``.
+    disk : DiskMargins or None
+        Of the Padé loop at ``delay``; None where that loop is unstable (no margin to speak of).
+    """
+
+    chain: CoupledStability
+    activation: float
+    delay: float
+    activation_time_constant: float
+    pade_order: int
+    gains: str
+    kp: np.ndarray
+    kd: np.ndarray
+    exact: LoopDelayMargin
+    delay_margin_pade: float
+    stable_at_delay: bool
+    disk: DiskMargins | None
+
+    def to_dict(self, model: Model) -> dict:
+        """The document of ``spinectl margins --coupled --json``.
+
+        Parameters
+        ----------
+        model : Model
+            The model of the result.
+
+        Returns
+        -------
+        dict
+            :meth:`CoupledStability.to_dict <spinectl.optimise.coupled.CoupledStability.to_dict>`
+            with ``delay_s``, ``activation_time_constant_s``, ``pade_order``, ``activation`` and
+            ``gains``, and under ``coupled`` also ``kp_Nm_per_rad``, ``kd_Nms_per_rad`` (per joint),
+            ``delay_margin_s``, ``delay_margin_status``, ``delay_margin_frequency_rad_s``,
+            ``delay_margin_pade_s``, ``disk_margin``, ``disk_gain_margin`` (a factor),
+            ``disk_phase_margin_deg``, ``disk_loop_at_a_time`` (per joint: ``disk_margin``,
+            ``disk_gain_margin``, ``disk_phase_margin_deg``) and ``stable_at_delay``; the disk
+            margins NaN where the loop is unstable at the delay.
+        """
+        out = self.chain.to_dict(model, pcsa_source="min_pcsa")
+        out.update(
+            delay_s=self.delay,
+            activation_time_constant_s=self.activation_time_constant,
+            pade_order=self.pade_order,
+            activation=self.activation,
+            gains=self.gains,
+        )
+        disk = self.disk
+        single = np.full((len(self.kp), 3), np.nan) if disk is None else disk.loop_at_a_time
+        out["coupled"].update(
+            kp_Nm_per_rad=self.kp.tolist(),
+            kd_Nms_per_rad=self.kd.tolist(),
+            delay_margin_s=float(self.exact.margin),
+            delay_margin_status=self.exact.status,
+            delay_margin_frequency_rad_s=float(self.exact.frequency),
+            delay_margin_pade_s=float(self.delay_margin_pade),
+            disk_margin=np.nan if disk is None else disk.disk_margin,
+            disk_gain_margin=np.nan if disk is None else disk.gain_margin,
+            disk_phase_margin_deg=np.nan if disk is None else disk.phase_margin_deg,
+            disk_loop_at_a_time=[
+                {"disk_margin": a, "disk_gain_margin": g, "disk_phase_margin_deg": p} for a, g, p in single.tolist()
+            ],
+            stable_at_delay=self.stable_at_delay,
+        )
+        return out
+
+    def table(self, model: Model) -> str:
+        """The chain's table (:meth:`CoupledStability.table`) and the reflex's margins.
+
+        Parameters
+        ----------
+        model : Model
+
+        Returns
+        -------
+        str
+            Text, no final newline.
+        """
+        exact, disk = self.exact, self.disk
+        margin = {np.inf: "unbounded"}.get(exact.margin, f"{exact.margin * 1000:.4g} ms")
+        where = f" at {exact.frequency:.4g} rad/s" if np.isfinite(exact.frequency) else ""
+        lines = [
+            self.chain.table(model),
+            "",
+            f"delayed reflex on the chain: activation {self.activation:g} x minimum PCSA, delay {self.delay:g} s, "
+            f"activation lag {self.activation_time_constant:g} s, gains: {self.gains}",
+            f"{'joint':8} {'kp [N m/rad]':>13} {'kd [N m s/rad]':>15} {'disk alpha':>11} {'GM':>9} {'PM[deg]':>8}",
+        ]
+        single = np.full((len(self.kp), 3), np.nan) if disk is None else disk.loop_at_a_time
+        for name, kp, kd, (a, g, p) in zip(self.chain.segment_names, self.kp, self.kd, single, strict=True):
+            lines.append(f"{name:8} {kp:13.3f} {kd:15.4f} {a:11.3f} {g:9.4g} {p:8.2f}")
+        lines += [
+            f"exact delay margin {margin}{where} ({exact.status}); Pade order {self.pade_order}: "
+            f"{self.delay_margin_pade * 1000:.4g} ms",
+            f"stable at the delay: {'yes' if self.stable_at_delay else 'NO'}",
+            "multiloop disk margin: "
+            + (
+                "none (the loop is unstable at the delay)"
+                if disk is None
+                else f"alpha {disk.disk_margin:.3f}, gain factor {disk.gain_margin:.3f}, "
+                f"phase {disk.phase_margin_deg:.2f} deg (per joint, the others closed: the table)"
+            ),
+        ]
+        return "\n".join(lines)
+
+
+def coupled_margins(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None) -> CoupledMargins:
+    """The chain's reflex margins with the settings of ``model.reflex`` (see the module).
+
+    Parameters
+    ----------
+    model : Model
+    eccentricity, lordosis : float
+        E and Lambda [m].
+    kp, kd : float, optional
+        One gain for every joint [N m/rad], [N m s/rad], replacing the configured or rule's.
+
+    Returns
+    -------
+    CoupledMargins
+
+    Raises
+    ------
+    ModelError
+        No per-segment optimum at (E, Lambda), or the mass matrix is singular.
+    ParameterError
+        E or Lambda out of range.
+
+    References
+    ----------
+    Seiler P, Packard A, Gahinet P (2020). An introduction to disk margins. IEEE Control
+    Systems Magazine 40(5):78-95. doi:10.1109/MCS.2020.3005277.
+    """
+    settings = model.reflex
+    point = operating_point(model, eccentricity, lordosis, settings.activation)
+    pcsa = point.pcsa if point.ok else None  # None: coupled_stability_at says why there is no optimum
+    chain = coupled_stability_at(model, eccentricity, lordosis, pcsa)
+    lag = settings.activation_time_constant
+    n = len(chain.segment_names)
+    if settings.gains == "rule":
+        kp0, kd0 = chain_gains(
+            chain.mass, chain.stiffness, chain.damping, chain.local.local_stiffness,
+            settings.gain_factor, settings.damping_ratio, lag,
+        )  # fmt: skip
+    else:
+        kp0, kd0 = np.full(n, settings.kp), np.full(n, settings.kd)
+    kp = kp0 if kp is None else np.full(n, float(kp))
+    kd = kd0 if kd is None else np.full(n, float(kd))
+    with arithmetic_guard(eccentricity, lordosis):  # gains or delays orders of magnitude off: a ModelError
+        exact = chain_delay_margin(chain.mass, chain.stiffness, chain.damping, kp, kd, lag)
+    stable = stable_at(exact, settings.delay)
+    disk = None
+    if stable:
+        loop = chain_loop(
+            chain.mass, chain.stiffness, chain.damping, kp, kd, settings.delay, settings.pade_order, lag,
+            chain.segment_names,
+        )  # fmt: skip
+        top = highest_crossing(chain.mass, chain.stiffness, chain.damping, kp, kd)
+        disk = chain_disk_margins(loop, np.logspace(-2, np.log10(10.0 * top), DISK_POINTS))
+    return CoupledMargins(
+        chain=chain,
+        activation=settings.activation,
+        delay=settings.delay,
+        activation_time_constant=lag,
+        pade_order=settings.pade_order,
+        gains=settings.gains,
+        kp=np.asarray(kp, float),
+        kd=np.asarray(kd, float),
+        exact=exact,
+        delay_margin_pade=pade_margin(exact, settings.pade_order),
+        stable_at_delay=stable,
+        disk=disk,
+    )

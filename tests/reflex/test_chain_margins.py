@@ -1,0 +1,85 @@
+"""``spinectl margins --coupled``'s library call: the chain at the operating point of ``margins`` (docs/chain.md)."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+
+import control as ct
+import numpy as np
+
+from spinectl.cli import main
+from spinectl.model import config
+from spinectl.reflex.chain_margins import coupled_margins
+from spinectl.reflex.chain_system import chain_loop
+
+KEYS = (
+    "stiffness_matrix_Nm_per_rad",
+    "gravity_stiffness_matrix_Nm_per_rad",
+    "stiffness_matrix_per_cm2",
+    "damping_matrix_Nms_per_rad",
+    "mass_matrix_kgm2",
+    "pcsa_cm2",
+    "local_stiffness_Nm_per_rad",
+    "margin_Nm_per_rad",
+    "eigenvalues",
+    "self_stable",
+    "kp_Nm_per_rad",
+    "kd_Nms_per_rad",
+    "delay_margin_s",
+    "delay_margin_pade_s",
+    "disk_gain_margin",
+    "disk_phase_margin_deg",
+    "stable_at_delay",
+)
+
+
+def _model(**reflex):
+    model = config.load_preset("wagner2012")
+    return model.replace(reflex=dataclasses.replace(model.reflex, **reflex))
+
+
+def _pade_closed_loop_stable(result, model):
+    c = result.chain
+    loop = chain_loop(
+        c.mass, c.stiffness, c.damping, result.kp, result.kd, result.delay, 6, result.activation_time_constant,
+        c.segment_names,
+    )  # fmt: skip
+    return bool(np.all(ct.feedback(loop, ct.ss([], [], [], np.eye(5))).poles().real < 0))
+
+
+def test_at_the_papers_delay_the_chain_is_unstable(capsys):
+    """delay 0.1 s: the rule's reflex cannot hold the chain (its unstable modes grow in 10-65 ms);
+    python-control's Padé closed loop (order 6) agrees; no disk margin. The JSON has the issue's keys."""
+    assert main(["margins", "--coupled", "--delay", "0.1", "--preset", "wagner2012", "--json"]) == 0
+    printed = json.loads(capsys.readouterr().out)
+    assert set(KEYS) <= set(printed["coupled"])
+    model = _model(delay=0.1)
+    result = coupled_margins(model, 0.0, 0.0)
+    assert printed == json.loads(json.dumps(result.to_dict(model)))  # NaN survives as NaN
+    assert result.stable_at_delay is False and result.exact.margin < 0.1
+    assert _pade_closed_loop_stable(result, model) is False
+    assert np.isnan(printed["coupled"]["disk_gain_margin"])
+
+
+def test_below_the_margin_the_loop_is_stable_with_disk_margins():
+    """At half the exact margin the loop is stable (python-control's Padé closed loop too) and the disk
+    margins exist: 0 < alpha < 2, the loop-at-a-time margins never below the multiloop one."""
+    probe = coupled_margins(_model(activation_time_constant=0.0), 0.0, 0.0)
+    model = _model(activation_time_constant=0.0, delay=0.5 * probe.exact.margin)
+    result = coupled_margins(model, 0.0, 0.0)
+    assert result.stable_at_delay and _pade_closed_loop_stable(result, model)
+    assert 0 < result.disk.disk_margin < 2
+    assert np.all(result.disk.loop_at_a_time[:, 0] >= result.disk.disk_margin * (1 - 1e-6))
+    assert "exact delay margin" in result.table(model)
+
+
+def test_command_line_errors_are_one_line(capsys):
+    """--plot has no chain version; gains orders of magnitude off overflow: exit 2, one line, no traceback."""
+    for argv, field in (
+        (["margins", "--coupled", "--plot", "out"], "--plot"),
+        (["margins", "--coupled", "--kp", "1e300"], "arithmetic"),
+    ):
+        assert main(argv) == 2
+        err = capsys.readouterr().err
+        assert field in err and len(err.strip().splitlines()) == 1 and "Traceback" not in err

@@ -1,0 +1,134 @@
+"""The exact delay margin of the chain under the diagonal delayed reflex (docs/chain.md, "The delayed reflex")."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import control as ct
+import numpy as np
+import pytest
+
+from spinectl import load_preset, reflex
+from spinectl.errors import ParameterError
+from spinectl.reflex.chain_system import chain_disk_margins, chain_loop
+from spinectl.reflex.gains import chain_gains, default_gains
+from spinectl.reflex.mimo import chain_delay_margin, delay_free_poles, pade_margin
+from spinectl.reflex.simulate import ChainPlant, simulate_chain
+
+# five uncoupled segments: S, D, theta and gains of mixed kinds (self-stable, unstable, no kp)
+S = np.array([-30.0, 10.0, 25.0, -5.0, 40.0])
+D = np.array([-1.0, -2.0, -0.5, -1.5, -3.0])
+THETA = np.array([2.0, 1.5, 1.0, 0.8, 2.5])
+KP = np.array([20.0, 30.0, 50.0, 0.0, 80.0])
+KD = np.array([5.0, 6.0, 4.0, 3.0, 10.0])
+
+
+def _coupled(seed=3, n=3):
+    """A non-diagonal chain: M positive definite, K with an unstable mode, D negative semidefinite."""
+    rng = np.random.default_rng(seed)
+    a, b, c = (rng.normal(size=(n, n)) for _ in range(3))
+    mass = a @ a.T + 0.5 * np.eye(n)
+    stiffness = 5.0 * (b + b.T) + np.diag(np.linspace(20.0, 10.0, n))
+    damping = -0.3 * c @ c.T
+    kp = np.full(n, 1.5 * np.linalg.eigvalsh(stiffness)[-1])
+    return mass, stiffness, damping, kp, np.full(n, 15.0)
+
+
+@pytest.mark.parametrize("lag", [0.0, 0.05])
+def test_diagonal_chain_is_the_smallest_segment_margin(lag):
+    """Diagonal M, K, D: det factorises into the segments' quasi-polynomials, so the chain's margin is
+    the smallest of reflex.delay_margin's closed forms (docs/reflex.md), to rounding."""
+    exact = chain_delay_margin(np.diag(THETA), np.diag(S), np.diag(D), KP, KD, lag)
+    segments = reflex.delay_margin(S, D, THETA, KP, KD, lag)
+    assert exact.status == "finite"
+    np.testing.assert_allclose(exact.margin, np.min(segments.margin), rtol=1e-10)
+    # every segment's destabilising first crossing is found, at its own frequency
+    finite = np.isfinite(segments.margin) & (segments.margin > 0)
+    first = sorted(t for t, _, d in exact.critical_delays(1.0) if d > 0)
+    for tau in segments.margin[finite]:
+        assert min(abs(np.array(first) - tau)) <= 1e-10 * tau
+
+
+def test_delay_free_poles_solve_the_characteristic_equation():
+    """Each root s of the lagged closed loop makes det((T_a s + 1)(M s^2 - D s - K) + K_p + K_d s) vanish."""
+    mass, stiffness, damping, kp, kd = _coupled()
+    for s in delay_free_poles(mass, stiffness, damping, kp, kd, 0.05):
+        t = (0.05 * s + 1) * (mass * s**2 - damping * s - stiffness) + np.diag(kp + kd * s)
+        singular = np.linalg.svd(t, compute_uv=False)
+        assert singular[-1] <= 1e-9 * singular[0]
+
+
+@pytest.mark.parametrize("lag", [0.0, 0.05])
+def test_crossing_is_a_root_on_the_axis(lag):
+    """At tau = margin, s = j w_c is a root: det(P(j w) + Q(j w) e^{-j w tau}) = 0 (smallest singular value)."""
+    mass, stiffness, damping, kp, kd = _coupled()
+    exact = chain_delay_margin(mass, stiffness, damping, kp, kd, lag)
+    s = 1j * exact.frequency
+    t = (lag * s + 1) * (mass * s**2 - damping * s - stiffness) + np.diag(kp + kd * s) * np.exp(-s * exact.margin)
+    singular = np.linalg.svd(t, compute_uv=False)
+    assert singular[-1] <= 1e-10 * singular[0]
+
+
+def test_pade_margins_converge_and_python_control_agrees():
+    """The Padé margin approaches the exact one with the order (error 3e-2, 2e-4, 5e-7, <1e-11 at orders
+    1, 2, 3, 5 here), and python-control's closed loop of chain_loop at that delay has a pole at j w_c:
+    a second computation of the same crossing."""
+    mass, stiffness, damping, kp, kd = _coupled()
+    exact = chain_delay_margin(mass, stiffness, damping, kp, kd, 0.05)
+    errors = []
+    for order in (1, 2, 3, 5):
+        tau = pade_margin(exact, order)
+        errors.append(abs(tau - exact.margin) / exact.margin)
+        loop = chain_loop(mass, stiffness, damping, kp, kd, tau, order, 0.05, ["a", "b", "c"])
+        poles = ct.feedback(loop, ct.ss([], [], [], np.eye(3))).poles()
+        assert np.min(np.abs(poles - 1j * exact.frequency)) <= 1e-6 * exact.frequency
+    assert all(np.diff(errors) < 0) and errors[-1] < 1e-9
+
+
+def test_simulation_with_the_true_delay_turns_unstable_at_the_margin():
+    """The linear chain integrated with the true delay (RK4 and Hermite history of reflex.simulate):
+    stable 1 % below the exact margin, unstable 1 % above; a batched bisection bracket around it."""
+    mass, stiffness, damping, kp, kd = _coupled()
+    exact = chain_delay_margin(mass, stiffness, damping, kp, kd, 0.05)
+    settings = dataclasses.replace(
+        load_preset("default").reflex, sim_duration=3.0, sim_time_step=0.002, activation_time_constant=0.05
+    )
+    delays = exact.margin * np.array([0.9, 0.99, 1.01, 1.1])
+    _, stable = simulate_chain(ChainPlant(mass, stiffness, damping), kp, kd, delays, settings, [0.01, -0.02, 0.015])
+    assert stable.tolist() == [True, True, False, False]
+
+
+def test_chain_rule_is_the_segment_rule_on_a_diagonal_chain():
+    """With k = max(S, 0), the segment's deficit, chain_gains gives default_gains of every segment."""
+    kp, kd = chain_gains(np.diag(THETA), np.diag(S), np.diag(D), np.maximum(S, 0.0), 1.5, 1.0, 0.05)
+    kp0, kd0 = default_gains(S, D, THETA, 1.5, 1.0, 0.05)
+    np.testing.assert_allclose(kp, kp0, rtol=1e-15)
+    np.testing.assert_allclose(kd, kd0, rtol=1e-15)
+
+
+def test_disk_margins_of_one_joint_are_the_siso_margin():
+    """n = 1: multiloop and loop-at-a-time disk margins are the SISO balanced disk margin,
+    1 / max_w abs(S(jw) - 1/2) with S = 1 / (1 + L) (Seiler et al. 2020, eq. for skew 0), computed here
+    from the loop's frequency response."""
+    loop = chain_loop([[2.0]], [[-30.0]], [[-1.5]], [10.0], [2.0], 0.02, 4, 0.0, ["L3L4"])
+    omega = np.logspace(-2, 3, 2000)
+    margins = chain_disk_margins(loop, omega)
+    response = loop(1j * omega).ravel()
+    alpha = 1.0 / np.max(np.abs(1.0 / (1.0 + response) - 0.5))
+    np.testing.assert_allclose([margins.disk_margin, margins.loop_at_a_time[0, 0]], alpha, rtol=1e-6)
+    np.testing.assert_allclose(margins.gain_margin, (1 + alpha / 2) / (1 - alpha / 2), rtol=1e-6)
+
+
+def test_bad_shapes_name_the_argument():
+    with pytest.raises(ParameterError, match="kp"):
+        chain_delay_margin(np.eye(2), np.eye(2), np.eye(2), [1.0, 2.0, 3.0], [1.0, 1.0])
+    with pytest.raises(ParameterError, match="stiffness"):
+        chain_delay_margin(np.eye(2), np.eye(3), np.eye(2), 1.0, 1.0)
+
+
+def test_nan_is_undefined_and_unstable_without_delay_is_zero():
+    nan = chain_delay_margin(np.eye(2), np.full((2, 2), np.nan), np.eye(2), 1.0, 1.0)
+    assert nan.status == "undefined" and np.isnan(nan.margin)
+    # K_p - K not positive definite: a static root in the right half-plane at tau = 0
+    weak = chain_delay_margin(np.eye(2), np.diag([10.0, 10.0]), -np.eye(2), [5.0, 20.0], [1.0, 1.0])
+    assert weak.status == "unstable_without_delay" and weak.margin == 0.0
