@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import dataclasses
 import json
 
 import control as ct
@@ -35,8 +34,8 @@ KEYS = (
 
 
 def _model(**reflex):
-    model = config.load_preset("wagner2012")
-    return model.replace(reflex=dataclasses.replace(model.reflex, **reflex))
+    """wagner2012 with reflex fields set as the CLI sets them (so its provenance names them as overridden)."""
+    return config.set_parameters(config.load_preset("wagner2012"), {f"reflex.{k}": v for k, v in reflex.items()})
 
 
 def _pade_closed_loop_stable(result, model):
