@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -493,7 +494,7 @@ def test_a_lost_chunk_file_is_refused_on_load_and_recomputed_on_resume(reference
     study.run_study(parsed, out, scheduler="synchronous", progress=False)
     assert parsed.chunk(5).combination == (0, 1) and parsed.chunk(5).eccentricity == slice(4, 6)
     delete_chunk_file(out, "min_pcsa_cm2", "0.1.2.0")
-    with pytest.raises(ParameterError, match=r"1 chunk\(s\) counted done have lost their data \(chunk 5\)"):
+    with pytest.raises(ParameterError, match=r"1 chunk\(s\) counted done have lost their data .*\(chunk 5\)"):
         study.load(out)
     notes = []
     result = study.run_study(parsed, out, scheduler="synchronous", resume=True, progress=False, notify=notes.append)
@@ -503,6 +504,49 @@ def test_a_lost_chunk_file_is_refused_on_load_and_recomputed_on_resume(reference
     del group.attrs[study_store.CHUNK_FILES]
     delete_chunk_file(out, "min_pcsa_cm2", "0.1.2.0")
     assert np.isnan(study.open_store(out)["min_pcsa_cm2"].values).sum() == TILE_POINTS
+
+
+def test_a_chunk_file_with_other_bytes_is_refused_on_load_and_recomputed_on_resume(reference, tmp_path):
+    """A chunk file present but not as written (a byte appended, as a partial or foreign copy would leave):
+    its CRC-32 differs from the one recorded with its count (presence alone would pass it)."""
+    parsed, out = study.parse_study(STUDY), tmp_path / "s.zarr"
+    study.run_study(parsed, out, scheduler="synchronous", progress=False)
+    with (out / "status" / "0.1.2.0").open("ab") as file:  # chunk 5, as in the test above
+        file.write(b"x")
+    with pytest.raises(ParameterError, match=r"1 chunk\(s\) .* hold other bytes than written \(chunk 5\)"):
+        study.load(out)
+    notes = []
+    result = study.run_study(parsed, out, scheduler="synchronous", resume=True, progress=False, notify=notes.append)
+    assert (result.done_before, result.computed) == (11, 1) and "computing it again" in notes[0]
+    xr.testing.assert_identical(study.load(out), reference)
+
+
+@pytest.mark.parametrize(
+    ("lost", "needle"),
+    [
+        ("min_pcsa_cm2/.zarray", "array 'min_pcsa_cm2': its metadata is lost"),  # the .zmetadata still lists it
+        ("E/0", "array 'E': its values are not those written"),  # a coordinate's chunk: read as fill values
+        ("K/0", "array 'K': its values are not those written"),
+        ("status/.zattrs", "array 'status': its attributes (the dimensions' names) are lost"),
+        ("chunk_done/.zarray", "array 'chunk_done': its metadata is lost"),
+    ],
+)
+def test_a_store_with_lost_metadata_or_coordinates_is_refused_in_one_line(tmp_path, capsys, lost, needle):
+    """Loading and resuming a store that lost an array's metadata or a coordinate's chunk: one line, exit 2.
+
+    Before, both passed: the loader read the coordinate E as NaN (or dropped the array), and
+    ``--resume`` found every chunk done.
+    """
+    path, out = write(tmp_path), tmp_path / "s.zarr"
+    arguments = ["study", str(path), "--out", str(out), "--scheduler", "synchronous", "--max-chunks", "3"]
+    assert main(arguments) == 0
+    (out / lost).unlink()
+    with pytest.raises(ParameterError, match=re.escape(needle)):
+        study.load(out)
+    capsys.readouterr()
+    assert main([*arguments, "--resume"]) == 2
+    err = capsys.readouterr().err
+    assert len(err.splitlines()) == 1 and needle in err and "remove it and run the study afresh" in err
 
 
 def test_an_all_nan_chunk_is_still_a_file(tmp_path):
