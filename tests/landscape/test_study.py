@@ -549,6 +549,40 @@ def test_a_store_with_lost_metadata_or_coordinates_is_refused_in_one_line(tmp_pa
     assert len(err.splitlines()) == 1 and needle in err and "remove it and run the study afresh" in err
 
 
+def test_resume_of_a_store_the_user_cannot_write_is_one_line(tmp_path, capsys, monkeypatch):
+    """A store the user may read but not write (another user's, read-only, immutable): exit 2, one line,
+    before any chunk is solved (before: a PermissionError traceback at the first chunk written).
+
+    Without root, the store's folders lose their write permission; as root (which permissions do
+    not stop) the making of a file inside the store fails as it would there.
+    """
+    path, out = write(tmp_path), tmp_path / "s.zarr"
+    arguments = ["study", str(path), "--out", str(out), "--scheduler", "synchronous"]
+    assert main([*arguments, "--max-chunks", "3"]) == 0
+    folders = [out, *(p for p in out.iterdir() if p.is_dir())]
+    real = study_store.tempfile.mkstemp
+
+    def refused(*args, dir=None, **kwargs):
+        if Path(dir).is_relative_to(out):
+            raise PermissionError(13, "Permission denied")
+        return real(*args, dir=dir, **kwargs)
+
+    if os.geteuid() == 0:
+        monkeypatch.setattr(study_store.tempfile, "mkstemp", refused)
+    for folder in folders:
+        folder.chmod(0o555)
+    try:
+        files = sorted(p.relative_to(out) for p in out.rglob("*"))
+        capsys.readouterr()
+        assert main([*arguments, "--resume"]) == 2
+        err = capsys.readouterr().err
+        assert err.startswith("spinectl: error: cannot write ") and "Permission denied" in err
+        assert len(err.splitlines()) == 1 and sorted(p.relative_to(out) for p in out.rglob("*")) == files
+    finally:
+        for folder in folders:
+            folder.chmod(0o755)
+
+
 def test_an_all_nan_chunk_is_still_a_file(tmp_path):
     """A chunk whose values are all fill values (every point infeasible: pcsa_max tiny) is written as a file.
 

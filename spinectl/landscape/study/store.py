@@ -31,6 +31,7 @@ import contextlib
 import json
 import os
 import socket
+import tempfile
 import warnings
 import zlib
 from collections.abc import Callable, Iterator
@@ -207,7 +208,7 @@ def existing(
     Raises
     ------
     OutputError
-        The store exists and ``resume`` is false.
+        The store exists and ``resume`` is false, or it cannot be written (read-only, immutable, not the user's).
     ParameterError
         ``resume`` and the path holds no study store, or one of another study (field ``store``).
     """
@@ -221,10 +222,25 @@ def existing(
         )
     counts = _done_counts(study, path)
     missing = damaged_chunks(path, counts)
+    _check_writable(path)  # before any work: a read-only store would fail at its first chunk
     if missing.size:
         notify(f"study: {_missing_text(path, missing)}; computing {'it' if missing.size == 1 else 'them'} again")
         counts[missing] = 0
     return counts
+
+
+def _check_writable(path: Path) -> None:
+    """Raise :class:`OutputError` if a file cannot be made in the store or one of its arrays' folders.
+
+    zarr writes each chunk (and the consolidated metadata at the end) to a temporary file
+    in its folder, then renames it: the same is tried here, in every folder, and undone.
+    """
+    for folder in (path, *sorted(p for p in path.iterdir() if p.is_dir())):
+        with output_errors(folder):
+            fd, name = tempfile.mkstemp(prefix=".spinectl-probe.", dir=folder)
+            os.close(fd)
+            os.replace(name, f"{name}.renamed")
+            os.unlink(f"{name}.renamed")
 
 
 def create(study: Study, path: str | Path, probe: dict) -> np.ndarray:
