@@ -638,6 +638,36 @@ def test_a_scheduler_without_workers_stops_after_the_worker_timeout(tmp_path, ca
     assert not (tmp_path / "s.zarr").exists()
 
 
+def test_workers_vanishing_mid_run_stop_the_study_after_the_worker_timeout(reference, tmp_path, capsys):
+    """Every worker of the cluster gone once a chunk is written: one line after --worker-timeout, exit 2,
+    a store that --resume finishes (before: the run waited for ever, silently)."""
+    import threading
+
+    from distributed import LocalCluster
+
+    options = {"processes": False, "protocol": "tcp://", "host": "127.0.0.1", "dashboard_address": None}
+    out = tmp_path / "s.zarr"
+    with LocalCluster(n_workers=1, threads_per_worker=1, **options) as cluster:
+        def stop_the_workers():
+            deadline = time.monotonic() + 120
+            while done_chunks(out) < 1 and time.monotonic() < deadline:
+                time.sleep(0.005)
+            cluster.scale(0)
+
+        threading.Thread(target=stop_the_workers, daemon=True).start()
+        arguments = ["study", str(write(tmp_path)), "--out", str(out), "--scheduler", cluster.scheduler_address]
+        start = time.monotonic()
+        code = main([*arguments, "--worker-timeout", "1"])
+        elapsed = time.monotonic() - start
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and elapsed < 60, (code, elapsed)
+    assert "every worker has gone, and none joined within 1 s" in err[-1] and "--resume" in err[-1]
+    assert 1 <= done_chunks(out) < 12 and not Path(f"{out}.lock").exists()
+    result = study.run_study(study.parse_study(STUDY), out, scheduler="synchronous", resume=True, progress=False)
+    assert result.complete
+    xr.testing.assert_identical(study.load(out), reference)
+
+
 @pytest.mark.parametrize("scheme", ["ucx", "inproc", "tls", "ws", "wss"])
 def test_schemes_spinectl_cannot_use_are_refused_with_the_reason(tmp_path, capsys, scheme):
     address = f"{scheme}://127.0.0.1:8786"
