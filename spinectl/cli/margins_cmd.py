@@ -65,8 +65,8 @@ def model_with_overrides(args):
     Parameters
     ----------
     args : argparse.Namespace
-        Parsed arguments; ``delay`` [s], ``activation_lag`` [s], ``activation``, ``pade_order``, ``kp``,
-        ``kd`` are optional.
+        Parsed arguments; ``delay`` [s], ``activation_lag`` [s], ``activation``, ``pade_order`` are
+        optional (``kp`` and ``kd`` are not parameters of the model here: :func:`analyse` takes them).
 
     Returns
     -------
@@ -78,11 +78,7 @@ def model_with_overrides(args):
         value = getattr(args, option)
         if value is not None:
             model = set_parameter(model, dotted, value)
-    for option in ("kp", "kd"):
-        value = getattr(args, option)
-        if value is not None:
-            set_parameter(model, f"reflex.{option}", value)  # validates: a gain must be >= 0
-    return model
+    return model  # --kp and --kd go to analyse, which checks them
 
 
 def run(args) -> int:
