@@ -67,7 +67,19 @@ def _edited(landscape, how):
         ds = ds.assign(min_pcsa_cm2=ds["min_pcsa_cm2"].isel(Lambda=0, drop=True))
     elif how == "extra_dimension":
         ds = ds.assign(status=ds["status"].expand_dims(run=2))
+    elif how in VALUES:  # one value of a solved point replaced: figures drew it silently
+        name, value = VALUES[how]
+        ds[name].values.flat[4] = value
     return ds
+
+
+VALUES = {
+    "infinite_pcsa": ("min_pcsa_cm2", float("inf")),
+    "negative_pcsa": ("min_pcsa_cm2", -3.0),
+    "negative_muscle_pcsa": ("pcsa_cm2", -1.0),
+    "minus_infinite_torque": ("counter_torque_norm_Nm", float("-inf")),
+    "nan_where_optimal": ("min_pcsa_cm2", float("nan")),
+}
 
 
 FOREIGN = {
@@ -77,6 +89,11 @@ FOREIGN = {
     "nan_coordinate": "coordinate E must be finite",
     "other_dimensions": "min_pcsa_cm2 has dimensions ('K', 'E'), expected ('K', 'E', 'Lambda')",
     "extra_dimension": "status has dimensions ('run', 'K', 'E', 'Lambda')",
+    "infinite_pcsa": "min_pcsa_cm2 must be finite and >= 0 (got inf at 1 value(s))",
+    "negative_pcsa": "min_pcsa_cm2 must be finite and >= 0 (got -3 at 1 value(s))",
+    "negative_muscle_pcsa": "pcsa_cm2 must be finite and >= 0 (got -1 at 1 value(s))",
+    "minus_infinite_torque": "counter_torque_norm_Nm must be finite and >= 0 (got -inf",
+    "nan_where_optimal": "min_pcsa_cm2 must be finite where the status is optimal (got nan",
 }
 
 
