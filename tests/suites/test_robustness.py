@@ -652,10 +652,8 @@ def _full_disk(*args, **kwargs):
         (["plot", "{out}/old.nc", "--out", "{out}"], "matplotlib.figure.Figure.savefig"),
         (["reproduce", "--points", "3", "--out", "{out}"], "matplotlib.figure.Figure.savefig"),
         (["margins", "--plot", "{out}"], "matplotlib.figure.Figure.savefig"),
-        (
-            ["study", "{out}/study.toml", "--out", "{out}/s.zarr", "--scheduler", "synchronous"],
-            "xarray.Dataset.to_zarr",
-        ),
+        (["study", "{out}/study.toml", "--out", "{out}/s.zarr", "--scheduler", "synchronous"],
+         "xarray.Dataset.to_zarr"),
     ],
 )
 def test_a_full_disk_is_one_line_and_keeps_the_previous_files(tmp_path, monkeypatch, capsys, command, patched):
