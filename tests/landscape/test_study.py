@@ -382,6 +382,11 @@ def test_cli_runs_and_resumes_a_study(tmp_path, capsys):
         (["--workers", "0"], "--workers must be >= 1"),
         (["--workers", "100000"], "workers: must be an integer in [1,"),
         (["--max-chunks", "-1"], "--max-chunks must be >= 0"),
+        # addresses without a host or a usable port: before, a wait of 10 s or Python's "invalid literal for int()"
+        (["--scheduler", "tcp://127.0.0.1:99999"], "scheduler: must be tcp://HOST:PORT with a host and a port in"),
+        (["--scheduler", "tcp://127.0.0.1:abc"], "scheduler: must be tcp://HOST:PORT"),
+        (["--scheduler", "tcp://:8786"], "scheduler: must be tcp://HOST:PORT"),
+        (["--scheduler", "tcp://127.0.0.1"], "scheduler: must be tcp://HOST:PORT"),
     ],
 )
 def test_cli_bad_options_are_one_line(tmp_path, capsys, arguments, needle):

@@ -293,6 +293,8 @@ def _check_options(scheduler, workers, max_chunks, timeouts: dict) -> None:
         scheme = str(scheduler).partition("://")[0]
         why = f": {scheme}:// {UNUSABLE_SCHEMES[scheme]}" if scheme in UNUSABLE_SCHEMES else ""
         raise ParameterError("scheduler", f"must be {allowed} (got {scheduler!r}){why}")
+    if scheduler is not None and scheduler != SYNCHRONOUS:
+        _check_host_port(scheduler)
     if workers is not None:
         if scheduler is not None:
             raise ParameterError("workers", "sets the size of the local cluster: not with a scheduler")
@@ -305,6 +307,23 @@ def _check_options(scheduler, workers, max_chunks, timeouts: dict) -> None:
     for name, seconds in timeouts.items():
         if isinstance(seconds, bool) or not isinstance(seconds, int | float) or not 0 < seconds < math.inf:
             raise ParameterError(name, f"must be a number of seconds > 0 (got {seconds!r})")
+
+
+def _check_host_port(scheduler: str) -> None:
+    """Refuse at once an address without a host, or with a port that is not an integer in [1, 65535]:
+    such an address used to fail only after the connection's timeout, or with Python's own words."""
+    from distributed.comm.addressing import parse_host_port
+
+    try:
+        host, port = parse_host_port(scheduler.removeprefix("tcp://"))
+    except ValueError as exc:
+        host, port = None, str(exc)
+    if not host or isinstance(port, str) or not 1 <= port <= 65535:
+        raise ParameterError(
+            "scheduler",
+            "must be tcp://HOST:PORT with a host and a port in [1, 65535], e.g. tcp://127.0.0.1:8786 "
+            f"(got {scheduler!r})",
+        )
 
 
 def _cores() -> int:
@@ -478,11 +497,16 @@ def _handshake(scheduler: str, timeout: float) -> int:
     server) would keep it waiting for ever.
     """
     import asyncio
+    import socket
     import struct
 
+    from distributed.comm.addressing import parse_host_port
     from distributed.core import rpc
 
     async def identity():
+        host, port = parse_host_port(scheduler.removeprefix("tcp://"))
+        # a name that does not resolve: said so (socket.gaierror), not "no answer within 10 s" after retries
+        await asyncio.get_running_loop().getaddrinfo(host, port, type=socket.SOCK_STREAM)
         async with rpc(scheduler, timeout=timeout) as remote:
             return await remote.identity()
 
