@@ -588,6 +588,32 @@ def test_resume_of_a_store_the_user_cannot_write_is_one_line(tmp_path, capsys, m
             folder.chmod(0o755)
 
 
+def test_a_full_disk_while_chunks_are_written_is_one_line_and_resumable(reference, tmp_path, capsys, monkeypatch):
+    """ENOSPC at the third chunk's write (as on a 400 kB tmpfs): one line, exit 2, two chunks done, and
+    --resume finishes the store (before: zarr's OSError traceback)."""
+    import errno
+
+    real, writes = xr.Dataset.to_zarr, []
+
+    def filling(self, *args, region=None, **kwargs):
+        if region is not None:
+            writes.append(region)
+            if len(writes) == 3:
+                raise OSError(errno.ENOSPC, "No space left on device")
+        return real(self, *args, region=region, **kwargs)
+
+    path, out = write(tmp_path), tmp_path / "s.zarr"
+    arguments = ["study", str(path), "--out", str(out), "--scheduler", "synchronous"]
+    with monkeypatch.context() as patch:
+        patch.setattr(xr.Dataset, "to_zarr", filling)
+        assert main(arguments) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "No space left on device" in err and "--resume" in err
+    assert done_chunks(out) == 2 and not Path(f"{out}.lock").exists()
+    assert main([*arguments, "--resume"]) == 0
+    xr.testing.assert_identical(study.load(out), reference)
+
+
 def test_an_all_nan_chunk_is_still_a_file(tmp_path):
     """A chunk whose values are all fill values (every point infeasible: pcsa_max tiny) is written as a file.
 

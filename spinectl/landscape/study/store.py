@@ -324,6 +324,12 @@ class Writer:
             Where the outputs go.
         outputs : dict of str to numpy.ndarray
             On the chunk's tile.
+
+        Raises
+        ------
+        OutputError
+            The store cannot be written (a full disk, a quota, permissions): the chunk
+            stays counted 0, the store resumable.
         """
         lead = (np.newaxis,) * len(self.study.dims)
         part = xr.Dataset(
@@ -331,10 +337,18 @@ class Writer:
         )
         region = {dim: slice(i, i + 1) for dim, i in zip(self.study.dims, chunk.combination, strict=True)}
         region |= {"E": chunk.eccentricity, "Lambda": chunk.lordosis}
-        part.to_zarr(self.path, region=region, consolidated=False, zarr_format=ZARR_FORMAT, write_empty_chunks=True)
-        self._crc[chunk.index] = self._files.checksum(chunk.index)
+        try:
+            part.to_zarr(
+                self.path, region=region, consolidated=False, zarr_format=ZARR_FORMAT, write_empty_chunks=True
+            )
+            self._crc[chunk.index] = self._files.checksum(chunk.index)
+            self._flags[chunk.index] = self.done[chunk.index] + 1
+        except OSError as exc:  # a full disk, a quota, a store made read-only meanwhile: the chunk counts 0
+            raise OutputError(
+                f"cannot write {str(self.path)!r}: {exc.strerror or exc.__class__.__name__}; the store holds every "
+                "chunk finished: run again with --resume once it can be written"
+            ) from None
         self.done[chunk.index] += 1
-        self._flags[chunk.index] = self.done[chunk.index]
 
 
 def consolidate(path: str | Path) -> None:
