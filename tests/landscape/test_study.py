@@ -758,3 +758,18 @@ def test_a_server_announcing_an_exabyte_frame_is_no_scheduler(tmp_path):
     finally:
         listener.close()
     assert not (tmp_path / "s.zarr").exists() and not (tmp_path / "s.zarr.lock").exists()
+
+
+def test_one_lock_per_store_however_it_is_named(tmp_path):
+    """A second run naming the store with a trailing slash, through '..' or a symbolic link is refused too
+    (before: each name had its own lock file, 's.zarr/.lock' even inside the store, and both runs went on)."""
+    out = tmp_path / "s.zarr"
+    out.mkdir()
+    (tmp_path / "link.zarr").symlink_to(out)
+    (tmp_path / "sub").mkdir()
+    with study_store.locked(out):
+        for name in (f"{out}/", tmp_path / "link.zarr", tmp_path / "sub" / ".." / "s.zarr"):
+            with pytest.raises(OutputError, match="is in use by another study run"):
+                with study_store.locked(name):
+                    pass
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["link.zarr", "s.zarr", "sub"]  # the lock removed

@@ -555,7 +555,8 @@ LOCK_SUFFIX = ".lock"
 def locked(path: str | Path) -> Iterator[Path]:
     """Hold the lock of the store ``path`` while the block runs: no second run can use it meanwhile.
 
-    The lock is a file beside the store, created exclusively (``O_EXCL``), holding the
+    The lock is a file beside the store (beside its real path, after symbolic links), created
+    exclusively (``O_EXCL``), holding the
     process id and host name of its holder; it is removed at the end, whatever happens.
     A lock left by a run that is gone (killed: its process id no longer runs on this
     host) is taken over; one of another host is never (its process cannot be checked):
@@ -576,7 +577,8 @@ def locked(path: str | Path) -> Iterator[Path]:
     OutputError
         Another run holds the lock (its process id and host are named), or the lock cannot be written.
     """
-    lock = Path(f"{path}{LOCK_SUFFIX}")
+    # one lock per store, however it is named: a trailing slash, '..' or a symbolic link leads to the same
+    lock = Path(f"{os.path.realpath(path)}{LOCK_SUFFIX}")
     with output_errors(lock):
         lock.parent.mkdir(parents=True, exist_ok=True)
         _acquire(lock)
