@@ -160,6 +160,8 @@ def _value_problem(dataset: xr.Dataset) -> str | None:
             if name in REQUIRED:
                 return f"{name} must be numbers"
             continue
+        if not set(dataset["status"].dims) <= set(dataset[name].dims):
+            return f"{name} has dimensions {dataset[name].dims}, expected {dataset['status'].dims} and its own"
         values = dataset[name].transpose(*dataset["status"].dims, ...).values
         at = solved.reshape(solved.shape + (1,) * (values.ndim - solved.ndim))
         bad = np.isinf(values) | (values < -ROUNDING) | (np.isnan(values) & at)

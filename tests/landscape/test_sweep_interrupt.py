@@ -67,6 +67,8 @@ def _edited(landscape, how):
         ds = ds.assign(min_pcsa_cm2=ds["min_pcsa_cm2"].isel(Lambda=0, drop=True))
     elif how == "extra_dimension":
         ds = ds.assign(status=ds["status"].expand_dims(run=2))
+    elif how == "muscle_pcsa_dimension_lost":
+        ds = ds.assign(pcsa_cm2=ds["pcsa_cm2"].isel(Lambda=0, drop=True))
     elif how in VALUES:  # one value of a solved point replaced: figures drew it silently
         name, value = VALUES[how]
         ds[name].values.flat[4] = value
@@ -94,6 +96,7 @@ FOREIGN = {
     "negative_muscle_pcsa": "pcsa_cm2 must be finite and >= 0 (got -1 at 1 value(s))",
     "minus_infinite_torque": "counter_torque_norm_Nm must be finite and >= 0 (got -inf",
     "nan_where_optimal": "min_pcsa_cm2 must be finite where the status is optimal (got nan",
+    "muscle_pcsa_dimension_lost": "pcsa_cm2 has dimensions ('K', 'E', 'muscle')",
 }
 
 
