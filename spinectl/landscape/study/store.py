@@ -395,9 +395,10 @@ def open_store(path: str | Path) -> xr.Dataset:
     if dataset is None or "study_digest" not in dataset.attrs or DONE not in dataset:
         try:
             _checked_group(path)  # a study store whose layout is damaged: say what is lost
-        except OPEN_ERRORS as exc:
-            if isinstance(exc, ParameterError):
-                raise
+        except ParameterError:
+            raise
+        except OPEN_ERRORS:
+            pass  # not a store at all
         raise ParameterError("store", f"{str(path)!r} is not a spinectl study store")
     missing = damaged_chunks(path, dataset[DONE].values)
     if missing.size:
@@ -555,9 +556,9 @@ LOCK_SUFFIX = ".lock"
 def locked(path: str | Path) -> Iterator[Path]:
     """Hold the lock of the store ``path`` while the block runs: no second run can use it meanwhile.
 
-    The lock is a file beside the store (beside its real path, after symbolic links), created
-    exclusively (``O_EXCL``), holding the
-    process id and host name of its holder; it is removed at the end, whatever happens.
+    The lock is a file beside the store (beside its real path, after symbolic links),
+    created exclusively (``O_EXCL``), holding the process id and host name of its
+    holder; it is removed at the end, whatever happens.
     A lock left by a run that is gone (killed: its process id no longer runs on this
     host) is taken over; one of another host is never (its process cannot be checked):
     remove it by hand once that run has ended.
