@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import os
 import tomllib
 from pathlib import Path
 
@@ -73,8 +74,21 @@ def save(dataset: xr.Dataset, path: str | Path) -> Path:
         except (OSError, RuntimeError) as exc:  # netCDF-C reports a full disk as e.g. "NetCDF: HDF error"
             if isinstance(exc, SpinectlError):
                 raise
-            raise OutputError(f"cannot write {str(path)!r}: {printable(str(exc))}") from None
+            raise OutputError(f"cannot write {str(path)!r}: {printable(str(exc))}{_full(path)}") from None
     return Path(path)
+
+
+FULL_BELOW = 1 << 20
+"""Free bytes below which a failed write names the full disk [B]: netCDF-C reports it in HDF5's words."""
+
+
+def _full(path: str | Path) -> str:
+    """``'; No space left on device'`` if the file system of ``path`` has (almost) no space left, else ''."""
+    try:
+        stats = os.statvfs(Path(path).resolve().parent)
+    except OSError:
+        return ""
+    return "; No space left on device" if stats.f_bavail * stats.f_frsize < FULL_BELOW else ""
 
 
 def load(path: str | Path) -> xr.Dataset:

@@ -168,3 +168,28 @@ def test_an_output_name_with_a_line_break_is_refused_before_the_work(tmp_path, m
     err = capsys.readouterr().err
     assert "the name must be printable" in err and err.count("\n") == 1
     assert [p.name for p in tmp_path.iterdir()] == ["good.nc"]
+
+
+def test_a_full_disk_in_the_netcdf_library_names_the_full_disk(tmp_path, monkeypatch):
+    """netCDF-C reports a full disk in HDF5's words ('NetCDF: Can't open HDF5 attribute', seen on a 2 MB
+    tmpfs): the message adds what the file system says, that no space is left (before: HDF5's words only)."""
+    import os
+    import types
+
+    import xarray as xr
+
+    from spinectl.errors import OutputError
+    from spinectl.landscape import netcdf
+
+    def failing(*args, **kwargs):
+        raise RuntimeError("NetCDF: Can't open HDF5 attribute")
+
+    monkeypatch.setattr(xr.Dataset, "to_netcdf", failing)
+    full = types.SimpleNamespace(f_bavail=3, f_frsize=4096)
+    monkeypatch.setattr(os, "statvfs", lambda path: full)
+    with pytest.raises(OutputError, match="Can't open HDF5 attribute; No space left on device"):
+        netcdf.save(xr.Dataset({"a": ("x", [1.0])}), tmp_path / "x.nc")
+    monkeypatch.setattr(os, "statvfs", lambda path: types.SimpleNamespace(f_bavail=10**6, f_frsize=4096))
+    with pytest.raises(OutputError, match="HDF5 attribute$"):
+        netcdf.save(xr.Dataset({"a": ("x", [1.0])}), tmp_path / "x.nc")
+    assert list(tmp_path.iterdir()) == []
