@@ -169,16 +169,14 @@ def _coefficients(loop):
 
 def _real(coefficients) -> np.ndarray:
     """Coefficients as floats; complex ones refused (numpy would drop the imaginary part)."""
+    c = np.atleast_1d(np.asarray(coefficients))
+    if np.iscomplexobj(c):
+        if np.any(c.imag != 0):
+            raise ParameterError("loop", f"must have real coefficients (got {c.tolist()})")
+        c = c.real
     try:
-        c = np.atleast_1d(np.asarray(coefficients))
-        if np.iscomplexobj(c):
-            if np.any(c.imag != 0):
-                raise ParameterError("loop", f"must have real coefficients (got {c.tolist()})")
-            c = c.real
         return c.astype(float)
-    except (TypeError, ValueError) as exc:
-        if isinstance(exc, ParameterError):
-            raise
+    except (TypeError, ValueError):
         raise ParameterError("loop", f"must have real numbers as coefficients (got {coefficients!r})") from None
 
 
@@ -186,7 +184,7 @@ def _scaled(num: np.ndarray, den: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """N and D divided by their largest coefficient (L unchanged), once their span is checked (:data:`MAX_SPAN`)."""
     both = np.abs(np.concatenate([num, den]))
     largest, smallest = both.max(), both[both > 0].min()
-    if largest / smallest > MAX_SPAN:  # also inf, for a span that overflows
+    if np.log10(largest) - np.log10(smallest) > np.log10(MAX_SPAN):  # in decades: a ratio could overflow
         raise ParameterError(
             "loop",
             f"has coefficients from {smallest:.3g} to {largest:.3g} in magnitude, a span over {MAX_SPAN:.0e}: "
