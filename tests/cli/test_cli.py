@@ -139,3 +139,18 @@ def test_an_output_never_replaces_an_input_or_another_output(tmp_path, capsys, a
     err = capsys.readouterr().err
     assert needle in err and err.count("\n") == 1
     assert {p.name: p.read_bytes() for p in tmp_path.iterdir() if p.is_file()} == before
+
+
+def test_a_home_that_cannot_be_written_leaves_stderr_empty(tmp_path):
+    """HOME=/proc (no folder can be made there, not even by root) and no MPLCONFIGDIR: matplotlib falls
+    back to a temporary configuration folder; before, it said so in two lines on stderr of a command
+    that succeeded."""
+    import os
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2]
+    env = {k: v for k, v in os.environ.items() if k not in ("MPLCONFIGDIR", "XDG_CONFIG_HOME", "XDG_CACHE_HOME")}
+    env |= {"HOME": "/proc", "PYTHONPATH": str(root)}
+    command = [sys.executable, "-m", "spinectl", "draw", "--E", "0.03", "--Lambda", "0.04", "--out"]
+    done = subprocess.run([*command, str(tmp_path / "d.png")], env=env, cwd=root, capture_output=True, text=True)
+    assert (done.returncode, done.stderr) == (0, "") and (tmp_path / "d.png").is_file()
