@@ -338,9 +338,7 @@ class Writer:
         region = {dim: slice(i, i + 1) for dim, i in zip(self.study.dims, chunk.combination, strict=True)}
         region |= {"E": chunk.eccentricity, "Lambda": chunk.lordosis}
         try:
-            part.to_zarr(
-                self.path, region=region, consolidated=False, zarr_format=ZARR_FORMAT, write_empty_chunks=True
-            )
+            part.to_zarr(self.path, region=region, consolidated=False, zarr_format=ZARR_FORMAT, write_empty_chunks=True)
             self._crc[chunk.index] = self._files.checksum(chunk.index)
             self._flags[chunk.index] = self.done[chunk.index] + 1
         except OSError as exc:  # a full disk, a quota, a store made read-only meanwhile: the chunk counts 0
