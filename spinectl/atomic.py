@@ -340,7 +340,7 @@ def staged_directory(target: str | Path, names=(), replaces=()) -> Iterator[Path
     every write: cheap for a folder of figures, not for one that also holds a large store.
     A mount point (a container's bind mount) cannot be replaced: there the staging
     folder is inside ``target`` and its files land one by one at the end, each by an
-    atomic rename (``replaces`` does not apply).
+    atomic rename; then the files of ``replaces`` that the run did not write are removed.
 
     Parameters
     ----------
@@ -365,7 +365,7 @@ def staged_directory(target: str | Path, names=(), replaces=()) -> Iterator[Path
     """
     target = Path(os.path.realpath(check_folder(target, names)))  # a link to a folder: replace the folder
     if _is_mount(target):
-        with _filled_in_place(target) as stage:
+        with _filled_in_place(target, set(replaces)) as stage:
             yield stage
         return
     with output_errors(target):
@@ -427,21 +427,26 @@ def _probe_inside(target: Path) -> None:
 
 
 @contextlib.contextmanager
-def _filled_in_place(target: Path) -> Iterator[Path]:
+def _filled_in_place(target: Path, replaced: set[str]) -> Iterator[Path]:
     """Stage inside a mount point and move each file into it at the end.
 
     A mount point cannot be replaced as a whole, and renames from its parent's file
     system fail (EXDEV); the files then land one by one, each by an atomic rename, all
     after the job has finished, and the files already there that the job does not
-    write are kept.
+    write are kept, but those ``replaced`` (removed last).
     """
     with output_errors(target):
         stage = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".tmp", dir=target))
     try:
         yield stage
         with output_errors(target):
+            written = set()
             for item in sorted(stage.iterdir()):
                 _set_mode(item, target / item.name, item.is_dir())
                 os.replace(item, target / item.name)
+                written.add(item.name)
+            for name in sorted(replaced - written):
+                with contextlib.suppress(FileNotFoundError, IsADirectoryError):
+                    (target / name).unlink()
     finally:
         shutil.rmtree(stage, ignore_errors=True)

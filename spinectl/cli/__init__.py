@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import logging
 import re
 import sys
 import warnings
@@ -99,6 +100,9 @@ def main(argv: list[str] | None = None) -> int:
         0 on success, 2 for an error the user can fix (one line on stderr), 130 on Ctrl-C.
     """
     _printable_streams()
+    # matplotlib logs two warnings when it cannot make its configuration folder (a HOME that is not
+    # writable, as in many containers) and uses a temporary one: harmless, yet they broke "nothing on stderr"
+    logging.getLogger("matplotlib").setLevel(logging.ERROR)
     try:
         with warnings.catch_warnings():
             warnings.showwarning = _one_line_warning

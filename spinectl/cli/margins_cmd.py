@@ -7,7 +7,6 @@ from pathlib import Path
 
 from ..atomic import check_distinct
 from ..errors import ParameterError
-from ..model.config import set_parameters
 from ..reflex.margins import analyse
 from ._common import add_model_options, add_position_options, emit_json, finite_float, load_model
 
@@ -71,8 +70,8 @@ def model_with_overrides(args):
     Parameters
     ----------
     args : argparse.Namespace
-        Parsed arguments; ``delay`` [s], ``activation_lag`` [s], ``activation``, ``pade_order``, ``kp``,
-        ``kd`` are optional.
+        Parsed arguments; ``delay`` [s], ``activation_lag`` [s], ``activation``, ``pade_order`` are
+        optional (``kp`` and ``kd`` are not parameters of the model here: :func:`analyse` takes them).
 
     Returns
     -------
@@ -80,9 +79,7 @@ def model_with_overrides(args):
         The validated model.
     """
     model = load_model(args, {dotted: getattr(args, option) for option, dotted in OVERRIDES})
-    gains = {f"reflex.{option}": getattr(args, option) for option in ("kp", "kd") if getattr(args, option) is not None}
-    set_parameters(model, gains)  # validates: a gain must be >= 0; analyse() takes them as explicit gains
-    return model
+    return model  # --kp and --kd go to analyse, which checks them
 
 
 def run(args) -> int:

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from ..optimise.coupled import coupled_stability_at
-from ..optimise.reference import stability_at
+from ..optimise.reference import NoStabilisingActivation, stability_at
 from ..units import cm2_to_m2
 from ._common import add_model_options, add_position_options, emit_json, finite_float, float_list, load_model
 
@@ -61,7 +61,10 @@ def run(args) -> int:
     model = load_model(args, {"passive.stiffness": args.K})
     given = args.pcsa is not None  # else the minimum stabilising PCSA
     analysis = coupled_stability_at if args.coupled else stability_at
-    result = analysis(model, args.E, args.Lambda, cm2_to_m2(args.pcsa) if given else None)
+    try:
+        result = analysis(model, args.E, args.Lambda, cm2_to_m2(args.pcsa) if given else None)
+    except NoStabilisingActivation as exc:  # the library names its argument; the user types the option
+        raise NoStabilisingActivation(str(exc).replace("(argument pcsa, [m^2])", "with --pcsa [cm2]")) from None
     source = "given" if given else "min_pcsa"
     if args.json:
         emit_json(result.to_dict(model, pcsa_source=source))

@@ -35,8 +35,8 @@ def register(sub) -> None:
         "--worker-timeout",
         type=finite_float("--worker-timeout"),
         metavar="SECONDS",
-        help="with --scheduler: how long to wait for a first worker if it has none "
-        "(default: spinectl.landscape.study.run.WORKER_TIMEOUT)",
+        help="how long to wait for a first worker of --scheduler if it has none, and for a worker again "
+        "once every worker has gone mid-run (default: spinectl.landscape.study.run.WORKER_TIMEOUT)",
     )
     parser.add_argument("--workers", type=_positive_int, metavar="N", help="local worker processes (default: cores)")
     parser.add_argument("--resume", action="store_true", help="continue the study in --out, skipping chunks done")

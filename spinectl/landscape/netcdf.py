@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import os
 import tomllib
 from pathlib import Path
 
@@ -73,8 +74,21 @@ def save(dataset: xr.Dataset, path: str | Path) -> Path:
         except (OSError, RuntimeError) as exc:  # netCDF-C reports a full disk as e.g. "NetCDF: HDF error"
             if isinstance(exc, SpinectlError):
                 raise
-            raise OutputError(f"cannot write {str(path)!r}: {printable(str(exc))}") from None
+            raise OutputError(f"cannot write {str(path)!r}: {printable(str(exc))}{_full(path)}") from None
     return Path(path)
+
+
+FULL_BELOW = 1 << 20
+"""Free bytes below which a failed write names the full disk [B]: netCDF-C reports it in HDF5's words."""
+
+
+def _full(path: str | Path) -> str:
+    """``'; No space left on device'`` if the file system of ``path`` has (almost) no space left, else ''."""
+    try:
+        stats = os.statvfs(Path(path).resolve().parent)
+    except OSError:
+        return ""
+    return "; No space left on device" if stats.f_bavail * stats.f_frsize < FULL_BELOW else ""
 
 
 def load(path: str | Path) -> xr.Dataset:
@@ -138,4 +152,35 @@ def _layout_problem(dataset: xr.Dataset) -> str | None:
             return f"coordinate {name} must be finite (got {show(values.tolist())})"
         if np.unique(values).size != values.size:
             return f"coordinate {name} must not repeat a value (got {show(values.tolist())})"
+    return _value_problem(dataset)
+
+
+SOLVED = ("optimal", "optimal_inaccurate")
+"""Statuses of a point with an optimum: its values are numbers (others are NaN)."""
+
+NON_NEGATIVE = ("min_pcsa_cm2", "pcsa_cm2", "counter_torque_norm_Nm")
+"""Variables that are >= 0 by definition: a PCSA [cm²] and a norm [N m]."""
+
+ROUNDING = 1e-6
+"""How far below 0 a solver's rounding may leave a value of :data:`NON_NEGATIVE` (1e-6 cm², 1e-6 N m)."""
+
+
+def _value_problem(dataset: xr.Dataset) -> str | None:
+    """What is wrong with the values a sweep writes, or None: a PCSA or a norm that is infinite or negative,
+    or NaN at a point whose status says it was solved (an edited or foreign file; figures would draw it)."""
+    solved = np.isin(dataset["status"].values.astype(str), SOLVED)
+    for name in NON_NEGATIVE:
+        if name not in dataset.variables or dataset[name].dtype.kind not in "iuf":
+            if name in REQUIRED:
+                return f"{name} must be numbers"
+            continue
+        if not set(dataset["status"].dims) <= set(dataset[name].dims):
+            return f"{name} has dimensions {dataset[name].dims}, expected {dataset['status'].dims} and its own"
+        values = dataset[name].transpose(*dataset["status"].dims, ...).values
+        at = solved.reshape(solved.shape + (1,) * (values.ndim - solved.ndim))
+        bad = np.isinf(values) | (values < -ROUNDING) | (np.isnan(values) & at)
+        if bad.any():
+            first = values[bad].flat[0]
+            rule = "finite where the status is optimal" if np.isnan(first) else "finite and >= 0"
+            return f"{name} must be {rule} (got {first:g} at {int(bad.sum())} value(s))"
     return None

@@ -44,7 +44,8 @@ def read_text(path: Path) -> str:
             raise ConfigError("config", f"file not found: {shown}")
         if not path.is_file():  # a folder, or a device such as /dev/zero that never ends
             raise ConfigError("config", f"not a regular file: {shown}")
-        return path.read_text(encoding="utf-8")  # TOML is UTF-8 whatever the locale
+        # TOML is UTF-8 whatever the locale; a byte-order mark (as some Windows editors write) is not content
+        return path.read_text(encoding="utf-8-sig")
     except ConfigError:
         raise
     except UnicodeDecodeError:

@@ -44,6 +44,13 @@ MAX_PADE_ORDER = 10
 spine's loops (docs/reflex.md); from order 9 python-control's polynomial margins overflow
 for delays of a few microseconds, its coefficients growing like (1/tau)^n."""
 
+MAX_MASS = 1000.0
+"""Largest upper-body mass [kg]: the upper body above L3 is about 55 % of the body (Dempster 1955,
+Winter 2009, table 4.1), and the heaviest bodies recorded are about 600 kg, so no human upper
+body comes near 1000 kg. A mass of 1e6 kg (grams typed as kilograms) made every point
+``infeasible`` without a reason: the solvers fail on constraints scaled that far, although the
+answer scales linearly with the mass."""
+
 MAX_DELAY = 10.0
 """Longest reflex delay [s]: fifty times the slowest loop the paper names (100 ms plus
 50-100 ms of force generation). A delay of 1e62 s, a unit typo, made the Padé
@@ -92,6 +99,13 @@ def _store(obj, **values) -> None:
         object.__setattr__(obj, name, value)
 
 
+def _mass(mass) -> float:
+    mass = v.positive("mass", mass)
+    if mass > MAX_MASS:
+        raise ParameterError("mass", f"must be at most {MAX_MASS:g} kg, more than any human upper body (got {mass:g})")
+    return mass
+
+
 @dataclass(frozen=True)
 class Body:
     """The upper body, a point mass above the lumbar spine (paper, Methods)."""
@@ -101,7 +115,8 @@ class Body:
         "kg",
         "Point mass m of the upper body. Not stated in the paper; head, arms and trunk above "
         "L3 are about 55 % of a 73 kg body (Dempster 1955 segment fractions, as tabulated by "
-        "Winter 2009, Biomechanics and Motor Control of Human Movement, table 4.1).",
+        "Winter 2009, Biomechanics and Motor Control of Human Movement, table 4.1). At most 1000 kg "
+        "(spinectl.model.params.MAX_MASS): more than any human upper body.",
     )
     mass_height: float = param(0.326, "m", "Height y of the point mass above P2 (paper: 326 mm).")
     gravity: float = param(9.81, "m/s^2", "Gravitational acceleration g.")
@@ -115,7 +130,7 @@ class Body:
     def __post_init__(self):
         _store(
             self,
-            mass=v.positive("mass", self.mass),
+            mass=_mass(self.mass),
             mass_height=v.positive("mass_height", self.mass_height),
             gravity=v.positive("gravity", self.gravity),
             radius_of_gyration=v.non_negative("radius_of_gyration", self.radius_of_gyration),

@@ -402,6 +402,11 @@ def pareto_front(model: Model, eccentricity: float, lordosis: float, n_points: i
     return ParetoFront(float(eccentricity), float(lordosis), budgets * M2_PER_CM2, np.asarray(norms), tuple(statuses))
 
 
+class NoStabilisingActivation(ModelError):
+    """No activation within the bounds stabilises every segment (or the solver failed): the caller may
+    give a PCSA instead (the library's ``pcsa`` argument; the CLI names its own option)."""
+
+
 def minimum_stabilising_pcsa(model: Model, eccentricity: float, lordosis: float) -> np.ndarray:
     """The chosen activation of :func:`solve_point`: the minimum stabilising PCSA [m^2].
 
@@ -419,9 +424,10 @@ def minimum_stabilising_pcsa(model: Model, eccentricity: float, lordosis: float)
 
     Raises
     ------
-    ModelError
-        No activation within the bounds stabilises every segment, or the solver failed
-        (the message names the optimiser's status and suggests giving ``--pcsa``).
+    NoStabilisingActivation
+        A :class:`~spinectl.errors.ModelError`: no activation within the bounds stabilises every
+        segment, or the solver failed (the message names the optimiser's status and suggests
+        giving the PCSA, the ``pcsa`` argument of :func:`stability_at`).
     """
     return _stabilising_optimum(model, eccentricity, lordosis).pcsa
 
@@ -430,9 +436,9 @@ def _stabilising_optimum(model: Model, eccentricity: float, lordosis: float) -> 
     """:func:`solve_point`, or the :class:`ModelError` of :func:`minimum_stabilising_pcsa` unless it is optimal."""
     optimum = solve_point(model, eccentricity, lordosis)
     if not optimum.ok:
-        raise ModelError(
+        raise NoStabilisingActivation(
             f"pcsa: no activation stabilises every segment at E = {eccentricity:g} m, Lambda = {lordosis:g} m "
-            f"(optimiser status {optimum.status}); give --pcsa"
+            f"(optimiser status {optimum.status}); give the PCSA (argument pcsa, [m^2])"
         )
     return optimum
 

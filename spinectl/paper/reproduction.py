@@ -113,10 +113,20 @@ def output_names(model: Model) -> tuple[str, ...]:
         The landscapes, the other convention's landscape, Figures 3, 4 (K = 0) and S1, 4
         (K = 15 N m/rad), the report.
     """
-    k15 = grid.PAPER_STIFFNESS
-    other_name = f"landscape_K{k15:g}_{grid.other_convention(model)}.nc"
-    figure_names = [name for k in (0.0, k15) for name in figures.figure_names(k)]
+    other_name = _other_landscape(grid.other_convention(model))
+    figure_names = [name for k in (0.0, grid.PAPER_STIFFNESS) for name in figures.figure_names(k)]
     return (LANDSCAPES, other_name, *figure_names, REPORT)
+
+
+def _other_landscape(convention: str) -> str:
+    """File name of the K = 15 N m/rad landscape with the passive-stiffness ``convention`` not the model's."""
+    return f"landscape_K{grid.PAPER_STIFFNESS:g}_{convention}.nc"
+
+
+def _own_files() -> tuple[str, ...]:
+    """Every name a run of the study may write whose name varies with the model: an earlier run's goes
+    (a stale landscape of the other convention never stays beside this run's)."""
+    return tuple(_other_landscape(convention) for convention in grid.CONVENTIONS)
 
 
 def reproduce_model(
@@ -145,7 +155,8 @@ def reproduce_model(
     Returns
     -------
     list of Path
-        The files written, inside ``out_dir``.
+        The files written, inside ``out_dir``; the folder's other files stay, but those of an
+        earlier run of the study that this one does not write (the landscape of another convention).
 
     Raises
     ------
@@ -171,7 +182,7 @@ def reproduce_model(
         specific_tension=model.fibre.specific_tension,
         calibrated=calibrated,
     )
-    with staged_directory(out_dir, names) as stage:
+    with staged_directory(out_dir, names, replaces=_own_files()) as stage:
         netcdf.save(both, stage / LANDSCAPES)
         netcdf.save(other, stage / other_name)
         for name, figure in drawn.items():

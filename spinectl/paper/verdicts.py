@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import landmarks
+from .grid import PAPER_POINTS
 from .landmarks import Measurement
 
 PRESET = "wagner2012"
@@ -173,10 +174,13 @@ def documented_table() -> str:
 
 
 def verdict_cell(measurement: Measurement) -> str:
-    """The verdict of docs/reproduction.md for a fresh measurement, for the report's table.
+    """The verdict for a fresh measurement, for the report's table: never one that its own value contradicts.
 
-    The documented verdict, flagged when the fresh value no longer matches the
-    documented one (another preset, or a changed model).
+    The verdict of docs/reproduction.md, with its reason, where the fresh value matches the
+    documented one and agrees (or not) with the paper as the documented verdict says. Otherwise
+    (another preset, a coarse grid, a changed model) the verdict is this run's own, from its
+    agreement, and the documented one follows as what holds under its condition: the
+    ``wagner2012`` preset on the paper's grid.
 
     Parameters
     ----------
@@ -186,13 +190,23 @@ def verdict_cell(measurement: Measurement) -> str:
     Returns
     -------
     str
-        "verdict: reason", with the documented value appended where the fresh one
-        differs; "n/a" for a landmark without a documented verdict.
+        "verdict: reason", or "this run: verdict (value); documented for `wagner2012` on the
+        paper's 81 x 81 grid: value, verdict: reason"; "n/a" for a landmark without a documented verdict.
     """
     v = VERDICTS.get(measurement.landmark.name)
     if v is None:
         return "n/a"
     text = f"{v.verdict}: {v.reason}" if v.reason else v.verdict
-    if not v.holds(measurement.value):
-        text += f" (documented for `{PRESET}`: {format_number(v.value)})"
-    return text
+    if v.holds(measurement.value) and measurement.agrees == (v.verdict == REPRODUCED):
+        return text
+    if measurement.agrees:
+        own = REPRODUCED
+    elif np.isfinite(measurement.value):
+        own = COMPROMISE
+    else:
+        own = f"{COMPROMISE}, not measurable here"
+    points = f"{PAPER_POINTS} x {PAPER_POINTS}"
+    return (
+        f"this run: {own} ({format_number(measurement.value)}); documented for `{PRESET}` on the paper's "
+        f"{points} grid: {format_number(v.value)}, {text}"
+    )

@@ -3,7 +3,8 @@
 The CLI validates a reflex through :class:`spinectl.model.params.Reflex`; a
 caller of the library passes arrays straight to :func:`~spinectl.reflex.delay_margin`
 and its neighbours. :func:`validated` gives every public function the same
-checks, by the names of its arguments, before any arithmetic: a negative or
+checks, by the names of its arguments, before any arithmetic: a bool, a text
+or a complex number where a real number belongs (``kp=True``, ``kp='200'``), a negative or
 zero inertia, magnitudes whose powers overflow, a negative or
 absurd delay and a Padé order below 1 raise a
 :class:`~spinectl.errors.ParameterError` naming the argument; NaN stays
@@ -16,6 +17,7 @@ import contextlib
 import contextvars
 import functools
 import inspect
+import numbers
 
 import numpy as np
 
@@ -62,12 +64,17 @@ def validated(func=None, *, zero_inertia: bool = False):
     if func is None:
         return functools.partial(validated, zero_inertia=zero_inertia)
     signature = inspect.signature(func)
+    arrays = (*SIGNED, "inertia", "delay")
+    required = [p.name for p in signature.parameters.values() if p.default is p.empty and p.name in arrays]
 
     @functools.wraps(func)
     def checked(*args, **kwargs):
         if _INSIDE.get():
             return func(*args, **kwargs)
         given = signature.bind(*args, **kwargs).arguments
+        for name in required:  # None where a value is required would read as NaN, an answer of "undefined"
+            if name in given and given[name] is None:
+                raise ParameterError(name, "must be real numbers (got None)")
         check_arrays(given, zero_inertia=zero_inertia)
         if given.get("delay") is not None:
             check_delay(given["delay"])
@@ -151,10 +158,18 @@ def check_order(order, name: str = "order") -> None:
 
 
 def _floats(name: str, value) -> np.ndarray:
+    """``value`` as floats, if it holds real numbers only: not bools, strings (``'200'`` would convert) or complex."""
     try:
-        return np.asarray(value, float)
-    except (TypeError, ValueError):
-        raise ParameterError(name, f"must be numbers (got {v.show(value)})") from None
+        raw = np.asarray(value)
+        numeric = raw.dtype.kind in "iuf" or (
+            raw.dtype.kind == "O"
+            and all(isinstance(x, numbers.Real) and not isinstance(x, bool | np.bool_) for x in raw.flat)
+        )
+        if numeric:
+            return np.asarray(raw, float)
+    except (TypeError, ValueError, OverflowError):
+        pass
+    raise ParameterError(name, f"must be real numbers, not bools or text (got {v.show(value)})")
 
 
 def _bounded(name: str, x: np.ndarray) -> None:

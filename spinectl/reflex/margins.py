@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .. import _validate as v
 from ..model import stability
 from ..model.checks import arithmetic_guard, checked_coefficients
 from ..model.params import Model
@@ -417,13 +418,24 @@ def analyse(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None
     eccentricity, lordosis : float
         E and Lambda [m].
     kp, kd : float, optional
-        Explicit gains for every segment [N m/rad], [N m s/rad], each replacing the configured one.
+        Explicit gains for every segment [N m/rad], [N m s/rad], each replacing the configured
+        one: finite numbers >= 0, as ``reflex.kp`` and ``reflex.kd`` of a model.
 
     Returns
     -------
     MarginsReport
         The operating point and one :class:`SegmentMargins` per segment.
+
+    Raises
+    ------
+    ParameterError
+        ``kp`` or ``kd`` not a finite number >= 0 (fields ``reflex.kp``, ``reflex.kd``), or too large
+        (:data:`spinectl.reflex.inputs.MAX_MAGNITUDE`); a position outside the modelled range.
+    ModelError
+        The arithmetic overflows at this position.
     """
+    kp = None if kp is None else v.non_negative("reflex.kp", kp)  # the gains of the model's Reflex, checked alike
+    kd = None if kd is None else v.non_negative("reflex.kd", kd)
     settings = model.reflex
     point = operating_point(model, eccentricity, lordosis, settings.activation)
     with arithmetic_guard(eccentricity, lordosis):  # absurd gains or delays: a ModelError, not NaN and warnings

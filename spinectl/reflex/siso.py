@@ -29,6 +29,13 @@ import numpy as np
 from ..errors import ParameterError
 from .delay import DELAY_INDEPENDENT, FINITE, STATUS, UNDEFINED, UNSTABLE_WITHOUT_DELAY
 
+MAX_SPAN = 1e100
+"""Largest ratio of the loop's coefficients in magnitude (the largest nonzero over the smallest).
+
+The coefficients are scaled to at most 1 before any product (L = N/D is unchanged);
+F(w^2) multiplies them in pairs, so a span of 1e100 keeps every product above 1e-200, far
+from underflow. A wider span is a loop in units many orders of magnitude off."""
+
 _REAL = 1e-8
 """Relative imaginary part below which a root of F counts as real (a double root splits by about sqrt(eps))."""
 
@@ -146,7 +153,7 @@ def _coefficients(loop):
     if not loop.isctime():
         raise ParameterError("loop", "must be continuous-time (dt = 0)")
     tf = ct.tf(loop) if isinstance(loop, ct.StateSpace) else loop
-    num, den = (np.trim_zeros(np.atleast_1d(np.asarray(c, float)), "f") for c in (tf.num[0][0], tf.den[0][0]))
+    num, den = (np.trim_zeros(_real(c), "f") for c in (tf.num[0][0], tf.den[0][0]))
     if den.size == 0:
         raise ParameterError("loop", "has a zero denominator")
     if num.size > den.size:
@@ -158,6 +165,32 @@ def _coefficients(loop):
             "right of the imaginary axis for every delay > 0, not covered",
         )
     return num, den
+
+
+def _real(coefficients) -> np.ndarray:
+    """Coefficients as floats; complex ones refused (numpy would drop the imaginary part)."""
+    c = np.atleast_1d(np.asarray(coefficients))
+    if np.iscomplexobj(c):
+        if np.any(c.imag != 0):
+            raise ParameterError("loop", f"must have real coefficients (got {c.tolist()})")
+        c = c.real
+    try:
+        return c.astype(float)
+    except (TypeError, ValueError):
+        raise ParameterError("loop", f"must have real numbers as coefficients (got {coefficients!r})") from None
+
+
+def _scaled(num: np.ndarray, den: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """N and D divided by their largest coefficient (L unchanged), once their span is checked (:data:`MAX_SPAN`)."""
+    both = np.abs(np.concatenate([num, den]))
+    largest, smallest = both.max(), both[both > 0].min()
+    if np.log10(largest) - np.log10(smallest) > np.log10(MAX_SPAN):  # in decades: a ratio could overflow
+        raise ParameterError(
+            "loop",
+            f"has coefficients from {smallest:.3g} to {largest:.3g} in magnitude, a span over {MAX_SPAN:.0e}: "
+            "are its time or gain units many orders of magnitude off?",
+        )
+    return num / largest, den / largest
 
 
 def _magnitude_squared(p):
@@ -225,8 +258,10 @@ def delay_margin(loop) -> LoopDelayMargin:
     Raises
     ------
     ParameterError
-        Naming ``loop``: not a python-control system, not SISO, discrete-time, improper, or
-        of neutral type with abs(L(inf)) >= 1.
+        Naming ``loop``: not a python-control system, not SISO, discrete-time, improper,
+        of neutral type with abs(L(inf)) >= 1, with complex coefficients, or with coefficients
+        spanning more than :data:`MAX_SPAN` in magnitude (finite ones are scaled first, so a
+        loop of uniformly huge or tiny coefficients is computed).
 
     References
     ----------
@@ -237,6 +272,7 @@ def delay_margin(loop) -> LoopDelayMargin:
     empty = np.empty(0)
     if not (np.all(np.isfinite(num)) and np.all(np.isfinite(den))):
         return LoopDelayMargin(np.nan, np.nan, STATUS[UNDEFINED], empty, empty, empty, False)
+    num, den = _scaled(num, den)
     closed = np.polyadd(den, num)
     poles = np.roots(closed)
     scale = max(1.0, float(np.max(np.abs(poles)))) if poles.size else 1.0

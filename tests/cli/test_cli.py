@@ -194,3 +194,18 @@ def test_a_file_that_replaces_the_muscles_warns_in_one_line(tmp_path, capsys):
         err == f"spinectl: warning: {path} replaces the preset's muscle pairs (muscles_mode = 'replace'): "
         "straight, oblique_outer, oblique_inner dropped, 1 pair(s) given\n"
     )
+
+
+def test_a_home_that_cannot_be_written_leaves_stderr_empty(tmp_path):
+    """HOME=/proc (no folder can be made there, not even by root) and no MPLCONFIGDIR: matplotlib falls
+    back to a temporary configuration folder; before, it said so in two lines on stderr of a command
+    that succeeded."""
+    import os
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2]
+    env = {k: v for k, v in os.environ.items() if k not in ("MPLCONFIGDIR", "XDG_CONFIG_HOME", "XDG_CACHE_HOME")}
+    env |= {"HOME": "/proc", "PYTHONPATH": str(root)}
+    command = [sys.executable, "-m", "spinectl", "draw", "--E", "0.03", "--Lambda", "0.04", "--out"]
+    done = subprocess.run([*command, str(tmp_path / "d.png")], env=env, cwd=root, capture_output=True, text=True)
+    assert (done.returncode, done.stderr) == (0, "") and (tmp_path / "d.png").is_file()

@@ -49,6 +49,25 @@ def test_reproduce_writes_everything(tmp_path, capsys):
     assert [p.name for p in tmp_path.iterdir()] == ["results"]  # no staging folder left behind
 
 
+@pytest.mark.parametrize("mount", [False, True])
+def test_a_run_with_another_convention_leaves_no_stale_landscape(tmp_path, monkeypatch, capsys, mount):
+    """A run with the other passive-stiffness convention, then one with the preset's: the folder holds
+    exactly the second run's files (and the user's own), not the first run's landscape_K15_paper.nc
+    (before: it stayed, beside a report that does not name it). Also into a mount point (simulated)."""
+    out = tmp_path / "results"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine")
+    if mount:
+        monkeypatch.setattr(atomic, "_is_mount", lambda target: pathlib.Path(target) == out)
+        monkeypatch.setattr(os, "replace", _mount_point(out))
+    physical = tmp_path / "physical.toml"
+    physical.write_text('preset = "wagner2012"\n[passive]\nconvention = "physical"\n')
+    assert main(["reproduce", "--out", str(out), "--points", "3", "--config", str(physical)]) == 0
+    assert "landscape_K15_paper.nc" in {p.name for p in out.iterdir()}
+    assert main(["reproduce", "--out", str(out), "--points", "3"]) == 0
+    assert {p.name for p in out.iterdir() if not p.name.startswith(".")} == EXPECTED | {"notes.txt"}
+
+
 def test_a_failure_leaves_the_output_folder_untouched(tmp_path, monkeypatch, capsys):
     def broken(*args, **kwargs):
         raise RuntimeError("simulated crash while drawing")

@@ -44,3 +44,13 @@ def test_massless_levels_leave_the_eigenvalues_undefined(tmp_path, capsys):
     assert np.all(np.isnan(document["eigenvalues"])) and document["self_stable"] is False
     assert np.linalg.matrix_rank(np.array(document["mass_matrix_kgm2"])) == 2
     assert document["margin_Nm_per_rad"] < 0  # the static analysis does not need M
+
+
+def test_no_stabilising_activation_names_the_option_on_the_command_line(tmp_path, capsys):
+    """The library's message names its argument pcsa; the CLI's names --pcsa, in cm² as the option takes it."""
+    config = tmp_path / "tiny.toml"
+    config.write_text("[optimisation]\npcsa_max = 1e-6\n")
+    assert main(["stability", "--E", "0", "--Lambda", "0", "--config", str(config)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "no activation stabilises every segment" in err
+    assert err.rstrip().endswith("give the PCSA with --pcsa [cm2]")

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -235,7 +236,7 @@ def test_one_chunk_runs_in_process_without_a_cluster(tmp_path):
     assert one.n_chunks == 1 and result.where == "in-process" and result.addresses == ()
     expected = sweep.sweep(one.model, one.eccentricity, one.lordosis, chunk_size=60, progress=False)
     got = study.load(tmp_path / "one.zarr")
-    assert set(got.data_vars) == {"min_pcsa_cm2", "status", "chunk_done"}
+    assert set(got.data_vars) == {"min_pcsa_cm2", "status", "chunk_done", "chunk_crc32"}
     xr.testing.assert_identical(got["status"].reset_coords(drop=True), expected["status"].reset_coords(drop=True))
 
 
@@ -394,6 +395,11 @@ def test_cli_runs_and_resumes_a_study(tmp_path, capsys):
         (["--workers", "0"], "--workers must be >= 1"),
         (["--workers", "100000"], "workers: must be an integer in [1,"),
         (["--max-chunks", "-1"], "--max-chunks must be >= 0"),
+        # addresses without a host or a usable port: before, a wait of 10 s or Python's "invalid literal for int()"
+        (["--scheduler", "tcp://127.0.0.1:99999"], "scheduler: must be tcp://HOST:PORT with a host and a port in"),
+        (["--scheduler", "tcp://127.0.0.1:abc"], "scheduler: must be tcp://HOST:PORT"),
+        (["--scheduler", "tcp://:8786"], "scheduler: must be tcp://HOST:PORT"),
+        (["--scheduler", "tcp://127.0.0.1"], "scheduler: must be tcp://HOST:PORT"),
     ],
 )
 def test_cli_bad_options_are_one_line(tmp_path, capsys, arguments, needle):
@@ -506,16 +512,119 @@ def test_a_lost_chunk_file_is_refused_on_load_and_recomputed_on_resume(reference
     study.run_study(parsed, out, scheduler="synchronous", progress=False)
     assert parsed.chunk(5).combination == (0, 1) and parsed.chunk(5).eccentricity == slice(4, 6)
     delete_chunk_file(out, "min_pcsa_cm2", "0.1.2.0")
-    with pytest.raises(ParameterError, match=r"1 chunk\(s\) counted done have lost their data \(chunk 5\)"):
+    assert_refused_then_computed_again(parsed, out, reference, r"have lost their data")
+    group = zarr.open_group(out, mode="r+")  # a store made before every chunk was a file: not checked
+    del group.attrs[study_store.CHUNK_FILES]
+    delete_chunk_file(out, "min_pcsa_cm2", "0.1.2.0")
+    assert np.isnan(study.open_store(out)["min_pcsa_cm2"].values).sum() == TILE_POINTS
+
+
+def test_a_chunk_file_with_other_bytes_is_refused_on_load_and_recomputed_on_resume(reference, tmp_path):
+    """A chunk file present but not as written (a byte appended, as a partial or foreign copy would leave):
+    its CRC-32 differs from the one recorded with its count (presence alone would pass it)."""
+    parsed, out = study.parse_study(STUDY), tmp_path / "s.zarr"
+    study.run_study(parsed, out, scheduler="synchronous", progress=False)
+    with (out / "status" / "0.1.2.0").open("ab") as file:  # chunk 5, as in the test above
+        file.write(b"x")
+    assert_refused_then_computed_again(parsed, out, reference, r"hold other bytes than written")
+
+
+def assert_refused_then_computed_again(parsed, out: Path, reference, needle: str) -> None:
+    """Chunk 5 of ``out`` is damaged: loading refuses it, --resume computes it again, and only it."""
+    with pytest.raises(ParameterError, match=r"1 chunk\(s\) counted done .*" + needle + r".* \(chunk 5\)"):
         study.load(out)
     notes = []
     result = study.run_study(parsed, out, scheduler="synchronous", resume=True, progress=False, notify=notes.append)
     assert (result.done_before, result.computed) == (11, 1) and "computing it again" in notes[0]
     xr.testing.assert_identical(study.load(out), reference)
-    group = zarr.open_group(out, mode="r+")  # a store made before every chunk was a file: not checked
-    del group.attrs[study_store.CHUNK_FILES]
-    delete_chunk_file(out, "min_pcsa_cm2", "0.1.2.0")
-    assert np.isnan(study.open_store(out)["min_pcsa_cm2"].values).sum() == TILE_POINTS
+
+
+@pytest.mark.parametrize(
+    ("lost", "needle"),
+    [
+        ("min_pcsa_cm2/.zarray", "array 'min_pcsa_cm2': its metadata is lost"),  # the .zmetadata still lists it
+        ("E/0", "array 'E': its values are not those written"),  # a coordinate's chunk: read as fill values
+        ("K/0", "array 'K': its values are not those written"),
+        ("status/.zattrs", "array 'status': its attributes (the dimensions' names) are lost"),
+        ("chunk_done/.zarray", "array 'chunk_done': its metadata is lost"),
+    ],
+)
+def test_a_store_with_lost_metadata_or_coordinates_is_refused_in_one_line(tmp_path, capsys, lost, needle):
+    """Loading and resuming a store that lost an array's metadata or a coordinate's chunk: one line, exit 2.
+
+    Before, both passed: the loader read the coordinate E as NaN (or dropped the array), and
+    ``--resume`` found every chunk done.
+    """
+    path, out = write(tmp_path), tmp_path / "s.zarr"
+    arguments = ["study", str(path), "--out", str(out), "--scheduler", "synchronous", "--max-chunks", "3"]
+    assert main(arguments) == 0
+    (out / lost).unlink()
+    with pytest.raises(ParameterError, match=re.escape(needle)):
+        study.load(out)
+    capsys.readouterr()
+    assert main([*arguments, "--resume"]) == 2
+    err = capsys.readouterr().err
+    assert len(err.splitlines()) == 1 and needle in err and "remove it and run the study afresh" in err
+
+
+def test_resume_of_a_store_the_user_cannot_write_is_one_line(tmp_path, capsys, monkeypatch):
+    """A store the user may read but not write (another user's, read-only, immutable): exit 2, one line,
+    before any chunk is solved (before: a PermissionError traceback at the first chunk written).
+
+    Without root, the store's folders lose their write permission; as root (which permissions do
+    not stop) the making of a file inside the store fails as it would there.
+    """
+    path, out = write(tmp_path), tmp_path / "s.zarr"
+    arguments = ["study", str(path), "--out", str(out), "--scheduler", "synchronous"]
+    assert main([*arguments, "--max-chunks", "3"]) == 0
+    folders = [out, *(p for p in out.iterdir() if p.is_dir())]
+    real = study_store.tempfile.mkstemp
+
+    def refused(*args, dir=None, **kwargs):
+        if Path(dir).is_relative_to(out):
+            raise PermissionError(13, "Permission denied")
+        return real(*args, dir=dir, **kwargs)
+
+    if os.geteuid() == 0:
+        monkeypatch.setattr(study_store.tempfile, "mkstemp", refused)
+    for folder in folders:
+        folder.chmod(0o555)
+    try:
+        files = sorted(p.relative_to(out) for p in out.rglob("*"))
+        capsys.readouterr()
+        assert main([*arguments, "--resume"]) == 2
+        err = capsys.readouterr().err
+        assert err.startswith("spinectl: error: cannot write ") and "Permission denied" in err
+        assert len(err.splitlines()) == 1 and sorted(p.relative_to(out) for p in out.rglob("*")) == files
+    finally:
+        for folder in folders:
+            folder.chmod(0o755)
+
+
+def test_a_full_disk_while_chunks_are_written_is_one_line_and_resumable(reference, tmp_path, capsys, monkeypatch):
+    """ENOSPC at the third chunk's write (as on a 400 kB tmpfs): one line, exit 2, two chunks done, and
+    --resume finishes the store (before: zarr's OSError traceback)."""
+    import errno
+
+    real, writes = xr.Dataset.to_zarr, []
+
+    def filling(self, *args, region=None, **kwargs):
+        if region is not None:
+            writes.append(region)
+            if len(writes) == 3:
+                raise OSError(errno.ENOSPC, "No space left on device")
+        return real(self, *args, region=region, **kwargs)
+
+    path, out = write(tmp_path), tmp_path / "s.zarr"
+    arguments = ["study", str(path), "--out", str(out), "--scheduler", "synchronous"]
+    with monkeypatch.context() as patch:
+        patch.setattr(xr.Dataset, "to_zarr", filling)
+        assert main(arguments) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "No space left on device" in err and "--resume" in err
+    assert done_chunks(out) == 2 and not Path(f"{out}.lock").exists()
+    assert main([*arguments, "--resume"]) == 0
+    xr.testing.assert_identical(study.load(out), reference)
 
 
 def test_an_all_nan_chunk_is_still_a_file(tmp_path):
@@ -571,6 +680,36 @@ def test_a_scheduler_without_workers_stops_after_the_worker_timeout(tmp_path, ca
     assert err[0] == f"study: {address} (0 workers)" and "waiting up to 0.5 s" in err[1]
     assert err[-1].startswith(f"spinectl: error: scheduler: {address} has no worker, and none joined within 0.5 s")
     assert not (tmp_path / "s.zarr").exists()
+
+
+def test_workers_vanishing_mid_run_stop_the_study_after_the_worker_timeout(reference, tmp_path, capsys):
+    """Every worker of the cluster gone once a chunk is written: one line after --worker-timeout, exit 2,
+    a store that --resume finishes (before: the run waited for ever, silently)."""
+    import threading
+
+    from distributed import LocalCluster
+
+    options = {"processes": False, "protocol": "tcp://", "host": "127.0.0.1", "dashboard_address": None}
+    out = tmp_path / "s.zarr"
+    with LocalCluster(n_workers=1, threads_per_worker=1, **options) as cluster:
+        def stop_the_workers():
+            deadline = time.monotonic() + 120
+            while done_chunks(out) < 1 and time.monotonic() < deadline:
+                time.sleep(0.005)
+            cluster.scale(0)
+
+        threading.Thread(target=stop_the_workers, daemon=True).start()
+        arguments = ["study", str(write(tmp_path)), "--out", str(out), "--scheduler", cluster.scheduler_address]
+        start = time.monotonic()
+        code = main([*arguments, "--worker-timeout", "1"])
+        elapsed = time.monotonic() - start
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and elapsed < 60, (code, elapsed)
+    assert "every worker has gone, and none joined within 1 s" in err[-1] and "--resume" in err[-1]
+    assert 1 <= done_chunks(out) < 12 and not Path(f"{out}.lock").exists()
+    result = study.run_study(study.parse_study(STUDY), out, scheduler="synchronous", resume=True, progress=False)
+    assert result.complete
+    xr.testing.assert_identical(study.load(out), reference)
 
 
 @pytest.mark.parametrize("scheme", ["ucx", "inproc", "tls", "ws", "wss"])
@@ -632,3 +771,18 @@ def test_a_server_announcing_an_exabyte_frame_is_no_scheduler(tmp_path):
     finally:
         listener.close()
     assert not (tmp_path / "s.zarr").exists() and not (tmp_path / "s.zarr.lock").exists()
+
+
+def test_one_lock_per_store_however_it_is_named(tmp_path):
+    """A second run naming the store with a trailing slash, through '..' or a symbolic link is refused too
+    (before: each name had its own lock file, 's.zarr/.lock' even inside the store, and both runs went on)."""
+    out = tmp_path / "s.zarr"
+    out.mkdir()
+    (tmp_path / "link.zarr").symlink_to(out)
+    (tmp_path / "sub").mkdir()
+    with study_store.locked(out):
+        for name in (f"{out}/", tmp_path / "link.zarr", tmp_path / "sub" / ".." / "s.zarr"):
+            with pytest.raises(OutputError, match="is in use by another study run"):
+                with study_store.locked(name):
+                    pass
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["link.zarr", "s.zarr", "sub"]  # the lock removed

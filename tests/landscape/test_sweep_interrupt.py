@@ -67,7 +67,21 @@ def _edited(landscape, how):
         ds = ds.assign(min_pcsa_cm2=ds["min_pcsa_cm2"].isel(Lambda=0, drop=True))
     elif how == "extra_dimension":
         ds = ds.assign(status=ds["status"].expand_dims(run=2))
+    elif how == "muscle_pcsa_dimension_lost":
+        ds = ds.assign(pcsa_cm2=ds["pcsa_cm2"].isel(Lambda=0, drop=True))
+    elif how in VALUES:  # one value of a solved point replaced: figures drew it silently
+        name, value = VALUES[how]
+        ds[name].values.flat[4] = value
     return ds
+
+
+VALUES = {
+    "infinite_pcsa": ("min_pcsa_cm2", float("inf")),
+    "negative_pcsa": ("min_pcsa_cm2", -3.0),
+    "negative_muscle_pcsa": ("pcsa_cm2", -1.0),
+    "minus_infinite_torque": ("counter_torque_norm_Nm", float("-inf")),
+    "nan_where_optimal": ("min_pcsa_cm2", float("nan")),
+}
 
 
 FOREIGN = {
@@ -77,6 +91,12 @@ FOREIGN = {
     "nan_coordinate": "coordinate E must be finite",
     "other_dimensions": "min_pcsa_cm2 has dimensions ('K', 'E'), expected ('K', 'E', 'Lambda')",
     "extra_dimension": "status has dimensions ('run', 'K', 'E', 'Lambda')",
+    "infinite_pcsa": "min_pcsa_cm2 must be finite and >= 0 (got inf at 1 value(s))",
+    "negative_pcsa": "min_pcsa_cm2 must be finite and >= 0 (got -3 at 1 value(s))",
+    "negative_muscle_pcsa": "pcsa_cm2 must be finite and >= 0 (got -1 at 1 value(s))",
+    "minus_infinite_torque": "counter_torque_norm_Nm must be finite and >= 0 (got -inf",
+    "nan_where_optimal": "min_pcsa_cm2 must be finite where the status is optimal (got nan",
+    "muscle_pcsa_dimension_lost": "pcsa_cm2 has dimensions ('K', 'E', 'muscle')",
 }
 
 
@@ -148,3 +168,28 @@ def test_an_output_name_with_a_line_break_is_refused_before_the_work(tmp_path, m
     err = capsys.readouterr().err
     assert "the name must be printable" in err and err.count("\n") == 1
     assert [p.name for p in tmp_path.iterdir()] == ["good.nc"]
+
+
+def test_a_full_disk_in_the_netcdf_library_names_the_full_disk(tmp_path, monkeypatch):
+    """netCDF-C reports a full disk in HDF5's words ('NetCDF: Can't open HDF5 attribute', seen on a 2 MB
+    tmpfs): the message adds what the file system says, that no space is left (before: HDF5's words only)."""
+    import os
+    import types
+
+    import xarray as xr
+
+    from spinectl.errors import OutputError
+    from spinectl.landscape import netcdf
+
+    def failing(*args, **kwargs):
+        raise RuntimeError("NetCDF: Can't open HDF5 attribute")
+
+    monkeypatch.setattr(xr.Dataset, "to_netcdf", failing)
+    full = types.SimpleNamespace(f_bavail=3, f_frsize=4096)
+    monkeypatch.setattr(os, "statvfs", lambda path: full)
+    with pytest.raises(OutputError, match="Can't open HDF5 attribute; No space left on device"):
+        netcdf.save(xr.Dataset({"a": ("x", [1.0])}), tmp_path / "x.nc")
+    monkeypatch.setattr(os, "statvfs", lambda path: types.SimpleNamespace(f_bavail=10**6, f_frsize=4096))
+    with pytest.raises(OutputError, match="HDF5 attribute$"):
+        netcdf.save(xr.Dataset({"a": ("x", [1.0])}), tmp_path / "x.nc")
+    assert list(tmp_path.iterdir()) == []

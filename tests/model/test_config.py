@@ -130,3 +130,17 @@ def test_every_parameter_has_a_unit_and_documentation():
 def test_reflex_section_is_validated(tmp_path, text, field, needle):
     err = _error_for(tmp_path, text)
     assert err.field == field and needle in str(err)
+
+
+def test_a_file_with_a_byte_order_mark_reads_as_without(tmp_path):
+    """A UTF-8 byte-order mark, as some Windows editors save it: before, "not valid TOML (Invalid statement
+    (at line 1, column 1))" for a file that is valid TOML; the mark is not content. Study files too."""
+    from spinectl.landscape.study import load_study
+
+    path = tmp_path / "bom.toml"
+    path.write_bytes(b"\xef\xbb\xbf[body]\nmass = 42.0\n")
+    assert config.load_config(path).body.mass == 42.0
+    study = tmp_path / "study.toml"
+    grid = "E = { start = 0.0, stop = 0.08, num = 3 }\nLambda = { start = 0.0, stop = 0.08, num = 3 }\n"
+    study.write_bytes(b"\xef\xbb\xbf[axes]\n" + grid.encode())
+    assert load_study(study).grid_shape == (3, 3)

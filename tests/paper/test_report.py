@@ -46,7 +46,27 @@ def test_report_of_the_calibrated_preset_gives_the_documented_verdicts():
         row = next(line for line in text.splitlines() if line.startswith(f"| `{m.landmark.name}` |"))
         documented = verdicts.VERDICTS[m.landmark.name]
         assert documented.verdict in row
-        assert ("documented for `wagner2012`" in row) == (not documented.holds(m.value))
+        consistent = documented.holds(m.value) and m.agrees == (documented.verdict == verdicts.REPRODUCED)
+        assert ("documented for `wagner2012`" in row) == (not consistent)
+
+
+def _verdict_of_row(row: str) -> str:
+    """The verdict a row's verdict column states for this run (its first verdict)."""
+    cell = row.split(" | ")[5].removeprefix("this run: ")
+    return next(v for v in (verdicts.COMPROMISE, verdicts.STRUCTURAL, verdicts.REPRODUCED) if cell.startswith(v))
+
+
+def test_no_verdict_contradicts_the_agreement_on_a_coarse_grid():
+    """reproduce --points 3 .. 5 of the calibrated preset: each row's verdict follows from its own "agrees"
+    (before: the documented verdicts of the 81 x 81 grid, e.g. "reproduced" beside a value that does not
+    agree, or "cannot be reproduced" beside one that does), and the page says the grid is the condition."""
+    for points in (3, 4, 5):
+        measured = _measurements(np.linspace(0.0, 0.08, points))
+        text = report.render(measured, dataclasses.replace(RUN, calibrated=True, points=points))
+        assert f"This run's grid is {points} × {points}" in text
+        for m in measured:
+            row = next(line for line in text.splitlines() if line.startswith(f"| `{m.landmark.name}` |"))
+            assert (_verdict_of_row(row) == verdicts.REPRODUCED) == m.agrees, row
 
 
 def test_halving_names_the_closer_convention():

@@ -32,6 +32,14 @@ S, D, THETA, KP, KD = 5.0, -10.0, 0.5, 20.0, 3.0
         (lambda: reflex.phase_margin(S, D, THETA, KP, KD, -0.1), "delay"),
         (lambda: loops.pade_delay(-0.1, 3), "delay"),
         (lambda: reflex.delay_margin("a", D, THETA, KP, KD), "stiffness"),
+        # a bool or a text where a number belongs: numpy would read True as 1 and '200' as 200
+        (lambda: reflex.delay_margin(S, D, THETA, True, KD), "kp"),
+        (lambda: reflex.delay_margin(S, D, THETA, "200", KD), "kp"),
+        (lambda: reflex.delay_margin(S, D, THETA, KP, [3.0, "1"]), "kd"),
+        (lambda: reflex.critical_gains(S, D, THETA, np.bool_(True), 0.1), "kd"),
+        (lambda: reflex.delay_margin(S, D, THETA, 1 + 2j, KD), "kp"),  # complex: numpy drops the imaginary part
+        (lambda: reflex.delay_margin(S, D, THETA, None, KD), "kp"),  # None: read as NaN, a silent "undefined"
+        (lambda: reflex.stable_at_delay(S, D, THETA, KP, KD, "0.1"), "delay"),
     ],
 )
 def test_nonsense_is_refused_by_name(call, field):
@@ -59,3 +67,18 @@ def test_library_callers_under_their_own_guard_are_not_checked_again():
         reflex.delay_margin(S, D, THETA, 1e100, KD)
     with pytest.raises(ParameterError):
         reflex.delay_margin(S, D, THETA, 1e100, KD)
+
+
+@pytest.mark.parametrize(
+    ("gains", "field"),
+    [({"kp": -3.0}, "reflex.kp"), ({"kd": -0.5}, "reflex.kd"), ({"kp": True}, "reflex.kp"), ({"kd": "2"}, "reflex.kd")],
+)
+def test_analyse_refuses_negative_or_non_numeric_gains_itself(gains, field):
+    """The library's ``analyse`` checks the gains it is given as the model's ``reflex.kp``/``kd`` are
+    checked (before: only the CLI did, through a discarded ``set_parameter``; the library gave margins)."""
+    from spinectl.model.config import load_config
+    from spinectl.reflex.margins import analyse
+
+    with pytest.raises(ParameterError) as info:
+        analyse(load_config(None, preset="wagner2012"), 0.0, 0.0, **gains)
+    assert info.value.field == field

@@ -3,6 +3,8 @@ closed forms and the segment's own closed form."""
 
 from __future__ import annotations
 
+import re
+
 import control as ct
 import numpy as np
 import pytest
@@ -100,3 +102,35 @@ def test_what_the_theory_does_not_cover_is_refused_naming_the_loop(loop):
     with pytest.raises(ParameterError) as info:
         spinectl.delay_margin(loop)
     assert info.value.field == "loop" and "\n" not in str(info.value)
+
+
+def test_uniformly_huge_coefficients_are_scaled_and_computed():
+    """L = 2e300 / (1e300 (s^2 + s + 1)) is L = 2 / (s^2 + s + 1): the same margin, not a LinAlgError.
+
+    Closed form for k / (s^2 + s + 1), k = 2: abs(D(jw)) = k gives w^4 - w^2 - 3 = 0, w^2 = (1 + sqrt 13) / 2;
+    the margin is arg(-L(jw)) / w with arg(-L) = pi - arg(1 - w^2 + j w).
+    """
+
+    w = np.sqrt((1.0 + np.sqrt(13.0)) / 2.0)
+    expected = (np.pi - np.angle(1.0 - w**2 + 1j * w)) / w
+    huge = spinectl.delay_margin(ct.tf([2e300], [1e300, 1e300, 1e300]))
+    assert huge.status == "finite" and huge.margin == pytest.approx(expected, rel=1e-12)
+    assert huge.frequency == pytest.approx(w, rel=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("num", "den", "needle"),
+    [
+        ([1e300], [1.0, 1e300, 1e300], "a span over 1e+100"),  # before: LinAlgError (F overflowed)
+        ([1e200], [1.0, 1.0, 1.0], "a span over 1e+100"),  # before: LinAlgError
+        ([1.0], [1e300, 2.0, 3.0], "a span over 1e+100"),  # before: "unstable_without_delay" for a stable loop
+        ([1.0 + 1.0j], [1.0, 2.0, 3.0], "must have real coefficients"),  # before: TypeError or a wrong margin
+    ],
+)
+def test_absurd_or_complex_coefficients_are_one_parameter_error(num, den, needle):
+
+    loop = ct.tf([1.0], den)
+    loop.num_array[0][0] = np.asarray(num)  # python-control's tf() refuses complex: as a computed loop may hold
+    with pytest.raises(ParameterError, match=re.escape(needle)) as info:
+        spinectl.delay_margin(loop)
+    assert isinstance(info.value, ValueError) and info.value.field == "loop" and "\n" not in str(info.value)

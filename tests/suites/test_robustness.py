@@ -130,7 +130,7 @@ KINDS = {
 """The kind of every parameter: which wrong types to try on it."""
 
 OUT_OF_RANGE = {
-    "body.mass": [0, -0.0, -1.0, -1e300],
+    "body.mass": [0, -0.0, -1.0, -1e300, 1000.5, 1e6],  # 1e6 kg: every point "infeasible", no reason given
     "body.mass_height": [0.0, -0.326, 0.1],  # 0.1: below the top CoR L1L2 (0.145 m)
     "body.gravity": [0.0, -9.81],
     "body.radius_of_gyration": [-1e-3],
@@ -695,3 +695,21 @@ def test_other_errors_of_a_writer_are_not_called_output_errors(tmp_path):
         tmp.write_text("x", encoding="utf-8")
         (tmp_path / "missing-input").read_text(encoding="utf-8")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_mass_beyond_any_human_upper_body_is_refused_with_the_reason(tmp_path, capsys):
+    """body.mass = 1e6 kg (grams typed as kilograms): before, every point of a sweep came out
+    'infeasible' without a word why; now the model names the limit (params.MAX_MASS) and its reason."""
+    from spinectl.model.config import set_parameter
+    from spinectl.model.params import MAX_MASS
+
+    with pytest.raises(ParameterError, match=r"body\.mass: must be at most 1000 kg, more than any human upper body"):
+        set_parameter(Model(), "body.mass", 1e6)
+    assert set_parameter(Model(), "body.mass", MAX_MASS).body.mass == MAX_MASS  # the limit itself is allowed
+    config = tmp_path / "heavy.toml"
+    config.write_text("[body]\nmass = 1e6\n")
+    code = main(
+        ["sweep", "--config", str(config), "--E", "0:0:1", "--Lambda", "0:0:1", "--out", str(tmp_path / "x.nc")]
+    )
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1 and "body.mass: must be at most 1000 kg" in err

@@ -64,7 +64,11 @@ CONNECT_TIMEOUT = 10.0
 """Seconds to wait for a remote scheduler's answer (connection and handshake) before giving up [s]."""
 
 WORKER_TIMEOUT = 60.0
-"""Seconds to wait for the first worker of a remote scheduler that has none [s]."""
+"""Seconds to wait for the first worker of a remote scheduler that has none, or for a worker again once
+every worker of the run has gone [s]."""
+
+POLL = 1.0
+"""Seconds between looks at the workers while no chunk finishes [s]."""
 
 MALLOC_TRIM_SETTING = "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_"
 """Dask sets ``MALLOC_TRIM_THRESHOLD_=65536`` in its workers so that glibc hands freed memory back at
@@ -223,7 +227,8 @@ def run_study(
     connect_timeout : float
         Seconds to wait for a remote ``scheduler``'s answer, connection and handshake [s].
     worker_timeout : float
-        Seconds to wait for the first worker of a remote ``scheduler`` that has none [s].
+        Seconds to wait for the first worker of a remote ``scheduler`` that has none, and for a
+        worker again once every worker of the cluster has gone mid-run [s].
     notify : callable or None
         Called with a line of text for what the user should know while it runs (a
         remote scheduler's worker count, a wait for a worker, chunks found missing).
@@ -289,6 +294,8 @@ def _check_options(scheduler, workers, max_chunks, timeouts: dict) -> None:
         scheme = str(scheduler).partition("://")[0]
         why = f": {scheme}:// {UNUSABLE_SCHEMES[scheme]}" if scheme in UNUSABLE_SCHEMES else ""
         raise ParameterError("scheduler", f"must be {allowed} (got {scheduler!r}){why}")
+    if scheduler is not None and scheduler != SYNCHRONOUS:
+        _check_host_port(scheduler)
     if workers is not None:
         if scheduler is not None:
             raise ParameterError("workers", "sets the size of the local cluster: not with a scheduler")
@@ -301,6 +308,23 @@ def _check_options(scheduler, workers, max_chunks, timeouts: dict) -> None:
     for name, seconds in timeouts.items():
         if isinstance(seconds, bool) or not isinstance(seconds, int | float) or not 0 < seconds < math.inf:
             raise ParameterError(name, f"must be a number of seconds > 0 (got {seconds!r})")
+
+
+def _check_host_port(scheduler: str) -> None:
+    """Refuse at once an address without a host, or with a port that is not an integer in [1, 65535]:
+    such an address used to fail only after the connection's timeout, or with Python's own words."""
+    from distributed.comm.addressing import parse_host_port
+
+    try:
+        host, port = parse_host_port(scheduler.removeprefix("tcp://"))
+    except ValueError as exc:
+        host, port = None, str(exc)
+    if not host or isinstance(port, str) or not 1 <= port <= 65535:
+        raise ParameterError(
+            "scheduler",
+            "must be tcp://HOST:PORT with a host and a port in [1, 65535], e.g. tcp://127.0.0.1:8786 "
+            f"(got {scheduler!r})",
+        )
 
 
 def _cores() -> int:
@@ -320,10 +344,15 @@ class _InProcess:
 
 
 class _Distributed:
-    """Chunks on a ``dask.distributed`` cluster, at most two per worker thread in flight."""
+    """Chunks on a ``dask.distributed`` cluster, at most two per worker thread in flight.
 
-    def __init__(self, client, where: str):
-        self.client, self.where = client, where
+    While no chunk finishes, the workers are counted every :data:`POLL` seconds: once
+    the cluster has had none for ``worker_timeout`` seconds (they were stopped, or lost
+    their network), the run stops with one line; the store holds every chunk written.
+    """
+
+    def __init__(self, client, where: str, worker_timeout: float = WORKER_TIMEOUT):
+        self.client, self.where, self.worker_timeout = client, where, worker_timeout
         info = client.scheduler_info()
         self.addresses = (info["address"], *sorted(info["workers"]))
 
@@ -336,13 +365,34 @@ class _Distributed:
             return self.client.submit(solve_chunk, task, key=f"{prefix}-{task.index}")
 
         pending = as_completed([submit(task) for task in itertools.islice(chunks, window)], loop=self.client.loop)
-        for future in pending:
-            result = future.result()  # a chunk's error ends the run here; the cluster is closed on the way out
-            future.release()
-            yield result
-            task = next(chunks, None)
-            if task is not None:
-                pending.add(submit(task))
+        while not pending.is_empty():
+            self._wait_for_one(pending)
+            for future in pending.next_batch(block=False):
+                result = future.result()  # a chunk's error ends the run here; the cluster is closed on the way out
+                future.release()
+                yield result
+                task = next(chunks, None)
+                if task is not None:
+                    pending.add(submit(task))
+
+    def _wait_for_one(self, pending) -> None:
+        """Return once a future of ``pending`` has finished, as long as the cluster has a worker."""
+        idle_since, looked = None, time.monotonic()
+        while not pending.has_ready():
+            time.sleep(0.01)
+            if time.monotonic() - looked < POLL:
+                continue
+            looked = time.monotonic()
+            if self.client.scheduler_info(n_workers=0).get("n_workers", 1) > 0:
+                idle_since = None
+            elif idle_since is None:
+                idle_since = looked
+            elif looked - idle_since > self.worker_timeout:
+                raise ParameterError(
+                    "scheduler",
+                    f"{self.where}: every worker has gone, and none joined within {self.worker_timeout:g} s: the "
+                    "store holds every chunk finished; start a worker and run again with --resume",
+                )
 
 
 @contextlib.contextmanager
@@ -352,11 +402,12 @@ def _executor(scheduler: str | None, workers: int | None, n_todo: int, timeouts:
         return
     if scheduler is not None:
         with _remote(scheduler, *timeouts, notify) as client:
-            yield _Distributed(client, _where(scheduler, len(client.scheduler_info()["workers"])))
+            n_workers = len(client.scheduler_info()["workers"])
+            yield _Distributed(client, _where(scheduler, n_workers), timeouts[1])
         return
     n = min(workers or _cores(), n_todo)
     with _local_cluster(n) as client:
-        yield _Distributed(client, f"{n} local worker{'s' * (n != 1)}")
+        yield _Distributed(client, f"{n} local worker{'s' * (n != 1)}", timeouts[1])
 
 
 def _where(scheduler: str, n_workers: int) -> str:
@@ -447,11 +498,16 @@ def _handshake(scheduler: str, timeout: float) -> int:
     server) would keep it waiting for ever.
     """
     import asyncio
+    import socket
     import struct
 
+    from distributed.comm.addressing import parse_host_port
     from distributed.core import rpc
 
     async def identity():
+        host, port = parse_host_port(scheduler.removeprefix("tcp://"))
+        # a name that does not resolve: said so (socket.gaierror), not "no answer within 10 s" after retries
+        await asyncio.get_running_loop().getaddrinfo(host, port, type=socket.SOCK_STREAM)
         async with rpc(scheduler, timeout=timeout) as remote:
             return await remote.identity()
 

@@ -13,8 +13,12 @@ warning that format 3 has no specification for them yet. Every Zarr file is
 written atomically (zarr's local store writes a temporary and renames it), so a
 killed run leaves whole chunks or none. Every chunk is written as a file, also
 one of fill values only (``write_empty_chunks``), so that a chunk counted done
-has a file of each output: a resume and :func:`open_store` check that it does
-(:func:`missing_chunks`).
+has a file of each output; with its count the writer records ``chunk_crc32``, the
+CRC-32 of those files' bytes. A resume and :func:`open_store` check every chunk
+counted done (its files present, their CRC-32 as recorded) and the store's
+layout (every array present with the shape it was made with, and the values of
+the arrays written once at creation, the coordinates, as recorded in the
+attribute ``layout``): :func:`damaged_chunks`.
 
 A run holds the store's lock file (:func:`locked`), ``<store>.lock`` beside it,
 from before the existence check to its end: a second run on the same store is
@@ -24,8 +28,12 @@ refused at once, naming the first.
 from __future__ import annotations
 
 import contextlib
+import json
 import os
 import socket
+import tempfile
+import warnings
+import zlib
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
@@ -44,9 +52,15 @@ from .spec import SAMPLE, STORE_FORMAT, Chunk, Study
 DONE = "chunk_done"
 """The per-chunk counter of writes."""
 
+CHECKSUM = "chunk_crc32"
+"""Per chunk, the CRC-32 of its files' bytes (every output, in name order), recorded before its count."""
+
+LAYOUT = "layout"
+"""The attribute (JSON text) of every array's shape, and the CRC-32 of the values of those written once at creation."""
+
 CHUNK_FILES = "every_chunk_a_file"
 """The attribute that says every chunk written is a file (``write_empty_chunks``); stores made before
-it may lack the files of chunks of fill values only, so their chunks are not checked (:func:`missing_chunks`)."""
+it may lack the files of chunks of fill values only, so their chunks are not checked (:func:`damaged_chunks`)."""
 
 STRING_WIDTH = 32
 """Characters of the fixed-width status strings; the longest status has 22."""
@@ -128,6 +142,8 @@ def template(study: Study, probe: dict[str, np.ndarray]) -> xr.Dataset:
         data_vars[name] = xr.Variable(dims, array, {"units": units, "long_name": long_name})
     done = da.zeros(study.n_chunks, dtype="int16", chunks=1)
     data_vars[DONE] = xr.Variable(("chunk",), done, {"long_name": "times the chunk was written: 0 not yet, 1 done"})
+    crc = da.zeros(study.n_chunks, dtype="int64", chunks=1)
+    data_vars[CHECKSUM] = xr.Variable(("chunk",), crc, {"long_name": "CRC-32 of the chunk's files, once done"})
     return xr.Dataset(data_vars, _coordinates(study), _attributes(study))
 
 
@@ -187,12 +203,12 @@ def existing(
     -------
     numpy.ndarray of int, shape (n_chunks,) or None
         How many times each chunk was written (0: not yet, or counted done but its data is
-        missing, :func:`missing_chunks`); None if ``path`` does not exist.
+        damaged, :func:`damaged_chunks`); None if ``path`` does not exist.
 
     Raises
     ------
     OutputError
-        The store exists and ``resume`` is false.
+        The store exists and ``resume`` is false, or it cannot be written (read-only, immutable, not the user's).
     ParameterError
         ``resume`` and the path holds no study store, or one of another study (field ``store``).
     """
@@ -205,11 +221,26 @@ def existing(
             "afresh (a study store is filled in place and never replaced, which would discard its chunks)"
         )
     counts = _done_counts(study, path)
-    missing = missing_chunks(path, counts)
+    missing = damaged_chunks(path, counts)
+    _check_writable(path)  # before any work: a read-only store would fail at its first chunk
     if missing.size:
         notify(f"study: {_missing_text(path, missing)}; computing {'it' if missing.size == 1 else 'them'} again")
         counts[missing] = 0
     return counts
+
+
+def _check_writable(path: Path) -> None:
+    """Raise :class:`OutputError` if a file cannot be made in the store or one of its arrays' folders.
+
+    zarr writes each chunk (and the consolidated metadata at the end) to a temporary file
+    in its folder, then renames it: the same is tried here, in every folder, and undone.
+    """
+    for folder in (path, *sorted(p for p in path.iterdir() if p.is_dir())):
+        with output_errors(folder):
+            fd, name = tempfile.mkstemp(prefix=".spinectl-probe.", dir=folder)
+            os.close(fd)
+            os.replace(name, f"{name}.renamed")
+            os.unlink(f"{name}.renamed")
 
 
 def create(study: Study, path: str | Path, probe: dict) -> np.ndarray:
@@ -238,17 +269,17 @@ def create(study: Study, path: str | Path, probe: dict) -> np.ndarray:
         template(study, probe).to_zarr(
             tmp, mode="w", compute=False, zarr_format=ZARR_FORMAT, consolidated=False, write_empty_chunks=True
         )
+        group = zarr.open_group(tmp, mode="r+", zarr_format=ZARR_FORMAT)
+        group.attrs[LAYOUT] = json.dumps({name: _layout_entry(array) for name, array in sorted(group.arrays())})
     return np.zeros(study.n_chunks, dtype=int)
 
 
 def _done_counts(study: Study, path: Path) -> np.ndarray:
     try:
-        group = zarr.open_group(path, mode="r", zarr_format=ZARR_FORMAT)
-        digest = group.attrs.get("study_digest")
-        counts = group[DONE][:] if digest else None
+        digest = zarr.open_group(path, mode="r", zarr_format=ZARR_FORMAT).attrs.get("study_digest")
     except OPEN_ERRORS:
         digest = None
-    if digest is None:
+    if not isinstance(digest, str):
         raise ParameterError("store", f"{str(path)!r} is not a spinectl study store")
     if digest != study.digest():
         raise ParameterError(
@@ -256,7 +287,11 @@ def _done_counts(study: Study, path: Path) -> np.ndarray:
             f"{str(path)!r} holds another study (digest {digest[:12]}, this file {study.digest()[:12]}): resume "
             "with the study file that made it, or write to another store",
         )
-    return counts.astype(int)
+    group = _checked_group(path)  # a study store, but its layout may be damaged: say what is lost
+    try:
+        return group[DONE][:].astype(int)
+    except OPEN_ERRORS as exc:  # a store made before the layout was recorded
+        raise ParameterError("store", f"{str(path)!r} is damaged: array {DONE!r}: {exc}") from None
 
 
 class Writer:
@@ -274,13 +309,14 @@ class Writer:
 
     def __init__(self, study: Study, path: str | Path, done: np.ndarray):
         self.study, self.path, self.done = study, Path(path), done
-        self._flags = zarr.open_group(self.path, mode="r+", zarr_format=ZARR_FORMAT)[DONE]
+        group = zarr.open_group(self.path, mode="r+", zarr_format=ZARR_FORMAT)
+        self._flags, self._crc, self._files = group[DONE], group[CHECKSUM], _ChunkFiles(self.path, group)
 
     def write(self, chunk: Chunk, outputs: dict[str, np.ndarray]) -> None:
         """Write one chunk's outputs (from :func:`encode`), then raise its count.
 
-        The data first, the count after: a run killed in between leaves the
-        chunk counted 0, and a resume writes it again, whole.
+        The data first, then the CRC-32 of its files, the count last: a run killed
+        in between leaves the chunk counted 0, and a resume writes it again, whole.
 
         Parameters
         ----------
@@ -288,6 +324,12 @@ class Writer:
             Where the outputs go.
         outputs : dict of str to numpy.ndarray
             On the chunk's tile.
+
+        Raises
+        ------
+        OutputError
+            The store cannot be written (a full disk, a quota, permissions): the chunk
+            stays counted 0, the store resumable.
         """
         lead = (np.newaxis,) * len(self.study.dims)
         part = xr.Dataset(
@@ -295,9 +337,16 @@ class Writer:
         )
         region = {dim: slice(i, i + 1) for dim, i in zip(self.study.dims, chunk.combination, strict=True)}
         region |= {"E": chunk.eccentricity, "Lambda": chunk.lordosis}
-        part.to_zarr(self.path, region=region, consolidated=False, zarr_format=ZARR_FORMAT, write_empty_chunks=True)
+        try:
+            part.to_zarr(self.path, region=region, consolidated=False, zarr_format=ZARR_FORMAT, write_empty_chunks=True)
+            self._crc[chunk.index] = self._files.checksum(chunk.index)
+            self._flags[chunk.index] = self.done[chunk.index] + 1
+        except OSError as exc:  # a full disk, a quota, a store made read-only meanwhile: the chunk counts 0
+            raise OutputError(
+                f"cannot write {str(self.path)!r}: {exc.strerror or exc.__class__.__name__}; the store holds every "
+                "chunk finished: run again with --resume once it can be written"
+            ) from None
         self.done[chunk.index] += 1
-        self._flags[chunk.index] = self.done[chunk.index]
 
 
 def consolidate(path: str | Path) -> None:
@@ -331,15 +380,25 @@ def open_store(path: str | Path) -> xr.Dataset:
     Raises
     ------
     ParameterError
-        Not a spinectl study store, or a chunk counted done has lost its data (field ``store``).
+        Not a spinectl study store, its layout is damaged (an array's metadata or a coordinate
+        lost or changed), or a chunk counted done has lost its data or has other bytes than
+        those written (field ``store``).
     """
     try:
-        dataset = xr.open_zarr(path, consolidated=False, zarr_format=ZARR_FORMAT)
+        with warnings.catch_warnings():  # zarr warns of a folder whose metadata is lost: checked below
+            warnings.simplefilter("ignore", zarr.errors.ZarrUserWarning)
+            dataset = xr.open_zarr(path, consolidated=False, zarr_format=ZARR_FORMAT)
     except OPEN_ERRORS:
         dataset = None
-    if dataset is None or "study_digest" not in dataset.attrs:
+    if dataset is None or "study_digest" not in dataset.attrs or DONE not in dataset:
+        try:
+            _checked_group(path)  # a study store whose layout is damaged: say what is lost
+        except ParameterError:
+            raise
+        except OPEN_ERRORS:
+            pass  # not a store at all
         raise ParameterError("store", f"{str(path)!r} is not a spinectl study store")
-    missing = missing_chunks(path, dataset[DONE].values)
+    missing = damaged_chunks(path, dataset[DONE].values)
     if missing.size:
         raise ParameterError("store", f"{_missing_text(path, missing)}: run the study again with --resume")
     return dataset
@@ -372,13 +431,15 @@ def load(path: str | Path) -> xr.Dataset:
     return dataset
 
 
-def missing_chunks(path: str | Path, counts: np.ndarray) -> np.ndarray:
-    """The chunks counted done of which an output has no file (deleted, or lost by a copy).
+def damaged_chunks(path: str | Path, counts: np.ndarray) -> np.ndarray:
+    """The chunks counted done that lost a file or whose files' bytes are not those written; the layout checked first.
 
     Every output array is chunked as the study (parameter dimensions one by one, then
     the tile of E and Lambda, the trailing dimensions whole), so chunk ``i`` of the study is
     the ``i``-th of the leading chunk grid in C order; and every chunk written is a file
-    (``write_empty_chunks``). One listing per output: cheap beside reading the data.
+    (``write_empty_chunks``). Reads each done chunk's files once, undecoded: cheap beside
+    reading the data. A store made before the CRC-32 were recorded is checked for the
+    files' presence only; one made before every chunk was a file is not checked.
 
     Parameters
     ----------
@@ -390,31 +451,99 @@ def missing_chunks(path: str | Path, counts: np.ndarray) -> np.ndarray:
     Returns
     -------
     numpy.ndarray of int
-        Indices of the chunks counted done with a chunk file missing, ascending; none
-        in a store made without :data:`CHUNK_FILES` (it cannot tell).
+        Indices of the chunks counted done with a chunk file missing or other bytes, ascending.
+
+    Raises
+    ------
+    ParameterError
+        The store's layout is damaged: an array lost (its metadata deleted), of another
+        shape, or an array written once at creation (a coordinate) with other values (field ``store``).
     """
-    group = zarr.open_group(path, mode="r", zarr_format=ZARR_FORMAT)
+    group = _checked_group(path)
     done = np.flatnonzero(np.asarray(counts) > 0)
-    missing = np.zeros(len(counts), dtype=bool)
     if group.attrs.get(CHUNK_FILES) is not True:
-        return np.flatnonzero(missing)  # an older store: a chunk of fill values only may lack its file
-    for name, array in group.arrays():
-        if not {"E", "Lambda"} <= set(array.attrs.get("_ARRAY_DIMENSIONS", ())):
-            continue  # the chunk counts, the coordinates
-        lead = array.attrs["_ARRAY_DIMENSIONS"].index("Lambda") + 1
-        grid = tuple(-(-n // c) for n, c in zip(array.shape, array.chunks, strict=True))
-        separator = array.metadata.dimension_separator
-        folder = Path(path, name)
-        present = {str(p.relative_to(folder)) for p in folder.rglob("*") if p.is_file()}
-        for index in done:
+        return np.zeros(0, dtype=int)  # an older store: a chunk of fill values only may lack its file
+    files = _ChunkFiles(path, group)
+    recorded = group[CHECKSUM][:] if CHECKSUM in group else None
+    bad = [i for i in done if (crc := files.checksum(i)) is None or (recorded is not None and crc != recorded[i])]
+    return np.asarray(bad, dtype=int)
+
+
+def _checked_group(path):
+    """The store's root group, its layout checked (:func:`_check_layout`)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", zarr.errors.ZarrUserWarning)
+        # not the consolidated metadata of a finished store: it would list an array whose own metadata is lost
+        group = zarr.open_group(path, mode="r", zarr_format=ZARR_FORMAT, use_consolidated=False)
+        _check_layout(path, group)
+    return group
+
+
+class _ChunkFiles:
+    """The files of each study chunk: one per output array (the arrays over E and Lambda)."""
+
+    def __init__(self, path: str | Path, group):
+        self.arrays = []
+        for name, array in sorted(group.arrays(), key=lambda item: item[0]):
+            dims = array.attrs.get("_ARRAY_DIMENSIONS", ())
+            if not {"E", "Lambda"} <= set(dims):
+                continue  # the chunk counts, the coordinates
+            grid = tuple(-(-n // c) for n, c in zip(array.shape, array.chunks, strict=True))
+            lead = list(dims).index("Lambda") + 1
+            self.arrays.append((Path(path, name), array.metadata.dimension_separator, grid, lead))
+
+    def checksum(self, index: int) -> int | None:
+        """CRC-32 of chunk ``index``'s files, in array name order; None if one is missing."""
+        crc = 0
+        for folder, separator, grid, lead in self.arrays:
             position = np.unravel_index(index, grid[:lead]) + (0,) * (len(grid) - lead)
-            missing[index] |= separator.join(str(int(i)) for i in position) not in present
-    return np.flatnonzero(missing)
+            try:
+                crc = zlib.crc32(Path(folder, separator.join(str(int(i)) for i in position)).read_bytes(), crc)
+            except (FileNotFoundError, IsADirectoryError, NotADirectoryError):
+                return None
+        return crc
+
+
+def _layout_entry(array) -> dict:
+    """An array's shape; for one written once at creation (not over E and Lambda, not a counter) its values' CRC-32."""
+    dims = array.attrs.get("_ARRAY_DIMENSIONS")
+    entry = {"shape": list(array.shape), "dims": dims}
+    if not {"E", "Lambda"} <= set(dims or ()) and array.basename not in (DONE, CHECKSUM):
+        entry["crc32"] = zlib.crc32(np.ascontiguousarray(array[...]).tobytes())
+    return entry
+
+
+def _check_layout(path, group) -> None:
+    """Every array of the attribute :data:`LAYOUT` present, of its shape, the fixed ones with their values."""
+    try:
+        layout = json.loads(group.attrs[LAYOUT])
+    except KeyError:
+        return  # a store made before the layout was recorded
+    except (TypeError, ValueError):
+        layout = None
+    if not isinstance(layout, dict) or not all(isinstance(entry, dict) for entry in layout.values()):
+        raise ParameterError("store", f"{str(path)!r} is damaged: its attribute {LAYOUT!r} is not as written")
+    arrays = dict(group.arrays())
+    for name, entry in layout.items():
+        problem = None
+        if name not in arrays:
+            problem = "its metadata is lost"
+        elif list(arrays[name].shape) != entry.get("shape"):
+            problem = f"its shape is {list(arrays[name].shape)}, not {entry.get('shape')}"
+        elif arrays[name].attrs.get("_ARRAY_DIMENSIONS") != entry.get("dims"):
+            problem = "its attributes (the dimensions' names) are lost or changed"
+        elif "crc32" in entry and _layout_entry(arrays[name]).get("crc32") != entry["crc32"]:
+            problem = "its values are not those written (a chunk file lost or changed)"
+        if problem:
+            raise ParameterError(
+                "store", f"{str(path)!r} is damaged: array {name!r}: {problem}; remove it and run the study afresh"
+            )
 
 
 def _missing_text(path, missing: np.ndarray) -> str:
     shown = ", ".join(str(i) for i in missing[:5]) + (", ..." if missing.size > 5 else "")
-    return f"{str(path)!r}: {missing.size} chunk(s) counted done have lost their data (chunk {shown})"
+    lost = "have lost their data or hold other bytes than written"
+    return f"{str(path)!r}: {missing.size} chunk(s) counted done {lost} (chunk {shown})"
 
 
 LOCK_SUFFIX = ".lock"
@@ -425,8 +554,9 @@ LOCK_SUFFIX = ".lock"
 def locked(path: str | Path) -> Iterator[Path]:
     """Hold the lock of the store ``path`` while the block runs: no second run can use it meanwhile.
 
-    The lock is a file beside the store, created exclusively (``O_EXCL``), holding the
-    process id and host name of its holder; it is removed at the end, whatever happens.
+    The lock is a file beside the store (beside its real path, after symbolic links),
+    created exclusively (``O_EXCL``), holding the process id and host name of its
+    holder; it is removed at the end, whatever happens.
     A lock left by a run that is gone (killed: its process id no longer runs on this
     host) is taken over; one of another host is never (its process cannot be checked):
     remove it by hand once that run has ended.
@@ -446,7 +576,8 @@ def locked(path: str | Path) -> Iterator[Path]:
     OutputError
         Another run holds the lock (its process id and host are named), or the lock cannot be written.
     """
-    lock = Path(f"{path}{LOCK_SUFFIX}")
+    # one lock per store, however it is named: a trailing slash, '..' or a symbolic link leads to the same
+    lock = Path(f"{os.path.realpath(path)}{LOCK_SUFFIX}")
     with output_errors(lock):
         lock.parent.mkdir(parents=True, exist_ok=True)
         _acquire(lock)
