@@ -31,7 +31,16 @@ from ..paper.drawing import draw_model
 from ..units import CM_PER_M
 from . import views
 from .numbers import LANDSCAPE_POINTS, PointNumbers, landscapes, point_numbers
-from .state import LANDSCAPE_PARAMETERS, SLIDERS, ExploreState, initial_state, replace, state_toml
+from .state import (
+    LANDSCAPE_PARAMETERS,
+    SLIDERS,
+    ExploreState,
+    from_shown,
+    initial_state,
+    replace,
+    slider_for,
+    state_toml,
+)
 
 DPI = 80
 """Resolution of the matplotlib views in the browser [dots per inch]."""
@@ -135,13 +144,13 @@ class Explorer:
         self.dataset: xr.Dataset | None = None
         self._generation = 0
         self.seconds = {"point": np.nan, "landscapes": np.nan}
-        self.preset = pn.widgets.Select(name="preset", value=preset, options=[*self.models, *list_presets()])
+        self.preset = pn.widgets.Select(label="preset", value=preset, options=[*self.models, *list_presets()])
         self.sliders = {s.field: self._slider(s) for s in SLIDERS}
         self.drawing = pn.pane.PNG(None, width=int(DRAWING_SIZE[0] * DPI), name="drawing")
         self.views = {name: pn.pane.PNG(None, width=int(views.VIEW_SIZE[0] * DPI), name=name) for name in VIEWS}
         self.table = pn.pane.HTML("", name="numbers")
         self.status = pn.pane.Markdown("", name="status")
-        self.progress = pn.indicators.Progress(active=False, visible=False, width=200, name="progress")
+        self.progress = pn.indicators.Progress(active=False, visible=False, width=200)
         self.maps = {variable: _LandscapeView(variable, self.move_to) for variable in views.LANDSCAPE_LABELS}
         self.preset.param.watch(self._on_preset, "value")
         self.layout = self._layout()
@@ -151,7 +160,7 @@ class Explorer:
     def _slider(self, spec) -> pn.widgets.FloatSlider:
         value = getattr(self.state, spec.field) * spec.scale
         slider = pn.widgets.FloatSlider(
-            name=spec.label,
+            label=spec.label,
             start=min(spec.start, value),
             end=max(spec.end, value),
             step=spec.step,
@@ -185,7 +194,7 @@ class Explorer:
 
     def _on_slider(self, spec, shown: float) -> None:
         old = self.state
-        self.state = replace(self.state, **{spec.field: shown / spec.scale})
+        self.state = replace(self.state, **{spec.field: from_shown(spec, shown)})
         self.update_point()
         if spec.field in LANDSCAPE_PARAMETERS and getattr(old, spec.field) != getattr(self.state, spec.field):
             self.refresh_landscapes()
@@ -211,9 +220,8 @@ class Explorer:
         """
         values = {}
         for field, value in (("eccentricity", eccentricity), ("lordosis", lordosis)):
-            slider, spec = self.sliders[field], next(s for s in SLIDERS if s.field == field)
-            shown = np.clip(round(value * spec.scale / spec.step) * spec.step, slider.start, slider.end)
-            values[field] = float(shown) / spec.scale
+            slider, spec = self.sliders[field], slider_for(field)
+            values[field] = from_shown(spec, float(np.clip(value * spec.scale, slider.start, slider.end)))
         self.state = replace(self.state, **values)
         self._show_state()
         self.update_point()

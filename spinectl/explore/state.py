@@ -160,6 +160,39 @@ def state_toml(base: Model, state: ExploreState) -> str:
     return point + dump_toml(model_at(base, state))
 
 
+def from_shown(slider: Slider, shown: float) -> float:
+    """A slider's value in SI units, on its grid of steps (a browser's slider may be off by an ulp).
+
+    Parameters
+    ----------
+    slider : Slider
+    shown : float
+        The value in the unit shown.
+
+    Returns
+    -------
+    float
+        The nearest step in the unit shown, rounded to 10 decimals (5.1, not 5.1000000000000005),
+        over ``scale``: in SI units.
+    """
+    return round(round(shown / slider.step) * slider.step, 10) / slider.scale
+
+
+def slider_for(field: str) -> Slider:
+    """The slider of a state's field.
+
+    Parameters
+    ----------
+    field : str
+        A field of :class:`ExploreState`.
+
+    Returns
+    -------
+    Slider
+    """
+    return next(s for s in SLIDERS if s.field == field)
+
+
 def replace(state: ExploreState, **changes) -> ExploreState:
     """``state`` with some fields changed (:func:`dataclasses.replace`), every value a float.
 

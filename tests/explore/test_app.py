@@ -1,0 +1,91 @@
+"""The Panel app without a browser: its widgets move the state, its views show the library's numbers."""
+
+from __future__ import annotations
+
+import base64
+
+import numpy as np
+import param
+import pytest
+
+from spinectl.explore import app
+from spinectl.explore import numbers as nb
+from spinectl.explore.state import initial_state, replace
+from spinectl.model.config import load_preset
+
+
+@pytest.fixture(scope="module")
+def explorer():
+    return app.Explorer(load_preset("default"), "default")
+
+
+def _drag(slider, value):
+    """What the browser sends when a slider is released: value and value_throttled."""
+    with param.edit_constant(slider):
+        slider.param.update(value=value, value_throttled=value)
+
+
+def test_views_show_the_numbers_of_the_state(explorer):
+    """The table's cells are PointNumbers.rows(); the drawing is drawing_png of the same numbers, byte for byte."""
+    expected = nb.point_numbers(explorer.base, explorer.state)
+    for row in expected.rows():
+        for key in app.ROW_KEYS:
+            assert f'<td data-key="{key}">{row[key]}</td>' in explorer.table.object
+    assert explorer.drawing.object == app.drawing_png(expected)
+    assert explorer.dataset is not None  # outside a server session the landscapes are solved at once
+    assert "point updated in" in explorer.status.object
+
+
+def test_a_slider_moves_the_point_and_the_views_follow(explorer):
+    """E to 5.2 cm: numbers, drawing and landscape markers at the new point."""
+    before = explorer.drawing.object
+    _drag(explorer.sliders["eccentricity"], 5.2)
+    assert explorer.state.eccentricity == pytest.approx(0.052, abs=1e-15)
+    expected = nb.point_numbers(explorer.base, explorer.state)
+    assert f'<td data-key="counter_torque_Nm">{expected.rows()[0]["counter_torque_Nm"]}</td>' in explorer.table.object
+    assert explorer.drawing.object != before and explorer.drawing.object == app.drawing_png(expected)
+    for view in explorer.maps.values():
+        assert view.marker.data == {"x": [pytest.approx(5.2)], "y": [pytest.approx(4.0)]}
+
+
+def test_mass_solves_the_landscapes_again(explorer):
+    """A new mass: the landscapes are those of nb.landscapes at the new state; a reflex change keeps them."""
+    _drag(explorer.sliders["mass"], 30.0)
+    expected = nb.landscapes(explorer.base, explorer.state)
+    np.testing.assert_array_equal(explorer.dataset.min_pcsa_cm2, expected.min_pcsa_cm2)
+    image = explorer.maps["min_pcsa_cm2"].image.data["image"][0]
+    np.testing.assert_array_equal(image, expected.min_pcsa_cm2.values.T)  # Bokeh's rows are Lambda
+    kept = explorer.dataset
+    _drag(explorer.sliders["delay"], 150.0)
+    assert explorer.dataset is kept and explorer.state.delay == pytest.approx(0.15)
+
+
+def test_a_click_moves_the_point_to_the_nearest_step_inside_the_range(explorer):
+    """(5.123 cm, -1 cm) -> E = 5.1 cm, Lambda = 0 (the sliders' step 0.1 cm, range 0 to 8 cm)."""
+    explorer.move_to(0.05123, -0.01)
+    assert (explorer.state.eccentricity, explorer.state.lordosis) == (0.051, 0.0)
+    assert explorer.sliders["eccentricity"].value == pytest.approx(5.1)
+    assert explorer.sliders["lordosis"].value == 0.0
+
+
+def test_preset_selector_loads_the_preset_and_keeps_the_point(explorer):
+    """wagner2012: its own mass and K on the sliders, the point kept."""
+    point = (explorer.state.eccentricity, explorer.state.lordosis)
+    explorer.preset.value = "wagner2012"
+    wagner = load_preset("wagner2012")
+    assert explorer.state == replace(initial_state(wagner), eccentricity=point[0], lordosis=point[1])
+    assert explorer.sliders["mass"].value == wagner.body.mass
+
+
+def test_exports_toml_and_png(explorer):
+    """The download buttons: the state's TOML (state_toml) and a PNG of every view."""
+    toml, png = (w for w in explorer.layout.select(app.pn.widgets.FileDownload))
+    assert toml.callback().getvalue().startswith("# spinectl explore: E = ")
+    assert png.callback().getvalue().startswith(b"\x89PNG")
+
+
+def test_png_bytes_are_reproducible(explorer):
+    """The same figure at the same dpi gives the same bytes (no timestamp): the browser test relies on it."""
+    numbers = nb.point_numbers(explorer.base, explorer.state)
+    assert app.drawing_png(numbers) == app.drawing_png(numbers)
+    assert base64.b64encode(app.drawing_png(numbers))[:8] == b"iVBORw0K"
