@@ -6,6 +6,8 @@ without it, and a missing extra is one line saying how to install it.
 
 from __future__ import annotations
 
+import argparse
+
 from ._common import add_model_options, load_model
 
 PORT = 5006
@@ -15,14 +17,13 @@ ADDRESS = "127.0.0.1"
 
 
 def _port(text: str) -> int:
-    from ..errors import ParameterError
-
+    """An argparse ``type``: a TCP port, 1 to 65535."""
     try:
         port = int(text)
     except ValueError:
         port = -1
     if not 1 <= port <= 65535:
-        raise ParameterError("--port", f"must be an integer from 1 to 65535 (got {text!r})")
+        raise argparse.ArgumentTypeError(f"--port must be an integer from 1 to 65535 (got {text!r})")
     return port
 
 

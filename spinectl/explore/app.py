@@ -144,7 +144,9 @@ class Explorer:
         self.dataset: xr.Dataset | None = None
         self._generation = 0
         self.seconds = {"point": np.nan, "landscapes": np.nan}
-        self.preset = pn.widgets.Select(label="preset", value=preset, options=[*self.models, *list_presets()])
+        self.preset = pn.widgets.Select(
+            label="preset", value=preset, options=[*self.models, *list_presets()], width=260
+        )
         self.sliders = {s.field: self._slider(s) for s in SLIDERS}
         self.drawing = pn.pane.PNG(None, width=int(DRAWING_SIZE[0] * DPI), name="drawing")
         self.views = {name: pn.pane.PNG(None, width=int(views.VIEW_SIZE[0] * DPI), name=name) for name in VIEWS}
