@@ -25,6 +25,7 @@ from bokeh.events import Tap
 from bokeh.models import ColorBar, ColumnDataSource, LinearColorMapper
 from bokeh.plotting import figure as bokeh_figure
 
+from ..canvas import new_figure
 from ..model.config import list_presets, load_preset
 from ..model.params import Model
 from ..paper.drawing import draw_model
@@ -46,6 +47,8 @@ DPI = 80
 """Resolution of the matplotlib views in the browser [dots per inch]."""
 DRAWING_SIZE = (4.6, 5.2)
 """Size of the model drawing [in]."""
+DRAWING_AXES = (0.14, 0.08, 0.83, 0.77)
+"""Left, bottom, width, height of the drawing's axes, as fractions of the figure (room for its title above)."""
 LANDSCAPE_PIXELS = 300
 """Width and height of a landscape view [px]."""
 CONFIG_CHOICE = "--config"
@@ -88,14 +91,15 @@ def drawing_png(numbers: PointNumbers) -> bytes:
         PNG at :data:`DPI`, :data:`DRAWING_SIZE` (:func:`spinectl.paper.drawing.draw_model`).
     """
     state = numbers.state
-    fig = draw_model(
+    fig = new_figure(figsize=DRAWING_SIZE)  # fixed axes: a constrained layout would double the drawing time
+    draw_model(
         numbers.model,
         state.eccentricity,
         state.lordosis,
         pcsa=numbers.pcsa,
         counter_torque=numbers.pcsa is not None,
+        ax=fig.add_axes(DRAWING_AXES),
     )
-    fig.set_size_inches(*DRAWING_SIZE)
     return png_bytes(fig)
 
 
