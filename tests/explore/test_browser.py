@@ -15,14 +15,9 @@ from __future__ import annotations
 import base64
 import os
 import re
-import shutil
-import socket
-import subprocess
-import sys
 import time
-import urllib.request
-from pathlib import Path
 
+import browser_harness
 import pytest
 
 from spinectl.explore import app
@@ -30,84 +25,22 @@ from spinectl.explore import numbers as nb
 from spinectl.explore.state import from_shown, initial_state, replace, slider_for
 from spinectl.model.config import load_preset
 
-ROOT = Path(__file__).resolve().parents[2]
-CHROMIUM = os.environ.get("SPINECTL_CHROMIUM", "/usr/bin/chromium")
 OPT_OUT = "SPINECTL_SKIP_BROWSER"
-CHROMIUM_ARGS = [
-    "--headless",
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-quic",
-    "--no-first-run",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-]
-TIMEOUT_MS = 90_000
-"""Longest wait for the app (first page: imports and the first solve, on a loaded 2-core machine)."""
 
 
-def _chromium() -> str:
+@pytest.fixture(scope="module")
+def page():
+    """The explorer served from this checkout, open in headless Chromium."""
     if os.environ.get(OPT_OUT):
         pytest.skip(f"{OPT_OUT} is set")
-    path = shutil.which(CHROMIUM)
-    if path is None:
+    executable = browser_harness.chromium()
+    if executable is None:
         pytest.fail(
-            f"the browser test needs Chromium at {CHROMIUM}: run scripts/setup (or apt-get install -y chromium), "
-            f"or set SPINECTL_CHROMIUM to a Chromium binary; {OPT_OUT}=1 skips this test"
+            f"the browser test needs Chromium at {browser_harness.CHROMIUM}: {browser_harness.INSTALL}; "
+            f"{OPT_OUT}=1 skips this test"
         )
-    return path
-
-
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-@pytest.fixture(scope="module")
-def server():
-    """``python -m spinectl explore`` from this checkout on a free loopback port; stopped afterwards."""
-    port = _free_port()
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))}
-    argv = [sys.executable, "-m", "spinectl", "explore", "--no-browser", "--port", str(port)]
-    process = subprocess.Popen(argv, cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    url = f"http://127.0.0.1:{port}/"
-    deadline = time.monotonic() + TIMEOUT_MS / 1000
-    try:
-        while True:
-            if process.poll() is not None:
-                pytest.fail(f"spinectl explore exited with {process.returncode}: {process.stdout.read()}")
-            try:
-                urllib.request.urlopen(url, timeout=5).close()
-                break
-            except OSError:
-                if time.monotonic() > deadline:
-                    raise
-                time.sleep(0.3)
-        yield url
-    finally:
-        process.terminate()
-        try:
-            process.wait(timeout=20)
-        except subprocess.TimeoutExpired:
-            process.kill()
-            process.wait()
-
-
-@pytest.fixture(scope="module")
-def page(server):
-    from playwright.sync_api import sync_playwright  # imported here: collecting the suite needs no browser
-
-    executable = _chromium()
-    with sync_playwright() as playwright:
-        browser = playwright.chromium.launch(executable_path=executable, args=CHROMIUM_ARGS)
-        tab = browser.new_page(viewport={"width": 1440, "height": 1000})
-        tab.set_default_timeout(TIMEOUT_MS)
-        tab.goto(server)
-        tab.wait_for_selector("td[data-key=counter_torque_Nm]")
+    with browser_harness.served() as url, browser_harness.opened(url, executable) as tab:
         yield tab
-        browser.close()
 
 
 def _table(page) -> list[dict[str, str]]:
@@ -140,7 +73,9 @@ def _expect(page, state):
 
     expected = nb.point_numbers(load_preset("default"), state)
     first = expected.rows()[0]["counter_torque_Nm"]
-    expect(page.locator("td[data-key=counter_torque_Nm]").first).to_have_text(first, timeout=TIMEOUT_MS)
+    expect(page.locator("td[data-key=counter_torque_Nm]").first).to_have_text(
+        first, timeout=browser_harness.TIMEOUT_S * 1000
+    )
     assert _table(page) == expected.rows()
     assert _drawing(page) == app.drawing_png(expected)
 
@@ -173,7 +108,7 @@ def test_slider_and_click_move_the_point_to_the_librarys_numbers(page):
 def _point_shown(page, state, changed):
     """``state`` at the (E, Lambda) the sliders' labels show, once ``changed((E, Lambda))`` holds [m]."""
     fields = ("eccentricity", "lordosis")
-    deadline = time.monotonic() + TIMEOUT_MS / 1000
+    deadline = time.monotonic() + browser_harness.TIMEOUT_S
     while True:
         point = tuple(from_shown(slider_for(f), _shown(page, slider_for(f).label)) for f in fields)
         if changed(point) or time.monotonic() > deadline:
