@@ -26,10 +26,11 @@ from bokeh.models import ColorBar, ColumnDataSource, LinearColorMapper
 from bokeh.plotting import figure as bokeh_figure
 
 from ..canvas import new_figure
+from ..errors import SpinectlError
 from ..model.config import list_presets, load_preset
 from ..model.params import Model
 from ..paper.drawing import draw_model
-from ..units import CM_PER_M
+from ..units import CM_PER_M, m2_to_cm2
 from . import views
 from .numbers import LANDSCAPE_POINTS, PointNumbers, landscapes, point_numbers
 from .state import (
@@ -121,7 +122,7 @@ def table_html(numbers: PointNumbers) -> str:
         for row in numbers.rows()
     )
     point = numbers.report.point
-    total = np.sum(point.pcsa) * 1e4
+    total = m2_to_cm2(np.sum(point.pcsa))
     status = (
         f'<p data-key="status">E = {point.eccentricity * CM_PER_M:.3g} cm, Λ = {point.lordosis * CM_PER_M:.3g} cm; '
         f"optimum: {html.escape(point.status)}; PCSA at this activation: {total:.4g} cm² in all</p>"
@@ -246,10 +247,15 @@ class Explorer:
         Returns
         -------
         float
-            Seconds taken [s] (also shown in the status line).
+            Seconds taken [s] (also shown in the status line, or the error of a model that is invalid
+            at this point; the views then keep the last point).
         """
         start = time.perf_counter()
-        numbers = point_numbers(self.base, self.state)
+        try:
+            numbers = point_numbers(self.base, self.state)
+        except SpinectlError as exc:  # e.g. a fibre attachment on a CoR of a --config model: say so, keep the views
+            self.status.object = f"**not shown:** {html.escape(str(exc))}"
+            return time.perf_counter() - start
         images = {
             "eigenvalues": views.eigenvalue_plot(numbers),
             "counter_torques": views.counter_torque_plot(numbers),

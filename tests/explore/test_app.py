@@ -8,6 +8,7 @@ import numpy as np
 import param
 import pytest
 
+from spinectl.errors import ModelError
 from spinectl.explore import app
 from spinectl.explore import numbers as nb
 from spinectl.explore.state import initial_state, replace
@@ -89,3 +90,27 @@ def test_png_bytes_are_reproducible(explorer):
     numbers = nb.point_numbers(explorer.base, explorer.state)
     assert app.drawing_png(numbers) == app.drawing_png(numbers)
     assert base64.b64encode(app.drawing_png(numbers))[:8] == b"iVBORw0K"
+
+
+def test_a_model_invalid_at_the_point_is_a_message_not_a_crash(explorer, monkeypatch):
+    """An error the user can cause (a SpinectlError) shows in the status line; the views keep the last point."""
+    shown = explorer.table.object
+
+    def invalid(base, state):
+        raise ModelError("fibre attachment on a centre of rotation")
+
+    monkeypatch.setattr(app, "point_numbers", invalid)
+    explorer.move_to(0.01, 0.01)
+    assert explorer.status.object == "**not shown:** fibre attachment on a centre of rotation"
+    assert explorer.table.object == shown
+
+
+def test_explorer_for_a_notebook_reads_the_config_named(tmp_path):
+    """explorer(config=...) starts from that file's model; the layout displays itself (Jupyter's mimebundle)."""
+    path = tmp_path / "mine.toml"
+    path.write_text("[body]\nmass = 33.0\n")
+    layout = app.explorer(config=path)
+    assert hasattr(layout, "_repr_mimebundle_")
+    sliders = [w for w in layout.select(app.pn.widgets.FloatSlider) if w.label == "mass [kg]"]
+    assert [s.value for s in sliders] == [33.0]
+    assert [w.value for w in layout.select(app.pn.widgets.Select)] == [app.CONFIG_CHOICE]
