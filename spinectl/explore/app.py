@@ -25,11 +25,9 @@ from bokeh.events import Tap
 from bokeh.models import ColorBar, ColumnDataSource, LinearColorMapper
 from bokeh.plotting import figure as bokeh_figure
 
-from ..canvas import new_figure
 from ..errors import SpinectlError
 from ..model.config import list_presets, load_preset
 from ..model.params import Model
-from ..paper.drawing import draw_model
 from ..units import CM_PER_M, m2_to_cm2
 from . import views
 from .numbers import LANDSCAPE_POINTS, PointNumbers, landscapes, point_numbers
@@ -46,10 +44,6 @@ from .state import (
 
 DPI = 80
 """Resolution of the matplotlib views in the browser [dots per inch]."""
-DRAWING_SIZE = (4.6, 5.2)
-"""Size of the model drawing [in]."""
-DRAWING_AXES = (0.14, 0.08, 0.83, 0.77)
-"""Left, bottom, width, height of the drawing's axes, as fractions of the figure (room for its title above)."""
 LANDSCAPE_PIXELS = 300
 """Width and height of a landscape view [px]."""
 CONFIG_CHOICE = "--config"
@@ -80,7 +74,7 @@ def png_bytes(fig, dpi: float = DPI) -> bytes:
 
 
 def drawing_png(numbers: PointNumbers) -> bytes:
-    """The model drawing at the state's point with the chosen activation and its counter torques.
+    """The model drawing of :func:`spinectl.explore.views.model_drawing` as PNG at :data:`DPI`.
 
     Parameters
     ----------
@@ -89,19 +83,8 @@ def drawing_png(numbers: PointNumbers) -> bytes:
     Returns
     -------
     bytes
-        PNG at :data:`DPI`, :data:`DRAWING_SIZE` (:func:`spinectl.paper.drawing.draw_model`).
     """
-    state = numbers.state
-    fig = new_figure(figsize=DRAWING_SIZE)  # fixed axes: a constrained layout would double the drawing time
-    draw_model(
-        numbers.model,
-        state.eccentricity,
-        state.lordosis,
-        pcsa=numbers.pcsa,
-        counter_torque=numbers.pcsa is not None,
-        ax=fig.add_axes(DRAWING_AXES),
-    )
-    return png_bytes(fig)
+    return png_bytes(views.model_drawing(numbers))
 
 
 def table_html(numbers: PointNumbers) -> str:
@@ -153,7 +136,7 @@ class Explorer:
             label="preset", value=preset, options=[*self.models, *list_presets()], width=260
         )
         self.sliders = {s.field: self._slider(s) for s in SLIDERS}
-        self.drawing = pn.pane.PNG(None, width=int(DRAWING_SIZE[0] * DPI), name="drawing")
+        self.drawing = pn.pane.PNG(None, width=int(views.DRAWING_SIZE[0] * DPI), name="drawing")
         self.views = {name: pn.pane.PNG(None, width=int(views.VIEW_SIZE[0] * DPI), name=name) for name in VIEWS}
         self.table = pn.pane.HTML("", name="numbers")
         self.status = pn.pane.Markdown("", name="status")

@@ -21,6 +21,10 @@ VIEW_SIZE = (3.6, 2.8)
 """Size of one view [in]."""
 VIEW_MARGINS = {"left": 0.19, "right": 0.97, "bottom": 0.16, "top": 0.9}
 """Fixed margins of a view, as fractions of the figure: a constrained layout would double its drawing time."""
+DRAWING_SIZE = (4.6, 5.2)
+"""Size of the model drawing [in]."""
+DRAWING_AXES = (0.14, 0.08, 0.83, 0.77)
+"""Left, bottom, width, height of the drawing's axes, as fractions of the figure (room for its title above)."""
 STATE_FIGURE_SIZE = (13.0, 8.0)
 """Size of the PNG export [in]."""
 LANDSCAPE_LABELS = {
@@ -40,6 +44,35 @@ def _axes(ax):
 
 def _colours(n: int) -> list[str]:
     return [PAIR_COLOURS[i % len(PAIR_COLOURS)] for i in range(n)]
+
+
+def model_drawing(numbers: PointNumbers, ax=None) -> Figure:
+    """The model at the state's point with the chosen activation and its counter torques (paper Figure 2).
+
+    Parameters
+    ----------
+    numbers : PointNumbers
+    ax : matplotlib.axes.Axes, optional
+        Default: a figure of :data:`DRAWING_SIZE` with fixed axes (a constrained layout would
+        double the drawing time).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        :func:`spinectl.paper.drawing.draw_model`, every fibre's width proportional to its PCSA
+        (geometry only where the optimum is infeasible).
+    """
+    if ax is None:
+        ax = new_figure(figsize=DRAWING_SIZE).add_axes(DRAWING_AXES)
+    state = numbers.state
+    return draw_model(
+        numbers.model,
+        state.eccentricity,
+        state.lordosis,
+        pcsa=numbers.pcsa,
+        counter_torque=numbers.pcsa is not None,
+        ax=ax,
+    )
 
 
 def eigenvalue_plot(numbers: PointNumbers, ax=None) -> Figure:
@@ -182,14 +215,7 @@ def state_figure(numbers: PointNumbers, dataset: xr.Dataset | None) -> Figure:
     fig = new_figure(figsize=STATE_FIGURE_SIZE, layout="constrained")
     axes = fig.subplots(2, 3)
     state = numbers.state
-    draw_model(
-        numbers.model,
-        state.eccentricity,
-        state.lordosis,
-        pcsa=numbers.pcsa,
-        counter_torque=numbers.pcsa is not None,
-        ax=axes[0, 0],
-    )
+    model_drawing(numbers, axes[0, 0])
     eigenvalue_plot(numbers, axes[0, 1])
     counter_torque_plot(numbers, axes[0, 2])
     delay_margin_plot(numbers, axes[1, 0])
