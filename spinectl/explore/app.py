@@ -30,7 +30,7 @@ from ..model.config import list_presets, load_preset
 from ..model.params import Model
 from ..units import CM_PER_M, m2_to_cm2
 from . import views
-from .numbers import LANDSCAPE_POINTS, PointNumbers, landscapes, point_numbers
+from .numbers import LANDSCAPE_POINTS, PointNumbers, landscape_axis, landscapes, point_numbers
 from .state import (
     LANDSCAPE_PARAMETERS,
     SLIDERS,
@@ -308,14 +308,16 @@ class _LandscapeView:
 
     def __init__(self, variable: str, on_click):
         self.variable = variable
+        axis = landscape_axis() * CM_PER_M
+        span = (float(axis[0]), float(axis[-1]))
         self.mapper = LinearColorMapper(palette="Viridis256", nan_color="lightgray")
         self.image = ColumnDataSource({"image": [np.full((2, 2), np.nan)]})
         self.marker = ColumnDataSource({"x": [np.nan], "y": [np.nan]})
         self.figure = bokeh_figure(
             width=LANDSCAPE_PIXELS + 80,
             height=LANDSCAPE_PIXELS,
-            x_range=(0, 8),
-            y_range=(0, 8),
+            x_range=span,
+            y_range=span,
             title=views.LANDSCAPE_LABELS[variable] + " (click to move the point)",
             x_axis_label="E [cm]",
             y_axis_label="Λ [cm]",
@@ -323,7 +325,15 @@ class _LandscapeView:
             toolbar_location=None,
             match_aspect=True,
         )
-        self.glyph = self.figure.image("image", source=self.image, x=0, y=0, dw=8, dh=8, color_mapper=self.mapper)
+        self.glyph = self.figure.image(
+            "image",
+            source=self.image,
+            x=span[0],
+            y=span[0],
+            dw=span[1] - span[0],
+            dh=span[1] - span[0],
+            color_mapper=self.mapper,
+        )
         self.figure.scatter("x", "y", source=self.marker, size=11, fill_color="white", line_color="black")
         self.figure.add_layout(ColorBar(color_mapper=self.mapper, width=10), "right")
         self.figure.on_event(Tap, lambda event: on_click(event.x / CM_PER_M, event.y / CM_PER_M))
