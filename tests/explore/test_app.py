@@ -114,3 +114,14 @@ def test_explorer_for_a_notebook_reads_the_config_named(tmp_path):
     sliders = [w for w in layout.select(app.pn.widgets.FloatSlider) if w.label == "mass [kg]"]
     assert [s.value for s in sliders] == [33.0]
     assert [w.value for w in layout.select(app.pn.widgets.Select)] == [app.CONFIG_CHOICE]
+
+
+def test_serve_binds_the_loopback_interface_by_default(monkeypatch, capsys):
+    """serve() asks Panel for 127.0.0.1 (no other machine can connect) and accepts pages from there only."""
+    calls = []
+    monkeypatch.setattr(app.pn, "serve", lambda panels, **options: calls.append(options))
+    app.serve(load_preset("default"), "default", 5999, show=False)
+    (options,) = calls
+    assert options["address"] == "127.0.0.1" and options["port"] == 5999 and options["show"] is False
+    assert options["websocket_origin"] == ["127.0.0.1:5999", "localhost:5999"]
+    assert capsys.readouterr().out == "spinectl explore: http://127.0.0.1:5999/ (Ctrl+C stops)\n"
