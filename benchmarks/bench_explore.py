@@ -5,9 +5,10 @@
 
 In-process, without a browser (the browser adds its own rendering):
 
-- a point: :meth:`spinectl.explore.app.Explorer.update_point` after a move of E,
-  split into the numbers (:func:`spinectl.explore.numbers.point_numbers`: the optimum,
-  the margins, the eigenvalues) and the pictures (the drawing and three views as PNG);
+- a point: :meth:`spinectl.explore.app.Explorer.update_point` after a move of E, split
+  into the numbers (:func:`spinectl.explore.numbers.point_numbers`: the optimum, the
+  margins, the eigenvalues) and the pictures (the drawing and three views as PNG); and
+  after a move of the delay slider, which redraws the margins only;
 - the landscapes: :func:`spinectl.explore.numbers.landscapes` at 41 x 41 on the stacked
   fast path, against the per-point reference solver on the same grid's every 4th point
   per axis (11 x 11), scaled per point: the ratio is the fast path's speed-up.
@@ -24,7 +25,7 @@ import statistics
 import time
 
 from spinectl.explore import app, numbers, views
-from spinectl.explore.state import model_at, replace
+from spinectl.explore.state import model_at, replace, slider_for
 from spinectl.landscape.sweep import sweep
 from spinectl.model.config import load_preset
 
@@ -50,6 +51,8 @@ def main() -> None:
         explorer.move_to(0.02 + 0.002 * i, 0.04)
 
     point = _median(move, args.repeats)
+    delay = slider_for("delay")
+    reflex = _median(lambda i: explorer._on_slider(delay, 80.0 + 5 * i), args.repeats)  # what the slider calls
     computed = _median(
         lambda i: numbers.point_numbers(base, replace(state, eccentricity=0.02 + 0.002 * i)), args.repeats
     )
@@ -62,6 +65,7 @@ def main() -> None:
 
     drawn = _median(pictures, args.repeats)
     print(f"point update: {point:.3f} s (numbers {computed:.3f} s, drawing and views as PNG {drawn:.3f} s)")
+    print(f"a reflex slider (delay): {reflex:.3f} s (the margins view only is redrawn)")
 
     fast = _median(lambda i: numbers.landscapes(base, replace(state, mass=30.0 + i)), 2)
     axis = numbers.landscape_axis()[::4]

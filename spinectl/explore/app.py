@@ -37,6 +37,7 @@ from .state import (
     ExploreState,
     from_shown,
     initial_state,
+    pictures_key,
     replace,
     slider_for,
     state_toml,
@@ -131,6 +132,7 @@ class Explorer:
         self.numbers: PointNumbers | None = None
         self.dataset: xr.Dataset | None = None
         self._generation = 0
+        self._pictures_key = None
         self.seconds = {"point": np.nan, "landscapes": np.nan}
         self.preset = pn.widgets.Select(
             label="preset", value=preset, options=[*self.models, *list_presets()], width=260
@@ -239,17 +241,16 @@ class Explorer:
         except SpinectlError as exc:  # e.g. a fibre attachment on a CoR of a --config model: say so, keep the views
             self.status.object = f"**not shown:** {html.escape(str(exc))}"
             return time.perf_counter() - start
-        images = {
-            "eigenvalues": views.eigenvalue_plot(numbers),
-            "counter_torques": views.counter_torque_plot(numbers),
-            "delay_margins": views.delay_margin_plot(numbers),
-        }
-        drawing = drawing_png(numbers)
+        key = (id(self.base), pictures_key(self.state))
+        pictures = {"delay_margins": png_bytes(views.delay_margin_plot(numbers))}
+        if key != self._pictures_key:  # the delay and the lag move the margins only: redraw the rest only if needed
+            pictures["eigenvalues"] = png_bytes(views.eigenvalue_plot(numbers))
+            pictures["counter_torques"] = png_bytes(views.counter_torque_plot(numbers))
+            pictures["drawing"] = drawing_png(numbers)
         with pn.io.hold():
-            self.numbers = numbers
-            self.drawing.object = drawing
-            for name, fig in images.items():
-                self.views[name].object = png_bytes(fig)
+            self.numbers, self._pictures_key = numbers, key
+            for name, png in pictures.items():
+                (self.drawing if name == "drawing" else self.views[name]).object = png
             self.table.object = table_html(numbers)
             for view in self.maps.values():
                 view.mark(self.state)

@@ -92,6 +92,23 @@ SLIDERS = (
 
 LANDSCAPE_PARAMETERS = ("mass", "stiffness")
 """Fields whose change moves the landscapes (minimum PCSA and ||CT|| do not depend on the reflex)."""
+REFLEX_ONLY = ("delay", "activation_lag")
+"""Fields that move the delay margins only: the PCSA, and so the drawing, eigenvalues and counter torques, stay."""
+
+
+def pictures_key(state: ExploreState) -> tuple[float, ...]:
+    """The fields that the drawing, the eigenvalues and the counter torques depend on (all but :data:`REFLEX_ONLY`).
+
+    Parameters
+    ----------
+    state : ExploreState
+
+    Returns
+    -------
+    tuple of float
+        Equal for two states whose pictures of the point are the same (for one model).
+    """
+    return tuple(getattr(state, f.name) for f in dataclasses.fields(state) if f.name not in REFLEX_ONLY)
 
 
 def initial_state(model: Model) -> ExploreState:

@@ -125,3 +125,20 @@ def test_serve_binds_the_loopback_interface_by_default(monkeypatch, capsys):
     assert options["address"] == "127.0.0.1" and options["port"] == 5999 and options["show"] is False
     assert options["websocket_origin"] == ["127.0.0.1:5999", "localhost:5999"]
     assert capsys.readouterr().out == "spinectl explore: http://127.0.0.1:5999/ (Ctrl+C stops)\n"
+
+
+def test_the_delay_redraws_the_margins_only():
+    """The reflex delay and the lag do not change the PCSA: the drawing, eigenvalues and CT pictures stay the same
+    objects; the margins view and the table follow (state.REFLEX_ONLY). At the README's point of 'default' every
+    delay margin is finite (0.22 to 0.42 s), so a longer lag changes them."""
+    explorer = app.Explorer(load_preset("default"), "default")
+    kept = {name: pane.object for name, pane in explorer.views.items()} | {"drawing": explorer.drawing.object}
+    margins, table = explorer.views["delay_margins"].object, explorer.table.object
+    _drag(explorer.sliders["activation_lag"], 100.0)
+    assert explorer.state.activation_lag == pytest.approx(0.1)
+    for name in ("eigenvalues", "counter_torques"):
+        assert explorer.views[name].object is kept[name]
+    assert explorer.drawing.object is kept["drawing"]
+    assert explorer.views["delay_margins"].object != margins and explorer.table.object != table
+    expected = nb.point_numbers(explorer.base, explorer.state)
+    assert explorer.views["delay_margins"].object == app.png_bytes(app.views.delay_margin_plot(expected))
