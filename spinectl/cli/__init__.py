@@ -25,6 +25,7 @@ COMMANDS = (
     "sweep_cmd",
     "plot_cmd",
     "draw_cmd",
+    "explore_cmd",
     "reproduce_cmd",
     "study_cmd",
     "calibrate_cmd",

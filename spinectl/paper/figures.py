@@ -98,6 +98,10 @@ def check_dpi(dpi: float) -> None:
         raise ParameterError("--dpi", f"must be {MIN_DPI} to {MAX_DPI} dots per inch (got {dpi:g})")
 
 
+COLOUR_BAR = (1.03, 0.0, 0.045, 1.0)
+"""Left, bottom, width, height of a landscape's colour bar in its axes' coordinates: beside them, as tall."""
+
+
 def _axes(title: str, fig=None, spec=None):
     fig = fig or new_figure(figsize=FIGURE_SIZE, layout="constrained")
     ax = fig.add_subplot(spec) if spec is not None else fig.add_subplot()
@@ -226,7 +230,7 @@ def _landscape(field: xr.DataArray, title: str, label: str, vmin=None, vmax=None
     if infeasible < values.size:
         levels, extend = _levels(values, vmin, vmax)
         filled = ax.contourf(e, lam, values, levels=levels, cmap="viridis", extend=extend)
-        fig.colorbar(filled, ax=ax).set_label(label)
+        fig.colorbar(filled, cax=ax.inset_axes(COLOUR_BAR)).set_label(label)  # as tall as the axes, not the figure
         if values.max() > values.min():
             lines = ax.contour(e, lam, values, levels=filled.levels[1:-1:3], colors="k", linewidths=0.4, alpha=0.6)
             for text in ax.clabel(lines, fmt="%.3g", fontsize=6):

@@ -46,7 +46,8 @@ def test_figure_functions_return_figures_and_write_nothing(results, tmp_path, mo
     monkeypatch.chdir(tmp_path)
     k0 = netcdf.load(results).sel(K=0.0)
     drawn = [figures.min_pcsa_figure(k0), figures.counter_torque_figure(k0, Model().fibre.specific_tension)]
-    assert all(isinstance(f, Figure) for f in drawn) and [len(f.axes) for f in drawn] == [2, 2]  # with colour bars
+    assert all(isinstance(f, Figure) for f in drawn) and [len(f.axes) for f in drawn] == [1, 1]
+    assert [len(f.axes[0].child_axes) for f in drawn] == [1, 1]  # the colour bar, inside the axes' frame
     assert drawn[0].axes[0].get_title().startswith("Fig. 3: minimum PCSA")
     assert list(tmp_path.iterdir()) == [] and plt.get_fignums() == []
     path = figures.save_figure(drawn[0], tmp_path / "f.png")
@@ -160,18 +161,34 @@ def test_shared_scale_and_given_range(results, tmp_path, monkeypatch):
     values = dataset["min_pcsa_cm2"].values
     assert seen == [(np.nanmin(values), np.nanmax(values))] * 2
     fig = original(dataset.sel(K=0.0), 20.0, 80.0)
-    assert fig.axes[1].get_ylim() == pytest.approx((20.0, 80.0))
+    assert _colour_bar(fig).get_ylim() == pytest.approx((20.0, 80.0))
     with pytest.raises(ParameterError, match="vmin"):
         original(dataset.sel(K=0.0), 50.0, 40.0)
+
+
+def _colour_bar(fig: Figure):
+    """The colour bar of a landscape figure: an inset of its first axes."""
+    return fig.axes[0].child_axes[0]
+
+
+def test_colour_bar_as_tall_as_the_axes(results):
+    """The colour bar spans the drawn axes exactly (figures.COLOUR_BAR), not the figure's height, also on a
+    non-square grid where equal scales shorten the axes."""
+    dataset = netcdf.load(results).sel(K=0.0)
+    for part in (dataset, dataset.isel(Lambda=slice(0, max(2, dataset.sizes["Lambda"] // 2)))):
+        fig = figures.min_pcsa_figure(part)
+        fig.canvas.draw()
+        axes, bar = fig.axes[0].get_window_extent(), _colour_bar(fig).get_window_extent()
+        assert (bar.y0, bar.y1) == pytest.approx((axes.y0, axes.y1), abs=0.5) and bar.x0 > axes.x1
 
 
 def test_ratio_map_and_insets(results, tmp_path, other_grids):
     """The ratio S1 / 3 on a 0-1 scale; insets: four model drawings around Figure 3; both need what they need."""
     dataset = netcdf.load(results)
     ratio = figures.ratio_figure(dataset)
-    assert ratio.axes[1].get_ylim() == pytest.approx((0.0, 1.0)) and "halving" in ratio.axes[0].get_title()
+    assert _colour_bar(ratio).get_ylim() == pytest.approx((0.0, 1.0)) and "halving" in ratio.axes[0].get_title()
     inset = figures.min_pcsa_figure(dataset.sel(K=0.0), insets=True)
-    titles = sorted(ax.get_title() for ax in inset.axes[2:])
+    titles = sorted(ax.get_title() for ax in inset.axes[1:])
     assert titles == ["A: E = 0, Λ = 0 cm", "B: E = 8, Λ = 0 cm", "C: E = 8, Λ = 8 cm", "D: E = 0, Λ = 8 cm"]
     with pytest.raises(ParameterError, match="K = 0"):
         figures.ratio_figure(other_grids["partial"])

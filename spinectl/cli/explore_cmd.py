@@ -1,0 +1,73 @@
+"""``spinectl explore``: the interactive explorer in the browser (needs the ``explore`` extra).
+
+Panel is imported only when the command runs, so that every other command starts
+without it, and a missing extra is one line saying how to install it.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+from ._common import add_model_options, load_model
+
+PORT = 5006
+"""Default TCP port (Bokeh's and Panel's)."""
+ADDRESS = "127.0.0.1"
+"""Default interface: the loopback one, reachable from this machine only."""
+
+
+def _port(text: str) -> int:
+    """An argparse ``type``: a TCP port, 1 to 65535."""
+    try:
+        port = int(text)
+    except ValueError:
+        port = -1
+    if not 1 <= port <= 65535:
+        raise argparse.ArgumentTypeError(f"--port must be an integer from 1 to 65535 (got {text!r})")
+    return port
+
+
+def register(sub) -> None:
+    """Add the ``explore`` sub-command to the ``spinectl`` parser.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The sub-command action of :func:`spinectl.cli.build_parser`.
+    """
+    parser = sub.add_parser(
+        "explore",
+        help="the interactive explorer in the browser (sliders, live drawing, margins, landscapes)",
+        description="A local web app (Panel): sliders for E, Lambda, mass, K, the reflex delay, the activation "
+        "and its lag; the model drawing, per-segment eigenvalues, counter torques and delay margins at the "
+        "current point; the minimum-PCSA and ||CT|| landscapes, clickable. Export the state as a TOML config "
+        "or a PNG. Needs pip install 'spinectl[explore]'. See docs/explore.md.",
+    )
+    parser.add_argument("--port", type=_port, default=PORT, help=f"TCP port (default {PORT})")
+    parser.add_argument(
+        "--address", default=ADDRESS, help=f"interface to listen on (default {ADDRESS}: this machine only)"
+    )
+    parser.add_argument("--no-browser", action="store_true", help="do not open a browser; print the address only")
+    add_model_options(parser)
+    parser.set_defaults(func=run)
+
+
+def run(args) -> int:
+    """Run ``spinectl explore``: serve the explorer until interrupted.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments: ``port``, ``address``, ``no_browser`` and the model options.
+
+    Returns
+    -------
+    int
+        Exit code 0 once the server stops.
+    """
+    model = load_model(args)  # a bad preset or config fails here, before Panel is imported
+    from ..explore.launch import serve_explorer
+
+    preset = "--config" if args.config else (args.preset or "default")
+    serve_explorer(model, preset, args.port, args.address, show=not args.no_browser)
+    return 0

@@ -1,0 +1,415 @@
+"""The explorer as a Panel app: sliders, the model drawing, the numbers, clickable landscapes.
+
+docs/explore.md. :class:`Explorer` holds one session's state and its views;
+:func:`explorer` returns its layout, which shows itself inline in a Jupyter notebook
+(after ``panel.extension()``), and :func:`serve` serves it on the loopback interface
+(``spinectl explore``). Every number comes from :mod:`spinectl.explore.numbers`, every
+picture but the landscapes from :mod:`spinectl.explore.views`; the landscapes are Bokeh
+images so that a click on them moves the point. They are solved again, in a worker
+thread with a progress indicator, only when the mass, K or the model change.
+
+Needs the ``explore`` extra (``pip install 'spinectl[explore]'``: Panel, which brings Bokeh).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import html
+import io
+import time
+
+import numpy as np
+import panel as pn
+import xarray as xr
+from bokeh.events import Tap
+from bokeh.models import ColorBar, ColumnDataSource, LinearColorMapper
+from bokeh.plotting import figure as bokeh_figure
+
+from ..errors import SpinectlError
+from ..model.config import list_presets, load_preset
+from ..model.params import Model
+from ..units import CM_PER_M, m2_to_cm2
+from . import views
+from .numbers import LANDSCAPE_POINTS, PointNumbers, landscape_axis, landscapes, point_numbers
+from .state import (
+    LANDSCAPE_PARAMETERS,
+    SLIDERS,
+    ExploreState,
+    from_shown,
+    initial_state,
+    pictures_key,
+    replace,
+    slider_for,
+    state_toml,
+)
+
+DPI = 80
+"""Resolution of the matplotlib views in the browser [dots per inch]."""
+LANDSCAPE_PIXELS = 300
+"""Width and height of a landscape view [px]."""
+CONFIG_CHOICE = "--config"
+"""The preset selector's entry for the model of ``--config``."""
+ROW_KEYS = ("segment", "eigenvalue_1", "eigenvalue_2", "counter_torque_Nm", "delay_margin_s", "stable_at_delay")
+"""The columns of the numbers table, keys of :meth:`PointNumbers.rows`."""
+ROW_HEADERS = ("segment", "λ₁ [1/s]", "λ₂ [1/s]", "CT [N m]", "delay margin [s]", "stable at τ")
+"""Their headers."""
+
+
+def png_bytes(fig, dpi: float = DPI) -> bytes:
+    """A matplotlib figure as PNG bytes, in memory.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+    dpi : float
+        Dots per inch.
+
+    Returns
+    -------
+    bytes
+        The PNG file's content; the same figure at the same dpi gives the same bytes.
+    """
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=dpi, metadata={"Software": None})
+    return buffer.getvalue()
+
+
+def drawing_png(numbers: PointNumbers) -> bytes:
+    """The model drawing of :func:`spinectl.explore.views.model_drawing` as PNG at :data:`DPI`.
+
+    Parameters
+    ----------
+    numbers : PointNumbers
+
+    Returns
+    -------
+    bytes
+    """
+    return png_bytes(views.model_drawing(numbers))
+
+
+def table_html(numbers: PointNumbers) -> str:
+    """The numbers of every segment as an HTML table; each cell carries its key (``data-key``).
+
+    Parameters
+    ----------
+    numbers : PointNumbers
+
+    Returns
+    -------
+    str
+        A ``<table>`` with one row per segment (:meth:`PointNumbers.rows`) and a status line.
+    """
+    head = "".join(f"<th>{h}</th>" for h in ROW_HEADERS)
+    body = "".join(
+        "<tr>" + "".join(f'<td data-key="{key}">{html.escape(row[key])}</td>' for key in ROW_KEYS) + "</tr>"
+        for row in numbers.rows()
+    )
+    point = numbers.report.point
+    total = m2_to_cm2(np.sum(point.pcsa))
+    status = (
+        f'<p data-key="status">E = {point.eccentricity * CM_PER_M:.3g} cm, Λ = {point.lordosis * CM_PER_M:.3g} cm; '
+        f"optimum: {html.escape(point.status)}; PCSA at this activation: {total:.4g} cm² in all</p>"
+    )
+    return f'{status}<table class="spinectl-numbers"><tr>{head}</tr>{body}</table>'
+
+
+class Explorer:
+    """One session of the explorer: its state, widgets and views.
+
+    Parameters
+    ----------
+    base : Model
+        The model to start from (a preset, or the model of ``--config``).
+    preset : str
+        The preset selector's entry for ``base``: a preset's name or :data:`CONFIG_CHOICE`.
+    """
+
+    def __init__(self, base: Model, preset: str):
+        self.models = {CONFIG_CHOICE: base} if preset == CONFIG_CHOICE else {}
+        self.base = base
+        self.state = initial_state(base)
+        self.numbers: PointNumbers | None = None
+        self.dataset: xr.Dataset | None = None
+        self._generation = 0
+        self._pictures_key = None
+        self.seconds = {"point": np.nan, "landscapes": np.nan}
+        self.preset = pn.widgets.Select(
+            label="preset", value=preset, options=[*self.models, *list_presets()], width=260
+        )
+        self.sliders = {s.field: self._slider(s) for s in SLIDERS}
+        self.drawing = pn.pane.PNG(None, width=int(views.DRAWING_SIZE[0] * DPI), name="drawing")
+        self.views = {name: pn.pane.PNG(None, width=int(views.VIEW_SIZE[0] * DPI), name=name) for name in VIEWS}
+        self.table = pn.pane.HTML("", name="numbers")
+        self.status = pn.pane.Markdown("", name="status")
+        self.progress = pn.indicators.Progress(active=False, visible=False, width=200)
+        self.maps = {variable: _LandscapeView(variable, self.move_to) for variable in views.LANDSCAPE_LABELS}
+        self.preset.param.watch(self._on_preset, "value")
+        self.layout = self._layout()
+        self.update_point()
+        self.refresh_landscapes()
+
+    def _slider(self, spec) -> pn.widgets.FloatSlider:
+        value = getattr(self.state, spec.field) * spec.scale
+        slider = pn.widgets.FloatSlider(
+            label=spec.label,
+            start=min(spec.start, value),
+            end=max(spec.end, value),
+            step=spec.step,
+            value=value,
+            width=260,
+        )
+        slider.param.watch(lambda event, spec=spec: self._on_slider(spec, event.new), "value_throttled")
+        return slider
+
+    def _layout(self) -> pn.viewable.Viewable:
+        toml = pn.widgets.FileDownload(
+            callback=lambda: io.StringIO(state_toml(self.base, self.state)),
+            filename="spinectl-explore.toml",
+            label="export TOML config",
+            width=260,
+        )
+        png = pn.widgets.FileDownload(
+            callback=lambda: io.BytesIO(png_bytes(views.state_figure(self.numbers, self.dataset), dpi=100)),
+            filename="spinectl-explore.png",
+            label="export PNG",
+            width=260,
+        )
+        controls = pn.Column(
+            "## spinectl explore", self.preset, *self.sliders.values(), toml, png, self.progress, self.status, width=290
+        )
+        point = pn.Row(self.drawing, self.views["eigenvalues"], self.views["counter_torques"])
+        below = pn.Row(self.views["delay_margins"], *(view.pane for view in self.maps.values()))
+        return pn.Row(controls, pn.Column(point, below, self.table))
+
+    # --- events ---------------------------------------------------------------------------
+
+    def _on_slider(self, spec, shown: float) -> None:
+        old = self.state
+        self.state = replace(self.state, **{spec.field: from_shown(spec, shown)})
+        self.update_point()
+        if spec.field in LANDSCAPE_PARAMETERS and getattr(old, spec.field) != getattr(self.state, spec.field):
+            self.refresh_landscapes()
+
+    def _on_preset(self, event) -> None:
+        name = event.new
+        if name not in self.models:
+            self.models[name] = load_preset(name)
+        self.base = self.models[name]
+        point = (self.state.eccentricity, self.state.lordosis)
+        self.state = replace(initial_state(self.base), eccentricity=point[0], lordosis=point[1])
+        self._show_state()
+        self.update_point()
+        self.refresh_landscapes()
+
+    def move_to(self, eccentricity: float, lordosis: float) -> None:
+        """Move the point to (E, Lambda) [m], snapped to the sliders' steps and clipped to their ranges.
+
+        Parameters
+        ----------
+        eccentricity, lordosis : float
+            E and Lambda [m], e.g. where a landscape was clicked.
+        """
+        values = {}
+        for field, value in (("eccentricity", eccentricity), ("lordosis", lordosis)):
+            slider, spec = self.sliders[field], slider_for(field)
+            values[field] = from_shown(spec, float(np.clip(value * spec.scale, slider.start, slider.end)))
+        self.state = replace(self.state, **values)
+        self._show_state()
+        self.update_point()
+
+    def _show_state(self) -> None:
+        for spec in SLIDERS:
+            slider = self.sliders[spec.field]
+            value = getattr(self.state, spec.field) * spec.scale
+            slider.param.update(start=min(slider.start, value), end=max(slider.end, value), value=value)
+
+    # --- views ----------------------------------------------------------------------------
+
+    def update_point(self) -> float:
+        """Recompute the numbers at the state and redraw every view of the point.
+
+        Returns
+        -------
+        float
+            Seconds taken [s] (also shown in the status line, or the error of a model that is invalid
+            at this point; the views then keep the last point).
+        """
+        start = time.perf_counter()
+        try:
+            numbers = point_numbers(self.base, self.state)
+        except SpinectlError as exc:  # e.g. a fibre attachment on a CoR of a --config model: say so, keep the views
+            self.status.object = f"**not shown:** {html.escape(str(exc))}"
+            return time.perf_counter() - start
+        key = (id(self.base), pictures_key(self.state))
+        pictures = {"delay_margins": png_bytes(views.delay_margin_plot(numbers))}
+        if key != self._pictures_key:  # the delay and the lag move the margins only: redraw the rest only if needed
+            pictures["eigenvalues"] = png_bytes(views.eigenvalue_plot(numbers))
+            pictures["counter_torques"] = png_bytes(views.counter_torque_plot(numbers))
+            pictures["drawing"] = drawing_png(numbers)
+        with pn.io.hold():
+            self.numbers, self._pictures_key = numbers, key
+            for name, png in pictures.items():
+                (self.drawing if name == "drawing" else self.views[name]).object = png
+            self.table.object = table_html(numbers)
+            for view in self.maps.values():
+                view.mark(self.state)
+            self.seconds["point"] = time.perf_counter() - start
+            self._show_status()
+        return self.seconds["point"]
+
+    def refresh_landscapes(self) -> None:
+        """Solve the landscapes again, in a worker thread inside a server session; progress shows meanwhile.
+
+        Outside a session (a notebook's first display, a test) they are solved at once.
+        """
+        self._generation += 1
+        generation, state, base = self._generation, self.state, self.base
+        self.progress.param.update(active=True, visible=True)
+        for view in self.maps.values():
+            view.pane.loading = True
+
+        async def solve():
+            start = time.perf_counter()
+            dataset = await asyncio.to_thread(landscapes, base, state)
+            if generation == self._generation:  # a later change started another solve: show only that one
+                self._show_landscapes(dataset, time.perf_counter() - start)
+
+        if pn.state.curdoc is None or pn.state.curdoc.session_context is None:
+            start = time.perf_counter()
+            self._show_landscapes(landscapes(base, state), time.perf_counter() - start)
+            return
+        self._show_status()
+        pn.state.execute(solve)
+
+    def _show_landscapes(self, dataset: xr.Dataset, elapsed: float) -> None:
+        with pn.io.hold():
+            self.dataset = dataset
+            for view in self.maps.values():
+                view.show(dataset, self.state)
+                view.pane.loading = False
+            self.progress.param.update(active=False, visible=False)
+            self.seconds["landscapes"] = elapsed
+            self._show_status()
+
+    def _show_status(self) -> None:
+        point, maps = self.seconds["point"], self.seconds["landscapes"]
+        solving = "solving…" if self.progress.active else f"solved in {maps:.2f} s"
+        self.status.object = (
+            f"point updated in {point:.2f} s; landscapes ({LANDSCAPE_POINTS} × {LANDSCAPE_POINTS}) {solving}"
+        )
+
+
+VIEWS = ("eigenvalues", "counter_torques", "delay_margins")
+"""The matplotlib views of the point, beside the drawing."""
+
+
+class _LandscapeView:
+    """One landscape as a Bokeh image, the point marked; a click moves the point."""
+
+    def __init__(self, variable: str, on_click):
+        self.variable = variable
+        axis = landscape_axis() * CM_PER_M
+        span = (float(axis[0]), float(axis[-1]))
+        self.mapper = LinearColorMapper(palette="Viridis256", nan_color="lightgray")
+        self.image = ColumnDataSource({"image": [np.full((2, 2), np.nan)]})
+        self.marker = ColumnDataSource({"x": [np.nan], "y": [np.nan]})
+        self.figure = bokeh_figure(
+            width=LANDSCAPE_PIXELS + 80,
+            height=LANDSCAPE_PIXELS,
+            x_range=span,
+            y_range=span,
+            title=views.LANDSCAPE_LABELS[variable] + " (click to move the point)",
+            x_axis_label="E [cm]",
+            y_axis_label="Λ [cm]",
+            tools="tap",
+            toolbar_location=None,
+            match_aspect=True,
+        )
+        self.glyph = self.figure.image(
+            "image",
+            source=self.image,
+            x=span[0],
+            y=span[0],
+            dw=span[1] - span[0],
+            dh=span[1] - span[0],
+            color_mapper=self.mapper,
+        )
+        self.figure.scatter("x", "y", source=self.marker, size=11, fill_color="white", line_color="black")
+        self.figure.add_layout(ColorBar(color_mapper=self.mapper, width=10), "right")
+        self.figure.on_event(Tap, lambda event: on_click(event.x / CM_PER_M, event.y / CM_PER_M))
+        self.pane = pn.pane.Bokeh(self.figure, name=variable)
+
+    def show(self, dataset: xr.Dataset, state: ExploreState) -> None:
+        e, lam = (dataset[name].values * CM_PER_M for name in ("E", "Lambda"))
+        half_e, half_l = (np.diff(a).mean() / 2 if a.size > 1 else 0.5 for a in (e, lam))
+        values = dataset[self.variable].values.T  # Bokeh: rows are y (Lambda)
+        self.glyph.glyph.update(
+            x=e[0] - half_e, y=lam[0] - half_l, dw=e[-1] - e[0] + 2 * half_e, dh=lam[-1] - lam[0] + 2 * half_l
+        )
+        finite = values[np.isfinite(values)]
+        if finite.size:
+            self.mapper.update(low=float(finite.min()), high=float(finite.max()))
+        self.image.data = {"image": [values]}
+        self.figure.title.text = (
+            f"{views.LANDSCAPE_LABELS[self.variable]}: mass {state.mass:g} kg, K {state.stiffness:g} N m/rad"
+        )
+        self.mark(state)
+
+    def mark(self, state: ExploreState) -> None:
+        self.marker.data = {"x": [state.eccentricity * CM_PER_M], "y": [state.lordosis * CM_PER_M]}
+
+
+def explorer(preset: str | None = None, config=None) -> pn.viewable.Viewable:
+    """The explorer's layout for a notebook or a server: ``explorer("wagner2012")`` in a cell.
+
+    Parameters
+    ----------
+    preset : str, optional
+        A built-in preset (default 'default').
+    config : str or path-like, optional
+        A model file, read once (:func:`spinectl.model.config.load_config`).
+
+    Returns
+    -------
+    panel.viewable.Viewable
+        The layout (call ``panel.extension()`` first in a notebook).
+
+    Raises
+    ------
+    ConfigError, ParameterError
+        A bad preset or configuration file.
+    """
+    from ..model.config import load_config
+
+    model = load_config(config, preset)
+    return Explorer(model, CONFIG_CHOICE if config else (preset or "default")).layout
+
+
+def serve(model: Model, preset: str, port: int, address: str = "127.0.0.1", show: bool = True) -> None:
+    """Serve the explorer at ``http://address:port/`` until interrupted; one :class:`Explorer` per browser tab.
+
+    Parameters
+    ----------
+    model : Model
+        The model to start from.
+    preset : str
+        Its entry in the preset selector (a preset's name or :data:`CONFIG_CHOICE`).
+    port : int
+        TCP port.
+    address : str
+        Interface to bind; the loopback interface by default, so that no other machine can connect.
+    show : bool
+        Open the app in the default browser.
+    """
+    origins = [f"{address}:{port}"] + ([f"localhost:{port}"] if address == "127.0.0.1" else [])
+    print(f"spinectl explore: http://{address}:{port}/ (Ctrl+C stops)", flush=True)
+    pn.serve(
+        {"/": lambda: Explorer(model, preset).layout},
+        port=port,
+        address=address,
+        websocket_origin=origins,
+        show=show,
+        title="spinectl explore",
+        verbose=False,
+    )

@@ -1,0 +1,48 @@
+"""Start the explorer's server, or say in one line what is missing (Panel) or in the way (the port).
+
+Kept apart from :mod:`spinectl.explore.app` so that the command line can import it
+without Panel installed.
+"""
+
+from __future__ import annotations
+
+from ..errors import OutputError, SpinectlError
+from ..model.params import Model
+
+EXTRA = "pip install 'spinectl[explore]'"
+"""How to install the explorer's dependencies."""
+
+
+def serve_explorer(model: Model, preset: str, port: int, address: str = "127.0.0.1", show: bool = True) -> None:
+    """Serve the explorer (:func:`spinectl.explore.app.serve`) until interrupted.
+
+    Parameters
+    ----------
+    model : Model
+        The model to start from.
+    preset : str
+        Its entry in the preset selector (a preset's name, or '--config').
+    port : int
+        TCP port.
+    address : str
+        Interface to bind (default the loopback one).
+    show : bool
+        Open the default browser.
+
+    Raises
+    ------
+    SpinectlError
+        Panel (the ``explore`` extra) is not installed.
+    OutputError
+        The address and port cannot be bound (in use, not this machine's).
+    """
+    try:
+        from . import app
+    except ModuleNotFoundError as exc:
+        if exc.name not in ("panel", "bokeh"):
+            raise
+        raise SpinectlError(f"spinectl explore needs Panel ({exc.name} is missing): {EXTRA}") from None
+    try:
+        app.serve(model, preset, port, address, show)
+    except OSError as exc:
+        raise OutputError(f"--port: cannot listen on {address}:{port} ({exc.strerror or exc})") from None

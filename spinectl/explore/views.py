@@ -1,0 +1,231 @@
+"""The explorer's views drawn with matplotlib: eigenvalues, counter torques, delay margins, landscapes.
+
+Each function draws into given Axes or on a new figure (:func:`spinectl.canvas.new_figure`)
+and writes nothing; :func:`state_figure` puts them, with the model drawing
+(:func:`spinectl.paper.drawing.draw_model`), on one figure: the explorer's PNG export.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+from matplotlib.figure import Figure
+
+from ..canvas import new_figure
+from ..paper.drawing import PAIR_COLOURS, draw_model
+from ..paper.landmarks import CT_LIMIT
+from ..units import CM_PER_M
+from .numbers import PointNumbers
+
+VIEW_SIZE = (3.6, 2.8)
+"""Size of one view [in]."""
+VIEW_MARGINS = {"left": 0.19, "right": 0.97, "bottom": 0.16, "top": 0.9}
+"""Fixed margins of a view, as fractions of the figure: a constrained layout would double its drawing time."""
+DRAWING_SIZE = (4.6, 5.2)
+"""Size of the model drawing [in]."""
+DRAWING_AXES = (0.14, 0.08, 0.83, 0.77)
+"""Left, bottom, width, height of the drawing's axes, as fractions of the figure (room for its title above)."""
+STATE_FIGURE_SIZE = (13.0, 8.0)
+"""Size of the PNG export [in]."""
+LANDSCAPE_LABELS = {
+    "min_pcsa_cm2": "minimum PCSA [cm²]",
+    "counter_torque_norm_Nm": "‖CT‖ [N m]",
+}
+"""The landscapes shown and their colour-bar labels."""
+
+
+def _axes(ax):
+    if ax is not None:
+        return ax
+    fig = new_figure(figsize=VIEW_SIZE)
+    fig.subplots_adjust(**VIEW_MARGINS)
+    return fig.add_subplot()
+
+
+def _colours(n: int) -> list[str]:
+    return [PAIR_COLOURS[i % len(PAIR_COLOURS)] for i in range(n)]
+
+
+def model_drawing(numbers: PointNumbers, ax=None) -> Figure:
+    """The model at the state's point with the chosen activation and its counter torques (paper Figure 2).
+
+    Parameters
+    ----------
+    numbers : PointNumbers
+    ax : matplotlib.axes.Axes, optional
+        Default: a figure of :data:`DRAWING_SIZE` with fixed axes (a constrained layout would
+        double the drawing time).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        :func:`spinectl.paper.drawing.draw_model`, every fibre's width proportional to its PCSA
+        (geometry only where the optimum is infeasible).
+    """
+    if ax is None:
+        ax = new_figure(figsize=DRAWING_SIZE).add_axes(DRAWING_AXES)
+    state = numbers.state
+    return draw_model(
+        numbers.model,
+        state.eccentricity,
+        state.lordosis,
+        pcsa=numbers.pcsa,
+        counter_torque=numbers.pcsa is not None,
+        ax=ax,
+    )
+
+
+def eigenvalue_plot(numbers: PointNumbers, ax=None) -> Figure:
+    """Both eigenvalues of each segment in the complex plane (paper eq. 1), a root-locus-style view.
+
+    Parameters
+    ----------
+    numbers : PointNumbers
+    ax : matplotlib.axes.Axes, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Re lambda [1/s] across, Im lambda [1/s] up; the unstable half plane shaded.
+    """
+    ax = _axes(ax)
+    ax.axvspan(0, 1, transform=ax.get_yaxis_transform(), color="tab:red", alpha=0.08, lw=0)
+    ax.axvline(0, color="0.3", lw=0.8)
+    ax.axhline(0, color="0.7", lw=0.5)
+    for name, eigs, colour in zip(
+        numbers.segment_names, numbers.eigenvalues, _colours(len(numbers.segment_names)), strict=True
+    ):
+        ax.plot(eigs.real, eigs.imag, "x", color=colour, ms=7, mew=2, label=name)
+    finite = numbers.eigenvalues[np.isfinite(numbers.eigenvalues)]
+    reach = max(1.0, float(np.max(np.abs(finite.real), initial=0.0)), float(np.max(np.abs(finite.imag), initial=0.0)))
+    ax.set_xlim(-1.1 * reach, 1.1 * reach)
+    ax.set_ylim(-1.1 * reach, 1.1 * reach)
+    ax.set_xlabel("Re λ [1/s]")
+    ax.set_ylabel("Im λ [1/s]")
+    ax.set_title("eigenvalues per segment (shaded: unstable)", fontsize=9)
+    ax.legend(fontsize=7, loc="upper left")
+    return ax.figure
+
+
+def _bars(ax, names, values, colours):
+    shown = np.where(np.isfinite(values), values, 0.0)
+    ax.bar(names, shown, color=colours)
+    for x, value in enumerate(values):
+        if not np.isfinite(value):
+            ax.annotate("∞" if value > 0 else "n/a", (x, 0), ha="center", va="bottom", fontsize=9)
+    ax.tick_params(axis="x", labelsize=8)
+
+
+def counter_torque_plot(numbers: PointNumbers, ax=None) -> Figure:
+    """CT_k of each segment at the chosen activation, and the local muscles' +-30 N m band.
+
+    Parameters
+    ----------
+    numbers : PointNumbers
+    ax : matplotlib.axes.Axes, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Bars [N m]; the band is :data:`spinectl.paper.landmarks.CT_LIMIT` (paper, Discussion).
+    """
+    ax = _axes(ax)
+    ax.axhspan(-CT_LIMIT, CT_LIMIT, color="tab:green", alpha=0.12, lw=0, label=f"±{CT_LIMIT:g} N m")
+    ax.axhline(0, color="0.3", lw=0.8)
+    _bars(ax, numbers.segment_names, numbers.counter_torque, _colours(len(numbers.segment_names)))
+    finite = numbers.counter_torque[np.isfinite(numbers.counter_torque)]
+    reach = 1.15 * max(CT_LIMIT, float(np.max(np.abs(finite), initial=0.0)))
+    ax.set_ylim(-reach, reach)
+    ax.set_ylabel("CT [N m]")
+    ax.set_title(f"counter torques, ‖CT‖ = {np.linalg.norm(numbers.counter_torque):.3g} N m", fontsize=9)
+    ax.legend(fontsize=7, loc="upper left")
+    return ax.figure
+
+
+def delay_margin_plot(numbers: PointNumbers, ax=None) -> Figure:
+    """The exact delay margin of each segment's reflex loop, and the reflex delay.
+
+    Parameters
+    ----------
+    numbers : PointNumbers
+    ax : matplotlib.axes.Axes, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Bars [ms]; a dashed line at the delay tau: a segment whose bar ends below it is unstable.
+    """
+    ax = _axes(ax)
+    ms = 1000.0
+    colours = ["tab:green" if ok else "tab:red" for ok in numbers.stable_at_delay]
+    _bars(ax, numbers.segment_names, numbers.delay_margin * ms, colours)
+    ax.axhline(numbers.state.delay * ms, color="0.2", ls="--", lw=1, label=f"delay τ = {numbers.state.delay * ms:g} ms")
+    finite = numbers.delay_margin[np.isfinite(numbers.delay_margin)] * ms
+    ax.set_ylim(0, 1.2 * max(numbers.state.delay * ms, float(np.max(finite, initial=0.0)), 1.0))
+    ax.set_ylabel("delay margin [ms]")
+    ax.set_title("delay margins (red: unstable at τ)", fontsize=9)
+    ax.legend(fontsize=7, loc="upper left")
+    return ax.figure
+
+
+def landscape_plot(dataset: xr.Dataset, variable: str, numbers: PointNumbers, ax=None) -> Figure:
+    """One landscape over E x Lambda [cm] with the current point marked.
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        From :func:`spinectl.explore.numbers.landscapes`.
+    variable : str
+        A key of :data:`LANDSCAPE_LABELS`.
+    numbers : PointNumbers
+        Its state gives the point.
+    ax : matplotlib.axes.Axes, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        E across, Lambda up, as the paper's Figure 3.
+    """
+    ax = _axes(ax)
+    e, lam = (dataset[name].values * CM_PER_M for name in ("E", "Lambda"))
+    mesh = ax.pcolormesh(e, lam, dataset[variable].values.T, shading="nearest", cmap="viridis")
+    ax.figure.colorbar(mesh, ax=ax, label=LANDSCAPE_LABELS[variable])
+    state = numbers.state
+    ax.plot(state.eccentricity * CM_PER_M, state.lordosis * CM_PER_M, "o", mfc="white", mec="black", ms=8)
+    ax.set_xlabel("E [cm]")
+    ax.set_ylabel("Λ [cm]")
+    ax.set_aspect("equal")
+    return ax.figure
+
+
+def state_figure(numbers: PointNumbers, dataset: xr.Dataset | None) -> Figure:
+    """Every view of the explorer on one figure: the explorer's PNG export.
+
+    Parameters
+    ----------
+    numbers : PointNumbers
+    dataset : xarray.Dataset or None
+        The landscapes; None leaves their places empty (still being solved).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The model drawing, eigenvalues, counter torques, delay margins and both landscapes.
+    """
+    fig = new_figure(figsize=STATE_FIGURE_SIZE, layout="constrained")
+    axes = fig.subplots(2, 3)
+    state = numbers.state
+    model_drawing(numbers, axes[0, 0])
+    eigenvalue_plot(numbers, axes[0, 1])
+    counter_torque_plot(numbers, axes[0, 2])
+    delay_margin_plot(numbers, axes[1, 0])
+    for ax, variable in zip(axes[1, 1:], LANDSCAPE_LABELS, strict=True):
+        if dataset is None:
+            ax.set_axis_off()
+        else:
+            landscape_plot(dataset, variable, numbers, ax)
+    fig.suptitle(
+        f"spinectl explore: mass {state.mass:g} kg, K {state.stiffness:g} N m/rad, delay {state.delay * 1000:g} ms, "
+        f"activation {state.activation:g} × minimum PCSA, lag {state.activation_lag * 1000:g} ms"
+    )
+    return fig

@@ -1,0 +1,96 @@
+"""The explorer served from this checkout and a headless Chromium page on it: for the browser test and
+``scripts/explore_screenshot.py``.
+
+Playwright's Python API drives the system's Chromium (Debian's ``chromium`` package,
+installed by ``scripts/setup``); nothing downloads a browser.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import shutil
+import socket
+import subprocess
+import sys
+import time
+import urllib.request
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+CHROMIUM = os.environ.get("SPINECTL_CHROMIUM", "/usr/bin/chromium")
+"""The Chromium binary (Debian's package installs it here)."""
+CHROMIUM_ARGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+]
+TIMEOUT_S = 180.0
+"""Longest wait for the app (the first page: imports and the first solves; 90 s were too few on a 2-core
+machine at a load average of 9)."""
+VIEWPORT = {"width": 1440, "height": 960}
+INSTALL = "run scripts/setup (or apt-get install -y chromium), or set SPINECTL_CHROMIUM to a Chromium binary"
+
+
+def chromium() -> str | None:
+    """The path of the Chromium binary, or None if there is none."""
+    return shutil.which(CHROMIUM)
+
+
+def free_port() -> int:
+    """A TCP port free on the loopback interface just now."""
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@contextlib.contextmanager
+def served(*options: str):
+    """``python -m spinectl explore --no-browser`` from this checkout on a free loopback port; yields its URL."""
+    port = free_port()
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))}
+    argv = [sys.executable, "-m", "spinectl", "explore", "--no-browser", "--port", str(port), *options]
+    process = subprocess.Popen(argv, cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    url = f"http://127.0.0.1:{port}/"
+    deadline = time.monotonic() + TIMEOUT_S
+    try:
+        while True:
+            if process.poll() is not None:
+                raise RuntimeError(f"spinectl explore exited with {process.returncode}: {process.stdout.read()}")
+            try:
+                urllib.request.urlopen(url, timeout=5).close()
+                break
+            except OSError:
+                if time.monotonic() > deadline:
+                    raise
+                time.sleep(0.3)
+        yield url
+    finally:
+        process.terminate()
+        try:
+            process.wait(timeout=20)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.wait()
+
+
+@contextlib.contextmanager
+def opened(url: str, executable: str):
+    """A headless Chromium page at ``url``, once the numbers table is shown."""
+    from playwright.sync_api import sync_playwright  # imported here: collecting the tests needs no browser
+
+    with sync_playwright() as playwright:
+        browser = playwright.chromium.launch(executable_path=executable, args=CHROMIUM_ARGS)
+        try:
+            page = browser.new_page(viewport=VIEWPORT)
+            page.set_default_timeout(TIMEOUT_S * 1000)
+            page.goto(url)
+            page.wait_for_selector("td[data-key=counter_torque_Nm]")
+            yield page
+        finally:
+            browser.close()

@@ -1,0 +1,144 @@
+"""The Panel app without a browser: its widgets move the state, its views show the library's numbers."""
+
+from __future__ import annotations
+
+import base64
+
+import numpy as np
+import param
+import pytest
+
+from spinectl.errors import ModelError
+from spinectl.explore import app
+from spinectl.explore import numbers as nb
+from spinectl.explore.state import initial_state, replace
+from spinectl.model.config import load_preset
+
+
+@pytest.fixture(scope="module")
+def explorer():
+    return app.Explorer(load_preset("default"), "default")
+
+
+def _drag(slider, value):
+    """What the browser sends when a slider is released: value and value_throttled."""
+    with param.edit_constant(slider):
+        slider.param.update(value=value, value_throttled=value)
+
+
+def test_views_show_the_numbers_of_the_state(explorer):
+    """The table's cells are PointNumbers.rows(); the drawing is drawing_png of the same numbers, byte for byte."""
+    expected = nb.point_numbers(explorer.base, explorer.state)
+    for row in expected.rows():
+        for key in app.ROW_KEYS:
+            assert f'<td data-key="{key}">{row[key]}</td>' in explorer.table.object
+    assert explorer.drawing.object == app.drawing_png(expected)
+    assert explorer.dataset is not None  # outside a server session the landscapes are solved at once
+    assert "point updated in" in explorer.status.object
+
+
+def test_a_slider_moves_the_point_and_the_views_follow(explorer):
+    """E to 5.2 cm: numbers, drawing and landscape markers at the new point."""
+    before = explorer.drawing.object
+    _drag(explorer.sliders["eccentricity"], 5.2)
+    assert explorer.state.eccentricity == pytest.approx(0.052, abs=1e-15)
+    expected = nb.point_numbers(explorer.base, explorer.state)
+    assert f'<td data-key="counter_torque_Nm">{expected.rows()[0]["counter_torque_Nm"]}</td>' in explorer.table.object
+    assert explorer.drawing.object != before and explorer.drawing.object == app.drawing_png(expected)
+    for view in explorer.maps.values():
+        assert view.marker.data == {"x": [pytest.approx(5.2)], "y": [pytest.approx(4.0)]}
+
+
+def test_mass_solves_the_landscapes_again(explorer):
+    """A new mass: the landscapes are those of nb.landscapes at the new state; a reflex change keeps them."""
+    _drag(explorer.sliders["mass"], 30.0)
+    expected = nb.landscapes(explorer.base, explorer.state)
+    np.testing.assert_array_equal(explorer.dataset.min_pcsa_cm2, expected.min_pcsa_cm2)
+    image = explorer.maps["min_pcsa_cm2"].image.data["image"][0]
+    np.testing.assert_array_equal(image, expected.min_pcsa_cm2.values.T)  # Bokeh's rows are Lambda
+    kept = explorer.dataset
+    _drag(explorer.sliders["delay"], 150.0)
+    assert explorer.dataset is kept and explorer.state.delay == pytest.approx(0.15)
+
+
+def test_a_click_moves_the_point_to_the_nearest_step_inside_the_range(explorer):
+    """(5.123 cm, -1 cm) -> E = 5.1 cm, Lambda = 0 (the sliders' step 0.1 cm, range 0 to 8 cm)."""
+    explorer.move_to(0.05123, -0.01)
+    assert (explorer.state.eccentricity, explorer.state.lordosis) == (0.051, 0.0)
+    assert explorer.sliders["eccentricity"].value == pytest.approx(5.1)
+    assert explorer.sliders["lordosis"].value == 0.0
+
+
+def test_preset_selector_loads_the_preset_and_keeps_the_point(explorer):
+    """wagner2012: its own mass and K on the sliders, the point kept."""
+    point = (explorer.state.eccentricity, explorer.state.lordosis)
+    explorer.preset.value = "wagner2012"
+    wagner = load_preset("wagner2012")
+    assert explorer.state == replace(initial_state(wagner), eccentricity=point[0], lordosis=point[1])
+    assert explorer.sliders["mass"].value == wagner.body.mass
+
+
+def test_exports_toml_and_png(explorer):
+    """The download buttons: the state's TOML (state_toml) and a PNG of every view."""
+    toml, png = (w for w in explorer.layout.select(app.pn.widgets.FileDownload))
+    assert toml.callback().getvalue().startswith("# spinectl explore: E = ")
+    assert png.callback().getvalue().startswith(b"\x89PNG")
+
+
+def test_png_bytes_are_reproducible(explorer):
+    """The same figure at the same dpi gives the same bytes (no timestamp): the browser test relies on it."""
+    numbers = nb.point_numbers(explorer.base, explorer.state)
+    assert app.drawing_png(numbers) == app.drawing_png(numbers)
+    assert base64.b64encode(app.drawing_png(numbers))[:8] == b"iVBORw0K"
+
+
+def test_a_model_invalid_at_the_point_is_a_message_not_a_crash(explorer, monkeypatch):
+    """An error the user can cause (a SpinectlError) shows in the status line; the views keep the last point."""
+    shown = explorer.table.object
+
+    def invalid(base, state):
+        raise ModelError("fibre attachment on a centre of rotation")
+
+    monkeypatch.setattr(app, "point_numbers", invalid)
+    explorer.move_to(0.01, 0.01)
+    assert explorer.status.object == "**not shown:** fibre attachment on a centre of rotation"
+    assert explorer.table.object == shown
+
+
+def test_explorer_for_a_notebook_reads_the_config_named(tmp_path):
+    """explorer(config=...) starts from that file's model; the layout displays itself (Jupyter's mimebundle)."""
+    path = tmp_path / "mine.toml"
+    path.write_text("[body]\nmass = 33.0\n")
+    layout = app.explorer(config=path)
+    assert hasattr(layout, "_repr_mimebundle_")
+    sliders = [w for w in layout.select(app.pn.widgets.FloatSlider) if w.label == "mass [kg]"]
+    assert [s.value for s in sliders] == [33.0]
+    assert [w.value for w in layout.select(app.pn.widgets.Select)] == [app.CONFIG_CHOICE]
+
+
+def test_serve_binds_the_loopback_interface_by_default(monkeypatch, capsys):
+    """serve() asks Panel for 127.0.0.1 (no other machine can connect) and accepts pages from there only."""
+    calls = []
+    monkeypatch.setattr(app.pn, "serve", lambda panels, **options: calls.append(options))
+    app.serve(load_preset("default"), "default", 5999, show=False)
+    (options,) = calls
+    assert options["address"] == "127.0.0.1" and options["port"] == 5999 and options["show"] is False
+    assert options["websocket_origin"] == ["127.0.0.1:5999", "localhost:5999"]
+    assert capsys.readouterr().out == "spinectl explore: http://127.0.0.1:5999/ (Ctrl+C stops)\n"
+
+
+def test_the_delay_redraws_the_margins_only():
+    """The reflex delay and the lag do not change the PCSA: the drawing, eigenvalues and CT pictures stay the same
+    objects; the margins view and the table follow (state.REFLEX_ONLY). At the README's point of 'default' every
+    delay margin is finite (0.22 to 0.42 s), so a longer lag changes them."""
+    explorer = app.Explorer(load_preset("default"), "default")
+    kept = {name: pane.object for name, pane in explorer.views.items()} | {"drawing": explorer.drawing.object}
+    margins, table = explorer.views["delay_margins"].object, explorer.table.object
+    _drag(explorer.sliders["activation_lag"], 100.0)
+    assert explorer.state.activation_lag == pytest.approx(0.1)
+    for name in ("eigenvalues", "counter_torques"):
+        assert explorer.views[name].object is kept[name]
+    assert explorer.drawing.object is kept["drawing"]
+    assert explorer.views["delay_margins"].object != margins and explorer.table.object != table
+    expected = nb.point_numbers(explorer.base, explorer.state)
+    assert explorer.views["delay_margins"].object == app.png_bytes(app.views.delay_margin_plot(expected))

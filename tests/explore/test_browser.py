@@ -1,0 +1,121 @@
+"""End to end in a real browser: ``spinectl explore`` served on a free loopback port, driven by headless Chromium.
+
+Playwright's Python API drives the system's Chromium (Debian's ``chromium`` package,
+installed by ``scripts/setup`` and ``.ci/run``; no browser is downloaded). The test moves
+the E slider and clicks a landscape, and checks that the table and the model drawing
+become those the library computes for the new point (:func:`spinectl.explore.numbers.point_numbers`,
+:func:`spinectl.explore.app.drawing_png`, byte for byte).
+
+Without Chromium the test fails with a message saying how to install it; a developer
+without it can set ``SPINECTL_SKIP_BROWSER=1`` (CI never does).
+"""
+
+from __future__ import annotations
+
+import base64
+import os
+import re
+import time
+
+import browser_harness
+import pytest
+
+from spinectl.explore import app
+from spinectl.explore import numbers as nb
+from spinectl.explore.state import from_shown, initial_state, replace, slider_for
+from spinectl.model.config import load_preset
+
+OPT_OUT = "SPINECTL_SKIP_BROWSER"
+
+
+@pytest.fixture(scope="module")
+def page():
+    """The explorer served from this checkout, open in headless Chromium."""
+    if os.environ.get(OPT_OUT):
+        pytest.skip(f"{OPT_OUT} is set")
+    executable = browser_harness.chromium()
+    if executable is None:
+        pytest.fail(
+            f"the browser test needs Chromium at {browser_harness.CHROMIUM}: {browser_harness.INSTALL}; "
+            f"{OPT_OUT}=1 skips this test"
+        )
+    with browser_harness.served() as url, browser_harness.opened(url, executable) as tab:
+        yield tab
+
+
+def _table(page) -> list[dict[str, str]]:
+    cells = page.locator("td[data-key]")
+    rows, row = [], {}
+    for i in range(cells.count()):
+        key = cells.nth(i).get_attribute("data-key")
+        row[key] = cells.nth(i).inner_text().strip()
+        if key == app.ROW_KEYS[-1]:
+            rows.append(row)
+            row = {}
+    return rows
+
+
+def _drawing(page) -> bytes:
+    """The PNG of the model drawing, the widest image of the page."""
+    sources = [s for s in page.locator("img").evaluate_all("els => els.map(e => e.src)") if "image/png" in s]
+    return base64.b64decode(max(sources, key=len).split(",", 1)[1])
+
+
+def _shown(page, label: str) -> float:
+    """A slider's value as its label shows it, e.g. 'E [cm]: 3.60' -> 3.6."""
+    text = page.get_by_text(re.compile("^" + re.escape(label) + ":")).first.inner_text()
+    return float(text.split(":")[1])
+
+
+def _expect(page, state):
+    """Wait until the table shows the numbers of ``state``; then they, and the drawing, must be the library's."""
+    from playwright.sync_api import expect
+
+    expected = nb.point_numbers(load_preset("default"), state)
+    first = expected.rows()[0]["counter_torque_Nm"]
+    expect(page.locator("td[data-key=counter_torque_Nm]").first).to_have_text(
+        first, timeout=browser_harness.TIMEOUT_S * 1000
+    )
+    assert _table(page) == expected.rows()
+    assert _drawing(page) == app.drawing_png(expected)
+
+
+def test_slider_and_click_move_the_point_to_the_librarys_numbers(page):
+    """Start: the README's point; drag E: the numbers and the drawing of the new E; click the minimum-PCSA
+    landscape: those of the clicked point (read back from the page)."""
+    state = initial_state(load_preset("default"))
+    assert _table(page) == nb.point_numbers(load_preset("default"), state).rows()
+    assert _drawing(page) == app.drawing_png(nb.point_numbers(load_preset("default"), state))
+
+    handle = page.locator(".noUi-handle").first  # the first slider is E
+    box = handle.bounding_box()
+    x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+    page.mouse.move(x, y)
+    page.mouse.down()
+    page.mouse.move(x + 40, y, steps=5)
+    page.mouse.up()
+    moved = _point_shown(page, state, state)
+    assert moved.eccentricity > state.eccentricity and moved.lordosis == state.lordosis
+    _expect(page, moved)
+
+    landscape = page.locator(".bk-Canvas").first.bounding_box()  # the minimum-PCSA landscape
+    page.mouse.click(landscape["x"] + 0.3 * landscape["width"], landscape["y"] + 0.25 * landscape["height"])
+    clicked = _point_shown(page, moved, moved)
+    assert clicked.eccentricity < moved.eccentricity and clicked.lordosis > moved.lordosis  # left of it, higher
+    _expect(page, clicked)
+
+
+def _point_shown(page, state, before):
+    """``state`` at the point the page shows once it differs from ``before``: (E, Lambda) [m] as the status
+    line above the table gives it (set with the table, at once), and the sliders' labels must agree."""
+    fields = ("eccentricity", "lordosis")
+    before = tuple(getattr(before, f) for f in fields)
+    deadline = time.monotonic() + browser_harness.TIMEOUT_S
+    while True:
+        status = page.locator("[data-key=status]").first.inner_text()
+        point = tuple(float(x) / 100 for x in re.match(r"E = (\S+) cm, Λ = (\S+) cm", status).groups())
+        labels = tuple(from_shown(slider_for(f), _shown(page, slider_for(f).label)) for f in fields)
+        if (point != before and labels == point) or time.monotonic() > deadline:
+            assert labels == point and point != before
+            return replace(state, **dict(zip(fields, point, strict=True)))
+        time.sleep(0.2)

@@ -1,0 +1,56 @@
+"""The explorer's state: the parameters it sets, its TOML export read back, the sliders' grid."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import pytest
+
+from spinectl.errors import ParameterError
+from spinectl.explore import state as st
+from spinectl.model.config import load_config, load_preset
+
+
+@pytest.fixture
+def state():
+    return st.ExploreState(0.02, 0.05, mass=31.5, stiffness=15.0, delay=0.12, activation=0.75, activation_lag=0.07)
+
+
+def test_initial_state_is_the_models_own(model):
+    """Mass, K, delay, activation and lag are those of the model (params.py defaults); the point is the README's."""
+    start = st.initial_state(model)
+    assert (start.eccentricity, start.lordosis) == (0.03, 0.04)
+    assert (start.mass, start.stiffness, start.delay, start.activation, start.activation_lag) == (
+        40.0,
+        0.0,
+        0.1,
+        0.5,
+        0.05,
+    )
+
+
+def test_model_at_sets_each_parameter_by_its_dotted_name(model, state):
+    """Each slider's field lands in the parameter the docs name (docs/explore.md), the rest untouched."""
+    new = st.model_at(model, state)
+    assert new.body.mass == 31.5 and new.passive.stiffness == 15.0
+    assert (new.reflex.delay, new.reflex.activation, new.reflex.activation_time_constant) == (0.12, 0.75, 0.07)
+    assert new.muscles == model.muscles and new.geometry == model.geometry
+    with pytest.raises(ParameterError, match="mass"):
+        st.model_at(model, dataclasses.replace(state, mass=-1.0))
+
+
+def test_state_toml_reads_back_to_the_same_model(tmp_path, state):
+    """The TOML export, read by --config, gives model_at(base, state); its first line gives the point."""
+    base = load_preset("wagner2012")
+    text = st.state_toml(base, state)
+    path = tmp_path / "state.toml"
+    path.write_text(text)
+    assert load_config(path) == st.model_at(base, state)
+    assert text.splitlines()[0] == "# spinectl explore: E = 0.02 m, Lambda = 0.05 m"
+
+
+def test_from_shown_snaps_to_the_step_and_converts_to_si():
+    """3.5999999999999996 cm (a browser's float) is 3.6 cm = 0.036 m; 105 ms is 0.105 s."""
+    assert st.from_shown(st.slider_for("eccentricity"), 3.5999999999999996) == 36 * 0.1 / 100
+    assert st.from_shown(st.slider_for("delay"), 105.0) == pytest.approx(0.105, abs=1e-15)
+    assert [s.field for s in st.SLIDERS] == [f.name for f in dataclasses.fields(st.ExploreState)]
