@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 
+from ..model.config import DEFAULT_PRESET
 from ._common import add_model_options, load_model
 
 PORT = 5006
@@ -68,6 +69,6 @@ def run(args) -> int:
     model = load_model(args)  # a bad preset or config fails here, before Panel is imported
     from ..explore.launch import serve_explorer
 
-    preset = "--config" if args.config else (args.preset or "default")
+    preset = "--config" if args.config else (args.preset or DEFAULT_PRESET)
     serve_explorer(model, preset, args.port, args.address, show=not args.no_browser)
     return 0

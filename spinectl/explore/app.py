@@ -26,7 +26,7 @@ from bokeh.models import ColorBar, ColumnDataSource, LinearColorMapper
 from bokeh.plotting import figure as bokeh_figure
 
 from ..errors import SpinectlError
-from ..model.config import list_presets, load_preset
+from ..model.config import DEFAULT_PRESET, list_presets, load_preset
 from ..model.params import Model
 from ..units import CM_PER_M, m2_to_cm2
 from . import views
@@ -383,7 +383,7 @@ def explorer(preset: str | None = None, config=None) -> pn.viewable.Viewable:
     from ..model.config import load_config
 
     model = load_config(config, preset)
-    return Explorer(model, CONFIG_CHOICE if config else (preset or "default")).layout
+    return Explorer(model, CONFIG_CHOICE if config else (preset or DEFAULT_PRESET)).layout
 
 
 def serve(model: Model, preset: str, port: int, address: str = "127.0.0.1", show: bool = True) -> None:

@@ -71,7 +71,7 @@ def _expect(page, state):
     """Wait until the table shows the numbers of ``state``; then they, and the drawing, must be the library's."""
     from playwright.sync_api import expect
 
-    expected = nb.point_numbers(load_preset("default"), state)
+    expected = nb.point_numbers(load_preset(), state)
     first = expected.rows()[0]["counter_torque_Nm"]
     expect(page.locator("td[data-key=counter_torque_Nm]").first).to_have_text(
         first, timeout=browser_harness.TIMEOUT_S * 1000
@@ -83,9 +83,9 @@ def _expect(page, state):
 def test_slider_and_click_move_the_point_to_the_librarys_numbers(page):
     """Start: the README's point; drag E: the numbers and the drawing of the new E; click the minimum-PCSA
     landscape: those of the clicked point (read back from the page)."""
-    state = initial_state(load_preset("default"))
-    assert _table(page) == nb.point_numbers(load_preset("default"), state).rows()
-    assert _drawing(page) == app.drawing_png(nb.point_numbers(load_preset("default"), state))
+    state = initial_state(load_preset())
+    assert _table(page) == nb.point_numbers(load_preset(), state).rows()
+    assert _drawing(page) == app.drawing_png(nb.point_numbers(load_preset(), state))
 
     handle = page.locator(".noUi-handle").first  # the first slider is E
     box = handle.bounding_box()
