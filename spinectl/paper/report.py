@@ -9,6 +9,8 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+import numpy as np
+
 from ..units import m2_to_cm2
 from . import grid, landmarks, verdicts
 from .landmarks import Measurement
@@ -73,10 +75,26 @@ def landmark_table(measurements: Sequence[Measurement]) -> str:
     for m in measurements:
         mark = m.landmark
         lines.append(
-            f"| `{mark.name}` | {RELATION[mark.relation]} {_number(mark.paper)} | {_number(m.value)} | {mark.unit} "
+            f"| `{mark.name}` | {RELATION[mark.relation]} {_number(mark.paper)} | {value_cell(m)} | {mark.unit} "
             f"| {'yes' if m.agrees else '**no**'} | {verdicts.verdict_cell(m)} | {m.how} | {mark.where} |"
         )
     return "\n".join(lines)
+
+
+def value_cell(measurement: Measurement) -> str:
+    """A measured value as the report prints it, with ``± standard error`` where it has one.
+
+    Parameters
+    ----------
+    measurement : Measurement
+
+    Returns
+    -------
+    str
+        E.g. ``"1.97"`` or ``"1.24 ± 0.0023"``.
+    """
+    spread = measurement.uncertainty
+    return _number(measurement.value) + (f" ± {spread:.2g}" if np.isfinite(spread) else "")
 
 
 def _find(measurements: Sequence[Measurement], name: str) -> Measurement:
