@@ -35,7 +35,16 @@ from .landscapes import (
     measure_model,
 )
 from .output import history_csv, preset_toml, summary
-from .parameters import FREE_PARAMETERS, FreeParameter, bounds, from_model, parameter_set, to_model
+from .parameters import (
+    FREE_PARAMETERS,
+    MASS_FREE,
+    FreeParameter,
+    bounds,
+    from_model,
+    parameter_set,
+    to_model,
+    with_bounds,
+)
 from .sensitivity import STEP_LANDMARKS, Sensitivity, sensitivity
 from .targets import (
     C_READINGS,
@@ -57,6 +66,7 @@ __all__ = [
     "FIT_POINTS",
     "FREE_PARAMETERS",
     "GENERATIONS",
+    "MASS_FREE",
     "MISSING_PENALTY",
     "POPSIZE",
     "REFINE_EVALUATIONS",
@@ -88,4 +98,5 @@ __all__ = [
     "summary",
     "synthetic_targets",
     "to_model",
+    "with_bounds",
 ]
