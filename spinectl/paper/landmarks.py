@@ -29,6 +29,11 @@ Figure 4, position C") and puts C on the ridge Lambda ~ 1.7 E (Results), which
 the corner (8 cm, 8 cm) is not on; the C-ratios are therefore reported for both readings.
 """
 
+FIGURE_POSITIONS = {**POSITIONS, "C": OPTIMUM}
+"""(E, Lambda) [m] of positions A-D as the figures and the report mark them: A, B and D at the corners,
+C at Figure 3's reading, the interior point of the physiological situation (E ~ 3 cm, Lambda ~ 4 cm;
+docs/reproduction.md, "The captions"). The landmarks keep every reading of C."""
+
 RIDGE_SLOPE = 1.7
 """Slope of the paper's ridge of minimum PCSA, Lambda = 1.7 E (paper, Results)."""
 
