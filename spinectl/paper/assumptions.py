@@ -13,22 +13,24 @@ that needs no new calibration: the other K convention (the K = 15 landscapes of
 both conventions are part of every measurement), the PCSA of one side of a
 pair, and the other activation mode at the same geometry. The mass is a bound
 of the calibration, so its alternative is the second calibrated preset
-(:data:`MASS_FREE_PRESET`); :func:`assumption_table` puts the two together.
+(:data:`MASS_FREE_PRESET`); :func:`documented_rows` puts the two together and
+:func:`markdown` writes the table of docs/reproduction.md.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from functools import cache
 
 import numpy as np
 
-from ..model.config import set_parameter
+from ..model.config import load_preset, set_parameter
 from ..model.params import Model
 from . import landmarks
 from .calibration.landscapes import coarse_landmarks
 from .landmarks import Landmarks, Measurement
-from .verdicts import ASSUMPTION_WORDS, RELATION, format_number
+from .verdicts import ASSUMPTION_WORDS, PRESET, RELATION, format_number
 
 TABLE_POINTS = 41
 """Grid points per axis of the assumption table (2 mm steps; A-D and E = 3, Lambda = 4 cm are grid points).
@@ -236,15 +238,46 @@ def markdown(rows: Sequence[Row], points: int = TABLE_POINTS) -> str:
     return "\n".join(lines) + "\n"
 
 
-def agreement_count(measurements: Sequence[Measurement]) -> int:
-    """How many landmarks agree.
+CALIBRATED_PRESETS = (PRESET, MASS_FREE_PRESET)
+"""The calibrated presets: the anatomical bounds, and the mass free (docs/reproduction.md)."""
+
+
+@cache
+def calibrated_counts(points: int = TABLE_POINTS) -> tuple[tuple[str, int, int], ...]:
+    """How many landmarks each calibrated preset reproduces, measured afresh (fast path).
+
+    Cached per process: the presets are files of the package.
 
     Parameters
     ----------
-    measurements : sequence of Measurement
+    points : int
+        Grid points per axis.
 
     Returns
     -------
-    int
+    tuple of (str, int, int)
+        (preset, landmarks that agree, landmarks) for each of :data:`CALIBRATED_PRESETS`.
     """
-    return int(np.sum([m.agrees for m in measurements]))
+    out = []
+    for name in CALIBRATED_PRESETS:
+        found = landmarks.measure(coarse_landmarks(load_preset(name), points, other=True))
+        out.append((name, int(np.sum([m.agrees for m in found])), len(found)))
+    return tuple(out)
+
+
+def documented_rows(points: int = TABLE_POINTS) -> list[Row]:
+    """The assumption table of docs/reproduction.md: ``wagner2012`` under every choice, and the mass-free preset.
+
+    Parameters
+    ----------
+    points : int
+        Grid points per axis.
+
+    Returns
+    -------
+    list of Row
+        :func:`assumption_rows` of :func:`measure_choices` of ``wagner2012`` and the landmarks of
+        :data:`MASS_FREE_PRESET`.
+    """
+    mass_free = landmarks.measure(coarse_landmarks(load_preset(MASS_FREE_PRESET), points, other=True))
+    return assumption_rows(measure_choices(load_preset(PRESET), points), mass_free)

@@ -39,6 +39,11 @@ class Run:
         f_iso per PCSA [N/m^2], for the local-muscle equivalent of CT.
     calibrated : bool
         Whether the parameters are the calibrated preset of docs/reproduction.md.
+    preset_counts : tuple of (str, int, int)
+        (preset, landmarks that agree, landmarks) of each calibrated preset
+        (:func:`spinectl.paper.assumptions.calibrated_counts`).
+    count_points : int
+        Grid points per axis on which ``preset_counts`` were measured.
     """
 
     preset: str
@@ -49,6 +54,8 @@ class Run:
     files: tuple[str, ...]
     specific_tension: float
     calibrated: bool = False
+    preset_counts: tuple = ()
+    count_points: int = 0
 
 
 def landmark_table(measurements: Sequence[Measurement]) -> str:
@@ -174,6 +181,18 @@ def figures_section(files: Sequence[str]) -> str:
     return "\n\n".join(f"### {name}\n\n![{name}]({name})" for name in images)
 
 
+def _counts(run: Run) -> str:
+    if not run.preset_counts:
+        return ""
+    parts = [f"`{name}` {agree} of {total}" for name, agree, total in run.preset_counts]
+    return (
+        f"The calibrated presets reproduce: {', '.join(parts)} (measured afresh on a "
+        f"{run.count_points} × {run.count_points} grid; docs/reproduction.md has the table of both). "
+        f"`{verdicts.PRESET}` keeps the mass within anatomical bounds (≥ 24 kg); the mass-free preset says what the "
+        "paper's numbers imply, with an upper body lighter than any adult's."
+    )
+
+
 def render(measurements: Sequence[Measurement], run: Run) -> str:
     """The Markdown report of a reproduction run.
 
@@ -205,14 +224,18 @@ Parameters: {run.preset}. Wall time: {run.seconds:.1f} s.
 
 **{agree} of {len(measurements)} landmarks agree** with the paper.
 
+{_counts(run)}
+
 ## Landmarks
 
 {landmark_table(measurements)}
 
-"About" is read as ±20 % of the paper's value; positions A–D are the corners of
-Figures 3 and 4 (A: E = Λ = 0; B: E = 8 cm, Λ = 0; C: E = Λ = 8 cm; D: E = 0,
-Λ = 8 cm). The paper's text also places C at its optimum (E ≈ 3 cm, Λ ≈ 4 cm),
-so the C-ratios are given for both readings.
+"About" is read as ±20 % of the paper's value; A, B and D are corners of
+Figures 3 and 4 (A: E = Λ = 0; B: E = 8 cm, Λ = 0; D: E = 0, Λ = 8 cm). C is
+read as Figure 3's caption and the Discussion place it, the physiological
+situation inside the grid (E ≈ 3 cm, Λ ≈ 4 cm: the `_text` rows); the
+C-ratios are also given with C at the corner (E = Λ = 8 cm) and where the ridge
+line Λ = 1.7 E leaves the grid (the `_ridge` rows).
 
 {_local_pcsa(measurements, run.specific_tension)}
 

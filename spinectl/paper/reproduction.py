@@ -20,7 +20,7 @@ from ..errors import ParameterError
 from ..landscape import netcdf, sweep
 from ..model.config import load_config
 from ..model.params import Model
-from . import figures, grid, landmarks, report, verdicts
+from . import assumptions, figures, grid, landmarks, report, verdicts
 
 DEFAULT_PRESET = verdicts.PRESET
 """The calibrated preset (docs/reproduction.md): what the study runs unless told otherwise."""
@@ -172,6 +172,8 @@ def reproduce_model(
         files=names,
         specific_tension=model.fibre.specific_tension,
         calibrated=calibrated,
+        preset_counts=assumptions.calibrated_counts(assumptions.TABLE_POINTS),
+        count_points=assumptions.TABLE_POINTS,
     )
     with staged_directory(out_dir, names) as stage:
         netcdf.save(both, stage / LANDSCAPES)

@@ -245,13 +245,17 @@ def verdict_cell(measurement: Measurement) -> str:
     Returns
     -------
     str
-        "verdict: reason", with the documented value appended where the fresh one
-        differs; "n/a" for a landmark without a documented verdict.
+        "verdict: reason"; where the fresh value differs from the documented one, it first says
+        whether this run's value agrees, so that no note contradicts the run; "n/a" for a
+        landmark without a documented verdict.
     """
     v = VERDICTS.get(measurement.landmark.name)
     if v is None:
         return "n/a"
     text = f"{v.label}: {v.reason}" if v.reason else v.label
-    if not v.holds(measurement.value):
-        text += f" (documented for `{PRESET}`: {format_number(v.value)})"
+    if not v.holds(
+        measurement.value
+    ):  # not the documented value: this run's agreement leads, the documentation follows
+        run = "agrees" if measurement.agrees else "does not agree"
+        text = f"this run's value {run}; documented for `{PRESET}` ({format_number(v.value)}): {text}"
     return text

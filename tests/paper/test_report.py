@@ -47,6 +47,8 @@ def test_report_of_the_calibrated_preset_gives_the_documented_verdicts():
         documented = verdicts.VERDICTS[m.landmark.name]
         assert documented.verdict in row
         assert ("documented for `wagner2012`" in row) == (not documented.holds(m.value))
+        if not documented.holds(m.value):  # the run's own agreement comes first, never contradicted
+            assert ("this run's value agrees" in row) == m.agrees
 
 
 def test_halving_names_the_closer_convention():

@@ -20,9 +20,11 @@ def preset():
 
 
 @pytest.fixture(scope="module")
-def measured(preset):
-    """Every landmark of the preset on the paper's 81 x 81 grid (three sweeps, a few seconds)."""
-    return {m.landmark.name: m for m in calibration.measure_model(preset, progress=False)}
+def measured(wagner2012_landscapes):
+    """Every landmark of the preset on the paper's 81 x 81 grid (tests/paper/conftest.py)."""
+    both, other = wagner2012_landscapes
+    found = landmarks.measure(landmarks.Landmarks(both.sel(K=0.0), both.sel(K=grid.PAPER_STIFFNESS), other))
+    return {m.landmark.name: m for m in found}
 
 
 def test_every_landmark_has_a_documented_verdict():

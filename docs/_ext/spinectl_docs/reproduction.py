@@ -2,14 +2,16 @@
 
 The free parameters with their bounds, sources and calibrated values (read
 from the ``wagner2012`` preset), and the documented verdict of every landmark.
-Nothing is computed here: the test suite checks the documented values against
-a fresh measurement of the preset (tests/test_reproduction.py).
+The assumption table is measured at each build (:mod:`spinectl.paper.assumptions`,
+on a coarse grid); the test suite checks the documented values against a fresh
+measurement of the preset (tests/paper/test_verdicts.py) and the documented
+assumptions against that table (tests/paper/test_assumptions.py).
 """
 
 from __future__ import annotations
 
 from spinectl.model.config import load_preset
-from spinectl.paper import calibration, verdicts
+from spinectl.paper import assumptions, calibration, verdicts
 
 from .markup import md_escape
 
@@ -27,6 +29,11 @@ def parameter_table() -> str:
             f"| {md_escape(p.doc)} | {md_escape(p.source)} |"
         )
     return "\n".join(lines) + "\n"
+
+
+def assumption_table() -> str:
+    """Every landmark under each choice the paper does not make, measured now (a coarse grid, about half a minute)."""
+    return assumptions.markdown(assumptions.documented_rows())
 
 
 def landmark_table() -> str:

@@ -27,6 +27,7 @@ from .fit import (
     CalibrationResult,
     Fit,
     calibrate,
+    convention_losses,
 )
 from .landscapes import (
     FIT_POINTS,
@@ -85,6 +86,7 @@ __all__ = [
     "calibrate",
     "coarse_landmarks",
     "coarse_landscape",
+    "convention_losses",
     "from_model",
     "history_csv",
     "loss",

@@ -243,32 +243,54 @@ def _refine(objective: _Objective, parameters, convention: str, evaluations: int
     )
 
 
+def convention_losses(model: Model, targets: Sequence[Target], points: int = grid.PAPER_POINTS) -> dict:
+    """The loss of ``model``'s parameter vector with each passive-stiffness convention, from one set of sweeps.
+
+    :func:`spinectl.paper.grid.paper_landscapes` solves K = 0 and K = 15 N m/rad with both conventions
+    at once, so scoring the vector with each convention costs no more than scoring it once.
+
+    Parameters
+    ----------
+    model : Model
+        The vector to score (its passive stiffness is replaced by 0 and 15 N m/rad).
+    targets : sequence of Target
+    points : int
+        Grid points per axis.
+
+    Returns
+    -------
+    dict
+        Convention (each of :data:`spinectl.paper.grid.CONVENTIONS`) to (loss [1], tuple of Residual).
+    """
+    both, other = grid.paper_landscapes(model, points, progress=False)
+    k15 = {model.passive.convention: both.sel(K=grid.PAPER_STIFFNESS), grid.other_convention(model): other}
+    out = {}
+    for convention in grid.CONVENTIONS:
+        alternative = next(k15[c] for c in grid.CONVENTIONS if c != convention)
+        found = residuals(landmarks.measure(Landmarks(both.sel(K=0.0), k15[convention], alternative)), targets)
+        out[convention] = (float(sum(r.penalty for r in found)), found)
+    return out
+
+
 def _verify(objective: _Objective, conventions: Sequence[str], verify_points: int, say) -> dict[str, Fit]:
     """Each convention's best vector measured on the verification grid, and its loss there with every convention.
 
-    The convention is picked at the final vector: one set of sweeps gives the K = 15 landscapes of
-    both conventions (:func:`spinectl.paper.grid.paper_landscapes`), so each vector is scored with
-    each convention, and each convention keeps the vector that scores best with it, whichever
-    convention's search found it (:attr:`Fit.origin`).
+    The convention is picked at the final vector (:func:`convention_losses`): each convention keeps
+    the vector that scores best with it, whichever convention's search found it (:attr:`Fit.origin`).
     """
     fits: dict[str, Fit] = {}
     for origin in conventions:
         vector, _ = objective.best(origin)
         model = grid.with_stiffness(to_model(objective.base, vector, objective.parameters), 0.0, origin)
-        both, other = grid.paper_landscapes(model, verify_points, progress=False)
-        k15 = {origin: both.sel(K=grid.PAPER_STIFFNESS), grid.other_convention(model): other}
+        scored = convention_losses(model, objective.targets, verify_points)
         for convention in conventions:
-            alternative = next((k15[c] for c in grid.CONVENTIONS if c != convention), None)
-            found = residuals(
-                landmarks.measure(Landmarks(both.sel(K=0.0), k15[convention], alternative)), objective.targets
-            )
-            verified = float(sum(r.penalty for r in found))
+            verified, found = scored[convention]
             if convention not in fits or verified < fits[convention].loss:
                 fit_loss = float(objective.evaluate(vector, (convention,))[0])
                 fits[convention] = Fit(convention, vector, fit_loss, verified, found, origin)
         say(
             f"best {origin} vector on the {verify_points}-point grid: "
-            + ", ".join(f"{c} {fits[c].loss:.4g}" for c in conventions if fits[c].origin == origin)
+            + ", ".join(f"{c} {scored[c][0]:.4g}" for c in conventions)
         )
     return fits
 
