@@ -23,8 +23,6 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from functools import cache
 
-import numpy as np
-
 from ..model.config import load_preset, set_parameter
 from ..model.params import Model
 from . import landmarks
@@ -243,8 +241,8 @@ CALIBRATED_PRESETS = (PRESET, MASS_FREE_PRESET)
 
 
 @cache
-def calibrated_counts(points: int = TABLE_POINTS) -> tuple[tuple[str, int, int], ...]:
-    """How many landmarks each calibrated preset reproduces, measured afresh (fast path).
+def calibrated_measurements(points: int = TABLE_POINTS) -> tuple[tuple[str, float, tuple[Measurement, ...]], ...]:
+    """Every landmark of each calibrated preset, measured afresh (fast path).
 
     Cached per process: the presets are files of the package.
 
@@ -255,13 +253,13 @@ def calibrated_counts(points: int = TABLE_POINTS) -> tuple[tuple[str, int, int],
 
     Returns
     -------
-    tuple of (str, int, int)
-        (preset, landmarks that agree, landmarks) for each of :data:`CALIBRATED_PRESETS`.
+    tuple of (str, float, tuple of Measurement)
+        (preset, its mass [kg], its landmarks) for each of :data:`CALIBRATED_PRESETS`.
     """
     out = []
     for name in CALIBRATED_PRESETS:
-        found = landmarks.measure(coarse_landmarks(load_preset(name), points, other=True))
-        out.append((name, int(np.sum([m.agrees for m in found])), len(found)))
+        model = load_preset(name)
+        out.append((name, model.body.mass, tuple(landmarks.measure(coarse_landmarks(model, points, other=True)))))
     return tuple(out)
 
 
@@ -279,5 +277,5 @@ def documented_rows(points: int = TABLE_POINTS) -> list[Row]:
         :func:`assumption_rows` of :func:`measure_choices` of ``wagner2012`` and the landmarks of
         :data:`MASS_FREE_PRESET`.
     """
-    mass_free = landmarks.measure(coarse_landmarks(load_preset(MASS_FREE_PRESET), points, other=True))
+    mass_free = dict((name, found) for name, _, found in calibrated_measurements(points))[MASS_FREE_PRESET]
     return assumption_rows(measure_choices(load_preset(PRESET), points), mass_free)

@@ -39,11 +39,11 @@ class Run:
         f_iso per PCSA [N/m^2], for the local-muscle equivalent of CT.
     calibrated : bool
         Whether the parameters are the calibrated preset of docs/reproduction.md.
-    preset_counts : tuple of (str, int, int)
-        (preset, landmarks that agree, landmarks) of each calibrated preset
-        (:func:`spinectl.paper.assumptions.calibrated_counts`).
-    count_points : int
-        Grid points per axis on which ``preset_counts`` were measured.
+    presets : tuple of (str, float, tuple of Measurement)
+        (preset, mass [kg], landmarks) of each calibrated preset
+        (:func:`spinectl.paper.assumptions.calibrated_measurements`).
+    preset_points : int
+        Grid points per axis on which ``presets`` were measured.
     """
 
     preset: str
@@ -54,8 +54,8 @@ class Run:
     files: tuple[str, ...]
     specific_tension: float
     calibrated: bool = False
-    preset_counts: tuple = ()
-    count_points: int = 0
+    presets: tuple = ()
+    preset_points: int = 0
 
 
 def landmark_table(measurements: Sequence[Measurement]) -> str:
@@ -181,16 +181,44 @@ def figures_section(files: Sequence[str]) -> str:
     return "\n\n".join(f"### {name}\n\n![{name}]({name})" for name in images)
 
 
-def _counts(run: Run) -> str:
-    if not run.preset_counts:
+ANATOMICAL_MASS = 24.0
+"""The lower bound of an adult upper body's mass [kg] (docs/reproduction.md, "What is fitted")."""
+
+
+def presets_section(run: Run) -> str:
+    """Both calibrated presets side by side: each landmark's value, agreement and documented verdict.
+
+    Parameters
+    ----------
+    run : Run
+        Its :attr:`Run.presets` (nothing without them).
+
+    Returns
+    -------
+    str
+        Markdown: the count of each preset, then one row per landmark; empty without presets.
+    """
+    if not run.presets:
         return ""
-    parts = [f"`{name}` {agree} of {total}" for name, agree, total in run.preset_counts]
-    return (
-        f"The calibrated presets reproduce: {', '.join(parts)} (measured afresh on a "
-        f"{run.count_points} × {run.count_points} grid; docs/reproduction.md has the table of both). "
-        f"`{verdicts.PRESET}` keeps the mass within anatomical bounds (≥ 24 kg); the mass-free preset says what the "
-        "paper's numbers imply, with an upper body lighter than any adult's."
-    )
+    counts = []
+    for name, mass, found in run.presets:
+        light = ", lighter than any adult upper body" if mass < ANATOMICAL_MASS else ""
+        counts.append(f"`{name}` (m = {mass:.3g} kg{light}): **{sum(m.agrees for m in found)} of {len(found)}**")
+    head = " | ".join(f"`{name}`" for name, _, _ in run.presets)
+    lines = [
+        "The calibrated presets, measured afresh on a "
+        f"{run.preset_points} × {run.preset_points} grid: " + "; ".join(counts) + ". The mass-free preset "
+        "says what the paper's numbers imply; docs/reproduction.md gives every landmark under each assumption.",
+        "",
+        f"| landmark | paper | {head} | verdict for `{verdicts.PRESET}`, and what it depends on |",
+        "| --- | --- | " + " | ".join("---" for _ in run.presets) + " | --- |",
+    ]
+    for i, mark in enumerate(landmarks.LANDMARKS):
+        cells = [f"{_number(found[i].value)} {'✓' if found[i].agrees else '✗'}" for _, _, found in run.presets]
+        verdict = verdicts.VERDICTS[mark.name].label
+        paper = f"{RELATION[mark.relation]} {_number(mark.paper)}"
+        lines.append(f"| `{mark.name}` | {paper} | " + " | ".join(cells) + f" | {verdict} |")
+    return "\n".join(lines)
 
 
 def render(measurements: Sequence[Measurement], run: Run) -> str:
@@ -224,7 +252,7 @@ Parameters: {run.preset}. Wall time: {run.seconds:.1f} s.
 
 **{agree} of {len(measurements)} landmarks agree** with the paper.
 
-{_counts(run)}
+{presets_section(run)}
 
 ## Landmarks
 

@@ -172,8 +172,8 @@ def reproduce_model(
         files=names,
         specific_tension=model.fibre.specific_tension,
         calibrated=calibrated,
-        preset_counts=assumptions.calibrated_counts(assumptions.TABLE_POINTS),
-        count_points=assumptions.TABLE_POINTS,
+        presets=assumptions.calibrated_measurements(assumptions.TABLE_POINTS),
+        preset_points=assumptions.TABLE_POINTS,
     )
     with staged_directory(out_dir, names) as stage:
         netcdf.save(both, stage / LANDSCAPES)

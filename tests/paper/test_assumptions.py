@@ -78,11 +78,28 @@ def test_c_ratio_families():
 @pytest.mark.parametrize("name", assumptions.CALIBRATED_PRESETS)
 def test_each_shipped_preset_reproduces_the_count_its_header_and_the_report_state(name):
     """The count in each preset's header (written by spinectl calibrate on the paper's grid) is the count
-    measured afresh, and it is what the report of spinectl reproduce states."""
-    counts = {n: (agree, total) for n, agree, total in assumptions.calibrated_counts()}
-    agree, total = counts[name]
+    measured afresh, and it is what the report of spinectl reproduce states, with the preset's mass."""
+    presets = assumptions.calibrated_measurements()
+    mass, found = next((m, f) for n, m, f in presets if n == name)
+    agree, total = sum(m.agrees for m in found), len(found)
     header = resources.files("spinectl.presets").joinpath(f"{name}.toml").read_text(encoding="utf-8")
     assert f"{agree} of {total} landmarks agree" in header.split("\n[body]")[0]
-    run = report.Run("preset", "physical", "paper", 9, 1.0, (), 25e4, True, assumptions.calibrated_counts(), 41)
-    found = landmarks.measure(calibration.coarse_landmarks(config.load_preset(name), 9, other=True))
-    assert f"`{name}` {agree} of {total}" in report.render(found, run)
+    assert mass == config.load_preset(name).body.mass
+    run = report.Run("preset", "physical", "paper", 9, 1.0, (), 25e4, True, presets, 41)
+    text = report.render(landmarks.measure(calibration.coarse_landmarks(config.load_preset(name), 9)), run)
+    assert f"`{name}` (m = {mass:.3g} kg" in text and f"**{agree} of {total}**" in text
+    rows = [line for line in text.splitlines() if line.startswith("| `") and line.count("✓") + line.count("✗") == 2]
+    assert len(rows) == len(landmarks.LANDMARKS)
+
+
+def test_the_table_has_a_row_per_landmark_and_a_count_per_column(rows):
+    """docs/reproduction.md's table: one row per landmark whose last cell names its deciders, and per column
+    the number of ✓, which for wagner2012's own choices is the count of its agreeing landmarks."""
+    table = assumptions.markdown(rows)
+    lines = [line for line in table.splitlines() if line.startswith("| `")]
+    assert len(lines) == len(landmarks.LANDMARKS)
+    for line, row in zip(lines, rows, strict=True):
+        words = [verdicts.ASSUMPTION_WORDS[d] for d in row.deciders] or ["none of these"]
+        assert line.endswith(f"| {', '.join(words)} |")
+    total = sum(row.values["chosen"][1] for row in rows)
+    assert f"**{total} of {len(rows)}**" in table.splitlines()[-1]

@@ -146,3 +146,22 @@ def test_the_ridge_slope_is_the_same_on_81_and_101_points(preset):
         assert fit.slope == pytest.approx(closed_form, abs=max(3 * fit.uncertainty, 1e-6)), points
         top, at_a = float(k0["min_pcsa_cm2"].max()), landmarks.at(k0, "min_pcsa_cm2", grid.POSITIONS["A"])
         assert top - at_a <= 1e-9 * at_a
+
+
+def test_the_preset_convention_has_the_least_loss_at_its_vector(preset, wagner2012_landscapes):
+    """The convention is picked at the final vector: the preset's own K convention has the least loss at its
+    parameters (both conventions' K = 15 landscapes, one set of sweeps), and the header states both losses."""
+    both, other = wagner2012_landscapes
+    k0, own = both.sel(K=0.0), both.sel(K=grid.PAPER_STIFFNESS)
+    targets = calibration.paper_targets()
+    losses = {
+        preset.passive.convention: calibration.loss(landmarks.measure(landmarks.Landmarks(k0, own, other)), targets),
+        grid.other_convention(preset): calibration.loss(
+            landmarks.measure(landmarks.Landmarks(k0, other, own)), targets
+        ),
+    }
+    assert losses[preset.passive.convention] == min(losses.values())
+    text = resources.files("spinectl.presets").joinpath(f"{verdicts.PRESET}.toml").read_text(encoding="utf-8")
+    header = text.split("\n[body]")[0]
+    for convention, value in losses.items():
+        assert f"{convention} {value:.4g}" in header, convention
