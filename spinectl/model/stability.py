@@ -103,7 +103,7 @@ def slowest_time_constant(stiffness, damping, inertia):
     """The slowest time constant of a set of segments, -1 / max Re(lambda) over their eigenvalues [s].
 
     How long a self-stable posture takes to recover from a small push: a segment whose stiffness
-    S only just beats gravity has a root near S / |D|, a time constant of |D| / |S| (eq. 1).
+    S only just beats gravity has a root near S / abs(D), a time constant of abs(D / S) (eq. 1).
 
     Parameters
     ----------
