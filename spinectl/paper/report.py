@@ -147,9 +147,10 @@ def _provenance(run: Run) -> str:
             "The parameters the paper does not state (upper-body mass, muscle attachment\n"
             "points, fibre spread) are **calibrated** against the landmarks below in this\n"
             "preset (`spinectl calibrate`; docs/reproduction.md gives the loss, the anatomical\n"
-            "bounds and the reason for every verdict). A landmark that does not agree is\n"
-            "either a compromise of the fit or one the model cannot reproduce whatever its\n"
-            "parameters; the verdict column says which."
+            "bounds and the reason for every verdict). The verdict column names the\n"
+            "assumptions each verdict depends on (mass bound, PCSA of one side or both,\n"
+            "K convention, activation mode, reading of C); \"cannot be reproduced\" only\n"
+            "where a proof covers every parameter and every choice."
         )
     return (
         "These parameters are **not** the calibrated preset: the landmarks below are\n"
