@@ -43,7 +43,7 @@ ASSUMPTION_WORDS = {
     "activation": "paired activation",
     "reading_C": "this reading of C",
 }
-"""How a verdict names each assumption it depends on (:data:`spinectl.paper.assumptions.ASSUMPTIONS`, whose
+"""How a verdict names each assumption it depends on (:data:`spinectl.paper.assumptions.ALTERNATIVES`, whose
 table measures which ones decide each landmark)."""
 
 
