@@ -107,3 +107,9 @@ def test_the_table_has_a_row_per_landmark_and_a_count_per_column(rows):
         assert line.endswith(f"| {', '.join(words)} |")
     total = sum(row.values["chosen"][1] for row in rows)
     assert f"**{total} of {len(rows)}**" in table.splitlines()[-1]
+
+
+def test_every_assumption_has_its_words_and_its_alternative():
+    """The verdicts' words and the table's columns name the same assumptions, in the same order."""
+    assert list(assumptions.ALTERNATIVES) == list(verdicts.ASSUMPTION_WORDS)
+    assert all(set(v.assumptions) <= set(verdicts.ASSUMPTION_WORDS) for v in verdicts.VERDICTS.values())
