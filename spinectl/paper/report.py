@@ -149,7 +149,7 @@ def _provenance(run: Run) -> str:
             "preset (`spinectl calibrate`; docs/reproduction.md gives the loss, the anatomical\n"
             "bounds and the reason for every verdict). The verdict column names the\n"
             "assumptions each verdict depends on (mass bound, PCSA of one side or both,\n"
-            "K convention, activation mode, reading of C); \"cannot be reproduced\" only\n"
+            'K convention, activation mode, reading of C); "cannot be reproduced" only\n'
             "where a proof covers every parameter and every choice."
         )
     return (

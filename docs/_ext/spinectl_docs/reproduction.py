@@ -31,7 +31,8 @@ def parameter_table() -> str:
         )
     lines.append(
         f"\n`{assumptions.MASS_FREE_PRESET}` is calibrated with the mass within "
-        f"{calibration.MASS_FREE[0]:g}-{calibration.MASS_FREE[1]:g} kg (`--bounds mass=10,55`), its other bounds as above."
+        f"{calibration.MASS_FREE[0]:g}-{calibration.MASS_FREE[1]:g} kg (`--bounds mass=10,55`), "
+        "its other bounds as above."
     )
     return "\n".join(lines) + "\n"
 
