@@ -47,8 +47,8 @@ print(
 
 # %% [markdown]
 # One function measures a model: a landscape over $E \times \Lambda$ for A, B, the ridge and the two slopes
-# (`landmarks.line_slope` fits $\Lambda = sE$ through the per-$E$ extremum), and a fine line along $\Lambda$ at
-# $E = 3$ cm for where the optimum and the peak sit there.
+# (`landmarks.line_slope` fits $\Lambda = sE$ through the crest, located between grid points), and a fine
+# line along $\Lambda$ at $E = 3$ cm for where the optimum and the peak sit there.
 
 
 # %%

@@ -13,6 +13,7 @@ import shlex
 import sys
 
 from ..atomic import atomic_write_text, check_distinct, check_writable
+from ..errors import ParameterError
 from ..paper import calibration, grid
 from ._common import add_model_options, load_model, require
 
@@ -71,6 +72,14 @@ def register(sub) -> None:
         metavar="NAME,...",
         help="free parameters to fit (default: all of " + ", ".join(p.name for p in calibration.FREE_PARAMETERS) + ")",
     )
+    parser.add_argument(
+        "--bounds",
+        action="append",
+        default=[],
+        metavar="NAME=LOW,HIGH",
+        help="replace a free parameter's bounds, in its unit (repeatable), e.g. mass=10,55 for the "
+        "mass-free preset wagner2012_mass_free",
+    )
     parser.add_argument("--out", metavar="FILE.toml", help="write the calibrated model here as a preset (atomically)")
     parser.add_argument(
         "--history", metavar="FILE.csv", help="write every loss evaluation (vector, loss per convention) as CSV"
@@ -96,6 +105,8 @@ def run(args) -> int:
     require(3 <= args.verify_grid <= 161, "--verify-grid", f"must be 3 to 161 (got {args.verify_grid})")
     names = [n.strip() for n in args.parameters.split(",")] if args.parameters else None
     parameters = calibration.parameter_set(names)
+    for text in args.bounds:
+        parameters = calibration.with_bounds(parameters, *_bounds(text))
     conventions = [c.strip() for c in args.conventions.split(",") if c.strip()]
     check_distinct({"--out": args.out, "--history": args.history}, {"--config": args.config})
     base = load_model(args, {"optimisation.activation": args.activation})
@@ -124,6 +135,17 @@ def run(args) -> int:
     return 0
 
 
+def _bounds(text: str) -> tuple[str, float, float]:
+    """NAME=LOW,HIGH as (name, low, high); a one-line error (field --bounds) otherwise."""
+    name, _, values = text.partition("=")
+    parts = values.split(",")
+    try:
+        low, high = (float(part) for part in parts)
+    except ValueError:
+        raise ParameterError("--bounds", f"must be NAME=LOW,HIGH (got {text!r})") from None
+    return name.strip(), low, high
+
+
 def _command(args) -> str:
     """The command line that reproduces this run, for the preset's header."""
     words = ["spinectl", "calibrate"]
@@ -132,6 +154,8 @@ def _command(args) -> str:
             words += [f"--{option}", getattr(args, option)]
     for assignment in args.assignments:
         words += ["--set", assignment]
+    for text in args.bounds:
+        words += ["--bounds", text]
     words += ["--seed", str(args.seed), "--starts", str(args.starts), "--grid", str(args.grid)]
     words += ["--verify-grid", str(args.verify_grid), "--generations", str(args.generations)]
     words += ["--popsize", str(args.popsize), "--refine", str(args.refine), "--conventions", args.conventions]

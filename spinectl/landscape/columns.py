@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..model import chain
+from ..model import chain, stability
 from ..model.checks import arithmetic_guard, checked_coefficients
 from ..model.params import Model
 from ..optimise import coupled, stacked
@@ -108,7 +108,15 @@ def _chunk_columns(result: stacked.BlockOptimum, coeffs, model: Model) -> dict[s
         "gravity_torque_Nm": coeffs.gravity_torque,
         "passive_stiffness_Nm_per_rad": coeffs.passive_stiffness,
         "inertia_kgm2": coeffs.inertia,
+        "slowest_time_constant_s": _slowest_time_constant(coeffs, result.pcsa),
     }
+
+
+def _slowest_time_constant(coeffs, pcsa) -> np.ndarray:
+    """The slowest time constant of the segments at the chosen activation [s], NaN where infeasible (eq. 1)."""
+    filled = np.nan_to_num(pcsa)
+    tau = stability.slowest_time_constant(coeffs.stiffness(filled), coeffs.damping(filled), coeffs.inertia)
+    return np.where(np.isnan(pcsa).any(axis=-1), np.nan, tau)
 
 
 def _chain_stiffness(model: Model, eccentricity, lordosis, pcsa) -> np.ndarray:

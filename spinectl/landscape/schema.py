@@ -42,6 +42,10 @@ VARIABLES = {
     "delay_margin_status": ("", "finite, delay_independent (inf), unstable_without_delay (0) or undefined (NaN)"),
     "stable_at_delay": ("", "closed loop stable with the delay reflex.delay and the activation lag (exact)"),
     "spine_delay_margin_s": ("s", "smallest delay margin over the segments: the delay the whole spine tolerates"),
+    "slowest_time_constant_s": (
+        "s",
+        "slowest time constant of the segments at the chosen activation, -1/max Re(lambda) (eq. 1; inf if not stable)",
+    ),
     "coupled_margin_Nm_per_rad": (
         "N m rad-1",
         "static margin of the coupled chain at the chosen activation: smallest eigenvalue of -K (> 0 stable)",

@@ -424,6 +424,14 @@ class Optimisation:
         "the optimum strictly self-stable rather than marginal (a zero eigenvalue); it costs well under "
         "0.1 cm^2 of PCSA.",
     )
+    relative_margin: float = param(
+        0.0,
+        "1",
+        "Relative stability margin: dM_k/dalpha <= -relative_margin * m g r_y,k at every CoR, a fraction of "
+        "the segment's gravity stiffness (the larger of this and stability_margin binds). 0 (the paper): "
+        "an optimum only just beats gravity, with time constants of minutes; 0.1 asks the muscles for 10 % "
+        "more stiffness than gravity takes away (docs/reproduction.md, 'A relative stability margin'); 0 to 1.",
+    )
     damping_margin: float = param(
         0.01,
         "N m s/rad",
@@ -451,6 +459,7 @@ class Optimisation:
         _store(
             self,
             stability_margin=v.non_negative("stability_margin", self.stability_margin),
+            relative_margin=v.in_range("relative_margin", self.relative_margin, 0.0, 1.0),
             damping_margin=v.non_negative("damping_margin", self.damping_margin),
             pcsa_max=pmax,
             ct_tolerance=v.non_negative("ct_tolerance", self.ct_tolerance),

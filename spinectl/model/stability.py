@@ -101,6 +101,34 @@ def eigenvalues(stiffness, damping, inertia):
     return np.stack([first, second], axis=-1).astype(complex)
 
 
+def slowest_time_constant(stiffness, damping, inertia):
+    """The slowest time constant of a set of segments, -1 / max Re(lambda) over their eigenvalues [s].
+
+    How long a self-stable posture takes to recover from a small push: a segment whose stiffness
+    S only just beats gravity has a root near S / abs(D), a time constant of abs(D / S) (eq. 1).
+
+    Parameters
+    ----------
+    stiffness, damping, inertia : array_like, shape (..., n_segments)
+        S [N m/rad], D [N m s/rad] and theta [kg m^2] of each segment (:func:`eigenvalues`).
+
+    Returns
+    -------
+    numpy.ndarray, shape (...)
+        The time constant [s]: inf where some eigenvalue has a real part >= 0 (not asymptotically
+        stable), NaN where an input is NaN.
+
+    References
+    ----------
+    .. [1] Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012). Spinal
+       lordosis optimizes the requirements for a stable erect posture. Theor Biol Med
+       Model 9:13. doi:10.1186/1742-4682-9-13 (eq. 1)
+    """
+    slowest = np.asarray(eigenvalues(stiffness, damping, inertia).real.max(axis=(-2, -1)))
+    out = np.where(np.isnan(slowest), np.nan, np.inf)
+    return np.divide(-1.0, slowest, out=out, where=slowest < 0)
+
+
 def hurwitz_stable(stiffness, damping):
     """Self-stability of eq. 1 from the signs of S and D alone (Routh-Hurwitz), shape (...) bool.
 
@@ -201,6 +229,11 @@ class StabilityResult:
         return float(np.linalg.norm(self.counter_torque))
 
     @property
+    def slowest_time_constant(self) -> float:
+        """The slowest time constant over the segments [s] (:func:`slowest_time_constant`); inf if not stable."""
+        return float(slowest_time_constant(self.stiffness, self.damping, self.inertia))
+
+    @property
     def all_self_stable(self) -> bool:
         """True if every segment is self-stable."""
         return bool(np.all(self.self_stable))
@@ -228,8 +261,8 @@ class StabilityResult:
             kept for one release), ``segments`` (each
             with ``name``, ``stiffness_Nm_per_rad``, ``damping_Nms_per_rad``, ``inertia_kgm2``,
             ``eigenvalues`` as [real, imaginary] pairs [1/s], ``self_stable``,
-            ``counter_torque_Nm``), ``all_self_stable`` and ``counter_torque_norm_Nm``; the
-            unit is in each key's name.
+            ``counter_torque_Nm``), ``all_self_stable``, ``slowest_time_constant_s`` (inf if not
+            stable) and ``counter_torque_norm_Nm``; the unit is in each key's name.
         """
         pcsa = m2_to_cm2(self.pcsa)
         return provenance(model) | {
@@ -253,6 +286,7 @@ class StabilityResult:
                 for k, name in enumerate(self.segment_names)
             ],
             "all_self_stable": self.all_self_stable,
+            "slowest_time_constant_s": self.slowest_time_constant,
             "counter_torque_norm_Nm": self.counter_torque_norm,
         }
 
@@ -298,7 +332,8 @@ class StabilityResult:
         lines += [
             "",
             f"||CT|| = {self.counter_torque_norm:.3f} N m; "
-            f"self-stable: {'all segments' if self.all_self_stable else 'NOT all segments'}",
+            f"self-stable: {'all segments' if self.all_self_stable else 'NOT all segments'}; "
+            f"slowest time constant {self.slowest_time_constant:.4g} s",
         ]
         return "\n".join(lines)
 

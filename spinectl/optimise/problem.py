@@ -66,7 +66,8 @@ class ProblemData:
         dM_k/domega per unit x [N m s/rad per cm^2]. Both eigenvalues of eq. 1
         have negative real part iff S_k < 0 and D_k < 0.
     stability_bound : numpy.ndarray, shape (..., 2 n_cor)
-        Right-hand side: -stability_margin - (gravity - passive) stiffness [N m/rad]
+        Right-hand side: -max(stability_margin, relative_margin * gravity stiffness)
+        - (gravity - passive) stiffness [N m/rad]
         for the stiffness rows, -damping_margin [N m s/rad] for the damping rows.
     torque : numpy.ndarray, shape (..., n_cor, n_var)
         Muscle torque per unit x [N m per cm^2].
@@ -161,7 +162,8 @@ def problem_data(model: Model, coeffs: SegmentCoefficients) -> ProblemData:
         to_muscles = np.eye(n_muscles)
     per_var = to_muscles * M2_PER_CM2  # m^2 of each muscle per cm^2 of x
     opt = model.optimisation
-    stiffness_bound = -opt.stability_margin - (coeffs.gravity_stiffness - coeffs.passive_stiffness)
+    margin = np.maximum(opt.stability_margin, opt.relative_margin * coeffs.gravity_stiffness)  # the larger binds
+    stiffness_bound = -margin - (coeffs.gravity_stiffness - coeffs.passive_stiffness)
     damping_bound = np.full_like(stiffness_bound, -opt.damping_margin)
     return ProblemData(
         stability=np.concatenate([coeffs.stiffness_per_pcsa @ per_var, coeffs.damping_per_pcsa @ per_var], axis=-2),

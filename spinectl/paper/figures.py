@@ -117,7 +117,7 @@ def _inside(position, e: np.ndarray, lam: np.ndarray) -> bool:
 
 
 def grid_marks(e: np.ndarray, lam: np.ndarray) -> list[tuple[str, tuple[float, float]]]:
-    """The labelled points of a landscape: positions A-D inside the grid, and its other corners.
+    """The labelled points of a landscape: positions A-D inside the grid, and its corners that are none of them.
 
     Parameters
     ----------
@@ -128,10 +128,10 @@ def grid_marks(e: np.ndarray, lam: np.ndarray) -> list[tuple[str, tuple[float, f
     -------
     list of (str, (float, float))
         Label and (E, Lambda) [m]: a letter for a position of
-        :data:`spinectl.paper.grid.POSITIONS` inside the grid, "E, Λ = ... cm" for a
-        corner of the grid that is none of them.
+        :data:`spinectl.paper.landmarks.FIGURE_POSITIONS` inside the grid (C at Figure 3's
+        interior point), "E, Λ = ... cm" for a corner of the grid that is none of them.
     """
-    marks = [(name, p) for name, p in grid.POSITIONS.items() if _inside(p, e, lam)]
+    marks = [(name, p) for name, p in landmarks.FIGURE_POSITIONS.items() if _inside(p, e, lam)]
     for corner in ((e.min(), lam.min()), (e.max(), lam.min()), (e.max(), lam.max()), (e.min(), lam.max())):
         if not any(np.allclose(corner, p, atol=_TOLERANCE) for _, p in marks):
             marks.append((f"{corner[0] * CM_PER_M:g}, {corner[1] * CM_PER_M:g} cm", corner))
@@ -182,7 +182,7 @@ def _mark_readings(ax, e: np.ndarray, lam: np.ndarray) -> None:
             color="red",
             markersize=10,
             gid="optimum",
-            label="the paper's optimum, C in its Discussion (E ≈ 3, Λ ≈ 4 cm)",
+            label="C, the physiological situation (Figure 3's caption; Discussion: E ≈ 3, Λ ≈ 4 cm)",
         )
     if ax.get_legend_handles_labels()[0]:
         ax.legend(loc="upper center", fontsize=7, framealpha=0.8)

@@ -29,8 +29,17 @@ Figure 4, position C") and puts C on the ridge Lambda ~ 1.7 E (Results), which
 the corner (8 cm, 8 cm) is not on; the C-ratios are therefore reported for both readings.
 """
 
+FIGURE_POSITIONS = {**POSITIONS, "C": OPTIMUM}
+"""(E, Lambda) [m] of positions A-D as the figures and the report mark them: A, B and D at the corners,
+C at Figure 3's reading, the interior point of the physiological situation (E ~ 3 cm, Lambda ~ 4 cm;
+docs/reproduction.md, "The captions"). The landmarks keep every reading of C."""
+
 RIDGE_SLOPE = 1.7
 """Slope of the paper's ridge of minimum PCSA, Lambda = 1.7 E (paper, Results)."""
+
+RIDGE_RISE = 40.0 / 35.0 - 1.0
+"""How far the ridge rises above A, relative to A [1]: the paper's ridge 'saturates at approximately
+40 cm2' along the line through A, where the PCSA is 'about 35 cm2' (Results): 40/35 - 1 = 0.14."""
 
 RIDGE_C = (POSITIONS["C"][1] / RIDGE_SLOPE, POSITIONS["C"][1])
 """(E, Lambda) [m] of position C read on the ridge line: where Lambda = 1.7 E reaches the top
@@ -93,6 +102,9 @@ class Landmark:
     positions : tuple of (float, float or None)
         The (E, Lambda) [m] it reads at the nearest grid point (Lambda None: the
         whole column at E); :func:`measure` reports the grid points used where they differ.
+    uncertainty : callable, optional
+        ``uncertainty(landmarks) -> float``, the measurement's standard error in ``unit``
+        (a slope fitted to a crest, :func:`crest_fit`); None where the value is read directly.
     """
 
     name: str
@@ -103,6 +115,7 @@ class Landmark:
     where: str
     measure: Callable[[Landmarks], float]
     positions: tuple = ()
+    uncertainty: Callable[[Landmarks], float] | None = None
 
     def agrees(self, value: float) -> bool:
         """Whether ``value`` matches the paper's value under :attr:`relation`.
@@ -186,13 +199,113 @@ def label(position) -> str:
     return f"E = {e * 100:.4g} cm" if lam is None else f"E = {e * 100:.4g}, Λ = {lam * 100:.4g} cm"
 
 
-def line_slope(dataset: xr.Dataset, name: str, pick: str) -> float:
-    """Slope of the line Lambda = s E through the per-E arg-max (or arg-min) of ``name`` over Lambda [1].
+@dataclass(frozen=True)
+class CrestFit:
+    """The line Lambda = s E fitted to a ridge's crest (or a valley's floor).
 
-    Only columns E > 0 whose extremum lies strictly inside the Lambda range
-    count (an extremum on the edge says the line left the grid), and only
-    columns with a value (infeasible points are NaN); least squares through
-    the origin. NaN if no column counts.
+    Attributes
+    ----------
+    slope : float
+        s = Lambda / E [1]; NaN if fewer than one column counts.
+    uncertainty : float
+        Standard error of ``slope`` from the scatter of the crest about the line [1]; NaN with
+        fewer than two columns.
+    columns : int
+        Columns E that the fit used.
+    """
+
+    slope: float
+    uncertainty: float
+    columns: int
+
+
+def vertex(axis, values, index) -> np.ndarray:
+    """Sub-grid position of an extremum: the vertex of the parabola through the grid point and its two neighbours.
+
+    Exact for a quadratic extremum; a flat top (three equal values) stays at the grid point.
+
+    Parameters
+    ----------
+    axis : array_like, shape (n,)
+        The grid coordinate [any unit].
+    values : array_like, shape (..., n)
+        The values along the axis, one row per extremum.
+    index : array_like of int, shape (...)
+        The grid index of each row's extremum, strictly inside (1 to n - 2).
+
+    Returns
+    -------
+    numpy.ndarray, shape (...)
+        The vertex's coordinate, in the unit of ``axis``.
+    """
+    axis, values, index = np.asarray(axis, float), np.asarray(values, float), np.asarray(index)
+    x0, x1, x2 = axis[index - 1], axis[index], axis[index + 1]
+    rows = np.take_along_axis(values, np.stack([index - 1, index, index + 1], axis=-1), axis=-1)
+    f0, f1, f2 = np.moveaxis(rows, -1, 0)
+    top = (x1 - x0) ** 2 * (f1 - f2) - (x1 - x2) ** 2 * (f1 - f0)
+    bottom = (x1 - x0) * (f1 - f2) - (x1 - x2) * (f1 - f0)
+    safe = np.where(bottom == 0, 1.0, bottom)
+    return np.where(bottom == 0, x1, x1 - 0.5 * top / safe)
+
+
+def crest_fit(dataset: xr.Dataset, name: str, pick: str) -> CrestFit:
+    """The line Lambda = s E through the crest of ``name`` (``pick`` 'max') or its floor ('min'), sub-grid.
+
+    In every column E > 0 the extremum over Lambda is located between grid points
+    (:func:`vertex`), so the slope does not move in steps of the grid. The crest
+    is followed from A: the first run of consecutive columns whose extremum lies
+    strictly inside the Lambda range (an extremum on the edge says the line left
+    the grid; a later, separate run is another feature, not this line), skipping
+    columns with an infeasible (NaN) point next to the extremum. Least squares through the origin; the
+    uncertainty is the slope's standard error from the scatter of the crest.
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        A landscape with dimensions E and Lambda.
+    name : str
+        Variable name.
+    pick : {'max', 'min'}
+        Ridge or valley.
+
+    Returns
+    -------
+    CrestFit
+        Slope [1], its standard error [1] and the number of columns used.
+    """
+    field = dataset[name].transpose("E", "Lambda").values
+    sign = 1.0 if pick == "max" else -1.0
+    signed = np.where(np.isnan(field), -np.inf, sign * field)
+    index = np.argmax(signed, axis=1)
+    e, lam = dataset["E"].values, dataset["Lambda"].values
+    n = field.shape[1]
+    inside = (e > 0) & (index > 0) & (index < n - 1)
+    inside &= np.isfinite(np.take_along_axis(signed, np.clip(index[:, None] + [-1, 0, 1], 0, n - 1), axis=1)).all(1)
+    run = _first_run(inside)
+    if not run.any():
+        return CrestFit(np.nan, np.nan, 0)
+    crest = vertex(lam, sign * field[run], index[run])
+    slope = float(np.sum(e[run] * crest) / np.sum(e[run] ** 2))
+    count = int(run.sum())
+    if count < 2:
+        return CrestFit(slope, np.nan, count)
+    scatter = np.sum((crest - slope * e[run]) ** 2) / (count - 1)
+    return CrestFit(slope, float(np.sqrt(scatter / np.sum(e[run] ** 2))), count)
+
+
+def _first_run(mask: np.ndarray) -> np.ndarray:
+    """The first run of consecutive True values of ``mask`` (all False if none)."""
+    out = np.zeros_like(mask)
+    start = int(np.argmax(mask))
+    if not mask[start]:
+        return out
+    stop = start + int(np.argmin(mask[start:])) if not mask[start:].all() else mask.size
+    out[start:stop] = True
+    return out
+
+
+def line_slope(dataset: xr.Dataset, name: str, pick: str) -> float:
+    """Slope [1] of the line Lambda = s E through the crest (:func:`crest_fit`); NaN if no column counts.
 
     Parameters
     ----------
@@ -206,21 +319,28 @@ def line_slope(dataset: xr.Dataset, name: str, pick: str) -> float:
     Returns
     -------
     float
-        s = Lambda / E [1]; NaN if no column counts.
+        s = Lambda / E [1].
     """
-    field = dataset[name].transpose("E", "Lambda").values
-    sign = 1.0 if pick == "max" else -1.0
-    index = np.argmax(np.where(np.isnan(field), -np.inf, sign * field), axis=1)
-    e = dataset["E"].values
-    lam = dataset["Lambda"].values[index]
-    inside = (e > 0) & (index > 0) & (index < field.shape[1] - 1) & ~np.all(np.isnan(field), axis=1)
-    if not inside.any():
-        return np.nan
-    return float(np.sum(e[inside] * lam[inside]) / np.sum(e[inside] ** 2))
+    return crest_fit(dataset, name, pick).slope
 
 
 def _ridge(dataset: xr.Dataset | None) -> float:
     return np.nan if dataset is None else float(dataset["min_pcsa_cm2"].max())
+
+
+def _rise(d: Landmarks) -> float:
+    """How far the ridge rises above A, relative to A [1]: 0 for a plateau at A's value."""
+    return _ratio(_ridge(d.k0), _pcsa("A")(d)) - 1.0
+
+
+def _crest(name: str, pick: str, k15: bool = False) -> dict[str, Callable]:
+    """The slope and its standard error (:func:`crest_fit`) of the K = 0 (or K = 15) landscape."""
+
+    def fit(d: Landmarks) -> CrestFit:
+        dataset = d.k15 if k15 else d.k0
+        return CrestFit(np.nan, np.nan, 0) if dataset is None else crest_fit(dataset, name, pick)
+
+    return {"measure": lambda d: fit(d).slope, "uncertainty": lambda d: fit(d).uncertainty}
 
 
 def _ratio(a: float, b: float) -> float:
@@ -240,11 +360,15 @@ def _ct_ratio(top, bottom) -> Callable[[Landmarks], float]:
 
 
 def _best_lordosis(d: Landmarks) -> float:
-    """Lambda [cm] of least ‖CT‖ at E = 3 cm."""
+    """Lambda [cm] of least ‖CT‖ at E = 3 cm, between grid points (:func:`vertex`) where it is inside."""
     column = d.k0["counter_torque_norm_Nm"].sel(E=OPTIMUM[0], method="nearest")
-    if np.all(np.isnan(column.values)):
+    values, axis = column.values, column["Lambda"].values
+    if np.all(np.isnan(values)):
         return np.nan
-    return float(column["Lambda"][int(np.nanargmin(column.values))]) * 100.0
+    i = int(np.nanargmin(values))
+    if 0 < i < values.size - 1 and np.isfinite(values[i - 1 : i + 2]).all():
+        return float(vertex(axis, values, i)) * 100.0
+    return float(axis[i]) * 100.0
 
 
 def _halving(other: bool) -> Callable[[Landmarks], float]:
@@ -292,13 +416,23 @@ LANDMARKS: tuple[Landmark, ...] = (
         lambda d: _ridge(d.k0),
     ),
     Landmark(
+        "ridge_rise",
+        RIDGE_RISE,
+        "~",
+        "1",
+        "largest minimum PCSA / minimum PCSA at A, minus 1 (0: a plateau at A's value)",
+        "Results: 'about 35 cm2 (position A)' on the line through A and C, which 'saturates at approximately 40'",
+        _rise,
+        positions=(POSITIONS["A"],),
+    ),
+    Landmark(
         "ridge_slope",
         RIDGE_SLOPE,
         "~",
         "1",
-        "Lambda/E of the per-E maximum of the minimum PCSA (fit through 0)",
+        "Lambda/E of the ridge's crest, located between grid points (fit through 0, ± its standard error)",
         "Results: 'Around the line Lambda = 1.7E'",
-        lambda d: line_slope(d.k0, "min_pcsa_cm2", "max"),
+        **_crest("min_pcsa_cm2", "max"),
     ),
     Landmark(
         "ridge_over_B",
@@ -325,9 +459,9 @@ LANDMARKS: tuple[Landmark, ...] = (
         1.0,
         "~",
         "1",
-        "Lambda/E of the per-E minimum of ‖CT‖ (fit through 0)",
+        "Lambda/E of the floor of ‖CT‖'s valley, located between grid points (fit through 0, ± its standard error)",
         "Results: 'the minimum counter torques were found along the angle bisector'",
-        lambda d: line_slope(d.k0, "counter_torque_norm_Nm", "min"),
+        **_crest("counter_torque_norm_Nm", "min"),
     ),
     Landmark(
         "ct_B",
@@ -404,7 +538,7 @@ LANDMARKS: tuple[Landmark, ...] = (
         4.0,
         "~",
         "cm",
-        "Lambda of least ‖CT‖ at E = 3 cm",
+        "Lambda of least ‖CT‖ at E = 3 cm (between grid points)",
         "Discussion: 'require an eccentricity of E ~ 3 cm and a lumbar lordosis of Lambda ~ 4 cm'",
         _best_lordosis,
         positions=((OPTIMUM[0], None),),
@@ -453,7 +587,7 @@ LANDMARKS: tuple[Landmark, ...] = (
         "1",
         "ridge slope as above, K = 15 N m/rad",
         "Results: elasticity 'does not affect the relationship ... qualitatively'",
-        lambda d: np.nan if d.k15 is None else line_slope(d.k15, "min_pcsa_cm2", "max"),
+        **_crest("min_pcsa_cm2", "max", k15=True),
     ),
 )
 """The paper's landmarks, in the order of its Results and Discussion."""
@@ -472,12 +606,15 @@ class Measurement:
     off_grid : tuple of ((float, float or None), (float, float or None))
         (position named, grid point read) [m] for each position of the landmark that is
         not a grid point (:func:`grid_point`).
+    uncertainty : float
+        Standard error of ``value`` in the landmark's unit; NaN where it has none.
     """
 
     landmark: Landmark
     value: float
     agrees: bool
     off_grid: tuple = ()
+    uncertainty: float = np.nan
 
     @property
     def how(self) -> str:
@@ -504,7 +641,8 @@ def measure(landmarks: Landmarks) -> list[Measurement]:
         value = float(mark.measure(landmarks))
         used = ((named, grid_point(landmarks.k0, named)) for named in mark.positions)
         off_grid = tuple((named, near) for named, near in used if not _same(named, near))
-        out.append(Measurement(mark, value, mark.agrees(value), off_grid))
+        spread = np.nan if mark.uncertainty is None else float(mark.uncertainty(landmarks))
+        out.append(Measurement(mark, value, mark.agrees(value), off_grid, spread))
     return out
 
 

@@ -9,6 +9,8 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+import numpy as np
+
 from ..units import m2_to_cm2
 from . import grid, landmarks, verdicts
 from .landmarks import Measurement
@@ -37,6 +39,11 @@ class Run:
         f_iso per PCSA [N/m^2], for the local-muscle equivalent of CT.
     calibrated : bool
         Whether the parameters are the calibrated preset of docs/reproduction.md.
+    presets : tuple of (str, float, tuple of Measurement)
+        (preset, mass [kg], landmarks) of each calibrated preset
+        (:func:`spinectl.paper.assumptions.calibrated_measurements`).
+    preset_points : int
+        Grid points per axis on which ``presets`` were measured.
     """
 
     preset: str
@@ -47,6 +54,8 @@ class Run:
     files: tuple[str, ...]
     specific_tension: float
     calibrated: bool = False
+    presets: tuple = ()
+    preset_points: int = 0
 
 
 def landmark_table(measurements: Sequence[Measurement]) -> str:
@@ -73,10 +82,26 @@ def landmark_table(measurements: Sequence[Measurement]) -> str:
     for m in measurements:
         mark = m.landmark
         lines.append(
-            f"| `{mark.name}` | {RELATION[mark.relation]} {_number(mark.paper)} | {_number(m.value)} | {mark.unit} "
+            f"| `{mark.name}` | {RELATION[mark.relation]} {_number(mark.paper)} | {value_cell(m)} | {mark.unit} "
             f"| {'yes' if m.agrees else '**no**'} | {verdicts.verdict_cell(m)} | {m.how} | {mark.where} |"
         )
     return "\n".join(lines)
+
+
+def value_cell(measurement: Measurement) -> str:
+    """A measured value as the report prints it, with ``± standard error`` where it has one.
+
+    Parameters
+    ----------
+    measurement : Measurement
+
+    Returns
+    -------
+    str
+        E.g. ``"1.97"`` or ``"1.24 ± 0.0023"``.
+    """
+    spread = measurement.uncertainty
+    return _number(measurement.value) + (f" ± {spread:.2g}" if np.isfinite(spread) else "")
 
 
 def _find(measurements: Sequence[Measurement], name: str) -> Measurement:
@@ -122,9 +147,10 @@ def _provenance(run: Run) -> str:
             "The parameters the paper does not state (upper-body mass, muscle attachment\n"
             "points, fibre spread) are **calibrated** against the landmarks below in this\n"
             "preset (`spinectl calibrate`; docs/reproduction.md gives the loss, the anatomical\n"
-            "bounds and the reason for every verdict). A landmark that does not agree is\n"
-            "either a compromise of the fit or one the model cannot reproduce whatever its\n"
-            "parameters; the verdict column says which."
+            "bounds and the reason for every verdict). The verdict column names the\n"
+            "assumptions each verdict depends on (mass bound, PCSA of one side or both,\n"
+            'K convention, activation mode, reading of C); "cannot be reproduced" only\n'
+            "where a proof covers every parameter and every choice."
         )
     if run.calibrated:
         paper = f"{grid.PAPER_POINTS} × {grid.PAPER_POINTS}"
@@ -167,6 +193,46 @@ def figures_section(files: Sequence[str]) -> str:
     return "\n\n".join(f"### {name}\n\n![{name}]({name})" for name in images)
 
 
+ANATOMICAL_MASS = 24.0
+"""The lower bound of an adult upper body's mass [kg] (docs/reproduction.md, "What is fitted")."""
+
+
+def presets_section(run: Run) -> str:
+    """Both calibrated presets side by side: each landmark's value, agreement and documented verdict.
+
+    Parameters
+    ----------
+    run : Run
+        Its :attr:`Run.presets` (nothing without them).
+
+    Returns
+    -------
+    str
+        Markdown: the count of each preset, then one row per landmark; empty without presets.
+    """
+    if not run.presets:
+        return ""
+    counts = []
+    for name, mass, found in run.presets:
+        light = ", lighter than any adult upper body" if mass < ANATOMICAL_MASS else ""
+        counts.append(f"`{name}` (m = {mass:.3g} kg{light}): **{sum(m.agrees for m in found)} of {len(found)}**")
+    head = " | ".join(f"`{name}`" for name, _, _ in run.presets)
+    lines = [
+        "The calibrated presets, measured afresh on a "
+        f"{run.preset_points} × {run.preset_points} grid: " + "; ".join(counts) + ". The mass-free preset "
+        "says what the paper's numbers imply; docs/reproduction.md gives every landmark under each assumption.",
+        "",
+        f"| landmark | paper | {head} | verdict for `{verdicts.PRESET}`, and what it depends on |",
+        "| --- | --- | " + " | ".join("---" for _ in run.presets) + " | --- |",
+    ]
+    for i, mark in enumerate(landmarks.LANDMARKS):
+        cells = [f"{_number(found[i].value)} {'✓' if found[i].agrees else '✗'}" for _, _, found in run.presets]
+        verdict = verdicts.VERDICTS[mark.name].label
+        paper = f"{RELATION[mark.relation]} {_number(mark.paper)}"
+        lines.append(f"| `{mark.name}` | {paper} | " + " | ".join(cells) + f" | {verdict} |")
+    return "\n".join(lines)
+
+
 def render(measurements: Sequence[Measurement], run: Run) -> str:
     """The Markdown report of a reproduction run.
 
@@ -198,14 +264,18 @@ Parameters: {run.preset}. Wall time: {run.seconds:.1f} s.
 
 **{agree} of {len(measurements)} landmarks agree** with the paper.
 
+{presets_section(run)}
+
 ## Landmarks
 
 {landmark_table(measurements)}
 
-"About" is read as ±20 % of the paper's value; positions A–D are the corners of
-Figures 3 and 4 (A: E = Λ = 0; B: E = 8 cm, Λ = 0; C: E = Λ = 8 cm; D: E = 0,
-Λ = 8 cm). The paper's text also places C at its optimum (E ≈ 3 cm, Λ ≈ 4 cm),
-so the C-ratios are given for both readings.
+"About" is read as ±20 % of the paper's value; A, B and D are corners of
+Figures 3 and 4 (A: E = Λ = 0; B: E = 8 cm, Λ = 0; D: E = 0, Λ = 8 cm). C is
+read as Figure 3's caption and the Discussion place it, the physiological
+situation inside the grid (E ≈ 3 cm, Λ ≈ 4 cm: the `_text` rows); the
+C-ratios are also given with C at the corner (E = Λ = 8 cm) and where the ridge
+line Λ = 1.7 E leaves the grid (the `_ridge` rows).
 
 {_local_pcsa(measurements, run.specific_tension)}
 

@@ -21,7 +21,7 @@ from ..landscape import netcdf, sweep
 from ..model.config import DEFAULT_PRESET, apply_overrides, load_config
 from ..model.params import Model
 from ..model.source import header, source_of
-from . import figures, grid, landmarks, report, verdicts
+from . import assumptions, figures, grid, landmarks, report, verdicts
 
 __all__ = ["DEFAULT_PRESET", "reproduce", "reproduce_model"]
 
@@ -181,6 +181,8 @@ def reproduce_model(
         files=names,
         specific_tension=model.fibre.specific_tension,
         calibrated=calibrated,
+        presets=assumptions.calibrated_measurements(assumptions.TABLE_POINTS),
+        preset_points=assumptions.TABLE_POINTS,
     )
     with staged_directory(out_dir, names, replaces=_own_files()) as stage:
         netcdf.save(both, stage / LANDSCAPES)

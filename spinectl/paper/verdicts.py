@@ -28,12 +28,24 @@ REPRODUCED = "reproduced"
 """Within the landmark's tolerance (:mod:`spinectl.paper.landmarks`: 'about' is +-20 %)."""
 
 COMPROMISE = "not reproduced"
-"""Outside the tolerance with the calibrated parameters: the bounds or the other landmarks forbid it."""
+"""Outside the tolerance with the calibrated parameters and the choices they were calibrated with; the
+verdict names the choices whose alternative changes it (:attr:`Verdict.assumptions`)."""
 
 STRUCTURAL = "cannot be reproduced"
-"""Outside the tolerance for a reason no unstated parameter can change (docs/reproduction.md)."""
+"""Outside the tolerance for every parameter and every choice, shown by a proof (a bound in closed form)
+or a certificate (a certified optimum): :attr:`Verdict.proof` links it. A search is neither."""
 
 VERDICTS_ALLOWED = (REPRODUCED, COMPROMISE, STRUCTURAL)
+
+ASSUMPTION_WORDS = {
+    "mass": "the mass ≥ 24 kg",
+    "side": "the PCSA of both sides of a pair",
+    "convention": "the K convention `physical`",
+    "activation": "paired activation",
+    "reading_C": "this reading of C",
+}
+"""How a verdict names each assumption it depends on (:data:`spinectl.paper.assumptions.ALTERNATIVES`, whose
+table measures which ones decide each landmark)."""
 
 
 @dataclass(frozen=True)
@@ -50,12 +62,29 @@ class Verdict:
         One of :data:`VERDICTS_ALLOWED`.
     reason : str
         Why, in one sentence; docs/reproduction.md gives the derivation.
+    assumptions : tuple of str
+        The choices the verdict depends on: names of :data:`ASSUMPTION_WORDS` whose alternative
+        changes whether the landmark agrees (measured: docs/reproduction.md's assumption table).
+    proof : str
+        For :data:`STRUCTURAL`: the docs/reproduction.md section with the proof or certificate.
     """
 
     name: str
     value: float
     verdict: str
     reason: str
+    assumptions: tuple[str, ...] = ()
+    proof: str = ""
+
+    @property
+    def label(self) -> str:
+        """The verdict with what it depends on, e.g. "not reproduced with paired activation"."""
+        words = " and ".join(ASSUMPTION_WORDS[a] for a in self.assumptions)
+        if self.verdict == STRUCTURAL:
+            return f"{STRUCTURAL} (proof: docs/reproduction.md, {self.proof})"
+        if self.verdict == COMPROMISE:
+            return f"{COMPROMISE} with {words}" if words else f"{COMPROMISE} under any choice measured"
+        return f"{REPRODUCED} with {words}" if words else REPRODUCED
 
     def holds(self, value: float) -> bool:
         """Whether a fresh measurement ``value`` matches the documented one (to :data:`RELATIVE`).
@@ -76,48 +105,84 @@ class Verdict:
         return bool(np.isfinite(value) and abs(value - self.value) <= RELATIVE * abs(self.value))
 
 
-def _v(name: str, value: float, verdict: str, reason: str = "") -> Verdict:
-    return Verdict(name, value, verdict, reason)
+def _v(name: str, value: float, verdict: str, reason: str = "", *assumptions: str) -> Verdict:
+    return Verdict(name, value, verdict, reason, tuple(assumptions))
 
 
-_FALL = (
-    "paired activation co-contracts both sides at every E, so the PCSA falls at most about 2-fold "
-    "for a mass >= 24 kg (independent activation gives the threefold fall)"
-)
+_FALL = "paired activation co-contracts both sides at every E; a deeper fall needs more PCSA per kg at A"
 _SPLINE = "‖CT‖ = F ‖x‖, x the CoRs' offsets from the mass, fixed by the spline"
 
 VERDICTS: dict[str, Verdict] = {
     v.name: v
     for v in (
-        _v("min_pcsa_A", 36.3, REPRODUCED, "the mass sets the scale (every constraint is linear in PCSA and mass)"),
-        _v("min_pcsa_D_over_A", 0.817, REPRODUCED, "the binding CoR moves off the mass's vertical"),
-        _v("min_pcsa_B", 19.3, STRUCTURAL, _FALL),
-        _v("min_pcsa_ridge", 36.3, REPRODUCED, "the ridge passes through A, where the PCSA is greatest"),
-        _v("ridge_slope", 1.97, REPRODUCED, "where the binding CoR, L1L2, lies under the mass: Λ = E/φ = 1.97 E"),
-        _v("ridge_over_B", 1.88, STRUCTURAL, _FALL),
-        _v("ct_A", 0.0, REPRODUCED, "symmetric pairs cancel and the mass is above every CoR"),
-        _v("ct_valley_slope", 1.24, STRUCTURAL, f"{_SPLINE}: least at Λ = 1.28 E (independent activation: 1.06)"),
-        _v("ct_B", 107.0, REPRODUCED, "every CoR is 8 cm behind the mass"),
-        _v("ct_D_over_C", 1.31, STRUCTURAL, f"{_SPLINE}; ‖x(D)‖/‖x(C)‖ = 1.37 and F(D) < F(C)"),
-        _v("ct_B_over_C", 1.44, STRUCTURAL, f"{_SPLINE}; ‖x(B)‖/‖x(C)‖ = 1.98 and F(B) < F(C)"),
-        _v("ct_D_over_C_text", 3.44, STRUCTURAL, f"{_SPLINE}; ‖x(D)‖/‖x(C)‖ = 3.94 and F(D) < F(C)"),
-        _v("ct_B_over_C_text", 3.77, COMPROMISE, "‖x(B)‖/‖x(C)‖ = 5.71 needs F(B)/F(C) = 0.53: the threefold fall"),
-        _v("ct_D_over_C_ridge", 1.86, REPRODUCED, "‖x(D)‖/‖x(C)‖ = 2.14 on this reading of C"),
-        _v("ct_B_over_C_ridge", 2.04, STRUCTURAL, "‖x(B)‖/‖x(C)‖ = 3.11 needs F(B) = F(C), but the PCSA falls with E"),
-        _v("optimum_lordosis", 3.8, REPRODUCED, "the valley Λ = 1.24 E passes through E = 3 cm at Λ = 3.8 cm"),
-        _v("ct_optimum", 28.4, REPRODUCED, "‖x‖ = 3.1 cm there, times F = 905 N"),
-        _v("min_pcsa_ridge_K15", 26.3, REPRODUCED, "the ridge falls to 0.72 of 36.3 cm²"),
         _v(
-            "halving_K15",
-            0.724,
-            COMPROMISE,
-            "eq. 2 as printed removes K r/g: 0.28 at the binding L1L2, 0.45-0.49 below",
+            "min_pcsa_A",
+            36.3,
+            REPRODUCED,
+            "the mass sets the scale (every constraint is linear in PCSA and mass)",
+            "side",
+        ),
+        _v("min_pcsa_D_over_A", 0.817, REPRODUCED, "the binding CoR moves off the mass's vertical"),
+        _v("min_pcsa_B", 19.3, COMPROMISE, _FALL, "side", "activation"),
+        _v(
+            "min_pcsa_ridge",
+            36.3,
+            REPRODUCED,
+            "only because A's value agrees: the ridge is a plateau at A's 36.3",
+            "side",
         ),
         _v(
-            "halving_K15_other",
+            "ridge_rise",
+            0.0,
+            COMPROMISE,
+            "along Λ = E/φ the binding CoR sits where it sits at A, so one binding CoR gives A's value exactly",
+        ),
+        _v("ridge_slope", 1.97, REPRODUCED, "where the binding CoR, L1L2, lies under the mass: Λ = E/φ = 1.97 E"),
+        _v("ridge_over_B", 1.88, COMPROMISE, _FALL + " (the mass-free preset: 2.28; a search: 2.85 at 12 kg)"),
+        _v("ct_A", 0.0, REPRODUCED, "symmetric pairs cancel and the mass is above every CoR"),
+        _v("ct_valley_slope", 1.24, COMPROMISE, f"{_SPLINE}: least ‖x‖ at Λ = 1.28 E; F moves it", "mass"),
+        _v("ct_B", 107.0, REPRODUCED, "every CoR is 8 cm behind the mass"),
+        _v("ct_D_over_C", 1.31, COMPROMISE, f"{_SPLINE}; ‖x(D)‖/‖x(C)‖ = 1.37 and F(D) < F(C)", "reading_C"),
+        _v("ct_B_over_C", 1.44, COMPROMISE, f"{_SPLINE}; ‖x(B)‖/‖x(C)‖ = 1.98 and F(B) < F(C)"),
+        _v(
+            "ct_D_over_C_text",
+            3.44,
+            COMPROMISE,
+            f"{_SPLINE}; ‖x(D)‖/‖x(C)‖ = 3.94 and F(D) < F(C)",
+            "activation",
+            "reading_C",
+        ),
+        _v(
+            "ct_B_over_C_text",
+            3.77,
+            COMPROMISE,
+            "‖x(B)‖/‖x(C)‖ = 5.71 needs F(B)/F(C) = 0.53: the threefold fall (the mass-free preset: 2.9)",
+            "mass",
+        ),
+        _v("ct_D_over_C_ridge", 1.86, REPRODUCED, "‖x(D)‖/‖x(C)‖ = 2.14 on this reading of C", "reading_C"),
+        _v("ct_B_over_C_ridge", 2.04, COMPROMISE, "‖x(B)‖/‖x(C)‖ = 3.11 needs F(B) = F(C), but the PCSA falls with E"),
+        _v(
+            "optimum_lordosis",
+            3.8,
+            REPRODUCED,
+            "the valley Λ = 1.24 E passes through E = 3 cm at Λ = 3.8 cm",
+            "activation",
+        ),
+        _v("ct_optimum", 28.4, REPRODUCED, "‖x‖ = 3.1 cm there, times F = 905 N", "activation"),
+        _v("min_pcsa_ridge_K15", 23.6, REPRODUCED, "the ridge falls to 0.65 of 36.3 cm²", "side"),
+        _v(
+            "halving_K15",
             0.650,
             COMPROMISE,
             "a physical spring removes K/(m g r): halving at L1L2 needs 17 kg",
+            "mass",
+        ),
+        _v(
+            "halving_K15_other",
+            0.724,
+            COMPROMISE,
+            "eq. 2 as printed removes K r/g: 0.28 at the binding L1L2, 0.45-0.49 below",
+            "mass",
         ),
         _v("ridge_slope_K15", 1.97, REPRODUCED, "L1L2 still binds along the ridge"),
     )
@@ -168,7 +233,7 @@ def documented_table() -> str:
         paper, value = format_number(mark.paper), format_number(v.value)
         lines.append(
             f"| `{mark.name}` | {mark.how} | {RELATION[mark.relation]} {paper} | {value} "
-            f"| {mark.unit} | {v.verdict} | {v.reason} |"
+            f"| {mark.unit} | {v.label} | {v.reason} |"
         )
     return "\n".join(lines) + "\n"
 
@@ -196,7 +261,7 @@ def verdict_cell(measurement: Measurement) -> str:
     v = VERDICTS.get(measurement.landmark.name)
     if v is None:
         return "n/a"
-    text = f"{v.verdict}: {v.reason}" if v.reason else v.verdict
+    text = f"{v.label}: {v.reason}" if v.reason else v.label
     if v.holds(measurement.value) and measurement.agrees == (v.verdict == REPRODUCED):
         return text
     if measurement.agrees:

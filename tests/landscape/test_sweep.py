@@ -10,9 +10,10 @@ from spinectl import optimise
 from spinectl.cli import main
 from spinectl.errors import OutputError, ParameterError
 from spinectl.landscape import netcdf, schema, sweep
-from spinectl.model import chain, source
+from spinectl.model import chain, config, source
 from spinectl.model.mechanics import segment_coefficients
 from spinectl.model.params import Model
+from spinectl.model.stability import segment_stability
 from spinectl.optimise.coupled import joint_optimum, least_local_stiffness
 
 E_AXIS = np.array([0.0, 0.04, 0.08])
@@ -250,3 +251,15 @@ def test_coupled_margin_is_that_of_the_chain_at_the_chosen_activation(landscape,
     assert float(here["coupled_margin_Nm_per_rad"]) == pytest.approx(expected, rel=1e-6)
     assert landscape["coupled_margin_Nm_per_rad"].dims == ("E", "Lambda")
     assert float(landscape["coupled_margin_Nm_per_rad"].max()) < 0
+
+
+def test_the_sweep_reports_the_slowest_time_constant_of_every_optimum():
+    """slowest_time_constant_s at a grid point is that of segment_stability at the point's chosen PCSA."""
+    preset = config.load_preset("wagner2012")
+    axis = np.array([0.0, 0.03])
+    land = sweep.sweep(preset, axis, np.array([0.0, 0.04]), progress=False)
+    here = land.sel(E=0.03, Lambda=0.04)
+    pcsa = here["pcsa_cm2"].values * 1e-4
+    expected = segment_stability(preset, 0.03, 0.04, pcsa).slowest_time_constant
+    assert float(here["slowest_time_constant_s"]) == pytest.approx(expected, rel=1e-9)
+    assert land["slowest_time_constant_s"].dims == ("E", "Lambda")

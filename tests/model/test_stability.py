@@ -5,12 +5,20 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from spinectl import optimise
 from spinectl.errors import ParameterError
 from spinectl.model import mechanics, muscle, source
 from spinectl.model.checks import MAX_PLAUSIBLE_PCSA
 from spinectl.model.config import set_parameter
 from spinectl.model.params import Errata, Passive
-from spinectl.model.stability import eigenvalues, hurwitz_stable, jacobian, segment_stability, self_stable
+from spinectl.model.stability import (
+    eigenvalues,
+    hurwitz_stable,
+    jacobian,
+    segment_stability,
+    self_stable,
+    slowest_time_constant,
+)
 
 ZERO = np.zeros(3)
 
@@ -212,3 +220,27 @@ def test_a_pcsa_in_cm2_given_as_m2_is_refused(model):
     with pytest.raises(ParameterError, match=r"if you meant 10 cm\^2, pass 0.001"):
         segment_stability(model, 0.03, 0.04, [10, 10, 10])
     segment_stability(model, 0.03, 0.04, [MAX_PLAUSIBLE_PCSA] * 3)  # the bound itself is allowed
+
+
+def test_slowest_time_constant_against_the_roots_of_the_characteristic_polynomial():
+    """-1 / max Re(lambda) over the segments, lambda the roots of theta s^2 - D s - S (numpy.roots, a second
+    method); a segment that only just beats gravity (S = -0.1 N m/rad, D = -15 N m s/rad) recovers in about
+    |D|/|S| = 150 s; inf for a segment that is not stable, NaN for NaN input."""
+    s, d, theta = np.array([-0.1, -40.0, -5.0]), np.array([-15.0, -20.0, -2.0]), np.array([2.0, 1.5, 1.0])
+    roots = [np.roots([t, -dk, -sk]) for sk, dk, t in zip(s, d, theta, strict=True)]
+    expected = -1.0 / max(r.real.max() for r in roots)
+    assert slowest_time_constant(s, d, theta) == pytest.approx(expected, rel=1e-12)
+    assert expected == pytest.approx(15.0 / 0.1, rel=0.01)
+    assert slowest_time_constant([-1.0, 0.5], [-1.0, -1.0], [1.0, 1.0]) == np.inf
+    assert np.isnan(slowest_time_constant([np.nan, -1.0], [-1.0, -1.0], [1.0, 1.0]))
+    rows = slowest_time_constant(np.stack([s, s * 2]), np.stack([d, d]), np.stack([theta, theta]))
+    assert rows.shape == (2,) and rows[1] < rows[0]  # stiffer: faster
+
+
+def test_the_result_reports_its_slowest_time_constant(model):
+    """StabilityResult: the property, the JSON key and the table line agree with the function."""
+    point = optimise.solve_point(model, 0.03, 0.04)
+    result = segment_stability(model, 0.03, 0.04, point.pcsa)
+    tau = float(slowest_time_constant(result.stiffness, result.damping, result.inertia))
+    assert result.slowest_time_constant == tau and result.to_dict(model)["slowest_time_constant_s"] == tau
+    assert f"slowest time constant {tau:.4g} s" in result.table(model)

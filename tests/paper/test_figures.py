@@ -123,15 +123,16 @@ def test_any_grid_keeps_every_marker_inside_and_the_axes_unsqueezed(other_grids,
 
 
 def test_the_paper_grid_marks_a_to_d_at_its_corners_the_ridge_and_the_optimum(results):
-    """On 0-8 cm: A-D at the corners (paper, Results), Lambda = 1.7 E from (0, 0) to (8/1.7, 8) cm, the star
-    at (3, 4) cm (paper, Discussion)."""
+    """On 0-8 cm: A, B and D at the corners (paper, Results), C at Figure 3's interior point (3, 4) cm with the
+    star (paper, Discussion), the corner (8, 8) cm by its coordinates; Lambda = 1.7 E from (0, 0) to (8/1.7, 8) cm."""
     fig = figures.min_pcsa_figure(netcdf.load(results).sel(K=0.0))
     assert _inside_axes(fig)
     lines = {line.get_gid(): line for line in fig.axes[0].lines if line.get_gid()}
-    assert {g for g in lines if g.startswith("position")} == {f"position {p}" for p in "ABCD"}
+    assert {g for g in lines if g.startswith("position")} == {f"position {p}" for p in ("A", "B", "C", "D", "8, 8 cm")}
     np.testing.assert_allclose(lines["ridge"].get_xdata(), [0.0, 8 / 1.7])
     np.testing.assert_allclose(lines["ridge"].get_ydata(), [0.0, 8.0])
     np.testing.assert_allclose(np.ravel(lines["optimum"].get_xydata()), [3.0, 4.0])
+    np.testing.assert_allclose(np.ravel(lines["position C"].get_xydata()), [3.0, 4.0])
     assert fig.axes[0].texts  # the contour lines' labels and A-D
 
 
@@ -189,7 +190,8 @@ def test_ratio_map_and_insets(results, tmp_path, other_grids):
     assert _colour_bar(ratio).get_ylim() == pytest.approx((0.0, 1.0)) and "halving" in ratio.axes[0].get_title()
     inset = figures.min_pcsa_figure(dataset.sel(K=0.0), insets=True)
     titles = sorted(ax.get_title() for ax in inset.axes[1:])
-    assert titles == ["A: E = 0, Λ = 0 cm", "B: E = 8, Λ = 0 cm", "C: E = 8, Λ = 8 cm", "D: E = 0, Λ = 8 cm"]
+    # C is Figure 3's interior point (3, 4) cm, so the corner (8, 8) cm is drawn under its coordinates
+    assert titles == ["A: E = 0, Λ = 0 cm", "B: E = 8, Λ = 0 cm", "D: E = 0, Λ = 8 cm", "E = 8, Λ = 8 cm"]
     with pytest.raises(ParameterError, match="K = 0"):
         figures.ratio_figure(other_grids["partial"])
     with pytest.raises(ParameterError, match="--ratio"):

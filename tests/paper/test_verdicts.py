@@ -20,9 +20,11 @@ def preset():
 
 
 @pytest.fixture(scope="module")
-def measured(preset):
-    """Every landmark of the preset on the paper's 81 x 81 grid (three sweeps, a few seconds)."""
-    return {m.landmark.name: m for m in calibration.measure_model(preset, progress=False)}
+def measured(wagner2012_landscapes):
+    """Every landmark of the preset on the paper's 81 x 81 grid (tests/paper/conftest.py)."""
+    both, other = wagner2012_landscapes
+    found = landmarks.measure(landmarks.Landmarks(both.sel(K=0.0), both.sel(K=grid.PAPER_STIFFNESS), other))
+    return {m.landmark.name: m for m in found}
 
 
 def test_every_landmark_has_a_documented_verdict():
@@ -130,3 +132,36 @@ def test_the_paper_convention_removes_k_r_over_g_whatever_the_mass(preset, mass)
     np.testing.assert_allclose(coeffs.passive_stiffness / coeffs.gravity_stiffness, 15.0 * r / 9.81, rtol=1e-12)
     ratio = optimise.solve_point(paper, 0.0, 0.0).min_pcsa / optimise.solve_point(model, 0.0, 0.0).min_pcsa
     assert ratio == pytest.approx(1.0 - 15.0 * r[0] / 9.81, abs=0.005)  # L1L2 binds at A: 0.72
+
+
+def test_the_ridge_slope_is_the_same_on_81_and_101_points(preset):
+    """docs/reproduction.md, "The ridge": the crest of wagner2012's ridge is where L1L2 lies under the mass,
+    Lambda = E / phi(L1L2) (closed form, from the spline alone). The sub-grid crest fit finds that line
+    on 81 and on 101 points alike (the per-column arg-max gave 1.97 and 1.82), and the ridge does not
+    rise above A: along that line L1L2 sits where it sits at A, with the same constraint."""
+    closed_form = 1.0 / geometry.lordosis_shape(preset.geometry)[0]
+    for points in (81, 101):
+        k0 = calibration.coarse_landscape(preset, grid.paper_axis(points), counter_torque=False)
+        fit = landmarks.crest_fit(k0, "min_pcsa_cm2", "max")
+        assert fit.slope == pytest.approx(closed_form, abs=max(3 * fit.uncertainty, 1e-6)), points
+        top, at_a = float(k0["min_pcsa_cm2"].max()), landmarks.at(k0, "min_pcsa_cm2", grid.POSITIONS["A"])
+        assert top - at_a <= 1e-9 * at_a
+
+
+def test_the_preset_convention_has_the_least_loss_at_its_vector(preset, wagner2012_landscapes):
+    """The convention is picked at the final vector: the preset's own K convention has the least loss at its
+    parameters (both conventions' K = 15 landscapes, one set of sweeps), and the header states both losses."""
+    both, other = wagner2012_landscapes
+    k0, own = both.sel(K=0.0), both.sel(K=grid.PAPER_STIFFNESS)
+    targets = calibration.paper_targets()
+    losses = {
+        preset.passive.convention: calibration.loss(landmarks.measure(landmarks.Landmarks(k0, own, other)), targets),
+        grid.other_convention(preset): calibration.loss(
+            landmarks.measure(landmarks.Landmarks(k0, other, own)), targets
+        ),
+    }
+    assert losses[preset.passive.convention] == min(losses.values())
+    text = resources.files("spinectl.presets").joinpath(f"{verdicts.PRESET}.toml").read_text(encoding="utf-8")
+    header = text.split("\n[body]")[0]
+    for convention, value in losses.items():
+        assert f"{convention} {value:.4g}" in header, convention

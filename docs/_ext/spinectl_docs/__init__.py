@@ -12,8 +12,9 @@ a text changed, so that incremental builds stay incremental):
 - ``notebooks/*.ipynb`` and ``_generated/notebooks-toctree.md``: copies of the
   notebooks of the repository's ``notebooks/`` and their toctree, included by
   ``notebooks.md`` (myst-nb executes them);
-- ``_generated/calibration-parameters.md`` and ``_generated/landmark-verdicts.md``:
-  the tables of ``reproduction.md`` (free parameters, verdict of every landmark).
+- ``_generated/calibration-parameters.md``, ``_generated/landmark-verdicts.md`` and
+  ``_generated/landmark-assumptions.md``: the tables of ``reproduction.md`` (free parameters,
+  verdict of every landmark, every landmark under each assumption, measured at the build).
 
 ``_generated/`` is excluded from the sources (its files are included by
 ``parameters.md``, ``index.md``, ``notebooks.md`` and ``reproduction.md``);
@@ -56,6 +57,7 @@ def generate(app) -> None:
     write_if_changed(out / "notebooks-toctree.md", notebooks.toctree_markdown(pages))
     write_if_changed(out / "calibration-parameters.md", reproduction.parameter_table())
     write_if_changed(out / "landmark-verdicts.md", reproduction.landmark_table())
+    write_if_changed(out / "landmark-assumptions.md", reproduction.assumption_table())
 
 
 def prune_api_pages(app) -> None:

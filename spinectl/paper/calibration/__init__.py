@@ -27,6 +27,7 @@ from .fit import (
     CalibrationResult,
     Fit,
     calibrate,
+    convention_losses,
 )
 from .landscapes import (
     FIT_POINTS,
@@ -35,7 +36,16 @@ from .landscapes import (
     measure_model,
 )
 from .output import history_csv, preset_toml, summary
-from .parameters import FREE_PARAMETERS, FreeParameter, bounds, from_model, parameter_set, to_model
+from .parameters import (
+    FREE_PARAMETERS,
+    MASS_FREE,
+    FreeParameter,
+    bounds,
+    from_model,
+    parameter_set,
+    to_model,
+    with_bounds,
+)
 from .sensitivity import STEP_LANDMARKS, Sensitivity, sensitivity
 from .targets import (
     C_READINGS,
@@ -57,6 +67,7 @@ __all__ = [
     "FIT_POINTS",
     "FREE_PARAMETERS",
     "GENERATIONS",
+    "MASS_FREE",
     "MISSING_PENALTY",
     "POPSIZE",
     "REFINE_EVALUATIONS",
@@ -75,6 +86,7 @@ __all__ = [
     "calibrate",
     "coarse_landmarks",
     "coarse_landscape",
+    "convention_losses",
     "from_model",
     "history_csv",
     "loss",
@@ -88,4 +100,5 @@ __all__ = [
     "summary",
     "synthetic_targets",
     "to_model",
+    "with_bounds",
 ]

@@ -21,11 +21,7 @@ from ...errors import ModelError, ParameterError
 from ...model.params import Model
 from .. import grid, landmarks
 from ..landmarks import Landmarks
-from .landscapes import (
-    FIT_POINTS,
-    coarse_landscape,
-    measure_model,
-)
+from .landscapes import FIT_POINTS, coarse_landscape
 from .parameters import FREE_PARAMETERS, FreeParameter, bounds, from_model, to_model
 from .targets import MISSING_PENALTY, Residual, Target, loss, paper_targets, residuals
 
@@ -70,6 +66,9 @@ class Fit:
         Its loss on the verification grid.
     residuals : tuple of Residual
         Every landmark on the verification grid.
+    origin : str
+        The convention whose search found ``vector`` (the convention is picked at the final
+        vector, so it may differ from ``convention``).
     """
 
     convention: str
@@ -77,6 +76,7 @@ class Fit:
     fit_loss: float
     loss: float
     residuals: tuple[Residual, ...]
+    origin: str = ""
 
 
 @dataclass(frozen=True)
@@ -243,6 +243,58 @@ def _refine(objective: _Objective, parameters, convention: str, evaluations: int
     )
 
 
+def convention_losses(model: Model, targets: Sequence[Target], points: int = grid.PAPER_POINTS) -> dict:
+    """The loss of ``model``'s parameter vector with each passive-stiffness convention, from one set of sweeps.
+
+    :func:`spinectl.paper.grid.paper_landscapes` solves K = 0 and K = 15 N m/rad with both conventions
+    at once, so scoring the vector with each convention costs no more than scoring it once.
+
+    Parameters
+    ----------
+    model : Model
+        The vector to score (its passive stiffness is replaced by 0 and 15 N m/rad).
+    targets : sequence of Target
+    points : int
+        Grid points per axis.
+
+    Returns
+    -------
+    dict
+        Convention (each of :data:`spinectl.paper.grid.CONVENTIONS`) to (loss [1], tuple of Residual).
+    """
+    both, other = grid.paper_landscapes(model, points, progress=False)
+    k15 = {model.passive.convention: both.sel(K=grid.PAPER_STIFFNESS), grid.other_convention(model): other}
+    out = {}
+    for convention in grid.CONVENTIONS:
+        alternative = next(k15[c] for c in grid.CONVENTIONS if c != convention)
+        found = residuals(landmarks.measure(Landmarks(both.sel(K=0.0), k15[convention], alternative)), targets)
+        out[convention] = (float(sum(r.penalty for r in found)), found)
+    return out
+
+
+def _verify(objective: _Objective, conventions: Sequence[str], verify_points: int, say) -> dict[str, Fit]:
+    """Each convention's best vector measured on the verification grid, and its loss there with every convention.
+
+    The convention is picked at the final vector (:func:`convention_losses`): each convention keeps
+    the vector that scores best with it, whichever convention's search found it (:attr:`Fit.origin`).
+    """
+    fits: dict[str, Fit] = {}
+    for origin in conventions:
+        vector, _ = objective.best(origin)
+        model = grid.with_stiffness(to_model(objective.base, vector, objective.parameters), 0.0, origin)
+        scored = convention_losses(model, objective.targets, verify_points)
+        for convention in conventions:
+            verified, found = scored[convention]
+            if convention not in fits or verified < fits[convention].loss:
+                fit_loss = float(objective.evaluate(vector, (convention,))[0])
+                fits[convention] = Fit(convention, vector, fit_loss, verified, found, origin)
+        say(
+            f"best {origin} vector on the {verify_points}-point grid: "
+            + ", ".join(f"{c} {scored[c][0]:.4g}" for c in conventions)
+        )
+    return fits
+
+
 def _check_settings(conventions: Sequence[str], **settings: int) -> None:
     """Raise :class:`ParameterError` for unknown or repeated conventions or a setting out of range."""
     unknown = [c for c in conventions if c not in grid.CONVENTIONS]
@@ -278,8 +330,9 @@ def calibrate(
     conventions; each initial population contains the base model's own vector,
     so the fit is never worse than the start. Local: Nelder-Mead [2]_ from the best
     vector of each convention (``refine`` evaluations each). Then the best
-    vector of each convention is measured on the verification grid, and the
-    least loss there wins.
+    vector of each convention is measured on the verification grid with every
+    convention, and the least loss there, over vectors and conventions, wins:
+    the convention is picked at the final vector.
 
     Parameters
     ----------
@@ -331,16 +384,7 @@ def calibrate(
     reports = _evolve(objective, parameters, **budget, say=say, started=started)
     if refine > 0:
         reports += [_refine(objective, parameters, c, refine, say, started) for c in conventions]
-    fits = {}
-    for convention in conventions:
-        vector, fit_loss = objective.best(convention)
-        model = grid.with_stiffness(to_model(base, vector, parameters), 0.0, convention)
-        found = residuals(measure_model(model, verify_points, progress=False), targets)
-        fits[convention] = Fit(convention, vector, fit_loss, float(sum(r.penalty for r in found)), found)
-        say(
-            f"{convention}: loss {fit_loss:.4g} on the {points}-point grid, "
-            f"{fits[convention].loss:.4g} on the {verify_points}-point grid"
-        )
+    fits = _verify(objective, conventions, verify_points, say)
     best = min(fits.values(), key=lambda f: f.loss)
     settings = {
         **budget,

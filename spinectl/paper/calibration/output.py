@@ -33,9 +33,9 @@ def summary(result: CalibrationResult) -> str:
     lines += ["", f"{'parameter':18} {'value':>9} {'lower':>8} {'upper':>8}  unit"]
     for p, v in zip(result.parameters, best.vector, strict=True):
         lines.append(f"{p.name:18} {v:9.4g} {p.lower:8.4g} {p.upper:8.4g}  {p.unit}")
-    lines += ["", "convention   loss (fit grid)   loss (verification grid)"]
+    lines += ["", "convention   loss (fit grid)   loss (verification grid)   vector found with"]
     for fit in result.fits.values():
-        lines.append(f"{fit.convention:12} {fit.fit_loss:15.4g}   {fit.loss:.4g}")
+        lines.append(f"{fit.convention:12} {fit.fit_loss:15.4g}   {fit.loss:24.4g}   {fit.origin}")
     lines += ["", f"{'landmark':22} {'paper':>9} {'spinectl':>10} {'log-ratio':>10} {'penalty':>8}  agrees"]
     for r in best.residuals:
         paper = f"{RELATION[r.relation]} {r.paper:.3g}"
@@ -72,8 +72,8 @@ def preset_toml(result: CalibrationResult, command: str, date: str | None = None
         f"# Loss: {best.loss:.4g} on the {result.settings['verify_points']}-point grid "
         f"({best.fit_loss:.4g} on the {result.settings['points']}-point fitting grid); "
         f"{sum(r.agrees for r in best.residuals)} of {len(best.residuals)} landmarks agree.",
-        f"# Passive-stiffness convention: {best.convention} (losses: "
-        + ", ".join(f"{f.convention} {f.loss:.4g}" for f in result.fits.values())
+        f"# Passive-stiffness convention: {best.convention}, picked at the final vector (losses: "
+        + ", ".join(f"{f.convention} {f.loss:.4g} with the vector found with {f.origin}" for f in result.fits.values())
         + ").",
         "# Free parameters (value; bounds):",
     ]

@@ -8,7 +8,7 @@ set several paths, e.g. the common height of all upper attachments.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -174,6 +174,48 @@ def parameter_set(names: Sequence[str] | None = None) -> tuple[FreeParameter, ..
     if unknown or not names or len(set(names)) != len(names):
         raise ParameterError("parameters", f"must be distinct names among {', '.join(known)} (got {list(names)})")
     return tuple(known[n] for n in names)
+
+
+MASS_FREE = (10.0, 55.0)
+"""Bounds of the mass [kg] for the preset of what the paper's numbers imply (docs/reproduction.md):
+wide enough to let the landmarks choose, below any adult upper body at the low end."""
+
+
+def with_bounds(
+    parameters: Sequence[FreeParameter], name: str, lower: float, upper: float
+) -> tuple[FreeParameter, ...]:
+    """``parameters`` with the bounds of the one called ``name`` replaced.
+
+    Parameters
+    ----------
+    parameters : sequence of FreeParameter
+    name : str
+        The parameter whose bounds change, e.g. ``"mass"``.
+    lower, upper : float
+        The new bounds, in its unit.
+
+    Returns
+    -------
+    tuple of FreeParameter
+        The same parameters in the same order; the one changed says in its source that its
+        bounds were set for this run.
+
+    Raises
+    ------
+    ParameterError
+        ``name`` not among ``parameters`` (field ``bounds``), or not ``lower < upper`` (both finite).
+    """
+    names = [p.name for p in parameters]
+    if name not in names:
+        raise ParameterError("bounds", f"must name one of {', '.join(names)} (got {name!r})")
+    if not (np.isfinite(lower) and np.isfinite(upper) and lower < upper):
+        raise ParameterError("bounds", f"{name} needs finite LOW < HIGH (got {lower:g}, {upper:g})")
+    return tuple(
+        replace(p, lower=float(lower), upper=float(upper), source=f"Set for this run: [{lower:g}, {upper:g}] {p.unit}.")
+        if p.name == name
+        else p
+        for p in parameters
+    )
 
 
 def to_model(base: Model, vector, parameters: Sequence[FreeParameter] = FREE_PARAMETERS) -> Model:

@@ -31,12 +31,15 @@ C_READINGS = 3
 
 WEIGHTS = {
     "ct_A": 0.0,
+    "ridge_rise": 0.0,
     **{f"ct_{r}_over_C{s}": 1.0 / C_READINGS for r in "DB" for s in ("", "_text", "_ridge")},
     "halving_K15_other": 0.0,
 }
 """Weights of the landmarks in the loss; 1 for any landmark not listed.
 
 ``ct_A`` is zero by symmetry under paired activation, whatever the parameters;
+``ridge_rise`` is zero wherever one CoR binds along the ridge (docs/reproduction.md), which
+has no log-ratio, so it would add a constant, not a direction;
 the three readings of position C share one weight; ``halving_K15_other`` belongs
 to the convention not being fitted (it is reported, not fitted).
 """
