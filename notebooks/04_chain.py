@@ -33,7 +33,6 @@ from IPython.display import display
 
 import spinectl
 from spinectl.landscape import sweep
-from spinectl.model import config
 from spinectl.optimise.coupled import coupled_stability_at, joint_optimum
 from spinectl.paper import grid, landmarks
 from spinectl.reflex.chain_margins import coupled_margins
