@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from ..landscape import netcdf
-from ..paper import figures
 from ._common import add_dpi_option, finite_float
 
 
@@ -23,6 +21,14 @@ def register(sub) -> None:
         "grid's other corners by their coordinates, the ridge Lambda = 1.7 E and the paper's optimum; "
         "as PNG, PDF or SVG files.",
     )
+    parser.defer(_options)
+    parser.set_defaults(func=run)
+
+
+def _options(parser) -> None:
+    """The options, their choices and defaults from :mod:`spinectl.paper.figures` (matplotlib)."""
+    from ..paper import figures
+
     parser.add_argument("results", metavar="RESULTS.nc", help="a file written by 'spinectl sweep' or 'reproduce'")
     parser.add_argument("--out", required=True, metavar="DIR", help="folder for the figure files")
     parser.add_argument("--format", choices=figures.FORMATS, default="png", help="file format (default png)")
@@ -40,7 +46,6 @@ def register(sub) -> None:
     extra.add_argument(
         "--insets", action="store_true", help="the model drawn at the grid's corners around Figures 3 and S1"
     )
-    parser.set_defaults(func=run)
 
 
 def run(args) -> int:
@@ -56,6 +61,9 @@ def run(args) -> int:
     int
         Exit code 0.
     """
+    from ..landscape import netcdf
+    from ..paper import figures
+
     options = figures.FigureOptions(
         format=args.format,
         dpi=args.dpi,
