@@ -22,10 +22,12 @@ RTOL = 1e-9
 ||CT|| (at least 1 N m). Both paths report exact KKT points (one linear solve each), so they differ by
 rounding where the optimum is unique (min PCSA, CT, and x after the least-norm tie-break)."""
 
-OBJECTIVE_RTOL = 1e-8
-"""Agreement of the optimal values with the second method: both ends verify feasibility to about 1e-9 of
-each row's scale (the KKT check here, Clarabel's tol_feas there), which moves a least norm at a vertex by
-about that much relative, so the two differ by up to a few 1e-9 (1.5e-9 seen)."""
+OBJECTIVE_RTOL = 1e-7
+"""Agreement of the optimal values with the second method. Both ends are optimal to tolerances of about
+1e-9 of each condition's scale (this solver's KKT check, like the polishing's; Clarabel's gaps and
+feasibility there), and where a multiplier is large (10^4) that bounds the objective only to about 1e-8
+relative: 2e-8 seen in ||CT||^2 for one drawn geometry (K = 16 N m/rad), where the per-point reference's
+value equals this path's. The paper's grid is compared with the reference itself, to 1e-9."""
 
 COARSE = np.linspace(0.0, 0.08, 9)
 """The paper's grid (0 to 8 cm) at 1 cm: positions A-D among its corners."""
