@@ -298,8 +298,9 @@ def verified_qp(hessian, linear, lhs, rhs, equalities, eq_rhs, guesses, x_start,
         trial = attempt(working, todo)
         working, point, going = _step(problem, trial, todo, point)
         todo, working, point = todo[going], working[going], point[going]
-    patterns, counts = np.unique(active[done], axis=0, return_counts=True)
-    for pattern in patterns[np.argsort(-counts)][:PATTERNS]:
+    keys = active[done] @ (1 << np.arange(n_rows, dtype=np.int64))
+    _, first, counts = np.unique(keys, return_index=True, return_counts=True)
+    for pattern in active[done][first[np.argsort(-counts)][:PATTERNS]]:
         todo = np.flatnonzero(~done)
         if todo.size:
             attempt(np.broadcast_to(pattern, (todo.size, n_rows)), todo)
@@ -379,7 +380,7 @@ def independent_rows(rows, chosen):
     basis = np.zeros((n_points, n, n))
     count = np.zeros(n_points, int)
     kept = np.zeros_like(chosen)
-    for j in range(n_rows):
+    for j in np.flatnonzero(chosen.any(axis=0)):  # most rows are active nowhere
         row = rows[:, j]
         residual = row
         for _ in range(2):  # twice is enough (Giraud et al. 2005, doi:10.1007/s00211-005-0615-4)
@@ -402,8 +403,9 @@ def _kkt_solve(hessian, linear, lhs, rhs, eq_rows, keep, eq_rhs, active):
     chosen = np.concatenate([active, keep], axis=1)
     x = np.full((n_points, n), np.nan)
     multipliers = np.zeros((n_points, rows.shape[1]))
-    patterns, group = np.unique(chosen, axis=0, return_inverse=True)
-    for k, pattern in enumerate(patterns):
+    keys = chosen @ (1 << np.arange(chosen.shape[1], dtype=np.int64))  # one integer per set of rows
+    _, first, group = np.unique(keys, return_index=True, return_inverse=True)
+    for k, pattern in enumerate(chosen[first]):
         members = np.flatnonzero(group.ravel() == k)
         picked = np.flatnonzero(pattern)
         a = rows[members][:, picked]
