@@ -32,7 +32,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from spinectl.landscape import sweep  # noqa: E402
-from spinectl.model import config, geometry, mechanics, muscle  # noqa: E402
+from spinectl.model import config, geometry, mechanics  # noqa: E402
 from spinectl.model.params import Passive  # noqa: E402
 
 
@@ -73,22 +73,6 @@ def compare(model, points: int, repeats: int) -> None:
         print(f"largest difference, {name:18}: {value:.2e}")
 
 
-def per_fibre_coefficients(model, eccentricity, lordosis):
-    """The per-fibre sums that :func:`spinectl.model.mechanics.segment_coefficients` replaced (torque, stiffness,
-    damping per unit PCSA), as the module computed them before its monomial form."""
-    cor = geometry.cor_positions(eccentricity, lordosis, model.geometry)[..., None, :]
-    upper, lower, share = geometry.all_fibres(model)
-    l0 = np.linalg.norm(lower - upper, axis=-1)
-    l_opt = model.fibre.optimal_length_ratio * l0
-    f_l = muscle.force_length(l0, l_opt, model.fibre)
-    f_l_slope = muscle.force_length_slope(l0, l_opt, model.fibre)
-    f_h_slope = muscle.force_velocity_slope(0.0 * l0, muscle.hill_constants(l_opt, model.fibre, model.errata))
-    _, h = mechanics.fibre_length_and_lever_arm(upper, lower, cor)
-    h_slope = mechanics.lever_arm_slope(upper, lower, cor)
-    to_muscle = model.fibre.specific_tension * share
-    return (h * f_l) @ to_muscle, (h_slope * f_l - h**2 * f_l_slope) @ to_muscle, (h**2 * f_l * f_h_slope) @ to_muscle
-
-
 def fused_pass_floor(model, eccentricity, lordosis) -> float:
     """Seconds of one fused numpy pass over the grid's fibre-CoR terms: the lever arm h = a + b cx + d cy of
     every fibre about every CoR (two multiply-adds per term) into a preallocated array; the least work
@@ -114,7 +98,7 @@ def coefficients(model, points: int, repeats: int) -> None:
     terms = e.size * len(model.geometry.cor_heights) * len(geometry.all_fibres(model)[0])
     print(f"== coefficients of the {points} x {points} grid ({terms:,} fibre-CoR terms)")
     kernel, _ = timed(lambda: mechanics.segment_coefficients(model, e, lam), repeats)
-    before, _ = timed(lambda: per_fibre_coefficients(model, e, lam), repeats)
+    before, _ = timed(lambda: mechanics.per_fibre_sums(model, e, lam), repeats)
     floor = min(fused_pass_floor(model, e, lam) for _ in range(repeats))
     print(f"segment_coefficients (monomial form): {1e3 * kernel:8.1f} ms")
     print(f"per-fibre sums (before):              {1e3 * before:8.1f} ms")

@@ -400,6 +400,38 @@ def _monomial_coefficients(model: Model):
     return torque, stiffness, damping
 
 
+def per_fibre_sums(model: Model, eccentricity, lordosis):
+    """The muscle terms of :func:`segment_coefficients` summed fibre by fibre, as the formulas read.
+
+    torque h f_l, stiffness h' f_l - h^2 f_l', damping h^2 f_l f_H'(0) of every fibre about every
+    CoR (:func:`fibre_length_and_lever_arm`, :func:`lever_arm_slope`), summed into muscles: the
+    direct form that :func:`segment_coefficients`'s monomial form equals (its test, and the
+    benchmark's "before").
+
+    Parameters
+    ----------
+    model : Model
+    eccentricity, lordosis : array_like
+        E and Lambda [m]; broadcast together.
+
+    Returns
+    -------
+    torque, stiffness, damping : numpy.ndarray, shape (..., n_cor, n_muscles)
+        Per unit PCSA [N m / m^2], [N m/rad / m^2], [N m s/rad / m^2].
+    """
+    cor = geometry.cor_positions(eccentricity, lordosis, model.geometry)[..., None, :]
+    upper, lower, share = geometry.all_fibres(model)
+    l0 = np.linalg.norm(lower - upper, axis=-1)
+    l_opt = model.fibre.optimal_length_ratio * l0
+    f_l = muscle.force_length(l0, l_opt, model.fibre)
+    f_l_slope = muscle.force_length_slope(l0, l_opt, model.fibre)
+    f_h_slope = muscle.force_velocity_slope(0.0 * l0, muscle.hill_constants(l_opt, model.fibre, model.errata))
+    _, h = fibre_length_and_lever_arm(upper, lower, cor)
+    h_slope = lever_arm_slope(upper, lower, cor)
+    to_muscle = model.fibre.specific_tension * share
+    return (h * f_l) @ to_muscle, (h_slope * f_l - h**2 * f_l_slope) @ to_muscle, (h**2 * f_l * f_h_slope) @ to_muscle
+
+
 def segment_coefficients(model: Model, eccentricity, lordosis) -> SegmentCoefficients:
     """Linearised torques, stiffness and damping of every muscle about every CoR.
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from spinectl.model import geometry, mechanics, muscle
+from spinectl.model import geometry, mechanics
 from spinectl.model.params import Errata, Model
 
 STEP = 1e-6
@@ -144,21 +144,7 @@ def test_coefficients_equal_the_per_fibre_sums(model):
     axis = np.linspace(-0.08, 0.08, 9)
     e, lam = np.meshgrid(axis, axis, indexing="ij")
     coeffs = mechanics.segment_coefficients(model, e, lam)
-    cor = geometry.cor_positions(e, lam, model.geometry)[..., None, :]
-    upper, lower, share = geometry.all_fibres(model)
-    l0 = np.linalg.norm(lower - upper, axis=-1)
-    l_opt = model.fibre.optimal_length_ratio * l0
-    f_l = muscle.force_length(l0, l_opt, model.fibre)
-    f_l_slope = muscle.force_length_slope(l0, l_opt, model.fibre)
-    f_h_slope = muscle.force_velocity_slope(0.0 * l0, muscle.hill_constants(l_opt, model.fibre, model.errata))
-    _, h = mechanics.fibre_length_and_lever_arm(upper, lower, cor)
-    h_slope = mechanics.lever_arm_slope(upper, lower, cor)
-    to_muscle = model.fibre.specific_tension * share
-    expected = {
-        "torque_per_pcsa": (h * f_l) @ to_muscle,
-        "stiffness_per_pcsa": (h_slope * f_l - h**2 * f_l_slope) @ to_muscle,
-        "damping_per_pcsa": (h**2 * f_l * f_h_slope) @ to_muscle,
-    }
-    for name, value in expected.items():
+    expected = mechanics.per_fibre_sums(model, e, lam)
+    for name, value in zip(("torque_per_pcsa", "stiffness_per_pcsa", "damping_per_pcsa"), expected, strict=True):
         got = getattr(coeffs, name)
         np.testing.assert_allclose(got, value, rtol=0, atol=1e-13 * np.abs(value).max(), err_msg=name)
