@@ -364,6 +364,18 @@ class SegmentCoefficients:
         return -(muscular + self.gravity_torque)
 
 
+def _fibre_laws(model: Model):
+    """Every fibre's attachments, its share of the muscles' PCSA times the specific tension (f_iso per PCSA),
+    upright length l0 and, there, f_l, df_l/dl and df_H/dv at v = 0 (per unit f_iso)."""
+    upper, lower, share = geometry.all_fibres(model)  # (F, 2), (F, 2), (F, M)
+    l0 = np.linalg.norm(lower - upper, axis=-1)
+    l_opt = model.fibre.optimal_length_ratio * l0
+    f_l = muscle.force_length(l0, l_opt, model.fibre)
+    f_l_slope = muscle.force_length_slope(l0, l_opt, model.fibre)
+    f_h_slope = muscle.force_velocity_slope(np.zeros_like(l0), muscle.hill_constants(l_opt, model.fibre, model.errata))
+    return upper, lower, model.fibre.specific_tension * share, l0, f_l, f_l_slope, f_h_slope
+
+
 def _monomial_coefficients(model: Model):
     """Per-muscle coefficients of the torque, stiffness and damping as polynomials in the CoR (cx, cy).
 
@@ -380,20 +392,12 @@ def _monomial_coefficients(model: Model):
     torque, stiffness, damping : numpy.ndarray, shapes (3, n_muscles), (6, n_muscles), (6, n_muscles)
         Coefficients of the monomials [N m / m^2 per m^k, k the monomial's degree; per rad, per rad/s].
     """
-    upper, lower, share = geometry.all_fibres(model)  # (F, 2), (F, 2), (F, M)
+    upper, lower, to_muscle, l0, f_l, f_l_slope, f_h_slope = _fibre_laws(model)
     e = lower - upper
-    l0 = np.hypot(e[:, 0], e[:, 1])
-    l_opt = model.fibre.optimal_length_ratio * l0
-    f_l = muscle.force_length(l0, l_opt, model.fibre)
-    f_l_slope = muscle.force_length_slope(l0, l_opt, model.fibre)
-    hill = muscle.hill_constants(l_opt, model.fibre, model.errata)
-    f_h_slope = muscle.force_velocity_slope(np.zeros_like(l0), hill)
     a, b, d = cross2(upper, e) / l0, -e[:, 1] / l0, e[:, 0] / l0  # h = a + b cx + d cy
     h2 = np.stack([a * a, 2 * a * b, 2 * a * d, b * b, d * d, 2 * b * d])  # h^2 in the monomials
     sums, one = upper + lower, np.ones_like(a)
     pu = np.stack([np.sum(upper * lower, axis=-1), -sums[:, 0], -sums[:, 1], one, one, 0.0 * one])  # p.u likewise
-    # per unit f_iso of each fibre, then summed into muscles per unit PCSA
-    to_muscle = model.fibre.specific_tension * share
     torque = (np.stack([a, b, d]) * f_l) @ to_muscle  # M = h f_l
     stiffness = (h2 * (f_l / l0 - f_l_slope) - pu * (f_l / l0)) @ to_muscle  # h' f_l - h^2 f_l', h' = (h^2 - p.u)/l
     damping = (h2 * (f_l * f_h_slope)) @ to_muscle  # h^2 f_l f_H'(0)
@@ -420,15 +424,9 @@ def per_fibre_sums(model: Model, eccentricity, lordosis):
         Per unit PCSA [N m / m^2], [N m/rad / m^2], [N m s/rad / m^2].
     """
     cor = geometry.cor_positions(eccentricity, lordosis, model.geometry)[..., None, :]
-    upper, lower, share = geometry.all_fibres(model)
-    l0 = np.linalg.norm(lower - upper, axis=-1)
-    l_opt = model.fibre.optimal_length_ratio * l0
-    f_l = muscle.force_length(l0, l_opt, model.fibre)
-    f_l_slope = muscle.force_length_slope(l0, l_opt, model.fibre)
-    f_h_slope = muscle.force_velocity_slope(0.0 * l0, muscle.hill_constants(l_opt, model.fibre, model.errata))
+    upper, lower, to_muscle, _, f_l, f_l_slope, f_h_slope = _fibre_laws(model)
     _, h = fibre_length_and_lever_arm(upper, lower, cor)
     h_slope = lever_arm_slope(upper, lower, cor)
-    to_muscle = model.fibre.specific_tension * share
     return (h * f_l) @ to_muscle, (h_slope * f_l - h**2 * f_l_slope) @ to_muscle, (h**2 * f_l * f_h_slope) @ to_muscle
 
 
