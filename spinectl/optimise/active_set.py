@@ -216,6 +216,9 @@ def _subsets(active, size: int):
     again in stage 3: the KKT system needs only n - rank(T) of the tight rows, and which ones
     decides the signs of the multipliers (a dual degenerate vertex).
     """
+    if size <= 0:  # the equalities fix x alone
+        yield np.zeros_like(active)
+        return
     count = active.sum(axis=1)
     first = np.argsort(~active, axis=1, kind="stable")  # each point's active rows first, in order
     for combo in itertools.combinations(range(int(count.max(initial=0))), size):

@@ -242,3 +242,13 @@ def test_random_geometries_equal_the_reference(model, data):
     problem = _data(m, e, lam)
     tol = m.optimisation.ct_tolerance
     _assert_optimal(problem, active_set.solve_block(problem, tol), stacked.solve_points(problem, tol), tol)
+
+
+def test_counter_torques_that_fix_x_alone(model):
+    """One pair, independent activation: two variables and T of rank 2, so stage 3's equalities fix x with
+    no inequality (an empty guess; found by tests/suites/test_cli_fuzz.py). Same answers as the reference."""
+    m = _with(model.replace(muscles=model.muscles[:1]), activation="independent")
+    data = _grid(m, np.linspace(0.0, 0.08, 4))
+    fast = active_set.solve_block(data, m.optimisation.ct_tolerance)
+    assert fast.per_point == 0
+    _assert_optimal(data, fast, stacked.solve_points(data, m.optimisation.ct_tolerance), m.optimisation.ct_tolerance)
