@@ -5,7 +5,7 @@ function; :data:`COMMANDS` lists them. Building the parser imports every
 command module, so their tops import nothing heavy: a command imports its
 library in its ``run``, and options whose defaults come from a heavy module
 are added when that command is used (:meth:`_Parser.defer`), so that
-``spinectl --help`` and ``spinectl stability`` start at once. Errors a user can cause
+``spinectl --help`` imports no heavy stack (xarray, matplotlib, cvxpy, Dask). Errors a user can cause
 (:class:`~spinectl.errors.SpinectlError`, bad arguments) end as one line on
 stderr and exit code 2, without a traceback.
 """
