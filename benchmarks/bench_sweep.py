@@ -1,14 +1,18 @@
 """Benchmark: the fast path against the per-point reference, on the same grid in the same run.
 
-    python benchmarks/bench_sweep.py                 # 81 x 81, then scaling, then reproduce
-    python benchmarks/bench_sweep.py --points 41 --skip-scaling --skip-reproduce
+    python benchmarks/bench_sweep.py                 # 81 x 81, coefficients, scaling, reproduce, 401 x 401 study
+    python benchmarks/bench_sweep.py --points 41 --skip-scaling --skip-reproduce --skip-study
+    python benchmarks/bench_sweep.py --variant independent --skip-scaling --skip-reproduce --skip-study
 
-Prints the wall time of both paths, their ratio and the largest difference
-between their answers (relative to each point's total PCSA or ||CT||, at least
-1 N m); then the fast path's time and working memory per grid point for growing
-grids (linear cost, flat memory); then the wall time of ``spinectl reproduce``
-end to end in a fresh interpreter. Timings on a shared machine are noisy: the
-ratio and the differences are what matter.
+Prints the wall time of both paths (all three stages, the reflex columns and the coupled
+margin: what a sweep computes), their ratio and the largest difference between their
+answers (relative to each point's total PCSA or ||CT||, at least 1 N m); then the time to
+build the coefficients of the grid against the floor of one fused numpy pass over its
+fibre-CoR terms and against the per-fibre sums it replaced; then the fast path's time and
+working memory per grid point for growing grids (linear cost, flat memory); then the wall
+time of ``spinectl reproduce`` end to end and of the 401 x 401 study on 2 local workers
+(``benchmarks/bench_study.py``), each in a fresh interpreter. Timings on a shared machine
+are noisy: the ratios and the differences are what matter.
 """
 
 from __future__ import annotations
@@ -28,7 +32,8 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from spinectl.landscape import sweep  # noqa: E402
-from spinectl.model import config  # noqa: E402
+from spinectl.model import config, geometry, mechanics  # noqa: E402
+from spinectl.model.params import Passive  # noqa: E402
 
 
 def timed(function, repeats: int = 1):
@@ -58,7 +63,7 @@ def largest_differences(fast, ref) -> dict[str, float]:
 
 def compare(model, points: int, repeats: int) -> None:
     axis = np.linspace(0.0, 0.08, points)
-    print(f"== fast path vs per-point reference, {points} x {points} grid (LP + least-||CT|| + tie-break)")
+    print(f"== fast path vs per-point reference, {points} x {points} grid (3 stages, reflex columns, coupled margin)")
     fast_time, fast = timed(lambda: sweep.sweep(model, axis, axis, method="fast", progress=False), repeats)
     print(f"fast path:  {fast_time:8.2f} s  (median of {repeats}; {fast.attrs['points_solved_per_point']} fell back)")
     ref_time, ref = timed(lambda: sweep.sweep(model, axis, axis, method="per-point", progress=None))
@@ -66,6 +71,39 @@ def compare(model, points: int, repeats: int) -> None:
     print(f"ratio:      {ref_time / fast_time:8.1f} x faster")
     for name, value in largest_differences(fast, ref).items():
         print(f"largest difference, {name:18}: {value:.2e}")
+
+
+def fused_pass_floor(model, eccentricity, lordosis) -> float:
+    """Seconds of one fused numpy pass over the grid's fibre-CoR terms: the lever arm h = a + b cx + d cy of
+    every fibre about every CoR (two multiply-adds per term) into a preallocated array; the least work
+    any per-term method does."""
+    cor = geometry.cor_positions(eccentricity, lordosis, model.geometry)
+    upper, lower, _ = geometry.all_fibres(model)
+    e = lower - upper
+    length = np.hypot(e[:, 0], e[:, 1])
+    a, b, d = mechanics.cross2(upper, e) / length, -e[:, 1] / length, e[:, 0] / length
+    out = np.empty(cor.shape[:-1] + a.shape)
+    scratch = np.empty_like(out)
+    start = time.perf_counter()
+    np.multiply(cor[..., 0, None], b, out=out)
+    np.multiply(cor[..., 1, None], d, out=scratch)
+    np.add(out, scratch, out=out)
+    np.add(out, a, out=out)
+    return time.perf_counter() - start
+
+
+def coefficients(model, points: int, repeats: int) -> None:
+    axis = np.linspace(0.0, 0.08, points)
+    e, lam = np.meshgrid(axis, axis, indexing="ij")
+    terms = e.size * len(model.geometry.cor_heights) * len(geometry.all_fibres(model)[0])
+    print(f"== coefficients of the {points} x {points} grid ({terms:,} fibre-CoR terms)")
+    kernel, _ = timed(lambda: mechanics.segment_coefficients(model, e, lam), repeats)
+    before, _ = timed(lambda: mechanics.per_fibre_sums(model, e, lam), repeats)
+    floor = min(fused_pass_floor(model, e, lam) for _ in range(repeats))
+    print(f"segment_coefficients (monomial form): {1e3 * kernel:8.1f} ms")
+    print(f"per-fibre sums (before):              {1e3 * before:8.1f} ms")
+    print(f"floor, one fused pass over the terms: {1e3 * floor:8.1f} ms")
+    print(f"kernel / floor: {kernel / floor:.2f}x (target <= 3x); per-fibre sums / kernel: {before / kernel:.1f}x")
 
 
 def scaling(model, sizes) -> None:
@@ -83,6 +121,18 @@ def scaling(model, sizes) -> None:
         print(f"{n:>4} x{n:>4} {n * n:>7} {seconds:>9.2f} {1e6 * seconds / n**2:>9.0f} {working:>20.1f}")
 
 
+def study(points: int) -> None:
+    from bench_study import STUDY, run
+
+    print(f"== spinectl study, {points} x {points} grid, 2 local workers, fresh interpreter")
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "study.toml"
+        path.write_text(STUDY.format(n=points))
+        command = [sys.executable, "-m", "spinectl", "study", str(path), "--out", str(Path(folder) / "s.zarr")]
+        r = run([*command, "--workers", "2"])
+    print(f"wall time:  {r['wall']:8.2f} s ({r['run']:.2f} s the run's own; load average {r['load']:.2f} at start)")
+
+
 def reproduce() -> None:
     print("== spinectl reproduce, end to end in a fresh interpreter (imports, K = 0 and 15, figures, report)")
     with tempfile.TemporaryDirectory() as out:
@@ -98,15 +148,27 @@ def main() -> None:
     parser.add_argument("--points", type=int, default=81, help="grid points per axis (default 81: 1 mm)")
     parser.add_argument("--repeats", type=int, default=3, help="fast-path repeats (median)")
     parser.add_argument("--preset", default="default")
+    parser.add_argument(
+        "--variant", choices=("paired", "independent", "K15"), default="paired", help="activation or K = 15 N m/rad"
+    )
+    parser.add_argument("--study-points", type=int, default=401, help="grid points per axis of the study (401)")
     parser.add_argument("--skip-scaling", action="store_true")
     parser.add_argument("--skip-reproduce", action="store_true")
+    parser.add_argument("--skip-study", action="store_true")
     args = parser.parse_args()
     model = config.load_preset(args.preset)
+    if args.variant == "independent":
+        model = config.set_parameter(model, "optimisation.activation", "independent")
+    elif args.variant == "K15":
+        model = model.replace(passive=Passive(15.0, model.passive.convention))
     compare(model, args.points, args.repeats)
+    coefficients(model, args.points, max(args.repeats, 5))
     if not args.skip_scaling:
         scaling(model, (21, 41, 81, 161))
     if not args.skip_reproduce:
         reproduce()
+    if not args.skip_study:
+        study(args.study_points)
 
 
 if __name__ == "__main__":

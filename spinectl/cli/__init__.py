@@ -1,7 +1,11 @@
 """The ``spinectl`` command line.
 
 Each sub-command lives in its own module with a ``register(subparsers)``
-function; :data:`COMMANDS` lists them. Errors a user can cause
+function; :data:`COMMANDS` lists them. Building the parser imports every
+command module, so their tops import nothing heavy: a command imports its
+library in its ``run``, and options whose defaults come from a heavy module
+are added when that command is used (:meth:`_Parser.defer`), so that
+``spinectl --help`` imports no heavy stack (xarray, matplotlib, cvxpy, Dask). Errors a user can cause
 (:class:`~spinectl.errors.SpinectlError`, bad arguments) end as one line on
 stderr and exit code 2, without a traceback.
 """
@@ -36,7 +40,8 @@ EXIT_USAGE = 2
 
 
 class _Parser(argparse.ArgumentParser):
-    """ArgumentParser whose errors are one line and exit 2, and that never calls ``sys.exit``.
+    """ArgumentParser whose errors are one line and exit 2, that never calls ``sys.exit``, and that
+    adds the options of :meth:`defer` when it is first used.
 
     A word that starts with a minus and a digit is a value, not an option: ``--E -0.02:0.1:25``
     (argparse 3.11 takes only plain negative numbers so, Python 3.13 any such word).
@@ -45,6 +50,37 @@ class _Parser(argparse.ArgumentParser):
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
         self._negative_number_matcher = re.compile(r"^-\.?\d")
+        self._deferred = []
+
+    def defer(self, add_options) -> None:
+        """Call ``add_options(self)`` before this parser first parses or prints its help.
+
+        For a command whose options take their defaults from a module that is slow to
+        import (xarray, matplotlib, cvxpy): only that command, when it runs, pays for it.
+
+        Parameters
+        ----------
+        add_options : callable
+            Adds the options to the parser it is given.
+        """
+        self._deferred.append(add_options)
+
+    def complete(self) -> None:
+        """Add the deferred options now (the docs' walk of the parser needs every option)."""
+        while self._deferred:
+            self._deferred.pop(0)(self)
+
+    def parse_known_args(self, args=None, namespace=None):
+        self.complete()
+        return super().parse_known_args(args, namespace)
+
+    def format_usage(self):
+        self.complete()
+        return super().format_usage()
+
+    def format_help(self):
+        self.complete()
+        return super().format_help()
 
     def error(self, message):  # noqa: D401 - argparse API
         raise _UsageError(f"{self.prog}: {message}")
@@ -65,8 +101,14 @@ class _ParserExit(Exception):
         self.status = status
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(*, lazy: bool = False) -> argparse.ArgumentParser:
     """The full argument parser with every registered sub-command.
+
+    Parameters
+    ----------
+    lazy : bool
+        Leave the deferred options (:meth:`_Parser.defer`) until a command is used, as
+        :func:`main` does; the default adds every option now (the docs walk the parser).
 
     Returns
     -------
@@ -84,6 +126,9 @@ def build_parser() -> argparse.ArgumentParser:
     sub.required = True
     for name in COMMANDS:
         importlib.import_module(f"{__name__}.{name}").register(sub)
+    if not lazy:
+        for command in sub.choices.values():
+            command.complete()
     return parser
 
 
@@ -107,7 +152,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         with warnings.catch_warnings():
             warnings.showwarning = _one_line_warning
-            args = build_parser().parse_args(argv)
+            args = build_parser(lazy=True).parse_args(argv)
             return int(args.func(args) or 0)
     except _ParserExit as exc:
         return exc.status

@@ -14,7 +14,6 @@ import sys
 
 from ..atomic import atomic_write_text, check_distinct, check_writable
 from ..errors import ParameterError
-from ..paper import calibration, grid
 from ._common import add_model_options, load_model, require
 
 
@@ -34,6 +33,14 @@ def register(sub) -> None:
         "coarse grid, with both passive-stiffness conventions; verify on the paper's 81 x 81 grid and "
         "write the best model as a preset TOML (docs/reproduction.md).",
     )
+    parser.defer(_options)
+    parser.set_defaults(func=run)
+
+
+def _options(parser) -> None:
+    """The options, their defaults from :mod:`spinectl.paper.calibration` (imported when the command is used)."""
+    from ..paper import calibration, grid
+
     parser.add_argument("--starts", type=int, default=1, help="independent optimiser runs, seeds SEED, SEED+1, ...")
     parser.add_argument("--seed", type=int, default=0, help="seed of the first run (default 0)")
     parser.add_argument(
@@ -85,7 +92,6 @@ def register(sub) -> None:
         "--history", metavar="FILE.csv", help="write every loss evaluation (vector, loss per convention) as CSV"
     )
     add_model_options(parser)
-    parser.set_defaults(func=run)
 
 
 def run(args) -> int:
@@ -101,6 +107,8 @@ def run(args) -> int:
     int
         Exit code 0.
     """
+    from ..paper import calibration
+
     require(3 <= args.grid <= 161, "--grid", f"must be 3 to 161 (got {args.grid})")
     require(3 <= args.verify_grid <= 161, "--verify-grid", f"must be 3 to 161 (got {args.verify_grid})")
     names = [n.strip() for n in args.parameters.split(",")] if args.parameters else None

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 from ..atomic import check_distinct
-from ..paper import drawing, figures
 from ..units import cm2_to_m2
 from ._common import add_dpi_option, add_model_options, add_position_options, float_list, load_model
 
@@ -24,6 +23,12 @@ def register(sub) -> None:
         "fibre (width proportional to its muscle's PCSA), the point mass and its line of gravity, and "
         "optionally the counter torque at each CoR.",
     )
+    parser.defer(_options)
+    parser.set_defaults(func=run)
+
+
+def _options(parser) -> None:
+    """The options; ``--dpi`` takes its default from :mod:`spinectl.paper.figures` (matplotlib)."""
     add_position_options(parser)
     activation = parser.add_mutually_exclusive_group()
     activation.add_argument(
@@ -39,7 +44,6 @@ def register(sub) -> None:
     parser.add_argument("--out", required=True, metavar="FILE", help="the figure: .png, .pdf or .svg")
     add_dpi_option(parser)
     add_model_options(parser)
-    parser.set_defaults(func=run)
 
 
 def run(args) -> int:
@@ -56,6 +60,8 @@ def run(args) -> int:
     int
         Exit code 0.
     """
+    from ..paper import drawing, figures
+
     check_distinct({"--out": args.out}, {"--config": args.config})  # before the work: never the input
     model = load_model(args)
     pcsa = None if args.geometry_only else ("optimum" if args.pcsa is None else cm2_to_m2(args.pcsa))

@@ -7,7 +7,6 @@ from pathlib import Path
 
 from ..atomic import check_distinct
 from ..errors import ParameterError
-from ..reflex.margins import analyse
 from ._common import add_model_options, add_position_options, emit_json, finite_float, load_model
 
 
@@ -96,6 +95,7 @@ def run(args) -> int:
     int
         Exit code 0 (also for an infeasible optimum, reported as a status).
     """
+    from ..reflex.margins import analyse
     if args.plot:
         from ..reflex.plots import PLOT_FILES
 

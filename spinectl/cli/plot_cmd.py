@@ -4,8 +4,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..landscape import netcdf
-from ..paper import figures
 from ._common import add_dpi_option, finite_float
 
 
@@ -25,6 +23,14 @@ def register(sub) -> None:
         "grid's other corners by their coordinates, the ridge Lambda = 1.7 E and the paper's optimum; "
         "as PNG, PDF or SVG files.",
     )
+    parser.defer(_options)
+    parser.set_defaults(func=run)
+
+
+def _options(parser) -> None:
+    """The options, their choices and defaults from :mod:`spinectl.paper.figures` (matplotlib)."""
+    from ..paper import figures
+
     parser.add_argument(
         "results",
         metavar="RESULTS",
@@ -52,7 +58,6 @@ def register(sub) -> None:
     extra.add_argument(
         "--insets", action="store_true", help="the model drawn at the grid's corners around Figures 3 and S1"
     )
-    parser.set_defaults(func=run)
 
 
 def run(args) -> int:
@@ -84,6 +89,9 @@ def run(args) -> int:
 
 
 def _draw_figures(args):
+    from ..landscape import netcdf
+    from ..paper import figures
+
     options = figures.FigureOptions(
         format=args.format,
         dpi=args.dpi,

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from ..paper import grid
-from ..paper.reproduction import reproduce
 from ._common import add_model_options
 
 
@@ -22,6 +20,14 @@ def register(sub) -> None:
         "1 mm steps by default, see --points) for K = 0 and 15 N m/rad and compare the paper's landmarks "
         "with spinectl's in report.md.",
     )
+    parser.defer(_options)
+    parser.set_defaults(func=run)
+
+
+def _options(parser) -> None:
+    """The options, their defaults from :mod:`spinectl.paper` (imported when the command is used)."""
+    from ..paper import grid
+
     parser.add_argument("--out", default="results", metavar="DIR", help="output folder (default: results)")
     parser.add_argument(
         "--points",
@@ -30,7 +36,6 @@ def register(sub) -> None:
         help=f"grid points per axis (default {grid.PAPER_POINTS}: 1 mm)",
     )
     add_model_options(parser)
-    parser.set_defaults(func=run)
 
 
 def run(args) -> int:
@@ -46,6 +51,8 @@ def run(args) -> int:
     int
         Exit code 0.
     """
+    from ..paper.reproduction import reproduce
+
     for path in reproduce(
         args.out, preset=args.preset, config=args.config, overrides=args.assignments, points=args.points
     ):

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from ..optimise.coupled import coupled_stability_at
-from ..optimise.reference import NoStabilisingActivation, stability_at
 from ..units import cm2_to_m2
 from ._common import add_model_options, add_position_options, emit_json, finite_float, float_list, load_model
 
@@ -58,6 +56,9 @@ def run(args) -> int:
     int
         Exit code 0.
     """
+    from ..optimise.coupled import coupled_stability_at
+    from ..optimise.reference import NoStabilisingActivation, stability_at
+
     model = load_model(args, {"passive.stiffness": args.K})
     given = args.pcsa is not None  # else the minimum stabilising PCSA
     analysis = coupled_stability_at if args.coupled else stability_at

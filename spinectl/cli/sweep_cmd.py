@@ -5,7 +5,6 @@ from __future__ import annotations
 import time
 
 from ..atomic import check_distinct
-from ..landscape import sweep
 from ._common import add_model_options, float_list, load_model
 
 DEFAULT_AXIS = "0:0.08:81"
@@ -26,6 +25,14 @@ def register(sub) -> None:
         description="Solve the minimum-PCSA LP and the least-counter-torque problem at every grid point "
         "(paper, Figures 3 and 4) and write an xarray Dataset as NetCDF.",
     )
+    parser.defer(_options)
+    parser.set_defaults(func=run)
+
+
+def _options(parser) -> None:
+    """The options, their choices and defaults from :mod:`spinectl.landscape.sweep` (xarray)."""
+    from ..landscape import sweep
+
     parser.add_argument("--E", default=DEFAULT_AXIS, metavar="START:STOP:NUM", help="eccentricity axis [m]")
     parser.add_argument("--Lambda", default=DEFAULT_AXIS, metavar="START:STOP:NUM", help="lordosis axis [m]")
     parser.add_argument(
@@ -41,7 +48,6 @@ def register(sub) -> None:
     )
     parser.add_argument("--out", required=True, metavar="FILE.nc", help="NetCDF file to write (atomically)")
     add_model_options(parser)
-    parser.set_defaults(func=run)
 
 
 def run(args) -> int:
@@ -57,6 +63,8 @@ def run(args) -> int:
     int
         Exit code 0.
     """
+    from ..landscape import sweep
+
     check_distinct({"--out": args.out}, {"--config": args.config})
     model = load_model(args)
     e_axis, l_axis = sweep.parse_grid(args.E, "--E"), sweep.parse_grid(args.Lambda, "--Lambda")

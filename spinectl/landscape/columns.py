@@ -1,7 +1,7 @@
 """The landscape's variables at a list of points, solved chunk by chunk.
 
 The grid is solved in chunks of points (working memory stays flat however fine the grid),
-each chunk by the fast path (:mod:`spinectl.optimise.stacked`) or the per-point reference
+each chunk by the fast path (:mod:`spinectl.optimise.active_set`) or the per-point reference
 (:mod:`spinectl.optimise.reference`); the reflex columns follow from the chosen activation
 (:mod:`spinectl.reflex.maps`).
 """
@@ -13,7 +13,7 @@ import numpy as np
 from ..model import chain, stability
 from ..model.checks import arithmetic_guard, checked_coefficients
 from ..model.params import Model
-from ..optimise import coupled, stacked
+from ..optimise import active_set, coupled, stacked
 from ..optimise.problem import OK_STATUSES, problem_data
 from ..reflex.delay import STATUS
 from ..reflex.inputs import guarded
@@ -73,7 +73,7 @@ def point_columns(
         data = problem_data(model, coeffs)
         tol = model.optimisation.ct_tolerance
         if method == "fast":
-            result = stacked.solve_stacked(data, tol)
+            result = active_set.solve_block(data, tol)
             update(len(data.stability))
         else:
             result = stacked.solve_points(data, tol, progress=update)

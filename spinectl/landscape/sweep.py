@@ -1,7 +1,7 @@
 """Sweeps over the (E, Lambda) grid: the paper's landscapes as an xarray Dataset.
 
 The grid is solved in chunks of points (working memory stays flat however
-fine the grid), each chunk by the fast path (:mod:`spinectl.optimise.stacked`) or the
+fine the grid), each chunk by the fast path (:mod:`spinectl.optimise.active_set`) or the
 per-point reference (:mod:`spinectl.optimise`). The Dataset carries the
 answers, the per-segment coefficients that define every problem (so that
 later analyses, e.g. delay margins, need not recompute them) and the
@@ -23,7 +23,8 @@ from .columns import DEFAULT_CHUNK, point_columns
 from .schema import landscape_dataset
 
 METHODS = ("fast", "per-point")
-"""'fast': stacked blocks (:func:`spinectl.optimise.stacked.solve_stacked`); 'per-point': the cvxpy reference."""
+"""'fast': exact batched active sets (:func:`spinectl.optimise.active_set.solve_block`, falling back to stacked
+Clarabel blocks); 'per-point': the cvxpy reference."""
 
 MAX_GRID_POINTS = 1_000_000
 """Largest grid of one sweep: the answer alone takes about 1.2 kB a point (1.2 GB here),

@@ -10,13 +10,14 @@ from __future__ import annotations
 from functools import lru_cache
 
 import numpy as np
-from scipy.interpolate import CubicSpline
 
 from .params import Geometry, Model, MusclePair
 
 
 @lru_cache(maxsize=32)
 def _lordosis_shape_cached(heights: tuple[float, ...], spine_length: float, bc: str) -> np.ndarray:
+    from scipy.interpolate import CubicSpline  # here: scipy.interpolate takes longer to import than numpy
+
     knots = [0.0, spine_length / 2, spine_length]
     bc_type = {"natural": "natural", "clamped": "clamped", "not-a-knot": "not-a-knot"}[bc]
     spline = CubicSpline(knots, [0.0, 1.0, 0.0], bc_type=bc_type)

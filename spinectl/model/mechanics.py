@@ -364,6 +364,72 @@ class SegmentCoefficients:
         return -(muscular + self.gravity_torque)
 
 
+def _fibre_laws(model: Model):
+    """Every fibre's attachments, its share of the muscles' PCSA times the specific tension (f_iso per PCSA),
+    upright length l0 and, there, f_l, df_l/dl and df_H/dv at v = 0 (per unit f_iso)."""
+    upper, lower, share = geometry.all_fibres(model)  # (F, 2), (F, 2), (F, M)
+    l0 = np.linalg.norm(lower - upper, axis=-1)
+    l_opt = model.fibre.optimal_length_ratio * l0
+    f_l = muscle.force_length(l0, l_opt, model.fibre)
+    f_l_slope = muscle.force_length_slope(l0, l_opt, model.fibre)
+    f_h_slope = muscle.force_velocity_slope(np.zeros_like(l0), muscle.hill_constants(l_opt, model.fibre, model.errata))
+    return upper, lower, model.fibre.specific_tension * share, l0, f_l, f_l_slope, f_h_slope
+
+
+def _monomial_coefficients(model: Model):
+    """Per-muscle coefficients of the torque, stiffness and damping as polynomials in the CoR (cx, cy).
+
+    At the upright posture the fibre vector e = P - U does not depend on the CoR c, so the
+    lever arm h = (u x e) / l with u = U - c is affine in c, h = a + b cx + d cy, and
+    p . u = (P - c) . (U - c) is quadratic; so the three sums over fibres of
+    :func:`segment_coefficients` are polynomials of degree <= 2 in (cx, cy) whose coefficients
+    depend on the fibres only. Summing the fibres into muscles here, once per model, leaves
+    a product with the 6 monomials (1, cx, cy, cx^2, cy^2, cx cy) per CoR: the same formulas,
+    no per-fibre work per grid point (benchmarks/bench_sweep.py measures it).
+
+    Returns
+    -------
+    torque, stiffness, damping : numpy.ndarray, shapes (3, n_muscles), (6, n_muscles), (6, n_muscles)
+        Coefficients of the monomials [N m / m^2 per m^k, k the monomial's degree; per rad, per rad/s].
+    """
+    upper, lower, to_muscle, l0, f_l, f_l_slope, f_h_slope = _fibre_laws(model)
+    e = lower - upper
+    a, b, d = cross2(upper, e) / l0, -e[:, 1] / l0, e[:, 0] / l0  # h = a + b cx + d cy
+    h2 = np.stack([a * a, 2 * a * b, 2 * a * d, b * b, d * d, 2 * b * d])  # h^2 in the monomials
+    sums, one = upper + lower, np.ones_like(a)
+    pu = np.stack([np.sum(upper * lower, axis=-1), -sums[:, 0], -sums[:, 1], one, one, 0.0 * one])  # p.u likewise
+    torque = (np.stack([a, b, d]) * f_l) @ to_muscle  # M = h f_l
+    stiffness = (h2 * (f_l / l0 - f_l_slope) - pu * (f_l / l0)) @ to_muscle  # h' f_l - h^2 f_l', h' = (h^2 - p.u)/l
+    damping = (h2 * (f_l * f_h_slope)) @ to_muscle  # h^2 f_l f_H'(0)
+    return torque, stiffness, damping
+
+
+def per_fibre_sums(model: Model, eccentricity, lordosis):
+    """The muscle terms of :func:`segment_coefficients` summed fibre by fibre, as the formulas read.
+
+    torque h f_l, stiffness h' f_l - h^2 f_l', damping h^2 f_l f_H'(0) of every fibre about every
+    CoR (:func:`fibre_length_and_lever_arm`, :func:`lever_arm_slope`), summed into muscles: the
+    direct form that :func:`segment_coefficients`'s monomial form equals (its test, and the
+    benchmark's "before").
+
+    Parameters
+    ----------
+    model : Model
+    eccentricity, lordosis : array_like
+        E and Lambda [m]; broadcast together.
+
+    Returns
+    -------
+    torque, stiffness, damping : numpy.ndarray, shape (..., n_cor, n_muscles)
+        Per unit PCSA [N m / m^2], [N m/rad / m^2], [N m s/rad / m^2].
+    """
+    cor = geometry.cor_positions(eccentricity, lordosis, model.geometry)[..., None, :]
+    upper, lower, to_muscle, _, f_l, f_l_slope, f_h_slope = _fibre_laws(model)
+    _, h = fibre_length_and_lever_arm(upper, lower, cor)
+    h_slope = lever_arm_slope(upper, lower, cor)
+    return (h * f_l) @ to_muscle, (h_slope * f_l - h**2 * f_l_slope) @ to_muscle, (h**2 * f_l * f_h_slope) @ to_muscle
+
+
 def segment_coefficients(model: Model, eccentricity, lordosis) -> SegmentCoefficients:
     """Linearised torques, stiffness and damping of every muscle about every CoR.
 
@@ -398,22 +464,12 @@ def segment_coefficients(model: Model, eccentricity, lordosis) -> SegmentCoeffic
        Model 9:13. doi:10.1186/1742-4682-9-13
     """
     cor = geometry.cor_positions(eccentricity, lordosis, model.geometry)  # (..., K, 2)
-    upper, lower, share = geometry.all_fibres(model)  # (F, 2), (F, 2), (F, M)
-    l0 = np.linalg.norm(lower - upper, axis=-1)
-    l_opt = model.fibre.optimal_length_ratio * l0
-    f_l = muscle.force_length(l0, l_opt, model.fibre)
-    f_l_slope = muscle.force_length_slope(l0, l_opt, model.fibre)
-    hill = muscle.hill_constants(l_opt, model.fibre, model.errata)
-    f_h_slope = muscle.force_velocity_slope(np.zeros_like(l0), hill)
-
-    c = cor[..., None, :]  # (..., K, 1, 2) against fibres (F, 2)
-    _, h = fibre_length_and_lever_arm(upper, lower, c)
-    h_slope = lever_arm_slope(upper, lower, c)
-    # per unit f_iso of each fibre, then summed into muscles per unit PCSA
-    to_muscle = model.fibre.specific_tension * share
-    torque = (h * f_l) @ to_muscle
-    stiffness = (h_slope * f_l - h**2 * f_l_slope) @ to_muscle
-    damping = (h**2 * f_l * f_h_slope) @ to_muscle
+    torque_terms, stiffness_terms, damping_terms = _monomial_coefficients(model)
+    cx, cy = cor[..., 0], cor[..., 1]
+    monomials = np.stack([np.ones_like(cx), cx, cy, cx * cx, cy * cy, cx * cy], axis=-1)  # (..., K, 6)
+    torque = monomials[..., :3] @ torque_terms
+    stiffness = monomials @ stiffness_terms
+    damping = monomials @ damping_terms
 
     theta = inertia(cor, model)
     r_y = model.body.mass_height - cor[..., 1]

@@ -1,10 +1,13 @@
 """The optimisation at every grid point: minimum PCSA, least counter torque, least-norm activation.
 
 docs/model.md, "The optimisation", and docs/optimisation.md. One formulation
-(:mod:`~spinectl.optimise.problem`) is solved two ways: per point with cvxpy, the
-readable reference (:mod:`~spinectl.optimise.reference`), and for blocks of points
-as one stacked Clarabel problem, the fast path (:mod:`~spinectl.optimise.stacked`);
-both answers are polished to the exact optimum (:mod:`~spinectl.optimise.polish`).
+(:mod:`~spinectl.optimise.problem`) is solved three ways: per point with cvxpy, the
+readable reference (:mod:`~spinectl.optimise.reference`); for blocks of points by
+guessed and verified active sets in batched numpy, the fast path
+(:mod:`~spinectl.optimise.active_set`); and for blocks of points as one stacked
+Clarabel problem, the fast path's fallback (:mod:`~spinectl.optimise.stacked`). The
+solvers' answers are polished to the exact optimum (:mod:`~spinectl.optimise.polish`);
+the fast path's are exact KKT points already.
 
 The per-point API is re-exported here: ``optimise.solve_point(model, E, Lambda)``.
 

@@ -377,6 +377,28 @@ def crossings(stiffness, damping, inertia, kp, kd, lag=0.0) -> Crossings:
        equations. Funkcialaj Ekvacioj 29:77-90.
     """
     s, d, theta, kp, kd, lag = as_arrays(stiffness, damping, inertia, kp, kd, lag)
+    return crossings_of(s, d, theta, kp, kd, lag, without_delay(s, d, theta, kp, kd, lag))
+
+
+def crossings_of(s, d, theta, kp, kd, lag, free: WithoutDelay) -> Crossings:
+    """:func:`crossings` of arrays of one shape, with their delay-free loop ``free`` (:func:`without_delay`) given.
+
+    The vectorised maps (:func:`spinectl.reflex.maps.landscape`) find the crossings and the
+    delay-free loop once per point and derive the exact margin, the Padé margin and the
+    verdict at the delay from them.
+
+    Parameters
+    ----------
+    s, d, theta, kp, kd, lag : numpy.ndarray
+        As :func:`crossings`, float arrays of one shape (:func:`as_arrays`).
+    free : WithoutDelay
+        ``without_delay(s, d, theta, kp, kd, lag)``.
+
+    Returns
+    -------
+    Crossings
+        As :func:`crossings`.
+    """
     x, direction = _positive_roots(*crossing_polynomial(s, d, theta, kp, kd, lag))
     with np.errstate(invalid="ignore"):
         w = np.sqrt(x)
@@ -387,7 +409,7 @@ def crossings(stiffness, damping, inertia, kp, kd, lag=0.0) -> Crossings:
     with np.errstate(divide="ignore", invalid="ignore"):
         phase = np.mod(np.angle(-qq / p), 2.0 * np.pi)
     phase = np.where(np.isnan(w), np.nan, phase)
-    phase = np.where(_axis_slot(w, without_delay(s, d, theta, kp, kd, lag).axis_frequency), 0.0, phase)
+    phase = np.where(_axis_slot(w, free.axis_frequency), 0.0, phase)
     return Crossings(frequency=w, phase=phase, direction=np.where(np.isnan(w), np.nan, direction))
 
 
@@ -534,14 +556,33 @@ def delay_margin(stiffness, damping, inertia, kp, kd, lag=0.0) -> DelayMargin:
        equations. Funkcialaj Ekvacioj 29:77-90.
     """
     check_retarded(inertia, damping, kd, lag)
-    cr = crossings(stiffness, damping, inertia, kp, kd, lag)
-    stable0 = stable_without_delay(stiffness, damping, inertia, kp, kd, lag)
-    undefined = undefined_inputs(stiffness, damping, inertia, kp, kd, lag)
-    result = margin_from_delays(cr.first_delay, cr.frequency, stable0, undefined)
-    gain = pure_gain(inertia, damping, kd, lag) & ~undefined & stable0
+    s, d, theta, kp, kd, lag = as_arrays(stiffness, damping, inertia, kp, kd, lag)
+    free = without_delay(s, d, theta, kp, kd, lag)
+    return delay_margin_of(s, d, theta, kp, kd, lag, free, crossings_of(s, d, theta, kp, kd, lag, free))
+
+
+def delay_margin_of(s, d, theta, kp, kd, lag, free: WithoutDelay, cr: Crossings) -> DelayMargin:
+    """:func:`delay_margin` from the delay-free loop and the crossings (:func:`crossings_of`).
+
+    Parameters
+    ----------
+    s, d, theta, kp, kd, lag : numpy.ndarray
+        As :func:`delay_margin`, float arrays of one shape, checked (:func:`check_retarded`).
+    free : WithoutDelay
+        Their :func:`without_delay`.
+    cr : Crossings
+        Their :func:`crossings_of`.
+
+    Returns
+    -------
+    DelayMargin
+        As :func:`delay_margin`.
+    """
+    undefined = undefined_inputs(s, d, theta, kp, kd, lag)
+    result = margin_from_delays(cr.first_delay, cr.frequency, free.stable, undefined)
+    gain = pure_gain(theta, d, kd, lag) & ~undefined & free.stable
     if not np.any(gain):
         return result
-    s, kp = as_arrays(stiffness, kp)
     small = np.abs(kp) < np.abs(s)
     return DelayMargin(
         margin=np.where(gain, np.where(small, np.inf, 0.0), result.margin),
@@ -585,7 +626,10 @@ def right_half_plane_roots(stiffness, damping, inertia, kp, kd, delay, lag=0.0):
     check_retarded(inertia, damping, kd, lag)
     s, d, theta, kp, kd, tau, lag = as_arrays(stiffness, damping, inertia, kp, kd, delay, lag)
     free = without_delay(s, d, theta, kp, kd, lag)
-    cr = crossings(s, d, theta, kp, kd, lag)
+    return _right_half_plane_roots(s, d, theta, kp, kd, tau, lag, free, crossings_of(s, d, theta, kp, kd, lag, free))
+
+
+def _right_half_plane_roots(s, d, theta, kp, kd, tau, lag, free: WithoutDelay, cr: Crossings):
     with np.errstate(invalid="ignore"):
         passed = np.floor((tau[..., None] - cr.first_delay) * cr.frequency / (2.0 * np.pi)) + 1.0
     passed = np.where(np.isnan(passed), 0.0, np.maximum(passed, 0.0))
@@ -632,9 +676,30 @@ def stable_at_delay(stiffness, damping, inertia, kp, kd, delay, lag=0.0):
     ParameterError
         Naming ``kd``, for a loop of neutral type (:func:`check_retarded`).
     """
+    check_retarded(inertia, damping, kd, lag)
     s, d, theta, kp, kd, tau, lag = as_arrays(stiffness, damping, inertia, kp, kd, delay, lag)
-    count = right_half_plane_roots(s, d, theta, kp, kd, tau, lag)
     free = without_delay(s, d, theta, kp, kd, lag)
+    return stable_at_delay_of(s, d, theta, kp, kd, tau, lag, free, crossings_of(s, d, theta, kp, kd, lag, free))
+
+
+def stable_at_delay_of(s, d, theta, kp, kd, tau, lag, free: WithoutDelay, cr: Crossings):
+    """:func:`stable_at_delay` from the delay-free loop and the crossings (:func:`crossings_of`).
+
+    Parameters
+    ----------
+    s, d, theta, kp, kd, tau, lag : numpy.ndarray
+        As :func:`stable_at_delay`, float arrays of one shape, checked (:func:`check_retarded`).
+    free : WithoutDelay
+        Their :func:`without_delay`.
+    cr : Crossings
+        Their :func:`crossings_of`.
+
+    Returns
+    -------
+    numpy.ndarray of bool
+        As :func:`stable_at_delay`.
+    """
+    count = _right_half_plane_roots(s, d, theta, kp, kd, tau, lag, free, cr)
     axis = ~np.isnan(free.axis_frequency) & ((tau == 0) | (free.departure == 0))
     marginal_gain = pure_gain(theta, d, kd, lag) & (tau > 0) & (np.abs(kp) == np.abs(s))
     return (count == 0) & ~free.zero_root & ~axis & ~marginal_gain

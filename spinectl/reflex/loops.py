@@ -249,8 +249,11 @@ def loop_margins(loop: ct.TransferFunction, stable: bool) -> LoopMargins:
         Gain margins [1], phase margin [deg], crossover frequencies [rad/s] and ``stable``.
     """
     with ignoring_underflow():
-        gm, pm, _, wpc, wgc, _ = ct.stability_margins(loop)
-        all_gm = np.asarray(ct.stability_margins(loop, returnall=True)[0], float)
+        every = ct.stability_margins(loop, returnall=True)
+    all_gm, all_pm, _, all_wpc, all_wgc, _ = (np.asarray(a, float) for a in every)
+    with np.errstate(divide="ignore"):  # a gain margin of 0 is infinitely far from 1
+        gm, wpc = _nearest(all_gm, all_wpc, np.abs(np.log(all_gm)))
+    pm, wgc = _nearest(all_pm, all_wgc, np.abs(all_pm))
     below, above = all_gm[all_gm < 1.0], all_gm[all_gm > 1.0]
     lower = float(below.max()) if below.size else 0.0
     upper = float(above.min()) if above.size else np.inf
@@ -265,6 +268,19 @@ def loop_margins(loop: ct.TransferFunction, stable: bool) -> LoopMargins:
         phase_crossover_rad_s=float(wpc),
         stable=bool(stable),
     )
+
+
+def _nearest(margins, frequencies, distance) -> tuple[float, float]:
+    """The margin nearest to its neutral value, and its frequency; (inf, NaN) if there is none.
+
+    python-control's own choice for ``stability_margins(returnall=False)`` (0.10): the gain margin
+    of least abs(log GM) (an all-infinite list counts as none), the phase margin of least abs(PM),
+    the first on a tie; made here from the one ``returnall=True`` call, not a second evaluation.
+    """
+    if not margins.size or np.isinf(margins).all():
+        return np.inf, np.nan
+    first = int(np.flatnonzero(distance == np.min(distance))[0])
+    return float(margins[first]), float(frequencies[first])
 
 
 @contextlib.contextmanager

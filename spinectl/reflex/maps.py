@@ -11,10 +11,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .delay import as_arrays, delay_margin, stable_at_delay
+from .delay import as_arrays, check_retarded, crossings_of, delay_margin_of, stable_at_delay_of, without_delay
 from .gains import resolve_gains
 from .inputs import validated
-from .pade import pade_delay_margin
+from .pade import pade_delay_margin_of
 
 
 @dataclass(frozen=True)
@@ -72,8 +72,13 @@ def landscape(stiffness, damping, inertia, reflex, kp=None, kd=None) -> ReflexLa
     s, d, theta = as_arrays(stiffness, damping, inertia)
     lag = reflex.activation_time_constant
     kp_, kd_ = resolve_gains(s, d, theta, reflex, kp, kd)
-    exact = delay_margin(s, d, theta, kp_, kd_, lag)
-    pade = pade_delay_margin(s, d, theta, kp_, kd_, reflex.pade_order, lag)
+    check_retarded(theta, d, kd_, lag)
+    s, d, theta, kp_, kd_, lag = as_arrays(s, d, theta, kp_, kd_, lag)
+    free = without_delay(s, d, theta, kp_, kd_, lag)  # the delay-free loop and the crossings, once for all three
+    cr = crossings_of(s, d, theta, kp_, kd_, lag, free)
+    exact = delay_margin_of(s, d, theta, kp_, kd_, lag, free, cr)
+    pade = pade_delay_margin_of(s, d, theta, kp_, kd_, reflex.pade_order, lag, free, cr)
+    tau = np.broadcast_to(np.asarray(reflex.delay, float), s.shape)
     return ReflexLandscape(
         kp=kp_,
         kd=kd_,
@@ -81,5 +86,5 @@ def landscape(stiffness, damping, inertia, reflex, kp=None, kd=None) -> ReflexLa
         delay_margin_status=exact.status,
         crossing_frequency=exact.frequency,
         delay_margin_pade=pade.margin,
-        stable_at_delay=stable_at_delay(s, d, theta, kp_, kd_, reflex.delay, lag),
+        stable_at_delay=stable_at_delay_of(s, d, theta, kp_, kd_, tau, lag, free, cr),
     )

@@ -20,14 +20,18 @@ import numpy as np
 
 from .delay import (
     BISECTIONS,
+    Crossings,
     DelayMargin,
+    WithoutDelay,
+    as_arrays,
     check_retarded,
-    crossings,
+    crossings_of,
     delay_margin,
+    delay_margin_of,
     margin_from_delays,
     pure_gain,
-    stable_without_delay,
     undefined_inputs,
+    without_delay,
 )
 from .inputs import validated
 
@@ -84,7 +88,16 @@ def pade_phase_lag(y, order: int):
     numpy.ndarray
         The lag [rad], in [0, n pi); the shape of ``y``.
     """
-    roots = np.roots(pade_coefficients(order)[::-1])
+    return _phase_lag(y, _roots(order))
+
+
+def _roots(order: int) -> np.ndarray:
+    """The roots of q (:func:`pade_coefficients`), all in Re < 0."""
+    return np.roots(pade_coefficients(order)[::-1])
+
+
+def _phase_lag(y, roots):
+    """:func:`pade_phase_lag` with the roots of q given: the bisection finds them once, not at every step."""
     y = np.asarray(y, float)[..., None]
     return 2.0 * np.sum(np.arctan((y - roots.imag) / -roots.real), axis=-1)
 
@@ -108,13 +121,17 @@ def pade_inverse_lag(phase, order: int):
         y = w tau [rad], the shape of ``phase``; inf where ``phase`` >= n pi.
     """
     phase = np.asarray(phase, float)
-    lo, hi = np.zeros_like(phase), np.ones_like(phase)
+    reached = phase < order * np.pi  # False for NaN: the empty crossing slots of a landscape cost nothing
+    target = phase[reached]
+    roots = _roots(order)
+    lo, hi = np.zeros_like(target), np.ones_like(target)
     for _ in range(BISECTIONS):
         mid = 0.5 * (lo + hi)
-        below = pade_phase_lag(np.tan(0.5 * np.pi * mid), order) < phase
+        below = _phase_lag(np.tan(0.5 * np.pi * mid), roots) < target
         lo, hi = np.where(below, mid, lo), np.where(below, hi, mid)
-    y = np.tan(0.5 * np.pi * 0.5 * (lo + hi))
-    return np.where(phase < order * np.pi, y, np.inf)
+    y = np.full(phase.shape, np.inf)
+    y[reached] = np.tan(0.5 * np.pi * 0.5 * (lo + hi))
+    return y
 
 
 @validated(zero_inertia=True)
@@ -148,15 +165,38 @@ def pade_delay_margin(stiffness, damping, inertia, kp, kd, order: int, lag=0.0) 
         Naming ``kd``, for a loop of neutral type (:func:`~spinectl.reflex.delay.check_retarded`).
     """
     check_retarded(inertia, damping, kd, lag)
-    cr = crossings(stiffness, damping, inertia, kp, kd, lag)
+    s, d, theta, kp, kd, lag = as_arrays(stiffness, damping, inertia, kp, kd, lag)
+    free = without_delay(s, d, theta, kp, kd, lag)
+    return pade_delay_margin_of(s, d, theta, kp, kd, order, lag, free, crossings_of(s, d, theta, kp, kd, lag, free))
+
+
+def pade_delay_margin_of(s, d, theta, kp, kd, order: int, lag, free: WithoutDelay, cr: Crossings) -> DelayMargin:
+    """:func:`pade_delay_margin` from the delay-free loop and the crossings (:func:`.delay.crossings_of`).
+
+    Parameters
+    ----------
+    s, d, theta, kp, kd, lag : numpy.ndarray
+        As :func:`pade_delay_margin`, float arrays of one shape, checked
+        (:func:`~spinectl.reflex.delay.check_retarded`).
+    order : int
+        Order n of the approximant.
+    free : WithoutDelay
+        Their :func:`~spinectl.reflex.delay.without_delay`.
+    cr : Crossings
+        Their crossings.
+
+    Returns
+    -------
+    DelayMargin
+        As :func:`pade_delay_margin`.
+    """
     first = pade_inverse_lag(cr.phase, order) / cr.frequency
-    stable0 = stable_without_delay(stiffness, damping, inertia, kp, kd, lag)
-    undefined = undefined_inputs(stiffness, damping, inertia, kp, kd, lag)
-    pade = margin_from_delays(first, cr.frequency, stable0, undefined)
-    gain = pure_gain(inertia, damping, kd, lag) & ~undefined
+    undefined = undefined_inputs(s, d, theta, kp, kd, lag)
+    pade = margin_from_delays(first, cr.frequency, free.stable, undefined)
+    gain = pure_gain(theta, d, kd, lag) & ~undefined
     if not np.any(gain):
         return pade
-    exact = delay_margin(stiffness, damping, inertia, kp, kd, lag)  # no crossings: the closed form holds for Padé too
+    exact = delay_margin_of(s, d, theta, kp, kd, lag, free, cr)  # no crossings: the closed form holds for Padé too
     fields = ("margin", "frequency", "status")
     return DelayMargin(*(np.where(gain, getattr(exact, f), getattr(pade, f)) for f in fields))
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from spinectl.cli import main
-from spinectl.optimise import stacked
+from spinectl.optimise import active_set
 
 
 def test_interrupted_sweep_keeps_the_previous_file(tmp_path, monkeypatch, capsys):
@@ -16,7 +16,7 @@ def test_interrupted_sweep_keeps_the_previous_file(tmp_path, monkeypatch, capsys
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt  # Ctrl-C in the middle of the solves
 
-    monkeypatch.setattr(stacked, "solve_stacked", interrupted)
+    monkeypatch.setattr(active_set, "solve_block", interrupted)
     code = main(["sweep", "--E", "0:0.08:5", "--Lambda", "0:0.08:5", "--out", str(out)])
     err = capsys.readouterr().err
     assert code == 130 and err.strip() == "spinectl: interrupted"
@@ -142,7 +142,7 @@ def test_plot_of_a_one_point_sweep_is_one_line(tmp_path, capsys):
 )
 def test_a_repeated_coordinate_is_refused_before_the_sweep(tmp_path, monkeypatch, capsys, axes, needle):
     """Before: `--K 15,15` wrote a file with K = [15, 15] that plot could not read."""
-    monkeypatch.setattr(stacked, "solve_stacked", lambda *a, **k: pytest.fail("solved before checking"))
+    monkeypatch.setattr(active_set, "solve_block", lambda *a, **k: pytest.fail("solved before checking"))
     argv = ["sweep", "--E", "0:0.08:3", "--Lambda", "0:0.08:3", *axes, "--out", str(tmp_path / "x.nc")]
     assert main(argv) == 2
     err = capsys.readouterr().err
@@ -163,7 +163,7 @@ def test_an_output_name_with_a_line_break_is_refused_before_the_work(tmp_path, m
     monkeypatch.chdir(tmp_path)
     assert main(["sweep", "--E", "0:0.08:3", "--Lambda", "0:0.08:3", "--out", "good.nc"]) == 0
     capsys.readouterr()
-    monkeypatch.setattr(stacked, "solve_stacked", lambda *a, **k: pytest.fail("solved before checking"))
+    monkeypatch.setattr(active_set, "solve_block", lambda *a, **k: pytest.fail("solved before checking"))
     assert main(command) == 2
     err = capsys.readouterr().err
     assert "the name must be printable" in err and err.count("\n") == 1

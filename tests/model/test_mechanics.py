@@ -135,3 +135,16 @@ def test_cor_positions_follow_eccentricity_and_lordosis(model):
     cor = geometry.cor_positions(0.03, 0.0, model.geometry)
     np.testing.assert_allclose(cor[:, 0], -0.03)
     np.testing.assert_allclose(cor[:, 1], model.geometry.cor_heights)
+
+
+def test_coefficients_equal_the_per_fibre_sums(model):
+    """The monomial form of segment_coefficients equals the per-fibre formulas summed directly (torque h f_l,
+    stiffness h' f_l - h^2 f_l', damping h^2 f_l f_H'(0); lever arms from fibre_length_and_lever_arm and
+    lever_arm_slope) to rounding, at CoRs over and beyond the paper's range."""
+    axis = np.linspace(-0.08, 0.08, 9)
+    e, lam = np.meshgrid(axis, axis, indexing="ij")
+    coeffs = mechanics.segment_coefficients(model, e, lam)
+    expected = mechanics.per_fibre_sums(model, e, lam)
+    for name, value in zip(("torque_per_pcsa", "stiffness_per_pcsa", "damping_per_pcsa"), expected, strict=True):
+        got = getattr(coeffs, name)
+        np.testing.assert_allclose(got, value, rtol=0, atol=1e-13 * np.abs(value).max(), err_msg=name)

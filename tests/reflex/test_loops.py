@@ -110,3 +110,19 @@ def test_subnormal_coefficients_give_the_margins_of_zero_without_warnings():
         warnings.simplefilter("error")
         tiny = loops.loop_margins(loops.loop_transfer(s, -1.1e-308, theta, kp, kd, tau, 5), stable=True)
     assert tiny == exact
+
+
+@pytest.mark.parametrize(
+    "segment",
+    [(30.0, -6.0, 2.0, 45.0, 4.0, 0.0), (49.8, -14.75, 2.58, 74.7, 22.1, 0.1), (-20.0, -5.0, 2.0, 0.0, 0.0, 0.1)],
+    ids=["rational", "delayed", "no-reflex"],
+)
+def test_loop_margins_pick_the_margins_python_control_picks(segment):
+    """One ``stability_margins(returnall=True)`` call gives the gain and phase margins (and their
+    frequencies) that python-control's own ``stability_margins(loop)`` returns (the second method)."""
+    s, d, theta, kp, kd, tau = segment
+    loop = loops.loop_transfer(s, d, theta, kp, kd, tau, 5)
+    gm, pm, _, wpc, wgc, _ = ct.stability_margins(loop)
+    margins = loops.loop_margins(loop, stable=True)
+    got = (margins.gain_margin, margins.phase_margin_deg, margins.phase_crossover_rad_s, margins.crossover_rad_s)
+    np.testing.assert_array_equal(got, (gm, pm, wpc, wgc))

@@ -1,7 +1,7 @@
 """The landscapes the landmarks are measured on: coarse ones for fitting, the paper's grid for verifying.
 
 The fitting landscapes are coarse (17 x 17 by default) and use the fast path
-(:mod:`spinectl.optimise.stacked`); the K = 15 N m/rad landscape needs only the minimum
+(:mod:`spinectl.optimise.active_set`); the K = 15 N m/rad landscape needs only the minimum
 PCSA (stage 1). The fitted model is measured again on the paper's 81 x 81 grid
 with full sweeps (:func:`measure_model`), as ``spinectl reproduce`` does.
 """
@@ -13,7 +13,7 @@ import xarray as xr
 
 from ...model.checks import checked_coefficients
 from ...model.params import Model
-from ...optimise import stacked
+from ...optimise import active_set
 from ...optimise.problem import problem_data
 from ...units import m2_to_cm2
 from .. import grid, landmarks
@@ -29,7 +29,7 @@ def coarse_landscape(model: Model, axis, *, counter_torque: bool = True) -> xr.D
 
     The variables that :func:`spinectl.paper.landmarks.measure` reads, without the rest
     of a :func:`spinectl.landscape.sweep.sweep` Dataset. Without ``counter_torque`` only
-    stage 1 is solved (:func:`spinectl.optimise.stacked.solve_stacked`), and
+    stage 1 is solved (:func:`spinectl.optimise.active_set.solve_block`), and
     ``counter_torque_norm_Nm`` is absent.
 
     Parameters
@@ -49,7 +49,7 @@ def coarse_landscape(model: Model, axis, *, counter_torque: bool = True) -> xr.D
     axis = np.asarray(axis, float)
     e, lam = (a.ravel() for a in np.meshgrid(axis, axis, indexing="ij"))
     data = problem_data(model, checked_coefficients(model, e, lam))
-    result = stacked.solve_stacked(data, model.optimisation.ct_tolerance, min_pcsa_only=not counter_torque)
+    result = active_set.solve_block(data, model.optimisation.ct_tolerance, min_pcsa_only=not counter_torque)
     shape, dims = (axis.size, axis.size), ("E", "Lambda")
     variables = {"min_pcsa_cm2": (dims, m2_to_cm2(result.min_pcsa).reshape(shape))}
     if counter_torque:
