@@ -201,15 +201,16 @@ def test_the_default_preset_is_the_calibrated_one():
 
 
 def test_diff_lists_every_differing_parameter_with_its_unit():
-    """wagner2012 against default: the calibrated mass, attachments, spreads and the K convention (the
-    calibration's free parameters and its chosen convention, docs/reproduction.md)."""
+    """wagner2012 against default: the calibrated mass, attachments and spreads (the calibration's free
+    parameters, docs/reproduction.md); both use the physical K convention, which wagner2012_mass_free does not."""
     differences = {d.name: d for d in config.diff_models(BASE, config.load_preset("default"))}
     assert differences["body.mass"].unit == "kg" and differences["body.mass"].second == 40.0
-    assert differences["passive.convention"].line() == "passive.convention: paper -> physical"
-    assert set(differences) == {"body.mass", "passive.convention"} | {
+    assert set(differences) == {"body.mass"} | {
         f"muscles.{pair}.{field}" for pair in BASE.pair_names for field in ("upper", "lower", "spread")
     }
     assert config.diff_models(BASE, BASE) == []
+    free = {d.name: d for d in config.diff_models(config.load_preset("wagner2012_mass_free"), BASE)}
+    assert free["passive.convention"].line() == "passive.convention: paper -> physical"  # the presets' files
 
 
 def test_diff_matches_pairs_by_name():
