@@ -7,8 +7,10 @@ In-process, without a browser (the browser adds its own rendering):
 
 - a point: :meth:`spinectl.explore.app.Explorer.update_point` after a move of E, split
   into the numbers (:func:`spinectl.explore.numbers.point_numbers`: the optimum, the
-  margins, the eigenvalues) and the pictures (the drawing and three views as PNG); and
-  after a move of the delay slider, which redraws the margins only;
+  margins, the eigenvalues) and the pictures: the drawing as PNG, and the three small views
+  (eigenvalues, counter torques, delay margins) as Bokeh data updates, against the same
+  three drawn as matplotlib PNGs, as the explorer did before (the reference); and after a
+  move of the delay slider, which updates the margins only;
 - the landscapes: :func:`spinectl.explore.numbers.landscapes` at 41 x 41 on the stacked
   fast path, against the per-point reference solver on the same grid's every 4th point
   per axis (11 x 11), scaled per point: the ratio is the fast path's speed-up.
@@ -58,14 +60,26 @@ def main() -> None:
     )
     shown = numbers.point_numbers(base, state)
 
-    def pictures(i):
-        app.drawing_png(shown)
-        for plot in (views.eigenvalue_plot, views.counter_torque_plot, views.delay_margin_plot):
-            app.png_bytes(plot(shown))
+    drawing = _median(lambda i: app.drawing_png(shown), args.repeats)
 
-    drawn = _median(pictures, args.repeats)
-    print(f"point update: {point:.3f} s (numbers {computed:.3f} s, drawing and views as PNG {drawn:.3f} s)")
-    print(f"a reflex slider (delay): {reflex:.3f} s (the margins view only is redrawn)")
+    def bokeh_views(i):
+        for view in explorer.views.values():
+            view.show(shown)
+
+    updated = _median(bokeh_views, args.repeats)
+    as_png = _median(
+        lambda i: [
+            app.png_bytes(plot(shown))
+            for plot in (views.eigenvalue_plot, views.counter_torque_plot, views.delay_margin_plot)
+        ],
+        args.repeats,
+    )
+    print(
+        f"point update: {point:.3f} s (numbers {computed:.3f} s, drawing as PNG {drawing:.3f} s, "
+        f"three views as Bokeh data {updated * 1e3:.1f} ms; as matplotlib PNGs they took {as_png:.3f} s, "
+        f"{as_png / updated:.0f} x longer)"
+    )
+    print(f"a reflex slider (delay): {reflex:.3f} s (the margins view only is updated)")
 
     fast = _median(lambda i: numbers.landscapes(base, replace(state, mass=30.0 + i)), 2)
     axis = numbers.landscape_axis()[::4]

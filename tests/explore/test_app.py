@@ -13,6 +13,7 @@ from spinectl.explore import app
 from spinectl.explore import numbers as nb
 from spinectl.explore.state import initial_state, replace
 from spinectl.model.config import load_preset
+from spinectl.paper.landmarks import CT_LIMIT
 
 
 @pytest.fixture(scope="module")
@@ -132,13 +133,34 @@ def test_the_delay_redraws_the_margins_only():
     objects; the margins view and the table follow (state.REFLEX_ONLY). At the README's point of 'default' every
     delay margin is finite (0.22 to 0.42 s), so a longer lag changes them."""
     explorer = app.Explorer(load_preset("default"), "default")
-    kept = {name: pane.object for name, pane in explorer.views.items()} | {"drawing": explorer.drawing.object}
-    margins, table = explorer.views["delay_margins"].object, explorer.table.object
+    kept = {name: view.source.data for name, view in explorer.views.items()} | {"drawing": explorer.drawing.object}
+    table = explorer.table.object
     _drag(explorer.sliders["activation_lag"], 100.0)
     assert explorer.state.activation_lag == pytest.approx(0.1)
     for name in ("eigenvalues", "counter_torques"):
-        assert explorer.views[name].object is kept[name]
+        assert explorer.views[name].source.data is kept[name]
     assert explorer.drawing.object is kept["drawing"]
-    assert explorer.views["delay_margins"].object != margins and explorer.table.object != table
+    margins = explorer.views["delay_margins"].source.data["value"]
+    assert margins != kept["delay_margins"]["value"] and explorer.table.object != table
     expected = nb.point_numbers(explorer.base, explorer.state)
-    assert explorer.views["delay_margins"].object == app.png_bytes(app.views.delay_margin_plot(expected))
+    np.testing.assert_allclose(margins, expected.delay_margin * 1000, rtol=1e-12)
+
+
+def test_the_bokeh_views_plot_the_librarys_numbers(explorer):
+    """Read back from the Bokeh views' data sources: the eigenvalues (paper eq. 1), CT_k [N m] and the exact
+    delay margins [ms] of point_numbers at the state, the delay line at tau [ms], the +-30 N m band."""
+    explorer.move_to(0.035, 0.045)
+    expected = nb.point_numbers(explorer.base, explorer.state)
+    eigen = explorer.views["eigenvalues"].source.data
+    np.testing.assert_allclose(eigen["re"], expected.eigenvalues.real.ravel(), rtol=1e-12)
+    np.testing.assert_allclose(eigen["im"], expected.eigenvalues.imag.ravel(), rtol=1e-12)
+    assert eigen["segment"][::2] == list(expected.segment_names)
+    torques = explorer.views["counter_torques"]
+    np.testing.assert_allclose(torques.source.data["value"], expected.counter_torque, rtol=1e-12)
+    band = next(r for r in torques.figure.center if isinstance(r, app.BoxAnnotation))
+    assert (band.bottom, band.top) == (-CT_LIMIT, CT_LIMIT)
+    margins = explorer.views["delay_margins"]
+    finite = np.isfinite(expected.delay_margin)  # an infinite margin (any delay): a bar of 0 marked '∞'
+    np.testing.assert_allclose(margins.source.data["value"], np.where(finite, expected.delay_margin * 1000, 0.0))
+    assert [m == "∞" for m in margins.source.data["mark"]] == list(~finite)
+    assert margins.line.location == pytest.approx(explorer.state.delay * 1000)
