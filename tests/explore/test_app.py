@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-import base64
+import xml.etree.ElementTree as ET
 
 import numpy as np
 import param
@@ -28,12 +28,12 @@ def _drag(slider, value):
 
 
 def test_views_show_the_numbers_of_the_state(explorer):
-    """The table's cells are PointNumbers.rows(); the drawing is drawing_png of the same numbers, byte for byte."""
+    """The table's cells are PointNumbers.rows(); the drawing is drawing_svg of the same numbers, byte for byte."""
     expected = nb.point_numbers(explorer.base, explorer.state)
     for row in expected.rows():
         for key in app.ROW_KEYS:
             assert f'<td data-key="{key}">{row[key]}</td>' in explorer.table.object
-    assert explorer.drawing.object == app.drawing_png(expected)
+    assert explorer.drawing.object == app.drawing_svg(expected)
     assert explorer.dataset is not None  # outside a server session the landscapes are solved at once
     assert "point updated in" in explorer.status.object
 
@@ -45,7 +45,7 @@ def test_a_slider_moves_the_point_and_the_views_follow(explorer):
     assert explorer.state.eccentricity == pytest.approx(0.052, abs=1e-15)
     expected = nb.point_numbers(explorer.base, explorer.state)
     assert f'<td data-key="counter_torque_Nm">{expected.rows()[0]["counter_torque_Nm"]}</td>' in explorer.table.object
-    assert explorer.drawing.object != before and explorer.drawing.object == app.drawing_png(expected)
+    assert explorer.drawing.object != before and explorer.drawing.object == app.drawing_svg(expected)
     for view in explorer.maps.values():
         assert view.marker.data == {"x": [pytest.approx(5.2)], "y": [pytest.approx(4.0)]}
 
@@ -86,11 +86,14 @@ def test_exports_toml_and_png(explorer):
     assert png.callback().getvalue().startswith(b"\x89PNG")
 
 
-def test_png_bytes_are_reproducible(explorer):
-    """The same figure at the same dpi gives the same bytes (no timestamp): the browser test relies on it."""
+def test_the_drawing_svg_is_reproducible_and_keeps_its_words_as_text(explorer):
+    """The same numbers give the same SVG text (no date, fixed ids): the browser test relies on it. It parses
+    as XML, and each CoR's name is an SVG text element (svg.fonttype none), not glyphs drawn as paths."""
     numbers = nb.point_numbers(explorer.base, explorer.state)
-    assert app.drawing_png(numbers) == app.drawing_png(numbers)
-    assert base64.b64encode(app.drawing_png(numbers))[:8] == b"iVBORw0K"
+    svg = app.drawing_svg(numbers)
+    assert svg == app.drawing_svg(numbers) and svg.startswith("<svg")
+    texts = {"".join(t.itertext()).strip() for t in ET.fromstring(svg).iter("{http://www.w3.org/2000/svg}text")}
+    assert set(numbers.segment_names) <= texts
 
 
 def test_a_model_invalid_at_the_point_is_a_message_not_a_crash(explorer, monkeypatch):
