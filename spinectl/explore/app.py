@@ -53,6 +53,8 @@ DPI = 80
 """Pixels per inch of the model drawing in the browser."""
 VIEW_PIXELS = (300, 240)
 """Width and height of a small view (eigenvalues, counter torques, delay margins) [px]."""
+EIGENVALUE_LEGEND_PIXELS = 70
+"""Width of the eigenvalue view's legend, beside the plane [px]."""
 LANDSCAPE_PIXELS = 300
 """Width and height of a landscape view [px]."""
 CONFIG_CHOICE = "--config"
@@ -323,7 +325,7 @@ BAR_VIEWS = {
 
 
 def _small_figure(x_range, y_range, **options):
-    return bokeh_figure(
+    figure = bokeh_figure(
         width=VIEW_PIXELS[0],
         height=VIEW_PIXELS[1],
         x_range=x_range,
@@ -332,6 +334,8 @@ def _small_figure(x_range, y_range, **options):
         toolbar_location=None,
         **options,
     )
+    figure.title.text_font_size = "8pt"
+    return figure
 
 
 def _hex(columns: dict) -> dict:
@@ -355,7 +359,8 @@ class _EigenvalueView:
         self.figure.scatter(
             "re", "im", source=self.source, marker="x", size=10, line_width=2, color="colour", legend_field="segment"
         )
-        self.figure.legend.location = "top_left"
+        self.figure.width += EIGENVALUE_LEGEND_PIXELS
+        self.figure.add_layout(self.figure.legend[0], "right")  # beside the plane: it hid eigenvalues inside
         self.figure.legend.label_text_font_size = "8pt"
         self.pane = pn.pane.Bokeh(self.figure, name=self.name)
 
@@ -391,7 +396,7 @@ class _BarView:
         self.source.data = _hex(data.columns)
         self.figure.y_range.update(start=data.limits[0], end=data.limits[1])
         self.line.update(location=data.line or 0.0, visible=data.line is not None)
-        self.figure.title.text = data.title if data.line is None else f"{data.title}; τ = {data.line:g} ms (dashed)"
+        self.figure.title.text = data.title
 
 
 class _LandscapeView:

@@ -137,14 +137,14 @@ def delay_margin_data(numbers: PointNumbers) -> ViewData:
     -------
     ViewData
         Columns ``segment``, ``colour``, ``value`` [ms] and ``mark`` ('∞': any delay); ``line`` the
-        delay tau [ms]; limits from 0 to 1.2 x the largest of tau, the finite margins and 1 ms.
+        delay tau [ms], which the title gives; limits from 0 to 1.2 x the largest of tau, the finite margins and 1 ms.
     """
     margins = numbers.delay_margin * MS_PER_S
     delay = numbers.state.delay * MS_PER_S
     colours = ["tab:green" if ok else "tab:red" for ok in numbers.stable_at_delay]
     top = 1.2 * max(delay, float(np.max(margins[np.isfinite(margins)], initial=0.0)), 1.0)
     columns = _bar_columns(numbers.segment_names, margins, colours)
-    return ViewData(columns, (0.0, top), "delay margins (red: unstable at τ)", delay)
+    return ViewData(columns, (0.0, top), f"delay margins (red: unstable at τ = {delay:g} ms)", delay)
 
 
 def _axes(ax):
