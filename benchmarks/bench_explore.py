@@ -7,8 +7,11 @@ In-process, without a browser (the browser adds its own rendering):
 
 - a point: :meth:`spinectl.explore.app.Explorer.update_point` after a move of E, split
   into the numbers (:func:`spinectl.explore.numbers.point_numbers`: the optimum, the
-  margins, the eigenvalues) and the pictures (the drawing and three views as PNG); and
-  after a move of the delay slider, which redraws the margins only;
+  margins, the eigenvalues) and the pictures: the drawing as SVG, and the three small views
+  (eigenvalues, counter torques, delay margins) as Bokeh data updates, each against what
+  the explorer did before in the same run (the reference): the drawing as PNG, the three
+  views drawn as matplotlib PNGs; and after a move of the delay slider, which updates the
+  margins only;
 - the landscapes: :func:`spinectl.explore.numbers.landscapes` at 41 x 41 on the stacked
   fast path, against the per-point reference solver on the same grid's every 4th point
   per axis (11 x 11), scaled per point: the ratio is the fast path's speed-up.
@@ -58,14 +61,31 @@ def main() -> None:
     )
     shown = numbers.point_numbers(base, state)
 
-    def pictures(i):
-        app.drawing_png(shown)
-        for plot in (views.eigenvalue_plot, views.counter_torque_plot, views.delay_margin_plot):
-            app.png_bytes(plot(shown))
+    drawing = _median(lambda i: app.drawing_svg(shown), args.repeats)
+    drawing_png = _median(lambda i: app.png_bytes(views.model_drawing(shown)), args.repeats)
 
-    drawn = _median(pictures, args.repeats)
-    print(f"point update: {point:.3f} s (numbers {computed:.3f} s, drawing and views as PNG {drawn:.3f} s)")
-    print(f"a reflex slider (delay): {reflex:.3f} s (the margins view only is redrawn)")
+    def bokeh_views(i):
+        for view in explorer.views.values():
+            view.show(shown)
+
+    updated = _median(bokeh_views, args.repeats)
+    as_png = _median(
+        lambda i: [
+            app.png_bytes(plot(shown))
+            for plot in (views.eigenvalue_plot, views.counter_torque_plot, views.delay_margin_plot)
+        ],
+        args.repeats,
+    )
+    before = computed + drawing_png + as_png
+    print(
+        f"point update: {point:.3f} s (numbers {computed:.3f} s, drawing as SVG {drawing:.3f} s, "
+        f"three views as Bokeh data {updated * 1e3:.1f} ms)"
+    )
+    print(
+        f"  as before (drawing as PNG {drawing_png:.3f} s, the three views as matplotlib PNGs {as_png:.3f} s): "
+        f"{before:.3f} s, {before / point:.1f} x the update now"
+    )
+    print(f"a reflex slider (delay): {reflex:.3f} s (the margins view only is updated)")
 
     fast = _median(lambda i: numbers.landscapes(base, replace(state, mass=30.0 + i)), 2)
     axis = numbers.landscape_axis()[::4]

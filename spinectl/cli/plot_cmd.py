@@ -21,6 +21,7 @@ def register(sub) -> None:
         description="Filled contours of the minimum PCSA (Fig. 3; Fig. S1 for K > 0) and of ||CT|| "
         "(Fig. 4, with the +-30 N m limit), on any grid: positions A-D where they lie inside it, the "
         "grid's other corners by their coordinates, the ridge Lambda = 1.7 E and the paper's optimum; "
+        "for a 'sweep --coupled' also the ratio coupled / per segment of the global PCSA; "
         "as PNG, PDF or SVG files.",
     )
     parser.defer(_options)

@@ -3,9 +3,12 @@
 docs/explore.md. :class:`Explorer` holds one session's state and its views;
 :func:`explorer` returns its layout, which shows itself inline in a Jupyter notebook
 (after ``panel.extension()``), and :func:`serve` serves it on the loopback interface
-(``spinectl explore``). Every number comes from :mod:`spinectl.explore.numbers`, every
-picture but the landscapes from :mod:`spinectl.explore.views`; the landscapes are Bokeh
-images so that a click on them moves the point. They are solved again, in a worker
+(``spinectl explore``). Every number comes from :mod:`spinectl.explore.numbers`. The model
+drawing is matplotlib's (:func:`spinectl.explore.views.model_drawing`, as SVG); the
+eigenvalues, counter torques and delay margins are Bokeh plots whose data
+(:func:`spinectl.explore.views.eigenvalue_data` and its siblings, the same data as the PNG
+export's matplotlib views) is replaced on a move, not re-rendered on the server; the
+landscapes are Bokeh images so that a click on them moves the point. They are solved again, in a worker
 thread with a progress indicator, only when the mass, K or the model change.
 
 Needs the ``explore`` extra (``pip install 'spinectl[explore]'``: Panel, which brings Bokeh).
@@ -18,16 +21,19 @@ import html
 import io
 import time
 
+import matplotlib
 import numpy as np
 import panel as pn
 import xarray as xr
 from bokeh.events import Tap
-from bokeh.models import ColorBar, ColumnDataSource, LinearColorMapper
+from bokeh.models import BoxAnnotation, ColorBar, ColumnDataSource, FactorRange, LinearColorMapper, Range1d, Span
 from bokeh.plotting import figure as bokeh_figure
+from matplotlib.colors import to_hex
 
 from ..errors import SpinectlError
 from ..model.config import DEFAULT_PRESET, list_presets, load_preset
 from ..model.params import Model
+from ..paper.landmarks import CT_LIMIT
 from ..units import CM_PER_M, m2_to_cm2
 from . import views
 from .numbers import LANDSCAPE_POINTS, PointNumbers, landscape_axis, landscapes, point_numbers
@@ -44,7 +50,11 @@ from .state import (
 )
 
 DPI = 80
-"""Resolution of the matplotlib views in the browser [dots per inch]."""
+"""Pixels per inch of the model drawing in the browser."""
+VIEW_PIXELS = (300, 240)
+"""Width and height of a small view (eigenvalues, counter torques, delay margins) [px]."""
+EIGENVALUE_LEGEND_PIXELS = 70
+"""Width of the eigenvalue view's legend, beside the plane [px]."""
 LANDSCAPE_PIXELS = 300
 """Width and height of a landscape view [px]."""
 CONFIG_CHOICE = "--config"
@@ -74,8 +84,10 @@ def png_bytes(fig, dpi: float = DPI) -> bytes:
     return buffer.getvalue()
 
 
-def drawing_png(numbers: PointNumbers) -> bytes:
-    """The model drawing of :func:`spinectl.explore.views.model_drawing` as PNG at :data:`DPI`.
+def drawing_svg(numbers: PointNumbers) -> str:
+    """The model drawing of :func:`spinectl.explore.views.model_drawing` as SVG, its words as SVG text.
+
+    The browser sets the glyphs: about 40 % faster than a PNG, in which matplotlib rasterises them.
 
     Parameters
     ----------
@@ -83,9 +95,14 @@ def drawing_png(numbers: PointNumbers) -> bytes:
 
     Returns
     -------
-    bytes
+    str
+        The ``<svg>`` element (no XML prolog); the same numbers give the same text (fixed ids, no date).
     """
-    return png_bytes(views.model_drawing(numbers))
+    buffer = io.StringIO()
+    with matplotlib.rc_context({"svg.fonttype": "none", "svg.hashsalt": "spinectl"}):
+        views.model_drawing(numbers).savefig(buffer, format="svg", metadata={"Date": None})
+    text = buffer.getvalue()
+    return text[text.index("<svg") :]
 
 
 def table_html(numbers: PointNumbers) -> str:
@@ -138,8 +155,8 @@ class Explorer:
             label="preset", value=preset, options=[*self.models, *list_presets()], width=260
         )
         self.sliders = {s.field: self._slider(s) for s in SLIDERS}
-        self.drawing = pn.pane.PNG(None, width=int(views.DRAWING_SIZE[0] * DPI), name="drawing")
-        self.views = {name: pn.pane.PNG(None, width=int(views.VIEW_SIZE[0] * DPI), name=name) for name in VIEWS}
+        self.drawing = pn.pane.SVG(None, width=int(views.DRAWING_SIZE[0] * DPI), name="drawing")
+        self.views = {"eigenvalues": _EigenvalueView(), **{name: _BarView(name) for name in BAR_VIEWS}}
         self.table = pn.pane.HTML("", name="numbers")
         self.status = pn.pane.Markdown("", name="status")
         self.progress = pn.indicators.Progress(active=False, visible=False, width=200)
@@ -178,8 +195,8 @@ class Explorer:
         controls = pn.Column(
             "## spinectl explore", self.preset, *self.sliders.values(), toml, png, self.progress, self.status, width=290
         )
-        point = pn.Row(self.drawing, self.views["eigenvalues"], self.views["counter_torques"])
-        below = pn.Row(self.views["delay_margins"], *(view.pane for view in self.maps.values()))
+        point = pn.Row(self.drawing, self.views["eigenvalues"].pane, self.views["counter_torques"].pane)
+        below = pn.Row(self.views["delay_margins"].pane, *(view.pane for view in self.maps.values()))
         return pn.Row(controls, pn.Column(point, below, self.table))
 
     # --- events ---------------------------------------------------------------------------
@@ -242,15 +259,15 @@ class Explorer:
             self.status.object = f"**not shown:** {html.escape(str(exc))}"
             return time.perf_counter() - start
         key = (id(self.base), pictures_key(self.state))
-        pictures = {"delay_margins": png_bytes(views.delay_margin_plot(numbers))}
-        if key != self._pictures_key:  # the delay and the lag move the margins only: redraw the rest only if needed
-            pictures["eigenvalues"] = png_bytes(views.eigenvalue_plot(numbers))
-            pictures["counter_torques"] = png_bytes(views.counter_torque_plot(numbers))
-            pictures["drawing"] = drawing_png(numbers)
+        changed = key != self._pictures_key  # the delay and the lag move the margins only: redraw the rest if needed
+        drawing = drawing_svg(numbers) if changed else None
         with pn.io.hold():
             self.numbers, self._pictures_key = numbers, key
-            for name, png in pictures.items():
-                (self.drawing if name == "drawing" else self.views[name]).object = png
+            if changed:
+                self.drawing.object = drawing
+            for view in self.views.values():
+                if changed or view.name == "delay_margins":
+                    view.show(numbers)
             self.table.object = table_html(numbers)
             for view in self.maps.values():
                 view.mark(self.state)
@@ -300,8 +317,86 @@ class Explorer:
         )
 
 
-VIEWS = ("eigenvalues", "counter_torques", "delay_margins")
-"""The matplotlib views of the point, beside the drawing."""
+BAR_VIEWS = {
+    "counter_torques": (views.counter_torque_data, "CT [N m]"),
+    "delay_margins": (views.delay_margin_data, "delay margin [ms]"),
+}
+"""The bar views of the point: their data function (:mod:`spinectl.explore.views`) and value axis."""
+
+
+def _small_figure(x_range, y_range, **options):
+    figure = bokeh_figure(
+        width=VIEW_PIXELS[0],
+        height=VIEW_PIXELS[1],
+        x_range=x_range,
+        y_range=y_range,
+        tools="",
+        toolbar_location=None,
+        **options,
+    )
+    figure.title.text_font_size = "8pt"
+    return figure
+
+
+def _hex(columns: dict) -> dict:
+    """The columns with matplotlib's colour names as hex, which Bokeh reads."""
+    return {**columns, "colour": [to_hex(c) for c in columns["colour"]]}
+
+
+class _EigenvalueView:
+    """Both eigenvalues of each segment as markers in the complex plane (Bokeh), the unstable half shaded."""
+
+    name = "eigenvalues"
+
+    def __init__(self):
+        self.source = ColumnDataSource({"segment": [], "colour": [], "re": [], "im": []})
+        self.figure = _small_figure(
+            Range1d(-1, 1), Range1d(-1, 1), x_axis_label="Re λ [1/s]", y_axis_label="Im λ [1/s]"
+        )
+        self.figure.add_layout(BoxAnnotation(left=0, fill_color="red", fill_alpha=0.08, line_alpha=0))
+        for dimension in ("width", "height"):
+            self.figure.add_layout(Span(location=0, dimension=dimension, line_color="gray", line_width=0.8))
+        self.figure.scatter(
+            "re", "im", source=self.source, marker="x", size=10, line_width=2, color="colour", legend_field="segment"
+        )
+        self.figure.width += EIGENVALUE_LEGEND_PIXELS
+        self.figure.add_layout(self.figure.legend[0], "right")  # beside the plane: it hid eigenvalues inside
+        self.figure.legend.label_text_font_size = "8pt"
+        self.pane = pn.pane.Bokeh(self.figure, name=self.name)
+
+    def show(self, numbers: PointNumbers) -> None:
+        data = views.eigenvalue_data(numbers)
+        self.source.data = _hex(data.columns)
+        for axis in (self.figure.x_range, self.figure.y_range):
+            axis.update(start=data.limits[0], end=data.limits[1])
+        self.figure.title.text = data.title
+
+
+class _BarView:
+    """Bars per segment (Bokeh): the counter torques with the local muscles' band, or the delay margins and tau."""
+
+    def __init__(self, name: str):
+        self.name = name
+        self.data_of, label = BAR_VIEWS[name]
+        self.source = ColumnDataSource({"segment": [], "colour": [], "value": [], "mark": []})
+        self.figure = _small_figure(FactorRange(), Range1d(0, 1), y_axis_label=label)
+        self.figure.add_layout(Span(location=0, dimension="width", line_color="gray", line_width=0.8))
+        if name == "counter_torques":  # the local muscles' +-30 N m (paper, Discussion)
+            band = BoxAnnotation(bottom=-CT_LIMIT, top=CT_LIMIT, fill_color="green", fill_alpha=0.12, line_alpha=0)
+            self.figure.add_layout(band)
+        self.line = Span(location=0, dimension="width", line_color="black", line_dash="dashed", visible=False)
+        self.figure.add_layout(self.line)
+        self.figure.vbar(x="segment", top="value", width=0.8, color="colour", source=self.source)
+        self.figure.text(x="segment", y=0, text="mark", source=self.source, text_align="center", text_font_size="9pt")
+        self.pane = pn.pane.Bokeh(self.figure, name=name)
+
+    def show(self, numbers: PointNumbers) -> None:
+        data = self.data_of(numbers)
+        self.figure.x_range.factors = list(data.columns["segment"])
+        self.source.data = _hex(data.columns)
+        self.figure.y_range.update(start=data.limits[0], end=data.limits[1])
+        self.line.update(location=data.line or 0.0, visible=data.line is not None)
+        self.figure.title.text = data.title
 
 
 class _LandscapeView:

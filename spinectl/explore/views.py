@@ -1,11 +1,17 @@
-"""The explorer's views drawn with matplotlib: eigenvalues, counter torques, delay margins, landscapes.
+"""The explorer's views: their data as pure functions, and drawn with matplotlib.
 
-Each function draws into given Axes or on a new figure (:func:`spinectl.canvas.new_figure`)
+:func:`eigenvalue_data`, :func:`counter_torque_data` and :func:`delay_margin_data` map the
+numbers of a point to what a view shows (columns, limits, title): the one source of the
+numbers both for the matplotlib views here (the PNG export) and for the explorer's live
+Bokeh views (:mod:`spinectl.explore.app`), which only map them to glyphs.
+Each ``*_plot`` function draws into given Axes or on a new figure (:func:`spinectl.canvas.new_figure`)
 and writes nothing; :func:`state_figure` puts them, with the model drawing
 (:func:`spinectl.paper.drawing.draw_model`), on one figure: the explorer's PNG export.
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 import xarray as xr
@@ -32,6 +38,113 @@ LANDSCAPE_LABELS = {
     "counter_torque_norm_Nm": "‖CT‖ [N m]",
 }
 """The landscapes shown and their colour-bar labels."""
+
+
+MS_PER_S = 1000.0
+"""Milliseconds per second: the delay margins are shown in ms."""
+
+
+@dataclass(frozen=True)
+class ViewData:
+    """What one small view shows, ready for any plotting library.
+
+    Attributes
+    ----------
+    columns : dict of str to list
+        Equal-length columns, one row per glyph (a marker or a bar): ``segment`` and ``colour``
+        and the view's values (see each ``*_data`` function).
+    limits : tuple of float
+        (low, high) of the value axis (both axes for the eigenvalues).
+    title : str
+    line : float or None
+        A level drawn across the view (the delay [ms]), or None.
+    """
+
+    columns: dict
+    limits: tuple[float, float]
+    title: str
+    line: float | None = None
+
+
+def eigenvalue_data(numbers: PointNumbers) -> ViewData:
+    """Both eigenvalues of each segment (paper eq. 1) as markers.
+
+    Parameters
+    ----------
+    numbers : PointNumbers
+
+    Returns
+    -------
+    ViewData
+        Columns ``segment``, ``colour``, ``re`` and ``im`` [1/s], two rows per segment; limits
+        symmetric about 0 and at least +-1.1 1/s, for both axes.
+    """
+    names = numbers.segment_names
+    colours = _colours(len(names))
+    eigs = numbers.eigenvalues
+    finite = eigs[np.isfinite(eigs)]
+    reach = 1.1 * max(
+        1.0, float(np.max(np.abs(finite.real), initial=0.0)), float(np.max(np.abs(finite.imag), initial=0.0))
+    )
+    columns = {
+        "segment": [name for name in names for _ in range(eigs.shape[1])],
+        "colour": [colour for colour in colours for _ in range(eigs.shape[1])],
+        "re": eigs.real.ravel().tolist(),
+        "im": eigs.imag.ravel().tolist(),
+    }
+    return ViewData(columns, (-reach, reach), "eigenvalues per segment (shaded: unstable)")
+
+
+def _bar_columns(names, values, colours) -> dict:
+    """Bars of finite height (0 where a value is not finite) and a mark for those: '∞' or 'n/a'."""
+    values = np.asarray(values, float)
+    return {
+        "segment": list(names),
+        "colour": list(colours),
+        "value": np.where(np.isfinite(values), values, 0.0).tolist(),
+        "mark": ["" if np.isfinite(v) else ("∞" if v > 0 else "n/a") for v in values],
+    }
+
+
+def counter_torque_data(numbers: PointNumbers) -> ViewData:
+    """CT_k of each segment [N m] as bars, with room for the +-30 N m band.
+
+    Parameters
+    ----------
+    numbers : PointNumbers
+
+    Returns
+    -------
+    ViewData
+        Columns ``segment``, ``colour``, ``value`` [N m] and ``mark``; limits symmetric, at least
+        1.15 x :data:`spinectl.paper.landmarks.CT_LIMIT` (paper, Discussion); the title gives ||CT||.
+    """
+    names = numbers.segment_names
+    finite = numbers.counter_torque[np.isfinite(numbers.counter_torque)]
+    reach = 1.15 * max(CT_LIMIT, float(np.max(np.abs(finite), initial=0.0)))
+    title = f"counter torques, ‖CT‖ = {np.linalg.norm(numbers.counter_torque):.3g} N m"
+    return ViewData(_bar_columns(names, numbers.counter_torque, _colours(len(names))), (-reach, reach), title)
+
+
+def delay_margin_data(numbers: PointNumbers) -> ViewData:
+    """The exact delay margin of each segment [ms] as bars, green where stable at the delay, and the delay.
+
+    Parameters
+    ----------
+    numbers : PointNumbers
+
+    Returns
+    -------
+    ViewData
+        Columns ``segment``, ``colour``, ``value`` [ms] and ``mark`` ('∞': any delay); ``line`` the
+        delay tau [ms], which the title gives; limits from 0 to 1.2 x the largest of tau, the finite margins and 1 ms.
+    """
+    margins = numbers.delay_margin * MS_PER_S
+    delay = numbers.state.delay * MS_PER_S
+    colours = ["tab:green" if ok else "tab:red" for ok in numbers.stable_at_delay]
+    top = 1.2 * max(delay, float(np.max(margins[np.isfinite(margins)], initial=0.0)), 1.0)
+    columns = _bar_columns(numbers.segment_names, margins, colours)
+    return ViewData(columns, (0.0, top), f"delay margins (red: unstable at τ = {delay:g} ms)", delay)
 
 
 def _axes(ax):
@@ -88,32 +201,34 @@ def eigenvalue_plot(numbers: PointNumbers, ax=None) -> Figure:
     matplotlib.figure.Figure
         Re lambda [1/s] across, Im lambda [1/s] up; the unstable half plane shaded.
     """
+    data = eigenvalue_data(numbers)
     ax = _axes(ax)
     ax.axvspan(0, 1, transform=ax.get_yaxis_transform(), color="tab:red", alpha=0.08, lw=0)
     ax.axvline(0, color="0.3", lw=0.8)
     ax.axhline(0, color="0.7", lw=0.5)
-    for name, eigs, colour in zip(
-        numbers.segment_names, numbers.eigenvalues, _colours(len(numbers.segment_names)), strict=True
-    ):
-        ax.plot(eigs.real, eigs.imag, "x", color=colour, ms=7, mew=2, label=name)
-    finite = numbers.eigenvalues[np.isfinite(numbers.eigenvalues)]
-    reach = max(1.0, float(np.max(np.abs(finite.real), initial=0.0)), float(np.max(np.abs(finite.imag), initial=0.0)))
-    ax.set_xlim(-1.1 * reach, 1.1 * reach)
-    ax.set_ylim(-1.1 * reach, 1.1 * reach)
+    columns = data.columns
+    for name in dict.fromkeys(columns["segment"]):
+        rows = [i for i, segment in enumerate(columns["segment"]) if segment == name]
+        re, im = (np.array(columns[key])[rows] for key in ("re", "im"))
+        ax.plot(re, im, "x", color=columns["colour"][rows[0]], ms=7, mew=2, label=name)
+    ax.set_xlim(*data.limits)
+    ax.set_ylim(*data.limits)
     ax.set_xlabel("Re λ [1/s]")
     ax.set_ylabel("Im λ [1/s]")
-    ax.set_title("eigenvalues per segment (shaded: unstable)", fontsize=9)
+    ax.set_title(data.title, fontsize=9)
     ax.legend(fontsize=7, loc="upper left")
     return ax.figure
 
 
-def _bars(ax, names, values, colours):
-    shown = np.where(np.isfinite(values), values, 0.0)
-    ax.bar(names, shown, color=colours)
-    for x, value in enumerate(values):
-        if not np.isfinite(value):
-            ax.annotate("∞" if value > 0 else "n/a", (x, 0), ha="center", va="bottom", fontsize=9)
+def _bars(ax, data: ViewData) -> None:
+    columns = data.columns
+    ax.bar(columns["segment"], columns["value"], color=columns["colour"])
+    for x, mark in enumerate(columns["mark"]):
+        if mark:
+            ax.annotate(mark, (x, 0), ha="center", va="bottom", fontsize=9)
     ax.tick_params(axis="x", labelsize=8)
+    ax.set_ylim(*data.limits)
+    ax.set_title(data.title, fontsize=9)
 
 
 def counter_torque_plot(numbers: PointNumbers, ax=None) -> Figure:
@@ -132,12 +247,8 @@ def counter_torque_plot(numbers: PointNumbers, ax=None) -> Figure:
     ax = _axes(ax)
     ax.axhspan(-CT_LIMIT, CT_LIMIT, color="tab:green", alpha=0.12, lw=0, label=f"±{CT_LIMIT:g} N m")
     ax.axhline(0, color="0.3", lw=0.8)
-    _bars(ax, numbers.segment_names, numbers.counter_torque, _colours(len(numbers.segment_names)))
-    finite = numbers.counter_torque[np.isfinite(numbers.counter_torque)]
-    reach = 1.15 * max(CT_LIMIT, float(np.max(np.abs(finite), initial=0.0)))
-    ax.set_ylim(-reach, reach)
+    _bars(ax, counter_torque_data(numbers))
     ax.set_ylabel("CT [N m]")
-    ax.set_title(f"counter torques, ‖CT‖ = {np.linalg.norm(numbers.counter_torque):.3g} N m", fontsize=9)
     ax.legend(fontsize=7, loc="upper left")
     return ax.figure
 
@@ -156,14 +267,10 @@ def delay_margin_plot(numbers: PointNumbers, ax=None) -> Figure:
         Bars [ms]; a dashed line at the delay tau: a segment whose bar ends below it is unstable.
     """
     ax = _axes(ax)
-    ms = 1000.0
-    colours = ["tab:green" if ok else "tab:red" for ok in numbers.stable_at_delay]
-    _bars(ax, numbers.segment_names, numbers.delay_margin * ms, colours)
-    ax.axhline(numbers.state.delay * ms, color="0.2", ls="--", lw=1, label=f"delay τ = {numbers.state.delay * ms:g} ms")
-    finite = numbers.delay_margin[np.isfinite(numbers.delay_margin)] * ms
-    ax.set_ylim(0, 1.2 * max(numbers.state.delay * ms, float(np.max(finite, initial=0.0)), 1.0))
+    data = delay_margin_data(numbers)
+    _bars(ax, data)
+    ax.axhline(data.line, color="0.2", ls="--", lw=1, label=f"delay τ = {data.line:g} ms")
     ax.set_ylabel("delay margin [ms]")
-    ax.set_title("delay margins (red: unstable at τ)", fontsize=9)
     ax.legend(fontsize=7, loc="upper left")
     return ax.figure
 

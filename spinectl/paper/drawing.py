@@ -67,7 +67,11 @@ GIDS = {
     "chord": "chord P1 P2",
 }
 """The ``gid`` of each single artist; fibres are ``"fibre <muscle> <i>"``, vertebrae ``"vertebra <name>"``,
-counter torques ``"counter torque <CoR>"``, dimensions ``"dimension E"`` and ``"dimension Lambda"``."""
+counter torques ``"counter torque <CoR>"`` and their labels ``"counter torque label <CoR>"``, the CoRs' labels
+``"cor label <CoR>"``, dimensions ``"dimension E"`` and ``"dimension Lambda"``."""
+TORQUE_LABEL_OFFSET = 8.0
+"""Height of a counter torque's label above its arrow [pt]: clear of the CoR's label beside the CoR
+(half a 7 pt line and its box, about 5 pt), which it touched at 3 pt."""
 
 
 def _line_geometry(model: Model, heights):
@@ -237,12 +241,13 @@ def _draw_counter_torques(ax, model: Model, cors: np.ndarray, counter_torque: np
         ax.annotate(
             f"{torque:+.1f} N m",
             (x + dx / 2, y),
-            xytext=(0, 3),
+            xytext=(0, TORQUE_LABEL_OFFSET),
             textcoords="offset points",
             ha="center",
             va="bottom",
             fontsize=6,
             color="crimson",
+            gid=f"counter torque label {name}",
         )
 
 
@@ -268,6 +273,7 @@ def _draw_spine(ax, model: Model, eccentricity: float, lordosis: float, annotate
                 fontsize=7,
                 bbox=_LABEL_BOX,
                 zorder=5,
+                gid=f"cor label {name}",
             )
         for label, (x, y) in zip(("P1", "P3", "P2"), points * CM_PER_M, strict=True):
             ax.annotate(label, (x, y), xytext=(6, 0), textcoords="offset points", va="center", fontsize=7)

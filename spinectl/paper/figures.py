@@ -1,4 +1,4 @@
-"""The paper's figures from a sweep Dataset: Figures 3, 4 and S1, and the ratio S1 / 3.
+"""The paper's figures from a sweep Dataset: Figures 3, 4 and S1, the ratio S1 / 3 and coupled / per segment.
 
 Filled contours over E (abscissa) and Lambda (ordinate), both in cm, on any
 grid: labelled contour lines, positions A-D (:data:`spinectl.paper.grid.POSITIONS`)
@@ -356,13 +356,76 @@ def ratio_figure(dataset: xr.Dataset, stiffness: float = grid.PAPER_STIFFNESS) -
     ratio = (pcsa.sel(K=float(stiffness)) / base).where(base > 0)
     part = dataset.sel(K=float(stiffness))
     title = f"Fig. S1 / Fig. 3: minimum PCSA at {_k_label(part)}\nover that at K = 0 (the paper: 0.5, a halving)"
-    fig, ax = _landscape(ratio, title, "ratio of minimum PCSA [1]", 0.0, 1.0)
+    return _ratio_map(ratio, title, "ratio of minimum PCSA [1]", (0.0, 1.0), HALVING, f"{HALVING:g}: halved")
+
+
+def _ratio_map(ratio: xr.DataArray, title: str, label: str, scale, level: float, level_text: str) -> Figure:
+    """A ratio over E and Lambda on the colour range ``scale``, ``level`` as a labelled white contour."""
+    fig, ax = _landscape(ratio, title, label, *scale)
     values = np.ma.masked_invalid(ratio.transpose("Lambda", "E").values)
-    if values.count() and values.min() < HALVING < values.max():
+    if values.count() and values.min() < level < values.max():
         e, lam = ratio["E"].values * CM_PER_M, ratio["Lambda"].values * CM_PER_M
-        half = ax.contour(e, lam, values, levels=[HALVING], colors="white", linewidths=1.5)
-        ax.clabel(half, fmt=lambda _: f"{HALVING:g}: halved", fontsize=8)
+        line = ax.contour(e, lam, values, levels=[level], colors="white", linewidths=1.5)
+        ax.clabel(line, fmt=lambda _: level_text, fontsize=8)
     return fig
+
+
+COUPLED_VARIABLE = "joint_global_pcsa_cm2"
+"""The sweep variable (``sweep --coupled``) whose presence draws :func:`coupled_ratio_figure`."""
+
+
+def coupled_ratio(dataset: xr.Dataset) -> xr.DataArray:
+    """Global PCSA of the coupled chain's joint optimum over the per-segment minimum PCSA, over E x Lambda.
+
+    The joint optimum (docs/chain.md) stabilises the coupled chain with global and local
+    muscle together; the per-segment minimum (paper, Figure 3) needs each segment stable on
+    global muscle alone. Below 1, the local muscles and the coupling take over part of the
+    global muscles' work.
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        A sweep with ``joint_global_pcsa_cm2`` and ``min_pcsa_cm2`` (``spinectl sweep --coupled``),
+        dims (E, Lambda[, K]).
+
+    Returns
+    -------
+    xarray.DataArray
+        The ratio [1], same dims; NaN where either is infeasible or the per-segment minimum is 0.
+
+    Raises
+    ------
+    ParameterError
+        ``dataset`` lacks ``joint_global_pcsa_cm2``.
+    """
+    if COUPLED_VARIABLE not in dataset:
+        raise ParameterError("dataset", f"the coupled ratio needs {COUPLED_VARIABLE} (spinectl sweep --coupled)")
+    per_segment = dataset["min_pcsa_cm2"]
+    return (dataset[COUPLED_VARIABLE] / per_segment).where(per_segment > 0).rename("coupled_ratio")
+
+
+def coupled_ratio_figure(dataset: xr.Dataset) -> Figure:
+    """:func:`coupled_ratio` as a map: the coupled chain's global PCSA over the per-segment minimum.
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        As for :func:`coupled_ratio`, with a scalar K.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Filled contours of the ratio [1] over E and Lambda [cm] from 0 to at least 1, 1 (no saving) as a contour.
+
+    Raises
+    ------
+    ParameterError
+        As :func:`coupled_ratio`.
+    """
+    ratio = coupled_ratio(dataset)
+    top = max(1.0, float(ratio.max())) if np.isfinite(ratio.values).any() else 1.0
+    title = f"coupled / per segment: global PCSA of the joint optimum over the minimum PCSA, {_k_label(dataset)}"
+    return _ratio_map(ratio, title, "ratio of global PCSA [1]", (0.0, top), 1.0, "1: no saving")
 
 
 def counter_torque_figure(dataset: xr.Dataset, specific_tension: float) -> Figure:
@@ -488,6 +551,24 @@ def ratio_name(stiffness: float, format: str = "png") -> str:
     return f"figS1_over_fig3_K{k_in_name(stiffness)}.{format}"
 
 
+def coupled_ratio_name(stiffness: float, format: str = "png") -> str:
+    """File name of :func:`coupled_ratio_figure`.
+
+    Parameters
+    ----------
+    stiffness : float
+        K [N m/rad].
+    format : str
+        File format and extension.
+
+    Returns
+    -------
+    str
+        E.g. ``coupled_over_per_segment_K0.png``.
+    """
+    return f"coupled_over_per_segment_K{k_in_name(stiffness)}.{format}"
+
+
 def _pcsa_range(dataset: xr.Dataset, options: FigureOptions) -> tuple[float | None, float | None]:
     """The colour range of the minimum-PCSA figures: the options', else with shared_scale that over every K."""
     vmin, vmax = options.vmin, options.vmax
@@ -544,6 +625,8 @@ def figure_set(
         pcsa_name, ct_name = figure_names(float(part["K"]), options.format)
         drawn[pcsa_name] = min_pcsa_figure(part, vmin, vmax, options.insets)
         drawn[ct_name] = counter_torque_figure(part, specific_tension)
+        if COUPLED_VARIABLE in part:
+            drawn[coupled_ratio_name(float(part["K"]), options.format)] = coupled_ratio_figure(part)
     for k in stiffnesses:
         drawn[ratio_name(k, options.format)] = ratio_figure(dataset, k)
     return drawn

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-import base64
+import xml.etree.ElementTree as ET
 
 import numpy as np
 import param
@@ -13,6 +13,7 @@ from spinectl.explore import app
 from spinectl.explore import numbers as nb
 from spinectl.explore.state import initial_state, replace
 from spinectl.model.config import load_preset
+from spinectl.paper.landmarks import CT_LIMIT
 
 
 @pytest.fixture(scope="module")
@@ -27,12 +28,12 @@ def _drag(slider, value):
 
 
 def test_views_show_the_numbers_of_the_state(explorer):
-    """The table's cells are PointNumbers.rows(); the drawing is drawing_png of the same numbers, byte for byte."""
+    """The table's cells are PointNumbers.rows(); the drawing is drawing_svg of the same numbers, byte for byte."""
     expected = nb.point_numbers(explorer.base, explorer.state)
     for row in expected.rows():
         for key in app.ROW_KEYS:
             assert f'<td data-key="{key}">{row[key]}</td>' in explorer.table.object
-    assert explorer.drawing.object == app.drawing_png(expected)
+    assert explorer.drawing.object == app.drawing_svg(expected)
     assert explorer.dataset is not None  # outside a server session the landscapes are solved at once
     assert "point updated in" in explorer.status.object
 
@@ -44,7 +45,7 @@ def test_a_slider_moves_the_point_and_the_views_follow(explorer):
     assert explorer.state.eccentricity == pytest.approx(0.052, abs=1e-15)
     expected = nb.point_numbers(explorer.base, explorer.state)
     assert f'<td data-key="counter_torque_Nm">{expected.rows()[0]["counter_torque_Nm"]}</td>' in explorer.table.object
-    assert explorer.drawing.object != before and explorer.drawing.object == app.drawing_png(expected)
+    assert explorer.drawing.object != before and explorer.drawing.object == app.drawing_svg(expected)
     for view in explorer.maps.values():
         assert view.marker.data == {"x": [pytest.approx(5.2)], "y": [pytest.approx(4.0)]}
 
@@ -85,11 +86,14 @@ def test_exports_toml_and_png(explorer):
     assert png.callback().getvalue().startswith(b"\x89PNG")
 
 
-def test_png_bytes_are_reproducible(explorer):
-    """The same figure at the same dpi gives the same bytes (no timestamp): the browser test relies on it."""
+def test_the_drawing_svg_is_reproducible_and_keeps_its_words_as_text(explorer):
+    """The same numbers give the same SVG text (no date, fixed ids): the browser test relies on it. It parses
+    as XML, and each CoR's name is an SVG text element (svg.fonttype none), not glyphs drawn as paths."""
     numbers = nb.point_numbers(explorer.base, explorer.state)
-    assert app.drawing_png(numbers) == app.drawing_png(numbers)
-    assert base64.b64encode(app.drawing_png(numbers))[:8] == b"iVBORw0K"
+    svg = app.drawing_svg(numbers)
+    assert svg == app.drawing_svg(numbers) and svg.startswith("<svg")
+    texts = {"".join(t.itertext()).strip() for t in ET.fromstring(svg).iter("{http://www.w3.org/2000/svg}text")}
+    assert set(numbers.segment_names) <= texts
 
 
 def test_a_model_invalid_at_the_point_is_a_message_not_a_crash(explorer, monkeypatch):
@@ -132,13 +136,34 @@ def test_the_delay_redraws_the_margins_only():
     objects; the margins view and the table follow (state.REFLEX_ONLY). At the README's point of 'default' every
     delay margin is finite (0.22 to 0.42 s), so a longer lag changes them."""
     explorer = app.Explorer(load_preset("default"), "default")
-    kept = {name: pane.object for name, pane in explorer.views.items()} | {"drawing": explorer.drawing.object}
-    margins, table = explorer.views["delay_margins"].object, explorer.table.object
+    kept = {name: view.source.data for name, view in explorer.views.items()} | {"drawing": explorer.drawing.object}
+    table = explorer.table.object
     _drag(explorer.sliders["activation_lag"], 100.0)
     assert explorer.state.activation_lag == pytest.approx(0.1)
     for name in ("eigenvalues", "counter_torques"):
-        assert explorer.views[name].object is kept[name]
+        assert explorer.views[name].source.data is kept[name]
     assert explorer.drawing.object is kept["drawing"]
-    assert explorer.views["delay_margins"].object != margins and explorer.table.object != table
+    margins = explorer.views["delay_margins"].source.data["value"]
+    assert margins != kept["delay_margins"]["value"] and explorer.table.object != table
     expected = nb.point_numbers(explorer.base, explorer.state)
-    assert explorer.views["delay_margins"].object == app.png_bytes(app.views.delay_margin_plot(expected))
+    np.testing.assert_allclose(margins, expected.delay_margin * 1000, rtol=1e-12)
+
+
+def test_the_bokeh_views_plot_the_librarys_numbers(explorer):
+    """Read back from the Bokeh views' data sources: the eigenvalues (paper eq. 1), CT_k [N m] and the exact
+    delay margins [ms] of point_numbers at the state, the delay line at tau [ms], the +-30 N m band."""
+    explorer.move_to(0.035, 0.045)
+    expected = nb.point_numbers(explorer.base, explorer.state)
+    eigen = explorer.views["eigenvalues"].source.data
+    np.testing.assert_allclose(eigen["re"], expected.eigenvalues.real.ravel(), rtol=1e-12)
+    np.testing.assert_allclose(eigen["im"], expected.eigenvalues.imag.ravel(), rtol=1e-12)
+    assert eigen["segment"][::2] == list(expected.segment_names)
+    torques = explorer.views["counter_torques"]
+    np.testing.assert_allclose(torques.source.data["value"], expected.counter_torque, rtol=1e-12)
+    band = next(r for r in torques.figure.center if isinstance(r, app.BoxAnnotation))
+    assert (band.bottom, band.top) == (-CT_LIMIT, CT_LIMIT)
+    margins = explorer.views["delay_margins"]
+    finite = np.isfinite(expected.delay_margin)  # an infinite margin (any delay): a bar of 0 marked '∞'
+    np.testing.assert_allclose(margins.source.data["value"], np.where(finite, expected.delay_margin * 1000, 0.0))
+    assert [m == "∞" for m in margins.source.data["mark"]] == list(~finite)
+    assert margins.line.location == pytest.approx(explorer.state.delay * 1000)

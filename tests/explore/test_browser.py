@@ -4,7 +4,7 @@ Playwright's Python API drives the system's Chromium (Debian's ``chromium`` pack
 installed by ``scripts/setup`` and ``.ci/run``; no browser is downloaded). The test moves
 the E slider and clicks a landscape, and checks that the table and the model drawing
 become those the library computes for the new point (:func:`spinectl.explore.numbers.point_numbers`,
-:func:`spinectl.explore.app.drawing_png`, byte for byte).
+:func:`spinectl.explore.app.drawing_svg`, byte for byte).
 
 Without Chromium the test fails with a message saying how to install it; a developer
 without it can set ``SPINECTL_SKIP_BROWSER=1`` (CI never does).
@@ -55,10 +55,11 @@ def _table(page) -> list[dict[str, str]]:
     return rows
 
 
-def _drawing(page) -> bytes:
-    """The PNG of the model drawing, the widest image of the page."""
-    sources = [s for s in page.locator("img").evaluate_all("els => els.map(e => e.src)") if "image/png" in s]
-    return base64.b64decode(max(sources, key=len).split(",", 1)[1])
+def _drawing(page) -> str:
+    """The SVG of the model drawing, the page's one SVG image."""
+    sources = [s for s in page.locator("img").evaluate_all("els => els.map(e => e.src)") if "image/svg+xml" in s]
+    (source,) = sources
+    return base64.b64decode(source.split(",", 1)[1]).decode()
 
 
 def _shown(page, label: str) -> float:
@@ -77,7 +78,7 @@ def _expect(page, state):
         first, timeout=browser_harness.TIMEOUT_S * 1000
     )
     assert _table(page) == expected.rows()
-    assert _drawing(page) == app.drawing_png(expected)
+    assert _drawing(page) == app.drawing_svg(expected)
 
 
 def test_slider_and_click_move_the_point_to_the_librarys_numbers(page):
@@ -85,7 +86,7 @@ def test_slider_and_click_move_the_point_to_the_librarys_numbers(page):
     landscape: those of the clicked point (read back from the page)."""
     state = initial_state(load_preset())
     assert _table(page) == nb.point_numbers(load_preset(), state).rows()
-    assert _drawing(page) == app.drawing_png(nb.point_numbers(load_preset(), state))
+    assert _drawing(page) == app.drawing_svg(nb.point_numbers(load_preset(), state))
 
     handle = page.locator(".noUi-handle").first  # the first slider is E
     box = handle.bounding_box()
@@ -98,7 +99,8 @@ def test_slider_and_click_move_the_point_to_the_librarys_numbers(page):
     assert moved.eccentricity > state.eccentricity and moved.lordosis == state.lordosis
     _expect(page, moved)
 
-    landscape = page.locator(".bk-Canvas").first.bounding_box()  # the minimum-PCSA landscape
+    canvases = page.locator(".bk-Canvas")  # the Bokeh plots: eigenvalues, CT, margins, then the two landscapes
+    landscape = canvases.nth(canvases.count() - 2).bounding_box()  # the minimum-PCSA landscape
     page.mouse.click(landscape["x"] + 0.3 * landscape["width"], landscape["y"] + 0.25 * landscape["height"])
     clicked = _point_shown(page, moved, moved)
     assert clicked.eccentricity < moved.eccentricity and clicked.lordosis > moved.lordosis  # left of it, higher

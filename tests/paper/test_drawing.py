@@ -147,3 +147,23 @@ def test_png_pdf_and_svg_files(model, tmp_path):
     with pytest.raises(ParameterError, match="--out"):
         figures.save_figure(fig, tmp_path / "model.txt")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["model.pdf", "model.png", "model.svg"]
+
+
+def _extent(text, renderer):
+    """A label's extent on the canvas [px], its box included."""
+    box = text.get_bbox_patch()
+    return box.get_window_extent(renderer) if box is not None else text.get_window_extent(renderer)
+
+
+@pytest.mark.parametrize(("e", "lam"), [(0.03, 0.04), (0.0, 0.0), (0.08, 0.08), (0.02, 0.0)])
+def test_counter_torque_labels_clear_the_cor_labels(model, e, lam):
+    """No counter torque's label overlaps a CoR's label, measured by the renderer (their drawn extents);
+    at a TORQUE_LABEL_OFFSET of 3 pt they touched (issue 15)."""
+    fig = drawing.draw_model(model, e, lam, pcsa="optimum", counter_torque=True)
+    renderer = fig.canvas.get_renderer()
+    fig.draw_without_rendering()
+    artists = _artists(fig)
+    cor_labels = [_extent(artists[f"cor label {name}"], renderer) for name in model.geometry.cor_names]
+    torque_labels = [_extent(artists[f"counter torque label {name}"], renderer) for name in model.geometry.cor_names]
+    for torque in torque_labels:
+        assert not any(torque.overlaps(cor) for cor in cor_labels)

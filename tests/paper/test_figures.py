@@ -287,3 +287,40 @@ def test_distinct_stiffnesses_give_distinct_figure_names(stiffness, near):
     for k, (pcsa, _) in zip((stiffness, near), names, strict=True):
         assert float(pcsa.removeprefix("figS1_min_pcsa_K").removesuffix(".png")) == k
     assert figures.figure_names(15.0) == ("figS1_min_pcsa_K15.png", "fig4_counter_torque_K15.png")
+
+
+@pytest.fixture(scope="module")
+def coupled(tmp_path_factory):
+    """A sweep --coupled of the default model on 3 x 3 points over the paper's 0 to 8 cm (A at the origin)."""
+    axis = np.linspace(0.0, 0.08, 3)
+    path = tmp_path_factory.mktemp("coupled") / "c.nc"
+    return netcdf.save(sweep.sweep(Model(), axis, axis, progress=False, coupled=True), path)
+
+
+def test_coupled_ratio_is_the_joint_global_pcsa_over_the_per_segment_minimum(coupled):
+    """At A: 33.0 cm^2 of global muscle in the joint optimum (docs/chain.md, the finding) over the paper's
+    63.7 cm^2 (Figure 3 at A), about 0.52; at (4, 8) cm the ratio of optimise.coupled.joint_optimum's total
+    global PCSA to optimise.solve_point's minimum, each solved on its own."""
+    from spinectl.optimise import solve_point
+    from spinectl.optimise.coupled import joint_optimum
+
+    ratio = figures.coupled_ratio(netcdf.load(coupled))
+    assert ratio.dims == ("E", "Lambda")
+    assert float(ratio.sel(E=0.0, Lambda=0.0)) == pytest.approx(33.0 / 63.7, abs=0.002)
+    expected = joint_optimum(Model(), 0.04, 0.08).total_pcsa / solve_point(Model(), 0.04, 0.08).min_pcsa
+    assert float(ratio.sel(E=0.04, Lambda=0.08)) == pytest.approx(expected, rel=1e-4)  # the SDP's tolerance
+
+
+def test_plot_draws_the_coupled_ratio_when_the_sweep_has_it(coupled, results, tmp_path):
+    """spinectl plot on a sweep --coupled adds the map (0 at the colour bar's foot, at least 1 at its top);
+    a sweep without the coupled variables has none, and coupled_ratio says what it needs."""
+    assert main(["plot", str(coupled), "--out", str(tmp_path / "c")]) == 0
+    name = figures.coupled_ratio_name(0.0)
+    assert name == "coupled_over_per_segment_K0.png" and _non_trivial(tmp_path / "c" / name)
+    fig = figures.coupled_ratio_figure(netcdf.load(coupled))
+    low, high = _colour_bar(fig).get_ylim()
+    assert low == pytest.approx(0.0) and high >= 1.0 and "coupled / per segment" in fig.axes[0].get_title()
+    assert main(["plot", str(results), "--out", str(tmp_path / "r")]) == 0
+    assert not any(p.name.startswith("coupled") for p in (tmp_path / "r").iterdir())
+    with pytest.raises(ParameterError, match="sweep --coupled"):
+        figures.coupled_ratio(netcdf.load(results))
