@@ -169,7 +169,8 @@ def test_set_errors_are_one_line_as_in_a_file(tmp_path, capsys):
 def test_set_reaches_every_command_and_is_marked(capsys):
     """The table's first line marks the overridden field; --K is an alias applied after --set."""
     code, out, _ = run(["stability", "--pcsa", "10,10,10", "--set", "passive.stiffness=15", "--K", "10"], capsys)
-    assert code == 0 and out.splitlines()[0].endswith("K = 10 N m/rad, convention physical; overridden: passive.stiffness")
+    header = out.splitlines()[0]
+    assert code == 0 and header.endswith("K = 10 N m/rad, convention physical; overridden: passive.stiffness")
     for argv in (["margins"], ["config", "show"], ["draw", "--geometry-only", "--out", "/nonexistent/x.png"]):
         code, _, err = run([*argv, "--set", "reflex.delay=-1"], capsys)
         assert code == 2 and "reflex.delay: must be" in err
