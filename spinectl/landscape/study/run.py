@@ -30,6 +30,8 @@ import math
 import os
 import re
 import signal
+import sys
+import tempfile
 import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
@@ -428,7 +430,7 @@ def _local_cluster(n: int):
 
     previous = _block_interrupts()
     try:
-        with dask.config.set({MALLOC_TRIM_SETTING: None}):  # unset in the workers' environment, see there
+        with dask.config.set({MALLOC_TRIM_SETTING: None}), _workers_stderr():  # see there for both
             cluster = LocalCluster(
                 n_workers=n,
                 threads_per_worker=1,  # cvxpy is not thread-safe; one process per worker
@@ -452,6 +454,26 @@ def _local_cluster(n: int):
             cluster.close()
     finally:
         _restore_interrupts(previous)
+
+
+@contextlib.contextmanager
+def _workers_stderr():
+    """Start worker processes with a temporary file as their standard error, not the terminal.
+
+    The worker processes are spawned from distributed's own threads, which do not share the
+    blocked SIGINT; a Ctrl-C that reaches a worker while its interpreter starts makes CPython
+    print "Fatal Python error: init_import_site" and a traceback there. The workers log at
+    error level only (``silence_logs``) and their failures reach the client as exceptions.
+    """
+    sys.stderr.flush()
+    saved = os.dup(2)
+    with tempfile.TemporaryFile() as log:
+        os.dup2(log.fileno(), 2)
+        try:
+            yield
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
 
 
 def _block_interrupts():
