@@ -287,3 +287,24 @@ def test_distinct_stiffnesses_give_distinct_figure_names(stiffness, near):
     for k, (pcsa, _) in zip((stiffness, near), names, strict=True):
         assert float(pcsa.removeprefix("figS1_min_pcsa_K").removesuffix(".png")) == k
     assert figures.figure_names(15.0) == ("figS1_min_pcsa_K15.png", "fig4_counter_torque_K15.png")
+
+
+def test_pareto_figure_draws_the_computed_front():
+    """The figure plots exactly the front's feasible points (global total in cm^2 against local total in
+    N m/rad) and reads the local stiffness as PCSA on the top axis; wagner2012 at A leaves out the
+    infeasible global-only point and draws no ring for it."""
+    from spinectl import load_preset
+    from spinectl.model import chain
+    from spinectl.optimise.coupled import pareto_front
+
+    model = load_preset("wagner2012")
+    front = pareto_front(model, 0.0, 0.0, 4)
+    fig = figures.pareto_figure(front, model)
+    ax = fig.axes[0]
+    (line,) = ax.get_lines()
+    np.testing.assert_allclose(line.get_xdata(), front.local_total[1:])
+    np.testing.assert_allclose(line.get_ydata(), front.global_total[1:] * 1e4)
+    fig.canvas.draw()  # the secondary axis takes its limits when drawn
+    (top,) = ax.child_axes  # the secondary axis: A = k / kappa, 1 cm^2 per kappa N m/rad (model.chain)
+    kappa = chain.local_stiffness_per_pcsa(model) * 1e-4
+    np.testing.assert_allclose(top.get_xlim(), np.array(ax.get_xlim()) / kappa)
