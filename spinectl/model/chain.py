@@ -228,6 +228,11 @@ def velocity_torque(model: Model, cor, q, qdot):
     -------
     numpy.ndarray, shape (..., n_cor)
         c [N m]; quadratic in ``qdot``.
+
+    References
+    ----------
+    Siciliano B, Sciavicco L, Villani L, Oriolo G (2009). Robotics: Modelling, Planning and
+    Control. Springer, London, ch. 7 (Lagrange formulation). doi:10.1007/978-1-84628-642-1.
     """
     cor = np.asarray(cor, float)
     n = cor.shape[-2]

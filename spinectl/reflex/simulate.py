@@ -1,4 +1,4 @@
-"""Nonlinear time-domain simulation of one segment under a reflex with the true delay.
+"""Nonlinear time-domain simulation of one segment, or of the chain, under a reflex with the true delay.
 
 The plant is the paper's equation of motion for CoR k (Methods):
 
@@ -17,6 +17,10 @@ omega, omega with slope omega'), which keeps the scheme fourth order. The step i
 to the delay when the delay is shorter, so every delayed time is already computed.
 Before t = 0 the segment is held at the perturbation angle at rest, then released.
 Runs are batched: every array argument broadcasts to a batch of independent runs.
+
+The chain runs through the same integrator, one run per joint (:func:`simulate_chain`): the
+linearised :class:`ChainPlant` or the nonlinear :class:`NonlinearChainPlant`, M(q) q'' +
+c(q, q') = tau(q, q') + u (docs/chain.md, "Nonlinear simulation").
 """
 
 from __future__ import annotations
