@@ -256,7 +256,7 @@ def simulate(plant, kp, kd, delay, settings: Reflex, perturbation=None) -> Simul
 
     Parameters
     ----------
-    plant : SegmentPlant or ChainPlant
+    plant : SegmentPlant, ChainPlant or NonlinearChainPlant
         Anything with ``acceleration(alpha, omega, torque)`` over the runs.
     kp, kd, delay : array_like
         Reflex gains [N m/rad], [N m s/rad] and delay [s]; kp = kd = 0 is "no reflex".
@@ -409,6 +409,11 @@ def _bracket(stable_at, low, high, batch, rounds):
     return float(low), float(high)
 
 
+def _per_chain(n: int, alpha, omega, torque):
+    """The runs (batch * n,), joint fastest, as (batch, n) arrays of angles, velocities and torques."""
+    return (np.broadcast_to(x, np.shape(alpha)).reshape(-1, n) for x in (alpha, omega, torque))
+
+
 @dataclass(frozen=True)
 class ChainPlant:
     """The linearised chain M q'' = K q + D q' + u (docs/chain.md, "Dynamic stability") for :func:`simulate`.
@@ -445,8 +450,7 @@ class ChainPlant:
         numpy.ndarray, shape (batch * n,)
             [rad/s^2].
         """
-        n = self.mass.shape[0]
-        q, qdot, u = (np.broadcast_to(x, np.shape(alpha)).reshape(-1, n) for x in (alpha, omega, torque))
+        q, qdot, u = _per_chain(self.joints, alpha, omega, torque)
         force = q @ self.stiffness.T + qdot @ self.damping.T + u
         return np.linalg.solve(self.mass, force.T).T.reshape(-1)
 
@@ -517,7 +521,7 @@ class NonlinearChainPlant:
             [rad/s^2].
         """
         n = self.joints
-        q, qdot, u = (np.broadcast_to(x, np.shape(alpha)).reshape(-1, n) for x in (alpha, omega, torque))
+        q, qdot, u = _per_chain(n, alpha, omega, torque)
         force = self.torque(q, qdot) + u - chain.velocity_torque(self.model, self.cor, q, qdot)
         return np.linalg.solve(chain.mass_matrix(self.model, self.cor, q), force[..., None])[..., 0].reshape(-1)
 
