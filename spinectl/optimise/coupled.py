@@ -15,7 +15,8 @@ solved with cvxpy and Clarabel (PSD cone; SCS as the fallback):
 (a) :func:`least_local_stiffness`: at a given global activation, the least sum of k;
 (b) :func:`min_global_pcsa`: global muscles only (k = 0), the least total PCSA;
 (c) :func:`joint_optimum`: the least total global PCSA + w * local PCSA, with the local
-    PCSA k / kappa of :func:`spinectl.model.chain.local_pcsa` and w ``local.cost_weight``.
+    PCSA k / kappa of :func:`spinectl.model.chain.local_pcsa` and w ``local.cost_weight``;
+    :func:`pareto_front`: every w at once, the least global PCSA for each bound on sum(k).
 
 (b) and (c) keep the per-segment problem's rows (:func:`~spinectl.optimise.problem.inequalities`):
 the damping rows D_k <= -damping_margin and the bounds on x; (b) also its stiffness rows
@@ -747,12 +748,13 @@ def pareto_front(model: Model, eccentricity: float, lordosis: float, points: int
         raise ParameterError("points", f"must be an integer >= 2 (got {points!r})")
     e, lam = float(eccentricity), float(lordosis)
     data = coupled_data(model, e, lam)
-    status, x, _ = least_global_within_budget_sdp(data, np.inf)
-    if x is None:  # no activation within the bounds, whatever the local muscles: nothing to trade
+    status, x, k = least_global_within_budget_sdp(data, np.inf)
+    if x is not None:
+        status, k = least_local_stiffness_sdp(data, x)
+    if k is None:  # no activation within the bounds, whatever the local muscles: nothing to trade
         empty = _result(model, data, e, lam, status, None, None)
         return ParetoFront(e, lam, np.full(int(points), np.nan), (empty,) * int(points))
-    status, k = least_local_stiffness_sdp(data, x)
-    budgets = np.linspace(0.0, float(np.sum(k)) if k is not None else np.nan, int(points))
+    budgets = np.linspace(0.0, float(np.sum(k)), int(points))
     far = _result(model, data, e, lam, status, x, k)
     inner = [_result(model, data, e, lam, *least_global_within_budget_sdp(data, b)) for b in budgets[:-1]]
     return ParetoFront(e, lam, budgets, tuple(inner) + (far,))
