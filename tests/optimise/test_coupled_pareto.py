@@ -86,3 +86,15 @@ def test_without_a_global_only_solution_the_first_point_is_infeasible():
 def test_too_few_points_name_the_field(stiff):
     with pytest.raises(ParameterError, match="points"):
         pareto_front(stiff, 0.0, 0.0, 1)
+
+
+def test_no_activation_at_all_is_an_infeasible_front():
+    """A damping margin of 1e4 N m s/rad with at most 1 cm^2 per variable: the damping rows alone cannot
+    hold (joint_optimum says 'infeasible' too), so every point is NaN with that status, no exception."""
+    model = config.set_parameters(
+        load_preset("wagner2012"), {"optimisation.damping_margin": 1e4, "optimisation.pcsa_max": 1e-4}
+    )
+    front = pareto_front(model, 0.0, 0.0, 3)
+    assert joint_optimum(model, 0.0, 0.0).status == "infeasible"
+    assert [p.status for p in front.points] == ["infeasible"] * 3
+    assert np.all(np.isnan(front.budgets)) and np.all(np.isnan(front.global_total))
