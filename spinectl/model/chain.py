@@ -144,8 +144,23 @@ def level_weight(model: Model) -> float:
     return model.levels.weight_in_gravity * model.levels.mass * model.body.gravity
 
 
-def mass_matrix(model: Model, cor):
-    """Mass matrix of the chain at the upright posture [kg m^2] (docs/chain.md, "The mass matrix").
+def _bodies(model: Model, q, cor):
+    """The bodies in the rotated chain: upper body then the levels, (..., n, 2) [m], and the moved CoRs."""
+    moved, _ = chain_positions(q, cor)
+    upper = carried_points(geometry.mass_position(model)[None, :], q, cor)
+    return np.concatenate([upper, level_positions(q, cor)], axis=-2), moved
+
+
+def _masses(model: Model, n: int):
+    """Masses [kg] and squared radii of gyration [m^2] of the upper body and the n - 1 levels."""
+    body, levels = model.body, model.levels
+    masses = np.array([body.mass] + [levels.mass] * (n - 1))
+    gyration = np.array([body.radius_of_gyration] + [levels.radius_of_gyration] * (n - 1)) ** 2
+    return masses, gyration
+
+
+def mass_matrix(model: Model, cor, q=None):
+    """Mass matrix of the chain [kg m^2], upright or at the posture ``q`` (docs/chain.md, "The mass matrix").
 
     M = sum over the bodies b of m_b J_v,b' J_v,b + I_b J_w,b' J_w,b, with the upper body (the
     point mass m at (0, ``body.mass_height``), I = m rho^2, rho ``body.radius_of_gyration``)
@@ -153,9 +168,10 @@ def mass_matrix(model: Model, cor):
     I = m rho_level^2) by the joints below it. A body carried by joint j moves with
     dP/dq_j = J (P - c_j) (J the quarter turn) and turns with dphi/dq_j = 1, so
 
-        M[j, k] = sum over b carried by j and k of m_b ((P_b - c_j) . (P_b - c_k) + rho_b^2).
+        M[j, k] = sum over b carried by j and k of m_b ((P_b - c_j) . (P_b - c_k) + rho_b^2),
 
-    M[k, k] without the levels is theta_k of :func:`spinectl.model.mechanics.inertia`.
+    with P_b and c_j where the posture ``q`` puts them (:func:`chain_positions`).
+    M[k, k] upright without the levels is theta_k of :func:`spinectl.model.mechanics.inertia`.
 
     Parameters
     ----------
@@ -163,6 +179,8 @@ def mass_matrix(model: Model, cor):
         ``body`` (mass, height, radius of gyration) and ``levels`` (mass, radius of gyration).
     cor : array_like, shape (..., n_cor, 2)
         Upright CoR positions [m], top to bottom.
+    q : array_like, shape (..., n_cor), optional
+        Joint rotations [rad]; None: upright.
 
     Returns
     -------
@@ -177,19 +195,57 @@ def mass_matrix(model: Model, cor):
     """
     cor = np.asarray(cor, float)
     n = cor.shape[-2]
-    body, levels = model.body, model.levels
-    positions = np.concatenate(
-        [np.broadcast_to(geometry.mass_position(model), cor.shape[:-2] + (1, 2)), level_positions(np.zeros(n), cor)],
-        axis=-2,
-    )  # (..., n, 2): the upper body, then the n - 1 levels
-    masses = np.array([body.mass] + [levels.mass] * (n - 1))
-    gyration = np.array([body.radius_of_gyration] + [levels.radius_of_gyration] * (n - 1)) ** 2
+    positions, moved = _bodies(model, np.zeros(n) if q is None else q, cor)  # (..., n, 2): upper body, levels
+    masses, gyration = _masses(model, n)
     carried = _carried_by(n)
-    arm = (positions[..., :, None, :] - cor[..., None, :, :]) * carried[..., None]  # (..., b, j, 2)
+    arm = (positions[..., :, None, :] - moved[..., None, :, :]) * carried[..., None]  # (..., b, j, 2)
     mass = np.einsum("b,...bjd,...bkd->...jk", masses, arm, arm) + np.einsum(
         "b,bj,bk->jk", masses * gyration, carried, carried
     )
     return (mass + np.swapaxes(mass, -1, -2)) / 2  # symmetric to the last bit, not just to rounding
+
+
+def velocity_torque(model: Model, cor, q, qdot):
+    """Coriolis and centripetal terms c(q, q') of the chain's equation M(q) q'' + c = tau [N m].
+
+    Every body hangs on a chain of rigid links: the link above joint j turns at
+    phi'_j = q'_j + ... + q'_n, so the part of a body's acceleration that does not come
+    from q'' is the centripetal a_b = -sum over its links of phi'^2 times the link vector
+    (CoR c_{j+1} to c_j, and the last one c_b to P_b). Lagrange's equations with
+    dP_b/dq_j = J (P_b - c_j) give c_j = sum over b carried by j of m_b (P_b - c_j) x a_b
+    (the planar cross product); the rotations add nothing, a plane body's spin having no
+    gyroscopic term (docs/chain.md, "Nonlinear simulation").
+
+    Parameters
+    ----------
+    model : Model
+    cor : array_like, shape (..., n_cor, 2)
+        Upright CoR positions [m].
+    q, qdot : array_like, shape (..., n_cor)
+        Joint rotations [rad] and angular velocities [rad/s].
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., n_cor)
+        c [N m]; quadratic in ``qdot``.
+
+    References
+    ----------
+    Siciliano B, Sciavicco L, Villani L, Oriolo G (2009). Robotics: Modelling, Planning and
+    Control. Springer, London, ch. 7 (Lagrange formulation). doi:10.1007/978-1-84628-642-1.
+    """
+    cor = np.asarray(cor, float)
+    n = cor.shape[-2]
+    positions, moved = _bodies(model, q, cor)
+    spin = np.cumsum(np.asarray(qdot, float)[..., ::-1], axis=-1)[..., ::-1]  # phi'_j
+    links = (moved[..., :-1, :] - moved[..., 1:, :]) * spin[..., 1:, None] ** 2  # link j (c_{j+1} to c_j)
+    above = np.cumsum(links[..., ::-1, :], axis=-2)[..., ::-1, :]  # sum over links j, ..., n - 2
+    above = np.concatenate([above, np.zeros_like(above[..., :1, :])], axis=-2)  # body b starts at link b
+    centripetal = -above - spin[..., None] ** 2 * (positions - moved)  # (..., b, 2), body b carried from joint b
+    arm = positions[..., :, None, :] - moved[..., None, :, :]  # (..., b, j, 2)
+    cross = arm[..., 0] * centripetal[..., :, None, 1] - arm[..., 1] * centripetal[..., :, None, 0]
+    masses, _ = _masses(model, n)
+    return np.einsum("b,bj,...bj->...j", masses, _carried_by(n), cross)
 
 
 def state_matrix(mass, stiffness, damping):

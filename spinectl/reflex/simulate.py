@@ -1,4 +1,4 @@
-"""Nonlinear time-domain simulation of one segment under a reflex with the true delay.
+"""Nonlinear time-domain simulation of one segment, or of the chain, under a reflex with the true delay.
 
 The plant is the paper's equation of motion for CoR k (Methods):
 
@@ -17,6 +17,10 @@ omega, omega with slope omega'), which keeps the scheme fourth order. The step i
 to the delay when the delay is shorter, so every delayed time is already computed.
 Before t = 0 the segment is held at the perturbation angle at rest, then released.
 Runs are batched: every array argument broadcasts to a batch of independent runs.
+
+The chain runs through the same integrator, one run per joint (:func:`simulate_chain`): the
+linearised :class:`ChainPlant` or the nonlinear :class:`NonlinearChainPlant`, M(q) q'' +
+c(q, q') = tau(q, q') + u (docs/chain.md, "Nonlinear simulation").
 """
 
 from __future__ import annotations
@@ -27,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
-from ..model import geometry, mechanics
+from ..model import chain, geometry, mechanics
 from ..model.params import Model, Reflex
 
 MAX_STEPS = 1_000_000
@@ -252,7 +256,7 @@ def simulate(plant, kp, kd, delay, settings: Reflex, perturbation=None) -> Simul
 
     Parameters
     ----------
-    plant : SegmentPlant or ChainPlant
+    plant : SegmentPlant, ChainPlant or NonlinearChainPlant
         Anything with ``acceleration(alpha, omega, torque)`` over the runs.
     kp, kd, delay : array_like
         Reflex gains [N m/rad], [N m s/rad] and delay [s]; kp = kd = 0 is "no reflex".
@@ -364,13 +368,50 @@ def simulated_delay_margin(plant: SegmentPlant, kp, kd, settings: Reflex, low, h
         Delays [s] with the simulation stable at ``low`` and unstable at ``high``
         (the initial bracket must be so).
     """
+    return _bracket(lambda delays: simulate(plant, kp, kd, delays, settings).stable, low, high, batch, rounds)
+
+
+def simulated_chain_delay_margin(plant, kp, kd, settings: Reflex, perturbation, low, high, batch=8, rounds=3):
+    """Bracket the delay where the simulated chain turns unstable, as :func:`simulated_delay_margin`.
+
+    Parameters
+    ----------
+    plant : ChainPlant or NonlinearChainPlant
+    kp, kd : array_like, shape (n,)
+        Gains per joint [N m/rad], [N m s/rad].
+    settings : Reflex
+        Simulation settings (see :func:`simulate`).
+    perturbation : array_like, shape (n,)
+        Initial joint angles [rad] (see :func:`simulate_chain`).
+    low, high : float
+        Initial bracket of delays [s]: stable at ``low``, unstable at ``high``.
+    batch, rounds : int
+        Delays simulated per round, and rounds.
+
+    Returns
+    -------
+    low, high : float
+        Delays [s] with the simulated chain stable at ``low`` and unstable at ``high``.
+    """
+    return _bracket(
+        lambda delays: simulate_chain(plant, kp, kd, delays, settings, perturbation)[1], low, high, batch, rounds
+    )
+
+
+def _bracket(stable_at, low, high, batch, rounds):
+    """Shrink [low, high] by batch + 1 per round: keep the last stable and the first unstable delay."""
     for _ in range(rounds):
         delays = np.linspace(low, high, batch + 2)[1:-1]
-        stable = simulate(plant, kp, kd, delays, settings).stable
+        stable = stable_at(delays)
         first_unstable = int(np.argmin(stable)) if not stable.all() else batch
         grid = np.concatenate([[low], delays, [high]])
         low, high = grid[first_unstable], grid[first_unstable + 1]
     return float(low), float(high)
+
+
+def _per_chain(n: int, alpha, omega, torque):
+    """The runs (batch * n,), joint fastest, as (batch, n) arrays of angles, velocities and torques."""
+    return (np.broadcast_to(x, np.shape(alpha)).reshape(-1, n) for x in (alpha, omega, torque))
 
 
 @dataclass(frozen=True)
@@ -391,6 +432,11 @@ class ChainPlant:
     stiffness: np.ndarray
     damping: np.ndarray
 
+    @property
+    def joints(self) -> int:
+        """n, the joints of one chain."""
+        return self.mass.shape[0]
+
     def acceleration(self, alpha, omega, torque):
         """q'' = M^-1 (K q + D q' + u) of every chain of the batch [rad/s^2].
 
@@ -404,10 +450,115 @@ class ChainPlant:
         numpy.ndarray, shape (batch * n,)
             [rad/s^2].
         """
-        n = self.mass.shape[0]
-        q, qdot, u = (np.broadcast_to(x, np.shape(alpha)).reshape(-1, n) for x in (alpha, omega, torque))
+        q, qdot, u = _per_chain(self.joints, alpha, omega, torque)
         force = q @ self.stiffness.T + qdot @ self.damping.T + u
         return np.linalg.solve(self.mass, force.T).T.reshape(-1)
+
+
+@dataclass(frozen=True)
+class NonlinearChainPlant:
+    """The nonlinear chain M(q) q'' + c(q, q') = tau(q, q') + u (docs/chain.md, "Nonlinear simulation").
+
+    tau is what :class:`ChainPlant`'s K q + D q' linearises: the global muscles' torques from the
+    nonlinear fibre lengths, lever arms and Hill forces
+    (:func:`~spinectl.model.chain.chain_muscle_torque_per_pcsa`), gravity
+    (:func:`~spinectl.model.chain.chain_gravity_torque`), the passive and local stiffness
+    -(K_pas + k) q, and the constant counter torques that make upright an equilibrium (as
+    :class:`SegmentPlant`'s). M(q) is the posture's mass matrix
+    (:func:`~spinectl.model.chain.mass_matrix`) and c the Coriolis and centripetal terms
+    (:func:`~spinectl.model.chain.velocity_torque`). Runs as :class:`ChainPlant`'s.
+
+    Attributes
+    ----------
+    model : Model
+    cor : numpy.ndarray, shape (n, 2)
+        Upright CoR positions [m].
+    pcsa : numpy.ndarray, shape (n_muscles,)
+        Global PCSA of each muscle [m^2].
+    stiffness : numpy.ndarray, shape (n,)
+        K_pas + k per joint [N m/rad]: passive and local.
+    counter_torque : numpy.ndarray, shape (n,)
+        Constant torques [N m] making tau(0, 0) = 0.
+    """
+
+    model: Model
+    cor: np.ndarray
+    pcsa: np.ndarray
+    stiffness: np.ndarray
+    counter_torque: np.ndarray
+
+    @property
+    def joints(self) -> int:
+        """n, the joints of one chain."""
+        return self.cor.shape[0]
+
+    def torque(self, q, qdot):
+        """tau(q, q') [N m], the counter torques included: zero upright.
+
+        Parameters
+        ----------
+        q, qdot : array_like, shape (..., n)
+            Joint angles [rad] and angular velocities [rad/s].
+
+        Returns
+        -------
+        numpy.ndarray, shape (..., n)
+            [N m].
+        """
+        return _chain_torque_without_ct(self, q, qdot) + self.counter_torque
+
+    def acceleration(self, alpha, omega, torque):
+        """q'' = M(q)^-1 (tau(q, q') + u - c(q, q')) of every chain of the batch [rad/s^2].
+
+        Parameters
+        ----------
+        alpha, omega, torque : numpy.ndarray, shape (batch * n,)
+            Joint angles [rad], angular velocities [rad/s] and reflex torques [N m], joint fastest.
+
+        Returns
+        -------
+        numpy.ndarray, shape (batch * n,)
+            [rad/s^2].
+        """
+        n = self.joints
+        q, qdot, u = _per_chain(n, alpha, omega, torque)
+        force = self.torque(q, qdot) + u - chain.velocity_torque(self.model, self.cor, q, qdot)
+        return np.linalg.solve(chain.mass_matrix(self.model, self.cor, q), force[..., None])[..., 0].reshape(-1)
+
+
+def _chain_torque_without_ct(plant: NonlinearChainPlant, q, qdot):
+    """Muscles, gravity and -(K_pas + k) q [N m]."""
+    m, q = plant.model, np.asarray(q, float)
+    muscles = chain.chain_muscle_torque_per_pcsa(m, plant.cor, q, qdot) @ plant.pcsa
+    return muscles + chain.chain_gravity_torque(m, plant.cor, q) - plant.stiffness * q
+
+
+def nonlinear_chain_plant(model: Model, eccentricity: float, lordosis: float, pcsa, local_stiffness=0.0):
+    """The :class:`NonlinearChainPlant` at a configuration, global activation and local stiffness.
+
+    Parameters
+    ----------
+    model : Model
+    eccentricity, lordosis : float
+        E and Lambda [m].
+    pcsa : array_like, shape (n_muscles,)
+        Global PCSA of each muscle [m^2].
+    local_stiffness : array_like, shape (n,)
+        k_j of the local muscles [N m/rad]; 0: none.
+
+    Returns
+    -------
+    NonlinearChainPlant
+        Linearised upright, its torques are :meth:`spinectl.model.chain.ChainCoefficients.stiffness`
+        and ``damping`` at ``pcsa`` and ``local_stiffness``, its mass matrix
+        :func:`~spinectl.model.chain.mass_matrix`.
+    """
+    cor = geometry.cor_positions(eccentricity, lordosis, model.geometry)
+    n = cor.shape[0]
+    passive = mechanics.passive_stiffness(model, mechanics.inertia(cor, model))  # as chain_coefficients
+    stiffness = np.broadcast_to(passive + np.asarray(local_stiffness, float), (n,)).copy()
+    plant = NonlinearChainPlant(model, cor, np.asarray(pcsa, float), stiffness, np.zeros(n))
+    return dataclasses.replace(plant, counter_torque=-_chain_torque_without_ct(plant, np.zeros(n), np.zeros(n)))
 
 
 def simulate_chain(plant: ChainPlant, kp, kd, delay, settings: Reflex, perturbation):
@@ -419,7 +570,7 @@ def simulate_chain(plant: ChainPlant, kp, kd, delay, settings: Reflex, perturbat
 
     Parameters
     ----------
-    plant : ChainPlant
+    plant : ChainPlant or NonlinearChainPlant
     kp, kd : array_like, shape (n,)
         Gains per joint [N m/rad], [N m s/rad].
     delay : array_like, shape (batch,)
@@ -441,7 +592,7 @@ def simulate_chain(plant: ChainPlant, kp, kd, delay, settings: Reflex, perturbat
     ParameterError
         As :func:`simulate`.
     """
-    n = plant.mass.shape[0]
+    n = plant.joints
     delay = np.atleast_1d(np.asarray(delay, float))
     tile = np.tile  # joint fastest
     start = tile(np.asarray(perturbation, float), delay.size)

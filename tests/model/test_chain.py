@@ -206,10 +206,11 @@ def _bodies_by_rotations(model, q, cor):
 
 
 @pytest.mark.parametrize("preset", ["default", "wagner2012"])
-def test_mass_matrix_is_the_hessian_of_the_kinetic_energy(rng, preset):
+@pytest.mark.parametrize("posture", [0.0, 0.2])
+def test_mass_matrix_is_the_hessian_of_the_kinetic_energy(rng, preset, posture):
     """T(q') = 1/2 sum m |v|^2 + 1/2 m rho^2 phi'^2 with v and phi' by central differences of the
     bodies' positions and angles (built rotation by rotation); M[j, k] = T(e_j + e_k) - T(e_j) - T(e_k)
-    (T is quadratic), and M is symmetric positive definite."""
+    (T is quadratic), and M is symmetric positive definite; upright and at a bent posture q."""
     model = load_preset(preset)
     model = model.replace(body=Body(mass=model.body.mass, mass_height=model.body.mass_height, radius_of_gyration=0.05))
     E, L = _random_positions(rng, 1)
@@ -217,8 +218,10 @@ def test_mass_matrix_is_the_hessian_of_the_kinetic_energy(rng, preset):
     masses = np.array([model.body.mass] + [model.levels.mass] * (N_COR - 1))
     gyration = np.array([0.05] + [model.levels.radius_of_gyration] * (N_COR - 1))
 
+    q = posture * rng.uniform(-1, 1, N_COR)
+
     def kinetic(qdot, h=1e-6):
-        (p_plus, a_plus), (p_minus, a_minus) = (_bodies_by_rotations(model, s * h * qdot, cor) for s in (1, -1))
+        (p_plus, a_plus), (p_minus, a_minus) = (_bodies_by_rotations(model, q + s * h * qdot, cor) for s in (1, -1))
         v, w = (p_plus - p_minus) / (2 * h), (a_plus - a_minus) / (2 * h)
         return 0.5 * np.sum(masses * (np.sum(v**2, axis=-1) + gyration**2 * w**2))
 
@@ -226,10 +229,22 @@ def test_mass_matrix_is_the_hessian_of_the_kinetic_energy(rng, preset):
     hessian = np.array(
         [[kinetic(eye[j] + eye[k]) - kinetic(eye[j]) - kinetic(eye[k]) for k in range(N_COR)] for j in range(N_COR)]
     )
-    mass = chain.mass_matrix(model, cor)
+    mass = chain.mass_matrix(model, cor, q)
     np.testing.assert_allclose(mass, hessian, rtol=1e-7, atol=1e-9 * np.abs(mass).max())
     np.testing.assert_array_equal(mass, mass.T)
     assert np.all(np.linalg.eigvalsh(mass) > 0)
+
+
+def test_velocity_torque_is_the_christoffel_form_of_the_mass_matrix(rng):
+    """Lagrange's equations give c_j = sum_kl (dM_jk/dq_l - 1/2 dM_kl/dq_j) q'_k q'_l; dM/dq here by
+    central differences of mass_matrix at a bent posture, a second route to velocity_torque's closed form."""
+    model = load_preset("wagner2012")
+    cor = geometry.cor_positions(0.02, -0.03, model.geometry)
+    q, qdot = rng.uniform(-0.3, 0.3, N_COR), rng.uniform(-2.0, 2.0, N_COR)
+    slope = _central_difference(lambda dq: chain.mass_matrix(model, cor, q + dq))  # (j, k, l) = dM_jk/dq_l
+    christoffel = np.einsum("jkl,k,l->j", slope, qdot, qdot) - 0.5 * np.einsum("klj,k,l->j", slope, qdot, qdot)
+    np.testing.assert_allclose(chain.velocity_torque(model, cor, q, qdot), christoffel, rtol=1e-7, atol=1e-9)
+    assert np.all(chain.velocity_torque(model, cor, q, np.zeros(N_COR)) == 0)
 
 
 def test_mass_matrix_diagonal_is_theta_without_levels(rng):

@@ -324,3 +324,24 @@ def test_plot_draws_the_coupled_ratio_when_the_sweep_has_it(coupled, results, tm
     assert not any(p.name.startswith("coupled") for p in (tmp_path / "r").iterdir())
     with pytest.raises(ParameterError, match="sweep --coupled"):
         figures.coupled_ratio(netcdf.load(results))
+
+
+def test_pareto_figure_draws_the_computed_front():
+    """The figure plots exactly the front's feasible points (global total in cm^2 against local total in
+    N m/rad) and reads the local stiffness as PCSA on the top axis; wagner2012 at A leaves out the
+    infeasible global-only point and draws no ring for it."""
+    from spinectl import load_preset
+    from spinectl.model import chain
+    from spinectl.optimise.coupled import pareto_front
+
+    model = load_preset("wagner2012")
+    front = pareto_front(model, 0.0, 0.0, 4)
+    fig = figures.pareto_figure(front, model)
+    ax = fig.axes[0]
+    (line,) = ax.get_lines()
+    np.testing.assert_allclose(line.get_xdata(), front.local_total[1:])
+    np.testing.assert_allclose(line.get_ydata(), front.global_total[1:] * 1e4)
+    fig.canvas.draw()  # the secondary axis takes its limits when drawn
+    (top,) = ax.child_axes  # the secondary axis: A = k / kappa, 1 cm^2 per kappa N m/rad (model.chain)
+    kappa = chain.local_stiffness_per_pcsa(model) * 1e-4
+    np.testing.assert_allclose(top.get_xlim(), np.array(ax.get_xlim()) / kappa)
