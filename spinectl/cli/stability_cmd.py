@@ -56,12 +56,13 @@ def run(args) -> int:
     int
         Exit code 0.
     """
-    from ..optimise.coupled import coupled_stability_at
     from ..optimise.reference import NoStabilisingActivation, stability_at
 
     model = load_model(args, {"passive.stiffness": args.K})
     given = args.pcsa is not None  # else the minimum stabilising PCSA
-    analysis = coupled_stability_at if args.coupled else stability_at
+    analysis = stability_at
+    if args.coupled:  # only here: the chain's semidefinite programs import cvxpy
+        from ..optimise.coupled import coupled_stability_at as analysis
     try:
         result = analysis(model, args.E, args.Lambda, cm2_to_m2(args.pcsa) if given else None)
     except NoStabilisingActivation as exc:  # the library names its argument; the user types the option

@@ -7,23 +7,23 @@ the body's symmetry axis is x = 0; P2 (pelvic joint) at y = 0.
 
 from __future__ import annotations
 
-from functools import lru_cache
-
 import numpy as np
 
 from .params import Geometry, Model, MusclePair
 
+SPLINE_SHAPES = {
+    "natural": lambda s: 1.5 * s - 0.5 * s**3,  # phi''(P1) = phi''(P2) = 0
+    "clamped": lambda s: 3.0 * s**2 - 2.0 * s**3,  # phi'(P1) = phi'(P2) = 0
+    "not-a-knot": lambda s: 2.0 * s - s**2,  # one cubic through three knots, symmetric: the parabola
+}
+"""The cubic spline phi through (0, 0), (L/2, 1), (L, 0) for each end condition, as a function of
+s = 1 - abs(y - L/2) / (L/2) in [0, 1] (docs/model.md, "The spine line").
 
-@lru_cache(maxsize=32)
-def _lordosis_shape_cached(heights: tuple[float, ...], spine_length: float, bc: str) -> np.ndarray:
-    from scipy.interpolate import CubicSpline  # here: scipy.interpolate takes longer to import than numpy
-
-    knots = [0.0, spine_length / 2, spine_length]
-    bc_type = {"natural": "natural", "clamped": "clamped", "not-a-knot": "not-a-knot"}[bc]
-    spline = CubicSpline(knots, [0.0, 1.0, 0.0], bc_type=bc_type)
-    shape = spline(np.asarray(heights))
-    shape.setflags(write=False)
-    return shape
+The data are symmetric about L/2, so the spline is, and phi'(L/2) = 0: each half is the cubic with
+phi(0) = 0, phi(1) = 1, phi'(1) = 0 and the end condition. In closed form because
+scipy.interpolate.CubicSpline, which gives the same values (tests/model/test_mechanics.py), takes
+longer to import than numpy and scipy together, and ``spinectl stability`` needs only these values.
+"""
 
 
 def lordosis_shape(geometry: Geometry) -> np.ndarray:
@@ -33,8 +33,8 @@ def lordosis_shape(geometry: Geometry) -> np.ndarray:
     (y = L), L the spine length (paper, Methods; docs/model.md, "The spine line"). The
     spline is linear in its data, so with P1 and P2 at x = -E and P3 at
     x = -E + Lambda the line is x(y) = -E + Lambda phi(y), phi being the spline
-    through (0, 0), (L/2, 1), (L, 0). For natural end conditions
-    phi = 1.5 s - 0.5 s^3 with s = 1 - abs(y - L/2) / (L/2).
+    through (0, 0), (L/2, 1), (L, 0), in closed form (:data:`SPLINE_SHAPES`); for natural
+    end conditions phi = 1.5 s - 0.5 s^3 with s = 1 - abs(y - L/2) / (L/2).
 
     Parameters
     ----------
@@ -46,7 +46,9 @@ def lordosis_shape(geometry: Geometry) -> np.ndarray:
     numpy.ndarray, shape (n_cor,)
         phi at each CoR height [1].
     """
-    return _lordosis_shape_cached(geometry.cor_heights, geometry.spine_length, geometry.spline_bc)
+    half = geometry.spine_length / 2
+    s = 1.0 - np.abs(np.asarray(geometry.cor_heights, float) - half) / half
+    return SPLINE_SHAPES[geometry.spline_bc](s)
 
 
 def cor_positions(eccentricity, lordosis, geometry: Geometry) -> np.ndarray:

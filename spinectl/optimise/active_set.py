@@ -35,8 +35,19 @@ import itertools
 
 import numpy as np
 
+from ..model.params import Model
 from . import stacked
-from .problem import DEFAULT_TOLERANCE, RANK_RTOL, ProblemData, ct_slab, inequalities, objective, to_si
+from .problem import (
+    DEFAULT_TOLERANCE,
+    RANK_RTOL,
+    PointOptimum,
+    ProblemData,
+    ct_slab,
+    inequalities,
+    objective,
+    point_data,
+    to_si,
+)
 
 PIVOTS = 60
 """Most dual simplex pivots per point; a point still running then (cycling at a degenerate vertex) falls back."""
@@ -94,6 +105,49 @@ def solve_block(data: ProblemData, ct_tolerance: float, *, min_pcsa_only: bool =
         status[redo], min_pcsa[redo], pcsa[redo] = again.status, again.min_pcsa, again.pcsa
         counter_torque[redo], per_point = again.counter_torque, again.per_point
     return stacked.BlockOptimum(status.astype(str), min_pcsa, pcsa, counter_torque, per_point)
+
+
+def solve_point(model: Model, eccentricity: float, lordosis: float) -> PointOptimum:
+    """Minimum PCSA and least counter torque at one configuration, by :func:`solve_block` on a block of one point.
+
+    The answer of :func:`spinectl.optimise.reference.solve_point` (the same problems, docs/optimisation.md,
+    "Formulation"; equal to rounding, tests/optimise/test_active_set.py) without importing cvxpy unless the
+    point fails verification and falls back: what ``spinectl stability`` needs to start at once. Stage 1
+    by the dual simplex method of [1]_ (the module's docstring).
+
+    Parameters
+    ----------
+    model : Model
+        ``optimisation`` sets activation mode, margin, bounds and tolerances.
+    eccentricity, lordosis : float
+        E and Lambda [m].
+
+    Returns
+    -------
+    PointOptimum
+        As :func:`spinectl.optimise.reference.solve_point`: status, minimum total PCSA [m^2], chosen PCSA
+        of each muscle [m^2], CT_k [N m] (shape (n_cor,)); NaN values unless optimal.
+
+    Raises
+    ------
+    ParameterError, ModelError
+        As :func:`spinectl.optimise.problem.point_data`.
+
+    References
+    ----------
+    .. [1] Nocedal J, Wright SJ (2006). Numerical Optimization, 2nd ed. Springer.
+       doi:10.1007/978-0-387-40065-5
+    """
+    data = point_data(model, eccentricity, lordosis).point(np.newaxis)  # a leading axis: a block of one point
+    block = solve_block(data, model.optimisation.ct_tolerance)
+    return PointOptimum(
+        float(eccentricity),
+        float(lordosis),
+        str(block.status[0]),
+        float(block.min_pcsa[0]),
+        block.pcsa[0],
+        block.counter_torque[0],
+    )
 
 
 OPTIMAL, INFEASIBLE, UNFINISHED = range(3)

@@ -22,7 +22,6 @@ References
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import nnls
 
 ACTIVE_RTOL = (1e-5, 1e-7, 1e-9)
 """Guesses of the active set: the constraints whose slack is below this fraction of their scale.
@@ -160,5 +159,7 @@ def _nonnegative_multipliers(lhs, gradient, active, n_eq, tolerance) -> bool:
         # No active row: stationary iff the gradient vanishes. SciPy's nnls aborts the
         # interpreter (double free) on a matrix without columns (scipy 1.17; cf. scipy#24866).
         return bool(np.all(np.abs(gradient) <= tolerance))
+    from scipy.optimize import nnls  # here: scipy.optimize takes longer to import than numpy and scipy
+
     multipliers, _ = nnls(columns, -gradient)
     return bool(np.all(np.abs(columns @ multipliers + gradient) <= tolerance))

@@ -12,19 +12,22 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
-import cvxpy as cp
 import numpy as np
 
 from ..model import geometry
+from ..model.checks import checked_coefficients
 from ..model.mechanics import SegmentCoefficients
 from ..model.params import Model
 from ..units import M2_PER_CM2
 from . import polish
 
-OK_STATUSES = (cp.OPTIMAL, cp.OPTIMAL_INACCURATE)
+OK_STATUSES = ("optimal", "optimal_inaccurate")
+"""cvxpy's ``OPTIMAL`` and ``OPTIMAL_INACCURATE``, spelt out: importing cvxpy takes about 2 s, which the
+fast path does not need."""
 
 
-INFEASIBLE_STATUSES = (cp.INFEASIBLE, cp.INFEASIBLE_INACCURATE)
+INFEASIBLE_STATUSES = ("infeasible", "infeasible_inaccurate")
+"""cvxpy's ``INFEASIBLE`` and ``INFEASIBLE_INACCURATE``, spelt out (as :data:`OK_STATUSES`)."""
 
 
 SOLVER_ERROR = "solver_error"
@@ -176,6 +179,30 @@ def problem_data(model: Model, coeffs: SegmentCoefficients) -> ProblemData:
         tolerance=model.optimisation.solver_tolerance,
         torque_scale=np.abs(coeffs.torque_per_pcsa).max(axis=(-2, -1)) * M2_PER_CM2,
     )
+
+
+def point_data(model: Model, eccentricity: float, lordosis: float) -> ProblemData:
+    """:class:`ProblemData` at one configuration, the position checked first.
+
+    Parameters
+    ----------
+    model : Model
+    eccentricity, lordosis : float
+        E and Lambda [m].
+
+    Returns
+    -------
+    ProblemData
+        Without leading dimensions.
+
+    Raises
+    ------
+    ParameterError
+        E or Lambda outside the modelled range.
+    ModelError
+        The model cannot be evaluated there (see :func:`~spinectl.model.checks.validate_position`).
+    """
+    return problem_data(model, checked_coefficients(model, float(eccentricity), float(lordosis)))
 
 
 def ct_slab(torque, x_ct, tolerance: float | None, scale=None):
@@ -406,7 +433,7 @@ def worst_status(*statuses: str) -> str:
     str
         The status of the point.
     """
-    return cp.OPTIMAL_INACCURATE if cp.OPTIMAL_INACCURATE in statuses else cp.OPTIMAL
+    return "optimal_inaccurate" if "optimal_inaccurate" in statuses else "optimal"
 
 
 @dataclass(frozen=True)

@@ -25,8 +25,12 @@ front is stage 2 for budgets from t* up to the total PCSA of the minimum-norm
 activation.
 
 Results are returned in SI (m^2). Infeasible points are answers, not
-exceptions: NaN values and a ``status``. :mod:`spinectl.optimise.stacked` solves the
-same problems for a block of points at once and is checked against this module.
+exceptions: NaN values and a ``status``. :func:`stability_at` and
+:func:`minimum_stabilising_pcsa` solve their point by the fast path
+(:func:`spinectl.optimise.active_set.solve_point`, the same answer to rounding), so that one
+point needs no cvxpy, which is imported only where a problem is built here (about 2 s).
+:mod:`spinectl.optimise.stacked` solves the same problems for a block of points at once and is
+checked against this module.
 """
 
 from __future__ import annotations
@@ -34,12 +38,11 @@ from __future__ import annotations
 import dataclasses
 import warnings
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
-import cvxpy as cp
 import numpy as np
 
 from ..errors import ModelError
-from ..model.checks import checked_coefficients
 from ..model.params import Model
 from ..model.stability import StabilityResult, segment_stability
 from ..units import M2_PER_CM2
@@ -50,12 +53,15 @@ from .problem import (
     PointOptimum,
     ProblemData,
     inequalities,
+    point_data,
     polished,
-    problem_data,
     solver_options,
     to_si,
     worst_status,
 )
+
+if TYPE_CHECKING:  # cvxpy is imported where a problem is built: it takes about 2 s
+    import cvxpy as cp
 
 SOLVERS = ("CLARABEL", "SCS")
 """Solvers tried in order: Clarabel, then SCS as the fallback when Clarabel fails."""
@@ -82,6 +88,8 @@ def solve_with_fallback(problem: cp.Problem, tolerance: float | None = None) -> 
     str
         cvxpy's status ('optimal', 'optimal_inaccurate', 'infeasible', ...) or 'solver_error'.
     """
+    import cvxpy as cp
+
     for solver in SOLVERS:
         try:
             with warnings.catch_warnings():
@@ -103,6 +111,8 @@ def _has_values(problem: cp.Problem) -> bool:
 
 def _stage(data: ProblemData, stage: str, cost, total_max=np.inf, x_ct=None) -> tuple[str, np.ndarray | None]:
     """Minimise ``cost(x)`` (a cvxpy expression builder) over G x <= h, then polish."""
+    import cvxpy as cp
+
     lhs, rhs = inequalities(data, total_max, x_ct)
     x = cp.Variable(data.weights.size)
     problem = cp.Problem(cp.Minimize(cost(x)), [lhs @ x <= rhs])
@@ -110,7 +120,7 @@ def _stage(data: ProblemData, stage: str, cost, total_max=np.inf, x_ct=None) -> 
     if status not in OK_STATUSES:
         return status, None
     x_opt, verified = polished(data, stage, x.value, total_max, x_ct)
-    return (cp.OPTIMAL if verified else status), x_opt
+    return ("optimal" if verified else status), x_opt
 
 
 def _ct_expression(data: ProblemData, x):
@@ -155,6 +165,8 @@ def min_counter_torque_socp(data: ProblemData, total_max: float) -> tuple[str, n
     x : numpy.ndarray or None
         Decision variables of least ||CT||_2 [cm^2], None unless optimal.
     """
+    import cvxpy as cp
+
     return _stage(data, "counter_torque", lambda x: cp.norm(_ct_expression(data, x), 2), total_max)
 
 
@@ -179,6 +191,8 @@ def least_norm_activation_qp(data: ProblemData, total_max: float, x_ct) -> tuple
     x : numpy.ndarray or None
         [cm^2], None unless optimal.
     """
+    import cvxpy as cp
+
     return _stage(data, "least_norm", cp.sum_squares, total_max, x_ct)
 
 
@@ -271,10 +285,6 @@ def point_optimum(data: ProblemData, ct_tolerance: float, eccentricity=np.nan, l
     return PointOptimum(float(eccentricity), float(lordosis), status, float(min_pcsa), pcsa, counter_torque)
 
 
-def _point_data(model: Model, eccentricity: float, lordosis: float) -> ProblemData:
-    return problem_data(model, checked_coefficients(model, float(eccentricity), float(lordosis)))
-
-
 def solve_point(model: Model, eccentricity: float, lordosis: float) -> PointOptimum:
     """Minimum PCSA and least counter torque at one configuration (per-point cvxpy reference).
 
@@ -309,7 +319,7 @@ def solve_point(model: Model, eccentricity: float, lordosis: float) -> PointOpti
        lordosis optimizes the requirements for a stable erect posture. Theor Biol Med
        Model 9:13. doi:10.1186/1742-4682-9-13
     """
-    data = _point_data(model, eccentricity, lordosis)
+    data = point_data(model, eccentricity, lordosis)
     return point_optimum(data, model.optimisation.ct_tolerance, eccentricity, lordosis)
 
 
@@ -331,7 +341,7 @@ def min_norm_activation(model: Model, eccentricity: float, lordosis: float) -> P
     PointOptimum
         As :func:`solve_point`, with the minimum-norm activation as ``pcsa`` [m^2].
     """
-    data = _point_data(model, eccentricity, lordosis)
+    data = point_data(model, eccentricity, lordosis)
     return point_optimum(data, np.inf, eccentricity, lordosis)
 
 
@@ -379,13 +389,15 @@ def pareto_front(model: Model, eccentricity: float, lordosis: float, n_points: i
         Budgets on the total PCSA [m^2], shape (n_points,), the least ||CT||_2 within
         each [N m] and the status per budget.
     """
-    data = _point_data(model, eccentricity, lordosis)
+    data = point_data(model, eccentricity, lordosis)
     far = point_optimum(data, np.inf)
     if not far.ok:
         return ParetoFront(float(eccentricity), float(lordosis), np.array([]), np.array([]), (far.status,))
     lowest = far.min_pcsa / M2_PER_CM2
     budgets = np.linspace(lowest, max(far.total_pcsa / M2_PER_CM2, lowest), n_points)
     norms, statuses = [], []
+    import cvxpy as cp
+
     lhs, rhs = inequalities(data)
     budget = cp.Parameter(nonneg=True)
     x = cp.Variable(data.weights.size)
@@ -408,7 +420,7 @@ class NoStabilisingActivation(ModelError):
 
 
 def minimum_stabilising_pcsa(model: Model, eccentricity: float, lordosis: float) -> np.ndarray:
-    """The chosen activation of :func:`solve_point`: the minimum stabilising PCSA [m^2].
+    """The chosen activation of :func:`solve_point` (solved by the fast path): the minimum stabilising PCSA [m^2].
 
     Parameters
     ----------
@@ -433,8 +445,14 @@ def minimum_stabilising_pcsa(model: Model, eccentricity: float, lordosis: float)
 
 
 def _stabilising_optimum(model: Model, eccentricity: float, lordosis: float) -> PointOptimum:
-    """:func:`solve_point`, or the :class:`ModelError` of :func:`minimum_stabilising_pcsa` unless it is optimal."""
-    optimum = solve_point(model, eccentricity, lordosis)
+    """The optimum of :func:`solve_point`, or :func:`minimum_stabilising_pcsa`'s :class:`ModelError` unless optimal.
+
+    Solved by the fast path (:func:`spinectl.optimise.active_set.solve_point`, the same answer to rounding),
+    which imports cvxpy only for a point that fails verification: ``spinectl stability`` starts at once.
+    """
+    from .active_set import solve_point as fast_solve_point  # here: active_set falls back on this module
+
+    optimum = fast_solve_point(model, eccentricity, lordosis)
     if not optimum.ok:
         raise NoStabilisingActivation(
             f"pcsa: no activation stabilises every segment at E = {eccentricity:g} m, Lambda = {lordosis:g} m "

@@ -23,10 +23,10 @@ so a bad block costs time, never an exception.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import clarabel
 import numpy as np
-import scipy.sparse as sp
 
 from .problem import (
     DEFAULT_TOLERANCE,
@@ -42,6 +42,9 @@ from .problem import (
     to_si,
 )
 from .reference import optimum
+
+if TYPE_CHECKING:  # scipy.sparse is imported where a block is stacked: it takes longer to import than scipy
+    import scipy.sparse as sp
 
 CLARABEL_STATUS = {
     clarabel.SolverStatus.Solved: "optimal",
@@ -88,6 +91,8 @@ def block_diagonal(blocks) -> sp.csc_matrix:
     -------
     scipy.sparse.csc_matrix, shape (P r, P c)
     """
+    import scipy.sparse as sp
+
     blocks = np.asarray(blocks, float)
     n, r, c = blocks.shape
     rows = np.broadcast_to(np.arange(n)[:, None, None] * r + np.arange(r)[None, :, None], blocks.shape)
@@ -134,6 +139,8 @@ def stacked_qp(hessian, linear, lhs, rhs, tolerance: float | None) -> tuple[str,
         In cvxpy's words ('optimal', 'infeasible', ...), for the whole block.
     x : numpy.ndarray, shape (P, n)
     """
+    import scipy.sparse as sp
+
     linear = np.asarray(linear, float)
     n_points, n = linear.shape
     if hessian is None:

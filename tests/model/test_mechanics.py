@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -129,6 +131,18 @@ def test_lordosis_shape_natural_spline_closed_form(model):
     h = model.geometry.spine_length / 2
     s = 1 - np.abs(np.asarray(model.geometry.cor_heights) - h) / h
     np.testing.assert_allclose(geometry.lordosis_shape(model.geometry), 1.5 * s - 0.5 * s**3, rtol=1e-12)
+
+
+@pytest.mark.parametrize("bc", ["natural", "clamped", "not-a-knot"])
+def test_lordosis_shape_is_scipys_cubic_spline(model, bc):
+    """The closed forms equal scipy.interpolate.CubicSpline through (0, 0), (L/2, 1), (L, 0) (a second method)."""
+    from scipy.interpolate import CubicSpline
+
+    length = model.geometry.spine_length
+    heights = tuple(np.linspace(length, 0.0, len(model.geometry.cor_heights)))  # both ends and between
+    shape = geometry.lordosis_shape(dataclasses.replace(model.geometry, cor_heights=heights, spline_bc=bc))
+    spline = CubicSpline([0.0, length / 2, length], [0.0, 1.0, 0.0], bc_type=bc)
+    np.testing.assert_allclose(shape, spline(np.asarray(heights)), rtol=1e-12, atol=1e-15)
 
 
 def test_cor_positions_follow_eccentricity_and_lordosis(model):

@@ -252,3 +252,50 @@ def test_counter_torques_that_fix_x_alone(model):
     fast = active_set.solve_block(data, m.optimisation.ct_tolerance)
     assert fast.per_point == 0
     _assert_optimal(data, fast, stacked.solve_points(data, m.optimisation.ct_tolerance), m.optimisation.ct_tolerance)
+
+
+POINTS = [(0.03, 0.04), (0.0, 0.0), (0.08, 0.0), (0.0, 0.08), (0.08, 0.08)]
+"""(E, Lambda) [m]: the CLI's example, the paper's positions A-D (corners of its grid)."""
+
+
+@pytest.mark.parametrize("variant", ["paired", "K15-physical", "bounded"])
+def test_stability_at_equals_the_per_point_reference(model, variant):
+    """``stability_at`` (routed through :func:`active_set.solve_point`) gives the per-point cvxpy reference's
+    optimum to 1e-9, and its stability at that PCSA; infeasible points (a bound of 12 cm^2) are infeasible
+    for both, and ``stability_at`` then raises. (With independent activation the reference's x is only as
+    exact as Clarabel's tolerance: :func:`test_independent_activation_is_optimal_by_a_second_method`.)"""
+    from spinectl.model.stability import segment_stability
+    from spinectl.optimise.reference import NoStabilisingActivation, solve_point, stability_at
+
+    m = _variants(model)[variant]
+    statuses = set()
+    for e, lam in POINTS:
+        ref, fast = solve_point(m, e, lam), active_set.solve_point(m, e, lam)
+        statuses.add(ref.status)
+        assert fast.status == ref.status
+        assert (fast.eccentricity, fast.lordosis) == (e, lam)
+        if not ref.ok:
+            assert np.isnan(fast.min_pcsa) and np.all(np.isnan(fast.pcsa))
+            with pytest.raises(NoStabilisingActivation, match="infeasible"):
+                stability_at(m, e, lam)
+            continue
+        total, norm = max(ref.min_pcsa, 1e-4), max(ref.counter_torque_norm, 1.0)
+        assert abs(fast.min_pcsa - ref.min_pcsa) <= RTOL * total
+        np.testing.assert_allclose(fast.pcsa, ref.pcsa, rtol=0, atol=RTOL * total)
+        np.testing.assert_allclose(fast.counter_torque, ref.counter_torque, rtol=0, atol=RTOL * norm)
+        result, expected = stability_at(m, e, lam), segment_stability(m, e, lam, ref.pcsa)
+        assert abs(result.min_pcsa - ref.min_pcsa) <= RTOL * total
+        np.testing.assert_allclose(result.pcsa, ref.pcsa, rtol=0, atol=RTOL * total)
+        scale = np.abs(expected.stiffness).max()  # S is affine in the PCSA: agrees as the PCSA does
+        np.testing.assert_allclose(result.stiffness, expected.stiffness, rtol=0, atol=RTOL * scale)
+        np.testing.assert_allclose(result.counter_torque, expected.counter_torque, rtol=0, atol=RTOL * norm)
+    if variant == "bounded":
+        assert {"infeasible", "optimal"} <= statuses
+
+
+def test_the_status_words_are_cvxpys():
+    """The statuses spelt out in :mod:`spinectl.optimise.problem` (so that it need not import cvxpy) are cvxpy's."""
+    assert optimise.OK_STATUSES == (cp.OPTIMAL, cp.OPTIMAL_INACCURATE)
+    assert optimise.INFEASIBLE_STATUSES == (cp.INFEASIBLE, cp.INFEASIBLE_INACCURATE)
+    assert optimise.worst_status(cp.OPTIMAL, cp.OPTIMAL_INACCURATE) == cp.OPTIMAL_INACCURATE
+    assert optimise.worst_status(cp.OPTIMAL) == cp.OPTIMAL

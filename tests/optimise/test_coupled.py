@@ -235,12 +235,15 @@ def test_coupled_stability_at_the_segment_optimum(preset):
     model = load_preset(preset)
     result = coupled.coupled_stability_at(model, 0.0, 0.0)
     opt = optimise.solve_point(model, 0.0, 0.0)
-    np.testing.assert_allclose(result.pcsa, opt.pcsa, rtol=1e-12)
-    x = opt.pcsa[::2] * 1e4  # paired: one variable per pair, cm^2 (both sides equal)
+    # its PCSA is the fast path's (optimise.active_set.solve_point): the reference's to 1e-9 of the total
+    # (the agreement of tests/optimise/test_active_set.py; 1e-12 relative seen)
+    np.testing.assert_allclose(result.pcsa, opt.pcsa, rtol=0, atol=1e-9 * opt.min_pcsa)
+    pcsa = result.pcsa
+    x = pcsa[::2] * 1e4  # paired: one variable per pair, cm^2 (both sides equal)
     rebuilt = result.gravity_stiffness - model.passive.stiffness * np.eye(5)
     rebuilt = rebuilt + np.einsum("i,ijk->jk", x, result.stiffness_per_variable)
     np.testing.assert_allclose(result.stiffness, rebuilt, rtol=1e-9, atol=1e-9)
-    segment = segment_stability(model, 0.0, 0.0, opt.pcsa)
+    segment = segment_stability(model, 0.0, 0.0, pcsa)
     np.testing.assert_allclose(np.diag(result.stiffness), segment.stiffness, rtol=1e-12, atol=1e-9)
     np.testing.assert_allclose(np.diag(result.damping), segment.damping, rtol=1e-12)
     a = np.block([[np.zeros((5, 5)), np.eye(5)], [result.stiffness, result.damping]])
@@ -250,7 +253,7 @@ def test_coupled_stability_at_the_segment_optimum(preset):
     )
     assert np.sum(result.eigenvalues.real > 0) == 4 and not result.self_stable
     assert result.margin == pytest.approx(np.linalg.eigvalsh(-result.stiffness)[0])
-    least = coupled.least_local_stiffness(model, 0.0, 0.0, opt.pcsa)
+    least = coupled.least_local_stiffness(model, 0.0, 0.0, pcsa)
     np.testing.assert_allclose(result.local.local_stiffness, least.local_stiffness, rtol=1e-9)
     assert result.stable_with_local and np.all(result.local_eigenvalues.real < 0)
 

@@ -154,8 +154,11 @@ def test_passive_stiffness_alone_still_needs_muscle_damping(model):
 
 
 def test_minimum_stabilising_pcsa_is_the_chosen_activation(model):
+    """The fast path's chosen activation (active_set.solve_point): the reference's to 1e-9 of the total PCSA
+    (the agreement of tests/optimise/test_active_set.py), and self-stable."""
     pcsa = reference.minimum_stabilising_pcsa(model, 0.03, 0.04)
-    np.testing.assert_array_equal(pcsa, optimise.solve_point(model, 0.03, 0.04).pcsa)
+    opt = optimise.solve_point(model, 0.03, 0.04)
+    np.testing.assert_allclose(pcsa, opt.pcsa, rtol=0, atol=1e-9 * opt.min_pcsa)
     assert segment_stability(model, 0.03, 0.04, pcsa).all_self_stable
 
 
@@ -169,7 +172,7 @@ def test_no_minimum_stabilising_pcsa_is_a_model_error(model):
 
 def test_stability_at_defaults_to_the_minimum_stabilising_pcsa(model):
     default = reference.stability_at(model, 0.03, 0.04)
-    np.testing.assert_array_equal(default.pcsa, optimise.solve_point(model, 0.03, 0.04).pcsa)
+    np.testing.assert_array_equal(default.pcsa, reference.minimum_stabilising_pcsa(model, 0.03, 0.04))
     given = reference.stability_at(model, 0.03, 0.04, [10e-4, 10e-4, 10e-4])
     expected = segment_stability(model, 0.03, 0.04, [10e-4, 10e-4, 10e-4])
     np.testing.assert_array_equal(given.eigenvalues, expected.eigenvalues)
