@@ -61,6 +61,11 @@ def _pure_delay_outputs() -> dict:
 REALISATION_DEPENDENT = ("cl_A",)
 """Outputs compared through their eigenvalues: state matrices of a realisation python-control may choose."""
 
+SPINE_LINE_DEPENDENT = ("sim_alpha", "sim_u")
+"""Outputs of a model's simulation, compared to 1e-12: the spine line is now computed in closed form, equal
+to scipy's CubicSpline (before) to rounding (tests/model/test_mechanics.py), so the model's coefficients differ
+in their last bits (seen: 8e-14 relative)."""
+
 
 def test_without_the_lag_every_result_is_bit_identical_to_before():
     """T_a = 0: crossings, margins (exact and Padé), phase margins, root counts, verdicts, critical gains, the
@@ -73,6 +78,9 @@ def test_without_the_lag_every_result_is_bit_identical_to_before():
     for name, value in now.items():
         assert value.shape == before[name].shape, name
         if name in REALISATION_DEPENDENT:
+            continue
+        if name in SPINE_LINE_DEPENDENT:
+            np.testing.assert_allclose(value, before[name], rtol=1e-12, atol=0, err_msg=name)
             continue
         assert np.array_equal(value, before[name], equal_nan=True), name
     # A state-space realisation is not unique: python-control builds another one when slycot is installed
