@@ -333,7 +333,7 @@ class StabilityResult:
             "",
             f"||CT|| = {self.counter_torque_norm:.3f} N m; "
             f"self-stable: {'all segments' if self.all_self_stable else 'NOT all segments'}; "
-            f"slowest time constant {self.slowest_time_constant:.4g} s",
+            f"slowest time constant {_time_constant_text(self.slowest_time_constant)}",
         ]
         return "\n".join(lines)
 
@@ -395,3 +395,8 @@ def segment_stability(model: Model, eccentricity: float, lordosis: float, pcsa) 
         counter_torque=counter_torque,
         coefficients=coeffs,
     )
+
+
+def _time_constant_text(tau: float) -> str:
+    """A time constant [s] as text; inf (a segment that does not return) as "none", as ``spinectl margins`` says."""
+    return f"{tau:.4g} s" if np.isfinite(tau) else "none (not every segment returns)"

@@ -244,3 +244,11 @@ def test_the_result_reports_its_slowest_time_constant(model):
     tau = float(slowest_time_constant(result.stiffness, result.damping, result.inertia))
     assert result.slowest_time_constant == tau and result.to_dict(model)["slowest_time_constant_s"] == tau
     assert f"slowest time constant {tau:.4g} s" in result.table(model)
+
+
+def test_a_segment_that_does_not_return_has_no_time_constant_in_the_table(model):
+    """10 cm^2 per muscle at (3, 4) cm leaves a segment unstable (S > 0): the time constant is inf, and the
+    table says "none", as spinectl margins does, not "inf s"."""
+    result = segment_stability(model, 0.03, 0.04, [10e-4, 10e-4, 10e-4])
+    assert not result.all_self_stable and result.slowest_time_constant == np.inf
+    assert result.table(model).endswith("slowest time constant none (not every segment returns)")
