@@ -370,7 +370,7 @@ class _Distributed:
         while not pending.is_empty():
             self._wait_for_one(pending)
             for future in pending.next_batch(block=False):
-                result = future.result()  # a chunk's error ends the run here; the cluster is closed on the way out
+                result = self._result(future)  # a chunk's error ends the run here; the cluster is closed on the way out
                 future.release()
                 yield result
                 task = next(chunks, None)
@@ -379,11 +379,30 @@ class _Distributed:
 
     def _wait_for_one(self, pending) -> None:
         """Return once a future of ``pending`` has finished, as long as the cluster has a worker."""
-        idle_since, looked = None, time.monotonic()
+        watch = self._watch()
         while not pending.has_ready():
             time.sleep(0.01)
+            watch()
+
+    def _result(self, future):
+        """The chunk of a finished future. Its data lives on the worker that solved it: a worker gone
+        before the data came back leaves the scheduler waiting for another, so this wait is bounded too."""
+        watch = self._watch()
+        while True:
+            try:
+                return future.result(timeout=POLL)
+            except TimeoutError:
+                watch()
+
+    def _watch(self):
+        """A function to call while waiting: every :data:`POLL` seconds it counts the workers, and raises
+        once there has been none for ``worker_timeout`` seconds."""
+        idle_since, looked = None, time.monotonic()
+
+        def watch() -> None:
+            nonlocal idle_since, looked
             if time.monotonic() - looked < POLL:
-                continue
+                return
             looked = time.monotonic()
             if self.client.scheduler_info(n_workers=0).get("n_workers", 1) > 0:
                 idle_since = None
@@ -395,6 +414,8 @@ class _Distributed:
                     f"{self.where}: every worker has gone, and none joined within {self.worker_timeout:g} s: the "
                     "store holds every chunk finished; start a worker and run again with --resume",
                 )
+
+        return watch
 
 
 @contextlib.contextmanager
