@@ -464,7 +464,7 @@ def _monomial_coefficients(model: Model):
     is affine in c_j, h_j = a + b x_j + d y_j, while u_j . u_k + e . u_hi is quadratic in
     (c_j, c_k) and affine in c_hi; both are combinations of the 8 monomials with coefficients
     that depend on the fibre alone (docs/chain.md, "The monomial form"). Summing them into
-    muscles here, once per model, leaves one product per grid point and pair (j, k).
+    muscles here, once for all points, leaves one product per grid point and pair (j, k).
 
     Returns
     -------
@@ -540,7 +540,7 @@ def chain_coefficients(model: Model, eccentricity, lordosis) -> ChainCoefficient
     -u_hi); its diagonal is -dh/dalpha of :func:`~spinectl.model.mechanics.lever_arm_slope`.
     Per unit f_iso of a fibre, K = -f_l' h h' - f_l d2l and D = f_l f_H'(0) h h'
     (docs/chain.md); gravity and the passive stiffness as in the per-segment model.
-    The fibres are summed once per model into polynomials in the CoR coordinates
+    The fibres are summed once for all points into polynomials in the CoR coordinates
     (:data:`CHAIN_MONOMIALS`; docs/chain.md, "The monomial form"), which equal the
     per-fibre sums (:func:`chain_per_fibre_sums`) to rounding.
 
