@@ -160,8 +160,9 @@ def arithmetic_guard(eccentricity, lordosis):
 
 
 ATTACHMENT_TOLERANCE = 4 * np.finfo(float).eps
-"""Relative distance [1] below which an attachment is on a centre of rotation: |offset|_1 <= tolerance
-times the sum of the absolute coordinates of both points (equal up to round-off of the coordinates)."""
+"""Relative distance [1] below which an attachment is on a centre of rotation: the sum of the absolute
+coordinates of their offset is at most this times the sum of the absolute coordinates of both points
+(equal up to round-off of the coordinates)."""
 
 
 def _check_attachments(model: Model, eccentricity, lordosis) -> None:
