@@ -8,7 +8,8 @@ Prints the wall time of both paths (all three stages, the reflex columns and the
 margin: what a sweep computes), their ratio and the largest difference between their
 answers (relative to each point's total PCSA or ||CT||, at least 1 N m); then the time to
 build the coefficients of the grid against the floor of one fused numpy pass over its
-fibre-CoR terms and against the per-fibre sums it replaced; then the fast path's time and
+fibre-CoR terms and against the per-fibre sums it replaced, and the coupled chain's matrices in the monomial
+form against their per-fibre sums (interleaved, best of N); then the fast path's time and
 working memory per grid point for growing grids (linear cost, flat memory); then the wall
 time of ``spinectl reproduce`` end to end and of the 401 x 401 study on 2 local workers
 (``benchmarks/bench_study.py``), each in a fresh interpreter. Timings on a shared machine
@@ -32,7 +33,8 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from spinectl.landscape import sweep  # noqa: E402
-from spinectl.model import config, geometry, mechanics  # noqa: E402
+from spinectl.landscape.columns import DEFAULT_CHUNK  # noqa: E402
+from spinectl.model import chain, config, geometry, mechanics  # noqa: E402
 from spinectl.model.params import Passive  # noqa: E402
 
 
@@ -104,6 +106,28 @@ def coefficients(model, points: int, repeats: int) -> None:
     print(f"per-fibre sums (before):              {1e3 * before:8.1f} ms")
     print(f"floor, one fused pass over the terms: {1e3 * floor:8.1f} ms")
     print(f"kernel / floor: {kernel / floor:.2f}x (target <= 3x); per-fibre sums / kernel: {before / kernel:.1f}x")
+    chain_coefficients(model, e.ravel(), lam.ravel(), repeats)
+
+
+def chain_coefficients(model, eccentricity, lordosis, repeats: int) -> None:
+    """The coupled chain's matrices in the sweep's chunks: monomial form against per-fibre sums, interleaved.
+
+    Best of ``repeats`` for each, alternating, so that both see the same load. The per-fibre sums
+    build the muscle matrices only (no gravity, no passive term), so the ratio understates the gain.
+    """
+    forms = {"monomial form": chain.chain_coefficients, "per-fibre sums": chain.chain_per_fibre_sums}
+    best = dict.fromkeys(forms, np.inf)
+    for _ in range(repeats):
+        for name, function in forms.items():
+            start = time.perf_counter()
+            for first in range(0, eccentricity.size, DEFAULT_CHUNK):
+                part = slice(first, first + DEFAULT_CHUNK)
+                function(model, eccentricity[part], lordosis[part])
+            best[name] = min(best[name], time.perf_counter() - start)
+    chunks = -(-eccentricity.size // DEFAULT_CHUNK)
+    print(f"chain_coefficients (monomial form), {chunks} chunks: {1e3 * best['monomial form']:8.1f} ms")
+    print(f"chain per-fibre sums (before), same chunks: {1e3 * best['per-fibre sums']:8.1f} ms")
+    print(f"per-fibre sums / monomial form: {best['per-fibre sums'] / best['monomial form']:.1f}x (best of {repeats})")
 
 
 def scaling(model, sizes) -> None:

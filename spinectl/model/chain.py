@@ -36,7 +36,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import geometry, muscle
-from .mechanics import fibre_length_and_lever_arm, gravity_sign, inertia, passive_stiffness, rotate
+from .mechanics import (
+    _fibre_laws,
+    cross2,
+    fibre_length_and_lever_arm,
+    gravity_sign,
+    inertia,
+    passive_stiffness,
+    rotate,
+)
 from .params import Model
 
 
@@ -444,6 +452,82 @@ class ChainCoefficients:
         return np.einsum("...jkm,...m->...jk", self.damping_per_pcsa, np.asarray(pcsa, float))
 
 
+CHAIN_MONOMIALS = ("1", "x_j + x_k", "y_j + y_k", "x_j x_k", "x_j y_k + y_j x_k", "y_j y_k", "x_hi", "y_hi")
+"""The monomials in the coordinates (x, y) of CoRs j and k (hi the higher of the two) of which every
+muscle's K_i[j, k] and D_i[j, k] is a linear combination (docs/chain.md, "The monomial form")."""
+
+
+def _monomial_coefficients(model: Model):
+    """Per-muscle coefficients of K_i[j, k] and D_i[j, k] in :data:`CHAIN_MONOMIALS`, and each fibre's lever arm.
+
+    Upright, e = P - U and l0 do not depend on the CoRs, so the lever arm h_j = (u_j x e) / l0
+    is affine in c_j, h_j = a + b x_j + d y_j, while u_j . u_k + e . u_hi is quadratic in
+    (c_j, c_k) and affine in c_hi; both are combinations of the 8 monomials with coefficients
+    that depend on the fibre alone (docs/chain.md, "The monomial form"). Summing them into
+    muscles here, once for all points, leaves one product per grid point and pair (j, k).
+
+    Returns
+    -------
+    stiffness, damping : numpy.ndarray, shape (8, n_muscles)
+        Coefficients of the monomials [N m/rad / m^2 per m^k, N m s/rad / m^2 per m^k; k the degree].
+    lever_arm : numpy.ndarray, shape (3, n_fibres)
+        a [m], b and d [1] of every fibre.
+    """
+    upper, lower, to_muscle, l0, f_l, f_l_slope, f_h_slope = _fibre_laws(model)
+    e = lower - upper
+    a, b, d = cross2(upper, e) / l0, -e[:, 1] / l0, e[:, 0] / l0
+    zero, one = np.zeros_like(a), np.ones_like(a)
+    hh = np.stack([a * a, a * b, a * d, b * b, b * d, d * d, zero, zero])  # h_j h_k
+    # u_j . u_k + e . u_hi = U . P - U . (c_j + c_k) + c_j . c_k - e . c_hi
+    uu = np.stack([np.sum(upper * lower, axis=-1), -upper[:, 0], -upper[:, 1], one, zero, one, -e[:, 0], -e[:, 1]])
+    stiffness = (hh * (f_l / l0 - f_l_slope) - uu * (f_l / l0)) @ to_muscle  # -f_l' hh - f_l d2l
+    damping = (hh * (f_l * f_h_slope)) @ to_muscle
+    return stiffness, damping, np.stack([a, b, d])
+
+
+def _pairs(n: int):
+    """The n (n + 1) / 2 pairs j <= k of CoRs, and the pair of every (j, k): K and D are symmetric by construction."""
+    j, k = np.triu_indices(n)
+    pair_of = np.empty((n, n), dtype=int)
+    pair_of[j, k] = pair_of[k, j] = np.arange(j.size)
+    return j, k, pair_of
+
+
+def _muscle_matrices(model: Model, cor):
+    """K_i and D_i per unit PCSA, (..., n, n, M), and dl/dq, (..., F, n), in the monomial form.
+
+    Stacked small matrix products (one per point), not one large one: BLAS threads the large
+    one, which costs more than it saves on a shared machine for an inner dimension of 8.
+    """
+    stiffness_terms, damping_terms, lever_terms = _monomial_coefficients(model)
+    x, y = cor[..., 0], cor[..., 1]
+    j, k, pair_of = _pairs(cor.shape[-2])  # j <= k: CoR j is the higher (they are ordered top to bottom)
+    xj, xk, yj, yk = x[..., j], x[..., k], y[..., j], y[..., k]
+    monomials = np.empty(cor.shape[:-2] + (j.size, len(CHAIN_MONOMIALS)))
+    for i, value in enumerate((1.0, xj + xk, yj + yk, xj * xk, xj * yk + yj * xk, yj * yk, xj, yj)):
+        monomials[..., i] = value
+    n_muscles = stiffness_terms.shape[-1]
+    both = monomials @ np.concatenate([stiffness_terms, damping_terms], axis=-1)  # (..., pairs, 2 M)
+    lever = np.stack([np.ones_like(x), x, y], axis=-1) @ -lever_terms  # (..., n, F): -h = -(a + b x + d y)
+    return both[..., pair_of, :n_muscles], both[..., pair_of, n_muscles:], np.swapaxes(lever, -1, -2)
+
+
+def _gravity_stiffness(model: Model, y):
+    """K_g [N m/rad] from the CoR heights y, (..., n): the point mass and the levels' weight (docs/chain.md).
+
+    Level b (upright at the height Y_b = (y_b + y_{b+1}) / 2, :func:`level_positions`) is carried
+    by the joints below it, so it adds w (Y_b - y_hi) wherever b < hi, the higher of j and k:
+    w (sum_{b < hi} Y_b - hi y_hi).
+    """
+    n = y.shape[-1]
+    higher = np.minimum.outer(np.arange(n), np.arange(n))  # CoRs are ordered top to bottom
+    y_hi = y[..., higher]
+    below = np.concatenate([np.zeros(y.shape[:-1] + (1,)), np.cumsum((y[..., :-1] + y[..., 1:]) / 2, axis=-1)], -1)
+    levels = level_weight(model) * (below[..., higher] - higher * y_hi)
+    weight = model.body.mass * model.body.gravity
+    return gravity_sign(model) * (weight * (model.body.mass_height - y_hi) + levels)
+
+
 def chain_coefficients(model: Model, eccentricity, lordosis) -> ChainCoefficients:
     """Stiffness and damping matrices of the chain at the upright equilibrium, per unit PCSA.
 
@@ -456,6 +540,9 @@ def chain_coefficients(model: Model, eccentricity, lordosis) -> ChainCoefficient
     -u_hi); its diagonal is -dh/dalpha of :func:`~spinectl.model.mechanics.lever_arm_slope`.
     Per unit f_iso of a fibre, K = -f_l' h h' - f_l d2l and D = f_l f_H'(0) h h'
     (docs/chain.md); gravity and the passive stiffness as in the per-segment model.
+    The fibres are summed once for all points into polynomials in the CoR coordinates
+    (:data:`CHAIN_MONOMIALS`; docs/chain.md, "The monomial form"), which equal the
+    per-fibre sums (:func:`chain_per_fibre_sums`) to rounding.
 
     Parameters
     ----------
@@ -474,32 +561,48 @@ def chain_coefficients(model: Model, eccentricity, lordosis) -> ChainCoefficient
     doi:10.1186/1742-4682-9-13.
     """
     cor = geometry.cor_positions(eccentricity, lordosis, model.geometry)  # (..., n, 2)
-    upper, lower, to_muscle, l0, l_opt, hill = _fibre_constants(model)
-    f_l = muscle.force_length(l0, l_opt, model.fibre)
-    f_l_slope = muscle.force_length_slope(l0, l_opt, model.fibre)
-    f_h_slope = muscle.force_velocity_slope(np.zeros_like(l0), hill)
+    stiffness, damping, length_gradient = _muscle_matrices(model, cor)
+    return ChainCoefficients(
+        stiffness_per_pcsa=stiffness,
+        damping_per_pcsa=damping,
+        gravity_stiffness=_gravity_stiffness(model, cor[..., 1]),
+        passive_stiffness=passive_stiffness(model, inertia(cor, model)),
+        length_gradient=length_gradient,
+    )
 
+
+def chain_per_fibre_sums(model: Model, eccentricity, lordosis):
+    """The muscle terms of :func:`chain_coefficients` summed fibre by fibre, as the formulas read.
+
+    K = -f_l' h h' - f_l d2l/dq dq' and D = f_l f_H'(0) h h' of every fibre at every pair of
+    CoRs, with h from :func:`~spinectl.model.mechanics.fibre_length_and_lever_arm` and the
+    Hessian of :func:`chain_coefficients`, summed into muscles: the direct form that the
+    monomial form equals (its test, and the "before" of benchmarks/bench_sweep.py).
+
+    Parameters
+    ----------
+    model : Model
+    eccentricity, lordosis : array_like
+        E and Lambda [m]; broadcast together.
+
+    Returns
+    -------
+    stiffness, damping : numpy.ndarray, shape (..., n_cor, n_cor, n_muscles)
+        Per unit PCSA [N m/rad / m^2], [N m s/rad / m^2].
+    length_gradient : numpy.ndarray, shape (..., n_fibres, n_cor)
+        dl/dq [m/rad].
+    """
+    cor = geometry.cor_positions(eccentricity, lordosis, model.geometry)  # (..., n, 2)
+    upper, lower, to_muscle, l0, f_l, f_l_slope, f_h_slope = _fibre_laws(model)
     _, h = fibre_length_and_lever_arm(upper, lower, cor[..., :, None, :])  # (..., n, F)
     u = upper - cor[..., :, None, :]  # (..., n, F, 2)
     n = cor.shape[-2]
-    higher = np.minimum.outer(np.arange(n), np.arange(n))  # CoRs are ordered top to bottom
+    higher = np.minimum.outer(np.arange(n), np.arange(n))
     e_dot_u = np.einsum("fd,...jfd->...jf", lower - upper, u)
     hh = h[..., :, None, :] * h[..., None, :, :]  # (..., n, n, F)
     hessian = (np.einsum("...jfd,...kfd->...jkf", u, u) + e_dot_u[..., higher, :] - hh) / l0
-
-    y = cor[..., 1]
-    weight = model.body.mass * model.body.gravity
-    # a level at height y_b carried by joints b+1, ...: w (y_b - y_hi) on those rows and columns
-    carried = _carried_by(n)[1:]  # (n - 1, n)
-    height = level_positions(np.zeros(n), cor)[..., :, None, None, 1] - y[..., None, higher]
-    levels = level_weight(model) * np.sum(height * carried[:, :, None] * carried[:, None, :], axis=-3)
-    return ChainCoefficients(
-        stiffness_per_pcsa=(-f_l_slope * hh - f_l * hessian) @ to_muscle,
-        damping_per_pcsa=(f_l * f_h_slope * hh) @ to_muscle,
-        gravity_stiffness=gravity_sign(model) * (weight * (model.body.mass_height - y[..., higher]) + levels),
-        passive_stiffness=passive_stiffness(model, inertia(cor, model)),
-        length_gradient=-np.swapaxes(h, -1, -2),
-    )
+    stiffness = (-f_l_slope * hh - f_l * hessian) @ to_muscle
+    return stiffness, (f_l * f_h_slope * hh) @ to_muscle, -np.swapaxes(h, -1, -2)
 
 
 def coupled_margin(stiffness):

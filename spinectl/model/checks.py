@@ -159,33 +159,69 @@ def arithmetic_guard(eccentricity, lordosis):
         ) from None
 
 
+ATTACHMENT_TOLERANCE = 4 * np.finfo(float).eps
+"""Relative distance [1] below which an attachment is on a centre of rotation: the sum of the absolute
+coordinates of their offset is at most this times the sum of the absolute coordinates of both points
+(equal up to round-off of the coordinates)."""
+
+
 def _check_attachments(model: Model, eccentricity, lordosis) -> None:
     """Raise :class:`ModelError` if a fibre attachment lies on a centre of rotation.
 
     A fibre's line of action may pass through a CoR (a zero lever arm is a
     valid answer), but an attachment on the CoR leaves no arm between the
     joint and the muscle: the fibre has zero length on one side of the joint.
-    "On" means equal up to round-off of the coordinates.
+    "On" means equal up to round-off of the coordinates (:data:`ATTACHMENT_TOLERANCE`).
+    Only the (CoR, fibre) pairs that :func:`_attachment_candidates` cannot rule out are
+    checked point by point, with the same arithmetic, so the verdict and the point named
+    are those of checking every pair.
     """
     cor = geometry.cor_positions(eccentricity, lordosis, model.geometry)  # (..., K, 2)
     upper, lower, share = geometry.all_fibres(model)  # (F, 2), (F, 2), (F, M)
-    tolerance = 4 * np.finfo(float).eps
     for end, points in (("upper", upper), ("lower", lower)):
-        offset = cor[..., :, None, :] - points  # (..., K, F, 2)
-        scale = np.abs(cor[..., :, None, :]).sum(-1) + np.abs(points).sum(-1)
-        on_cor = np.abs(offset).sum(-1) <= tolerance * scale
+        cors, fibres = _attachment_candidates(cor, points)  # in the order (k, f) of all pairs
+        if cors.size == 0:
+            continue
+        offset = cor[..., cors, :] - points[fibres]  # (..., C, 2)
+        scale = np.abs(cor[..., cors, :]).sum(-1) + np.abs(points[fibres]).sum(-1)
+        on_cor = np.abs(offset).sum(-1) <= ATTACHMENT_TOLERANCE * scale
         if on_cor.any():
-            *at, k, f = np.argwhere(on_cor)[0]
+            *at, c = np.argwhere(on_cor)[0]  # the first point, then the first pair: as over all pairs
+            k, f = cors[c], fibres[c]
             muscle = int(np.argmax(share[f]))
             pair = muscle // 2
             e, lam = (
-                np.broadcast_to(np.asarray(x, float), on_cor.shape[:-2])[tuple(at)] for x in (eccentricity, lordosis)
+                np.broadcast_to(np.asarray(x, float), on_cor.shape[:-1])[tuple(at)] for x in (eccentricity, lordosis)
             )
             raise ModelError(
                 f"muscles.{pair}.{end}: the {end} attachment of a fibre of {model.muscle_names[muscle]} lies on the "
                 f"centre of rotation {model.geometry.cor_names[k]} {_where(e, lam)}; a fibre needs a non-zero "
                 "arm between the joint and each attachment"
             )
+
+
+def _attachment_candidates(cor, points):
+    """The (CoR, point) pairs that can be "on" somewhere on the grid, as two index arrays in row-major order.
+
+    Rounding is monotonic, so over the box that the CoR's coordinates span on the grid
+    [lo, hi], |fl(c - P)| >= fl(max(lo - P, P - hi, 0)) per coordinate, and the scale
+    |c|_1 + |P|_1 is at most its value at the largest |c_x| and |c_y|: a pair whose lower
+    bound of the offset exceeds the tolerance times that upper bound of the scale is "on"
+    nowhere (the bound rules out every pair of the presets). Coordinates near the overflow
+    threshold keep every pair, so that the arithmetic (and its overflow) is that of the
+    full check.
+    """
+    flat = cor.reshape(-1, *cor.shape[-2:])  # (P, K, 2)
+    n_cor, n_points = cor.shape[-2], points.shape[0]
+    if flat.shape[0] == 0:
+        return np.empty(0, int), np.empty(0, int)
+    lo, hi = flat.min(axis=0)[:, None, :], flat.max(axis=0)[:, None, :]  # (K, 1, 2)
+    largest = max(np.abs(lo).max(initial=0.0), np.abs(hi).max(initial=0.0), np.abs(points).max(initial=0.0))
+    if not largest <= np.finfo(float).max / 8:  # sums of four coordinates could overflow: check every pair
+        return np.divmod(np.arange(n_cor * n_points), n_points)
+    gap = np.maximum(np.maximum(lo - points, points - hi), 0.0).sum(-1)  # (K, F)
+    scale = np.maximum(np.abs(lo), np.abs(hi)).sum(-1) + np.abs(points).sum(-1)
+    return np.nonzero(gap <= ATTACHMENT_TOLERANCE * scale)
 
 
 def _check_range(model: Model, eccentricity, lordosis) -> None:

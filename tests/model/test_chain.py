@@ -4,10 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from spinectl import load_preset
 from spinectl.model import chain, geometry, mechanics, muscle, stability
-from spinectl.model.params import Body, Errata, Levels, Local, Model, Passive
+from spinectl.model.params import Body, Errata, Fibre, Geometry, Levels, Local, Model, MusclePair, Passive
 
 STEP = 1e-6
 N_COR = 5
@@ -182,6 +184,87 @@ def test_coefficients_broadcast_over_a_grid(model):
     assert grid.length_gradient.shape == (3, 2, 30, 5)
     one = chain.chain_coefficients(model, E[2, 1], L[2, 1])
     np.testing.assert_allclose(grid.stiffness_per_pcsa[2, 1], one.stiffness_per_pcsa, rtol=1e-12)
+
+
+# --- the monomial form against the per-fibre sums ------------------------------------------------
+
+
+def _term_scales(model, E, L):
+    """The size of the largest term that either form adds up, per muscle for K and D and per fibre for dl/dq.
+
+    Every term of either form is at most r^2 times a fibre's weight (f_l' h h', f_l/l (u . u, e . u, h h),
+    U . P, U . c, c . c, f_l f_H' h h), r = |U| + |P| + the largest |c|; both forms round at that size,
+    so an entry near 0 (a vertical fibre through a CoR) is compared at it, not at its own size.
+    """
+    upper, lower, share = geometry.all_fibres(model)
+    cor = geometry.cor_positions(E, L, model.geometry)
+    reach = np.linalg.norm(upper, axis=-1) + np.linalg.norm(lower, axis=-1) + np.abs(cor).sum(-1).max(-1)[..., None]
+    l0 = np.linalg.norm(lower - upper, axis=-1)
+    l_opt = model.fibre.optimal_length_ratio * l0
+    f_l = muscle.force_length(l0, l_opt, model.fibre)
+    f_l_slope = muscle.force_length_slope(l0, l_opt, model.fibre)
+    f_h_slope = muscle.force_velocity_slope(0.0 * l0, muscle.hill_constants(l_opt, model.fibre, model.errata))
+    weights = model.fibre.specific_tension * share
+    stiffness = (reach**2 * (np.abs(f_l_slope) + 2 * f_l / l0)) @ weights
+    damping = (reach**2 * np.abs(f_l * f_h_slope)) @ weights
+    return stiffness[..., None, None, :], damping[..., None, None, :], reach[..., :, None]
+
+
+def _assert_equals_per_fibre_sums(model, E, L):
+    """chain_coefficients (the monomial form) against chain_per_fibre_sums (the formulas of docs/chain.md
+    fibre by fibre, as before the monomial form) to 1e-12 of the terms they add (:func:`_term_scales`)."""
+    coupled = chain.chain_coefficients(model, E, L)
+    expected = chain.chain_per_fibre_sums(model, E, L)
+    got = (coupled.stiffness_per_pcsa, coupled.damping_per_pcsa, coupled.length_gradient)
+    for value, reference, scale in zip(got, expected, _term_scales(model, E, L), strict=True):
+        assert value.shape == reference.shape
+        assert np.all(np.abs(value - reference) <= 1e-12 * scale)
+    for matrix in got[:2]:
+        np.testing.assert_array_equal(matrix, np.swapaxes(matrix, -3, -2))  # symmetric by construction
+    return coupled, expected
+
+
+@pytest.mark.parametrize("preset", ["default", "wagner2012"])
+def test_monomial_form_equals_per_fibre_sums_on_the_papers_grid(preset):
+    """The paper's 0-8 cm in 5 mm steps, and the mirrored range beyond it (the modelled -10 to 10 cm);
+    there also to 1e-12 of each muscle's largest entry at the point (about 1e-14 measured)."""
+    model = load_preset(preset)
+    for axis in (np.linspace(0.0, 0.08, 17), np.linspace(-0.1, 0.1, 9)):
+        coupled, (stiffness, damping, _) = _assert_equals_per_fibre_sums(model, *np.meshgrid(axis, axis, indexing="ij"))
+        for value, reference in ((coupled.stiffness_per_pcsa, stiffness), (coupled.damping_per_pcsa, damping)):
+            largest = np.abs(reference).max(axis=(-3, -2), keepdims=True)
+            assert np.all(np.abs(value - reference) <= 1e-12 * largest)
+
+
+def _reals(low, high):
+    return st.floats(low, high, allow_nan=False, allow_infinity=False)
+
+
+@st.composite
+def _chain_models(draw):
+    """1-3 pairs anywhere around the spine (attachments may cross the CoRs' heights), 1-6 CoRs at random
+    heights on the spine, a random optimal length, and passive stiffness and levels' weight on or off."""
+    pairs = []
+    for i in range(draw(st.integers(1, 3))):
+        top = draw(_reals(0.03, 0.35))
+        upper, lower = (draw(_reals(-0.2, 0.2)), top), (draw(_reals(-0.2, 0.2)), draw(_reals(-0.1, top - 0.025)))
+        pairs.append(MusclePair(f"p{i}", upper, lower, draw(_reals(0.0, 0.02)), draw(st.integers(1, 5))))
+    heights = draw(st.lists(_reals(0.0, 0.176), min_size=1, max_size=6, unique=True))
+    return Model(
+        muscles=tuple(pairs),
+        geometry=Geometry(cor_names=tuple(f"C{i}" for i in range(len(heights))), cor_heights=sorted(heights)[::-1]),
+        fibre=Fibre(optimal_length_ratio=draw(_reals(1.01, 1.6))),
+        passive=Passive(draw(st.sampled_from([0.0, 15.0])), draw(st.sampled_from(["physical", "paper"]))),
+        levels=Levels(weight_in_gravity=draw(st.sampled_from([0.0, 1.0]))),
+    )
+
+
+@settings(max_examples=100, deadline=None)
+@given(_chain_models(), st.lists(st.tuples(_reals(-0.1, 0.1), _reals(-0.1, 0.1)), min_size=1, max_size=4))
+def test_monomial_form_equals_per_fibre_sums_on_random_geometries(model, positions):
+    E, L = np.array(positions).T
+    _assert_equals_per_fibre_sums(model, E, L)
+    _assert_equals_per_fibre_sums(model, E[0], L[0])  # a single point: no leading dimensions
 
 
 # --- inertia and dynamic stability -------------------------------------------------------------
