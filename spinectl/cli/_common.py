@@ -3,10 +3,10 @@
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import sys
 
+from .. import jsondoc
 from ..atomic import atomic_write_text
 from ..errors import ParameterError
 from ..model.config import DEFAULT_PRESET, apply_overrides, load_config, set_parameters
@@ -141,11 +141,12 @@ def emit_json(payload: dict, out: str | None = None) -> None:
     Parameters
     ----------
     payload : dict
-        JSON-serialisable document; NaN is written as ``NaN``.
+        JSON-ready document; a NaN or infinite number is written ``null`` with a ``<key>_reason``
+        beside it (:func:`spinectl.jsondoc.dumps`, docs/cli.md "JSON output").
     out : str, optional
         Output file; default standard output.
     """
-    text = json.dumps(payload, indent=2, allow_nan=True) + "\n"
+    text = jsondoc.dumps(payload)
     if out:
         atomic_write_text(out, text)
     else:

@@ -9,7 +9,7 @@ import tomllib
 
 import pytest
 
-from spinectl import optimise
+from spinectl import jsondoc, optimise
 from spinectl.cli import main
 from spinectl.model import config
 from spinectl.model.stability import segment_stability
@@ -34,7 +34,7 @@ def test_stability_prints_the_results_dict_and_table(capsys):
     model = config.set_parameter(config.load_preset(config.DEFAULT_PRESET), "passive.stiffness", 15.0)
     result = segment_stability(model, 0.03, 0.04, [10e-4, 10e-4, 10e-4])
     code, out, _ = run([*argv, "--json"], capsys)
-    assert code == 0 and out == json.dumps(result.to_dict(model), indent=2) + "\n"
+    assert code == 0 and out == jsondoc.dumps(result.to_dict(model))
     code, out, _ = run(argv, capsys)
     assert code == 0 and out == result.table(model) + "\n"
 
