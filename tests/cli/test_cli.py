@@ -211,3 +211,35 @@ def test_a_home_that_cannot_be_written_leaves_stderr_empty(tmp_path):
     command = [sys.executable, "-m", "spinectl", "draw", "--E", "0.03", "--Lambda", "0.04", "--out"]
     done = subprocess.run([*command, str(tmp_path / "d.png")], env=env, cwd=root, capture_output=True, text=True)
     assert (done.returncode, done.stderr) == (0, "") and (tmp_path / "d.png").is_file()
+
+
+@pytest.mark.parametrize("preset", config.list_presets())
+def test_config_show_comments_describe_the_shown_value_or_name_the_default(preset, capsys):
+    """A comment that justifies a number must be about the value printed under it: where the preset's value
+    is not the default, a comment that states the default (e.g. wagner2012's mass, 24.06 kg, under a comment
+    of the default's 40 kg) must say that number is the default's."""
+    import dataclasses
+    import re
+
+    assert main(["config", "show", "--preset", preset]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    model = config.load_preset(preset)
+    checked = 0
+    for section in ("body", "levels", "local", "passive", "reflex", "optimisation", "fibre"):
+        if not hasattr(model, section):
+            continue
+        start = lines.index(f"[{section}]")
+        for f in dataclasses.fields(getattr(model, section)):
+            value, default = getattr(getattr(model, section), f.name), f.default
+            if not isinstance(default, float) or value == default:
+                continue
+            row = next(k for k in range(start, len(lines)) if lines[k].startswith(f"{f.name} = "))
+            comment = lines[row - 1]
+            unit = re.escape(f.metadata["unit"])
+            states_a_value = re.search(rf"(?<![\d.]){re.escape(f'{default:g}')}(?![\d.])", comment) or re.search(
+                rf"\d ?{unit}\b", comment.split("]", 1)[1]
+            )
+            if states_a_value:  # e.g. "55 % of a 73 kg body": a value the shown one is not
+                assert "default" in comment, (section, f.name, comment)
+            checked += 1
+    assert checked > 0 or preset == "default"
