@@ -5,12 +5,14 @@ from __future__ import annotations
 import argparse
 import math
 import sys
+import warnings
 
 from .. import jsondoc
 from ..atomic import atomic_write_text
 from ..errors import ParameterError
 from ..model.config import DEFAULT_PRESET, apply_overrides, load_config, set_parameters
 from ..model.params import Model
+from ..units import CM_PER_M, centimetre_slip, cm2_to_m2, square_metre_slip
 
 
 def add_model_options(parser: argparse.ArgumentParser) -> None:
@@ -73,6 +75,67 @@ def add_dpi_option(parser: argparse.ArgumentParser) -> None:
     from ..paper.figures import DPI
 
     parser.add_argument("--dpi", type=finite_float("--dpi"), default=DPI, help=f"PNG resolution (default {DPI})")
+
+
+def check_position(model: Model, args: argparse.Namespace) -> None:
+    """``--E`` and ``--Lambda`` within the model's range, or an error naming the option and a cm slip.
+
+    The library refuses them too (:mod:`spinectl.model.checks`), but names its argument; the
+    command line says which option, and ``--E 3`` gets "if you meant 3 cm, give 0.03".
+
+    Parameters
+    ----------
+    model : Model
+        Its ``geometry`` gives the ranges [m].
+    args : argparse.Namespace
+        With ``E`` and ``Lambda`` [m] (:func:`add_position_options`).
+
+    Raises
+    ------
+    ParameterError
+        A value out of range, naming ``--E`` or ``--Lambda``.
+    """
+    for option, value, (low, high) in (
+        ("--E", args.E, model.geometry.eccentricity_range),
+        ("--Lambda", args.Lambda, model.geometry.lordosis_range),
+    ):
+        if not low <= value <= high:
+            hint = centimetre_slip(value, low, high, f"{value:g}", f"{value / CM_PER_M:g}")
+            raise ParameterError(option, f"must be in [{low:g}, {high:g}] m, the modelled range (got {value:g}){hint}")
+
+
+def pcsa_option(values: list[float] | None):
+    """``--pcsa`` [cm^2] in m^2, refusing more than any muscle and warning of m^2 typed for cm^2.
+
+    Parameters
+    ----------
+    values : list of float or None
+        As parsed (:func:`float_list`); None: not given.
+
+    Returns
+    -------
+    numpy.ndarray or None
+        PCSA [m^2] (the library checks the count and signs), or None.
+
+    Raises
+    ------
+    ParameterError
+        A value above :data:`spinectl.model.checks.MAX_PLAUSIBLE_PCSA` (1000 cm^2), named in cm^2.
+    """
+    if values is None:
+        return None
+    from ..model.checks import MAX_PLAUSIBLE_PCSA
+
+    largest = max(values, default=0.0)
+    limit = MAX_PLAUSIBLE_PCSA / cm2_to_m2(1.0)
+    if largest > limit:
+        raise ParameterError(
+            "--pcsa", f"must be at most {limit:g} cm^2 per muscle, more than any muscle (got {largest:g})"
+        )
+    slip = square_metre_slip(values)
+    if slip:
+        warnings.warn(f"--pcsa: {slip}", UserWarning, stacklevel=2)
+    return cm2_to_m2(values)
 
 
 def load_model(args: argparse.Namespace, aliases: dict | None = None) -> Model:

@@ -243,3 +243,55 @@ def test_config_show_comments_describe_the_shown_value_or_name_the_default(prese
                 assert "default" in comment, (section, f.name, comment)
             checked += 1
     assert checked > 0 or preset == "default"
+
+
+@pytest.mark.parametrize(
+    ("argv", "option", "hint"),
+    [
+        (["stability", "--E", "3"], "--E", "if you meant 3 cm, give 0.03"),
+        (["margins", "--Lambda", "4"], "--Lambda", "if you meant 4 cm, give 0.04"),
+        (["draw", "--E", "-2", "--out", "never.png"], "--E", "if you meant -2 cm, give -0.02"),
+        (["stability", "--E", "0.5"], "--E", ""),  # 5 times the range: no likely cm slip, no hint
+        (["stability", "--E", "30"], "--E", ""),  # 30 cm is out of range too
+    ],
+)
+def test_a_length_in_cm_gets_a_hint_naming_the_option(argv, option, hint, capsys, tmp_path, monkeypatch):
+    """The range check names the option typed, and a value that is in range once read as cm says so
+    (the model's range is [-0.1, 0.1] m: docs/model.md)."""
+    monkeypatch.chdir(tmp_path)
+    code, out, err = run(argv, capsys)
+    assert code == 2 and out == "" and err.count("\n") == 1
+    assert err.startswith(f"spinectl: error: {option}: must be in [-0.1, 0.1] m, the modelled range (got ")
+    assert (hint in err) if hint else ("if you meant" not in err)
+    assert not (tmp_path / "never.png").exists()
+
+
+def test_a_grid_out_of_range_names_the_spec_typed_and_the_spec_in_metres(tmp_path, capsys):
+    """Before: 'E: must be in [-0.1, 0.1] m ... (got 0.2)', the first bad grid point, not what was typed."""
+    out_file = tmp_path / "r.nc"
+    code, _, err = run(["sweep", "--E", "0:8:81", "--out", str(out_file)], capsys)
+    assert code == 2 and err.count("\n") == 1 and not out_file.exists()
+    assert "--E: must be in [-0.1, 0.1] m, the modelled range (got '0:8:81': 0 to 8 m)" in err
+    assert err.rstrip().endswith("if you meant 0:8:81 cm, give 0:0.08:81")
+    code, _, err = run(["sweep", "--Lambda", "0:0.5:3", "--out", str(out_file)], capsys)
+    assert code == 2 and "(got '0:0.5:3': 0 to 0.5 m)" in err and "if you meant" not in err
+
+
+def test_a_pcsa_in_square_metres_gets_a_warning_and_runs(capsys):
+    """0.001 typed for 0.001 m^2 (10 cm^2): a warning naming --pcsa and the value to give; zeros and
+    plausible values warn of nothing."""
+    code, out, err = run(["stability", "--pcsa", "0.001,0.002,0"], capsys)
+    assert code == 0 and "L5S1" in out
+    assert err == (
+        "spinectl: warning: --pcsa: 0.001 cm^2 is less than any muscle's PCSA (below 0.1 cm^2); PCSA is in "
+        "cm^2 here: if you meant 0.001 m^2, give 10\n"
+    )
+    code, _, err = run(["stability", "--pcsa", "0,10,0.5"], capsys)
+    assert code == 0 and err == ""
+
+
+def test_a_pcsa_beyond_any_muscle_is_refused_in_cm2(capsys):
+    """The command line takes cm^2, so its refusal speaks cm^2 (the library's speaks m^2: 'got 0.2 m^2')."""
+    code, out, err = run(["stability", "--pcsa", "2000,1,1"], capsys)
+    assert code == 2 and out == "" and err.count("\n") == 1
+    assert err == "spinectl: error: --pcsa: must be at most 1000 cm^2 per muscle, more than any muscle (got 2000)\n"

@@ -48,7 +48,9 @@ def _reasons_are_words(document) -> int:
             for name, why in value.items():
                 if name.endswith("_reason"):
                     number = value[name.removesuffix("_reason")]
-                    pairs = list(zip(_flat(number), _flat(why), strict=True)) if isinstance(why, list) else [(number, why)]
+                    pairs = (
+                        list(zip(_flat(number), _flat(why), strict=True)) if isinstance(why, list) else [(number, why)]
+                    )
                     assert all((n is None) == (w is not None) for n, w in pairs), (key, name)
                     assert all(w in jsondoc.REASONS for _, w in pairs if w is not None), (key, name)
                     count += 1
