@@ -295,3 +295,32 @@ def test_a_pcsa_beyond_any_muscle_is_refused_in_cm2(capsys):
     code, out, err = run(["stability", "--pcsa", "2000,1,1"], capsys)
     assert code == 2 and out == "" and err.count("\n") == 1
     assert err == "spinectl: error: --pcsa: must be at most 1000 cm^2 per muscle, more than any muscle (got 2000)\n"
+
+
+@pytest.mark.parametrize(
+    ("argv", "line"),
+    [
+        (["stability", "--E", "nan"], "spinectl: error: stability: argument --E: --E must be finite (got 'nan')"),
+        (["stability", "--pcsa"], "spinectl: error: stability: argument --pcsa: expected one argument"),
+        (
+            ["margins", "--delya", "0.05"],
+            "spinectl: error: margins: unrecognized arguments: --delya 0.05; did you mean --delay?",
+        ),
+        (
+            ["margins", "--activaton=1"],
+            "spinectl: error: margins: unrecognized arguments: --activaton=1; did you mean --activation?",
+        ),
+        (["stability", "--frob"], "spinectl: error: stability: unrecognized arguments: --frob"),
+        (["stabilty"], "spinectl: error: argument COMMAND: invalid choice: 'stabilty' (choose from "),
+    ],
+)
+def test_argparse_errors_read_like_the_others_with_a_suggestion(argv, line, capsys):
+    """One line, 'spinectl: error: ...' as the library's errors (before: 'error: spinectl stability: ...'), exit 2;
+    a mistyped option or command gets difflib's closest name."""
+    code, out, err = run(argv, capsys)
+    assert code == 2 and out == "" and err.count("\n") == 1
+    assert err.startswith(line)
+    if argv == ["stabilty"]:
+        assert err.rstrip().endswith("; did you mean stability?")
+    if argv == ["stability", "--frob"]:
+        assert "did you mean" not in err  # nothing close: no guess
