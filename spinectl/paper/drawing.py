@@ -316,8 +316,9 @@ def _draw_spine(ax, model: Model, eccentricity: float, lordosis: float, annotate
             )
         for label, (x, y) in zip(("P1", "P3", "P2"), points * CM_PER_M, strict=True):
             ax.annotate(
-                label, (x, y), xytext=(6, 0), textcoords="offset points", va="center", fontsize=7, gid=f"point label {label}"
-            )
+                label, (x, y), xytext=(6, 0), textcoords="offset points", va="center", fontsize=7,
+                gid=f"point label {label}",
+            )  # fmt: skip
     return cors
 
 
