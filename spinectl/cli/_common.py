@@ -5,9 +5,9 @@ from __future__ import annotations
 import argparse
 import math
 import sys
-import warnings
 
 from .. import jsondoc
+from .._validate import printable
 from ..atomic import atomic_write_text
 from ..errors import ParameterError
 from ..model.config import DEFAULT_PRESET, apply_overrides, load_config, set_parameters
@@ -105,7 +105,7 @@ def check_position(model: Model, args: argparse.Namespace) -> None:
 
 
 def pcsa_option(values: list[float] | None):
-    """``--pcsa`` [cm^2] in m^2, refusing more than any muscle and warning of m^2 typed for cm^2.
+    """``--pcsa`` [cm^2] in m^2, refusing more than any muscle (:func:`note_pcsa_slip` warns of m^2 for cm^2).
 
     Parameters
     ----------
@@ -132,10 +132,22 @@ def pcsa_option(values: list[float] | None):
         raise ParameterError(
             "--pcsa", f"must be at most {limit:g} cm^2 per muscle, more than any muscle (got {largest:g})"
         )
-    slip = square_metre_slip(values)
-    if slip:
-        warnings.warn(f"--pcsa: {slip}", UserWarning, stacklevel=2)
     return cm2_to_m2(values)
+
+
+def note_pcsa_slip(values: list[float] | None) -> None:
+    """After a command's answer: one line on stderr if ``--pcsa`` looks like m^2 typed for cm^2.
+
+    After the answer, not before: a run that then fails prints its one-line error alone.
+
+    Parameters
+    ----------
+    values : list of float or None
+        ``--pcsa`` as parsed [cm^2] (:func:`spinectl.units.square_metre_slip`).
+    """
+    slip = square_metre_slip(values) if values is not None else ""
+    if slip:
+        print(f"spinectl: warning: --pcsa: {printable(slip)}", file=sys.stderr)
 
 
 def load_model(args: argparse.Namespace, aliases: dict | None = None) -> Model:

@@ -10,6 +10,7 @@ from ._common import (
     check_position,
     float_list,
     load_model,
+    note_pcsa_slip,
     pcsa_option,
 )
 
@@ -75,4 +76,5 @@ def run(args) -> int:
     pcsa = None if args.geometry_only else ("optimum" if args.pcsa is None else pcsa_option(args.pcsa))
     fig = drawing.draw_model(model, args.E, args.Lambda, pcsa=pcsa, counter_torque=args.counter_torque)
     print(figures.save_figure(fig, args.out, args.dpi))
+    note_pcsa_slip(None if args.geometry_only else args.pcsa)
     return 0

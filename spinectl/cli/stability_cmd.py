@@ -10,6 +10,7 @@ from ._common import (
     finite_float,
     float_list,
     load_model,
+    note_pcsa_slip,
     pcsa_option,
 )
 
@@ -81,4 +82,5 @@ def run(args) -> int:
         emit_json(result.to_dict(model, pcsa_source=source))
     else:
         print(result.table(model, pcsa_source=source))
+    note_pcsa_slip(args.pcsa)
     return 0
