@@ -288,7 +288,7 @@ def test_a_pcsa_in_square_metres_gets_a_warning_and_runs(capsys):
     )
     code, _, err = run(["stability", "--pcsa", "0,10,0.5"], capsys)
     assert code == 0 and err == ""
-    code, _, err = run(["stability", "--pcsa", "0.001,0.001,0.001", "--E", "3"], capsys)  # a failed run: its error alone
+    code, _, err = run(["stability", "--pcsa", "0.001,0.001,0.001", "--E", "3"], capsys)  # failed: error only
     assert code == 2 and err.count("\n") == 1 and err.startswith("spinectl: error: --E")
 
 
