@@ -48,8 +48,8 @@ def m2_to_cm2(value):
 
 CM2_LEAST_PLAUSIBLE = 0.1
 """Smallest non-zero PCSA of one muscle [cm^2] taken without a warning at the command line: 10 mm^2,
-a few hundredths of the paper's least stabilising totals (tens of cm^2; 35.8 cm^2 at E = 3, Lambda =
-4 cm, docs/reproduction.md). A value below it is far more likely m^2 typed where the CLI takes cm^2
+under 1 % of the paper's least stabilising totals (tens of cm^2; 35.8 cm^2 at E = 3, Lambda = 4 cm,
+docs/reproduction.md). A value below it is far more likely m^2 typed where the CLI takes cm^2
 (0.001 m^2 = 10 cm^2), which the model accepts silently as a muscle too weak to matter."""
 
 
