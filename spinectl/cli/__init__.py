@@ -13,6 +13,7 @@ stderr and exit code 2, without a traceback.
 from __future__ import annotations
 
 import argparse
+import difflib
 import importlib
 import logging
 import re
@@ -82,8 +83,51 @@ class _Parser(argparse.ArgumentParser):
         self.complete()
         return super().format_help()
 
+    def parse_args(self, args=None, namespace=None):
+        """As argparse's, but an unknown option is reported by the command that was used, with a "did you mean"."""
+        parsed, extras = self.parse_known_args(args, namespace)
+        if extras:
+            command = self._command(parsed) or self
+            command.error(f"unrecognized arguments: {' '.join(extras)}{command.suggestion(extras)}")
+        return parsed
+
+    def _command(self, parsed):
+        """The sub-command's parser that ``parsed`` went through, or None."""
+        for action in self._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                return action.choices.get(getattr(parsed, action.dest, None))
+        return None
+
+    def suggestion(self, words) -> str:
+        """``"; did you mean --delay?"`` for the first of ``words`` close to an option of this parser, else ``""``.
+
+        Parameters
+        ----------
+        words : list of str
+            The arguments argparse did not recognise (``--delya``, ``--delya=3``, values).
+
+        Returns
+        -------
+        str
+            The hint (difflib's closest option string), or an empty string.
+        """
+        options = [o for o in self._option_string_actions if o.startswith("--")]
+        for word in words:
+            if word.startswith("-") and not self._negative_number_matcher.match(word):
+                close = difflib.get_close_matches(word.split("=", 1)[0], options, n=1, cutoff=0.75)
+                if close:
+                    return f"; did you mean {close[0]}?"
+        return ""
+
     def error(self, message):  # noqa: D401 - argparse API
-        raise _UsageError(f"{self.prog}: {message}")
+        """One line, ``spinectl: error: <command>: <message>`` (printed by :func:`main`), with a "did you mean"."""
+        match = re.search(r"invalid choice: '([^']*)' \(choose from (.*)\)$", message)
+        if match:
+            choices = re.findall(r"'([^']*)'", match.group(2))
+            close = difflib.get_close_matches(match.group(1), choices, n=1, cutoff=0.6)
+            message += f"; did you mean {close[0]}?" if close else ""
+        command = self.prog.removeprefix("spinectl").strip()
+        raise _UsageError(f"{command}: {message}" if command else message)
 
     def exit(self, status=0, message=None):  # --help and --version end here
         if message:
@@ -156,10 +200,7 @@ def main(argv: list[str] | None = None) -> int:
             return int(args.func(args) or 0)
     except _ParserExit as exc:
         return exc.status
-    except _UsageError as exc:
-        print(f"error: {printable(str(exc))}", file=sys.stderr)
-        return EXIT_USAGE
-    except SpinectlError as exc:
+    except (_UsageError, SpinectlError) as exc:  # argparse's and the library's errors read alike
         print(f"spinectl: error: {printable(str(exc))}", file=sys.stderr)
         return EXIT_USAGE
     except KeyboardInterrupt:

@@ -3,14 +3,16 @@
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import sys
 
+from .. import jsondoc
+from .._validate import printable
 from ..atomic import atomic_write_text
 from ..errors import ParameterError
 from ..model.config import DEFAULT_PRESET, apply_overrides, load_config, set_parameters
 from ..model.params import Model
+from ..units import CM_PER_M, centimetre_slip, cm2_to_m2, square_metre_slip
 
 
 def add_model_options(parser: argparse.ArgumentParser) -> None:
@@ -73,6 +75,79 @@ def add_dpi_option(parser: argparse.ArgumentParser) -> None:
     from ..paper.figures import DPI
 
     parser.add_argument("--dpi", type=finite_float("--dpi"), default=DPI, help=f"PNG resolution (default {DPI})")
+
+
+def check_position(model: Model, args: argparse.Namespace) -> None:
+    """``--E`` and ``--Lambda`` within the model's range, or an error naming the option and a cm slip.
+
+    The library refuses them too (:mod:`spinectl.model.checks`), but names its argument; the
+    command line says which option, and ``--E 3`` gets "if you meant 3 cm, give 0.03".
+
+    Parameters
+    ----------
+    model : Model
+        Its ``geometry`` gives the ranges [m].
+    args : argparse.Namespace
+        With ``E`` and ``Lambda`` [m] (:func:`add_position_options`).
+
+    Raises
+    ------
+    ParameterError
+        A value out of range, naming ``--E`` or ``--Lambda``.
+    """
+    for option, value, (low, high) in (
+        ("--E", args.E, model.geometry.eccentricity_range),
+        ("--Lambda", args.Lambda, model.geometry.lordosis_range),
+    ):
+        if not low <= value <= high:
+            hint = centimetre_slip(value, low, high, f"{value:g}", f"{value / CM_PER_M:g}")
+            raise ParameterError(option, f"must be in [{low:g}, {high:g}] m, the modelled range (got {value:g}){hint}")
+
+
+def pcsa_option(values: list[float] | None):
+    """``--pcsa`` [cm^2] in m^2, refusing more than any muscle (:func:`note_pcsa_slip` warns of m^2 for cm^2).
+
+    Parameters
+    ----------
+    values : list of float or None
+        As parsed (:func:`float_list`); None: not given.
+
+    Returns
+    -------
+    numpy.ndarray or None
+        PCSA [m^2] (the library checks the count and signs), or None.
+
+    Raises
+    ------
+    ParameterError
+        A value above :data:`spinectl.model.checks.MAX_PLAUSIBLE_PCSA` (1000 cm^2), named in cm^2.
+    """
+    if values is None:
+        return None
+    from ..model.checks import MAX_PLAUSIBLE_PCSA
+
+    largest = max(values, default=0.0)
+    limit = MAX_PLAUSIBLE_PCSA / cm2_to_m2(1.0)
+    if largest > limit:
+        raise ParameterError(
+            "--pcsa", f"must be at most {limit:g} cm^2 per muscle, more than any muscle (got {largest:g})"
+        )
+    return cm2_to_m2(values)
+
+
+def note_pcsa_slip(values: list[float] | None) -> None:
+    """After a command's answer: one line on stderr if ``--pcsa`` looks like m^2 typed for cm^2.
+
+    After the answer, not before: a run that then fails prints its one-line error alone.
+
+    Parameters
+    ----------
+    values : list of float or None
+        ``--pcsa`` as parsed [cm^2] (:func:`spinectl.units.square_metre_slip`).
+    """
+    slip = square_metre_slip(values) if values is not None else ""
+    if slip:
+        print(f"spinectl: warning: --pcsa: {printable(slip)}", file=sys.stderr)
 
 
 def load_model(args: argparse.Namespace, aliases: dict | None = None) -> Model:
@@ -141,11 +216,12 @@ def emit_json(payload: dict, out: str | None = None) -> None:
     Parameters
     ----------
     payload : dict
-        JSON-serialisable document; NaN is written as ``NaN``.
+        JSON-ready document; a NaN or infinite number is written ``null`` with a ``<key>_reason``
+        beside it (:func:`spinectl.jsondoc.dumps`, docs/cli.md "JSON output").
     out : str, optional
         Output file; default standard output.
     """
-    text = json.dumps(payload, indent=2, allow_nan=True) + "\n"
+    text = jsondoc.dumps(payload)
     if out:
         atomic_write_text(out, text)
     else:

@@ -3,8 +3,16 @@
 from __future__ import annotations
 
 from ..atomic import check_distinct
-from ..units import cm2_to_m2
-from ._common import add_dpi_option, add_model_options, add_position_options, float_list, load_model
+from ._common import (
+    add_dpi_option,
+    add_model_options,
+    add_position_options,
+    check_position,
+    float_list,
+    load_model,
+    note_pcsa_slip,
+    pcsa_option,
+)
 
 
 def register(sub) -> None:
@@ -64,7 +72,9 @@ def run(args) -> int:
 
     check_distinct({"--out": args.out}, {"--config": args.config})  # before the work: never the input
     model = load_model(args)
-    pcsa = None if args.geometry_only else ("optimum" if args.pcsa is None else cm2_to_m2(args.pcsa))
+    check_position(model, args)
+    pcsa = None if args.geometry_only else ("optimum" if args.pcsa is None else pcsa_option(args.pcsa))
     fig = drawing.draw_model(model, args.E, args.Lambda, pcsa=pcsa, counter_torque=args.counter_torque)
     print(figures.save_figure(fig, args.out, args.dpi))
+    note_pcsa_slip(None if args.geometry_only else args.pcsa)
     return 0

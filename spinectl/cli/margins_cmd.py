@@ -7,7 +7,7 @@ from pathlib import Path
 
 from ..atomic import check_distinct
 from ..errors import ParameterError
-from ._common import add_model_options, add_position_options, emit_json, finite_float, load_model
+from ._common import add_model_options, add_position_options, check_position, emit_json, finite_float, load_model
 
 
 def register(sub) -> None:
@@ -101,6 +101,7 @@ def run(args) -> int:
 
         check_distinct({"--plot": [Path(args.plot, name) for name in PLOT_FILES]}, {"--config": args.config})
     model = model_with_overrides(args)
+    check_position(model, args)
     if args.coupled:
         return _coupled(model, args)
     report = analyse(model, args.E, args.Lambda, kp=args.kp, kd=args.kd)

@@ -2,8 +2,17 @@
 
 from __future__ import annotations
 
-from ..units import cm2_to_m2
-from ._common import add_model_options, add_position_options, emit_json, finite_float, float_list, load_model
+from ._common import (
+    add_model_options,
+    add_position_options,
+    check_position,
+    emit_json,
+    finite_float,
+    float_list,
+    load_model,
+    note_pcsa_slip,
+    pcsa_option,
+)
 
 
 def register(sub) -> None:
@@ -59,12 +68,13 @@ def run(args) -> int:
     from ..optimise.reference import NoStabilisingActivation, stability_at
 
     model = load_model(args, {"passive.stiffness": args.K})
+    check_position(model, args)
     given = args.pcsa is not None  # else the minimum stabilising PCSA
     analysis = stability_at
     if args.coupled:  # only here: the chain's semidefinite programs import cvxpy
         from ..optimise.coupled import coupled_stability_at as analysis
     try:
-        result = analysis(model, args.E, args.Lambda, cm2_to_m2(args.pcsa) if given else None)
+        result = analysis(model, args.E, args.Lambda, pcsa_option(args.pcsa))
     except NoStabilisingActivation as exc:  # the library names its argument; the user types the option
         raise NoStabilisingActivation(str(exc).replace("(argument pcsa, [m^2])", "with --pcsa [cm2]")) from None
     source = "given" if given else "min_pcsa"
@@ -72,4 +82,5 @@ def run(args) -> int:
         emit_json(result.to_dict(model, pcsa_source=source))
     else:
         print(result.table(model, pcsa_source=source))
+    note_pcsa_slip(args.pcsa)
     return 0

@@ -67,7 +67,9 @@ def run(args) -> int:
 
     check_distinct({"--out": args.out}, {"--config": args.config})
     model = load_model(args)
-    e_axis, l_axis = sweep.parse_grid(args.E, "--E"), sweep.parse_grid(args.Lambda, "--Lambda")
+    geometry = model.geometry
+    e_axis = sweep.parse_grid(args.E, "--E", geometry.eccentricity_range)
+    l_axis = sweep.parse_grid(args.Lambda, "--Lambda", geometry.lordosis_range)
     options = {"stiffnesses": args.K, "method": args.method, "chunk_size": args.chunk_size, "coupled": args.coupled}
     start = time.perf_counter()
     dataset = sweep.write_sweep(model, e_axis, l_axis, args.out, **options)

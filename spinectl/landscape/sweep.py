@@ -18,6 +18,7 @@ from ..atomic import check_writable
 from ..errors import ParameterError
 from ..model import config
 from ..model.params import Model
+from ..units import CM_PER_M, centimetre_slip
 from . import netcdf
 from .columns import DEFAULT_CHUNK, point_columns
 from .schema import landscape_dataset
@@ -32,7 +33,7 @@ and at about 0.2 ms a point the fast path needs some minutes. A larger request i
 likely a typo (a step count in place of a point count) than a plan."""
 
 
-def parse_grid(spec: str, name: str) -> np.ndarray:
+def parse_grid(spec: str, name: str, bounds: tuple[float, float] | None = None) -> np.ndarray:
     """A grid axis from ``"start:stop:num"`` (inclusive, metres) or a single value.
 
     Parameters
@@ -41,6 +42,9 @@ def parse_grid(spec: str, name: str) -> np.ndarray:
         E.g. ``"0:0.08:81"`` or ``"0.03"``.
     name : str
         The option, for the error message.
+    bounds : (float, float), optional
+        The allowed range [m] (``geometry.eccentricity_range``, ``lordosis_range``): an axis beyond it
+        is refused naming ``spec`` as typed, and the spec in metres where cm were likely typed.
 
     Returns
     -------
@@ -50,7 +54,7 @@ def parse_grid(spec: str, name: str) -> np.ndarray:
     Raises
     ------
     ParameterError
-        Naming ``name`` (e.g. ``"--E"``) and the allowed form.
+        Naming ``name`` (e.g. ``"--E"``) and the allowed form, or the range and the spec as typed.
     """
     parts = spec.split(":")
     try:
@@ -63,7 +67,23 @@ def parse_grid(spec: str, name: str) -> np.ndarray:
         raise ParameterError(
             name, f"must be START:STOP:NUM with START <= STOP and 1 <= NUM <= {MAX_GRID_POINTS:,} (got {spec!r})"
         )
-    return np.linspace(start, stop, num)
+    axis = np.linspace(start, stop, num)
+    _check_bounds(axis, spec, name, bounds)
+    return axis
+
+
+def _check_bounds(axis: np.ndarray, spec: str, name: str, bounds) -> None:
+    """Refuse an axis beyond ``bounds``, naming the spec as typed (not its first bad point) and a cm slip."""
+    if bounds is None:
+        return
+    low, high = bounds
+    if np.all((axis >= low) & (axis <= high)):
+        return
+    parts = spec.split(":")
+    in_metres = ":".join([f"{float(p) / CM_PER_M:g}" for p in parts[:2]] + parts[2:])
+    hint = centimetre_slip(axis, low, high, spec, in_metres)
+    got = f"got {spec!r}: {axis.min():g} to {axis.max():g} m"
+    raise ParameterError(name, f"must be in [{low:g}, {high:g}] m, the modelled range ({got}){hint}")
 
 
 def sweep(

@@ -113,8 +113,8 @@ class Body:
     mass: float = param(
         40.0,
         "kg",
-        "Point mass m of the upper body. Not stated in the paper; head, arms and trunk above "
-        "L3 are about 55 % of a 73 kg body (Dempster 1955 segment fractions, as tabulated by "
+        "Point mass m of the upper body. Not stated in the paper; spinectl's default, 40 kg, is head, arms "
+        "and trunk above L3, about 55 % of a 73 kg body (Dempster 1955 segment fractions, as tabulated by "
         "Winter 2009, Biomechanics and Motor Control of Human Movement, table 4.1). At most 1000 kg "
         "(spinectl.model.params.MAX_MASS): more than any human upper body.",
     )
@@ -361,15 +361,17 @@ class Levels:
     mass: float = param(
         1.8,
         "kg",
-        "Mass of each lumbar level (a slice of the trunk between two CoRs). 2.5 % of a 73 kg body, within "
+        "Mass of each lumbar level (a slice of the trunk between two CoRs). The default, 1.8 kg, is 2.5 % of "
+        "a 73 kg body, within "
         "the per-vertebral-level masses measured by CT (1.1 % at T1 rising to 2.6 % at L5; Pearsall, Reid "
         "and Livingston 1996, doi:10.1007/BF02667349). 0 removes the levels (the paper's point mass alone).",
     )
     radius_of_gyration: float = param(
         0.06,
         "m",
-        "Radius of gyration of a level about its centre of mass for sagittal rotation: a uniform slab of "
-        "the abdomen's sagittal depth d of about 0.2 m, sqrt(d^2 / 12) = 0.058 m; spinectl's estimate.",
+        "Radius of gyration of a level about its centre of mass for sagittal rotation. The default, 0.06 m, "
+        "is spinectl's estimate: a uniform slab of the abdomen's sagittal depth d of about 0.2 m, "
+        "sqrt(d^2 / 12) = 0.058 m.",
     )
     weight_in_gravity: float = param(
         0.0,

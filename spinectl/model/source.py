@@ -101,14 +101,35 @@ def header(model: Model) -> str:
         E.g. ``preset wagner2012, K = 0 N m/rad, convention paper; config my.toml (sha256 1a2b3c4d5e6f);
         overridden: passive.stiffness``.
     """
+    first, *rest = _origin_parts(model)
+    passive = f"K = {model.passive.stiffness:g} N m/rad, convention {model.passive.convention}"
+    return "; ".join([f"{first}, {passive}", *rest])
+
+
+def origin(model: Model) -> str:
+    """Where a model came from, without its K: for a run over several K (``spinectl reproduce``).
+
+    Parameters
+    ----------
+    model : Model
+
+    Returns
+    -------
+    str
+        :func:`header` without ``K = ..., convention ...``, e.g. ``preset wagner2012; overridden: body.mass``.
+    """
+    return "; ".join(_origin_parts(model))
+
+
+def _origin_parts(model: Model) -> list[str]:
+    """The preset, the file with its SHA-256 and the overridden fields, each a part of :func:`header`."""
     src = source_of(model)
-    name = src.preset or "none (a Model built in Python)"
-    parts = [f"preset {name}, K = {model.passive.stiffness:g} N m/rad, convention {model.passive.convention}"]
+    parts = [f"preset {src.preset or 'none (a Model built in Python)'}"]
     if src.config:
         parts.append(f"config {src.config} (sha256 {src.config_sha256[:12]})")
     if src.overridden:
         parts.append(f"overridden: {', '.join(src.overridden)}")
-    return "; ".join(parts)
+    return parts
 
 
 def provenance(model: Model) -> dict:

@@ -827,8 +827,9 @@ class CoupledStability:
         ----------
         model : Model
             The model the result was computed with (muscle names, K and its convention).
-        pcsa_source : {'given', 'min_pcsa'}
-            Where the PCSA came from (as in :meth:`spinectl.model.stability.StabilityResult.to_dict`).
+        pcsa_source : {'given', 'min_pcsa', 'activation'}
+            Where the PCSA came from (as in :meth:`spinectl.model.stability.StabilityResult.to_dict`);
+            'activation': the reflex's activation times the minimum stabilising PCSA (:meth:`table`).
 
         Returns
         -------
@@ -870,15 +871,18 @@ class CoupledStability:
             },
         }
 
-    def table(self, model: Model, pcsa_source: str = "min_pcsa") -> str:
+    def table(self, model: Model, pcsa_source: str = "min_pcsa", activation: float = 1.0) -> str:
         """The result as readable text: the matrices row by row, then the verdicts.
 
         Parameters
         ----------
         model : Model
             The model the result was computed with.
-        pcsa_source : {'given', 'min_pcsa'}
-            Where the PCSA came from.
+        pcsa_source : {'given', 'min_pcsa', 'activation'}
+            Where the PCSA came from: given, the minimum stabilising PCSA per segment, or
+            ``activation`` times it (the reflex's operating point, ``spinectl margins --coupled``).
+        activation : float
+            The fraction of the minimum stabilising PCSA [1] the PCSA line names with 'activation'.
 
         Returns
         -------
@@ -886,12 +890,16 @@ class CoupledStability:
             The text ``spinectl stability --coupled`` prints (no final newline).
         """
         pcsa = m2_to_cm2(self.pcsa)
-        given = pcsa_source == "given"
         names = self.segment_names
+        source = {
+            "given": "",
+            "min_pcsa": " (minimum stabilising per segment)",
+            "activation": f" ({activation:g} x the minimum stabilising per segment, the reflex's activation)",
+        }[pcsa_source]
         lines = [
             header(model),
             f"Coupled chain at E = {self.eccentricity * 100:.2f} cm, Lambda = {self.lordosis * 100:.2f} cm",
-            ("PCSA [cm^2]: " if given else "PCSA [cm^2] (minimum stabilising per segment): ")
+            f"PCSA [cm^2]{source}: "
             + ", ".join(f"{n} {p:.2f}" for n, p in zip(model.muscle_names, pcsa, strict=True))
             + f"  (total {pcsa.sum():.2f})",
         ]

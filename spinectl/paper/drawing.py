@@ -22,6 +22,7 @@ import re
 import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.patches import Polygon
+from matplotlib.transforms import Bbox
 
 from ..canvas import new_figure
 from ..errors import ParameterError
@@ -68,10 +69,15 @@ GIDS = {
 }
 """The ``gid`` of each single artist; fibres are ``"fibre <muscle> <i>"``, vertebrae ``"vertebra <name>"``,
 counter torques ``"counter torque <CoR>"`` and their labels ``"counter torque label <CoR>"``, the CoRs' labels
-``"cor label <CoR>"``, dimensions ``"dimension E"`` and ``"dimension Lambda"``."""
-TORQUE_LABEL_OFFSET = 8.0
-"""Height of a counter torque's label above its arrow [pt]: clear of the CoR's label beside the CoR
-(half a 7 pt line and its box, about 5 pt), which it touched at 3 pt."""
+``"cor label <CoR>"``, the spline points' labels ``"point label P1"`` (P3, P2), dimensions ``"dimension E"``
+and ``"dimension Lambda"``."""
+TORQUE_LABEL_OFFSET = 3.0
+"""Gap [pt] between a counter torque's label and the outermost thing drawn at its height on its arrow's
+side: the arrow's tip, a vertebra, the CoR's label, the label of P1, P3 or P2 (:func:`_beyond`). Above
+each arrow's middle (before) a label touched a vertebra and the label of P3."""
+TORQUE_LABEL_BAND = 6.0
+"""Half the height [pt] of the band about a CoR whose artists a torque label must clear: half its
+6 pt line and box, and a point to spare."""
 
 
 def _line_geometry(model: Model, heights):
@@ -226,11 +232,13 @@ def _draw_counter_torques(ax, model: Model, cors: np.ndarray, counter_torque: np
 
     A positive (counter-clockwise) torque turns the part above CoR k towards -x
     (docs/model.md, "Frame and units"), so it points to -x; its length is
-    TORQUE_SCALE per N m.
+    TORQUE_SCALE per N m. Its label stands beyond the tip, clear of the spine's parts at that
+    height (:func:`_beyond`).
     """
+    obstacles = [a for a in (*ax.patches, *ax.texts) if (a.get_gid() or "").startswith(_OBSTACLES)]
     for name, (x, y), torque in zip(model.geometry.cor_names, cors, counter_torque, strict=True):
         dx = -torque * TORQUE_SCALE * CM_PER_M
-        ax.annotate(
+        arrow = ax.annotate(
             "",
             xy=(x + dx, y),
             xytext=(x, y),
@@ -238,17 +246,48 @@ def _draw_counter_torques(ax, model: Model, cors: np.ndarray, counter_torque: np
             gid=f"counter torque {name}",
             zorder=3,
         )
+        left = dx < 0
         ax.annotate(
             f"{torque:+.1f} N m",
-            (x + dx / 2, y),
-            xytext=(0, TORQUE_LABEL_OFFSET),
+            (0.0 if left else 1.0, 0.5),
+            xycoords=_beyond(arrow, obstacles),
+            xytext=(-TORQUE_LABEL_OFFSET if left else TORQUE_LABEL_OFFSET, 0),
             textcoords="offset points",
-            ha="center",
-            va="bottom",
+            ha="right" if left else "left",
+            va="center",
             fontsize=6,
             color="crimson",
+            bbox=_LABEL_BOX,
             gid=f"counter torque label {name}",
         )
+
+
+_OBSTACLES = ("vertebra ", "cor label ", "point label ")
+"""The ``gid`` prefixes of what a counter torque's label must not touch (besides the arrows)."""
+
+
+def _beyond(arrow, obstacles):
+    """``xycoords`` of a torque label: at draw time, the box spanning its arrow and the obstacles at its height.
+
+    Measured on the canvas when drawn (the label sizes in points, the drawing in cm), so it holds at any
+    figure size or resolution; the label goes on the box's outer side (:func:`_draw_counter_torques`).
+    """
+
+    def box(renderer):
+        own = arrow.get_window_extent(renderer)  # an Annotation places itself first (also in a layout pass)
+        band = renderer.points_to_pixels(TORQUE_LABEL_BAND)
+        middle = (own.y0 + own.y1) / 2
+        near = [
+            extent
+            for extent in (o.get_window_extent(renderer) for o in obstacles)
+            if extent.y0 <= middle + band and extent.y1 >= middle - band
+        ]
+        span = Bbox.union([own, *near]).expanded(1.0, 1.0)
+        # the label boxes' padding (0.1 of the font size) lies outside a text's extent
+        pad = renderer.points_to_pixels(1.0)
+        return Bbox.from_extents(span.x0 - pad, own.y0, span.x1 + pad, own.y1)
+
+    return box
 
 
 def _draw_spine(ax, model: Model, eccentricity: float, lordosis: float, annotate: bool) -> np.ndarray:
@@ -276,7 +315,10 @@ def _draw_spine(ax, model: Model, eccentricity: float, lordosis: float, annotate
                 gid=f"cor label {name}",
             )
         for label, (x, y) in zip(("P1", "P3", "P2"), points * CM_PER_M, strict=True):
-            ax.annotate(label, (x, y), xytext=(6, 0), textcoords="offset points", va="center", fontsize=7)
+            ax.annotate(
+                label, (x, y), xytext=(6, 0), textcoords="offset points", va="center", fontsize=7,
+                gid=f"point label {label}",
+            )  # fmt: skip
     return cors
 
 
@@ -297,9 +339,11 @@ def _draw_body(ax, model: Model, eccentricity: float, lordosis: float, annotate:
     _dimension(ax, (-e, length / 2), (-e + lam, length / 2), f"Λ = {lam:g} cm", "dimension Lambda", (-30, 0))
 
 
-def _limits(ax, model: Model, cors: np.ndarray) -> None:
+def _limits(ax, model: Model, cors: np.ndarray, tips: np.ndarray) -> None:
+    """Limits around the fibres, CoRs, point mass and the counter torques' tips ``tips`` [m], shape (n, 2)."""
     upper, lower, _ = geometry.all_fibres(model)
-    points = np.concatenate([upper, lower, cors, geometry.mass_position(model)[None]]) * CM_PER_M
+    # the tips too: an arrow whose tip lay outside the axes was not drawn, and its label had no place
+    points = np.concatenate([upper, lower, cors, tips, geometry.mass_position(model)[None]]) * CM_PER_M
     low, high = points.min(axis=0), points.max(axis=0)
     pad = 0.08 * (high - low).max()
     ax.set_xlim(low[0] - pad, high[0] + pad)
@@ -352,9 +396,11 @@ def draw_model(
     _draw_fibres(ax, model, pcsa_used)
     cors = _draw_spine(ax, model, eccentricity, lordosis, annotate)
     _draw_body(ax, model, eccentricity, lordosis, annotate)
+    tips = np.empty((0, 2))
     if counter_torque and torques is not None:
         _draw_counter_torques(ax, model, cors * CM_PER_M, torques)
-    _limits(ax, model, cors)
+        tips = cors - np.column_stack([torques * TORQUE_SCALE, np.zeros_like(torques)])
+    _limits(ax, model, cors, tips)
     if annotate:
         ax.set_xlabel("x [cm] (ventral / right →)")
         ax.set_ylabel("y [cm] (above P2)")

@@ -48,6 +48,8 @@ EQUAL_ASPECT = 2.0
 """E and Lambda share one scale unless one axis spans more than this many times the other."""
 HALVING = 0.5
 """The paper's ratio of minimum PCSA with and without K = 15 N m/rad (Additional file 1: "halves")."""
+LABEL_MARGIN = 0.08
+"""Least distance of a placed contour label from the axes' edges, as a fraction of their span."""
 _TOLERANCE = 1e-9
 """[m] A position on a grid's edge counts as inside."""
 
@@ -187,8 +189,10 @@ def _mark_readings(ax, e: np.ndarray, lam: np.ndarray) -> None:
             gid="optimum",
             label="C, the physiological situation (Figure 3's caption; Discussion: E ≈ 3, Λ ≈ 4 cm)",
         )
-    if ax.get_legend_handles_labels()[0]:
-        ax.legend(loc="upper center", fontsize=7, framealpha=0.8)
+    handles, labels = ax.get_legend_handles_labels()
+    if handles:  # below the figure, outside every axes: inside, it covered the label of D and the corner (8, 8) cm
+        # grey, so that the white ridge line shows
+        ax.figure.legend(handles, labels, loc="outside lower center", fontsize=7, facecolor="0.7", framealpha=1.0)
 
 
 def _shape(ax, e: np.ndarray, lam: np.ndarray) -> None:
@@ -461,8 +465,46 @@ def counter_torque_figure(dataset: xr.Dataset, specific_tension: float) -> Figur
     values = np.ma.masked_invalid(field.transpose("Lambda", "E").values)
     if values.count() and values.min() < landmarks.CT_LIMIT < values.max():
         limit = ax.contour(e, lam, values, levels=[landmarks.CT_LIMIT], colors="white", linestyles="--")
-        ax.clabel(limit, fmt=lambda _: f"±{landmarks.CT_LIMIT:g} N m", fontsize=8)
+        marks = [np.asarray(p) * CM_PER_M for _, p in grid_marks(field["E"].values, field["Lambda"].values)]
+        contour_labels = [t.get_position() for t in ax.texts if not t.get_gid()]  # the lines' values
+        place = _label_place(limit, [*marks, np.asarray(landmarks.OPTIMUM) * CM_PER_M, *contour_labels], ax)
+        text = f"±{landmarks.CT_LIMIT:g} N m"
+        ax.clabel(limit, fmt=lambda _: text, fontsize=8, manual=None if place is None else [place])
     return fig
+
+
+def _label_place(contour, marks, ax) -> tuple[float, float] | None:
+    """Where a contour's one label goes [cm]: its vertex farthest from every mark (A-D, the corners, C's star,
+    the other contour lines' labels).
+
+    matplotlib's own choice can fall on C, which the ±30 N m line passes close by. Distances are measured
+    in fractions of the axes' spans; vertices within :data:`LABEL_MARGIN` of the edges are skipped (the
+    label would be cut). None if no vertex qualifies (matplotlib's choice then).
+
+    Parameters
+    ----------
+    contour : matplotlib.contour.QuadContourSet
+        A contour of one level.
+    marks : list of (float, float)
+        Points to keep clear of [cm].
+    ax : matplotlib.axes.Axes
+        The axes, their limits set.
+
+    Returns
+    -------
+    (float, float) or None
+        (E, Lambda) [cm] of the label.
+    """
+    vertices = np.concatenate([s for s in contour.allsegs[0] if len(s)] or [np.empty((0, 2))])
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    span = np.array([x1 - x0, y1 - y0])
+    scaled = (vertices - (x0, y0)) / span
+    inside = np.all((scaled >= LABEL_MARGIN) & (scaled <= 1 - LABEL_MARGIN), axis=1)
+    if not inside.any():
+        return None
+    points = (np.array(marks, float).reshape(-1, 2) - (x0, y0)) / span
+    distance = np.linalg.norm(scaled[inside, None, :] - points[None], axis=-1).min(axis=1)
+    return tuple(float(c) for c in vertices[inside][np.argmax(distance)])
 
 
 def pareto_figure(front: ParetoFront, model: Model) -> Figure:

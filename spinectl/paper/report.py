@@ -25,7 +25,8 @@ class Run:
     Attributes
     ----------
     preset : str
-        Where the parameters came from (preset name or config file).
+        Where the parameters came from (preset name or config file; :func:`spinectl.model.source.origin`,
+        without a K: the run covers K = 0 and 15).
     convention : str
         ``passive.convention`` of the K = 15 landscape.
     other_convention : str
@@ -216,10 +217,12 @@ def presets_section(run: Run) -> str:
     for name, mass, found in run.presets:
         light = ", lighter than any adult upper body" if mass < ANATOMICAL_MASS else ""
         counts.append(f"`{name}` (m = {mass:.3g} kg{light}): **{sum(m.agrees for m in found)} of {len(found)}**")
-    head = " | ".join(f"`{name}`" for name, _, _ in run.presets)
+    size = f"{run.preset_points} × {run.preset_points}"
+    # their own grid, not this run's: the column says so
+    head = " | ".join(f"`{name}` (separate {size} grid)" for name, _, _ in run.presets)
     lines = [
-        "The calibrated presets, measured afresh on a "
-        f"{run.preset_points} × {run.preset_points} grid: " + "; ".join(counts) + ". The mass-free preset "
+        "The calibrated presets, measured afresh on a separate "
+        f"{size} grid (not this run's landscapes): " + "; ".join(counts) + ". The mass-free preset "
         "says what the paper's numbers imply; docs/reproduction.md gives every landmark under each assumption.",
         "",
         f"| landmark | paper | {head} | verdict for `{verdicts.PRESET}`, and what it depends on |",
@@ -256,7 +259,8 @@ def render(measurements: Sequence[Measurement], run: Run) -> str:
 Minimum PCSA for self-stability (Figure 3), local counter torques (Figure 4) and
 the effect of passive stiffness (Figure S1) on the paper's grid: E and Λ from 0
 to 8 cm, {run.points} × {run.points} points, K = 0 and K = {grid.PAPER_STIFFNESS:g} N m/rad.
-Parameters: {run.preset}. Wall time: {run.seconds:.1f} s.
+Parameters: {run.preset}; K = 0 and K = {grid.PAPER_STIFFNESS:g} N m/rad with the `{run.convention}` convention,
+K = {grid.PAPER_STIFFNESS:g} N m/rad also with the `{run.other_convention}` convention. Wall time: {run.seconds:.1f} s.
 
 ## Read this first
 

@@ -20,7 +20,7 @@ from ..errors import ParameterError
 from ..landscape import netcdf, sweep
 from ..model.config import DEFAULT_PRESET, apply_overrides, load_config
 from ..model.params import Model
-from ..model.source import header, source_of
+from ..model.source import origin, source_of
 from . import assumptions, figures, grid, landmarks, report, verdicts
 
 __all__ = ["DEFAULT_PRESET", "reproduce", "reproduce_model"]
@@ -173,7 +173,7 @@ def reproduce_model(
     measured = landmarks.measure(landmarks.Landmarks(both.sel(K=0.0), both.sel(K=k15), other))
     drawn = figures.figure_set(both, model.fibre.specific_tension)
     run_facts = report.Run(
-        preset=header(model),
+        preset=origin(model),  # the run covers K = 0 and 15: the report names both (not the model's own K)
         convention=model.passive.convention,
         other_convention=other_convention,
         points=points,

@@ -20,7 +20,7 @@ from ..model.params import Model
 from ..optimise.coupled import CoupledStability, coupled_stability_at
 from .chain_system import DiskMargins, chain_disk_margins, chain_loop
 from .gains import chain_gains
-from .margins import operating_point
+from .margins import _num, operating_point
 from .mimo import chain_delay_margin, highest_crossing, pade_margin
 from .siso import LoopDelayMargin
 
@@ -112,9 +112,10 @@ class CoupledMargins:
             ``delay_margin_pade_s``, ``disk_margin``, ``disk_gain_margin`` (a factor),
             ``disk_phase_margin_deg``, ``disk_loop_at_a_time`` (per joint: ``disk_margin``,
             ``disk_gain_margin``, ``disk_phase_margin_deg``) and ``stable_at_delay``; the disk
-            margins NaN where the loop is unstable at the delay.
+            margins NaN where the loop is unstable at the delay; ``pcsa_source`` is 'activation'
+            (``activation`` x the minimum stabilising PCSA per segment).
         """
-        out = self.chain.to_dict(model, pcsa_source="min_pcsa")
+        out = self.chain.to_dict(model, pcsa_source="activation")
         out.update(
             delay_s=self.delay,
             activation_time_constant_s=self.activation_time_constant,
@@ -157,7 +158,7 @@ class CoupledMargins:
         margin = {np.inf: "unbounded"}.get(exact.margin, f"{exact.margin * 1000:.4g} ms")
         where = f" at {exact.frequency:.4g} rad/s" if np.isfinite(exact.frequency) else ""
         lines = [
-            self.chain.table(model),
+            self.chain.table(model, pcsa_source="activation", activation=self.activation),
             "",
             f"delayed reflex on the chain: activation {self.activation:g} x minimum PCSA, delay {self.delay:g} s, "
             f"activation lag {self.activation_time_constant:g} s, gains: {self.gains}",
@@ -165,7 +166,7 @@ class CoupledMargins:
         ]
         single = np.full((len(self.kp), 3), np.nan) if disk is None else disk.loop_at_a_time
         for name, kp, kd, (a, g, p) in zip(self.chain.segment_names, self.kp, self.kd, single, strict=True):
-            lines.append(f"{name:8} {kp:13.3f} {kd:15.4f} {a:11.3f} {g:9.4g} {p:8.2f}")
+            lines.append(f"{name:8} {kp:13.3f} {kd:15.4f} {_num(a, 11, 3)} {_num(g, 9, 3)} {_num(p, 8, 2)}")
         lines += [
             f"exact delay margin {margin}{where} ({exact.status}); Pade order {self.pade_order}: "
             f"{self.delay_margin_pade * 1000:.4g} ms",

@@ -122,7 +122,8 @@ class SegmentMargins:
         Stable without reflex (:func:`spinectl.model.stability.self_stable`): no open-loop pole in Re s >= 0.
     slowest_time_constant : float
         -1 / max Re lambda over the eigenvalues of paper eq. (1) [s]: how slowly the segment without
-        reflex settles; NaN unless self-stable.
+        reflex settles; inf if not self-stable (it never returns), as
+        :func:`spinectl.model.stability.slowest_time_constant`; NaN without an optimum.
     delay_margin : float
         Exact delay margin [s] (inf: any delay; 0: unstable without delay; NaN: undefined).
     delay_margin_status : str
@@ -177,7 +178,8 @@ class SegmentMargins:
             ``delay_margin_status``, ``delay_margin_pade_s``, ``kp_min_Nm_per_rad``,
             ``kp_max_Nm_per_rad``, ``stable_at_delay`` and ``python_control`` (None, or its
             ``gain_margin``, ``phase_margin_deg``, ``crossover_rad_s``, ``phase_crossover_rad_s``).
-            Infinite and NaN values stay floats (``Infinity``, ``NaN`` in JSON).
+            Infinite and NaN values stay floats; ``--json`` writes them ``null`` with a reason
+            (:func:`spinectl.jsondoc.dumps`).
         """
         pc = self.python_control
         return {
@@ -253,7 +255,7 @@ def segment_margins(
         kp=kp,
         kd=kd,
         self_stable=self_stable,
-        slowest_time_constant=float(-1.0 / np.max(np.real(poles))) if self_stable else np.nan,
+        slowest_time_constant=float(stability.slowest_time_constant([s], [d], [theta])),
         delay_margin=float(exact.margin),
         delay_margin_status=str(exact.status_names),
         delay_margin_pade=float(pade.pade_delay_margin(s, d, theta, kp, kd, order, lag).margin),
@@ -392,7 +394,7 @@ def _row(s: SegmentMargins) -> str:
     self_stable = "n/a" if na == "n/a" else ("yes" if s.self_stable else "no")
     return (
         f"{s.name:8} {num(s.stiffness, 8, 2)} {num(s.damping, 8, 2)} {num(s.inertia, 6, 3)} {self_stable:>11} "
-        f"{num(s.slowest_time_constant, 9, 3)} {num(s.kp, 8, 2)} {num(s.kd, 7, 2)} "
+        f"{num(s.slowest_time_constant, 9, 3, inf='none')} {num(s.kp, 8, 2)} {num(s.kd, 7, 2)} "
         f"{num(s.gain_margin_lower, 7, 3)} {num(s.gain_margin, 9, 3)} {num(s.phase_margin_deg, 8, 2, inf='none')} "
         f"{num(s.crossover_rad_s, 7, 3)} {num(s.delay_margin, 9, 4)} {num(s.delay_margin_pade, 9, 4)} "
         f"[{num(s.kp_min, 9, 1)},{num(s.kp_max, 9, 1)}] {'yes' if s.stable_at_delay else 'NO':>6}"

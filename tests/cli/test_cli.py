@@ -9,7 +9,7 @@ import tomllib
 
 import pytest
 
-from spinectl import optimise
+from spinectl import jsondoc, optimise
 from spinectl.cli import main
 from spinectl.model import config
 from spinectl.model.stability import segment_stability
@@ -34,7 +34,7 @@ def test_stability_prints_the_results_dict_and_table(capsys):
     model = config.set_parameter(config.load_preset(config.DEFAULT_PRESET), "passive.stiffness", 15.0)
     result = segment_stability(model, 0.03, 0.04, [10e-4, 10e-4, 10e-4])
     code, out, _ = run([*argv, "--json"], capsys)
-    assert code == 0 and out == json.dumps(result.to_dict(model), indent=2) + "\n"
+    assert code == 0 and out == jsondoc.dumps(result.to_dict(model))
     code, out, _ = run(argv, capsys)
     assert code == 0 and out == result.table(model) + "\n"
 
@@ -211,3 +211,118 @@ def test_a_home_that_cannot_be_written_leaves_stderr_empty(tmp_path):
     command = [sys.executable, "-m", "spinectl", "draw", "--E", "0.03", "--Lambda", "0.04", "--out"]
     done = subprocess.run([*command, str(tmp_path / "d.png")], env=env, cwd=root, capture_output=True, text=True)
     assert (done.returncode, done.stderr) == (0, "") and (tmp_path / "d.png").is_file()
+
+
+@pytest.mark.parametrize("preset", config.list_presets())
+def test_config_show_comments_describe_the_shown_value_or_name_the_default(preset, capsys):
+    """A comment that justifies a number must be about the value printed under it: where the preset's value
+    is not the default, a comment that states the default (e.g. wagner2012's mass, 24.06 kg, under a comment
+    of the default's 40 kg) must say that number is the default's."""
+    import dataclasses
+    import re
+
+    assert main(["config", "show", "--preset", preset]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    model = config.load_preset(preset)
+    checked = 0
+    for section in ("body", "levels", "local", "passive", "reflex", "optimisation", "fibre"):
+        if not hasattr(model, section):
+            continue
+        start = lines.index(f"[{section}]")
+        for f in dataclasses.fields(getattr(model, section)):
+            value, default = getattr(getattr(model, section), f.name), f.default
+            if not isinstance(default, float) or value == default:
+                continue
+            row = next(k for k in range(start, len(lines)) if lines[k].startswith(f"{f.name} = "))
+            comment = lines[row - 1]
+            unit = re.escape(f.metadata["unit"])
+            states_a_value = re.search(rf"(?<![\d.]){re.escape(f'{default:g}')}(?![\d.])", comment) or re.search(
+                rf"\d ?{unit}\b", comment.split("]", 1)[1]
+            )
+            if states_a_value:  # e.g. "55 % of a 73 kg body": a value the shown one is not
+                assert "default" in comment, (section, f.name, comment)
+            checked += 1
+    assert checked > 0 or preset == "default"
+
+
+@pytest.mark.parametrize(
+    ("argv", "option", "hint"),
+    [
+        (["stability", "--E", "3"], "--E", "if you meant 3 cm, give 0.03"),
+        (["margins", "--Lambda", "4"], "--Lambda", "if you meant 4 cm, give 0.04"),
+        (["draw", "--E", "-2", "--out", "never.png"], "--E", "if you meant -2 cm, give -0.02"),
+        (["stability", "--E", "0.5"], "--E", ""),  # 5 times the range: no likely cm slip, no hint
+        (["stability", "--E", "30"], "--E", ""),  # 30 cm is out of range too
+    ],
+)
+def test_a_length_in_cm_gets_a_hint_naming_the_option(argv, option, hint, capsys, tmp_path, monkeypatch):
+    """The range check names the option typed, and a value that is in range once read as cm says so
+    (the model's range is [-0.1, 0.1] m: docs/model.md)."""
+    monkeypatch.chdir(tmp_path)
+    code, out, err = run(argv, capsys)
+    assert code == 2 and out == "" and err.count("\n") == 1
+    assert err.startswith(f"spinectl: error: {option}: must be in [-0.1, 0.1] m, the modelled range (got ")
+    assert (hint in err) if hint else ("if you meant" not in err)
+    assert not (tmp_path / "never.png").exists()
+
+
+def test_a_grid_out_of_range_names_the_spec_typed_and_the_spec_in_metres(tmp_path, capsys):
+    """Before: 'E: must be in [-0.1, 0.1] m ... (got 0.2)', the first bad grid point, not what was typed."""
+    out_file = tmp_path / "r.nc"
+    code, _, err = run(["sweep", "--E", "0:8:81", "--out", str(out_file)], capsys)
+    assert code == 2 and err.count("\n") == 1 and not out_file.exists()
+    assert "--E: must be in [-0.1, 0.1] m, the modelled range (got '0:8:81': 0 to 8 m)" in err
+    assert err.rstrip().endswith("if you meant 0:8:81 cm, give 0:0.08:81")
+    code, _, err = run(["sweep", "--Lambda", "0:0.5:3", "--out", str(out_file)], capsys)
+    assert code == 2 and "(got '0:0.5:3': 0 to 0.5 m)" in err and "if you meant" not in err
+
+
+def test_a_pcsa_in_square_metres_gets_a_warning_and_runs(capsys):
+    """0.001 typed for 0.001 m^2 (10 cm^2): a warning naming --pcsa and the value to give; zeros and
+    plausible values warn of nothing."""
+    code, out, err = run(["stability", "--pcsa", "0.001,0.002,0"], capsys)
+    assert code == 0 and "L5S1" in out
+    assert err == (
+        "spinectl: warning: --pcsa: 0.001 cm^2 is less than any muscle's PCSA (below 0.1 cm^2); PCSA is in "
+        "cm^2 here: if you meant 0.001 m^2, give 10\n"
+    )
+    code, _, err = run(["stability", "--pcsa", "0,10,0.5"], capsys)
+    assert code == 0 and err == ""
+    code, _, err = run(["stability", "--pcsa", "0.001,0.001,0.001", "--E", "3"], capsys)  # failed: error only
+    assert code == 2 and err.count("\n") == 1 and err.startswith("spinectl: error: --E")
+
+
+def test_a_pcsa_beyond_any_muscle_is_refused_in_cm2(capsys):
+    """The command line takes cm^2, so its refusal speaks cm^2 (the library's speaks m^2: 'got 0.2 m^2')."""
+    code, out, err = run(["stability", "--pcsa", "2000,1,1"], capsys)
+    assert code == 2 and out == "" and err.count("\n") == 1
+    assert err == "spinectl: error: --pcsa: must be at most 1000 cm^2 per muscle, more than any muscle (got 2000)\n"
+
+
+@pytest.mark.parametrize(
+    ("argv", "line"),
+    [
+        (["stability", "--E", "nan"], "spinectl: error: stability: argument --E: --E must be finite (got 'nan')"),
+        (["stability", "--pcsa"], "spinectl: error: stability: argument --pcsa: expected one argument"),
+        (
+            ["margins", "--delya", "0.05"],
+            "spinectl: error: margins: unrecognized arguments: --delya 0.05; did you mean --delay?",
+        ),
+        (
+            ["margins", "--activaton=1"],
+            "spinectl: error: margins: unrecognized arguments: --activaton=1; did you mean --activation?",
+        ),
+        (["stability", "--frob"], "spinectl: error: stability: unrecognized arguments: --frob"),
+        (["stabilty"], "spinectl: error: argument COMMAND: invalid choice: 'stabilty' (choose from "),
+    ],
+)
+def test_argparse_errors_read_like_the_others_with_a_suggestion(argv, line, capsys):
+    """One line, 'spinectl: error: ...' as the library's errors (before: 'error: spinectl stability: ...'), exit 2;
+    a mistyped option or command gets difflib's closest name."""
+    code, out, err = run(argv, capsys)
+    assert code == 2 and out == "" and err.count("\n") == 1
+    assert err.startswith(line)
+    if argv == ["stabilty"]:
+        assert err.rstrip().endswith("; did you mean stability?")
+    if argv == ["stability", "--frob"]:
+        assert "did you mean" not in err  # nothing close: no guess

@@ -6,6 +6,7 @@ import json
 
 import pytest
 
+from spinectl import jsondoc
 from spinectl.cli import main
 from spinectl.model import config
 from spinectl.reflex import margins
@@ -44,18 +45,22 @@ def test_json_is_the_reports_dict(capsys):
     )
     assert code == 0
     report = margins.analyse(_model(delay=0.1, activation=0.0, pade_order=3), 0.0, 0.0)
-    assert out == json.dumps(report.to_dict(), indent=2) + "\n"
+    assert out == jsondoc.dumps(report.to_dict())
     doc = json.loads(out)
     assert doc["delay_s"] == 0.1 and doc["optimum_status"] == "skipped"
     assert all(all(key in seg for key in REQUIRED) for seg in doc["segments"])
 
 
-def test_self_stable_margins_are_infinite_in_json(capsys):
+def test_self_stable_margins_are_unbounded_in_json(capsys):
+    """An infinite delay margin is null with the reason 'unbounded' (docs/cli.md, JSON output)."""
     code, out, _ = run(["margins", "--E", "0.03", "--Lambda", "0.04", "--activation", "1", "--json"], capsys)
     assert code == 0
     segments = json.loads(out)["segments"]
     assert all(
-        s["delay_margin_s"] == float("inf") and s["delay_margin_status"] == "delay_independent" for s in segments
+        s["delay_margin_s"] is None
+        and s["delay_margin_s_reason"] == "unbounded"
+        and s["delay_margin_status"] == "delay_independent"
+        for s in segments
     )
 
 

@@ -40,7 +40,8 @@ def test_reproduce_writes_everything(tmp_path, capsys):
     assert list(ds["K"].values) == [0.0, 15.0] and ds.sizes["E"] == 5
     assert float(ds["counter_torque_norm_Nm"].sel(K=0.0, E=0.0, Lambda=0.0)) < 1e-9  # CT = 0 at A (paired)
     text = (out / "report.md").read_text()
-    assert "| `min_pcsa_A` |" in text and "Parameters: preset wagner2012, " in text and "**calibrated**" in text
+    assert "| `min_pcsa_A` |" in text and "**calibrated**" in text
+    assert "Parameters: preset wagner2012; K = 0 and K = 15 N m/rad with the `physical` convention" in text
     assert [p.split("/")[-1] for p in capsys.readouterr().out.split()] == [
         "landscapes.nc",
         OTHER,
@@ -93,7 +94,7 @@ def test_reproduce_rejects_a_degenerate_or_oversized_grid(tmp_path, capsys, poin
 def test_reproduce_of_another_preset_says_it_is_not_calibrated(tmp_path, capsys):
     assert main(["reproduce", "--out", str(tmp_path), "--points", "3", "--preset", "default"]) == 0
     text = (tmp_path / "report.md").read_text()
-    assert "Parameters: preset default, " in text and "are **not** the calibrated preset" in text
+    assert "Parameters: preset default; K = 0 and K = 15" in text and "are **not** the calibrated preset" in text
     assert (tmp_path / "landscape_K15_paper.nc").exists()  # default uses the physical convention
 
 

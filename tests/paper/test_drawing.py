@@ -167,3 +167,25 @@ def test_counter_torque_labels_clear_the_cor_labels(model, e, lam):
     torque_labels = [_extent(artists[f"counter torque label {name}"], renderer) for name in model.geometry.cor_names]
     for torque in torque_labels:
         assert not any(torque.overlaps(cor) for cor in cor_labels)
+
+
+@pytest.mark.parametrize(("e", "lam"), [(0.03, 0.04), (0.0, 0.0), (0.08, 0.08), (0.02, 0.0), (0.0, 0.08)])
+def test_counter_torque_labels_touch_no_vertebra_arrow_or_point_label(model, e, lam):
+    """Measured by the renderer: no counter torque's label overlaps a vertebra, a counter-torque arrow, the
+    labels of P1, P3, P2 or another torque label. Above each arrow's middle (before) the labels of L2L3 and
+    L3L4 touched a vertebra and the label of P3 at E = 3, Lambda = 4 cm (the newcomer's trial)."""
+    fig = drawing.draw_model(model, e, lam, pcsa="optimum", counter_torque=True)
+    renderer = fig.canvas.get_renderer()
+    fig.draw_without_rendering()
+    artists = _artists(fig)
+    names = model.geometry.cor_names
+    labels = [_extent(artists[f"counter torque label {name}"], renderer) for name in names]
+    others = [
+        *(artists[g].get_window_extent(renderer) for g in artists if g.startswith("vertebra ")),
+        *(artists[f"counter torque {name}"].arrow_patch.get_window_extent(renderer) for name in names),
+        *(_extent(artists[f"point label {p}"], renderer) for p in ("P1", "P3", "P2")),
+    ]
+    assert len(others) == 2 * len(names) + 3
+    for k, label in enumerate(labels):
+        assert not any(label.overlaps(other) for other in others), names[k]
+        assert not any(label.overlaps(other) for other in labels[k + 1 :]), names[k]

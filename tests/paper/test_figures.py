@@ -345,3 +345,61 @@ def test_pareto_figure_draws_the_computed_front():
     (top,) = ax.child_axes  # the secondary axis: A = k / kappa, 1 cm^2 per kappa N m/rad (model.chain)
     kappa = chain.local_stiffness_per_pcsa(model) * 1e-4
     np.testing.assert_allclose(top.get_xlim(), np.array(ax.get_xlim()) / kappa)
+
+
+def _drawn(fig):
+    """The figure's landscape axes and a renderer, after a draw (extents on the canvas)."""
+    renderer = fig.canvas.get_renderer()
+    fig.draw_without_rendering()
+    return fig.axes[0], renderer
+
+
+def _position_labels(ax, renderer):
+    return {
+        t.get_gid(): t.get_bbox_patch().get_window_extent(renderer)
+        for t in ax.texts
+        if (t.get_gid() or "").startswith("label")
+    }
+
+
+@pytest.mark.parametrize("stiffness", [0.0, 15.0])
+def test_the_legend_covers_no_label_or_marker_on_the_papers_grid(wagner2012_landscapes, stiffness):
+    """wagner2012 on the 81 x 81 grid (the report's figures): the legend lies outside the landscape, so it covers
+    neither D's label nor the corner (8, 8) cm (inside the axes at the top, it covered both)."""
+    dataset = wagner2012_landscapes[0].sel(K=stiffness)
+    for fig in (figures.min_pcsa_figure(dataset), figures.counter_torque_figure(dataset, 2.5e5)):
+        ax, renderer = _drawn(fig)
+        (legend,) = fig.legends
+        box = legend.get_window_extent(renderer)
+        labels = _position_labels(ax, renderer)
+        assert {"label D", "label C"} <= set(labels)
+        assert not box.overlaps(ax.get_window_extent(renderer))
+        assert not any(box.overlaps(label) for label in labels.values())
+        assert not any(box.overlaps(a.get_window_extent(renderer)) for a in fig.axes)  # nor the colour bar
+
+
+@pytest.fixture(scope="module")
+def coarse_wagner2012():
+    """wagner2012 at K = 0 and 15 on 21 x 21 points (4 mm): matplotlib's own place for the ±30 N m label lay on C."""
+    from spinectl.model import config
+    from spinectl.paper import grid
+
+    return grid.paper_landscapes(config.load_preset("wagner2012"), 21, progress=False)[0]
+
+
+@pytest.mark.parametrize("stiffness", [0.0, 15.0])
+@pytest.mark.parametrize("points", [21, 81])
+def test_the_30_n_m_label_clears_c_and_every_label(wagner2012_landscapes, coarse_wagner2012, points, stiffness):
+    """The ±30 N m line passes close by C (3, 4) cm: its label overlaps neither C's star nor any position's
+    label nor the other contour lines' labels, measured on the canvas (before: on C's star and label on the
+    21-point grid at K = 0, and on C's label at K = 15)."""
+    dataset = (coarse_wagner2012 if points == 21 else wagner2012_landscapes[0]).sel(K=stiffness)
+    ax, renderer = _drawn(figures.counter_torque_figure(dataset, 2.5e5))
+    (limit,) = [t for t in ax.texts if t.get_text() == "±30 N m"]
+    box = limit.get_window_extent(renderer)
+    star = next(line for line in ax.lines if line.get_gid() == "optimum").get_window_extent(renderer)
+    assert not box.overlaps(star)
+    assert not any(box.overlaps(label) for label in _position_labels(ax, renderer).values())
+    others = [t.get_window_extent(renderer) for t in ax.texts if t is not limit and not t.get_gid()]
+    assert others and not any(box.overlaps(other) for other in others)
+    assert ax.get_window_extent(renderer).contains(*box.p0) and ax.get_window_extent(renderer).contains(*box.p1)

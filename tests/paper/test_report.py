@@ -97,3 +97,25 @@ def test_report_names_the_grid_point_of_an_off_grid_landmark():
     assert "E = 3, Λ = 4 cm: 30 N m" in text  # ‖CT‖ = 1000 E at E = 3 cm
     coarse = report.render(_measurements(np.linspace(0.0, 0.08, 11)), RUN)  # reproduce --points 11
     assert "E = 3.2, Λ = 4 cm (nearest grid point to E = 3, Λ = 4 cm): 32 N m" in coarse
+
+
+def test_the_header_names_both_stiffnesses_and_the_table_its_own_grid():
+    """The run covers K = 0 and 15 (and 15 in the other convention): the header says so, not only the model's K = 0
+    (before: 'Parameters: preset wagner2012, K = 0 N m/rad, convention physical'). The preset table comes from a
+    separate 41 x 41 grid (assumptions.TABLE_POINTS), not this run's 9 x 9: its columns say so."""
+    from spinectl.model import config, source
+
+    measured = _measurements()
+    presets = (("wagner2012", 24.06, measured), ("wagner2012_mass_free", 10.2, measured))
+    text = report.render(measured, dataclasses.replace(RUN, presets=presets, preset_points=41))
+    assert (
+        "Parameters: preset `default`; K = 0 and K = 15 N m/rad with the `physical` convention,\n"
+        "K = 15 N m/rad also with the `paper` convention." in text
+    )
+    head = next(line for line in text.splitlines() if line.startswith("| landmark | paper | `wagner2012`"))
+    assert "`wagner2012` (separate 41 × 41 grid)" in head and "`wagner2012_mass_free` (separate 41 × 41 grid)" in head
+    assert "measured afresh on a separate 41 × 41 grid (not this run's landscapes)" in text
+    model = config.load_preset("wagner2012")  # what reproduce passes as Run.preset: no K of its own
+    assert source.origin(model) == "preset wagner2012" and "K = " not in source.origin(model)
+    assert source.header(model) == "preset wagner2012, K = 0 N m/rad, convention physical"
+    assert source.origin(config.set_parameter(model, "body.mass", 30.0)) == "preset wagner2012; overridden: body.mass"

@@ -7,6 +7,7 @@ import json
 import control as ct
 import numpy as np
 
+from spinectl import jsondoc
 from spinectl.cli import main
 from spinectl.model import config
 from spinectl.reflex.chain_margins import coupled_margins
@@ -55,10 +56,10 @@ def test_at_the_papers_delay_the_chain_is_unstable(capsys):
     assert set(KEYS) <= set(printed["coupled"])
     model = _model(delay=0.1)
     result = coupled_margins(model, 0.0, 0.0)
-    assert printed == json.loads(json.dumps(result.to_dict(model)))  # NaN survives as NaN
+    assert printed == json.loads(jsondoc.dumps(result.to_dict(model)))  # NaN: null with its reason
     assert result.stable_at_delay is False and result.exact.margin < 0.1
     assert _pade_closed_loop_stable(result, model) is False
-    assert np.isnan(printed["coupled"]["disk_gain_margin"])
+    assert printed["coupled"]["disk_gain_margin"] is None and printed["coupled"]["disk_gain_margin_reason"] == "none"
 
 
 def test_below_the_margin_the_loop_is_stable_with_disk_margins():

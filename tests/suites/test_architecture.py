@@ -3,7 +3,7 @@
 The layers and their order are those of CONTRIBUTING.md ("Architecture", "Layers"; a test
 checks that its table and :data:`LAYERS` agree, and that its tree names every module):
 
-    errors units _validate atomic canvas presets  <  model  <  optimise  <  reflex  <  landscape  <  paper
+    errors units _validate atomic jsondoc canvas presets  <  model  <  optimise  <  reflex  <  landscape  <  paper
     <  explore  <  cli
 
 A module may import modules of its own layer and of the layers before it, never
@@ -37,7 +37,7 @@ ROOT = Path(__file__).resolve().parents[2]
 PACKAGE = ROOT / "spinectl"
 
 LAYERS = (
-    ("errors", "units", "_validate", "atomic", "canvas", "presets"),
+    ("errors", "units", "_validate", "atomic", "jsondoc", "canvas", "presets"),
     ("model",),
     ("optimise",),
     ("reflex",),

@@ -103,8 +103,8 @@ def check(argv: list[str]) -> None:
     if code == 2:
         assert err.endswith("\n") and err.count("\n") == 1 and len(err.splitlines()) == 1, (argv, err)
         assert "Traceback" not in err
-    else:
-        assert err == "", (argv, err)
+    else:  # the one note a run may print: a tiny --pcsa, m^2 typed for cm^2 (docs/robustness.md)
+        assert err == "" or (err.startswith("spinectl: warning: --pcsa: ") and err.count("\n") == 1), (argv, err)
 
 
 @settings(max_examples=1500, deadline=None, suppress_health_check=[HealthCheck.too_slow])

@@ -39,7 +39,8 @@ def test_every_command_reports_the_same_model_and_numbers(tmp_path, capsys):
     preset = config.DEFAULT_PRESET
     assert stability["preset"] == margins["preset"] == swept.attrs["preset"] == preset
     assert netcdf.load(tmp_path / "results" / "landscapes.nc").attrs["preset"] == preset
-    assert f"Parameters: preset {preset}, K = 0 N m/rad" in report  # reproduce's K = 0 is the preset's K
+    assert f"Parameters: preset {preset}; K = 0 and K = 15 N m/rad" in report  # both stiffnesses of the run
+    assert stability["K_Nm_per_rad"] == margins["K_Nm_per_rad"] == 0.0  # reproduce's K = 0 is the preset's K
 
     min_pcsa, torque = stability["min_pcsa_cm2"], stability["counter_torque_norm_Nm"]
     assert float(swept["min_pcsa_cm2"]) == pytest.approx(min_pcsa, rel=1e-5)
