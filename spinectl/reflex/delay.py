@@ -206,8 +206,16 @@ def without_delay(stiffness, damping, inertia, kp, kd, lag=0.0) -> WithoutDelay:
     s, d, theta, kp, kd, lag = as_arrays(stiffness, damping, inertia, kp, kd, lag)
     unstable, w0 = _routh(*without_delay_coefficients(s, d, theta, kp, kd, lag))
     axis = np.isfinite(w0)
-    s0 = 1j * np.where(axis, w0, 0.0)
-    with np.errstate(all="ignore"):  # only the points with an axis pair are read
+    departure = np.full(w0.shape, np.nan)
+    if np.any(axis):  # only at the points with an axis pair, rare in a landscape
+        departure[axis] = _departure(*(v[axis] for v in (s, d, theta, kp, kd, lag, w0)))
+    return WithoutDelay(unstable=unstable, axis_frequency=w0, zero_root=kp == s, departure=departure)
+
+
+def _departure(s, d, theta, kp, kd, lag, w0):
+    """Where the axis pair +-j w0 goes as tau grows from 0 (:func:`without_delay`): +1, -1 or 0."""
+    s0 = 1j * w0
+    with np.errstate(all="ignore"):
         p2, dp2 = theta * s0**2 - d * s0 - s, 2.0 * theta * s0 - d
         r1 = lag * p2 + (lag * s0 + 1.0) * dp2 + kd  # R'(s0)
         r2 = 2.0 * lag * dp2 + 2.0 * theta * (lag * s0 + 1.0)  # R''(s0)
@@ -216,8 +224,7 @@ def without_delay(stiffness, damping, inertia, kp, kd, lag=0.0) -> WithoutDelay:
         s2 = (sq1 * s1 - 0.5 * r2 * s1**2 - 0.5 * s0**2 * q0) / r1
         first = np.where(np.abs(s1.real) > 1e-12 * np.abs(s1), np.sign(s1.real), 0.0)
         second = np.where(np.abs(s2.real) > 1e-12 * np.abs(s2), np.sign(s2.real), 0.0)
-    departure = np.where(axis, np.where(first != 0, first, second), np.nan)
-    return WithoutDelay(unstable=unstable, axis_frequency=w0, zero_root=kp == s, departure=departure)
+    return np.where(first != 0, first, second)
 
 
 @validated(zero_inertia=True)
@@ -511,19 +518,24 @@ def crossings_of(s, d, theta, kp, kd, lag, free: WithoutDelay) -> Crossings:
     x, direction = _positive_roots(*crossing_polynomial(s, d, theta, kp, kd, lag))
     with np.errstate(invalid="ignore"):
         w = np.sqrt(x)
-    jw = 1j * np.nan_to_num(w)
-    p = theta[..., None] * jw**2 - d[..., None] * jw - s[..., None]
-    p = np.where(lag[..., None] == 0, p, p * (1.0 + lag[..., None] * jw))
-    qq = kp[..., None] + kd[..., None] * jw
+    found = ~np.isnan(w)
+    point = np.nonzero(found)[:-1]  # the phase only at the crossings, often a third of the slots
+    theta_, d_, s_, lag_, kp_, kd_ = (v[point] for v in (theta, d, s, lag, kp, kd))
+    jw = 1j * w[found]
+    p = theta_ * jw**2 - d_ * jw - s_
+    p = np.where(lag_ == 0, p, p * (1.0 + lag_ * jw))
+    qq = kp_ + kd_ * jw
+    phase = np.full(w.shape, np.nan)
     with np.errstate(divide="ignore", invalid="ignore"):
-        phase = np.mod(np.angle(-qq / p), 2.0 * np.pi)
-    phase = np.where(np.isnan(w), np.nan, phase)
+        phase[found] = np.mod(np.angle(-qq / p), 2.0 * np.pi)
     phase = np.where(_axis_slot(w, free.axis_frequency), 0.0, phase)
     return Crossings(frequency=w, phase=phase, direction=np.where(np.isnan(w), np.nan, direction))
 
 
 def _axis_slot(frequency, axis_frequency):
     """The slot of each point whose crossing is the delay-free axis pair (at tau = 0), as a mask."""
+    if not np.any(np.isfinite(axis_frequency)):  # no axis pair: the usual landscape
+        return np.zeros(frequency.shape, bool)
     gap = np.abs(frequency - axis_frequency[..., None])
     gap = np.where(np.isnan(gap), np.inf, gap)
     nearest = np.argmin(gap, axis=-1)[..., None] == np.arange(frequency.shape[-1])

@@ -141,14 +141,16 @@ def pade_inverse_lag(phase, order: int):
 
 
 def _inverse_lag_newton(target, roots):
-    """Safeguarded Newton iteration for lag(y) = ``target`` (1-d, each in [0, n pi)), only on the points not yet converged.
+    """y with lag(y) = ``target`` (1-d, in [0, n pi)) by safeguarded Newton steps on the points not yet done.
 
-    A point is done when Newton's step is below 1e-10 of y (the step after it is below rounding: the
-    convergence is quadratic and the lag's curvature is at most about its slope, every root of q having
-    Re r <= -2) or the residual is at the rounding of the lag's sum of n arctangents.
+    A point is done when Newton's step is below 1e-10 of y (the convergence is quadratic and the lag's
+    curvature is at most about its slope, every root of q having Re r <= -2: the step after it would be
+    below rounding), when the residual is at the rounding of the lag's n arctangents, or when the
+    bracket has shrunk to rounding.
     """
     a, b = -roots.real, roots.imag
-    noise = 8.0 * np.finfo(float).eps * np.pi * roots.size
+    eps = np.finfo(float).eps
+    noise = 8.0 * eps * np.pi * roots.size
     y = target.copy()
     lo, hi = np.zeros_like(target), np.full_like(target, np.tan(0.5 * np.pi))  # the bisection's range of y
     todo = np.arange(target.size)
@@ -157,19 +159,18 @@ def _inverse_lag_newton(target, roots):
             break
         yy, goal = y[todo], target[todo]
         z = (yy[:, None] - b) / a
-        residual = goal - 2.0 * np.sum(np.arctan(z), axis=-1)
-        slope = 2.0 * np.sum(1.0 / (a * (1.0 + z * z)), axis=-1)
+        residual = goal - 2.0 * np.sum(np.arctan(z), axis=-1)  # _phase_lag, and its derivative below
+        step = residual / (2.0 * np.sum(1.0 / (a * (1.0 + z * z)), axis=-1))
         below = residual > 0
         low, high = np.where(below, yy, lo[todo]), np.where(below, hi[todo], yy)
         lo[todo], hi[todo] = low, high
-        step = residual / slope
-        newton = yy + step
-        inside = (newton >= low) & (newton <= high)
+        new = yy + step
+        inside = (new >= low) & (new <= high)
         outside = np.flatnonzero(~inside)
-        newton[outside] = np.tan(0.5 * (np.arctan(low[outside]) + np.arctan(high[outside])))  # u's midpoint
-        y[todo] = newton
-        done = inside & ((np.abs(step) <= 1e-10 * yy) | (np.abs(residual) <= noise)) | (high - low <= 4 * np.finfo(float).eps * high)
-        todo = todo[~done]
+        new[outside] = np.tan(0.5 * (np.arctan(low[outside]) + np.arctan(high[outside])))  # u's midpoint
+        y[todo] = new
+        converged = (np.abs(step) <= 1e-10 * yy) | (np.abs(residual) <= noise)
+        todo = todo[~((inside & converged) | (high - low <= 4.0 * eps * high))]
     return y
 
 
