@@ -337,12 +337,14 @@ def _quadratic_roots(a, b, c):
 def _cubic_roots(f3, f2, f1, f0):
     """Real roots of f3 x^3 + f2 x^2 + f1 x + f0 (f3 != 0; NaN where not real), and double-root flags.
 
-    In closed form (:func:`_cubic_candidates`), then one Newton step (:func:`_newton_polish`); two roots
+    In closed form (:func:`_cubic_candidates`), then one Newton step (:func:`_newton_polish`), then real
+    where the imaginary part is within :data:`_TANGENT` of the modulus; two roots
     within :data:`_TANGENT` of each other are one double root (a tangency): one of them is kept
     (docs/reflex.md, "Crossing frequencies and the exact delay margin").
     """
     real_part, imag_part = _cubic_candidates(f3, f2, f1, f0)
-    x = _newton_polish(np.where(_is_real(real_part, imag_part), real_part, np.nan), f3, f2, f1, f0, steps=1)
+    real = np.where(_is_real(real_part, imag_part), real_part, np.nan)
+    x = _newton_polish(real, f3, f2, f1, f0, steps=1, longest=1e-6)
     x0, x1, x2 = x[..., 0], x[..., 1], x[..., 2]
     with np.errstate(invalid="ignore"):
         c01, c02, c12 = np.abs(x0 - x1), np.abs(x0 - x2), np.abs(x1 - x2)
@@ -377,15 +379,19 @@ def _is_real(real_part, imag_part):
     return np.abs(imag_part) <= _TANGENT * np.maximum(np.hypot(real_part, imag_part), np.finfo(float).tiny)
 
 
-def _newton_polish(x, f3, f2, f1, f0, steps: int):
-    """``steps`` Newton steps on the roots ``x`` (..., 3) of the cubic; a step longer than a tenth of the root
-    (near a double root, where the slope vanishes) is not taken."""
+def _newton_polish(x, f3, f2, f1, f0, steps: int, longest: float = 0.1):
+    """``steps`` Newton steps on the roots ``x`` (..., 3) of the cubic; a step longer than ``longest`` times the
+    root is not taken: near a double root the slope is rounding noise and so is the step.
+
+    The closed form is within about 1e-14 of a simple root, so it takes ``longest`` = 1e-6; the companion
+    matrix's eigenvalues took 0.1, which let an exact double root at 4 move to 4.087 (x^3 - 7x^2 + 8x + 16).
+    """
     cf = [c[..., None] for c in (f3, f2, f1, f0)]
     for _ in range(steps):
         value = ((cf[0] * x + cf[1]) * x + cf[2]) * x + cf[3]
         slope = (3.0 * cf[0] * x + 2.0 * cf[1]) * x + cf[2]
         step = np.where(slope != 0, value / np.where(slope != 0, slope, 1.0), 0.0)
-        x = x - np.where(np.abs(step) < 0.1 * np.abs(x) + 1e-300, step, 0.0)
+        x = x - np.where(np.abs(step) < longest * np.abs(x) + 1e-300, step, 0.0)
     return x
 
 
@@ -414,12 +420,14 @@ def _cubic_candidates(f3, f2, f1, f0):
         for _ in range(2):
             value, slope = ((r + a) * r + b) * r + c, (3.0 * r + 2.0 * a) * r + b
             step = np.where(slope != 0, value / np.where(slope != 0, slope, 1.0), 0.0)
-            r = r - np.where(np.abs(step) < 0.1 * np.abs(r) + 1e-300, step, 0.0)
+            r = r - np.where(np.abs(step) < 1e-6 * np.abs(r) + 1e-300, step, 0.0)
         backward = (np.abs(r) ** 3 >= np.abs(c)) & (r != 0)  # |r| at least the modulus of the other two
         gamma = np.where(backward, -c / r, b + r * (a + r))
         beta = np.where(backward, (gamma - b) / r, a + r)
-        disc = beta * beta - 4.0 * gamma
-        root = np.sqrt(np.abs(disc))
+        scale = np.ldexp(1.0, np.frexp(np.maximum(np.abs(beta), np.sqrt(np.abs(gamma))))[1])  # no underflow
+        beta_, gamma_ = beta / scale, gamma / scale / scale
+        disc = beta_ * beta_ - 4.0 * gamma_
+        root = scale * np.sqrt(np.abs(disc))
         q = -0.5 * (beta + np.copysign(root, beta))
         pair = disc >= 0
         second = np.where(pair, q, -0.5 * beta)
