@@ -452,7 +452,7 @@ def _scaled_monic(f3, f2, f1, f0):
 
 def _one_real_root(a, b, c):
     """A real root of z^3 + a z^2 + b z + c: of largest modulus if all three are real (trigonometric form),
-    else the only one (Cardano's, with the sign that avoids cancellation); Press et al. 2007, eqs. 5.6.10-5.6.12."""
+    else the only one (Cardano's, with the sign that avoids cancellation); Press et al. 2007, section 5.6."""
     q = (a * a - 3.0 * b) / 9.0
     r = ((2.0 * a * a - 9.0 * b) * a + 27.0 * c) / 54.0
     q3 = q * q * q
