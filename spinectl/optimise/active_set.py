@@ -229,12 +229,12 @@ def _least_counter_torque(data: ProblemData, x1, basis, ct_tolerance: float, tol
     band = lhs.shape[1] - 1
     first = np.zeros(lhs.shape[:2], bool)
     np.put_along_axis(first, basis, True, axis=1)
-    swaps = [_exchanged(first, basis[:, j], band) for j in range(n)]
+    swaps = (_exchanged(first, basis[:, j], band) for j in range(n))
     with_band = first.copy()
     with_band[:, band] = True  # a tie between vertices: more tight rows than variables
-    subsets = [subset for size in range(n, max(n - 3, 0), -1) for subset in _subsets(with_band, size)]
+    subsets = (subset for size in range(n, max(n - 3, 0), -1) for subset in _subsets(with_band, size))
     hessian, linear = objective(data, "counter_torque")
-    guesses = [first, *swaps, *subsets]
+    guesses = itertools.chain([first], swaps, subsets)  # built only while some point is unsolved
     x_ct, ok_ct, active_ct = verified_qp(hessian, linear, lhs, rhs, None, None, guesses, x1, tol)
     x = np.full((n_points, n), np.nan)
     good = np.flatnonzero(ok_ct)
@@ -242,9 +242,9 @@ def _least_counter_torque(data: ProblemData, x1, basis, ct_tolerance: float, tol
     hessian, linear = objective(data.point(good), "least_norm")
     guess = active_ct[good]
     sizes = sorted({n - k for k in np.unique(keep.sum(axis=1))}, reverse=True)
-    subsets = [subset for size in sizes for subset in _subsets(guess, size)]
+    subsets = (subset for size in sizes for subset in _subsets(guess, size))
     problem = (hessian, linear, lhs[good], rhs[good], (rows, keep), centre)
-    x3, ok3, _ = verified_qp(*problem, [guess, *subsets], x_ct[good], tol)
+    x3, ok3, _ = verified_qp(*problem, itertools.chain([guess], subsets), x_ct[good], tol)
     x[good] = x3
     verified = np.zeros(n_points, bool)
     verified[good] = ok3
@@ -306,8 +306,9 @@ def verified_qp(hessian, linear, lhs, rhs, equalities, eq_rhs, guesses, x_start,
         directions T does not act on, are dropped).
     eq_rhs : numpy.ndarray, shape (P, e), or None
         c.
-    guesses : list of numpy.ndarray of bool, shape (P, r)
-        Active sets to try, in order; the first must hold at ``x_start``.
+    guesses : iterable of numpy.ndarray of bool, shape (P, r)
+        Active sets to try, in order; the first must hold at ``x_start``. Taken one at a time, and no
+        more once every point is solved (a generator builds only the guesses that are tried).
     x_start : numpy.ndarray, shape (P, n)
         A feasible point of each problem.
     tolerance : float
@@ -341,14 +342,17 @@ def verified_qp(hessian, linear, lhs, rhs, equalities, eq_rhs, guesses, x_start,
         x[todo[ok]], active[todo[ok]], done[todo[ok]] = trial.x[ok], trial.used[ok], True
         return trial
 
-    for k, guess in enumerate(guesses):
+    guesses = iter(guesses)
+    first = next(guesses)
+    for k, guess in enumerate(itertools.chain([first], guesses)):
         todo = np.flatnonzero(~done)
-        if todo.size:
-            attempt(guess[todo], todo)
-        if k == 0 and equalities is not None and todo.size:
+        if not todo.size:  # every point solved: the remaining guesses are never built
+            break
+        attempt(guess[todo], todo)
+        if k == 0 and equalities is not None:
             attempt(guess[np.flatnonzero(~done)], np.flatnonzero(~done), equalities_first=False)
     todo = np.flatnonzero(~done)
-    working, point = guesses[0][todo], np.asarray(x_start, float)[todo]
+    working, point = first[todo], np.asarray(x_start, float)[todo]
     for _ in range(STEPS):
         if not todo.size:
             break
