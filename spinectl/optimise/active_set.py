@@ -94,7 +94,8 @@ def solve_block(data: ProblemData, ct_tolerance: float, *, min_pcsa_only: bool =
         x[solved] = x1[solved]
     else:
         good = np.flatnonzero(solved)
-        x_good, ok = _least_counter_torque(data.point(good), x1[good], basis[good], ct_tolerance, tol)
+        stage1 = (lhs[good], rhs[good])
+        x_good, ok = _least_counter_torque(data.point(good), x1[good], basis[good], ct_tolerance, tol, stage1)
         x[good[ok]] = x_good[ok]
         solved[good[~ok]] = False
     min_pcsa, pcsa, counter_torque = to_si(data, total, np.maximum(x, 0.0))
@@ -221,11 +222,16 @@ def min_pcsa_vertices(lhs, rhs, weights, first_bound: int, tolerance: float):
     return code, x, basis
 
 
-def _least_counter_torque(data: ProblemData, x1, basis, ct_tolerance: float, tol: float):
-    """Stages 2 and 3 for points whose stage 1 is solved: x [cm^2] and the mask of verified points."""
+def _least_counter_torque(data: ProblemData, x1, basis, ct_tolerance: float, tol: float, stage1):
+    """Stages 2 and 3 for points whose stage 1 is solved: x [cm^2] and the mask of verified points.
+
+    Stage 2's G and h are stage 1's (``stage1``, of these points) with the band w.x <= limit appended, as
+    :func:`~spinectl.optimise.problem.inequalities` orders them (the limit is finite: x1 is a vertex).
+    """
     n_points, n = x1.shape
     limit = (x1 @ data.weights) * (1.0 + ct_tolerance)
-    lhs, rhs = inequalities(data, limit)
+    lhs = np.concatenate([stage1[0], np.broadcast_to(data.weights, (n_points, 1, n))], axis=1)
+    rhs = np.concatenate([stage1[1], limit[:, None]], axis=1)
     band = lhs.shape[1] - 1
     first = np.zeros(lhs.shape[:2], bool)
     np.put_along_axis(first, basis, True, axis=1)
@@ -442,16 +448,17 @@ def independent_rows(rows, chosen):
     count = np.zeros(n_points, int)
     kept = np.zeros_like(chosen)
     for j in np.flatnonzero(chosen.any(axis=0)):  # most rows are active nowhere
-        row = rows[:, j]
+        at = np.flatnonzero(chosen[:, j] & (count < n))  # and the others at few points: only there
+        row, span = rows[at, j], basis[at]
         residual = row
         for _ in range(2):  # twice is enough (Giraud et al. 2005, doi:10.1007/s00211-005-0615-4)
-            residual = residual - np.einsum("pkn,pk->pn", basis, np.einsum("pkn,pn->pk", basis, residual))
+            residual = residual - np.einsum("pkn,pk->pn", span, np.einsum("pkn,pn->pk", span, residual))
         size = np.linalg.norm(residual, axis=1)
-        new = chosen[:, j] & (size > RANK_RTOL * np.linalg.norm(row, axis=1)) & (count < n)
-        index = np.flatnonzero(new)
-        basis[index, count[index]] = residual[index] / size[index, None]
+        new = size > RANK_RTOL * np.linalg.norm(row, axis=1)
+        index = at[new]
+        basis[index, count[index]] = residual[new] / size[new, None]
         count[index] += 1
-        kept[:, j] = new
+        kept[index, j] = True
     return kept
 
 
