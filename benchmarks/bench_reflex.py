@@ -7,8 +7,8 @@ companion matrix and the bisection they replaced, in the same run.
 Builds what the sweep's reflex columns see (S, D, theta of every segment at the reflex's activation of the
 chosen optimum, chunk by chunk as ``spinectl.landscape.columns`` does), then times, interleaved and best of
 N in CPU time (``time.process_time``; the machine is shared): the roots of the crossing cubics, the inverse
-of the Padé lag at the crossings' phases, and the whole ``reflex.landscape`` with both old forms switched
-in. Prints each pair, their ratio and the largest relative difference of the answers.
+of the Padé lag at the crossings' phases, the whole ``reflex.landscape`` and the whole fast sweep with
+both old forms switched in. Prints each pair, their ratio and the largest relative difference of the answers.
 """
 
 from __future__ import annotations
@@ -24,6 +24,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from spinectl.landscape import sweep  # noqa: E402
 from spinectl.landscape.columns import DEFAULT_CHUNK  # noqa: E402
 from spinectl.model import config  # noqa: E402
 from spinectl.model.checks import checked_coefficients  # noqa: E402
@@ -133,6 +134,21 @@ def main() -> None:
     for field in ("delay_margin", "delay_margin_pade", "crossing_frequency", "delay_margin_status", "stable_at_delay"):
         new, old = (np.concatenate([getattr(x, field).ravel() for x in answer]) for answer in (a, b))
         print(f"  largest relative difference, {field:20} {largest_relative_difference(new, old):.1e}")
+    axis = np.linspace(0.0, 0.08, args.points)
+
+    def whole_sweep():
+        return sweep.sweep(model, axis, axis, method="fast", progress=False)
+
+    def whole_sweep_before():
+        with reference_forms():
+            return whole_sweep()
+
+    t_new, t_old, a, b = interleaved(whole_sweep, whole_sweep_before, args.repeats)
+    report("whole fast sweep (3 stages, reflex)", t_new, t_old)
+    names = ("delay_margin_s", "delay_margin_pade_s", "min_pcsa_cm2", "counter_torque_norm_Nm")
+    for name in names:
+        difference = largest_relative_difference(a[name].values, b[name].values)
+        print(f"  largest relative difference, {name:22} {difference:.1e}")
     print("(best CPU time of interleaved runs)")
 
 if __name__ == "__main__":
