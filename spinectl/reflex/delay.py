@@ -337,10 +337,9 @@ def _quadratic_roots(a, b, c):
 def _cubic_roots(f3, f2, f1, f0):
     """Real roots of f3 x^3 + f2 x^2 + f1 x + f0 (f3 != 0; NaN where not real), and double-root flags.
 
-    In closed form (:func:`_cubic_candidates`), then one Newton step (:func:`_newton_polish`), then real
-    where the imaginary part is within :data:`_TANGENT` of the modulus; two roots
-    within :data:`_TANGENT` of each other are one double root (a tangency): one of them is kept
-    (docs/reflex.md, "Crossing frequencies and the exact delay margin").
+    In closed form (:func:`_cubic_candidates`); the real ones (:func:`_is_real`) polished by one Newton step
+    (:func:`_newton_polish`); two roots within :data:`_TANGENT` of each other are one double root (a
+    tangency): one of them is kept (docs/reflex.md, "Crossing frequencies and the exact delay margin").
     """
     real_part, imag_part = _cubic_candidates(f3, f2, f1, f0)
     real = np.where(_is_real(real_part, imag_part), real_part, np.nan)
@@ -446,7 +445,7 @@ def _scaled_monic(f3, f2, f1, f0):
     exponent = [np.where(f != 0, np.frexp(f)[1], -4096) for f in (f3, f2, f1, f0)]
     shift = [e - exponent[0] for e in exponent[1:]]
     k = np.maximum(np.maximum(shift[0], shift[1] // 2), shift[2] // 3)
-    k = np.where(f3 != 0, np.clip(k, -1100, 1100), 0)  # all zero but f3: z^3, any scale
+    k = np.clip(k, -1100, 1100)  # f2 = f1 = f0 = 0 gives -4096: z^3, any scale does
     return np.ldexp(f2, -k) / f3, np.ldexp(f1, -2 * k) / f3, np.ldexp(f0, -3 * k) / f3, k
 
 

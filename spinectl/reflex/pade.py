@@ -151,7 +151,7 @@ def _inverse_lag_newton(target, roots):
     a, b = -roots.real, roots.imag
     eps = np.finfo(float).eps
     noise = 8.0 * eps * np.pi * roots.size
-    y = target.copy()
+    y = np.maximum(target, 0.0)  # a negative phase has no y >= 0: it ends at 0, as the bisection did
     lo, hi = np.zeros_like(target), np.full_like(target, np.tan(0.5 * np.pi))  # the bisection's range of y
     todo = np.arange(target.size)
     for _ in range(2 * BISECTIONS):  # a bisection step at worst halves u's bracket: done long before

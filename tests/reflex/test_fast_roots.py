@@ -290,11 +290,13 @@ def test_inverse_lag_of_order_two_in_closed_form(phase):
 
 
 def test_inverse_lag_edges():
-    """phase 0: y = 0 exactly (the bisection returned 7e-19); phase >= n pi and NaN (an empty slot): inf, as
-    before."""
-    phase = np.array([0.0, 5 * np.pi, 6 * np.pi, np.nan])
-    np.testing.assert_array_equal(reflex.pade_inverse_lag(phase, 5), [0.0, np.inf, np.inf, np.inf])
-    np.testing.assert_array_equal(pade._inverse_lag_bisection(phase, 5)[1:], [np.inf, np.inf, np.inf])
+    """phase 0, and a negative phase (no y >= 0 reaches it): y = 0 exactly (the bisection returned 7e-19);
+    phase >= n pi and NaN (an empty slot): inf, as before."""
+    phase = np.array([0.0, -0.5, 5 * np.pi, 6 * np.pi, np.nan])
+    np.testing.assert_array_equal(reflex.pade_inverse_lag(phase, 5), [0.0, 0.0, np.inf, np.inf, np.inf])
+    old = pade._inverse_lag_bisection(phase, 5)
+    assert np.all(old[:2] < 1e-18)
+    np.testing.assert_array_equal(old[2:], [np.inf, np.inf, np.inf])
 
 
 # --- the whole reflex landscape ------------------------------------------------------------------
