@@ -355,8 +355,9 @@ def verified_qp(hessian, linear, lhs, rhs, equalities, eq_rhs, guesses, x_start,
         if not todo.size:  # every point solved: the remaining guesses are never built
             break
         attempt(guess[todo], todo)
-        if k == 0 and equalities is not None:
-            attempt(guess[np.flatnonzero(~done)], np.flatnonzero(~done), equalities_first=False)
+        rest = np.flatnonzero(~done)
+        if k == 0 and equalities is not None and rest.size:
+            attempt(guess[rest], rest, equalities_first=False)
     todo = np.flatnonzero(~done)
     working, point = first[todo], np.asarray(x_start, float)[todo]
     for _ in range(STEPS):
