@@ -58,6 +58,10 @@ STEPS = 12
 PATTERNS = 6
 """Most active sets of other points of the block tried on a point that no guess or repair solved."""
 
+BATCH = 2048
+"""Most (point, guess) pairs in one batched attempt: the guesses after the first are tried several at a time
+on the few points they are for; each point keeps its first guess, in order, that verifies."""
+
 
 def solve_block(data: ProblemData, ct_tolerance: float, *, min_pcsa_only: bool = False) -> stacked.BlockOptimum:
     """Stages 1-3 for a block of points (leading dimension P), exactly, in batched numpy; the fast path.
@@ -313,8 +317,9 @@ def verified_qp(hessian, linear, lhs, rhs, equalities, eq_rhs, guesses, x_start,
     eq_rhs : numpy.ndarray, shape (P, e), or None
         c.
     guesses : iterable of numpy.ndarray of bool, shape (P, r)
-        Active sets to try, in order; the first must hold at ``x_start``. Taken one at a time, and no
-        more once every point is solved (a generator builds only the guesses that are tried).
+        Active sets to try, in order; the first must hold at ``x_start``. The others are taken a batch
+        at a time (:data:`BATCH`), and no more once every point is solved (a generator builds only the
+        guesses that are tried); a point keeps the first that verifies, as if tried one by one.
     x_start : numpy.ndarray, shape (P, n)
         A feasible point of each problem.
     tolerance : float
@@ -349,17 +354,23 @@ def verified_qp(hessian, linear, lhs, rhs, equalities, eq_rhs, guesses, x_start,
         return trial
 
     guesses = iter(guesses)
-    first = next(guesses)
-    for k, guess in enumerate(itertools.chain([first], guesses)):
-        todo = np.flatnonzero(~done)
-        if not todo.size:  # every point solved: the remaining guesses are never built
-            break
-        attempt(guess[todo], todo)
-        rest = np.flatnonzero(~done)
-        if k == 0 and equalities is not None and rest.size:
-            attempt(guess[rest], rest, equalities_first=False)
+    start = next(guesses)
     todo = np.flatnonzero(~done)
-    working, point = first[todo], np.asarray(x_start, float)[todo]
+    attempt(start[todo], todo)
+    rest = np.flatnonzero(~done)
+    if equalities is not None and rest.size:
+        attempt(start[rest], rest, equalities_first=False)
+    while (todo := np.flatnonzero(~done)).size:  # the other guesses, several in one batched attempt
+        batch = list(itertools.islice(guesses, max(1, BATCH // todo.size)))  # none built once all are solved
+        if not batch:
+            break
+        trial = _attempt(problem, np.concatenate([guess[todo] for guess in batch]), np.tile(todo, len(batch)))
+        ok = trial.ok.reshape(len(batch), todo.size)
+        found = np.flatnonzero(ok.any(axis=0))
+        pick = np.argmax(ok[:, found], axis=0) * todo.size + found  # each point's first guess that verifies
+        x[todo[found]], active[todo[found]], done[todo[found]] = trial.x[pick], trial.used[pick], True
+    todo = np.flatnonzero(~done)
+    working, point = start[todo], np.asarray(x_start, float)[todo]
     for _ in range(STEPS):
         if not todo.size:
             break
