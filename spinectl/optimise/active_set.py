@@ -60,7 +60,8 @@ PATTERNS = 6
 
 BATCH = 2048
 """Most (point, guess) pairs in one batched attempt: the guesses after the first are tried several at a time
-on the few points they are for; each point keeps its first guess, in order, that verifies."""
+(4, then twice as many each round) on the points still unsolved; each keeps its first guess, in order, that
+verifies."""
 
 
 def solve_block(data: ProblemData, ct_tolerance: float, *, min_pcsa_only: bool = False) -> stacked.BlockOptimum:
@@ -360,8 +361,10 @@ def verified_qp(hessian, linear, lhs, rhs, equalities, eq_rhs, guesses, x_start,
     rest = np.flatnonzero(~done)
     if equalities is not None and rest.size:
         attempt(start[rest], rest, equalities_first=False)
+    size = 2
     while (todo := np.flatnonzero(~done)).size:  # the other guesses, several in one batched attempt
-        batch = list(itertools.islice(guesses, max(1, BATCH // todo.size)))  # none built once all are solved
+        size = min(2 * size, max(1, BATCH // todo.size))  # 4, 8, 16, ...: few wasted where one soon verifies
+        batch = list(itertools.islice(guesses, size))  # none built once all are solved
         if not batch:
             break
         trial = _attempt(problem, np.concatenate([guess[todo] for guess in batch]), np.tile(todo, len(batch)))
