@@ -58,6 +58,11 @@ STEPS = 12
 PATTERNS = 6
 """Most active sets of other points of the block tried on a point that no guess or repair solved."""
 
+BATCH = 2048
+"""Most (point, guess) pairs in one batched attempt: the guesses after the first are tried several at a time
+(4, then twice as many each round) on the points still unsolved; each keeps its first guess, in order, that
+verifies."""
+
 
 def solve_block(data: ProblemData, ct_tolerance: float, *, min_pcsa_only: bool = False) -> stacked.BlockOptimum:
     """Stages 1-3 for a block of points (leading dimension P), exactly, in batched numpy; the fast path.
@@ -94,7 +99,8 @@ def solve_block(data: ProblemData, ct_tolerance: float, *, min_pcsa_only: bool =
         x[solved] = x1[solved]
     else:
         good = np.flatnonzero(solved)
-        x_good, ok = _least_counter_torque(data.point(good), x1[good], basis[good], ct_tolerance, tol)
+        stage1 = (lhs[good], rhs[good])
+        x_good, ok = _least_counter_torque(data.point(good), x1[good], basis[good], ct_tolerance, tol, stage1)
         x[good[ok]] = x_good[ok]
         solved[good[~ok]] = False
     min_pcsa, pcsa, counter_torque = to_si(data, total, np.maximum(x, 0.0))
@@ -221,20 +227,25 @@ def min_pcsa_vertices(lhs, rhs, weights, first_bound: int, tolerance: float):
     return code, x, basis
 
 
-def _least_counter_torque(data: ProblemData, x1, basis, ct_tolerance: float, tol: float):
-    """Stages 2 and 3 for points whose stage 1 is solved: x [cm^2] and the mask of verified points."""
+def _least_counter_torque(data: ProblemData, x1, basis, ct_tolerance: float, tol: float, stage1):
+    """Stages 2 and 3 for points whose stage 1 is solved: x [cm^2] and the mask of verified points.
+
+    Stage 2's G and h are stage 1's (``stage1``, of these points) with the band w.x <= limit appended, as
+    :func:`~spinectl.optimise.problem.inequalities` orders them (the limit is finite: x1 is a vertex).
+    """
     n_points, n = x1.shape
     limit = (x1 @ data.weights) * (1.0 + ct_tolerance)
-    lhs, rhs = inequalities(data, limit)
+    lhs = np.concatenate([stage1[0], np.broadcast_to(data.weights, (n_points, 1, n))], axis=1)
+    rhs = np.concatenate([stage1[1], limit[:, None]], axis=1)
     band = lhs.shape[1] - 1
     first = np.zeros(lhs.shape[:2], bool)
     np.put_along_axis(first, basis, True, axis=1)
-    swaps = [_exchanged(first, basis[:, j], band) for j in range(n)]
+    swaps = (_exchanged(first, basis[:, j], band) for j in range(n))
     with_band = first.copy()
     with_band[:, band] = True  # a tie between vertices: more tight rows than variables
-    subsets = [subset for size in range(n, max(n - 3, 0), -1) for subset in _subsets(with_band, size)]
+    subsets = (subset for size in range(n, max(n - 3, 0), -1) for subset in _subsets(with_band, size))
     hessian, linear = objective(data, "counter_torque")
-    guesses = [first, *swaps, *subsets]
+    guesses = itertools.chain([first], swaps, subsets)  # built only while some point is unsolved
     x_ct, ok_ct, active_ct = verified_qp(hessian, linear, lhs, rhs, None, None, guesses, x1, tol)
     x = np.full((n_points, n), np.nan)
     good = np.flatnonzero(ok_ct)
@@ -242,9 +253,9 @@ def _least_counter_torque(data: ProblemData, x1, basis, ct_tolerance: float, tol
     hessian, linear = objective(data.point(good), "least_norm")
     guess = active_ct[good]
     sizes = sorted({n - k for k in np.unique(keep.sum(axis=1))}, reverse=True)
-    subsets = [subset for size in sizes for subset in _subsets(guess, size)]
+    subsets = (subset for size in sizes for subset in _subsets(guess, size))
     problem = (hessian, linear, lhs[good], rhs[good], (rows, keep), centre)
-    x3, ok3, _ = verified_qp(*problem, [guess, *subsets], x_ct[good], tol)
+    x3, ok3, _ = verified_qp(*problem, itertools.chain([guess], subsets), x_ct[good], tol)
     x[good] = x3
     verified = np.zeros(n_points, bool)
     verified[good] = ok3
@@ -306,8 +317,10 @@ def verified_qp(hessian, linear, lhs, rhs, equalities, eq_rhs, guesses, x_start,
         directions T does not act on, are dropped).
     eq_rhs : numpy.ndarray, shape (P, e), or None
         c.
-    guesses : list of numpy.ndarray of bool, shape (P, r)
-        Active sets to try, in order; the first must hold at ``x_start``.
+    guesses : iterable of numpy.ndarray of bool, shape (P, r)
+        Active sets to try, in order; the first must hold at ``x_start``. The others are taken a batch
+        at a time (:data:`BATCH`), and no more once every point is solved (a generator builds only the
+        guesses that are tried); a point keeps the first that verifies, as if tried one by one.
     x_start : numpy.ndarray, shape (P, n)
         A feasible point of each problem.
     tolerance : float
@@ -341,14 +354,26 @@ def verified_qp(hessian, linear, lhs, rhs, equalities, eq_rhs, guesses, x_start,
         x[todo[ok]], active[todo[ok]], done[todo[ok]] = trial.x[ok], trial.used[ok], True
         return trial
 
-    for k, guess in enumerate(guesses):
-        todo = np.flatnonzero(~done)
-        if todo.size:
-            attempt(guess[todo], todo)
-        if k == 0 and equalities is not None and todo.size:
-            attempt(guess[np.flatnonzero(~done)], np.flatnonzero(~done), equalities_first=False)
+    guesses = iter(guesses)
+    start = next(guesses)
     todo = np.flatnonzero(~done)
-    working, point = guesses[0][todo], np.asarray(x_start, float)[todo]
+    attempt(start[todo], todo)
+    rest = np.flatnonzero(~done)
+    if equalities is not None and rest.size:
+        attempt(start[rest], rest, equalities_first=False)
+    size = 2
+    while (todo := np.flatnonzero(~done)).size:  # the other guesses, several in one batched attempt
+        size = min(2 * size, max(1, BATCH // todo.size))  # 4, 8, 16, ...: few wasted where one soon verifies
+        batch = list(itertools.islice(guesses, size))  # none built once all are solved
+        if not batch:
+            break
+        trial = _attempt(problem, np.concatenate([guess[todo] for guess in batch]), np.tile(todo, len(batch)))
+        ok = trial.ok.reshape(len(batch), todo.size)
+        found = np.flatnonzero(ok.any(axis=0))
+        pick = np.argmax(ok[:, found], axis=0) * todo.size + found  # each point's first guess that verifies
+        x[todo[found]], active[todo[found]], done[todo[found]] = trial.x[pick], trial.used[pick], True
+    todo = np.flatnonzero(~done)
+    working, point = start[todo], np.asarray(x_start, float)[todo]
     for _ in range(STEPS):
         if not todo.size:
             break
@@ -438,16 +463,17 @@ def independent_rows(rows, chosen):
     count = np.zeros(n_points, int)
     kept = np.zeros_like(chosen)
     for j in np.flatnonzero(chosen.any(axis=0)):  # most rows are active nowhere
-        row = rows[:, j]
+        at = np.flatnonzero(chosen[:, j] & (count < n))  # and the others at few points: only there
+        row, span = rows[at, j], basis[at]
         residual = row
         for _ in range(2):  # twice is enough (Giraud et al. 2005, doi:10.1007/s00211-005-0615-4)
-            residual = residual - np.einsum("pkn,pk->pn", basis, np.einsum("pkn,pn->pk", basis, residual))
+            residual = residual - np.einsum("pkn,pk->pn", span, np.einsum("pkn,pn->pk", span, residual))
         size = np.linalg.norm(residual, axis=1)
-        new = chosen[:, j] & (size > RANK_RTOL * np.linalg.norm(row, axis=1)) & (count < n)
-        index = np.flatnonzero(new)
-        basis[index, count[index]] = residual[index] / size[index, None]
+        new = size > RANK_RTOL * np.linalg.norm(row, axis=1)
+        index = at[new]
+        basis[index, count[index]] = residual[new] / size[new, None]
         count[index] += 1
-        kept[:, j] = new
+        kept[index, j] = True
     return kept
 
 
