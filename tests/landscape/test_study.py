@@ -24,10 +24,8 @@ import zarr
 
 from spinectl.cli import main
 from spinectl.errors import ConfigError, ModelError, OutputError, ParameterError
-from spinectl.landscape import study, sweep
-from spinectl.landscape.study import spec
-from spinectl.landscape import schema
-from spinectl.landscape.study import run
+from spinectl.landscape import schema, study, sweep
+from spinectl.landscape.study import run, spec
 from spinectl.landscape.study import store as study_store
 from spinectl.model import config
 
@@ -643,12 +641,11 @@ def test_an_all_nan_chunk_is_still_a_file(tmp_path):
     assert np.isnan(loaded["min_pcsa_cm2"].values).all() and (out / "min_pcsa_cm2" / "0.0").is_file()
 
 
-
 def test_the_writer_writes_the_files_that_xarray_writes(tmp_path):
     """Each chunk goes straight into its zarr arrays' regions: the same files, bit for bit, as the
     ``Dataset.to_zarr(region=...)`` the writer used before (the second method), also for a chunk of
     fill values only (every point infeasible), which both write as a file."""
-    text = STUDY.replace("[axes]\n", "[axes]\n\"optimisation.pcsa_max\" = [1e-6, 1.0]\n")
+    text = STUDY.replace("[axes]\n", '[axes]\n"optimisation.pcsa_max" = [1e-6, 1.0]\n')
     parsed = study.parse_study(text)
     chunks = [parsed.chunk(i) for i in (0, parsed.n_chunks - 1)]  # all-infeasible, and one of pcsa_max = 1
     solved = [run.solve_chunk(task) for task in run.tasks(parsed, [c.index for c in chunks])]
@@ -669,6 +666,7 @@ def test_the_writer_writes_the_files_that_xarray_writes(tmp_path):
     assert len(outputs) == 2 * len(solved[0][1])  # a file per output and chunk, the empty one too
     for name in sorted(p for p in files if p.parts[0] not in (study_store.DONE, study_store.CHECKSUM)):
         assert (ours / name).read_bytes() == (theirs / name).read_bytes(), name
+
 
 @pytest.fixture
 def http_server():
@@ -721,6 +719,7 @@ def test_workers_vanishing_mid_run_stop_the_study_after_the_worker_timeout(refer
     options = {"processes": False, "protocol": "tcp://", "host": "127.0.0.1", "dashboard_address": None}
     out = tmp_path / "s.zarr"
     with LocalCluster(n_workers=1, threads_per_worker=1, **options) as cluster:
+
         def stop_the_workers():
             deadline = time.monotonic() + 120
             while done_chunks(out) < 1 and time.monotonic() < deadline:
