@@ -259,10 +259,12 @@ def run_study(
         indices = np.arange(study.n_chunks) if done is None else np.flatnonzero(done == 0)
         todo = indices[: None if max_chunks is None else max_chunks]
         with _executor(scheduler, workers, todo.size, tuple(timeouts.values()), notify) as executor:
+            # a cluster's first chunks are submitted now: its workers start on them while the store is made
+            results = executor.run(tasks(study, todo), f"spinectl-{study.digest()[:16]}")
             if done is None:  # after connecting: an unreachable scheduler leaves no store behind
                 done = store.create(study, out, _probe(study))
             done_before = int(np.count_nonzero(done))
-            _run_chunks(study, out, done, executor.run(tasks(study, todo), f"spinectl-{study.digest()[:16]}"), progress)
+            _run_chunks(study, out, done, results, progress)
         if np.all(done > 0):
             store.consolidate(out)
     seconds = time.perf_counter() - start
@@ -358,7 +360,8 @@ class _Distributed:
         info = client.scheduler_info()
         self.addresses = (info["address"], *sorted(info["workers"]))
 
-    def run(self, chunks: Iterator[Task], prefix: str):
+    def run(self, chunks: Iterator[Task], prefix: str) -> Iterator[tuple[int, dict[str, np.ndarray]]]:
+        """Submit the first chunks at once; return the chunks' results as they finish, submitting one as one ends."""
         from distributed import as_completed
 
         window = 2 * max(1, sum(self.client.nthreads().values()))
@@ -367,55 +370,68 @@ class _Distributed:
             return self.client.submit(solve_chunk, task, key=f"{prefix}-{task.index}")
 
         pending = as_completed([submit(task) for task in itertools.islice(chunks, window)], loop=self.client.loop)
+        return self._results(pending, chunks, submit)
+
+    def _results(self, pending, chunks: Iterator[Task], submit):
+        watch = _Watch(self.client, self.where, self.worker_timeout)  # one for the run
         while not pending.is_empty():
-            self._wait_for_one(pending)
+            self._wait_for_one(pending, watch)
             for future in pending.next_batch(block=False):
-                result = self._result(future)  # a chunk's error ends the run here; the cluster is closed on the way out
+                result = self._result(future, watch)  # a chunk's error ends the run here; the cluster is closed after
                 future.release()
+                watch.alive()
                 yield result
                 task = next(chunks, None)
                 if task is not None:
                     pending.add(submit(task))
 
-    def _wait_for_one(self, pending) -> None:
+    @staticmethod
+    def _wait_for_one(pending, watch: _Watch) -> None:
         """Return once a future of ``pending`` has finished, as long as the cluster has a worker."""
-        watch = self._watch()
         while not pending.has_ready():
             time.sleep(0.01)
             watch()
 
-    def _result(self, future):
+    @staticmethod
+    def _result(future, watch: _Watch):
         """The chunk of a finished future. Its data lives on the worker that solved it: a worker gone
         before the data came back leaves the scheduler waiting for another, so this wait is bounded too."""
-        watch = self._watch()
         while True:
             try:
                 return future.result(timeout=POLL)
             except TimeoutError:
                 watch()
 
-    def _watch(self):
-        """A function to call while waiting: every :data:`POLL` seconds it counts the workers, and raises
-        once there has been none for ``worker_timeout`` seconds."""
-        idle_since, looked = None, time.monotonic()
 
-        def watch() -> None:
-            nonlocal idle_since, looked
-            if time.monotonic() - looked < POLL:
-                return
-            looked = time.monotonic()
-            if self.client.scheduler_info(n_workers=0).get("n_workers", 1) > 0:
-                idle_since = None
-            elif idle_since is None:
-                idle_since = looked
-            elif looked - idle_since > self.worker_timeout:
-                raise ParameterError(
-                    "scheduler",
-                    f"{self.where}: every worker has gone, and none joined within {self.worker_timeout:g} s: the "
-                    "store holds every chunk finished; start a worker and run again with --resume",
-                )
+class _Watch:
+    """Call while waiting: every :data:`POLL` seconds without a finished chunk it counts the
+    cluster's workers, and raises once there has been none for ``worker_timeout`` seconds.
 
-        return watch
+    A finished chunk (:meth:`alive`) shows a worker: no question to the scheduler while chunks come.
+    """
+
+    def __init__(self, client, where: str, worker_timeout: float):
+        self.client, self.where, self.worker_timeout = client, where, worker_timeout
+        self.idle_since, self.looked = None, time.monotonic()
+
+    def alive(self) -> None:
+        """A chunk has just finished: the cluster had a worker now."""
+        self.idle_since, self.looked = None, time.monotonic()
+
+    def __call__(self) -> None:
+        if time.monotonic() - self.looked < POLL:
+            return
+        self.looked = time.monotonic()
+        if self.client.scheduler_info(n_workers=0).get("n_workers", 1) > 0:
+            self.idle_since = None
+        elif self.idle_since is None:
+            self.idle_since = self.looked
+        elif self.looked - self.idle_since > self.worker_timeout:
+            raise ParameterError(
+                "scheduler",
+                f"{self.where}: every worker has gone, and none joined within {self.worker_timeout:g} s: the "
+                "store holds every chunk finished; start a worker and run again with --resume",
+            )
 
 
 @contextlib.contextmanager
