@@ -27,6 +27,7 @@ import contextlib
 import itertools
 import logging
 import math
+import multiprocessing
 import os
 import re
 import signal
@@ -77,6 +78,12 @@ MALLOC_TRIM_SETTING = "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD
 once; the fast path allocates and frees many arrays of a few hundred kB per chunk and then runs about
 15 % slower (measured on one chunk of 4010 points). Local workers keep glibc's own threshold; a chunk's
 memory is bounded anyway (the benchmark's peak, docs/studies.md)."""
+
+START_METHOD = "forkserver" if "forkserver" in multiprocessing.get_all_start_methods() else "spawn"
+"""How local worker processes start: forked from a fresh server process where the platform allows
+(Linux, macOS), rather than dask's default, a new interpreter each (``spawn``). Both start from a clean
+process (never a fork of the client and its threads); a forked worker ends with ``os._exit``, without the
+interpreter's shutdown, which took 1.2 s of a closing cluster of two workers (0.05 s now; load 5)."""
 
 WORKERS_PER_CORE = 4
 """Most local workers per core: the solver is CPU-bound, more only costs memory."""
@@ -467,7 +474,8 @@ def _local_cluster(n: int):
 
     previous = _block_interrupts()
     try:
-        with dask.config.set({MALLOC_TRIM_SETTING: None}), _workers_stderr():  # see there for both
+        settings = {MALLOC_TRIM_SETTING: None, "distributed.worker.multiprocessing-method": START_METHOD}
+        with dask.config.set(settings), _workers_stderr():  # see there for all three
             cluster = LocalCluster(
                 n_workers=n,
                 threads_per_worker=1,  # cvxpy is not thread-safe; one process per worker
