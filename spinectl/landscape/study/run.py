@@ -505,9 +505,9 @@ def _local_cluster(n: int):
 def _workers_stderr():
     """Start worker processes with a temporary file as their standard error, not the terminal.
 
-    The worker processes are spawned from distributed's own threads, which do not share the
-    blocked SIGINT; a Ctrl-C that reaches a worker while its interpreter starts makes CPython
-    print "Fatal Python error: init_import_site" and a traceback there. The workers log at
+    The worker processes (or their fork server, :data:`START_METHOD`) are started from distributed's
+    own threads, which do not share the blocked SIGINT; a Ctrl-C that reaches a new interpreter while it
+    starts makes CPython print "Fatal Python error: init_import_site" and a traceback there. The workers log at
     error level only (``silence_logs``) and their failures reach the client as exceptions.
     """
     sys.stderr.flush()
