@@ -309,12 +309,12 @@ class Writer:
 
     def __init__(self, study: Study, path: str | Path, done: np.ndarray):
         self.study, self.path, self.done = study, Path(path), done
-        group = zarr.open_group(self.path, mode="r+", zarr_format=ZARR_FORMAT)
-        self._flags, self._crc, self._files = group[DONE], group[CHECKSUM], _ChunkFiles(self.path, group)
         # every chunk a file, also one of fill values only (zarr's default skips those): see CHUNK_FILES;
         # an array's runtime configuration is fixed when it is opened
         with zarr.config.set({"array.write_empty_chunks": True}):
-            self._arrays = dict(zarr.open_group(self.path, mode="r+", zarr_format=ZARR_FORMAT).arrays())
+            group = zarr.open_group(self.path, mode="r+", zarr_format=ZARR_FORMAT)
+            self._arrays = dict(group.arrays())
+        self._flags, self._crc, self._files = self._arrays[DONE], self._arrays[CHECKSUM], _ChunkFiles(self.path, group)
 
     def write(self, chunk: Chunk, outputs: dict[str, np.ndarray]) -> None:
         """Write one chunk's outputs (from :func:`encode`), then raise its count.
