@@ -196,7 +196,7 @@ def attachments_on_cors(cor: np.ndarray, points: np.ndarray) -> np.ndarray:
     pair that is compared. Only pairs whose x coordinates are that close can qualify, so
     those alone are compared: the CoRs' x coordinates are sorted once and each
     attachment's neighbours found by bisection, in O((N K + F) log(N K)) instead of
-    the O(N K F) of comparing every pair (4 million pairs of a study chunk of 4096 points).
+    the O(N K F) of comparing every pair (600 000 pairs for each end in a study chunk of 4096 points).
     The answer is that of comparing every pair, for any input (tests/model/test_checks.py).
 
     Parameters
