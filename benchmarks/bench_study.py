@@ -12,7 +12,10 @@ process, no Dask), ``--workers 1`` and ``--workers 2`` (a LocalCluster on
 minimum PCSA, the least-counter-torque problem, the tie-break) and the delay
 margins. Printed per run: wall time of the command (imports, cluster start-up
 and shutdown included), the run's own time from its summary line, the CPU
-time of the command and every process it started, the peak of their summed
+time of the command and every process it started (sampled every 0.1 s, so a
+process's last tenth of a second may be missed; the local workers are children
+of a fork server, which the kernel's count of a command's children misses),
+the peak of their summed
 resident memory (shared pages count once per process: an upper bound) and
 the load average of the machine at the start. Then the 1 -> 2 worker speed-up,
 the cost of the cluster against the in-process reference, and whether the
@@ -28,7 +31,6 @@ from __future__ import annotations
 import argparse
 import os
 import re
-import resource
 import subprocess
 import sys
 import tempfile
@@ -53,33 +55,30 @@ Lambda = {{ start = 0.0, stop = 0.08, num = {n} }}
 """
 
 
-def tree_rss(process: psutil.Process) -> int:
-    """Resident memory of ``process`` and all its descendants [bytes]."""
+def tree_sample(process: psutil.Process, cpu: dict[int, float]) -> int:
+    """Resident memory of ``process`` and all its descendants [bytes]; their CPU times [s] into ``cpu`` by pid."""
     total = 0
     for p in [process, *process.children(recursive=True)]:
         try:
-            total += p.memory_info().rss
+            with p.oneshot():
+                total += p.memory_info().rss
+                times = p.cpu_times()
+                cpu[p.pid] = times.user + times.system
         except psutil.Error:  # ended between the listing and the reading
             pass
     return total
 
 
-def cpu_of_children() -> float:
-    """User + system CPU time of every finished child process and their waited-for children [s]."""
-    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return usage.ru_utime + usage.ru_stime
-
-
 def run(command: list[str]) -> dict:
     """Wall time [s], the run's own time [s], CPU time [s], peak memory of the process tree [bytes], load, where."""
-    load, cpu, start = os.getloadavg()[0], cpu_of_children(), time.perf_counter()
+    load, start = os.getloadavg()[0], time.perf_counter()
     proc = subprocess.Popen(command, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    peak, watched = 0, psutil.Process(proc.pid)
+    peak, watched, cpu = 0, psutil.Process(proc.pid), {}
 
     def sample():
         nonlocal peak
         while proc.poll() is None:
-            peak = max(peak, tree_rss(watched))
+            peak = max(peak, tree_sample(watched, cpu))
             time.sleep(0.1)
 
     sampler = threading.Thread(target=sample, daemon=True)
@@ -90,7 +89,7 @@ def run(command: list[str]) -> dict:
     if proc.returncode:
         raise SystemExit(f"{' '.join(command)} failed ({proc.returncode}):\n{err}")
     own, where = re.search(r"in ([0-9.]+) s, ([^;]+);", out).groups()
-    return {"wall": wall, "run": float(own), "cpu": cpu_of_children() - cpu, "peak": peak, "load": load, "where": where}
+    return {"wall": wall, "run": float(own), "cpu": sum(cpu.values()), "peak": peak, "load": load, "where": where}
 
 
 def main() -> None:

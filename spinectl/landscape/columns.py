@@ -13,7 +13,7 @@ import numpy as np
 from ..model import chain, stability
 from ..model.checks import arithmetic_guard, checked_coefficients
 from ..model.params import Model
-from ..optimise import active_set, coupled, stacked
+from ..optimise import active_set, stacked
 from ..optimise.problem import OK_STATUSES, problem_data
 from ..reflex.delay import STATUS
 from ..reflex.inputs import guarded
@@ -130,6 +130,8 @@ def _local_stiffness(model: Model, stiffness, method: str) -> dict[str, np.ndarr
 
     The fast path solves the chunk as one stacked SDP, the per-point method one cvxpy SDP per point.
     """
+    from ..optimise import coupled  # cvxpy (a second of imports) only where the chain's SDPs are asked for
+
     opt = model.optimisation
     if method == "fast":
         _, k = coupled.least_local_stiffness_stacked(stiffness, opt.stability_margin, opt.solver_tolerance)
@@ -147,6 +149,8 @@ def _joint_optimum(model: Model, eccentricity, lordosis, data, method: str) -> d
     The fast path solves the chunk as one stacked SDP and falls back to one cvxpy SDP per point
     where the stack fails as a whole (e.g. one infeasible point); the per-point method always does.
     """
+    from ..optimise import coupled  # as in _local_stiffness
+
     kappa = chain.local_stiffness_per_pcsa(model) * M2_PER_CM2  # N m/rad per cm^2
     status = "per-point"
     if method == "fast":

@@ -24,8 +24,8 @@ import zarr
 
 from spinectl.cli import main
 from spinectl.errors import ConfigError, ModelError, OutputError, ParameterError
-from spinectl.landscape import study, sweep
-from spinectl.landscape.study import spec
+from spinectl.landscape import schema, study, sweep
+from spinectl.landscape.study import run, spec
 from spinectl.landscape.study import store as study_store
 from spinectl.model import config
 
@@ -606,19 +606,19 @@ def test_a_full_disk_while_chunks_are_written_is_one_line_and_resumable(referenc
     --resume finishes the store (before: zarr's OSError traceback)."""
     import errno
 
-    real, writes = xr.Dataset.to_zarr, []
+    real, writes = zarr.Array.__setitem__, []
 
-    def filling(self, *args, region=None, **kwargs):
-        if region is not None:
-            writes.append(region)
+    def filling(self, selection, value):
+        if self.basename == "status":  # one output of each chunk: the third chunk's write fails
+            writes.append(selection)
             if len(writes) == 3:
                 raise OSError(errno.ENOSPC, "No space left on device")
-        return real(self, *args, region=region, **kwargs)
+        return real(self, selection, value)
 
     path, out = write(tmp_path), tmp_path / "s.zarr"
     arguments = ["study", str(path), "--out", str(out), "--scheduler", "synchronous"]
     with monkeypatch.context() as patch:
-        patch.setattr(xr.Dataset, "to_zarr", filling)
+        patch.setattr(zarr.Array, "__setitem__", filling)
         assert main(arguments) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "No space left on device" in err and "--resume" in err
@@ -639,6 +639,33 @@ def test_an_all_nan_chunk_is_still_a_file(tmp_path):
     study.run_study(parsed, out, scheduler="synchronous", progress=False)
     loaded = study.load(out)
     assert np.isnan(loaded["min_pcsa_cm2"].values).all() and (out / "min_pcsa_cm2" / "0.0").is_file()
+
+
+def test_the_writer_writes_the_files_that_xarray_writes(tmp_path):
+    """Each chunk goes straight into its zarr arrays' regions: the same files, bit for bit, as the
+    ``Dataset.to_zarr(region=...)`` the writer used before (the second method), also for a chunk of
+    fill values only (every point infeasible), which both write as a file."""
+    text = STUDY.replace("[axes]\n", '[axes]\n"optimisation.pcsa_max" = [1e-6, 1.0]\n')
+    parsed = study.parse_study(text)
+    chunks = [parsed.chunk(i) for i in (0, parsed.n_chunks - 1)]  # all-infeasible, and one of pcsa_max = 1
+    solved = [run.solve_chunk(task) for task in run.tasks(parsed, [c.index for c in chunks])]
+    probe = run._probe(parsed)
+    ours, theirs = tmp_path / "ours.zarr", tmp_path / "theirs.zarr"
+    writer = study_store.Writer(parsed, ours, study_store.create(parsed, ours, probe))
+    study_store.create(parsed, theirs, probe)
+    lead = (np.newaxis,) * len(parsed.dims)
+    for chunk, (_, outputs) in zip(chunks, solved, strict=True):
+        writer.write(chunk, outputs)
+        region = {d: slice(i, i + 1) for d, i in zip(parsed.dims, chunk.combination, strict=True)}
+        region |= {"E": chunk.eccentricity, "Lambda": chunk.lordosis}
+        part = {n: (parsed.dims + schema.dims_of(n, x.ndim), x[lead]) for n, x in outputs.items()}
+        xr.Dataset(part).to_zarr(theirs, region=region, consolidated=False, zarr_format=2, write_empty_chunks=True)
+    assert np.isnan(solved[0][1]["min_pcsa_cm2"]).all() and not np.isnan(solved[1][1]["min_pcsa_cm2"]).all()
+    files = {p.relative_to(theirs) for p in theirs.rglob("*") if p.is_file()} - {Path(".zattrs")}
+    outputs = [p for p in files if p.parts[0] in solved[0][1] and not p.name.startswith(".")]
+    assert len(outputs) == 2 * len(solved[0][1])  # a file per output and chunk, the empty one too
+    for name in sorted(p for p in files if p.parts[0] not in (study_store.DONE, study_store.CHECKSUM)):
+        assert (ours / name).read_bytes() == (theirs / name).read_bytes(), name
 
 
 @pytest.fixture
@@ -692,6 +719,7 @@ def test_workers_vanishing_mid_run_stop_the_study_after_the_worker_timeout(refer
     options = {"processes": False, "protocol": "tcp://", "host": "127.0.0.1", "dashboard_address": None}
     out = tmp_path / "s.zarr"
     with LocalCluster(n_workers=1, threads_per_worker=1, **options) as cluster:
+
         def stop_the_workers():
             deadline = time.monotonic() + 120
             while done_chunks(out) < 1 and time.monotonic() < deadline:

@@ -27,6 +27,7 @@ import contextlib
 import itertools
 import logging
 import math
+import multiprocessing
 import os
 import re
 import signal
@@ -77,6 +78,12 @@ MALLOC_TRIM_SETTING = "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD
 once; the fast path allocates and frees many arrays of a few hundred kB per chunk and then runs about
 15 % slower (measured on one chunk of 4010 points). Local workers keep glibc's own threshold; a chunk's
 memory is bounded anyway (the benchmark's peak, docs/studies.md)."""
+
+START_METHOD = "forkserver" if "forkserver" in multiprocessing.get_all_start_methods() else "spawn"
+"""How local worker processes start: forked from a fresh server process where the platform allows
+(Linux, macOS), rather than dask's default, a new interpreter each (``spawn``). Both start from a clean
+process (never a fork of the client and its threads); a forked worker ends with ``os._exit``, without the
+interpreter's shutdown, which took 1.2 s of a closing cluster of two workers (0.05 s now; load 5)."""
 
 WORKERS_PER_CORE = 4
 """Most local workers per core: the solver is CPU-bound, more only costs memory."""
@@ -259,10 +266,12 @@ def run_study(
         indices = np.arange(study.n_chunks) if done is None else np.flatnonzero(done == 0)
         todo = indices[: None if max_chunks is None else max_chunks]
         with _executor(scheduler, workers, todo.size, tuple(timeouts.values()), notify) as executor:
+            # a cluster's first chunks are submitted now: its workers start on them while the store is made
+            results = executor.run(tasks(study, todo), f"spinectl-{study.digest()[:16]}")
             if done is None:  # after connecting: an unreachable scheduler leaves no store behind
                 done = store.create(study, out, _probe(study))
             done_before = int(np.count_nonzero(done))
-            _run_chunks(study, out, done, executor.run(tasks(study, todo), f"spinectl-{study.digest()[:16]}"), progress)
+            _run_chunks(study, out, done, results, progress)
         if np.all(done > 0):
             store.consolidate(out)
     seconds = time.perf_counter() - start
@@ -358,7 +367,8 @@ class _Distributed:
         info = client.scheduler_info()
         self.addresses = (info["address"], *sorted(info["workers"]))
 
-    def run(self, chunks: Iterator[Task], prefix: str):
+    def run(self, chunks: Iterator[Task], prefix: str) -> Iterator[tuple[int, dict[str, np.ndarray]]]:
+        """Submit the first chunks at once; return the chunks' results as they finish, submitting one as one ends."""
         from distributed import as_completed
 
         window = 2 * max(1, sum(self.client.nthreads().values()))
@@ -367,55 +377,68 @@ class _Distributed:
             return self.client.submit(solve_chunk, task, key=f"{prefix}-{task.index}")
 
         pending = as_completed([submit(task) for task in itertools.islice(chunks, window)], loop=self.client.loop)
+        return self._results(pending, chunks, submit)
+
+    def _results(self, pending, chunks: Iterator[Task], submit):
+        watch = _Watch(self.client, self.where, self.worker_timeout)  # one for the run
         while not pending.is_empty():
-            self._wait_for_one(pending)
+            self._wait_for_one(pending, watch)
             for future in pending.next_batch(block=False):
-                result = self._result(future)  # a chunk's error ends the run here; the cluster is closed on the way out
+                result = self._result(future, watch)  # a chunk's error ends the run here; the cluster is closed after
                 future.release()
+                watch.alive()
                 yield result
                 task = next(chunks, None)
                 if task is not None:
                     pending.add(submit(task))
 
-    def _wait_for_one(self, pending) -> None:
+    @staticmethod
+    def _wait_for_one(pending, watch: _Watch) -> None:
         """Return once a future of ``pending`` has finished, as long as the cluster has a worker."""
-        watch = self._watch()
         while not pending.has_ready():
             time.sleep(0.01)
             watch()
 
-    def _result(self, future):
+    @staticmethod
+    def _result(future, watch: _Watch):
         """The chunk of a finished future. Its data lives on the worker that solved it: a worker gone
         before the data came back leaves the scheduler waiting for another, so this wait is bounded too."""
-        watch = self._watch()
         while True:
             try:
                 return future.result(timeout=POLL)
             except TimeoutError:
                 watch()
 
-    def _watch(self):
-        """A function to call while waiting: every :data:`POLL` seconds it counts the workers, and raises
-        once there has been none for ``worker_timeout`` seconds."""
-        idle_since, looked = None, time.monotonic()
 
-        def watch() -> None:
-            nonlocal idle_since, looked
-            if time.monotonic() - looked < POLL:
-                return
-            looked = time.monotonic()
-            if self.client.scheduler_info(n_workers=0).get("n_workers", 1) > 0:
-                idle_since = None
-            elif idle_since is None:
-                idle_since = looked
-            elif looked - idle_since > self.worker_timeout:
-                raise ParameterError(
-                    "scheduler",
-                    f"{self.where}: every worker has gone, and none joined within {self.worker_timeout:g} s: the "
-                    "store holds every chunk finished; start a worker and run again with --resume",
-                )
+class _Watch:
+    """Call while waiting: every :data:`POLL` seconds without a finished chunk it counts the
+    cluster's workers, and raises once there has been none for ``worker_timeout`` seconds.
 
-        return watch
+    A finished chunk (:meth:`alive`) shows a worker: no question to the scheduler while chunks come.
+    """
+
+    def __init__(self, client, where: str, worker_timeout: float):
+        self.client, self.where, self.worker_timeout = client, where, worker_timeout
+        self.idle_since, self.looked = None, time.monotonic()
+
+    def alive(self) -> None:
+        """A chunk has just finished: the cluster had a worker now."""
+        self.idle_since, self.looked = None, time.monotonic()
+
+    def __call__(self) -> None:
+        if time.monotonic() - self.looked < POLL:
+            return
+        self.looked = time.monotonic()
+        if self.client.scheduler_info(n_workers=0).get("n_workers", 1) > 0:
+            self.idle_since = None
+        elif self.idle_since is None:
+            self.idle_since = self.looked
+        elif self.looked - self.idle_since > self.worker_timeout:
+            raise ParameterError(
+                "scheduler",
+                f"{self.where}: every worker has gone, and none joined within {self.worker_timeout:g} s: the "
+                "store holds every chunk finished; start a worker and run again with --resume",
+            )
 
 
 @contextlib.contextmanager
@@ -451,7 +474,8 @@ def _local_cluster(n: int):
 
     previous = _block_interrupts()
     try:
-        with dask.config.set({MALLOC_TRIM_SETTING: None}), _workers_stderr():  # see there for both
+        settings = {MALLOC_TRIM_SETTING: None, "distributed.worker.multiprocessing-method": START_METHOD}
+        with dask.config.set(settings), _workers_stderr():  # see there for all three
             cluster = LocalCluster(
                 n_workers=n,
                 threads_per_worker=1,  # cvxpy is not thread-safe; one process per worker
@@ -481,9 +505,9 @@ def _local_cluster(n: int):
 def _workers_stderr():
     """Start worker processes with a temporary file as their standard error, not the terminal.
 
-    The worker processes are spawned from distributed's own threads, which do not share the
-    blocked SIGINT; a Ctrl-C that reaches a worker while its interpreter starts makes CPython
-    print "Fatal Python error: init_import_site" and a traceback there. The workers log at
+    The worker processes (or their fork server, :data:`START_METHOD`) are started from distributed's
+    own threads, which do not share the blocked SIGINT; a Ctrl-C that reaches a new interpreter while it
+    starts makes CPython print "Fatal Python error: init_import_site" and a traceback there. The workers log at
     error level only (``silence_logs``) and their failures reach the client as exceptions.
     """
     sys.stderr.flush()
