@@ -112,9 +112,13 @@ def paper_landscapes(model: Model, points: int = PAPER_POINTS, progress=None) ->
         :func:`spinectl.landscape.sweep.stiffness_sweep` over K = 0 and 15.
     other : xarray.Dataset
         :func:`spinectl.landscape.sweep.sweep` at K = 15 with the other convention.
+
+    The three share the grid and everything but K, so they are solved in one pass
+    (:func:`spinectl.landscape.sweep.passive_sweeps`).
     """
     axis = paper_axis(points)
-    k15 = PAPER_STIFFNESS
-    both = sweep.stiffness_sweep(model, list(STIFFNESSES), axis, axis, progress=progress)
-    other = sweep.sweep(with_stiffness(model, k15, other_convention(model)), axis, axis, progress=progress)
-    return both, other
+    models = [with_stiffness(model, k) for k in STIFFNESSES] + [
+        with_stiffness(model, PAPER_STIFFNESS, other_convention(model))
+    ]
+    *parts, other = sweep.passive_sweeps(models, axis, axis, progress=progress)  # one geometry: coefficients shared
+    return sweep.stack_stiffnesses(parts), other
