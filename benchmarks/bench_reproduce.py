@@ -2,13 +2,16 @@
 
     python benchmarks/bench_reproduce.py               # fastest of 5 runs each, interleaved
     python benchmarks/bench_reproduce.py --repeats 9   # on a busy machine
+    git archive a769033 | tar -x -C /tmp/before && python benchmarks/bench_reproduce.py --before /tmp/before
 
 End to end: the command as a user types it, in a fresh interpreter (``python -m spinectl
 reproduce`` from this checkout), taking turns with ``python -c "import numpy, scipy"``;
 printed, the fastest wall time of each and their ratio (issue 14's target: 4 s on the quiet
-2-core machine). Then the breakdown, each part against the code path it replaced, timed in
-this process, interleaved, fastest of the runs (CPU seconds, ``time.process_time``, which
-other users' load disturbs less than the wall time):
+2-core machine); with ``--before DIR``, also the command from an earlier checkout in DIR (a
+``git archive`` of an earlier commit), taking turns with the other two. Then the breakdown,
+each part against the code path it replaced, timed in this process, interleaved, fastest of
+the runs (CPU seconds, ``time.process_time``, which other users' load disturbs less than the
+wall time):
 
 - imports: ``import spinectl.paper.reproduction`` in a fresh interpreter (wall), against the
   same with cvxpy and scipy.stats, which it imported before (through optimise.coupled and
@@ -47,9 +50,9 @@ TARGET = 4.0
 """Issue 14: ``spinectl reproduce`` end to end within 4 s on the quiet 2-core machine [s]."""
 
 
-def wall(command: list[str]) -> float:
-    """Wall time of one run of ``command`` in a fresh interpreter [s]; it must succeed."""
-    env = dict(os.environ, PYTHONPATH=str(ROOT))
+def wall(command: list[str], root: Path = ROOT) -> float:
+    """Wall time of one run of ``command`` in a fresh interpreter, spinectl from ``root`` [s]; it must succeed."""
+    env = dict(os.environ, PYTHONPATH=str(root))
     start = time.perf_counter()
     subprocess.run(command, cwd=ROOT, env=env, check=True, capture_output=True)
     return time.perf_counter() - start
@@ -76,18 +79,23 @@ def line(name: str, now: float, before: float | None = None) -> None:
     print(f"{name:>10}: {now:6.3f} s{ratio}")
 
 
-def end_to_end(repeats: int) -> float:
+def end_to_end(repeats: int, before: Path | None) -> float:
     print(f"== end to end, fresh interpreters, fastest of {repeats}, interleaved; load {os.getloadavg()[0]:.2f}")
     with tempfile.TemporaryDirectory() as out:
-        commands = {
-            "import numpy, scipy": [sys.executable, "-c", "import numpy, scipy"],
-            "spinectl reproduce": [sys.executable, "-m", "spinectl", "reproduce", "--out", out],
+        reproduce = [sys.executable, "-m", "spinectl", "reproduce", "--out", out]
+        candidates = {
+            "import numpy, scipy": lambda: wall([sys.executable, "-c", "import numpy, scipy"]),
+            "spinectl reproduce": lambda: wall(reproduce),
         }
-        best = fastest({name: lambda c=command: wall(c) for name, command in commands.items()}, repeats)
+        if before is not None:
+            candidates["before"] = lambda: wall(reproduce, before)
+        best = fastest(candidates, repeats)
     reference, command = best["import numpy, scipy"], best["spinectl reproduce"]
     print(f"import numpy, scipy: {reference:6.3f} s")
     verdict = "meets" if command <= TARGET else "misses"
     print(f" spinectl reproduce: {command:6.3f} s = {command / reference:5.1f}x the reference ({verdict} {TARGET:g} s)")
+    if before is not None:
+        print(f"    before ({before}): {best['before']:6.3f} s; now / before {command / best['before']:5.2f}")
     return command
 
 
@@ -157,8 +165,9 @@ def breakdown(repeats: int, command: float) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=5, help="runs per candidate, taking turns; fastest counts")
+    parser.add_argument("--before", type=Path, metavar="DIR", help="an earlier checkout to time end to end too")
     args = parser.parse_args()
-    command = end_to_end(args.repeats)
+    command = end_to_end(args.repeats, args.before)
     breakdown(max(1, args.repeats // 2 + 1), command)
 
 
