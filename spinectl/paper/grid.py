@@ -98,6 +98,9 @@ def with_stiffness(model: Model, stiffness: float, convention: str | None = None
 def paper_landscapes(model: Model, points: int = PAPER_POINTS, progress=None) -> tuple[xr.Dataset, xr.Dataset]:
     """Full sweeps for the landmarks: K = 0 and 15 N m/rad (model's convention), and K = 15 (other).
 
+    The three share the grid and everything but K, so they are solved in one pass
+    (:func:`spinectl.landscape.sweep.passive_sweeps`: the coefficients computed once).
+
     Parameters
     ----------
     model : Model
@@ -112,13 +115,10 @@ def paper_landscapes(model: Model, points: int = PAPER_POINTS, progress=None) ->
         :func:`spinectl.landscape.sweep.stiffness_sweep` over K = 0 and 15.
     other : xarray.Dataset
         :func:`spinectl.landscape.sweep.sweep` at K = 15 with the other convention.
-
-    The three share the grid and everything but K, so they are solved in one pass
-    (:func:`spinectl.landscape.sweep.passive_sweeps`).
     """
     axis = paper_axis(points)
     models = [with_stiffness(model, k) for k in STIFFNESSES] + [
         with_stiffness(model, PAPER_STIFFNESS, other_convention(model))
     ]
-    *parts, other = sweep.passive_sweeps(models, axis, axis, progress=progress)  # one geometry: coefficients shared
+    *parts, other = sweep.passive_sweeps(models, axis, axis, progress=progress)
     return sweep.stack_stiffnesses(parts), other
