@@ -54,7 +54,7 @@ def wall(command: list[str], root: Path = ROOT) -> float:
     """Wall time of one run of ``command`` in a fresh interpreter, spinectl from ``root`` [s]; it must succeed."""
     env = dict(os.environ, PYTHONPATH=str(root))
     start = time.perf_counter()
-    subprocess.run(command, cwd=ROOT, env=env, check=True, capture_output=True)
+    subprocess.run(command, cwd=root, env=env, check=True, capture_output=True)  # -m puts the cwd first on the path
     return time.perf_counter() - start
 
 
