@@ -181,8 +181,9 @@ def distinct(name: str, axis: np.ndarray) -> None:
 def stiffness_sweep(model: Model, stiffnesses, eccentricity, lordosis, **options) -> xr.Dataset:
     """:func:`sweep` for several passive stiffnesses K [N m/rad], stacked along a ``K`` dimension.
 
-    The landscapes are solved in one pass (:func:`passive_sweeps`). ``config_toml`` is then the model of the first K; the ``K`` coordinate gives each one's
-    ``passive.stiffness`` (convention: ``passive_convention``).
+    The landscapes are solved in one pass (:func:`passive_sweeps`). ``config_toml`` is then
+    the model of the first K; the ``K`` coordinate gives each one's ``passive.stiffness``
+    (convention: ``passive_convention``).
 
     Parameters
     ----------
