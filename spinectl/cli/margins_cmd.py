@@ -96,7 +96,6 @@ def run(args) -> int:
         Exit code 0 (also for an infeasible optimum, reported as a status).
     """
     from ..reflex.margins import analyse
-
     if args.plot:
         from ..reflex.plots import PLOT_FILES
 
