@@ -73,8 +73,7 @@ def _print_png(figure: Figure, path, dpi: float) -> None:
     ``savefig`` draws a figure that has a layout engine twice: once without rendering, to
     lay it out, and once to render it with the layout engine off
     (``FigureCanvasBase.print_figure``). The Agg canvas's own ``print_png`` lays the figure
-    out and renders it in one draw, which saves a quarter of the time of a landscape figure
-    (benchmarks/bench_reproduce.py).
+    out and renders it in one draw (benchmarks/bench_reproduce.py measures the saving).
     """
     original = figure.dpi
     figure.set_dpi(dpi)

@@ -7,6 +7,8 @@ Figures 3, 4 and S1 as PNG, and a Markdown report with the paper's landmarks
 beside spinectl's and a verdict for each (docs/reproduction.md). The folder is
 checked before the work, everything is staged, and the staging folder replaces
 the output folder as a whole at the end (:func:`spinectl.atomic.staged_directory`).
+On Linux a worker process draws the figures while this one writes the landscapes
+and the report (benchmarks/bench_reproduce.py).
 """
 
 from __future__ import annotations
