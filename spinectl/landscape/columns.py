@@ -123,9 +123,10 @@ def passive_columns(
         with arithmetic_guard(e, lam):
             shared_chain = chain.chain_coefficients(models[0], e, lam)
         for i, model in enumerate(models):
-            coeffs, chain_coeffs = (
-                (shared, shared_chain) if i == 0 else _with_passive(model, shared, shared_chain, e, lam)
-            )
+            coeffs, chain_coeffs = shared, shared_chain
+            if i > 0:  # the chain's K_pas is the segments' (the same CoRs and theta_k)
+                coeffs = with_passive(model, shared, e, lam)
+                chain_coeffs = dataclasses.replace(shared_chain, passive_stiffness=coeffs.passive_stiffness)
             columns, per_point = _chunk(model, e, lam, coeffs, chain_coeffs, method, update, coupled)
             arrays = answers[i][0]
             for name, values in columns.items():
@@ -145,16 +146,37 @@ def _check_passive_only(models: Sequence[Model]) -> None:
         raise ParameterError("models", "must differ in passive (K and its convention) alone")
 
 
-def _with_passive(model: Model, coeffs: SegmentCoefficients, chain_coeffs, eccentricity, lordosis):
-    """The coefficients with the K_pas of ``model``: about the same CoRs, so from the same theta_k; checked finite."""
+def with_passive(model: Model, coeffs: SegmentCoefficients, eccentricity, lordosis) -> SegmentCoefficients:
+    """The segment coefficients of ``model`` from those of a model that differs from it in ``passive`` alone.
+
+    K enters only as K_pas (:func:`spinectl.model.mechanics.passive_stiffness`), about the same
+    CoRs, so from the same theta_k: the arrays of
+    :func:`~spinectl.model.checks.checked_coefficients` for ``model``, bit for bit, checked finite.
+
+    Parameters
+    ----------
+    model : Model
+        The model whose K_pas is wanted.
+    coeffs : SegmentCoefficients
+        Checked coefficients at the points, of a model equal to ``model`` but for ``passive``.
+    eccentricity, lordosis : array_like
+        E and Lambda of the points [m], named by an error.
+
+    Returns
+    -------
+    SegmentCoefficients
+        ``coeffs`` with the passive stiffness of ``model`` [N m/rad].
+
+    Raises
+    ------
+    ModelError
+        K_pas overflows (:func:`spinectl.model.checks.arithmetic_guard`).
+    """
     with arithmetic_guard(eccentricity, lordosis):
         passive = passive_stiffness(model, coeffs.inertia)
         if not np.all(np.isfinite(passive)):
             raise FloatingPointError("non-finite passive stiffness")
-    return (
-        dataclasses.replace(coeffs, passive_stiffness=passive),
-        dataclasses.replace(chain_coeffs, passive_stiffness=passive),
-    )
+    return dataclasses.replace(coeffs, passive_stiffness=passive)
 
 
 def _chunk(model: Model, e, lam, coeffs, chain_coeffs, method: str, update, coupled: bool):
