@@ -58,9 +58,29 @@ def save_file(figure: Figure, path: str | Path, dpi: float) -> Path:
     OutputError
         The file cannot be written; a previous file of that name is left as it was.
     """
+    file_format = Path(path).suffix.lower().lstrip(".") or "png"
     with atomic_path(path) as tmp:
-        figure.savefig(tmp, format=Path(path).suffix.lower().lstrip(".") or "png", dpi=dpi)
+        if file_format == "png" and isinstance(figure.canvas, FigureCanvasAgg):
+            _print_png(figure, tmp, dpi)
+        else:
+            figure.savefig(tmp, format=file_format, dpi=dpi)
     return Path(path)
+
+
+def _print_png(figure: Figure, path, dpi: float) -> None:
+    """``figure.savefig(path, dpi=dpi)`` as PNG, the figure drawn once: the same file, byte for byte.
+
+    ``savefig`` draws a figure that has a layout engine twice: once without rendering, to
+    lay it out, and once to render it with the layout engine off
+    (``FigureCanvasBase.print_figure``). The Agg canvas's own ``print_png`` lays the figure
+    out and renders it in one draw (benchmarks/bench_reproduce.py measures the saving).
+    """
+    original = figure.dpi
+    figure.set_dpi(dpi)
+    try:
+        figure.canvas.print_png(path)
+    finally:
+        figure.set_dpi(original)
 
 
 def save_figures(figures: dict[str, Figure], folder: str | Path, dpi: float, replaces=()) -> list[Path]:

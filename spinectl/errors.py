@@ -29,6 +29,10 @@ class ParameterError(SpinectlError, ValueError):
         self.message = message
         super().__init__(f"{field}: {message}")
 
+    def __reduce__(self):
+        """Pickled by its field and message (an error of a worker process comes back as itself)."""
+        return type(self), (self.field, self.message)
+
     def under(self, prefix: str) -> ParameterError:
         """Return the same error with ``prefix`` prepended to the field name.
 

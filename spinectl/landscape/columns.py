@@ -8,10 +8,15 @@ each chunk by the fast path (:mod:`spinectl.optimise.active_set`) or the per-poi
 
 from __future__ import annotations
 
+import dataclasses
+from collections.abc import Sequence
+
 import numpy as np
 
+from ..errors import ParameterError
 from ..model import chain, stability
 from ..model.checks import arithmetic_guard, checked_coefficients
+from ..model.mechanics import SegmentCoefficients, passive_stiffness
 from ..model.params import Model
 from ..optimise import active_set, stacked
 from ..optimise.problem import OK_STATUSES, problem_data
@@ -63,34 +68,135 @@ def point_columns(
     per_point : int
         Points that the per-point reference solved (all of them with ``method='per-point'``).
     """
+    options = {"method": method, "chunk_size": chunk_size, "update": update, "coupled": coupled}
+    return passive_columns([model], eccentricity, lordosis, **options)[0]
+
+
+def passive_columns(
+    models: Sequence[Model],
+    eccentricity,
+    lordosis,
+    *,
+    method: str = "fast",
+    chunk_size: int = DEFAULT_CHUNK,
+    update=None,
+    coupled: bool = False,
+) -> list[tuple[dict[str, np.ndarray], int]]:
+    """:func:`point_columns` of several models that differ in their passive stiffness alone, in one pass.
+
+    K enters the model only as -K_pas on the diagonal of the stiffness
+    (:func:`spinectl.model.mechanics.passive_stiffness`, docs/model.md, "Passive stiffness: two
+    conventions"), so the segments' and the chain's coefficients per unit PCSA are computed and
+    checked once per chunk and each model gets its own K_pas: the same arrays, bit for bit, as one
+    :func:`point_columns` per model (the paper's landscapes, K = 0 and 15 N m/rad in both
+    conventions, share one geometry).
+
+    Parameters
+    ----------
+    models : sequence of Model
+        Equal but for ``passive`` (K and its convention); at least one.
+    eccentricity, lordosis : array_like, shape (P,)
+        E and Lambda of each point [m].
+    method, chunk_size, coupled
+        As for :func:`point_columns`.
+    update : callable, optional
+        Called with the number of points solved, for each model in turn.
+
+    Returns
+    -------
+    list of (dict of str to numpy.ndarray, int)
+        :func:`point_columns`'s answer for each model, in the order of ``models``.
+
+    Raises
+    ------
+    ParameterError
+        ``models`` empty, or differing in more than ``passive``.
+    """
+    _check_passive_only(models)
     e_grid, l_grid = np.asarray(eccentricity, float), np.asarray(lordosis, float)
     update = update or (lambda n: None)
-    arrays: dict[str, np.ndarray] = {}  # filled chunk by chunk: no copies of the answer beyond the answer
-    per_point = 0
+    answers = [({}, 0) for _ in models]  # filled chunk by chunk: no copies of the answer beyond the answer
     for start in range(0, e_grid.size, int(chunk_size)):
         part = slice(start, start + int(chunk_size))
-        coeffs = checked_coefficients(model, e_grid[part], l_grid[part])  # raises for bad input
-        data = problem_data(model, coeffs)
-        tol = model.optimisation.ct_tolerance
-        if method == "fast":
-            result = active_set.solve_block(data, tol)
-            update(len(data.stability))
-        else:
-            result = stacked.solve_points(data, tol, progress=update)
-        per_point += result.per_point
-        with arithmetic_guard(e_grid[part], l_grid[part]), guarded():  # e.g. K = 1e154 overflows S^2 in the reflex
-            columns = _chunk_columns(result, coeffs, model)
-            stiffness = _chain_stiffness(model, e_grid[part], l_grid[part], result.pcsa)
-            margin = chain.coupled_margin(np.nan_to_num(stiffness))
-            columns["coupled_margin_Nm_per_rad"] = np.where(np.isnan(stiffness[:, 0, 0]), np.nan, margin)
-        if coupled:  # SDPs: outside numpy's guard
-            columns |= _local_stiffness(model, stiffness, method)
-            columns |= _joint_optimum(model, e_grid[part], l_grid[part], data, method)
-        for name, values in columns.items():
-            if name not in arrays:
-                arrays[name] = np.empty((e_grid.size,) + values.shape[1:], values.dtype)
-            arrays[name][part] = values
-    return arrays, per_point
+        e, lam = e_grid[part], l_grid[part]
+        shared = checked_coefficients(models[0], e, lam)  # raises for bad input
+        with arithmetic_guard(e, lam):
+            shared_chain = chain.chain_coefficients(models[0], e, lam)
+        for i, model in enumerate(models):
+            coeffs, chain_coeffs = shared, shared_chain
+            if i > 0:  # the chain's K_pas is the segments' (the same CoRs and theta_k)
+                coeffs = with_passive(model, shared, e, lam)
+                chain_coeffs = dataclasses.replace(shared_chain, passive_stiffness=coeffs.passive_stiffness)
+            columns, per_point = _chunk(model, e, lam, coeffs, chain_coeffs, method, update, coupled)
+            arrays = answers[i][0]
+            for name, values in columns.items():
+                if name not in arrays:
+                    arrays[name] = np.empty((e_grid.size,) + values.shape[1:], values.dtype)
+                arrays[name][part] = values
+            answers[i] = (arrays, answers[i][1] + per_point)
+    return answers
+
+
+def _check_passive_only(models: Sequence[Model]) -> None:
+    """Raise :class:`ParameterError` unless ``models`` is not empty and its models differ in ``passive`` alone."""
+    if not models:
+        raise ParameterError("models", "must hold at least one model")
+    first = models[0]
+    if any(dataclasses.replace(model, passive=first.passive) != first for model in models[1:]):
+        raise ParameterError("models", "must differ in passive (K and its convention) alone")
+
+
+def with_passive(model: Model, coeffs: SegmentCoefficients, eccentricity, lordosis) -> SegmentCoefficients:
+    """The segment coefficients of ``model`` from those of a model that differs from it in ``passive`` alone.
+
+    K enters only as K_pas (:func:`spinectl.model.mechanics.passive_stiffness`), about the same
+    CoRs, so from the same theta_k: the arrays of
+    :func:`~spinectl.model.checks.checked_coefficients` for ``model``, bit for bit, checked finite.
+
+    Parameters
+    ----------
+    model : Model
+        The model whose K_pas is wanted.
+    coeffs : SegmentCoefficients
+        Checked coefficients at the points, of a model equal to ``model`` but for ``passive``.
+    eccentricity, lordosis : array_like
+        E and Lambda of the points [m], named by an error.
+
+    Returns
+    -------
+    SegmentCoefficients
+        ``coeffs`` with the passive stiffness of ``model`` [N m/rad].
+
+    Raises
+    ------
+    ModelError
+        K_pas overflows (:func:`spinectl.model.checks.arithmetic_guard`).
+    """
+    with arithmetic_guard(eccentricity, lordosis):
+        passive = passive_stiffness(model, coeffs.inertia)
+        if not np.all(np.isfinite(passive)):
+            raise FloatingPointError("non-finite passive stiffness")
+    return dataclasses.replace(coeffs, passive_stiffness=passive)
+
+
+def _chunk(model: Model, e, lam, coeffs, chain_coeffs, method: str, update, coupled: bool):
+    """One model's variables on one chunk of points, from its coefficients; and the points solved per point."""
+    data = problem_data(model, coeffs)
+    tol = model.optimisation.ct_tolerance
+    if method == "fast":
+        result = active_set.solve_block(data, tol)
+        update(len(data.stability))
+    else:
+        result = stacked.solve_points(data, tol, progress=update)
+    with arithmetic_guard(e, lam), guarded():  # e.g. K = 1e154 overflows S^2 in the reflex
+        columns = _chunk_columns(result, coeffs, model)
+        stiffness = _chain_stiffness(chain_coeffs, result.pcsa)
+        margin = chain.coupled_margin(np.nan_to_num(stiffness))
+        columns["coupled_margin_Nm_per_rad"] = np.where(np.isnan(stiffness[:, 0, 0]), np.nan, margin)
+    if coupled:  # SDPs: outside numpy's guard
+        columns |= _local_stiffness(model, stiffness, method)
+        columns |= _joint_optimum(model, e, lam, data, chain_coeffs, method)
+    return columns, result.per_point
 
 
 def _chunk_columns(result: stacked.BlockOptimum, coeffs, model: Model) -> dict[str, np.ndarray]:
@@ -119,9 +225,9 @@ def _slowest_time_constant(coeffs, pcsa) -> np.ndarray:
     return np.where(np.isnan(pcsa).any(axis=-1), np.nan, tau)
 
 
-def _chain_stiffness(model: Model, eccentricity, lordosis, pcsa) -> np.ndarray:
+def _chain_stiffness(chain_coeffs: chain.ChainCoefficients, pcsa) -> np.ndarray:
     """The coupled chain's K at the chosen activation [N m/rad], NaN where infeasible (docs/chain.md)."""
-    stiffness = chain.chain_coefficients(model, eccentricity, lordosis).stiffness(np.nan_to_num(pcsa))
+    stiffness = chain_coeffs.stiffness(np.nan_to_num(pcsa))
     return np.where(np.isnan(pcsa).any(axis=-1)[:, None, None], np.nan, stiffness)
 
 
@@ -143,7 +249,7 @@ def _local_stiffness(model: Model, stiffness, method: str) -> dict[str, np.ndarr
     return {"local_stiffness_Nm_per_rad": k, "local_stiffness_total_Nm_per_rad": np.sum(k, axis=-1)}
 
 
-def _joint_optimum(model: Model, eccentricity, lordosis, data, method: str) -> dict[str, np.ndarray]:
+def _joint_optimum(model: Model, eccentricity, lordosis, data, coefficients, method: str) -> dict[str, np.ndarray]:
     """The joint optimum of global and local muscle, problem (c) of docs/chain.md: its two totals [cm^2].
 
     The fast path solves the chunk as one stacked SDP and falls back to one cvxpy SDP per point
@@ -154,7 +260,6 @@ def _joint_optimum(model: Model, eccentricity, lordosis, data, method: str) -> d
     kappa = chain.local_stiffness_per_pcsa(model) * M2_PER_CM2  # N m/rad per cm^2
     status = "per-point"
     if method == "fast":
-        coefficients = chain.chain_coefficients(model, eccentricity, lordosis)
         opt = model.optimisation
         status, x, k = coupled.joint_optimum_stacked(
             data, coefficients, opt.stability_margin, kappa, model.local.cost_weight

@@ -20,7 +20,7 @@ from ..model import config
 from ..model.params import Model
 from ..units import CM_PER_M, centimetre_slip
 from . import netcdf
-from .columns import DEFAULT_CHUNK, point_columns
+from .columns import DEFAULT_CHUNK, passive_columns
 from .schema import landscape_dataset
 
 METHODS = ("fast", "per-point")
@@ -117,6 +117,45 @@ def sweep(
     xarray.Dataset
         Dimensions ``E``, ``Lambda``, ``segment``, ``muscle``; schema in docs/optimisation.md.
     """
+    options = {"method": method, "chunk_size": chunk_size, "progress": progress, "coupled": coupled}
+    return passive_sweeps([model], eccentricity, lordosis, **options)[0]
+
+
+def passive_sweeps(
+    models,
+    eccentricity,
+    lordosis,
+    *,
+    method: str = "fast",
+    chunk_size: int = DEFAULT_CHUNK,
+    progress: bool | None = None,
+    coupled: bool = False,
+) -> list[xr.Dataset]:
+    """:func:`sweep` of several models that differ in their passive stiffness alone (K, its convention), in one pass.
+
+    The coefficients that do not depend on K are computed once per chunk for all of them
+    (:func:`spinectl.landscape.columns.passive_columns`); each Dataset equals that of its
+    own :func:`sweep`.
+
+    Parameters
+    ----------
+    models : sequence of Model
+        Equal but for ``passive``; at least one.
+    eccentricity, lordosis : array_like, 1-D
+        Grid axes E and Lambda [m].
+    method, chunk_size, progress, coupled
+        As for :func:`sweep`; one progress bar for all models.
+
+    Returns
+    -------
+    list of xarray.Dataset
+        One landscape per model, in the order of ``models``.
+
+    Raises
+    ------
+    ParameterError
+        A bad option or grid (as :func:`sweep`), or models that differ in more than ``passive``.
+    """
     if method not in METHODS:
         raise ParameterError("method", f"must be one of {', '.join(map(repr, METHODS))} (got {method!r})")
     if int(chunk_size) < 1:
@@ -129,12 +168,15 @@ def sweep(
         distinct(name, axis)
     e_grid, l_grid = (a.ravel() for a in np.meshgrid(e_axis, l_axis, indexing="ij"))
     disable = None if progress is None else not progress  # None: tqdm shows it on a terminal only
-    with tqdm(total=e_grid.size, disable=disable, unit="pt", desc="sweep") as bar:
+    with tqdm(total=e_grid.size * len(models), disable=disable, unit="pt", desc="sweep") as bar:
         options = {"method": method, "chunk_size": chunk_size, "update": bar.update, "coupled": coupled}
-        arrays, per_point = point_columns(model, e_grid, l_grid, **options)
+        answers = passive_columns(models, e_grid, l_grid, **options)
     shape = (e_axis.size, l_axis.size)
-    arrays = {name: values.reshape(shape + values.shape[1:]) for name, values in arrays.items()}
-    return landscape_dataset(model, e_axis, l_axis, arrays, method, per_point)
+    datasets = []
+    for model, (arrays, per_point) in zip(models, answers, strict=True):
+        arrays = {name: values.reshape(shape + values.shape[1:]) for name, values in arrays.items()}
+        datasets.append(landscape_dataset(model, e_axis, l_axis, arrays, method, per_point))
+    return datasets
 
 
 def distinct(name: str, axis: np.ndarray) -> None:
@@ -159,8 +201,9 @@ def distinct(name: str, axis: np.ndarray) -> None:
 def stiffness_sweep(model: Model, stiffnesses, eccentricity, lordosis, **options) -> xr.Dataset:
     """:func:`sweep` for several passive stiffnesses K [N m/rad], stacked along a ``K`` dimension.
 
-    ``config_toml`` is then the model of the first K; the ``K`` coordinate gives each one's
-    ``passive.stiffness`` (convention: ``passive_convention``).
+    The landscapes are solved in one pass (:func:`passive_sweeps`). ``config_toml`` is then
+    the model of the first K; the ``K`` coordinate gives each one's ``passive.stiffness``
+    (convention: ``passive_convention``).
 
     Parameters
     ----------
@@ -184,10 +227,24 @@ def stiffness_sweep(model: Model, stiffnesses, eccentricity, lordosis, **options
         A K repeated (:func:`distinct`), or as :func:`sweep`.
     """
     distinct("K", np.asarray(stiffnesses, float))
-    parts = [
-        sweep(config.set_parameter(model, "passive.stiffness", float(k)), eccentricity, lordosis, **options)
-        for k in stiffnesses
-    ]
+    models = [config.set_parameter(model, "passive.stiffness", float(k)) for k in stiffnesses]
+    return stack_stiffnesses(passive_sweeps(models, eccentricity, lordosis, **options))
+
+
+def stack_stiffnesses(parts) -> xr.Dataset:
+    """Landscapes of one model at several K stacked along a ``K`` dimension, as :func:`stiffness_sweep` gives them.
+
+    Parameters
+    ----------
+    parts : sequence of xarray.Dataset
+        :func:`sweep`'s landscapes (scalar ``K``), distinct in K alone.
+
+    Returns
+    -------
+    xarray.Dataset
+        Stacked along ``K`` [N m/rad] in the order of ``parts``; the attributes of the first,
+        ``points_solved_per_point`` summed.
+    """
     combined = xr.concat(parts, dim="K", data_vars="all", coords="minimal", compat="override", combine_attrs="override")
     combined.attrs["points_solved_per_point"] = sum(p.attrs["points_solved_per_point"] for p in parts)
     return combined

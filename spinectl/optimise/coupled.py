@@ -41,11 +41,10 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import clarabel
-import cvxpy as cp
 import numpy as np
-import scipy.sparse as sp
 
 from ..errors import ParameterError
 from ..model import chain, geometry
@@ -57,6 +56,9 @@ from ..units import M2_PER_CM2, m2_to_cm2
 from .problem import OK_STATUSES, ProblemData, inequalities, problem_data, to_si
 from .reference import minimum_stabilising_pcsa, solve_with_fallback
 from .stacked import CLARABEL_STATUS, stacked_settings
+
+if TYPE_CHECKING:  # imported where a problem is built: cvxpy takes over a second, and a sweep needs neither
+    import cvxpy as cp
 
 
 @dataclass(frozen=True)
@@ -147,6 +149,8 @@ def coupled_data(model: Model, eccentricity: float, lordosis: float) -> CoupledD
 
 def _lmi(data: CoupledData, x, k=None) -> cp.Constraint:
     """diag(k) - K(x) - mu I >> 0 as a cvxpy constraint; x a cvxpy variable or fixed values [cm^2]."""
+    import cvxpy as cp
+
     n = data.stiffness_offset.shape[0]
     if isinstance(x, cp.Expression):
         stiffness = data.stiffness_offset + sum(x[i] * data.stiffness[:, :, i] for i in range(data.stiffness.shape[-1]))
@@ -191,6 +195,8 @@ def least_local_stiffness_at(stiffness, margin: float, tolerance: float | None =
     k : numpy.ndarray or None
         Local stiffness per joint [N m/rad], None unless optimal; exactly feasible (a uniform shift).
     """
+    import cvxpy as cp
+
     stiffness = np.asarray(stiffness, float)
     n = stiffness.shape[0]
     k = cp.Variable(n, nonneg=True)
@@ -261,6 +267,8 @@ def least_local_stiffness_stacked(stiffness, margin: float, tolerance: float | N
     Goulart PJ, Chen Y (2024). Clarabel: an interior-point solver for conic programs with
     quadratic objectives. arXiv:2405.12762. doi:10.48550/arXiv.2405.12762.
     """
+    import scipy.sparse as sp
+
     a = np.asarray(stiffness, float)
     points, n = a.shape[0], a.shape[-1]
     k = np.full((points, n), np.nan)
@@ -326,6 +334,8 @@ def joint_optimum_stacked(
     k : numpy.ndarray, shape (P, n_cor)
         Local stiffness [N m/rad]; NaN unless optimal.
     """
+    import scipy.sparse as sp
+
     per_var = coefficients.stiffness_per_pcsa @ (data.to_muscles * M2_PER_CM2)  # (P, n, n, v)
     offset = coefficients.stiffness(np.zeros(data.to_muscles.shape[0]))  # (P, n, n)
     points, n, v = per_var.shape[0], per_var.shape[1], per_var.shape[-1]
@@ -377,6 +387,8 @@ def min_global_pcsa_sdp(data: CoupledData) -> tuple[str, np.ndarray | None]:
     x : numpy.ndarray or None
         Decision variables [cm^2], None unless optimal.
     """
+    import cvxpy as cp
+
     lhs, rhs = inequalities(data.problem)
     x = cp.Variable(data.problem.weights.size)
     problem = cp.Problem(cp.Minimize(data.problem.weights @ x), [lhs @ x <= rhs, _lmi(data, x)])
@@ -405,6 +417,8 @@ def joint_optimum_sdp(data: CoupledData) -> tuple[str, np.ndarray | None, np.nda
     k : numpy.ndarray or None
         Local stiffness per joint [N m/rad], None unless optimal.
     """
+    import cvxpy as cp
+
     x, k, constraints = _joint_variables(data)
     cost = data.problem.weights @ x + data.cost_weight * cp.sum(k) / data.local_per_cm2
     return _solve_joint(data, cp.Problem(cp.Minimize(cost), constraints), x, k)
@@ -412,6 +426,8 @@ def joint_optimum_sdp(data: CoupledData) -> tuple[str, np.ndarray | None, np.nda
 
 def _joint_variables(data: CoupledData):
     """x, k >= 0 and the constraints of (c): the per-segment rows without the stiffness rows, and the LMI."""
+    import cvxpy as cp
+
     n_cor = data.stiffness_offset.shape[0]
     lhs, rhs = inequalities(data.problem)
     lhs, rhs = lhs[n_cor:], rhs[n_cor:]  # drop the per-segment stiffness rows (the first n_cor)
@@ -452,6 +468,8 @@ def least_global_within_budget_sdp(data: CoupledData, budget: float):
     k : numpy.ndarray or None
         Local stiffness per joint [N m/rad], None unless optimal.
     """
+    import cvxpy as cp
+
     x, k, constraints = _joint_variables(data)
     if np.isfinite(budget):
         constraints = constraints + [cp.sum(k) <= budget]

@@ -98,6 +98,9 @@ def with_stiffness(model: Model, stiffness: float, convention: str | None = None
 def paper_landscapes(model: Model, points: int = PAPER_POINTS, progress=None) -> tuple[xr.Dataset, xr.Dataset]:
     """Full sweeps for the landmarks: K = 0 and 15 N m/rad (model's convention), and K = 15 (other).
 
+    The three share the grid and everything but K, so they are solved in one pass
+    (:func:`spinectl.landscape.sweep.passive_sweeps`: the coefficients computed once).
+
     Parameters
     ----------
     model : Model
@@ -114,7 +117,8 @@ def paper_landscapes(model: Model, points: int = PAPER_POINTS, progress=None) ->
         :func:`spinectl.landscape.sweep.sweep` at K = 15 with the other convention.
     """
     axis = paper_axis(points)
-    k15 = PAPER_STIFFNESS
-    both = sweep.stiffness_sweep(model, list(STIFFNESSES), axis, axis, progress=progress)
-    other = sweep.sweep(with_stiffness(model, k15, other_convention(model)), axis, axis, progress=progress)
-    return both, other
+    models = [with_stiffness(model, k) for k in STIFFNESSES] + [
+        with_stiffness(model, PAPER_STIFFNESS, other_convention(model))
+    ]
+    *parts, other = sweep.passive_sweeps(models, axis, axis, progress=progress)
+    return sweep.stack_stiffnesses(parts), other

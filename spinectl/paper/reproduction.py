@@ -7,12 +7,18 @@ Figures 3, 4 and S1 as PNG, and a Markdown report with the paper's landmarks
 beside spinectl's and a verdict for each (docs/reproduction.md). The folder is
 checked before the work, everything is staged, and the staging folder replaces
 the output folder as a whole at the end (:func:`spinectl.atomic.staged_directory`).
+On Linux a worker process draws the figures while this one writes the landscapes
+and the report (benchmarks/bench_reproduce.py).
 """
 
 from __future__ import annotations
 
 import math
+import multiprocessing
+import signal
+import sys
 import time
+from concurrent import futures
 from pathlib import Path
 
 from ..atomic import atomic_write_text, check_distinct, check_folder, staged_directory
@@ -171,23 +177,62 @@ def reproduce_model(
     check_folder(out_dir, names)  # before minutes of solving
     both, other = grid.paper_landscapes(model, points, progress)
     measured = landmarks.measure(landmarks.Landmarks(both.sel(K=0.0), both.sel(K=k15), other))
-    drawn = figures.figure_set(both, model.fibre.specific_tension)
-    run_facts = report.Run(
-        preset=origin(model),  # the run covers K = 0 and 15: the report names both (not the model's own K)
-        convention=model.passive.convention,
-        other_convention=other_convention,
-        points=points,
-        seconds=time.perf_counter() - start,
-        files=names,
-        specific_tension=model.fibre.specific_tension,
-        calibrated=calibrated,
-        presets=assumptions.calibrated_measurements(assumptions.TABLE_POINTS),
-        preset_points=assumptions.TABLE_POINTS,
-    )
-    with staged_directory(out_dir, names, replaces=_own_files()) as stage:
-        netcdf.save(both, stage / LANDSCAPES)
-        netcdf.save(other, stage / other_name)
-        for name, figure in drawn.items():
-            figures.save_figure(figure, stage / name)
-        atomic_write_text(stage / REPORT, report.render(measured, run_facts))  # UTF-8; a full disk: OutputError
+    with _beside() as beside, staged_directory(out_dir, names, replaces=_own_files()) as stage:
+        drawing = beside.submit(_draw_figures, both, model.fibre.specific_tension, stage)  # beside the rest
+        try:
+            netcdf.save(both, stage / LANDSCAPES)
+            netcdf.save(other, stage / other_name)
+            run_facts = report.Run(
+                preset=origin(model),  # the run covers K = 0 and 15: the report names both (not the model's own K)
+                convention=model.passive.convention,
+                other_convention=other_convention,
+                points=points,
+                seconds=time.perf_counter() - start,
+                files=names,
+                specific_tension=model.fibre.specific_tension,
+                calibrated=calibrated,
+                presets=assumptions.calibrated_measurements(assumptions.TABLE_POINTS),
+                preset_points=assumptions.TABLE_POINTS,
+            )
+            atomic_write_text(stage / REPORT, report.render(measured, run_facts))  # UTF-8; a full disk: OutputError
+        finally:
+            futures.wait([drawing])  # the staging folder stays until the figures are in it, or have failed
+        drawing.result()  # the drawing's error, if any, here
     return [Path(out_dir) / name for name in names]
+
+
+def _draw_figures(both, specific_tension: float, stage: Path) -> None:
+    """Figures 3, 4 and S1 of ``both`` drawn and saved into the folder ``stage``."""
+    for name, figure in figures.figure_set(both, specific_tension).items():
+        figures.save_figure(figure, stage / name)
+
+
+def _beside():
+    """Where the figures are drawn and saved, beside the landscapes' files and the report.
+
+    One worker process forked from this one (it inherits every module imported, so it starts at once),
+    on Linux; a job's error comes back as itself (:meth:`concurrent.futures.Future.result`). Elsewhere,
+    and inside a worker process of another pool (which cannot have children), each job runs here at once:
+    macOS's system libraries do not survive a fork, and Windows cannot fork.
+    """
+    if sys.platform != "linux" or multiprocessing.current_process().daemon:
+        return _Here()
+    context = multiprocessing.get_context("fork")
+    return futures.ProcessPoolExecutor(1, mp_context=context, initializer=_ignore_interrupts)
+
+
+def _ignore_interrupts() -> None:
+    """Ctrl-C is this process's to handle: the worker ignores it, and ends when the pool is shut down."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+class _Here(futures.Executor):
+    """An executor that runs each job in this process when it is submitted."""
+
+    def submit(self, fn, /, *args, **kwargs) -> futures.Future:
+        future = futures.Future()
+        try:
+            future.set_result(fn(*args, **kwargs))
+        except Exception as error:
+            future.set_exception(error)
+        return future

@@ -5,6 +5,7 @@ from __future__ import annotations
 import errno
 import os
 import pathlib
+import sys
 
 import pytest
 
@@ -12,7 +13,7 @@ from spinectl import atomic
 from spinectl.cli import main
 from spinectl.landscape import netcdf
 from spinectl.model import config
-from spinectl.paper import figures, grid
+from spinectl.paper import figures, grid, reproduction
 
 OTHER = f"landscape_K15_{grid.other_convention(config.load_preset('wagner2012'))}.nc"
 """The K = 15 landscape of the convention that the default preset, wagner2012, does not use (its convention is
@@ -80,6 +81,31 @@ def test_a_failure_leaves_the_output_folder_untouched(tmp_path, monkeypatch, cap
     with pytest.raises(RuntimeError):
         main(["reproduce", "--out", str(out), "--points", "3"])
     assert not out.exists() and list(tmp_path.iterdir()) == []
+
+
+def test_the_figures_drawn_beside_the_rest_are_those_drawn_here(tmp_path, monkeypatch, capsys):
+    """On Linux a worker process draws the figures while this one writes the landscapes and the report; the
+    files are byte for byte those that this process draws (the path of the other platforms)."""
+    pids = tmp_path / "pids.txt"
+    save = figures.save_figure
+
+    def recorded(figure, path, *args, **kwargs):
+        with open(pids, "a") as file:
+            file.write(f"{os.getpid()}\n")
+        return save(figure, path, *args, **kwargs)
+
+    monkeypatch.setattr(figures, "save_figure", recorded)
+    assert main(["reproduce", "--out", str(tmp_path / "beside"), "--points", "5"]) == 0
+    beside = set(pids.read_text().split())
+    pids.unlink()
+    monkeypatch.setattr(reproduction, "_beside", reproduction._Here)
+    assert main(["reproduce", "--out", str(tmp_path / "here"), "--points", "5"]) == 0
+    here = set(pids.read_text().split())
+    assert here == {str(os.getpid())}
+    if sys.platform == "linux":
+        assert len(beside) == 1 and beside != here
+    for name in (*figures.figure_names(0.0), *figures.figure_names(15.0)):
+        assert (tmp_path / "beside" / name).read_bytes() == (tmp_path / "here" / name).read_bytes(), name
 
 
 @pytest.mark.parametrize("points", ["1", "1001", "4" * 400])

@@ -12,7 +12,7 @@ from spinectl.errors import OutputError, ParameterError
 from spinectl.landscape import netcdf, schema, sweep
 from spinectl.model import chain, config, source
 from spinectl.model.mechanics import segment_coefficients
-from spinectl.model.params import Model
+from spinectl.model.params import Body, Model, MusclePair, Optimisation
 from spinectl.model.stability import segment_stability
 from spinectl.optimise.coupled import joint_optimum, least_local_stiffness
 
@@ -263,3 +263,53 @@ def test_the_sweep_reports_the_slowest_time_constant_of_every_optimum():
     expected = segment_stability(preset, 0.03, 0.04, pcsa).slowest_time_constant
     assert float(here["slowest_time_constant_s"]) == pytest.approx(expected, rel=1e-9)
     assert land["slowest_time_constant_s"].dims == ("E", "Lambda")
+
+
+def _random_model(rng) -> Model:
+    """A random valid model, as tests/suites/test_properties.py draws them: 1 to 3 pairs whose fibres start
+    above y = 0.165 m and end below y = -0.015 m (clear of every CoR), mass 10-100 kg at 0.2-0.5 m."""
+    pairs = tuple(
+        MusclePair(
+            f"pair{i}",
+            (rng.uniform(0.02, 0.20), rng.uniform(0.165, 0.30)),
+            (rng.uniform(0.02, 0.20), rng.uniform(-0.05, -0.015)),
+            rng.uniform(0.0, 0.02),
+            int(rng.integers(1, 6)),
+        )
+        for i in range(int(rng.integers(1, 4)))
+    )
+    body = Body(mass=rng.uniform(10.0, 100.0), mass_height=rng.uniform(0.2, 0.5), radius_of_gyration=0.1)
+    activation = str(rng.choice(["paired", "independent"]))
+    return Model(body=body, muscles=pairs, optimisation=Optimisation(activation=activation))
+
+
+@pytest.mark.parametrize("case", ["paper", "random-1", "random-2", "coupled"])
+def test_one_pass_over_several_k_gives_each_sweep_bit_for_bit(case):
+    """passive_sweeps computes the coefficients once per chunk for models that differ in K alone: each of its
+    landscapes is that of the model's own sweep, bit for bit (the second path: one full sweep per model), for
+    K = 0, 15 and a random K in both conventions, with chunks that split the grid; on the paper's preset and
+    grid (at 4 mm), on random geometries, and with the chain's SDPs."""
+    rng = np.random.default_rng(len(case))
+    e_axis, l_axis, chunk = E_AXIS, L_AXIS, 5
+    if case == "paper":
+        base, e_axis, chunk = config.load_preset("wagner2012"), np.linspace(0.0, 0.08, 21), 100
+        l_axis = e_axis
+    else:
+        base = Model() if case == "coupled" else _random_model(rng)
+    passive = [(0.0, "physical"), (15.0, "physical"), (15.0, "paper"), (rng.uniform(0.0, 30.0), "paper")]
+    models = [config.set_parameters(base, {"passive.stiffness": k, "passive.convention": c}) for k, c in passive]
+    if case == "coupled":
+        models = models[:2]
+    options = {"chunk_size": chunk, "progress": False, "coupled": case == "coupled"}
+    together = sweep.passive_sweeps(models, e_axis, l_axis, **options)
+    for model, landscape in zip(models, together, strict=True):
+        alone = sweep.sweep(model, e_axis, l_axis, **options)
+        xr.testing.assert_identical(landscape, alone)  # exact equality of every value, NaN where NaN
+
+
+def test_one_pass_refuses_models_that_differ_in_more_than_k(model):
+    other = config.set_parameters(model, {"passive.stiffness": 15.0, "body.mass": 41.0})
+    for models in ([], [model, other]):
+        with pytest.raises(ParameterError) as info:
+            sweep.passive_sweeps(models, E_AXIS, L_AXIS, progress=False)
+        assert info.value.field == "models"

@@ -273,3 +273,23 @@ def test_bounds_can_be_replaced_for_a_run(capsys):
         assert main(["calibrate", "--bounds", text, "--grid", "3"]) == 2
         err = capsys.readouterr().err
         assert needle in err and len(err.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("preset", ["wagner2012", "wagner2012_mass_free", "default"])
+def test_coarse_landmarks_share_the_coefficients_bit_for_bit(preset):
+    """coarse_landmarks computes the coefficients once for its three landscapes (K enters as K_pas alone):
+    each landscape is that of its own coarse_landscape, which computes them afresh (the second path), exactly."""
+    import xarray as xr
+
+    model = config.load_preset(preset)
+    axis, k15 = grid.paper_axis(calibration.FIT_POINTS), grid.PAPER_STIFFNESS
+    shared = calibration.coarse_landmarks(model, other=True)
+    alone = (
+        calibration.coarse_landscape(grid.with_stiffness(model, 0.0), axis),
+        calibration.coarse_landscape(grid.with_stiffness(model, k15), axis, counter_torque=False),
+        calibration.coarse_landscape(
+            grid.with_stiffness(model, k15, grid.other_convention(model)), axis, counter_torque=False
+        ),
+    )
+    for together, own in zip((shared.k0, shared.k15, shared.k15_other), alone, strict=True):
+        xr.testing.assert_identical(together, own)

@@ -8,7 +8,9 @@ import sys
 from pathlib import Path
 
 import matplotlib.pyplot as plt
+import numpy as np
 import pytest
+from matplotlib.artist import Artist
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 
 from spinectl.canvas import new_figure, save_file
@@ -53,17 +55,41 @@ def test_save_file_writes_a_png_and_no_temporary(tmp_path):
     assert [p.name for p in path.parent.iterdir()] == ["f.png"]
 
 
-def test_a_failed_save_leaves_the_previous_file(tmp_path, monkeypatch):
-    target = tmp_path / "f.png"
-    target.write_bytes(b"previous")
-    fig = new_figure()
+class _Broken(Artist):
+    """An artist that fails to draw: a failure while rendering, whichever way the figure is saved."""
 
-    def broken(*args, **kwargs):
+    def draw(self, renderer):
         raise RuntimeError("simulated failure while rendering")
 
-    monkeypatch.setattr(fig, "savefig", broken)
+
+@pytest.mark.parametrize("suffix", ["png", "svg"])
+def test_a_failed_save_leaves_the_previous_file(tmp_path, suffix):
+    target = tmp_path / f"f.{suffix}"
+    target.write_bytes(b"previous")
+    fig = new_figure()
+    fig.add_artist(_Broken())
     with pytest.raises(RuntimeError):
         save_file(fig, target, dpi=50)
-    assert target.read_bytes() == b"previous" and [p.name for p in tmp_path.iterdir()] == ["f.png"]
+    assert target.read_bytes() == b"previous" and [p.name for p in tmp_path.iterdir()] == [target.name]
     with pytest.raises(OutputError, match="cannot write"):
         save_file(new_figure(), target / "below.png", dpi=50)  # a file where a folder should be
+
+
+def _laid_out_figure():
+    """A figure with a layout engine, a colour bar and labels whose extents decide the layout."""
+    fig = new_figure(figsize=(3, 2), layout="constrained", dpi=72)
+    ax = fig.add_subplot()
+    mesh = ax.contourf(np.arange(4.0), np.arange(3.0), np.arange(12.0).reshape(3, 4))
+    fig.colorbar(mesh).set_label("a long colour-bar label [cm²]")
+    ax.set_title("a title\non two lines")
+    return fig
+
+
+def test_a_png_is_the_file_that_savefig_writes(tmp_path):
+    """save_file draws a PNG once (the Agg canvas lays it out and renders it), savefig twice (a draw without
+    rendering for the layout first): the same bytes from two equal figures; the figure keeps its own dpi."""
+    once = _laid_out_figure()
+    save_file(once, tmp_path / "once.png", dpi=90)
+    assert once.dpi == 72
+    _laid_out_figure().savefig(tmp_path / "twice.png", dpi=90)
+    assert (tmp_path / "once.png").read_bytes() == (tmp_path / "twice.png").read_bytes()

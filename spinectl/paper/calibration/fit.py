@@ -13,8 +13,6 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.optimize
-import scipy.stats
 
 from ... import _validate as v
 from ...errors import ModelError, ParameterError
@@ -172,6 +170,8 @@ class _Objective:
 
 def _initial_population(base: Model, parameters, popsize: int, seed: int) -> np.ndarray:
     """A Latin hypercube sample of the bounds whose first member is the base model (clipped to the bounds)."""
+    import scipy.stats  # here: scipy.stats and scipy.optimize take most of a second, and only a fit needs them
+
     lows, highs = np.array(bounds(parameters)).T
     sample = scipy.stats.qmc.LatinHypercube(len(lows), seed=seed).random(max(5, popsize * len(lows)))
     init = lows + sample * (highs - lows)
@@ -200,6 +200,8 @@ def _reporter(objective: _Objective, say, label: str, every: int, started: float
 
 def _evolve(objective: _Objective, parameters, *, seed, starts, popsize, generations, say, started) -> list:
     """The global stage: differential evolution, ``starts`` times, over all conventions at once."""
+    import scipy.optimize
+
     reports = []
     for start in range(int(starts)):
         label = f"start {start + 1}/{starts}, generation"
@@ -232,6 +234,8 @@ def _refine(objective: _Objective, parameters, convention: str, evaluations: int
 
     def scaled(u) -> float:
         return float(objective.evaluate(lows + np.clip(u, 0.0, 1.0) * (highs - lows), (convention,))[0])
+
+    import scipy.optimize
 
     return scipy.optimize.minimize(
         scaled,

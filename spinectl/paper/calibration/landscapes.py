@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
+from ...landscape.columns import with_passive
 from ...model.checks import checked_coefficients
 from ...model.params import Model
 from ...optimise import active_set
@@ -24,7 +25,7 @@ FIT_POINTS = 17
 A-D and its optimum (E = 3 cm, Lambda = 4 cm)."""
 
 
-def coarse_landscape(model: Model, axis, *, counter_torque: bool = True) -> xr.Dataset:
+def coarse_landscape(model: Model, axis, *, counter_torque: bool = True, coefficients=None) -> xr.Dataset:
     """Minimum PCSA (and ‖CT‖) on the grid axis x axis by the fast path, for fitting.
 
     The variables that :func:`spinectl.paper.landmarks.measure` reads, without the rest
@@ -39,6 +40,9 @@ def coarse_landscape(model: Model, axis, *, counter_torque: bool = True) -> xr.D
         E and Lambda axis [m].
     counter_torque : bool
         Also solve for the least counter torques.
+    coefficients : SegmentCoefficients, optional
+        Checked coefficients of ``model`` on the grid, E major (as :func:`coarse_landmarks` shares
+        them between its landscapes); default: computed here.
 
     Returns
     -------
@@ -48,7 +52,7 @@ def coarse_landscape(model: Model, axis, *, counter_torque: bool = True) -> xr.D
     """
     axis = np.asarray(axis, float)
     e, lam = (a.ravel() for a in np.meshgrid(axis, axis, indexing="ij"))
-    data = problem_data(model, checked_coefficients(model, e, lam))
+    data = problem_data(model, checked_coefficients(model, e, lam) if coefficients is None else coefficients)
     result = active_set.solve_block(data, model.optimisation.ct_tolerance, min_pcsa_only=not counter_torque)
     shape, dims = (axis.size, axis.size), ("E", "Lambda")
     variables = {"min_pcsa_cm2": (dims, m2_to_cm2(result.min_pcsa).reshape(shape))}
@@ -79,12 +83,17 @@ def coarse_landmarks(model: Model, points: int = FIT_POINTS, *, other: bool = Fa
     """
     axis = grid.paper_axis(points)
     k15 = grid.PAPER_STIFFNESS
-    k0 = coarse_landscape(grid.with_stiffness(model, 0.0), axis)
-    own = coarse_landscape(grid.with_stiffness(model, k15), axis, counter_torque=False)
-    alt = None
-    if other:
-        other_model = grid.with_stiffness(model, k15, grid.other_convention(model))
-        alt = coarse_landscape(other_model, axis, counter_torque=False)
+    e, lam = (a.ravel() for a in np.meshgrid(axis, axis, indexing="ij"))
+    zero = grid.with_stiffness(model, 0.0)
+    shared = checked_coefficients(zero, e, lam)  # K enters as K_pas alone: computed once (columns.with_passive)
+
+    def landscape(model_k: Model, counter_torque: bool = False) -> xr.Dataset:
+        coefficients = with_passive(model_k, shared, e, lam)
+        return coarse_landscape(model_k, axis, counter_torque=counter_torque, coefficients=coefficients)
+
+    k0 = landscape(zero, counter_torque=True)
+    own = landscape(grid.with_stiffness(model, k15))
+    alt = landscape(grid.with_stiffness(model, k15, grid.other_convention(model))) if other else None
     return Landmarks(k0, own, alt)
 
 
