@@ -17,6 +17,7 @@ import math
 import multiprocessing
 import signal
 import sys
+import threading
 import time
 from concurrent import futures
 from pathlib import Path
@@ -213,12 +214,19 @@ def _beside():
     One worker process forked from this one (it inherits every module imported, so it starts at once),
     on Linux; a job's error comes back as itself (:meth:`concurrent.futures.Future.result`). Elsewhere,
     and inside a worker process of another pool (which cannot have children), each job runs here at once:
-    macOS's system libraries do not survive a fork, and Windows cannot fork.
+    macOS's system libraries do not survive a fork, and Windows cannot fork. A process running other
+    Python threads (a notebook's kernel, an explorer, a threaded Dask worker) draws here too: a fork copies
+    only the calling thread, and a lock another thread held would stay locked in the child.
     """
-    if sys.platform != "linux" or multiprocessing.current_process().daemon:
+    if not _can_fork():
         return _Here()
     context = multiprocessing.get_context("fork")
     return futures.ProcessPoolExecutor(1, mp_context=context, initializer=_ignore_interrupts)
+
+
+def _can_fork() -> bool:
+    """Whether :func:`_beside` forks: on Linux, outside a daemon worker, with no other Python thread."""
+    return sys.platform == "linux" and not multiprocessing.current_process().daemon and threading.active_count() == 1
 
 
 def _ignore_interrupts() -> None:
