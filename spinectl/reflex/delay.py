@@ -415,7 +415,9 @@ def _cubic_candidates(f3, f2, f1, f0):
     with np.errstate(all="ignore"):
         lead = np.where(f3 != 0, f3, 1.0)
         a, b, c, k = _scaled_monic(lead, f2, f1, f0)
-        r = _one_real_root(a, b, c)
+        # f0 = 0 (S^2 = kp^2: the reflex just cancels gravity) makes z = 0 a root: exact, and deflated forward;
+        # Cardano's form gives it as rounding noise, which backward deflation would divide by
+        r = np.where(c == 0, 0.0, _one_real_root(a, b, c))
         for _ in range(2):
             value, slope = ((r + a) * r + b) * r + c, (3.0 * r + 2.0 * a) * r + b
             step = np.where(slope != 0, value / np.where(slope != 0, slope, 1.0), 0.0)
