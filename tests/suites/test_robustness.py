@@ -667,9 +667,9 @@ def _full_disk(*args, **kwargs):
     ("command", "patched"),
     [
         (["sweep", "--E", "0:0.08:3", "--Lambda", "0:0.08:3", "--out", "{out}/old.nc"], "xarray.Dataset.to_netcdf"),
-        (["plot", "{out}/old.nc", "--out", "{out}"], "matplotlib.figure.Figure.savefig"),
-        (["reproduce", "--points", "3", "--out", "{out}"], "matplotlib.figure.Figure.savefig"),
-        (["margins", "--plot", "{out}"], "matplotlib.figure.Figure.savefig"),
+        (["plot", "{out}/old.nc", "--out", "{out}"], "matplotlib.backends.backend_agg.FigureCanvasAgg.print_png"),
+        (["reproduce", "--points", "3", "--out", "{out}"], "matplotlib.backends.backend_agg.FigureCanvasAgg.print_png"),
+        (["margins", "--plot", "{out}"], "matplotlib.backends.backend_agg.FigureCanvasAgg.print_png"),
         (
             ["study", "{out}/study.toml", "--out", "{out}/s.zarr", "--scheduler", "synchronous"],
             "xarray.Dataset.to_zarr",
