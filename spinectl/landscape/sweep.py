@@ -16,7 +16,7 @@ from tqdm import tqdm
 
 from ..atomic import check_writable
 from ..errors import ParameterError
-from ..model import config
+from ..model import config, source
 from ..model.params import Model
 from ..units import CM_PER_M, centimetre_slip
 from . import netcdf
@@ -228,24 +228,27 @@ def stiffness_sweep(model: Model, stiffnesses, eccentricity, lordosis, **options
     """
     distinct("K", np.asarray(stiffnesses, float))
     models = [config.set_parameter(model, "passive.stiffness", float(k)) for k in stiffnesses]
-    return stack_stiffnesses(passive_sweeps(models, eccentricity, lordosis, **options))
+    return stack_stiffnesses(passive_sweeps(models, eccentricity, lordosis, **options), model)
 
 
-def stack_stiffnesses(parts) -> xr.Dataset:
+def stack_stiffnesses(parts, model: Model) -> xr.Dataset:
     """Landscapes of one model at several K stacked along a ``K`` dimension, as :func:`stiffness_sweep` gives them.
 
     Parameters
     ----------
     parts : sequence of xarray.Dataset
         :func:`sweep`'s landscapes (scalar ``K``), distinct in K alone.
+    model : Model
+        The model they share but for K: its source names every K (:func:`spinectl.model.source.attributes`).
 
     Returns
     -------
     xarray.Dataset
         Stacked along ``K`` [N m/rad] in the order of ``parts``; the attributes of the first,
-        ``points_solved_per_point`` summed.
+        with the source's naming every K, and ``points_solved_per_point`` summed.
     """
     combined = xr.concat(parts, dim="K", data_vars="all", coords="minimal", compat="override", combine_attrs="override")
+    combined.attrs |= source.attributes(model, stiffnesses=combined["K"].values)
     combined.attrs["points_solved_per_point"] = sum(p.attrs["points_solved_per_point"] for p in parts)
     return combined
 

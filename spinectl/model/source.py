@@ -156,12 +156,15 @@ def provenance(model: Model) -> dict:
     }
 
 
-def attributes(model: Model) -> dict:
+def attributes(model: Model, stiffnesses=None) -> dict:
     """The model's source as NetCDF/Zarr attributes: strings only (netCDF has no null).
 
     Parameters
     ----------
     model : Model
+    stiffnesses : sequence of float, optional
+        The K [N m/rad] of a dataset stacked along ``K``: the ``model`` line names them all, and
+        ``passive.stiffness`` is not counted as overridden (each K is a coordinate).
 
     Returns
     -------
@@ -170,10 +173,18 @@ def attributes(model: Model) -> dict:
         ``overridden`` (comma-separated); empty strings where there is none.
     """
     src = source_of(model)
+    overridden = list(src.overridden)
+    line = header(model)
+    if stiffnesses is not None:
+        overridden = [name for name in overridden if name != "passive.stiffness"]
+        stacked = with_source(model, dataclasses.replace(src, overridden=tuple(overridden)))
+        first, *rest = _origin_parts(stacked)
+        ks = ", ".join(f"{k:g}" for k in stiffnesses)
+        line = "; ".join([f"{first}, K = {ks} N m/rad, convention {model.passive.convention}", *rest])
     return {
-        "model": header(model),
+        "model": line,
         "preset": src.preset or "",
         "config": src.config or "",
         "config_sha256": src.config_sha256 or "",
-        "overridden": ", ".join(src.overridden),
+        "overridden": ", ".join(overridden),
     }

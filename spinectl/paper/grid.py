@@ -121,4 +121,4 @@ def paper_landscapes(model: Model, points: int = PAPER_POINTS, progress=None) ->
         with_stiffness(model, PAPER_STIFFNESS, other_convention(model))
     ]
     *parts, other = sweep.passive_sweeps(models, axis, axis, progress=progress)
-    return sweep.stack_stiffnesses(parts), other
+    return sweep.stack_stiffnesses(parts, model), other

@@ -313,3 +313,16 @@ def test_one_pass_refuses_models_that_differ_in_more_than_k(model):
         with pytest.raises(ParameterError) as info:
             sweep.passive_sweeps(models, E_AXIS, L_AXIS, progress=False)
         assert info.value.field == "models"
+
+
+def test_a_landscape_stacked_over_k_names_every_k_and_no_k_override():
+    """A file over K = 0 and 15 (``sweep --K 0,15``, reproduce's landscapes.nc) said "K = 0 N m/rad ...;
+    overridden: passive.stiffness", the first K's model: K is its coordinate, so the source line names
+    every K and only what the user overrode."""
+    model = config.apply_overrides(config.load_preset(config.DEFAULT_PRESET), ["body.mass=30"])
+    both = sweep.stiffness_sweep(model, [0.0, 15.0], [0.0, 0.08], [0.0], progress=False)
+    assert both.attrs["model"] == (
+        f"preset {config.DEFAULT_PRESET}, K = 0, 15 N m/rad, convention {model.passive.convention}; "
+        "overridden: body.mass"
+    )
+    assert both.attrs["overridden"] == "body.mass"
