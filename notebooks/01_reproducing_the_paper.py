@@ -74,7 +74,8 @@ print("solver statuses (K = 0):", dict(zip(*np.unique(k0["status"].values, retur
 # of about 35 cm² (position A). Increasing the spinal curvature slightly reduces the required PCSA (position D).
 # [...] increasing the eccentricity, without spinal curvature ($\Lambda = 0$), the necessary PCSA for
 # self-stability is reduced (position B). Around the line $\Lambda = 1.7E$ [...] the PCSA saturates at
-# approximately 40 cm²." The positions A-D are the corners of the figure.
+# approximately 40 cm²." A, B and D are corners of the figure; C is marked where Figure 3's caption and the
+# Discussion place it, E ≈ 3 cm, Λ ≈ 4 cm, and the fourth corner is labelled by its coordinates, "8, 8 cm".
 
 # %%
 display(figures.min_pcsa_figure(k0))
@@ -104,8 +105,9 @@ display(figures.min_pcsa_figure(k15))
 # %% [markdown]
 # ## The positions A-D
 #
-# The corners of Figures 3 and 4, and the optimum the Discussion names (it also calls that region "position C",
-# which is why the landmark table below gives the C-ratios for both readings). The last column converts $\|CT\|$
+# The corners of the grid (the row C is the corner, 8, 8 cm) and the optimum E ≈ 3, Λ ≈ 4 cm, which Figure 3's
+# caption and the Discussion call position C and the figures mark as C (spinectl's primary reading; the landmark
+# table below gives the C-ratios for this reading, the corner and the ridge line). The last column converts $\|CT\|$
 # as the paper does: "Assuming [...] a lever arm of 7.0 cm", a counter torque is the PCSA of a local muscle.
 
 # %%
