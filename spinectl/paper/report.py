@@ -59,7 +59,7 @@ class Run:
     preset_points: int = 0
 
 
-def landmark_table(measurements: Sequence[Measurement]) -> str:
+def landmark_table(measurements: Sequence[Measurement], points: int | None = None) -> str:
     """The landmark table as Markdown: name, paper, spinectl, unit, agrees, verdict, how measured, where.
 
     The verdict is that of docs/reproduction.md for the calibrated preset
@@ -69,14 +69,18 @@ def landmark_table(measurements: Sequence[Measurement]) -> str:
     ----------
     measurements : sequence of Measurement
         From :func:`spinectl.paper.landmarks.measure`.
+    points : int, optional
+        Grid points per axis of the run measured: the column names its grid (the summary's preset
+        table comes from another grid).
 
     Returns
     -------
     str
         A Markdown table, one row per measurement, without a trailing newline.
     """
+    measured = "spinectl" if points is None else f"spinectl ({points} × {points} grid)"
     lines = [
-        f"| landmark | paper | spinectl | unit | agrees | verdict for `{verdicts.PRESET}` "
+        f"| landmark | paper | {measured} | unit | agrees | verdict for `{verdicts.PRESET}` "
         "(docs/reproduction.md) | how spinectl measures it | where the paper says it |",
         "| --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
@@ -272,7 +276,7 @@ K = {grid.PAPER_STIFFNESS:g} N m/rad also with the `{run.other_convention}` conv
 
 ## Landmarks
 
-{landmark_table(measurements)}
+{landmark_table(measurements, run.points)}
 
 "About" is read as ±20 % of the paper's value; A, B and D are corners of
 Figures 3 and 4 (A: E = Λ = 0; B: E = 8 cm, Λ = 0; D: E = 0, Λ = 8 cm). C is

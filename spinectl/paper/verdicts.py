@@ -146,7 +146,7 @@ VERDICTS: dict[str, Verdict] = {
         _v("ct_B_over_C", 1.44, COMPROMISE, f"{_SPLINE}; ‖x(B)‖/‖x(C)‖ = 1.98 and F(B) < F(C)"),
         _v(
             "ct_D_over_C_text",
-            3.44,
+            3.43,
             COMPROMISE,
             f"{_SPLINE}; ‖x(D)‖/‖x(C)‖ = 3.94 and F(D) < F(C)",
             "activation",
