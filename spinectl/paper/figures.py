@@ -58,8 +58,9 @@ NICE_STEPS = (1, 2, 2.5, 5, 10)
 """Steps of round contour levels and colour-bar ticks (matplotlib's MaxNLocator ``steps``)."""
 LINE_LEVELS = 6
 """At most about this many labelled contour lines (round values) on a landscape."""
-TITLE_CHARS = 56
-"""Characters a title line holds: at fontsize 9 the landscape axes (about 4 in wide) take no more."""
+TITLE_CHARS = 56, 46
+"""Characters a title line holds at fontsize 9: on the landscape axes (about 4 in wide) and on those of
+Figure 3 with the model drawn at its corners (about 3.4 in)."""
 
 _CONVENTION = {"paper": "eq. 2 as printed", "physical": "physical, -K in dM/dα"}
 """How a title names the passive-stiffness convention (docs/model.md, "Passive stiffness: two conventions")."""
@@ -120,13 +121,13 @@ def _axes(title: str, fig=None, spec=None):
     ax = fig.add_subplot(spec) if spec is not None else fig.add_subplot()
     ax.set_xlabel("eccentricity E [cm]")
     ax.set_ylabel("lordosis Λ [cm]")
-    ax.set_title(_wrap(title), fontsize=9)  # wider than the axes, it crowded the top tick label
+    ax.set_title(_wrap(title, TITLE_CHARS[spec is not None]), fontsize=9)  # wider, it crowded the top tick label
     return fig, ax
 
 
-def _wrap(title: str) -> str:
-    """``title`` broken into lines of at most :data:`TITLE_CHARS` characters, its own line breaks kept."""
-    return "\n".join(textwrap.fill(line, TITLE_CHARS) for line in title.split("\n"))
+def _wrap(title: str, width: int) -> str:
+    """``title`` broken into lines of at most ``width`` characters, its own line breaks kept."""
+    return "\n".join(textwrap.fill(line, width) for line in title.split("\n"))
 
 
 def _round_levels(low: float, high: float, count: int) -> np.ndarray:
