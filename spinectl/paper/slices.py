@@ -2,9 +2,9 @@
 
 A study store (:mod:`spinectl.landscape.study`) holds one landscape per value of each parameter axis
 and per Monte-Carlo draw. Each slice is drawn as the landscape figures are
-(:func:`spinectl.paper.figures.landscape_figure`): its minimum PCSA and its ‖CT‖ with the ±30 N m limit,
-the title naming the slice's parameter values with their units. A store with more slices than :data:`MAX_SLICES` is refused with the
-way to select from it.
+(:func:`spinectl.paper.figures.landscape_figure`): its minimum PCSA and its ‖CT‖ with the ±30 N m
+limit, the title naming the slice's parameter values with their units. A store with more slices than
+:data:`MAX_SLICES` is refused with the way to select from it.
 """
 
 from __future__ import annotations

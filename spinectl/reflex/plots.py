@@ -98,8 +98,11 @@ def bode_figure(
             Line2D([], [], ls="", marker="v", ms=5, color="0.3", label="phase -180 deg: abs(L) = 1/GM (gain margin)"),
         ]
         axes[1, 0].legend(
-            [*handles, *keys], [*texts, *(k.get_label() for k in keys)], loc="upper center",
-            bbox_to_anchor=(0.5, -0.25), fontsize=7,
+            [*handles, *keys],
+            [*texts, *(k.get_label() for k in keys)],
+            loc="upper center",
+            bbox_to_anchor=(0.5, -0.25),
+            fontsize=7,
         )
     plot.set_plot_title(title or "Reflex loop L(jw)", frame="figure")
     fig.align_labels()
