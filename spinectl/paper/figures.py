@@ -54,7 +54,7 @@ LABEL_MARGIN = 0.08
 """Least distance of a placed contour label from the axes' edges, as a fraction of their span."""
 _TOLERANCE = 1e-9
 """[m] A position on a grid's edge counts as inside."""
-NICE_STEPS = (1, 2, 2.5, 5, 10)
+NICE_STEPS = (1, 2, 5, 10)
 """Steps of round contour levels and colour-bar ticks (matplotlib's MaxNLocator ``steps``)."""
 LINE_LEVELS = 6
 """At most about this many labelled contour lines (round values) on a landscape."""
