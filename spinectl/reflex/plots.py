@@ -42,6 +42,7 @@ BODE_SIZE = (7.0, 8.0)
 PHASE_TICKS = 180.0
 """[deg] Phase tick spacing (twice that over more than :data:`PHASE_TICKS_MAX` ticks)."""
 PHASE_TICKS_MAX = 8
+"""Most phase ticks at :data:`PHASE_TICKS` spacing."""
 
 
 def _control_figure(rows: int, **subplots):
@@ -92,7 +93,8 @@ def bode_figure(
     if margins:  # the legend below the axes: on the magnitude axes it covered the curves
         fig.set_size_inches(*BODE_SIZE)
         handles, texts = axes[0, 0].get_legend_handles_labels()
-        axes[0, 0].get_legend().remove()
+        if axes[0, 0].get_legend() is not None:  # python-control's, on the magnitude axes
+            axes[0, 0].get_legend().remove()
         keys = [
             Line2D([], [], ls="", marker="o", ms=4, color="0.3", label="abs(L) = 1; below it the phase margin"),
             Line2D([], [], ls="", marker="v", ms=5, color="0.3", label="phase -180 deg: abs(L) = 1/GM (gain margin)"),
