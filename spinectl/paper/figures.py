@@ -539,8 +539,8 @@ def _clear_of(ax, gid: str, contour) -> None:
     label = next((t for t in ax.texts if t.get_gid() == gid), None)
     if label is None:
         return
-    renderer = ax.figure.canvas.get_renderer()
-    ax.figure.draw_without_rendering()  # the layout first: the label's offset is in points, the line in data
+    ax.figure.canvas.draw()  # the layout first: the label's offset is in points, the line in data
+    renderer = ax.figure.canvas.get_renderer()  # (draw_without_rendering would print a PNG to get one)
     paths = [ax.transData.transform_path(p) for p in contour.get_paths()]
     frame = ax.get_window_extent(renderer)
     first = label.xyann
