@@ -1,6 +1,6 @@
 """Two landscapes on the same grid compared: difference and ratio maps (``spinectl plot a.nc --vs b.nc``).
 
-For each K the two files share, the minimum PCSA (Figure 3 / S1) and ||CT|| (Figure 4) of the first
+For each K the two files share, the minimum PCSA (Figure 3 / S1) and ‖CT‖ (Figure 4) of the first
 file minus, and over, those of the second, drawn as the landscape figures are
 (:mod:`spinectl.paper.figures`). Landscapes on different grids are not interpolated: the comparison
 names the axis that differs and stops.
@@ -21,7 +21,7 @@ from . import figures
 
 COMPARED = (
     ("min_pcsa_cm2", "minimum PCSA", "cm²", "min_pcsa"),
-    ("counter_torque_norm_Nm", "||CT||", "N m", "counter_torque"),
+    ("counter_torque_norm_Nm", "‖CT‖", "N m", "counter_torque"),
 )
 """The variables compared: name in the dataset, what it is, unit, stem of the file name."""
 
@@ -74,7 +74,7 @@ def _at(dataset: xr.Dataset, stiffness: float) -> xr.Dataset:
 
 
 def comparison_set(first: xr.Dataset, second: xr.Dataset, labels=("first", "second"), format: str = "png") -> dict:
-    """Difference and ratio maps of the minimum PCSA and ||CT|| of two landscapes, by file name.
+    """Difference and ratio maps of the minimum PCSA and ‖CT‖ of two landscapes, by file name.
 
     Parameters
     ----------

@@ -17,12 +17,14 @@ as a whole.
 
 from __future__ import annotations
 
+import textwrap
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import xarray as xr
 from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
 
 from ..canvas import new_figure, save_figures, save_file
 from ..errors import ParameterError
@@ -52,6 +54,13 @@ LABEL_MARGIN = 0.08
 """Least distance of a placed contour label from the axes' edges, as a fraction of their span."""
 _TOLERANCE = 1e-9
 """[m] A position on a grid's edge counts as inside."""
+NICE_STEPS = (1, 2, 5, 10)
+"""Steps of round contour levels and colour-bar ticks (matplotlib's MaxNLocator ``steps``)."""
+LINE_LEVELS = 6
+"""At most about this many labelled contour lines (round values) on a landscape."""
+TITLE_CHARS = 56, 46
+"""Characters a title line holds at fontsize 9: on the landscape axes (about 4 in wide) and on those of
+Figure 3 with the model drawn at its corners (about 3.4 in)."""
 
 _CONVENTION = {"paper": "eq. 2 as printed", "physical": "physical, -K in dM/dα"}
 """How a title names the passive-stiffness convention (docs/model.md, "Passive stiffness: two conventions")."""
@@ -112,8 +121,18 @@ def _axes(title: str, fig=None, spec=None):
     ax = fig.add_subplot(spec) if spec is not None else fig.add_subplot()
     ax.set_xlabel("eccentricity E [cm]")
     ax.set_ylabel("lordosis Λ [cm]")
-    ax.set_title(title, fontsize=9)
+    ax.set_title(_wrap(title, TITLE_CHARS[spec is not None]), fontsize=9)  # wider, it crowded the top tick label
     return fig, ax
+
+
+def _wrap(title: str, width: int) -> str:
+    """``title`` broken into lines of at most ``width`` characters, its own line breaks kept."""
+    return "\n".join(textwrap.fill(line, width) for line in title.split("\n"))
+
+
+def _round_levels(low: float, high: float, count: int) -> np.ndarray:
+    """About ``count`` round values (steps of :data:`NICE_STEPS` times a power of ten) from ``low`` to ``high``."""
+    return MaxNLocator(count, steps=NICE_STEPS).tick_values(low, high)
 
 
 def _inside(position, e: np.ndarray, lam: np.ndarray) -> bool:
@@ -205,9 +224,9 @@ def _shape(ax, e: np.ndarray, lam: np.ndarray) -> None:
 
 
 def _levels(values: np.ma.MaskedArray, vmin: float | None, vmax: float | None):
-    """Filled levels: LEVELS steps over the data, or over [vmin, vmax] (extended past it)."""
+    """Filled levels: about LEVELS round steps over the data, or LEVELS steps over [vmin, vmax] (extended past it)."""
     if vmin is None and vmax is None:
-        return LEVELS, "neither"
+        return _round_levels(values.min(), values.max(), LEVELS), "neither"
     low = values.min() if vmin is None else vmin
     high = values.max() if vmax is None else vmax
     if not high > low:
@@ -237,9 +256,12 @@ def _landscape(field: xr.DataArray, title: str, label: str, vmin=None, vmax=None
     if infeasible < values.size:
         levels, extend = _levels(values, vmin, vmax)
         filled = ax.contourf(e, lam, values, levels=levels, cmap="viridis", extend=extend)
-        fig.colorbar(filled, cax=ax.inset_axes(COLOUR_BAR)).set_label(label)  # as tall as the axes, not the figure
+        bar = fig.colorbar(filled, cax=ax.inset_axes(COLOUR_BAR))  # as tall as the axes, not the figure
+        bar.set_label(label)
+        bar.locator = MaxNLocator(8, steps=NICE_STEPS)  # round ticks also on a given or shared range
         if values.max() > values.min():
-            lines = ax.contour(e, lam, values, levels=filled.levels[1:-1:3], colors="k", linewidths=0.4, alpha=0.6)
+            at = [v for v in _round_levels(values.min(), values.max(), LINE_LEVELS) if values.min() < v < values.max()]
+            lines = ax.contour(e, lam, values, levels=at or None, colors="k", linewidths=0.4, alpha=0.6)
             for text in ax.clabel(lines, fmt="%.3g", fontsize=6):
                 text.set_clip_on(True)  # a label near the edge is cut, never drawn outside the axes
     _shape(ax, e_m, lam_m)
@@ -348,7 +370,8 @@ def ratio_figure(dataset: xr.Dataset, stiffness: float = grid.PAPER_STIFFNESS) -
     Returns
     -------
     matplotlib.figure.Figure
-        Filled contours of the ratio [1] on a 0 to 1 scale over E and Lambda [cm], the paper's 0.5 as a contour;
+        Filled contours of the ratio [1] on round levels over its range, over E and Lambda [cm], labelled contour
+        lines; the paper's 0.5 and 1 (equal) as white contours where the ratio reaches them;
         white where either landscape is infeasible or the K = 0 minimum is 0.
 
     Raises
@@ -363,17 +386,28 @@ def ratio_figure(dataset: xr.Dataset, stiffness: float = grid.PAPER_STIFFNESS) -
     ratio = (pcsa.sel(K=float(stiffness)) / base).where(base > 0)
     part = dataset.sel(K=float(stiffness))
     title = f"Fig. S1 / Fig. 3: minimum PCSA at {_k_label(part)}\nover that at K = 0 (the paper: 0.5, a halving)"
-    return _ratio_map(ratio, title, "ratio of minimum PCSA [1]", (0.0, 1.0), HALVING, f"{HALVING:g}: halved")
+    return _ratio_map(ratio, title, "ratio of minimum PCSA [1]")
 
 
-def _ratio_map(ratio: xr.DataArray, title: str, label: str, scale, level: float, level_text: str) -> Figure:
-    """A ratio over E and Lambda on the colour range ``scale``, ``level`` as a labelled white contour."""
-    fig, ax = _landscape(ratio, title, label, *scale)
+RATIO_MARKS = {HALVING: f"{HALVING:g}: halved", 1.0: "1: equal"}
+"""The ratios a ratio map marks, with their labels: the paper's halving and no change."""
+
+
+def _ratio_map(ratio: xr.DataArray, title: str, label: str) -> Figure:
+    """A ratio over E and Lambda on round levels over its range; each of :data:`RATIO_MARKS` inside that range a
+    labelled white contour and a white line on the colour bar, the others named in the title as not reached."""
     values = np.ma.masked_invalid(ratio.transpose("Lambda", "E").values)
-    if values.count() and values.min() < level < values.max():
-        e, lam = ratio["E"].values * CM_PER_M, ratio["Lambda"].values * CM_PER_M
+    inside = {v: text for v, text in RATIO_MARKS.items() if values.count() and values.min() < v < values.max()}
+    if values.count():
+        outside = [text.split(":")[0] for v, text in RATIO_MARKS.items() if v not in inside]
+        if outside:
+            title += f"\n(range {values.min():.2f} to {values.max():.2f}: {' and '.join(outside)} not reached)"
+    fig, ax = _landscape(ratio, title, label)
+    e, lam = ratio["E"].values * CM_PER_M, ratio["Lambda"].values * CM_PER_M
+    for level, text in inside.items():
         line = ax.contour(e, lam, values, levels=[level], colors="white", linewidths=1.5)
-        ax.clabel(line, fmt=lambda _: level_text, fontsize=8)
+        ax.clabel(line, fmt=lambda _, text=text: text, fontsize=8)
+        ax.child_axes[0].axhline(level, color="white", lw=1.5, gid=f"ratio {level:g}")
     return fig
 
 
@@ -422,7 +456,8 @@ def coupled_ratio_figure(dataset: xr.Dataset) -> Figure:
     Returns
     -------
     matplotlib.figure.Figure
-        Filled contours of the ratio [1] over E and Lambda [cm] from 0 to at least 1, 1 (no saving) as a contour.
+        Filled contours of the ratio [1] over E and Lambda [cm] on round levels over its range, labelled contour
+        lines; 0.5 and 1 (no saving) as white contours where the ratio reaches them.
 
     Raises
     ------
@@ -430,9 +465,8 @@ def coupled_ratio_figure(dataset: xr.Dataset) -> Figure:
         As :func:`coupled_ratio`.
     """
     ratio = coupled_ratio(dataset)
-    top = max(1.0, float(ratio.max())) if np.isfinite(ratio.values).any() else 1.0
     title = f"coupled / per segment: global PCSA of the joint optimum over the minimum PCSA, {_k_label(dataset)}"
-    return _ratio_map(ratio, title, "ratio of global PCSA [1]", (0.0, top), 1.0, "1: no saving")
+    return _ratio_map(ratio, title, "ratio of global PCSA [1]")
 
 
 def counter_torque_figure(dataset: xr.Dataset, specific_tension: float) -> Figure:
@@ -461,16 +495,61 @@ def counter_torque_figure(dataset: xr.Dataset, specific_tension: float) -> Figur
         f"at {landmarks.LOCAL_LEVER_ARM * CM_PER_M:g} cm lever arm)"
     )
     fig, ax = _landscape(field, title, label)
+    torque_limit(ax, field)
+    return fig
+
+
+def torque_limit(ax, field: xr.DataArray) -> None:
+    """The ±30 N m limit of the local muscles (paper, Figure 4) as a dashed white contour on a landscape of ‖CT‖.
+
+    Its label keeps clear of A-D, the corners, C's star, the ridge and the other contour labels
+    (:func:`_label_place`); C's label moves to a side of its point off the line. Nothing is drawn
+    where ‖CT‖ does not cross the limit.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        The axes of :func:`landscape_figure` of ``field``.
+    field : xarray.DataArray
+        ‖CT‖ [N m], dimensions ``E`` and ``Lambda`` [m].
+    """
     e, lam = field["E"].values * CM_PER_M, field["Lambda"].values * CM_PER_M
     values = np.ma.masked_invalid(field.transpose("Lambda", "E").values)
     if values.count() and values.min() < landmarks.CT_LIMIT < values.max():
         limit = ax.contour(e, lam, values, levels=[landmarks.CT_LIMIT], colors="white", linestyles="--")
+        _clear_of(ax, "label C", limit)
         marks = [np.asarray(p) * CM_PER_M for _, p in grid_marks(field["E"].values, field["Lambda"].values)]
         contour_labels = [t.get_position() for t in ax.texts if not t.get_gid()]  # the lines' values
-        place = _label_place(limit, [*marks, np.asarray(landmarks.OPTIMUM) * CM_PER_M, *contour_labels], ax)
+        ridge = [line for line in ax.lines if line.get_gid() == "ridge"]  # on it, the label hid the ridge
+        along = np.linspace(0.0, 1.0, 40)[:, None]
+        ridge = [p for line in ridge for p in (1 - along) * line.get_xydata()[0] + along * line.get_xydata()[-1]]
+        optimum = np.asarray(landmarks.OPTIMUM) * CM_PER_M
+        place = _label_place(limit, [*marks, optimum, *contour_labels, *ridge], ax)
         text = f"±{landmarks.CT_LIMIT:g} N m"
         ax.clabel(limit, fmt=lambda _: text, fontsize=8, manual=None if place is None else [place])
-    return fig
+
+
+OFFSETS = ((6, 6), (-6, 6), (6, -6), (-6, -6))
+"""Offsets [points] of a position's label from its point, in the order tried: right and up first."""
+
+
+def _clear_of(ax, gid: str, contour) -> None:
+    """Move the label ``gid`` of a position to the first side of its point (:data:`OFFSETS`) where its box
+    neither touches ``contour`` nor leaves the axes; where none is, it stays. Measured on the laid-out canvas."""
+    label = next((t for t in ax.texts if t.get_gid() == gid), None)
+    if label is None:
+        return
+    ax.figure.canvas.draw()  # the layout first: the label's offset is in points, the line in data
+    renderer = ax.figure.canvas.get_renderer()  # (draw_without_rendering would print a PNG to get one)
+    paths = [ax.transData.transform_path(p) for p in contour.get_paths()]
+    frame = ax.get_window_extent(renderer)
+    first = label.xyann
+    for dx, dy in (first, *OFFSETS, first):  # none clear: back where it was
+        label.set(position=(dx, dy), ha="left" if dx > 0 else "right", va="bottom" if dy > 0 else "top")
+        box = label.get_window_extent(renderer).padded(3)  # the round box around the text
+        inside = frame.contains(box.x0, box.y0) and frame.contains(box.x1, box.y1)
+        if inside and not any(p.intersects_bbox(box, filled=False) for p in paths):
+            return
 
 
 def _label_place(contour, marks, ax) -> tuple[float, float] | None:

@@ -2,9 +2,9 @@
 
 A study store (:mod:`spinectl.landscape.study`) holds one landscape per value of each parameter axis
 and per Monte-Carlo draw. Each slice is drawn as the landscape figures are
-(:func:`spinectl.paper.figures.landscape_figure`): its minimum PCSA and its ||CT||, the title naming
-the slice's parameter values. A store with more slices than :data:`MAX_SLICES` is refused with the
-way to select from it.
+(:func:`spinectl.paper.figures.landscape_figure`): its minimum PCSA and its ‖CT‖ with the ±30 N m
+limit, the title naming the slice's parameter values with their units. A store with more slices than
+:data:`MAX_SLICES` is refused with the way to select from it.
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ MAX_SLICES = 24
 
 
 def slice_figures(dataset: xr.Dataset, format: str = "png") -> dict:
-    """The minimum PCSA and ||CT|| of every E x Lambda slice of a study, by file name.
+    """The minimum PCSA and ‖CT‖ (with the ±30 N m limit) of every E x Lambda slice of a study, by file name.
 
     Parameters
     ----------
@@ -60,12 +60,21 @@ def slice_figures(dataset: xr.Dataset, format: str = "png") -> dict:
     for index in itertools.product(*(range(dataset.sizes[d]) for d in dims)):
         part = dataset.isel(dict(zip(dims, index, strict=True)))
         values = [(d, part[d].values.item()) for d in dims]
-        where = ", ".join(f"{d} = {v:g}" for d, v in values) or "the study's model"
+        where = ", ".join(f"{d} = {v:g}{_unit(part[d])}" for d, v in values) or "the study's model"
         name = "".join(f"_{d}={v:g}" for d, v in values)
         for variable, what, unit, stem in comparison.COMPARED:
             title = f"{what} of the study, {where}"
-            drawn[f"{stem}{name}.{format}"] = figures.landscape_figure(part[variable], title, f"{what} [{unit}]")
+            fig = figures.landscape_figure(part[variable], title, f"{what} [{unit}]")
+            if variable == "counter_torque_norm_Nm":  # as Figure 4
+                figures.torque_limit(fig.axes[0], part[variable])
+            drawn[f"{stem}{name}.{format}"] = fig
     return drawn
+
+
+def _unit(coordinate: xr.DataArray) -> str:
+    """The unit of a study axis as a title writes it after a value (" kg"), from the store's ``units``."""
+    unit = coordinate.attrs.get("units", "")
+    return f" {unit}" if unit and unit != "1" else ""
 
 
 def draw_study(path, out_dir, format: str = "png", dpi: float = figures.DPI) -> list[Path]:

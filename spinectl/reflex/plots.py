@@ -20,6 +20,8 @@ import control as ct
 import matplotlib
 import numpy as np
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+from matplotlib.ticker import MultipleLocator
 
 from ..canvas import new_figure, save_figures, save_file
 from ..model.params import Model
@@ -32,6 +34,15 @@ DPI = 110
 
 PLOT_FILES = ("bode.png", "nyquist.png", "response.png")
 """The files :func:`write_plots` may write, in this order."""
+
+RESPONSE_NOTE = "each segment over its own time: five of its slowest time constants, at most sim_duration"
+"""The response figure's note on its time axes, which differ between segments."""
+BODE_SIZE = (7.0, 8.0)
+"""Inches: the Bode plot with its legend below the phase axes."""
+PHASE_TICKS = 180.0
+"""[deg] Phase tick spacing (twice that over more than :data:`PHASE_TICKS_MAX` ticks)."""
+PHASE_TICKS_MAX = 8
+"""Most phase ticks at :data:`PHASE_TICKS` spacing."""
 
 
 def _control_figure(rows: int, **subplots):
@@ -50,8 +61,9 @@ def bode_figure(
 
     With ``margins`` each curve carries its margins: a dot where abs(L) = 1 (the crossover that
     limits the delay margin) and, below it, the phase margin as a bar from the phase curve to
-    -180 deg; a bar from abs(L) up to 1 at the phase crossover of the upper gain margin; and the
-    exact delay margin tau_m, the phase margin and the upper gain margin in the legend.
+    -180 deg; a triangle at abs(L) = 1/GM on the phase crossover of the upper gain margin, a thin
+    line from it up to 1; and the exact delay margin tau_m, the phase margin and the upper gain
+    margin in the legend, which lies below the phase axes and names the markers.
 
     Parameters
     ----------
@@ -77,9 +89,33 @@ def bode_figure(
     for i, name in enumerate(loops):
         if name in margins:
             _mark_margins(axes[0, 0], axes[1, 0], i, margins[name])
+    _phase_ticks(axes[1, 0])
+    if margins:  # the legend below the axes: on the magnitude axes it covered the curves
+        fig.set_size_inches(*BODE_SIZE)
+        handles, texts = axes[0, 0].get_legend_handles_labels()
+        if axes[0, 0].get_legend() is not None:  # python-control's, on the magnitude axes
+            axes[0, 0].get_legend().remove()
+        keys = [
+            Line2D([], [], ls="", marker="o", ms=4, color="0.3", label="abs(L) = 1; below it the phase margin"),
+            Line2D([], [], ls="", marker="v", ms=5, color="0.3", label="phase -180 deg: abs(L) = 1/GM (gain margin)"),
+        ]
+        axes[1, 0].legend(
+            [*handles, *keys],
+            [*texts, *(k.get_label() for k in keys)],
+            loc="upper center",
+            bbox_to_anchor=(0.5, -0.25),
+            fontsize=7,
+        )
     plot.set_plot_title(title or "Reflex loop L(jw)", frame="figure")
     fig.align_labels()
     return fig
+
+
+def _phase_ticks(ax) -> None:
+    """Phase ticks every :data:`PHASE_TICKS` deg (twice that where too many): python-control's 90 deg ran to -990."""
+    low, high = ax.get_ylim()
+    step = PHASE_TICKS if (high - low) / PHASE_TICKS <= PHASE_TICKS_MAX else 2 * PHASE_TICKS
+    ax.yaxis.set_major_locator(MultipleLocator(step))
 
 
 def _margin_label(name: str, seg) -> str:
@@ -111,7 +147,9 @@ def _mark_margins(magnitude_ax, phase_ax, index: int, seg) -> None:
         jumps = np.flatnonzero(np.abs(np.diff(wrapped)) > 180.0)
         if jumps.size:
             i = jumps[np.argmin(np.abs(np.log(mag[jumps] * seg.gain_margin)))]
-            magnitude_ax.plot([w[i], w[i]], [mag[i], 1.0], "-", color=colour, lw=3, alpha=0.6)
+            # thin: the loops' phase crossovers lie close together (the delay sets them), thick bars merged
+            magnitude_ax.plot([w[i], w[i]], [mag[i], 1.0], "-", color=colour, lw=0.8, gid="gain margin")
+            magnitude_ax.plot([w[i]], [mag[i]], "v", color=colour, ms=5, gid="gain margin")
 
 
 def nyquist_figure(loops: Mapping[str, ct.TransferFunction], title: str = "") -> Figure:
@@ -140,7 +178,10 @@ def response_figure(responses: Mapping[str, Simulation], title: str = "") -> Fig
     """Angle after the perturbation, with the reflex (run 0) and without it (run 1), per segment.
 
     Each panel is scaled to the response with the reflex; a response without it that
-    diverges leaves the panel (the simulation stops at ``sim_divergence``).
+    diverges leaves the panel (the simulation stops at ``sim_divergence``). Each panel has its
+    own time axis, the length of its simulation (five slowest time constants of its segment,
+    :func:`spinectl.reflex.margins.response_duration`): on one shared axis the fast segments'
+    curves stopped early.
 
     Parameters
     ----------
@@ -155,7 +196,7 @@ def response_figure(responses: Mapping[str, Simulation], title: str = "") -> Fig
         One panel per segment; nothing is written.
     """
     fig = new_figure(figsize=(7, 1.6 * len(responses) + 1))
-    axes = fig.subplots(len(responses), 1, sharex=True, squeeze=False)
+    axes = fig.subplots(len(responses), 1, squeeze=False)
     for ax, (name, sim) in zip(axes[:, 0], responses.items(), strict=True):
         scale = 1e3  # mrad
         verdict = ["stable" if s else "unstable" for s in sim.stable]
@@ -164,9 +205,11 @@ def response_figure(responses: Mapping[str, Simulation], title: str = "") -> Fig
         top = 1.3 * abs(sim.alpha[0]).max() * scale
         ax.set_ylim(-top, top)
         ax.set_ylabel(f"{name}\nalpha [mrad]")
-        ax.legend(loc="upper right", fontsize="small")
+        ax.set_xlim(sim.time[0], sim.time[-1])
+        ax.legend(loc="best", fontsize="small")
     axes[-1, 0].set_xlabel("time [s]")
-    fig.suptitle(title or "Response to a perturbation (nonlinear segment, true delay)")
+    default = "Response to a perturbation (nonlinear segment, true delay)"
+    fig.suptitle(f"{title or default}\n{RESPONSE_NOTE}" if len(responses) > 1 else title or default)
     fig.tight_layout()
     return fig
 
@@ -219,13 +262,28 @@ def report_figures(report: MarginsReport, responses: ReportResponses) -> dict[st
     )
     figures = {}
     if responses.loops:
-        title = f"Reflex loops, Pade {report.pade_order}; {where}"
+        title = f"Reflex loops, Pade {report.pade_order}; {where}{_left_out(report, responses)}"
         by_name = {seg.name: seg for seg in report.segments}
         figures["bode.png"] = bode_figure(responses.loops, frequency_range(report), title, by_name)
-        figures["nyquist.png"] = nyquist_figure(responses.loops, f"Nyquist, tau = {report.delay:g} s; {where}")
+        nyquist_title = f"Nyquist, tau = {report.delay:g} s; {where}{_left_out(report, responses)}"
+        figures["nyquist.png"] = nyquist_figure(responses.loops, nyquist_title)
     if responses.simulations:
         figures["response.png"] = response_figure(responses.simulations, f"Response to a perturbation; {where}")
     return figures
+
+
+def _left_out(report: MarginsReport, responses: ReportResponses) -> str:
+    """A title's note on the segments without a loop in the plot, and why ("" if every segment has one)."""
+    reasons = []
+    for seg in report.segments:
+        if seg.name in responses.loops:
+            continue
+        if seg.kp == 0 and seg.kd == 0:
+            why = "kp = kd = 0" + (", self-stable" if seg.self_stable else "")
+        else:
+            why = "margins not defined"
+        reasons.append(f"{seg.name} ({why})")
+    return f"\nno reflex loop drawn: {'; '.join(reasons)}" if reasons else ""
 
 
 def save_figure(fig: Figure, path: str | Path) -> Path:

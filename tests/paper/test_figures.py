@@ -8,6 +8,7 @@ import xml.etree.ElementTree as ET
 import matplotlib.pyplot as plt
 import numpy as np
 import pytest
+import xarray as xr
 from matplotlib.figure import Figure
 from matplotlib.image import imread
 
@@ -184,10 +185,13 @@ def test_colour_bar_as_tall_as_the_axes(results):
 
 
 def test_ratio_map_and_insets(results, tmp_path, other_grids):
-    """The ratio S1 / 3 on a 0-1 scale; insets: four model drawings around Figure 3; both need what they need."""
+    """The ratio S1 / 3 on round levels over its range (numpy's nanmin, nanmax); insets: four model drawings around
+    Figure 3; both need what they need."""
     dataset = netcdf.load(results)
     ratio = figures.ratio_figure(dataset)
-    assert _colour_bar(ratio).get_ylim() == pytest.approx((0.0, 1.0)) and "halving" in ratio.axes[0].get_title()
+    values = (dataset["min_pcsa_cm2"].sel(K=15.0) / dataset["min_pcsa_cm2"].sel(K=0.0)).values
+    low, high = _colour_bar(ratio).get_ylim()
+    assert low <= np.nanmin(values) < np.nanmax(values) <= high and "halving" in ratio.axes[0].get_title()
     inset = figures.min_pcsa_figure(dataset.sel(K=0.0), insets=True)
     titles = sorted(ax.get_title() for ax in inset.axes[1:])
     # C is Figure 3's interior point (3, 4) cm, so the corner (8, 8) cm is drawn under its coordinates
@@ -312,14 +316,16 @@ def test_coupled_ratio_is_the_joint_global_pcsa_over_the_per_segment_minimum(cou
 
 
 def test_plot_draws_the_coupled_ratio_when_the_sweep_has_it(coupled, results, tmp_path):
-    """spinectl plot on a sweep --coupled adds the map (0 at the colour bar's foot, at least 1 at its top);
+    """spinectl plot on a sweep --coupled adds the map (the colour bar holds the ratio's range);
     a sweep without the coupled variables has none, and coupled_ratio says what it needs."""
     assert main(["plot", str(coupled), "--out", str(tmp_path / "c")]) == 0
     name = figures.coupled_ratio_name(0.0)
     assert name == "coupled_over_per_segment_K0.png" and _non_trivial(tmp_path / "c" / name)
     fig = figures.coupled_ratio_figure(netcdf.load(coupled))
     low, high = _colour_bar(fig).get_ylim()
-    assert low == pytest.approx(0.0) and high >= 1.0 and "coupled / per segment" in fig.axes[0].get_title()
+    ratio = figures.coupled_ratio(netcdf.load(coupled)).values
+    assert low <= np.nanmin(ratio) < np.nanmax(ratio) <= high
+    assert "coupled / per segment" in fig.axes[0].get_title()
     assert main(["plot", str(results), "--out", str(tmp_path / "r")]) == 0
     assert not any(p.name.startswith("coupled") for p in (tmp_path / "r").iterdir())
     with pytest.raises(ParameterError, match="sweep --coupled"):
@@ -403,3 +409,133 @@ def test_the_30_n_m_label_clears_c_and_every_label(wagner2012_landscapes, coarse
     others = [t.get_window_extent(renderer) for t in ax.texts if t is not limit and not t.get_gid()]
     assert others and not any(box.overlaps(other) for other in others)
     assert ax.get_window_extent(renderer).contains(*box.p0) and ax.get_window_extent(renderer).contains(*box.p1)
+
+
+def _round(values) -> bool:
+    """Whether ``values`` are equally spaced multiples of a round step: 1, 2, 2.5 or 5 times a power of ten."""
+    values = np.asarray(values, float)
+    step = np.diff(values)
+    if values.size < 2 or not np.allclose(step, step[0], rtol=1e-6):
+        return False
+    mantissa = step[0] / 10.0 ** np.floor(np.log10(step[0]))
+    multiples = values / step[0]
+    return any(np.isclose(mantissa, m) for m in (1, 2, 2.5, 5)) and np.allclose(multiples, np.round(multiples))
+
+
+def _bar_ticks(fig):
+    bar = _colour_bar(fig)
+    low, high = bar.get_ylim()
+    return [t for t in bar.get_yticks() if low - 1e-9 <= t <= high + 1e-9]
+
+
+def test_colour_bar_ticks_filled_levels_and_contour_lines_are_round(results):
+    """Figure S1 on its own range, on a shared range of non-round ends (13.75 to 36.26 cm^2, as --shared-scale gave
+    13.75, 16.56, ...) and Figure 4: colour-bar ticks round; levels and contour lines round on the data's range."""
+    dataset = netcdf.load(results)
+    s1 = dataset.sel(K=15.0)
+    for fig in (
+        figures.min_pcsa_figure(s1),
+        figures.min_pcsa_figure(s1, 13.75, 36.26),
+        figures.counter_torque_figure(s1, 2.5e5),
+    ):
+        fig.draw_without_rendering()
+        assert len(_bar_ticks(fig)) >= 3 and _round(_bar_ticks(fig))
+    fig = figures.min_pcsa_figure(s1)
+    filled, lines = fig.axes[0].collections[:2]
+    assert _round(filled.levels) and _round(lines.levels) and len(lines.levels) >= 2
+
+
+def _title_clear(fig):
+    """The title lies inside the figure and within the axes' width, so it overlaps no tick label (measured drawn)."""
+    ax, renderer = _drawn(fig)
+    title = ax.title.get_window_extent(renderer)
+    frame, page = ax.get_window_extent(renderer), fig.bbox
+    ticks = [t.get_window_extent(renderer) for t in (*ax.get_xticklabels(), *ax.get_yticklabels()) if t.get_text()]
+    return (
+        frame.x0 - 1 <= title.x0
+        and title.x1 <= frame.x1 + 1
+        and page.x0 <= title.x0
+        and title.x1 <= page.x1
+        and title.y1 <= page.y1
+        and not any(title.overlaps(t) for t in ticks)
+    )
+
+
+def test_titles_fit_the_axes(results, coupled):
+    """Figure S1, Figure 4 at K = 15 (the longest titles: K and its convention) and the ratio maps: each title is
+    wrapped to the axes' width (before, wider than the axes, they crowded the top "8" tick label)."""
+    dataset = netcdf.load(results)
+    drawn = [
+        figures.min_pcsa_figure(dataset.sel(K=15.0)),
+        figures.counter_torque_figure(dataset.sel(K=15.0), 2.5e5),
+        figures.ratio_figure(dataset),
+        figures.coupled_ratio_figure(netcdf.load(coupled)),
+        figures.min_pcsa_figure(dataset.sel(K=15.0), insets=True),
+    ]
+    assert all(_title_clear(fig) for fig in drawn)
+    assert "K convention: physical" in drawn[0].axes[0].get_title().replace("\n", " ")
+
+
+def _linear_ratio():
+    """A sweep --coupled stand-in whose ratio rises linearly in E from 0.3 at E = 0 to 1.2 at E = 8 cm."""
+    axis = np.linspace(0.0, 0.08, 9)
+    e = xr.DataArray(axis, dims="E")
+    per_segment = 40.0 + 0.0 * (e + xr.DataArray(axis, dims="Lambda"))
+    joint = per_segment * (0.3 + 0.9 * e / 0.08)
+    return xr.Dataset(
+        {"min_pcsa_cm2": per_segment, figures.COUPLED_VARIABLE: joint},
+        coords={"E": axis, "Lambda": axis, "K": 0.0},
+    )
+
+
+def test_ratio_maps_take_their_levels_from_the_data_and_mark_halving_and_equal():
+    """Ratio 0.3 + 0.9 E / 8 cm: the colour bar spans the data (not 0 to 1), on round levels with labelled contour
+    lines; 0.5 and 1 are white labelled contours at E = 8 (0.5 - 0.3) / 0.9 = 1.78 cm and 8 (1 - 0.3) / 0.9 =
+    6.22 cm (solved by hand from the linear ratio), and lines on the colour bar."""
+    fig = figures.coupled_ratio_figure(_linear_ratio())
+    ax = fig.axes[0]
+    low, high = _colour_bar(fig).get_ylim()
+    assert low == pytest.approx(0.3) and high == pytest.approx(1.2)  # round ends that hold the data
+    filled = ax.collections[0]
+    assert _round(filled.levels) and len(filled.levels) >= 8  # not 2 or 3 bands
+    texts = [t.get_text() for t in ax.texts if not t.get_gid()]
+    assert "0.5: halved" in texts and "1: equal" in texts and len(texts) >= 4  # the round lines labelled too
+    marked = [c for c in ax.collections if len(getattr(c, "levels", [])) == 1]
+    assert sorted(float(c.levels[0]) for c in marked) == [0.5, 1.0]
+    for contour in marked:
+        x = np.concatenate(contour.allsegs[0])[:, 0]
+        expected = 8 * (float(contour.levels[0]) - 0.3) / 0.9
+        np.testing.assert_allclose(x, expected, atol=1e-9)
+    assert {line.get_gid() for line in _colour_bar(fig).lines} == {"ratio 0.5", "ratio 1"}
+
+
+def test_a_ratio_map_says_which_marks_its_range_does_not_reach():
+    """Ratio 0.3 + 0.9 E / 8 cm on E up to 4 cm only: at most 0.75, so the title says 1 is not reached."""
+    fig = figures.coupled_ratio_figure(_linear_ratio().isel(E=slice(0, 5)))
+    title = fig.axes[0].get_title()
+    assert "1 not reached" in title and "0.5 and" not in title and "0.30 to 0.75" in title
+
+
+def _touches(text, paths, renderer, pad=0.0):
+    box = text.get_window_extent(renderer).padded(pad)
+    return any(path.intersects_bbox(box, filled=False) for path in paths)
+
+
+@pytest.mark.parametrize("stiffness", [0.0, 15.0])
+@pytest.mark.parametrize("points", [21, 81])
+def test_c_s_label_clears_the_30_n_m_line_and_the_30_n_m_label_the_ridge(
+    wagner2012_landscapes, coarse_wagner2012, points, stiffness
+):
+    """The ±30 N m line passes close by C: C's label box touches neither the line nor (drawn) the ridge; the
+    ±30 N m label does not sit on the ridge (before: C's box on the line at K = 0, the label on the ridge at
+    K = 15). Measured as paths on the canvas crossing the labels' extents."""
+    dataset = (coarse_wagner2012 if points == 21 else wagner2012_landscapes[0]).sel(K=stiffness)
+    ax, renderer = _drawn(figures.counter_torque_figure(dataset, 2.5e5))
+    limit = next(c for c in ax.collections if list(getattr(c, "levels", [])) == [30.0])
+    line = [ax.transData.transform_path(p) for p in limit.get_paths()]
+    ridge = next(line for line in ax.lines if line.get_gid() == "ridge")
+    ridge = [ridge.get_transform().transform_path(ridge.get_path())]
+    c = next(t for t in ax.texts if t.get_gid() == "label C")
+    assert not _touches(c, line, renderer, pad=3)  # the round box's padding
+    (label,) = [t for t in ax.texts if t.get_text() == "±30 N m"]
+    assert not _touches(label, ridge, renderer)

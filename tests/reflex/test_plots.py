@@ -130,7 +130,7 @@ def test_bode_marks_the_margins_of_a_report(model):
     responses = margins.report_responses(model, report)
     fig = plots.report_figures(report, responses)["bode.png"]
     magnitude, phase = fig.axes[:2]
-    labels = [text.get_text() for text in magnitude.get_legend().get_texts()]
+    labels = [text.get_text() for text in phase.get_legend().get_texts()][: len(report.segments)]  # then the keys
     assert all(f"tau_m {s.delay_margin:.3g} s" in label for s, label in zip(report.segments, labels, strict=True))
     n = len(report.segments)
     bars = phase.get_lines()[n:]
@@ -156,3 +156,61 @@ def test_responses_span_five_slowest_time_constants(model):
     duration = margins.response_duration(seg, report, model.reflex)
     assert duration == pytest.approx(min(max(5 * slow, 1.0), model.reflex.sim_duration), rel=1e-9)
     assert 1.0 < duration < model.reflex.sim_duration  # here neither bound applies
+
+
+@pytest.fixture(scope="module")
+def at_a():
+    """wagner2012 at A, half activation (``spinectl margins --plot`` as the CLI runs it): L5S1 is self-stable
+    there, the gain rule gives it kp = kd = 0, so it has no loop; the four others have finite gain margins."""
+    from spinectl import load_preset
+
+    model = load_preset("wagner2012")
+    model = _reflex(model, activation=0.5, sim_duration=3.0)
+    report = margins.analyse(model, 0.0, 0.0)
+    return report, plots.report_figures(report, margins.report_responses(model, report))
+
+
+def test_bode_legend_below_the_curves_labelled_markers_and_round_phase_ticks(at_a):
+    """The legend lies outside both axes (on the magnitude axes it covered the curves) and names the markers; the
+    gain-margin markers are thin, a triangle at abs(L) = 1/GM (the definition of the upper gain margin, GM from
+    the report), not merged thick bars; phase ticks every 180 deg or more (python-control's every 90 deg ran to
+    -990); the title says which segment is left out and why."""
+    report, figures = at_a
+    fig = figures["bode.png"]
+    renderer = fig.canvas.get_renderer()
+    fig.draw_without_rendering()
+    magnitude, phase = fig.axes[:2]
+    legend = phase.get_legend()
+    assert magnitude.get_legend() is None and legend is not None
+    box = legend.get_window_extent(renderer)
+    assert not any(box.overlaps(ax.get_window_extent(renderer)) for ax in (magnitude, phase))
+    assert fig.bbox.contains(box.x0, box.y0) and fig.bbox.contains(box.x1, box.y1)
+    assert any("gain margin" in t.get_text() for t in legend.get_texts())
+    marks = [line for line in magnitude.get_lines() if line.get_gid() == "gain margin"]
+    assert marks and all(line.get_linewidth() <= 1.0 for line in marks if line.get_linestyle() != "None")
+    triangles = [line for line in marks if line.get_marker() == "v"]
+    drawn = [s for s in report.segments if s.name != "L5S1"]
+    assert len(triangles) == len(drawn) == 4
+    for seg, triangle in zip(drawn, triangles, strict=True):
+        assert triangle.get_ydata()[0] * seg.gain_margin == pytest.approx(1.0, rel=0.05)  # on the drawn grid
+    low, high = phase.get_ylim()
+    ticks = [t for t in phase.get_yticks() if low <= t <= high]
+    assert np.all(np.diff(ticks) >= 180.0) and len(ticks) <= plots.PHASE_TICKS_MAX + 1
+    assert "no reflex loop drawn: L5S1 (kp = kd = 0, self-stable)" in fig.get_suptitle()
+    assert "L5S1" in figures["nyquist.png"].get_suptitle()
+
+
+def test_each_response_panel_spans_its_own_simulation(at_a):
+    """The simulations of the segments end at different times (five slowest time constants each, see
+    test_responses_span_five_slowest_time_constants): each panel's time axis is that of its simulation,
+    and the title says why, instead of short curves on one shared axis."""
+    report, figures = at_a
+    fig = figures["response.png"]
+    assert plots.RESPONSE_NOTE in fig.get_suptitle()
+    ends = []
+    assert len(fig.axes) == len(report.segments)  # every segment simulated, L5S1 too
+    for ax in fig.axes:
+        time = ax.get_lines()[0].get_xdata()
+        assert ax.get_xlim() == pytest.approx((time[0], time[-1]))
+        ends.append(time[-1])
+    assert len(set(np.round(ends, 6))) > 1  # the lengths differ, so one shared axis would cut some curves short
