@@ -24,7 +24,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Polygon
 from matplotlib.transforms import Bbox
 
-from ..canvas import new_figure
+from ..canvas import laid_out, new_figure
 from ..errors import ParameterError
 from ..model import geometry
 from ..model.checks import expand_pcsa
@@ -328,12 +328,8 @@ def _fit_labels(ax, labels, tries: int = 6) -> None:
     the label of a long arrow (60 N m at E = Lambda = 8 cm) crossed the frame. Each widening
     shrinks the scale, so the labels are measured again.
     """
-    fig = ax.figure
     for _ in range(tries):
-        if fig.get_layout_engine() is not None:
-            fig.draw_without_rendering()  # the layout sizes the axes (fixed axes, as the explorer's, need no draw)
-        ax.apply_aspect()
-        renderer = fig.canvas.get_renderer()
+        renderer = laid_out(ax.figure)
         frame = ax.get_window_extent(renderer)
         # a text's extent places it (its xycoords measured, :func:`_beyond`); its box's padding lies outside
         boxes = Bbox.union([t.get_window_extent(renderer) for t in labels]).padded(renderer.points_to_pixels(1.0))

@@ -24,7 +24,7 @@ import numpy as np
 import xarray as xr
 from matplotlib.figure import Figure
 
-from ..canvas import new_figure, save_figures, save_file
+from ..canvas import laid_out, new_figure, save_figures, save_file
 from ..errors import ParameterError
 from ..landscape import netcdf
 from ..model.chain import local_stiffness_per_pcsa
@@ -267,11 +267,10 @@ def _label_lines(ax) -> None:
     lines = next((c for c in ax.collections if c.get_gid() == _LINES), None)
     if lines is None:
         return
-    fig = ax.figure
-    fig.draw_without_rendering()  # the layout sizes the axes
-    renderer = fig.canvas.get_renderer()
+    renderer = laid_out(ax.figure)  # the layout sizes the axes
+    pad = renderer.points_to_pixels(2.0)  # their boxes' padding (0.2 of a 9 pt font) lies outside a text's extent
     labels = (t for t in ax.texts if (t.get_gid() or "").startswith("label"))  # A-D and the corners
-    marks = [t.get_bbox_patch().get_window_extent(renderer) for t in labels]
+    marks = [t.get_window_extent(renderer).padded(pad) for t in labels]
     ax.clabel(lines, fmt="%.3g", fontsize=6, inline=False)  # matplotlib's places, to be checked
     frame = ax.get_window_extent(renderer)
     places, boxes = [], []

@@ -84,7 +84,25 @@ def _scalar(where: str, value):
 
 
 def grid_axis(name: str, values) -> tuple[float, ...]:
-    """The grid axis ``name`` (``"E"`` or ``"Lambda"``) [m]: distinct finite numbers; errors name ``axes.<name>[i]``."""
+    """A grid axis of a study, validated; errors name it as the study file does (``axes.E[2]``).
+
+    Parameters
+    ----------
+    name : str
+        ``"E"`` or ``"Lambda"``.
+    values : sequence of float
+        The axis [m]: distinct finite numbers, at least one.
+
+    Returns
+    -------
+    tuple of float
+        The values [m].
+
+    Raises
+    ------
+    ParameterError
+        Not numbers, not finite, repeated or empty.
+    """
     values = _scalars(f"axes.{name}", values)
     return tuple(v.real(f"axes.{name}[{i}]", x) for i, x in enumerate(values))
 
