@@ -51,9 +51,9 @@ HALVING = 0.5
 LABEL_MARGIN = 0.08
 """Least distance of a placed contour label from the axes' edges, as a fraction of their span."""
 _TOLERANCE = 1e-9
+"""[m] A position on a grid's edge counts as inside."""
 _LINES = "contour lines"
 """gid of a landscape's labelled contour lines."""
-"""[m] A position on a grid's edge counts as inside."""
 
 _CONVENTION = {"paper": "eq. 2 as printed", "physical": "physical, -K in dM/dα"}
 """How a title names the passive-stiffness convention (docs/model.md, "Passive stiffness: two conventions")."""
