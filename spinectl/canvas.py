@@ -36,6 +36,34 @@ def new_figure(**options) -> Figure:
     return figure
 
 
+def laid_out(figure: Figure):
+    """Lay ``figure`` out as its next draw will, without drawing it; returns a renderer to measure with.
+
+    The layout engine (if any) places the axes, then each axes takes its aspect, so axes' boxes, data
+    transforms and text extents hold as they will be drawn: labels can be placed by their measured
+    extents (:mod:`spinectl.paper.figures`, :mod:`spinectl.paper.drawing`). Cheaper than
+    ``draw_without_rendering``, and no print: that one prints to memory through the canvas's
+    ``print_png``, so a failing writer would fail here, before any file is written.
+
+    Parameters
+    ----------
+    figure : matplotlib.figure.Figure
+        A figure on a canvas with a renderer (the Agg canvas of :func:`new_figure`, pyplot's).
+
+    Returns
+    -------
+    matplotlib.backend_bases.RendererBase
+        The canvas's renderer, for ``get_window_extent``.
+    """
+    engine = figure.get_layout_engine()
+    if engine is not None:
+        engine.execute(figure)
+    for ax in figure.axes:
+        if ax.get_axes_locator() is None:  # an inset (a colour bar) is placed by its locator when drawn
+            ax.apply_aspect()
+    return figure.canvas.get_renderer()
+
+
 def save_file(figure: Figure, path: str | Path, dpi: float) -> Path:
     """Write ``figure`` atomically in the format its suffix names (``.png``, ``.pdf``, ``.svg``, ...).
 

@@ -60,25 +60,8 @@ OVERRIDES = (
     ("activation", "reflex.activation"),
     ("pade_order", "reflex.pade_order"),
 )
-"""Command-line options that are aliases of ``--set reflex.FIELD=VALUE``."""
-
-
-def model_with_overrides(args):
-    """The model of ``--preset``/``--config``/``--set`` with the reflex options applied (validated there).
-
-    Parameters
-    ----------
-    args : argparse.Namespace
-        Parsed arguments; ``delay`` [s], ``activation_lag`` [s], ``activation``, ``pade_order`` are
-        optional (``kp`` and ``kd`` are not parameters of the model here: :func:`analyse` takes them).
-
-    Returns
-    -------
-    Model
-        The validated model.
-    """
-    model = load_model(args, {dotted: getattr(args, option) for option, dotted in OVERRIDES})
-    return model  # --kp and --kd go to analyse, which checks them
+"""Command-line options that are aliases of ``--set reflex.FIELD=VALUE`` (``--kp`` and ``--kd`` are no
+parameters of the model: :func:`spinectl.reflex.margins.analyse` takes and checks them)."""
 
 
 def run(args) -> int:
@@ -96,11 +79,12 @@ def run(args) -> int:
         Exit code 0 (also for an infeasible optimum, reported as a status).
     """
     from ..reflex.margins import analyse
+
     if args.plot:
         from ..reflex.plots import PLOT_FILES
 
         check_distinct({"--plot": [Path(args.plot, name) for name in PLOT_FILES]}, {"--config": args.config})
-    model = model_with_overrides(args)
+    model = load_model(args, {dotted: getattr(args, option) for option, dotted in OVERRIDES})
     check_position(model, args)
     if args.coupled:
         return _coupled(model, args)

@@ -17,8 +17,9 @@ from tqdm import tqdm
 from ..atomic import check_writable
 from ..errors import ParameterError
 from ..model import config, source
+from ..model.checks import check_axis_range
 from ..model.params import Model
-from ..units import CM_PER_M, centimetre_slip
+from ..units import CM_PER_M
 from . import netcdf
 from .columns import DEFAULT_CHUNK, passive_columns
 from .schema import landscape_dataset
@@ -76,14 +77,9 @@ def _check_bounds(axis: np.ndarray, spec: str, name: str, bounds) -> None:
     """Refuse an axis beyond ``bounds``, naming the spec as typed (not its first bad point) and a cm slip."""
     if bounds is None:
         return
-    low, high = bounds
-    if np.all((axis >= low) & (axis <= high)):
-        return
     parts = spec.split(":")
     in_metres = ":".join([f"{float(p) / CM_PER_M:g}" for p in parts[:2]] + parts[2:])
-    hint = centimetre_slip(axis, low, high, spec, in_metres)
-    got = f"got {spec!r}: {axis.min():g} to {axis.max():g} m"
-    raise ParameterError(name, f"must be in [{low:g}, {high:g}] m, the modelled range ({got}){hint}")
+    check_axis_range(name, axis, bounds, spec, in_metres)
 
 
 def sweep(

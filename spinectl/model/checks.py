@@ -14,6 +14,7 @@ import dataclasses
 import numpy as np
 
 from ..errors import ModelError, ParameterError
+from ..units import centimetre_slip
 from . import geometry
 from .mechanics import SegmentCoefficients, segment_coefficients
 from .params import Model
@@ -222,6 +223,41 @@ def _attachment_candidates(cor, points):
     gap = np.maximum(np.maximum(lo - points, points - hi), 0.0).sum(-1)  # (K, F)
     scale = np.maximum(np.abs(lo), np.abs(hi)).sum(-1) + np.abs(points).sum(-1)
     return np.nonzero(gap <= ATTACHMENT_TOLERANCE * scale)
+
+
+def check_axis_range(name: str, axis, bounds, typed: str, corrected: str) -> None:
+    """Refuse a grid axis beyond the modelled range, naming it as the user wrote it and a cm slip.
+
+    The message shows ``typed`` (not the first bad point, which the user never wrote)
+    and, where every value read as cm lies in the range, ``corrected``
+    (:func:`spinectl.units.centimetre_slip`). ``spinectl sweep --E 0:8:81`` and a study
+    file's ``E = { start = 0, stop = 8, num = 81 }`` share it.
+
+    Parameters
+    ----------
+    name : str
+        The field as the user names it, e.g. ``"--E"`` or ``"axes.E"``.
+    axis : array_like, 1-d
+        The axis [m], finite.
+    bounds : (float, float)
+        The allowed range [m] (``geometry.eccentricity_range`` or ``lordosis_range``).
+    typed, corrected : str
+        The axis as written (``"0:8:81"``) and the same in metres if it was cm (``"0:0.08:81"``).
+
+    Raises
+    ------
+    ParameterError
+        Naming ``name``, the range, ``typed`` with the axis's extent [m] and the cm hint if it fits,
+        e.g. ``--E: must be in [-0.1, 0.1] m, the modelled range (got '0:8:81': 0 to 8 m); lengths
+        are in metres: if you meant 0:8:81 cm, give 0:0.08:81``.
+    """
+    axis = np.asarray(axis, float)
+    low, high = bounds
+    if np.all((axis >= low) & (axis <= high)):
+        return
+    hint = centimetre_slip(axis, low, high, typed, corrected)
+    got = f"got {typed!r}: {axis.min():g} to {axis.max():g} m"
+    raise ParameterError(name, f"must be in [{low:g}, {high:g}] m, the modelled range ({got}){hint}")
 
 
 def _check_range(model: Model, eccentricity, lordosis) -> None:

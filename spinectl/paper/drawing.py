@@ -24,7 +24,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Polygon
 from matplotlib.transforms import Bbox
 
-from ..canvas import new_figure
+from ..canvas import laid_out, new_figure
 from ..errors import ParameterError
 from ..model import geometry
 from ..model.checks import expand_pcsa
@@ -75,6 +75,9 @@ TORQUE_LABEL_OFFSET = 3.0
 """Gap [pt] between a counter torque's label and the outermost thing drawn at its height on its arrow's
 side: the arrow's tip, a vertebra, the CoR's label, the label of P1, P3 or P2 (:func:`_beyond`). Above
 each arrow's middle (before) a label touched a vertebra and the label of P3."""
+COR_LABEL_OFFSET = 4.0
+"""Gap [pt] between a CoR's label, right of its CoR where its arrow points left, and the CoR or the label of
+P1, P3 or P2 at its height (:func:`_label_cors`)."""
 TORQUE_LABEL_BAND = 6.0
 """Half the height [pt] of the band about a CoR whose artists a torque label must clear: half its
 6 pt line and box, and a point to spare."""
@@ -227,18 +230,18 @@ def _dimension(ax, start, end, text: str, gid: str, offset) -> None:
     )
 
 
-def _draw_counter_torques(ax, model: Model, cors: np.ndarray, counter_torque: np.ndarray) -> None:
-    """Each CT_k as a horizontal arrow at its CoR: the push it gives the part above.
+def _draw_counter_torques(ax, model: Model, cors: np.ndarray, counter_torque: np.ndarray) -> dict:
+    """Each CT_k as a horizontal arrow at its CoR: the push it gives the part above; returns the arrows by CoR.
 
     A positive (counter-clockwise) torque turns the part above CoR k towards -x
     (docs/model.md, "Frame and units"), so it points to -x; its length is
     TORQUE_SCALE per N m. Its label stands beyond the tip, clear of the spine's parts at that
     height (:func:`_beyond`).
     """
-    obstacles = [a for a in (*ax.patches, *ax.texts) if (a.get_gid() or "").startswith(_OBSTACLES)]
+    arrows = {}
     for name, (x, y), torque in zip(model.geometry.cor_names, cors, counter_torque, strict=True):
         dx = -torque * TORQUE_SCALE * CM_PER_M
-        arrow = ax.annotate(
+        arrows[name] = ax.annotate(
             "",
             xy=(x + dx, y),
             xytext=(x, y),
@@ -250,7 +253,7 @@ def _draw_counter_torques(ax, model: Model, cors: np.ndarray, counter_torque: np
         ax.annotate(
             f"{torque:+.1f} N m",
             (0.0 if left else 1.0, 0.5),
-            xycoords=_beyond(arrow, obstacles),
+            xycoords=_beyond(arrows[name], _OBSTACLES),
             xytext=(-TORQUE_LABEL_OFFSET if left else TORQUE_LABEL_OFFSET, 0),
             textcoords="offset points",
             ha="right" if left else "left",
@@ -260,23 +263,27 @@ def _draw_counter_torques(ax, model: Model, cors: np.ndarray, counter_torque: np
             bbox=_LABEL_BOX,
             gid=f"counter torque label {name}",
         )
+    return arrows
 
 
 _OBSTACLES = ("vertebra ", "cor label ", "point label ")
 """The ``gid`` prefixes of what a counter torque's label must not touch (besides the arrows)."""
 
 
-def _beyond(arrow, obstacles):
-    """``xycoords`` of a torque label: at draw time, the box spanning its arrow and the obstacles at its height.
+def _beyond(arrow, prefixes: tuple[str, ...]):
+    """``xycoords`` of a label: at draw time, the box spanning ``arrow`` and what is drawn at its height.
 
-    Measured on the canvas when drawn (the label sizes in points, the drawing in cm), so it holds at any
-    figure size or resolution; the label goes on the box's outer side (:func:`_draw_counter_torques`).
+    What is drawn there: the artists of the axes whose ``gid`` starts with one of ``prefixes``, found
+    when drawn (a CoR's label may come after its torque's). Measured on the canvas when drawn (the
+    labels sized in points, the drawing in cm), so it holds at any figure size or resolution; the label
+    goes on the box's outer side (:func:`_draw_counter_torques`, :func:`_label_cors`).
     """
 
     def box(renderer):
         own = arrow.get_window_extent(renderer)  # an Annotation places itself first (also in a layout pass)
         band = renderer.points_to_pixels(TORQUE_LABEL_BAND)
         middle = (own.y0 + own.y1) / 2
+        obstacles = (a for a in (*arrow.axes.patches, *arrow.axes.texts) if (a.get_gid() or "").startswith(prefixes))
         near = [
             extent
             for extent in (o.get_window_extent(renderer) for o in obstacles)
@@ -290,6 +297,51 @@ def _beyond(arrow, obstacles):
     return box
 
 
+def _label_cors(ax, model: Model, cors: np.ndarray, arrows: dict) -> None:
+    """Each CoR's name [cors in cm], on the side its counter torque's arrow leaves free.
+
+    Left of the CoR as a rule; where the arrow points left (a positive torque), right of it and of the
+    label of P1, P3 or P2 at its height (:func:`_beyond`): on the left it lay on its own arrow.
+    """
+    for name, (x, y) in zip(model.geometry.cor_names, cors, strict=True):
+        arrow = arrows.get(name)
+        right = arrow is not None and arrow.xy[0] < x
+        ax.annotate(
+            name,
+            (1.0, 0.5) if right else (x, y),
+            xycoords=_beyond(arrow, ("point label ",)) if right else "data",
+            xytext=(COR_LABEL_OFFSET if right else -8, 0),
+            textcoords="offset points",
+            ha="left" if right else "right",
+            va="center",
+            fontsize=7,
+            bbox=_LABEL_BOX,
+            zorder=5,
+            gid=f"cor label {name}",
+        )
+
+
+def _fit_labels(ax, labels, tries: int = 6) -> None:
+    """Widen the limits until ``labels`` lie inside the axes, measured on the canvas after the layout.
+
+    The labels are sized in points, the limits in cm (:func:`_limits` holds the arrows' tips):
+    the label of a long arrow (60 N m at E = Lambda = 8 cm) crossed the frame. Each widening
+    shrinks the scale, so the labels are measured again.
+    """
+    for _ in range(tries):
+        renderer = laid_out(ax.figure)
+        frame = ax.get_window_extent(renderer)
+        # a text's extent places it (its xycoords measured, :func:`_beyond`); its box's padding lies outside
+        boxes = Bbox.union([t.get_window_extent(renderer) for t in labels]).padded(renderer.points_to_pixels(1.0))
+        if frame.x0 <= boxes.x0 and boxes.x1 <= frame.x1 and frame.y0 <= boxes.y0 and boxes.y1 <= frame.y1:
+            return
+        (x0, y0), (x1, y1) = ax.transData.inverted().transform([[boxes.x0, boxes.y0], [boxes.x1, boxes.y1]])
+        (low_x, high_x), (low_y, high_y) = ax.get_xlim(), ax.get_ylim()
+        pad = 0.02 * max(high_x - low_x, high_y - low_y)
+        ax.set_xlim(min(low_x, x0 - pad), max(high_x, x1 + pad))
+        ax.set_ylim(min(low_y, y0 - pad), max(high_y, y1 + pad))
+
+
 def _draw_spine(ax, model: Model, eccentricity: float, lordosis: float, annotate: bool) -> np.ndarray:
     for name, corners in _vertebrae(model, eccentricity, lordosis):
         ax.add_patch(Polygon(corners * CM_PER_M, closed=True, fc="0.85", ec="0.4", lw=0.6, gid=f"vertebra {name}"))
@@ -300,20 +352,7 @@ def _draw_spine(ax, model: Model, eccentricity: float, lordosis: float, annotate
     ax.plot(*(points * CM_PER_M).T, "s", color="k", ms=3, gid=GIDS["spline"])
     cors = geometry.cor_positions(eccentricity, lordosis, model.geometry)
     ax.plot(*(cors * CM_PER_M).T, "o", mfc="white", mec="k", ms=5 if annotate else 3, gid=GIDS["cor"], zorder=4)
-    if annotate:
-        for name, (x, y) in zip(model.geometry.cor_names, cors * CM_PER_M, strict=True):
-            ax.annotate(
-                name,
-                (x, y),
-                xytext=(-8, 0),
-                textcoords="offset points",
-                ha="right",
-                va="center",
-                fontsize=7,
-                bbox=_LABEL_BOX,
-                zorder=5,
-                gid=f"cor label {name}",
-            )
+    if annotate:  # the CoRs' labels come with the torques' arrows (_label_cors)
         for label, (x, y) in zip(("P1", "P3", "P2"), points * CM_PER_M, strict=True):
             ax.annotate(
                 label, (x, y), xytext=(6, 0), textcoords="offset points", va="center", fontsize=7,
@@ -396,10 +435,12 @@ def draw_model(
     _draw_fibres(ax, model, pcsa_used)
     cors = _draw_spine(ax, model, eccentricity, lordosis, annotate)
     _draw_body(ax, model, eccentricity, lordosis, annotate)
-    tips = np.empty((0, 2))
+    tips, arrows = np.empty((0, 2)), {}
     if counter_torque and torques is not None:
-        _draw_counter_torques(ax, model, cors * CM_PER_M, torques)
+        arrows = _draw_counter_torques(ax, model, cors * CM_PER_M, torques)
         tips = cors - np.column_stack([torques * TORQUE_SCALE, np.zeros_like(torques)])
+    if annotate:
+        _label_cors(ax, model, cors * CM_PER_M, arrows)
     _limits(ax, model, cors, tips)
     if annotate:
         ax.set_xlabel("x [cm] (ventral / right →)")
@@ -414,4 +455,6 @@ def draw_model(
     else:
         ax.set_xticks([])
         ax.set_yticks([])
+    if arrows:  # after the title and axis labels: the layout they take decides the scale
+        _fit_labels(ax, [t for t in ax.texts if (t.get_gid() or "").startswith(("counter torque label", "cor label"))])
     return ax.figure

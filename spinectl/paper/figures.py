@@ -26,7 +26,7 @@ import xarray as xr
 from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
-from ..canvas import new_figure, save_figures, save_file
+from ..canvas import laid_out, new_figure, save_figures, save_file
 from ..errors import ParameterError
 from ..landscape import netcdf
 from ..model.chain import local_stiffness_per_pcsa
@@ -61,6 +61,8 @@ LINE_LEVELS = 6
 TITLE_CHARS = 56, 46
 """Characters a title line holds at fontsize 9: on the landscape axes (about 4 in wide) and on those of
 Figure 3 with the model drawn at its corners (about 3.4 in)."""
+_LINES = "contour lines"
+"""gid of a landscape's labelled contour lines."""
 
 _CONVENTION = {"paper": "eq. 2 as printed", "physical": "physical, -K in dM/dα"}
 """How a title names the passive-stiffness convention (docs/model.md, "Passive stiffness: two conventions")."""
@@ -235,10 +237,13 @@ def _levels(values: np.ma.MaskedArray, vmin: float | None, vmax: float | None):
     return np.linspace(low, high, LEVELS + 1), extend[(bool(values.min() < low), bool(values.max() > high))]
 
 
-def _landscape(field: xr.DataArray, title: str, label: str, vmin=None, vmax=None, fig=None, spec=None):
+def _landscape(
+    field: xr.DataArray, title: str, label: str, vmin=None, vmax=None, fig=None, spec=None, label_lines=True
+):
     """A filled contour of ``field`` (dims E, Lambda), contour lines labelled, A-D marked; returns (figure, axes).
 
-    Infeasible points (NaN) stay white, and the title says how many there are.
+    Infeasible points (NaN) stay white, and the title says how many there are. ``label_lines=False``
+    leaves the lines' values to :func:`_label_lines`, once everything else of the figure is drawn.
     """
     if field.sizes["E"] < 2 or field.sizes["Lambda"] < 2:  # a contour needs an area
         raise ParameterError(
@@ -261,13 +266,77 @@ def _landscape(field: xr.DataArray, title: str, label: str, vmin=None, vmax=None
         bar.locator = MaxNLocator(8, steps=NICE_STEPS)  # round ticks also on a given or shared range
         if values.max() > values.min():
             at = [v for v in _round_levels(values.min(), values.max(), LINE_LEVELS) if values.min() < v < values.max()]
-            lines = ax.contour(e, lam, values, levels=at or None, colors="k", linewidths=0.4, alpha=0.6)
-            for text in ax.clabel(lines, fmt="%.3g", fontsize=6):
-                text.set_clip_on(True)  # a label near the edge is cut, never drawn outside the axes
+            ax.contour(e, lam, values, levels=at or None, colors="k", linewidths=0.4, alpha=0.6, gid=_LINES)
     _shape(ax, e_m, lam_m)
     _mark_positions(ax, e_m, lam_m)
     _mark_readings(ax, e_m, lam_m)
+    if label_lines:
+        _label_lines(ax)
     return fig, ax
+
+
+def _label_lines(ax) -> None:
+    """Each contour line's value, clear of the labels of A-D and the corners as drawn.
+
+    matplotlib places a value where its line is straight enough, blind to other artists: the 20 cm²
+    of Figure 3 (K = 0) lay under B's label. So, as for the ±30 N m label (:func:`_label_place`), the
+    places are measured on the canvas after the layout (the labels' offsets are in points, the lines
+    in data units that the layout scales): a value whose box meets a mark's label, or is cut by the
+    axes' edge, moves along its own line to the nearest vertex where it is whole and meets no mark's
+    label and no other value, or is left out.
+    """
+    lines = next((c for c in ax.collections if c.get_gid() == _LINES), None)
+    if lines is None:
+        return
+    renderer = laid_out(ax.figure)  # the layout sizes the axes
+    pad = renderer.points_to_pixels(2.0)  # their boxes' padding (0.2 of a 9 pt font) lies outside a text's extent
+    labels = (t for t in ax.texts if (t.get_gid() or "").startswith("label"))  # A-D and the corners
+    marks = [t.get_window_extent(renderer).padded(pad) for t in labels]
+    ax.clabel(lines, fmt="%.3g", fontsize=6, inline=False)  # matplotlib's places, to be checked
+    frame = ax.get_window_extent(renderer)
+    places, boxes = [], []
+    for text in list(lines.labelTexts):
+        place = text.get_position()
+        if not _clear(text.get_window_extent(renderer), marks, frame):
+            place = _clear_place(lines, place, marks + boxes, frame, renderer)
+        if place is not None:
+            places.append(place)
+            boxes.append(_label_box(lines, *place, renderer))
+    while lines.labelTexts:
+        lines.pop_label()
+    for text in ax.clabel(lines, fmt="%.3g", fontsize=6, manual=places):  # the lines broken where labelled
+        text.set_clip_on(True)  # a label near the edge is cut, never drawn outside the axes
+
+
+def _clear(box, others, frame) -> bool:
+    """``box`` inside ``frame`` (not cut by the axes' edge) and meeting none of ``others`` (window extents)."""
+    inside = frame.x0 <= box.x0 and box.x1 <= frame.x1 and frame.y0 <= box.y0 and box.y1 <= frame.y1
+    return inside and not any(box.overlaps(other) for other in others)
+
+
+def _label_box(lines, x: float, y: float, renderer):
+    """The window extent of a value label at the point of ``lines`` nearest (x, y) [cm], as clabel draws it."""
+    lines.add_label_near(x, y, inline=False)
+    box = lines.labelTexts[-1].get_window_extent(renderer)
+    lines.pop_label()
+    return box
+
+
+def _clear_place(lines, start, keep_clear, frame, renderer, tries: int = 60):
+    """The vertex of the line through ``start`` [cm] nearest it whose value label meets nothing of ``keep_clear``
+    and lies inside ``frame``, away from the axes' edges (:data:`LABEL_MARGIN`); None if none does within
+    ``tries`` vertices. The same connected line only: matplotlib labels each of a level's lines once."""
+    segments = [segment for level in lines.allsegs for segment in level if len(segment)]
+    vertices = min(segments, key=lambda v: np.linalg.norm(v - np.asarray(start), axis=1).min())
+    ax = lines.axes
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    scaled = (vertices - (x0, y0)) / (x1 - x0, y1 - y0)
+    vertices = vertices[np.all((scaled >= LABEL_MARGIN) & (scaled <= 1 - LABEL_MARGIN), axis=1)]
+    order = np.argsort(np.linalg.norm(vertices - np.asarray(start), axis=1))
+    for x, y in vertices[order][:: max(1, len(order) // tries)]:
+        if _clear(_label_box(lines, x, y, renderer), keep_clear, frame):
+            return float(x), float(y)
+    return None
 
 
 def landscape_figure(field: xr.DataArray, title: str, label: str) -> Figure:
@@ -335,8 +404,9 @@ def min_pcsa_figure(
         return fig
     fig = new_figure(figsize=INSET_FIGURE_SIZE, layout="constrained")
     spec = fig.add_gridspec(3, 3, width_ratios=(1, 2.4, 1), height_ratios=(1, 2.4, 1))
-    _landscape(dataset["min_pcsa_cm2"], title, "minimum PCSA [cm²]", vmin, vmax, fig, spec[1, 1])
+    _, ax = _landscape(dataset["min_pcsa_cm2"], title, "minimum PCSA [cm²]", vmin, vmax, fig, spec[1, 1], False)
     _draw_corners(fig, spec, dataset)
+    _label_lines(ax)  # after the corners: the layout they change decides where the labels fall
     return fig
 
 
@@ -539,8 +609,7 @@ def _clear_of(ax, gid: str, contour) -> None:
     label = next((t for t in ax.texts if t.get_gid() == gid), None)
     if label is None:
         return
-    ax.figure.canvas.draw()  # the layout first: the label's offset is in points, the line in data
-    renderer = ax.figure.canvas.get_renderer()  # (draw_without_rendering would print a PNG to get one)
+    renderer = laid_out(ax.figure)  # the layout first: the label's offset is in points, the line in data
     paths = [ax.transData.transform_path(p) for p in contour.get_paths()]
     frame = ax.get_window_extent(renderer)
     first = label.xyann

@@ -277,6 +277,19 @@ def test_a_grid_out_of_range_names_the_spec_typed_and_the_spec_in_metres(tmp_pat
     assert code == 2 and "(got '0:0.5:3': 0 to 0.5 m)" in err and "if you meant" not in err
 
 
+def test_a_study_grid_out_of_range_is_one_line_naming_the_axis_as_written(tmp_path, capsys):
+    """``spinectl study`` says what ``spinectl sweep`` says, in the study file's words: exit 2, one line,
+    no store (the range [-0.1, 0.1] m: docs/model.md)."""
+    path, out_dir = tmp_path / "s.toml", tmp_path / "s.zarr"
+    path.write_text("[axes]\nE = { start = 0, stop = 8, num = 81 }\nLambda = [0.0]\n")
+    code, out, err = run(["study", str(path), "--out", str(out_dir)], capsys)
+    assert code == 2 and out == "" and err.count("\n") == 1 and not out_dir.exists()
+    assert err.startswith("spinectl: error: axes.E: must be in [-0.1, 0.1] m, the modelled range (got ")
+    assert err.rstrip().endswith(
+        "if you meant { start = 0, stop = 8, num = 81 } cm, give { start = 0, stop = 0.08, num = 81 }"
+    )
+
+
 def test_a_pcsa_in_square_metres_gets_a_warning_and_runs(capsys):
     """0.001 typed for 0.001 m^2 (10 cm^2): a warning naming --pcsa and the value to give; zeros and
     plausible values warn of nothing."""

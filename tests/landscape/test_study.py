@@ -88,7 +88,7 @@ BAD_STUDIES = [
     ("[axes]\nLambda = [0.0]\n", ParameterError, "axes.E", "is required"),
     ("[axes]\nE = { start = 0.0, stop = 0.08 }\nLambda = [0.0]\n", ParameterError, "axes.E", "missing num"),
     ("[axes]\nE = { start = 0.08, stop = 0.0, num = 3 }\nLambda = [0.0]\n", ParameterError, "axes.E.stop", ">= start"),
-    ("[axes]\nE = [0.5]\nLambda = [0.0]\n", ParameterError, "E", "must be in [-0.1, 0.1] m"),
+    ("[axes]\nE = [0.5]\nLambda = [0.0]\n", ParameterError, "axes.E", "must be in [-0.1, 0.1] m"),
     (study_with(more=NORMAL_MASS.format('distribution = "gauss", mean = 40.0, std = 1.0')), ParameterError,
      'samples.parameters."body.mass".distribution', "must be one of 'normal'"),
     (study_with(more=NORMAL_MASS.format('distribution = "normal", mean = 40.0')), ParameterError,
@@ -106,6 +106,39 @@ def test_study_file_errors_name_the_field(text, kind, field, needle):
     with pytest.raises(kind) as info:
         study.parse_study(text)
     assert info.value.field == field and needle in info.value.message
+
+
+@pytest.mark.parametrize(
+    ("axis", "got", "hint"),
+    [
+        ("E = { start = 0, stop = 8, num = 81 }", "'{ start = 0, stop = 8, num = 81 }': 0 to 8 m",
+         "; lengths are in metres: if you meant { start = 0, stop = 8, num = 81 } cm, "
+         "give { start = 0, stop = 0.08, num = 81 }"),
+        ("E = [0, 4, 8]", "'[0, 4, 8]': 0 to 8 m",
+         "; lengths are in metres: if you meant [0, 4, 8] cm, give [0, 0.04, 0.08]"),
+        ("E = [0, 1, 2, 3, 4, 5, 6, 7, 8]", "'[0, 1, 2, ..., 8]': 0 to 8 m",
+         "; lengths are in metres: if you meant [0, 1, 2, ..., 8] cm, give [0, 0.01, 0.02, ..., 0.08]"),
+        ("E = 0.5", "'0.5': 0.5 to 0.5 m", ""),  # 0.5 cm would be in range, but 0.5 m is no cm slip (5 x the range)
+    ],
+)  # fmt: skip
+def test_a_grid_out_of_range_is_named_as_written_with_a_cm_hint(axis, got, hint):
+    """Before: 'E: ... (got 0.2)', the first bad point, which the file never wrote; now the axis as the file
+    writes it, its extent and, where every value read as cm lies in the range, the same axis in metres
+    (the default model's range is [-0.1, 0.1] m: docs/model.md), as ``spinectl sweep --E 0:8:81`` says."""
+    with pytest.raises(ParameterError) as info:
+        study.parse_study(f"[axes]\n{axis}\nLambda = [0.0, 0.04]\n")
+    assert info.value.field == "axes.E"
+    assert info.value.message == f"must be in [-0.1, 0.1] m, the modelled range (got {got}){hint}"
+
+
+def test_set_applies_before_the_grid_is_checked(tmp_path):
+    """``--set`` on the base model is part of the study before its grid is checked: a wider range admits
+    the grid (before, the file's own model refused it first)."""
+    path = write(tmp_path, "[axes]\nE = [0.0, 0.15]\nLambda = [0.0]\n")
+    with pytest.raises(ParameterError, match="got '\\[0, 0.15\\]'"):
+        study.load_study(path)
+    widened = study.load_study(path, overrides=["geometry.eccentricity_range=[-0.2, 0.2]"])
+    assert widened.eccentricity == (0.0, 0.15)
 
 
 def test_a_draw_out_of_range_is_caught_before_any_work():

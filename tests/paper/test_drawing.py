@@ -189,3 +189,42 @@ def test_counter_torque_labels_touch_no_vertebra_arrow_or_point_label(model, e, 
     for k, label in enumerate(labels):
         assert not any(label.overlaps(other) for other in others), names[k]
         assert not any(label.overlaps(other) for other in labels[k + 1 :]), names[k]
+
+
+@pytest.mark.parametrize(("e", "lam"), [(0.03, 0.04), (0.08, 0.08), (0.02, 0.0), (0.0, 0.08), (0.08, 0.0)])
+def test_cor_labels_clear_every_arrow(model, e, lam):
+    """Measured by the renderer: no CoR's label lies on a counter-torque arrow or a torque label, nor on the
+    labels of P1, P3, P2. Left of its CoR (before) the label of L5S1 lay on its own arrow wherever CT > 0
+    (at E = 3, Lambda = 4 cm the optimum's CT of L5S1 is +24 N m; segment_stability)."""
+    fig = drawing.draw_model(model, e, lam, pcsa="optimum", counter_torque=True)
+    renderer = fig.canvas.get_renderer()
+    fig.draw_without_rendering()
+    artists = _artists(fig)
+    names = model.geometry.cor_names
+    others = [
+        *(artists[f"counter torque {name}"].arrow_patch.get_window_extent(renderer) for name in names),
+        *(_extent(artists[f"counter torque label {name}"], renderer) for name in names),
+        *(_extent(artists[f"point label {p}"], renderer) for p in ("P1", "P3", "P2")),
+    ]
+    for name in names:
+        label = _extent(artists[f"cor label {name}"], renderer)
+        assert not any(label.overlaps(other) for other in others), name
+
+
+@pytest.mark.parametrize(("e", "lam", "pcsa"), [(0.08, 0.0, 2.5e-3), (0.0, 0.08, 1.5e-3), (0.08, 0.08, 4e-3)])
+def test_the_labels_of_long_arrows_stay_inside_the_frame(model, e, lam, pcsa):
+    """Counter torques of about 100 N m and more (20 cm arrows and longer): every torque label and CoR label
+    lies whole inside the axes, measured by the renderer (before: the labels of long arrows crossed the
+    frame; the limits held the arrows' tips, not the labels beyond them)."""
+    given = np.full(3, pcsa)
+    torques = segment_stability(model, e, lam, given).counter_torque
+    assert np.abs(torques).max() >= 90.0  # the long arrows this test is about
+    fig = drawing.draw_model(model, e, lam, pcsa=given, counter_torque=True)
+    renderer = fig.canvas.get_renderer()
+    fig.draw_without_rendering()
+    frame = fig.axes[0].get_window_extent(renderer)
+    artists = _artists(fig)
+    for name in model.geometry.cor_names:
+        for gid in (f"counter torque label {name}", f"cor label {name}"):
+            box = _extent(artists[gid], renderer)
+            assert frame.x0 <= box.x0 and box.x1 <= frame.x1 and frame.y0 <= box.y0 and box.y1 <= frame.y1, gid

@@ -539,3 +539,28 @@ def test_c_s_label_clears_the_30_n_m_line_and_the_30_n_m_label_the_ridge(
     assert not _touches(c, line, renderer, pad=3)  # the round box's padding
     (label,) = [t for t in ax.texts if t.get_text() == "±30 N m"]
     assert not _touches(label, ridge, renderer)
+
+
+@pytest.mark.parametrize("stiffness", [0.0, 15.0])
+@pytest.mark.parametrize("points", [21, 81])
+def test_contour_values_clear_the_labels_of_a_to_d_and_the_corners(
+    wagner2012_landscapes, coarse_wagner2012, points, stiffness
+):
+    """Every contour line's value lies whole inside the axes and under no position's label, measured on the
+    canvas, in Figures 3 (alone and with the corner drawings) and 4 (before: the 20 cm² of Figure 3 and the
+    104 N m of Figure 4 lay under B's label at K = 0, on either grid)."""
+    dataset = (coarse_wagner2012 if points == 21 else wagner2012_landscapes[0]).sel(K=stiffness)
+    for fig in (
+        figures.min_pcsa_figure(dataset),
+        figures.min_pcsa_figure(dataset, insets=True),
+        figures.counter_torque_figure(dataset, 2.5e5),
+    ):
+        ax, renderer = _drawn(fig)
+        labels = _position_labels(ax, renderer)
+        assert {"label A", "label B", "label D"} <= set(labels)
+        values = [t.get_window_extent(renderer) for t in ax.texts if not t.get_gid()]
+        frame = ax.get_window_extent(renderer)
+        assert len(values) >= 4  # the lines are still labelled
+        for box in values:
+            assert not any(box.overlaps(label) for label in labels.values())
+            assert frame.x0 <= box.x0 and box.x1 <= frame.x1 and frame.y0 <= box.y0 and box.y1 <= frame.y1

@@ -13,7 +13,7 @@ import pytest
 from matplotlib.artist import Artist
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 
-from spinectl.canvas import new_figure, save_file
+from spinectl.canvas import laid_out, new_figure, save_file
 from spinectl.errors import OutputError
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -93,3 +93,29 @@ def test_a_png_is_the_file_that_savefig_writes(tmp_path):
     assert once.dpi == 72
     _laid_out_figure().savefig(tmp_path / "twice.png", dpi=90)
     assert (tmp_path / "once.png").read_bytes() == (tmp_path / "twice.png").read_bytes()
+
+
+@pytest.mark.parametrize("layout", ["constrained", None])
+def test_laid_out_measures_as_drawn_without_printing(layout, monkeypatch):
+    """After laid_out, an equal-aspect axes' box and a label's extent are those of the next draw (matplotlib's
+    own draw_without_rendering, the second method), and nothing was printed: a failing print_png (a full disk)
+    cannot fail there."""
+    fig = new_figure(figsize=(6, 4), layout=layout)
+    ax = fig.add_subplot()
+    ax.set_title("a title\nof two lines")
+    ax.set_xlim(0, 10)
+    ax.set_ylim(0, 2)
+    ax.set_aspect("equal")
+    label = ax.annotate("label", (5, 1), xytext=(8, 0), textcoords="offset points")
+
+    def refuse(*args, **kwargs):
+        raise OSError("printed")
+
+    monkeypatch.setattr(FigureCanvasAgg, "print_png", refuse)
+    renderer = laid_out(fig)
+    measured = ax.get_window_extent(renderer).bounds, label.get_window_extent(renderer).bounds
+    monkeypatch.undo()
+    fig.draw_without_rendering()
+    renderer = fig.canvas.get_renderer()
+    drawn = ax.get_window_extent(renderer).bounds, label.get_window_extent(renderer).bounds
+    np.testing.assert_allclose(measured, drawn, rtol=0, atol=1e-9)

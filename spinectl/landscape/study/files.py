@@ -11,7 +11,6 @@ values are validated by the dataclasses of :mod:`spinectl.landscape.study.spec`.
 
 from __future__ import annotations
 
-import dataclasses
 from pathlib import Path
 
 import numpy as np
@@ -21,9 +20,11 @@ from ..._validate import escaped, show
 from ...errors import ConfigError, ParameterError
 from ...model import config
 from ...model._toml import check_keys, check_table, flatten, parse, quoted_key, read_text
+from ...model.checks import check_axis_range
 from ...model.params import Model
+from ...units import CM_PER_M
 from .. import sweep
-from .spec import GRID, Axis, Sampled, Samples, Study
+from .spec import GRID, Axis, Sampled, Samples, Study, grid_axis
 
 SECTIONS = ("study", "model", "axes", "samples")
 """The sections of a study file."""
@@ -66,13 +67,10 @@ def load_study(path: str | Path, overrides=()) -> Study:
         text = read_text(path)
     except ConfigError as exc:
         raise ConfigError("study", exc.message) from None
-    study = parse_study(text, base_dir=path.parent, source=str(path))
-    if not overrides:
-        return study
-    return dataclasses.replace(study, model=config.apply_overrides(study.model, overrides))
+    return parse_study(text, base_dir=path.parent, source=str(path), overrides=overrides)
 
 
-def parse_study(text: str, base_dir: str | Path = ".", source: str = "study") -> Study:
+def parse_study(text: str, base_dir: str | Path = ".", source: str = "study", overrides=()) -> Study:
     """A :class:`~.spec.Study` from the text of a study file.
 
     Parameters
@@ -83,6 +81,9 @@ def parse_study(text: str, base_dir: str | Path = ".", source: str = "study") ->
         Folder against which ``study.config`` is resolved.
     source : str
         Where the text came from, for messages.
+    overrides : sequence of str
+        ``SECTION.FIELD=VALUE`` assignments on the base model, after its ``[model]``
+        (:func:`spinectl.model.config.apply_overrides`).
 
     Returns
     -------
@@ -95,7 +96,8 @@ def parse_study(text: str, base_dir: str | Path = ".", source: str = "study") ->
         Not TOML, an unknown section or key ("did you mean"), a section that is not a table,
         or a base model that cannot be loaded.
     ParameterError
-        A value is invalid, or ``axes.E`` or ``axes.Lambda`` is missing.
+        A value is invalid, or ``axes.E`` or ``axes.Lambda`` is missing or beyond the model's range
+        (named as written, with the value in metres where cm were likely meant).
     """
     try:
         data = parse(text, source)
@@ -111,10 +113,11 @@ def parse_study(text: str, base_dir: str | Path = ".", source: str = "study") ->
         if name not in axes:
             raise ParameterError(f"axes.{name}", "is required: a list of values or { start, stop, num } [m]")
     options = {k: head[k] for k in ("outputs", "chunk_size", "description") if k in head}
+    model = config.apply_overrides(_base_model(head, data.get("model"), Path(base_dir)), overrides)
     return Study(
-        model=_base_model(head, data.get("model"), Path(base_dir)),
-        eccentricity=_axis_values("axes.E", axes.pop("E")),
-        lordosis=_axis_values("axes.Lambda", axes.pop("Lambda")),
+        model=model,
+        eccentricity=_grid_axis("E", axes.pop("E"), model.geometry.eccentricity_range),
+        lordosis=_grid_axis("Lambda", axes.pop("Lambda"), model.geometry.lordosis_range),
         axes=tuple(Axis(name, _axis_values(quoted_key("axes", name), value)) for name, value in axes.items()),
         samples=_samples(data["samples"]) if "samples" in data else None,
         text=text,
@@ -135,6 +138,23 @@ def _axis_values(where: str, value) -> tuple:
     if start > stop:
         raise ParameterError(f"{where}.stop", f"must be >= start = {start:g} (got {stop:g})")
     return tuple(np.linspace(start, stop, num).tolist())
+
+
+def _grid_axis(name: str, written, bounds) -> tuple[float, ...]:
+    """A grid axis, refused beyond ``bounds`` [m] as written in the file: its range or its values, not a point."""
+    values = grid_axis(name, _axis_values(f"axes.{name}", written))
+    check_axis_range(f"axes.{name}", values, bounds, _toml_axis(written), _toml_axis(written, CM_PER_M))
+    return values
+
+
+def _toml_axis(written, scale: float = 1.0) -> str:
+    """An axis as the file writes it, its lengths divided by ``scale``; a long list shortened with ``...``."""
+    if isinstance(written, dict):
+        return f"{{ start = {written['start'] / scale:g}, stop = {written['stop'] / scale:g}, num = {written['num']} }}"
+    if not isinstance(written, list):
+        return f"{written / scale:g}"
+    shown = [f"{x / scale:g}" for x in written]
+    return "[" + ", ".join(shown if len(shown) <= 6 else [*shown[:3], "...", shown[-1]]) + "]"
 
 
 def _base_model(head: dict, overrides, base_dir: Path) -> Model:

@@ -83,6 +83,30 @@ def _scalar(where: str, value):
     return int(value) if isinstance(value, numbers.Integral) else number
 
 
+def grid_axis(name: str, values) -> tuple[float, ...]:
+    """A grid axis of a study, validated; errors name it as the study file does (``axes.E[2]``).
+
+    Parameters
+    ----------
+    name : str
+        ``"E"`` or ``"Lambda"``.
+    values : sequence of float
+        The axis [m]: distinct finite numbers, at least one.
+
+    Returns
+    -------
+    tuple of float
+        The values [m].
+
+    Raises
+    ------
+    ParameterError
+        Not numbers, not finite, repeated or empty.
+    """
+    values = _scalars(f"axes.{name}", values)
+    return tuple(v.real(f"axes.{name}[{i}]", x) for i, x in enumerate(values))
+
+
 def _check_name(where: str, parameter: str, model: Model) -> None:
     """``parameter`` must name one value of the model: a ConfigError ("did you mean") otherwise."""
     try:
@@ -305,7 +329,7 @@ class Study:
             raise ParameterError("study.axes", f"must be a sequence of Axis (got {show(self.axes)})")
         object.__setattr__(self, "axes", tuple(self.axes))
         for name, axis in zip(GRID, (self.eccentricity, self.lordosis), strict=True):
-            object.__setattr__(self, "eccentricity" if name == "E" else "lordosis", self._grid_axis(name, axis))
+            object.__setattr__(self, "eccentricity" if name == "E" else "lordosis", grid_axis(name, axis))
         if len(self.eccentricity) * len(self.lordosis) > sweep.MAX_GRID_POINTS:
             raise ParameterError("axes", f"the E x Lambda grid must have at most {sweep.MAX_GRID_POINTS:,} points")
         object.__setattr__(self, "outputs", self._outputs(self.outputs))
@@ -319,11 +343,6 @@ class Study:
         checked_shapes: set = set()  # geometry and muscles whose attachments passed on the whole grid
         for combination in np.ndindex(*self.shape):
             self._check_combination(combination, checked_shapes)
-
-    @staticmethod
-    def _grid_axis(name: str, values) -> tuple[float, ...]:
-        values = _scalars(f"axes.{name}", values)
-        return tuple(v.real(f"axes.{name}[{i}]", x) for i, x in enumerate(values))
 
     @staticmethod
     def _outputs(outputs) -> tuple[str, ...]:
