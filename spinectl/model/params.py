@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 
 from .. import _validate as v
 from ..errors import ParameterError
+from ..units import CM_PER_M, centimetre_slip
 
 SIDES = ("ventral", "dorsal")
 """Sides of an antagonistic pair: ``ventral`` is +x, ``dorsal`` its mirror at -x.
@@ -64,6 +65,64 @@ the upper end of force generation; a value beyond it is more likely milliseconds
 MAX_ACTIVATION = 10.0
 """Largest activation of the reflex section, a sanity bound: ten times the co-contraction that
 self-stability needs (a larger value is more likely a PCSA typed in place of a fraction)."""
+
+
+MAX_BODY_LENGTH = 1.0
+"""Largest length of the modelled trunk [m]: every height, coordinate, lever arm and radius of gyration of
+the model lies within the trunk from the pelvis to the head. Sitting height (seat to vertex) is about
+0.9 m in adults (Winter 2009, Biomechanics and Motor Control of Human Movement, fig. 4.1: 0.52 of body
+height) and the pelvic joint P2 lies above the seat, so no length of the model reaches 1 m; the paper's
+largest is the mass height, 0.326 m. A length typed in cm (``mass_height = 32.6``) is 30 times beyond."""
+
+SPECIFIC_TENSION_RANGE = (1e4, 1e7)
+"""Allowed ``fibre.specific_tension`` [N/m^2]: published values for human muscle lie between about
+2e5 and 1e6 N/m^2 (Buchanan TS 1995, J Biomech 28:1229-1233, doi:10.1016/0021-9290(95)00042-N, reviews
+them; the paper takes 25 N/cm^2 = 2.5e5 N/m^2); the range is an order of magnitude wider on both sides
+and still excludes N/cm^2 (25, a factor 1e4) and kPa (250, a factor 1e3) typed for N/m^2."""
+
+MAX_GRAVITY = 30.0
+"""Largest gravitational acceleration [m/s^2]: above Jupiter's 24.8; cm/s^2 (981) typed for m/s^2 is far beyond."""
+
+
+def _length(name: str, value, *, allow_zero: bool = False, signed: bool = False) -> float:
+    """A length of the trunk [m], at most :data:`MAX_BODY_LENGTH` in size, with the cm-for-m hint."""
+    if signed:
+        value = v.real(name, value)
+    else:
+        value = v.non_negative(name, value) if allow_zero else v.positive(name, value)
+    if abs(value) > MAX_BODY_LENGTH:
+        low = -MAX_BODY_LENGTH if signed else 0.0
+        hint = centimetre_slip(value, low, MAX_BODY_LENGTH, f"{value:g}", f"{value / CM_PER_M:g}")
+        raise ParameterError(
+            name,
+            f"must be at most {MAX_BODY_LENGTH:g} m{' in size' if signed else ''}, the modelled trunk's scale "
+            f"(got {value:g}){hint}",
+        )
+    return value
+
+
+def _specific_tension(value) -> float:
+    value = v.positive("specific_tension", value)
+    low, high = SPECIFIC_TENSION_RANGE
+    if low <= value <= high:
+        return value
+    hint = ""
+    for factor, unit in ((1e4, "N/cm^2"), (1e3, "kPa"), (1e6, "MPa")):  # the likely slips, in this order
+        if low <= value * factor <= high:
+            hint = f"; if you meant {value:g} {unit}, give {value * factor:g}"
+            break
+    raise ParameterError(
+        "specific_tension",
+        f"must be in [{low:g}, {high:g}] N/m^2, around published values of 2e5-1e6 N/m^2 (got {value:g}){hint}",
+    )
+
+
+def _gravity(value) -> float:
+    value = v.positive("gravity", value)
+    if value > MAX_GRAVITY:
+        hint = f"; if you meant {value:g} cm/s^2, give {value / CM_PER_M:g}" if value / CM_PER_M <= MAX_GRAVITY else ""
+        raise ParameterError("gravity", f"must be at most {MAX_GRAVITY:g} m/s^2 (got {value:g}){hint}")
+    return value
 
 
 def param(default, unit: str, doc: str):
@@ -131,9 +190,9 @@ class Body:
         _store(
             self,
             mass=_mass(self.mass),
-            mass_height=v.positive("mass_height", self.mass_height),
-            gravity=v.positive("gravity", self.gravity),
-            radius_of_gyration=v.non_negative("radius_of_gyration", self.radius_of_gyration),
+            mass_height=_length("mass_height", self.mass_height),
+            gravity=_gravity(self.gravity),
+            radius_of_gyration=_length("radius_of_gyration", self.radius_of_gyration, allow_zero=True),
         )
 
 
@@ -173,7 +232,7 @@ class Geometry:
                 "cor_names", f"must have one name per entry of cor_heights ({len(heights)}; got {len(names)})"
             )
         _store(self, cor_heights=heights, cor_names=names)
-        length = v.positive("spine_length", self.spine_length)
+        length = _length("spine_length", self.spine_length)
         _store(self, spine_length=length)
         if any(b >= a for a, b in zip(heights, heights[1:], strict=False)):
             raise ParameterError("cor_heights", f"must be strictly decreasing, top to bottom (got {list(heights)})")
@@ -181,7 +240,7 @@ class Geometry:
             raise ParameterError("cor_heights", f"must lie on the spine, in [0, spine_length={length:g}] m")
         v.choice("spline_bc", self.spline_bc, ("natural", "clamped", "not-a-knot"))
         for name in ("eccentricity_range", "lordosis_range"):
-            lo, hi = v.real_vector(name, getattr(self, name), 2)
+            lo, hi = (_length(name, x, signed=True) for x in v.real_vector(name, getattr(self, name), 2))
             if lo >= hi:
                 raise ParameterError(name, f"must be [low, high] with low < high (got [{lo:g}, {hi:g}])")
             _store(self, **{name: (lo, hi)})
@@ -219,7 +278,7 @@ class Fibre:
             raise ParameterError("eccentric_enhancement", f"must be > 1 (got {ecc:g})")
         _store(
             self,
-            specific_tension=v.positive("specific_tension", self.specific_tension),
+            specific_tension=_specific_tension(self.specific_tension),
             optimal_length_ratio=ratio,
             k1=v.positive("k1", self.k1),
             k2=v.positive("k2", self.k2),
@@ -255,8 +314,8 @@ class MusclePair:
 
     def __post_init__(self):
         name = v.label("name", self.name)
-        upper = v.real_vector("upper", self.upper, 2)
-        lower = v.real_vector("lower", self.lower, 2)
+        upper = tuple(_length("upper", x, signed=True) for x in v.real_vector("upper", self.upper, 2))
+        lower = tuple(_length("lower", x, signed=True) for x in v.real_vector("lower", self.lower, 2))
         if upper[1] <= lower[1]:
             raise ParameterError("upper", f"must lie above lower (got y {upper[1]:g} <= {lower[1]:g})")
         length = math.dist(upper, lower)
@@ -341,8 +400,8 @@ class Local:
         _store(
             self,
             stiffness_gain=v.positive("stiffness_gain", self.stiffness_gain),
-            lever_arm=v.positive("lever_arm", self.lever_arm),
-            length=v.positive("length", self.length),
+            lever_arm=_length("lever_arm", self.lever_arm),
+            length=_length("length", self.length),
             cost_weight=v.non_negative("cost_weight", self.cost_weight),
         )
 
@@ -385,7 +444,7 @@ class Levels:
         _store(
             self,
             mass=v.non_negative("mass", self.mass),
-            radius_of_gyration=v.non_negative("radius_of_gyration", self.radius_of_gyration),
+            radius_of_gyration=_length("radius_of_gyration", self.radius_of_gyration, allow_zero=True),
             weight_in_gravity=v.in_range("weight_in_gravity", self.weight_in_gravity, 0.0, 1.0),
         )
 
