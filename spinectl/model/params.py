@@ -106,11 +106,12 @@ def _specific_tension(value) -> float:
     low, high = SPECIFIC_TENSION_RANGE
     if low <= value <= high:
         return value
+    # the likely slip: the unit that brings the value nearest the paper's 2.5e5 N/m^2 (in decades)
+    slips = [(f, u) for f, u in ((1e4, "N/cm^2"), (1e3, "kPa"), (1e6, "MPa")) if low <= value * f <= high]
     hint = ""
-    for factor, unit in ((1e4, "N/cm^2"), (1e3, "kPa"), (1e6, "MPa")):  # the likely slips, in this order
-        if low <= value * factor <= high:
-            hint = f"; if you meant {value:g} {unit}, give {value * factor:g}"
-            break
+    if slips:
+        factor, unit = min(slips, key=lambda slip: abs(math.log10(value * slip[0] / 2.5e5)))
+        hint = f"; if you meant {value:g} {unit}, give {value * factor:g}"
     raise ParameterError(
         "specific_tension",
         f"must be in [{low:g}, {high:g}] N/m^2, around published values of 2e5-1e6 N/m^2 (got {value:g}){hint}",

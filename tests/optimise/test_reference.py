@@ -178,3 +178,24 @@ def test_stability_at_defaults_to_the_minimum_stabilising_pcsa(model):
     np.testing.assert_array_equal(given.eigenvalues, expected.eigenvalues)
     with pytest.raises(ModelError):
         reference.stability_at(_with(model, pcsa_max=1e-4), 0.0, 0.0)
+
+
+def test_a_computed_optimum_beyond_any_muscle_is_an_answer_not_a_unit_slip():
+    """A 1000 kg body on fibres of 1e4 N/m^2 (both inside the allowed ranges) needs more than the
+    1000 cm^2 that a *given* PCSA may have: stability_at reports it, as a sweep does, instead of
+    refusing its own optimum as m^2 typed for cm^2. With zero margins the problem is linear in m / sigma
+    (gravity stiffness m g r, muscle stiffness sigma PCSA; paper, eq. 2), so the optimum is exactly
+    (1000 / 40) x (2.5e5 / 1e4) = 625 times the preset's."""
+    from spinectl.model import config
+    from spinectl.model.checks import MAX_PLAUSIBLE_PCSA
+
+    base = config.load_preset("wagner2012")
+    base = base.replace(optimisation=dataclasses.replace(base.optimisation, stability_margin=0.0, damping_margin=0.0))
+    heavy = base.replace(
+        body=dataclasses.replace(base.body, mass=1000.0),
+        fibre=dataclasses.replace(base.fibre, specific_tension=1e4),
+    )
+    scale = (1000.0 / base.body.mass) * (base.fibre.specific_tension / 1e4)
+    result = reference.stability_at(heavy, 0.03, 0.04)
+    assert result.pcsa.max() > MAX_PLAUSIBLE_PCSA  # (zero margins: marginally stable by construction)
+    assert result.min_pcsa == pytest.approx(scale * reference.stability_at(base, 0.03, 0.04).min_pcsa, rel=1e-6)
