@@ -77,7 +77,9 @@ def model_with_overrides(args):
     Model
         The validated model.
     """
-    model = load_model(args, {dotted: getattr(args, option) for option, dotted in OVERRIDES})
+    model = load_model(
+        args, {dotted: ("--" + option.replace("_", "-"), getattr(args, option)) for option, dotted in OVERRIDES}
+    )
     return model  # --kp and --kd go to analyse, which checks them
 
 
@@ -96,6 +98,7 @@ def run(args) -> int:
         Exit code 0 (also for an infeasible optimum, reported as a status).
     """
     from ..reflex.margins import analyse
+
     if args.plot:
         from ..reflex.plots import PLOT_FILES
 

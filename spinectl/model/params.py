@@ -128,6 +128,15 @@ def _gravity(value) -> float:
     return value
 
 
+def _seconds(name: str, value, high: float) -> float:
+    """A time in [0, high] s, with the hint for milliseconds typed as seconds."""
+    value = v.real(name, value)
+    if not 0.0 <= value <= high:
+        hint = f"; if you meant {value:g} ms, give {value / 1e3:g}" if 0.0 < value / 1e3 <= high else ""
+        raise ParameterError(name, f"must be in [0, {high:g}] s (got {value:g}){hint}")
+    return value
+
+
 def param(default, unit: str, doc: str):
     """A dataclass field carrying its unit and documentation.
 
@@ -621,9 +630,9 @@ class Reflex:
             raise ParameterError("sim_perturbation", f"must be < sim_divergence = {limit:g} rad (got {kick:g})")
         _store(
             self,
-            delay=v.in_range("delay", self.delay, 0.0, MAX_DELAY),
-            activation_time_constant=v.in_range(
-                "activation_time_constant", self.activation_time_constant, 0.0, MAX_ACTIVATION_TIME_CONSTANT
+            delay=_seconds("delay", self.delay, MAX_DELAY),
+            activation_time_constant=_seconds(
+                "activation_time_constant", self.activation_time_constant, MAX_ACTIVATION_TIME_CONSTANT
             ),
             pade_order=v.integer("pade_order", self.pade_order, 1, MAX_PADE_ORDER),
             activation=v.in_range("activation", self.activation, 0.0, MAX_ACTIVATION),
