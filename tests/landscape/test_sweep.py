@@ -165,10 +165,13 @@ def test_write_sweep_one_k_is_a_scalar_landscape(model, tmp_path):
 
 
 def test_write_sweep_checks_its_file_before_solving(model, tmp_path, monkeypatch):
-    (tmp_path / "taken").mkdir()
+    (tmp_path / "taken.nc").mkdir()
     monkeypatch.setattr(sweep, "sweep", lambda *a, **k: pytest.fail("the sweep ran"))
     with pytest.raises(OutputError, match="cannot write"):
-        sweep.write_sweep(model, [0.0], [0.0], tmp_path / "taken")
+        sweep.write_sweep(model, [0.0], [0.0], tmp_path / "taken.nc")
+    with pytest.raises(ParameterError, match=r"--out: must end in \.nc"):  # NetCDF under another name
+        sweep.write_sweep(model, [0.0], [0.0], tmp_path / "x.csv")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["taken.nc"]
 
 
 def test_describe(landscape):
