@@ -616,13 +616,16 @@ def test_check_writable_fails_where_the_write_would_and_leaves_nothing(tmp_path)
 @pytest.mark.parametrize(
     ("argv", "job"),
     [
-        (["sweep", "--E", "0:0.08:3", "--Lambda", "0:0.08:3", "--out", "taken"], ("spinectl.landscape.sweep", "sweep")),
+        (
+            ["sweep", "--E", "0:0.08:3", "--Lambda", "0:0.08:3", "--out", "taken.nc"],
+            ("spinectl.landscape.sweep", "sweep"),
+        ),
         (["calibrate", "--grid", "3", "--history", "a_file/h.csv"], ("spinectl.paper.calibration", "calibrate")),
     ],
 )
 def test_long_jobs_check_their_outputs_before_they_start(tmp_path, monkeypatch, capsys, argv, job):
     """A typo in --out costs a second, not the run: the job itself is never called."""
-    (tmp_path / "taken").mkdir()
+    (tmp_path / "taken.nc").mkdir()
     (tmp_path / "a_file").write_text("keep")
     monkeypatch.setattr(importlib.import_module(job[0]), job[1], lambda *a, **k: pytest.fail("the job ran"))
     monkeypatch.chdir(tmp_path)
