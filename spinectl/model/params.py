@@ -74,13 +74,14 @@ the model lies within the trunk from the pelvis to the head. Sitting height (sea
 height) and the pelvic joint P2 lies above the seat, so no length of the model reaches 1 m; the paper's
 largest is the mass height, 0.326 m. A length typed in cm (``mass_height = 32.6``) is 30 times beyond."""
 
-SPECIFIC_TENSION_RANGE = (5e4, 1e7)
-"""Allowed ``fibre.specific_tension`` [N/m^2]: published values for human muscle lie between about
-2e5 and 1e6 N/m^2 (Buchanan TS 1995, J Biomech 28:1229-1233, doi:10.1016/0021-9290(95)00042-N, reviews
-them; the paper takes 25 N/cm^2 = 2.5e5 N/m^2); the range is four times wider below and ten times above,
-and still excludes N/cm^2 (25, a factor 1e4) and kPa (250, a factor 1e3) typed for N/m^2. The lower end
-also keeps the optimiser within the scales on which its statuses are verified (docs/robustness.md,
-"Large models"): at 1e4 N/m^2 with a 1000 kg body 1 m up, both solvers call feasible points infeasible."""
+SPECIFIC_TENSION_RANGE = (1e4, 1e7)
+"""Allowed ``fibre.specific_tension`` [N/m^2]: human values reported in vivo range from 2 to 73 N/cm^2
+(2e4 to 7.3e5 N/m^2; Persad LS et al. 2024, J Appl Physiol 137:945-962, doi:10.1152/japplphysiol.00296.2024,
+who recommend 26.8 N/cm^2), older estimates up to 137 N/cm^2 (Buchanan TS 1995, Med Eng Phys 17:529-536,
+doi:10.1016/1350-4533(95)00005-8); the paper takes 25 N/cm^2 = 2.5e5 N/m^2. The range is wider than all
+of them and still excludes N/cm^2 (25, a factor 1e4) and kPa (250, a factor 1e3) typed for N/m^2. Near
+its lower end with the heaviest, tallest bodies the optimiser's statuses are not reliable
+(docs/robustness.md, "Optimisation": large models)."""
 
 MAX_GRAVITY = 30.0
 """Largest gravitational acceleration [m/s^2]: above Jupiter's 24.8; cm/s^2 (981) typed for m/s^2 is far beyond."""

@@ -202,10 +202,11 @@ def test_a_computed_optimum_beyond_any_muscle_is_an_answer_not_a_unit_slip():
 
 
 @pytest.mark.parametrize("activation", ["paired", "independent"])
-def test_the_corner_of_the_allowed_ranges_keeps_the_statuses(activation):
-    """The largest problem the parameter ranges allow (1000 kg, 30 m/s^2, mass 1 m up, 5e4 N/m^2) is the
-    smaller one scaled by m g / sigma (zero margins: linear, paper eq. 2), so statuses are equal and the
-    minimum scales exactly. At 1e4 N/m^2 both solvers called these points infeasible (docs/robustness.md)."""
+def test_a_large_model_keeps_the_statuses(activation):
+    """A problem of minimum PCSA ~1e5 cm^2 (1000 kg, 30 m/s^2, mass 1 m up, 5e4 N/m^2) is the smaller one
+    scaled by m g / sigma (zero margins: linear, paper eq. 2), so statuses are equal and the minimum scales
+    exactly. At 1e4 N/m^2 (~5e5 cm^2) both solvers call some of these points infeasible: a documented
+    limit (docs/robustness.md, "large models")."""
     from spinectl.model import config
     from spinectl.optimise import active_set
 
