@@ -69,10 +69,10 @@ self-stability needs (a larger value is more likely a PCSA typed in place of a f
 
 MAX_BODY_LENGTH = 1.0
 """Largest length of the modelled trunk [m]: every height, coordinate, lever arm and radius of gyration of
-the model lies within the trunk from the pelvis to the head. Sitting height (seat to vertex) is about
-0.9 m in adults (Winter 2009, Biomechanics and Motor Control of Human Movement, fig. 4.1: 0.52 of body
-height) and the pelvic joint P2 lies above the seat, so no length of the model reaches 1 m; the paper's
-largest is the mass height, 0.326 m. A length typed in cm (``mass_height = 32.6``) is 30 times beyond."""
+the model lies within the trunk between the pelvis and the head, which spans about half of body height
+above the hip joint (Winter 2009, Biomechanics and Motor Control of Human Movement, fig. 4.1), some 0.9 m
+for a body 1.8 m tall; the paper's largest length is the mass height, 0.326 m. A length typed in cm
+(``mass_height = 32.6``) is 30 times beyond."""
 
 SPECIFIC_TENSION_RANGE = (1e4, 1e7)
 """Allowed ``fibre.specific_tension`` [N/m^2]: human values reported in vivo range from 2 to 73 N/cm^2
