@@ -316,3 +316,22 @@ def test_one_pass_refuses_models_that_differ_in_more_than_k(model):
         with pytest.raises(ParameterError) as info:
             sweep.passive_sweeps(models, E_AXIS, L_AXIS, progress=False)
         assert info.value.field == "models"
+
+
+def test_sweep_and_stability_agree_on_an_optimum_beyond_any_muscle():
+    """A 1000 kg body on fibres of 5e4 N/m^2 needs more than 1000 cm^2 per muscle: the sweep and
+    `stability` (which refused its own optimum as a unit slip before) give the same number."""
+    import dataclasses
+
+    from spinectl.optimise.reference import stability_at
+
+    base = config.load_preset("wagner2012")
+    heavy = base.replace(
+        body=dataclasses.replace(base.body, mass=1000.0),
+        fibre=dataclasses.replace(base.fibre, specific_tension=5e4),
+    )
+    landscape = sweep.sweep(heavy, [0.03], [0.04], progress=False)
+    point = stability_at(heavy, 0.03, 0.04)
+    assert str(landscape["status"].values[0, 0]) == "optimal"
+    assert landscape["pcsa_cm2"].values[0, 0].max() > 1000.0
+    np.testing.assert_allclose(landscape["min_pcsa_cm2"].values[0, 0], point.min_pcsa * 1e4, rtol=1e-6)
