@@ -117,7 +117,7 @@ def _specific_tension(value) -> float:
         hint = f"; if you meant {value:g} {unit}, give {value * factor:g}"
     raise ParameterError(
         "specific_tension",
-        f"must be in [{low:g}, {high:g}] N/m^2, around published values of 2e5-1e6 N/m^2 (got {value:g}){hint}",
+        f"must be in [{low:g}, {high:g}] N/m^2, around reported human values (2-137 N/cm^2) (got {value:g}){hint}",
     )
 
 

@@ -26,8 +26,8 @@ from spinectl.model.params import Body, Fibre, Geometry, Local, Model, MusclePai
         # the paper's 25 N/cm^2 typed without the conversion to N/m^2 (x 1e4)
         (
             lambda: Fibre(specific_tension=25.0),
-            "specific_tension: must be in [10000, 1e+07] N/m^2, around "
-            "published values of 2e5-1e6 N/m^2 (got 25); if you meant 25 N/cm^2, give 250000",
+            "specific_tension: must be in [10000, 1e+07] N/m^2, around reported human values (2-137 N/cm^2) "
+            "(got 25); if you meant 25 N/cm^2, give 250000",
         ),
         (lambda: Fibre(specific_tension=250.0), "if you meant 250 kPa, give 250000"),
         (
