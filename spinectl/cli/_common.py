@@ -159,16 +159,46 @@ def load_model(args: argparse.Namespace, aliases: dict | None = None) -> Model:
         Parsed arguments with ``config``, ``preset`` and ``assignments`` (see :func:`add_model_options`).
     aliases : dict, optional
         A command's options that are aliases of ``--set`` (e.g. ``--K`` for ``passive.stiffness``):
-        value by dotted field; None values (options not given) are skipped. Applied after ``--set``.
+        ``(option, value)`` by dotted field; None values (options not given) are skipped.
 
     Returns
     -------
     Model
         The validated model; its source names the preset, the file and every overridden field.
+
+    Raises
+    ------
+    ParameterError
+        An option given together with ``--set`` of the same field (which would win is no one's guess).
     """
-    model = apply_overrides(load_config(args.config, preset=args.preset), getattr(args, "assignments", []))
-    given = {dotted: value for dotted, value in (aliases or {}).items() if value is not None}
+    assignments = getattr(args, "assignments", None) or []
+    given = {dotted: value for dotted, (_, value) in (aliases or {}).items() if value is not None}
+    refuse_set_twice(
+        assignments, {dotted: option for dotted, (option, _) in (aliases or {}).items() if dotted in given}
+    )
+    model = apply_overrides(load_config(args.config, preset=args.preset), assignments)
     return set_parameters(model, given) if given else model
+
+
+def refuse_set_twice(assignments: list[str], options: dict) -> None:
+    """Refuse ``--set FIELD=...`` together with an option that sets the same field.
+
+    Parameters
+    ----------
+    assignments : list of str
+        The ``--set`` arguments, ``SECTION.FIELD=VALUE``.
+    options : dict
+        Option (e.g. ``"--K"``) by the dotted field it sets, for the options given.
+
+    Raises
+    ------
+    ParameterError
+        Naming the option and the field.
+    """
+    for text in assignments:
+        dotted = text.partition("=")[0].strip()
+        if dotted in options:
+            raise ParameterError(options[dotted], f"sets {dotted}, as does --set {dotted}: give one of them")
 
 
 def finite_float(name: str):

@@ -117,7 +117,7 @@ def run(args) -> int:
         parameters = calibration.with_bounds(parameters, *_bounds(text))
     conventions = [c.strip() for c in args.conventions.split(",") if c.strip()]
     check_distinct({"--out": args.out, "--history": args.history}, {"--config": args.config})
-    base = load_model(args, {"optimisation.activation": args.activation})
+    base = load_model(args, {"optimisation.activation": ("--activation", args.activation)})
     for path in filter(None, (args.out, args.history)):
         check_writable(path)  # before minutes of fitting
     result = calibration.calibrate(

@@ -84,7 +84,8 @@ def run(args) -> int:
         from ..reflex.plots import PLOT_FILES
 
         check_distinct({"--plot": [Path(args.plot, name) for name in PLOT_FILES]}, {"--config": args.config})
-    model = load_model(args, {dotted: getattr(args, option) for option, dotted in OVERRIDES})
+    aliases = {dotted: ("--" + option.replace("_", "-"), getattr(args, option)) for option, dotted in OVERRIDES}
+    model = load_model(args, aliases)  # --kp and --kd go to analyse, which checks them
     check_position(model, args)
     if args.coupled:
         return _coupled(model, args)

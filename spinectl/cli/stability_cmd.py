@@ -38,7 +38,9 @@ def register(sub) -> None:
         "(default: the minimum stabilising PCSA, the optimiser's chosen activation)",
     )
     parser.add_argument(
-        "--K", type=finite_float("--K"), help="passive stiffness K [N m/rad] (alias of --set passive.stiffness=K)"
+        "--K",
+        type=finite_float("--K"),
+        help="passive stiffness K [N m/rad] (alias of --set passive.stiffness=K; not both)",
     )
     parser.add_argument(
         "--coupled",
@@ -67,7 +69,7 @@ def run(args) -> int:
     """
     from ..optimise.reference import NoStabilisingActivation, stability_at
 
-    model = load_model(args, {"passive.stiffness": args.K})
+    model = load_model(args, {"passive.stiffness": ("--K", args.K)})
     check_position(model, args)
     given = args.pcsa is not None  # else the minimum stabilising PCSA
     analysis = stability_at

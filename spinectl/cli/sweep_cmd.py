@@ -5,7 +5,7 @@ from __future__ import annotations
 import time
 
 from ..atomic import check_distinct
-from ._common import add_model_options, float_list, load_model
+from ._common import add_model_options, float_list, load_model, refuse_set_twice
 
 DEFAULT_AXIS = "0:0.08:81"
 """The paper's grid: 0 to 8 cm in 1 mm steps (paper, Methods)."""
@@ -46,7 +46,9 @@ def _options(parser) -> None:
     parser.add_argument(
         "--coupled", action="store_true", help="also the coupled chain's least local stiffness and joint optimum (SDPs)"
     )
-    parser.add_argument("--out", required=True, metavar="FILE.nc", help="NetCDF file to write (atomically)")
+    parser.add_argument(
+        "--out", required=True, metavar="FILE.nc", help="NetCDF file to write (atomically; must end in .nc)"
+    )
     add_model_options(parser)
 
 
@@ -66,6 +68,8 @@ def run(args) -> int:
     from ..landscape import sweep
 
     check_distinct({"--out": args.out}, {"--config": args.config})
+    if args.K:
+        refuse_set_twice(args.assignments or [], {"passive.stiffness": "--K"})
     model = load_model(args)
     geometry = model.geometry
     e_axis = sweep.parse_grid(args.E, "--E", geometry.eccentricity_range)

@@ -10,6 +10,8 @@ resolved configuration; docs/optimisation.md lists the schema with units.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import xarray as xr
 from tqdm import tqdm
@@ -55,7 +57,8 @@ def parse_grid(spec: str, name: str, bounds: tuple[float, float] | None = None) 
     Raises
     ------
     ParameterError
-        Naming ``name`` (e.g. ``"--E"``) and the allowed form, or the range and the spec as typed.
+        Naming ``name`` (e.g. ``"--E"``) and the allowed form (NUM = 1 only with START = STOP), or the
+        range and the spec as typed.
     """
     parts = spec.split(":")
     try:
@@ -67,6 +70,10 @@ def parse_grid(spec: str, name: str, bounds: tuple[float, float] | None = None) 
     if len(parts) != 3 or not 1 <= num <= MAX_GRID_POINTS or not start <= stop or not np.isfinite([start, stop]).all():
         raise ParameterError(
             name, f"must be START:STOP:NUM with START <= STOP and 1 <= NUM <= {MAX_GRID_POINTS:,} (got {spec!r})"
+        )
+    if num == 1 and start != stop:  # linspace would keep START alone, silently dropping STOP
+        raise ParameterError(
+            name, f"with NUM = 1 must have START = STOP, or give the single value alone, e.g. {start:g} (got {spec!r})"
         )
     axis = np.linspace(start, stop, num)
     _check_bounds(axis, spec, name, bounds)
@@ -276,8 +283,10 @@ def write_sweep(model: Model, eccentricity, lordosis, path, *, stiffnesses=None,
     OutputError
         ``path`` cannot be written.
     ParameterError
-        A bad option or K.
+        A bad option or K, or ``path`` not ending in ``.nc`` (named ``--out``, as the CLI's option).
     """
+    if Path(path).suffix.lower() != ".nc":  # NetCDF under another name (x.csv) misleads every reader
+        raise ParameterError("--out", f"must end in .nc: the sweep is written as NetCDF (got {str(path)!r})")
     check_writable(path)
     stiffnesses = list(stiffnesses or [model.passive.stiffness])
     if len(stiffnesses) == 1:
@@ -320,4 +329,5 @@ def describe(dataset: xr.Dataset) -> str:
     if inaccurate:
         ranges += f"; WARNING: {inaccurate} inaccurate (status optimal_inaccurate: values may be far off)"
     model = f"{dataset.attrs['model']}: " if "model" in dataset.attrs else ""
-    return f"{model}{status.size} points ({int(ok.sum())} solved, {int((~ok).sum())} infeasible or failed){ranges}"
+    points = "1 point" if status.size == 1 else f"{status.size} points"
+    return f"{model}{points} ({int(ok.sum())} solved, {int((~ok).sum())} infeasible or failed){ranges}"

@@ -280,7 +280,7 @@ largest human muscle's (the soleus, about 230 cm^2; Ward SR et al. 2009, Clin Or
 API means m^2 (``pcsa=[10, 10, 10]``)."""
 
 
-def expand_pcsa(model: Model, pcsa) -> np.ndarray:
+def expand_pcsa(model: Model, pcsa, *, given: bool = True) -> np.ndarray:
     """Per-muscle PCSA [m^2] from per-muscle (2 n values) or per-pair (n values, each side) input.
 
     With n values, both muscles of pair j get ``pcsa[j]`` (paired activation).
@@ -291,6 +291,10 @@ def expand_pcsa(model: Model, pcsa) -> np.ndarray:
         Supplies the muscle pairs.
     pcsa : array_like, shape (..., n) or (..., 2 n)
         PCSA [m^2], finite and >= 0.
+    given : bool
+        True (the default): the caller gave the PCSA, and one above :data:`MAX_PLAUSIBLE_PCSA` is
+        refused as a unit slip. False: spinectl computed it (a minimum stabilising PCSA), which is an
+        answer whatever its size: a heavy body with weak fibres needs more than any muscle has.
 
     Returns
     -------
@@ -301,7 +305,7 @@ def expand_pcsa(model: Model, pcsa) -> np.ndarray:
     Raises
     ------
     ParameterError
-        Neither n nor 2 n values, a value negative or not finite, or one above
+        Neither n nor 2 n values, a value negative or not finite, or (``given``) one above
         :data:`MAX_PLAUSIBLE_PCSA` (most likely cm^2 given where m^2 are meant).
     """
     pcsa = np.asarray(pcsa, float)
@@ -315,7 +319,7 @@ def expand_pcsa(model: Model, pcsa) -> np.ndarray:
         )
     if not np.all(np.isfinite(pcsa)) or np.any(pcsa < 0):
         raise ParameterError("pcsa", "must be finite and >= 0")
-    if np.any(pcsa > MAX_PLAUSIBLE_PCSA):
+    if given and np.any(pcsa > MAX_PLAUSIBLE_PCSA):
         largest = float(pcsa.max())
         raise ParameterError(
             "pcsa",

@@ -11,6 +11,7 @@ loaded or changed here carries its :class:`~spinectl.model.source.ModelSource`.
 from __future__ import annotations
 
 import dataclasses
+import difflib
 import hashlib
 import tomllib
 import warnings
@@ -188,10 +189,32 @@ def _muscles(base: list, given, mode: str, source: str) -> list:
         if pair["name"] in names:
             out[names.index(pair["name"])].update(pair)
         else:
+            _check_new_pair(pair, i, names)
             out.append(dict(pair))
             names.append(pair["name"])
         from_dict(MusclePair, out[names.index(pair["name"])], f"muscles.{i}")  # errors name the file's table
     return out
+
+
+NEW_PAIR_REQUIRED = ("upper", "lower")
+"""Keys that a ``[[muscles]]`` table must give when its name is new: the attachments that no default
+can supply (MusclePair's defaults are one pair's; a misspelt name would silently copy them)."""
+
+
+def _check_new_pair(pair: dict, index: int, names: list) -> None:
+    """Raise unless a pair that is not the preset's gives its attachments; suggest the name meant."""
+    missing = [key for key in NEW_PAIR_REQUIRED if key not in pair]
+    if not missing:
+        return
+    name = pair["name"]
+    from_dict(MusclePair, {"name": name}, f"muscles.{index}")  # a name that is no name: that error first
+    close = difflib.get_close_matches(name, names, n=1)
+    hint = f"; did you mean {close[0]!r}?" if close else f" (the pairs are {', '.join(map(repr, names))})"
+    raise ConfigError(
+        f"muscles.{index}.{missing[0]}",
+        f"is required for the new pair {show(name)}: a pair that is not the preset's gives its attachments "
+        f"{' and '.join(NEW_PAIR_REQUIRED)} [m]{hint}",
+    )
 
 
 def _deep_merge(base: dict, new: dict) -> dict:

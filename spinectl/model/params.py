@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 
 from .. import _validate as v
 from ..errors import ParameterError
+from ..units import CM_PER_M, centimetre_slip
 
 SIDES = ("ventral", "dorsal")
 """Sides of an antagonistic pair: ``ventral`` is +x, ``dorsal`` its mirror at -x.
@@ -64,6 +65,77 @@ the upper end of force generation; a value beyond it is more likely milliseconds
 MAX_ACTIVATION = 10.0
 """Largest activation of the reflex section, a sanity bound: ten times the co-contraction that
 self-stability needs (a larger value is more likely a PCSA typed in place of a fraction)."""
+
+
+MAX_BODY_LENGTH = 1.0
+"""Largest length of the modelled trunk [m]: every height, coordinate, lever arm and radius of gyration of
+the model lies within the trunk between the pelvis and the head, which spans about half of body height
+above the hip joint (Winter 2009, Biomechanics and Motor Control of Human Movement, fig. 4.1), some 0.9 m
+for a body 1.8 m tall; the paper's largest length is the mass height, 0.326 m. A length typed in cm
+(``mass_height = 32.6``) is 30 times beyond."""
+
+SPECIFIC_TENSION_RANGE = (1e4, 1e7)
+"""Allowed ``fibre.specific_tension`` [N/m^2]: human values reported in vivo range from 2 to 73 N/cm^2
+(2e4 to 7.3e5 N/m^2; Persad LS et al. 2024, J Appl Physiol 137:945-962, doi:10.1152/japplphysiol.00296.2024,
+who recommend 26.8 N/cm^2), older estimates up to 137 N/cm^2 (Buchanan TS 1995, Med Eng Phys 17:529-536,
+doi:10.1016/1350-4533(95)00005-8); the paper takes 25 N/cm^2 = 2.5e5 N/m^2. The range is wider than all
+of them and still excludes N/cm^2 (25, a factor 1e4) and kPa (250, a factor 1e3) typed for N/m^2. Near
+its lower end with the heaviest, tallest bodies the optimiser's statuses are not reliable
+(docs/robustness.md, "Optimisation": large models)."""
+
+MAX_GRAVITY = 30.0
+"""Largest gravitational acceleration [m/s^2]: above Jupiter's 24.8; cm/s^2 (981) typed for m/s^2 is far beyond."""
+
+
+def _length(name: str, value, *, allow_zero: bool = False, signed: bool = False) -> float:
+    """A length of the trunk [m], at most :data:`MAX_BODY_LENGTH` in size, with the cm-for-m hint."""
+    if signed:
+        value = v.real(name, value)
+    else:
+        value = v.non_negative(name, value) if allow_zero else v.positive(name, value)
+    if abs(value) > MAX_BODY_LENGTH:
+        low = -MAX_BODY_LENGTH if signed else 0.0
+        hint = centimetre_slip(value, low, MAX_BODY_LENGTH, f"{value:g}", f"{value / CM_PER_M:g}")
+        raise ParameterError(
+            name,
+            f"must be at most {MAX_BODY_LENGTH:g} m{' in size' if signed else ''}, the modelled trunk's scale "
+            f"(got {value:g}){hint}",
+        )
+    return value
+
+
+def _specific_tension(value) -> float:
+    value = v.positive("specific_tension", value)
+    low, high = SPECIFIC_TENSION_RANGE
+    if low <= value <= high:
+        return value
+    # the likely slip: the unit that brings the value nearest the paper's 2.5e5 N/m^2 (in decades)
+    slips = [(f, u) for f, u in ((1e4, "N/cm^2"), (1e3, "kPa"), (1e6, "MPa")) if low <= value * f <= high]
+    hint = ""
+    if slips:
+        factor, unit = min(slips, key=lambda slip: abs(math.log10(value * slip[0] / 2.5e5)))
+        hint = f"; if you meant {value:g} {unit}, give {value * factor:g}"
+    raise ParameterError(
+        "specific_tension",
+        f"must be in [{low:g}, {high:g}] N/m^2, around reported human values (2-137 N/cm^2) (got {value:g}){hint}",
+    )
+
+
+def _gravity(value) -> float:
+    value = v.positive("gravity", value)
+    if value > MAX_GRAVITY:
+        hint = f"; if you meant {value:g} cm/s^2, give {value / CM_PER_M:g}" if value / CM_PER_M <= MAX_GRAVITY else ""
+        raise ParameterError("gravity", f"must be at most {MAX_GRAVITY:g} m/s^2 (got {value:g}){hint}")
+    return value
+
+
+def _seconds(name: str, value, high: float) -> float:
+    """A time in [0, high] s, with the hint for milliseconds typed as seconds."""
+    value = v.real(name, value)
+    if not 0.0 <= value <= high:
+        hint = f"; if you meant {value:g} ms, give {value / 1e3:g}" if 0.0 < value / 1e3 <= high else ""
+        raise ParameterError(name, f"must be in [0, {high:g}] s (got {value:g}){hint}")
+    return value
 
 
 def param(default, unit: str, doc: str):
@@ -131,9 +203,9 @@ class Body:
         _store(
             self,
             mass=_mass(self.mass),
-            mass_height=v.positive("mass_height", self.mass_height),
-            gravity=v.positive("gravity", self.gravity),
-            radius_of_gyration=v.non_negative("radius_of_gyration", self.radius_of_gyration),
+            mass_height=_length("mass_height", self.mass_height),
+            gravity=_gravity(self.gravity),
+            radius_of_gyration=_length("radius_of_gyration", self.radius_of_gyration, allow_zero=True),
         )
 
 
@@ -173,7 +245,7 @@ class Geometry:
                 "cor_names", f"must have one name per entry of cor_heights ({len(heights)}; got {len(names)})"
             )
         _store(self, cor_heights=heights, cor_names=names)
-        length = v.positive("spine_length", self.spine_length)
+        length = _length("spine_length", self.spine_length)
         _store(self, spine_length=length)
         if any(b >= a for a, b in zip(heights, heights[1:], strict=False)):
             raise ParameterError("cor_heights", f"must be strictly decreasing, top to bottom (got {list(heights)})")
@@ -181,7 +253,7 @@ class Geometry:
             raise ParameterError("cor_heights", f"must lie on the spine, in [0, spine_length={length:g}] m")
         v.choice("spline_bc", self.spline_bc, ("natural", "clamped", "not-a-knot"))
         for name in ("eccentricity_range", "lordosis_range"):
-            lo, hi = v.real_vector(name, getattr(self, name), 2)
+            lo, hi = (_length(name, x, signed=True) for x in v.real_vector(name, getattr(self, name), 2))
             if lo >= hi:
                 raise ParameterError(name, f"must be [low, high] with low < high (got [{lo:g}, {hi:g}])")
             _store(self, **{name: (lo, hi)})
@@ -219,7 +291,7 @@ class Fibre:
             raise ParameterError("eccentric_enhancement", f"must be > 1 (got {ecc:g})")
         _store(
             self,
-            specific_tension=v.positive("specific_tension", self.specific_tension),
+            specific_tension=_specific_tension(self.specific_tension),
             optimal_length_ratio=ratio,
             k1=v.positive("k1", self.k1),
             k2=v.positive("k2", self.k2),
@@ -255,8 +327,8 @@ class MusclePair:
 
     def __post_init__(self):
         name = v.label("name", self.name)
-        upper = v.real_vector("upper", self.upper, 2)
-        lower = v.real_vector("lower", self.lower, 2)
+        upper = tuple(_length("upper", x, signed=True) for x in v.real_vector("upper", self.upper, 2))
+        lower = tuple(_length("lower", x, signed=True) for x in v.real_vector("lower", self.lower, 2))
         if upper[1] <= lower[1]:
             raise ParameterError("upper", f"must lie above lower (got y {upper[1]:g} <= {lower[1]:g})")
         length = math.dist(upper, lower)
@@ -341,8 +413,8 @@ class Local:
         _store(
             self,
             stiffness_gain=v.positive("stiffness_gain", self.stiffness_gain),
-            lever_arm=v.positive("lever_arm", self.lever_arm),
-            length=v.positive("length", self.length),
+            lever_arm=_length("lever_arm", self.lever_arm),
+            length=_length("length", self.length),
             cost_weight=v.non_negative("cost_weight", self.cost_weight),
         )
 
@@ -385,7 +457,7 @@ class Levels:
         _store(
             self,
             mass=v.non_negative("mass", self.mass),
-            radius_of_gyration=v.non_negative("radius_of_gyration", self.radius_of_gyration),
+            radius_of_gyration=_length("radius_of_gyration", self.radius_of_gyration, allow_zero=True),
             weight_in_gravity=v.in_range("weight_in_gravity", self.weight_in_gravity, 0.0, 1.0),
         )
 
@@ -559,9 +631,9 @@ class Reflex:
             raise ParameterError("sim_perturbation", f"must be < sim_divergence = {limit:g} rad (got {kick:g})")
         _store(
             self,
-            delay=v.in_range("delay", self.delay, 0.0, MAX_DELAY),
-            activation_time_constant=v.in_range(
-                "activation_time_constant", self.activation_time_constant, 0.0, MAX_ACTIVATION_TIME_CONSTANT
+            delay=_seconds("delay", self.delay, MAX_DELAY),
+            activation_time_constant=_seconds(
+                "activation_time_constant", self.activation_time_constant, MAX_ACTIVATION_TIME_CONSTANT
             ),
             pade_order=v.integer("pade_order", self.pade_order, 1, MAX_PADE_ORDER),
             activation=v.in_range("activation", self.activation, 0.0, MAX_ACTIVATION),

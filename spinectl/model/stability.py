@@ -338,7 +338,9 @@ class StabilityResult:
         return "\n".join(lines)
 
 
-def segment_stability(model: Model, eccentricity: float, lordosis: float, pcsa) -> StabilityResult:
+def segment_stability(
+    model: Model, eccentricity: float, lordosis: float, pcsa, *, given: bool = True
+) -> StabilityResult:
     """Jacobian eigenvalues, self-stability and counter torque of every segment.
 
     The analysis of the paper [1]_ (Methods, Stability analysis and calculation of
@@ -351,6 +353,9 @@ def segment_stability(model: Model, eccentricity: float, lordosis: float, pcsa) 
         E and Lambda [m], inside the modelled range.
     pcsa : array_like
         PCSA [m^2], per pair (n values) or per muscle (2 n values); see :func:`expand_pcsa`.
+    given : bool
+        False for a PCSA that spinectl computed: not checked against the plausible size of a
+        typed one (:func:`expand_pcsa`).
 
     Returns
     -------
@@ -374,7 +379,7 @@ def segment_stability(model: Model, eccentricity: float, lordosis: float, pcsa) 
        Model 9:13. doi:10.1186/1742-4682-9-13
     """
     coeffs = checked_coefficients(model, float(eccentricity), float(lordosis))
-    pcsa = expand_pcsa(model, pcsa)
+    pcsa = expand_pcsa(model, pcsa, given=given)
     with arithmetic_guard(eccentricity, lordosis):  # e.g. a PCSA of 1e300 cm^2
         stiffness = coeffs.stiffness(pcsa)
         damping = coeffs.damping(pcsa)

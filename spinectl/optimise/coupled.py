@@ -534,7 +534,9 @@ def _result(model: Model, data: CoupledData, e: float, lam: float, status: str, 
     return CoupledOptimum(e, lam, status, pcsa, k, chain.local_pcsa(k, model), counter_torque, margin)
 
 
-def least_local_stiffness(model: Model, eccentricity: float, lordosis: float, pcsa) -> CoupledOptimum:
+def least_local_stiffness(
+    model: Model, eccentricity: float, lordosis: float, pcsa, *, given: bool = True
+) -> CoupledOptimum:
     """(a) The least local stiffness that makes the chain stable at a global activation.
 
     Parameters
@@ -545,6 +547,8 @@ def least_local_stiffness(model: Model, eccentricity: float, lordosis: float, pc
     pcsa : array_like
         Global PCSA [m^2], one value per pair (both sides) or per muscle, whatever
         ``optimisation.activation`` says.
+    given : bool
+        False for a PCSA that spinectl computed (:func:`spinectl.model.checks.expand_pcsa`).
 
     Returns
     -------
@@ -564,9 +568,9 @@ def least_local_stiffness(model: Model, eccentricity: float, lordosis: float, pc
     Bergmark A (1989). Stability of the lumbar spine. A study in mechanical engineering.
     Acta Orthop Scand Suppl 230:1-54. doi:10.3109/17453678909154177.
     """
-    given = model.replace(optimisation=dataclasses.replace(model.optimisation, activation="independent"))
-    data = coupled_data(given, eccentricity, lordosis)  # one variable per muscle: x = pcsa in cm^2
-    x = expand_pcsa(model, pcsa) / M2_PER_CM2
+    independent = model.replace(optimisation=dataclasses.replace(model.optimisation, activation="independent"))
+    data = coupled_data(independent, eccentricity, lordosis)  # one variable per muscle: x = pcsa in cm^2
+    x = expand_pcsa(model, pcsa, given=given) / M2_PER_CM2
     status, k = least_local_stiffness_sdp(data, x)
     return _result(model, data, float(eccentricity), float(lordosis), status, x, k)
 
@@ -987,10 +991,11 @@ def coupled_stability_at(model: Model, eccentricity: float, lordosis: float, pcs
     Acta Orthop Scand Suppl 230:1-54. doi:10.3109/17453678909154177.
     """
     e, lam = float(eccentricity), float(lordosis)
-    pcsa = minimum_stabilising_pcsa(model, e, lam) if pcsa is None else expand_pcsa(model, pcsa)
+    given = pcsa is not None
+    pcsa = expand_pcsa(model, pcsa) if given else minimum_stabilising_pcsa(model, e, lam)
     data = coupled_data(model, e, lam)
     coefficients = data.coefficients
-    local = least_local_stiffness(model, e, lam, pcsa)  # the SDP, outside numpy's guard
+    local = least_local_stiffness(model, e, lam, pcsa, given=given)  # the SDP, outside numpy's guard
     with arithmetic_guard(e, lam):
         stiffness = coefficients.stiffness(pcsa)
         damping = coefficients.damping(pcsa)

@@ -489,5 +489,6 @@ def stability_at(model: Model, eccentricity: float, lordosis: float, pcsa=None) 
     if pcsa is not None:
         return segment_stability(model, eccentricity, lordosis, pcsa)
     optimum = _stabilising_optimum(model, eccentricity, lordosis)
-    result = segment_stability(model, eccentricity, lordosis, optimum.pcsa)
+    # the optimum is an answer however large (as in a sweep), not a PCSA typed in the wrong unit
+    result = segment_stability(model, eccentricity, lordosis, optimum.pcsa, given=False)
     return dataclasses.replace(result, min_pcsa=optimum.min_pcsa)

@@ -167,10 +167,14 @@ def test_set_errors_are_one_line_as_in_a_file(tmp_path, capsys):
 
 
 def test_set_reaches_every_command_and_is_marked(capsys):
-    """The table's first line marks the overridden field; --K is an alias applied after --set."""
-    code, out, _ = run(["stability", "--pcsa", "10,10,10", "--set", "passive.stiffness=15", "--K", "10"], capsys)
+    """The table's first line marks the overridden field; --K is an alias of --set passive.stiffness."""
+    code, out, _ = run(["stability", "--pcsa", "10,10,10", "--set", "passive.stiffness=15"], capsys)
     header = out.splitlines()[0]
-    assert code == 0 and header.endswith("K = 10 N m/rad, convention physical; overridden: passive.stiffness")
+    assert code == 0 and header.endswith("K = 15 N m/rad, convention physical; overridden: passive.stiffness")
+    code, out, _ = run(["stability", "--pcsa", "10,10,10", "--K", "10"], capsys)
+    assert code == 0 and out.splitlines()[0].endswith(
+        "K = 10 N m/rad, convention physical; overridden: passive.stiffness"
+    )
     for argv in (["margins"], ["config", "show"], ["draw", "--geometry-only", "--out", "/nonexistent/x.png"]):
         code, _, err = run([*argv, "--set", "reflex.delay=-1"], capsys)
         assert code == 2 and "reflex.delay: must be" in err
@@ -339,3 +343,30 @@ def test_argparse_errors_read_like_the_others_with_a_suggestion(argv, line, caps
         assert err.rstrip().endswith("; did you mean stability?")
     if argv == ["stability", "--frob"]:
         assert "did you mean" not in err  # nothing close: no guess
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        # before: K = 15 whatever the order, silently
+        (["stability", "--K", "15", "--set", "passive.stiffness=0"], "--K: sets passive.stiffness, as does --set"),
+        (["sweep", "--K", "15", "--set", "passive.stiffness=0", "--out", "k.nc"], "--K: sets passive.stiffness"),
+        (["margins", "--delay", "0.1", "--set", "reflex.delay=0.2"], "--delay: sets reflex.delay, as does --set"),
+        # before: the single point E = 0, silently
+        (["sweep", "--E", "0:0.08:1", "--out", "one.nc"], "--E: with NUM = 1 must have START = STOP"),
+        # before: NetCDF written under the .csv name
+        (["sweep", "--E", "0.03", "--Lambda", "0.04", "--out", "x.csv"], "--out: must end in .nc"),
+        # before: "must be in [0, 10]" without a unit
+        (["margins", "--delay", "100"], "reflex.delay: must be in [0, 10] s (got 100); if you meant 100 ms, give 0.1"),
+    ],
+)
+def test_silent_choices_are_refused(argv, message, capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    code, _, err = run(argv, capsys)
+    assert code == 2 and message in err and err.count("\n") == 1
+    assert not list(tmp_path.iterdir())  # nothing written
+
+
+def test_a_one_point_sweep_says_point(capsys, tmp_path):
+    code, out, _ = run(["sweep", "--E", "0.03", "--Lambda", "0.04", "--out", str(tmp_path / "one.nc")], capsys)
+    assert code == 0 and ": 1 point (1 solved" in out

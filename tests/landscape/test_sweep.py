@@ -165,10 +165,13 @@ def test_write_sweep_one_k_is_a_scalar_landscape(model, tmp_path):
 
 
 def test_write_sweep_checks_its_file_before_solving(model, tmp_path, monkeypatch):
-    (tmp_path / "taken").mkdir()
+    (tmp_path / "taken.nc").mkdir()
     monkeypatch.setattr(sweep, "sweep", lambda *a, **k: pytest.fail("the sweep ran"))
     with pytest.raises(OutputError, match="cannot write"):
-        sweep.write_sweep(model, [0.0], [0.0], tmp_path / "taken")
+        sweep.write_sweep(model, [0.0], [0.0], tmp_path / "taken.nc")
+    with pytest.raises(ParameterError, match=r"--out: must end in \.nc"):  # NetCDF under another name
+        sweep.write_sweep(model, [0.0], [0.0], tmp_path / "x.csv")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["taken.nc"]
 
 
 def test_describe(landscape):
@@ -326,3 +329,22 @@ def test_a_landscape_stacked_over_k_names_every_k_and_no_k_override():
         "overridden: body.mass"
     )
     assert both.attrs["overridden"] == "body.mass"
+
+
+def test_sweep_and_stability_agree_on_an_optimum_beyond_any_muscle():
+    """A 1000 kg body on fibres of 5e4 N/m^2 needs more than 1000 cm^2 per muscle: the sweep and
+    `stability` (which refused its own optimum as a unit slip before) give the same number."""
+    import dataclasses
+
+    from spinectl.optimise.reference import stability_at
+
+    base = config.load_preset("wagner2012")
+    heavy = base.replace(
+        body=dataclasses.replace(base.body, mass=1000.0),
+        fibre=dataclasses.replace(base.fibre, specific_tension=5e4),
+    )
+    landscape = sweep.sweep(heavy, [0.03], [0.04], progress=False)
+    point = stability_at(heavy, 0.03, 0.04)
+    assert str(landscape["status"].values[0, 0]) == "optimal"
+    assert landscape["pcsa_cm2"].values[0, 0].max() > 1000.0
+    np.testing.assert_allclose(landscape["min_pcsa_cm2"].values[0, 0], point.min_pcsa * 1e4, rtol=1e-6)

@@ -134,11 +134,39 @@ def test_set_without_field_and_value_is_refused(text):
 
 def test_a_file_pair_merges_by_name_and_a_new_name_adds_one(tmp_path):
     path = tmp_path / "m.toml"
-    path.write_text('[[muscles]]\nname = "straight"\nspread = 0.02\n[[muscles]]\nname = "extra"\n')
+    path.write_text(
+        '[[muscles]]\nname = "straight"\nspread = 0.02\n'
+        '[[muscles]]\nname = "extra"\nupper = [0.05, 0.2]\nlower = [0.05, 0.0]\n'
+    )
     model = config.load_config(path)
     assert model.pair_names == (*BASE.pair_names, "extra")
+    assert model.muscles[3].upper == (0.05, 0.2) and model.muscles[3].lower == (0.05, 0.0)
     assert model.muscles[0].spread == 0.02 and model.muscles[0].upper == BASE.muscles[0].upper
     assert model.muscles[1:3] == BASE.muscles[1:3]
+
+
+@pytest.mark.parametrize(
+    ("tables", "message"),
+    [
+        # the newcomer's typo: before, a fourth pair with straight's default attachments, silently
+        (
+            'name = "straigth"\nspread = 0.02\n',
+            "muscles.0.upper: is required for the new pair 'straigth': a pair that is not the preset's gives its "
+            "attachments upper and lower [m]; did you mean 'straight'?",
+        ),
+        (
+            'name = "psoas"\nupper = [0.03, 0.2]\n',
+            "muscles.0.lower: is required for the new pair 'psoas': a pair that is not the preset's gives its "
+            "attachments upper and lower [m] (the pairs are 'straight', 'oblique_outer', 'oblique_inner')",
+        ),
+    ],
+)
+def test_a_new_pair_must_give_its_attachments(tmp_path, tables, message):
+    path = tmp_path / "m.toml"
+    path.write_text("[[muscles]]\n" + tables)
+    with pytest.raises(ConfigError) as err:
+        config.load_config(path)
+    assert str(err.value) == message
 
 
 def test_a_nameless_pair_in_merge_mode_is_an_error(tmp_path):
@@ -214,6 +242,6 @@ def test_diff_lists_every_differing_parameter_with_its_unit():
 
 
 def test_diff_matches_pairs_by_name():
-    extra = config.merge(BASE, {"muscles": [{"name": "extra"}]})
+    extra = config.merge(BASE, {"muscles": [{"name": "extra", "upper": [0.12, 0.24], "lower": [0.12, 0.0]}]})
     lines = [d.line() for d in config.diff_models(BASE, extra)]
     assert "muscles.extra.spread [m]: (absent) -> 0.03" in lines and len(lines) == 5

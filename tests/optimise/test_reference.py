@@ -178,3 +178,47 @@ def test_stability_at_defaults_to_the_minimum_stabilising_pcsa(model):
     np.testing.assert_array_equal(given.eigenvalues, expected.eigenvalues)
     with pytest.raises(ModelError):
         reference.stability_at(_with(model, pcsa_max=1e-4), 0.0, 0.0)
+
+
+def test_a_computed_optimum_beyond_any_muscle_is_an_answer_not_a_unit_slip():
+    """A 1000 kg body on fibres of 5e4 N/m^2 (both inside the allowed ranges) needs more than the
+    1000 cm^2 that a *given* PCSA may have: stability_at reports it, as a sweep does, instead of
+    refusing its own optimum as m^2 typed for cm^2. With zero margins the problem is linear in m / sigma
+    (gravity stiffness m g r, muscle stiffness sigma PCSA; paper, eq. 2), so the optimum is exactly
+    (1000 / 24.06) x (2.5e5 / 5e4) = 208 times the preset's."""
+    from spinectl.model import config
+    from spinectl.model.checks import MAX_PLAUSIBLE_PCSA
+
+    base = config.load_preset("wagner2012")
+    base = base.replace(optimisation=dataclasses.replace(base.optimisation, stability_margin=0.0, damping_margin=0.0))
+    heavy = base.replace(
+        body=dataclasses.replace(base.body, mass=1000.0),
+        fibre=dataclasses.replace(base.fibre, specific_tension=5e4),
+    )
+    scale = (1000.0 / base.body.mass) * (base.fibre.specific_tension / 5e4)
+    result = reference.stability_at(heavy, 0.03, 0.04)
+    assert result.pcsa.max() > MAX_PLAUSIBLE_PCSA  # (zero margins: marginally stable by construction)
+    assert result.min_pcsa == pytest.approx(scale * reference.stability_at(base, 0.03, 0.04).min_pcsa, rel=1e-6)
+
+
+@pytest.mark.parametrize("activation", ["paired", "independent"])
+def test_a_large_model_keeps_the_statuses(activation):
+    """A problem of minimum PCSA ~1e5 cm^2 (1000 kg, 30 m/s^2, mass 1 m up, 5e4 N/m^2) is the smaller one
+    scaled by m g / sigma (zero margins: linear, paper eq. 2), so statuses are equal and the minimum scales
+    exactly. At 1e4 N/m^2 (~5e5 cm^2) both solvers call some of these points infeasible: a documented
+    limit (docs/robustness.md, "large models")."""
+    from spinectl.model import config
+    from spinectl.optimise import active_set
+
+    base = config.load_preset("wagner2012")
+    opt = dataclasses.replace(base.optimisation, stability_margin=0.0, damping_margin=0.0, activation=activation)
+    base = base.replace(optimisation=opt, body=dataclasses.replace(base.body, mass_height=1.0))
+    corner = base.replace(
+        body=dataclasses.replace(base.body, mass=1000.0, gravity=30.0),
+        fibre=dataclasses.replace(base.fibre, specific_tension=5e4),
+    )
+    scale = (1000.0 / base.body.mass) * (30.0 / base.body.gravity) * (base.fibre.specific_tension / 5e4)
+    for e, lam in ((0.0, 0.0), (0.0, 0.06), (0.04, 0.04), (0.08, 0.08)):
+        small, large = active_set.solve_point(base, e, lam), active_set.solve_point(corner, e, lam)
+        assert small.status == large.status == "optimal"
+        assert large.min_pcsa == pytest.approx(scale * small.min_pcsa, rel=1e-6)

@@ -64,10 +64,11 @@ def _toml_char(c: str) -> str:
 
 
 def toml_document(dotted: str, value) -> str:
-    """A configuration file setting one field; ``muscles.KEY`` sets it in a single pair."""
+    """A configuration file setting one field; ``muscles.KEY`` sets it in the preset's pair ``straight``
+    (a new pair must give its attachments)."""
     section, key = dotted.split(".")
     if section == "muscles":
-        name = "" if key == "name" else 'name = "only"\n'
+        name = "" if key == "name" else 'name = "straight"\n'
         return f"[[muscles]]\n{name}{key} = {toml_value(value)}\n"
     return f"[{section}]\n{key} = {toml_value(value)}\n"
 
@@ -259,14 +260,14 @@ def test_an_invalid_value_is_a_parameter_error_naming_the_field(tmp_path, case):
 @pytest.mark.parametrize(
     ("text", "field", "needle"),
     [
-        ('[[muscles]]\nname = "a"\n[[muscles]]\nname = "a"\n', "muscles.1.name", "unique"),
+        ('[[muscles]]\nname = "straight"\n[[muscles]]\nname = "straight"\n', "muscles.1.name", "unique"),
         ("[geometry]\ncor_heights = [0.145, 0.072]\n", "geometry.cor_names", "one name per entry of cor_heights"),
         ("[geometry]\nspine_length = 0.1\n", "geometry.cor_heights", "spine_length=0.1"),
         ('[[muscles]]\nname = "straight"\nlower = [0.12, 0.3]\n', "muscles.0.upper", "must lie above lower"),
         (
             '[[muscles]]\nname = "straight"\nupper = [1e308, 1.0]\nlower = [-1e308, 0.0]\n',
             "muscles.0.upper",
-            "finite distance",
+            "modelled trunk's scale",  # was "finite distance"; lengths above 1 m are refused first
         ),
         ("[body]\nmass_height = 0.145\n", "body.mass_height", "above the top centre of rotation L1L2"),
         ("[geometry]\ncor_heights = [0.3, 0.1]\ncor_names = ['a', 'b']\n", "geometry.cor_heights", "on the spine"),
@@ -445,9 +446,9 @@ def test_extreme_magnitudes_give_finite_answers_or_a_model_error(tmp_path_factor
 @pytest.mark.parametrize(
     ("dotted", "value"),
     [
-        ("body.radius_of_gyration", 1e300),  # float ** 2 raised OverflowError
+        # (radius_of_gyration and specific_tension of 1e300 are refused at load now: MAX_BODY_LENGTH,
+        # SPECIFIC_TENSION_RANGE; tests/model/test_params.py)
         ("body.mass", 5e-324),  # inertia underflows to 0: division by zero
-        ("fibre.specific_tension", 1e300),
         ("fibre.k2", 5e-324),
     ],
 )
@@ -468,8 +469,13 @@ def test_overflow_is_a_model_error_or_a_solver_status(tmp_path, dotted, value):
 
 def test_a_huge_spine_length_stays_finite(tmp_path):
     """spine_length = 1e300 m: scipy's spline raised ValueError; the closed-form spine line (docs/model.md)
-    keeps every coefficient finite, without a numpy warning; the solver answers with a status."""
-    model = load_text(tmp_path, toml_document("geometry.spine_length", 1e300))
+    keeps every coefficient finite, without a numpy warning; the solver answers with a status. Validation
+    refuses lengths above 1 m now, so the model is built around it (the spine line is still the defence)."""
+    with pytest.raises(ParameterError, match="modelled trunk's scale"):
+        load_text(tmp_path, toml_document("geometry.spine_length", 1e300))
+    geometry = Model().geometry
+    object.__setattr__(geometry, "spine_length", 1e300)
+    model = Model(geometry=geometry)
     with warnings.catch_warnings():
         warnings.simplefilter("error", RuntimeWarning)
         result = segment_stability(model, 0.03, 0.04, PCSA)
@@ -610,13 +616,16 @@ def test_check_writable_fails_where_the_write_would_and_leaves_nothing(tmp_path)
 @pytest.mark.parametrize(
     ("argv", "job"),
     [
-        (["sweep", "--E", "0:0.08:3", "--Lambda", "0:0.08:3", "--out", "taken"], ("spinectl.landscape.sweep", "sweep")),
+        (
+            ["sweep", "--E", "0:0.08:3", "--Lambda", "0:0.08:3", "--out", "taken.nc"],
+            ("spinectl.landscape.sweep", "sweep"),
+        ),
         (["calibrate", "--grid", "3", "--history", "a_file/h.csv"], ("spinectl.paper.calibration", "calibrate")),
     ],
 )
 def test_long_jobs_check_their_outputs_before_they_start(tmp_path, monkeypatch, capsys, argv, job):
     """A typo in --out costs a second, not the run: the job itself is never called."""
-    (tmp_path / "taken").mkdir()
+    (tmp_path / "taken.nc").mkdir()
     (tmp_path / "a_file").write_text("keep")
     monkeypatch.setattr(importlib.import_module(job[0]), job[1], lambda *a, **k: pytest.fail("the job ran"))
     monkeypatch.chdir(tmp_path)

@@ -1,0 +1,67 @@
+"""Plausible ranges of the model's lengths and forces: a unit slip is refused with its hint (docs/robustness.md)."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import pytest
+
+from spinectl.errors import ParameterError
+from spinectl.model import config
+from spinectl.model.params import Body, Fibre, Geometry, Local, Model, MusclePair
+
+
+@pytest.mark.parametrize(
+    ("build", "message"),
+    [
+        # the paper's 326 mm typed as 32.6 cm: 32.6 m, a hundred times the trunk
+        (
+            lambda: Body(mass_height=32.6),
+            "mass_height: must be at most 1 m, the modelled trunk's scale (got 32.6); "
+            "lengths are in metres: if you meant 32.6 cm, give 0.326",
+        ),
+        (lambda: Geometry(spine_length=17.6), "spine_length: must be at most 1 m"),
+        (lambda: MusclePair(upper=(12.0, 24.0)), "upper: must be at most 1 m in size"),
+        (lambda: Local(lever_arm=7.0), "lever_arm: must be at most 1 m"),
+        # the paper's 25 N/cm^2 typed without the conversion to N/m^2 (x 1e4)
+        (
+            lambda: Fibre(specific_tension=25.0),
+            "specific_tension: must be in [10000, 1e+07] N/m^2, around reported human values (2-137 N/cm^2) "
+            "(got 25); if you meant 25 N/cm^2, give 250000",
+        ),
+        (lambda: Fibre(specific_tension=250.0), "if you meant 250 kPa, give 250000"),
+        (
+            lambda: Body(gravity=981.0),
+            "gravity: must be at most 30 m/s^2 (got 981); if you meant 981 cm/s^2, give 9.81",
+        ),
+    ],
+)
+def test_unit_slips_are_refused_with_their_hint(build, message):
+    with pytest.raises(ParameterError) as err:
+        build()
+    assert message in str(err.value)
+
+
+def test_the_presets_and_the_edges_of_the_ranges_are_accepted():
+    for name in ("default", "wagner2012", "wagner2012_mass_free"):
+        config.load_preset(name)
+    Fibre(specific_tension=1e4)
+    Fibre(specific_tension=1e7)
+    Body(mass_height=1.0, gravity=30.0)
+
+
+def test_the_cli_refuses_a_mass_height_in_cm(tmp_path, capsys):
+    """The newcomer's case: the message names the field and the slip, not a PCSA the user never gave."""
+    from spinectl.cli import main
+
+    path = tmp_path / "m.toml"
+    path.write_text("[body]\nmass_height = 32.6\n")
+    for extra in (["--set", "body.mass_height=32.6"], ["--config", str(path)]):
+        assert main(["stability", "--E", "0.03", "--Lambda", "0.04", *extra]) == 2
+        err = capsys.readouterr().err
+        assert "body.mass_height: must be at most 1 m" in err and "give 0.326" in err and "pcsa" not in err
+
+
+def test_model_level_check_still_names_the_top_cor():
+    with pytest.raises(ParameterError, match="body.mass_height: must lie above the top centre of rotation"):
+        Model(body=dataclasses.replace(Body(), mass_height=0.1))
