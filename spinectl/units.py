@@ -53,6 +53,10 @@ docs/reproduction.md). A value below it is far more likely m^2 typed where the C
 (0.001 m^2 = 10 cm^2), which the model accepts silently as a muscle too weak to matter."""
 
 
+LEAST_CM_SLIP = 1e-3
+"""Least length [m] (0.1 cm) that a value typed in cm is taken to mean: below it no cm hint is given."""
+
+
 def centimetre_slip(values, low: float, high: float, typed: str, corrected: str) -> str:
     """The hint for lengths in cm typed where metres are meant, or ``""`` if that is not the likely slip.
 
@@ -69,13 +73,17 @@ def centimetre_slip(values, low: float, high: float, typed: str, corrected: str)
     -------
     str
         ``"; lengths are in metres: if you meant 3 cm, give 0.03"`` when every value divided by 100
-        lies in the range and some value lies ten times beyond it, else ``""``.
+        lies in the range, some value lies ten times beyond it and the largest read as cm is at least
+        :data:`LEAST_CM_SLIP` [m], else ``""``.
     """
     values = np.asarray(values, float)
     scaled = values / CM_PER_M
     # an order of magnitude beyond the range (--E 3, not --E 0.5, which may be a plain slip)
     far = np.max(np.abs(values)) >= 10.0 * max(abs(low), abs(high))
-    if far and np.all((scaled >= low) & (scaled <= high)):
+    # a length typed in cm is rarely below 0.1 cm: --E 0.03 against a +-1 mm range (the coronal plane)
+    # is a plain value out of range, not 0.03 cm
+    plausible = np.max(np.abs(scaled)) >= LEAST_CM_SLIP
+    if far and plausible and np.all((scaled >= low) & (scaled <= high)):
         return f"; lengths are in metres: if you meant {typed} cm, give {corrected}"
     return ""
 

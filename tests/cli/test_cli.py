@@ -370,3 +370,16 @@ def test_silent_choices_are_refused(argv, message, capsys, tmp_path, monkeypatch
 def test_a_one_point_sweep_says_point(capsys, tmp_path):
     code, out, _ = run(["sweep", "--E", "0.03", "--Lambda", "0.04", "--out", str(tmp_path / "one.nc")], capsys)
     assert code == 0 and ": 1 point (1 solved" in out
+
+
+def test_no_cm_hint_for_a_plain_value_beyond_a_narrow_range(capsys):
+    """examples/coronal.toml allows E within +-1 mm: --E 0.03 is out of range, and reading it as 0.03 cm
+    (0.3 mm) would fit, but nobody types 0.03 meaning cm. The hint is kept for --E 3 against the usual range."""
+    from pathlib import Path
+
+    coronal = Path(__file__).resolve().parents[2] / "examples" / "coronal.toml"
+    assert main(["stability", "--config", str(coronal), "--E", "0.03", "--Lambda", "0"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert "--E: must be in [-0.001, 0.001] m" in err and "if you meant" not in err
+    assert main(["stability", "--E", "3", "--Lambda", "0.04"]) == 2
+    assert "if you meant 3 cm, give 0.03" in capsys.readouterr().err
