@@ -35,7 +35,7 @@ DPI = 110
 PLOT_FILES = ("bode.png", "nyquist.png", "response.png")
 """The files :func:`write_plots` may write, in this order."""
 
-RESPONSE_NOTE = "each segment over its own time: five of its slowest time constants, at most sim_duration"
+RESPONSE_NOTE = "each panel its own time: 5 slowest time constants, at most reflex.sim_duration"
 """The response figure's note on its time axes, which differ between segments."""
 BODE_SIZE = (7.0, 8.0)
 """Inches: the Bode plot with its legend below the phase axes."""
@@ -209,7 +209,7 @@ def response_figure(responses: Mapping[str, Simulation], title: str = "") -> Fig
         ax.legend(loc="best", fontsize="small")
     axes[-1, 0].set_xlabel("time [s]")
     default = "Response to a perturbation (nonlinear segment, true delay)"
-    fig.suptitle(f"{title or default}\n{RESPONSE_NOTE}" if len(responses) > 1 else title or default)
+    fig.suptitle(f"{title or default}\n{RESPONSE_NOTE}" if len(responses) > 1 else title or default, fontsize="medium")
     fig.tight_layout()
     return fig
 

@@ -214,3 +214,13 @@ def test_each_response_panel_spans_its_own_simulation(at_a):
         assert ax.get_xlim() == pytest.approx((time[0], time[-1]))
         ends.append(time[-1])
     assert len(set(np.round(ends, 6))) > 1  # the lengths differ, so one shared axis would cut some curves short
+
+
+def test_the_response_title_lies_inside_the_figure(at_a):
+    """The response figure's two-line title (the note on the panels' own time axes) was cut at both edges
+    (a newcomer read 'ach segment over its own time ... at most sim_duratio'): measured drawn, it lies inside."""
+    _, figures = at_a
+    fig = figures["response.png"]
+    fig.canvas.draw()
+    box = fig._suptitle.get_window_extent(fig.canvas.get_renderer())
+    assert fig.bbox.x0 <= box.x0 and box.x1 <= fig.bbox.x1 and box.y1 <= fig.bbox.y1
