@@ -313,8 +313,9 @@ def check_folder(target: str | Path, names=()) -> Path:
             return target
         if Path.cwd().resolve().is_relative_to(target.resolve()):
             raise OutputError(
-                f"cannot write {str(target)!r}: it is the working directory or holds it, and an output folder "
-                "is replaced as a whole: name a folder for the output"
+                f"cannot write {str(target)!r}: it is the working directory or holds it; the output folder is swapped "
+                "for a new one when the run ends (its other files are kept), which would pull it from under the "
+                "shell: run from another folder or name another for the output"
             )
         target.parent.mkdir(parents=True, exist_ok=True)
         _temporary(target, directory=True).rmdir()

@@ -276,7 +276,9 @@ def test_a_link_to_the_output_folder_stays_a_link(results, tmp_path):
 def test_the_working_directory_is_not_replaced_as_an_output_folder(results, tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     assert main(["plot", str(results), "--out", "."]) == 2
-    assert "it is the working directory or holds it" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "it is the working directory or holds it" in err
+    assert "its other files are kept" in err  # a newcomer read the old wording as "the run would wipe it"
     assert list(tmp_path.iterdir()) == []
 
 
