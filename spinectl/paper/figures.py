@@ -17,6 +17,7 @@ as a whole.
 
 from __future__ import annotations
 
+import re
 import textwrap
 from dataclasses import dataclass
 from pathlib import Path
@@ -127,9 +128,19 @@ def _axes(title: str, fig=None, spec=None):
     return fig, ax
 
 
+_UNBROKEN = re.compile(r"\([^()\n]{1,40}\)|(?:[\w.]+ = )?[\d.]+ (?:N m(?:/rad)?|kg|cm|m|s)\b|N m/rad|N m")
+"""Spans a title line is not broken inside: a short parenthesis, a setting with its value and unit, a unit."""
+
+
 def _wrap(title: str, width: int) -> str:
-    """``title`` broken into lines of at most ``width`` characters, its own line breaks kept."""
-    return "\n".join(textwrap.fill(line, width) for line in title.split("\n"))
+    """``title`` broken into lines of at most ``width`` characters, its own line breaks kept, never inside a
+    value with its unit or a short parenthesis (:data:`_UNBROKEN`; "K = 0 N / m/rad" read oddly)."""
+
+    def glued(match):
+        return match.group(0).replace(" ", "\u00a0")
+
+    lines = (textwrap.fill(_UNBROKEN.sub(glued, line), width, break_long_words=False) for line in title.split("\n"))
+    return "\n".join(lines).replace("\u00a0", " ")
 
 
 def _round_levels(low: float, high: float, count: int) -> np.ndarray:

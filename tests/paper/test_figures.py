@@ -566,3 +566,15 @@ def test_contour_values_clear_the_labels_of_a_to_d_and_the_corners(
         for box in values:
             assert not any(box.overlaps(label) for label in labels.values())
             assert frame.x0 <= box.x0 and box.x1 <= frame.x1 and frame.y0 <= box.y0 and box.y1 <= frame.y1
+
+
+@pytest.mark.parametrize("width", [30, 40, 46, 56])
+def test_a_wrapped_title_keeps_settings_units_and_short_parentheses_whole(width):
+    """A newcomer read "K = 0 N / m/rad" and "(K / convention: ...)" split across lines: a setting with its value
+    and unit, and a parenthesis of at most 40 characters, stay on one line; the text is unchanged otherwise."""
+    title = "Minimum PCSA of the study, body.mass = 24 kg, K = 15 N m/rad (K convention: physical, -K in dM/dα)"
+    wrapped = figures._wrap(title, width)
+    lines = wrapped.split("\n")
+    for whole in ("body.mass = 24 kg", "K = 15 N m/rad", "(K convention: physical, -K in dM/dα)"):
+        assert any(whole in line for line in lines), (whole, lines)
+    assert " ".join(lines) == title
