@@ -173,12 +173,10 @@ def attributes(model: Model, stiffnesses=None) -> dict:
         ``overridden`` (comma-separated); empty strings where there is none.
     """
     src = source_of(model)
-    overridden = list(src.overridden)
     line = header(model)
-    if stiffnesses is not None:
-        overridden = [name for name in overridden if name != "passive.stiffness"]
-        stacked = with_source(model, dataclasses.replace(src, overridden=tuple(overridden)))
-        first, *rest = _origin_parts(stacked)
+    if stiffnesses is not None:  # K is a coordinate: no override, and the line names every K
+        src = dataclasses.replace(src, overridden=tuple(n for n in src.overridden if n != "passive.stiffness"))
+        first, *rest = _origin_parts(with_source(model, src))
         ks = ", ".join(f"{k:g}" for k in stiffnesses)
         line = "; ".join([f"{first}, K = {ks} N m/rad, convention {model.passive.convention}", *rest])
     return {
@@ -186,5 +184,5 @@ def attributes(model: Model, stiffnesses=None) -> dict:
         "preset": src.preset or "",
         "config": src.config or "",
         "config_sha256": src.config_sha256 or "",
-        "overridden": ", ".join(overridden),
+        "overridden": ", ".join(src.overridden),
     }

@@ -304,8 +304,7 @@ def verified_qp(hessian, linear, lhs, rhs, equalities, eq_rhs, guesses, x_start,
     on the points still unsolved; then up to :data:`PATTERNS` of the active sets that solved other
     points, most common first. (The steps come before the other guesses because, with independent
     activation, they solve in a dozen batched attempts most of the points that the combinatorial
-    guesses took about a hundred for: 1.5 times less CPU on the 81 x 81 grid, the answers within
-    7e-11; on the paired grid nothing changes, bit for bit.)
+    guesses took about a hundred for; docs/optimisation.md, "Benchmark", gives the measured saving.)
     A point's answer is kept only if it passes :func:`kkt_check`.
 
     Parameters

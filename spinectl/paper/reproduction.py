@@ -89,8 +89,8 @@ def reproduce(
     check_points(points)
     model = apply_overrides(load_config(config, preset=preset), overrides)
     check_distinct({"--out": [Path(out_dir, name) for name in output_names(model)]}, {"--config": config})
-    origin = source_of(model)
-    calibrated = origin.preset == verdicts.PRESET and not (origin.config or origin.overridden)
+    src = source_of(model)  # not `origin`: that is the imported function reproduce_model uses
+    calibrated = src.preset == verdicts.PRESET and not (src.config or src.overridden)
     return reproduce_model(model, out_dir, points=points, calibrated=calibrated, progress=progress)
 
 
