@@ -1,0 +1,174 @@
+"""One description of a linearised chain of joints, whatever model produced it (docs/chain.md).
+
+The chain analyses (the semidefinite programmes of :mod:`spinectl.optimise`, the
+multivariable delay margins and python-control systems of :mod:`spinectl.reflex`) need
+only the chain linearised about an equilibrium,
+
+    M q'' = tau(q, q'),   tau ~ tau_0 + K(u) q + D(u) q',
+    K(u) = K_0 + sum_i u_i K_i,   D(u) = D_0 + sum_i u_i D_i,
+
+with q the joint angles [rad], u the controls (the muscles' PCSA of the paper's model
+[cm^2], or the activations in [0, 1] of an anatomical model [1]), and the matrices per unit
+of each control. The paper's model produces it with
+:func:`spinectl.model.chain.chain_coefficients`; an anatomical model through its engine.
+Sign convention of :mod:`spinectl.model.chain`: K = dtau/dq, so the chain is statically
+stable when -K is positive definite (Bergmark 1989).
+
+References
+----------
+Bergmark A (1989). Stability of the lumbar spine. A study in mechanical engineering.
+Acta Orthop Scand Suppl 230:1-54. doi:10.3109/17453678909154177.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import ParameterError
+
+CONTROL_CLASSES = ("global", "local", "between")
+"""Muscle classes by the bodies a muscle attaches to (docs/chain.md): thorax and pelvis only;
+any vertebra of the chain; a body in between that is neither (e.g. MyoTorso's abdomen)."""
+
+
+@dataclass(frozen=True)
+class LinearChain:
+    """A chain of n joints and m controls, linearised about an equilibrium.
+
+    Attributes
+    ----------
+    joints : tuple of str, length n
+        Joint names, in the order of q (the paper's: top to bottom, ``L1L2`` ... ``L5S1``).
+    controls : tuple of str, length m
+        Control (muscle) names, in the order of u.
+    control_class : tuple of str, length m
+        Each control's class, one of :data:`CONTROL_CLASSES`.
+    stiffness_per_control : numpy.ndarray, shape (n, n, m)
+        K_i = dtau/dq per unit of control i [N m/rad per control unit]; symmetric in (n, n).
+    damping_per_control : numpy.ndarray, shape (n, n, m)
+        D_i = dtau/dq' per unit of control i [N m s/rad per control unit].
+    stiffness_offset : numpy.ndarray, shape (n, n)
+        K_0: gravity, passive tissue and joint springs [N m/rad].
+    damping_offset : numpy.ndarray, shape (n, n)
+        D_0 [N m s/rad].
+    mass_matrix : numpy.ndarray, shape (n, n)
+        M [kg m^2], symmetric positive definite.
+    lower, upper : numpy.ndarray, shape (m,)
+        Bounds of each control (``upper`` may be inf) [control unit].
+    control_unit : str
+        The unit of u: ``"cm^2"`` (PCSA) or ``"1"`` (activation).
+    source : str
+        What produced it (a preset and posture, a model file), for outputs.
+    """
+
+    joints: tuple
+    controls: tuple
+    control_class: tuple
+    stiffness_per_control: np.ndarray
+    damping_per_control: np.ndarray
+    stiffness_offset: np.ndarray
+    damping_offset: np.ndarray
+    mass_matrix: np.ndarray
+    lower: np.ndarray
+    upper: np.ndarray
+    control_unit: str = "1"
+    source: str = field(default="", compare=False)
+
+    def __post_init__(self):
+        n, m = len(self.joints), len(self.controls)
+        shapes = {
+            "stiffness_per_control": (n, n, m),
+            "damping_per_control": (n, n, m),
+            "stiffness_offset": (n, n),
+            "damping_offset": (n, n),
+            "mass_matrix": (n, n),
+            "lower": (m,),
+            "upper": (m,),
+        }
+        for name, shape in shapes.items():
+            value = np.asarray(getattr(self, name), float)
+            if value.shape != shape:
+                raise ParameterError(f"LinearChain.{name}", f"must have shape {shape} (got {value.shape})")
+            if name != "upper" and not np.all(np.isfinite(value)):
+                raise ParameterError(f"LinearChain.{name}", "must be finite")
+            object.__setattr__(self, name, value)
+        if len(self.control_class) != m or not set(self.control_class) <= set(CONTROL_CLASSES):
+            raise ParameterError("LinearChain.control_class", f"must give one of {CONTROL_CLASSES} per control")
+        if np.any(self.lower > self.upper):
+            raise ParameterError("LinearChain.lower", "must not exceed upper")
+        object.__setattr__(self, "joints", tuple(self.joints))
+        object.__setattr__(self, "controls", tuple(self.controls))
+        object.__setattr__(self, "control_class", tuple(self.control_class))
+
+    @property
+    def n_joints(self) -> int:
+        """n, the number of joints."""
+        return len(self.joints)
+
+    @property
+    def n_controls(self) -> int:
+        """m, the number of controls."""
+        return len(self.controls)
+
+    def stiffness(self, u, local_stiffness=0.0) -> np.ndarray:
+        """K(u) - diag(k) [N m/rad]: K_0 + sum_i u_i K_i, less local joint stiffness k.
+
+        Parameters
+        ----------
+        u : array_like, shape (m,)
+            The controls [control unit].
+        local_stiffness : array_like, shape (n,)
+            k_j >= 0 added at each joint [N m/rad]; 0: none.
+
+        Returns
+        -------
+        numpy.ndarray, shape (n, n)
+            [N m/rad].
+        """
+        k = np.broadcast_to(np.asarray(local_stiffness, float), (self.n_joints,))
+        return self.stiffness_offset + self.stiffness_per_control @ np.asarray(u, float) - np.diag(k)
+
+    def damping(self, u) -> np.ndarray:
+        """D(u) = D_0 + sum_i u_i D_i [N m s/rad].
+
+        Parameters
+        ----------
+        u : array_like, shape (m,)
+            The controls [control unit].
+
+        Returns
+        -------
+        numpy.ndarray, shape (n, n)
+            [N m s/rad].
+        """
+        return self.damping_offset + self.damping_per_control @ np.asarray(u, float)
+
+    def select(self, classes) -> LinearChain:
+        """The same chain with only the controls of ``classes``; the others held at 0.
+
+        Parameters
+        ----------
+        classes : iterable of str
+            Classes of :data:`CONTROL_CLASSES` to keep.
+
+        Returns
+        -------
+        LinearChain
+        """
+        keep = np.array([c in set(classes) for c in self.control_class], bool)
+        return LinearChain(
+            joints=self.joints,
+            controls=tuple(np.array(self.controls, object)[keep]),
+            control_class=tuple(np.array(self.control_class, object)[keep]),
+            stiffness_per_control=self.stiffness_per_control[..., keep],
+            damping_per_control=self.damping_per_control[..., keep],
+            stiffness_offset=self.stiffness_offset,
+            damping_offset=self.damping_offset,
+            mass_matrix=self.mass_matrix,
+            lower=self.lower[keep],
+            upper=self.upper[keep],
+            control_unit=self.control_unit,
+            source=self.source,
+        )
