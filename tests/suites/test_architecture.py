@@ -3,7 +3,7 @@
 The layers and their order are those of CONTRIBUTING.md ("Architecture", "Layers"; a test
 checks that its table and :data:`LAYERS` agree, and that its tree names every module):
 
-    errors units _validate atomic jsondoc canvas presets  <  model  <  optimise  <  reflex  <  landscape  <  paper
+    _version errors units _validate atomic jsondoc canvas presets  <  model  <  optimise  <  reflex  <  landscape  <  paper
     <  explore  <  cli
 
 A module may import modules of its own layer and of the layers before it, never
@@ -28,6 +28,7 @@ from __future__ import annotations
 import ast
 import graphlib
 import re
+import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -37,7 +38,7 @@ ROOT = Path(__file__).resolve().parents[2]
 PACKAGE = ROOT / "spinectl"
 
 LAYERS = (
-    ("errors", "units", "_validate", "atomic", "jsondoc", "canvas", "presets"),
+    ("_version", "errors", "units", "_validate", "atomic", "jsondoc", "canvas", "presets"),
     ("model",),
     ("optimise",),
     ("reflex",),
@@ -267,3 +268,12 @@ def test_the_cycle_check_ignores_imports_inside_functions(tmp_path):
     assert import_cycle(imports(package)) is None
     (package / "model" / "b.py").write_text("from .a import g\n")
     assert set(import_cycle(imports(package))) == {"spinectl.model.a", "spinectl.model.b"}
+
+
+def test_the_version_is_that_of_pyproject():
+    """spinectl/_version.py (the basics layer, re-exported by the root) states pyproject.toml's version."""
+    from spinectl import __version__
+    from spinectl._version import __version__ as basics
+
+    stated = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["version"]
+    assert basics == __version__ == stated
