@@ -24,7 +24,7 @@ import importlib.util
 import sys
 import warnings
 
-from ._version import __version__
+from ._version import __version__ as __version__  # re-exported: the version has its home in the basics
 from .errors import ConfigError, ModelError, ParameterError, SpinectlError
 from .model.config import DEFAULT_PRESET, apply_overrides, dump_toml, list_presets, load_config, load_preset
 from .model.mechanics import SegmentCoefficients, segment_coefficients

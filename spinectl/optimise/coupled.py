@@ -54,7 +54,8 @@ from ..model.source import header, provenance
 from ..model.stability import self_stable
 from ..units import M2_PER_CM2, m2_to_cm2
 from .problem import OK_STATUSES, ProblemData, inequalities, problem_data, to_si
-from .reference import minimum_stabilising_pcsa, solve_with_fallback
+from .reference import solve_with_fallback
+from .stabilising import minimum_stabilising_pcsa
 from .stacked import CLARABEL_STATUS, stacked_settings
 
 if TYPE_CHECKING:  # imported where a problem is built: cvxpy takes over a second, and a sweep needs neither
@@ -971,7 +972,7 @@ def coupled_stability_at(model: Model, eccentricity: float, lordosis: float, pcs
     pcsa : array_like, optional
         Global PCSA [m^2], per pair or per muscle; default the minimum stabilising PCSA of
         :func:`spinectl.optimise.reference.solve_point`
-        (:func:`~spinectl.optimise.reference.minimum_stabilising_pcsa`).
+        (:func:`~spinectl.optimise.stabilising.minimum_stabilising_pcsa`).
 
     Returns
     -------
