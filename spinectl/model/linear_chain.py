@@ -145,6 +145,54 @@ class LinearChain:
         """
         return self.damping_offset + self.damping_per_control @ np.asarray(u, float)
 
+    def at(self, u, local_stiffness=0.0) -> LinearChain:
+        """The chain with its controls fixed at ``u``: no controls, K_0 = K(u) - diag(k), D_0 = D(u).
+
+        The linear system at one activation, which the reflex analyses take
+        (:mod:`spinectl.reflex.mimo`, :mod:`spinectl.reflex.chain_system`).
+
+        Parameters
+        ----------
+        u : array_like, shape (m,)
+            The controls [control unit].
+        local_stiffness : array_like, shape (n,)
+            k_j >= 0 added at each joint [N m/rad]; 0: none.
+
+        Returns
+        -------
+        LinearChain
+            With zero controls; ``stiffness(())`` and ``damping(())`` are the matrices at ``u``.
+        """
+        n = self.n_joints
+        return LinearChain(
+            joints=self.joints,
+            controls=(),
+            control_class=(),
+            stiffness_per_control=np.zeros((n, n, 0)),
+            damping_per_control=np.zeros((n, n, 0)),
+            stiffness_offset=self.stiffness(u, local_stiffness),
+            damping_offset=self.damping(u),
+            mass_matrix=self.mass_matrix,
+            lower=np.zeros(0),
+            upper=np.zeros(0),
+            control_unit=self.control_unit,
+            source=self.source,
+        )
+
+    def bound_rows(self) -> tuple[np.ndarray, np.ndarray]:
+        """The bounds lower <= u <= upper as rows G u <= h (an infinite upper bound gives no row).
+
+        Returns
+        -------
+        lhs : numpy.ndarray, shape (r, m)
+            G [1].
+        rhs : numpy.ndarray, shape (r,)
+            h [control unit].
+        """
+        eye = np.eye(self.n_controls)
+        finite = np.isfinite(self.upper)
+        return np.concatenate([-eye, eye[finite]]), np.concatenate([-self.lower, self.upper[finite]])
+
     def select(self, classes) -> LinearChain:
         """The same chain with only the controls of ``classes``; the others held at 0.
 
