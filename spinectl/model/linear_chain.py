@@ -179,6 +179,48 @@ class LinearChain:
             source=self.source,
         )
 
+    def fix(self, values: dict) -> LinearChain:
+        """The chain with some controls fixed: their u_i K_i and u_i D_i moved into K_0 and D_0.
+
+        E.g. the global muscles held at an activation, the local ones left to a programme
+        (:mod:`spinectl.optimise.coupled.sdp`); :meth:`at` fixes them all.
+
+        Parameters
+        ----------
+        values : dict of str to float
+            Control name -> its value [control unit].
+
+        Returns
+        -------
+        LinearChain
+            The other controls, in their order, with their bounds.
+
+        Raises
+        ------
+        ParameterError
+            A name that is no control of the chain.
+        """
+        unknown = sorted(set(values) - set(self.controls))
+        if unknown:
+            raise ParameterError("LinearChain.fix", f"names no control of the chain: {', '.join(unknown)}")
+        fixed = np.array([c in values for c in self.controls], bool)
+        u = np.array([float(values.get(c, 0.0)) for c in self.controls])
+        keep = ~fixed
+        return LinearChain(
+            joints=self.joints,
+            controls=tuple(np.array(self.controls, object)[keep]),
+            control_class=tuple(np.array(self.control_class, object)[keep]),
+            stiffness_per_control=self.stiffness_per_control[..., keep],
+            damping_per_control=self.damping_per_control[..., keep],
+            stiffness_offset=self.stiffness_offset + self.stiffness_per_control[..., fixed] @ u[fixed],
+            damping_offset=self.damping_offset + self.damping_per_control[..., fixed] @ u[fixed],
+            mass_matrix=self.mass_matrix,
+            lower=self.lower[keep],
+            upper=self.upper[keep],
+            control_unit=self.control_unit,
+            source=self.source,
+        )
+
     def bound_rows(self) -> tuple[np.ndarray, np.ndarray]:
         """The bounds lower <= u <= upper as rows G u <= h (an infinite upper bound gives no row).
 

@@ -17,6 +17,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from spinectl.errors import ParameterError
 from spinectl.model.linear_chain import LinearChain
 from spinectl.optimise.coupled import sdp
 
@@ -96,3 +97,19 @@ def test_the_chain_at_fixed_controls_is_the_same_linear_system():
     assert fixed.n_controls == 0 and fixed.joints == chain.joints
     np.testing.assert_array_equal(fixed.stiffness(()), chain.stiffness(u))
     np.testing.assert_array_equal(fixed.damping(()), chain.damping(u))
+
+
+def test_local_controls_at_a_fixed_global_activation():
+    """LinearChain.fix: the global control held at u_3 (moved into K_0), the local ones left to (b).
+    Over u_1 = u_2 = s the rows are s >= mu and s >= mu + 2 (g - u_3): at u_3 = 2, s = mu + 2 = 2.5;
+    at u_3 = g the margin alone, s = mu. The fixed chain's K equals the full chain's, to rounding."""
+    chain = _chain()
+    held = chain.fix({"global": 2.0})
+    assert held.controls == ("local_top", "local_bottom") and held.control_class == ("local", "local")
+    np.testing.assert_allclose(held.stiffness([1.0, 2.0]), chain.stiffness([1.0, 2.0, 2.0]), atol=1e-12)
+    for u3, s in ((2.0, MU + 2 * (G - 2.0)), (G, MU)):
+        status, u = sdp.least_control_sdp(chain.fix({"global": u3}), np.ones(2), MU, tolerance=1e-9)
+        assert status == "optimal"
+        np.testing.assert_allclose(u, [s, s], atol=1e-6)
+    with pytest.raises(ParameterError, match="no control of the chain: nope"):
+        chain.fix({"nope": 1.0})
