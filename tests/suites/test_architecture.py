@@ -275,6 +275,7 @@ def test_the_cycle_check_finds_a_cycle_closed_inside_a_function(tmp_path):
     (package / "model" / "b.py").write_text("from .a import g\n")
     assert set(import_cycle(imports(package))) == {"spinectl.model.a", "spinectl.model.b"}
 
+
 def test_the_version_is_that_of_pyproject():
     """spinectl/_version.py (the basics layer, re-exported by the root) states pyproject.toml's version."""
     from spinectl import __version__
