@@ -5,14 +5,14 @@
 
 The least local stiffness of docs/chain.md, problem (a), at the per-segment optimum of every
 grid point: the fast path (one stacked Clarabel problem per chunk of 1024 points,
-:func:`spinectl.optimise.coupled.least_local_stiffness_stacked`) on the whole grid, and the
-per-point cvxpy reference (:func:`~spinectl.optimise.coupled.least_local_stiffness_at`) on a
+:func:`spinectl.optimise.coupled.stacked_sdp.least_local_stiffness_stacked`) on the whole grid, and the
+per-point cvxpy reference (:func:`~spinectl.optimise.coupled.sdp.least_local_stiffness_at`) on a
 random sample of its points, its time extrapolated to the grid. Prints both times, their
 ratio and the largest relative difference of the totals on the sample. The per-segment
 optimum the SDPs start from is solved first and not timed. Target: <= 30 s for 81 x 81 on the
 project's 2-core machine. Then the same for the joint optimum of global and local muscle,
-problem (c) (:func:`~spinectl.optimise.coupled.joint_optimum_stacked` against
-:func:`~spinectl.optimise.coupled.joint_optimum_sdp`), compared by its objective.
+problem (c) (:func:`~spinectl.optimise.coupled.stacked_sdp.joint_optimum_stacked` against
+:func:`~spinectl.optimise.coupled.joint.joint_optimum_sdp`), compared by its objective.
 Timings on a shared machine are noisy: the ratio is what matters.
 """
 

@@ -6,7 +6,7 @@
 
 End to end: the command as a user types it, in a fresh interpreter (``python -m spinectl
 reproduce`` from this checkout), taking turns with ``python -c "import numpy, scipy"``;
-printed, the fastest wall time of each and their ratio (issue 14's target: 4 s on the quiet
+printed, the fastest wall time of each and their ratio (the 0.2 performance target: 4 s on the quiet
 2-core machine); with ``--before DIR``, also the command from an earlier checkout in DIR (a
 ``git archive`` of an earlier commit), taking turns with the other two. Then the breakdown,
 each part against the code path it replaced, timed in this process, interleaved, fastest of
@@ -47,7 +47,7 @@ from spinectl.model.config import load_preset  # noqa: E402
 from spinectl.paper import assumptions, figures, grid, landmarks, report  # noqa: E402
 
 TARGET = 4.0
-"""Issue 14: ``spinectl reproduce`` end to end within 4 s on the quiet 2-core machine [s]."""
+"""The 0.2 performance target: ``spinectl reproduce`` end to end within 4 s on the quiet 2-core machine [s]."""
 
 
 CPU_SECONDS: dict[str, float] = {}

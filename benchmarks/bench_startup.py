@@ -37,7 +37,7 @@ RATIOS = (
     ("spinectl --help", "import numpy", 3.0),
     ("spinectl stability", "import numpy, scipy", 2.0),
 )
-"""(command, reference, target ratio) of issue 14."""
+"""(command, reference, target ratio): the start-up targets of the 0.2 performance work."""
 
 
 def wall(command: list[str]) -> float:

@@ -24,14 +24,13 @@ import importlib.util
 import sys
 import warnings
 
+from ._version import __version__ as __version__  # re-exported: the version has its home in the basics
 from .errors import ConfigError, ModelError, ParameterError, SpinectlError
 from .model.config import DEFAULT_PRESET, apply_overrides, dump_toml, list_presets, load_config, load_preset
 from .model.mechanics import SegmentCoefficients, segment_coefficients
 from .model.params import Model
 from .model.stability import StabilityResult, segment_stability
 from .reflex.siso import LoopDelayMargin, delay_margin
-
-__version__ = "0.1.0"
 
 __all__ = [
     "DEFAULT_PRESET",

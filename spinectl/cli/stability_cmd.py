@@ -67,7 +67,7 @@ def run(args) -> int:
     int
         Exit code 0.
     """
-    from ..optimise.reference import NoStabilisingActivation, stability_at
+    from ..optimise.stabilising import NoStabilisingActivation, stability_at
 
     model = load_model(args, {"passive.stiffness": ("--K", args.K)})
     check_position(model, args)

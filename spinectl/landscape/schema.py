@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import xarray as xr
 
-from .. import __version__
+from .._version import __version__
 from ..model import config, source
 from ..model.params import Model
 

@@ -35,7 +35,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..units import M2_PER_CM2
 from . import geometry, muscle
+from .linear_chain import LinearChain
 from .mechanics import (
     _fibre_laws,
     cross2,
@@ -46,6 +48,7 @@ from .mechanics import (
     rotate,
 )
 from .params import Model
+from .source import header
 
 
 def chain_positions(q, cor):
@@ -568,6 +571,60 @@ def chain_coefficients(model: Model, eccentricity, lordosis) -> ChainCoefficient
         gravity_stiffness=_gravity_stiffness(model, cor[..., 1]),
         passive_stiffness=passive_stiffness(model, inertia(cor, model)),
         length_gradient=length_gradient,
+    )
+
+
+def linear_chain(model: Model, eccentricity: float, lordosis: float, coefficients=None) -> LinearChain:
+    """The paper's chain at one (E, Lambda) as a :class:`~spinectl.model.linear_chain.LinearChain`.
+
+    The controls are the decision variables x of the optimisation (docs/optimisation.md,
+    "Formulation"), so that the chain's programmes and the per-segment problem share them: with
+    ``optimisation.activation = "paired"`` one per pair, the PCSA of either side (a pair's total
+    is twice it); with ``"independent"`` one per muscle; in cm^2, class ``"global"`` (thorax to
+    pelvis), bounds 0 <= x <= ``optimisation.pcsa_max``. Per unit x, K_i and D_i are those of
+    :func:`chain_coefficients` per m^2 of the muscles it sets; K_0 = K_g - diag(K_pas) (gravity and
+    the passive stiffness), D_0 = 0 (the model has no passive damping), M of :func:`mass_matrix`.
+
+    Parameters
+    ----------
+    model : Model
+        ``optimisation`` (activation, pcsa_max) and the physics.
+    eccentricity, lordosis : float
+        E and Lambda [m].
+    coefficients : ChainCoefficients, optional
+        :func:`chain_coefficients` at (E, Lambda), if computed already.
+
+    Returns
+    -------
+    LinearChain
+        ``control_unit`` "cm^2"; ``source`` the model's :func:`~spinectl.model.source.header` and (E, Lambda).
+
+    References
+    ----------
+    Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012). Spinal lordosis
+    optimizes the requirements for a stable erect posture. Theor Biol Med Model 9:13.
+    doi:10.1186/1742-4682-9-13.
+    """
+    e, lam = float(eccentricity), float(lordosis)
+    coeffs = chain_coefficients(model, e, lam) if coefficients is None else coefficients
+    n_muscles = coeffs.stiffness_per_pcsa.shape[-1]
+    paired = model.optimisation.activation == "paired"
+    to_muscles = geometry.pairing_matrix(n_muscles // 2) if paired else np.eye(n_muscles)
+    per_var = to_muscles * M2_PER_CM2  # m^2 of each muscle per cm^2 of x
+    n, m = coeffs.stiffness_per_pcsa.shape[0], per_var.shape[1]
+    return LinearChain(
+        joints=model.geometry.cor_names,
+        controls=model.pair_names if paired else model.muscle_names,
+        control_class=("global",) * m,
+        stiffness_per_control=coeffs.stiffness_per_pcsa @ per_var,
+        damping_per_control=coeffs.damping_per_pcsa @ per_var,
+        stiffness_offset=coeffs.stiffness(np.zeros(n_muscles)),
+        damping_offset=np.zeros((n, n)),
+        mass_matrix=mass_matrix(model, geometry.cor_positions(e, lam, model.geometry)),
+        lower=np.zeros(m),
+        upper=np.full(m, model.optimisation.pcsa_max / M2_PER_CM2),
+        control_unit="cm^2",
+        source=f"{header(model)}; E = {e:g} m, Lambda = {lam:g} m",
     )
 
 

@@ -145,6 +145,96 @@ class LinearChain:
         """
         return self.damping_offset + self.damping_per_control @ np.asarray(u, float)
 
+    def at(self, u, local_stiffness=0.0) -> LinearChain:
+        """The chain with its controls fixed at ``u``: no controls, K_0 = K(u) - diag(k), D_0 = D(u).
+
+        The linear system at one activation, which the reflex analyses take
+        (:mod:`spinectl.reflex.mimo`, :mod:`spinectl.reflex.chain_system`).
+
+        Parameters
+        ----------
+        u : array_like, shape (m,)
+            The controls [control unit].
+        local_stiffness : array_like, shape (n,)
+            k_j >= 0 added at each joint [N m/rad]; 0: none.
+
+        Returns
+        -------
+        LinearChain
+            With zero controls; ``stiffness(())`` and ``damping(())`` are the matrices at ``u``.
+        """
+        n = self.n_joints
+        return LinearChain(
+            joints=self.joints,
+            controls=(),
+            control_class=(),
+            stiffness_per_control=np.zeros((n, n, 0)),
+            damping_per_control=np.zeros((n, n, 0)),
+            stiffness_offset=self.stiffness(u, local_stiffness),
+            damping_offset=self.damping(u),
+            mass_matrix=self.mass_matrix,
+            lower=np.zeros(0),
+            upper=np.zeros(0),
+            control_unit=self.control_unit,
+            source=self.source,
+        )
+
+    def fix(self, values: dict) -> LinearChain:
+        """The chain with some controls fixed: their u_i K_i and u_i D_i moved into K_0 and D_0.
+
+        E.g. the global muscles held at an activation, the local ones left to a programme
+        (:mod:`spinectl.optimise.coupled.sdp`); :meth:`at` fixes them all.
+
+        Parameters
+        ----------
+        values : dict of str to float
+            Control name -> its value [control unit].
+
+        Returns
+        -------
+        LinearChain
+            The other controls, in their order, with their bounds.
+
+        Raises
+        ------
+        ParameterError
+            A name that is no control of the chain.
+        """
+        unknown = sorted(set(values) - set(self.controls))
+        if unknown:
+            raise ParameterError("LinearChain.fix", f"names no control of the chain: {', '.join(unknown)}")
+        fixed = np.array([c in values for c in self.controls], bool)
+        u = np.array([float(values.get(c, 0.0)) for c in self.controls])
+        keep = ~fixed
+        return LinearChain(
+            joints=self.joints,
+            controls=tuple(np.array(self.controls, object)[keep]),
+            control_class=tuple(np.array(self.control_class, object)[keep]),
+            stiffness_per_control=self.stiffness_per_control[..., keep],
+            damping_per_control=self.damping_per_control[..., keep],
+            stiffness_offset=self.stiffness_offset + self.stiffness_per_control[..., fixed] @ u[fixed],
+            damping_offset=self.damping_offset + self.damping_per_control[..., fixed] @ u[fixed],
+            mass_matrix=self.mass_matrix,
+            lower=self.lower[keep],
+            upper=self.upper[keep],
+            control_unit=self.control_unit,
+            source=self.source,
+        )
+
+    def bound_rows(self) -> tuple[np.ndarray, np.ndarray]:
+        """The bounds lower <= u <= upper as rows G u <= h (an infinite upper bound gives no row).
+
+        Returns
+        -------
+        lhs : numpy.ndarray, shape (r, m)
+            G [1].
+        rhs : numpy.ndarray, shape (r,)
+            h [control unit].
+        """
+        eye = np.eye(self.n_controls)
+        finite = np.isfinite(self.upper)
+        return np.concatenate([-eye, eye[finite]]), np.concatenate([-self.lower, self.upper[finite]])
+
     def select(self, classes) -> LinearChain:
         """The same chain with only the controls of ``classes``; the others held at 0.
 

@@ -197,7 +197,7 @@ class StabilityResult:
         The per-unit-PCSA problem data the result was computed from.
     min_pcsa : float
         The minimum total PCSA [m^2] of the LP (paper, Figure 3) when the PCSA is the optimiser's
-        chosen activation (:func:`spinectl.optimise.reference.stability_at`); NaN when the PCSA was given.
+        chosen activation (:func:`spinectl.optimise.stabilising.stability_at`); NaN when the PCSA was given.
         The chosen activation's total lies within ``optimisation.ct_tolerance`` above it.
 
     Use :attr:`all_self_stable` for one verdict: the truth value of a result is ambiguous
@@ -248,7 +248,7 @@ class StabilityResult:
         pcsa_source : {'given', 'min_pcsa'}
             Where the PCSA came from: given by the caller, or the minimum stabilising
             PCSA (the optimiser's chosen activation,
-            :func:`spinectl.optimise.reference.minimum_stabilising_pcsa`).
+            :func:`spinectl.optimise.stabilising.minimum_stabilising_pcsa`).
 
         Returns
         -------

@@ -7,7 +7,10 @@ guessed and verified active sets in batched numpy, the fast path
 (:mod:`~spinectl.optimise.active_set`); and for blocks of points as one stacked
 Clarabel problem, the fast path's fallback (:mod:`~spinectl.optimise.stacked`). The
 solvers' answers are polished to the exact optimum (:mod:`~spinectl.optimise.polish`);
-the fast path's are exact KKT points already.
+the fast path's are exact KKT points already. The reference imports neither fast path; the
+stability of one point at its minimum stabilising PCSA, solved by the fast path, sits above both
+(:mod:`~spinectl.optimise.stabilising`). The coupled chain's semidefinite programmes, on any
+:class:`~spinectl.model.linear_chain.LinearChain`, are :mod:`~spinectl.optimise.coupled`.
 
 The per-point API is re-exported here: ``optimise.solve_point(model, E, Lambda)``.
 

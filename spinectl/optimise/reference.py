@@ -25,26 +25,24 @@ front is stage 2 for budgets from t* up to the total PCSA of the minimum-norm
 activation.
 
 Results are returned in SI (m^2). Infeasible points are answers, not
-exceptions: NaN values and a ``status``. :func:`stability_at` and
-:func:`minimum_stabilising_pcsa` solve their point by the fast path
-(:func:`spinectl.optimise.active_set.solve_point`, the same answer to rounding), so that one
-point needs no cvxpy, which is imported only where a problem is built here (about 2 s).
-:mod:`spinectl.optimise.stacked` solves the same problems for a block of points at once and is
-checked against this module.
+exceptions: NaN values and a ``status``. cvxpy is imported only where a problem is built here
+(about 2 s). :mod:`spinectl.optimise.stacked` and :mod:`spinectl.optimise.active_set` solve the
+same problems for a block of points at once, fall back on this module and are checked against
+it; this module imports neither. The stability at one point with its minimum stabilising PCSA,
+solved by the fast path, is :mod:`spinectl.optimise.stabilising` (its names here are deprecated
+aliases, :data:`MOVED`).
 """
 
 from __future__ import annotations
 
-import dataclasses
 import warnings
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..errors import ModelError
+from .._aliases import moved_names
 from ..model.params import Model
-from ..model.stability import StabilityResult, segment_stability
 from ..units import M2_PER_CM2
 from .problem import (
     INFEASIBLE_STATUSES,
@@ -414,81 +412,10 @@ def pareto_front(model: Model, eccentricity: float, lordosis: float, n_points: i
     return ParetoFront(float(eccentricity), float(lordosis), budgets * M2_PER_CM2, np.asarray(norms), tuple(statuses))
 
 
-class NoStabilisingActivation(ModelError):
-    """No activation within the bounds stabilises every segment (or the solver failed): the caller may
-    give a PCSA instead (the library's ``pcsa`` argument; the CLI names its own option)."""
+MOVED = dict.fromkeys(
+    ("NoStabilisingActivation", "minimum_stabilising_pcsa", "stability_at"), "spinectl.optimise.stabilising"
+)
+"""Names that lived here until the fast path answered them (it falls back on this module, so they
+moved above both): their module now; the old names warn until the next release."""
 
-
-def minimum_stabilising_pcsa(model: Model, eccentricity: float, lordosis: float) -> np.ndarray:
-    """The chosen activation of :func:`solve_point` (solved by the fast path): the minimum stabilising PCSA [m^2].
-
-    Parameters
-    ----------
-    model : Model
-        ``optimisation`` sets activation mode, margin, bounds and tolerances.
-    eccentricity, lordosis : float
-        E and Lambda [m].
-
-    Returns
-    -------
-    numpy.ndarray, shape (n_muscles,)
-        PCSA of each muscle [m^2] that makes every segment self-stable.
-
-    Raises
-    ------
-    NoStabilisingActivation
-        A :class:`~spinectl.errors.ModelError`: no activation within the bounds stabilises every
-        segment, or the solver failed (the message names the optimiser's status and suggests
-        giving the PCSA, the ``pcsa`` argument of :func:`stability_at`).
-    """
-    return _stabilising_optimum(model, eccentricity, lordosis).pcsa
-
-
-def _stabilising_optimum(model: Model, eccentricity: float, lordosis: float) -> PointOptimum:
-    """The optimum of :func:`solve_point`, or :func:`minimum_stabilising_pcsa`'s :class:`ModelError` unless optimal.
-
-    Solved by the fast path (:func:`spinectl.optimise.active_set.solve_point`, the same answer to rounding),
-    which imports cvxpy only for a point that fails verification: ``spinectl stability`` starts at once.
-    """
-    from .active_set import solve_point as fast_solve_point  # here: active_set falls back on this module
-
-    optimum = fast_solve_point(model, eccentricity, lordosis)
-    if not optimum.ok:
-        raise NoStabilisingActivation(
-            f"pcsa: no activation stabilises every segment at E = {eccentricity:g} m, Lambda = {lordosis:g} m "
-            f"(optimiser status {optimum.status}); give the PCSA (argument pcsa, [m^2])"
-        )
-    return optimum
-
-
-def stability_at(model: Model, eccentricity: float, lordosis: float, pcsa=None) -> StabilityResult:
-    """Stability of every segment for a PCSA, by default the minimum stabilising one.
-
-    Parameters
-    ----------
-    model : Model
-    eccentricity, lordosis : float
-        E and Lambda [m].
-    pcsa : array_like, optional
-        PCSA [m^2], per pair or per muscle (:func:`spinectl.model.checks.expand_pcsa`);
-        default :func:`minimum_stabilising_pcsa`.
-
-    Returns
-    -------
-    StabilityResult
-        :func:`spinectl.model.stability.segment_stability` at that PCSA; with the optimiser's
-        PCSA, its ``min_pcsa`` is the LP minimum [m^2].
-
-    Raises
-    ------
-    ModelError
-        ``pcsa`` not given and no activation stabilises every segment.
-    ParameterError
-        E, Lambda or ``pcsa`` out of range.
-    """
-    if pcsa is not None:
-        return segment_stability(model, eccentricity, lordosis, pcsa)
-    optimum = _stabilising_optimum(model, eccentricity, lordosis)
-    # the optimum is an answer however large (as in a sweep), not a PCSA typed in the wrong unit
-    result = segment_stability(model, eccentricity, lordosis, optimum.pcsa, given=False)
-    return dataclasses.replace(result, min_pcsa=optimum.min_pcsa)
+__getattr__ = moved_names(__name__, MOVED)

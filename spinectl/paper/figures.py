@@ -669,7 +669,7 @@ def _label_place(contour, marks, ax) -> tuple[float, float] | None:
 def pareto_figure(front: ParetoFront, model: Model) -> Figure:
     """The Pareto front of the chain: global PCSA total against local stiffness total (docs/chain.md).
 
-    One marker per point of :func:`spinectl.optimise.coupled.pareto_front`; infeasible
+    One marker per point of :func:`spinectl.optimise.coupled.joint.pareto_front`; infeasible
     points are left out, the global-only point (budget 0), where it exists, is ringed; the top
     axis reads the local stiffness as local-muscle PCSA (:func:`spinectl.model.chain.local_pcsa`).
 

@@ -1,8 +1,12 @@
 """Reflex margins of the whole chain at one configuration: ``spinectl margins --coupled`` (docs/chain.md).
 
+The margins of any linearised chain under the diagonal delayed reflex are
+:func:`chain_reflex_margins` (on a :class:`~spinectl.model.linear_chain.LinearChain`); the paper's
+chain at its operating point is :func:`coupled_margins`.
+
 The operating point is that of ``spinectl margins`` (``reflex.activation`` times the per-segment
 optimum, :func:`spinectl.reflex.margins.operating_point`); the chain's matrices there come from
-:func:`spinectl.optimise.coupled.coupled_stability_at`; the diagonal gains from the rule
+:func:`spinectl.optimise.coupled.at_activation.coupled_stability_at`; the diagonal gains from the rule
 :func:`spinectl.reflex.gains.chain_gains` (or ``reflex.kp``, ``reflex.kd``, or the options); the
 exact delay margin from :func:`spinectl.reflex.mimo.chain_delay_margin`, its Padé estimate from
 :func:`~spinectl.reflex.mimo.pade_margin`, the disk margins of the Padé loop from
@@ -11,17 +15,19 @@ exact delay margin from :func:`spinectl.reflex.mimo.chain_delay_margin`, its Pad
 
 from __future__ import annotations
 
+import contextlib
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..model.checks import arithmetic_guard
+from ..model.linear_chain import LinearChain
 from ..model.params import Model
 from ..optimise.coupled import CoupledStability, coupled_stability_at
-from .chain_system import DiskMargins, chain_disk_margins, chain_loop
+from .chain_system import DiskMargins, chain_disk_margins, linear_chain_loop
 from .gains import chain_gains
 from .margins import _num, operating_point
-from .mimo import chain_delay_margin, highest_crossing, pade_margin
+from .mimo import delay_margin_of, highest_crossing, pade_margin
 from .siso import LoopDelayMargin
 
 DISK_POINTS = 600
@@ -50,6 +56,76 @@ def stable_at(exact: LoopDelayMargin, delay: float) -> bool:
     if exact.margin == np.inf:
         return True
     return sum(d for t, _, d in exact.critical_delays(delay) if t < delay) == 0 and exact.margin != delay
+
+
+@dataclass(frozen=True)
+class ChainReflexMargins:
+    """Any linearised chain under the diagonal delayed reflex: its margins.
+
+    Attributes
+    ----------
+    exact : LoopDelayMargin
+        The exact delay margin and the crossings (:func:`spinectl.reflex.mimo.chain_delay_margin`).
+    delay_margin_pade : float
+        The Padé loop's delay margin [s].
+    stable_at_delay : bool
+        The true-delay loop is stable at the delay.
+    disk : DiskMargins or None
+        Of the Padé loop at the delay; None where that loop is unstable (no margin to speak of).
+    """
+
+    exact: LoopDelayMargin
+    delay_margin_pade: float
+    stable_at_delay: bool
+    disk: DiskMargins | None
+
+
+def chain_reflex_margins(
+    chain: LinearChain, kp, kd, delay: float, order: int, lag: float, u=(), guard=contextlib.nullcontext
+) -> ChainReflexMargins:
+    """The exact and Padé delay margins and the disk margins of a chain at its controls ``u``.
+
+    Parameters
+    ----------
+    chain : LinearChain
+        M, K(u), D(u); fixed at an activation (:meth:`LinearChain.at`), ``u`` is empty.
+    kp, kd : array_like, shape (n,)
+        Diagonal gains [N m/rad], [N m s/rad].
+    delay : float
+        tau [s].
+    order : int
+        Padé order.
+    lag : float
+        T_a [s]; 0 none.
+    u : array_like, shape (m,)
+        The controls [control unit].
+    guard : callable
+        A context manager factory around the exact margin (the paper's: numpy's floating-point
+        errors as a :class:`~spinectl.errors.ModelError` naming the configuration); none by default.
+
+    Returns
+    -------
+    ChainReflexMargins
+
+    Raises
+    ------
+    ModelError
+        M is singular (for the disk margins of a loop stable at the delay).
+
+    References
+    ----------
+    Seiler P, Packard A, Gahinet P (2020). An introduction to disk margins. IEEE Control
+    Systems Magazine 40(5):78-95. doi:10.1109/MCS.2020.3005277.
+    """
+    with guard():  # gains or delays orders of magnitude off: the caller's error
+        exact = delay_margin_of(chain, kp, kd, lag, u)
+    stable = stable_at(exact, delay)
+    disk = None
+    if stable:
+        loop = linear_chain_loop(chain, kp, kd, delay, order, lag, u)
+        top = highest_crossing(chain.mass_matrix, chain.stiffness(u), chain.damping(u), kp, kd)
+        disk = chain_disk_margins(loop, np.logspace(-2, np.log10(10.0 * top), DISK_POINTS))
+    return ChainReflexMargins(exact, pade_margin(exact, order), stable, disk)
 
 
 @dataclass(frozen=True)
@@ -105,7 +181,7 @@ class CoupledMargins:
         Returns
         -------
         dict
-            :meth:`CoupledStability.to_dict <spinectl.optimise.coupled.CoupledStability.to_dict>`
+            :meth:`CoupledStability.to_dict <spinectl.optimise.coupled.at_activation.CoupledStability.to_dict>`
             with ``delay_s``, ``activation_time_constant_s``, ``pade_order``, ``activation`` and
             ``gains``, and under ``coupled`` also ``kp_Nm_per_rad``, ``kd_Nms_per_rad`` (per joint),
             ``delay_margin_s``, ``delay_margin_status``, ``delay_margin_frequency_rad_s``,
@@ -224,17 +300,10 @@ def coupled_margins(model: Model, eccentricity: float, lordosis: float, kp=None,
         kp0, kd0 = np.full(n, settings.kp), np.full(n, settings.kd)
     kp = kp0 if kp is None else np.full(n, float(kp))
     kd = kd0 if kd is None else np.full(n, float(kd))
-    with arithmetic_guard(eccentricity, lordosis):  # gains or delays orders of magnitude off: a ModelError
-        exact = chain_delay_margin(chain.mass, chain.stiffness, chain.damping, kp, kd, lag)
-    stable = stable_at(exact, settings.delay)
-    disk = None
-    if stable:
-        loop = chain_loop(
-            chain.mass, chain.stiffness, chain.damping, kp, kd, settings.delay, settings.pade_order, lag,
-            chain.segment_names,
-        )  # fmt: skip
-        top = highest_crossing(chain.mass, chain.stiffness, chain.damping, kp, kd)
-        disk = chain_disk_margins(loop, np.logspace(-2, np.log10(10.0 * top), DISK_POINTS))
+    margins = chain_reflex_margins(
+        chain.linear_chain, kp, kd, settings.delay, settings.pade_order, lag,
+        guard=lambda: arithmetic_guard(eccentricity, lordosis),
+    )  # fmt: skip
     return CoupledMargins(
         chain=chain,
         activation=settings.activation,
@@ -244,8 +313,8 @@ def coupled_margins(model: Model, eccentricity: float, lordosis: float, kp=None,
         gains=settings.gains,
         kp=np.asarray(kp, float),
         kd=np.asarray(kd, float),
-        exact=exact,
-        delay_margin_pade=pade_margin(exact, settings.pade_order),
-        stable_at_delay=stable,
-        disk=disk,
+        exact=margins.exact,
+        delay_margin_pade=margins.delay_margin_pade,
+        stable_at_delay=margins.stable_at_delay,
+        disk=margins.disk,
     )

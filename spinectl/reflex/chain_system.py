@@ -5,6 +5,9 @@ at once, M q'' = K q + D q' + u (:func:`spinectl.model.chain.state_matrix`), one
 and one angle output per joint; the loop of the diagonal delayed reflex with Padé delays
 (:func:`chain_loop`) and its disk margins (:func:`chain_disk_margins`, docs/chain.md,
 "The delayed reflex"). The exact delay margin is :func:`spinectl.reflex.mimo.chain_delay_margin`.
+Each takes the matrices M, K, D and the joints' names, or any
+:class:`~spinectl.model.linear_chain.LinearChain` at its controls (:func:`linear_chain_system`,
+:func:`linear_chain_loop`).
 """
 
 from __future__ import annotations
@@ -16,6 +19,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..model.chain import state_matrix
+from ..model.linear_chain import LinearChain
 
 
 def chain_system(mass, stiffness, damping, names) -> ct.StateSpace:
@@ -122,6 +126,59 @@ def chain_loop(mass, stiffness, damping, kp, kd, delay: float, order: int, lag: 
     return ct.ss(
         loop.A, loop.B, loop.C, loop.D, inputs=[f"torque_{k}" for k in names], outputs=[f"reflex_{k}" for k in names]
     )
+
+
+def linear_chain_system(chain: LinearChain, u=()) -> ct.StateSpace:
+    """:func:`chain_system` of a linearised chain at the controls ``u``: M, K(u), D(u), its joints.
+
+    Parameters
+    ----------
+    chain : LinearChain
+        Fixed at an activation (:meth:`LinearChain.at`), ``u`` is empty.
+    u : array_like, shape (m,)
+        The controls [control unit].
+
+    Returns
+    -------
+    control.StateSpace
+        As :func:`chain_system`.
+
+    Raises
+    ------
+    ModelError
+        M is singular.
+    """
+    return chain_system(chain.mass_matrix, chain.stiffness(u), chain.damping(u), chain.joints)
+
+
+def linear_chain_loop(chain: LinearChain, kp, kd, delay: float, order: int, lag: float, u=()) -> ct.StateSpace:
+    """:func:`chain_loop` of a linearised chain at the controls ``u``.
+
+    Parameters
+    ----------
+    chain : LinearChain
+    kp, kd : array_like, shape (n,)
+        Diagonal gains [N m/rad], [N m s/rad].
+    delay : float
+        tau [s].
+    order : int
+        Padé order.
+    lag : float
+        T_a [s]; 0 none.
+    u : array_like, shape (m,)
+        The controls [control unit].
+
+    Returns
+    -------
+    control.StateSpace
+        As :func:`chain_loop`.
+
+    Raises
+    ------
+    ModelError
+        M is singular.
+    """
+    return chain_loop(chain.mass_matrix, chain.stiffness(u), chain.damping(u), kp, kd, delay, order, lag, chain.joints)
 
 
 @dataclass(frozen=True)

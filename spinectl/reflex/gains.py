@@ -66,7 +66,7 @@ def chain_gains(mass, stiffness, damping, local_stiffness, gain_factor, damping_
     """The default rule on the chain: diagonal gains from the chain's stiffness deficit (docs/chain.md).
 
     A joint's deficit is the least local stiffness k_j of
-    :func:`spinectl.optimise.coupled.least_local_stiffness` (diag(k) - K >= mu I): what the
+    :func:`spinectl.optimise.coupled.local.least_local_stiffness` (diag(k) - K >= mu I): what the
     joint lacks for the whole chain to be stable, where the segment's deficit max(S, 0) is
     what it lacks alone. kp_j = gain_factor k_j, and kd_j is the segment rule's
     (:func:`default_gains`) with theta = M[j, j], S = K[j, j], D = D[j, j]. Without delay,

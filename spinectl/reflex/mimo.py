@@ -35,6 +35,7 @@ import numpy as np
 import scipy.linalg
 
 from ..errors import ParameterError
+from ..model.linear_chain import LinearChain
 from .delay import STATUS, UNDEFINED, UNSTABLE_WITHOUT_DELAY
 from .pade import pade_inverse_lag
 from .siso import LoopDelayMargin, from_crossings
@@ -240,6 +241,34 @@ def chain_delay_margin(mass, stiffness, damping, kp, kd, lag=0.0) -> LoopDelayMa
     phases = np.array([np.mod(-np.angle(c[1]), 2.0 * np.pi) for c in found])
     directions = np.array([_direction(mass, stiffness, damping, kp, kd, lag, *c) for c in found], float)
     return from_crossings(w, phases, directions, stable)
+
+
+def delay_margin_of(chain: LinearChain, kp, kd, lag=0.0, u=()) -> LoopDelayMargin:
+    """:func:`chain_delay_margin` of any linearised chain at the controls ``u``: M, K(u), D(u).
+
+    Parameters
+    ----------
+    chain : LinearChain
+        The chain (:mod:`spinectl.model.linear_chain`); one fixed at an activation
+        (:meth:`LinearChain.at`) has no controls, and ``u`` is then empty.
+    kp, kd : array_like, shape (n,)
+        Diagonal reflex gains per joint [N m/rad], [N m s/rad].
+    lag : float, optional
+        Activation time constant T_a [s]; 0 the pure delay.
+    u : array_like, shape (m,)
+        The controls [control unit].
+
+    Returns
+    -------
+    LoopDelayMargin
+        As :func:`chain_delay_margin`.
+
+    References
+    ----------
+    .. [1] Michiels W, Niculescu S-I (2014). Stability, Control, and Computation for Time-Delay
+       Systems. An Eigenvalue-Based Approach. 2nd ed., SIAM. doi:10.1137/1.9781611973631.
+    """
+    return chain_delay_margin(chain.mass_matrix, chain.stiffness(u), chain.damping(u), kp, kd, lag)
 
 
 def pade_margin(exact: LoopDelayMargin, order: int) -> float:

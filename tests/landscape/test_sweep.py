@@ -336,7 +336,7 @@ def test_sweep_and_stability_agree_on_an_optimum_beyond_any_muscle():
     `stability` (which refused its own optimum as a unit slip before) give the same number."""
     import dataclasses
 
-    from spinectl.optimise.reference import stability_at
+    from spinectl.optimise.stabilising import stability_at
 
     base = config.load_preset("wagner2012")
     heavy = base.replace(

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -384,3 +386,29 @@ def test_level_weight_in_gravity(rng, sign):
     by_hand = w * sum((y[i] + y[i + 1]) / 2 - y[4] for i in range(4))
     np.testing.assert_allclose(extra[..., 4, 4], by_hand, rtol=1e-12)
     np.testing.assert_allclose(extra[..., 0, :], 0.0, atol=1e-12)  # L1L2 carries no level
+
+
+@pytest.mark.parametrize("activation", ["paired", "independent"])
+def test_linear_chain_is_the_chain_at_the_decision_variables(activation):
+    """model.chain.linear_chain: controls the optimisation's decision variables x [cm^2] (one per pair,
+    either side's PCSA, or one per muscle). Checked against chain_coefficients at the muscles' PCSA
+    (pairing_matrix @ x, times 1e-4 m^2 per cm^2), a second route: K(x), D(x) to rounding; M is
+    mass_matrix's; names, classes and the bounds 0 <= x <= pcsa_max as the model states them."""
+    base = load_preset("wagner2012")
+    model = base.replace(optimisation=dataclasses.replace(base.optimisation, activation=activation))
+    e, lam = 0.03, 0.04
+    linear = chain.linear_chain(model, e, lam)
+    coefficients = chain.chain_coefficients(model, e, lam)
+    paired = activation == "paired"
+    to_muscles = geometry.pairing_matrix(3) if paired else np.eye(6)
+    x = np.arange(1.0, to_muscles.shape[1] + 1.0)  # cm^2
+    pcsa = to_muscles @ x * 1e-4
+    np.testing.assert_allclose(linear.stiffness(x), coefficients.stiffness(pcsa), rtol=1e-12, atol=1e-9)
+    np.testing.assert_allclose(linear.damping(x), coefficients.damping(pcsa), rtol=1e-12, atol=1e-12)
+    cor = geometry.cor_positions(e, lam, model.geometry)
+    np.testing.assert_array_equal(linear.mass_matrix, chain.mass_matrix(model, cor))
+    assert linear.joints == model.geometry.cor_names
+    assert linear.controls == (model.pair_names if paired else model.muscle_names)
+    assert set(linear.control_class) == {"global"} and linear.control_unit == "cm^2"
+    np.testing.assert_array_equal(linear.upper, model.optimisation.pcsa_max * 1e4)
+    assert not linear.lower.any()

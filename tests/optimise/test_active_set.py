@@ -302,7 +302,8 @@ def test_stability_at_equals_the_per_point_reference(model, variant):
     for both, and ``stability_at`` then raises. (With independent activation the reference's x is only as
     exact as Clarabel's tolerance: :func:`test_independent_activation_is_optimal_by_a_second_method`.)"""
     from spinectl.model.stability import segment_stability
-    from spinectl.optimise.reference import NoStabilisingActivation, solve_point, stability_at
+    from spinectl.optimise.reference import solve_point
+    from spinectl.optimise.stabilising import NoStabilisingActivation, stability_at
 
     m = _variants(model)[variant]
     statuses = set()

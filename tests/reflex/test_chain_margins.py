@@ -83,3 +83,28 @@ def test_command_line_errors_are_one_line(capsys):
         assert main(argv) == 2
         err = capsys.readouterr().err
         assert field in err and len(err.strip().splitlines()) == 1 and "Traceback" not in err
+
+
+def test_the_margins_of_any_linear_chain_follow_its_delay_margin():
+    """chain_reflex_margins on a LinearChain written down (two uncoupled joints, M = I, K = diag(1, 2),
+    D = -0.5 I, kp = 10, kd = 2): each joint is the segment s^2 + 0.5 s - lambda + (10 + 2 s) e^{-s tau}, with
+    one destabilising crossing (kp > |lambda|, tests/reflex/test_mimo.py), so the true-delay loop is stable
+    below the margin and not above; the disk margins exist only where it is. The Padé estimate of order 6 is
+    the exact margin to 1e-9: the crossing is at w tau = 0.72 rad, where the phase error of the [6/6]
+    approximant, of order (w tau)^13 (n!)^2 / ((2n)! (2n + 1)!), is below 1e-12 rad."""
+    from spinectl.model.linear_chain import LinearChain
+    from spinectl.reflex.chain_margins import chain_reflex_margins
+
+    chain = LinearChain(
+        joints=("a", "b"), controls=(), control_class=(), stiffness_per_control=np.zeros((2, 2, 0)),
+        damping_per_control=np.zeros((2, 2, 0)), stiffness_offset=np.diag([1.0, 2.0]),
+        damping_offset=-0.5 * np.eye(2), mass_matrix=np.eye(2), lower=np.zeros(0), upper=np.zeros(0),
+    )  # fmt: skip
+    kp, kd = np.full(2, 10.0), np.full(2, 2.0)
+    first = chain_reflex_margins(chain, kp, kd, 0.0, 6, 0.0)
+    margin = first.exact.margin
+    assert first.exact.status == "finite"
+    np.testing.assert_allclose(first.delay_margin_pade, margin, rtol=1e-9)
+    below, above = (chain_reflex_margins(chain, kp, kd, f * margin, 6, 0.0) for f in (0.5, 1.5))
+    assert below.stable_at_delay and below.disk is not None and 0 < below.disk.disk_margin
+    assert not above.stable_at_delay and above.disk is None

@@ -132,3 +132,48 @@ def test_nan_is_undefined_and_unstable_without_delay_is_zero():
     # K_p - K not positive definite: a static root in the right half-plane at tau = 0
     weak = chain_delay_margin(np.eye(2), np.diag([10.0, 10.0]), -np.eye(2), [5.0, 20.0], [1.0, 1.0])
     assert weak.status == "unstable_without_delay" and weak.margin == 0.0
+
+
+def test_the_delay_margin_of_a_chain_built_by_hand_is_that_of_its_modes():
+    """A LinearChain written down (two joints, three controls, tests/optimise/test_coupled_sdp.py):
+    K(u) = g 1 1' - diag(u_1, u_2) - u_3 1 1', D = -beta I, M = m I, with equal gains on both joints.
+    Then M, D and K_p, K_d commute with K, and in K's eigenbasis every mode j (eigenvalue lambda_j) is
+    the segment m s^2 + beta s - lambda_j + (k_p + k_d s) exp(-s tau) = 0. On s = j w the moduli of
+    both parts agree where m^2 w^4 + (2 m lambda + beta^2 - k_d^2) w^2 + lambda^2 - k_p^2 = 0: with
+    k_p > |lambda| one root w^2 > 0, a destabilising crossing at tau = (-arg(-P/Q) mod 2 pi) / w. The
+    chain's margin is the smallest of the two modes' (u = (1, 2, 0.5), g = 3: lambda = 1 +- sqrt(6.5))."""
+    from spinectl.model.linear_chain import LinearChain
+    from spinectl.reflex.chain_system import linear_chain_system
+    from spinectl.reflex.mimo import delay_margin_of
+
+    g, m, beta, kp, kd = 3.0, 2.0, 0.5, 10.0, 2.0
+    e1, e2, one = np.diag([1.0, 0.0]), np.diag([0.0, 1.0]), np.ones((2, 2))
+    chain = LinearChain(
+        joints=("top", "bottom"),
+        controls=("local_top", "local_bottom", "global"),
+        control_class=("local", "local", "global"),
+        stiffness_per_control=np.stack([-e1, -e2, -one], axis=-1),
+        damping_per_control=np.zeros((2, 2, 3)),
+        stiffness_offset=g * one,
+        damping_offset=-beta * np.eye(2),
+        mass_matrix=m * np.eye(2),
+        lower=np.zeros(3),
+        upper=np.full(3, np.inf),
+    )
+    u = np.array([1.0, 2.0, 0.5])
+    taus = []
+    for lam in (1.0 + np.sqrt(6.5), 1.0 - np.sqrt(6.5)):
+        b = 2 * m * lam + beta**2 - kd**2
+        w = np.sqrt((-b + np.sqrt(b * b - 4 * m**2 * (lam**2 - kp**2))) / (2 * m**2))
+        p, q = -m * w**2 + 1j * beta * w - lam, kp + 1j * kd * w
+        taus.append(np.mod(-np.angle(-p / q), 2 * np.pi) / w)
+    exact = delay_margin_of(chain, np.full(2, kp), np.full(2, kd), 0.0, u)
+    assert exact.status == "finite" and exact.stable_without_delay
+    np.testing.assert_allclose(exact.margin, min(taus), rtol=1e-9)
+    # the same on the chain fixed at u (no controls), and its state-space poles are eq. 1's of each mode
+    assert delay_margin_of(chain.at(u), np.full(2, kp), np.full(2, kd)).margin == exact.margin
+    poles = np.sort_complex(linear_chain_system(chain, u).poles())
+    modes = np.sort_complex(
+        np.concatenate([np.roots([m, beta, -lam]) for lam in np.linalg.eigvalsh(chain.stiffness(u))])
+    )
+    np.testing.assert_allclose(poles, modes, rtol=1e-9)

@@ -41,7 +41,7 @@ import numpy as np
 import xarray as xr
 import zarr
 
-from ... import __version__
+from ..._version import __version__
 from ...atomic import atomic_path, output_errors
 from ...errors import OutputError, ParameterError
 from ...model import config, source

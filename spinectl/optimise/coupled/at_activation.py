@@ -1,0 +1,282 @@
+"""The paper's chain at one (E, Lambda) and one global activation: ``spinectl stability --coupled`` (docs/chain.md).
+
+Its matrices K, D and M, the static margin (the smallest eigenvalue of -K), the dynamic
+eigenvalues with the global muscles alone and with the least local stiffness of problem (a)
+(:func:`~spinectl.optimise.coupled.local.least_local_stiffness`) added.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...model import chain
+from ...model.checks import arithmetic_guard, expand_pcsa
+from ...model.linear_chain import LinearChain
+from ...model.params import Model
+from ...model.source import header, provenance
+from ...model.stability import self_stable
+from ...units import m2_to_cm2
+from ..stabilising import minimum_stabilising_pcsa
+from .data import CoupledOptimum, coupled_data
+from .local import least_local_stiffness
+
+
+@dataclass(frozen=True)
+class CoupledStability:
+    """The coupled chain at one (E, Lambda) and one global activation: ``spinectl stability --coupled``.
+
+    Attributes
+    ----------
+    eccentricity, lordosis : float
+        E and Lambda [m].
+    segment_names : tuple of str
+        The joints, top to bottom.
+    variable_names : tuple of str
+        The decision variables: the pairs (paired activation) or the muscles (independent).
+    pcsa : numpy.ndarray, shape (n_muscles,)
+        Global PCSA of each muscle [m^2].
+    stiffness : numpy.ndarray, shape (n_cor, n_cor)
+        K: global muscles, gravity and passive stiffness [N m/rad].
+    gravity_stiffness : numpy.ndarray, shape (n_cor, n_cor)
+        K_g [N m/rad].
+    stiffness_per_variable : numpy.ndarray, shape (n_var, n_cor, n_cor)
+        dK/dx of each decision variable [N m/rad per cm^2].
+    damping : numpy.ndarray, shape (n_cor, n_cor)
+        D [N m s/rad].
+    mass : numpy.ndarray, shape (n_cor, n_cor)
+        M [kg m^2] (:func:`spinectl.model.chain.mass_matrix`).
+    local : CoupledOptimum
+        The least local stiffness that makes the chain statically stable at this activation
+        (:func:`least_local_stiffness`, problem (a)).
+    margin : float
+        Smallest eigenvalue of -K, global muscles only [N m/rad]; > 0 statically stable.
+    eigenvalues : numpy.ndarray, shape (2 n_cor,), complex
+        Of the state matrix [[0, I], [M^-1 K, M^-1 D]], global muscles only [1/s].
+    local_eigenvalues : numpy.ndarray, shape (2 n_cor,), complex
+        The same with the least local stiffness added, K - diag(k) [1/s]; NaN if (a) failed.
+    """
+
+    eccentricity: float
+    lordosis: float
+    segment_names: tuple[str, ...]
+    variable_names: tuple[str, ...]
+    pcsa: np.ndarray
+    stiffness: np.ndarray
+    gravity_stiffness: np.ndarray
+    stiffness_per_variable: np.ndarray
+    damping: np.ndarray
+    mass: np.ndarray
+    local: CoupledOptimum
+    margin: float
+    eigenvalues: np.ndarray
+    local_eigenvalues: np.ndarray
+
+    @property
+    def linear_chain(self) -> LinearChain:
+        """The chain at this activation as a :class:`~spinectl.model.linear_chain.LinearChain` without controls.
+
+        K_0 = K (global muscles, gravity, passive), D_0 = D and M: the linear system the reflex
+        analyses take (:func:`spinectl.reflex.chain_margins.chain_reflex_margins`).
+        """
+        n = len(self.segment_names)
+        return LinearChain(
+            joints=self.segment_names,
+            controls=(),
+            control_class=(),
+            stiffness_per_control=np.zeros((n, n, 0)),
+            damping_per_control=np.zeros((n, n, 0)),
+            stiffness_offset=self.stiffness,
+            damping_offset=self.damping,
+            mass_matrix=self.mass,
+            lower=np.zeros(0),
+            upper=np.zeros(0),
+        )
+
+    @property
+    def self_stable(self) -> bool:
+        """True if the chain is dynamically stable with the global muscles alone (every eigenvalue Re < 0)."""
+        return bool(self_stable(self.eigenvalues))
+
+    @property
+    def stable_with_local(self) -> bool:
+        """True if the chain is dynamically stable with the least local stiffness added."""
+        return bool(self_stable(self.local_eigenvalues))
+
+    def to_dict(self, model: Model, pcsa_source: str = "min_pcsa") -> dict:
+        """The result as a JSON-ready dict: the document of ``spinectl stability --coupled --json``.
+
+        Parameters
+        ----------
+        model : Model
+            The model the result was computed with (muscle names, K and its convention).
+        pcsa_source : {'given', 'min_pcsa', 'activation'}
+            Where the PCSA came from (as in :meth:`spinectl.model.stability.StabilityResult.to_dict`);
+            'activation': the reflex's activation times the minimum stabilising PCSA (:meth:`table`).
+
+        Returns
+        -------
+        dict
+            The model's :func:`~spinectl.model.source.provenance` (``preset``, ``config``, ``config_sha256``,
+            ``overridden``, ``K_Nm_per_rad``, ``K_convention``), ``E_m``, ``Lambda_m``, ``pcsa_source`` and
+            ``coupled``: ``segments``, ``decision_variables``, ``pcsa_cm2`` (muscle -> cm^2),
+            ``stiffness_matrix_Nm_per_rad``, ``gravity_stiffness_matrix_Nm_per_rad``,
+            ``stiffness_matrix_per_cm2`` (n_var x n_cor x n_cor, N m/rad per cm^2),
+            ``damping_matrix_Nms_per_rad``, ``mass_matrix_kgm2``, ``local_stiffness_Nm_per_rad``
+            (the least, per joint), ``local_stiffness_total_Nm_per_rad``, ``local_pcsa_cm2``,
+            ``local_status``, ``margin_Nm_per_rad`` (global muscles only), ``eigenvalues`` as
+            [real, imaginary] pairs [1/s] and ``self_stable`` (global muscles only), and
+            ``eigenvalues_with_local`` and ``stable_with_local`` (with the least local stiffness).
+        """
+        local = self.local
+        return provenance(model) | {
+            "E_m": self.eccentricity,
+            "Lambda_m": self.lordosis,
+            "pcsa_source": pcsa_source,
+            "coupled": {
+                "segments": list(self.segment_names),
+                "decision_variables": list(self.variable_names),
+                "pcsa_cm2": dict(zip(model.muscle_names, m2_to_cm2(self.pcsa).tolist(), strict=True)),
+                "stiffness_matrix_Nm_per_rad": self.stiffness.tolist(),
+                "gravity_stiffness_matrix_Nm_per_rad": self.gravity_stiffness.tolist(),
+                "stiffness_matrix_per_cm2": self.stiffness_per_variable.tolist(),
+                "damping_matrix_Nms_per_rad": self.damping.tolist(),
+                "mass_matrix_kgm2": self.mass.tolist(),
+                "local_stiffness_Nm_per_rad": local.local_stiffness.tolist(),
+                "local_stiffness_total_Nm_per_rad": float(np.sum(local.local_stiffness)),
+                "local_pcsa_cm2": m2_to_cm2(local.local_pcsa).tolist(),
+                "local_status": local.status,
+                "margin_Nm_per_rad": self.margin,
+                "eigenvalues": [[float(z.real), float(z.imag)] for z in self.eigenvalues],
+                "self_stable": self.self_stable,
+                "eigenvalues_with_local": [[float(z.real), float(z.imag)] for z in self.local_eigenvalues],
+                "stable_with_local": self.stable_with_local,
+            },
+        }
+
+    def table(self, model: Model, pcsa_source: str = "min_pcsa", activation: float = 1.0) -> str:
+        """The result as readable text: the matrices row by row, then the verdicts.
+
+        Parameters
+        ----------
+        model : Model
+            The model the result was computed with.
+        pcsa_source : {'given', 'min_pcsa', 'activation'}
+            Where the PCSA came from: given, the minimum stabilising PCSA per segment, or
+            ``activation`` times it (the reflex's operating point, ``spinectl margins --coupled``).
+        activation : float
+            The fraction of the minimum stabilising PCSA [1] the PCSA line names with 'activation'.
+
+        Returns
+        -------
+        str
+            The text ``spinectl stability --coupled`` prints (no final newline).
+        """
+        pcsa = m2_to_cm2(self.pcsa)
+        names = self.segment_names
+        source = {
+            "given": "",
+            "min_pcsa": " (minimum stabilising per segment)",
+            "activation": f" ({activation:g} x the minimum stabilising per segment, the reflex's activation)",
+        }[pcsa_source]
+        lines = [
+            header(model),
+            f"Coupled chain at E = {self.eccentricity * 100:.2f} cm, Lambda = {self.lordosis * 100:.2f} cm",
+            f"PCSA [cm^2]{source}: "
+            + ", ".join(f"{n} {p:.2f}" for n, p in zip(model.muscle_names, pcsa, strict=True))
+            + f"  (total {pcsa.sum():.2f})",
+        ]
+        for title, matrix, fmt in (
+            ("stiffness K [N m/rad] (global muscles, gravity, passive)", self.stiffness, "10.3f"),
+            ("damping D [N m s/rad]", self.damping, "10.4f"),
+            ("mass M [kg m^2]", self.mass, "10.4f"),
+        ):
+            lines += ["", title, " " * 8 + "".join(f"{n:>10}" for n in names)]
+            lines += [f"{n:8}" + "".join(f"{v:{fmt}}" for v in row) for n, row in zip(names, matrix, strict=True)]
+        local = self.local.local_stiffness
+        lines += [
+            "",
+            f"static margin (smallest eigenvalue of -K) = {self.margin:.3f} N m/rad "
+            f"({'stable' if self.margin > 0 else 'UNSTABLE'})",
+            "eigenvalues [1/s]: " + ", ".join(f"{z.real:.3f}{z.imag:+.3f}j" for z in self.eigenvalues),
+            "global muscles alone: "
+            + (
+                "eigenvalues undefined, the mass matrix is singular (levels.mass = 0)"
+                if np.isnan(self.eigenvalues).any()
+                else f"{'dynamically stable' if self.self_stable else 'NOT stable'} "
+                f"({int(np.sum(self.eigenvalues.real >= 0))} of {self.eigenvalues.size} eigenvalues with Re >= 0)"
+            ),
+            "least local stiffness [N m/rad]: "
+            + ", ".join(f"{n} {k:.2f}" for n, k in zip(names, local, strict=True))
+            + f"  (total {np.sum(local):.2f}; local PCSA {m2_to_cm2(self.local.total_local_pcsa):.2f} cm^2; "
+            f"{self.local.status}); with it: {'dynamically stable' if self.stable_with_local else 'NOT stable'}, "
+            f"slowest eigenvalue {self.local_eigenvalues[0].real:.3f}{self.local_eigenvalues[0].imag:+.3f}j 1/s",
+        ]
+        return "\n".join(lines)
+
+
+def coupled_stability_at(model: Model, eccentricity: float, lordosis: float, pcsa=None) -> CoupledStability:
+    """The coupled chain at a global activation, by default the per-segment optimum.
+
+    The matrices of :func:`spinectl.model.chain.chain_coefficients` and
+    :func:`spinectl.model.chain.mass_matrix` at that activation, the static margin
+    (:func:`spinectl.model.chain.coupled_margin`), the dynamic eigenvalues
+    (:func:`spinectl.model.chain.dynamic_eigenvalues`) and the least local stiffness
+    (:func:`least_local_stiffness`); docs/chain.md.
+
+    Parameters
+    ----------
+    model : Model
+    eccentricity, lordosis : float
+        E and Lambda [m].
+    pcsa : array_like, optional
+        Global PCSA [m^2], per pair or per muscle; default the minimum stabilising PCSA of
+        :func:`spinectl.optimise.reference.solve_point`
+        (:func:`~spinectl.optimise.stabilising.minimum_stabilising_pcsa`).
+
+    Returns
+    -------
+    CoupledStability
+
+    Raises
+    ------
+    ModelError
+        ``pcsa`` not given and no activation stabilises every segment; or the model cannot be
+        evaluated there.
+    ParameterError
+        E, Lambda or ``pcsa`` out of range.
+
+    References
+    ----------
+    Bergmark A (1989). Stability of the lumbar spine. A study in mechanical engineering.
+    Acta Orthop Scand Suppl 230:1-54. doi:10.3109/17453678909154177.
+    """
+    e, lam = float(eccentricity), float(lordosis)
+    given = pcsa is not None
+    pcsa = expand_pcsa(model, pcsa) if given else minimum_stabilising_pcsa(model, e, lam)
+    data = coupled_data(model, e, lam)
+    coefficients = data.coefficients
+    local = least_local_stiffness(model, e, lam, pcsa, given=given)  # the SDP, outside numpy's guard
+    with arithmetic_guard(e, lam):
+        stiffness = coefficients.stiffness(pcsa)
+        damping = coefficients.damping(pcsa)
+        mass = data.chain.mass_matrix
+        eigenvalues = chain.dynamic_eigenvalues(mass, stiffness, damping)
+        with_local = chain.dynamic_eigenvalues(mass, stiffness - np.diag(local.local_stiffness), damping)
+    return CoupledStability(
+        eccentricity=e,
+        lordosis=lam,
+        segment_names=data.chain.joints,
+        variable_names=data.chain.controls,
+        pcsa=pcsa,
+        stiffness=stiffness,
+        gravity_stiffness=coefficients.gravity_stiffness,
+        stiffness_per_variable=np.moveaxis(data.chain.stiffness_per_control, -1, 0),
+        damping=damping,
+        mass=mass,
+        local=local,
+        margin=float(chain.coupled_margin(stiffness)),
+        eigenvalues=eigenvalues,
+        local_eigenvalues=with_local,
+    )
