@@ -61,7 +61,7 @@ def activations(anatomy: Anatomy, activation) -> np.ndarray:
         except (TypeError, ValueError):
             raise ParameterError("activation", f"must be one number or {m} numbers in [0, 1]") from None
     if not np.all(np.isfinite(a)) or np.any(a < 0) or np.any(a > 1):
-        raise ParameterError("activation", f"must be in [0, 1] (got {printable(a.min())} ... {printable(a.max())})")
+        raise ParameterError("activation", f"must be in [0, 1] (got {a.min():g} ... {a.max():g})")
     return a
 
 

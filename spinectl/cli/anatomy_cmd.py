@@ -1,0 +1,81 @@
+"""``spinectl anatomy``: the paper's question and the chain's on a MuJoCo musculoskeletal model."""
+
+from __future__ import annotations
+
+from ._common import emit_json, finite_float
+
+
+def register(sub) -> None:
+    """Add the ``anatomy`` sub-command to the ``spinectl`` parser.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The sub-command action of :func:`spinectl.cli.build_parser`.
+    """
+    parser = sub.add_parser(
+        "anatomy",
+        help="stability of an anatomical model's lumbar chain (MuJoCo; MyoTorso built in)",
+        description="Load a MuJoCo musculoskeletal model (the built-in 'myotorso' from myo-sim, or an MJCF "
+        "file with --mapping), linearise its lumbar chain at the reference posture and uniform muscle "
+        "activation, and report each joint's stiffness (joint by joint, the others fixed), the chain's "
+        "eigenvalues (every joint free, equality constraints off), the chain constrained by the model's "
+        "lumbar rhythm, and the global muscles' rank. Needs pip install 'spinectl[anatomy]'. "
+        "See docs/anatomy.md.",
+    )
+    parser.add_argument("model", nargs="?", default="myotorso", help="'myotorso' or an MJCF file (default: myotorso)")
+    parser.add_argument("--mapping", metavar="FILE", help="mapping TOML (default: the built-in one of the model)")
+    parser.add_argument("--plane", default="sagittal", help="sagittal, coronal or 3d (default: sagittal)")
+    parser.add_argument(
+        "--activation",
+        type=finite_float("--activation"),
+        default=0.0,
+        metavar="A",
+        help="activation of every muscle, in [0, 1] (default: 0)",
+    )
+    parser.add_argument(
+        "--joint-stiffness",
+        default="none",
+        metavar="K",
+        help="intervertebral stiffness added at each chain joint: none (the model's own, default), "
+        "mapped (the mapping's cited value) or a number [N m/rad]",
+    )
+    parser.add_argument(
+        "--check",
+        action="store_true",
+        help="compare the eigenvalues with MuJoCo's own linearisation (mjd_transitionFD, free chain)",
+    )
+    parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    parser.set_defaults(func=run)
+
+
+def run(args) -> int:
+    """Run ``spinectl anatomy``: print the table, or JSON with ``--json``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments: ``model``, ``mapping``, ``plane``, ``activation``, ``joint_stiffness``,
+        ``check``, ``json``.
+
+    Returns
+    -------
+    int
+        Exit code 0 (an unstable chain is an answer).
+    """
+    from ..anatomy import load
+    from ..anatomy.analyses import analyse
+
+    anatomy = load(args.model, args.mapping)
+    result = analyse(
+        anatomy,
+        plane=args.plane,
+        activation=args.activation,
+        joint_stiffness=args.joint_stiffness,
+        check=args.check,
+    )
+    if args.json:
+        emit_json(result.to_dict())
+    else:
+        print(result.table())
+    return 0
