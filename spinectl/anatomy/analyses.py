@@ -25,7 +25,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._validate import printable
 from ..errors import ParameterError
 from ..model.linear_chain import LinearChain
 from .engine import require_mujoco
@@ -410,7 +409,8 @@ class AnatomyResult:
         lines += [
             "",
             f"the chain, free (every joint free, equality constraints off): eigenvalues of -K {eig} N m/rad: "
-            f"{word[free.chain_stable]} ({int(np.sum(free.eigenvalues <= 0))} of {len(free.eigenvalues)} modes unstable)",
+            f"{word[free.chain_stable]} ({int(np.sum(free.eigenvalues <= 0))} of {len(free.eigenvalues)} modes "
+            "unstable)",
             f"the chain constrained by the model's rhythm ({len(con.joints)} coordinate(s): {', '.join(con.joints)}): "
             f"eigenvalues of -K {', '.join(f'{v:.4g}' for v in con.eigenvalues)} N m/rad: "
             f"{word[con.chain_stable]}; the rhythm removes {len(free.joints) - len(con.joints)} modes",
@@ -466,8 +466,10 @@ def analyse(
     return AnatomyResult(
         model={"name": anatomy.name, "source": anatomy.engine.source, "sha256": anatomy.engine.sha256},
         plane=plane,
-        muscles={c: tuple(m for m, k in zip(anatomy.muscles, classes, strict=True) if k == c) for c in
-                 ("global", "local", "between")},
+        muscles={
+            c: tuple(m for m, k in zip(anatomy.muscles, classes, strict=True) if k == c)
+            for c in ("global", "local", "between")
+        },
         activations=a,
         joint_stiffness_added=added,
         stiffness_source=anatomy.mapping.stiffness_source if np.any(added > 0) else "",

@@ -1,0 +1,81 @@
+"""``spinectl anatomy``: JSON keys, the table's criteria and clean failures (MyoTorso loaded once)."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from spinectl import jsondoc
+from spinectl.cli import main
+
+KEYS = (
+    "model",
+    "joints",
+    "muscles",
+    "global_rank",
+    "stiffness_matrix_Nm_per_rad",
+    "damping_matrix_Nms_per_rad",
+    "mass_matrix_kgm2",
+    "joint_stiffness_Nm_per_rad",
+    "eigenvalues",
+    "dynamic_eigenvalues",
+    "joint_self_stable",
+    "chain_stable",
+    "constrained",
+)
+
+
+@pytest.fixture
+def cached(monkeypatch):
+    """The session's MyoTorso for ``myotorso`` (loading it takes seconds), MuJoCo's own load otherwise."""
+    pytest.importorskip("mujoco", reason="needs the anatomy extra: pip install 'spinectl[anatomy]'")
+    pytest.importorskip("myo_sim", reason="needs the anatomy extra: pip install 'spinectl[anatomy]'")
+    import spinectl.anatomy as package
+
+    real = package.load
+    cache = {}
+
+    def load(model="myotorso", mapping=None):
+        if model == "myotorso" and mapping is None:
+            return cache.setdefault("torso", real("myotorso"))
+        return real(model, mapping)
+
+    monkeypatch.setattr(package, "load", load)
+
+
+def test_json_is_the_results_dict(cached, capsys):
+    """``--json --check`` prints :meth:`AnatomyResult.to_dict` with the documented keys and MuJoCo's eigenvalues."""
+    import spinectl.anatomy as package
+    from spinectl.anatomy.analyses import analyse
+
+    assert main(["anatomy", "--activation", "0.05", "--check", "--json"]) == 0
+    out = capsys.readouterr().out
+    doc = json.loads(out)
+    assert all(key in doc for key in KEYS)
+    assert set(doc["model"]) == {"name", "source", "sha256"} and set(doc["muscles"]) == {"global", "local", "between"}
+    assert len(doc["mujoco_eigenvalues"]) == 10
+    assert out == jsondoc.dumps(analyse(package.load(), activation=0.05, check=True).to_dict())
+
+
+def test_the_table_names_every_criterion(cached, capsys):
+    assert main(["anatomy"]) == 0
+    out = capsys.readouterr().out
+    assert "joint by joint (others fixed)" in out
+    assert "the chain, free (every joint free, equality constraints off)" in out
+    assert "the chain constrained by the model's rhythm" in out
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--activation", "1.5"], "activation: must be in [0, 1]"),
+        (["--plane", "axial"], "plane: must be one of"),
+        (["--joint-stiffness", "soft"], "joint_stiffness: must be"),
+        (["no-such-model"], "model: must be one of"),
+    ],
+)
+def test_bad_input_is_one_line_exit_2(cached, capsys, argv, message):
+    assert main(["anatomy", *argv]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == "" and message in captured.err and len(captured.err.strip().splitlines()) == 1
