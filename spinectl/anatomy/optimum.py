@@ -1,0 +1,235 @@
+"""Stability-constrained static optimisation on an anatomical model (docs/anatomy.md, "The optimum").
+
+The least muscle effort that holds the posture,
+
+    minimise    sum_i w_i a_i^2
+    subject to  equilibrium, tau_0 + sum_i a_i tau_i = 0:
+                  "free":   on every lumbar joint, the model's equality constraints off;
+                  "rhythm": on the rhythm's independent coordinates (T^T tau = 0 in all three
+                            planes); the model's joint equalities carry the rest, as constant
+                            torques (the paper's counter torques, here the rhythm's),
+                0 <= a_i <= 1,
+                and the stability criterion:
+                  "chain":  -K(a) >= mu I           (the free chain, every joint free at once),
+                  "joints": -K_jj(a) >= mu, each j  (the paper's joint-by-joint criterion),
+                  "rhythm": -K_c(a) >= mu I         (the chain constrained by the model's rhythm),
+                  "none":   nothing (classic static optimisation).
+
+The cost is OpenSim's static optimisation criterion sum a_i^2 (Anderson and Pandy 2001)
+with ``weights="none"``; with ``weights="volume"`` (the default) each muscle counts by its
+volume, w_i proportional to F0_i L0_i (maximal isometric force times optimal fibre length,
+so PCSA times fibre length at a common specific tension), normalised to mean 1: a large
+muscle's activation costs more than a small one's. Convex in a (a quadratic cost, linear
+equalities and bounds, one linear matrix inequality), solved with cvxpy and Clarabel.
+
+This is a small direct SDP written against :class:`~spinectl.model.linear_chain.LinearChain`
+(:func:`solve_on_chain`); the chain SDPs of :mod:`spinectl.optimise` may take its place.
+
+References
+----------
+Anderson FC, Pandy MG (2001). Static and dynamic optimization solutions for gait are
+practically equivalent. J Biomech 34(2):153-161. doi:10.1016/S0021-9290(00)00155-X.
+Goulart PJ, Chen Y (2024). Clarabel: an interior-point solver for conic programs with
+quadratic objectives. arXiv:2405.12762.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..model.linear_chain import LinearChain
+from .linearise import rhythm
+from .model import Anatomy
+
+STABILITY = ("chain", "joints", "rhythm", "none")
+EQUILIBRIUM = ("rhythm", "free")
+WEIGHTS = ("volume", "none")
+MARGIN = 1.0
+"""Default static margin mu [N m/rad] of the stability constraints."""
+
+
+def volume_weights(anatomy: Anatomy) -> np.ndarray:
+    """w_i proportional to F0_i L0_i (MuJoCo's muscle parameters), normalised to mean 1.
+
+    Parameters
+    ----------
+    anatomy : Anatomy
+        The model.
+
+    Returns
+    -------
+    numpy.ndarray, shape (m,)
+    """
+    model = anatomy.engine.model
+    gain = model.actuator_gainprm
+    lr = model.actuator_lengthrange
+    # MuJoCo's muscle: L0 = (lengthrange span) / (operating range span); F0 = force, or scale / acc0 if force < 0
+    length0 = (lr[:, 1] - lr[:, 0]) / (gain[:, 1] - gain[:, 0])
+    force0 = np.where(gain[:, 2] > 0, gain[:, 2], gain[:, 3] / model.actuator_acc0)
+    volume = force0 * length0
+    return volume / volume.mean()
+
+
+def solve_on_chain(chain: LinearChain, tau_per, tau_0, weights, stability: str, margin: float):
+    """The optimum on a LinearChain with equilibrium rows; ``(status, a)`` (a NaN where infeasible).
+
+    Parameters
+    ----------
+    chain : LinearChain
+        The free chain: K(a) for the stability constraint, bounds of a.
+    tau_per : numpy.ndarray, shape (r, m)
+        Each control's generalised force per unit on the r equilibrium rows [N m].
+    tau_0 : numpy.ndarray, shape (r,)
+        The rest of the net torque on those rows [N m].
+    weights : numpy.ndarray, shape (m,)
+        Cost weights w_i.
+    stability : str
+        One of :data:`STABILITY`.
+    margin : float
+        mu [N m/rad].
+
+    Returns
+    -------
+    tuple
+        (cvxpy's status, numpy.ndarray of shape (m,)).
+    """
+    import cvxpy as cp
+
+    n, m = chain.n_joints, chain.n_controls
+    a = cp.Variable(m)
+    constraints = [tau_per @ a + tau_0 == 0, a >= chain.lower, a <= chain.upper]
+    flat = chain.stiffness_per_control.reshape(n * n, m)
+    neg_k = -(cp.reshape(flat @ a, (n, n), order="C") + chain.stiffness_offset)
+    if stability == "chain":
+        constraints.append(0.5 * (neg_k + neg_k.T) - margin * np.eye(n) >> 0)
+    elif stability == "joints":
+        constraints.append(cp.diag(neg_k) >= margin)
+    problem = cp.Problem(cp.Minimize(cp.sum(cp.multiply(weights, cp.square(a)))), constraints)
+    try:
+        problem.solve(solver=cp.CLARABEL)
+    except cp.error.SolverError:
+        return "solver_error", np.full(m, np.nan)
+    if problem.status not in ("optimal", "optimal_inaccurate") or a.value is None:
+        return problem.status, np.full(m, np.nan)
+    return problem.status, np.clip(a.value, chain.lower, chain.upper)
+
+
+@dataclass(frozen=True)
+class Optimum:
+    """One optimum (:func:`optimise`).
+
+    Attributes
+    ----------
+    stability : str
+        The criterion imposed (:data:`STABILITY`).
+    status : str
+        cvxpy's status; the numbers are NaN unless it is optimal.
+    activations : numpy.ndarray, shape (m,)
+        [1].
+    cost : float
+        sum w_i a_i^2.
+    equilibrium : str
+        ``"rhythm"`` or ``"free"``.
+    net_torque : numpy.ndarray, shape (r,)
+        On every equilibrium row at the optimum [N m] (0 up to the solver's tolerance).
+    lumbar_torque : numpy.ndarray, shape (l,)
+        The net torque on every lumbar joint at the optimum [N m]: what the rhythm carries
+        (0 with ``"free"``).
+    eigenvalues : numpy.ndarray, shape (n,)
+        Of -K(a) of the free chain [N m/rad]: the least is the margin.
+    joint_stiffness : numpy.ndarray, shape (n,)
+        Diagonal of -K(a) [N m/rad].
+    """
+
+    stability: str
+    status: str
+    activations: np.ndarray
+    cost: float
+    equilibrium: str
+    net_torque: np.ndarray
+    lumbar_torque: np.ndarray
+    eigenvalues: np.ndarray
+    joint_stiffness: np.ndarray
+
+    @property
+    def ok(self) -> bool:
+        """Solved (optimal or optimal_inaccurate)."""
+        return self.status in ("optimal", "optimal_inaccurate")
+
+
+def optimise(
+    anatomy: Anatomy,
+    plane: str = "sagittal",
+    stability: str = "chain",
+    margin: float = MARGIN,
+    posture=None,
+    joint_stiffness="none",
+    weights: str = "volume",
+    equilibrium: str = "rhythm",
+) -> Optimum:
+    """The least-effort activations that hold the posture, with a stability criterion.
+
+    Parameters
+    ----------
+    anatomy : Anatomy
+        The model.
+    plane : str
+        The chain whose stability is imposed (equilibrium holds on every lumbar joint: the
+        mapping's ``3d`` plane, or this plane's joints if it has none).
+    stability : str
+        ``"chain"``, ``"joints"`` or ``"none"`` (module docstring).
+    margin : float
+        mu [N m/rad], >= 0.
+    posture : array_like, optional
+        Full qpos; default the model's reference posture.
+    joint_stiffness : {"none", "mapped"} or float
+        Added at each chain joint [N m/rad].
+    weights : str
+        ``"volume"`` or ``"none"`` (:func:`volume_weights`).
+    equilibrium : str
+        ``"rhythm"`` or ``"free"`` (module docstring).
+
+    Returns
+    -------
+    Optimum
+    """
+    if stability not in STABILITY:
+        raise ParameterError("stability", f"must be one of {STABILITY} (got {stability!r})")
+    if weights not in WEIGHTS:
+        raise ParameterError("weights", f"must be one of {WEIGHTS} (got {weights!r})")
+    if equilibrium not in EQUILIBRIUM:
+        raise ParameterError("equilibrium", f"must be one of {EQUILIBRIUM} (got {equilibrium!r})")
+    if not (np.isfinite(margin) and margin >= 0):
+        raise ParameterError("margin", f"must be >= 0 [N m/rad] (got {margin!r})")
+    free, constrained, lin = anatomy.chains(plane, posture, joint_stiffness)
+    lumbar = anatomy.mapping.planes.get("3d", anatomy.plane_joints(plane))
+    model = anatomy.engine.model
+    rows = [int(model.jnt_dofadr[j]) for j in anatomy.joint_ids(lumbar)]
+    if equilibrium == "free":
+        tau_per, tau_0 = lin.torque_per_muscle[rows], lin.torque_offset[rows]
+    else:
+        anatomy.engine.set_state(anatomy.posture(posture))
+        rhy = rhythm(anatomy.engine, anatomy.joint_ids(lumbar))
+        dofs = list(rhy.dofs)
+        tau_per, tau_0 = rhy.transform.T @ lin.torque_per_muscle[dofs], rhy.transform.T @ lin.torque_offset[dofs]
+    w = volume_weights(anatomy) if weights == "volume" else np.ones(free.n_controls)
+    if stability == "rhythm":
+        status, a = solve_on_chain(constrained, tau_per, tau_0, w, "chain", margin)
+    else:
+        status, a = solve_on_chain(free, tau_per, tau_0, w, stability, margin)
+    k = free.stiffness(a) if np.all(np.isfinite(a)) else np.full((free.n_joints,) * 2, np.nan)
+    ok = np.all(np.isfinite(k))
+    return Optimum(
+        stability=stability,
+        status=status,
+        activations=a,
+        cost=float(w @ a**2),
+        equilibrium=equilibrium,
+        net_torque=tau_per @ a + tau_0,
+        lumbar_torque=lin.torque_per_muscle[rows] @ a + lin.torque_offset[rows],
+        eigenvalues=np.linalg.eigvalsh(-0.5 * (k + k.T)) if ok else np.full(free.n_joints, np.nan),
+        joint_stiffness=-np.diag(k),
+    )
