@@ -233,3 +233,149 @@ def optimise(
         eigenvalues=np.linalg.eigvalsh(-0.5 * (k + k.T)) if ok else np.full(free.n_joints, np.nan),
         joint_stiffness=-np.diag(k),
     )
+
+
+def _optimum_dict(anatomy: Anatomy, opt: Optimum) -> dict:
+    return {
+        "stability": opt.stability,
+        "equilibrium": opt.equilibrium,
+        "status": opt.status,
+        "cost": opt.cost,
+        "activation_sum": float(np.sum(opt.activations)),
+        "eigenvalues": opt.eigenvalues.tolist(),
+        "diagonal_stiffness_Nm_per_rad": opt.joint_stiffness.tolist(),
+        "net_torque_Nm": opt.net_torque.tolist(),
+        "lumbar_torque_Nm": opt.lumbar_torque.tolist(),
+    }
+
+
+@dataclass(frozen=True)
+class OptimisedResult:
+    """The optimum with a stability criterion, beside classic static optimisation, and the analysis at it.
+
+    Attributes
+    ----------
+    anatomy : Anatomy
+        The model.
+    optimum : Optimum
+        With the criterion asked for.
+    classic : Optimum
+        Without a stability criterion (classic static optimisation).
+    margin : float
+        mu [N m/rad].
+    plane : str
+        The chain's plane.
+    analysis : AnatomyResult or None
+        :func:`~spinectl.anatomy.analyses.analyse` at the optimum's activations; None where infeasible.
+    """
+
+    anatomy: Anatomy
+    optimum: Optimum
+    classic: Optimum
+    margin: float
+    plane: str
+    analysis: object
+
+    @property
+    def price(self) -> float:
+        """The price of stability: the optimum's cost over the classic optimum's (NaN if either is infeasible)."""
+        return self.optimum.cost / self.classic.cost if self.classic.cost > 0 else float("nan")
+
+    def to_dict(self) -> dict:
+        """JSON-ready: the analysis at the optimum's activations, ``activations`` by muscle, ``cost``, ``net_torque_Nm``.
+
+        Returns
+        -------
+        dict
+        """
+        out = self.analysis.to_dict() if self.analysis is not None else self._header()
+        out.update(
+            {
+                "activations": dict(zip(self.anatomy.muscles, self.optimum.activations.tolist(), strict=True)),
+                "cost": self.optimum.cost,
+                "net_torque_Nm": self.optimum.net_torque.tolist(),
+                "margin_Nm_per_rad": self.margin,
+                "optimum": _optimum_dict(self.anatomy, self.optimum),
+                "classic": _optimum_dict(self.anatomy, self.classic),
+                "price_of_stability": self.price,
+            }
+        )
+        return out
+
+    def _header(self) -> dict:
+        """The model and the chain, where there is no analysis (an infeasible optimum)."""
+        engine = self.anatomy.engine
+        return {
+            "model": {"name": engine.name, "source": engine.source, "sha256": engine.sha256},
+            "plane": self.plane,
+            "joints": list(self.anatomy.plane_joints(self.plane)),
+        }
+
+    def table(self) -> str:
+        """The optimum and the classic one, each with its criterion; then the analysis at the optimum.
+
+        Returns
+        -------
+        str
+        """
+        crit = {
+            "chain": "the chain free, -K >= mu I",
+            "joints": "joint by joint, each -K_jj >= mu",
+            "rhythm": "the chain constrained by the rhythm, -K_c >= mu",
+            "none": "no stability criterion (classic static optimisation)",
+        }
+        lines = []
+        for label, opt in (("optimum", self.optimum), ("classic", self.classic)):
+            eig = ", ".join(f"{v:.4g}" for v in opt.eigenvalues)
+            lines.append(
+                f"{label}: {crit[opt.stability]} (mu = {self.margin:g} N m/rad), equilibrium {opt.equilibrium}: "
+                f"{opt.status}; cost {opt.cost:.4g}, sum of activations {np.sum(opt.activations):.4g}; "
+                f"eigenvalues of -K (free chain) {eig} N m/rad"
+            )
+        lines.append(f"price of stability (cost ratio): {self.price:.4g}")
+        if self.analysis is not None:
+            lines += ["", "at the optimum's activations:", self.analysis.table()]
+        return "\n".join(lines)
+
+
+def optimised(
+    anatomy: Anatomy,
+    plane: str = "sagittal",
+    stability: str = "chain",
+    margin: float = MARGIN,
+    joint_stiffness="none",
+    equilibrium: str = "rhythm",
+    check: bool = False,
+) -> OptimisedResult:
+    """The optimum with a criterion and without, at the reference posture, and the analysis at the optimum.
+
+    Parameters
+    ----------
+    anatomy : Anatomy
+        The model.
+    plane : str
+        The chain.
+    stability : str
+        One of :data:`STABILITY`.
+    margin : float
+        mu [N m/rad].
+    joint_stiffness : {"none", "mapped"} or float
+        Added at each chain joint [N m/rad].
+    equilibrium : str
+        One of :data:`EQUILIBRIUM`.
+    check : bool
+        MuJoCo's own eigenvalues at the optimum (:func:`~spinectl.anatomy.analyses.mujoco_eigenvalues`).
+
+    Returns
+    -------
+    OptimisedResult
+    """
+    from .analyses import analyse
+
+    kwargs = {"plane": plane, "margin": margin, "joint_stiffness": joint_stiffness, "equilibrium": equilibrium}
+    opt = optimise(anatomy, stability=stability, **kwargs)
+    classic = opt if stability == "none" else optimise(anatomy, stability="none", **kwargs)
+    analysis = None
+    if opt.ok:
+        analysis = analyse(anatomy, plane, opt.activations, joint_stiffness=joint_stiffness, check=check)
+    return OptimisedResult(anatomy, opt, classic, float(margin), plane, analysis)

@@ -45,6 +45,32 @@ def register(sub) -> None:
         action="store_true",
         help="compare the eigenvalues with MuJoCo's own linearisation (mjd_transitionFD, free chain)",
     )
+    parser.add_argument(
+        "--optimise",
+        action="store_true",
+        help="the least muscle effort (volume-weighted sum of a_i^2) that holds the posture, "
+        "with the stability criterion of --stability, beside the same without it",
+    )
+    parser.add_argument(
+        "--stability",
+        choices=("chain", "joints", "rhythm", "none"),
+        default="chain",
+        help="with --optimise: -K >= margin on the free chain (default), on each joint alone (the paper's), "
+        "on the chain constrained by the rhythm, or none (classic static optimisation)",
+    )
+    parser.add_argument(
+        "--equilibrium",
+        choices=("rhythm", "free"),
+        default="rhythm",
+        help="with --optimise: net torque zero on the rhythm's coordinates, the model's equalities carrying "
+        "the rest (default), or on every lumbar joint by muscles alone",
+    )
+    parser.add_argument(
+        "--margin",
+        type=finite_float("--margin"),
+        default=1.0,
+        help="with --optimise: the static margin mu of the stability criterion [N m/rad] (default: 1)",
+    )
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     parser.set_defaults(func=run)
 
@@ -56,24 +82,37 @@ def run(args) -> int:
     ----------
     args : argparse.Namespace
         Parsed arguments: ``model``, ``mapping``, ``plane``, ``activation``, ``joint_stiffness``,
-        ``check``, ``json``.
+        ``check``, ``optimise``, ``stability``, ``equilibrium``, ``margin``, ``json``.
 
     Returns
     -------
     int
-        Exit code 0 (an unstable chain is an answer).
+        Exit code 0 (an unstable chain and an infeasible optimum are answers).
     """
     from ..anatomy import load
     from ..anatomy.analyses import analyse
 
     anatomy = load(args.model, args.mapping)
-    result = analyse(
-        anatomy,
-        plane=args.plane,
-        activation=args.activation,
-        joint_stiffness=args.joint_stiffness,
-        check=args.check,
-    )
+    if args.optimise:
+        from ..anatomy.optimum import optimised
+
+        result = optimised(
+            anatomy,
+            plane=args.plane,
+            stability=args.stability,
+            margin=args.margin,
+            joint_stiffness=args.joint_stiffness,
+            equilibrium=args.equilibrium,
+            check=args.check,
+        )
+    else:
+        result = analyse(
+            anatomy,
+            plane=args.plane,
+            activation=args.activation,
+            joint_stiffness=args.joint_stiffness,
+            check=args.check,
+        )
     if args.json:
         emit_json(result.to_dict())
     else:

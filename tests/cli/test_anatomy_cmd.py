@@ -79,3 +79,20 @@ def test_bad_input_is_one_line_exit_2(cached, capsys, argv, message):
     assert main(["anatomy", *argv]) == 2
     captured = capsys.readouterr()
     assert captured.out == "" and message in captured.err and len(captured.err.strip().splitlines()) == 1
+
+
+def test_optimise_json_has_the_activations_cost_and_net_torque(cached, capsys):
+    """``--optimise --json``: activations by muscle name, cost and net torque at top level, the classic optimum
+    beside, and the analysis at the optimum's activations (its eigenvalues those of the optimum)."""
+    argv = ["anatomy", "--optimise", "--stability", "joints", "--joint-stiffness", "50", "--json"]
+    assert main(argv) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert len(doc["activations"]) == 210 and doc["cost"] > 0 and len(doc["net_torque_Nm"]) == 3
+    assert doc["optimum"]["stability"] == "joints" and doc["classic"]["stability"] == "none"
+    assert doc["eigenvalues"] == pytest.approx(doc["optimum"]["eigenvalues"], abs=1e-6)
+    assert doc["price_of_stability"] >= 1
+
+
+def test_an_infeasible_optimum_is_an_answer(cached, capsys):
+    assert main(["anatomy", "--optimise", "--equilibrium", "free"]) == 0
+    assert "infeasible" in capsys.readouterr().out
