@@ -282,7 +282,7 @@ class OptimisedResult:
         return self.optimum.cost / self.classic.cost if self.classic.cost > 0 else float("nan")
 
     def to_dict(self) -> dict:
-        """JSON-ready: the analysis at the optimum's activations, ``activations`` by muscle, ``cost``, ``net_torque_Nm``.
+        """JSON-ready: the analysis at the optimum, ``activations`` by muscle, ``cost``, ``net_torque_Nm``.
 
         Returns
         -------
