@@ -379,3 +379,78 @@ def optimised(
     if opt.ok:
         analysis = analyse(anatomy, plane, opt.activations, joint_stiffness=joint_stiffness, check=check)
     return OptimisedResult(anatomy, opt, classic, float(margin), plane, analysis)
+
+
+def lordosis_posture(anatomy: Anatomy, degrees: float, plane: str = "sagittal") -> np.ndarray:
+    """The reference posture with the plane's chain moved along the model's rhythm by ``degrees`` in total.
+
+    The chain's joints (and those the rhythm slaves, e.g. MyoTorso's abdomen) move as the
+    rhythm's coefficients distribute them, their angles summing to ``degrees`` over the chain;
+    the thorax is not held upright (it turns with the chain).
+
+    Parameters
+    ----------
+    anatomy : Anatomy
+        The model.
+    degrees : float
+        The change of the chain's summed angle [deg].
+    plane : str
+        The chain.
+
+    Returns
+    -------
+    numpy.ndarray, shape (nq,)
+    """
+    lin, rhy, _ = anatomy.linearise(plane)
+    direction = rhy.transform[:, 0]
+    q = anatomy.posture()
+    q[list(rhy.dofs)] += direction * np.radians(degrees) / direction[: lin.n].sum()
+    return q
+
+
+def lordosis_curve(
+    anatomy: Anatomy,
+    degrees,
+    plane: str = "sagittal",
+    margin: float = MARGIN,
+    joint_stiffness="none",
+    equilibrium: str = "rhythm",
+) -> dict:
+    """The three optima (classic, joint by joint, the chain) over the lordosis.
+
+    Parameters
+    ----------
+    anatomy : Anatomy
+        The model.
+    degrees : array_like
+        Changes of the chain's summed angle about the reference posture [deg].
+    plane, margin, joint_stiffness, equilibrium
+        As in :func:`optimise`.
+
+    Returns
+    -------
+    dict
+        ``lordosis_deg`` and, per criterion (``none``, ``joints``, ``chain``), ``cost``,
+        ``status`` and ``margin_Nm_per_rad`` (the least eigenvalue of -K) lists.
+    """
+    degrees = np.asarray(degrees, float)
+    out = {"lordosis_deg": degrees.tolist()}
+    for criterion in ("none", "joints", "chain"):
+        rows = [
+            optimise(
+                anatomy,
+                plane,
+                criterion,
+                margin,
+                lordosis_posture(anatomy, d, plane),
+                joint_stiffness,
+                equilibrium=equilibrium,
+            )
+            for d in degrees
+        ]
+        out[criterion] = {
+            "cost": [r.cost for r in rows],
+            "status": [r.status for r in rows],
+            "margin_Nm_per_rad": [float(r.eigenvalues[0]) for r in rows],
+        }
+    return out

@@ -71,6 +71,13 @@ def register(sub) -> None:
         default=1.0,
         help="with --optimise: the static margin mu of the stability criterion [N m/rad] (default: 1)",
     )
+    parser.add_argument(
+        "--lordosis",
+        metavar="START:STOP:N",
+        help="also the three optima (classic, joint by joint, the chain) at N changes of the chain's summed "
+        "angle from START to STOP [deg] along the model's rhythm (positive: the model's positive "
+        "flex_extension, extension for MyoTorso), e.g. -20:20:41",
+    )
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     parser.set_defaults(func=run)
 
@@ -113,8 +120,54 @@ def run(args) -> int:
             joint_stiffness=args.joint_stiffness,
             check=args.check,
         )
+    curve = None
+    if args.lordosis:
+        from ..anatomy.optimum import lordosis_curve
+
+        curve = lordosis_curve(
+            anatomy,
+            _degrees(args.lordosis),
+            plane=args.plane,
+            margin=args.margin,
+            joint_stiffness=args.joint_stiffness,
+            equilibrium=args.equilibrium,
+        )
     if args.json:
-        emit_json(result.to_dict())
+        doc = result.to_dict()
+        if curve is not None:
+            doc["lordosis_curve"] = curve
+        emit_json(doc)
     else:
         print(result.table())
+        if curve is not None:
+            print(_curve_table(curve))
     return 0
+
+
+def _degrees(text: str):
+    """START:STOP:N as N evenly spaced values [deg]; one line naming --lordosis otherwise."""
+    import numpy as np
+
+    from ..errors import ParameterError
+
+    try:
+        start, stop, count = text.split(":")
+        start, stop, count = float(start), float(stop), int(count)
+    except ValueError:
+        raise ParameterError("--lordosis", f"must be START:STOP:N, e.g. -20:20:41 (got {text!r})") from None
+    if not (np.isfinite(start) and np.isfinite(stop) and 1 <= count <= 1000 and abs(start) <= 90 and abs(stop) <= 90):
+        raise ParameterError("--lordosis", f"needs |START|, |STOP| <= 90 deg and 1 <= N <= 1000 (got {text!r})")
+    return np.linspace(start, stop, count)
+
+
+def _curve_table(curve: dict) -> str:
+    """The lordosis curve as rows: each criterion's least cost (or its status) per posture."""
+    lines = ["", "lordosis [deg]  cost: classic  joint by joint  the chain (free)"]
+    for i, deg in enumerate(curve["lordosis_deg"]):
+        cells = []
+        for criterion in ("none", "joints", "chain"):
+            row = curve[criterion]
+            ok = row["status"][i] in ("optimal", "optimal_inaccurate")
+            cells.append(f"{row['cost'][i]:.4g}" if ok else row["status"][i])
+        lines.append(f"{deg:>14.3g}  {cells[0]:>13}  {cells[1]:>14}  {cells[2]:>16}")
+    return "\n".join(lines)

@@ -85,3 +85,27 @@ def test_bad_criterion_is_refused(torso):
         optimise(torso, stability="diagonal")
     with pytest.raises(ParameterError, match="margin"):
         optimise(torso, margin=-1)
+
+
+def test_the_lordosis_moves_the_chain_along_the_rhythm(torso):
+    """lordosis_posture(10 deg): the five FE angles sum to 10 deg, in the ratios of MyoTorso's equality coefficients
+    (each joint's eq_data[1] on flex_extension), the other lumbar joints unmoved; the curve at 0 deg is the optimum
+    at the reference posture."""
+    import mujoco
+
+    from spinectl.anatomy.optimum import lordosis_curve, lordosis_posture
+
+    q = lordosis_posture(torso, 10.0)
+    model = torso.engine.model
+    fe = torso.joint_ids(torso.mapping.planes["sagittal"])
+    angles = q[[model.jnt_qposadr[j] for j in fe]]
+    assert np.degrees(angles.sum()) == pytest.approx(10.0)
+    for j, angle in zip(fe[1:], angles[1:], strict=True):
+        eq = [e for e in range(model.neq) if model.eq_obj1id[e] == j]
+        assert angle / angles[0] == pytest.approx(model.eq_data[eq[0]][1])
+    others = torso.joint_ids(torso.mapping.planes["coronal"] + torso.mapping.planes["3d"][10:])
+    assert np.all(q[[model.jnt_qposadr[j] for j in others]] == 0)
+    abdomen = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "Abs_r3")
+    assert q[model.jnt_qposadr[abdomen]] != 0  # slaved to flex_extension by the rhythm
+    curve = lordosis_curve(torso, [0.0], joint_stiffness=50)
+    assert curve["chain"]["cost"][0] == pytest.approx(optimise(torso, joint_stiffness=50).cost, rel=1e-6)

@@ -96,3 +96,11 @@ def test_optimise_json_has_the_activations_cost_and_net_torque(cached, capsys):
 def test_an_infeasible_optimum_is_an_answer(cached, capsys):
     assert main(["anatomy", "--optimise", "--equilibrium", "free"]) == 0
     assert "infeasible" in capsys.readouterr().out
+
+
+def test_lordosis_curve_in_json_and_bad_range(cached, capsys):
+    assert main(["anatomy", "--lordosis", "-10:10:3", "--joint-stiffness", "50", "--json"]) == 0
+    curve = json.loads(capsys.readouterr().out)["lordosis_curve"]
+    assert curve["lordosis_deg"] == [-10.0, 0.0, 10.0] and len(curve["chain"]["cost"]) == 3
+    assert main(["anatomy", "--lordosis", "1:2"]) == 2
+    assert "--lordosis: must be START:STOP:N" in capsys.readouterr().err
