@@ -216,6 +216,98 @@ def global_certificate(anatomy: Anatomy, chain: LinearChain, arms, a) -> GlobalC
     )
 
 
+def referee_model(anatomy: Anatomy, chain: LinearChain, a, added) -> tuple:
+    """MuJoCo's model of the free chain, held at the reference posture (:func:`mujoco_eigenvalues`).
+
+    Parameters
+    ----------
+    anatomy : Anatomy
+        The model.
+    chain : LinearChain
+        The free chain, for its joints.
+    a : array_like, shape (m,)
+        Activations, set as MuJoCo's activation states and controls (so that they stay).
+    added : array_like, shape (n,)
+        Joint stiffness added at each chain joint [N m/rad].
+
+    Returns
+    -------
+    tuple
+        (mujoco.MjModel, mujoco.MjData) at the posture, forward dynamics run.
+    """
+    mujoco = require_mujoco()
+    spec = anatomy.engine.spec_factory()
+    keep = dict(zip(chain.joints, np.asarray(added, float), strict=True))
+    for joint in list(spec.joints):
+        if joint.name not in keep:
+            spec.delete(joint)
+    for equality in list(spec.equalities):
+        spec.delete(equality)
+    model = spec.compile()
+    for name, value in keep.items():
+        model.jnt_stiffness[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name)] = value
+    flags = mujoco.mjtDisableBit
+    model.opt.disableflags |= flags.mjDSBL_CONTACT | flags.mjDSBL_EQUALITY | flags.mjDSBL_LIMIT
+    model.opt.disableflags |= flags.mjDSBL_EULERDAMP
+    model.opt.integrator = mujoco.mjtIntegrator.mjINT_EULER
+    data = mujoco.MjData(model)
+    data.act[:] = a
+    data.ctrl[:] = a  # muscle dynamics drive act to ctrl: held
+    mujoco.mj_forward(model, data)
+    # held by constant torques where the posture is no equilibrium: off one, a step's
+    # derivative would also hold dM^-1/dq times the net torque, which K = dtau/dq leaves out
+    data.qfrc_applied[:] = -(data.qfrc_actuator + data.qfrc_passive - data.qfrc_bias)
+    mujoco.mj_forward(model, data)
+    return model, data
+
+
+def mujoco_growth_rate(anatomy: Anatomy, chain: LinearChain, a, added, eigenvalue, mode, duration=0.1, step=1e-4):
+    """The rate at which MuJoCo's own simulation (:func:`mujoco.mj_step`) grows or decays along a mode.
+
+    Starts at the posture displaced by 1e-5 rad along the mode (its velocity the eigenvalue times
+    that), steps MuJoCo's free chain (:func:`referee_model`, time step ``step``) for ``duration``
+    and fits log |projection on the mode| against time (least squares).
+
+    Parameters
+    ----------
+    anatomy : Anatomy
+        The model.
+    chain : LinearChain
+        The free chain.
+    a : array_like, shape (m,)
+        Activations, held.
+    added : array_like, shape (n,)
+        Joint stiffness added [N m/rad].
+    eigenvalue : float
+        A real eigenvalue of the state matrix [1/s].
+    mode : array_like, shape (n,)
+        Its joint-angle part [rad].
+    duration, step : float
+        Simulated time and MuJoCo's time step [s].
+
+    Returns
+    -------
+    float
+        The fitted rate [1/s].
+    """
+    mujoco = require_mujoco()
+    model, data = referee_model(anatomy, chain, a, added)
+    model.opt.timestep = step
+    order = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in chain.joints]
+    qadr = np.array([model.jnt_qposadr[j] for j in order])
+    vadr = np.array([model.jnt_dofadr[j] for j in order])
+    v = np.asarray(mode, float) / np.linalg.norm(mode)
+    q0 = data.qpos[qadr].copy()
+    data.qpos[qadr] += 1e-5 * v
+    data.qvel[vadr] = 1e-5 * eigenvalue * v
+    times, amplitude = [], []
+    for k in range(int(round(duration / step))):
+        mujoco.mj_step(model, data)
+        times.append((k + 1) * step)
+        amplitude.append(abs(v @ (data.qpos[qadr] - q0)))
+    return float(np.polyfit(times, np.log(amplitude), 1)[0])
+
+
 def mujoco_eigenvalues(anatomy: Anatomy, chain: LinearChain, a, added) -> np.ndarray:
     """MuJoCo's own linearisation of the free chain: eigenvalues from :func:`mujoco.mjd_transitionFD`.
 
@@ -245,27 +337,7 @@ def mujoco_eigenvalues(anatomy: Anatomy, chain: LinearChain, a, added) -> np.nda
         Eigenvalues [1/s], by descending real part.
     """
     mujoco = require_mujoco()
-    spec = anatomy.engine.spec_factory()
-    keep = dict(zip(chain.joints, np.asarray(added, float), strict=True))
-    for joint in list(spec.joints):
-        if joint.name not in keep:
-            spec.delete(joint)
-    for equality in list(spec.equalities):
-        spec.delete(equality)
-    model = spec.compile()
-    for name, value in keep.items():
-        model.jnt_stiffness[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name)] = value
-    flags = mujoco.mjtDisableBit
-    model.opt.disableflags |= flags.mjDSBL_CONTACT | flags.mjDSBL_EQUALITY | flags.mjDSBL_LIMIT
-    model.opt.disableflags |= flags.mjDSBL_EULERDAMP
-    model.opt.integrator = mujoco.mjtIntegrator.mjINT_EULER
-    data = mujoco.MjData(model)
-    data.act[:] = a
-    mujoco.mj_forward(model, data)
-    # held by constant torques where the posture is no equilibrium: off one, a step's
-    # derivative would also hold dM^-1/dq times the net torque, which K = dtau/dq leaves out
-    data.qfrc_applied[:] = -(data.qfrc_actuator + data.qfrc_passive - data.qfrc_bias)
-    mujoco.mj_forward(model, data)
+    model, data = referee_model(anatomy, chain, a, added)
     n, h = model.nv, model.opt.timestep
     order = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in chain.joints]
     size = 2 * n + model.na
@@ -303,6 +375,9 @@ class AnatomyResult:
         The global muscles' rank and null space.
     mujoco_eigenvalues : numpy.ndarray or None
         The referee's eigenvalues of the free chain (``check=True``) [1/s].
+    simulated_rate : float
+        With ``check``: the rate fitted to MuJoCo's simulation started along the free chain's
+        mode of largest real eigenvalue (:func:`mujoco_growth_rate`; NaN if that is complex) [1/s].
     """
 
     model: dict
@@ -315,6 +390,7 @@ class AnatomyResult:
     constrained: ChainVerdict
     certificate: GlobalCertificate
     mujoco_eigenvalues: np.ndarray | None = field(default=None)
+    simulated_rate: float = float("nan")
 
     def referee_error(self) -> float:
         """Largest relative difference between spinectl's and MuJoCo's eigenvalues, matched one to one.
@@ -382,6 +458,8 @@ class AnatomyResult:
         if self.mujoco_eigenvalues is not None:
             out["mujoco_eigenvalues"] = cplx(self.mujoco_eigenvalues)
             out["mujoco_relative_difference"] = self.referee_error()
+            out["predicted_rate_per_s"] = float(self.free.dynamic_eigenvalues[0].real)
+            out["mujoco_simulated_rate_per_s"] = self.simulated_rate
         return out
 
     def table(self) -> str:
@@ -424,7 +502,9 @@ class AnatomyResult:
         if self.mujoco_eigenvalues is not None:
             lines.append(
                 f"MuJoCo's own linearisation (mjd_transitionFD, free chain): largest relative difference "
-                f"{self.referee_error():.2e} over {len(self.mujoco_eigenvalues)} eigenvalues"
+                f"{self.referee_error():.2e} over {len(self.mujoco_eigenvalues)} eigenvalues; its simulation (mj_step) "
+                f"along the slowest-decaying mode: rate {self.simulated_rate:.4g} 1/s, predicted "
+                f"{self.free.dynamic_eigenvalues[0].real:.4g} 1/s"
             )
         return "\n".join(lines)
 
@@ -447,7 +527,8 @@ def analyse(
     joint_stiffness : {"none", "mapped"} or float
         Intervertebral stiffness added at each chain joint [N m/rad].
     check : bool
-        Also MuJoCo's own eigenvalues (:func:`mujoco_eigenvalues`; reference posture only).
+        Also MuJoCo's own eigenvalues (:func:`mujoco_eigenvalues`) and its simulation along the
+        leading mode (:func:`mujoco_growth_rate`); reference posture only.
 
     Returns
     -------
@@ -457,11 +538,15 @@ def analyse(
     free, con, lin = anatomy.chains(plane, posture, joint_stiffness)
     added = anatomy.added_stiffness(joint_stiffness, free.n_joints)
     arms = lin.moment_arms[:, list(lin.dofs[: lin.n])]
-    referee = None
+    referee, rate = None, float("nan")
     if check:
         if posture is not None and not np.allclose(anatomy.posture(posture), anatomy.engine.model.qpos0):
             raise ParameterError("check", "compares at the model's reference posture only")
         referee = mujoco_eigenvalues(anatomy, free, a, added)
+        values, vectors = np.linalg.eig(state_matrix(free, a))
+        lead = int(np.argmax(values.real))
+        if abs(values[lead].imag) == 0:
+            rate = mujoco_growth_rate(anatomy, free, a, added, values[lead].real, vectors[: free.n_joints, lead].real)
     classes = anatomy.classes
     return AnatomyResult(
         model={"name": anatomy.name, "source": anatomy.engine.source, "sha256": anatomy.engine.sha256},
@@ -477,4 +562,5 @@ def analyse(
         constrained=verdict(con, a),
         certificate=global_certificate(anatomy, free, arms, a),
         mujoco_eigenvalues=referee,
+        simulated_rate=rate,
     )
