@@ -503,7 +503,7 @@ class AnatomyResult:
             lines.append(
                 f"MuJoCo's own linearisation (mjd_transitionFD, free chain): largest relative difference "
                 f"{self.referee_error():.2e} over {len(self.mujoco_eigenvalues)} eigenvalues; its simulation (mj_step) "
-                f"along the slowest-decaying mode: rate {self.simulated_rate:.4g} 1/s, predicted "
+                f"along the leading mode (largest real part): rate {self.simulated_rate:.4g} 1/s, predicted "
                 f"{self.free.dynamic_eigenvalues[0].real:.4g} 1/s"
             )
         return "\n".join(lines)
