@@ -35,6 +35,7 @@ quadratic objectives. arXiv:2405.12762.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -109,7 +110,9 @@ def solve_on_chain(chain: LinearChain, tau_per, tau_0, weights, stability: str, 
         constraints.append(cp.diag(neg_k) >= margin)
     problem = cp.Problem(cp.Minimize(cp.sum(cp.multiply(weights, cp.square(a)))), constraints)
     try:
-        problem.solve(solver=cp.CLARABEL)
+        with warnings.catch_warnings():  # "may be inaccurate": the status says so ('optimal_inaccurate')
+            warnings.simplefilter("ignore", UserWarning)
+            problem.solve(solver=cp.CLARABEL)
     except cp.error.SolverError:
         return "solver_error", np.full(m, np.nan)
     if problem.status not in ("optimal", "optimal_inaccurate") or a.value is None:
