@@ -375,6 +375,9 @@ class AnatomyResult:
         The global muscles' rank and null space.
     mujoco_eigenvalues : numpy.ndarray or None
         The referee's eigenvalues of the free chain (``check=True``) [1/s].
+    reflex : dict or None
+        With a reflex: ``kp``, ``kd`` [N m/rad, N m s/rad], ``lag`` [s] and the free chain's exact
+        delay margin (:func:`reflex_margin`).
     simulated_rate : float
         With ``check``: the rate fitted to MuJoCo's simulation started along the free chain's
         mode of largest real eigenvalue (:func:`mujoco_growth_rate`; NaN if that is complex) [1/s].
@@ -391,6 +394,7 @@ class AnatomyResult:
     certificate: GlobalCertificate
     mujoco_eigenvalues: np.ndarray | None = field(default=None)
     simulated_rate: float = float("nan")
+    reflex: dict | None = None
 
     def referee_error(self) -> float:
         """Largest relative difference between spinectl's and MuJoCo's eigenvalues, matched one to one.
@@ -460,6 +464,8 @@ class AnatomyResult:
             out["mujoco_relative_difference"] = self.referee_error()
             out["predicted_rate_per_s"] = float(self.free.dynamic_eigenvalues[0].real)
             out["mujoco_simulated_rate_per_s"] = self.simulated_rate
+        if self.reflex is not None:
+            out["reflex"] = self.reflex
         return out
 
     def table(self) -> str:
@@ -506,11 +512,63 @@ class AnatomyResult:
                 f"along the leading mode (largest real part): rate {self.simulated_rate:.4g} 1/s, predicted "
                 f"{self.free.dynamic_eigenvalues[0].real:.4g} 1/s"
             )
+        if self.reflex is not None:
+            r = self.reflex
+            lines.append(
+                f"the chain (free) under a delayed PD reflex kp = {r['kp_Nm_per_rad']:g} N m/rad, kd = "
+                f"{r['kd_Nms_per_rad']:g} N m s/rad at every joint, activation lag {r['activation_lag_s']:g} s: "
+                f"exact delay margin {r['delay_margin_s']:.4g} s ({r['delay_margin_status']})"
+            )
         return "\n".join(lines)
 
 
+def reflex_margin(chain: LinearChain, a, kp: float, kd: float, lag: float) -> dict:
+    """The free chain's exact delay margin under a diagonal delayed PD reflex (:mod:`spinectl.reflex.mimo`).
+
+    Parameters
+    ----------
+    chain : LinearChain
+        The free chain.
+    a : array_like, shape (m,)
+        Activations.
+    kp, kd : float
+        The reflex gains at every joint [N m/rad], [N m s/rad], >= 0.
+    lag : float
+        The force generation's time constant T_a [s], >= 0.
+
+    Returns
+    -------
+    dict
+        ``kp_Nm_per_rad``, ``kd_Nms_per_rad``, ``activation_lag_s``, ``delay_margin_s`` (inf:
+        any delay; 0: unstable without delay), ``delay_margin_status``, ``delay_margin_frequency_rad_s``.
+    """
+    from ..reflex.mimo import chain_delay_margin
+
+    for name, value in (("kp", kp), ("kd", kd), ("activation_lag", lag)):
+        if not (np.isfinite(value) and value >= 0):
+            raise ParameterError(name, f"must be a finite number >= 0 (got {value!r})")
+    n = chain.n_joints
+    margin = chain_delay_margin(
+        chain.mass_matrix, chain.stiffness(a), chain.damping(a), np.full(n, kp), np.full(n, kd), lag
+    )
+    return {
+        "kp_Nm_per_rad": float(kp),
+        "kd_Nms_per_rad": float(kd),
+        "activation_lag_s": float(lag),
+        "delay_margin_s": float(margin.margin),
+        "delay_margin_status": margin.status,
+        "delay_margin_frequency_rad_s": float(margin.frequency),
+    }
+
+
 def analyse(
-    anatomy: Anatomy, plane: str = "sagittal", activation=0.0, posture=None, joint_stiffness="none", check=False
+    anatomy: Anatomy,
+    plane: str = "sagittal",
+    activation=0.0,
+    posture=None,
+    joint_stiffness="none",
+    check=False,
+    reflex=None,
 ) -> AnatomyResult:
     """Joint-by-joint and chain verdicts of a model at an activation, free and constrained.
 
@@ -529,6 +587,8 @@ def analyse(
     check : bool
         Also MuJoCo's own eigenvalues (:func:`mujoco_eigenvalues`) and its simulation along the
         leading mode (:func:`mujoco_growth_rate`); reference posture only.
+    reflex : tuple, optional
+        ``(kp, kd, lag)``: also the free chain's exact delay margin under that reflex (:func:`reflex_margin`).
 
     Returns
     -------
@@ -563,4 +623,5 @@ def analyse(
         certificate=global_certificate(anatomy, free, arms, a),
         mujoco_eigenvalues=referee,
         simulated_rate=rate,
+        reflex=None if reflex is None else reflex_margin(free, a, *reflex),
     )

@@ -349,6 +349,7 @@ def optimised(
     joint_stiffness="none",
     equilibrium: str = "rhythm",
     check: bool = False,
+    reflex=None,
 ) -> OptimisedResult:
     """The optimum with a criterion and without, at the reference posture, and the analysis at the optimum.
 
@@ -368,6 +369,9 @@ def optimised(
         One of :data:`EQUILIBRIUM`.
     check : bool
         MuJoCo's own eigenvalues at the optimum (:func:`~spinectl.anatomy.analyses.mujoco_eigenvalues`).
+    reflex : tuple, optional
+        ``(kp, kd, lag)``: the chain's exact delay margin at the optimum
+        (:func:`~spinectl.anatomy.analyses.reflex_margin`).
 
     Returns
     -------
@@ -380,7 +384,7 @@ def optimised(
     classic = opt if stability == "none" else optimise(anatomy, stability="none", **kwargs)
     analysis = None
     if opt.ok:
-        analysis = analyse(anatomy, plane, opt.activations, joint_stiffness=joint_stiffness, check=check)
+        analysis = analyse(anatomy, plane, opt.activations, joint_stiffness=joint_stiffness, check=check, reflex=reflex)
     return OptimisedResult(anatomy, opt, classic, float(margin), plane, analysis)
 
 

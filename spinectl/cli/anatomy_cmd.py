@@ -72,6 +72,20 @@ def register(sub) -> None:
         help="with --optimise: the static margin mu of the stability criterion [N m/rad] (default: 1)",
     )
     parser.add_argument(
+        "--kp",
+        type=finite_float("--kp"),
+        help="also the free chain's exact delay margin under a delayed PD reflex with this proportional gain "
+        "at every joint [N m/rad] (with --kd)",
+    )
+    parser.add_argument("--kd", type=finite_float("--kd"), default=0.0, help="the reflex's derivative gain [N m s/rad]")
+    parser.add_argument(
+        "--activation-lag",
+        type=finite_float("--activation-lag"),
+        default=0.05,
+        metavar="T_A",
+        help="time constant of the reflex's force generation [s] (default: 0.05)",
+    )
+    parser.add_argument(
         "--lordosis",
         metavar="START:STOP:N",
         help="also the three optima (classic, joint by joint, the chain) at N changes of the chain's summed "
@@ -100,6 +114,7 @@ def run(args) -> int:
     from ..anatomy.analyses import analyse
 
     anatomy = load(args.model, args.mapping)
+    reflex = None if args.kp is None else (args.kp, args.kd, args.activation_lag)
     if args.optimise:
         from ..anatomy.optimum import optimised
 
@@ -111,6 +126,7 @@ def run(args) -> int:
             joint_stiffness=args.joint_stiffness,
             equilibrium=args.equilibrium,
             check=args.check,
+            reflex=reflex,
         )
     else:
         result = analyse(
@@ -119,6 +135,7 @@ def run(args) -> int:
             activation=args.activation,
             joint_stiffness=args.joint_stiffness,
             check=args.check,
+            reflex=reflex,
         )
     curve = None
     if args.lordosis:

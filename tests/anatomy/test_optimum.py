@@ -109,3 +109,21 @@ def test_the_lordosis_moves_the_chain_along_the_rhythm(torso):
     assert q[model.jnt_qposadr[abdomen]] != 0  # slaved to flex_extension by the rhythm
     curve = lordosis_curve(torso, [0.0], joint_stiffness=50)
     assert curve["chain"]["cost"][0] == pytest.approx(optimise(torso, joint_stiffness=50).cost, rel=1e-6)
+
+
+def test_the_delay_margin_at_the_optimum_is_a_root_on_the_imaginary_axis(torso):
+    """At the classic optimum under kp = 120 N m/rad, kd = 5 N m s/rad at every joint and a 50 ms lag, the
+    reported delay margin tau and frequency w make the characteristic matrix
+    (T_a jw + 1)(M (jw)^2 - D jw - K) + (K_p + K_d jw) exp(-jw tau) singular (its smallest singular value over its
+    largest below 1e-6): the closed form of the delayed chain, evaluated here without spinectl.reflex."""
+    result = optimised(torso, stability="none", reflex=(120.0, 5.0, 0.05))
+    reflex = result.analysis.reflex
+    tau, w = reflex["delay_margin_s"], reflex["delay_margin_frequency_rad_s"]
+    assert reflex["delay_margin_status"] == "finite" and 0 < tau < 0.1
+    free = result.analysis.free
+    s = 1j * w
+    matrix = (0.05 * s + 1) * (free.mass * s**2 - free.damping * s - free.stiffness) + (120 + 5 * s) * np.eye(
+        5
+    ) * np.exp(-s * tau)
+    sv = np.linalg.svd(matrix, compute_uv=False)
+    assert sv[-1] / sv[0] < 1e-6

@@ -104,3 +104,10 @@ def test_lordosis_curve_in_json_and_bad_range(cached, capsys):
     assert curve["lordosis_deg"] == [-10.0, 0.0, 10.0] and len(curve["chain"]["cost"]) == 3
     assert main(["anatomy", "--lordosis", "1:2"]) == 2
     assert "--lordosis: must be START:STOP:N" in capsys.readouterr().err
+
+
+def test_reflex_options_give_the_delay_margin(cached, capsys):
+    assert main(["anatomy", "--optimise", "--stability", "none", "--kp", "120", "--kd", "5", "--json"]) == 0
+    reflex = json.loads(capsys.readouterr().out)["reflex"]
+    assert reflex["kp_Nm_per_rad"] == 120 and reflex["activation_lag_s"] == 0.05 and reflex["delay_margin_s"] > 0
+    assert main(["anatomy", "--kp", "-1"]) == 2
