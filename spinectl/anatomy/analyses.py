@@ -266,7 +266,7 @@ def mujoco_growth_rate(anatomy: Anatomy, chain: LinearChain, a, added, eigenvalu
 
     Starts at the posture displaced by 1e-5 rad along the mode (its velocity the eigenvalue times
     that), steps MuJoCo's free chain (:func:`referee_model`, time step ``step``) for ``duration``
-    and fits log |projection on the mode| against time (least squares).
+    and fits the log of the displacement's projection on the mode against time (least squares).
 
     Parameters
     ----------
@@ -402,7 +402,7 @@ class AnatomyResult:
         Returns
         -------
         float
-            max |lambda - mu| / |mu| over the modes; NaN without ``check``.
+            max over the modes of abs(lambda - mu) / abs(mu); NaN without ``check``.
         """
         if self.mujoco_eigenvalues is None:
             return float("nan")

@@ -1,6 +1,6 @@
 """Stability-constrained static optimisation on an anatomical model (docs/anatomy.md, "The optimum").
 
-The least muscle effort that holds the posture,
+The least muscle effort that holds the posture::
 
     minimise    sum_i w_i a_i^2
     subject to  equilibrium, tau_0 + sum_i a_i tau_i = 0:
