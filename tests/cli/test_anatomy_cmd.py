@@ -111,3 +111,13 @@ def test_reflex_options_give_the_delay_margin(cached, capsys):
     reflex = json.loads(capsys.readouterr().out)["reflex"]
     assert reflex["kp_Nm_per_rad"] == 120 and reflex["activation_lag_s"] == 0.05 and reflex["delay_margin_s"] > 0
     assert main(["anatomy", "--kp", "-1"]) == 2
+
+
+def test_without_the_extra_one_line_says_what_to_install(monkeypatch, capsys):
+    """MuJoCo's import blocked: one line naming ``pip install 'spinectl[anatomy]'``, exit 2, no traceback."""
+    import sys
+
+    monkeypatch.setitem(sys.modules, "mujoco", None)
+    assert main(["anatomy"]) == 2
+    err = capsys.readouterr().err
+    assert "pip install 'spinectl[anatomy]'" in err and len(err.strip().splitlines()) == 1
