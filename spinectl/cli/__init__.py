@@ -34,6 +34,7 @@ COMMANDS = (
     "reproduce_cmd",
     "study_cmd",
     "calibrate_cmd",
+    "anatomy_cmd",
 )
 """Modules of :mod:`spinectl.cli` that each register one sub-command."""
 

@@ -4,7 +4,7 @@ The layers and their order are those of CONTRIBUTING.md ("Architecture", "Layers
 checks that its table and :data:`LAYERS` agree, and that its tree names every module):
 
     _version _aliases errors units _validate atomic jsondoc canvas presets  <  model  <  optimise  <  reflex
-    <  landscape  <  paper  <  explore  <  cli
+    <  anatomy  <  landscape  <  paper  <  explore  <  cli
 
 A module may import modules of its own layer and of the layers before it, never
 of a later one (:data:`LAYERS`). ``spinectl/__init__.py`` is exempt as an
@@ -43,6 +43,7 @@ LAYERS = (
     ("model",),
     ("optimise",),
     ("reflex",),
+    ("anatomy",),
     ("landscape",),
     ("paper",),
     ("explore",),
@@ -251,7 +252,8 @@ def test_the_checks_find_upward_imports_of_every_form(tmp_path):
     assert upward_imports(found, "spinectl") == [
         "spinectl.errors (line 2) imports spinectl.cli: " + f"{LAYERS[0]} < {LAYERS[-1]}",
         "spinectl.model.params (line 2) imports spinectl.reflex.delay: " + f"{LAYERS[1]} < {LAYERS[3]}",
-        "spinectl.reflex.delay (line 1) imports spinectl.landscape.sweep: " + f"{LAYERS[3]} < {LAYERS[4]}",
+        "spinectl.reflex.delay (line 1) imports spinectl.landscape.sweep: "
+        + f"{LAYERS[3]} < {LAYERS[LAYERS.index(('landscape',))]}",
     ]
     assert import_cycle(found) is not None  # model.params -> reflex.delay -> model.params
 

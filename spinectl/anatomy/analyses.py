@@ -1,0 +1,627 @@
+"""The paper's question and the chain's on an anatomical model, at one activation (docs/anatomy.md).
+
+Verdicts, each with its criterion:
+
+- **joint by joint** (the paper's): each joint alone, the others fixed, is self-stable when
+  its diagonal entry of -K is positive;
+- **the chain**: every chain joint free at once, stable when -K is positive definite (its
+  least eigenvalue, the static margin, > 0), and its dynamics x' = [[0, I], [M^-1 K, M^-1 D]] x;
+- both for the **free** chain (the model's equality constraints off) and the chain
+  **constrained by the model's rhythm** (its independent coordinates only).
+
+The global muscles' certificate: their moment arms over the chain's joints have rank r;
+the n - r directions of their null space are modes whose stiffness they can give only
+through their lengths' curvature (docs/chain.md), left to the local muscles, passive
+tissue and reflexes.
+
+These are small direct calls on the :class:`~spinectl.model.linear_chain.LinearChain`
+(numpy eigenvalues); the chain analyses of :mod:`spinectl.optimise` and
+:mod:`spinectl.reflex` take the same LinearChain.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..model.linear_chain import LinearChain
+from .engine import require_mujoco
+from .model import Anatomy
+
+RANK_TOLERANCE = 1e-9
+"""A singular value below this times the largest counts as zero (the global muscles' rank)."""
+
+
+def activations(anatomy: Anatomy, activation) -> np.ndarray:
+    """The activation vector: one value for every muscle, a vector, or a dict by muscle name (others 0).
+
+    Parameters
+    ----------
+    anatomy : Anatomy
+        The model.
+    activation : float, array_like or dict
+        Activations in [0, 1].
+
+    Returns
+    -------
+    numpy.ndarray, shape (m,)
+    """
+    m = len(anatomy.muscles)
+    if isinstance(activation, dict):
+        unknown = sorted(set(activation) - set(anatomy.muscles))
+        if unknown:
+            raise ParameterError("activation", f"names muscles that {anatomy.name} lacks: {unknown[:5]}")
+        a = np.array([float(activation.get(name, 0.0)) for name in anatomy.muscles])
+    else:
+        try:
+            a = np.broadcast_to(np.asarray(activation, float), (m,)).copy()
+        except (TypeError, ValueError):
+            raise ParameterError("activation", f"must be one number or {m} numbers in [0, 1]") from None
+    if not np.all(np.isfinite(a)) or np.any(a < 0) or np.any(a > 1):
+        raise ParameterError("activation", f"must be in [0, 1] (got {a.min():g} ... {a.max():g})")
+    return a
+
+
+def state_matrix(chain: LinearChain, a) -> np.ndarray:
+    """x' = A x with x = (q, q'): [[0, I], [M^-1 K(a), M^-1 D(a)]] [1/s^2, 1/s].
+
+    Parameters
+    ----------
+    chain : LinearChain
+        The chain.
+    a : array_like, shape (m,)
+        Activations.
+
+    Returns
+    -------
+    numpy.ndarray, shape (2n, 2n)
+    """
+    n = chain.n_joints
+    minv = np.linalg.inv(chain.mass_matrix)
+    return np.block([[np.zeros((n, n)), np.eye(n)], [minv @ chain.stiffness(a), minv @ chain.damping(a)]])
+
+
+@dataclass(frozen=True)
+class ChainVerdict:
+    """One chain at one activation: its matrices, joint-by-joint and chain verdicts.
+
+    Attributes
+    ----------
+    joints : tuple of str
+        Its coordinates.
+    stiffness, damping, mass : numpy.ndarray, shape (n, n)
+        K(a) [N m/rad], D(a) [N m s/rad], M [kg m^2].
+    joint_stiffness : numpy.ndarray, shape (n,)
+        Diagonal of -K: each joint alone, the others fixed [N m/rad].
+    eigenvalues : numpy.ndarray, shape (n,)
+        Of -K, ascending [N m/rad].
+    modes : numpy.ndarray, shape (n, n)
+        Unit eigenvectors of -K, one per column, in the order of ``eigenvalues``.
+    dynamic_eigenvalues : numpy.ndarray, shape (2n,)
+        Of the state matrix [1/s], by descending real part.
+    """
+
+    joints: tuple
+    stiffness: np.ndarray
+    damping: np.ndarray
+    mass: np.ndarray
+    joint_stiffness: np.ndarray
+    eigenvalues: np.ndarray
+    modes: np.ndarray
+    dynamic_eigenvalues: np.ndarray
+
+    @property
+    def joint_self_stable(self) -> tuple:
+        """Each joint self-stable, joint by joint (the paper's criterion)."""
+        return tuple(bool(s > 0) for s in self.joint_stiffness)
+
+    @property
+    def chain_stable(self) -> bool:
+        """The chain stable, every joint free at once: -K positive definite."""
+        return bool(self.eigenvalues[0] > 0)
+
+
+def verdict(chain: LinearChain, a) -> ChainVerdict:
+    """The joint-by-joint and chain verdicts of one chain at activations a.
+
+    Parameters
+    ----------
+    chain : LinearChain
+        The chain.
+    a : array_like, shape (m,)
+        Activations.
+
+    Returns
+    -------
+    ChainVerdict
+    """
+    k = chain.stiffness(a)
+    values, vectors = np.linalg.eigh(-0.5 * (k + k.T))
+    dyn = np.linalg.eigvals(state_matrix(chain, a))
+    return ChainVerdict(
+        joints=chain.joints,
+        stiffness=k,
+        damping=chain.damping(a),
+        mass=chain.mass_matrix,
+        joint_stiffness=-np.diag(k),
+        eigenvalues=values,
+        modes=vectors,
+        dynamic_eigenvalues=dyn[np.lexsort((-dyn.imag, -dyn.real))],
+    )
+
+
+@dataclass(frozen=True)
+class GlobalCertificate:
+    """The global muscles' moment arms over the chain: rank, null space and what is left in it.
+
+    Attributes
+    ----------
+    muscles : tuple of str
+        The global muscles.
+    singular_values : numpy.ndarray, shape (n,)
+        Of their moment-arm matrix [m/rad].
+    rank : int
+        Singular values above :data:`RANK_TOLERANCE` times the largest.
+    null_space : numpy.ndarray, shape (n, n - rank)
+        Orthonormal directions in which no global muscle changes length.
+    null_space_stiffness : numpy.ndarray, shape (n - rank,)
+        Eigenvalues of -N^T K(a) N: the chain's stiffness there at the activations [N m/rad].
+    global_null_space_stiffness : numpy.ndarray, shape (n - rank,)
+        Eigenvalues of -N^T (sum over global i of K_i) N: what all global muscles at full activation add
+        there (their lengths' curvature only) [N m/rad].
+    """
+
+    muscles: tuple
+    singular_values: np.ndarray
+    rank: int
+    null_space: np.ndarray
+    null_space_stiffness: np.ndarray
+    global_null_space_stiffness: np.ndarray
+
+
+def global_certificate(anatomy: Anatomy, chain: LinearChain, arms, a) -> GlobalCertificate:
+    """The global muscles' null-space certificate on a chain.
+
+    Parameters
+    ----------
+    anatomy : Anatomy
+        The model (its muscle classes).
+    chain : LinearChain
+        The (free) chain.
+    arms : numpy.ndarray, shape (m, n)
+        The muscles' moment arms over the chain's coordinates [m/rad].
+    a : array_like, shape (m,)
+        Activations.
+
+    Returns
+    -------
+    GlobalCertificate
+    """
+    is_global = np.array([c == "global" for c in chain.control_class])
+    _, sv, vt = np.linalg.svd(arms[is_global], full_matrices=True)
+    sv = np.concatenate([sv, np.zeros(chain.n_joints - sv.size)])
+    rank = int(np.sum(sv > RANK_TOLERANCE * sv.max())) if sv.size and sv.max() > 0 else 0
+    null = vt[rank:].T
+    k = chain.stiffness(a)
+    k_global = chain.stiffness_per_control[..., is_global].sum(axis=-1)
+    return GlobalCertificate(
+        muscles=tuple(np.array(chain.controls, object)[is_global]),
+        singular_values=sv[: chain.n_joints],
+        rank=rank,
+        null_space=null,
+        null_space_stiffness=np.linalg.eigvalsh(-null.T @ k @ null) if null.size else np.zeros(0),
+        global_null_space_stiffness=np.linalg.eigvalsh(-null.T @ k_global @ null) if null.size else np.zeros(0),
+    )
+
+
+def referee_model(anatomy: Anatomy, chain: LinearChain, a, added) -> tuple:
+    """MuJoCo's model of the free chain, held at the reference posture (:func:`mujoco_eigenvalues`).
+
+    Parameters
+    ----------
+    anatomy : Anatomy
+        The model.
+    chain : LinearChain
+        The free chain, for its joints.
+    a : array_like, shape (m,)
+        Activations, set as MuJoCo's activation states and controls (so that they stay).
+    added : array_like, shape (n,)
+        Joint stiffness added at each chain joint [N m/rad].
+
+    Returns
+    -------
+    tuple
+        (mujoco.MjModel, mujoco.MjData) at the posture, forward dynamics run.
+    """
+    mujoco = require_mujoco()
+    spec = anatomy.engine.spec_factory()
+    keep = dict(zip(chain.joints, np.asarray(added, float), strict=True))
+    for joint in list(spec.joints):
+        if joint.name not in keep:
+            spec.delete(joint)
+    for equality in list(spec.equalities):
+        spec.delete(equality)
+    model = spec.compile()
+    for name, value in keep.items():
+        model.jnt_stiffness[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name)] = value
+    flags = mujoco.mjtDisableBit
+    model.opt.disableflags |= flags.mjDSBL_CONTACT | flags.mjDSBL_EQUALITY | flags.mjDSBL_LIMIT
+    model.opt.disableflags |= flags.mjDSBL_EULERDAMP
+    model.opt.integrator = mujoco.mjtIntegrator.mjINT_EULER
+    data = mujoco.MjData(model)
+    data.act[:] = a
+    data.ctrl[:] = a  # muscle dynamics drive act to ctrl: held
+    mujoco.mj_forward(model, data)
+    # held by constant torques where the posture is no equilibrium: off one, a step's
+    # derivative would also hold dM^-1/dq times the net torque, which K = dtau/dq leaves out
+    data.qfrc_applied[:] = -(data.qfrc_actuator + data.qfrc_passive - data.qfrc_bias)
+    mujoco.mj_forward(model, data)
+    return model, data
+
+
+def mujoco_growth_rate(anatomy: Anatomy, chain: LinearChain, a, added, eigenvalue, mode, duration=0.1, step=1e-4):
+    """The rate at which MuJoCo's own simulation (:func:`mujoco.mj_step`) grows or decays along a mode.
+
+    Starts at the posture displaced by 1e-5 rad along the mode (its velocity the eigenvalue times
+    that), steps MuJoCo's free chain (:func:`referee_model`, time step ``step``) for ``duration``
+    and fits the log of the displacement's projection on the mode against time (least squares).
+
+    Parameters
+    ----------
+    anatomy : Anatomy
+        The model.
+    chain : LinearChain
+        The free chain.
+    a : array_like, shape (m,)
+        Activations, held.
+    added : array_like, shape (n,)
+        Joint stiffness added [N m/rad].
+    eigenvalue : float
+        A real eigenvalue of the state matrix [1/s].
+    mode : array_like, shape (n,)
+        Its joint-angle part [rad].
+    duration, step : float
+        Simulated time and MuJoCo's time step [s].
+
+    Returns
+    -------
+    float
+        The fitted rate [1/s].
+    """
+    mujoco = require_mujoco()
+    model, data = referee_model(anatomy, chain, a, added)
+    model.opt.timestep = step
+    order = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in chain.joints]
+    qadr = np.array([model.jnt_qposadr[j] for j in order])
+    vadr = np.array([model.jnt_dofadr[j] for j in order])
+    v = np.asarray(mode, float) / np.linalg.norm(mode)
+    q0 = data.qpos[qadr].copy()
+    data.qpos[qadr] += 1e-5 * v
+    data.qvel[vadr] = 1e-5 * eigenvalue * v
+    times, amplitude = [], []
+    for k in range(int(round(duration / step))):
+        mujoco.mj_step(model, data)
+        times.append((k + 1) * step)
+        amplitude.append(abs(v @ (data.qpos[qadr] - q0)))
+    return float(np.polyfit(times, np.log(amplitude), 1)[0])
+
+
+def mujoco_eigenvalues(anatomy: Anatomy, chain: LinearChain, a, added) -> np.ndarray:
+    """MuJoCo's own linearisation of the free chain: eigenvalues from :func:`mujoco.mjd_transitionFD`.
+
+    The referee: a copy of the model with every joint off the chain removed (its body
+    welded at the reference posture), equality constraints, contacts and limits disabled,
+    the added stiffness as MuJoCo joint stiffness, the posture held by constant applied
+    torques where it is no equilibrium (as the paper's counter torques would), and Euler's
+    implicit joint damping off,
+    so that one step is v+ = v + h M^-1 f(q, v) exactly. Its discrete transition's velocity
+    rows give the continuous state matrix, [[0, I], [A_vq/h, (A_vv - I)/h]]; the
+    activations are states of their own, held.
+
+    Parameters
+    ----------
+    anatomy : Anatomy
+        The model (at its reference posture).
+    chain : LinearChain
+        The free chain, for its joints.
+    a : array_like, shape (m,)
+        Activations.
+    added : array_like, shape (n,)
+        Joint stiffness added at each chain joint [N m/rad].
+
+    Returns
+    -------
+    numpy.ndarray, shape (2n,)
+        Eigenvalues [1/s], by descending real part.
+    """
+    mujoco = require_mujoco()
+    model, data = referee_model(anatomy, chain, a, added)
+    n, h = model.nv, model.opt.timestep
+    order = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in chain.joints]
+    size = 2 * n + model.na
+    A = np.zeros((size, size))
+    mujoco.mjd_transitionFD(model, data, 1e-6, True, A, None, None, None)
+    dofs = np.array([model.jnt_dofadr[j] for j in order])
+    a_vq = A[np.ix_(n + dofs, dofs)]
+    a_vv = A[np.ix_(n + dofs, n + dofs)]
+    cont = np.block([[np.zeros((n, n)), np.eye(n)], [a_vq / h, (a_vv - np.eye(n)) / h]])
+    dyn = np.linalg.eigvals(cont)
+    return dyn[np.lexsort((-dyn.imag, -dyn.real))]
+
+
+@dataclass(frozen=True)
+class AnatomyResult:
+    """The analysis of one model, plane, posture and activation (:func:`analyse`).
+
+    Attributes
+    ----------
+    model : dict
+        ``name``, ``source``, ``sha256``.
+    plane : str
+        The plane.
+    muscles : dict
+        ``global``, ``local``, ``between``: muscle names by class.
+    activations : numpy.ndarray, shape (m,)
+        [1].
+    joint_stiffness_added : numpy.ndarray, shape (n,)
+        Added at each chain joint [N m/rad].
+    stiffness_source : str
+        The source of the added stiffness ('' when none is added).
+    free, constrained : ChainVerdict
+        The free chain and the chain constrained by the model's rhythm.
+    certificate : GlobalCertificate
+        The global muscles' rank and null space.
+    mujoco_eigenvalues : numpy.ndarray or None
+        The referee's eigenvalues of the free chain (``check=True``) [1/s].
+    reflex : dict or None
+        With a reflex: ``kp``, ``kd`` [N m/rad, N m s/rad], ``lag`` [s] and the free chain's exact
+        delay margin (:func:`reflex_margin`).
+    simulated_rate : float
+        With ``check``: the rate fitted to MuJoCo's simulation started along the free chain's
+        mode of largest real eigenvalue (:func:`mujoco_growth_rate`; NaN if that is complex) [1/s].
+    """
+
+    model: dict
+    plane: str
+    muscles: dict
+    activations: np.ndarray
+    joint_stiffness_added: np.ndarray
+    stiffness_source: str
+    free: ChainVerdict
+    constrained: ChainVerdict
+    certificate: GlobalCertificate
+    mujoco_eigenvalues: np.ndarray | None = field(default=None)
+    simulated_rate: float = float("nan")
+    reflex: dict | None = None
+
+    def referee_error(self) -> float:
+        """Largest relative difference between spinectl's and MuJoCo's eigenvalues, matched one to one.
+
+        Returns
+        -------
+        float
+            max over the modes of abs(lambda - mu) / abs(mu); NaN without ``check``.
+        """
+        if self.mujoco_eigenvalues is None:
+            return float("nan")
+        from scipy.optimize import linear_sum_assignment
+
+        ours, theirs = self.free.dynamic_eigenvalues, self.mujoco_eigenvalues
+        cost = np.abs(ours[:, None] - theirs[None, :]) / np.abs(theirs)[None, :]
+        rows, cols = linear_sum_assignment(cost)
+        return float(cost[rows, cols].max())
+
+    def to_dict(self) -> dict:
+        """JSON-ready: the keys of docs/anatomy.md ("JSON").
+
+        Returns
+        -------
+        dict
+        """
+
+        def cplx(values):
+            return [{"real": float(v.real), "imag": float(v.imag)} for v in values]
+
+        free, con, cert = self.free, self.constrained, self.certificate
+        out = {
+            "model": self.model,
+            "plane": self.plane,
+            "joints": list(free.joints),
+            "muscles": {k: list(v) for k, v in self.muscles.items()},
+            "global_rank": cert.rank,
+            "global_singular_values_m_per_rad": cert.singular_values.tolist(),
+            "global_null_space": cert.null_space.T.tolist(),
+            "null_space_stiffness_Nm_per_rad": cert.null_space_stiffness.tolist(),
+            "activation_mean": float(self.activations.mean()),
+            "stiffness_matrix_Nm_per_rad": free.stiffness.tolist(),
+            "damping_matrix_Nms_per_rad": free.damping.tolist(),
+            "mass_matrix_kgm2": free.mass.tolist(),
+            "joint_stiffness_Nm_per_rad": self.joint_stiffness_added.tolist(),
+            "joint_stiffness_source": self.stiffness_source,
+            "diagonal_stiffness_Nm_per_rad": free.joint_stiffness.tolist(),
+            "eigenvalues": free.eigenvalues.tolist(),
+            "modes": free.modes.T.tolist(),
+            "dynamic_eigenvalues": cplx(free.dynamic_eigenvalues),
+            "joint_self_stable": list(free.joint_self_stable),
+            "joint_self_stable_criterion": "joint by joint: each joint alone, the others fixed (free chain)",
+            "chain_stable": free.chain_stable,
+            "chain_stable_criterion": "the chain: every chain joint free at once, equality constraints off",
+            "constrained": {
+                "joints": list(con.joints),
+                "stiffness_matrix_Nm_per_rad": con.stiffness.tolist(),
+                "mass_matrix_kgm2": con.mass.tolist(),
+                "eigenvalues": con.eigenvalues.tolist(),
+                "dynamic_eigenvalues": cplx(con.dynamic_eigenvalues),
+                "chain_stable": con.chain_stable,
+                "chain_stable_criterion": "the chain constrained by the model's lumbar rhythm",
+                "modes_removed": free.stiffness.shape[0] - con.stiffness.shape[0],
+            },
+        }
+        if self.mujoco_eigenvalues is not None:
+            out["mujoco_eigenvalues"] = cplx(self.mujoco_eigenvalues)
+            out["mujoco_relative_difference"] = self.referee_error()
+            out["predicted_rate_per_s"] = float(self.free.dynamic_eigenvalues[0].real)
+            out["mujoco_simulated_rate_per_s"] = self.simulated_rate
+        if self.reflex is not None:
+            out["reflex"] = self.reflex
+        return out
+
+    def table(self) -> str:
+        """A plain-text table; every verdict names its criterion.
+
+        Returns
+        -------
+        str
+        """
+        free, con, cert = self.free, self.constrained, self.certificate
+        word = {True: "stable", False: "unstable"}
+        counts = ", ".join(f"{len(v)} {k}" for k, v in self.muscles.items())
+        lines = [
+            f"{self.model['name']} ({self.model['source']}), {self.plane} plane, "
+            f"mean activation {self.activations.mean():.3g}",
+            f"muscles: {counts}; global muscles' moment-arm rank {cert.rank} of {len(free.joints)} "
+            f"(singular values {', '.join(f'{s:.3g}' for s in cert.singular_values)} m/rad)",
+            f"joint stiffness added: {self.joint_stiffness_added[0]:.4g} N m/rad per joint",
+            "",
+            f"{'joint':<16}{'-K_jj [N m/rad]':>16}  joint by joint (others fixed)",
+        ]
+        for name, s, ok in zip(free.joints, free.joint_stiffness, free.joint_self_stable, strict=True):
+            lines.append(f"{name:<16}{s:>16.4g}  {'self-' + word[ok]}")
+        eig = ", ".join(f"{v:.4g}" for v in free.eigenvalues)
+        lines += [
+            "",
+            f"the chain, free (every joint free, equality constraints off): eigenvalues of -K {eig} N m/rad: "
+            f"{word[free.chain_stable]} ({int(np.sum(free.eigenvalues <= 0))} of {len(free.eigenvalues)} modes "
+            "unstable)",
+            f"the chain constrained by the model's rhythm ({len(con.joints)} coordinate(s): {', '.join(con.joints)}): "
+            f"eigenvalues of -K {', '.join(f'{v:.4g}' for v in con.eigenvalues)} N m/rad: "
+            f"{word[con.chain_stable]}; the rhythm removes {len(free.joints) - len(con.joints)} modes",
+        ]
+        if cert.null_space.size:
+            lines.append(
+                f"global muscles' null space ({cert.null_space.shape[1]} modes): -K there "
+                f"{', '.join(f'{v:.4g}' for v in cert.null_space_stiffness)} N m/rad (left to local muscles, "
+                "passive tissue and reflexes)"
+            )
+        if self.mujoco_eigenvalues is not None:
+            lines.append(
+                f"MuJoCo's own linearisation (mjd_transitionFD, free chain): largest relative difference "
+                f"{self.referee_error():.2e} over {len(self.mujoco_eigenvalues)} eigenvalues; its simulation (mj_step) "
+                f"along the leading mode (largest real part): rate {self.simulated_rate:.4g} 1/s, predicted "
+                f"{self.free.dynamic_eigenvalues[0].real:.4g} 1/s"
+            )
+        if self.reflex is not None:
+            r = self.reflex
+            lines.append(
+                f"the chain (free) under a delayed PD reflex kp = {r['kp_Nm_per_rad']:g} N m/rad, kd = "
+                f"{r['kd_Nms_per_rad']:g} N m s/rad at every joint, activation lag {r['activation_lag_s']:g} s: "
+                f"exact delay margin {r['delay_margin_s']:.4g} s ({r['delay_margin_status']})"
+            )
+        return "\n".join(lines)
+
+
+def reflex_margin(chain: LinearChain, a, kp: float, kd: float, lag: float) -> dict:
+    """The free chain's exact delay margin under a diagonal delayed PD reflex (:mod:`spinectl.reflex.mimo`).
+
+    Parameters
+    ----------
+    chain : LinearChain
+        The free chain.
+    a : array_like, shape (m,)
+        Activations.
+    kp, kd : float
+        The reflex gains at every joint [N m/rad], [N m s/rad], >= 0.
+    lag : float
+        The force generation's time constant T_a [s], >= 0.
+
+    Returns
+    -------
+    dict
+        ``kp_Nm_per_rad``, ``kd_Nms_per_rad``, ``activation_lag_s``, ``delay_margin_s`` (inf:
+        any delay; 0: unstable without delay), ``delay_margin_status``, ``delay_margin_frequency_rad_s``.
+    """
+    from ..reflex.mimo import chain_delay_margin
+
+    for name, value in (("kp", kp), ("kd", kd), ("activation_lag", lag)):
+        if not (np.isfinite(value) and value >= 0):
+            raise ParameterError(name, f"must be a finite number >= 0 (got {value!r})")
+    n = chain.n_joints
+    margin = chain_delay_margin(
+        chain.mass_matrix, chain.stiffness(a), chain.damping(a), np.full(n, kp), np.full(n, kd), lag
+    )
+    return {
+        "kp_Nm_per_rad": float(kp),
+        "kd_Nms_per_rad": float(kd),
+        "activation_lag_s": float(lag),
+        "delay_margin_s": float(margin.margin),
+        "delay_margin_status": margin.status,
+        "delay_margin_frequency_rad_s": float(margin.frequency),
+    }
+
+
+def analyse(
+    anatomy: Anatomy,
+    plane: str = "sagittal",
+    activation=0.0,
+    posture=None,
+    joint_stiffness="none",
+    check=False,
+    reflex=None,
+) -> AnatomyResult:
+    """Joint-by-joint and chain verdicts of a model at an activation, free and constrained.
+
+    Parameters
+    ----------
+    anatomy : Anatomy
+        From :func:`spinectl.anatomy.load`.
+    plane : str
+        One of the mapping's planes.
+    activation : float, array_like or dict
+        Activations in [0, 1] (:func:`activations`).
+    posture : array_like, optional
+        Full qpos; default the model's reference posture.
+    joint_stiffness : {"none", "mapped"} or float
+        Intervertebral stiffness added at each chain joint [N m/rad].
+    check : bool
+        Also MuJoCo's own eigenvalues (:func:`mujoco_eigenvalues`) and its simulation along the
+        leading mode (:func:`mujoco_growth_rate`); reference posture only.
+    reflex : tuple, optional
+        ``(kp, kd, lag)``: also the free chain's exact delay margin under that reflex (:func:`reflex_margin`).
+
+    Returns
+    -------
+    AnatomyResult
+    """
+    a = activations(anatomy, activation)
+    free, con, lin = anatomy.chains(plane, posture, joint_stiffness)
+    added = anatomy.added_stiffness(joint_stiffness, free.n_joints)
+    arms = lin.moment_arms[:, list(lin.dofs[: lin.n])]
+    referee, rate = None, float("nan")
+    if check:
+        if posture is not None and not np.allclose(anatomy.posture(posture), anatomy.engine.model.qpos0):
+            raise ParameterError("check", "compares at the model's reference posture only")
+        referee = mujoco_eigenvalues(anatomy, free, a, added)
+        values, vectors = np.linalg.eig(state_matrix(free, a))
+        lead = int(np.argmax(values.real))
+        if abs(values[lead].imag) == 0:
+            rate = mujoco_growth_rate(anatomy, free, a, added, values[lead].real, vectors[: free.n_joints, lead].real)
+    classes = anatomy.classes
+    return AnatomyResult(
+        model={"name": anatomy.name, "source": anatomy.engine.source, "sha256": anatomy.engine.sha256},
+        plane=plane,
+        muscles={
+            c: tuple(m for m, k in zip(anatomy.muscles, classes, strict=True) if k == c)
+            for c in ("global", "local", "between")
+        },
+        activations=a,
+        joint_stiffness_added=added,
+        stiffness_source=anatomy.mapping.stiffness_source if np.any(added > 0) else "",
+        free=verdict(free, a),
+        constrained=verdict(con, a),
+        certificate=global_certificate(anatomy, free, arms, a),
+        mujoco_eigenvalues=referee,
+        simulated_rate=rate,
+        reflex=None if reflex is None else reflex_margin(free, a, *reflex),
+    )

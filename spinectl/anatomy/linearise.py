@@ -1,0 +1,312 @@
+"""The anatomical chain linearised at a posture: K(a), D(a), M as a LinearChain (docs/anatomy.md).
+
+At zero velocity the generalised force on the joints is
+
+    tau(q, q', a) = sum_i r_i(q) f_i(l_i, v_i, a_i) + tau_passive(q') - g(q),
+    f_i = a_i gain_i(l_i, v_i) + bias_i(l_i),
+
+with r_i = dl_i/dq MuJoCo's moment arms (``actuator_moment``), gain and bias MuJoCo's muscle
+curves and g gravity (``qfrc_bias`` at zero velocity). It is affine in the activations a,
+so K(a) = dtau/dq = K_0 + sum_i a_i K_i with
+
+    K_i = H_i gain_i + gain_i' r_i r_i^T,    K_0 = -dg/dq + sum_i (H_i bias_i + bias_i' r_i r_i^T),
+
+H_i = d^2 l_i/dq^2 the Hessian of the muscle's length (central differences of MuJoCo's
+moment arms: MuJoCo has no tendon Hessian), gain' and bias' the curves' slopes in length
+(central differences of the scalar curves, exact on their quadratic pieces). Likewise
+D_i = (d gain_i/dv) r_i r_i^T and D_0 = -diag(joint damping). One pass of 2 s position
+evaluations over the s joints involved gives every K_i, whatever a.
+
+Two chains: the **free** chain, every chain joint its own degree of freedom and the model's
+equality constraints off (the other joints held); and the chain **constrained** by the
+model's own rhythm (MuJoCo joint equalities q_dep = P(q_ind)), reduced to its independent
+coordinates: K_c = T^T K T + sum_dep tau_dep P''_dep, M_c = T^T M T, D_c = T^T D T, with
+T = dq/dq_ind.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ModelError, ParameterError
+from ..model.linear_chain import LinearChain
+from .engine import Engine, require_mujoco
+
+STEP = 1e-5
+"""Central-difference step of the moment arms over q [rad]: truncation ~STEP^2, rounding ~eps/STEP."""
+
+
+@dataclass(frozen=True)
+class Rhythm:
+    """The model's joint equalities that involve the chain: q = q0 + T(q_ind) (docs/anatomy.md).
+
+    Attributes
+    ----------
+    independent : tuple of int
+        Dof indices (into ``dofs``) of the independent chain coordinates.
+    dofs : tuple of int
+        Every dof involved: the chain's and the joints slaved to its independent ones.
+    transform : numpy.ndarray, shape (len(dofs), len(independent))
+        T = dq/dq_ind at the posture.
+    curvature : numpy.ndarray, shape (len(dofs), len(independent))
+        d^2 q/dq_ind^2 of each dof on its own independent coordinate (0 for a linear rhythm).
+    """
+
+    independent: tuple
+    dofs: tuple
+    transform: np.ndarray
+    curvature: np.ndarray
+
+
+def _joint_dof(model, joint: int) -> int:
+    return int(model.jnt_dofadr[joint])
+
+
+def rhythm(engine: Engine, chain_joints) -> Rhythm:
+    """The active joint equalities of the model, as a map from the chain's independent coordinates.
+
+    Parameters
+    ----------
+    engine : Engine
+        The compiled model (its posture set by :meth:`Engine.set_state`).
+    chain_joints : sequence of int
+        Joint ids of the chain.
+
+    Returns
+    -------
+    Rhythm
+    """
+    mujoco = require_mujoco()
+    model, qpos = engine.model, engine.data.qpos
+    slaved = {}  # dependent joint -> (independent joint or -1, polynomial coefficients)
+    for e in range(model.neq):
+        if not model.eq_active0[e]:
+            continue
+        if model.eq_type[e] != mujoco.mjtEq.mjEQ_JOINT:
+            raise ModelError(f"{engine.name}: the constrained chain supports joint equalities only (equality {e})")
+        slaved[int(model.eq_obj1id[e])] = (int(model.eq_obj2id[e]), np.array(model.eq_data[e][:5]))
+    if any(j2 in slaved for j2, _ in slaved.values() if j2 >= 0):
+        raise ModelError(f"{engine.name}: a joint equality on a joint that is itself slaved is not supported")
+    chain = list(chain_joints)
+    independent = [j for j in chain if j not in slaved]
+    involved = chain + [j for j, (j2, _) in slaved.items() if j2 in independent and j not in chain]
+    T = np.zeros((len(involved), len(independent)))
+    C = np.zeros_like(T)
+    for row, j in enumerate(involved):
+        if j in independent:
+            T[row, independent.index(j)] = 1.0
+            continue
+        j2, c = slaved[j]
+        if j2 < 0:
+            continue  # locked
+        x = qpos[model.jnt_qposadr[j2]] - model.qpos0[model.jnt_qposadr[j2]]
+        powers = np.arange(5)
+        T[row, independent.index(j2)] = np.sum(powers[1:] * c[1:] * x ** (powers[1:] - 1))
+        C[row, independent.index(j2)] = np.sum(powers[2:] * (powers[2:] - 1) * c[2:] * x ** (powers[2:] - 2))
+    dofs = tuple(_joint_dof(model, j) for j in involved)
+    return Rhythm(tuple(involved.index(j) for j in independent), dofs, T, C)
+
+
+@dataclass(frozen=True)
+class Linearisation:
+    """Everything read from MuJoCo at one posture, over the dofs involved (chain and slaved joints).
+
+    Attributes
+    ----------
+    dofs : tuple of int
+        MuJoCo dof indices, the first n those of the chain.
+    n : int
+        The number of chain joints.
+    stiffness_per_muscle, stiffness_offset, damping_per_muscle, damping_offset, mass
+        K_i (s, s, m), K_0 (s, s), D_i, D_0, M (s, s), over ``dofs`` [SI per unit activation].
+    torque_per_muscle : numpy.ndarray, shape (nv, m)
+        r_i gain_i: each muscle's generalised force per unit activation on every dof [N m].
+    torque_offset : numpy.ndarray, shape (nv,)
+        Passive muscle forces less gravity on every dof at the posture [N m].
+    moment_arms : numpy.ndarray, shape (m, nv)
+        r_i [m/rad].
+    """
+
+    dofs: tuple
+    n: int
+    stiffness_per_muscle: np.ndarray
+    stiffness_offset: np.ndarray
+    damping_per_muscle: np.ndarray
+    damping_offset: np.ndarray
+    mass: np.ndarray
+    torque_per_muscle: np.ndarray
+    torque_offset: np.ndarray
+    moment_arms: np.ndarray
+
+
+def _curves(engine: Engine):
+    """Each muscle's gain and bias at the set state and their slopes in length and velocity."""
+    mujoco = require_mujoco()
+    model, d = engine.model, engine.data
+    m = model.nu
+    out = np.zeros((5, m))  # gain, dgain/dl, dgain/dv, bias, dbias/dl
+    for i in range(m):
+        lr, acc0 = model.actuator_lengthrange[i], model.actuator_acc0[i]
+        gp, bp = model.actuator_gainprm[i][:9], model.actuator_biasprm[i][:9]  # the curves read 9
+        length, vel = d.actuator_length[i], d.actuator_velocity[i]
+        h = 1e-6 * (lr[1] - lr[0])
+
+        def gain(dl=0.0, dv=0.0, lr=lr, acc0=acc0, gp=gp, length=length, vel=vel):
+            return mujoco.mju_muscleGain(length + dl, vel + dv, lr, acc0, gp)
+
+        def bias(dl=0.0, lr=lr, acc0=acc0, bp=bp, length=length):
+            return mujoco.mju_muscleBias(length + dl, lr, acc0, bp)
+
+        out[:, i] = (
+            gain(),
+            (gain(h) - gain(-h)) / (2 * h),
+            (gain(dv=h) - gain(dv=-h)) / (2 * h),
+            bias(),
+            (bias(h) - bias(-h)) / (2 * h),
+        )
+    return out
+
+
+def linearise(engine: Engine, qpos, dofs, n: int) -> Linearisation:
+    """K_i, K_0, D_i, D_0, M at a posture over the given dofs (module docstring).
+
+    Parameters
+    ----------
+    engine : Engine
+        The compiled model.
+    qpos : array_like, shape (nq,)
+        The posture.
+    dofs : sequence of int
+        MuJoCo dof indices (hinge joints), the chain's first.
+    n : int
+        How many of ``dofs`` are the chain's.
+
+    Returns
+    -------
+    Linearisation
+    """
+    mujoco = require_mujoco()
+    model, d = engine.model, engine.data
+    if model.nq != model.nv:
+        raise ModelError(f"{engine.name}: free or ball joints are not supported (nq != nv)")
+    if np.any(model.actuator_dyntype != mujoco.mjtDyn.mjDYN_MUSCLE):
+        raise ModelError(f"{engine.name}: every actuator must be a muscle (muscle dynamics)")
+    dofs = list(dofs)
+    s, nu = len(dofs), model.nu
+    qpos = np.asarray(qpos, float)
+    engine.set_state(qpos)
+    arms = engine.moment_arms()
+    r = arms[:, dofs]
+    curves = _curves(engine)
+    gravity = -d.qfrc_bias.copy()
+    mass = engine.mass_matrix()
+    hessian = np.zeros((nu, s, s))
+    dgravity = np.zeros((s, s))
+    for k, dof in enumerate(dofs):
+        sides = []
+        for sign in (1.0, -1.0):
+            q = qpos.copy()
+            q[model.dof_jntid[dof]] += sign * STEP
+            engine.set_state(q)
+            sides.append((engine.moment_arms()[:, dofs], -d.qfrc_bias[dofs].copy()))
+        hessian[:, :, k] = (sides[0][0] - sides[1][0]) / (2 * STEP)
+        dgravity[:, k] = (sides[0][1] - sides[1][1]) / (2 * STEP)
+    engine.set_state(qpos)
+    hessian = 0.5 * (hessian + hessian.transpose(0, 2, 1))  # a Hessian: symmetric up to rounding
+    rr = np.einsum("ij,ik->jki", r, r)  # (s, s, m): r_i r_i^T
+    gain, dgain_dl, dgain_dv, bias, dbias_dl = curves
+    k_per = hessian.transpose(1, 2, 0) * gain + rr * dgain_dl
+    k_0 = 0.5 * (dgravity + dgravity.T) + np.einsum("ijk,i->jk", hessian, bias) + rr @ dbias_dl
+    k_0 -= np.diag(model.jnt_stiffness[model.dof_jntid[dofs]])
+    return Linearisation(
+        dofs=tuple(dofs),
+        n=n,
+        stiffness_per_muscle=k_per,
+        stiffness_offset=k_0,
+        damping_per_muscle=rr * dgain_dv,
+        damping_offset=-np.diag(model.dof_damping[dofs]),
+        mass=mass[np.ix_(dofs, dofs)],
+        torque_per_muscle=arms.T * gain,
+        torque_offset=gravity + d.qfrc_passive + arms.T @ bias,
+        moment_arms=arms,
+    )
+
+
+def _chain(lin: Linearisation, rows, T, joints, controls, classes, added, source, curvature=None):
+    """A LinearChain of the linearisation reduced by T (the free chain: T selects the chain's rows)."""
+    k_per = np.einsum("ai,abm,bj->ijm", T, lin.stiffness_per_muscle[np.ix_(rows, rows)], T)
+    k_0 = T.T @ lin.stiffness_offset[np.ix_(rows, rows)] @ T - T.T @ np.diag(added) @ T
+    if curvature is not None:  # the rhythm's second derivative times the slaved joints' torques
+        dofs = [lin.dofs[r] for r in rows]
+        diag = np.arange(T.shape[1])
+        k_0[diag, diag] += curvature.T @ lin.torque_offset[dofs]
+        k_per[diag, diag, :] += curvature.T @ lin.torque_per_muscle[dofs]
+    return LinearChain(
+        joints=joints,
+        controls=controls,
+        control_class=classes,
+        stiffness_per_control=k_per,
+        damping_per_control=np.einsum("ai,abm,bj->ijm", T, lin.damping_per_muscle[np.ix_(rows, rows)], T),
+        stiffness_offset=k_0,
+        damping_offset=T.T @ lin.damping_offset[np.ix_(rows, rows)] @ T,
+        mass_matrix=T.T @ lin.mass[np.ix_(rows, rows)] @ T,
+        lower=np.zeros(len(controls)),
+        upper=np.ones(len(controls)),
+        control_unit="1",
+        source=source,
+    )
+
+
+def free_chain(lin: Linearisation, joints, controls, classes, added, source) -> LinearChain:
+    """The free chain: every chain joint free, the model's equalities off, the other joints held.
+
+    Parameters
+    ----------
+    lin : Linearisation
+        From :func:`linearise`.
+    joints, controls, classes : sequence of str
+        Chain joint names, muscle names and classes.
+    added : array_like, shape (n,)
+        Joint stiffness added at each chain joint [N m/rad].
+    source : str
+        For outputs.
+
+    Returns
+    -------
+    LinearChain
+    """
+    n = lin.n
+    return _chain(lin, list(range(n)), np.eye(n), joints, controls, classes, np.asarray(added, float), source)
+
+
+def constrained_chain(lin: Linearisation, rhy: Rhythm, joint_names, controls, classes, added, source) -> LinearChain:
+    """The chain constrained by the model's rhythm, in its independent coordinates.
+
+    Parameters
+    ----------
+    lin : Linearisation
+        From :func:`linearise` over ``rhy.dofs``.
+    rhy : Rhythm
+        From :func:`rhythm`.
+    joint_names : sequence of str
+        Names of ``rhy.dofs``' joints.
+    controls, classes : sequence of str
+        Muscle names and classes.
+    added : array_like, shape (len(rhy.dofs),)
+        Joint stiffness added at each involved joint [N m/rad] (0 off the chain).
+    source : str
+        For outputs.
+
+    Returns
+    -------
+    LinearChain
+    """
+    if tuple(lin.dofs) != tuple(rhy.dofs):
+        raise ParameterError("rhythm", "must be over the linearisation's dofs")
+    rows = list(range(len(rhy.dofs)))
+    joints = tuple(joint_names[i] for i in rhy.independent)
+    return _chain(
+        lin, rows, rhy.transform, joints, controls, classes, np.asarray(added, float), source, curvature=rhy.curvature
+    )

@@ -1,0 +1,463 @@
+"""Stability-constrained static optimisation on an anatomical model (docs/anatomy.md, "The optimum").
+
+The least muscle effort that holds the posture::
+
+    minimise    sum_i w_i a_i^2
+    subject to  equilibrium, tau_0 + sum_i a_i tau_i = 0:
+                  "free":   on every lumbar joint, the model's equality constraints off;
+                  "rhythm": on the rhythm's independent coordinates (T^T tau = 0 in all three
+                            planes); the model's joint equalities carry the rest, as constant
+                            torques (the paper's counter torques, here the rhythm's),
+                0 <= a_i <= 1,
+                and the stability criterion:
+                  "chain":  -K(a) >= mu I           (the free chain, every joint free at once),
+                  "joints": -K_jj(a) >= mu, each j  (the paper's joint-by-joint criterion),
+                  "rhythm": -K_c(a) >= mu I         (the chain constrained by the model's rhythm),
+                  "none":   nothing (classic static optimisation).
+
+The cost is OpenSim's static optimisation criterion sum a_i^2 (Anderson and Pandy 2001)
+with ``weights="none"``; with ``weights="volume"`` (the default) each muscle counts by its
+volume, w_i proportional to F0_i L0_i (maximal isometric force times optimal fibre length,
+so PCSA times fibre length at a common specific tension), normalised to mean 1: a large
+muscle's activation costs more than a small one's. Convex in a (a quadratic cost, linear
+equalities and bounds, one linear matrix inequality), solved with cvxpy and Clarabel.
+
+This is a small direct SDP written against :class:`~spinectl.model.linear_chain.LinearChain`
+(:func:`solve_on_chain`); the chain SDPs of :mod:`spinectl.optimise` may take its place.
+
+References
+----------
+Anderson FC, Pandy MG (2001). Static and dynamic optimization solutions for gait are
+practically equivalent. J Biomech 34(2):153-161. doi:10.1016/S0021-9290(00)00155-X.
+Goulart PJ, Chen Y (2024). Clarabel: an interior-point solver for conic programs with
+quadratic objectives. arXiv:2405.12762.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ParameterError
+from ..model.linear_chain import LinearChain
+from .linearise import rhythm
+from .model import Anatomy
+
+STABILITY = ("chain", "joints", "rhythm", "none")
+EQUILIBRIUM = ("rhythm", "free")
+WEIGHTS = ("volume", "none")
+MARGIN = 1.0
+"""Default static margin mu [N m/rad] of the stability constraints."""
+
+
+def volume_weights(anatomy: Anatomy) -> np.ndarray:
+    """w_i proportional to F0_i L0_i (MuJoCo's muscle parameters), normalised to mean 1.
+
+    Parameters
+    ----------
+    anatomy : Anatomy
+        The model.
+
+    Returns
+    -------
+    numpy.ndarray, shape (m,)
+    """
+    model = anatomy.engine.model
+    gain = model.actuator_gainprm
+    lr = model.actuator_lengthrange
+    # MuJoCo's muscle: L0 = (lengthrange span) / (operating range span); F0 = force, or scale / acc0 if force < 0
+    length0 = (lr[:, 1] - lr[:, 0]) / (gain[:, 1] - gain[:, 0])
+    force0 = np.where(gain[:, 2] > 0, gain[:, 2], gain[:, 3] / model.actuator_acc0)
+    volume = force0 * length0
+    return volume / volume.mean()
+
+
+def solve_on_chain(chain: LinearChain, tau_per, tau_0, weights, stability: str, margin: float):
+    """The optimum on a LinearChain with equilibrium rows; ``(status, a)`` (a NaN where infeasible).
+
+    Parameters
+    ----------
+    chain : LinearChain
+        The free chain: K(a) for the stability constraint, bounds of a.
+    tau_per : numpy.ndarray, shape (r, m)
+        Each control's generalised force per unit on the r equilibrium rows [N m].
+    tau_0 : numpy.ndarray, shape (r,)
+        The rest of the net torque on those rows [N m].
+    weights : numpy.ndarray, shape (m,)
+        Cost weights w_i.
+    stability : str
+        One of :data:`STABILITY`.
+    margin : float
+        mu [N m/rad].
+
+    Returns
+    -------
+    tuple
+        (cvxpy's status, numpy.ndarray of shape (m,)).
+    """
+    import cvxpy as cp
+
+    n, m = chain.n_joints, chain.n_controls
+    a = cp.Variable(m)
+    constraints = [tau_per @ a + tau_0 == 0, a >= chain.lower, a <= chain.upper]
+    flat = chain.stiffness_per_control.reshape(n * n, m)
+    neg_k = -(cp.reshape(flat @ a, (n, n), order="C") + chain.stiffness_offset)
+    if stability == "chain":
+        constraints.append(0.5 * (neg_k + neg_k.T) - margin * np.eye(n) >> 0)
+    elif stability == "joints":
+        constraints.append(cp.diag(neg_k) >= margin)
+    problem = cp.Problem(cp.Minimize(cp.sum(cp.multiply(weights, cp.square(a)))), constraints)
+    try:
+        with warnings.catch_warnings():  # "may be inaccurate": the status says so ('optimal_inaccurate')
+            warnings.simplefilter("ignore", UserWarning)
+            problem.solve(solver=cp.CLARABEL)
+    except cp.error.SolverError:
+        return "solver_error", np.full(m, np.nan)
+    if problem.status not in ("optimal", "optimal_inaccurate") or a.value is None:
+        return problem.status, np.full(m, np.nan)
+    return problem.status, np.clip(a.value, chain.lower, chain.upper)
+
+
+@dataclass(frozen=True)
+class Optimum:
+    """One optimum (:func:`optimise`).
+
+    Attributes
+    ----------
+    stability : str
+        The criterion imposed (:data:`STABILITY`).
+    status : str
+        cvxpy's status; the numbers are NaN unless it is optimal.
+    activations : numpy.ndarray, shape (m,)
+        [1].
+    cost : float
+        sum w_i a_i^2.
+    equilibrium : str
+        ``"rhythm"`` or ``"free"``.
+    net_torque : numpy.ndarray, shape (r,)
+        On every equilibrium row at the optimum [N m] (0 up to the solver's tolerance).
+    lumbar_torque : numpy.ndarray, shape (l,)
+        The net torque on every lumbar joint at the optimum [N m]: what the rhythm carries
+        (0 with ``"free"``).
+    eigenvalues : numpy.ndarray, shape (n,)
+        Of -K(a) of the free chain [N m/rad]: the least is the margin.
+    joint_stiffness : numpy.ndarray, shape (n,)
+        Diagonal of -K(a) [N m/rad].
+    """
+
+    stability: str
+    status: str
+    activations: np.ndarray
+    cost: float
+    equilibrium: str
+    net_torque: np.ndarray
+    lumbar_torque: np.ndarray
+    eigenvalues: np.ndarray
+    joint_stiffness: np.ndarray
+
+    @property
+    def ok(self) -> bool:
+        """Solved (optimal or optimal_inaccurate)."""
+        return self.status in ("optimal", "optimal_inaccurate")
+
+
+def optimise(
+    anatomy: Anatomy,
+    plane: str = "sagittal",
+    stability: str = "chain",
+    margin: float = MARGIN,
+    posture=None,
+    joint_stiffness="none",
+    weights: str = "volume",
+    equilibrium: str = "rhythm",
+) -> Optimum:
+    """The least-effort activations that hold the posture, with a stability criterion.
+
+    Parameters
+    ----------
+    anatomy : Anatomy
+        The model.
+    plane : str
+        The chain whose stability is imposed (equilibrium holds on every lumbar joint: the
+        mapping's ``3d`` plane, or this plane's joints if it has none).
+    stability : str
+        ``"chain"``, ``"joints"`` or ``"none"`` (module docstring).
+    margin : float
+        mu [N m/rad], >= 0.
+    posture : array_like, optional
+        Full qpos; default the model's reference posture.
+    joint_stiffness : {"none", "mapped"} or float
+        Added at each chain joint [N m/rad].
+    weights : str
+        ``"volume"`` or ``"none"`` (:func:`volume_weights`).
+    equilibrium : str
+        ``"rhythm"`` or ``"free"`` (module docstring).
+
+    Returns
+    -------
+    Optimum
+    """
+    if stability not in STABILITY:
+        raise ParameterError("stability", f"must be one of {STABILITY} (got {stability!r})")
+    if weights not in WEIGHTS:
+        raise ParameterError("weights", f"must be one of {WEIGHTS} (got {weights!r})")
+    if equilibrium not in EQUILIBRIUM:
+        raise ParameterError("equilibrium", f"must be one of {EQUILIBRIUM} (got {equilibrium!r})")
+    if not (np.isfinite(margin) and margin >= 0):
+        raise ParameterError("margin", f"must be >= 0 [N m/rad] (got {margin!r})")
+    free, constrained, lin = anatomy.chains(plane, posture, joint_stiffness)
+    lumbar = anatomy.mapping.planes.get("3d", anatomy.plane_joints(plane))
+    model = anatomy.engine.model
+    rows = [int(model.jnt_dofadr[j]) for j in anatomy.joint_ids(lumbar)]
+    if equilibrium == "free":
+        tau_per, tau_0 = lin.torque_per_muscle[rows], lin.torque_offset[rows]
+    else:
+        anatomy.engine.set_state(anatomy.posture(posture))
+        rhy = rhythm(anatomy.engine, anatomy.joint_ids(lumbar))
+        dofs = list(rhy.dofs)
+        tau_per, tau_0 = rhy.transform.T @ lin.torque_per_muscle[dofs], rhy.transform.T @ lin.torque_offset[dofs]
+    w = volume_weights(anatomy) if weights == "volume" else np.ones(free.n_controls)
+    if stability == "rhythm":
+        status, a = solve_on_chain(constrained, tau_per, tau_0, w, "chain", margin)
+    else:
+        status, a = solve_on_chain(free, tau_per, tau_0, w, stability, margin)
+    k = free.stiffness(a) if np.all(np.isfinite(a)) else np.full((free.n_joints,) * 2, np.nan)
+    ok = np.all(np.isfinite(k))
+    return Optimum(
+        stability=stability,
+        status=status,
+        activations=a,
+        cost=float(w @ a**2),
+        equilibrium=equilibrium,
+        net_torque=tau_per @ a + tau_0,
+        lumbar_torque=lin.torque_per_muscle[rows] @ a + lin.torque_offset[rows],
+        eigenvalues=np.linalg.eigvalsh(-0.5 * (k + k.T)) if ok else np.full(free.n_joints, np.nan),
+        joint_stiffness=-np.diag(k),
+    )
+
+
+def _optimum_dict(anatomy: Anatomy, opt: Optimum) -> dict:
+    return {
+        "stability": opt.stability,
+        "equilibrium": opt.equilibrium,
+        "status": opt.status,
+        "cost": opt.cost,
+        "activation_sum": float(np.sum(opt.activations)),
+        "eigenvalues": opt.eigenvalues.tolist(),
+        "diagonal_stiffness_Nm_per_rad": opt.joint_stiffness.tolist(),
+        "net_torque_Nm": opt.net_torque.tolist(),
+        "lumbar_torque_Nm": opt.lumbar_torque.tolist(),
+    }
+
+
+@dataclass(frozen=True)
+class OptimisedResult:
+    """The optimum with a stability criterion, beside classic static optimisation, and the analysis at it.
+
+    Attributes
+    ----------
+    anatomy : Anatomy
+        The model.
+    optimum : Optimum
+        With the criterion asked for.
+    classic : Optimum
+        Without a stability criterion (classic static optimisation).
+    margin : float
+        mu [N m/rad].
+    plane : str
+        The chain's plane.
+    analysis : AnatomyResult or None
+        :func:`~spinectl.anatomy.analyses.analyse` at the optimum's activations; None where infeasible.
+    """
+
+    anatomy: Anatomy
+    optimum: Optimum
+    classic: Optimum
+    margin: float
+    plane: str
+    analysis: object
+
+    @property
+    def price(self) -> float:
+        """The price of stability: the optimum's cost over the classic optimum's (NaN if either is infeasible)."""
+        return self.optimum.cost / self.classic.cost if self.classic.cost > 0 else float("nan")
+
+    def to_dict(self) -> dict:
+        """JSON-ready: the analysis at the optimum, ``activations`` by muscle, ``cost``, ``net_torque_Nm``.
+
+        Returns
+        -------
+        dict
+        """
+        out = self.analysis.to_dict() if self.analysis is not None else self._header()
+        out.update(
+            {
+                "activations": dict(zip(self.anatomy.muscles, self.optimum.activations.tolist(), strict=True)),
+                "cost": self.optimum.cost,
+                "net_torque_Nm": self.optimum.net_torque.tolist(),
+                "margin_Nm_per_rad": self.margin,
+                "optimum": _optimum_dict(self.anatomy, self.optimum),
+                "classic": _optimum_dict(self.anatomy, self.classic),
+                "price_of_stability": self.price,
+            }
+        )
+        return out
+
+    def _header(self) -> dict:
+        """The model and the chain, where there is no analysis (an infeasible optimum)."""
+        engine = self.anatomy.engine
+        return {
+            "model": {"name": engine.name, "source": engine.source, "sha256": engine.sha256},
+            "plane": self.plane,
+            "joints": list(self.anatomy.plane_joints(self.plane)),
+        }
+
+    def table(self) -> str:
+        """The optimum and the classic one, each with its criterion; then the analysis at the optimum.
+
+        Returns
+        -------
+        str
+        """
+        crit = {
+            "chain": "the chain free, -K >= mu I",
+            "joints": "joint by joint, each -K_jj >= mu",
+            "rhythm": "the chain constrained by the rhythm, -K_c >= mu",
+            "none": "no stability criterion (classic static optimisation)",
+        }
+        lines = []
+        for label, opt in (("optimum", self.optimum), ("classic", self.classic)):
+            eig = ", ".join(f"{v:.4g}" for v in opt.eigenvalues)
+            lines.append(
+                f"{label}: {crit[opt.stability]} (mu = {self.margin:g} N m/rad), equilibrium {opt.equilibrium}: "
+                f"{opt.status}; cost {opt.cost:.4g}, sum of activations {np.sum(opt.activations):.4g}; "
+                f"eigenvalues of -K (free chain) {eig} N m/rad"
+            )
+        lines.append(f"price of stability (cost ratio): {self.price:.4g}")
+        if self.analysis is not None:
+            lines += ["", "at the optimum's activations:", self.analysis.table()]
+        return "\n".join(lines)
+
+
+def optimised(
+    anatomy: Anatomy,
+    plane: str = "sagittal",
+    stability: str = "chain",
+    margin: float = MARGIN,
+    joint_stiffness="none",
+    equilibrium: str = "rhythm",
+    check: bool = False,
+    reflex=None,
+) -> OptimisedResult:
+    """The optimum with a criterion and without, at the reference posture, and the analysis at the optimum.
+
+    Parameters
+    ----------
+    anatomy : Anatomy
+        The model.
+    plane : str
+        The chain.
+    stability : str
+        One of :data:`STABILITY`.
+    margin : float
+        mu [N m/rad].
+    joint_stiffness : {"none", "mapped"} or float
+        Added at each chain joint [N m/rad].
+    equilibrium : str
+        One of :data:`EQUILIBRIUM`.
+    check : bool
+        MuJoCo's own eigenvalues at the optimum (:func:`~spinectl.anatomy.analyses.mujoco_eigenvalues`).
+    reflex : tuple, optional
+        ``(kp, kd, lag)``: the chain's exact delay margin at the optimum
+        (:func:`~spinectl.anatomy.analyses.reflex_margin`).
+
+    Returns
+    -------
+    OptimisedResult
+    """
+    from .analyses import analyse
+
+    kwargs = {"plane": plane, "margin": margin, "joint_stiffness": joint_stiffness, "equilibrium": equilibrium}
+    opt = optimise(anatomy, stability=stability, **kwargs)
+    classic = opt if stability == "none" else optimise(anatomy, stability="none", **kwargs)
+    analysis = None
+    if opt.ok:
+        analysis = analyse(anatomy, plane, opt.activations, joint_stiffness=joint_stiffness, check=check, reflex=reflex)
+    return OptimisedResult(anatomy, opt, classic, float(margin), plane, analysis)
+
+
+def lordosis_posture(anatomy: Anatomy, degrees: float, plane: str = "sagittal") -> np.ndarray:
+    """The reference posture with the plane's chain moved along the model's rhythm by ``degrees`` in total.
+
+    The chain's joints (and those the rhythm slaves, e.g. MyoTorso's abdomen) move as the
+    rhythm's coefficients distribute them, their angles summing to ``degrees`` over the chain;
+    the thorax is not held upright (it turns with the chain).
+
+    Parameters
+    ----------
+    anatomy : Anatomy
+        The model.
+    degrees : float
+        The change of the chain's summed angle [deg].
+    plane : str
+        The chain.
+
+    Returns
+    -------
+    numpy.ndarray, shape (nq,)
+    """
+    lin, rhy, _ = anatomy.linearise(plane)
+    direction = rhy.transform[:, 0]
+    q = anatomy.posture()
+    q[list(rhy.dofs)] += direction * np.radians(degrees) / direction[: lin.n].sum()
+    return q
+
+
+def lordosis_curve(
+    anatomy: Anatomy,
+    degrees,
+    plane: str = "sagittal",
+    margin: float = MARGIN,
+    joint_stiffness="none",
+    equilibrium: str = "rhythm",
+) -> dict:
+    """The three optima (classic, joint by joint, the chain) over the lordosis.
+
+    Parameters
+    ----------
+    anatomy : Anatomy
+        The model.
+    degrees : array_like
+        Changes of the chain's summed angle about the reference posture [deg].
+    plane, margin, joint_stiffness, equilibrium
+        As in :func:`optimise`.
+
+    Returns
+    -------
+    dict
+        ``lordosis_deg`` and, per criterion (``none``, ``joints``, ``chain``), ``cost``,
+        ``status`` and ``margin_Nm_per_rad`` (the least eigenvalue of -K) lists.
+    """
+    degrees = np.asarray(degrees, float)
+    out = {"lordosis_deg": degrees.tolist()}
+    for criterion in ("none", "joints", "chain"):
+        rows = [
+            optimise(
+                anatomy,
+                plane,
+                criterion,
+                margin,
+                lordosis_posture(anatomy, d, plane),
+                joint_stiffness,
+                equilibrium=equilibrium,
+            )
+            for d in degrees
+        ]
+        out[criterion] = {
+            "cost": [r.cost for r in rows],
+            "status": [r.status for r in rows],
+            "margin_Nm_per_rad": [float(r.eigenvalues[0]) for r in rows],
+        }
+    return out

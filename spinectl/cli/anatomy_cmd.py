@@ -1,0 +1,190 @@
+"""``spinectl anatomy``: the paper's question and the chain's on a MuJoCo musculoskeletal model."""
+
+from __future__ import annotations
+
+from ._common import emit_json, finite_float
+
+
+def register(sub) -> None:
+    """Add the ``anatomy`` sub-command to the ``spinectl`` parser.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The sub-command action of :func:`spinectl.cli.build_parser`.
+    """
+    parser = sub.add_parser(
+        "anatomy",
+        help="stability of an anatomical model's lumbar chain (MuJoCo; MyoTorso built in)",
+        description="Load a MuJoCo musculoskeletal model (the built-in 'myotorso' from myo-sim, or an MJCF "
+        "file with --mapping), linearise its lumbar chain at the reference posture and uniform muscle "
+        "activation, and report each joint's stiffness (joint by joint, the others fixed), the chain's "
+        "eigenvalues (every joint free, equality constraints off), the chain constrained by the model's "
+        "lumbar rhythm, and the global muscles' rank. Needs pip install 'spinectl[anatomy]'. "
+        "See docs/anatomy.md.",
+    )
+    parser.add_argument("model", nargs="?", default="myotorso", help="'myotorso' or an MJCF file (default: myotorso)")
+    parser.add_argument("--mapping", metavar="FILE", help="mapping TOML (default: the built-in one of the model)")
+    parser.add_argument("--plane", default="sagittal", help="sagittal, coronal or 3d (default: sagittal)")
+    parser.add_argument(
+        "--activation",
+        type=finite_float("--activation"),
+        default=0.0,
+        metavar="A",
+        help="activation of every muscle, in [0, 1] (default: 0)",
+    )
+    parser.add_argument(
+        "--joint-stiffness",
+        default="none",
+        metavar="K",
+        help="intervertebral stiffness added at each chain joint: none (the model's own, default), "
+        "mapped (the mapping's cited value) or a number [N m/rad]",
+    )
+    parser.add_argument(
+        "--check",
+        action="store_true",
+        help="compare the eigenvalues with MuJoCo's own linearisation (mjd_transitionFD, free chain)",
+    )
+    parser.add_argument(
+        "--optimise",
+        action="store_true",
+        help="the least muscle effort (volume-weighted sum of a_i^2) that holds the posture, "
+        "with the stability criterion of --stability, beside the same without it",
+    )
+    parser.add_argument(
+        "--stability",
+        choices=("chain", "joints", "rhythm", "none"),
+        default="chain",
+        help="with --optimise: -K >= margin on the free chain (default), on each joint alone (the paper's), "
+        "on the chain constrained by the rhythm, or none (classic static optimisation)",
+    )
+    parser.add_argument(
+        "--equilibrium",
+        choices=("rhythm", "free"),
+        default="rhythm",
+        help="with --optimise: net torque zero on the rhythm's coordinates, the model's equalities carrying "
+        "the rest (default), or on every lumbar joint by muscles alone",
+    )
+    parser.add_argument(
+        "--margin",
+        type=finite_float("--margin"),
+        default=1.0,
+        help="with --optimise: the static margin mu of the stability criterion [N m/rad] (default: 1)",
+    )
+    parser.add_argument(
+        "--kp",
+        type=finite_float("--kp"),
+        help="also the free chain's exact delay margin under a delayed PD reflex with this proportional gain "
+        "at every joint [N m/rad] (with --kd)",
+    )
+    parser.add_argument("--kd", type=finite_float("--kd"), default=0.0, help="the reflex's derivative gain [N m s/rad]")
+    parser.add_argument(
+        "--activation-lag",
+        type=finite_float("--activation-lag"),
+        default=0.05,
+        metavar="T_A",
+        help="time constant of the reflex's force generation [s] (default: 0.05)",
+    )
+    parser.add_argument(
+        "--lordosis",
+        metavar="START:STOP:N",
+        help="also the three optima (classic, joint by joint, the chain) at N changes of the chain's summed "
+        "angle from START to STOP [deg] along the model's rhythm (positive: the model's positive "
+        "flex_extension, extension for MyoTorso), e.g. -20:20:41",
+    )
+    parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    parser.set_defaults(func=run)
+
+
+def run(args) -> int:
+    """Run ``spinectl anatomy``: print the table, or JSON with ``--json``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments: ``model``, ``mapping``, ``plane``, ``activation``, ``joint_stiffness``,
+        ``check``, ``optimise``, ``stability``, ``equilibrium``, ``margin``, ``json``.
+
+    Returns
+    -------
+    int
+        Exit code 0 (an unstable chain and an infeasible optimum are answers).
+    """
+    from ..anatomy import load
+    from ..anatomy.analyses import analyse
+
+    anatomy = load(args.model, args.mapping)
+    reflex = None if args.kp is None else (args.kp, args.kd, args.activation_lag)
+    if args.optimise:
+        from ..anatomy.optimum import optimised
+
+        result = optimised(
+            anatomy,
+            plane=args.plane,
+            stability=args.stability,
+            margin=args.margin,
+            joint_stiffness=args.joint_stiffness,
+            equilibrium=args.equilibrium,
+            check=args.check,
+            reflex=reflex,
+        )
+    else:
+        result = analyse(
+            anatomy,
+            plane=args.plane,
+            activation=args.activation,
+            joint_stiffness=args.joint_stiffness,
+            check=args.check,
+            reflex=reflex,
+        )
+    curve = None
+    if args.lordosis:
+        from ..anatomy.optimum import lordosis_curve
+
+        curve = lordosis_curve(
+            anatomy,
+            _degrees(args.lordosis),
+            plane=args.plane,
+            margin=args.margin,
+            joint_stiffness=args.joint_stiffness,
+            equilibrium=args.equilibrium,
+        )
+    if args.json:
+        doc = result.to_dict()
+        if curve is not None:
+            doc["lordosis_curve"] = curve
+        emit_json(doc)
+    else:
+        print(result.table())
+        if curve is not None:
+            print(_curve_table(curve))
+    return 0
+
+
+def _degrees(text: str):
+    """START:STOP:N as N evenly spaced values [deg]; one line naming --lordosis otherwise."""
+    import numpy as np
+
+    from ..errors import ParameterError
+
+    try:
+        start, stop, count = text.split(":")
+        start, stop, count = float(start), float(stop), int(count)
+    except ValueError:
+        raise ParameterError("--lordosis", f"must be START:STOP:N, e.g. -20:20:41 (got {text!r})") from None
+    if not (np.isfinite(start) and np.isfinite(stop) and 1 <= count <= 1000 and abs(start) <= 90 and abs(stop) <= 90):
+        raise ParameterError("--lordosis", f"needs |START|, |STOP| <= 90 deg and 1 <= N <= 1000 (got {text!r})")
+    return np.linspace(start, stop, count)
+
+
+def _curve_table(curve: dict) -> str:
+    """The lordosis curve as rows: each criterion's least cost (or its status) per posture."""
+    lines = ["", "lordosis [deg]  cost: classic  joint by joint  the chain (free)"]
+    for i, deg in enumerate(curve["lordosis_deg"]):
+        cells = []
+        for criterion in ("none", "joints", "chain"):
+            row = curve[criterion]
+            ok = row["status"][i] in ("optimal", "optimal_inaccurate")
+            cells.append(f"{row['cost'][i]:.4g}" if ok else row["status"][i])
+        lines.append(f"{deg:>14.3g}  {cells[0]:>13}  {cells[1]:>14}  {cells[2]:>16}")
+    return "\n".join(lines)

@@ -1,0 +1,129 @@
+"""The stability-constrained static optimum on MyoTorso: its constraints checked with MuJoCo's own forces.
+
+The optimum's equilibrium is checked with MuJoCo's generalised forces at its activations (not the
+affine torques the optimiser used), its stability with spinectl's linearisation at those
+activations (tested against finite differences in test_linearise.py) and MuJoCo's mjd_transitionFD.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from spinectl.anatomy.optimum import optimise, optimised, volume_weights
+from spinectl.errors import ParameterError
+
+
+@pytest.fixture(scope="module")
+def optima(torso):
+    """The optima at 50 N m/rad of added joint stiffness, each criterion, equilibrium on the rhythm."""
+    return {s: optimise(torso, stability=s, joint_stiffness=50) for s in ("none", "joints", "rhythm", "chain")}
+
+
+def test_the_optimum_holds_the_posture_by_mujocos_forces(torso, optima):
+    """At each optimum, MuJoCo's own generalised force projected on the rhythm's coordinates (T^T tau, all three
+    planes) is zero to 1e-6 N m, and every activation is in [0, 1]."""
+    from spinectl.anatomy.linearise import rhythm
+
+    engine = torso.engine
+    engine.set_state(torso.posture())
+    rhy = rhythm(engine, torso.joint_ids(torso.mapping.planes["3d"]))
+    for opt in optima.values():
+        assert opt.ok and opt.activations.min() >= 0 and opt.activations.max() <= 1
+        tau = engine.generalised_force(torso.posture(), opt.activations)[list(rhy.dofs)]
+        assert np.abs(rhy.transform.T @ tau).max() <= 1e-6
+
+
+def test_each_criterion_holds_at_its_optimum(torso, optima):
+    """The chain optimum: least eigenvalue of -K >= mu (to the solver's tolerance), confirmed by MuJoCo's own
+    linearisation (all ten dynamic eigenvalues in the left half plane); the joint-by-joint optimum: every diagonal
+    entry >= mu; the classic optimum leaves a mode unstable (the criterion binds)."""
+    from spinectl.anatomy.analyses import analyse
+
+    mu = 1.0
+    assert optima["chain"].eigenvalues.min() >= mu - 1e-6
+    assert optima["joints"].joint_stiffness.min() >= mu - 1e-6
+    assert optima["none"].eigenvalues.min() < 0
+    check = analyse(torso, activation=optima["chain"].activations, joint_stiffness=50, check=True)
+    assert check.referee_error() <= 1e-3 and check.mujoco_eigenvalues.real.max() < 0
+
+
+def test_stability_has_a_price(optima):
+    """Each stability criterion adds constraints to the classic problem, so its least cost is no lower; the chain's
+    (every joint free) is no lower than the joint-by-joint one here, and strictly higher than the classic one."""
+    assert optima["none"].cost <= optima["joints"].cost <= optima["chain"].cost
+    assert optima["none"].cost <= optima["rhythm"].cost
+    assert optima["chain"].cost > 1.05 * optima["none"].cost
+
+
+def test_infeasible_is_an_answer(torso):
+    """Muscles alone cannot zero the net torque on all fifteen lumbar joints of MyoTorso upright (the least
+    worst-case residual is about 8 N m): status 'infeasible', NaN activations and cost."""
+    opt = optimise(torso, stability="none", equilibrium="free")
+    assert opt.status == "infeasible" and np.isnan(opt.cost) and np.all(np.isnan(opt.activations))
+    result = optimised(torso, stability="none", equilibrium="free")
+    assert result.analysis is None and result.to_dict()["joints"][0] == "flex_extension"
+
+
+def test_volume_weights_are_force_times_optimal_length(torso):
+    """w_i is proportional to F0_i L0_i, read from MuJoCo's muscle parameters (mean 1)."""
+    model = torso.engine.model
+    w = volume_weights(torso)
+    i, j = 0, 100
+    l0 = [
+        (model.actuator_lengthrange[k, 1] - model.actuator_lengthrange[k, 0])
+        / (model.actuator_gainprm[k, 1] - model.actuator_gainprm[k, 0])
+        for k in (i, j)
+    ]
+    f0 = [model.actuator_gainprm[k, 2] for k in (i, j)]
+    assert w.mean() == pytest.approx(1.0)
+    assert w[i] / w[j] == pytest.approx(f0[0] * l0[0] / (f0[1] * l0[1]))
+
+
+def test_bad_criterion_is_refused(torso):
+    with pytest.raises(ParameterError, match="stability: must be one of"):
+        optimise(torso, stability="diagonal")
+    with pytest.raises(ParameterError, match="margin"):
+        optimise(torso, margin=-1)
+
+
+def test_the_lordosis_moves_the_chain_along_the_rhythm(torso):
+    """lordosis_posture(10 deg): the five FE angles sum to 10 deg, in the ratios of MyoTorso's equality coefficients
+    (each joint's eq_data[1] on flex_extension), the other lumbar joints unmoved; the curve at 0 deg is the optimum
+    at the reference posture."""
+    import mujoco
+
+    from spinectl.anatomy.optimum import lordosis_curve, lordosis_posture
+
+    q = lordosis_posture(torso, 10.0)
+    model = torso.engine.model
+    fe = torso.joint_ids(torso.mapping.planes["sagittal"])
+    angles = q[[model.jnt_qposadr[j] for j in fe]]
+    assert np.degrees(angles.sum()) == pytest.approx(10.0)
+    for j, angle in zip(fe[1:], angles[1:], strict=True):
+        eq = [e for e in range(model.neq) if model.eq_obj1id[e] == j]
+        assert angle / angles[0] == pytest.approx(model.eq_data[eq[0]][1])
+    others = torso.joint_ids(torso.mapping.planes["coronal"] + torso.mapping.planes["3d"][10:])
+    assert np.all(q[[model.jnt_qposadr[j] for j in others]] == 0)
+    abdomen = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "Abs_r3")
+    assert q[model.jnt_qposadr[abdomen]] != 0  # slaved to flex_extension by the rhythm
+    curve = lordosis_curve(torso, [0.0], joint_stiffness=50)
+    assert curve["chain"]["cost"][0] == pytest.approx(optimise(torso, joint_stiffness=50).cost, rel=1e-6)
+
+
+def test_the_delay_margin_at_the_optimum_is_a_root_on_the_imaginary_axis(torso):
+    """At the classic optimum under kp = 120 N m/rad, kd = 5 N m s/rad at every joint and a 50 ms lag, the
+    reported delay margin tau and frequency w make the characteristic matrix
+    (T_a jw + 1)(M (jw)^2 - D jw - K) + (K_p + K_d jw) exp(-jw tau) singular (its smallest singular value over its
+    largest below 1e-6): the closed form of the delayed chain, evaluated here without spinectl.reflex."""
+    result = optimised(torso, stability="none", reflex=(120.0, 5.0, 0.05))
+    reflex = result.analysis.reflex
+    tau, w = reflex["delay_margin_s"], reflex["delay_margin_frequency_rad_s"]
+    assert reflex["delay_margin_status"] == "finite" and 0 < tau < 0.1
+    free = result.analysis.free
+    s = 1j * w
+    matrix = (0.05 * s + 1) * (free.mass * s**2 - free.damping * s - free.stiffness) + (120 + 5 * s) * np.eye(
+        5
+    ) * np.exp(-s * tau)
+    sv = np.linalg.svd(matrix, compute_uv=False)
+    assert sv[-1] / sv[0] < 1e-6

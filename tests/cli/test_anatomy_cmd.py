@@ -1,0 +1,123 @@
+"""``spinectl anatomy``: JSON keys, the table's criteria and clean failures (MyoTorso loaded once)."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from spinectl import jsondoc
+from spinectl.cli import main
+
+KEYS = (
+    "model",
+    "joints",
+    "muscles",
+    "global_rank",
+    "stiffness_matrix_Nm_per_rad",
+    "damping_matrix_Nms_per_rad",
+    "mass_matrix_kgm2",
+    "joint_stiffness_Nm_per_rad",
+    "eigenvalues",
+    "dynamic_eigenvalues",
+    "joint_self_stable",
+    "chain_stable",
+    "constrained",
+)
+
+
+@pytest.fixture
+def cached(monkeypatch):
+    """The session's MyoTorso for ``myotorso`` (loading it takes seconds), MuJoCo's own load otherwise."""
+    pytest.importorskip("mujoco", reason="needs the anatomy extra: pip install 'spinectl[anatomy]'")
+    pytest.importorskip("myo_sim", reason="needs the anatomy extra: pip install 'spinectl[anatomy]'")
+    import spinectl.anatomy as package
+
+    real = package.load
+    cache = {}
+
+    def load(model="myotorso", mapping=None):
+        if model == "myotorso" and mapping is None:
+            return cache.setdefault("torso", real("myotorso"))
+        return real(model, mapping)
+
+    monkeypatch.setattr(package, "load", load)
+
+
+def test_json_is_the_results_dict(cached, capsys):
+    """``--json --check`` prints :meth:`AnatomyResult.to_dict` with the documented keys and MuJoCo's eigenvalues."""
+    import spinectl.anatomy as package
+    from spinectl.anatomy.analyses import analyse
+
+    assert main(["anatomy", "--activation", "0.05", "--check", "--json"]) == 0
+    out = capsys.readouterr().out
+    doc = json.loads(out)
+    assert all(key in doc for key in KEYS)
+    assert set(doc["model"]) == {"name", "source", "sha256"} and set(doc["muscles"]) == {"global", "local", "between"}
+    assert len(doc["mujoco_eigenvalues"]) == 10
+    assert out == jsondoc.dumps(analyse(package.load(), activation=0.05, check=True).to_dict())
+
+
+def test_the_table_names_every_criterion(cached, capsys):
+    assert main(["anatomy"]) == 0
+    out = capsys.readouterr().out
+    assert "joint by joint (others fixed)" in out
+    assert "the chain, free (every joint free, equality constraints off)" in out
+    assert "the chain constrained by the model's rhythm" in out
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--activation", "1.5"], "activation: must be in [0, 1]"),
+        (["--plane", "axial"], "plane: must be one of"),
+        (["--joint-stiffness", "soft"], "joint_stiffness: must be"),
+        (["no-such-model"], "model: must be one of"),
+    ],
+)
+def test_bad_input_is_one_line_exit_2(cached, capsys, argv, message):
+    assert main(["anatomy", *argv]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == "" and message in captured.err and len(captured.err.strip().splitlines()) == 1
+
+
+def test_optimise_json_has_the_activations_cost_and_net_torque(cached, capsys):
+    """``--optimise --json``: activations by muscle name, cost and net torque at top level, the classic optimum
+    beside, and the analysis at the optimum's activations (its eigenvalues those of the optimum)."""
+    argv = ["anatomy", "--optimise", "--stability", "joints", "--joint-stiffness", "50", "--json"]
+    assert main(argv) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert len(doc["activations"]) == 210 and doc["cost"] > 0 and len(doc["net_torque_Nm"]) == 3
+    assert doc["optimum"]["stability"] == "joints" and doc["classic"]["stability"] == "none"
+    assert doc["eigenvalues"] == pytest.approx(doc["optimum"]["eigenvalues"], abs=1e-6)
+    assert doc["price_of_stability"] >= 1
+
+
+def test_an_infeasible_optimum_is_an_answer(cached, capsys):
+    assert main(["anatomy", "--optimise", "--equilibrium", "free"]) == 0
+    assert "infeasible" in capsys.readouterr().out
+
+
+def test_lordosis_curve_in_json_and_bad_range(cached, capsys):
+    assert main(["anatomy", "--lordosis", "-10:10:3", "--joint-stiffness", "50", "--json"]) == 0
+    curve = json.loads(capsys.readouterr().out)["lordosis_curve"]
+    assert curve["lordosis_deg"] == [-10.0, 0.0, 10.0] and len(curve["chain"]["cost"]) == 3
+    assert main(["anatomy", "--lordosis", "1:2"]) == 2
+    assert "--lordosis: must be START:STOP:N" in capsys.readouterr().err
+
+
+def test_reflex_options_give_the_delay_margin(cached, capsys):
+    assert main(["anatomy", "--optimise", "--stability", "none", "--kp", "120", "--kd", "5", "--json"]) == 0
+    reflex = json.loads(capsys.readouterr().out)["reflex"]
+    assert reflex["kp_Nm_per_rad"] == 120 and reflex["activation_lag_s"] == 0.05 and reflex["delay_margin_s"] > 0
+    assert main(["anatomy", "--kp", "-1"]) == 2
+
+
+def test_without_the_extra_one_line_says_what_to_install(monkeypatch, capsys):
+    """MuJoCo's import blocked: one line naming ``pip install 'spinectl[anatomy]'``, exit 2, no traceback."""
+    import sys
+
+    monkeypatch.setitem(sys.modules, "mujoco", None)
+    assert main(["anatomy"]) == 2
+    err = capsys.readouterr().err
+    assert "pip install 'spinectl[anatomy]'" in err and len(err.strip().splitlines()) == 1
