@@ -254,7 +254,7 @@ class StabilityResult:
         -------
         dict
             The model's :func:`~spinectl.model.source.provenance` (``preset``, ``config``,
-            ``config_sha256``, ``overridden``, ``K_Nm_per_rad``, ``K_convention``), ``E_m``,
+            ``config_sha256``, ``overridden``, ``K_Nm_per_rad`` or ``K_per_s2``, ``K_convention``), ``E_m``,
             ``Lambda_m``, ``pcsa_source``, ``pcsa_cm2`` (muscle name -> PCSA [cm^2]),
             ``chosen_pcsa_total_cm2`` (the total of that PCSA), ``min_pcsa_cm2`` (the LP minimum,
             NaN for a given PCSA), ``total_pcsa_cm2`` (deprecated name of ``chosen_pcsa_total_cm2``,
@@ -313,7 +313,7 @@ class StabilityResult:
         given = pcsa_source == "given"
         minimum = "" if math.isnan(self.min_pcsa) else f"; LP minimum {m2_to_cm2(self.min_pcsa):.2f}"
         lines = [
-            header(model),
+            header(model, self.inertia),
             f"E = {self.eccentricity * 100:.2f} cm, Lambda = {self.lordosis * 100:.2f} cm",
             ("PCSA [cm^2]: " if given else "PCSA [cm^2] (minimum stabilising, chosen activation): ")
             + ", ".join(f"{n} {p:.2f}" for n, p in zip(model.muscle_names, pcsa, strict=False))

@@ -33,11 +33,11 @@ to about sqrt(eps) times its scale (the largest value of the map); below that a 
 (docs/robustness.md, "Analysis commands")."""
 
 _TOLERANCE = 1e-9
-"""Coordinates [m or N m/rad] closer than this are the same grid point (rounding in a file)."""
+"""Coordinates [m, or K's unit] closer than this are the same grid point (rounding in a file)."""
 
 
 def stiffnesses(dataset: xr.Dataset) -> list[float]:
-    """The values of K [N m/rad] of a landscape, whether K is a dimension or a scalar coordinate.
+    """The values of K (N m/rad or 1/s², by its convention) of a landscape, whether K is a dimension or a scalar.
 
     Parameters
     ----------
@@ -62,7 +62,7 @@ def check_same_grid(first: xr.Dataset, second: xr.Dataset) -> None:
     ParameterError
         Field ``--vs``: the axis that differs, with both files' ranges.
     """
-    for name, unit in (("E", "m"), ("Lambda", "m"), ("K", "N m/rad")):
+    for name, unit in (("E", "m"), ("Lambda", "m"), ("K", figures.k_unit(first.attrs.get("passive_convention", "?")))):
         x, y = np.atleast_1d(first[name].values), np.atleast_1d(second[name].values)
         if x.shape != y.shape or not np.allclose(x, y, rtol=0, atol=_TOLERANCE):
             raise ParameterError(
@@ -107,10 +107,13 @@ def comparison_set(first: xr.Dataset, second: xr.Dataset, labels=("first", "seco
     """
     check_same_grid(first, second)
     drawn: dict[str, Figure] = {}
+    units = [figures.k_unit(d.attrs.get("passive_convention", "?")) for d in (first, second)]
     for k in stiffnesses(first):
         a, b = _at(first, k), _at(second, k)
+        where = f"K = {k:g} {units[0]}"
+        if units[1] != units[0]:  # the same number, two quantities: name both
+            where = f"K = {k:g} {units[0]} ({labels[0]}), {units[1]} ({labels[1]})"
         for name, what, unit, stem in COMPARED:
-            where = f"K = {k:g} N m/rad"
             suffix = f"_K{figures.k_in_name(k)}.{format}"
             difference = a[name] - b[name]
             title = f"{what}: {labels[0]} minus {labels[1]}, {where}"

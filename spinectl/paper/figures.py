@@ -32,6 +32,7 @@ from ..errors import ParameterError
 from ..landscape import netcdf
 from ..model.chain import local_stiffness_per_pcsa
 from ..model.params import Model
+from ..model.source import stiffness_unit
 from ..optimise.coupled import ParetoFront
 from ..units import CM_PER_M, M2_PER_CM2
 from . import drawing, grid, landmarks
@@ -128,7 +129,7 @@ def _axes(title: str, fig=None, spec=None):
     return fig, ax
 
 
-_UNBROKEN = re.compile(r"\([^()\n]{1,40}\)|(?:[\w.]+ = )?[\d.]+ (?:N m(?:/rad)?|kg|cm|m|s)\b|N m/rad|N m")
+_UNBROKEN = re.compile(r"\([^()\n]{1,40}\)|(?:[\w.]+ = )?[\d.]+ (?:N m(?:/rad)?|1/s²|kg|cm|m|s)\b|N m/rad|N m")
 """Spans a title line is not broken inside: a short parenthesis, a setting with its value and unit, a unit."""
 
 
@@ -389,12 +390,28 @@ def landscape_figure(field: xr.DataArray, title: str, label: str, blank: str | N
     return _landscape(field, title, label, blank=blank)[0]
 
 
+def k_unit(convention: str) -> str:
+    """The unit of K under a ``passive.convention`` as a figure writes it (``N m/rad``, ``1/s²``).
+
+    Parameters
+    ----------
+    convention : str
+        ``"physical"`` or ``"paper"`` (a landscape's ``passive_convention`` attribute).
+
+    Returns
+    -------
+    str
+        :func:`spinectl.model.source.stiffness_unit` with a superscript square.
+    """
+    return stiffness_unit(convention).replace("^2", "²")
+
+
 def _k_label(dataset: xr.Dataset) -> str:
     stiffness = float(dataset["K"])
     if stiffness == 0:
         return "K = 0"
     convention = dataset.attrs.get("passive_convention", "?")
-    return f"K = {stiffness:g} N m/rad (K convention: {_CONVENTION.get(convention, convention)})"
+    return f"K = {stiffness:g} {k_unit(convention)} (K convention: {_CONVENTION.get(convention, convention)})"
 
 
 def min_pcsa_figure(

@@ -160,7 +160,8 @@ def _coordinates(study: Study) -> dict:
 def _parameter_attributes(model, dotted: str) -> dict[str, str]:
     """``units``, ``long_name`` and ``parameter`` of a parameter's coordinate, from its field metadata."""
     meta = field_metadata(model, dotted)
-    return {"units": meta.get("unit", ""), "long_name": meta.get("doc", dotted), "parameter": dotted}
+    unit = source.stiffness_unit(model.passive.convention) if dotted == "passive.stiffness" else meta.get("unit", "")
+    return {"units": unit, "long_name": meta.get("doc", dotted), "parameter": dotted}
 
 
 def _attributes(study: Study) -> dict:

@@ -119,7 +119,8 @@ class CoupledStability:
         -------
         dict
             The model's :func:`~spinectl.model.source.provenance` (``preset``, ``config``, ``config_sha256``,
-            ``overridden``, ``K_Nm_per_rad``, ``K_convention``), ``E_m``, ``Lambda_m``, ``pcsa_source`` and
+            ``overridden``, ``K_Nm_per_rad`` or ``K_per_s2``, ``K_convention``), ``E_m``, ``Lambda_m``,
+            ``pcsa_source`` and
             ``coupled``: ``segments``, ``decision_variables``, ``pcsa_cm2`` (muscle -> cm^2),
             ``stiffness_matrix_Nm_per_rad``, ``gravity_stiffness_matrix_Nm_per_rad``,
             ``stiffness_matrix_per_cm2`` (n_var x n_cor x n_cor, N m/rad per cm^2),
