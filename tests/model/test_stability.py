@@ -277,3 +277,19 @@ def test_the_header_names_k_in_the_unit_its_convention_gives_and_what_it_adds():
     assert source.header(paper.replace(passive=Passive(15.0, "paper"))).endswith(
         "K = 15 1/s^2, convention paper (K theta_k [N m/rad] at each CoR)"
     )
+
+
+def test_eigenvalues_of_a_stiffness_whose_discriminant_overflows():
+    """S = -+1e308 N m/rad (``--K 1e308``): D^2 + 4 theta S overflows, the roots do not. Closed forms with theta = 0.79,
+    D = -0.01: S < 0 gives D / (2 theta) +- j sqrt(-S / theta - D^2 / (4 theta^2)) (the D^2 term below rounding);
+    S > 0 gives real roots of product -S / theta and sum D / theta, about +-sqrt(S / theta)."""
+    theta, d = 0.79, -0.01
+    with np.errstate(over="raise"):
+        stable, unstable = eigenvalues(np.array([-1e308, 1e308]), d, theta)
+    assert stable[0].real == pytest.approx(d / (2 * theta), rel=1e-12)
+    assert stable[0].imag == pytest.approx(np.sqrt(1e308 / theta), rel=1e-12) and stable[1] == np.conj(stable[0])
+    assert unstable.imag.tolist() == [0.0, 0.0]
+    assert unstable[0].real == pytest.approx(np.sqrt(1e308 / theta), rel=1e-12)
+    assert unstable[0].real * unstable[1].real == pytest.approx(-1e308 / theta, rel=1e-12)
+    ordinary = eigenvalues(np.array([-50.0, 20.0]), d, theta)  # the unscaled path, as before
+    np.testing.assert_allclose(ordinary.prod(axis=-1), [50.0 / theta, -20.0 / theta], rtol=1e-14)
