@@ -115,7 +115,7 @@ def unfinished(computed: xr.DataArray, path) -> str:
 
 def _unit(coordinate: xr.DataArray) -> str:
     """The unit of a study axis as a title writes it after a value (" kg"), from the store's ``units``."""
-    unit = coordinate.attrs.get("units", "")
+    unit = coordinate.attrs.get("units", "").replace("^2", "²")  # K under eq. 2 as printed: 1/s^2
     return f" {unit}" if unit and unit != "1" else ""
 
 

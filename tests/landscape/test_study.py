@@ -345,6 +345,14 @@ def test_computed_points_are_those_of_the_chunks_done(tmp_path):
     assert int(done.sum()) == 5 * TILE_POINTS
 
 
+def test_the_k_axis_has_the_unit_of_its_convention():
+    """Under eq. 2 as printed (``wagner2012_mass_free``) K is read in 1/s^2 (docs/model.md, "Passive stiffness: two
+    conventions"), so a study's K axis says so; under 'physical' it stays N m/rad (before: N m/rad for both)."""
+    for preset, unit in (("wagner2012_mass_free", "1/s^2"), ("wagner2012", "N m/rad")):
+        parsed = study.parse_study(f'[study]\npreset = "{preset}"\n[axes]\n{GRID}K = [0.0, 15.0]\n')
+        assert study_store._parameter_attributes(parsed.model, "passive.stiffness")["units"] == unit
+
+
 def test_killed_study_resumes_without_computing_a_chunk_twice(reference, tmp_path):
     """SIGKILL a study run by the CLI once two chunks are done, then resume it.
 
