@@ -452,10 +452,17 @@ def computed(dataset: xr.Dataset) -> xr.DataArray:
     xarray.DataArray of bool
         Over the parameter dimensions, then ``E`` and ``Lambda``: True where the point's chunk is done
         (its numbers are answers, NaN an infeasible point), False where it is not yet (NaN: not computed).
+
+    Raises
+    ------
+    ParameterError
+        The store's attribute ``chunk_tile`` is lost (field ``store``).
     """
     output = next(v for v in dataset.data_vars.values() if "Lambda" in v.dims)  # parameters, E, Lambda, own
     dims = list(output.dims[: output.dims.index("Lambda") + 1])
     shape = [dataset.sizes[d] for d in dims]
+    if "chunk_tile" not in dataset.attrs:  # an edited store: its chunks' tiles are unknown
+        raise ParameterError("store", "its attribute chunk_tile is lost: which points are computed is unknown")
     tile = [int(n) for n in dataset.attrs["chunk_tile"]]
     tiles = [-(-n // t) for n, t in zip(shape[-2:], tile, strict=True)]
     done = np.asarray(dataset[DONE].values).reshape(shape[:-2] + tiles) > 0
