@@ -105,7 +105,10 @@ def check_position(model: Model, args: argparse.Namespace) -> None:
 
 
 def pcsa_option(values: list[float] | None):
-    """``--pcsa`` [cm^2] in m^2, refusing more than any muscle (:func:`note_pcsa_slip` warns of m^2 for cm^2).
+    """``--pcsa`` [cm^2] in m^2, for the library with ``slip_check=False`` (the unit is the option's).
+
+    A value above any muscle's is analysed, as an optimum of that size is printed (a heavy body on weak
+    fibres); :func:`note_pcsa_slip` says so after the answer, and warns of m^2 typed for cm^2.
 
     Parameters
     ----------
@@ -115,39 +118,48 @@ def pcsa_option(values: list[float] | None):
     Returns
     -------
     numpy.ndarray or None
-        PCSA [m^2] (the library checks the count and signs), or None.
+        PCSA [m^2] (the library checks the count, signs and finiteness), or None.
 
     Raises
     ------
     ParameterError
-        A value above :data:`spinectl.model.checks.MAX_PLAUSIBLE_PCSA` (1000 cm^2), named in cm^2.
+        A value above :data:`spinectl.model.checks.MAX_PCSA`, named in cm^2.
     """
     if values is None:
         return None
-    from ..model.checks import MAX_PLAUSIBLE_PCSA
+    from ..model.checks import MAX_PCSA
 
-    largest = max(values, default=0.0)
-    limit = MAX_PLAUSIBLE_PCSA / cm2_to_m2(1.0)
-    if largest > limit:
+    limit = MAX_PCSA / cm2_to_m2(1.0)
+    if max(values, default=0.0) > limit:
         raise ParameterError(
-            "--pcsa", f"must be at most {limit:g} cm^2 per muscle, more than any muscle (got {largest:g})"
+            "--pcsa",
+            f"must be at most {limit:g} cm^2 per muscle, beyond which the torques overflow (got {max(values):g})",
         )
     return cm2_to_m2(values)
 
 
 def note_pcsa_slip(values: list[float] | None) -> None:
-    """After a command's answer: one line on stderr if ``--pcsa`` looks like m^2 typed for cm^2.
+    """After a command's answer: one line on stderr if ``--pcsa`` looks like m^2 typed for cm^2, or exceeds any muscle.
 
-    After the answer, not before: a run that then fails prints its one-line error alone.
+    After the answer, not before: a run that then fails prints its one-line error alone. A PCSA above
+    :data:`spinectl.model.checks.MAX_PLAUSIBLE_PCSA` is analysed (an optimum of that size is an answer,
+    and can be given back), and said to be more than any muscle's.
 
     Parameters
     ----------
     values : list of float or None
         ``--pcsa`` as parsed [cm^2] (:func:`spinectl.units.square_metre_slip`).
     """
-    slip = square_metre_slip(values) if values is not None else ""
-    if slip:
-        print(f"spinectl: warning: --pcsa: {printable(slip)}", file=sys.stderr)
+    if values is None:
+        return
+    from ..model.checks import MAX_PLAUSIBLE_PCSA
+
+    limit = MAX_PLAUSIBLE_PCSA / cm2_to_m2(1.0)
+    notes = [square_metre_slip(values)]
+    if max(values, default=0.0) > limit:
+        notes.append(f"{max(values):g} cm^2 is more than any muscle's PCSA (above {limit:g} cm^2); analysed as given")
+    if any(notes):
+        print(f"spinectl: warning: --pcsa: {printable('; '.join(n for n in notes if n))}", file=sys.stderr)
 
 
 def load_model(args: argparse.Namespace, aliases: dict | None = None) -> Model:

@@ -74,7 +74,9 @@ def run(args) -> int:
     model = load_model(args)
     check_position(model, args)
     pcsa = None if args.geometry_only else ("optimum" if args.pcsa is None else pcsa_option(args.pcsa))
-    fig = drawing.draw_model(model, args.E, args.Lambda, pcsa=pcsa, counter_torque=args.counter_torque)
+    fig = drawing.draw_model(
+        model, args.E, args.Lambda, pcsa=pcsa, counter_torque=args.counter_torque, slip_check=False
+    )
     print(figures.save_figure(fig, args.out, args.dpi))
     note_pcsa_slip(None if args.geometry_only else args.pcsa)
     return 0

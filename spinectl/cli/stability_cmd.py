@@ -76,7 +76,7 @@ def run(args) -> int:
     if args.coupled:  # only here: the chain's semidefinite programs import cvxpy
         from ..optimise.coupled import coupled_stability_at as analysis
     try:
-        result = analysis(model, args.E, args.Lambda, pcsa_option(args.pcsa))
+        result = analysis(model, args.E, args.Lambda, pcsa_option(args.pcsa), slip_check=False)
     except NoStabilisingActivation as exc:  # the library names its argument; the user types the option
         raise NoStabilisingActivation(str(exc).replace("(argument pcsa, [m^2])", "with --pcsa [cm2]")) from None
     source = "given" if given else "min_pcsa"

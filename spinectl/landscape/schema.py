@@ -89,6 +89,11 @@ def dims_of(name: str, ndim: int) -> tuple[str, ...]:
     return ("E", "Lambda") + extra.get(ndim, ())
 
 
+K_UNITS = {"physical": "N m rad-1", "paper": "s-2"}
+"""UDUNITS of the coordinate ``K`` under each ``passive.convention`` (``spinectl.model.source.STIFFNESS_UNITS``):
+under eq. 2 as printed K is an angular acceleration per radian (docs/model.md, "Passive stiffness: two conventions")."""
+
+
 def grid_coordinates(model: Model, e_axis, l_axis) -> dict:
     """The coordinates ``E``, ``Lambda``, ``segment`` and ``muscle`` of a landscape, with units and names.
 
@@ -139,7 +144,11 @@ def landscape_dataset(model: Model, e_axis, l_axis, arrays: dict, method: str, p
         for name, arr in arrays.items()
     }
     coords = grid_coordinates(model, e_axis, l_axis) | {
-        "K": ((), model.passive.stiffness, {"units": "N m rad-1", "long_name": "passive stiffness K"}),
+        "K": (
+            (),
+            model.passive.stiffness,
+            {"units": K_UNITS[model.passive.convention], "long_name": "passive stiffness K"},
+        ),
     }
     attrs = {
         "title": "spinectl landscapes of minimum PCSA and counter torques",

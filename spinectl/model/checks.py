@@ -280,6 +280,13 @@ largest human muscle's (the soleus, about 230 cm^2; Ward SR et al. 2009, Clin Or
 API means m^2 (``pcsa=[10, 10, 10]``)."""
 
 
+MAX_PCSA = 1e100
+"""Largest PCSA of one muscle [m^2] that any analysis takes, given or computed: its force (at most 1e7 N/m^2,
+:data:`spinectl.model.params.SPECIFIC_TENSION_RANGE`) on a lever of at most 1 m
+(:data:`spinectl.model.params.MAX_BODY_LENGTH`) is a torque of at most 1e107 N m, whose sums and squares
+(‖CT‖) stay far from overflow. Far beyond any optimum a valid model has; a larger value is no PCSA."""
+
+
 def expand_pcsa(model: Model, pcsa, *, given: bool = True) -> np.ndarray:
     """Per-muscle PCSA [m^2] from per-muscle (2 n values) or per-pair (n values, each side) input.
 
@@ -305,7 +312,7 @@ def expand_pcsa(model: Model, pcsa, *, given: bool = True) -> np.ndarray:
     Raises
     ------
     ParameterError
-        Neither n nor 2 n values, a value negative or not finite, or (``given``) one above
+        Neither n nor 2 n values, a value negative, not finite or above :data:`MAX_PCSA`, or (``given``) one above
         :data:`MAX_PLAUSIBLE_PCSA` (most likely cm^2 given where m^2 are meant).
     """
     pcsa = np.asarray(pcsa, float)
@@ -319,6 +326,11 @@ def expand_pcsa(model: Model, pcsa, *, given: bool = True) -> np.ndarray:
         )
     if not np.all(np.isfinite(pcsa)) or np.any(pcsa < 0):
         raise ParameterError("pcsa", "must be finite and >= 0")
+    if np.any(pcsa > MAX_PCSA):
+        raise ParameterError(
+            "pcsa",
+            f"must be at most {MAX_PCSA:g} m^2 per muscle, beyond which the torques overflow (got {pcsa.max():g})",
+        )
     if given and np.any(pcsa > MAX_PLAUSIBLE_PCSA):
         largest = float(pcsa.max())
         raise ParameterError(

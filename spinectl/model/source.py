@@ -13,6 +13,8 @@ import copy
 import dataclasses
 from dataclasses import dataclass
 
+import numpy as np
+
 from .params import Model
 
 _ATTRIBUTE = "_spinectl_source"
@@ -88,21 +90,74 @@ def with_source(model: Model, source: ModelSource) -> Model:
     return out
 
 
-def header(model: Model) -> str:
-    """One line naming the model: ``preset wagner2012, K = 15 N m/rad, convention paper``, then the file and overrides.
+STIFFNESS_UNITS = {"physical": "N m/rad", "paper": "1/s^2"}
+"""The unit of ``passive.stiffness`` K under each convention (docs/model.md, "Passive stiffness: two
+conventions"): a torque per radian added as -K, or, under eq. 2 as printed, an angular acceleration per
+radian, which adds -K theta_k [N m/rad] at CoR k."""
+
+
+def stiffness_unit(convention: str) -> str:
+    """The unit of ``passive.stiffness`` under ``convention``, as text (``"N m/rad"`` or ``"1/s^2"``).
 
     Parameters
     ----------
-    model : Model
+    convention : str
+        ``passive.convention``: ``"physical"`` or ``"paper"``.
 
     Returns
     -------
     str
-        E.g. ``preset wagner2012, K = 0 N m/rad, convention paper; config my.toml (sha256 1a2b3c4d5e6f);
+        The unit; ``"?"`` for a convention spinectl does not know (an edited file).
+    """
+    return STIFFNESS_UNITS.get(convention, "?")
+
+
+def stiffness_text(stiffness, convention: str, inertia=None) -> str:
+    """K with the unit it has under its convention, and what it adds where that is not K itself.
+
+    Parameters
+    ----------
+    stiffness : float or sequence of float
+        ``passive.stiffness`` K, one value or the several of a dataset stacked along ``K``.
+    convention : str
+        ``passive.convention``.
+    inertia : sequence of float, optional
+        theta_k of each CoR [kg m^2] at the posture of a table: under ``"paper"`` the stiffness added,
+        K theta_k [N m/rad], is printed CoR by CoR.
+
+    Returns
+    -------
+    str
+        ``K = 15 N m/rad, convention physical``; ``K = 15 1/s^2, convention paper (K theta_k [N m/rad] at
+        each CoR)``; with ``inertia``, ``K = 15 1/s^2, convention paper: K theta_k = 5.02, 7.40 ... N m/rad``.
+    """
+    values = [float(k) for k in np.atleast_1d(stiffness)]
+    text = f"K = {', '.join(f'{k:g}' for k in values)} {stiffness_unit(convention)}, convention {convention}"
+    if convention != "paper" or not any(values):
+        return text
+    if inertia is None or len(values) != 1:
+        return f"{text} (K theta_k [N m/rad] at each CoR)"
+    return f"{text}: K theta_k = {', '.join(f'{values[0] * th:.4g}' for th in inertia)} N m/rad"
+
+
+def header(model: Model, inertia=None) -> str:
+    """One line naming the model: ``preset wagner2012, K = 15 N m/rad, convention physical``, then file and overrides.
+
+    Parameters
+    ----------
+    model : Model
+    inertia : sequence of float, optional
+        theta_k [kg m^2] of each CoR at the table's posture: under the ``"paper"`` convention the
+        stiffness K theta_k [N m/rad] that K adds there is named (:func:`stiffness_text`).
+
+    Returns
+    -------
+    str
+        E.g. ``preset wagner2012, K = 0 N m/rad, convention physical; config my.toml (sha256 1a2b3c4d5e6f);
         overridden: passive.stiffness``.
     """
     first, *rest = _origin_parts(model)
-    passive = f"K = {model.passive.stiffness:g} N m/rad, convention {model.passive.convention}"
+    passive = stiffness_text(model.passive.stiffness, model.passive.convention, inertia)
     return "; ".join([f"{first}, {passive}", *rest])
 
 
@@ -143,15 +198,17 @@ def provenance(model: Model) -> dict:
     -------
     dict
         ``preset`` (str or None), ``config`` (path or None), ``config_sha256`` (hex or None),
-        ``overridden`` (list of dotted fields), ``K_Nm_per_rad`` and ``K_convention``.
+        ``overridden`` (list of dotted fields), K in its unit (``K_Nm_per_rad`` under the ``"physical"``
+        convention, ``K_per_s2`` under ``"paper"``, :data:`STIFFNESS_UNITS`) and ``K_convention``.
     """
     src = source_of(model)
+    key = "K_per_s2" if model.passive.convention == "paper" else "K_Nm_per_rad"
     return {
         "preset": src.preset,
         "config": src.config,
         "config_sha256": src.config_sha256,
         "overridden": list(src.overridden),
-        "K_Nm_per_rad": model.passive.stiffness,
+        key: model.passive.stiffness,
         "K_convention": model.passive.convention,
     }
 
@@ -163,7 +220,7 @@ def attributes(model: Model, stiffnesses=None) -> dict:
     ----------
     model : Model
     stiffnesses : sequence of float, optional
-        The K [N m/rad] of a dataset stacked along ``K``: the ``model`` line names them all, and
+        The K (:func:`stiffness_unit`) of a dataset stacked along ``K``: the ``model`` line names them all, and
         ``passive.stiffness`` is not counted as overridden (each K is a coordinate).
 
     Returns
@@ -177,8 +234,7 @@ def attributes(model: Model, stiffnesses=None) -> dict:
     if stiffnesses is not None:  # K is a coordinate: no override, and the line names every K
         src = dataclasses.replace(src, overridden=tuple(n for n in src.overridden if n != "passive.stiffness"))
         first, *rest = _origin_parts(with_source(model, src))
-        ks = ", ".join(f"{k:g}" for k in stiffnesses)
-        line = "; ".join([f"{first}, K = {ks} N m/rad, convention {model.passive.convention}", *rest])
+        line = "; ".join([f"{first}, {stiffness_text(list(stiffnesses), model.passive.convention)}", *rest])
     return {
         "model": line,
         "preset": src.preset or "",

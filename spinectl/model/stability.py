@@ -89,9 +89,12 @@ def eigenvalues(stiffness, damping, inertia):
        3rd ed., section 5.6, "Quadratic and Cubic Equations". Cambridge University Press.
     """
     s, d, theta = np.broadcast_arrays(*(np.asarray(x, float) for x in (stiffness, damping, inertia)))
-    disc = d * d + 4.0 * theta * s  # theta^2 times (D/(2 theta))^2 + S/theta, times 4
+    with np.errstate(over="ignore"):  # a stiffness beyond 1e307 overflows here only: scaled below
+        disc = d * d + 4.0 * theta * s  # theta^2 times (D/(2 theta))^2 + S/theta, times 4
     real = disc >= 0
     root = np.sqrt(np.abs(disc))
+    if not np.all(np.isfinite(disc[np.isfinite(s) & np.isfinite(d) & np.isfinite(theta)])):
+        real, root = _scaled_discriminant(s, d, theta, np.isfinite(disc), real, root)
     q = 0.5 * (d + np.where(d < 0, -root, root))  # |q| = (|D| + root) / 2: no cancellation
     nonzero = q != 0  # q = 0 only for D = S = 0: a double root at 0
     big = np.where(nonzero, q / theta, 0.0)
@@ -99,6 +102,16 @@ def eigenvalues(stiffness, damping, inertia):
     first = np.where(real, np.maximum(big, small), d / (2.0 * theta) + 1j * root / (2.0 * theta))
     second = np.where(real, np.minimum(big, small), d / (2.0 * theta) - 1j * root / (2.0 * theta))
     return np.stack([first, second], axis=-1).astype(complex)
+
+
+def _scaled_discriminant(s, d, theta, finite, real, root):
+    """Sign and square root of D^2 + 4 theta S where it overflows: divided by c^2, c = max(abs(D), 2 sqrt(abs(theta S)))
+    (each factor's square root taken apart, so nothing overflows); elsewhere ``real`` and ``root`` as given."""
+    cross = 2.0 * np.sqrt(np.abs(theta)) * np.sqrt(np.abs(s))  # sqrt(4 abs(theta S))
+    c = np.maximum(np.abs(d), cross)
+    c = np.where(c > 0, c, 1.0)
+    scaled = (d / c) ** 2 + np.sign(theta * np.sign(s)) * (cross / c) ** 2
+    return np.where(finite, real, scaled >= 0), np.where(finite, root, c * np.sqrt(np.abs(scaled)))
 
 
 def slowest_time_constant(stiffness, damping, inertia):
@@ -254,7 +267,7 @@ class StabilityResult:
         -------
         dict
             The model's :func:`~spinectl.model.source.provenance` (``preset``, ``config``,
-            ``config_sha256``, ``overridden``, ``K_Nm_per_rad``, ``K_convention``), ``E_m``,
+            ``config_sha256``, ``overridden``, ``K_Nm_per_rad`` or ``K_per_s2``, ``K_convention``), ``E_m``,
             ``Lambda_m``, ``pcsa_source``, ``pcsa_cm2`` (muscle name -> PCSA [cm^2]),
             ``chosen_pcsa_total_cm2`` (the total of that PCSA), ``min_pcsa_cm2`` (the LP minimum,
             NaN for a given PCSA), ``total_pcsa_cm2`` (deprecated name of ``chosen_pcsa_total_cm2``,
@@ -307,13 +320,13 @@ class StabilityResult:
         """
 
         def complex_column(z: complex) -> str:
-            return f"{z.real:9.3f}{z.imag:+9.3f}j"
+            return f"{_fixed(z.real, '9', 3)}{_fixed(z.imag, '+9', 3)}j"
 
         pcsa = m2_to_cm2(self.pcsa)
         given = pcsa_source == "given"
         minimum = "" if math.isnan(self.min_pcsa) else f"; LP minimum {m2_to_cm2(self.min_pcsa):.2f}"
         lines = [
-            header(model),
+            header(model, self.inertia),
             f"E = {self.eccentricity * 100:.2f} cm, Lambda = {self.lordosis * 100:.2f} cm",
             ("PCSA [cm^2]: " if given else "PCSA [cm^2] (minimum stabilising, chosen activation): ")
             + ", ".join(f"{n} {p:.2f}" for n, p in zip(model.muscle_names, pcsa, strict=False))
@@ -325,9 +338,9 @@ class StabilityResult:
         for k, name in enumerate(self.segment_names):
             eig = self.eigenvalues[k]
             lines.append(
-                f"{name:8} {self.stiffness[k]:12.3f} {self.damping[k]:14.4f} {self.inertia[k]:14.4f} "
-                f"{complex_column(eig[0]):>20} {complex_column(eig[1]):>20} "
-                f"{'yes' if self.self_stable[k] else 'NO':>7} {self.counter_torque[k]:10.3f}"
+                f"{name:8} {_fixed(self.stiffness[k], '12', 3)} {_fixed(self.damping[k], '14', 4)} "
+                f"{_fixed(self.inertia[k], '14', 4)} {complex_column(eig[0]):>20} {complex_column(eig[1]):>20} "
+                f"{'yes' if self.self_stable[k] else 'NO':>7} {_fixed(self.counter_torque[k], '10', 3)}"
             )
         lines += [
             "",
@@ -400,6 +413,17 @@ def segment_stability(
         counter_torque=counter_torque,
         coefficients=coeffs,
     )
+
+
+FIXED_LIMIT = 1e9
+"""Magnitude from which a table prints a number in exponent notation: a stiffness of 1e308 (``--K 1e308``)
+in fixed notation is 309 digits wide."""
+
+
+def _fixed(value: float, width: str, decimals: int) -> str:
+    """``value`` in fixed notation of ``width`` (a format width, e.g. ``'12'`` or ``'+9'``), or as ``1.000e+308``."""
+    kind = "f" if abs(value) < FIXED_LIMIT or not math.isfinite(value) else "e"
+    return f"{value:{width}.{decimals}{kind}}"
 
 
 def _time_constant_text(tau: float) -> str:

@@ -64,7 +64,9 @@ def _stabilising_optimum(model: Model, eccentricity: float, lordosis: float) -> 
     return optimum
 
 
-def stability_at(model: Model, eccentricity: float, lordosis: float, pcsa=None) -> StabilityResult:
+def stability_at(
+    model: Model, eccentricity: float, lordosis: float, pcsa=None, *, slip_check: bool = True
+) -> StabilityResult:
     """Stability of every segment for a PCSA, by default the minimum stabilising one.
 
     Parameters
@@ -75,6 +77,10 @@ def stability_at(model: Model, eccentricity: float, lordosis: float, pcsa=None) 
     pcsa : array_like, optional
         PCSA [m^2], per pair or per muscle (:func:`spinectl.model.checks.expand_pcsa`);
         default :func:`minimum_stabilising_pcsa`.
+    slip_check : bool
+        True (the default): a ``pcsa`` above :data:`spinectl.model.checks.MAX_PLAUSIBLE_PCSA` is refused
+        as cm^2 typed where m^2 are meant. False: the caller has checked its unit (``--pcsa``, in cm^2), and
+        it is analysed whatever its size, as a computed optimum is (docs/robustness.md, "Model evaluation").
 
     Returns
     -------
@@ -90,7 +96,7 @@ def stability_at(model: Model, eccentricity: float, lordosis: float, pcsa=None) 
         E, Lambda or ``pcsa`` out of range.
     """
     if pcsa is not None:
-        return segment_stability(model, eccentricity, lordosis, pcsa)
+        return segment_stability(model, eccentricity, lordosis, pcsa, given=slip_check)
     optimum = _stabilising_optimum(model, eccentricity, lordosis)
     # the optimum is an answer however large (as in a sweep), not a PCSA typed in the wrong unit
     result = segment_stability(model, eccentricity, lordosis, optimum.pcsa, given=False)

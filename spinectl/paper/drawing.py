@@ -141,7 +141,7 @@ def _upper_vertebra(cor_name: str) -> str:
 
 
 def activation(
-    model: Model, eccentricity: float, lordosis: float, pcsa=None
+    model: Model, eccentricity: float, lordosis: float, pcsa=None, slip_check: bool = True
 ) -> tuple[np.ndarray | None, np.ndarray | None, str]:
     """The PCSA and counter torques to draw, and a phrase that says where they come from.
 
@@ -154,6 +154,9 @@ def activation(
         None: no activation; ``"optimum"``: the chosen activation of
         :func:`spinectl.optimise.reference.solve_point`; else PCSA [m^2] per pair or per muscle
         (:func:`spinectl.model.checks.expand_pcsa`).
+    slip_check : bool
+        True (the default): PCSA values above :data:`spinectl.model.checks.MAX_PLAUSIBLE_PCSA` are refused
+        as cm^2 typed where m^2 are meant; False: their unit is checked (``--pcsa``, in cm^2), any size is drawn.
 
     Returns
     -------
@@ -177,8 +180,8 @@ def activation(
             best.counter_torque,
             f"activation: the optimum (solve_point), {_cm2(best.pcsa.sum())} cm² in all",
         )
-    per_muscle = expand_pcsa(model, pcsa)
-    result = segment_stability(model, eccentricity, lordosis, per_muscle)
+    per_muscle = expand_pcsa(model, pcsa, given=slip_check)
+    result = segment_stability(model, eccentricity, lordosis, per_muscle, given=slip_check)
     return result.pcsa, result.counter_torque, f"activation: given, {_cm2(per_muscle.sum())} cm² in all"
 
 
@@ -398,6 +401,7 @@ def draw_model(
     counter_torque: bool = False,
     ax=None,
     annotate: bool = True,
+    slip_check: bool = True,
 ) -> Figure:
     """Draw the model at one (E, Lambda): the paper's Figure 2, to scale [cm].
 
@@ -415,6 +419,9 @@ def draw_model(
         Draw into these Axes; default a new figure (:func:`spinectl.canvas.new_figure`).
     annotate : bool
         Labels, dimensions, legend, title and axis labels; False for a small inset.
+    slip_check : bool
+        True (the default): PCSA values above :data:`spinectl.model.checks.MAX_PLAUSIBLE_PCSA` are refused
+        as cm^2 typed where m^2 are meant; False: their unit is checked (``--pcsa``, in cm^2), any size is drawn.
 
     Returns
     -------
@@ -427,7 +434,7 @@ def draw_model(
         E or Lambda outside the modelled range, a bad ``pcsa``, or ``counter_torque``
         without an activation.
     """
-    pcsa_used, torques, source = activation(model, eccentricity, lordosis, pcsa)
+    pcsa_used, torques, source = activation(model, eccentricity, lordosis, pcsa, slip_check)
     if counter_torque and pcsa is None:
         raise ParameterError("counter_torque", "needs an activation: give pcsa ('optimum' or values)")
     if ax is None:

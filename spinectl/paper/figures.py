@@ -32,6 +32,7 @@ from ..errors import ParameterError
 from ..landscape import netcdf
 from ..model.chain import local_stiffness_per_pcsa
 from ..model.params import Model
+from ..model.source import stiffness_unit
 from ..optimise.coupled import ParetoFront
 from ..units import CM_PER_M, M2_PER_CM2
 from . import drawing, grid, landmarks
@@ -128,7 +129,7 @@ def _axes(title: str, fig=None, spec=None):
     return fig, ax
 
 
-_UNBROKEN = re.compile(r"\([^()\n]{1,40}\)|(?:[\w.]+ = )?[\d.]+ (?:N m(?:/rad)?|kg|cm|m|s)\b|N m/rad|N m")
+_UNBROKEN = re.compile(r"\([^()\n]{1,40}\)|(?:[\w.]+ = )?[\d.]+ (?:N m(?:/rad)?|1/s²|kg|cm|m|s)\b|N m/rad|N m")
 """Spans a title line is not broken inside: a short parenthesis, a setting with its value and unit, a unit."""
 
 
@@ -249,11 +250,20 @@ def _levels(values: np.ma.MaskedArray, vmin: float | None, vmax: float | None):
 
 
 def _landscape(
-    field: xr.DataArray, title: str, label: str, vmin=None, vmax=None, fig=None, spec=None, label_lines=True
+    field: xr.DataArray,
+    title: str,
+    label: str,
+    vmin=None,
+    vmax=None,
+    fig=None,
+    spec=None,
+    label_lines=True,
+    blank: str | None = None,
 ):
     """A filled contour of ``field`` (dims E, Lambda), contour lines labelled, A-D marked; returns (figure, axes).
 
-    Infeasible points (NaN) stay white, and the title says how many there are. ``label_lines=False``
+    Infeasible points (NaN) stay white, and the title says how many there are (``blank``: the caller's
+    line on what its white points are, instead). ``label_lines=False``
     leaves the lines' values to :func:`_label_lines`, once everything else of the figure is drawn.
     """
     if field.sizes["E"] < 2 or field.sizes["Lambda"] < 2:  # a contour needs an area
@@ -265,7 +275,9 @@ def _landscape(
     values = np.ma.masked_invalid(field.transpose("Lambda", "E").values)
     infeasible = int(values.mask.sum()) if np.ma.is_masked(values) else 0
     if infeasible:
-        title += f"\nwhite: no self-stable activation within the bounds ({infeasible} of {values.size} points)"
+        title += "\n" + (
+            blank or f"white: no self-stable activation within the bounds ({infeasible} of {values.size} points)"
+        )
     fig, ax = _axes(title, fig, spec)
     e_m, lam_m = field["E"].values, field["Lambda"].values
     e, lam = e_m * CM_PER_M, lam_m * CM_PER_M
@@ -350,7 +362,7 @@ def _clear_place(lines, start, keep_clear, frame, renderer, tries: int = 60):
     return None
 
 
-def landscape_figure(field: xr.DataArray, title: str, label: str) -> Figure:
+def landscape_figure(field: xr.DataArray, title: str, label: str, blank: str | None = None) -> Figure:
     """Any variable over E and Lambda drawn as the landscape figures are: filled contours, A-D marked.
 
     Parameters
@@ -361,6 +373,9 @@ def landscape_figure(field: xr.DataArray, title: str, label: str) -> Figure:
         The figure's title.
     label : str
         The colour bar's label, with the unit.
+    blank : str, optional
+        The title's line on what the white (NaN) points are, if there are any; default: no self-stable
+        activation, with their count.
 
     Returns
     -------
@@ -372,7 +387,23 @@ def landscape_figure(field: xr.DataArray, title: str, label: str) -> Figure:
     ParameterError
         Fewer than 2 values of E or of Lambda (field ``grid``).
     """
-    return _landscape(field, title, label)[0]
+    return _landscape(field, title, label, blank=blank)[0]
+
+
+def k_unit(convention: str) -> str:
+    """The unit of K under a ``passive.convention`` as a figure writes it (``N m/rad``, ``1/s²``).
+
+    Parameters
+    ----------
+    convention : str
+        ``"physical"`` or ``"paper"`` (a landscape's ``passive_convention`` attribute).
+
+    Returns
+    -------
+    str
+        :func:`spinectl.model.source.stiffness_unit` with a superscript square.
+    """
+    return stiffness_unit(convention).replace("^2", "²")
 
 
 def _k_label(dataset: xr.Dataset) -> str:
@@ -380,7 +411,7 @@ def _k_label(dataset: xr.Dataset) -> str:
     if stiffness == 0:
         return "K = 0"
     convention = dataset.attrs.get("passive_convention", "?")
-    return f"K = {stiffness:g} N m/rad (K convention: {_CONVENTION.get(convention, convention)})"
+    return f"K = {stiffness:g} {k_unit(convention)} (K convention: {_CONVENTION.get(convention, convention)})"
 
 
 def min_pcsa_figure(

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..model.source import stiffness_unit
 from ..units import m2_to_cm2
 from . import grid, landmarks, verdicts
 from .landmarks import Measurement
@@ -132,6 +133,11 @@ def _local_pcsa(measurements: Sequence[Measurement], specific_tension: float) ->
         f"{landmarks.LOCAL_LEVER_ARM * 100:g} cm lever arm (the paper: 30 N m ≙ 17 cm²; "
         f"spinectl: {landmarks.CT_LIMIT:g} N m ≙ {_number(float(limit))} cm²): " + "; ".join(parts) + "."
     )
+
+
+def _k_unit(convention: str) -> str:
+    """K's unit under ``convention`` as the report writes it (docs/model.md, "Passive stiffness: two conventions")."""
+    return stiffness_unit(convention).replace("^2", "²")
 
 
 def _halving(measurements: Sequence[Measurement], run: Run) -> str:
@@ -258,13 +264,14 @@ def render(measurements: Sequence[Measurement], run: Run) -> str:
     """
     agree = sum(m.agrees for m in measurements)
     files = "\n".join(f"- [`{name}`]({name})" for name in run.files)
+    k, own, other = f"K = {grid.PAPER_STIFFNESS:g}", _k_unit(run.convention), _k_unit(run.other_convention)
     return f"""# spinectl reproduction of Wagner et al. (2012)
 
 Minimum PCSA for self-stability (Figure 3), local counter torques (Figure 4) and
 the effect of passive stiffness (Figure S1) on the paper's grid: E and Λ from 0
 to 8 cm, {run.points} × {run.points} points, K = 0 and K = {grid.PAPER_STIFFNESS:g} N m/rad.
-Parameters: {run.preset}; K = 0 and K = {grid.PAPER_STIFFNESS:g} N m/rad with the `{run.convention}` convention,
-K = {grid.PAPER_STIFFNESS:g} N m/rad also with the `{run.other_convention}` convention. Wall time: {run.seconds:.1f} s.
+Parameters: {run.preset}; K = 0 and {k} {own} with the `{run.convention}` convention,
+{k} {other} also with the `{run.other_convention}` convention. Wall time: {run.seconds:.1f} s.
 
 ## Read this first
 

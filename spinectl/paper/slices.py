@@ -10,6 +10,7 @@ limit, the title naming the slice's parameter values with their units. A store w
 from __future__ import annotations
 
 import itertools
+import warnings
 from pathlib import Path
 
 import xarray as xr
@@ -22,7 +23,7 @@ MAX_SLICES = 24
 """Most slices one ``spinectl plot`` of a store draws (two figures each)."""
 
 
-def slice_figures(dataset: xr.Dataset, format: str = "png") -> dict:
+def slice_figures(dataset: xr.Dataset, format: str = "png", computed: xr.DataArray | None = None) -> dict:
     """The minimum PCSA and ‖CT‖ (with the ±30 N m limit) of every E x Lambda slice of a study, by file name.
 
     Parameters
@@ -31,6 +32,9 @@ def slice_figures(dataset: xr.Dataset, format: str = "png") -> dict:
         A study store as :func:`spinectl.landscape.study.load` reads it.
     format : str
         One of :data:`spinectl.paper.figures.FORMATS`.
+    computed : xarray.DataArray of bool, optional
+        Which points are computed (:func:`spinectl.landscape.study.store.computed`); the others are
+        drawn white as not computed, counted apart from infeasible points. Default: every point.
 
     Returns
     -------
@@ -62,18 +66,56 @@ def slice_figures(dataset: xr.Dataset, format: str = "png") -> dict:
         values = [(d, part[d].values.item()) for d in dims]
         where = ", ".join(f"{d} = {v:g}{_unit(part[d])}" for d, v in values) or "the study's model"
         name = "".join(f"_{d}={v:g}" for d, v in values)
+        done = None if computed is None else computed.isel(dict(zip(dims, index, strict=True)))
         for variable, what, unit, stem in comparison.COMPARED:
             title = f"{what} of the study, {where}"
-            fig = figures.landscape_figure(part[variable], title, f"{what} [{unit}]")
+            fig = figures.landscape_figure(part[variable], title, f"{what} [{unit}]", _blank(part[variable], done))
             if variable == "counter_torque_norm_Nm":  # as Figure 4
                 figures.torque_limit(fig.axes[0], part[variable])
             drawn[f"{stem}{name}.{format}"] = fig
     return drawn
 
 
+def _blank(field: xr.DataArray, done: xr.DataArray | None) -> str | None:
+    """The title's line on a slice's white points where some are not computed (None: all computed)."""
+    if done is None or bool(done.all()):
+        return None
+    missing = int((~done).sum())
+    infeasible = int((done & field.isnull()).sum())
+    parts = [f"not computed yet, the study is unfinished ({missing})"]
+    if infeasible:
+        parts.append(f"no self-stable activation within the bounds ({infeasible})")
+    return f"white ({missing + infeasible} of {field.size} points): {'; '.join(parts)}"
+
+
+def unfinished(computed: xr.DataArray, path) -> str:
+    """The warning for a store with points not computed, or ``""``.
+
+    Parameters
+    ----------
+    computed : xarray.DataArray of bool
+        :func:`spinectl.landscape.study.store.computed` of the store.
+    path : str or Path
+        The store, as the user named it.
+
+    Returns
+    -------
+    str
+        E.g. ``'s.zarr' is unfinished: 9 of 18 points not computed, drawn white as such; run the study
+        again with --resume``.
+    """
+    missing = int((~computed).sum())
+    if not missing:
+        return ""
+    return (
+        f"{str(path)!r} is unfinished: {missing} of {computed.size} points not computed, drawn white as such; "
+        "run the study again with --resume"
+    )
+
+
 def _unit(coordinate: xr.DataArray) -> str:
     """The unit of a study axis as a title writes it after a value (" kg"), from the store's ``units``."""
-    unit = coordinate.attrs.get("units", "")
+    unit = coordinate.attrs.get("units", "").replace("^2", "²")  # K under eq. 2 as printed: 1/s^2
     return f" {unit}" if unit and unit != "1" else ""
 
 
@@ -96,13 +138,23 @@ def draw_study(path, out_dir, format: str = "png", dpi: float = figures.DPI) -> 
     list of Path
         The files written.
 
+    Warns
+    -----
+    UserWarning
+        The store is unfinished (:func:`unfinished`): its points not yet computed are drawn white as such.
+
     Raises
     ------
     ParameterError
-        Not a finished study store (field ``store``), or too many slices (field ``results``).
+        Not a study store (field ``store``), or too many slices (field ``results``).
     OutputError
         ``out_dir`` cannot take the files; nothing is written.
     """
     from ..landscape.study import store  # zarr and dask only for a store
 
-    return save_figures(slice_figures(store.load(path), format), out_dir, dpi)
+    dataset = store.load(path)
+    computed = store.computed(dataset)
+    written = save_figures(slice_figures(dataset, format, computed), out_dir, dpi)
+    if note := unfinished(computed, path):
+        warnings.warn(note, UserWarning, stacklevel=2)  # the CLI prints it as one line
+    return written

@@ -951,10 +951,44 @@ def critical_gains(stiffness, damping, inertia, kd, delay, lobes: int = 8, point
     found = np.any(ok, axis=-1)
     kp_min = np.where(found, np.take_along_axis(lows, first, axis=-1)[..., 0], np.nan)
     kp_max = np.where(found, np.take_along_axis(highs, first, axis=-1)[..., 0], np.nan)
-    no_delay = (tau == 0) & (lag == 0)  # with the lag even tau = 0 bounds kp: the cubic's Hurwitz condition
-    kp_min = np.where(no_delay, np.where(kd > d, s, np.nan), kp_min)
-    kp_max = np.where(no_delay, np.where(kd > d, np.inf, np.nan), kp_max)
-    return kp_min, kp_max
+    # tau = 0: no jw crossing moves with the delay; the search above ran at a stand-in delay of 1 s
+    low, high = _delay_free_gains(s, d, theta, kd, lag)
+    return np.where(tau == 0, low, kp_min), np.where(tau == 0, high, kp_max)
+
+
+def _delay_free_gains(stiffness, damping, inertia, kd, lag=0.0):
+    """Range (kp_min, kp_max) of proportional gains that stabilise the segment without delay, given kd.
+
+    Routh-Hurwitz on the delay-free characteristic polynomial (docs/reflex.md, "Critical gains")
+    T_a theta s^3 + (theta - T_a D) s^2 + (kd - D - T_a S) s + (kp - S): with T_a > 0 every
+    coefficient positive and (theta - T_a D)(kd - D - T_a S) > T_a theta (kp - S), so
+    kp in (S, S + (theta - T_a D)(kd - D - T_a S) / (T_a theta)); without the lag the quadratic
+    theta s^2 + (kd - D) s + (kp - S) needs kd > D and kp > S only.
+
+    Parameters
+    ----------
+    stiffness, damping, inertia, kd : array_like
+        S [N m/rad], D [N m s/rad], theta [kg m^2], kd [N m s/rad].
+    lag : array_like, optional
+        Activation time constant T_a [s].
+
+    Returns
+    -------
+    kp_min, kp_max : numpy.ndarray
+        [N m/rad], of the broadcast shape; kp_max = inf without the lag (or with theta = 0), NaN, NaN
+        where no kp stabilises.
+
+    References
+    ----------
+    .. [1] Hurwitz A (1895). Ueber die Bedingungen, unter welchen eine Gleichung nur Wurzeln mit
+       negativen reellen Theilen besitzt. Math Ann 46:273-284. doi:10.1007/BF01446812
+    """
+    s, d, theta, kd, lag = as_arrays(stiffness, damping, inertia, kd, lag)
+    second, first = theta - lag * d, kd - d - lag * s  # coefficients of s^2 and s
+    with np.errstate(divide="ignore", invalid="ignore"):
+        room = np.where(lag * theta > 0, second * first / np.where(lag * theta > 0, lag * theta, 1.0), np.inf)
+    ok = np.where(lag > 0, (second > 0) & (first > 0), kd > d)
+    return np.where(ok, s, np.nan), np.where(ok, s + room, np.nan)
 
 
 # --- the landscape over a grid ---------------------------------------------------------------

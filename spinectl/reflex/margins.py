@@ -328,7 +328,7 @@ class MarginsReport:
         -------
         dict
             The model's :func:`~spinectl.model.source.provenance` (``preset``, ``config``,
-            ``config_sha256``, ``overridden``, ``K_Nm_per_rad``, ``K_convention``),
+            ``config_sha256``, ``overridden``, ``K_Nm_per_rad`` or ``K_per_s2``, ``K_convention``),
             ``E_m``, ``Lambda_m``, ``delay_s``, ``activation_time_constant_s``, ``pade_order``,
             ``activation``, ``optimum_status``, ``gains``, ``pcsa_cm2`` (muscle name -> PCSA [cm^2]), ``segments`` (one
             :meth:`SegmentMargins.to_dict` each) and ``all_stable_at_delay``; the unit is in each
@@ -449,7 +449,7 @@ def analyse(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None
         pade_order=settings.pade_order,
         segments=segments,
         gains=_gains_label(settings.gains, kp, kd),
-        model=provenance(model) | {"header": header(model)},
+        model=provenance(model) | {"header": header(model, [s.inertia for s in segments])},
     )
 
 

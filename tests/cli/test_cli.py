@@ -309,11 +309,38 @@ def test_a_pcsa_in_square_metres_gets_a_warning_and_runs(capsys):
     assert code == 2 and err.count("\n") == 1 and err.startswith("spinectl: error: --E")
 
 
-def test_a_pcsa_beyond_any_muscle_is_refused_in_cm2(capsys):
-    """The command line takes cm^2, so its refusal speaks cm^2 (the library's speaks m^2: 'got 0.2 m^2')."""
-    code, out, err = run(["stability", "--pcsa", "2000,1,1"], capsys)
+def test_an_optimum_beyond_any_muscle_can_be_fed_back_to_pcsa(capsys):
+    """A 100 kg body on fibres of 1e4 N/m^2 needs about 1857 cm^2 in each outer oblique at E = 3, Lambda = 4 cm:
+    `stability` prints that optimum, and `--pcsa` with it (refused before, above 1000 cm^2 per muscle) gives the
+    same table, S(L1L2) at the optimiser's stability margin, -0.1 N m/rad (optimisation.stability_margin), with
+    one warning line that the PCSA is more than any muscle's. Only a PCSA beyond which the torques overflow
+    (checks.MAX_PCSA, 1e104 cm^2) is refused, in cm^2."""
+    heavy = ["stability", "--E", "0.03", "--Lambda", "0.04", "--set", "body.mass=100", "--set"]
+    heavy.append("fibre.specific_tension=1e4")
+    code, out, err = run(heavy, capsys)
+    assert code == 0 and err == ""
+    pcsa = out.splitlines()[2].split(": ", 1)[1].split("  (total")[0]
+    per_muscle = [float(item.rsplit(" ", 1)[1]) for item in pcsa.split(", ")]
+    assert max(per_muscle) > 1000
+    code, again, err = run([*heavy, "--pcsa", ",".join(f"{p:.6f}" for p in per_muscle)], capsys)
+    assert code == 0 and err.count("\n") == 1 and "more than any muscle's PCSA (above 1000 cm^2" in err
+    assert float(again.splitlines()[5].split()[1]) == pytest.approx(-0.1, abs=2e-3)
+    code, out, err = run(["stability", "--pcsa", "1e300,1,1"], capsys)
     assert code == 2 and out == "" and err.count("\n") == 1
-    assert err == "spinectl: error: --pcsa: must be at most 1000 cm^2 per muscle, more than any muscle (got 2000)\n"
+    assert err.startswith("spinectl: error: --pcsa: must be at most 1e+104 cm^2 per muscle, beyond which the torques")
+
+
+def test_k_1e308_is_answered(capsys):
+    """docs/robustness.md, "extreme but harmless values": --K 1e308 gives a table, exit 0 (before: the
+    discriminant D^2 + 4 theta S overflowed, a ModelError). S = -1e308 N m/rad at every CoR, printed as such
+    (not 309 digits); the eigenvalues are D / (2 theta) +- j sqrt(-S / theta) to rounding (closed form)."""
+    code, out, err = run(["stability", "--E", "0.03", "--Lambda", "0.04", "--K", "1e308"], capsys)
+    assert code == 0 and err == ""
+    row = out.splitlines()[5].split()  # L1L2: S, D, theta, lambda_1, lambda_2, stable, CT
+    assert row[0] == "L1L2" and row[1] == "-1.000e+308" and row[-2] == "yes"
+    theta, imag = float(row[3]), float(row[4].split("+", 1)[1].rstrip("j"))
+    assert imag == pytest.approx((1e308 / theta) ** 0.5, rel=1e-3)  # theta as printed, to 4 decimals
+    assert max(len(line) for line in out.splitlines()[4:10]) < 120  # the header and rows of the table
 
 
 @pytest.mark.parametrize(

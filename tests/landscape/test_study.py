@@ -331,6 +331,28 @@ def test_stopped_study_resumes_to_the_same_bits(reference, tmp_path):
     xr.testing.assert_identical(study.load(out), reference)  # every chunk written exactly once
 
 
+def test_computed_points_are_those_of_the_chunks_done(tmp_path):
+    """5 of the 12 chunks done (3 tiles of 2 E-rows each per combination of K and body.mass): the points the
+    store marks computed are those whose status was written (a second reading: statuses read '' where not),
+    the first combination whole and the first 4 of 6 E-rows of the second."""
+    parsed, out = study.parse_study(STUDY), tmp_path / "s.zarr"
+    study.run_study(parsed, out, scheduler="synchronous", max_chunks=5, progress=False)
+    partial = study.load(out)
+    done = study_store.computed(partial)
+    assert done.dims == ("K", "body.mass", "E", "Lambda")
+    np.testing.assert_array_equal(done.values, partial["status"].values != "")
+    assert done.values[0, 0].all() and done.values[0, 1, :4].all() and not done.values[0, 1, 4:].any()
+    assert int(done.sum()) == 5 * TILE_POINTS
+
+
+def test_the_k_axis_has_the_unit_of_its_convention():
+    """Under eq. 2 as printed (``wagner2012_mass_free``) K is read in 1/s^2 (docs/model.md, "Passive stiffness: two
+    conventions"), so a study's K axis says so; under 'physical' it stays N m/rad (before: N m/rad for both)."""
+    for preset, unit in (("wagner2012_mass_free", "1/s^2"), ("wagner2012", "N m/rad")):
+        parsed = study.parse_study(f'[study]\npreset = "{preset}"\n[axes]\n{GRID}K = [0.0, 15.0]\n')
+        assert study_store._parameter_attributes(parsed.model, "passive.stiffness")["units"] == unit
+
+
 def test_killed_study_resumes_without_computing_a_chunk_twice(reference, tmp_path):
     """SIGKILL a study run by the CLI once two chunks are done, then resume it.
 

@@ -180,7 +180,8 @@ def test_to_dict_schema_and_values(model):
     result = segment_stability(stiff, 0.03, 0.04, [10e-4, 10e-4, 10e-4])
     doc = result.to_dict(stiff)
     assert doc["E_m"] == 0.03 and doc["Lambda_m"] == 0.04
-    assert doc["K_Nm_per_rad"] == 15 and doc["K_convention"] == "paper" and doc["pcsa_source"] == "given"
+    assert doc["K_per_s2"] == 15 and "K_Nm_per_rad" not in doc  # eq. 2 as printed: K in 1/s^2
+    assert doc["K_convention"] == "paper" and doc["pcsa_source"] == "given"
     assert doc["pcsa_cm2"] == dict.fromkeys(model.muscle_names, pytest.approx(10.0))
     assert doc["total_pcsa_cm2"] == pytest.approx(60)
     assert [s["name"] for s in doc["segments"]] == list(result.segment_names)
@@ -252,3 +253,43 @@ def test_a_segment_that_does_not_return_has_no_time_constant_in_the_table(model)
     result = segment_stability(model, 0.03, 0.04, [10e-4, 10e-4, 10e-4])
     assert not result.all_self_stable and result.slowest_time_constant == np.inf
     assert result.table(model).endswith("slowest time constant none (not every segment returns)")
+
+
+def test_the_header_names_k_in_the_unit_its_convention_gives_and_what_it_adds():
+    """Under eq. 2 as printed (``wagner2012_mass_free``) K = 15 is 15 1/s^2 and adds K theta_k [N m/rad] at each
+    CoR; the header printed "K = 15 N m/rad" where 5.0 N m/rad was added at L1L2. The values it names now are
+    the drop of S from K = 0 to K = 15 in the same table (a second reading: S itself, at a given PCSA);
+    'physical' K stays N m/rad and adds K."""
+    from spinectl.model.config import load_preset
+
+    pcsa = [10e-4, 10e-4, 10e-4]
+    paper = load_preset("wagner2012_mass_free")
+    assert paper.passive.convention == "paper"
+    k0, k15 = (segment_stability(paper.replace(passive=Passive(k, "paper")), 0.03, 0.04, pcsa) for k in (0.0, 15.0))
+    line = k15.table(paper.replace(passive=Passive(15.0, "paper"))).splitlines()[0]
+    assert "K = 15 1/s^2, convention paper: K theta_k = " in line and "N m/rad, convention" not in line
+    named = [float(x) for x in line.split("K theta_k = ")[1].split(" N m/rad")[0].split(", ")]
+    np.testing.assert_allclose(named, k0.stiffness - k15.stiffness, rtol=1e-3)
+    assert 4.9 < named[0] < 5.1  # L1L2: 5.0 N m/rad
+    physical = paper.replace(passive=Passive(15.0, "physical"))
+    assert "K = 15 N m/rad, convention physical" in source.header(physical)
+    assert "theta" not in source.header(physical)
+    assert source.header(paper.replace(passive=Passive(15.0, "paper"))).endswith(
+        "K = 15 1/s^2, convention paper (K theta_k [N m/rad] at each CoR)"
+    )
+
+
+def test_eigenvalues_of_a_stiffness_whose_discriminant_overflows():
+    """S = -+1e308 N m/rad (``--K 1e308``): D^2 + 4 theta S overflows, the roots do not. Closed forms with theta = 0.79,
+    D = -0.01: S < 0 gives D / (2 theta) +- j sqrt(-S / theta - D^2 / (4 theta^2)) (the D^2 term below rounding);
+    S > 0 gives real roots of product -S / theta and sum D / theta, about +-sqrt(S / theta)."""
+    theta, d = 0.79, -0.01
+    with np.errstate(over="raise"):
+        stable, unstable = eigenvalues(np.array([-1e308, 1e308]), d, theta)
+    assert stable[0].real == pytest.approx(d / (2 * theta), rel=1e-12)
+    assert stable[0].imag == pytest.approx(np.sqrt(1e308 / theta), rel=1e-12) and stable[1] == np.conj(stable[0])
+    assert unstable.imag.tolist() == [0.0, 0.0]
+    assert unstable[0].real == pytest.approx(np.sqrt(1e308 / theta), rel=1e-12)
+    assert unstable[0].real * unstable[1].real == pytest.approx(-1e308 / theta, rel=1e-12)
+    ordinary = eigenvalues(np.array([-50.0, 20.0]), d, theta)  # the unscaled path, as before
+    np.testing.assert_allclose(ordinary.prod(axis=-1), [50.0 / theta, -20.0 / theta], rtol=1e-14)

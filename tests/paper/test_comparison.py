@@ -27,7 +27,7 @@ def test_maps_are_the_difference_and_the_ratio(two, monkeypatch):
     """The drawn fields are first - second and first / second, point by point (numpy on the same arrays)."""
     drawn = {}
     monkeypatch.setattr(
-        comparison.figures, "landscape_figure", lambda field, title, label: drawn.setdefault(title, field)
+        comparison.figures, "landscape_figure", lambda field, title, label, blank=None: drawn.setdefault(title, field)
     )
     figures = comparison.comparison_set(*two, labels=("a.nc", "b.nc"))
     assert sorted(figures) == [
@@ -41,6 +41,31 @@ def test_maps_are_the_difference_and_the_ratio(two, monkeypatch):
     ratio = drawn["minimum PCSA: a.nc over b.nc, K = 0 N m/rad"]
     np.testing.assert_allclose(difference.values, a - b)
     np.testing.assert_allclose(ratio.values, a / b)
+
+
+def test_ratios_over_rounding_noise_are_masked_and_the_title_says_so(two, monkeypatch):
+    """At position A (E = Lambda = 0) both presets' ‖CT‖ is 0 up to rounding (the optimum balances gravity
+    exactly; of order 1e-15 N m), which made a ratio of 17 that set the colour scale of the whole map. The ratio
+    is masked where the second file's ‖CT‖ is at most sqrt(eps) times its largest (numpy's machine epsilon;
+    the norm of a least-squares optimum is known to about that), drawn elsewhere as first / second, and the
+    title counts the masked point apart from infeasible ones."""
+    drawn = {}
+    monkeypatch.setattr(
+        comparison.figures,
+        "landscape_figure",
+        lambda field, title, label, blank=None: drawn.setdefault(title, (field, blank)),
+    )
+    comparison.comparison_set(*two, labels=("a.nc", "b.nc"))
+    ratio, blank = drawn["‖CT‖: a.nc over b.nc, K = 0 N m/rad"]
+    a, b = (ds["counter_torque_norm_Nm"].values for ds in two)
+    level = np.sqrt(np.finfo(float).eps) * np.abs(b).max()
+    assert a[0, 0] < level and b[0, 0] < level  # A is rounding noise in both
+    noise = b <= level
+    assert noise.sum() == 1 and b[~noise].min() > 1e3 * level  # the other points are far above it
+    assert np.isnan(ratio.values[noise]).all()
+    np.testing.assert_allclose(ratio.values[~noise], a[~noise] / b[~noise])
+    assert blank.startswith("white (1 of 9 points): ‖CT‖ of b.nc at rounding level") and "undefined (1)" in blank
+    assert "no self-stable activation" not in blank
 
 
 def test_different_grids_are_refused_naming_the_axis(two):

@@ -138,13 +138,16 @@ def test_the_paper_grid_marks_a_to_d_at_its_corners_the_ridge_and_the_optimum(re
 
 
 def test_titles_name_the_convention_not_a_bare_word(results):
+    """K's unit follows its convention (docs/model.md, "Passive stiffness: two conventions"): N m/rad under
+    'physical', 1/s² under eq. 2 as printed, where it adds K theta_k [N m/rad] (before: N m/rad for both)."""
     dataset = netcdf.load(results)
     k0 = figures.min_pcsa_figure(dataset.sel(K=0.0)).axes[0].get_title()
     k15 = figures.min_pcsa_figure(dataset.sel(K=15.0)).axes[0].get_title()
     assert "K = 0" in k0 and "convention" not in k0
     assert "K convention: physical" in k15 and "(physical)" not in k15 and "(paper)" not in k15
     printed = figures.min_pcsa_figure(dataset.sel(K=15.0).assign_attrs(passive_convention="paper"))
-    assert "K convention: eq. 2 as printed" in printed.axes[0].get_title()
+    assert "K = 15 1/s² (K convention: eq. 2 as printed)" in printed.axes[0].get_title().replace("\n", " ")
+    assert "K = 15 N m/rad (K convention: physical" in k15.replace("\n", " ")
 
 
 def test_shared_scale_and_given_range(results, tmp_path, monkeypatch):

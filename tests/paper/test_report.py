@@ -110,7 +110,7 @@ def test_the_header_names_both_stiffnesses_and_the_table_its_own_grid():
     text = report.render(measured, dataclasses.replace(RUN, presets=presets, preset_points=41))
     assert (
         "Parameters: preset `default`; K = 0 and K = 15 N m/rad with the `physical` convention,\n"
-        "K = 15 N m/rad also with the `paper` convention." in text
+        "K = 15 1/s² also with the `paper` convention." in text  # eq. 2 as printed reads K in 1/s^2
     )
     head = next(line for line in text.splitlines() if line.startswith("| landmark | paper | `wagner2012`"))
     assert "`wagner2012` (separate 41 × 41 grid)" in head and "`wagner2012_mass_free` (separate 41 × 41 grid)" in head

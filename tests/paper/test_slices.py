@@ -43,3 +43,27 @@ def test_the_ct_slices_carry_the_30_n_m_limit_and_round_levels(study):
         step = np.diff(lines)[0]
         assert np.allclose(np.diff(lines), step) and np.allclose(lines / step, np.round(lines / step))
         assert step / 10 ** np.floor(np.log10(step)) in (1, 2, 2.5, 5)
+
+
+def test_an_unfinished_store_draws_its_uncomputed_points_as_not_computed(tmp_path):
+    """A study of K = 0 and 15 on a 3 x 3 grid, one chunk (the K = 0 slice) of two done: the K = 15 slice's
+    9 points read NaN because nothing computed them, which the figure must say (not "no self-stable activation",
+    the infeasible answer), and :func:`slices.draw_study` warns with the count, 9 of 18 points."""
+    from spinectl.landscape import study
+
+    text = (
+        '[study]\nchunk_size = 9\noutputs = ["min_pcsa_cm2", "counter_torque_norm_Nm", "status"]\n[axes]\n'
+        "E = { start = 0.0, stop = 0.08, num = 3 }\nLambda = { start = 0.0, stop = 0.08, num = 3 }\nK = [0.0, 15.0]\n"
+    )
+    out = tmp_path / "s.zarr"
+    study.run_study(study.parse_study(text), out, scheduler="synchronous", max_chunks=1, progress=False)
+    with pytest.warns(UserWarning, match=r"'.*s\.zarr' is unfinished: 9 of 18 points not computed"):
+        written = slices.draw_study(out, tmp_path / "figures")
+    assert len(written) == 4
+    dataset = study.load(out)
+    drawn = slices.slice_figures(dataset, computed=study.store.computed(dataset))
+    for stem in ("min_pcsa", "counter_torque"):
+        pending = drawn[f"{stem}_K=15.png"].axes[0].get_title().replace("\n", " ")
+        assert "white (9 of 9 points): not computed yet, the study is unfinished (9)" in pending
+        assert "no self-stable activation" not in pending
+        assert "white" not in drawn[f"{stem}_K=0.png"].axes[0].get_title()  # every point computed and feasible

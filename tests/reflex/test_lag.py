@@ -192,3 +192,31 @@ def test_landscape_with_the_lag_is_the_pointwise_answer(rng):
     needs_reflex = np.isfinite(lag_free.delay_margin) & (lag_free.delay_margin > 0)
     same_gains = reflex.delay_margin(s, d, theta, lag_free.kp, lag_free.kd, 0.08).margin
     assert np.all(same_gains[needs_reflex] < lag_free.delay_margin[needs_reflex])  # the lag costs delay
+
+
+def test_critical_gains_without_delay_are_the_hurwitz_range_of_the_lagged_cubic():
+    """tau = 0 with T_a = 0.05 s (the default lag): the delay-free loop's characteristic polynomial
+    T_a theta s^3 + (theta - T_a D) s^2 + (kd - D - T_a S) s + (kp - S) is stable for kp in
+    (S, S + (theta - T_a D)(kd - D - T_a S) / (T_a theta)) (Routh-Hurwitz, closed form), about 381 N m/rad
+    for L4L5 of ``spinectl margins --E 0.03 --Lambda 0.04`` (S, D, theta, kd as that table prints them);
+    numpy's roots of the cubic cross the axis there (a second method). Before, the search ran at a
+    stand-in delay of 1 s and returned its range, [9.8, 15.0]."""
+    s, d, theta, kd, lag = 9.79, -13.65, 2.038, 0.73, 0.05
+    high = s + (theta - lag * d) * (kd - d - lag * s) / (lag * theta)
+    lo, hi = reflex.critical_gains(s, d, theta, kd, 0.0, lag=lag)
+    assert lo == pytest.approx(s, rel=1e-12) and hi == pytest.approx(high, rel=1e-12) and 380 < hi < 382
+
+    def largest_real_part(kp):
+        return np.roots([lag * theta, theta - lag * d, kd - d - lag * s, kp - s]).real.max()
+
+    assert largest_real_part(0.999 * hi) < 0 < largest_real_part(1.001 * hi)
+    assert largest_real_part(s + 0.01) < 0 < largest_real_part(s - 0.01)
+
+
+def test_critical_gains_without_delay_and_without_a_stabilising_gain_are_nan():
+    """tau = 0, T_a = 0.05 s and kd - D - T_a S <= 0: the coefficient of s in the cubic is not positive for any kp,
+    so no kp stabilises (Routh-Hurwitz): NaN, NaN, as the exact root count says at a few gains."""
+    s, d, theta, lag = 100.0, -1.0, 1.0, 0.05
+    kd = 3.0  # kd - D - T_a S = 3 + 1 - 5 < 0
+    assert np.isnan(reflex.critical_gains(s, d, theta, kd, 0.0, lag=lag)).all()
+    assert not reflex.stable_at_delay(s, d, theta, np.array([101.0, 150.0, 1e3]), kd, 0.0, lag).any()

@@ -220,3 +220,19 @@ def test_gains_say_how_they_were_chosen(model, kp, kd, label):
     """Gains given to analyse are explicit in the report, also where the model's setting is 'rule'."""
     report = margins.analyse(_with_reflex(model, activation=0.0), E, LAMBDA, kp=kp, kd=kd)
     assert report.gains == label and report.to_dict()["gains"] == label
+
+
+def test_kp_range_without_delay_is_the_hurwitz_range_with_the_lag(model):
+    """``spinectl margins --delay 0`` with the default lag (T_a = 0.05 s): each segment's kp range is that of the
+    delay-free cubic T_a theta s^3 + (theta - T_a D) s^2 + (kd - D - T_a S) s + (kp - S) (Routh-Hurwitz, from the
+    segment's own S, D, theta and kd), and the verdict at kp = 100 agrees with it (before: the range of a 1 s delay,
+    L4L5 [9.8, 15.0], printed beside "stable: yes")."""
+    lagged = _with_reflex(model, delay=0.0)
+    lag = lagged.reflex.activation_time_constant
+    assert lag > 0
+    for kp in (None, 100.0):
+        for seg in margins.analyse(lagged, E, LAMBDA, kp=kp).segments:
+            s, d, theta, kd = seg.stiffness, seg.damping, seg.inertia, seg.kd
+            high = s + (theta - lag * d) * (kd - d - lag * s) / (lag * theta)
+            assert seg.kp_min == pytest.approx(s) and seg.kp_max == pytest.approx(high, rel=1e-12)
+            assert seg.stable_at_delay == (s < seg.kp < high)

@@ -160,7 +160,8 @@ def _coordinates(study: Study) -> dict:
 def _parameter_attributes(model, dotted: str) -> dict[str, str]:
     """``units``, ``long_name`` and ``parameter`` of a parameter's coordinate, from its field metadata."""
     meta = field_metadata(model, dotted)
-    return {"units": meta.get("unit", ""), "long_name": meta.get("doc", dotted), "parameter": dotted}
+    unit = source.stiffness_unit(model.passive.convention) if dotted == "passive.stiffness" else meta.get("unit", "")
+    return {"units": unit, "long_name": meta.get("doc", dotted), "parameter": dotted}
 
 
 def _attributes(study: Study) -> dict:
@@ -432,6 +433,41 @@ def load(path: str | Path) -> xr.Dataset:
         if variable.dtype.kind == "U":
             dataset[name] = variable.astype(object)
     return dataset
+
+
+def computed(dataset: xr.Dataset) -> xr.DataArray:
+    """Which points of a store are computed: those of the chunks counted done in ``chunk_done``.
+
+    The chunks are the study's order (:meth:`spinectl.landscape.study.spec.Study.chunk`): the
+    combinations of the parameter dimensions outer, then tiles of ``chunk_tile`` points along E and
+    Lambda, so the counts, reshaped, repeated over each tile and cut to the grid, give every point's.
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        A store as :func:`open_store` or :func:`load` reads it.
+
+    Returns
+    -------
+    xarray.DataArray of bool
+        Over the parameter dimensions, then ``E`` and ``Lambda``: True where the point's chunk is done
+        (its numbers are answers, NaN an infeasible point), False where it is not yet (NaN: not computed).
+
+    Raises
+    ------
+    ParameterError
+        The store's attribute ``chunk_tile`` is lost (field ``store``).
+    """
+    output = next(v for v in dataset.data_vars.values() if "Lambda" in v.dims)  # parameters, E, Lambda, own
+    dims = list(output.dims[: output.dims.index("Lambda") + 1])
+    shape = [dataset.sizes[d] for d in dims]
+    if "chunk_tile" not in dataset.attrs:  # an edited store: its chunks' tiles are unknown
+        raise ParameterError("store", "its attribute chunk_tile is lost: which points are computed is unknown")
+    tile = [int(n) for n in dataset.attrs["chunk_tile"]]
+    tiles = [-(-n // t) for n, t in zip(shape[-2:], tile, strict=True)]
+    done = np.asarray(dataset[DONE].values).reshape(shape[:-2] + tiles) > 0
+    points = done.repeat(tile[0], axis=-2).repeat(tile[1], axis=-1)[..., : shape[-2], : shape[-1]]
+    return xr.DataArray(points, coords={d: dataset[d] for d in dims}, dims=dims, name="computed")
 
 
 def damaged_chunks(path: str | Path, counts: np.ndarray) -> np.ndarray:

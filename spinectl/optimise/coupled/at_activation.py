@@ -119,7 +119,8 @@ class CoupledStability:
         -------
         dict
             The model's :func:`~spinectl.model.source.provenance` (``preset``, ``config``, ``config_sha256``,
-            ``overridden``, ``K_Nm_per_rad``, ``K_convention``), ``E_m``, ``Lambda_m``, ``pcsa_source`` and
+            ``overridden``, ``K_Nm_per_rad`` or ``K_per_s2``, ``K_convention``), ``E_m``, ``Lambda_m``,
+            ``pcsa_source`` and
             ``coupled``: ``segments``, ``decision_variables``, ``pcsa_cm2`` (muscle -> cm^2),
             ``stiffness_matrix_Nm_per_rad``, ``gravity_stiffness_matrix_Nm_per_rad``,
             ``stiffness_matrix_per_cm2`` (n_var x n_cor x n_cor, N m/rad per cm^2),
@@ -216,7 +217,9 @@ class CoupledStability:
         return "\n".join(lines)
 
 
-def coupled_stability_at(model: Model, eccentricity: float, lordosis: float, pcsa=None) -> CoupledStability:
+def coupled_stability_at(
+    model: Model, eccentricity: float, lordosis: float, pcsa=None, *, slip_check: bool = True
+) -> CoupledStability:
     """The coupled chain at a global activation, by default the per-segment optimum.
 
     The matrices of :func:`spinectl.model.chain.chain_coefficients` and
@@ -234,6 +237,10 @@ def coupled_stability_at(model: Model, eccentricity: float, lordosis: float, pcs
         Global PCSA [m^2], per pair or per muscle; default the minimum stabilising PCSA of
         :func:`spinectl.optimise.reference.solve_point`
         (:func:`~spinectl.optimise.stabilising.minimum_stabilising_pcsa`).
+    slip_check : bool
+        True (the default): a ``pcsa`` above :data:`spinectl.model.checks.MAX_PLAUSIBLE_PCSA` is refused
+        as cm^2 typed where m^2 are meant. False: the caller has checked its unit (``--pcsa``, in cm^2), and
+        it is analysed whatever its size, as a computed optimum is (docs/robustness.md, "Model evaluation").
 
     Returns
     -------
@@ -253,8 +260,8 @@ def coupled_stability_at(model: Model, eccentricity: float, lordosis: float, pcs
     Acta Orthop Scand Suppl 230:1-54. doi:10.3109/17453678909154177.
     """
     e, lam = float(eccentricity), float(lordosis)
-    given = pcsa is not None
-    pcsa = expand_pcsa(model, pcsa) if given else minimum_stabilising_pcsa(model, e, lam)
+    given = pcsa is not None and slip_check  # a computed optimum, or a checked unit: any size is an answer
+    pcsa = expand_pcsa(model, pcsa, given=given) if pcsa is not None else minimum_stabilising_pcsa(model, e, lam)
     data = coupled_data(model, e, lam)
     coefficients = data.coefficients
     local = least_local_stiffness(model, e, lam, pcsa, given=given)  # the SDP, outside numpy's guard
