@@ -34,8 +34,8 @@ docs/reproduction.md checks (docs/model.md, "The default model"). ``"default"``,
 anatomical, uncalibrated estimate, stays selectable by name."""
 
 PRESET_GUIDANCE = (
-    "wagner2012 (used when none is named): 24 kg, its unstated parameters calibrated to the paper's landmarks, to compare "
-    "with the paper; default: the anatomical, uncalibrated 40 kg estimate, the start for one's own subject "
+    "wagner2012 (used when none is named): 24 kg, its unstated parameters calibrated to the paper's landmarks, "
+    "to compare with the paper; default: the anatomical, uncalibrated 40 kg estimate, the start for one's own subject "
     "(set its mass and attachments)"
 )
 """Which preset to use, in one sentence: the ``--preset`` help, ``spinectl config show`` and the README."""
@@ -375,7 +375,8 @@ def dump_toml(model: Model, origins: dict | None = None) -> str:
 
 def _section(notes: dict, prefix: str) -> dict:
     """The notes of one table (``body``, ``muscles.straight``) by field name."""
-    return {dotted.removeprefix(f"{prefix}."): note for dotted, note in notes.items() if dotted.startswith(f"{prefix}.")}
+    start = f"{prefix}."
+    return {dotted.removeprefix(start): note for dotted, note in notes.items() if dotted.startswith(start)}
 
 
 def value_notes(model: Model, origins: dict) -> dict:
