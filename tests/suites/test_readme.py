@@ -25,7 +25,7 @@ ROOT = README.parent
 SLOW = {
     "reproduce": "the paper's 81 x 81 study; tests/cli/test_reproduce_cmd.py and test_consistency.py run it coarse",
     "study": "starts a local Dask cluster; tests/suites/test_examples.py runs examples/study.toml in-process",
-    "calibrate": "3-4 minutes; tests/paper/test_calibration.py runs a short fit",
+    "calibrate": "about a minute; tests/paper/test_calibration.py runs a short fit",
     "explore": "serves until interrupted; tests/explore/test_browser.py serves it and drives it in Chromium",
 }
 """README commands not run here (too long, or a server), and where they are tested."""
