@@ -306,8 +306,8 @@ class StabilityResult:
             The text ``spinectl stability`` prints (no final newline).
         """
 
-        def complex_column(z: complex) -> str:
-            return f"{z.real:9.3f}{z.imag:+9.3f}j"
+        def complex_column(z: complex) -> str:  # a real root as a real number (its imaginary part is exactly 0)
+            return f"{z.real:9.3f}{z.imag:+9.3f}j" if z.imag else f"{z.real:9.3f}{'':10}"
 
         pcsa = m2_to_cm2(self.pcsa)
         given = pcsa_source == "given"
