@@ -239,8 +239,8 @@ def _draw_counter_torques(ax, model: Model, cors: np.ndarray, counter_torque: np
 
     A positive (counter-clockwise) torque turns the part above CoR k towards -x
     (docs/model.md, "Frame and units"), so its arrow goes from the CoR to -x over an arc that turns
-    counter-clockwise (a negative one to +x, clockwise); the chord is TORQUE_SCALE per N m long. Its label stands beyond the tip, clear of the spine's parts at that
-    height (:func:`_beyond`).
+    counter-clockwise (a negative one to +x, clockwise); the chord is TORQUE_SCALE per N m long. Its
+    label stands beyond the tip, clear of the spine's parts at that height (:func:`_beyond`).
     """
     arrows = {}
     for name, (x, y), torque in zip(model.geometry.cor_names, cors, counter_torque, strict=True):
