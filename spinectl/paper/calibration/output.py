@@ -83,7 +83,7 @@ def preset_toml(result: CalibrationResult, command: str, date: str | None = None
 
 
 def _fitted(result: CalibrationResult) -> dict:
-    """ "fitted by this calibration" by dotted field of each free parameter and the convention (dump_toml's notes)."""
+    """The note "fitted by this calibration" by dotted field of each free parameter and of the convention."""
     fields = {"passive.convention"}
     for p in result.parameters:
         for path in p.paths:  # "body.mass", "muscles.0.upper.1": a pair by index, a coordinate by index
