@@ -14,8 +14,9 @@ per subpackage, is in CONTRIBUTING.md ("Architecture"):
 - :mod:`spinectl.paper`: the paper's study, its landmarks and verdicts;
 - :mod:`spinectl.cli`: the ``spinectl`` command.
 
-The optimiser and the edges are not imported here (cvxpy, matplotlib and
-xarray take a second to import): ``from spinectl import optimise``.
+The subpackages are imported when first used (PEP 562), not by ``import spinectl``
+(cvxpy, matplotlib and xarray take a second to import): ``spinectl.paper.reproduce(...)``
+and ``from spinectl import optimise`` both work, and ``spinectl --help`` stays quick.
 """
 
 import importlib
@@ -51,6 +52,9 @@ __all__ = [
     "segment_coefficients",
     "segment_stability",
 ]
+
+SUBPACKAGES = ("model", "optimise", "reflex", "landscape", "paper", "explore", "cli")
+"""The layers, reachable as ``spinectl.<name>`` after ``import spinectl``, each imported on first use."""
 
 MOVED = {
     "params": "spinectl.model.params",
@@ -97,7 +101,8 @@ def _moved(old: str, stacklevel: int):
 
 
 def __getattr__(name: str):
-    """The moved modules of :data:`MOVED`, with a :class:`DeprecationWarning` (PEP 562).
+    """The subpackages of :data:`SUBPACKAGES`, imported on first use, and the moved modules of :data:`MOVED`,
+    with a :class:`DeprecationWarning` (PEP 562).
 
     Parameters
     ----------
@@ -107,16 +112,29 @@ def __getattr__(name: str):
     Returns
     -------
     module
-        The module that ``spinectl.<name>`` now is.
+        The subpackage ``spinectl.<name>``, or the module that ``spinectl.<name>`` now is.
 
     Raises
     ------
     AttributeError
-        ``name`` is neither an attribute nor a moved module.
+        ``name`` is neither an attribute, a subpackage nor a moved module.
     """
+    if name in SUBPACKAGES:
+        return importlib.import_module(f"{__name__}.{name}")  # the import sets it as an attribute too
     if name not in MOVED:
         raise AttributeError(f"module 'spinectl' has no attribute {name!r}")
     return _moved(name, stacklevel=3)
+
+
+def __dir__() -> list[str]:
+    """The package's names with the subpackages that :func:`__getattr__` imports on first use (tab completion).
+
+    Returns
+    -------
+    list of str
+        The sorted names.
+    """
+    return sorted(set(globals()) | set(SUBPACKAGES))
 
 
 class _MovedModules(importlib.abc.MetaPathFinder, importlib.abc.Loader):

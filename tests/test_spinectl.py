@@ -80,3 +80,21 @@ def test_import_statements_of_old_names_give_the_new_module_with_a_warning(state
     assert ok.returncode == 0, ok.stderr
     warned = _python(statement, "-W", "error::DeprecationWarning")
     assert warned.returncode != 0 and f"has moved to {new.rsplit('.', 1)[0]}" in warned.stderr
+
+
+def test_the_subpackages_are_reachable_after_import_spinectl_and_imported_on_first_use():
+    """``import spinectl`` then ``spinectl.paper``, ``.optimise``, ... (the README's inline API): each layer is an
+    attribute, imported only when first used, so that ``import spinectl`` loads none but the two its own API comes
+    from (model, reflex), nor cvxpy or xarray, and ``spinectl.explore`` loads no Panel (only its app module does)."""
+    check = (
+        "import sys, spinectl; names = spinectl.SUBPACKAGES\n"
+        "lazy = {f'spinectl.{n}' for n in names if n not in ('model', 'reflex')}\n"
+        "assert not lazy & set(sys.modules), sorted(lazy & set(sys.modules))\n"
+        "assert not {'cvxpy', 'xarray', 'matplotlib'} & set(sys.modules)\n"
+        "assert set(names) <= set(dir(spinectl))\n"
+        "assert callable(spinectl.paper.reproduce) and callable(spinectl.optimise.solve_point)\n"
+        "assert spinectl.landscape.__name__ == 'spinectl.landscape' and spinectl.explore.point_numbers\n"
+        "assert 'panel' not in sys.modules\n"
+    )
+    done = _python(check, "-W", "error::DeprecationWarning")
+    assert done.returncode == 0, done.stderr

@@ -17,6 +17,7 @@ import difflib
 import importlib
 import logging
 import re
+import shlex
 import sys
 import warnings
 
@@ -86,7 +87,10 @@ class _Parser(argparse.ArgumentParser):
 
     def parse_args(self, args=None, namespace=None):
         """As argparse's, but an unknown option is reported by the command that was used, with a "did you mean"."""
-        parsed, extras = self.parse_known_args(args, namespace)
+        try:
+            parsed, extras = self.parse_known_args(args, namespace)
+        except _UsageError as exc:  # options before the command: say so instead of "invalid choice: '35'"
+            raise _UsageError(self._misplaced(sys.argv[1:] if args is None else list(args)) or str(exc)) from None
         if extras:
             command = self._command(parsed) or self
             command.error(f"unrecognized arguments: {' '.join(extras)}{command.suggestion(extras)}")
@@ -99,6 +103,30 @@ class _Parser(argparse.ArgumentParser):
                 return action.choices.get(getattr(parsed, action.dest, None))
         return None
 
+    def _misplaced(self, argv: list[str]) -> str:
+        """``"options go after the command: spinectl stability --set ..."`` where options precede it, else ``""``.
+
+        ``spinectl --set body.mass=35 stability`` read ``body.mass=35`` as the command ("invalid choice").
+
+        Parameters
+        ----------
+        argv : list of str
+            The arguments after ``spinectl``.
+
+        Returns
+        -------
+        str
+            The hint, with the command line reordered where a command is among ``argv``.
+        """
+        commands = next((a.choices for a in self._actions if isinstance(a, argparse._SubParsersAction)), {})
+        first = next((k for k, word in enumerate(argv) if word in commands), None)
+        before = argv[:first] if first is not None else argv
+        if not any(word.startswith("-") and word not in ("-h", "--help", "--version") for word in before):
+            return ""
+        if first is None:
+            return "options go after the command: spinectl COMMAND [OPTIONS] (spinectl --help lists the commands)"
+        return f"options go after the command: {shlex.join(['spinectl', argv[first], *before, *argv[first + 1 :]])}"
+
     def suggestion(self, words) -> str:
         """``"; did you mean --delay?"`` for the first of ``words`` close to an option of this parser, else ``""``.
 
@@ -110,12 +138,15 @@ class _Parser(argparse.ArgumentParser):
         Returns
         -------
         str
-            The hint (difflib's closest option string), or an empty string.
+            The hint (the option that differs only in case, else difflib's closest option string), or an
+            empty string.
         """
         options = [o for o in self._option_string_actions if o.startswith("--")]
         for word in words:
             if word.startswith("-") and not self._negative_number_matcher.match(word):
-                close = difflib.get_close_matches(word.split("=", 1)[0], options, n=1, cutoff=0.75)
+                given = word.split("=", 1)[0]
+                same = [o for o in options if o.casefold() == given.casefold()]  # --e for --E before --set
+                close = same or difflib.get_close_matches(given, options, n=1, cutoff=0.75)
                 if close:
                     return f"; did you mean {close[0]}?"
         return ""

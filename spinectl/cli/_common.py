@@ -10,7 +10,7 @@ from .. import jsondoc
 from .._validate import printable
 from ..atomic import atomic_write_text
 from ..errors import ParameterError
-from ..model.config import DEFAULT_PRESET, apply_overrides, load_config, set_parameters
+from ..model.config import DEFAULT_PRESET, PRESET_GUIDANCE, apply_overrides, load_config, set_parameters
 from ..model.params import Model
 from ..units import CM_PER_M, centimetre_slip, cm2_to_m2, square_metre_slip
 
@@ -29,7 +29,11 @@ def add_model_options(parser: argparse.ArgumentParser) -> None:
         metavar="FILE",
         help="TOML file overriding the preset's parameters ([[muscles]] merge with the preset's by name)",
     )
-    group.add_argument("--preset", metavar="NAME", help=f"built-in parameter preset (default: {DEFAULT_PRESET!r})")
+    group.add_argument(
+        "--preset",
+        metavar="NAME",
+        help=f"built-in parameter preset (default: {DEFAULT_PRESET!r}): {PRESET_GUIDANCE.replace('%', '%%')}",
+    )
     add_set_option(group)
 
 
@@ -50,6 +54,59 @@ def add_set_option(group) -> None:
         help="set one parameter, validated as in a TOML file, e.g. --set passive.stiffness=15 "
         "or --set muscles.straight.spread=0.02 (repeatable; 'spinectl config show' lists every field)",
     )
+
+
+def add_stiffness_option(parser: argparse.ArgumentParser) -> None:
+    """``--K`` [N m/rad], an alias of ``--set passive.stiffness=K``, into ``args.K`` (:func:`body_aliases`).
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        The sub-command's parser.
+    """
+    parser.add_argument(
+        "--K",
+        type=finite_float("--K"),
+        help="passive stiffness K [N m/rad] (alias of --set passive.stiffness=K; not both)",
+    )
+
+
+def add_mass_option(parser: argparse.ArgumentParser) -> None:
+    """``--mass`` [kg], an alias of ``--set body.mass=M``, into ``args.mass`` (:func:`body_aliases`).
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        The sub-command's parser; wherever it has ``--K``.
+    """
+    parser.add_argument(
+        "--mass",
+        type=finite_float("--mass"),
+        metavar="KG",
+        help="upper-body mass m [kg] (alias of --set body.mass=M; not both)",
+    )
+
+
+def body_aliases(args: argparse.Namespace) -> dict:
+    """The ``--K`` and ``--mass`` given, for :func:`load_model`'s ``aliases``.
+
+    ``spinectl sweep``'s ``--K`` is a list (an axis of its own), not an alias: only a single value is one.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments, with ``mass`` and possibly ``K``.
+
+    Returns
+    -------
+    dict
+        ``(option, value)`` by dotted field.
+    """
+    stiffness = getattr(args, "K", None)
+    aliases = {"body.mass": ("--mass", args.mass)}
+    if not isinstance(stiffness, list):
+        aliases["passive.stiffness"] = ("--K", stiffness)
+    return aliases
 
 
 def add_position_options(parser: argparse.ArgumentParser) -> None:

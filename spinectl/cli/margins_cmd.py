@@ -7,7 +7,17 @@ from pathlib import Path
 
 from ..atomic import check_distinct
 from ..errors import ParameterError
-from ._common import add_model_options, add_position_options, check_position, emit_json, finite_float, load_model
+from ._common import (
+    add_mass_option,
+    add_model_options,
+    add_position_options,
+    add_stiffness_option,
+    body_aliases,
+    check_position,
+    emit_json,
+    finite_float,
+    load_model,
+)
 
 
 def register(sub) -> None:
@@ -48,6 +58,8 @@ def register(sub) -> None:
         action="store_true",
         help="the whole chain under a diagonal reflex: exact delay margin, Pade margin, disk margins (docs/chain.md)",
     )
+    add_stiffness_option(parser)
+    add_mass_option(parser)
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     parser.add_argument("--plot", metavar="DIR", help="write bode.png, nyquist.png and response.png into DIR")
     add_model_options(parser)
@@ -85,6 +97,7 @@ def run(args) -> int:
 
         check_distinct({"--plot": [Path(args.plot, name) for name in PLOT_FILES]}, {"--config": args.config})
     aliases = {dotted: ("--" + option.replace("_", "-"), getattr(args, option)) for option, dotted in OVERRIDES}
+    aliases |= body_aliases(args)  # --K and --mass, as on stability and sweep
     model = load_model(args, aliases)  # --kp and --kd go to analyse, which checks them
     check_position(model, args)
     if args.coupled:

@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 from ._common import (
+    add_mass_option,
     add_model_options,
     add_position_options,
+    body_aliases,
     check_position,
     emit_json,
     finite_float,
@@ -42,6 +44,7 @@ def register(sub) -> None:
         type=finite_float("--K"),
         help="passive stiffness K [N m/rad] (alias of --set passive.stiffness=K; not both)",
     )
+    add_mass_option(parser)
     parser.add_argument(
         "--coupled",
         action="store_true",
@@ -69,7 +72,7 @@ def run(args) -> int:
     """
     from ..optimise.stabilising import NoStabilisingActivation, stability_at
 
-    model = load_model(args, {"passive.stiffness": ("--K", args.K)})
+    model = load_model(args, body_aliases(args))
     check_position(model, args)
     given = args.pcsa is not None  # else the minimum stabilising PCSA
     analysis = stability_at

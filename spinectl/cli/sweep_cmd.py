@@ -5,7 +5,7 @@ from __future__ import annotations
 import time
 
 from ..atomic import check_distinct
-from ._common import add_model_options, float_list, load_model, refuse_set_twice
+from ._common import add_mass_option, add_model_options, body_aliases, float_list, load_model, refuse_set_twice
 
 DEFAULT_AXIS = "0:0.08:81"
 """The paper's grid: 0 to 8 cm in 1 mm steps (paper, Methods)."""
@@ -41,6 +41,7 @@ def _options(parser) -> None:
         metavar="NMRAD,...",
         help="passive stiffness K [N m/rad]; several values give a K dimension (default: the model's)",
     )
+    add_mass_option(parser)
     parser.add_argument("--method", choices=sweep.METHODS, default="fast", help="solution path (default: fast)")
     parser.add_argument("--chunk-size", type=int, default=sweep.DEFAULT_CHUNK, help="grid points per stacked solve")
     parser.add_argument(
@@ -70,7 +71,7 @@ def run(args) -> int:
     check_distinct({"--out": args.out}, {"--config": args.config})
     if args.K:
         refuse_set_twice(args.assignments or [], {"passive.stiffness": "--K"})
-    model = load_model(args)
+    model = load_model(args, body_aliases(args))
     geometry = model.geometry
     e_axis = sweep.parse_grid(args.E, "--E", geometry.eccentricity_range)
     l_axis = sweep.parse_grid(args.Lambda, "--Lambda", geometry.lordosis_range)

@@ -384,13 +384,16 @@ def _convert(hint, value, path: str):
     return value
 
 
-def table_lines(obj) -> list[str]:
+def table_lines(obj, notes: dict | None = None) -> list[str]:
     """The fields of a dataclass as the lines of a TOML table, each after a comment with its unit and doc.
 
     Parameters
     ----------
     obj : dataclass instance
         One section of a model, e.g. its ``body``.
+    notes : dict, optional
+        A comment line by field name, put after the doc and before the value (what this value is, where the
+        doc describes the default).
 
     Returns
     -------
@@ -408,6 +411,8 @@ def table_lines(obj) -> list[str]:
         doc = f.metadata.get("doc", "")
         comment = f"[{unit}] {doc}" if unit else doc
         lines.append(f"# {comment}")
+        if notes and f.name in notes:
+            lines.append(f"# {notes[f.name]}")
         lines.append(f"{f.name} = {_toml_value(getattr(obj, f.name))}")
     return lines
 

@@ -322,7 +322,7 @@ def expand_pcsa(model: Model, pcsa, *, given: bool = True) -> np.ndarray:
     elif pcsa.shape[-1:] != (2 * n_pairs,):
         raise ParameterError(
             "pcsa",
-            f"must have {n_pairs} values (one per pair) or {2 * n_pairs} (one per muscle); got {pcsa.shape[-1:]}",
+            f"must have {n_pairs} values (one per pair) or {2 * n_pairs} (one per muscle); got {_count(pcsa)}",
         )
     if not np.all(np.isfinite(pcsa)) or np.any(pcsa < 0):
         raise ParameterError("pcsa", "must be finite and >= 0")
@@ -339,3 +339,11 @@ def expand_pcsa(model: Model, pcsa, *, given: bool = True) -> np.ndarray:
             f"m^2; if you meant {largest:g} cm^2, pass {largest * 1e-4:g} (spinectl.units.cm2_to_m2)",
         )
     return pcsa
+
+
+def _count(values: np.ndarray) -> str:
+    """How many values an array holds, in words: ``"2 values"``, ``"one number"``, ``"2 per row (shape (4, 2))"``."""
+    if values.ndim == 0:
+        return "one number, not one per pair"
+    count = f"{values.shape[-1]} value{'s' if values.shape[-1] != 1 else ''}"
+    return count if values.ndim == 1 else f"{values.shape[-1]} per row (shape {values.shape})"

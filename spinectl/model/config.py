@@ -13,6 +13,7 @@ from __future__ import annotations
 import dataclasses
 import difflib
 import hashlib
+import textwrap
 import tomllib
 import warnings
 from importlib import resources
@@ -31,6 +32,13 @@ DEFAULT_PRESET = "wagner2012"
 ``spinectl reproduce`` runs, so that every answer belongs to the model whose landmarks
 docs/reproduction.md checks (docs/model.md, "The default model"). ``"default"``, the
 anatomical, uncalibrated estimate, stays selectable by name."""
+
+PRESET_GUIDANCE = (
+    "wagner2012 (used when none is named): 24 kg, its unstated parameters calibrated to the paper's landmarks, "
+    "to compare with the paper; default: the anatomical, uncalibrated 40 kg estimate, the start for one's own subject "
+    "(set its mass and attachments)"
+)
+"""Which preset to use, in one sentence: the ``--preset`` help, ``spinectl config show`` and the README."""
 
 MUSCLES_MODES = ("merge", "replace")
 """How a file's ``[[muscles]]`` tables combine with the preset's pairs (its key ``muscles_mode``):
@@ -332,31 +340,122 @@ def _toml_value(text: str):
     return data["value"] if list(data) == ["value"] else text
 
 
-def dump_toml(model: Model) -> str:
+def dump_toml(model: Model, origins: dict | None = None) -> str:
     """The fully resolved parameter set as TOML, with units and docs as comments.
 
     Parameters
     ----------
     model : Model
         The parameters to write.
+    origins : dict, optional
+        Where each value comes from, by dotted field (``"body.mass"``, ``"muscles.straight.upper"``), e.g.
+        ``"calibrated (spinectl calibrate)"``. A field given here whose value differs from the ``default``
+        preset's gets a comment saying so (:func:`value_notes`): a field's doc describes the default, and
+        its comment must not stand above another value unremarked.
 
     Returns
     -------
     str
         TOML text that :func:`~spinectl.model._toml.from_dict` reads back to ``model`` (and
         :func:`load_config` when its pairs include the preset's); every field is preceded by a
-        comment with its unit in brackets and its ``doc`` metadata. It names no source, so that
-        what it identifies (a study's digest) depends on the parameters alone.
+        comment with its unit in brackets and its ``doc`` metadata. Without ``origins`` it names no
+        source, so that what it identifies (a study's digest) depends on the parameters alone.
     """
+    notes = value_notes(model, origins) if origins else {}
     lines = ["# spinectl model parameters (SI units unless a comment says otherwise)", ""]
     for f in dataclasses.fields(model):
         value = getattr(model, f.name)
         if isinstance(value, tuple):
             for item in value:
-                lines += [f"[[{f.name}]]", *table_lines(item), ""]
+                lines += [f"[[{f.name}]]", *table_lines(item, _section(notes, f"{f.name}.{item.name}")), ""]
         else:
-            lines += [f"[{f.name}]", *table_lines(value), ""]
+            lines += [f"[{f.name}]", *table_lines(value, _section(notes, f.name)), ""]
     return "\n".join(lines)
+
+
+def _section(notes: dict, prefix: str) -> dict:
+    """The notes of one table (``body``, ``muscles.straight``) by field name."""
+    start = f"{prefix}."
+    return {dotted.removeprefix(start): note for dotted, note in notes.items() if dotted.startswith(start)}
+
+
+def value_notes(model: Model, origins: dict) -> dict:
+    """A comment for each field of ``origins`` whose value differs from the ``default`` preset's.
+
+    The docs of the fields describe the anatomical default (``mass``: "spinectl's default, 40 kg, ...");
+    beside another value the comment says what this one is, where it comes from, and the default's
+    value, each to 6 significant digits (what a fitted or typed value means; the value line keeps
+    every digit, so that the file reads back to the same model).
+
+    Parameters
+    ----------
+    model : Model
+    origins : dict
+        Where the value comes from by dotted field, e.g. ``{"body.mass": "calibrated (preset wagner2012)"}``.
+
+    Returns
+    -------
+    dict
+        ``"This value: 24.0566 kg (calibrated ...); the default preset's: 40 kg."`` by dotted field.
+    """
+    ours, default = _parameters(model), _parameters(load_preset("default"))
+    notes = {}
+    for dotted, origin in origins.items():
+        if dotted in ours and dotted in default and ours[dotted][1] != default[dotted][1]:
+            unit = ours[dotted][0]
+            unit = f" {unit}" if unit and unit != "1" else ""
+            here, there = _shown(ours[dotted][1]), _shown(default[dotted][1])
+            notes[dotted] = f"This value: {here}{unit} ({origin}); the default preset's: {there}{unit}."
+    return notes
+
+
+def model_origins(model: Model) -> dict:
+    """Where each parameter of a loaded model comes from: ``--set``, its file, or its preset.
+
+    Parameters
+    ----------
+    model : Model
+        A model of :func:`load_config` or :func:`apply_overrides` (its source names them).
+
+    Returns
+    -------
+    dict
+        By dotted field: ``"set on the command line"``, ``"from FILE"`` or ``"preset NAME: <what the preset
+        file's first line says it is>"`` (e.g. calibrated against the paper's landmarks).
+    """
+    source = source_of(model)
+    ours = _parameters(model)
+    preset = _parameters(load_preset(source.preset)) if source.preset in list_presets() else {}
+    about = preset_description(source.preset) if preset else ""
+    origins = {}
+    for dotted, (_, value) in ours.items():
+        if dotted in source.overridden:
+            origins[dotted] = "set on the command line"
+        elif dotted not in preset or preset[dotted][1] != value:
+            origins[dotted] = f"from {source.config}" if source.config else "set in Python"
+        elif preset:
+            origins[dotted] = f"preset {source.preset}" + (f": {about}" if about else "")
+    return origins
+
+
+def preset_description(name: str) -> str:
+    """What the preset file says it is, from its first comment line (``"calibrated against ..."``), or ``""``.
+
+    Parameters
+    ----------
+    name : str
+        One of :func:`list_presets`.
+
+    Returns
+    -------
+    str
+        The line without ``# spinectl preset`` and its final full stop.
+    """
+    text = resources.files(PRESET_PACKAGE).joinpath(f"{name}.toml").read_text(encoding="utf-8")
+    first = text.splitlines()[0] if text else ""
+    if not first.startswith("# spinectl preset "):
+        return ""
+    return first.removeprefix("# spinectl preset ").rstrip(".")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -477,12 +576,13 @@ def show_toml(model: Model) -> str:
     return "\n".join(
         [
             f"# model: {header(model)}",
+            *textwrap.wrap(f"Presets: {PRESET_GUIDANCE}.", 110, initial_indent="# ", subsequent_indent="# "),
             '# A --config file gives any subset of these parameters, over its preset (preset = "NAME").',
             "# Its [[muscles]] tables merge with the preset's pairs by name: a known name changes the keys",
             '# given, a new name adds a pair. muscles_mode = "replace" (as here, where every pair is listed)',
             "# puts the file's pairs in place of the preset's; spinectl warns if that drops a preset's pair.",
             'muscles_mode = "replace"',
             "",
-            dump_toml(model),
+            dump_toml(model, model_origins(model)),
         ]
     )

@@ -319,8 +319,8 @@ class StabilityResult:
             The text ``spinectl stability`` prints (no final newline).
         """
 
-        def complex_column(z: complex) -> str:
-            return f"{_fixed(z.real, '9', 3)}{_fixed(z.imag, '+9', 3)}j"
+        def complex_column(z: complex) -> str:  # a real root as a real number (its imaginary part is exactly 0)
+            return f"{_fixed(z.real, '9', 3)}{_fixed(z.imag, '+9', 3)}j" if z.imag else f"{_fixed(z.real, '9', 3)}{'':10}"
 
         pcsa = m2_to_cm2(self.pcsa)
         given = pcsa_source == "given"

@@ -53,6 +53,10 @@ VERTEBRA_FILL = 0.7
 """Fraction of the height between two CoRs that a vertebral body fills (the rest is the disc)."""
 TORQUE_SCALE = 0.002
 """Length of a counter-torque arrow per N m [m/(N m)]: 10 N m are drawn as 2 cm."""
+
+TORQUE_RISE = 0.006
+"""Height [m] of a counter-torque arrow's arc above its chord, a quarter of a chord at most: the same for
+every torque, so that a long arrow bends as a short one does and its arc stays clear of the labels above it."""
 LINE_SAMPLES = 101
 """Points of the drawn spine line."""
 
@@ -234,21 +238,32 @@ def _dimension(ax, start, end, text: str, gid: str, offset) -> None:
 
 
 def _draw_counter_torques(ax, model: Model, cors: np.ndarray, counter_torque: np.ndarray) -> dict:
-    """Each CT_k as a horizontal arrow at its CoR: the push it gives the part above; returns the arrows by CoR.
+    """Each CT_k as a curved arrow from its CoR: the turn it gives the part above; returns the arrows by CoR.
 
     A positive (counter-clockwise) torque turns the part above CoR k towards -x
-    (docs/model.md, "Frame and units"), so it points to -x; its length is
-    TORQUE_SCALE per N m. Its label stands beyond the tip, clear of the spine's parts at that
-    height (:func:`_beyond`).
+    (docs/model.md, "Frame and units"), so its arrow goes from the CoR to -x over an arc that turns
+    counter-clockwise (a negative one to +x, clockwise); the chord is TORQUE_SCALE per N m long. Its
+    label stands beyond the tip, clear of the spine's parts at that height (:func:`_beyond`).
     """
     arrows = {}
     for name, (x, y), torque in zip(model.geometry.cor_names, cors, counter_torque, strict=True):
         dx = -torque * TORQUE_SCALE * CM_PER_M
+        # an arc over the CoR (arc3 bends to the left of the way from start to tip): counter-clockwise for a
+        # positive torque, clockwise for a negative one, as a torque is drawn (a straight arrow read as a force)
+        bend = min(0.5, 2 * TORQUE_RISE * CM_PER_M / abs(dx)) if dx else 0.0  # the arc rises TORQUE_RISE at most
+        bend = bend if dx < 0 else -bend
         arrows[name] = ax.annotate(
             "",
             xy=(x + dx, y),
             xytext=(x, y),
-            arrowprops={"arrowstyle": "-|>", "color": "crimson", "lw": 1.4, "shrinkA": 0, "shrinkB": 0},
+            arrowprops={
+                "arrowstyle": "-|>",
+                "color": "crimson",
+                "lw": 1.4,
+                "shrinkA": 0,
+                "shrinkB": 0,
+                "connectionstyle": f"arc3,rad={bend}",
+            },
             gid=f"counter torque {name}",
             zorder=3,
         )

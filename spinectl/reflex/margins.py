@@ -363,10 +363,11 @@ class MarginsReport:
             The text ``spinectl margins`` prints (no final newline).
         """
         point = self.point
+        solved = "" if point.status == "optimal" else f" (minimum PCSA: {point.status})"  # was "(optimum: optimal)"
         lines = [
             self.model.get("header", "preset unknown"),
             f"E = {point.eccentricity * 100:.2f} cm, Lambda = {point.lordosis * 100:.2f} cm, "
-            f"activation {point.activation:g} x minimum PCSA (optimum: {point.status}), "
+            f"activation {point.activation:g} x minimum PCSA{solved}, "
             f"delay {self.delay:g} s, activation lag {self.activation_time_constant:g} s, "
             f"Pade order {self.pade_order}, gains: {self.gains}",
             "",

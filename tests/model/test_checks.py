@@ -14,7 +14,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from spinectl import load_preset
-from spinectl.errors import ModelError
+from spinectl.errors import ModelError, ParameterError
 from spinectl.model import checks, geometry
 from spinectl.model.params import Geometry, Model, MusclePair
 
@@ -161,3 +161,21 @@ def test_coordinates_near_overflow_give_the_same_verdict(eccentricity, x):
         assert verdict.startswith("muscles.0.upper: ") and "rotation L1L2 " in verdict
     else:
         assert verdict is None
+
+
+@pytest.mark.parametrize(
+    ("pcsa", "said"),
+    [
+        ([1e-3, 1e-3], "got 2 values"),
+        ([1e-3], "got 1 value"),
+        (1e-3, "got one number"),
+        ([[1e-3] * 4] * 2, "got 4 per row (shape (2, 4))"),
+    ],
+)
+def test_a_pcsa_of_the_wrong_length_is_counted_in_words(pcsa, said):
+    """The count given, in words (was numpy's shape, ``got (2,)``); the preset has 3 pairs, 6 muscles."""
+    from spinectl.model.stability import segment_stability
+
+    with pytest.raises(ParameterError, match=r"must have 3 values \(one per pair\) or 6 \(one per muscle\); ") as err:
+        segment_stability(load_preset("wagner2012"), 0.03, 0.04, pcsa)
+    assert said in str(err.value) and "(2,)" not in str(err.value)

@@ -144,3 +144,35 @@ def test_a_file_with_a_byte_order_mark_reads_as_without(tmp_path):
     grid = "E = { start = 0.0, stop = 0.08, num = 3 }\nLambda = { start = 0.0, stop = 0.08, num = 3 }\n"
     study.write_bytes(b"\xef\xbb\xbf[axes]\n" + grid.encode())
     assert load_study(study).grid_shape == (3, 3)
+
+
+@pytest.mark.parametrize("preset", config.list_presets())
+def test_show_says_what_each_value_is_where_it_is_not_the_defaults(preset):
+    """``config show``: a field's doc describes the default preset's value (mass: "spinectl's default, 40 kg");
+    above every value that differs from it, a comment gives this value to 6 significant digits, where it
+    comes from (the preset file's own first line: calibrated) and the default's. The differing fields are
+    found by comparing the two presets' parameters here; nothing else gets such a comment."""
+    model = config.load_preset(preset)
+    lines = config.show_toml(model).splitlines()
+    ours, default = config._parameters(model), config._parameters(config.load_preset("default"))
+    differing = {d for d in ours if d in default and ours[d][1] != default[d][1]}
+    assert len([line for line in lines if line.startswith("# This value: ")]) == len(differing)
+    assert (preset == "default") == (not differing)
+    if "body.mass" in differing:
+        row = lines.index(f"mass = {model.body.mass!r}")
+        assert lines[row - 1] == (
+            f"# This value: {model.body.mass:.6g} kg (preset {preset}: calibrated against the landmarks of "
+            "Wagner et al. (2012); docs/reproduction.md); the default preset's: 40 kg."
+        )
+
+
+def test_show_names_a_value_set_on_the_command_line_and_the_presets_to_choose_from():
+    model = config.apply_overrides(config.load_preset("wagner2012"), ["body.mass=35"])
+    text = config.show_toml(model)
+    assert "# This value: 35 kg (set on the command line); the default preset's: 40 kg.\nmass = 35.0" in text
+    assert "Presets: wagner2012" in text and "one's own" in text
+
+
+def test_dump_toml_without_origins_names_no_source(model):
+    """What a study's digest hashes depends on the parameters alone: no value notes without ``origins``."""
+    assert "This value" not in config.dump_toml(config.apply_overrides(model, ["body.mass=35"]))

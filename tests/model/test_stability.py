@@ -208,6 +208,23 @@ def test_table(model):
     assert "(minimum stabilising, chosen activation)" in result.table(model, pcsa_source="min_pcsa")
 
 
+def test_table_prints_real_eigenvalues_as_real_numbers():
+    """A real root (discriminant D^2 + 4 theta S >= 0, imaginary part exactly 0) is printed as a real number,
+    not ``0.608 +0.000j``; a complex pair keeps its imaginary parts. Which is which: from the eigenvalues
+    (the README's point in the preset wagner2012 has both kinds)."""
+    from spinectl.model.config import load_preset
+
+    model = load_preset("wagner2012")
+    result = segment_stability(model, 0.03, 0.04, [10e-4, 10e-4, 10e-4])
+    rows = result.table(model).splitlines()[5 : 5 + len(result.segment_names)]
+    for row, eig in zip(rows, result.eigenvalues, strict=True):
+        complex_pair = bool(np.any(eig.imag))
+        assert row.count("j") == (2 if complex_pair else 0), row
+        if not complex_pair:
+            assert [float(w) for w in row.split()[4:6]] == pytest.approx(eig.real, abs=5e-4)
+    assert {bool(np.any(e.imag)) for e in result.eigenvalues} == {True, False}  # both kinds are checked here
+
+
 def test_a_result_has_no_truth_value(model):
     """``if result:`` is ambiguous (every segment or any?): a TypeError naming all_self_stable."""
     result = segment_stability(model, 0.03, 0.04, [10e-4, 10e-4, 10e-4])

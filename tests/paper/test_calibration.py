@@ -195,7 +195,8 @@ def test_independent_activation_trades_the_counter_torques_for_the_fall(model):
 
 def test_cli_writes_a_loadable_preset(tmp_path, capsys):
     """A tiny run end to end: progress on stderr, the residual table on stdout, a preset TOML whose header
-    says how it was made and which loads back as the fitted model."""
+    says how it was made, whose comment above a fitted value says it is fitted, and which loads back as the
+    fitted model."""
     out = tmp_path / "fitted.toml"
     argv = ["calibrate", "--grid", "5", "--verify-grid", "5", "--generations", "1", "--popsize", "1"]
     history = tmp_path / "history.csv"
@@ -209,6 +210,9 @@ def test_cli_writes_a_loadable_preset(tmp_path, capsys):
     text = out.read_text()
     assert text.startswith("# spinectl preset calibrated") and "--parameters mass,spread" in text
     assert "# Loss: " in text and "#   mass = " in text
+    lines = text.splitlines()  # the comment above a fitted value says so (before: the default's 40 kg alone)
+    above = lines[next(k for k, line in enumerate(lines) if line.startswith("mass = ")) - 1]
+    assert above.startswith("# This value: ") and "fitted by this calibration" in above
     loaded = config.load_config(out)
     assert loaded.passive.stiffness == 0.0 and loaded.passive.convention in grid.CONVENTIONS
     assert sorted(p.name for p in tmp_path.iterdir()) == ["fitted.toml", "history.csv"]  # atomic: nothing else

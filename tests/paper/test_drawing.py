@@ -118,6 +118,31 @@ def test_counter_torque_arrows_are_scaled_in_newton_metres(model):
         np.testing.assert_allclose(end - start, [-torque * drawing.TORQUE_SCALE, 0.0], atol=1e-12)
 
 
+def test_counter_torque_arrows_are_curved_as_torques_are_drawn(model):
+    """A torque is drawn as an arc, not as a straight arrow (which reads as a force): from the CoR to the tip
+    over an arc above them, counter-clockwise for CT_k > 0 (going to -x), clockwise for CT_k < 0 (to +x). Its
+    height over the chord: TORQUE_RISE, or a quarter of a short chord, measured on the drawn path (the
+    quadratic Bezier of matplotlib's arc3 rises half its control point's offset)."""
+    fig = drawing.draw_model(model, 0.08, 0.08, pcsa="optimum", counter_torque=True)
+    fig.draw_without_rendering()
+    ax, artists, T = fig.axes[0], _artists(fig), np.linspace(0, 1, 41)
+    checked = 0
+    for name in model.geometry.cor_names:
+        arrow = artists[f"counter torque {name}"]
+        start, end = np.array(arrow.xyann), np.array(arrow.xy)  # [cm]
+        chord = abs(end[0] - start[0])
+        if chord < 4 * drawing.TORQUE_RISE * CM:
+            continue  # the head is as large as the arc
+        curve = [point for segment, _ in arrow.arrow_patch.get_path().iter_bezier() for point in segment(T)]
+        path = ax.transData.inverted().transform(np.array(curve))  # the drawn curve, not its control points
+        along = path[(path[:, 0] - start[0]) * (end[0] - start[0]) > 0]  # the arc, without the start
+        rise = along[:, 1].max() - start[1]
+        assert rise == pytest.approx(drawing.TORQUE_RISE * CM, rel=0.15), name
+        assert along[:, 1].min() > start[1] - 0.3, name  # above the chord: the head dips a little at the tip
+        checked += 1
+    assert checked >= 2
+
+
 def test_the_optimum_is_the_default_activation_of_the_cli_and_is_named(model):
     fig = drawing.draw_model(model, 0.03, 0.04, pcsa="optimum")
     assert "the optimum (solve_point)" in fig.axes[0].get_title()

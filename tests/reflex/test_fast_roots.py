@@ -104,7 +104,9 @@ def _separated(f, by=1e-4):
     closed form instead."""
     re, im = delay._cubic_candidates(*f)
     z = re + 1j * im
-    gap = np.abs(z[..., :, None] - z[..., None, :]) / np.maximum(np.abs(z[..., :, None]), np.abs(z[..., None, :]))
+    apart = np.abs(z[..., :, None] - z[..., None, :])
+    larger = np.maximum(np.abs(z[..., :, None]), np.abs(z[..., None, :]))
+    gap = np.divide(apart, larger, out=np.zeros_like(apart), where=larger > 0)  # two roots at 0: not apart (was 0/0)
     return bool(np.all(gap[..., [0, 0, 1], [1, 2, 2]] >= by))
 
 

@@ -151,11 +151,18 @@ def test_undefined_python_control_reading_is_none_in_the_dict(model):
     assert all(s["python_control"] is None for s in report.to_dict()["segments"])
 
 
+def test_table_names_the_minimum_pcsa_status_only_where_it_was_not_solved(model):
+    """A solved minimum PCSA goes without saying (was "(optimum: optimal)"); another status is named."""
+    report = margins.analyse(_with_reflex(model, activation=0.5), E, LAMBDA, kp=150.0, kd=20.0)
+    assert report.point.status == "optimal"
+    assert "activation 0.5 x minimum PCSA, delay" in report.table().splitlines()[1]
+
+
 def test_table(model):
     report = margins.analyse(_with_reflex(model, activation=0.0), E, LAMBDA, kp=150.0, kd=20.0)
     lines = report.table().splitlines()
     assert lines[0] == source.header(model)  # the model's line first (docs/model.md, "The default model")
-    assert lines[1].startswith("E = 3.00 cm, Lambda = 4.00 cm, activation 0 x minimum PCSA (optimum: skipped)")
+    assert lines[1].startswith("E = 3.00 cm, Lambda = 4.00 cm, activation 0 x minimum PCSA (minimum PCSA: skipped)")
     assert lines[1].endswith("gains: explicit")  # both gains given
     rows = [line for line in lines if line.split()[:1] in (["L1L2"], ["L2L3"], ["L3L4"], ["L4L5"], ["L5S1"])]
     assert len(rows) == 5 and all(row.split()[6:8] == ["150.00", "20.00"] for row in rows)

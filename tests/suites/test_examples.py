@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import pytest
@@ -60,8 +61,14 @@ def test_the_coronal_plane_runs_at_e_0_and_refuses_a_sagittal_e(capsys):
 
 @pytest.mark.parametrize("name", ["four_pairs.toml", "coronal.toml"])
 def test_config_show_of_an_example_reads_back(name, tmp_path, capsys):
-    """config show's output (every pair named) loads back to the same model."""
+    """config show's output (every pair named) loads back to the same model; the coronal file, and its shown
+    copy, replace the preset's pairs and say so (the warning the CLI prints as one line), the other is silent."""
     assert main(["config", "show", "--config", str(EXAMPLES / name)]) == 0
     shown = tmp_path / "shown.toml"
     shown.write_text(capsys.readouterr().out)
-    assert config.load_config(shown) == config.load_config(EXAMPLES / name)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        assert config.load_config(shown) == config.load_config(EXAMPLES / name)
+    dropped = [str(w.message) for w in caught if issubclass(w.category, config.ConfigWarning)]
+    assert len(dropped) == (2 if name == "coronal.toml" else 0) == len(caught), dropped
+    assert all("replaces the preset's muscle pairs" in message for message in dropped)

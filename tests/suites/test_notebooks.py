@@ -10,7 +10,13 @@ exercise the code under test and not an installed copy (checked from the kernel)
 
 from __future__ import annotations
 
+import json
 import os
+import re
+import shlex
+import shutil
+import subprocess
+import sys
 from pathlib import Path
 
 import jupytext
@@ -85,3 +91,41 @@ def test_runs(path, tmp_path, monkeypatch):
     figures = sum("image/png" in o.get("data", {}) for c in notebook.cells for o in c.get("outputs", []))
     assert figures > 0
     assert not list(tmp_path.iterdir()), "a notebook wrote files"
+
+
+def _documented(program: str) -> list[str]:
+    """The line of docs/notebooks.md's bash block that runs ``program``, as its words (comment removed)."""
+    text = (ROOT / "docs" / "notebooks.md").read_text(encoding="utf-8")
+    lines = [line for block in re.findall(r"```bash\n(.*?)```", text, flags=re.S) for line in block.splitlines()]
+    return next(shlex.split(line, comments=True) for line in lines if line.startswith(program))
+
+
+def test_the_documented_way_runs_a_notebook(tmp_path):
+    """docs/notebooks.md's command line, as written, in a folder holding the notebooks, with the extra that
+    the page names installed: it runs a notebook in the ``python3`` kernel and writes it, with its outputs
+    and no error, to its output folder, leaving the committed notebook as it was (the old advice,
+    ``jupytext --execute``, found no kernel, then no nbconvert, and wrote into notebooks/). A coarse grid
+    (``SPINECTL_NB_GRID``, which the page documents) and this checkout first on the path."""
+    argv = _documented("jupyter nbconvert")
+    assert argv[:2] == ["jupyter", "nbconvert"] and "--execute" in argv
+    (tmp_path / "notebooks").symlink_to(ROOT / "notebooks")
+    before = {p.name: p.read_bytes() for p in NOTEBOOKS}
+    env = {**os.environ, "SPINECTL_NB_GRID": "5"}
+    env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))
+    jupyter = shutil.which("jupyter") or str(Path(sys.executable).with_name("jupyter"))
+    done = subprocess.run([jupyter, *argv[1:]], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr[-3000:]
+    name = Path(next(word for word in argv if word.endswith(".ipynb"))).name
+    written = tmp_path / argv[argv.index("--output-dir") + 1] / name
+    cells = json.loads(written.read_text(encoding="utf-8"))["cells"]
+    outputs = [o for c in cells if c["cell_type"] == "code" for o in c["outputs"]]
+    assert outputs and not [o for o in outputs if o["output_type"] == "error"]
+    assert {p.name: p.read_bytes() for p in NOTEBOOKS} == before
+
+
+def test_the_documented_extra_installs_jupyterlab():
+    """``jupyter lab notebooks/``, the page's first way: the ``notebooks`` extra (in ``test`` too) brings it."""
+    assert _documented("jupyter lab")[:2] == ["jupyter", "lab"]
+    jupyter = shutil.which("jupyter") or str(Path(sys.executable).with_name("jupyter"))
+    done = subprocess.run([jupyter, "lab", "--version"], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0 and done.stdout.strip()[0].isdigit(), done.stderr

@@ -1,4 +1,5 @@
-"""README.md's examples run: every ```python block, and the spinectl commands of its ```bash blocks.
+"""README.md's examples run: every ```python block, the spinectl commands of its ```bash blocks, and the code
+named inline in its prose (```spinectl.paper.reproduce("results")```, ```spinectl config show```), as written.
 
 A command that takes minutes, or a local Dask cluster, is listed in SLOW with the test that runs it
 instead; a new command in the README must be either run here or listed there.
@@ -6,8 +7,12 @@ instead; a new command in the README must be either run here or listed there.
 
 from __future__ import annotations
 
+import json
+import os
 import re
 import shlex
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -20,7 +25,7 @@ ROOT = README.parent
 SLOW = {
     "reproduce": "the paper's 81 x 81 study; tests/cli/test_reproduce_cmd.py and test_consistency.py run it coarse",
     "study": "starts a local Dask cluster; tests/suites/test_examples.py runs examples/study.toml in-process",
-    "calibrate": "3-4 minutes; tests/paper/test_calibration.py runs a short fit",
+    "calibrate": "about a minute; tests/paper/test_calibration.py runs a short fit",
     "explore": "serves until interrupted; tests/explore/test_browser.py serves it and drives it in Chromium",
 }
 """README commands not run here (too long, or a server), and where they are tested."""
@@ -79,3 +84,62 @@ def test_every_quick_command_runs(argv, tmp_path, monkeypatch, capsys):
 def test_every_slow_command_is_known():
     """A README command is either run above or listed in SLOW with the test that covers it."""
     assert {a[0] for a in _commands() if _is_slow(a)} <= set(SLOW) | {"plot"}
+
+
+def _inline() -> list[str]:
+    """The inline code spans of the prose (outside fenced blocks), in order, each once."""
+    prose = re.sub(r"```.*?```", "", README.read_text(encoding="utf-8"), flags=re.S)
+    return list(dict.fromkeys(re.findall(r"`([^`\n]+)`", prose)))
+
+
+def _inline_api() -> list[str]:
+    """The inline Python expressions of the API: ``spinectl.NAME...``, with or without a call."""
+    return [span for span in _inline() if re.fullmatch(r"spinectl(\.\w+)+(\(.*\))?", span)]
+
+
+def test_the_readme_names_the_api_inline():
+    assert {"spinectl.DEFAULT_PRESET", 'spinectl.paper.reproduce("results")'} <= set(_inline_api())
+
+
+def test_every_inline_api_name_runs_after_import_spinectl(tmp_path):
+    """Each inline ``spinectl.x.y(...)`` of the prose is evaluated as written after a bare ``import spinectl``, in a
+    fresh interpreter (this one has imported every subpackage already, which would hide a missing lazy import),
+    in an empty folder; a call returns what it says (``reproduce`` the files it wrote, which exist)."""
+    probe = (
+        "import json, sys, spinectl\n"
+        "out = {}\n"
+        "for span in json.loads(sys.argv[1]):\n"
+        "    value = eval(span, {'spinectl': spinectl})\n"
+        "    out[span] = [str(v) for v in value] if isinstance(value, list) else repr(value)\n"
+        "print(json.dumps(out))\n"
+    )
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))}
+    done = subprocess.run(
+        [sys.executable, "-c", probe, json.dumps(_inline_api())], cwd=tmp_path, env=env, capture_output=True, text=True
+    )
+    assert done.returncode == 0, done.stderr
+    values = json.loads(done.stdout)
+    written = values['spinectl.paper.reproduce("results")']
+    assert "results/report.md" in written and all((tmp_path / path).is_file() for path in written)
+
+
+def _inline_commands() -> list[list[str]]:
+    """The inline ``spinectl ...`` commands of the prose that take arguments (a bare name like ``spinectl margins``
+    names the command and is run by the blocks above)."""
+    commands = [shlex.split(span)[1:] for span in _inline() if span.startswith("spinectl ")]
+    return [argv for argv in commands if len(argv) > 1]
+
+
+def test_the_readme_has_inline_commands():
+    assert ["config", "show"] in _inline_commands()
+
+
+@pytest.mark.parametrize("argv", [a for a in _inline_commands() if not _is_slow(a)], ids=shlex.join)
+def test_every_quick_inline_command_runs(argv, tmp_path, monkeypatch, capsys):
+    """Each quick inline command of the prose exits 0 (the slow ones are covered as :data:`SLOW` says)."""
+    monkeypatch.chdir(tmp_path)
+    assert main(argv) == 0, capsys.readouterr().err
+
+
+def test_every_slow_inline_command_is_known():
+    assert {a[0] for a in _inline_commands() if _is_slow(a)} <= set(SLOW)

@@ -79,7 +79,19 @@ def preset_toml(result: CalibrationResult, command: str, date: str | None = None
     ]
     for p, v in zip(result.parameters, best.vector, strict=True):
         header.append(f"#   {p.name} = {v:.6g} {p.unit}; [{p.lower:g}, {p.upper:g}]")
-    return "\n".join(header) + "\n" + dump_toml(result.model)
+    return "\n".join(header) + "\n" + dump_toml(result.model, _fitted(result))
+
+
+def _fitted(result: CalibrationResult) -> dict:
+    """The note "fitted by this calibration" by dotted field of each free parameter and of the convention."""
+    fields = {"passive.convention"}
+    for p in result.parameters:
+        for path in p.paths:  # "body.mass", "muscles.0.upper.1": a pair by index, a coordinate by index
+            parts = path.split(".")
+            if parts[0] == "muscles":
+                parts[1] = result.model.muscles[int(parts[1])].name
+            fields.add(".".join(part for part in parts[:3] if not part.isdigit()))
+    return dict.fromkeys(sorted(fields), "fitted by this calibration: the free parameters above")
 
 
 def history_csv(result: CalibrationResult) -> str:
