@@ -320,7 +320,8 @@ class StabilityResult:
         """
 
         def complex_column(z: complex) -> str:  # a real root as a real number (its imaginary part is exactly 0)
-            return f"{_fixed(z.real, '9', 3)}{_fixed(z.imag, '+9', 3)}j" if z.imag else f"{_fixed(z.real, '9', 3)}{'':10}"
+            real = _fixed(z.real, "9", 3)
+            return f"{real}{_fixed(z.imag, '+9', 3)}j" if z.imag else f"{real}{'':10}"
 
         pcsa = m2_to_cm2(self.pcsa)
         given = pcsa_source == "given"
