@@ -121,3 +121,11 @@ def test_without_the_extra_one_line_says_what_to_install(monkeypatch, capsys):
     assert main(["anatomy"]) == 2
     err = capsys.readouterr().err
     assert "pip install 'spinectl[anatomy]'" in err and len(err.strip().splitlines()) == 1
+
+
+def test_plot_writes_the_figures(cached, capsys, tmp_path):
+    """``--plot DIR --lordosis`` writes the three PNGs (non-empty, PNG signature) and prints the usual table."""
+    assert main(["anatomy", "--activation", "0.05", "--lordosis", "-5:5:2", "--plot", str(tmp_path / "fig")]) == 0
+    assert "the chain, free" in capsys.readouterr().out
+    for name in ("sagittal.png", "modes.png", "lordosis.png"):
+        assert (tmp_path / "fig" / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
