@@ -14,9 +14,10 @@ the n - r directions of their null space are modes whose stiffness they can give
 through their lengths' curvature (docs/chain.md), left to the local muscles, passive
 tissue and reflexes.
 
-These are small direct calls on the :class:`~spinectl.model.linear_chain.LinearChain`
-(numpy eigenvalues); the chain analyses of :mod:`spinectl.optimise` and
-:mod:`spinectl.reflex` take the same LinearChain.
+All on the :class:`~spinectl.model.linear_chain.LinearChain` of the model, through the chain's
+own functions: its state matrix and dynamic eigenvalues (:mod:`spinectl.model.chain`), its
+programmes (:mod:`spinectl.optimise.coupled.sdp`) and its exact delay margin
+(:func:`spinectl.reflex.mimo.delay_margin_of`).
 """
 
 from __future__ import annotations
@@ -26,6 +27,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ParameterError
+from ..model.chain import dynamic_eigenvalues
+from ..model.chain import state_matrix as chain_state_matrix
 from ..model.linear_chain import LinearChain
 from .engine import require_mujoco
 from .model import Anatomy
@@ -67,6 +70,8 @@ def activations(anatomy: Anatomy, activation) -> np.ndarray:
 def state_matrix(chain: LinearChain, a) -> np.ndarray:
     """x' = A x with x = (q, q'): [[0, I], [M^-1 K(a), M^-1 D(a)]] [1/s^2, 1/s].
 
+    :func:`spinectl.model.chain.state_matrix` at K(a), D(a).
+
     Parameters
     ----------
     chain : LinearChain
@@ -78,9 +83,7 @@ def state_matrix(chain: LinearChain, a) -> np.ndarray:
     -------
     numpy.ndarray, shape (2n, 2n)
     """
-    n = chain.n_joints
-    minv = np.linalg.inv(chain.mass_matrix)
-    return np.block([[np.zeros((n, n)), np.eye(n)], [minv @ chain.stiffness(a), minv @ chain.damping(a)]])
+    return chain_state_matrix(chain.mass_matrix, chain.stiffness(a), chain.damping(a))
 
 
 @dataclass(frozen=True)
@@ -139,7 +142,7 @@ def verdict(chain: LinearChain, a) -> ChainVerdict:
     """
     k = chain.stiffness(a)
     values, vectors = np.linalg.eigh(-0.5 * (k + k.T))
-    dyn = np.linalg.eigvals(state_matrix(chain, a))
+    dyn = dynamic_eigenvalues(chain.mass_matrix, k, chain.damping(a))
     return ChainVerdict(
         joints=chain.joints,
         stiffness=k,
@@ -148,7 +151,7 @@ def verdict(chain: LinearChain, a) -> ChainVerdict:
         joint_stiffness=-np.diag(k),
         eigenvalues=values,
         modes=vectors,
-        dynamic_eigenvalues=dyn[np.lexsort((-dyn.imag, -dyn.real))],
+        dynamic_eigenvalues=dyn,
     )
 
 
@@ -542,15 +545,13 @@ def reflex_margin(chain: LinearChain, a, kp: float, kd: float, lag: float) -> di
         ``kp_Nm_per_rad``, ``kd_Nms_per_rad``, ``activation_lag_s``, ``delay_margin_s`` (inf:
         any delay; 0: unstable without delay), ``delay_margin_status``, ``delay_margin_frequency_rad_s``.
     """
-    from ..reflex.mimo import chain_delay_margin
+    from ..reflex.mimo import delay_margin_of
 
     for name, value in (("kp", kp), ("kd", kd), ("activation_lag", lag)):
         if not (np.isfinite(value) and value >= 0):
             raise ParameterError(name, f"must be a finite number >= 0 (got {value!r})")
     n = chain.n_joints
-    margin = chain_delay_margin(
-        chain.mass_matrix, chain.stiffness(a), chain.damping(a), np.full(n, kp), np.full(n, kd), lag
-    )
+    margin = delay_margin_of(chain, np.full(n, kp), np.full(n, kd), lag, u=a)
     return {
         "kp_Nm_per_rad": float(kp),
         "kd_Nms_per_rad": float(kd),

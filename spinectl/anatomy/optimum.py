@@ -20,10 +20,9 @@ with ``weights="none"``; with ``weights="volume"`` (the default) each muscle cou
 volume, w_i proportional to F0_i L0_i (maximal isometric force times optimal fibre length,
 so PCSA times fibre length at a common specific tension), normalised to mean 1: a large
 muscle's activation costs more than a small one's. Convex in a (a quadratic cost, linear
-equalities and bounds, one linear matrix inequality), solved with cvxpy and Clarabel.
-
-This is a small direct SDP written against :class:`~spinectl.model.linear_chain.LinearChain`
-(:func:`solve_on_chain`); the chain SDPs of :mod:`spinectl.optimise` may take its place.
+equalities and bounds, one linear matrix inequality), solved by the chain programmes of
+:mod:`spinectl.optimise.coupled.sdp` (:func:`~spinectl.optimise.coupled.sdp.least_quadratic_cost_sdp`,
+cvxpy and Clarabel) on the :class:`~spinectl.model.linear_chain.LinearChain` of the model.
 
 References
 ----------
@@ -35,7 +34,6 @@ quadratic objectives. arXiv:2405.12762.
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -77,10 +75,13 @@ def volume_weights(anatomy: Anatomy) -> np.ndarray:
 def solve_on_chain(chain: LinearChain, tau_per, tau_0, weights, stability: str, margin: float):
     """The optimum on a LinearChain with equilibrium rows; ``(status, a)`` (a NaN where infeasible).
 
+    :func:`spinectl.optimise.coupled.sdp.least_quadratic_cost_sdp` with the equilibrium
+    tau_per a + tau_0 = 0 as its equality rows and the chain's bounds 0 <= a <= 1.
+
     Parameters
     ----------
     chain : LinearChain
-        The free chain: K(a) for the stability constraint, bounds of a.
+        The chain whose K(a) the criterion constrains; its bounds bound a.
     tau_per : numpy.ndarray, shape (r, m)
         Each control's generalised force per unit on the r equilibrium rows [N m].
     tau_0 : numpy.ndarray, shape (r,)
@@ -88,7 +89,8 @@ def solve_on_chain(chain: LinearChain, tau_per, tau_0, weights, stability: str, 
     weights : numpy.ndarray, shape (m,)
         Cost weights w_i.
     stability : str
-        One of :data:`STABILITY`.
+        ``"chain"``, ``"joints"`` or ``"none"``
+        (:data:`~spinectl.optimise.coupled.sdp.QUADRATIC_CRITERIA`).
     margin : float
         mu [N m/rad].
 
@@ -97,27 +99,10 @@ def solve_on_chain(chain: LinearChain, tau_per, tau_0, weights, stability: str, 
     tuple
         (cvxpy's status, numpy.ndarray of shape (m,)).
     """
-    import cvxpy as cp
+    from ..optimise.coupled.sdp import least_quadratic_cost_sdp
 
-    n, m = chain.n_joints, chain.n_controls
-    a = cp.Variable(m)
-    constraints = [tau_per @ a + tau_0 == 0, a >= chain.lower, a <= chain.upper]
-    flat = chain.stiffness_per_control.reshape(n * n, m)
-    neg_k = -(cp.reshape(flat @ a, (n, n), order="C") + chain.stiffness_offset)
-    if stability == "chain":
-        constraints.append(0.5 * (neg_k + neg_k.T) - margin * np.eye(n) >> 0)
-    elif stability == "joints":
-        constraints.append(cp.diag(neg_k) >= margin)
-    problem = cp.Problem(cp.Minimize(cp.sum(cp.multiply(weights, cp.square(a)))), constraints)
-    try:
-        with warnings.catch_warnings():  # "may be inaccurate": the status says so ('optimal_inaccurate')
-            warnings.simplefilter("ignore", UserWarning)
-            problem.solve(solver=cp.CLARABEL)
-    except cp.error.SolverError:
-        return "solver_error", np.full(m, np.nan)
-    if problem.status not in ("optimal", "optimal_inaccurate") or a.value is None:
-        return problem.status, np.full(m, np.nan)
-    return problem.status, np.clip(a.value, chain.lower, chain.upper)
+    status, a = least_quadratic_cost_sdp(chain, weights, margin, stability, equalities=(tau_per, -tau_0))
+    return status, (np.full(chain.n_controls, np.nan) if a is None else a)
 
 
 @dataclass(frozen=True)

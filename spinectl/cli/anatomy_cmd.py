@@ -92,6 +92,12 @@ def register(sub) -> None:
         "angle from START to STOP [deg] along the model's rhythm (positive: the model's positive "
         "flex_extension, extension for MyoTorso), e.g. -20:20:41",
     )
+    parser.add_argument(
+        "--plot",
+        metavar="DIR",
+        help="write sagittal.png (the model, muscles by class, CoRs), modes.png (each mode of -K as a bent "
+        "spine, sagittal plane) and, with --lordosis, lordosis.png into DIR",
+    )
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     parser.set_defaults(func=run)
 
@@ -103,7 +109,7 @@ def run(args) -> int:
     ----------
     args : argparse.Namespace
         Parsed arguments: ``model``, ``mapping``, ``plane``, ``activation``, ``joint_stiffness``,
-        ``check``, ``optimise``, ``stability``, ``equilibrium``, ``margin``, ``json``.
+        ``check``, ``optimise``, ``stability``, ``equilibrium``, ``margin``, ``lordosis``, ``plot``, ``json``.
 
     Returns
     -------
@@ -149,6 +155,11 @@ def run(args) -> int:
             joint_stiffness=args.joint_stiffness,
             equilibrium=args.equilibrium,
         )
+    if args.plot:
+        from ..anatomy.figures import save_anatomy_figures
+
+        analysis = result.analysis if args.optimise else result
+        save_anatomy_figures(anatomy, analysis, curve, args.plot)
     if args.json:
         doc = result.to_dict()
         if curve is not None:

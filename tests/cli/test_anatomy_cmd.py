@@ -121,3 +121,21 @@ def test_without_the_extra_one_line_says_what_to_install(monkeypatch, capsys):
     assert main(["anatomy"]) == 2
     err = capsys.readouterr().err
     assert "pip install 'spinectl[anatomy]'" in err and len(err.strip().splitlines()) == 1
+
+
+def test_plot_writes_the_figures(cached, capsys, tmp_path):
+    """``--plot DIR --lordosis`` writes the three PNGs (non-empty, PNG signature) and prints the usual table."""
+    assert main(["anatomy", "--activation", "0.05", "--lordosis", "-5:5:2", "--plot", str(tmp_path / "fig")]) == 0
+    assert "the chain, free" in capsys.readouterr().out
+    for name in ("sagittal.png", "modes.png", "lordosis.png"):
+        assert (tmp_path / "fig" / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_plot_into_an_unwritable_folder_is_one_line(cached, capsys, tmp_path):
+    """``--plot`` under a regular file: one line naming the path, exit 2, no table printed, nothing written."""
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    assert main(["anatomy", "--plot", str(blocker / "figs")]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == "" and len(captured.err.strip().splitlines()) == 1 and "file" in captured.err
+    assert blocker.read_text() == ""

@@ -113,3 +113,38 @@ def test_local_controls_at_a_fixed_global_activation():
         np.testing.assert_allclose(u, [s, s], atol=1e-6)
     with pytest.raises(ParameterError, match="no control of the chain: nope"):
         chain.fix({"nope": 1.0})
+
+
+@pytest.mark.parametrize(
+    ("criterion", "expected"),
+    [("joints", [7 / 6, 7 / 6, 7 / 3]), ("chain", [13 / 18, 13 / 18, 26 / 9])],
+)
+def test_least_quadratic_cost_under_each_criterion(criterion, expected):
+    """(d) min u_1^2 + u_2^2 + u_3^2, strictly convex and symmetric, so its optimum has u_1 = u_2 = s
+    and is min 2 s^2 + u_3^2 on the criterion's rows: joints, -K_jj = s + u_3 - g >= mu,
+    the active row by Lagrange (4 s = lambda, 2 u_3 = lambda) u_3 = 2 s, 3 s = g + mu: s = 7/6;
+    the chain, s >= mu (inactive) and s + 2 (u_3 - g) >= mu active, u_3 = 4 s, 9 s = mu + 2 g: s = 13/18."""
+    status, u = sdp.least_quadratic_cost_sdp(_chain(), np.ones(3), MU, criterion, tolerance=1e-9)
+    assert status == "optimal"
+    np.testing.assert_allclose(u, expected, atol=1e-6)
+
+
+def test_least_quadratic_cost_with_equality_rows():
+    """Equality rows A u = b: without a criterion, u_1 + u_2 + u_3 = 3 gives the least-norm point of that
+    plane, u = (1, 1, 1); u_3 = 1 held, the chain's rows become s >= mu and s >= mu + 2 (g - 1) = 4.5,
+    so u = (4.5, 4.5, 1); u_3 = 2 with the bound u_3 <= 1 is infeasible, an answer (status, None);
+    an unknown criterion is refused in one line."""
+    plane = (np.ones((1, 3)), np.array([3.0]))
+    status, u = sdp.least_quadratic_cost_sdp(_chain(), np.ones(3), MU, "none", equalities=plane, tolerance=1e-9)
+    assert status == "optimal"
+    np.testing.assert_allclose(u, [1.0, 1.0, 1.0], atol=1e-6)
+    rows = (np.array([[0.0, 0.0, 1.0]]), np.array([1.0]))
+    status, u = sdp.least_quadratic_cost_sdp(_chain(), np.ones(3), MU, "chain", equalities=rows, tolerance=1e-9)
+    assert status == "optimal"
+    np.testing.assert_allclose(u, [MU + 2 * (G - 1), MU + 2 * (G - 1), 1.0], atol=1e-6)
+    status, u = sdp.least_quadratic_cost_sdp(
+        _chain(upper=1.0), np.ones(3), MU, "none", equalities=(rows[0], np.array([2.0]))
+    )
+    assert status.startswith("infeasible") and u is None
+    with pytest.raises(ParameterError, match="criterion: must be one of"):
+        sdp.least_quadratic_cost_sdp(_chain(), np.ones(3), MU, "diagonal")

@@ -11,7 +11,10 @@ k >= 0 a stiffness added freely at each joint [N m/rad] (the paper's local muscl
 - :func:`least_local_stiffness_at`, :func:`least_local_stiffness_of`: at fixed controls, the least sum(k);
 - :func:`least_control_sdp`: k = 0, the least cost c.u;
 - :func:`least_cost_with_local_sdp`: the least c.u + w sum(k) / kappa, or the least c.u with
-  sum(k) bounded (the epsilon-constraint form).
+  sum(k) bounded (the epsilon-constraint form);
+- :func:`least_quadratic_cost_sdp`: k = 0, the least sum_i w_i u_i^2 with equality rows A u = b
+  (equilibrium) and the LMI, its diagonal only (the joint-by-joint criterion) or no criterion
+  (static optimisation of an anatomical model, docs/anatomy.md).
 
 Each is solved with cvxpy and Clarabel (PSD cone; SCS as the fallback,
 :func:`spinectl.optimise.reference.solve_with_fallback`). The linear rows the controls obey are the
@@ -31,6 +34,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ...errors import ParameterError
 from ...model.chain import coupled_margin
 from ...model.linear_chain import LinearChain
 from ..problem import OK_STATUSES
@@ -59,13 +63,20 @@ def lmi(chain: LinearChain, u, margin: float, k=None) -> cp.Constraint:
     """
     import cvxpy as cp
 
-    if isinstance(u, cp.Expression):
-        per_control = chain.stiffness_per_control
-        stiffness = chain.stiffness_offset + sum(u[i] * per_control[:, :, i] for i in range(per_control.shape[-1]))
-    else:
-        stiffness = chain.stiffness(u)
-    matrix = -stiffness - margin * np.eye(chain.n_joints)
+    matrix = -_stiffness_expression(chain, u) - margin * np.eye(chain.n_joints)
+    matrix = 0.5 * (matrix + matrix.T)  # K_i of a model's finite differences are symmetric to rounding only
     return (matrix if k is None else matrix + cp.diag(k)) >> 0
+
+
+def _stiffness_expression(chain: LinearChain, u):
+    """K(u) as one affine cvxpy expression (one product with the (n n, m) matrix, whatever m), or K(u)."""
+    import cvxpy as cp
+
+    if not isinstance(u, cp.Expression):
+        return chain.stiffness(u)
+    n, m = chain.n_joints, chain.n_controls
+    flat = chain.stiffness_per_control.reshape(n * n, m)
+    return chain.stiffness_offset + cp.reshape(flat @ u, (n, n), order="C")
 
 
 def shifted(stiffness, margin: float, k) -> np.ndarray:
@@ -239,6 +250,74 @@ def least_cost_with_local_sdp(
         return status, None, None
     u_opt = np.maximum(u.value, chain.lower)
     return status, u_opt, shifted(chain.stiffness(u_opt), margin, k.value)
+
+
+QUADRATIC_CRITERIA = ("chain", "joints", "none")
+"""The stability criteria of :func:`least_quadratic_cost_sdp`: the chain's LMI, each joint's diagonal entry, none."""
+
+
+def least_quadratic_cost_sdp(
+    chain: LinearChain,
+    weights,
+    margin: float,
+    criterion: str = "chain",
+    equalities=None,
+    rows=None,
+    tolerance: float | None = None,
+):
+    """(d) The least sum_i w_i u_i^2 with A u = b, G u <= h and a stability criterion (no added stiffness).
+
+    The criterion: ``"chain"``, -K(u) >= mu I; ``"joints"``, -K_jj(u) >= mu at each joint (the
+    paper's joint-by-joint criterion, linear rows); ``"none"``, nothing (classic static
+    optimisation, Anderson and Pandy 2001). Convex: a quadratic cost, linear rows, one LMI.
+
+    Parameters
+    ----------
+    chain : LinearChain
+    weights : array_like, shape (m,)
+        w_i >= 0, the price of each control squared [1 per control unit^2].
+    margin : float
+        mu [N m/rad].
+    criterion : str
+        One of :data:`QUADRATIC_CRITERIA`.
+    equalities : tuple of numpy.ndarray, optional
+        (A, b), shapes (r, m) and (r,): rows the controls meet exactly (e.g. equilibrium,
+        the net torque A u - b = 0 [N m]); None: none.
+    rows : tuple of numpy.ndarray, optional
+        (G, h); default the chain's bounds (as in :func:`least_control_sdp`).
+    tolerance : float, optional
+        The solver's gap and feasibility tolerance.
+
+    Returns
+    -------
+    status : str
+        As for :func:`least_control_sdp`.
+    u : numpy.ndarray or None
+        The controls [control unit], clipped to the bounds (the solver's rounding); None unless optimal.
+
+    References
+    ----------
+    Anderson FC, Pandy MG (2001). Static and dynamic optimization solutions for gait are
+    practically equivalent. J Biomech 34(2):153-161. doi:10.1016/S0021-9290(00)00155-X.
+    """
+    import cvxpy as cp
+
+    if criterion not in QUADRATIC_CRITERIA:
+        raise ParameterError("criterion", f"must be one of {QUADRATIC_CRITERIA} (got {criterion!r})")
+    lhs, rhs = chain.bound_rows() if rows is None else rows
+    u = cp.Variable(chain.n_controls)
+    constraints = [lhs @ u <= rhs]
+    if equalities is not None:
+        constraints.append(equalities[0] @ u == equalities[1])
+    if criterion == "chain":
+        constraints.append(lmi(chain, u, margin))
+    elif criterion == "joints":
+        constraints.append(-cp.diag(_stiffness_expression(chain, u)) >= margin)
+    objective = cp.Minimize(cp.sum(cp.multiply(np.asarray(weights, float), cp.square(u))))
+    status = solve_with_fallback(cp.Problem(objective, constraints), tolerance)
+    if status not in OK_STATUSES:
+        return status, None
+    return status, np.clip(u.value, chain.lower, chain.upper)
 
 
 def svec(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -1,0 +1,114 @@
+"""Benchmark: an anatomical model (MyoTorso) loaded, linearised and optimised; the lordosis curve; K per muscle.
+
+    python benchmarks/bench_anatomy.py                  # MyoTorso, 50 N m/rad added, 41 postures
+    python benchmarks/bench_anatomy.py --postures 21 --joint-stiffness 0
+
+Three timings in one run, each against its target or its reference (docs/anatomy.md, "Speed"):
+
+1. after import: ``spinectl.anatomy.load("myotorso")`` (MuJoCo compiles the model), the free and
+   constrained sagittal chains at the reference posture (K_0 + sum a_i K_i, D, M) and the
+   stability-constrained optimum (the chain criterion); target <= 1 s in all;
+2. the lordosis curve (:func:`spinectl.anatomy.optimum.lordosis_curve`): the three optima at each of
+   41 postures over -20 ... +20 deg; target <= 20 s;
+3. spinectl's per-muscle stiffness K_i over the five FE joints (one linearisation for all 210
+   muscles) against the reference, central differences of MuJoCo's own generalised forces
+   (``qfrc_actuator + qfrc_passive - qfrc_bias``) at a = e_i less a = 0, muscle by muscle: the
+   ratio of the times and the largest difference relative to the largest entry of any K_i.
+
+Needs the anatomy extra (``pip install 'spinectl[anatomy]'``). Timings on a shared machine
+are noisy: the ratios are what matters.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+STEP = 1e-6
+"""The reference's central-difference step [rad] (as tests/anatomy/test_linearise.py)."""
+
+
+def per_muscle_reference(anatomy, dofs):
+    """K_i by central differences of MuJoCo's forces, muscle by muscle: (m, n, n) [N m/rad per unit activation]."""
+    engine, q0 = anatomy.engine, anatomy.posture()
+    m, n = len(anatomy.muscles), len(dofs)
+
+    def stiffness(act):
+        out = np.zeros((n, n))
+        for k, dof in enumerate(dofs):
+            sides = []
+            for sign in (1.0, -1.0):
+                q = q0.copy()
+                q[engine.model.jnt_qposadr[engine.model.dof_jntid[dof]]] += sign * STEP
+                sides.append(engine.generalised_force(q, act)[list(dofs)])
+            out[:, k] = (sides[0] - sides[1]) / (2 * STEP)
+        return out
+
+    base = stiffness(np.zeros(m))
+    return np.array([stiffness(np.eye(m)[i]) - base for i in range(m)])
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--postures", type=int, default=41, help="postures of the lordosis curve")
+    parser.add_argument("--joint-stiffness", type=float, default=50.0, help="added at each joint [N m/rad]")
+    args = parser.parse_args()
+
+    start = time.perf_counter()
+    import cvxpy  # noqa: F401  (imported by the optimum: its import is no part of the timing)
+
+    from spinectl import anatomy
+    from spinectl.anatomy.optimum import lordosis_curve, optimise
+
+    imported = time.perf_counter() - start
+
+    start = time.perf_counter()
+    torso = anatomy.load("myotorso")
+    loaded = time.perf_counter()
+    free, _, lin = torso.chains("sagittal", joint_stiffness=args.joint_stiffness)
+    linearised = time.perf_counter()
+    opt = optimise(torso, stability="chain", joint_stiffness=args.joint_stiffness)
+    solved = time.perf_counter()
+    total = solved - start
+    print(f"MyoTorso ({torso.engine.source}), {len(torso.muscles)} muscles, {args.joint_stiffness:g} N m/rad added")
+    print(f"  import of spinectl.anatomy, mujoco, cvxpy (not counted): {imported:8.3f} s")
+    print(f"  load (MuJoCo compiles the model):                        {loaded - start:8.3f} s")
+    print(f"  the chains (K_0 + sum a_i K_i, D, M; free and constrained): {linearised - loaded:8.3f} s")
+    print(f"  the optimum, chain criterion ({opt.status}, cost {opt.cost:.4g}):   {solved - linearised:8.3f} s")
+    print(f"  load + K + optimum: {total:.3f} s (target <= 1 s: ratio {total / 1.0:.2f})")
+
+    degrees = np.linspace(-20.0, 20.0, args.postures)
+    start = time.perf_counter()
+    curve = lordosis_curve(torso, degrees, joint_stiffness=args.joint_stiffness)
+    swept = time.perf_counter() - start
+    statuses = [s for key in ("none", "joints", "chain") for s in curve[key]["status"]]
+    solved = sum(s in ("optimal", "optimal_inaccurate") for s in statuses)
+    print(f"lordosis curve, {args.postures} postures x 3 optima ({solved} solved)")
+    print(f"  {swept:.2f} s (target <= 20 s: ratio {swept / 20.0:.2f}); {swept / args.postures:.3f} s per posture")
+
+    dofs = list(lin.dofs[: lin.n])
+    start = time.perf_counter()
+    ours_lin = torso.linearise("sagittal")[0]
+    ours_time = time.perf_counter() - start
+    ours = np.moveaxis(ours_lin.stiffness_per_muscle[: lin.n, : lin.n], -1, 0)
+    start = time.perf_counter()
+    reference = per_muscle_reference(torso, dofs)
+    reference_time = time.perf_counter() - start
+    scale = np.abs(reference).max()
+    error = np.abs(ours - reference).max() / scale
+    print(f"K per muscle over the {lin.n} FE joints, {len(torso.muscles)} muscles")
+    print(f"  spinectl (one linearisation, every K_i):                 {ours_time:8.3f} s")
+    print(f"  reference (central differences of MuJoCo's forces, per muscle): {reference_time:8.3f} s")
+    print(f"  ratio reference / spinectl: {reference_time / ours_time:.1f}")
+    print(f"  largest difference over the largest entry of any K_i: {error:.2e}")
+
+
+if __name__ == "__main__":
+    main()
