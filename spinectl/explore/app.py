@@ -20,6 +20,7 @@ import asyncio
 import html
 import io
 import time
+import webbrowser
 
 import matplotlib
 import numpy as np
@@ -29,6 +30,9 @@ from bokeh.events import Tap
 from bokeh.models import BoxAnnotation, ColorBar, ColumnDataSource, FactorRange, LinearColorMapper, Range1d, Span
 from bokeh.plotting import figure as bokeh_figure
 from matplotlib.colors import to_hex
+from tornado.log import app_log
+from tornado.routing import Matcher, Rule
+from tornado.web import RequestHandler
 
 from ..errors import SpinectlError
 from ..model.config import DEFAULT_PRESET, list_presets, load_preset
@@ -36,6 +40,7 @@ from ..model.params import Model
 from ..paper.landmarks import CT_LIMIT
 from ..units import CM_PER_M, m2_to_cm2
 from . import views
+from .launch import allowed_hosts, request_allowed, url_host
 from .numbers import LANDSCAPE_POINTS, PointNumbers, landscape_axis, landscapes, point_numbers
 from .state import (
     LANDSCAPE_PARAMETERS,
@@ -484,6 +489,10 @@ def explorer(preset: str | None = None, config=None) -> pn.viewable.Viewable:
 def serve(model: Model, preset: str, port: int, address: str = "127.0.0.1", show: bool = True) -> None:
     """Serve the explorer at ``http://address:port/`` until interrupted; one :class:`Explorer` per browser tab.
 
+    Every request, the websocket's included, must address the server by the address bound
+    (:func:`spinectl.explore.launch.request_allowed`; others get 403): a DNS-rebinding page,
+    served under another site's name that resolves to this machine, gets no session.
+
     Parameters
     ----------
     model : Model
@@ -496,15 +505,87 @@ def serve(model: Model, preset: str, port: int, address: str = "127.0.0.1", show
         Interface to bind; the loopback interface by default, so that no other machine can connect.
     show : bool
         Open the app in the default browser.
+
+    Raises
+    ------
+    ParameterError
+        An address that names no one interface (:func:`spinectl.explore.launch.allowed_hosts`).
     """
-    origins = [f"{address}:{port}"] + ([f"localhost:{port}"] if address == "127.0.0.1" else [])
-    print(f"spinectl explore: http://{address}:{port}/ (Ctrl+C stops)", flush=True)
-    pn.serve(
+    allowed = allowed_hosts(address, port)
+    url = f"http://{url_host(address)}:{port}/"
+    print(f"spinectl explore: {url} (Ctrl+C stops)", flush=True)
+    server = pn.serve(
         {"/": lambda: Explorer(model, preset).layout},
         port=port,
-        address=address,
-        websocket_origin=origins,
-        show=show,
+        address=address.strip().strip("[]"),
+        websocket_origin=bokeh_origins(allowed),
+        show=False,  # Bokeh's own opener writes an IPv6 address without brackets
+        start=False,
         title="spinectl explore",
+        location=False,  # the app reads no URL; Panel's Location cannot parse an IPv6 Host
         verbose=False,
     )
+    guard(server._tornado, allowed)  # Bokeh's Tornado application (Panel reads it by this name too)
+    server.start()
+    if show:
+        server.io_loop.add_callback(webbrowser.open_new_tab, url)
+    server.io_loop.start()
+
+
+def bokeh_origins(allowed: frozenset[tuple[str, int]]) -> list[str]:
+    """The allowed pairs as Bokeh's websocket origins, ``host:port``, sorted.
+
+    Bokeh's list cannot hold an IPv6 address (it splits at every colon); for those the guard
+    (:func:`guard`) is the only check, as Tornado skips Bokeh's for a same-origin websocket.
+
+    Parameters
+    ----------
+    allowed : frozenset of (str, int)
+        :func:`spinectl.explore.launch.allowed_hosts`.
+
+    Returns
+    -------
+    list of str
+        E.g. ``['127.0.0.1:5006', 'localhost:5006']``.
+    """
+    return sorted(f"{host}:{port}" for host, port in allowed if ":" not in host)
+
+
+class _ForeignRequest(Matcher):
+    """Tornado's routing: matches a request whose Host or Origin is not the address bound."""
+
+    def __init__(self, allowed: frozenset[tuple[str, int]]):
+        self.allowed = allowed
+
+    def match(self, request) -> dict | None:
+        headers = request.headers
+        return None if request_allowed(headers.get("Host"), headers.get("Origin"), self.allowed) else {}
+
+
+class _Refused(RequestHandler):
+    """Answers 403, whatever the method, and says why in one line (in the page and the server's log)."""
+
+    def prepare(self) -> None:
+        host, origin = (self.request.headers.get(h) for h in ("Host", "Origin"))
+        reason = f"refused: Host {host!r}, Origin {origin!r} is not the address the explorer is bound to"
+        app_log.warning("spinectl explore: %s", reason)
+        self.set_status(403)
+        self.finish(reason + "\n")
+
+
+def guard(application, allowed: frozenset[tuple[str, int]]) -> None:
+    """Route every request that does not address ``allowed`` to a 403, before any of Bokeh's handlers.
+
+    The first rule of the Tornado application's router (Tornado's own ``add_handlers`` inserts its
+    host rules into the same list): it sees each request, the websocket's upgrade included, before
+    Bokeh's handlers. Tornado lets a websocket whose Origin equals its Host skip Bokeh's origin list,
+    so a DNS-rebinding page would pass that list; the Host check stops it.
+
+    Parameters
+    ----------
+    application : tornado.web.Application
+        The Bokeh server's Tornado application.
+    allowed : frozenset of (str, int)
+        :func:`spinectl.explore.launch.allowed_hosts`.
+    """
+    application.default_router.rules.insert(0, Rule(_ForeignRequest(allowed), _Refused))

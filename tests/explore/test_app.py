@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
+from types import SimpleNamespace
 
 import numpy as np
 import param
 import pytest
+from tornado.web import Application
 
 from spinectl.errors import ModelError
 from spinectl.explore import app
@@ -120,15 +122,48 @@ def test_explorer_for_a_notebook_reads_the_config_named(tmp_path):
     assert [w.value for w in layout.select(app.pn.widgets.Select)] == [app.CONFIG_CHOICE]
 
 
+class _Server:
+    """What ``pn.serve(start=False)`` returns, as far as serve() uses it: Bokeh's Tornado application, a loop."""
+
+    def __init__(self):
+        self._tornado = Application()
+        self.calls = []
+        self.io_loop = SimpleNamespace(start=lambda: self.calls.append("loop"), add_callback=self._callback)
+
+    def start(self):
+        self.calls.append("start")
+
+    def _callback(self, function, *args):
+        self.calls.append((function, *args))
+
+
 def test_serve_binds_the_loopback_interface_by_default(monkeypatch, capsys):
-    """serve() asks Panel for 127.0.0.1 (no other machine can connect) and accepts pages from there only."""
-    calls = []
-    monkeypatch.setattr(app.pn, "serve", lambda panels, **options: calls.append(options))
+    """serve() asks Panel for 127.0.0.1 (no other machine can connect), accepts websockets from there only, and
+    puts the guard of Host and Origin first in Tornado's routing (so that it sees every request)."""
+    calls, server = [], _Server()
+    monkeypatch.setattr(app.pn, "serve", lambda panels, **options: calls.append(options) or server)
     app.serve(load_preset("default"), "default", 5999, show=False)
     (options,) = calls
-    assert options["address"] == "127.0.0.1" and options["port"] == 5999 and options["show"] is False
+    assert options["address"] == "127.0.0.1" and options["port"] == 5999 and options["start"] is False
     assert options["websocket_origin"] == ["127.0.0.1:5999", "localhost:5999"]
+    first = server._tornado.default_router.rules[0]
+    assert isinstance(first.matcher, app._ForeignRequest) and first.target is app._Refused
+    assert first.matcher.allowed == {("127.0.0.1", 5999), ("localhost", 5999)}
+    assert server.calls == ["start", "loop"]  # no browser opened
     assert capsys.readouterr().out == "spinectl explore: http://127.0.0.1:5999/ (Ctrl+C stops)\n"
+
+
+def test_serve_on_ipv6_loopback_writes_the_url_with_brackets(monkeypatch, capsys):
+    """--address ::1: Panel binds ::1; the URL printed and opened is http://[::1]:P/ (RFC 3986, 3.2.2); Bokeh's
+    origin list, which cannot hold an IPv6 address, gets localhost only; the guard allows [::1] and localhost."""
+    calls, server = [], _Server()
+    monkeypatch.setattr(app.pn, "serve", lambda panels, **options: calls.append(options) or server)
+    app.serve(load_preset("default"), "default", 5999, address="::1", show=True)
+    (options,) = calls
+    assert options["address"] == "::1" and options["websocket_origin"] == ["localhost:5999"]
+    assert server._tornado.default_router.rules[0].matcher.allowed == {("::1", 5999), ("localhost", 5999)}
+    assert server.calls == ["start", (app.webbrowser.open_new_tab, "http://[::1]:5999/"), "loop"]
+    assert capsys.readouterr().out == "spinectl explore: http://[::1]:5999/ (Ctrl+C stops)\n"
 
 
 def test_the_delay_redraws_the_margins_only():

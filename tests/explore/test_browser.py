@@ -16,6 +16,7 @@ import base64
 import os
 import re
 import time
+import urllib.parse
 
 import browser_harness
 import pytest
@@ -29,17 +30,23 @@ OPT_OUT = "SPINECTL_SKIP_BROWSER"
 
 
 @pytest.fixture(scope="module")
-def page():
-    """The explorer served from this checkout, open in headless Chromium."""
+def executable():
+    """The Chromium binary, or the test fails saying how to install it (or skips, opted out)."""
     if os.environ.get(OPT_OUT):
         pytest.skip(f"{OPT_OUT} is set")
-    executable = browser_harness.chromium()
-    if executable is None:
+    found = browser_harness.chromium()
+    if found is None:
         pytest.fail(
             f"the browser test needs Chromium at {browser_harness.CHROMIUM}: {browser_harness.INSTALL}; "
             f"{OPT_OUT}=1 skips this test"
         )
-    with browser_harness.served() as url, browser_harness.opened(url, executable) as tab:
+    return found
+
+
+@pytest.fixture(scope="module")
+def page(served_url, executable):
+    """The explorer served from this checkout, open in headless Chromium."""
+    with browser_harness.opened(served_url, executable) as tab:
         yield tab
 
 
@@ -121,3 +128,18 @@ def _point_shown(page, state, before):
             assert labels == point and point != before
             return replace(state, **dict(zip(fields, point, strict=True)))
         time.sleep(0.2)
+
+
+def test_a_dns_rebinding_page_gets_no_session(served_url, executable):
+    """Chromium resolves evil.example to 127.0.0.1 (--host-resolver-rules), as a rebinding attacker's DNS makes
+    it: http://evil.example:P/ is the explorer's port under another site's name. The page is refused (403) and
+    no websocket opens (before the Host check it got a session: sliders, table and the TOML export)."""
+    port = urllib.parse.urlsplit(served_url).port
+    rule = "--host-resolver-rules=MAP evil.example 127.0.0.1"
+    with browser_harness.browser_page(executable, rule) as tab:
+        sockets = []
+        tab.on("websocket", lambda socket: sockets.append(socket.url))
+        response = tab.goto(f"http://evil.example:{port}/")
+        assert response.status == 403 and "not the address the explorer is bound to" in tab.content()
+        tab.wait_for_timeout(1000)  # a script of the page, had it been served, would have opened the socket
+        assert sockets == [] and tab.locator("td[data-key]").count() == 0

@@ -1,0 +1,106 @@
+"""The served explorer answers only requests that address it as bound: a DNS-rebinding page gets no session.
+
+A page of another site (``http://evil.example:P/``) whose name its owner makes resolve to
+127.0.0.1 is, to the browser, of that site: its requests reach the explorer with
+``Host: evil.example:P`` and, for the websocket, ``Origin: http://evil.example:P``. Tornado
+lets a websocket whose Origin equals its Host skip Bokeh's origin list, so only a check of
+the Host stops it (:func:`spinectl.explore.app.guard`). These tests send the headers such a
+page sends, over HTTP and over Bokeh's websocket (with a valid session token, so that only
+the headers differ), and the explorer's own pair, which must work. The same in Chromium:
+tests/explore/test_browser.py.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import http.client
+import json
+import re
+import urllib.parse
+import urllib.request
+
+import browser_harness
+import pytest
+from tornado.httpclient import HTTPClientError, HTTPRequest
+from tornado.websocket import websocket_connect
+
+EVIL = "evil.example"
+
+
+def _port(url: str) -> int:
+    return urllib.parse.urlsplit(url).port
+
+
+def _pairs(url: str) -> dict[str, tuple[str, str | None]]:
+    """(Host, Origin) of a rebinding page, of a foreign page calling the explorer, of the explorer's pages."""
+    port = _port(url)
+    return {
+        "rebinding": (f"{EVIL}:{port}", f"http://{EVIL}:{port}"),
+        "rebinding, no Origin": (f"{EVIL}:{port}", None),
+        "foreign Origin": (f"127.0.0.1:{port}", f"http://{EVIL}:{port}"),
+        "other port": (f"127.0.0.1:{port + 1}", None),
+        "own": (f"127.0.0.1:{port}", f"http://127.0.0.1:{port}"),
+        "own, localhost": (f"localhost:{port}", f"http://localhost:{port}"),
+    }
+
+
+def _get(url: str, host: str, origin: str | None, path: str = "/") -> int:
+    connection = http.client.HTTPConnection("127.0.0.1", _port(url), timeout=60)
+    try:
+        connection.putrequest("GET", path, skip_host=True)
+        connection.putheader("Host", host)
+        if origin:
+            connection.putheader("Origin", origin)
+        connection.endheaders()
+        return connection.getresponse().status
+    finally:
+        connection.close()
+
+
+PAIRS = ("rebinding", "rebinding, no Origin", "foreign Origin", "other port", "own", "own, localhost")
+
+
+@pytest.mark.parametrize("pair", PAIRS)
+def test_http_requests_must_address_the_server_as_bound(served_url, pair):
+    """The page and a static file: 403 for every forged pair, 200 for the explorer's own two."""
+    host, origin = _pairs(served_url)[pair]
+    expected = 200 if pair.startswith("own") else 403
+    assert _get(served_url, host, origin) == expected
+    assert _get(served_url, host, origin, "/static/js/bokeh.min.js") == expected
+
+
+async def _websocket(url: str, host: str, origin: str | None) -> str:
+    """Bokeh's websocket opened with a fresh session's token and these headers: its first message type or the
+    HTTP status that refused it."""
+    page = urllib.request.urlopen(url, timeout=60).read().decode()
+    token = re.search(r'"token":"([^"]+)"', page).group(1)
+    headers = {"Host": host} | ({"Origin": origin} if origin else {})
+    request = HTTPRequest(f"ws://{urllib.parse.urlsplit(url).netloc}/ws", headers=headers, request_timeout=60)
+    try:
+        socket = await websocket_connect(request, subprotocols=["bokeh", token])
+    except HTTPClientError as exc:
+        return f"HTTP {exc.code}"
+    try:
+        return json.loads(await socket.read_message())["msgtype"]  # a Bokeh message's header comes first
+    finally:
+        socket.close()
+
+
+def test_the_websocket_refuses_a_rebinding_page_and_serves_the_explorers_own(served_url):
+    """With a valid token, the rebinding pair and a foreign Origin get 403; the explorer's own pair gets Bokeh's
+    ACK, the start of a session (before the guard the rebinding pair got it too)."""
+    pairs = _pairs(served_url)
+    names = ("rebinding", "foreign Origin", "own")
+    answers = {name: asyncio.run(_websocket(served_url, *pairs[name])) for name in names}
+    assert answers == {"rebinding": "HTTP 403", "foreign Origin": "HTTP 403", "own": "ACK"}
+
+
+def test_ipv6_loopback_is_served_and_guarded():
+    """``--address ::1``: the page and the websocket at http://[::1]:P/ work; Host evil.example is refused."""
+    with browser_harness.served(address="::1") as url:
+        port = _port(url)
+        with urllib.request.urlopen(url, timeout=60) as response:
+            assert response.status == 200
+        own, evil = f"[::1]:{port}", f"{EVIL}:{port}"
+        assert asyncio.run(_websocket(url, own, f"http://{own}")) == "ACK"
+        assert asyncio.run(_websocket(url, evil, f"http://{evil}")) == "HTTP 403"
