@@ -34,6 +34,8 @@ from tornado.log import app_log
 from tornado.routing import Matcher, Rule
 from tornado.web import RequestHandler
 
+from .._validate import printable
+from .._validate import real as _validate_real
 from ..errors import SpinectlError
 from ..model.config import DEFAULT_PRESET, list_presets, load_preset
 from ..model.params import Model
@@ -46,7 +48,7 @@ from .state import (
     LANDSCAPE_PARAMETERS,
     SLIDERS,
     ExploreState,
-    from_shown,
+    from_client,
     initial_state,
     pictures_key,
     replace,
@@ -149,13 +151,14 @@ class Explorer:
 
     def __init__(self, base: Model, preset: str):
         self.models = {CONFIG_CHOICE: base} if preset == CONFIG_CHOICE else {}
-        self.base = base
+        self.base, self.current = base, preset
         self.state = initial_state(base)
         self.numbers: PointNumbers | None = None
         self.dataset: xr.Dataset | None = None
         self._generation = 0
         self._pictures_key = None
         self.seconds = {"point": np.nan, "landscapes": np.nan}
+        self.errors: dict[str, str | None] = {"input": None, "point": None, "landscapes": None}
         self.preset = pn.widgets.Select(
             label="preset", value=preset, options=[*self.models, *list_presets()], width=260
         )
@@ -206,17 +209,37 @@ class Explorer:
 
     # --- events ---------------------------------------------------------------------------
 
-    def _on_slider(self, spec, shown: float) -> None:
-        old = self.state
-        self.state = replace(self.state, **{spec.field: from_shown(spec, shown)})
+    def _on_slider(self, spec, shown) -> None:
+        old, slider = self.state, self.sliders[spec.field]
+        try:  # a forged message can send anything: refused in one line, the state kept
+            value = from_client(spec, shown, slider.start, slider.end)
+        except SpinectlError as exc:
+            self._refuse(exc)
+            return
+        self.errors["input"] = None
+        self.state = replace(self.state, **{spec.field: value})
         self.update_point()
         if spec.field in LANDSCAPE_PARAMETERS and getattr(old, spec.field) != getattr(self.state, spec.field):
             self.refresh_landscapes()
 
+    def _refuse(self, exc: SpinectlError) -> None:
+        """A value from the page refused: say so in the status line, show the state's values again."""
+        self.errors["input"] = printable(str(exc))
+        self.preset.value = self.current
+        self._show_state()
+        self._show_status()
+
     def _on_preset(self, event) -> None:
         name = event.new
+        if name == self.current:  # the selector set back after a refusal
+            return
         if name not in self.models:
-            self.models[name] = load_preset(name)
+            try:  # a forged message can name any preset
+                self.models[name] = load_preset(name)
+            except SpinectlError as exc:
+                self._refuse(exc)
+                return
+        self.current, self.errors["input"] = name, None
         self.base = self.models[name]
         point = (self.state.eccentricity, self.state.lordosis)
         self.state = replace(initial_state(self.base), eccentricity=point[0], lordosis=point[1])
@@ -235,7 +258,13 @@ class Explorer:
         values = {}
         for field, value in (("eccentricity", eccentricity), ("lordosis", lordosis)):
             slider, spec = self.sliders[field], slider_for(field)
-            values[field] = from_shown(spec, float(np.clip(value * spec.scale, slider.start, slider.end)))
+            try:  # a click's coordinates come from the page: a forged NaN is refused, not clipped
+                shown = float(np.clip(_validate_real(spec.label, value) * spec.scale, slider.start, slider.end))
+                values[field] = from_client(spec, shown, slider.start, slider.end)
+            except SpinectlError as exc:
+                self._refuse(exc)
+                return
+        self.errors["input"] = None
         self.state = replace(self.state, **values)
         self._show_state()
         self.update_point()
@@ -261,8 +290,10 @@ class Explorer:
         try:
             numbers = point_numbers(self.base, self.state)
         except SpinectlError as exc:  # e.g. a fibre attachment on a CoR of a --config model: say so, keep the views
-            self.status.object = f"**not shown:** {html.escape(str(exc))}"
+            self.errors["point"] = printable(str(exc))
+            self._show_status()
             return time.perf_counter() - start
+        self.errors["point"] = None
         key = (id(self.base), pictures_key(self.state))
         changed = key != self._pictures_key  # the delay and the lag move the margins only: redraw the rest if needed
         drawing = drawing_svg(numbers) if changed else None
@@ -293,33 +324,78 @@ class Explorer:
 
         async def solve():
             start = time.perf_counter()
-            dataset = await asyncio.to_thread(landscapes, base, state)
-            if generation == self._generation:  # a later change started another solve: show only that one
-                self._show_landscapes(dataset, time.perf_counter() - start)
+            dataset, error = None, "internal error (the server's log has the traceback)"
+            try:
+                dataset, error = await asyncio.to_thread(_solved, base, state)
+            finally:  # a bug too stops the progress bar; its traceback goes to the server's log
+                if generation == self._generation:  # a later change started another solve: show only that one
+                    self._show_landscapes(dataset, time.perf_counter() - start, error)
 
-        if pn.state.curdoc is None or pn.state.curdoc.session_context is None:
+        if not in_session():
             start = time.perf_counter()
-            self._show_landscapes(landscapes(base, state), time.perf_counter() - start)
+            dataset, error = _solved(base, state)
+            self._show_landscapes(dataset, time.perf_counter() - start, error)
             return
         self._show_status()
         pn.state.execute(solve)
 
-    def _show_landscapes(self, dataset: xr.Dataset, elapsed: float) -> None:
+    def _show_landscapes(self, dataset: xr.Dataset | None, elapsed: float, error: str | None = None) -> None:
+        """Show the landscapes solved, or keep the last ones (each titled with its own mass and K) and the error."""
         with pn.io.hold():
-            self.dataset = dataset
+            if dataset is not None:
+                self.dataset = dataset
             for view in self.maps.values():
-                view.show(dataset, self.state)
+                if dataset is not None:
+                    view.show(dataset, self.state)
                 view.pane.loading = False
             self.progress.param.update(active=False, visible=False)
             self.seconds["landscapes"] = elapsed
+            self.errors["landscapes"] = error
             self._show_status()
 
     def _show_status(self) -> None:
-        point, maps = self.seconds["point"], self.seconds["landscapes"]
-        solving = "solving…" if self.progress.active else f"solved in {maps:.2f} s"
-        self.status.object = (
-            f"point updated in {point:.2f} s; landscapes ({LANDSCAPE_POINTS} × {LANDSCAPE_POINTS}) {solving}"
-        )
+        self.status.object = status_text(self.seconds, self.errors, self.progress.active)
+
+
+def in_session() -> bool:
+    """Whether the code runs in a server session (a browser tab), not in a notebook's first display or a test."""
+    return pn.state.curdoc is not None and pn.state.curdoc.session_context is not None
+
+
+def status_text(seconds: dict[str, float], errors: dict[str, str | None], solving: bool) -> str:
+    """The status line: a refused input, the point's time or error, the landscapes' time, progress or error.
+
+    Parameters
+    ----------
+    seconds : dict
+        ``point`` and ``landscapes``: the last times taken [s].
+    errors : dict
+        ``input``, ``point``, ``landscapes``: one-line errors, or None.
+    solving : bool
+        The landscapes are being solved.
+
+    Returns
+    -------
+    str
+        Markdown, e.g. ``point updated in 0.15 s; landscapes (41 × 41) solved in 0.68 s``.
+    """
+    point = f"point updated in {seconds['point']:.2f} s"
+    if errors["point"]:
+        point = f"**point not shown:** {html.escape(errors['point'])}"
+    maps = "solving…" if solving else f"solved in {seconds['landscapes']:.2f} s"
+    if errors["landscapes"] and not solving:
+        maps = f"**not solved:** {html.escape(errors['landscapes'])}"
+    text = f"{point}; landscapes ({LANDSCAPE_POINTS} × {LANDSCAPE_POINTS}) {maps}"
+    return f"**refused:** {html.escape(errors['input'])}; {text}" if errors["input"] else text
+
+
+def _solved(base: Model, state: ExploreState) -> tuple[xr.Dataset | None, str | None]:
+    """The landscapes of :func:`spinectl.explore.numbers.landscapes`, or the one-line error of a model invalid
+    at one of their points (e.g. a fibre attachment on a CoR at E = Lambda = 0)."""
+    try:
+        return landscapes(base, state), None
+    except SpinectlError as exc:
+        return None, printable(str(exc))
 
 
 BAR_VIEWS = {

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import asyncio
 import xml.etree.ElementTree as ET
 from types import SimpleNamespace
 
@@ -13,8 +14,8 @@ from tornado.web import Application
 from spinectl.errors import ModelError
 from spinectl.explore import app
 from spinectl.explore import numbers as nb
-from spinectl.explore.state import initial_state, replace
-from spinectl.model.config import load_preset
+from spinectl.explore.state import initial_state, replace, slider_for
+from spinectl.model.config import load_config, load_preset
 from spinectl.paper.landmarks import CT_LIMIT
 
 
@@ -107,8 +108,69 @@ def test_a_model_invalid_at_the_point_is_a_message_not_a_crash(explorer, monkeyp
 
     monkeypatch.setattr(app, "point_numbers", invalid)
     explorer.move_to(0.01, 0.01)
-    assert explorer.status.object == "**not shown:** fibre attachment on a centre of rotation"
+    assert explorer.status.object.startswith("**point not shown:** fibre attachment on a centre of rotation; ")
     assert explorer.table.object == shown
+
+
+ON_COR = '[[muscles]]\nname = "p"\nupper = [0.1, 0.3]\nlower = [0.0, 0.005]\nspread = 0.0\nfibres = 1\n'
+"""A fourth pair whose lower attachment is the CoR L5S1 (y = 0.005 m) at E = Lambda = 0, a corner of the
+landscapes' grid, and nowhere else (docs/robustness.md, "Model evaluation")."""
+
+
+def test_a_model_invalid_at_one_grid_point_stops_the_progress_and_says_why(tmp_path, monkeypatch):
+    """In a server session the landscapes are solved in a worker thread; the model of ON_COR is invalid at
+    E = Lambda = 0 only: the solve ends with the library's one-line ModelError in the status line, the progress
+    bar stopped and the maps no longer loading (before: the task raised, the progress ran for ever and the
+    traceback went to the server's log). The point itself (3 cm, 4 cm) is valid and shown."""
+    path = tmp_path / "on_cor.toml"
+    path.write_text(ON_COR)
+    model = load_config(path)
+    with pytest.raises(ModelError, match="L5S1 at E = 0 m, Lambda = 0 m") as raised:
+        nb.landscapes(model, initial_state(model))
+    tasks = []
+    monkeypatch.setattr(app, "in_session", lambda: True)
+    monkeypatch.setattr(app.pn.state, "execute", tasks.append)
+    explorer = app.Explorer(model, app.CONFIG_CHOICE)
+    assert explorer.progress.active and "solving…" in explorer.status.object
+    (solve,) = tasks
+    asyncio.run(solve())
+    assert not explorer.progress.active and not any(view.pane.loading for view in explorer.maps.values())
+    assert explorer.status.object.endswith(f"landscapes (41 × 41) **not solved:** {raised.value}")
+    assert explorer.status.object.startswith("point updated in ") and explorer.dataset is None
+
+
+@pytest.mark.parametrize(
+    ("field", "sent", "message"),
+    [
+        ("eccentricity", float("nan"), "E [cm]: must be finite (got nan)"),
+        ("mass", 1e6, "mass [kg]: must be in [10, 80] (got 1e+06)"),
+        ("delay", -5.0, "reflex delay τ [ms]: must be in [0, 250] (got -5)"),
+        ("stiffness", float("inf"), "K [N m/rad]: must be finite (got inf)"),
+    ],
+)
+def test_a_forged_slider_value_is_refused_in_one_line(field, sent, message):
+    """What a forged message can send past Bokeh's own type check (which refuses a string): NaN, inf, a value
+    outside the slider's range. The status line says so, the state, the views and the landscapes stay (before:
+    NaN raised in the server, its traceback sent back to the page; 1e6 kg left the landscapes solving for ever)."""
+    explorer = app.Explorer(load_preset("default"), "default")
+    state, table, dataset = explorer.state, explorer.table.object, explorer.dataset
+    _drag(explorer.sliders[field], sent)
+    assert explorer.status.object.startswith(f"**refused:** {message}; point updated in ")
+    assert explorer.state == state and explorer.table.object == table and explorer.dataset is dataset
+    assert explorer.sliders[field].value == pytest.approx(getattr(state, field) * slider_for(field).scale)
+    _drag(explorer.sliders[field], explorer.sliders[field].start)  # a valid value clears the message
+    assert not explorer.status.object.startswith("**refused:**")
+
+
+def test_a_forged_click_or_preset_is_refused_in_one_line():
+    """A tap at NaN (a forged Bokeh event), a preset that is not one: one line; the point and preset stay."""
+    explorer = app.Explorer(load_preset("default"), "default")
+    state = explorer.state
+    explorer.move_to(float("nan"), 0.02)
+    assert explorer.status.object.startswith("**refused:** E [cm]: must be finite (got nan); ")
+    explorer.preset.value = "nope"  # Panel's Select takes a value outside its options, as a forged message sends
+    assert explorer.status.object.startswith("**refused:** preset: must be one of ")
+    assert explorer.state == state and explorer.preset.value == "default"
 
 
 def test_explorer_for_a_notebook_reads_the_config_named(tmp_path):

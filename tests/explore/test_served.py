@@ -18,6 +18,7 @@ import json
 import re
 import urllib.parse
 import urllib.request
+import uuid
 
 import browser_harness
 import pytest
@@ -93,6 +94,68 @@ def test_the_websocket_refuses_a_rebinding_page_and_serves_the_explorers_own(ser
     names = ("rebinding", "foreign Origin", "own")
     answers = {name: asyncio.run(_websocket(served_url, *pairs[name])) for name in names}
     assert answers == {"rebinding": "HTTP 403", "foreign Origin": "HTTP 403", "own": "ACK"}
+
+
+async def _frames(socket) -> tuple[dict, str]:
+    """One Bokeh message: its header and its content's text (header, metadata, content, then each buffer as two
+    frames: its id and its bytes)."""
+    header = json.loads(await socket.read_message())
+    await socket.read_message()
+    content = await socket.read_message()
+    for _ in range(2 * header.get("num_buffers", 0)):
+        await socket.read_message()
+    return header, content
+
+
+async def _send(socket, msgtype: str, content: dict) -> None:
+    await socket.write_message(json.dumps({"msgid": uuid.uuid4().hex, "msgtype": msgtype}))
+    await socket.write_message("{}")
+    await socket.write_message(json.dumps(content))
+
+
+def _objects(tree):
+    """Every Bokeh model object in a document's JSON."""
+    if isinstance(tree, dict):
+        if tree.get("type") == "object":
+            yield tree
+        for value in tree.values():
+            yield from _objects(value)
+    elif isinstance(tree, list):
+        for value in tree:
+            yield from _objects(value)
+
+
+async def _forged_mass(url: str, value) -> list[tuple[str, str]]:
+    """Open a session, set the mass slider's value_throttled to ``value`` as a forged PATCH-DOC, and collect the
+    server's messages (type, content) until the status line answers or 60 s pass."""
+    page = urllib.request.urlopen(url, timeout=60).read().decode()
+    token = re.search(r'"token":"([^"]+)"', page).group(1)
+    request = HTTPRequest(f"ws://127.0.0.1:{_port(url)}/ws", headers={"Origin": url.rstrip("/")})
+    socket = await websocket_connect(request, subprotocols=["bokeh", token])
+    try:
+        await _frames(socket)  # ACK
+        await _send(socket, "PULL-DOC-REQ", {})
+        _, document = await _frames(socket)
+        objects = _objects(json.loads(document))
+        (mass,) = (o["id"] for o in objects if o.get("attributes", {}).get("title") == "mass [kg]")
+        event = {"kind": "ModelChanged", "model": {"id": mass}, "attr": "value_throttled", "new": value}
+        await _send(socket, "PATCH-DOC", {"events": [event]})
+        answers = []
+        while not any("refused" in content or kind == "ERROR" for kind, content in answers):
+            header, content = await asyncio.wait_for(_frames(socket), 60)
+            answers.append((header["msgtype"], content))
+        return answers
+    finally:
+        socket.close()
+
+
+def test_a_forged_slider_value_is_answered_in_the_page_not_with_a_traceback(served_url):
+    """NaN for the mass (Bokeh's encoding of a NaN number; its type check lets NaN through): no ERROR message
+    back (before: the ValueError of the server, with its traceback), and the status line says in one line what
+    was refused."""
+    answers = asyncio.run(_forged_mass(served_url, {"type": "number", "value": "nan"}))
+    assert [kind for kind, _ in answers if kind == "ERROR"] == []
+    assert any("mass [kg]: must be finite (got nan)" in content for _, content in answers)
 
 
 def test_ipv6_loopback_is_served_and_guarded():
