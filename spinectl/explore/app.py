@@ -34,8 +34,7 @@ from tornado.log import app_log
 from tornado.routing import Matcher, Rule
 from tornado.web import RequestHandler
 
-from .._validate import printable
-from .._validate import real as _validate_real
+from .._validate import printable, real
 from ..errors import SpinectlError
 from ..model.config import DEFAULT_PRESET, list_presets, load_preset
 from ..model.params import Model
@@ -48,10 +47,12 @@ from .state import (
     LANDSCAPE_PARAMETERS,
     SLIDERS,
     ExploreState,
+    decimals,
     from_client,
     initial_state,
     pictures_key,
     replace,
+    shown_text,
     slider_for,
     state_toml,
 )
@@ -182,6 +183,7 @@ class Explorer:
             end=max(spec.end, value),
             step=spec.step,
             value=value,
+            format="0" if not decimals(spec) else "0." + "0" * decimals(spec),  # the digits a step means
             width=260,
         )
         slider.param.watch(lambda event, spec=spec: self._on_slider(spec, event.new), "value_throttled")
@@ -259,7 +261,7 @@ class Explorer:
         for field, value in (("eccentricity", eccentricity), ("lordosis", lordosis)):
             slider, spec = self.sliders[field], slider_for(field)
             try:  # a click's coordinates come from the page: a forged NaN is refused, not clipped
-                shown = float(np.clip(_validate_real(spec.label, value) * spec.scale, slider.start, slider.end))
+                shown = float(np.clip(real(spec.label, value) * spec.scale, slider.start, slider.end))
                 values[field] = from_client(spec, shown, slider.start, slider.end)
             except SpinectlError as exc:
                 self._refuse(exc)
@@ -477,7 +479,7 @@ class _BarView:
         self.source.data = _hex(data.columns)
         self.figure.y_range.update(start=data.limits[0], end=data.limits[1])
         self.line.update(location=data.line or 0.0, visible=data.line is not None)
-        self.figure.title.text = data.title
+        self.figure.title.text = data.title.replace(" (", "\n(", 1)  # two lines: one is wider than the view
 
 
 class _LandscapeView:
@@ -495,7 +497,7 @@ class _LandscapeView:
             height=LANDSCAPE_PIXELS,
             x_range=span,
             y_range=span,
-            title=views.LANDSCAPE_LABELS[variable] + " (click to move the point)",
+            title=views.LANDSCAPE_LABELS[variable] + "\nclick to move the point",
             x_axis_label="E [cm]",
             y_axis_label="Λ [cm]",
             tools="tap",
@@ -527,9 +529,8 @@ class _LandscapeView:
         if finite.size:
             self.mapper.update(low=float(finite.min()), high=float(finite.max()))
         self.image.data = {"image": [values]}
-        self.figure.title.text = (
-            f"{views.LANDSCAPE_LABELS[self.variable]}: mass {state.mass:g} kg, K {state.stiffness:g} N m/rad"
-        )
+        mass, stiffness = (shown_text(slider_for(f), getattr(state, f)) for f in ("mass", "stiffness"))
+        self.figure.title.text = f"{views.LANDSCAPE_LABELS[self.variable]}\nmass {mass} kg, K {stiffness} N m/rad"
         self.mark(state)
 
     def mark(self, state: ExploreState) -> None:

@@ -227,6 +227,37 @@ def from_client(slider: Slider, shown, start: float | None = None, end: float | 
     return from_shown(slider, in_range(slider.label, shown, low, high))
 
 
+def decimals(slider: Slider) -> int:
+    """Decimals a value of ``slider`` means: those of its step (0.5 kg: 1; 0.05: 2; 5 ms: 0).
+
+    Parameters
+    ----------
+    slider : Slider
+
+    Returns
+    -------
+    int
+    """
+    return len(f"{slider.step:g}".partition(".")[2])
+
+
+def shown_text(slider: Slider, value: float) -> str:
+    """A state's value as its slider shows it: in the unit shown, to the decimals of the step.
+
+    Parameters
+    ----------
+    slider : Slider
+    value : float
+        In SI units.
+
+    Returns
+    -------
+    str
+        E.g. ``'24.1'`` for the mass 24.056578609556272 kg of a calibrated preset (steps of 0.5 kg).
+    """
+    return f"{value * slider.scale:.{decimals(slider)}f}"
+
+
 def slider_for(field: str) -> Slider:
     """The slider of a state's field.
 

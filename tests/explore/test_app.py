@@ -264,3 +264,42 @@ def test_the_bokeh_views_plot_the_librarys_numbers(explorer):
     np.testing.assert_allclose(margins.source.data["value"], np.where(finite, expected.delay_margin * 1000, 0.0))
     assert [m == "∞" for m in margins.source.data["mark"]] == list(~finite)
     assert margins.line.location == pytest.approx(explorer.state.delay * 1000)
+
+
+def _text_px(text: str, size: str, bold: bool) -> float:
+    """Width [px] of one line as Chromium sets a Bokeh title here: Bokeh's 'helvetica' is DejaVu Sans on Debian
+    (fc-match), matplotlib's own font, measured at 72 dpi so that a point is a pixel (8pt = 8 * 96 / 72 px)."""
+    from matplotlib.backends.backend_agg import RendererAgg
+    from matplotlib.font_manager import FontProperties
+
+    px = float(size[:-2]) * (96 / 72 if size.endswith("pt") else 1.0)
+    font = FontProperties(family="DejaVu Sans", weight="bold" if bold else "normal", size=px)
+    return RendererAgg(1, 1, 72).get_text_width_height_descent(text, font, ismath=False)[0]
+
+
+FRAME_LEFT_PX = 60
+"""Room taken left of a plot's frame, where its title starts, by the y axis: its label, tick labels and ticks
+(about 45 px in the browser; 60 to be safe)."""
+
+
+def test_every_title_of_the_bokeh_views_fits_its_view():
+    """Each title line of every Bokeh view, for the calibrated preset wagner2012 (24.056578609556272 kg) and a
+    3-digit delay, is narrower than the view right of its frame (before: 'minimum PCSA [cm²]: mass 24.0566 kg,
+    K 0 N m/rad' and 'delay margins (red: unstable at τ = 100 ms)' were cut at the view's right edge)."""
+    explorer = app.Explorer(load_preset("wagner2012"), "wagner2012")
+    figures = [view.figure for view in explorer.views.values()] + [view.figure for view in explorer.maps.values()]
+    for figure in figures:
+        title = figure.title
+        bold = title.text_font_style == "bold"
+        for line in title.text.split("\n"):
+            assert _text_px(line, title.text_font_size, bold) <= figure.width - FRAME_LEFT_PX, line
+
+
+def test_values_show_the_digits_their_slider_steps_mean():
+    """wagner2012's calibrated mass 24.056578609556272 kg is shown as 24.1 kg (steps of 0.5 kg) in its slider's
+    format and the landscapes' titles, not 24.0566; the state keeps the model's own value."""
+    explorer = app.Explorer(load_preset("wagner2012"), "wagner2012")
+    assert explorer.state.mass == load_preset("wagner2012").body.mass
+    assert explorer.sliders["mass"].format == "0.0" and explorer.sliders["activation"].format == "0.00"
+    assert explorer.sliders["delay"].format == "0"
+    assert explorer.maps["min_pcsa_cm2"].figure.title.text == "minimum PCSA [cm²]\nmass 24.1 kg, K 0.0 N m/rad"

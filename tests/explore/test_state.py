@@ -79,3 +79,13 @@ def test_from_client_takes_the_range_shown():
     assert st.from_client(mass, 90.0, 10.0, 90.0) == 90.0 and st.from_client(mass, 24.2) == 24.0
     with pytest.raises(ParameterError, match=r"must be in \[10, 80\]"):
         st.from_client(mass, 90.0)
+
+
+def test_shown_text_has_the_decimals_of_the_step():
+    """Steps 0.1 cm, 0.5 kg, 0.05 and 5 ms mean 1, 1, 2 and 0 decimals: 24.056578609556272 kg is '24.1'."""
+    assert [st.decimals(st.slider_for(f)) for f in ("eccentricity", "mass", "activation", "delay")] == [1, 1, 2, 0]
+    assert st.shown_text(st.slider_for("mass"), 24.056578609556272) == "24.1"
+    assert (
+        st.shown_text(st.slider_for("delay"), 0.105) == "105"
+        and st.shown_text(st.slider_for("lordosis"), 0.04) == "4.0"
+    )
