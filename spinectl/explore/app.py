@@ -172,8 +172,13 @@ class Explorer:
         self.maps = {variable: _LandscapeView(variable, self.move_to) for variable in views.LANDSCAPE_LABELS}
         self.preset.param.watch(self._on_preset, "value")
         self.layout = self._layout()
+        if in_session():
+            self.progress.param.update(active=True, visible=True)  # "solving…" until the page is connected
         self.update_point()
-        self.refresh_landscapes()
+        if in_session():  # solved once the page is connected: a solve done before, its views were at times not sent
+            pn.state.onload(self.refresh_landscapes)
+        else:
+            self.refresh_landscapes()
 
     def _slider(self, spec) -> pn.widgets.FloatSlider:
         value = getattr(self.state, spec.field) * spec.scale
@@ -360,7 +365,12 @@ class Explorer:
 
 
 def in_session() -> bool:
-    """Whether the code runs in a server session (a browser tab), not in a notebook's first display or a test."""
+    """Whether the code runs in a server session (a browser tab), not in a notebook's first display or a test.
+
+    Returns
+    -------
+    bool
+    """
     return pn.state.curdoc is not None and pn.state.curdoc.session_context is not None
 
 

@@ -100,7 +100,7 @@ def browser_page(executable: str, *args: str):
     with sync_playwright() as playwright:
         browser = playwright.chromium.launch(executable_path=executable, args=[*CHROMIUM_ARGS, *args])
         try:
-            page = browser.new_page(viewport=VIEWPORT)
+            page = browser.new_context(viewport=VIEWPORT).new_page()  # a context of its own: more pages can open in it
             page.set_default_timeout(TIMEOUT_S * 1000)
             yield page
         finally:

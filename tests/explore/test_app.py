@@ -129,7 +129,8 @@ def test_a_model_invalid_at_one_grid_point_stops_the_progress_and_says_why(tmp_p
         nb.landscapes(model, initial_state(model))
     tasks = []
     monkeypatch.setattr(app, "in_session", lambda: True)
-    monkeypatch.setattr(app.pn.state, "execute", tasks.append)
+    monkeypatch.setattr(app.pn.state, "onload", lambda callback, **options: callback())  # the page has loaded
+    monkeypatch.setattr(app.pn.state, "execute", lambda function, **options: tasks.append(function))
     explorer = app.Explorer(model, app.CONFIG_CHOICE)
     assert explorer.progress.active and "solving…" in explorer.status.object
     (solve,) = tasks
