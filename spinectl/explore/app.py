@@ -20,6 +20,7 @@ import asyncio
 import html
 import io
 import time
+import webbrowser
 
 import matplotlib
 import numpy as np
@@ -29,22 +30,29 @@ from bokeh.events import Tap
 from bokeh.models import BoxAnnotation, ColorBar, ColumnDataSource, FactorRange, LinearColorMapper, Range1d, Span
 from bokeh.plotting import figure as bokeh_figure
 from matplotlib.colors import to_hex
+from tornado.log import app_log
+from tornado.routing import Matcher, Rule
+from tornado.web import RequestHandler
 
+from .._validate import printable, real
 from ..errors import SpinectlError
 from ..model.config import DEFAULT_PRESET, list_presets, load_preset
 from ..model.params import Model
 from ..paper.landmarks import CT_LIMIT
 from ..units import CM_PER_M, m2_to_cm2
 from . import views
+from .launch import allowed_hosts, request_allowed, url_host
 from .numbers import LANDSCAPE_POINTS, PointNumbers, landscape_axis, landscapes, point_numbers
 from .state import (
     LANDSCAPE_PARAMETERS,
     SLIDERS,
     ExploreState,
-    from_shown,
+    decimals,
+    from_client,
     initial_state,
     pictures_key,
     replace,
+    shown_text,
     slider_for,
     state_toml,
 )
@@ -144,13 +152,14 @@ class Explorer:
 
     def __init__(self, base: Model, preset: str):
         self.models = {CONFIG_CHOICE: base} if preset == CONFIG_CHOICE else {}
-        self.base = base
+        self.base, self.current = base, preset
         self.state = initial_state(base)
         self.numbers: PointNumbers | None = None
         self.dataset: xr.Dataset | None = None
         self._generation = 0
         self._pictures_key = None
         self.seconds = {"point": np.nan, "landscapes": np.nan}
+        self.errors: dict[str, str | None] = {"input": None, "point": None, "landscapes": None}
         self.preset = pn.widgets.Select(
             label="preset", value=preset, options=[*self.models, *list_presets()], width=260
         )
@@ -163,8 +172,13 @@ class Explorer:
         self.maps = {variable: _LandscapeView(variable, self.move_to) for variable in views.LANDSCAPE_LABELS}
         self.preset.param.watch(self._on_preset, "value")
         self.layout = self._layout()
+        if in_session():
+            self.progress.param.update(active=True, visible=True)  # "solving…" until the page is connected
         self.update_point()
-        self.refresh_landscapes()
+        if in_session():  # solved once the page is connected: a solve done before, its views were at times not sent
+            pn.state.onload(self.refresh_landscapes)
+        else:
+            self.refresh_landscapes()
 
     def _slider(self, spec) -> pn.widgets.FloatSlider:
         value = getattr(self.state, spec.field) * spec.scale
@@ -174,6 +188,7 @@ class Explorer:
             end=max(spec.end, value),
             step=spec.step,
             value=value,
+            format="0" if not decimals(spec) else "0." + "0" * decimals(spec),  # the digits a step means
             width=260,
         )
         slider.param.watch(lambda event, spec=spec: self._on_slider(spec, event.new), "value_throttled")
@@ -201,17 +216,37 @@ class Explorer:
 
     # --- events ---------------------------------------------------------------------------
 
-    def _on_slider(self, spec, shown: float) -> None:
-        old = self.state
-        self.state = replace(self.state, **{spec.field: from_shown(spec, shown)})
+    def _on_slider(self, spec, shown) -> None:
+        old, slider = self.state, self.sliders[spec.field]
+        try:  # a forged message can send anything: refused in one line, the state kept
+            value = from_client(spec, shown, slider.start, slider.end)
+        except SpinectlError as exc:
+            self._refuse(exc)
+            return
+        self.errors["input"] = None
+        self.state = replace(self.state, **{spec.field: value})
         self.update_point()
         if spec.field in LANDSCAPE_PARAMETERS and getattr(old, spec.field) != getattr(self.state, spec.field):
             self.refresh_landscapes()
 
+    def _refuse(self, exc: SpinectlError) -> None:
+        """A value from the page refused: say so in the status line, show the state's values again."""
+        self.errors["input"] = printable(str(exc))
+        self.preset.value = self.current
+        self._show_state()
+        self._show_status()
+
     def _on_preset(self, event) -> None:
         name = event.new
+        if name == self.current:  # the selector set back after a refusal
+            return
         if name not in self.models:
-            self.models[name] = load_preset(name)
+            try:  # a forged message can name any preset
+                self.models[name] = load_preset(name)
+            except SpinectlError as exc:
+                self._refuse(exc)
+                return
+        self.current, self.errors["input"] = name, None
         self.base = self.models[name]
         point = (self.state.eccentricity, self.state.lordosis)
         self.state = replace(initial_state(self.base), eccentricity=point[0], lordosis=point[1])
@@ -230,7 +265,13 @@ class Explorer:
         values = {}
         for field, value in (("eccentricity", eccentricity), ("lordosis", lordosis)):
             slider, spec = self.sliders[field], slider_for(field)
-            values[field] = from_shown(spec, float(np.clip(value * spec.scale, slider.start, slider.end)))
+            try:  # a click's coordinates come from the page: a forged NaN is refused, not clipped
+                shown = float(np.clip(real(spec.label, value) * spec.scale, slider.start, slider.end))
+                values[field] = from_client(spec, shown, slider.start, slider.end)
+            except SpinectlError as exc:
+                self._refuse(exc)
+                return
+        self.errors["input"] = None
         self.state = replace(self.state, **values)
         self._show_state()
         self.update_point()
@@ -256,8 +297,10 @@ class Explorer:
         try:
             numbers = point_numbers(self.base, self.state)
         except SpinectlError as exc:  # e.g. a fibre attachment on a CoR of a --config model: say so, keep the views
-            self.status.object = f"**not shown:** {html.escape(str(exc))}"
+            self.errors["point"] = printable(str(exc))
+            self._show_status()
             return time.perf_counter() - start
+        self.errors["point"] = None
         key = (id(self.base), pictures_key(self.state))
         changed = key != self._pictures_key  # the delay and the lag move the margins only: redraw the rest if needed
         drawing = drawing_svg(numbers) if changed else None
@@ -288,33 +331,83 @@ class Explorer:
 
         async def solve():
             start = time.perf_counter()
-            dataset = await asyncio.to_thread(landscapes, base, state)
-            if generation == self._generation:  # a later change started another solve: show only that one
-                self._show_landscapes(dataset, time.perf_counter() - start)
+            dataset, error = None, "internal error (the server's log has the traceback)"
+            try:
+                dataset, error = await asyncio.to_thread(_solved, base, state)
+            finally:  # a bug too stops the progress bar; its traceback goes to the server's log
+                if generation == self._generation:  # a later change started another solve: show only that one
+                    self._show_landscapes(dataset, time.perf_counter() - start, error)
 
-        if pn.state.curdoc is None or pn.state.curdoc.session_context is None:
+        if not in_session():
             start = time.perf_counter()
-            self._show_landscapes(landscapes(base, state), time.perf_counter() - start)
+            dataset, error = _solved(base, state)
+            self._show_landscapes(dataset, time.perf_counter() - start, error)
             return
         self._show_status()
         pn.state.execute(solve)
 
-    def _show_landscapes(self, dataset: xr.Dataset, elapsed: float) -> None:
+    def _show_landscapes(self, dataset: xr.Dataset | None, elapsed: float, error: str | None = None) -> None:
+        """Show the landscapes solved, or keep the last ones (each titled with its own mass and K) and the error."""
         with pn.io.hold():
-            self.dataset = dataset
+            if dataset is not None:
+                self.dataset = dataset
             for view in self.maps.values():
-                view.show(dataset, self.state)
+                if dataset is not None:
+                    view.show(dataset, self.state)
                 view.pane.loading = False
             self.progress.param.update(active=False, visible=False)
             self.seconds["landscapes"] = elapsed
+            self.errors["landscapes"] = error
             self._show_status()
 
     def _show_status(self) -> None:
-        point, maps = self.seconds["point"], self.seconds["landscapes"]
-        solving = "solving…" if self.progress.active else f"solved in {maps:.2f} s"
-        self.status.object = (
-            f"point updated in {point:.2f} s; landscapes ({LANDSCAPE_POINTS} × {LANDSCAPE_POINTS}) {solving}"
-        )
+        self.status.object = status_text(self.seconds, self.errors, self.progress.active)
+
+
+def in_session() -> bool:
+    """Whether the code runs in a server session (a browser tab), not in a notebook's first display or a test.
+
+    Returns
+    -------
+    bool
+    """
+    return pn.state.curdoc is not None and pn.state.curdoc.session_context is not None
+
+
+def status_text(seconds: dict[str, float], errors: dict[str, str | None], solving: bool) -> str:
+    """The status line: a refused input, the point's time or error, the landscapes' time, progress or error.
+
+    Parameters
+    ----------
+    seconds : dict
+        ``point`` and ``landscapes``: the last times taken [s].
+    errors : dict
+        ``input``, ``point``, ``landscapes``: one-line errors, or None.
+    solving : bool
+        The landscapes are being solved.
+
+    Returns
+    -------
+    str
+        Markdown, e.g. ``point updated in 0.15 s; landscapes (41 × 41) solved in 0.68 s``.
+    """
+    point = f"point updated in {seconds['point']:.2f} s"
+    if errors["point"]:
+        point = f"**point not shown:** {html.escape(errors['point'])}"
+    maps = "solving…" if solving else f"solved in {seconds['landscapes']:.2f} s"
+    if errors["landscapes"] and not solving:
+        maps = f"**not solved:** {html.escape(errors['landscapes'])}"
+    text = f"{point}; landscapes ({LANDSCAPE_POINTS} × {LANDSCAPE_POINTS}) {maps}"
+    return f"**refused:** {html.escape(errors['input'])}; {text}" if errors["input"] else text
+
+
+def _solved(base: Model, state: ExploreState) -> tuple[xr.Dataset | None, str | None]:
+    """The landscapes of :func:`spinectl.explore.numbers.landscapes`, or the one-line error of a model invalid
+    at one of their points (e.g. a fibre attachment on a CoR at E = Lambda = 0)."""
+    try:
+        return landscapes(base, state), None
+    except SpinectlError as exc:
+        return None, printable(str(exc))
 
 
 BAR_VIEWS = {
@@ -396,7 +489,7 @@ class _BarView:
         self.source.data = _hex(data.columns)
         self.figure.y_range.update(start=data.limits[0], end=data.limits[1])
         self.line.update(location=data.line or 0.0, visible=data.line is not None)
-        self.figure.title.text = data.title
+        self.figure.title.text = data.title.replace(" (", "\n(", 1)  # two lines: one is wider than the view
 
 
 class _LandscapeView:
@@ -414,7 +507,7 @@ class _LandscapeView:
             height=LANDSCAPE_PIXELS,
             x_range=span,
             y_range=span,
-            title=views.LANDSCAPE_LABELS[variable] + " (click to move the point)",
+            title=views.LANDSCAPE_LABELS[variable] + "\nclick to move the point",
             x_axis_label="E [cm]",
             y_axis_label="Λ [cm]",
             tools="tap",
@@ -446,9 +539,8 @@ class _LandscapeView:
         if finite.size:
             self.mapper.update(low=float(finite.min()), high=float(finite.max()))
         self.image.data = {"image": [values]}
-        self.figure.title.text = (
-            f"{views.LANDSCAPE_LABELS[self.variable]}: mass {state.mass:g} kg, K {state.stiffness:g} N m/rad"
-        )
+        mass, stiffness = (shown_text(slider_for(f), getattr(state, f)) for f in ("mass", "stiffness"))
+        self.figure.title.text = f"{views.LANDSCAPE_LABELS[self.variable]}\nmass {mass} kg, K {stiffness} N m/rad"
         self.mark(state)
 
     def mark(self, state: ExploreState) -> None:
@@ -484,6 +576,10 @@ def explorer(preset: str | None = None, config=None) -> pn.viewable.Viewable:
 def serve(model: Model, preset: str, port: int, address: str = "127.0.0.1", show: bool = True) -> None:
     """Serve the explorer at ``http://address:port/`` until interrupted; one :class:`Explorer` per browser tab.
 
+    Every request, the websocket's included, must address the server by the address bound
+    (:func:`spinectl.explore.launch.request_allowed`; others get 403): a DNS-rebinding page,
+    served under another site's name that resolves to this machine, gets no session.
+
     Parameters
     ----------
     model : Model
@@ -496,15 +592,87 @@ def serve(model: Model, preset: str, port: int, address: str = "127.0.0.1", show
         Interface to bind; the loopback interface by default, so that no other machine can connect.
     show : bool
         Open the app in the default browser.
+
+    Raises
+    ------
+    ParameterError
+        An address that names no one interface (:func:`spinectl.explore.launch.allowed_hosts`).
     """
-    origins = [f"{address}:{port}"] + ([f"localhost:{port}"] if address == "127.0.0.1" else [])
-    print(f"spinectl explore: http://{address}:{port}/ (Ctrl+C stops)", flush=True)
-    pn.serve(
+    allowed = allowed_hosts(address, port)
+    url = f"http://{url_host(address)}:{port}/"
+    print(f"spinectl explore: {url} (Ctrl+C stops)", flush=True)
+    server = pn.serve(
         {"/": lambda: Explorer(model, preset).layout},
         port=port,
-        address=address,
-        websocket_origin=origins,
-        show=show,
+        address=address.strip().strip("[]"),
+        websocket_origin=bokeh_origins(allowed),
+        show=False,  # Bokeh's own opener writes an IPv6 address without brackets
+        start=False,
         title="spinectl explore",
+        location=False,  # the app reads no URL; Panel's Location cannot parse an IPv6 Host
         verbose=False,
     )
+    guard(server._tornado, allowed)  # Bokeh's Tornado application (Panel reads it by this name too)
+    server.start()
+    if show:
+        server.io_loop.add_callback(webbrowser.open_new_tab, url)
+    server.io_loop.start()
+
+
+def bokeh_origins(allowed: frozenset[tuple[str, int]]) -> list[str]:
+    """The allowed pairs as Bokeh's websocket origins, ``host:port``, sorted.
+
+    Bokeh's list cannot hold an IPv6 address (it splits at every colon); for those the guard
+    (:func:`guard`) is the only check, as Tornado skips Bokeh's for a same-origin websocket.
+
+    Parameters
+    ----------
+    allowed : frozenset of (str, int)
+        :func:`spinectl.explore.launch.allowed_hosts`.
+
+    Returns
+    -------
+    list of str
+        E.g. ``['127.0.0.1:5006', 'localhost:5006']``.
+    """
+    return sorted(f"{host}:{port}" for host, port in allowed if ":" not in host)
+
+
+class _ForeignRequest(Matcher):
+    """Tornado's routing: matches a request whose Host or Origin is not the address bound."""
+
+    def __init__(self, allowed: frozenset[tuple[str, int]]):
+        self.allowed = allowed
+
+    def match(self, request) -> dict | None:
+        headers = request.headers
+        return None if request_allowed(headers.get("Host"), headers.get("Origin"), self.allowed) else {}
+
+
+class _Refused(RequestHandler):
+    """Answers 403, whatever the method, and says why in one line (in the page and the server's log)."""
+
+    def prepare(self) -> None:
+        host, origin = (self.request.headers.get(h) for h in ("Host", "Origin"))
+        reason = f"refused: Host {host!r}, Origin {origin!r} is not the address the explorer is bound to"
+        app_log.warning("spinectl explore: %s", reason)
+        self.set_status(403)
+        self.finish(reason + "\n")
+
+
+def guard(application, allowed: frozenset[tuple[str, int]]) -> None:
+    """Route every request that does not address ``allowed`` to a 403, before any of Bokeh's handlers.
+
+    The first rule of the Tornado application's router (Tornado's own ``add_handlers`` inserts its
+    host rules into the same list): it sees each request, the websocket's upgrade included, before
+    Bokeh's handlers. Tornado lets a websocket whose Origin equals its Host skip Bokeh's origin list,
+    so a DNS-rebinding page would pass that list; the Host check stops it.
+
+    Parameters
+    ----------
+    application : tornado.web.Application
+        The Bokeh server's Tornado application.
+    allowed : frozenset of (str, int)
+        :func:`spinectl.explore.launch.allowed_hosts`.
+    """
+    application.default_router.rules.insert(0, Rule(_ForeignRequest(allowed), _Refused))

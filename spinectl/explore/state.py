@@ -11,6 +11,7 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass
 
+from .._validate import in_range
 from ..model.config import dump_toml, set_parameters
 from ..model.params import Model
 from ..paper import grid
@@ -193,6 +194,68 @@ def from_shown(slider: Slider, shown: float) -> float:
         over ``scale``: in SI units.
     """
     return round(round(shown / slider.step) * slider.step, 10) / slider.scale
+
+
+def from_client(slider: Slider, shown, start: float | None = None, end: float | None = None) -> float:
+    """A value a browser sent for ``slider`` (in the unit shown), checked, on the grid of steps and in SI units.
+
+    A page sends what its user or a forged message gives: the explorer takes it only as a
+    finite number inside the slider's range, and answers anything else in one line.
+
+    Parameters
+    ----------
+    slider : Slider
+    shown : object
+        The value sent.
+    start, end : float, optional
+        The range of the slider shown, in the unit shown (default ``slider.start`` and ``slider.end``;
+        a model whose own value lies outside widens it).
+
+    Returns
+    -------
+    float
+        :func:`from_shown` of the value [SI units].
+
+    Raises
+    ------
+    ParameterError
+        Not a real number (a string, a bool), NaN or infinite, or outside [start, end]; the field is
+        the slider's label, e.g. ``mass [kg]: must be in [10, 80] (got 1e+06)``.
+    """
+    low = slider.start if start is None else start
+    high = slider.end if end is None else end
+    return from_shown(slider, in_range(slider.label, shown, low, high))
+
+
+def decimals(slider: Slider) -> int:
+    """Decimals a value of ``slider`` means: those of its step (0.5 kg: 1; 0.05: 2; 5 ms: 0).
+
+    Parameters
+    ----------
+    slider : Slider
+
+    Returns
+    -------
+    int
+    """
+    return len(f"{slider.step:g}".partition(".")[2])
+
+
+def shown_text(slider: Slider, value: float) -> str:
+    """A state's value as its slider shows it: in the unit shown, to the decimals of the step.
+
+    Parameters
+    ----------
+    slider : Slider
+    value : float
+        In SI units.
+
+    Returns
+    -------
+    str
+        E.g. ``'24.1'`` for the mass 24.056578609556272 kg of a calibrated preset (steps of 0.5 kg).
+    """
+    return f"{value * slider.scale:.{decimals(slider)}f}"
 
 
 def slider_for(field: str) -> Slider:

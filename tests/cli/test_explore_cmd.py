@@ -20,9 +20,13 @@ ROOT = Path(__file__).resolve().parents[2]
         (["--port", "0"], "--port must be an integer from 1 to 65535 (got '0')"),
         (["--port", "http"], "--port must be an integer from 1 to 65535 (got 'http')"),
         (["--preset", "nope"], "preset"),
+        (["--address", ""], "--address: must name the interface to listen on, e.g. 127.0.0.1 or ::1 (got '')"),
+        (["--address", "0.0.0.0"], "--address: must name one interface"),
     ],
 )
 def test_bad_options_are_one_line(capsys, argv, message):
+    """A bad port, preset or address: one line, exit 2, before any server starts (an empty address was a
+    traceback of Bokeh's origin list)."""
     assert main(["explore", "--no-browser", *argv]) == 2
     err = capsys.readouterr().err
     assert message in err and err.count("\n") == 1

@@ -42,21 +42,25 @@ def chromium() -> str | None:
     return shutil.which(CHROMIUM)
 
 
-def free_port() -> int:
-    """A TCP port free on the loopback interface just now."""
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
+def free_port(address: str = "127.0.0.1", family: int = socket.AF_INET) -> int:
+    """A TCP port free on the loopback interface (``address``) just now."""
+    with socket.socket(family) as s:
+        s.bind((address, 0))
         return s.getsockname()[1]
 
 
 @contextlib.contextmanager
-def served(*options: str):
-    """``python -m spinectl explore --no-browser`` from this checkout on a free loopback port; yields its URL."""
-    port = free_port()
+def served(*options: str, address: str = "127.0.0.1"):
+    """``python -m spinectl explore --no-browser`` from this checkout on a free port of ``address`` (a loopback
+    one); yields its URL."""
+    family = socket.AF_INET6 if ":" in address else socket.AF_INET
+    port = free_port(address, family)
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))}
-    argv = [sys.executable, "-m", "spinectl", "explore", "--no-browser", "--port", str(port), *options]
-    process = subprocess.Popen(argv, cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    url = f"http://127.0.0.1:{port}/"
+    argv = [sys.executable, "-m", "spinectl", "explore", "--no-browser", "--port", str(port), "--address", address]
+    process = subprocess.Popen(
+        [*argv, *options], cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True
+    )
+    url = f"http://[{address}]:{port}/" if family == socket.AF_INET6 else f"http://{address}:{port}/"
     deadline = time.monotonic() + TIMEOUT_S
     try:
         while True:
@@ -82,15 +86,22 @@ def served(*options: str):
 @contextlib.contextmanager
 def opened(url: str, executable: str):
     """A headless Chromium page at ``url``, once the numbers table is shown."""
+    with browser_page(executable) as page:
+        page.goto(url)
+        page.wait_for_selector("td[data-key=counter_torque_Nm]")
+        yield page
+
+
+@contextlib.contextmanager
+def browser_page(executable: str, *args: str):
+    """A blank page of a headless Chromium started with :data:`CHROMIUM_ARGS` and ``args``."""
     from playwright.sync_api import sync_playwright  # imported here: collecting the tests needs no browser
 
     with sync_playwright() as playwright:
-        browser = playwright.chromium.launch(executable_path=executable, args=CHROMIUM_ARGS)
+        browser = playwright.chromium.launch(executable_path=executable, args=[*CHROMIUM_ARGS, *args])
         try:
-            page = browser.new_page(viewport=VIEWPORT)
+            page = browser.new_context(viewport=VIEWPORT).new_page()  # a context of its own: more pages can open in it
             page.set_default_timeout(TIMEOUT_S * 1000)
-            page.goto(url)
-            page.wait_for_selector("td[data-key=counter_torque_Nm]")
             yield page
         finally:
             browser.close()

@@ -2,17 +2,20 @@
 
 from __future__ import annotations
 
+import asyncio
 import xml.etree.ElementTree as ET
+from types import SimpleNamespace
 
 import numpy as np
 import param
 import pytest
+from tornado.web import Application
 
 from spinectl.errors import ModelError
 from spinectl.explore import app
 from spinectl.explore import numbers as nb
-from spinectl.explore.state import initial_state, replace
-from spinectl.model.config import load_preset
+from spinectl.explore.state import initial_state, replace, slider_for
+from spinectl.model.config import load_config, load_preset
 from spinectl.paper.landmarks import CT_LIMIT
 
 
@@ -105,8 +108,70 @@ def test_a_model_invalid_at_the_point_is_a_message_not_a_crash(explorer, monkeyp
 
     monkeypatch.setattr(app, "point_numbers", invalid)
     explorer.move_to(0.01, 0.01)
-    assert explorer.status.object == "**not shown:** fibre attachment on a centre of rotation"
+    assert explorer.status.object.startswith("**point not shown:** fibre attachment on a centre of rotation; ")
     assert explorer.table.object == shown
+
+
+ON_COR = '[[muscles]]\nname = "p"\nupper = [0.1, 0.3]\nlower = [0.0, 0.005]\nspread = 0.0\nfibres = 1\n'
+"""A fourth pair whose lower attachment is the CoR L5S1 (y = 0.005 m) at E = Lambda = 0, a corner of the
+landscapes' grid, and nowhere else (docs/robustness.md, "Model evaluation")."""
+
+
+def test_a_model_invalid_at_one_grid_point_stops_the_progress_and_says_why(tmp_path, monkeypatch):
+    """In a server session the landscapes are solved in a worker thread; the model of ON_COR is invalid at
+    E = Lambda = 0 only: the solve ends with the library's one-line ModelError in the status line, the progress
+    bar stopped and the maps no longer loading (before: the task raised, the progress ran for ever and the
+    traceback went to the server's log). The point itself (3 cm, 4 cm) is valid and shown."""
+    path = tmp_path / "on_cor.toml"
+    path.write_text(ON_COR)
+    model = load_config(path)
+    with pytest.raises(ModelError, match="L5S1 at E = 0 m, Lambda = 0 m") as raised:
+        nb.landscapes(model, initial_state(model))
+    tasks = []
+    monkeypatch.setattr(app, "in_session", lambda: True)
+    monkeypatch.setattr(app.pn.state, "onload", lambda callback, **options: callback())  # the page has loaded
+    monkeypatch.setattr(app.pn.state, "execute", lambda function, **options: tasks.append(function))
+    explorer = app.Explorer(model, app.CONFIG_CHOICE)
+    assert explorer.progress.active and "solving…" in explorer.status.object
+    (solve,) = tasks
+    asyncio.run(solve())
+    assert not explorer.progress.active and not any(view.pane.loading for view in explorer.maps.values())
+    assert explorer.status.object.endswith(f"landscapes (41 × 41) **not solved:** {raised.value}")
+    assert explorer.status.object.startswith("point updated in ") and explorer.dataset is None
+
+
+@pytest.mark.parametrize(
+    ("field", "sent", "message"),
+    [
+        ("eccentricity", float("nan"), "E [cm]: must be finite (got nan)"),
+        ("mass", 1e6, "mass [kg]: must be in [10, 80] (got 1e+06)"),
+        ("delay", -5.0, "reflex delay τ [ms]: must be in [0, 250] (got -5)"),
+        ("stiffness", float("inf"), "K [N m/rad]: must be finite (got inf)"),
+    ],
+)
+def test_a_forged_slider_value_is_refused_in_one_line(field, sent, message):
+    """What a forged message can send past Bokeh's own type check (which refuses a string): NaN, inf, a value
+    outside the slider's range. The status line says so, the state, the views and the landscapes stay (before:
+    NaN raised in the server, its traceback sent back to the page; 1e6 kg left the landscapes solving for ever)."""
+    explorer = app.Explorer(load_preset("default"), "default")
+    state, table, dataset = explorer.state, explorer.table.object, explorer.dataset
+    _drag(explorer.sliders[field], sent)
+    assert explorer.status.object.startswith(f"**refused:** {message}; point updated in ")
+    assert explorer.state == state and explorer.table.object == table and explorer.dataset is dataset
+    assert explorer.sliders[field].value == pytest.approx(getattr(state, field) * slider_for(field).scale)
+    _drag(explorer.sliders[field], explorer.sliders[field].start)  # a valid value clears the message
+    assert not explorer.status.object.startswith("**refused:**")
+
+
+def test_a_forged_click_or_preset_is_refused_in_one_line():
+    """A tap at NaN (a forged Bokeh event), a preset that is not one: one line; the point and preset stay."""
+    explorer = app.Explorer(load_preset("default"), "default")
+    state = explorer.state
+    explorer.move_to(float("nan"), 0.02)
+    assert explorer.status.object.startswith("**refused:** E [cm]: must be finite (got nan); ")
+    explorer.preset.value = "nope"  # Panel's Select takes a value outside its options, as a forged message sends
+    assert explorer.status.object.startswith("**refused:** preset: must be one of ")
+    assert explorer.state == state and explorer.preset.value == "default"
 
 
 def test_explorer_for_a_notebook_reads_the_config_named(tmp_path):
@@ -120,15 +185,48 @@ def test_explorer_for_a_notebook_reads_the_config_named(tmp_path):
     assert [w.value for w in layout.select(app.pn.widgets.Select)] == [app.CONFIG_CHOICE]
 
 
+class _Server:
+    """What ``pn.serve(start=False)`` returns, as far as serve() uses it: Bokeh's Tornado application, a loop."""
+
+    def __init__(self):
+        self._tornado = Application()
+        self.calls = []
+        self.io_loop = SimpleNamespace(start=lambda: self.calls.append("loop"), add_callback=self._callback)
+
+    def start(self):
+        self.calls.append("start")
+
+    def _callback(self, function, *args):
+        self.calls.append((function, *args))
+
+
 def test_serve_binds_the_loopback_interface_by_default(monkeypatch, capsys):
-    """serve() asks Panel for 127.0.0.1 (no other machine can connect) and accepts pages from there only."""
-    calls = []
-    monkeypatch.setattr(app.pn, "serve", lambda panels, **options: calls.append(options))
+    """serve() asks Panel for 127.0.0.1 (no other machine can connect), accepts websockets from there only, and
+    puts the guard of Host and Origin first in Tornado's routing (so that it sees every request)."""
+    calls, server = [], _Server()
+    monkeypatch.setattr(app.pn, "serve", lambda panels, **options: calls.append(options) or server)
     app.serve(load_preset("default"), "default", 5999, show=False)
     (options,) = calls
-    assert options["address"] == "127.0.0.1" and options["port"] == 5999 and options["show"] is False
+    assert options["address"] == "127.0.0.1" and options["port"] == 5999 and options["start"] is False
     assert options["websocket_origin"] == ["127.0.0.1:5999", "localhost:5999"]
+    first = server._tornado.default_router.rules[0]
+    assert isinstance(first.matcher, app._ForeignRequest) and first.target is app._Refused
+    assert first.matcher.allowed == {("127.0.0.1", 5999), ("localhost", 5999)}
+    assert server.calls == ["start", "loop"]  # no browser opened
     assert capsys.readouterr().out == "spinectl explore: http://127.0.0.1:5999/ (Ctrl+C stops)\n"
+
+
+def test_serve_on_ipv6_loopback_writes_the_url_with_brackets(monkeypatch, capsys):
+    """--address ::1: Panel binds ::1; the URL printed and opened is http://[::1]:P/ (RFC 3986, 3.2.2); Bokeh's
+    origin list, which cannot hold an IPv6 address, gets localhost only; the guard allows [::1] and localhost."""
+    calls, server = [], _Server()
+    monkeypatch.setattr(app.pn, "serve", lambda panels, **options: calls.append(options) or server)
+    app.serve(load_preset("default"), "default", 5999, address="::1", show=True)
+    (options,) = calls
+    assert options["address"] == "::1" and options["websocket_origin"] == ["localhost:5999"]
+    assert server._tornado.default_router.rules[0].matcher.allowed == {("::1", 5999), ("localhost", 5999)}
+    assert server.calls == ["start", (app.webbrowser.open_new_tab, "http://[::1]:5999/"), "loop"]
+    assert capsys.readouterr().out == "spinectl explore: http://[::1]:5999/ (Ctrl+C stops)\n"
 
 
 def test_the_delay_redraws_the_margins_only():
@@ -167,3 +265,42 @@ def test_the_bokeh_views_plot_the_librarys_numbers(explorer):
     np.testing.assert_allclose(margins.source.data["value"], np.where(finite, expected.delay_margin * 1000, 0.0))
     assert [m == "∞" for m in margins.source.data["mark"]] == list(~finite)
     assert margins.line.location == pytest.approx(explorer.state.delay * 1000)
+
+
+def _text_px(text: str, size: str, bold: bool) -> float:
+    """Width [px] of one line as Chromium sets a Bokeh title here: Bokeh's 'helvetica' is DejaVu Sans on Debian
+    (fc-match), matplotlib's own font, measured at 72 dpi so that a point is a pixel (8pt = 8 * 96 / 72 px)."""
+    from matplotlib.backends.backend_agg import RendererAgg
+    from matplotlib.font_manager import FontProperties
+
+    px = float(size[:-2]) * (96 / 72 if size.endswith("pt") else 1.0)
+    font = FontProperties(family="DejaVu Sans", weight="bold" if bold else "normal", size=px)
+    return RendererAgg(1, 1, 72).get_text_width_height_descent(text, font, ismath=False)[0]
+
+
+FRAME_LEFT_PX = 60
+"""Room taken left of a plot's frame, where its title starts, by the y axis: its label, tick labels and ticks
+(about 45 px in the browser; 60 to be safe)."""
+
+
+def test_every_title_of_the_bokeh_views_fits_its_view():
+    """Each title line of every Bokeh view, for the calibrated preset wagner2012 (24.056578609556272 kg) and a
+    3-digit delay, is narrower than the view right of its frame (before: 'minimum PCSA [cm²]: mass 24.0566 kg,
+    K 0 N m/rad' and 'delay margins (red: unstable at τ = 100 ms)' were cut at the view's right edge)."""
+    explorer = app.Explorer(load_preset("wagner2012"), "wagner2012")
+    figures = [view.figure for view in explorer.views.values()] + [view.figure for view in explorer.maps.values()]
+    for figure in figures:
+        title = figure.title
+        bold = title.text_font_style == "bold"
+        for line in title.text.split("\n"):
+            assert _text_px(line, title.text_font_size, bold) <= figure.width - FRAME_LEFT_PX, line
+
+
+def test_values_show_the_digits_their_slider_steps_mean():
+    """wagner2012's calibrated mass 24.056578609556272 kg is shown as 24.1 kg (steps of 0.5 kg) in its slider's
+    format and the landscapes' titles, not 24.0566; the state keeps the model's own value."""
+    explorer = app.Explorer(load_preset("wagner2012"), "wagner2012")
+    assert explorer.state.mass == load_preset("wagner2012").body.mass
+    assert explorer.sliders["mass"].format == "0.0" and explorer.sliders["activation"].format == "0.00"
+    assert explorer.sliders["delay"].format == "0"
+    assert explorer.maps["min_pcsa_cm2"].figure.title.text == "minimum PCSA [cm²]\nmass 24.1 kg, K 0.0 N m/rad"

@@ -54,3 +54,38 @@ def test_from_shown_snaps_to_the_step_and_converts_to_si():
     assert st.from_shown(st.slider_for("eccentricity"), 3.5999999999999996) == 36 * 0.1 / 100
     assert st.from_shown(st.slider_for("delay"), 105.0) == pytest.approx(0.105, abs=1e-15)
     assert [s.field for s in st.SLIDERS] == [f.name for f in dataclasses.fields(st.ExploreState)]
+
+
+@pytest.mark.parametrize(
+    ("sent", "message"),
+    [
+        ("3.6", "E [cm]: must be a number (got '3.6')"),
+        (True, "E [cm]: must be a number (got True)"),
+        (None, "E [cm]: must be a number (got None)"),
+        (float("nan"), "E [cm]: must be finite (got nan)"),
+        (8.05, "E [cm]: must be in [0, 8] (got 8.05)"),
+    ],
+)
+def test_from_client_refuses_what_no_slider_sends(sent, message):
+    """A browser's slider sends a number in its range; anything else is a ParameterError named by the label."""
+    with pytest.raises(ParameterError) as raised:
+        st.from_client(st.slider_for("eccentricity"), sent)
+    assert str(raised.value) == message
+
+
+def test_from_client_takes_the_range_shown():
+    """A model whose own mass lies outside 10-80 kg widens its slider; that range is the one checked."""
+    mass = st.slider_for("mass")
+    assert st.from_client(mass, 90.0, 10.0, 90.0) == 90.0 and st.from_client(mass, 24.2) == 24.0
+    with pytest.raises(ParameterError, match=r"must be in \[10, 80\]"):
+        st.from_client(mass, 90.0)
+
+
+def test_shown_text_has_the_decimals_of_the_step():
+    """Steps 0.1 cm, 0.5 kg, 0.05 and 5 ms mean 1, 1, 2 and 0 decimals: 24.056578609556272 kg is '24.1'."""
+    assert [st.decimals(st.slider_for(f)) for f in ("eccentricity", "mass", "activation", "delay")] == [1, 1, 2, 0]
+    assert st.shown_text(st.slider_for("mass"), 24.056578609556272) == "24.1"
+    assert (
+        st.shown_text(st.slider_for("delay"), 0.105) == "105"
+        and st.shown_text(st.slider_for("lordosis"), 0.04) == "4.0"
+    )
