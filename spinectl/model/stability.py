@@ -28,7 +28,6 @@ from .mechanics import SegmentCoefficients
 from .params import Model
 from .source import header, provenance
 
-
 MARGINAL_TIME_CONSTANT = 10.0
 """Slowest time constant [s] above which a self-stable segment is reported *marginal*.
 
@@ -298,7 +297,13 @@ class StabilityResult:
         return chain_modes(model, self.eccentricity, self.lordosis, self.pcsa)
 
     def verdict(self) -> str:
-        """The joint-by-joint verdict in words, with its criterion and the marginal segments."""
+        """The joint-by-joint verdict in words, with its criterion and the marginal segments.
+
+        Returns
+        -------
+        str
+            One line, e.g. "joint by joint (...): self-stable: all segments (L1L2 marginal: ...)".
+        """
         words = "all segments" if self.all_self_stable else "NOT all segments"
         marginal = [
             f"{name} marginal: slowest time constant {tau:.4g} s > {MARGINAL_TIME_CONSTANT:g} s"
@@ -489,10 +494,16 @@ class ChainModes:
         }
 
     def summary(self) -> str:
-        """One line: the chain's verdict, its limiting modes and their time constants."""
+        """The chain's verdict, its limiting modes and their time constants, and what they depend on.
+
+        Returns
+        -------
+        str
+            One line, its criterion first.
+        """
         name = criterion("chain", len(self.segment_names))
         if not self.defined:
-            return f"{name}: undefined, the mass matrix is singular (levels.mass = 0)"
+            return f"{name}: undefined (no optimum, or a singular mass matrix: levels.mass = 0)"
         if self.stable:
             return f"{name}: stable; slowest time constant {_time_constant_text(self.slowest_time_constant)}"
         times = self.growth_times

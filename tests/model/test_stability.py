@@ -206,7 +206,9 @@ def test_table(model):
     assert [row.split()[0] for row in rows] == list(result.segment_names)
     assert [float(row.split()[-1]) for row in rows] == pytest.approx(result.counter_torque, abs=5e-4)
     assert lines[-3].startswith(f"||CT|| = {result.counter_torque_norm:.3f} N m; slowest time constant ")
-    assert lines[-2].startswith("joint by joint (each CoR alone, the others fixed; the paper's criterion): self-stable: ")
+    assert lines[-2].startswith(
+        "joint by joint (each CoR alone, the others fixed; the paper's criterion): self-stable: "
+    )
     assert lines[-1].startswith("chain (all 5 CoRs free): ")
     assert "(minimum stabilising, chosen activation)" in result.table(model, pcsa_source="min_pcsa")
 
@@ -275,7 +277,10 @@ def test_every_verdict_names_its_criterion_and_the_chain_stands_beside_it(model)
     a = np.block(
         [
             [np.zeros((n, n)), np.eye(n)],
-            [np.linalg.solve(mass, coefficients.stiffness(point.pcsa)), np.linalg.solve(mass, coefficients.damping(point.pcsa))],
+            [
+                np.linalg.solve(mass, coefficients.stiffness(point.pcsa)),
+                np.linalg.solve(mass, coefficients.damping(point.pcsa)),
+            ],
         ]
     )
     expected = np.linalg.eigvals(a)
