@@ -477,7 +477,7 @@ def rightmost_root(mass, stiffness, damping, kp, kd, delay: float, lag: float = 
     References
     ----------
     Breda D, Maset S, Vermiglio R (2005). Pseudospectral differencing methods for characteristic
-    roots of delay differential equations. SIAM J Sci Comput 27(2):482-495. doi:10.1137/030601600.
+    roots of delay differential equations. SIAM J Sci Comput 27(2):482-495.
     """
     m, k, d = (np.asarray(x, float) for x in (mass, stiffness, damping))
     if not delay > 0:  # no delay: the delay-free closed loop's poles
