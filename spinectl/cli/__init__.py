@@ -28,6 +28,7 @@ COMMANDS = (
     "config_cmd",
     "stability_cmd",
     "margins_cmd",
+    "design_cmd",
     "sweep_cmd",
     "plot_cmd",
     "draw_cmd",

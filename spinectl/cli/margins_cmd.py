@@ -34,7 +34,9 @@ def register(sub) -> None:
         description="Close each segment's loop with a delayed PD reflex -(kp alpha + kd omega)(t - tau), "
         "its torque lagged by the force generation 1/(T_a s + 1), and report the exact delay margin "
         "(quasi-polynomial), its Pade estimate, gain and phase margins, "
-        "the stabilising range of kp and whether the loop is stable at the delay. See docs/reflex.md.",
+        "the stabilising range of kp and whether the loop is stable at the delay: each joint alone, the others "
+        "fixed (the paper's criterion); beside it the chain's verdict, all CoRs free, under the same reflex. "
+        "See docs/reflex.md.",
     )
     add_position_options(parser)
     parser.add_argument("--delay", type=finite_float("--delay"), help="reflex delay tau [s] (default: config, 0.1)")
@@ -90,7 +92,7 @@ def run(args) -> int:
     int
         Exit code 0 (also for an infeasible optimum, reported as a status).
     """
-    from ..reflex.margins import analyse
+    from ..reflex.chain_verdict import margins_with_chain
 
     if args.plot:
         from ..reflex.plots import PLOT_FILES
@@ -102,7 +104,7 @@ def run(args) -> int:
     check_position(model, args)
     if args.coupled:
         return _coupled(model, args)
-    report = analyse(model, args.E, args.Lambda, kp=args.kp, kd=args.kd)
+    report = margins_with_chain(model, args.E, args.Lambda, kp=args.kp, kd=args.kd)
     if args.plot:
         from ..reflex import plots
 

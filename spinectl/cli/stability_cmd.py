@@ -29,7 +29,9 @@ def register(sub) -> None:
         "stability",
         help="eigenvalues, self-stability and counter torque of each segment",
         description="Linearise every lumbar segment about the upright posture and report its "
-        "stiffness, damping, eigenvalues (paper, eq. 1), self-stability and local counter torque.",
+        "stiffness, damping, eigenvalues (paper, eq. 1), self-stability and local counter torque: each CoR alone, "
+        "the others fixed (the paper's criterion); beside it the chain's verdict, all CoRs free (its modes and "
+        "their time constants; --coupled for the full chain report).",
     )
     add_position_options(parser)
     parser.add_argument(

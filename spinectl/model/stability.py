@@ -22,10 +22,44 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..units import m2_to_cm2
+from . import chain, geometry
 from .checks import arithmetic_guard, checked_coefficients, expand_pcsa
 from .mechanics import SegmentCoefficients
 from .params import Model
 from .source import header, provenance
+
+MARGINAL_TIME_CONSTANT = 10.0
+"""Slowest time constant [s] above which a self-stable segment is reported *marginal*.
+
+A self-stable segment whose muscles only just beat gravity returns in about abs(D / S)
+(:func:`slowest_time_constant`); above 10 s it is stable in name only: in quiet standing
+the closed-loop corrections act over intervals of about a second (the critical time
+interval of the stabilogram diffusion; Collins and De Luca 1993, Exp Brain Res
+95:308-318), so such a segment has hardly moved back before the next correction, and its
+net stiffness abs(S) is below a tenth of abs(D) per second (docs/reflex.md,
+"Which question each command answers").
+"""
+
+
+def criterion(kind: str, n_cor: int = 5) -> str:
+    """The words that name a verdict's criterion, as every table and JSON document prints them.
+
+    Parameters
+    ----------
+    kind : {'joint', 'chain'}
+        'joint': the paper's criterion, each CoR alone with the others fixed (eq. 1);
+        'chain': every CoR free at once (docs/chain.md).
+    n_cor : int
+        The number of CoRs of the chain.
+
+    Returns
+    -------
+    str
+        E.g. "joint by joint (each CoR alone, the others fixed; the paper's criterion)".
+    """
+    if kind == "joint":
+        return "joint by joint (each CoR alone, the others fixed; the paper's criterion)"
+    return f"chain (all {n_cor} CoRs free)"
 
 
 def jacobian(stiffness, damping, inertia):
@@ -251,6 +285,48 @@ class StabilityResult:
         """True if every segment is self-stable."""
         return bool(np.all(self.self_stable))
 
+    @property
+    def time_constants(self) -> np.ndarray:
+        """Each segment's slowest time constant [s], shape (n_cor,) (:func:`slowest_time_constant`)."""
+        return slowest_time_constant(self.stiffness[:, None], self.damping[:, None], self.inertia[:, None])
+
+    @property
+    def marginal(self) -> np.ndarray:
+        """Self-stable segments slower than :data:`MARGINAL_TIME_CONSTANT`, shape (n_cor,) bool."""
+        return self.self_stable & (self.time_constants > MARGINAL_TIME_CONSTANT)
+
+    def chain(self, model: Model) -> ChainModes:
+        """The chain's modes at this PCSA, every CoR free (:func:`chain_modes`): the chain's verdict.
+
+        Parameters
+        ----------
+        model : Model
+            The model the result was computed with.
+
+        Returns
+        -------
+        ChainModes
+        """
+        return chain_modes(model, self.eccentricity, self.lordosis, self.pcsa)
+
+    def verdict(self) -> str:
+        """The joint-by-joint verdict in words, with its criterion and the marginal segments.
+
+        Returns
+        -------
+        str
+            One line, e.g. "joint by joint (...): self-stable: all segments (L1L2 marginal: ...)".
+        """
+        words = "all segments" if self.all_self_stable else "NOT all segments"
+        marginal = [
+            f"{name} marginal: slowest time constant {tau:.4g} s > {MARGINAL_TIME_CONSTANT:g} s"
+            for name, tau, flag in zip(self.segment_names, self.time_constants, self.marginal, strict=True)
+            if flag
+        ]
+        return f"{criterion('joint', len(self.segment_names))}: self-stable: {words}" + (
+            f" ({'; '.join(marginal)})" if marginal else ""
+        )
+
     def to_dict(self, model: Model, pcsa_source: str = "given") -> dict:
         """The result as a JSON-ready dict: the document of ``spinectl stability --json``.
 
@@ -273,9 +349,12 @@ class StabilityResult:
             NaN for a given PCSA), ``total_pcsa_cm2`` (deprecated name of ``chosen_pcsa_total_cm2``,
             kept for one release), ``segments`` (each
             with ``name``, ``stiffness_Nm_per_rad``, ``damping_Nms_per_rad``, ``inertia_kgm2``,
-            ``eigenvalues`` as [real, imaginary] pairs [1/s], ``self_stable``,
-            ``counter_torque_Nm``), ``all_self_stable``, ``slowest_time_constant_s`` (inf if not
-            stable) and ``counter_torque_norm_Nm``; the unit is in each key's name.
+            ``eigenvalues`` as [real, imaginary] pairs [1/s], ``self_stable``, ``slowest_time_constant_s``,
+            ``marginal`` (slower than :data:`MARGINAL_TIME_CONSTANT`), ``counter_torque_Nm``),
+            ``criterion`` (of these verdicts: joint by joint, :func:`criterion`), ``all_self_stable``,
+            ``marginal_segments``, ``marginal_time_constant_s``, ``slowest_time_constant_s`` (inf if not
+            stable), ``counter_torque_norm_Nm`` and ``chain`` (the chain's verdict beside it,
+            :meth:`ChainModes.to_dict`); the unit is in each key's name.
         """
         pcsa = m2_to_cm2(self.pcsa)
         return provenance(model) | {
@@ -294,13 +373,19 @@ class StabilityResult:
                     "inertia_kgm2": float(self.inertia[k]),
                     "eigenvalues": [[float(z.real), float(z.imag)] for z in self.eigenvalues[k]],
                     "self_stable": bool(self.self_stable[k]),
+                    "slowest_time_constant_s": float(self.time_constants[k]),
+                    "marginal": bool(self.marginal[k]),
                     "counter_torque_Nm": float(self.counter_torque[k]),
                 }
                 for k, name in enumerate(self.segment_names)
             ],
+            "criterion": criterion("joint", len(self.segment_names)),
             "all_self_stable": self.all_self_stable,
+            "marginal_segments": [n for n, f in zip(self.segment_names, self.marginal, strict=True) if f],
+            "marginal_time_constant_s": MARGINAL_TIME_CONSTANT,
             "slowest_time_constant_s": self.slowest_time_constant,
             "counter_torque_norm_Nm": self.counter_torque_norm,
+            "chain": self.chain(model).to_dict(),
         }
 
     def table(self, model: Model, pcsa_source: str = "given") -> str:
@@ -334,22 +419,149 @@ class StabilityResult:
             + f"  (total {pcsa.sum():.2f}{minimum})",
             "",
             f"{'segment':8} {'S [N m/rad]':>12} {'D [N m s/rad]':>14} {'theta [kg m2]':>14} "
-            f"{'lambda_1 [1/s]':>20} {'lambda_2 [1/s]':>20} {'stable':>7} {'CT [N m]':>10}",
+            f"{'lambda_1 [1/s]':>20} {'lambda_2 [1/s]':>20} {'stable':>8} {'CT [N m]':>10}",
         ]
         for k, name in enumerate(self.segment_names):
             eig = self.eigenvalues[k]
             lines.append(
                 f"{name:8} {_fixed(self.stiffness[k], '12', 3)} {_fixed(self.damping[k], '14', 4)} "
                 f"{_fixed(self.inertia[k], '14', 4)} {complex_column(eig[0]):>20} {complex_column(eig[1]):>20} "
-                f"{'yes' if self.self_stable[k] else 'NO':>7} {_fixed(self.counter_torque[k], '10', 3)}"
+                f"{_stable_word(self.self_stable[k], self.marginal[k]):>8} {_fixed(self.counter_torque[k], '10', 3)}"
             )
         lines += [
             "",
-            f"||CT|| = {self.counter_torque_norm:.3f} N m; "
-            f"self-stable: {'all segments' if self.all_self_stable else 'NOT all segments'}; "
-            f"slowest time constant {_time_constant_text(self.slowest_time_constant)}",
+            f"||CT|| = {self.counter_torque_norm:.3f} N m; slowest time constant "
+            f"{_time_constant_text(self.slowest_time_constant)}",
+            self.verdict(),
+            self.chain(model).summary(),
         ]
         return "\n".join(lines)
+
+
+CHAIN_DEPENDS_ON = (
+    "levels.mass and levels.radius_of_gyration (the inertia of the lumbar levels), passive.stiffness "
+    "and the global PCSA (the joints' stiffness), local muscles (spinectl stability --coupled: the least "
+    "local stiffness)"
+)
+"""What the chain's modes depend on, as the tables and JSON documents say it (docs/chain.md, "Dynamic stability")."""
+
+
+@dataclass(frozen=True)
+class ChainModes:
+    """The chain's modes at one global PCSA, every CoR free (docs/chain.md, "Dynamic stability").
+
+    Attributes
+    ----------
+    segment_names : tuple of str
+    eigenvalues : numpy.ndarray, shape (2 n_cor,), complex
+        Of :func:`spinectl.model.chain.state_matrix` [1/s], the largest real part first; NaN
+        where the mass matrix is singular (``levels.mass`` = 0).
+    """
+
+    segment_names: tuple[str, ...]
+    eigenvalues: np.ndarray
+
+    @property
+    def defined(self) -> bool:
+        """False where the mass matrix is singular (the eigenvalues are NaN)."""
+        return bool(np.all(np.isfinite(self.eigenvalues)))
+
+    @property
+    def stable(self) -> bool:
+        """True if every mode decays (Re lambda < 0); False if one does not or the modes are undefined."""
+        return self.defined and bool(self_stable(self.eigenvalues))
+
+    @property
+    def growth_times(self) -> np.ndarray:
+        """1 / Re lambda of the modes that do not decay [s], fastest first (a mode grows by e in that time)."""
+        rates = np.sort(self.eigenvalues.real[self.eigenvalues.real >= 0])[::-1]
+        with np.errstate(divide="ignore"):
+            return 1.0 / rates
+
+    @property
+    def slowest_time_constant(self) -> float:
+        """-1 / max Re lambda [s] of a stable chain; inf if a mode does not decay, NaN if undefined."""
+        if not self.defined:
+            return np.nan
+        top = float(np.max(self.eigenvalues.real))
+        return -1.0 / top if top < 0 else np.inf
+
+    def to_dict(self) -> dict:
+        """The chain's verdict as a JSON-ready dict.
+
+        Returns
+        -------
+        dict
+            ``criterion``, ``stable``, ``defined``, ``eigenvalues`` ([real, imaginary] pairs [1/s]),
+            ``growing_modes`` (how many do not decay), ``growth_time_constants_s`` (of those, fastest
+            first), ``slowest_time_constant_s`` and ``depends_on``.
+        """
+        return {
+            "criterion": criterion("chain", len(self.segment_names)),
+            "stable": self.stable,
+            "defined": self.defined,
+            "eigenvalues": [[float(z.real), float(z.imag)] for z in self.eigenvalues],
+            "growing_modes": int(self.growth_times.size),
+            "growth_time_constants_s": self.growth_times.tolist(),
+            "slowest_time_constant_s": self.slowest_time_constant,
+            "depends_on": CHAIN_DEPENDS_ON,
+        }
+
+    def summary(self) -> str:
+        """The chain's verdict, its limiting modes and their time constants, and what they depend on.
+
+        Returns
+        -------
+        str
+            One line, its criterion first.
+        """
+        name = criterion("chain", len(self.segment_names))
+        if not self.defined:
+            return f"{name}: undefined (no optimum, or a singular mass matrix: levels.mass = 0)"
+        if self.stable:
+            return f"{name}: stable; slowest time constant {_time_constant_text(self.slowest_time_constant)}"
+        times = self.growth_times
+        finite = times[np.isfinite(times)]
+        span = (
+            f"{finite[0] * 1000:.3g} to {finite[-1] * 1000:.3g} ms" if finite.size > 1
+            else (f"{finite[0] * 1000:.3g} ms" if finite.size else "no finite time")
+        )  # fmt: skip
+        return (
+            f"{name}: NOT stable, {times.size} of {self.eigenvalues.size} modes grow (by e in {span}); "
+            f"they depend on {CHAIN_DEPENDS_ON}"
+        )
+
+
+def chain_modes(model: Model, eccentricity: float, lordosis: float, pcsa, local_stiffness=0.0) -> ChainModes:
+    """The chain's modes at a global PCSA: its matrices (milliseconds) and their eigenvalues.
+
+    Parameters
+    ----------
+    model : Model
+    eccentricity, lordosis : float
+        E and Lambda [m].
+    pcsa : array_like, shape (n_muscles,)
+        Global PCSA of each muscle [m^2].
+    local_stiffness : array_like, shape (n_cor,), optional
+        Stiffness of the local muscles at each joint [N m/rad] (docs/chain.md, "Local muscles as joint stiffness").
+
+    Returns
+    -------
+    ChainModes
+        The eigenvalues [1/s] of :func:`spinectl.model.chain.dynamic_eigenvalues`.
+
+    References
+    ----------
+    Bergmark A (1989). Stability of the lumbar spine. A study in mechanical engineering.
+    Acta Orthop Scand Suppl 230:1-54. doi:10.3109/17453678909154177.
+    """
+    e, lam = float(eccentricity), float(lordosis)
+    with arithmetic_guard(e, lam):
+        coefficients = chain.chain_coefficients(model, e, lam)
+        mass = chain.mass_matrix(model, geometry.cor_positions(e, lam, model.geometry))
+        stiffness = coefficients.stiffness(pcsa, local_stiffness)
+        eigs = chain.dynamic_eigenvalues(mass, stiffness, coefficients.damping(pcsa))
+    return ChainModes(segment_names=model.geometry.cor_names, eigenvalues=eigs)
 
 
 def segment_stability(
@@ -425,6 +637,11 @@ def _fixed(value: float, width: str, decimals: int) -> str:
     """``value`` in fixed notation of ``width`` (a format width, e.g. ``'12'`` or ``'+9'``), or as ``1.000e+308``."""
     kind = "f" if abs(value) < FIXED_LIMIT or not math.isfinite(value) else "e"
     return f"{value:{width}.{decimals}{kind}}"
+
+
+def _stable_word(stable: bool, marginal: bool) -> str:
+    """A segment's joint-by-joint verdict in a table column: yes, marginal or NO."""
+    return ("marginal" if marginal else "yes") if stable else "NO"
 
 
 def _time_constant_text(tau: float) -> str:

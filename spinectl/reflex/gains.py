@@ -21,9 +21,13 @@ def default_gains(stiffness, damping, inertia, gain_factor, damping_ratio, lag=0
     reflex. kd = max(0, 2 zeta sqrt(theta (kp - S)) + D): the delay-free closed loop
     theta s^2 + (kd - D) s + (kp - S) gets the damping ratio zeta, counting the
     muscles' own damping -D >= 0 first (kd = 0 when they already damp enough).
-    The activation lag 1/(T_a s + 1) is compensated to first order: kd gains kp T_a, so
-    that (kp + kd s)/(T_a s + 1) = kp + (kd - kp T_a) s + O(s^2) is the lag-free rule's
-    reflex at low frequency (docs/reflex.md, "The default reflex, and the activation level").
+    The rule is the lag-free segment's: the activation lag 1/(T_a s + 1) acts on the reflex's
+    torque after it, as the muscles' force generation does, and the gains do not undo it. (Before, the
+    rule added kp T_a to kd; where the damping part is 0, at the default operating point,
+    that made the reflex kp (T_a s + 1), which cancels the lag exactly, so that the margins did
+    not depend on T_a.) Trunk reflexes are identified so: delayed gains on the trunk's angle and
+    angular velocity, in series with the muscles' activation dynamics (Moorhouse and Granata
+    2007 [3]_; docs/reflex.md, "The default reflex, and the activation level").
     The factor 1.5 and zeta = 1 were chosen against Stépán's bound sqrt(2 theta / S),
     the longest delay any delayed PD can balance the reflex-only segment with [1]_ [2]_
     (docs/reflex.md).
@@ -37,7 +41,8 @@ def default_gains(stiffness, damping, inertia, gain_factor, damping_ratio, lag=0
     damping_ratio : float
         zeta [1], > 0.
     lag : array_like, optional
-        Activation time constant T_a [s]; 0 leaves the rule as without the lag, bit for bit.
+        Activation time constant T_a [s]; the rule does not use it (the lag acts after the reflex),
+        kept for the callers that pass it.
 
     Returns
     -------
@@ -50,6 +55,9 @@ def default_gains(stiffness, damping, inertia, gain_factor, damping_ratio, lag=0
        Functions. Longman Scientific & Technical, Harlow.
     .. [2] Stépán G, Kollár L (2000). Balancing with reflex delay. Math Comput Model
        31:199-205.
+    .. [3] Moorhouse KM, Granata KP (2007). Role of reflex dynamics in spinal stability:
+       intrinsic muscle stiffness alone is insufficient for stability. J Biomech 40:1058-1065.
+       doi:10.1016/j.jbiomech.2006.04.018.
     """
     s, d, theta, lag = as_arrays(stiffness, damping, inertia, lag)
     kp = gain_factor * np.maximum(s, 0.0)
@@ -57,9 +65,10 @@ def default_gains(stiffness, damping, inertia, gain_factor, damping_ratio, lag=0
 
 
 def _derivative_gain(kp, stiffness, damping, inertia, damping_ratio, lag):
-    """kd = max(0, 2 zeta sqrt(theta (kp - S)) + D) + kp T_a: the rule's damping (see :func:`default_gains`)."""
+    """kd = max(0, 2 zeta sqrt(theta (kp - S)) + D): the rule's damping (see :func:`default_gains`; T_a unused)."""
     net = np.maximum(kp - stiffness, 0.0)
-    return np.maximum(2.0 * damping_ratio * np.sqrt(inertia * net) + damping, 0.0) + kp * lag
+    kd = np.maximum(2.0 * damping_ratio * np.sqrt(inertia * net) + damping, 0.0)
+    return kd + 0.0 * np.asarray(lag, float)  # the broadcast shape of the inputs, lag included
 
 
 def chain_gains(mass, stiffness, damping, local_stiffness, gain_factor, damping_ratio, lag=0.0):
@@ -83,7 +92,7 @@ def chain_gains(mass, stiffness, damping, local_stiffness, gain_factor, damping_
     gain_factor, damping_ratio : float
         As in :func:`default_gains` [1].
     lag : float, optional
-        Activation time constant T_a [s].
+        Activation time constant T_a [s]; unused, as in :func:`default_gains`.
 
     Returns
     -------

@@ -306,6 +306,9 @@ class MarginsReport:
     model : dict
         The model's :func:`~spinectl.model.source.provenance` and its :func:`~spinectl.model.source.header`
         line (key ``header``).
+    chain : spinectl.reflex.chain_verdict.ChainVerdict or None
+        The chain's verdict at the same point (every CoR free), where it was computed
+        (:func:`spinectl.reflex.chain_verdict.margins_with_chain`); None: the segments' alone.
     """
 
     point: OperatingPoint
@@ -315,11 +318,24 @@ class MarginsReport:
     segments: tuple[SegmentMargins, ...]
     gains: str
     model: dict = field(default_factory=dict)
+    chain: object | None = None
 
     @property
     def all_stable_at_delay(self) -> bool:
-        """True if the closed loop of every segment is stable at the delay (exact)."""
+        """True if the closed loop of every segment is stable at the delay (exact): joint by joint."""
         return all(s.stable_at_delay for s in self.segments)
+
+    def verdict(self) -> str:
+        """The joint-by-joint verdict in words, its criterion first.
+
+        Returns
+        -------
+        str
+            One line: the criterion, then "stable at the delay: all segments" or the unstable ones.
+        """
+        unstable = [s.name for s in self.segments if not s.stable_at_delay]
+        words = "all segments" if not unstable else "NOT " + ", ".join(unstable)
+        return f"{stability.criterion('joint', len(self.segments))}: stable at the delay: {words}"
 
     def to_dict(self) -> dict:
         """The report as a JSON-ready dict: the document of ``spinectl margins --json``.
@@ -331,24 +347,31 @@ class MarginsReport:
             ``config_sha256``, ``overridden``, ``K_Nm_per_rad`` or ``K_per_s2``, ``K_convention``),
             ``E_m``, ``Lambda_m``, ``delay_s``, ``activation_time_constant_s``, ``pade_order``,
             ``activation``, ``optimum_status``, ``gains``, ``pcsa_cm2`` (muscle name -> PCSA [cm^2]), ``segments`` (one
-            :meth:`SegmentMargins.to_dict` each) and ``all_stable_at_delay``; the unit is in each
-            key's name.
+            :meth:`SegmentMargins.to_dict` each), ``criterion`` (of the segments' verdicts: joint by
+            joint), ``all_stable_at_delay`` and, where computed, ``chain`` (the chain's verdict,
+            :meth:`spinectl.reflex.chain_verdict.ChainVerdict.to_dict`, with its own ``criterion``);
+            the unit is in each key's name.
         """
         point = self.point
         model = {k: v for k, v in self.model.items() if k != "header"}
-        return model | {
-            "E_m": point.eccentricity,
-            "Lambda_m": point.lordosis,
-            "delay_s": self.delay,
-            "activation_time_constant_s": self.activation_time_constant,
-            "pade_order": self.pade_order,
-            "activation": point.activation,
-            "optimum_status": point.status,
-            "gains": self.gains,
-            "pcsa_cm2": dict(zip(point.muscle_names, m2_to_cm2(point.pcsa).tolist(), strict=True)),
-            "segments": [s.to_dict() for s in self.segments],
-            "all_stable_at_delay": self.all_stable_at_delay,
-        }
+        return (
+            model
+            | {
+                "E_m": point.eccentricity,
+                "Lambda_m": point.lordosis,
+                "delay_s": self.delay,
+                "activation_time_constant_s": self.activation_time_constant,
+                "pade_order": self.pade_order,
+                "activation": point.activation,
+                "optimum_status": point.status,
+                "gains": self.gains,
+                "pcsa_cm2": dict(zip(point.muscle_names, m2_to_cm2(point.pcsa).tolist(), strict=True)),
+                "segments": [s.to_dict() for s in self.segments],
+                "criterion": stability.criterion("joint", len(self.segments)),
+                "all_stable_at_delay": self.all_stable_at_delay,
+            }
+            | ({} if self.chain is None else {"chain": self.chain.to_dict()})
+        )
 
     def table(self) -> str:
         """The report as a readable table, one row a segment, with a header and a key to the columns.
@@ -381,7 +404,11 @@ class MarginsReport:
             "S, kp in N m/rad; D, kd in N m s/rad; theta in kg m^2; w_c in rad/s. T_slow: slowest time constant",
             "of the segment without reflex. GM: stable range of a common factor on kp and kd. tau_m: exact delay",
             "margin (unbounded: any delay; 0: unstable without delay).",
+            "",
+            self.verdict(),
         ]
+        if self.chain is not None:
+            lines += self.chain.lines()
         return "\n".join(lines)
 
 

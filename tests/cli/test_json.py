@@ -96,7 +96,7 @@ def test_stability_and_margins_mark_a_segment_that_never_returns_alike(capsys):
 
 
 def test_coupled_margins_without_a_disk_margin_say_none(capsys):
-    """wagner2012 at (3, 4) cm: the chain is unstable at 0.1 s (margin 0.14 ms, docs/chain.md), so it has no disk
+    """wagner2012 at (3, 4) cm: the chain is unstable at 0.1 s (margin 0.16 ms, docs/chain.md), so it has no disk
     margin: null with 'none', as the table's 'none' (before: NaN in JSON, 'nan' in the table)."""
     argv = ["margins", "--coupled", "--E", "0.03", "--Lambda", "0.04", "--preset", "wagner2012"]
     assert main([*argv, "--json"]) == 0

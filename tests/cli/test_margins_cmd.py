@@ -9,7 +9,7 @@ import pytest
 from spinectl import jsondoc
 from spinectl.cli import main
 from spinectl.model import config
-from spinectl.reflex import margins
+from spinectl.reflex.chain_verdict import margins_with_chain
 
 REQUIRED = (
     "name",
@@ -44,7 +44,7 @@ def test_json_is_the_reports_dict(capsys):
         ["margins", "--preset", "default", "--delay", "0.1", "--activation", "0", "--pade-order", "3", "--json"], capsys
     )
     assert code == 0
-    report = margins.analyse(_model(delay=0.1, activation=0.0, pade_order=3), 0.0, 0.0)
+    report = margins_with_chain(_model(delay=0.1, activation=0.0, pade_order=3), 0.0, 0.0)
     assert out == jsondoc.dumps(report.to_dict())
     doc = json.loads(out)
     assert doc["delay_s"] == 0.1 and doc["optimum_status"] == "skipped"
@@ -67,7 +67,7 @@ def test_self_stable_margins_are_unbounded_in_json(capsys):
 def test_table_is_the_reports_table(capsys):
     code, out, _ = run(["margins", "--preset", "default", "--activation", "0", "--kp", "150", "--kd", "20"], capsys)
     assert code == 0 and "L5S1" in out and "tau_m" in out and "150.00" in out
-    assert out == margins.analyse(_model(activation=0.0), 0.0, 0.0, kp=150.0, kd=20.0).table() + "\n"
+    assert out == margins_with_chain(_model(activation=0.0), 0.0, 0.0, kp=150.0, kd=20.0).table() + "\n"
 
 
 def test_plot_writes_three_pngs(tmp_path, capsys):

@@ -169,6 +169,8 @@ SEGMENT_KEYS = (
     "inertia_kgm2",
     "eigenvalues",
     "self_stable",
+    "slowest_time_constant_s",
+    "marginal",
     "counter_torque_Nm",
 )
 """Every key of a segment in ``spinectl stability --json``: the unit in the name."""
@@ -204,7 +206,11 @@ def test_table(model):
     rows = lines[5 : 5 + len(result.segment_names)]
     assert [row.split()[0] for row in rows] == list(result.segment_names)
     assert [float(row.split()[-1]) for row in rows] == pytest.approx(result.counter_torque, abs=5e-4)
-    assert lines[-1].startswith(f"||CT|| = {result.counter_torque_norm:.3f} N m; self-stable: ")
+    assert lines[-3].startswith(f"||CT|| = {result.counter_torque_norm:.3f} N m; slowest time constant ")
+    assert lines[-2].startswith(
+        "joint by joint (each CoR alone, the others fixed; the paper's criterion): self-stable: "
+    )
+    assert lines[-1].startswith("chain (all 5 CoRs free): ")
     assert "(minimum stabilising, chosen activation)" in result.table(model, pcsa_source="min_pcsa")
 
 
@@ -269,7 +275,7 @@ def test_a_segment_that_does_not_return_has_no_time_constant_in_the_table(model)
     table says "none", as spinectl margins does, not "inf s"."""
     result = segment_stability(model, 0.03, 0.04, [10e-4, 10e-4, 10e-4])
     assert not result.all_self_stable and result.slowest_time_constant == np.inf
-    assert result.table(model).endswith("slowest time constant none (not every segment returns)")
+    assert "slowest time constant none (not every segment returns)\n" in result.table(model)
 
 
 def test_the_header_names_k_in_the_unit_its_convention_gives_and_what_it_adds():
@@ -310,3 +316,55 @@ def test_eigenvalues_of_a_stiffness_whose_discriminant_overflows():
     assert unstable[0].real * unstable[1].real == pytest.approx(-1e308 / theta, rel=1e-12)
     ordinary = eigenvalues(np.array([-50.0, 20.0]), d, theta)  # the unscaled path, as before
     np.testing.assert_allclose(ordinary.prod(axis=-1), [50.0 / theta, -20.0 / theta], rtol=1e-14)
+
+
+def test_every_verdict_names_its_criterion_and_the_chain_stands_beside_it(model):
+    """The JSON names the criterion of the segments' verdicts and carries the chain's own, whose eigenvalues
+    are those of the state matrix [[0, I], [M^-1 K, M^-1 D]] built here from chain.py's matrices (a second
+    assembly); the table prints both verdicts with their criteria."""
+    from spinectl.model import chain, geometry
+
+    point = optimise.solve_point(model, 0.03, 0.04)
+    result = segment_stability(model, 0.03, 0.04, point.pcsa)
+    doc = result.to_dict(model)
+    assert doc["criterion"] == "joint by joint (each CoR alone, the others fixed; the paper's criterion)"
+    assert doc["chain"]["criterion"] == "chain (all 5 CoRs free)"
+    coefficients = chain.chain_coefficients(model, 0.03, 0.04)
+    mass = chain.mass_matrix(model, geometry.cor_positions(0.03, 0.04, model.geometry))
+    n = mass.shape[0]
+    a = np.block(
+        [
+            [np.zeros((n, n)), np.eye(n)],
+            [
+                np.linalg.solve(mass, coefficients.stiffness(point.pcsa)),
+                np.linalg.solve(mass, coefficients.damping(point.pcsa)),
+            ],
+        ]
+    )
+    expected = np.linalg.eigvals(a)
+    got = np.array([complex(*z) for z in doc["chain"]["eigenvalues"]])
+    assert np.sort_complex(got) == pytest.approx(np.sort_complex(expected), rel=1e-9, abs=1e-9)
+    growing = expected.real[expected.real >= 0]
+    assert doc["chain"]["stable"] == (growing.size == 0) and doc["chain"]["growing_modes"] == growing.size
+    assert doc["chain"]["growth_time_constants_s"] == pytest.approx(sorted(1 / growing))
+    table = result.table(model)
+    assert "joint by joint (each CoR alone" in table and "chain (all 5 CoRs free): " in table
+
+
+def test_a_segment_that_returns_only_slowly_is_flagged_marginal():
+    """At the minimum PCSA of the wagner2012 preset at (0, 0) L1L2 has S = -0.10, D = -14.67 N m s/rad: its
+    slow root is about S / D, a time constant of |D / S| = 147 s (eq. 1), above the 10 s threshold, so it is
+    'marginal' in the table and the JSON, and the verdict line says so; the stiffer segments are not."""
+    from spinectl.model.config import load_preset
+    from spinectl.model.stability import MARGINAL_TIME_CONSTANT
+
+    model = load_preset("wagner2012")
+    point = optimise.solve_point(model, 0.0, 0.0)
+    result = segment_stability(model, 0.0, 0.0, point.pcsa)
+    approx = np.abs(result.damping / result.stiffness)  # the slow root's closed form for |S| << D^2 / theta
+    expected = result.self_stable & (approx > MARGINAL_TIME_CONSTANT)
+    assert result.marginal.tolist() == expected.tolist() and expected[0] and not expected[-1]
+    doc = result.to_dict(model)
+    assert doc["marginal_segments"] == [n for n, f in zip(result.segment_names, expected, strict=True) if f]
+    assert result.time_constants[0] == pytest.approx(approx[0], rel=0.01)
+    assert f"{result.segment_names[0]} marginal: slowest time constant" in result.verdict()

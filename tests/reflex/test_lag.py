@@ -168,15 +168,31 @@ def test_critical_gains_with_the_lag():
     assert poles[0] < 0 < poles[1]
 
 
-def test_the_rule_compensates_the_lag_to_first_order():
-    """kd grows by kp T_a: (kp + kd' s)/(T_a s + 1) = kp + (kd' - kp T_a) s + O(s^2), the lag-free rule's PD
-    at low frequency (the slope of the lagged reflex at s = 0, by a finite difference, is the lag-free kd)."""
-    s, d, theta, lag = 50.0, -10.0, 2.0, 0.05
+def test_the_rule_does_not_cancel_the_lag():
+    """The rule's gains are the lag-free segment's whatever T_a (the lag acts after the reflex); before, kd gained
+    kp T_a, and where the damping part was 0 the reflex kp (T_a s + 1) cancelled the lag exactly."""
+    s, d, theta = 50.0, -20.0, 2.0  # 2 sqrt(theta (kp - S)) = 14.1 < |D|: the rule's damping part is 0
     kp0, kd0 = reflex.default_gains(s, d, theta, 1.5, 1.0)
-    kp, kd = reflex.default_gains(s, d, theta, 1.5, 1.0, lag)
-    h = 1e-6
-    slope = ((kp + kd * h) / (lag * h + 1) - (kp - kd * h) / (1 - lag * h)) / (2 * h)
-    assert kp == kp0 and slope == pytest.approx(kd0, rel=1e-8)
+    for lag in (0.05, 0.1):
+        kp, kd = reflex.default_gains(s, d, theta, 1.5, 1.0, lag)
+        assert kp == kp0 == 75.0 and kd == kd0 == 0.0
+
+
+def test_the_margins_at_the_default_operating_point_change_with_the_lag():
+    """``spinectl margins`` at its defaults (wagner2012, (0, 0), activation 0.5): L1L2's margin falls as T_a grows
+    (identical for T_a = 0, 0.05, 0.1 s before), and equals the first delay of the crossing found by a scalar
+    bisection of |P(jw)| = |Q(jw)| (a second method) with the lagged plant."""
+    from spinectl.model import config
+    from spinectl.reflex import margins
+
+    found = []
+    for lag in (0.0, 0.05, 0.1):
+        model = config.set_parameters(config.load_preset("wagner2012"), {"reflex.activation_time_constant": lag})
+        seg = margins.analyse(model, 0.0, 0.0).segments[0]
+        tau, _ = _crossing_by_bisection(seg.stiffness, seg.damping, seg.inertia, seg.kp, seg.kd, lag)
+        assert seg.delay_margin == pytest.approx(tau, rel=1e-9)
+        found.append(seg.delay_margin)
+    assert found[0] > found[1] > found[2]
 
 
 def test_landscape_with_the_lag_is_the_pointwise_answer(rng):

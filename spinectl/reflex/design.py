@@ -1,0 +1,655 @@
+"""The design question: how much intrinsic stiffness does a given reflex delay need? (``spinectl design``).
+
+Two answers at one (E, Lambda), one per criterion (docs/reflex.md, "The design question"):
+
+1. **joint by joint** (each CoR alone, the others fixed; the paper's criterion): the least
+   co-contraction, the activation a (a fraction of the minimum stabilising PCSA, as
+   ``margins --activation`` takes it), for which every segment's exact delay margin with
+   the lag (:func:`spinectl.reflex.delay.delay_margin`) under the reflex rule at that
+   activation is at least the delay. The margins are first scanned over a in [0, 1]
+   (:data:`SCAN`); where every segment's margin is non-decreasing on the scan the search is a
+   bisection in the bracket of the first scanned activation that meets the delay, and says
+   so ('bisection: monotone on the scan'); otherwise the same bracket is refined by bisection and
+   the method is 'scan and refine: not monotone'.
+2. **the chain** (every CoR free): at the global activation ``reflex.activation`` (the
+   operating point of ``spinectl margins``; ``--activation``; its muscles give the chain's
+   only damping, so activation 0 leaves the chain undamped), the
+   least local stiffness f k* (k* the least local stiffness for static stability,
+   problem (a) of docs/chain.md; the local muscles of "Local muscles as joint stiffness")
+   for which the chain under the delayed reflex is stable at the delay. The reflex is the
+   rule on the chain (:func:`spinectl.reflex.gains.chain_gains`) scaled by the deficit left,
+   (1 - f)+ times its gains (:func:`chain_loop_at`), or the explicit gains. The certificate:
+   the exact multivariable delay margin (:func:`spinectl.reflex.mimo.chain_delay_margin`) at
+   the returned design is at least the delay, and the rightmost characteristic root at the
+   delay (:func:`rightmost_root`, a second method: a spectral discretisation of the delay
+   equation) lies in the left half-plane. Both are required: the margin's frequency sweep
+   (0.15 % steps) can step over the band of a crossing of a nearly undamped mode under a weak
+   reflex (0.05 % wide at f = 0.9999 for the subject of docs/reflex.md, "The design
+   question"), which the spectral root does not miss. The search scans f, then bisects the
+   bracket of the first f that meets the delay (exact for a set of designs that, once met,
+   stays met for every larger f; the method says whether the scan showed that).
+
+No design meets the delay: status 'infeasible' and the largest delay that the scan meets.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..model import chain, geometry
+from ..model.checks import arithmetic_guard, checked_coefficients
+from ..model.params import Model
+from ..model.stability import criterion
+from ..optimise.coupled import least_local_stiffness_stacked
+from ..optimise.reference import solve_point
+from ..units import m2_to_cm2
+from . import gains
+from .chain_margins import stable_at
+from .delay import delay_margin
+from .mimo import chain_delay_margin, delay_free_poles
+from .siso import from_crossings
+
+SCAN = 41
+"""Activations scanned in [0, 1] (and local-stiffness fractions in [0, :data:`LOCAL_MAX`]) before the bisection."""
+
+BISECTIONS = 20
+"""Halvings of the bracket: the answer to 1e-6 of the scanned step above the least design."""
+
+LOCAL_MAX = 2.0
+"""Largest local stiffness searched with explicit gains, as a multiple of the least for static stability k*
+(the rule's reflex vanishes at 1 k*, where the search ends)."""
+
+CHAIN_SCAN = 11
+"""Local-stiffness fractions scanned in [0, :data:`LOCAL_MAX`] (each a rightmost root and an exact margin)."""
+
+SPECTRAL_NODES = 24
+"""Chebyshev nodes of the delay interval in the certificate's :func:`rightmost_root` (converged to 1e-12
+against 96 nodes on the subject of docs/reflex.md, "The design question"); the search seeds it from poles alone."""
+
+
+@dataclass(frozen=True)
+class SegmentDesign:
+    """One segment's least co-contraction, joint by joint.
+
+    Attributes
+    ----------
+    name : str
+    activation : float
+        The least fraction of the minimum stabilising PCSA [1]; NaN if none in [0, 1].
+    pcsa : float
+        The total PCSA at that activation [m^2].
+    delay_margin : float
+        The segment's exact delay margin there [s].
+    monotone : bool
+        The margin is non-decreasing in the activation on the scan.
+    """
+
+    name: str
+    activation: float
+    pcsa: float
+    delay_margin: float
+    monotone: bool
+
+    def to_dict(self) -> dict:
+        """``name``, ``activation``, ``pcsa_cm2``, ``delay_margin_s``, ``monotone``.
+
+        Returns
+        -------
+        dict
+        """
+        return {
+            "name": self.name,
+            "activation": self.activation,
+            "pcsa_cm2": float(m2_to_cm2(self.pcsa)),
+            "delay_margin_s": self.delay_margin,
+            "monotone": self.monotone,
+        }
+
+
+@dataclass(frozen=True)
+class ChainDesign:
+    """The chain's least local stiffness at a global activation.
+
+    Attributes
+    ----------
+    activation : float
+        The global activation [1] (``reflex.activation``).
+    fraction : float
+        f: the local stiffness as a multiple of k* [1]; NaN if none up to :data:`LOCAL_MAX`.
+    local_stiffness : numpy.ndarray, shape (n_cor,)
+        f k* per joint [N m/rad].
+    least_static : numpy.ndarray, shape (n_cor,)
+        k* per joint [N m/rad].
+    delay_margin : float
+        The exact multivariable delay margin at the design [s].
+    max_root_real : float
+        Re of the rightmost characteristic root at the delay [1/s] (:func:`rightmost_root`).
+    largest_delay : float
+        The largest delay met on the scan [s] (the margin at its best fraction).
+    method : str
+    """
+
+    activation: float
+    fraction: float
+    local_stiffness: np.ndarray
+    least_static: np.ndarray
+    delay_margin: float
+    max_root_real: float
+    largest_delay: float
+    method: str
+
+    def to_dict(self) -> dict:
+        """``criterion``, ``activation``, ``local_stiffness_fraction``, ``local_stiffness_Nm_per_rad``, ....
+
+        Returns
+        -------
+        dict
+            Also ``least_static_local_stiffness_Nm_per_rad``, ``delay_margin_s``,
+            ``max_root_real_per_s``, ``largest_delay_met_s`` and ``method``.
+        """
+        return {
+            "criterion": criterion("chain", len(self.local_stiffness)),
+            "activation": self.activation,
+            "local_stiffness_fraction": self.fraction,
+            "local_stiffness_Nm_per_rad": self.local_stiffness.tolist(),
+            "least_static_local_stiffness_Nm_per_rad": self.least_static.tolist(),
+            "delay_margin_s": self.delay_margin,
+            "max_root_real_per_s": self.max_root_real,
+            "largest_delay_met_s": self.largest_delay,
+            "method": self.method,
+        }
+
+
+@dataclass(frozen=True)
+class Design:
+    """Both answers to the design question at one (E, Lambda) and delay.
+
+    Attributes
+    ----------
+    eccentricity, lordosis : float
+        E and Lambda [m].
+    delay, activation_time_constant : float
+        tau [s] and T_a [s].
+    activation : float
+        The least activation for every segment at once [1]; NaN if infeasible.
+    pcsa : float
+        Total PCSA at it [m^2].
+    segments : tuple of SegmentDesign
+    chain : ChainDesign
+    status : str
+        'ok'; 'infeasible' (joint by joint: no activation in [0, 1] meets the delay); 'chain_infeasible'
+        (no local stiffness up to :data:`LOCAL_MAX` k*); or the optimum's status.
+    largest_delay : float
+        Joint by joint, the largest delay met on the scan [s].
+    method : str
+        How the activation was searched (see the module).
+    model : dict
+        The model's provenance and header line.
+    """
+
+    eccentricity: float
+    lordosis: float
+    delay: float
+    activation_time_constant: float
+    activation: float
+    pcsa: float
+    segments: tuple[SegmentDesign, ...]
+    chain: ChainDesign
+    status: str
+    largest_delay: float
+    method: str
+    model: dict
+
+    def to_dict(self) -> dict:
+        """The document of ``spinectl design --json``.
+
+        Returns
+        -------
+        dict
+            The model's provenance, ``E_m``, ``Lambda_m``, ``delay_s``, ``activation_time_constant_s``,
+            ``status``, ``criterion`` (joint by joint), ``activation``, ``pcsa_cm2``, ``method``,
+            ``largest_delay_met_s``, ``segments`` (:meth:`SegmentDesign.to_dict`) and ``chain``
+            (:meth:`ChainDesign.to_dict`).
+        """
+        model = {k: v for k, v in self.model.items() if k != "header"}
+        return model | {
+            "E_m": self.eccentricity,
+            "Lambda_m": self.lordosis,
+            "delay_s": self.delay,
+            "activation_time_constant_s": self.activation_time_constant,
+            "status": self.status,
+            "criterion": criterion("joint", len(self.segments)),
+            "activation": self.activation,
+            "pcsa_cm2": float(m2_to_cm2(self.pcsa)),
+            "method": self.method,
+            "largest_delay_met_s": self.largest_delay,
+            "segments": [s.to_dict() for s in self.segments],
+            "chain": self.chain.to_dict(),
+        }
+
+    def table(self) -> str:
+        """The design as readable text: both criteria, each with its answer and certificate.
+
+        Returns
+        -------
+        str
+            No final newline.
+        """
+        c = self.chain
+        lines = [
+            self.model.get("header", "preset unknown"),
+            f"E = {self.eccentricity * 100:.2f} cm, Lambda = {self.lordosis * 100:.2f} cm, delay "
+            f"{self.delay * 1000:.4g} ms, activation lag {self.activation_time_constant * 1000:.4g} ms; "
+            f"status {self.status}",
+            "",
+            f"{criterion('joint', len(self.segments))}: least co-contraction ({self.method})",
+            f"{'segment':8} {'activation':>10} {'PCSA[cm2]':>10} {'tau_m[s]':>10}",
+        ]
+        lines += [
+            f"{s.name:8} {_word(s.activation, 10, '.4f')} {_word(m2_to_cm2(s.pcsa), 10, '.2f')} "
+            f"{_word(s.delay_margin, 10, '.4f')}"
+            for s in self.segments
+        ]
+        lines += [
+            f"every segment at once: activation {_word(self.activation, 0, '.4f')} x minimum PCSA "
+            f"({_word(m2_to_cm2(self.pcsa), 0, '.2f')} cm^2)"
+            + ("" if np.isfinite(self.activation) else f"; the largest delay met: {self.largest_delay * 1000:.4g} ms"),
+            "",
+            f"{criterion('chain', len(c.local_stiffness))}: least local stiffness at activation "
+            f"{_word(c.activation, 0, '.4f')} ({c.method})",
+            "local stiffness [N m/rad]: "
+            + ", ".join(f"{s.name} {_word(k, 0, '.2f')}" for s, k in zip(self.segments, c.local_stiffness, strict=True))
+            + f"  ({_word(c.fraction, 0, '.4f')} x the least for static stability, total "
+            f"{_word(float(np.sum(c.local_stiffness)), 0, '.1f')})",
+            f"certificate: exact delay margin {_word(c.delay_margin * 1000, 0, '.4g')} ms "
+            f">= {self.delay * 1000:.4g} ms; "
+            f"rightmost root at the delay Re s = {_word(c.max_root_real, 0, '.4g')} 1/s"
+            + ("" if np.isfinite(c.fraction) else f"; the largest delay met: {c.largest_delay * 1000:.4g} ms"),
+        ]
+        return "\n".join(lines)
+
+
+def _word(value: float, width: int, fmt: str) -> str:
+    """A number, or 'none' (NaN) / 'unbounded' (inf), right-aligned in ``width``."""
+    text = "none" if np.isnan(value) else ("unbounded" if np.isinf(value) else format(value, fmt))
+    return f"{text:>{width}}"
+
+
+def segment_margins_at(model: Model, coefficients, optimum_pcsa, activations, kp=None, kd=None) -> np.ndarray:
+    """Every segment's exact delay margin with the lag at each activation, shape (n_activations, n_cor) [s].
+
+    Parameters
+    ----------
+    model : Model
+        ``model.reflex``: gains (rule or explicit) and the lag T_a.
+    coefficients : spinectl.model.mechanics.SegmentCoefficients
+        At the position.
+    optimum_pcsa : numpy.ndarray, shape (n_muscles,)
+        The minimum stabilising PCSA [m^2].
+    activations : array_like, shape (m,)
+        Fractions of it [1].
+    kp, kd : float, optional
+        Explicit gains [N m/rad], [N m s/rad].
+
+    Returns
+    -------
+    numpy.ndarray, shape (m, n_cor)
+        [s]; inf where any delay is stable, 0 where unstable without delay.
+    """
+    a = np.asarray(activations, float)[:, None]
+    pcsa = a * optimum_pcsa[None, :]
+    s = np.stack([coefficients.stiffness(p) for p in pcsa])
+    d = np.stack([coefficients.damping(p) for p in pcsa])
+    theta = np.broadcast_to(coefficients.inertia, s.shape)
+    kps, kds = gains.resolve_gains(s, d, theta, model.reflex, kp, kd)
+    return np.asarray(delay_margin(s, d, theta, kps, kds, model.reflex.activation_time_constant).margin)
+
+
+def _least(meets, scan: np.ndarray, ok: np.ndarray) -> float:
+    """The least x with meets(x): the first scanned x that meets it (``ok``), refined by bisection in its bracket.
+
+    NaN if no scanned x meets it.
+    """
+    if not ok.any():
+        return np.nan
+    i = int(np.argmax(ok))
+    if i == 0:
+        return float(scan[0])
+    lo, hi = scan[i - 1], scan[i]
+    for _ in range(BISECTIONS):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (lo, mid) if meets(mid) else (mid, hi)
+    return float(hi)
+
+
+def _nondecreasing(values: np.ndarray) -> np.ndarray:
+    """True per column where the scanned values never fall (inf equal to inf), shape (n,)."""
+    with np.errstate(invalid="ignore"):
+        steps = np.diff(values, axis=0)
+    return np.all((steps >= 0) | (values[1:] == values[:-1]), axis=0)
+
+
+def joint_design(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None):
+    """Joint by joint: each segment's and the common least activation whose margins meet ``reflex.delay``.
+
+    Parameters
+    ----------
+    model : Model
+    eccentricity, lordosis : float
+        E and Lambda [m].
+    kp, kd : float, optional
+        Explicit gains [N m/rad], [N m s/rad].
+
+    Returns
+    -------
+    activation : float
+        The least for every segment at once [1]; NaN if none in [0, 1].
+    segments : tuple of SegmentDesign
+    optimum_pcsa : numpy.ndarray
+        The minimum stabilising PCSA [m^2] (NaN without an optimum).
+    status : str
+        'ok', 'infeasible' or the optimum's status.
+    largest_delay : float
+        The largest common delay met on the scan [s].
+    method : str
+    """
+    e, lam = float(eccentricity), float(lordosis)
+    coefficients = checked_coefficients(model, e, lam)
+    optimum = solve_point(model, e, lam)
+    names = model.geometry.cor_names
+    delay = model.reflex.delay
+    if not np.all(np.isfinite(optimum.pcsa)):
+        nan = tuple(SegmentDesign(n, np.nan, np.nan, np.nan, False) for n in names)
+        return np.nan, nan, optimum.pcsa, optimum.status, np.nan, "none: no optimum"
+    p = np.asarray(optimum.pcsa, float)
+    scan = np.linspace(0.0, 1.0, SCAN)
+    with arithmetic_guard(e, lam):
+        margins = segment_margins_at(model, coefficients, p, scan, kp, kd)
+        monotone = _nondecreasing(margins)
+
+        def meets(a, k=None):
+            m = segment_margins_at(model, coefficients, p, [a], kp, kd)[0]
+            return bool(np.all(m >= delay)) if k is None else bool(m[k] >= delay)
+
+        segments = []
+        for k, name in enumerate(names):
+            a = _least(lambda x, k=k: meets(x, k), scan, margins[:, k] >= delay)
+            margin = np.nan if np.isnan(a) else segment_margins_at(model, coefficients, p, [a], kp, kd)[0, k]
+            total = a * p.sum() if np.isfinite(a) else np.nan
+            segments.append(SegmentDesign(name, a, total, float(margin), bool(monotone[k])))
+        activation = _least(meets, scan, np.all(margins >= delay, axis=1))
+        feasible = np.isfinite(activation)
+    method = "bisection: monotone on the scan" if monotone.all() else "scan and refine: not monotone"
+    largest = float(np.max(np.min(margins, axis=1)))
+    return activation, tuple(segments), p, ("ok" if feasible else "infeasible"), largest, method
+
+
+def chain_matrices(model: Model, eccentricity: float, lordosis: float, pcsa):
+    """M, K and D of the chain at a global PCSA [kg m^2], [N m/rad], [N m s/rad] (docs/chain.md).
+
+    Parameters
+    ----------
+    model : Model
+    eccentricity, lordosis : float
+        E and Lambda [m].
+    pcsa : array_like, shape (n_muscles,)
+        Global PCSA [m^2].
+
+    Returns
+    -------
+    mass, stiffness, damping : numpy.ndarray, shape (n_cor, n_cor)
+    """
+    with arithmetic_guard(eccentricity, lordosis):
+        coefficients = chain.chain_coefficients(model, eccentricity, lordosis)
+        mass = chain.mass_matrix(model, geometry.cor_positions(eccentricity, lordosis, model.geometry))
+        return mass, coefficients.stiffness(pcsa), coefficients.damping(pcsa)
+
+
+def chain_loop_at(model: Model, mass, stiffness, damping, least_static, fraction, kp=None, kd=None):
+    """The chain's stiffness with local stiffness f k*, and its reflex gains: (1 - f)+ times the rule's.
+
+    The rule on the chain (:func:`spinectl.reflex.gains.chain_gains`) at f = 0 compensates the
+    whole deficit k*; as the local muscles take over a fraction f of it, the reflex keeps the
+    rest, (1 - f)+ times both gains, so that at f >= 1 the chain holds itself without reflex.
+
+    Parameters
+    ----------
+    model : Model
+    mass, stiffness, damping : numpy.ndarray, shape (n, n)
+        M, K (global muscles, gravity, passive), D.
+    least_static : numpy.ndarray, shape (n,)
+        k* [N m/rad].
+    fraction : float
+        f [1].
+    kp, kd : float, optional
+        Explicit gains for every joint.
+
+    Returns
+    -------
+    stiffness : numpy.ndarray, shape (n, n)
+        K - f diag(k*) [N m/rad].
+    kp, kd : numpy.ndarray, shape (n,)
+        [N m/rad], [N m s/rad].
+    """
+    r, n = model.reflex, len(least_static)
+    k = stiffness - fraction * np.diag(least_static)
+    if r.gains == "rule":  # the reflex hands over to the local muscles: (1 - f)+ times the rule's gains at f = 0
+        kp0, kd0 = gains.chain_gains(
+            mass, stiffness, damping, least_static, r.gain_factor, r.damping_ratio, r.activation_time_constant
+        )
+        scale = max(1.0 - fraction, 0.0)
+        kp0, kd0 = scale * kp0, scale * kd0
+    else:
+        kp0, kd0 = np.full(n, r.kp), np.full(n, r.kd)
+    return k, kp0 if kp is None else np.full(n, float(kp)), kd0 if kd is None else np.full(n, float(kd))
+
+
+def rightmost_root(mass, stiffness, damping, kp, kd, delay: float, lag: float = 0.0, nodes: int = 0) -> complex:
+    """The rightmost root of det((T_a s + 1)(M s^2 - D s - K) + (K_p + K_d s) e^{-s tau}) = 0 [1/s].
+
+    Newton's method on the determinant (f / f' = 1 / trace(T^-1 T')) from seeds: the poles of
+    the open loop and of the closed loop without delay (the roots a weak or slow reflex
+    perturbs) and, with ``nodes`` > 0, the rightmost eigenvalues of the delayed chain
+    x' = A_0 x(t) + A_1 x(t - tau), x = (q, q', u) (the lag's states u where T_a > 0),
+    discretised by its infinitesimal generator on ``nodes`` Chebyshev nodes of [-tau, 0]
+    (Breda, Maset and Vermiglio 2005). Each seed converges to a true root; the rightmost is returned.
+
+    Parameters
+    ----------
+    mass, stiffness, damping : array_like, shape (n, n)
+        M [kg m^2], K [N m/rad], D [N m s/rad].
+    kp, kd : array_like, shape (n,)
+        Diagonal gains [N m/rad], [N m s/rad].
+    delay : float
+        tau [s]; 0: the closed loop's poles without delay.
+    lag : float
+        T_a [s].
+    nodes : int
+        Chebyshev nodes of the discretisation; 0: the poles' seeds alone.
+
+    Returns
+    -------
+    complex
+        [1/s]; NaN where no seed converges.
+
+    References
+    ----------
+    Breda D, Maset S, Vermiglio R (2005). Pseudospectral differencing methods for characteristic
+    roots of delay differential equations. SIAM J Sci Comput 27(2):482-495.
+    """
+    m, k, d = (np.asarray(x, float) for x in (mass, stiffness, damping))
+    if not delay > 0:  # no delay: the delay-free closed loop's poles
+        poles = delay_free_poles(m, k, d, kp, kd, lag)
+        return complex(poles[np.argmax(poles.real)])
+    kp_m, kd_m = np.diag(np.asarray(kp, float)), np.diag(np.asarray(kd, float))
+    n = m.shape[0]
+    minv = np.linalg.inv(m)
+    z = np.zeros((n, n))
+    if lag > 0:
+        a0 = np.block([[z, np.eye(n), z], [minv @ k, minv @ d, minv], [z, z, -np.eye(n) / lag]])
+        a1 = np.block([[z, z, z], [z, z, z], [-kp_m / lag, -kd_m / lag, z]])
+    else:
+        a0 = np.block([[z, np.eye(n)], [minv @ k, minv @ d]])
+        a1 = np.block([[z, z], [-minv @ kp_m, -minv @ kd_m]])
+    none = np.zeros(n)
+    seeds = [delay_free_poles(m, k, d, kp, kd, lag), delay_free_poles(m, k, d, none, none, lag)]
+    if nodes > 0:
+        dim = a0.shape[0]
+        generator = np.kron(_chebyshev(nodes) * (2.0 / delay), np.eye(dim))  # theta_j = tau (x_j - 1) / 2
+        generator[:dim, :] = 0.0
+        generator[:dim, :dim] = a0
+        generator[:dim, -dim:] = a1
+        eigs = np.linalg.eigvals(generator)
+        seeds.append(eigs[np.argsort(-eigs.real)][: 2 * dim])
+    roots = [_newton(m, k, d, kp_m, kd_m, delay, lag, s) for s in np.concatenate(seeds)]
+    roots = [r for r in roots if np.isfinite(r)]
+    return complex(max(roots, key=lambda r: r.real)) if roots else complex(np.nan, np.nan)
+
+
+def _chebyshev(n: int) -> np.ndarray:
+    """Chebyshev differentiation matrix on x_j = cos(j pi / n), j = 0..n (Trefethen 2000, cheb)."""
+    x = np.cos(np.pi * np.arange(n + 1) / n)
+    c = np.ones(n + 1)
+    c[0] = c[-1] = 2.0
+    c *= (-1.0) ** np.arange(n + 1)
+    dx = x[:, None] - x[None, :] + np.eye(n + 1)
+    dmat = np.outer(c, 1.0 / c) / dx
+    return dmat - np.diag(dmat.sum(axis=1))
+
+
+def _newton(m, k, d, kp, kd, tau, lag, s, steps: int = 30):
+    """Newton's method on det T(s) from ``s``; NaN if it does not converge."""
+    for _ in range(steps):
+        e = np.exp(-s * tau)
+        plant = m * s**2 - d * s - k
+        t = (lag * s + 1.0) * plant + (kp + kd * s) * e
+        dt = lag * plant + (lag * s + 1.0) * (2.0 * m * s - d) + (kd - tau * (kp + kd * s)) * e
+        try:
+            step = 1.0 / np.trace(np.linalg.solve(t, dt))
+        except np.linalg.LinAlgError:
+            return s
+        s = s - step
+        if abs(step) <= 1e-12 * max(1.0, abs(s)):
+            return s
+    return complex(np.nan, np.nan)
+
+
+def chain_design(model: Model, eccentricity: float, lordosis: float, pcsa, activation: float, kp=None, kd=None):
+    """The chain: the least local stiffness f k* for which the delayed chain is stable at ``reflex.delay``.
+
+    Parameters
+    ----------
+    model : Model
+    eccentricity, lordosis : float
+        E and Lambda [m].
+    pcsa : numpy.ndarray, shape (n_muscles,)
+        The global PCSA [m^2] (NaN: no design).
+    activation : float
+        Its fraction of the minimum stabilising PCSA [1], for the report.
+    kp, kd : float, optional
+        Explicit gains for every joint.
+
+    Returns
+    -------
+    ChainDesign
+    """
+    n = len(model.geometry.cor_names)
+    delay, lag = model.reflex.delay, model.reflex.activation_time_constant
+    if not np.all(np.isfinite(pcsa)):
+        nan = np.full(n, np.nan)
+        return ChainDesign(activation, np.nan, nan, nan, np.nan, np.nan, np.nan, "none: no global activation")
+    mass, stiffness, damping = chain_matrices(model, eccentricity, lordosis, pcsa)
+    _, least = least_local_stiffness_stacked(stiffness[None], model.optimisation.stability_margin)
+    least = least[0]
+
+    def judge(f):
+        """(meets, rightmost root, exact margin or None): the spectral root first, the exact margin where it is left."""
+        k, p, dd = chain_loop_at(model, mass, stiffness, damping, least, f, kp, kd)
+        with arithmetic_guard(eccentricity, lordosis):
+            root = rightmost_root(mass, k, damping, p, dd, delay, lag)
+            if not root.real < 0:
+                return False, root, None
+            if not (np.any(p) or np.any(dd)):  # no reflex: stable at every delay (no crossing to find)
+                return True, root, from_crossings(np.empty(0), np.empty(0), np.empty(0), True)
+            exact = chain_delay_margin(mass, k, damping, p, dd, lag)
+        return bool(stable_at(exact, delay) and exact.margin >= delay), root, exact
+
+    top = 1.0 if model.reflex.gains == "rule" and kp is None and kd is None else LOCAL_MAX  # f >= 1: no reflex
+    scan = np.linspace(0.0, top, CHAIN_SCAN)
+    ok = np.array([judge(f)[0] for f in scan])
+    upper = bool(np.all(ok[np.argmax(ok) :])) if ok.any() else True  # once met, met for every larger f
+    method = "bisection: met for every larger fraction on the scan" if upper else "scan and refine: not monotone"
+    fraction = _least(lambda f: judge(f)[0], scan, ok)
+    if np.isnan(fraction):
+        largest = max(_chain_margin(model, mass, stiffness, damping, least, f, kp, kd, lag) for f in scan)
+        nan = np.full(n, np.nan)
+        return ChainDesign(activation, np.nan, nan, least, np.nan, np.nan, float(largest), method)
+    _, _, exact = judge(fraction)
+    k, p, dd = chain_loop_at(model, mass, stiffness, damping, least, fraction, kp, kd)
+    root = rightmost_root(mass, k, damping, p, dd, delay, lag, SPECTRAL_NODES)
+    return ChainDesign(
+        activation,
+        fraction,
+        fraction * least,
+        least,
+        float(exact.margin),
+        float(root.real),
+        float(exact.margin),
+        method,
+    )
+
+
+def _chain_margin(model, mass, stiffness, damping, least, fraction, kp, kd, lag) -> float:
+    """The chain's exact delay margin at local stiffness f k* [s]; 0 if unstable without delay."""
+    k, p, dd = chain_loop_at(model, mass, stiffness, damping, least, fraction, kp, kd)
+    exact = chain_delay_margin(mass, k, damping, p, dd, lag)
+    return float(exact.margin) if exact.stable_without_delay else 0.0
+
+
+def design(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None) -> Design:
+    """Both answers to the design question at ``model.reflex.delay`` (see the module).
+
+    Parameters
+    ----------
+    model : Model
+        ``model.reflex``: delay, lag, gains (rule or explicit).
+    eccentricity, lordosis : float
+        E and Lambda [m].
+    kp, kd : float, optional
+        Explicit gains for every segment and joint [N m/rad], [N m s/rad].
+
+    Returns
+    -------
+    Design
+
+    Raises
+    ------
+    ParameterError
+        E or Lambda out of range.
+    """
+    from ..model.source import header, provenance
+
+    activation, segments, optimum, status, largest, method = joint_design(model, eccentricity, lordosis, kp, kd)
+    pcsa = activation * optimum if np.isfinite(activation) else np.full_like(np.asarray(optimum, float), np.nan)
+    at = model.reflex.activation  # the chain at the operating point of spinectl margins
+    chain_answer = chain_design(
+        model, float(eccentricity), float(lordosis), at * np.asarray(optimum, float), at, kp, kd
+    )
+    if status == "ok" and np.isnan(chain_answer.fraction):
+        status = "chain_infeasible"
+    return Design(
+        eccentricity=float(eccentricity),
+        lordosis=float(lordosis),
+        delay=model.reflex.delay,
+        activation_time_constant=model.reflex.activation_time_constant,
+        activation=activation,
+        pcsa=float(np.sum(pcsa)),
+        segments=segments,
+        chain=chain_answer,
+        status=status,
+        largest_delay=largest,
+        method=method,
+        model=provenance(model) | {"header": header(model)},
+    )

@@ -1,0 +1,110 @@
+"""The design question (spinectl.reflex.design): the least co-contraction and local stiffness for a delay."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from spinectl.model import config
+from spinectl.model.checks import checked_coefficients
+from spinectl.reflex import design as dz
+from spinectl.reflex import margins
+from spinectl.reflex.chain_margins import stable_at
+from spinectl.reflex.mimo import chain_delay_margin
+
+SUBJECT = {"body.mass": 35.0, "passive.stiffness": 10.0, "reflex.delay": 0.12}
+"""A 35 kg subject with K = 10 N m/rad and a 120 ms reflex delay, at E = 3 cm, Lambda = 4 cm."""
+
+
+def _subject(**extra):
+    return config.set_parameters(config.load_preset("wagner2012"), SUBJECT | extra)
+
+
+def test_the_least_activation_meets_the_delay_and_a_little_less_does_not():
+    """Joint by joint, checked through margins.analyse (the operating point re-solved, the rule's gains, the exact
+    margins): at the returned activation every segment's margin is >= 120 ms; 1e-4 below it L1L2's is not. About
+    31 % of the minimum PCSA, 13.7 cm^2 (19 %, 8.3 cm^2, under the former rule that cancelled the lag, as found by
+    looping over ``margins --activation`` by hand)."""
+    model = _subject()
+    activation, segments, optimum, status, _, method = dz.joint_design(model, 0.03, 0.04)
+    assert status == "ok" and method.startswith("bisection")
+    at = margins.analyse(config.set_parameters(model, {"reflex.activation": activation}), 0.03, 0.04)
+    assert all(s.delay_margin >= 0.12 for s in at.segments) and at.all_stable_at_delay
+    below = margins.analyse(config.set_parameters(model, {"reflex.activation": activation - 1e-4}), 0.03, 0.04)
+    assert min(s.delay_margin for s in below.segments) < 0.12
+    assert activation == pytest.approx(max(s.activation for s in segments))  # monotone: the slowest segment's
+    assert activation == pytest.approx(0.3145, abs=1e-3)
+    assert 1e4 * activation * optimum.sum() == pytest.approx(13.74, abs=0.01)
+
+
+def test_a_segment_at_its_least_activation_has_the_closed_form_margin_equal_to_the_delay():
+    """Without the lag (T_a = 0) a segment's loop theta s^2 - D s - S + (kp + kd s) e^{-s tau} crosses where
+    theta^2 w^4 + (2 theta S + D^2 - kd^2) w^2 + S^2 - kp^2 = 0 (|P(jw)| = |Q(jw)|), at tau = arg(-Q/P)... /w:
+    at the returned activation this closed-form margin equals the delay (the search stops on the boundary)."""
+    model = _subject(**{"reflex.activation_time_constant": 0.0})
+    _, segments, optimum, _, _, _ = dz.joint_design(model, 0.03, 0.04)
+    coefficients = checked_coefficients(model, 0.03, 0.04)
+    k = 0  # L1L2
+    pcsa = segments[k].activation * optimum
+    s, d, theta = coefficients.stiffness(pcsa)[k], coefficients.damping(pcsa)[k], coefficients.inertia[k]
+    r = model.reflex
+    kp = r.gain_factor * max(s, 0.0)
+    kd = max(0.0, 2 * r.damping_ratio * np.sqrt(theta * max(kp - s, 0.0)) + d)
+    w2 = np.roots([theta**2, 2 * theta * s + d**2 - kd**2, s**2 - kp**2])
+    w = np.sqrt(np.max(w2.real[(np.abs(w2.imag) < 1e-12) & (w2.real > 0)]))
+    p = -theta * w**2 - 1j * d * w - s  # P(jw) of theta s^2 - D s - S
+    q = kp + 1j * kd * w
+    tau = np.mod(-np.angle(-p / q), 2 * np.pi) / w  # e^{-j w tau} = -P/Q
+    assert tau == pytest.approx(0.12, rel=1e-6)
+
+
+def test_the_chain_design_has_its_certificate_and_a_little_less_fails(monkeypatch):
+    """The chain at activation 0.5: the returned local stiffness f k* gives an exact multivariable margin >= the
+    delay and a rightmost root in the left half-plane (recomputed here); one bisection step below it (the scan step
+    halved BISECTIONS times) the rightmost root lies on the right. The rule's reflex vanishes at f = 1, so f <= 1."""
+    monkeypatch.setattr(dz, "CHAIN_SCAN", 5)
+    monkeypatch.setattr(dz, "BISECTIONS", 12)
+    model = _subject(**{"reflex.activation": 0.5})
+    optimum = margins.solve_point(model, 0.03, 0.04).pcsa
+    result = dz.chain_design(model, 0.03, 0.04, 0.5 * optimum, 0.5)
+    assert 0 < result.fraction <= 1 and result.delay_margin >= 0.12 and result.max_root_real < 0
+    mass, stiffness, damping = dz.chain_matrices(model, 0.03, 0.04, 0.5 * optimum)
+
+    def loop(f):
+        return dz.chain_loop_at(model, mass, stiffness, damping, result.least_static, f)
+
+    k, kp, kd = loop(result.fraction)
+    exact = chain_delay_margin(mass, k, damping, kp, kd, 0.05)
+    assert stable_at(exact, 0.12) and exact.margin >= 0.12
+    assert dz.rightmost_root(mass, k, damping, kp, kd, 0.12, 0.05, dz.SPECTRAL_NODES).real < 0
+    step = 1.0 / (dz.CHAIN_SCAN - 1) / 2**dz.BISECTIONS
+    k, kp, kd = loop(result.fraction - step)
+    assert dz.rightmost_root(mass, k, damping, kp, kd, 0.12, 0.05, dz.SPECTRAL_NODES).real > 0
+
+
+def test_the_rightmost_root_is_a_root_and_agrees_with_the_exact_margin_on_one_joint():
+    """One joint (theta = 1, S = 2, D = -0.5, kp = 6, kd = 1.5, T_a = 0.05): the returned s makes
+    (T_a s + 1)(theta s^2 - D s - S) + (kp + kd s) e^{-s tau} vanish, and its real part changes sign at the
+    exact delay margin of reflex.delay (the quasi-polynomial, a second method)."""
+    from spinectl.reflex.delay import delay_margin
+
+    m, k, d, kp, kd, lag = np.eye(1), 2.0 * np.eye(1), -0.5 * np.eye(1), [6.0], [1.5], 0.05
+    tau_m = float(delay_margin(2.0, -0.5, 1.0, 6.0, 1.5, lag).margin)
+    for tau, sign in ((0.98 * tau_m, -1), (1.02 * tau_m, 1)):
+        s = dz.rightmost_root(m, k, d, kp, kd, tau, lag, dz.SPECTRAL_NODES)
+        residual = (lag * s + 1) * (s**2 + 0.5 * s - 2.0) + (6.0 + 1.5 * s) * np.exp(-s * tau)
+        assert abs(residual) < 1e-9 and np.sign(s.real) == sign
+
+
+def test_a_delay_no_activation_meets_is_an_answer():
+    """Explicit gains too strong for a 50 ms delay (kp = 300 N m/rad, kd = 0) at every activation: status
+    'infeasible', NaN activation, and the largest delay met on the scan, which is below 50 ms."""
+    model = _subject(**{"reflex.delay": 0.05})
+    activation, segments, _, status, largest, _ = dz.joint_design(model, 0.0, 0.0, kp=300.0, kd=0.0)
+    assert status == "infeasible" and np.isnan(activation) and 0 < largest < 0.05
+    scan = np.linspace(0, 1, dz.SCAN)
+    at = [
+        margins.analyse(config.set_parameters(model, {"reflex.activation": a}), 0.0, 0.0, kp=300.0, kd=0.0)
+        for a in scan[::10]
+    ]
+    assert max(min(s.delay_margin for s in r.segments) for r in at) <= largest + 1e-12
