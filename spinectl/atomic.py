@@ -580,30 +580,40 @@ def _keep_the_others(target: Path, stage: Path, replaced: set[str]) -> dict[str,
 
     Returns the :func:`_inventory` of ``target`` read before (what the swap may remove afterwards).
     """
-    seen = _inventory(target)
+    seen = _inventory(target, files=False)  # the files kept are checked by their link (below)
+    link = functools.partial(_link_or_copy, root=target)
     for item in target.iterdir():
         new = stage / item.name
-        if item.name in replaced and not (new.exists() or new.is_symlink()):
-            continue
-        if new.exists() or new.is_symlink():
-            if new.is_dir() != item.is_dir():
+        if (item.name in replaced and not (new.exists() or new.is_symlink())) or new.exists() or new.is_symlink():
+            if (new.exists() or new.is_symlink()) and new.is_dir() != item.is_dir():
                 kind = "a folder" if item.is_dir() else "a file"
                 raise OutputError(f"cannot write {str(item)!r}: {kind} of that name is in the way")
+            if item.is_dir() and not item.is_symlink():
+                _inventory(item)  # not linked: its files are checked here
+            else:
+                _check_removable(item, os.lstat(item), target)
             continue
         if item.is_dir() and not item.is_symlink():
-            shutil.copytree(item, new, symlinks=True, copy_function=_link_or_copy)
+            shutil.copytree(item, new, symlinks=True, copy_function=link)
         else:
-            _link_or_copy(item, new)
+            link(item, new)
     return seen
 
 
-def _link_or_copy(source, destination) -> None:
+def _link_or_copy(source, destination, root: Path | None = None) -> None:
+    """Hard-link ``source`` as ``destination`` (a symbolic link as itself), or copy it where links fail.
+
+    Linux refuses to link an immutable or append-only file (EPERM): that is an
+    :class:`OutputError` (via :func:`_check_removable`), since the swap could not remove it.
+    """
     if os.path.islink(source):
         os.symlink(os.readlink(source), destination)
         return
     try:
         os.link(source, destination)
-    except OSError:  # no hard links on this file system
+    except OSError as exc:  # no hard links on this file system, or a file that may not be linked
+        if exc.errno == errno.EPERM and root is not None:
+            _check_removable(Path(source), os.lstat(source), root)
         shutil.copy2(source, destination)
 
 
@@ -665,13 +675,15 @@ PINNED_FLAGS = {0x10: "immutable (chattr +i)", 0x20: "append-only (chattr +a)"}
 """Linux's FS_IMMUTABLE_FL and FS_APPEND_FL: such an entry cannot be removed, nor one inside such a folder."""
 
 
-def _inventory(root: Path) -> dict[str, tuple]:
+def _inventory(root: Path, files: bool = True) -> dict[str, tuple]:
     """Every entry below ``root`` (path relative to it) -> its :func:`_identity`, read now.
 
     Raises :class:`OutputError` for what a swap of ``root`` cannot move or remove: a
     mount point inside (an entry on another device, or a mount point of
     ``/proc/self/mountinfo``, e.g. a bind mount on the same device), an immutable or
     append-only entry, or a folder (``root`` too) whose entries this user cannot remove.
+    With ``files=False`` the attributes of regular files are not read (one ``open`` each):
+    for a caller that links every file, which Linux refuses for such a file.
     """
     top = os.lstat(root)
     mounted = _mount_points_below(root)
@@ -688,7 +700,8 @@ def _inventory(root: Path) -> dict[str, tuple]:
                 name = f"{rel}/{entry.name}" if rel else entry.name
                 if info.st_dev != top.st_dev:
                     raise _refused(root, entry.path, "is on another file system (a mount point)")
-                _check_removable(Path(entry.path), info, root)
+                if files or not stat.S_ISREG(info.st_mode):
+                    _check_removable(Path(entry.path), info, root)
                 seen[name] = _identity(info)
                 if stat.S_ISDIR(info.st_mode):
                     folders.append((entry.path, name))

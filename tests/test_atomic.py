@@ -103,6 +103,26 @@ def test_an_immutable_file_in_the_output_folder_is_refused_and_kept(pinned):
     assert sorted(p.name for p in pinned.parent.iterdir()) == ["out"]
 
 
+def test_a_file_made_immutable_during_the_run_is_refused_at_the_swap(tmp_path):
+    """``chattr +i`` after the run checked its folder, while it writes: the swap refuses it (Linux will not
+    hard-link such a file), and the folder is as it was, with no staging folder left."""
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine")
+    try:
+        with pytest.raises(OutputError, match="'notes.txt' in it is immutable"):
+            with staged_directory(out, ["fig.png"]) as stage:
+                (stage / "fig.png").write_text("new")
+                if not _run("chattr", "+i", str(out / "notes.txt")):
+                    pytest.skip(
+                        "cannot set the immutable attribute here (needs root and a file system with attributes)"
+                    )
+        assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]
+        assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]
+    finally:
+        _run("chattr", "-i", str(out / "notes.txt"))
+
+
 def _writing_during_the_swap(monkeypatch, before=None, after=None):
     """Wrap ``atomic._swap``: another process's writes, as files ``before`` into the folder just before the
     swap and ``after`` into the old folder just after it (a writer that looked up the folder before)."""
