@@ -268,8 +268,14 @@ def load(path: str | Path) -> xr.Dataset:
 
 def _verify_or_foreign(path: Path) -> bool:
     """:func:`_verify`, but a file that is not NetCDF at all is named so."""
-    with open(path, "rb") as file:
-        magic = file.read(8)
+    try:
+        fd = os.open(path, os.O_RDONLY)
+        try:
+            magic = os.read(fd, 8)
+        finally:
+            os.close(fd)
+    except OSError as exc:  # no permission, a failing device
+        raise ParameterError("results", f"{str(path)!r} cannot be read: {_reason(exc)}") from None
     if not (magic.startswith(b"\x89HDF") or magic.startswith(b"CDF")):
         raise ParameterError("results", f"{path} is not a spinectl NetCDF file (not NetCDF)")
     return _verify(path)
