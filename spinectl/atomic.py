@@ -4,16 +4,43 @@ An interrupted run leaves either the previous file or the new one, never a
 half-written file. A folder replaces a folder in one step where the OS can
 (Linux's ``renameat2`` with ``RENAME_EXCHANGE``), else in two (the old one moved
 aside, the new one in), so that a set of files changes as a whole.
+
+The folder swap moves only what it can move back and remove. Before it, the old
+folder is read whole (:func:`_inventory`): a mount point inside it (another
+device, or a mount point of ``/proc/self/mountinfo``: a rename would carry the
+mounted file system into the hidden old folder, whose removal would empty it), an
+immutable or append-only entry (``chattr +i``: it could be swapped away but never
+removed) or a folder whose entries this user cannot remove is refused with one line,
+before anything moves. After the swap the old folder is removed entry by entry
+(:func:`_settle`), never as a tree: an entry goes only if it was there when the run
+read the folder (it was kept in the new folder, or replaced by this run's file) or
+is a hard link to the entry of the new folder; an entry that another process wrote
+during the swap is moved back into the new folder, and one that cannot be (the
+run wrote that name too) is kept in a visible folder beside, with a warning.
+
+Every temporary is named ``.<target>.~<pid>-<start>-<host>~<random>.tmp``: the
+process id, its start time (``/proc/<pid>/stat`` field 22, clock ticks after boot;
+0 where there is no ``/proc``) and a hash of the host name (:class:`Owner`). A run
+removes the temporaries beside its output whose process has ended (a SIGKILL's
+litter; :func:`remove_stale`): a process id that runs again with another start
+time is another process; one of another host is never judged.
 """
 
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import errno
 import functools
 import os
+import re
 import shutil
+import socket
+import stat
+import struct
 import tempfile
+import warnings
+import zlib
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -58,13 +85,18 @@ def atomic_path(target: str | Path, *, directory: bool = False) -> Iterator[Path
             yield tmp
         with output_errors(target):
             _set_mode(tmp, target, directory)
-            _replace(tmp, target, directory)
+            # an old folder: refused if a swap could not move or remove it all, before anything moves
+            seen = _inventory(target) if directory and target.is_dir() else {}
+            written = frozenset(os.listdir(tmp)) if directory else frozenset()
+            old = _swap(tmp, target, directory)
     except BaseException:
         if tmp.is_dir():
             shutil.rmtree(tmp, ignore_errors=True)
         else:
             tmp.unlink(missing_ok=True)
         raise
+    if old is not None:  # the old folder, now at the temporary's name: only what was read goes
+        _settle(old, target, seen, written)
 
 
 def _named(target: str | Path) -> Path:
@@ -112,12 +144,157 @@ def output_errors(target: str | Path, errnos=None) -> Iterator[None]:
 
 
 def _temporary(target: Path, directory: bool) -> Path:
-    prefix = f".{target.name}."
+    """A new temporary beside ``target``, named after it and after this process (:class:`Owner`)."""
+    remove_stale(target.parent)
+    marker = f".~{Owner.me().token()}~"
+    tail = ".tmp" + (target.suffix if not directory else "")
+    room = NAME_MAX - len(os.fsencode(marker + tail)) - 8 - 1  # 8: mkstemp's random part; 1: the leading dot
+    name = os.fsencode(target.name)[: max(room, 1)].decode(errors="ignore") or "out"  # a long name: its start
+    prefix = f".{name}{marker}"
     if directory:
-        return Path(tempfile.mkdtemp(prefix=prefix, suffix=".tmp", dir=target.parent))
-    fd, name = tempfile.mkstemp(prefix=prefix, suffix=".tmp" + target.suffix, dir=target.parent)
+        return Path(tempfile.mkdtemp(prefix=prefix, suffix=tail, dir=target.parent))
+    fd, path = tempfile.mkstemp(prefix=prefix, suffix=tail, dir=target.parent)
     os.close(fd)
-    return Path(name)
+    return Path(path)
+
+
+def temporary_beside(target: str | Path) -> Path:
+    """A new empty file beside ``target``, named as the temporaries of :func:`atomic_path` are.
+
+    For a writer that puts it in place itself (e.g. by a hard link); if the run is killed,
+    a later run removes it (:func:`remove_stale`).
+
+    Parameters
+    ----------
+    target : str or Path
+        The file it stands for.
+
+    Returns
+    -------
+    Path
+        The temporary (the caller removes it).
+    """
+    return _temporary(Path(target), directory=False)
+
+
+NAME_MAX = 255
+"""The longest file name of the usual file systems [bytes]."""
+
+
+@dataclasses.dataclass(frozen=True)
+class Owner:
+    """A process that writes: its id, start time and host (that of a temporary, or a lock's holder).
+
+    Parameters
+    ----------
+    pid : int
+        Process id.
+    start : int
+        Its start time: clock ticks after boot (``/proc/<pid>/stat`` field 22), 0 where unknown
+        (no ``/proc``, or a lock written by an older version).
+    host : str
+        Host name, or the 8 hex digits of its CRC-32 (as a temporary's name holds it).
+    """
+
+    pid: int
+    start: int
+    host: str
+
+    @classmethod
+    def me(cls) -> Owner:
+        """This process.
+
+        Returns
+        -------
+        Owner
+        """
+        return cls(os.getpid(), _start_time(os.getpid()) or 0, socket.gethostname())
+
+    def token(self) -> str:
+        """``<pid>-<start>-<crc32 of host>``, the part of a temporary's name that names its owner.
+
+        Returns
+        -------
+        str
+        """
+        return f"{self.pid}-{self.start}-{_host_hash(self.host)}"
+
+    def gone(self) -> bool:
+        """Whether this process has ended: its id runs no more, or runs another process (another start time).
+
+        A process of another host is never gone (it cannot be checked from here); one whose
+        start time is unknown is gone only once its id runs no more.
+
+        Returns
+        -------
+        bool
+        """
+        if self.host not in (socket.gethostname(), _host_hash(socket.gethostname())):
+            return False
+        try:
+            os.kill(self.pid, 0)
+        except ProcessLookupError:
+            return True
+        except PermissionError:  # runs, as another user: compare its start time below
+            pass
+        now = _start_time(self.pid)
+        return bool(self.start) and now is not None and now != self.start
+
+
+def _start_time(pid: int) -> int | None:
+    """The start time of process ``pid`` [clock ticks after boot] (Linux's ``/proc``), or None."""
+    try:
+        text = Path(f"/proc/{pid}/stat").read_bytes()
+    except OSError:
+        return None
+    try:  # the name (field 2) is in parentheses and may hold spaces: count from the last ')'
+        return int(text.rsplit(b")", 1)[1].split()[19])
+    except (IndexError, ValueError):
+        return None
+
+
+def _host_hash(host: str) -> str:
+    return f"{zlib.crc32(host.encode()):08x}"
+
+
+TEMPORARY = re.compile(r"\..*\.~(\d+)-(\d+)-([0-9a-f]{8})~.{8}\.tmp.*", re.DOTALL)
+"""The name of a temporary of :func:`_temporary` (its owner's pid, start time and host hash)."""
+
+
+def remove_stale(folder: str | Path) -> list[Path]:
+    """Remove the temporaries in ``folder`` of runs that have ended (e.g. killed by SIGKILL).
+
+    Only names of :func:`_temporary` count, and only those whose owner is gone
+    (:meth:`Owner.gone`); a folder goes only if nothing in it lies on another file
+    system or is pinned (:func:`_inventory`). Best effort: what cannot be removed stays.
+
+    Parameters
+    ----------
+    folder : str or Path
+        Where to look (not below).
+
+    Returns
+    -------
+    list of Path
+        The temporaries removed.
+    """
+    removed = []
+    try:
+        entries = list(os.scandir(folder))
+    except OSError:
+        return removed
+    for entry in entries:
+        match = TEMPORARY.fullmatch(entry.name)
+        if match is None or not Owner(int(match[1]), int(match[2]), match[3]).gone():
+            continue
+        with contextlib.suppress(OSError, OutputError):
+            if entry.is_dir(follow_symlinks=False):
+                _inventory(Path(entry.path))  # nothing mounted or pinned inside
+                shutil.rmtree(entry.path)
+            else:
+                os.unlink(entry.path)
+            removed.append(Path(entry.path))
+    return removed
 
 
 def _set_mode(tmp: Path, target: Path, directory: bool) -> None:
@@ -131,28 +308,34 @@ def _set_mode(tmp: Path, target: Path, directory: bool) -> None:
     os.chmod(tmp, mode & 0o7777)
 
 
-def _replace(tmp: Path, target: Path, directory: bool) -> None:
+def _swap(tmp: Path, target: Path, directory: bool) -> Path | None:
+    """Put ``tmp`` in the place of ``target``; return where the old folder went (None: no old folder).
+
+    The old folder is not removed here: :func:`_settle` removes what the run read of it.
+    """
     if not (directory and target.exists()):
         os.replace(tmp, target)
-        return
+        return None
     if _exchange(tmp, target):  # one step: the new folder at target, the old one at tmp
-        shutil.rmtree(tmp, ignore_errors=True)
-        return
-    # A folder cannot be renamed over a non-empty one: move the old aside first,
-    # and put it back if the new one cannot take its place.
-    old = target.with_name(f".{target.name}.old")
-    shutil.rmtree(old, ignore_errors=True)
+        return tmp
+    # A folder cannot be renamed over a non-empty one: move the old aside first (onto an
+    # empty temporary: a rename may replace an empty folder), and put it back if the new
+    # one cannot take its place.
+    old = _temporary(target, directory=True)
     os.replace(target, old)
     try:
         os.replace(tmp, target)
     except BaseException:
         os.replace(old, target)
         raise
-    shutil.rmtree(old, ignore_errors=True)
+    return old
 
 
 RENAME_EXCHANGE = 2
 """Linux's ``renameat2`` flag that swaps two paths in one step (<linux/fs.h>)."""
+
+RENAME_NOREPLACE = 1
+"""Linux's ``renameat2`` flag that fails (EEXIST) rather than replace the destination (<linux/fs.h>)."""
 
 
 @functools.cache
@@ -167,15 +350,18 @@ def _renameat2():
         return None
 
 
-def _exchange(a: Path, b: Path) -> bool:
-    """Swap the paths ``a`` and ``b`` atomically (Linux >= 3.15); False where the OS or file system cannot."""
+def _exchange(a: Path, b: Path, flags: int = RENAME_EXCHANGE) -> bool:
+    """Swap the paths ``a`` and ``b`` atomically (Linux >= 3.15); False where the OS or file system cannot.
+
+    With ``flags=RENAME_NOREPLACE``: rename ``a`` to ``b`` unless ``b`` exists (then ``FileExistsError``).
+    """
     import ctypes
 
     renameat2 = _renameat2()
     if renameat2 is None:
         return False
     at_cwd = -100  # AT_FDCWD: paths relative to the working directory
-    if renameat2(at_cwd, os.fsencode(a), at_cwd, os.fsencode(b), RENAME_EXCHANGE) == 0:
+    if renameat2(at_cwd, os.fsencode(a), at_cwd, os.fsencode(b), flags) == 0:
         return True
     error = ctypes.get_errno()
     if error in (errno.ENOSYS, errno.EINVAL, errno.ENOTSUP):
@@ -301,8 +487,9 @@ def check_folder(target: str | Path, names=()) -> Path:
     ------
     OutputError
         ``target`` is a file, the working directory or a folder above it (it could not be
-        replaced as a whole), one of ``names`` is a folder in it, or its folder cannot be
-        created or written.
+        replaced as a whole), holds what a swap cannot move or remove (a mount point, an
+        immutable or append-only entry, a folder whose entries cannot be removed), one of
+        ``names`` is a folder in it, or its folder cannot be created or written.
     """
     target = _named(target)
     with output_errors(target):
@@ -319,6 +506,8 @@ def check_folder(target: str | Path, names=()) -> Path:
             )
         target.parent.mkdir(parents=True, exist_ok=True)
         _temporary(target, directory=True).rmdir()
+        if target.is_dir():
+            _inventory(target)  # a mount point or a pinned file inside: refused before the work
     for name in names:
         with output_errors(target / name):
             if (target / name).is_dir():
@@ -371,41 +560,60 @@ def staged_directory(target: str | Path, names=(), replaces=()) -> Iterator[Path
         return
     with output_errors(target):
         stage = _temporary(target, directory=True)
+    old = None
     try:
         yield stage
         with output_errors(target):
-            if target.is_dir():
-                _keep_the_others(target, stage, set(replaces))
+            written = frozenset(os.listdir(stage))
+            seen = _keep_the_others(target, stage, set(replaces)) if target.is_dir() else {}
             _set_mode(stage, target, directory=True)
-            _replace(stage, target, directory=True)
+            old = _swap(stage, target, directory=True)
     finally:
-        shutil.rmtree(stage, ignore_errors=True)
+        if old is None:  # not swapped: the staging folder holds this run's files and links only
+            shutil.rmtree(stage, ignore_errors=True)
+    if old is not None:
+        _settle(old, target, seen, written)
 
 
-def _keep_the_others(target: Path, stage: Path, replaced: set[str]) -> None:
-    """Hard-link (or copy) into ``stage`` every entry of ``target`` that the run did not write, but ``replaced``."""
+def _keep_the_others(target: Path, stage: Path, replaced: set[str]) -> dict[str, tuple]:
+    """Hard-link (or copy) into ``stage`` every entry of ``target`` that the run did not write, but ``replaced``.
+
+    Returns the :func:`_inventory` of ``target`` read before (what the swap may remove afterwards).
+    """
+    seen = _inventory(target, files=False)  # the files kept are checked by their link (below)
+    link = functools.partial(_link_or_copy, root=target)
     for item in target.iterdir():
         new = stage / item.name
-        if item.name in replaced and not (new.exists() or new.is_symlink()):
-            continue
-        if new.exists() or new.is_symlink():
-            if new.is_dir() != item.is_dir():
+        if (item.name in replaced and not (new.exists() or new.is_symlink())) or new.exists() or new.is_symlink():
+            if (new.exists() or new.is_symlink()) and new.is_dir() != item.is_dir():
                 kind = "a folder" if item.is_dir() else "a file"
                 raise OutputError(f"cannot write {str(item)!r}: {kind} of that name is in the way")
+            if item.is_dir() and not item.is_symlink():
+                _inventory(item)  # not linked: its files are checked here
+            else:
+                _check_removable(item, os.lstat(item), target)
             continue
         if item.is_dir() and not item.is_symlink():
-            shutil.copytree(item, new, symlinks=True, copy_function=_link_or_copy)
+            shutil.copytree(item, new, symlinks=True, copy_function=link)
         else:
-            _link_or_copy(item, new)
+            link(item, new)
+    return seen
 
 
-def _link_or_copy(source, destination) -> None:
+def _link_or_copy(source, destination, root: Path | None = None) -> None:
+    """Hard-link ``source`` as ``destination`` (a symbolic link as itself), or copy it where links fail.
+
+    Linux refuses to link an immutable or append-only file (EPERM): that is an
+    :class:`OutputError` (via :func:`_check_removable`), since the swap could not remove it.
+    """
     if os.path.islink(source):
         os.symlink(os.readlink(source), destination)
         return
     try:
         os.link(source, destination)
-    except OSError:  # no hard links on this file system
+    except OSError as exc:  # no hard links on this file system, or a file that may not be linked
+        if exc.errno == errno.EPERM and root is not None:
+            _check_removable(Path(source), os.lstat(source), root)
         shutil.copy2(source, destination)
 
 
@@ -416,7 +624,7 @@ def _is_mount(target: Path) -> bool:
 
 def _probe_inside(target: Path) -> None:
     """Make a staging folder inside ``target`` and move a file from it into ``target``, as the end of a job will."""
-    stage = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".tmp", dir=target))
+    stage = _temporary(target / target.name, directory=True)  # inside target, named after it
     try:
         probe = stage / "probe"
         probe.touch()
@@ -437,7 +645,7 @@ def _filled_in_place(target: Path, replaced: set[str]) -> Iterator[Path]:
     write are kept, but those ``replaced`` (removed last).
     """
     with output_errors(target):
-        stage = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".tmp", dir=target))
+        stage = _temporary(target / target.name, directory=True)  # inside target, named after it
     try:
         yield stage
         with output_errors(target):
@@ -451,3 +659,197 @@ def _filled_in_place(target: Path, replaced: set[str]) -> Iterator[Path]:
                     (target / name).unlink()
     finally:
         shutil.rmtree(stage, ignore_errors=True)
+
+
+# --- what a folder swap may move and remove ----------------------------------------------
+
+
+class OutputWarning(UserWarning):
+    """Files that another process wrote into an output folder while it was replaced were kept aside."""
+
+
+FS_IOC_GETFLAGS = 0x80086601 if struct.calcsize("l") == 8 else 0x80046601
+"""Linux's ioctl that reads a file's attributes (``lsattr``; <linux/fs.h>, ``_IOR('f', 1, long)``)."""
+
+PINNED_FLAGS = {0x10: "immutable (chattr +i)", 0x20: "append-only (chattr +a)"}
+"""Linux's FS_IMMUTABLE_FL and FS_APPEND_FL: such an entry cannot be removed, nor one inside such a folder."""
+
+
+def _inventory(root: Path, files: bool = True) -> dict[str, tuple]:
+    """Every entry below ``root`` (path relative to it) -> its :func:`_identity`, read now.
+
+    Raises :class:`OutputError` for what a swap of ``root`` cannot move or remove: a
+    mount point inside (an entry on another device, or a mount point of
+    ``/proc/self/mountinfo``, e.g. a bind mount on the same device), an immutable or
+    append-only entry, or a folder (``root`` too) whose entries this user cannot remove.
+    With ``files=False`` the attributes of regular files are not read (one ``open`` each):
+    for a caller that links every file, which Linux refuses for such a file.
+    """
+    top = os.lstat(root)
+    mounted = _mount_points_below(root)
+    if mounted:
+        raise _refused(root, mounted[0], "is a mount point")
+    _check_removable(root, top)
+    seen: dict[str, tuple] = {}
+    folders = [(str(root), "")]
+    while folders:
+        folder, rel = folders.pop()
+        with os.scandir(folder) as entries:
+            for entry in entries:
+                info = entry.stat(follow_symlinks=False)
+                name = f"{rel}/{entry.name}" if rel else entry.name
+                if info.st_dev != top.st_dev:
+                    raise _refused(root, entry.path, "is on another file system (a mount point)")
+                if files or not stat.S_ISREG(info.st_mode):
+                    _check_removable(Path(entry.path), info, root)
+                seen[name] = _identity(info)
+                if stat.S_ISDIR(info.st_mode):
+                    folders.append((entry.path, name))
+    return seen
+
+
+def _identity(info: os.stat_result) -> tuple:
+    """(device, inode, type, size, modification time): an entry unchanged since it was read has the same."""
+    return (info.st_dev, info.st_ino, stat.S_IFMT(info.st_mode), info.st_size, info.st_mtime_ns)
+
+
+def _check_removable(path: Path, info: os.stat_result, root: Path | None = None) -> None:
+    """:class:`OutputError` if the entry ``path`` is pinned, or is a folder whose entries cannot be removed."""
+    pinned = _pinned(path, info)
+    if pinned:
+        raise _refused(root or path.parent, path, f"is {pinned}")
+    if stat.S_ISDIR(info.st_mode) and not os.access(path, os.W_OK | os.X_OK):
+        raise _refused(root or path.parent, path, "is a folder whose entries this user cannot remove")
+
+
+def _refused(root: Path, entry, why: str) -> OutputError:
+    return OutputError(
+        f"cannot write {str(root)!r}: {show(os.path.relpath(entry, root))} in it {why}; the folder is "
+        "replaced as a whole when the "
+        "run ends, and that entry could not go with it safely: move it out, or write to another folder"
+    )
+
+
+def _pinned(path: Path, info: os.stat_result) -> str | None:
+    """'immutable (...)' or 'append-only (...)' if the entry carries such a flag (Linux, BSD, macOS), else None."""
+    flags = getattr(info, "st_flags", 0)  # BSD and macOS: chflags
+    if flags & (stat.UF_IMMUTABLE | stat.SF_IMMUTABLE):
+        return "immutable (chflags uchg)"
+    if flags & (stat.UF_APPEND | stat.SF_APPEND):
+        return "append-only (chflags uappnd)"
+    if not (stat.S_ISREG(info.st_mode) or stat.S_ISDIR(info.st_mode)):
+        return None  # devices and pipes are not opened (an open may act); symbolic links carry no flags
+    flags = _linux_flags(path)
+    return next((what for flag, what in PINNED_FLAGS.items() if flags & flag), None)
+
+
+def _linux_flags(path: Path) -> int:
+    """The attributes of ``path`` (``lsattr``), or 0 where they cannot be read (not Linux, no permission)."""
+    try:
+        import fcntl
+    except ImportError:  # not POSIX
+        return 0
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NOCTTY", 0))
+    except OSError:
+        return 0
+    try:
+        return struct.unpack("i", fcntl.ioctl(fd, FS_IOC_GETFLAGS, bytes(8))[:4])[0]  # the kernel writes an int
+    except OSError:  # not Linux, or a file system without attributes
+        return 0
+    finally:
+        os.close(fd)
+
+
+def _mount_points_below(root: Path) -> list[str]:
+    """The mount points strictly inside ``root`` (Linux's ``/proc/self/mountinfo``; [] elsewhere)."""
+    try:
+        lines = Path("/proc/self/mountinfo").read_text(encoding="utf-8", errors="surrogateescape").splitlines()
+    except OSError:
+        return []
+    inside = os.path.realpath(root) + os.sep
+    points = (re.sub(r"\\([0-7]{3})", lambda m: chr(int(m[1], 8)), line.split(" ")[4]) for line in lines if line)
+    return sorted(point for point in points if point.startswith(inside))
+
+
+def _settle(old: Path, new: Path, seen: dict[str, tuple], written: frozenset) -> None:
+    """Remove the old folder after a swap, entry by entry; move back what another process wrote meanwhile.
+
+    An entry goes if it is a hard link to the entry of ``new`` of its name, or is as it
+    was read (``seen``: kept in ``new``, or replaced by this run's file). Anything else
+    appeared or changed during the swap: it moves into ``new`` where that name is free or
+    holds only a kept copy; where the run wrote that name too (``written``, top-level
+    names), the old folder is kept, renamed to a visible ``<name>.kept-…`` beside, with
+    an :class:`OutputWarning`.
+    """
+    device = os.lstat(old).st_dev
+    for _ in range(3):  # an entry that came while the folder was emptied: look again
+        _settle_folder(old, new, "", seen, written, device)
+        try:
+            old.rmdir()
+            return
+        except FileNotFoundError:
+            return
+        except OSError:
+            continue
+    _keep_aside(old, new)
+
+
+def _settle_folder(folder: Path, new: Path, rel: str, seen: dict, written: frozenset, device: int) -> None:
+    try:
+        entries = list(os.scandir(folder))
+    except OSError:
+        return
+    for entry in entries:
+        name = f"{rel}/{entry.name}" if rel else entry.name
+        here, there = Path(entry.path), new / entry.name
+        with contextlib.suppress(OSError):
+            info = entry.stat(follow_symlinks=False)
+            now, then = _identity(info), seen.get(name)
+            if stat.S_ISDIR(info.st_mode) and info.st_dev == device and then is not None and then[:3] == now[:3]:
+                _settle_folder(here, there, name, seen, written, device)
+                here.rmdir()
+            elif _linked(here, there) or (now == then and not stat.S_ISDIR(info.st_mode)):
+                here.unlink()
+            elif not os.path.lexists(there):
+                _move_back(here, there)
+            elif name.split("/")[0] not in written and not here.is_dir() and not there.is_dir():
+                os.replace(here, there)  # a newer version of a file kept: it takes the kept copy's place
+
+
+def _linked(a: Path, b: Path) -> bool:
+    try:
+        one, two = os.lstat(a), os.lstat(b)
+    except OSError:
+        return False
+    return (one.st_dev, one.st_ino) == (two.st_dev, two.st_ino)
+
+
+def _move_back(here: Path, there: Path) -> None:
+    """Rename ``here`` to ``there`` unless ``there`` exists by then (``FileExistsError``)."""
+    if _exchange(here, there, RENAME_NOREPLACE):
+        return
+    if here.is_dir() and not here.is_symlink():
+        if os.path.lexists(there):
+            raise FileExistsError(errno.EEXIST, "File exists", str(there))
+        os.rename(here, there)
+    else:
+        os.link(here, there, follow_symlinks=False)  # fails if there exists
+        here.unlink()
+
+
+def _keep_aside(old: Path, new: Path) -> None:
+    """Rename what is left of the old folder to a visible name beside ``new`` and say so."""
+    kept = old
+    with contextlib.suppress(OSError):
+        aside = Path(tempfile.mkdtemp(prefix=f"{new.name}.kept-", dir=new.parent))
+        os.replace(old, aside)  # onto the empty folder just made
+        kept = aside
+    left = sorted(str(path.relative_to(kept)) for path in kept.rglob("*") if not path.is_dir())
+    warnings.warn(
+        OutputWarning(
+            f"{len(left)} file(s) written into {str(new)!r} by another process while it was replaced could not "
+            f"be put back (this run wrote the same names): they are kept in {str(kept)!r}"
+        ),
+        stacklevel=2,
+    )

@@ -1,10 +1,22 @@
 """Landscapes on disk: NetCDF written atomically, read back checked, and the model they used.
+
+Every file carries checksums, as a study store's chunks do: each variable has the
+attribute ``spinectl_crc32``, the CRC-32 of its bytes as stored (with its type,
+dimensions, shape and other attributes), and the file has one of its global
+attributes (``config_toml`` among them), written by :func:`save` and checked by
+:func:`load` before anything is used, so that a flipped bit is a one-line error
+naming the variable, not a different number in a figure. A file that netCDF-C
+cannot read (a damaged HDF5 structure) is a one-line error too; one without
+checksums (written by spinectl before they were recorded, or by another program)
+loads with a :class:`ChecksumWarning` saying that it could not be checked.
 """
 
 from __future__ import annotations
 
 import os
 import tomllib
+import warnings
+import zlib
 from pathlib import Path
 
 import numpy as np
@@ -70,12 +82,118 @@ def save(dataset: xr.Dataset, path: str | Path) -> Path:
     """
     with atomic_path(path) as tmp:
         try:
-            dataset.to_netcdf(tmp, engine="netcdf4")
+            _unstamped(dataset).to_netcdf(tmp, engine="netcdf4")
+            _stamp(tmp)
         except (OSError, RuntimeError) as exc:  # netCDF-C reports a full disk as e.g. "NetCDF: HDF error"
             if isinstance(exc, SpinectlError):
                 raise
             raise OutputError(f"cannot write {str(path)!r}: {printable(str(exc))}{_full(path)}") from None
     return Path(path)
+
+
+CHECKSUM = "spinectl_crc32"
+"""The attribute of every variable (and of the file, for its global attributes): a CRC-32 as 8 hex digits."""
+
+
+class ChecksumWarning(UserWarning):
+    """A NetCDF file without checksums was read: a damaged value in it cannot be detected."""
+
+
+def _unstamped(dataset: xr.Dataset) -> xr.Dataset:
+    """``dataset`` without checksum attributes (e.g. one loaded, then edited): :func:`save` writes them anew."""
+    if CHECKSUM not in dataset.attrs and not any(CHECKSUM in v.attrs for v in dataset.variables.values()):
+        return dataset
+    dataset = dataset.copy()
+    dataset.attrs.pop(CHECKSUM, None)
+    for variable in dataset.variables.values():
+        variable.attrs.pop(CHECKSUM, None)
+    return dataset
+
+
+def _stamp(path: Path) -> None:
+    """Record the checksum of every variable and of the global attributes in the NetCDF file ``path``."""
+    import netCDF4
+
+    with netCDF4.Dataset(path, "r+") as file:
+        for variable in file.variables.values():
+            variable.setncattr(CHECKSUM, _variable_crc(variable))
+        file.setncattr(CHECKSUM, _attributes_crc(file))
+
+
+def _variable_crc(variable) -> str:
+    """CRC-32 of a netCDF4 variable: its name, type, dimensions, shape, other attributes and values as stored."""
+    variable.set_auto_maskandscale(False)  # the bytes stored, not a decoded copy
+    variable.set_auto_chartostring(False)
+    head = f"{variable.name}|{variable.dtype}|{variable.dimensions}|{variable.shape}|{_attributes_text(variable)}"
+    return f"{zlib.crc32(_stored_bytes(variable[...]), zlib.crc32(head.encode())):08x}"
+
+
+def _attributes_crc(holder) -> str:
+    return f"{zlib.crc32(_attributes_text(holder).encode('utf-8', 'surrogatepass')):08x}"
+
+
+def _attributes_text(holder) -> str:
+    """The attributes of a netCDF4 file or variable but the checksum, as text in name order."""
+    names = sorted(name for name in holder.ncattrs() if name != CHECKSUM)
+    return "|".join(f"{name}={np.asarray(holder.getncattr(name)).tolist()!r}" for name in names)
+
+
+def _stored_bytes(values) -> bytes:
+    values = np.asarray(values)
+    if values.dtype.kind == "O":  # variable-length strings: each with its length
+        items = [str(item).encode("utf-8", "surrogatepass") for item in values.ravel()]
+        return b"".join(len(item).to_bytes(8, "little") + item for item in items)
+    if values.dtype.byteorder not in "|<":  # the same bytes on any machine
+        values = values.astype(values.dtype.newbyteorder("<"))
+    return np.ascontiguousarray(values).tobytes()
+
+
+READ_ERRORS = (
+    OSError,
+    RuntimeError,
+    ValueError,
+    KeyError,
+    IndexError,
+    TypeError,
+    AttributeError,
+    UnicodeError,
+    OverflowError,
+)
+"""What netCDF4-python and xarray raise on a file whose HDF5 structure is damaged (found by flipping its bits)."""
+
+
+def _verify(path: Path) -> bool:
+    """Check the checksums of the NetCDF file ``path``; False if it has none.
+
+    Raises :class:`ParameterError` (field ``results``) naming the first variable (or the
+    global attributes) whose bytes differ from those written, or the reason netCDF-C gives
+    for not reading it.
+    """
+    import netCDF4
+
+    try:
+        with netCDF4.Dataset(path) as file:
+            if CHECKSUM not in file.ncattrs():
+                return False
+            wrong = [] if file.getncattr(CHECKSUM) == _attributes_crc(file) else ["its global attributes differ"]
+            for name, variable in file.variables.items():
+                stamped = variable.getncattr(CHECKSUM) if CHECKSUM in variable.ncattrs() else None
+                if not wrong and stamped != _variable_crc(variable):
+                    wrong.append(f"variable {name!r} differs")
+    except READ_ERRORS as exc:
+        raise ParameterError("results", f"{str(path)!r} cannot be read: {_reason(exc)}") from None
+    if wrong:
+        raise ParameterError(
+            "results",
+            f"{str(path)!r} is damaged: {wrong[0]} from what was written (its CRC-32, attribute "
+            f"{CHECKSUM}, does not match); write it again",
+        )
+    return True
+
+
+def _reason(exc: Exception) -> str:
+    text = printable(str(exc).splitlines()[0] if str(exc) else "")
+    return f"{exc.__class__.__name__}: {text}" if text else exc.__class__.__name__
 
 
 FULL_BELOW = 1 << 20
@@ -107,17 +225,24 @@ def load(path: str | Path) -> xr.Dataset:
     Raises
     ------
     ParameterError
-        The file is missing, not NetCDF or not a sweep (field ``results``): a required
-        variable, the dimensions E and Lambda (and K when K is a dimension),
-        finite coordinates with no value repeated, or a ``config_toml`` that is a valid model.
+        The file is missing, not NetCDF, damaged (a variable or the global attributes
+        differ from their checksums, or netCDF-C cannot read it) or not a sweep (field
+        ``results``): a required variable, the dimensions E and Lambda (and K when K is a
+        dimension), finite coordinates with no value repeated, or a ``config_toml`` that is a valid model.
+
+    Warns
+    -----
+    ChecksumWarning
+        The file carries no checksums (an older spinectl's, or another program's): it could not be checked.
     """
     path = Path(path)
     if not path.is_file():
         raise ParameterError("results", f"file not found: {path}")
+    checked = _verify_or_foreign(path)
     try:
-        dataset = xr.load_dataset(path, engine="netcdf4")
-    except (OSError, ValueError) as exc:
-        raise ParameterError("results", f"{path} is not a spinectl NetCDF file ({exc.__class__.__name__})") from None
+        dataset = _unstamped(xr.load_dataset(path, engine="netcdf4"))
+    except READ_ERRORS as exc:
+        raise ParameterError("results", f"{str(path)!r} cannot be read: {_reason(exc)}") from None
     missing = [name for name in (*REQUIRED, "E", "Lambda") if name not in dataset.variables]
     if missing or "config_toml" not in dataset.attrs:
         what = ", ".join(missing) or "attribute config_toml"
@@ -130,7 +255,30 @@ def load(path: str | Path) -> xr.Dataset:
             problem = str(exc)
     if problem:
         raise ParameterError("results", f"{show(str(path))} is not a spinectl sweep as written ({printable(problem)})")
+    if not checked:
+        warnings.warn(
+            ChecksumWarning(
+                f"{str(path)!r} carries no checksums (written by spinectl before they were recorded, or by "
+                "another program): a damaged value in it cannot be detected; write it again to add them"
+            ),
+            stacklevel=2,
+        )
     return dataset
+
+
+def _verify_or_foreign(path: Path) -> bool:
+    """:func:`_verify`, but a file that is not NetCDF at all is named so."""
+    try:
+        fd = os.open(path, os.O_RDONLY)
+        try:
+            magic = os.read(fd, 8)
+        finally:
+            os.close(fd)
+    except OSError as exc:  # no permission, a failing device
+        raise ParameterError("results", f"{str(path)!r} cannot be read: {_reason(exc)}") from None
+    if not (magic.startswith(b"\x89HDF") or magic.startswith(b"CDF")):
+        raise ParameterError("results", f"{path} is not a spinectl NetCDF file (not NetCDF)")
+    return _verify(path)
 
 
 def _layout_problem(dataset: xr.Dataset) -> str | None:

@@ -552,6 +552,31 @@ def test_a_stale_lock_of_a_dead_process_is_taken_over(tmp_path):
     assert lock.read_text() == f"{dead.pid} another-host.invalid\n"  # not the refused run's to remove
 
 
+def test_a_lock_whose_pid_runs_another_process_is_taken_over(tmp_path):
+    """A lock naming a live pid with another start time (the pid reused after the run died) is stale and
+    taken over (before: the live pid blocked the store for ever); with its true start time it is held, and
+    so is a lock of an older version (pid and host only) whose pid runs."""
+    import socket
+
+    from spinectl.atomic import Owner
+
+    me, host = Owner.me(), socket.gethostname()
+    if not me.start:
+        pytest.skip("no /proc: process start times cannot be read here")
+    out = tmp_path / "s.zarr"
+    lock = Path(f"{out}.lock")
+    lock.write_text(f"{me.pid} {me.start + 1} {host}\n")
+    with study_store.locked(out):
+        assert lock.read_text() == f"{me.pid} {me.start} {host}\n"
+    for held in (f"{me.pid} {me.start} {host}\n", f"{me.pid} {host}\n"):
+        lock.write_text(held)
+        with pytest.raises(OutputError, match=f"in use by another study run \\(process {me.pid} on host"):
+            with study_store.locked(out):
+                pass
+        assert lock.read_text() == held
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.zarr.lock"]  # no temporary left
+
+
 def delete_chunk_file(out: Path, name: str, key: str) -> None:
     """Remove one chunk file of a finished store (and the consolidated metadata is left as it was)."""
     (out / name / key).unlink()

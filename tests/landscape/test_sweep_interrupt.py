@@ -44,12 +44,18 @@ def test_plot_of_a_bad_dataset_is_one_line(tmp_path, monkeypatch, capsys, comman
 
 @pytest.fixture(scope="module")
 def landscape(tmp_path_factory):
-    """A 3 x 3 sweep, as `spinectl sweep` writes it, for the readers to be fed edited copies."""
+    """A 3 x 3 sweep, as `spinectl sweep` writes it, for the readers to be fed edited copies: without its
+    checksums, as another program writes it (with them, every edit is refused as damage, netcdf.CHECKSUM)."""
     import xarray as xr
+
+    from spinectl.landscape import netcdf
 
     path = tmp_path_factory.mktemp("sweep") / "good.nc"
     assert main(["sweep", "--E", "0:0.08:3", "--Lambda", "0:0.08:3", "--K", "0,15", "--out", str(path)]) == 0
-    return xr.load_dataset(path)
+    dataset = xr.load_dataset(path)
+    for attrs in (dataset.attrs, *(variable.attrs for variable in dataset.variables.values())):
+        attrs.pop(netcdf.CHECKSUM)
+    return dataset
 
 
 def _edited(landscape, how):

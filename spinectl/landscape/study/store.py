@@ -30,7 +30,6 @@ from __future__ import annotations
 import contextlib
 import json
 import os
-import socket
 import tempfile
 import warnings
 import zlib
@@ -42,7 +41,7 @@ import xarray as xr
 import zarr
 
 from ..._version import __version__
-from ...atomic import atomic_path, output_errors
+from ...atomic import Owner, atomic_path, output_errors, temporary_beside
 from ...errors import OutputError, ParameterError
 from ...model import config, source
 from ...model._toml import field_metadata
@@ -594,11 +593,13 @@ def locked(path: str | Path) -> Iterator[Path]:
     """Hold the lock of the store ``path`` while the block runs: no second run can use it meanwhile.
 
     The lock is a file beside the store (beside its real path, after symbolic links),
-    created exclusively (``O_EXCL``), holding the process id and host name of its
-    holder; it is removed at the end, whatever happens.
+    created whole or not at all (written to a temporary, then hard-linked: a link fails
+    where the name exists), holding the process id, start time and host name of its
+    holder (:class:`spinectl.atomic.Owner`); it is removed at the end, whatever happens.
     A lock left by a run that is gone (killed: its process id no longer runs on this
-    host) is taken over; one of another host is never (its process cannot be checked):
-    remove it by hand once that run has ended.
+    host, or runs a process that started at another time, the id reused) is taken
+    over; one of another host is never (its process cannot be checked): remove it by
+    hand once that run has ended.
 
     Parameters
     ----------
@@ -627,56 +628,60 @@ def locked(path: str | Path) -> Iterator[Path]:
 
 
 def _acquire(lock: Path, attempts: int = 3) -> None:
-    me = f"{os.getpid()} {socket.gethostname()}\n"
+    me = Owner.me()
     for _ in range(attempts):  # a stale lock that another run took over meanwhile: look again
-        try:
-            fd = os.open(lock, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644)
-        except FileExistsError:
-            holder = _holder(lock)
-            if holder is None or not _gone(*holder):
-                who = "unknown" if holder is None else f"process {holder[0]} on host {holder[1]}"
-                raise OutputError(
-                    f"{str(lock)[: -len(LOCK_SUFFIX)]!r} is in use by another study run ({who}, lock file "
-                    f"{str(lock)!r}): wait for it to end, or remove the lock file if that run has ended"
-                ) from None
-            _take_over(lock, holder)
-            continue
-        with os.fdopen(fd, "w") as file:
-            file.write(me)
-        return
+        if _create(lock, f"{me.pid} {me.start} {me.host}\n"):
+            return
+        holder = _holder(lock)
+        if holder is None or not holder.gone():
+            who = "unknown" if holder is None else f"process {holder.pid} on host {holder.host}"
+            raise OutputError(
+                f"{str(lock)[: -len(LOCK_SUFFIX)]!r} is in use by another study run ({who}, lock file "
+                f"{str(lock)!r}): wait for it to end, or remove the lock file if that run has ended"
+            )
+        _take_over(lock, holder)
     raise OutputError(f"cannot lock {str(lock)!r}: other runs keep taking it")
 
 
-def _holder(lock: Path) -> tuple[int, str] | None:
-    """(pid, host) of a lock file, or None if it is unreadable or half-written (then it counts as held)."""
+def _create(lock: Path, text: str) -> bool:
+    """Create ``lock`` holding ``text``, whole or not at all (False: it exists).
+
+    The text is written to a temporary first and hard-linked as the lock (a link fails where
+    the name exists), so that a run killed meanwhile leaves no empty lock that would count as held.
+    """
+    tmp = temporary_beside(lock)  # named after this run: a later run removes it if this one is killed
     try:
-        pid, host = lock.read_text(encoding="utf-8").split()
-        return int(pid), host
+        tmp.write_text(text, encoding="utf-8")
+        os.link(tmp, lock)
+    except FileExistsError:
+        return False
+    finally:
+        tmp.unlink(missing_ok=True)
+    return True
+
+
+def _holder(lock: Path) -> Owner | None:
+    """The holder of a lock file (pid, start time, host; an older version's lock has no start time), or None
+    if it is unreadable (then it counts as held)."""
+    try:
+        fields = lock.read_text(encoding="utf-8").split()
+        if len(fields) == 2:
+            return Owner(int(fields[0]), 0, fields[1])
+        pid, start, host = fields
+        return Owner(int(pid), int(start), host)
     except (OSError, ValueError, UnicodeDecodeError):
         return None
 
 
-def _gone(pid: int, host: str) -> bool:
-    """Whether the holder has ended: only decidable for a process of this host."""
-    if host != socket.gethostname():
-        return False
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return True
-    except PermissionError:  # runs, as another user
-        return False
-    return False
-
-
-def _take_over(lock: Path, holder: tuple[int, str]) -> None:
+def _take_over(lock: Path, holder: Owner) -> None:
     """Remove a stale lock, unless another run replaced it meanwhile (then it is put back)."""
-    aside = lock.with_name(f"{lock.name}.{os.getpid()}.stale")
+    aside = temporary_beside(lock)
     try:
         os.replace(lock, aside)
+        if _holder(aside) != holder:  # a live lock of another run, taken over meanwhile
+            with contextlib.suppress(FileExistsError):
+                os.link(aside, lock)
     except FileNotFoundError:
-        return  # removed by its holder or by another run: try again
-    if _holder(aside) != holder:  # a live lock of another run, taken over meanwhile
-        with contextlib.suppress(FileExistsError):
-            os.link(aside, lock)
-    aside.unlink(missing_ok=True)
+        pass  # removed by its holder or by another run: try again
+    finally:
+        aside.unlink(missing_ok=True)
