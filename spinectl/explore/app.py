@@ -41,7 +41,7 @@ from ..model.params import Model
 from ..paper.landmarks import CT_LIMIT
 from ..units import CM_PER_M, m2_to_cm2
 from . import views
-from .launch import allowed_hosts, request_allowed, url_host
+from .hosts import allowed_hosts, request_allowed, url_host
 from .numbers import LANDSCAPE_POINTS, PointNumbers, landscape_axis, landscapes, point_numbers
 from .state import (
     LANDSCAPE_PARAMETERS,
@@ -577,7 +577,7 @@ def serve(model: Model, preset: str, port: int, address: str = "127.0.0.1", show
     """Serve the explorer at ``http://address:port/`` until interrupted; one :class:`Explorer` per browser tab.
 
     Every request, the websocket's included, must address the server by the address bound
-    (:func:`spinectl.explore.launch.request_allowed`; others get 403): a DNS-rebinding page,
+    (:func:`spinectl.explore.hosts.request_allowed`; others get 403): a DNS-rebinding page,
     served under another site's name that resolves to this machine, gets no session.
 
     Parameters
@@ -596,7 +596,7 @@ def serve(model: Model, preset: str, port: int, address: str = "127.0.0.1", show
     Raises
     ------
     ParameterError
-        An address that names no one interface (:func:`spinectl.explore.launch.allowed_hosts`).
+        An address that names no one interface (:func:`spinectl.explore.hosts.allowed_hosts`).
     """
     allowed = allowed_hosts(address, port)
     url = f"http://{url_host(address)}:{port}/"
@@ -628,7 +628,7 @@ def bokeh_origins(allowed: frozenset[tuple[str, int]]) -> list[str]:
     Parameters
     ----------
     allowed : frozenset of (str, int)
-        :func:`spinectl.explore.launch.allowed_hosts`.
+        :func:`spinectl.explore.hosts.allowed_hosts`.
 
     Returns
     -------
@@ -673,6 +673,6 @@ def guard(application, allowed: frozenset[tuple[str, int]]) -> None:
     application : tornado.web.Application
         The Bokeh server's Tornado application.
     allowed : frozenset of (str, int)
-        :func:`spinectl.explore.launch.allowed_hosts`.
+        :func:`spinectl.explore.hosts.allowed_hosts`.
     """
     application.default_router.rules.insert(0, Rule(_ForeignRequest(allowed), _Refused))

@@ -1,141 +1,18 @@
 """Start the explorer's server, or say in one line what is missing (Panel) or in the way (the port, the address).
 
 Kept apart from :mod:`spinectl.explore.app` so that the command line can import it
-without Panel installed. It also holds what the server checks on every request:
-:func:`allowed_hosts` (the names a request may address the server by) and
-:func:`request_allowed`, the guard against DNS rebinding (docs/explore.md, "Who can
-reach it"): a page of another site whose name is made to resolve to this machine is
-served by the browser as that site, so the ``Host`` and ``Origin`` it sends name that
-site, not the address bound; such requests are refused.
+without Panel installed. What the server checks on every request (the guard against
+DNS rebinding) is :mod:`spinectl.explore.hosts`.
 """
 
 from __future__ import annotations
 
-import ipaddress
-import socket
-import urllib.parse
-
-from ..errors import OutputError, ParameterError, SpinectlError
+from ..errors import OutputError, SpinectlError
 from ..model.params import Model
+from .hosts import allowed_hosts, url_host
 
 EXTRA = "pip install 'spinectl[explore]'"
 """How to install the explorer's dependencies."""
-LOCALHOST = "localhost"
-"""The loopback interface's name, which browsers resolve to the loopback addresses themselves."""
-HTTP_PORT = 80
-"""The port a ``Host`` or ``Origin`` without one means (RFC 9110, section 4.2.1)."""
-
-
-def _refused(address: str, why: str) -> ParameterError:
-    return ParameterError("--address", f"{why} (got {address!r})")
-
-
-def allowed_hosts(address: str, port: int) -> frozenset[tuple[str, int]]:
-    """The (host, port) pairs by which a request may address a server bound to ``address`` and ``port``.
-
-    An IP address allows itself (an IPv6 one written in brackets in a URL), a loopback address
-    ``localhost`` too, and a host name itself and the addresses it resolves to. Nothing else: a
-    request whose ``Host`` or ``Origin`` names another site is refused (:func:`request_allowed`).
-
-    Parameters
-    ----------
-    address : str
-        The interface to bind, e.g. ``127.0.0.1``, ``::1`` (or ``[::1]``), ``localhost``.
-    port : int
-        TCP port.
-
-    Returns
-    -------
-    frozenset of (str, int)
-        Host names, lower case, IPv6 addresses without brackets, each with ``port``.
-
-    Raises
-    ------
-    ParameterError
-        An empty address, one of every interface (``0.0.0.0``, ``::``: no one name to check a
-        request against), or a name that does not resolve.
-    """
-    name = address.strip()
-    if name.startswith("[") and name.endswith("]"):
-        name = name[1:-1]
-    if not name:
-        raise _refused(address, "must name the interface to listen on, e.g. 127.0.0.1 or ::1")
-    try:
-        ip = ipaddress.ip_address(name)
-    except ValueError:
-        ip = None
-    if ip is not None:
-        if ip.is_unspecified:
-            raise _refused(
-                address,
-                "must name one interface: every request's Host is checked against it, and this one "
-                "stands for all of them; give the address of the one to serve on",
-            )
-        names = {ip.compressed} | ({LOCALHOST} if ip.is_loopback else set())
-        return frozenset((n, port) for n in names)
-    try:
-        resolved = socket.getaddrinfo(name, port, type=socket.SOCK_STREAM)
-    except (OSError, UnicodeError) as exc:
-        why = f"must be an IP address or a name of this machine; it does not resolve ({exc})"
-        raise _refused(address, why) from None
-    names = {name.lower()} | {ipaddress.ip_address(info[4][0].split("%")[0]).compressed for info in resolved}
-    return frozenset((n, port) for n in names)
-
-
-def url_host(address: str) -> str:
-    """``address`` as written in a URL: an IPv6 address in brackets.
-
-    Parameters
-    ----------
-    address : str
-
-    Returns
-    -------
-    str
-        E.g. ``127.0.0.1``, ``[::1]``, ``localhost``.
-    """
-    name = address.strip().strip("[]")
-    return f"[{name}]" if ":" in name else name
-
-
-def _host_port(netloc: str) -> tuple[str, int] | None:
-    """``host[:port]`` as (host, port), or None if it is not exactly that (user info, a path, a bad port)."""
-    parts = urllib.parse.urlsplit("//" + netloc)
-    try:
-        port = parts.port
-    except ValueError:
-        return None
-    if parts.netloc != netloc or "@" in netloc or parts.path or parts.query or not parts.hostname:
-        return None
-    return parts.hostname.lower(), HTTP_PORT if port is None else port
-
-
-def request_allowed(host: str | None, origin: str | None, allowed: frozenset[tuple[str, int]]) -> bool:
-    """Whether a request with these ``Host`` and ``Origin`` headers addresses the server as bound.
-
-    A browser always sends ``Host``, and ``Origin`` with every websocket and cross-site request;
-    a DNS-rebinding page sends its own site's name in both.
-
-    Parameters
-    ----------
-    host : str or None
-        The ``Host`` header; missing is refused.
-    origin : str or None
-        The ``Origin`` header; missing is allowed (a same-origin page load, a non-browser client),
-        present it must be ``http://`` and a pair of ``allowed``.
-    allowed : frozenset of (str, int)
-        :func:`allowed_hosts`.
-
-    Returns
-    -------
-    bool
-    """
-    if host is None or _host_port(host) not in allowed:
-        return False
-    if origin is None:
-        return True
-    parts = urllib.parse.urlsplit(origin)
-    return parts.scheme == "http" and parts.path in ("", "/") and _host_port(parts.netloc) in allowed
 
 
 def serve_explorer(model: Model, preset: str, port: int, address: str = "127.0.0.1", show: bool = True) -> None:
@@ -157,7 +34,7 @@ def serve_explorer(model: Model, preset: str, port: int, address: str = "127.0.0
     Raises
     ------
     ParameterError
-        An address that names no one interface (:func:`allowed_hosts`).
+        An address that names no one interface (:func:`~spinectl.explore.hosts.allowed_hosts`).
     SpinectlError
         Panel (the ``explore`` extra) is not installed.
     OutputError

@@ -10,7 +10,7 @@ from __future__ import annotations
 import pytest
 
 from spinectl.errors import ParameterError
-from spinectl.explore.launch import allowed_hosts, request_allowed, url_host
+from spinectl.explore.hosts import allowed_hosts, request_allowed, url_host
 
 P = 5006
 
