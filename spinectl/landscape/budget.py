@@ -177,7 +177,7 @@ def free_disk(path: str | Path) -> float | None:
         return None
 
 
-def check(estimate: Estimate, path: str | Path | None = None, *, memory=available_memory, disk=free_disk) -> None:
+def check(estimate: Estimate, path: str | Path | None = None) -> None:
     """Refuse in one line work whose estimate does not fit in the available memory or on the free disk.
 
     Parameters
@@ -186,8 +186,6 @@ def check(estimate: Estimate, path: str | Path | None = None, *, memory=availabl
         The work.
     path : str or Path, optional
         Where it is written (its file system's free space is compared with ``estimate.disk``).
-    memory, disk : callable
-        :func:`available_memory` and :func:`free_disk` (replaceable: tests pass tiny limits).
 
     Raises
     ------
@@ -196,14 +194,14 @@ def check(estimate: Estimate, path: str | Path | None = None, *, memory=availabl
     OutputError
         The disk estimate exceeds the free space at ``path``.
     """
-    available = memory()
+    available = available_memory()  # looked up here, so that tests can give tiny limits
     if available is not None and estimate.memory > available:
         raise ParameterError(
             estimate.what,
             f"{estimate.points:,} points need about {size(estimate.memory)} of memory, and "
             f"{size(available)} is available: use fewer points (a coarser grid, fewer K values or axis values)",
         )
-    free = None if path is None else disk(path)
+    free = None if path is None else free_disk(path)
     if free is not None and estimate.disk > free:
         raise OutputError(
             f"cannot write {str(path)!r}: {estimate.points:,} points need about {size(estimate.disk)}, and its "
