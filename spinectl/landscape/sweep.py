@@ -19,7 +19,7 @@ from tqdm import tqdm
 
 from .._validate import show
 from ..atomic import check_writable
-from ..errors import OutputError, ParameterError
+from ..errors import ModelError, OutputError, ParameterError
 from ..model import config, source
 from ..model.checks import check_axis_range
 from ..model.params import Model
@@ -189,10 +189,14 @@ def passive_sweeps(
         distinct(name, axis)
     e_grid, l_grid = (a.ravel() for a in np.meshgrid(e_axis, l_axis, indexing="ij"))
     columns._check_passive_only(models)  # before the estimate, which solves the first model at one point
-    cost = estimate(models[0], e_grid[:1], l_grid[:1], e_grid.size * len(models), chunk_size, coupled)
-    budget.check(cost, out)
-    if cost.long and notify is not None:
-        notify(cost.line())
+    try:
+        cost = estimate(models[0], e_grid[:1], l_grid[:1], e_grid.size * len(models), chunk_size, coupled)
+    except ModelError:  # the sweep itself says so, naming the grid rather than its first point
+        cost = None
+    if cost is not None:
+        budget.check(cost, out)
+        if cost.long and notify is not None:
+            notify(cost.line())
     disable = None if progress is None else not progress  # None: tqdm shows it on a terminal only
     with tqdm(total=e_grid.size * len(models), disable=disable, unit="pt", desc="sweep") as bar:
         options = {"method": method, "chunk_size": chunk_size, "update": bar.update, "coupled": coupled}
