@@ -463,3 +463,12 @@ def test_a_utf8_output_name_under_the_c_locale(tmp_path):
     )
     assert sweep.returncode == 2 and sweep.stderr.count(b"\n") == 1 and b"UTF-8 locale" in sweep.stderr
     assert not (tmp_path / "Λ.nc").exists()
+
+
+def test_the_largest_stiffness_in_a_sweep_is_one_line(tmp_path, capsys):
+    """``sweep --K 1e308``: the arithmetic of the reflex columns overflows (as for K = 1.3e154), one line,
+    exit 2, no file; before, the solver's "overflow encountered in divide" warning came first, a second line."""
+    out = tmp_path / "k.nc"
+    assert main(["sweep", "--E", "0:0.08:3", "--Lambda", "0:0.08:3", "--K", "1e308", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "the model's arithmetic fails on the grid" in err and not out.exists()
