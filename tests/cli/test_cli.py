@@ -472,3 +472,16 @@ def test_the_largest_stiffness_in_a_sweep_is_one_line(tmp_path, capsys):
     assert main(["sweep", "--E", "0:0.08:3", "--Lambda", "0:0.08:3", "--K", "1e308", "--out", str(out)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "the model's arithmetic fails on the grid" in err and not out.exists()
+
+
+def test_sweep_states_its_estimate_on_stderr_before_long_work(tmp_path, capsys, monkeypatch):
+    """The command prints the library's estimate line on stderr when the work is long (NOTICE_SECONDS = 0
+    here), before the solves: 2 x 2 points at 2 values of K are 8 points; stdout keeps the one result line."""
+    from spinectl.landscape import budget
+
+    monkeypatch.setattr(budget, "NOTICE_SECONDS", 0.0)
+    out = tmp_path / "x.nc"
+    assert main(["sweep", "--E", "0:0.08:2", "--Lambda", "0:0.08:2", "--K", "0,15", "--out", str(out)]) == 0
+    captured = capsys.readouterr()
+    assert captured.err.startswith("sweep: 8 points, about ") and captured.err.count("\n") == 1
+    assert captured.out.startswith(f"wrote {out}")
