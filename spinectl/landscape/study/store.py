@@ -42,7 +42,6 @@ import xarray as xr
 import zarr
 
 from ... import __version__
-from ..._validate import printable
 from ...atomic import atomic_path, output_errors
 from ...errors import OutputError, ParameterError
 from ...model import config, source
@@ -592,7 +591,7 @@ def _check_layout(path, group) -> None:
         except KeyError:
             pass  # lost: said below
         except OPEN_ERRORS as exc:
-            reason = printable(str(exc).splitlines()[0] if str(exc) else type(exc).__name__)[:120]
+            reason = (str(exc).splitlines() or [type(exc).__name__])[0][:120]  # the CLI escapes what is not printable
             raise ParameterError(
                 "store",
                 f"{str(path)!r} is damaged: array {name!r}: its metadata cannot be read ({reason}); remove it "
