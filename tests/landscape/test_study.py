@@ -931,3 +931,13 @@ def test_a_folder_in_place_of_a_chunk_file_gets_advice_that_works(tmp_path):
     chunk.rmdir()
     result = study.run_study(parsed, out, scheduler="synchronous", resume=True, progress=False)
     assert result.complete and result.computed == 11
+
+
+def test_a_combination_whose_arithmetic_fails_is_named(tmp_path):
+    """K = 1e308 passes validation (a finite stiffness) but overflows the reflex columns of its chunks: the one
+    line names the combination, as validation errors do, so the user knows which value to change."""
+    text = study_with(axes="K = [0.0, 1e308]\n")
+    with pytest.raises(
+        ModelError, match=r"the model's arithmetic fails .*\(study combination passive\.stiffness = 1e\+308\)"
+    ):
+        study.run_study(study.parse_study(text), tmp_path / "s.zarr", scheduler="synchronous", progress=False)

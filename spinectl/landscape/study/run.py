@@ -41,7 +41,8 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm  # plain: tqdm.auto warns in kernels without ipywidgets (as the sweep)
 
-from ...errors import ParameterError
+from ..._validate import show
+from ...errors import ModelError, ParameterError
 from ...model import config
 from ...model.params import Model
 from .. import budget, columns, schema
@@ -133,11 +134,20 @@ def solve_chunk(task: Task) -> tuple[int, dict[str, np.ndarray]]:
         ``task.index``.
     outputs : dict of str to numpy.ndarray
         On the tile, as :func:`spinectl.landscape.study.store.encode` gives them.
+
+    Raises
+    ------
+    ModelError
+        The model's arithmetic fails on the tile; the message names the chunk's combination.
     """
     model = config.set_parameters(task.model, task.overrides)
     e_grid, l_grid = (a.ravel() for a in np.meshgrid(task.eccentricity, task.lordosis, indexing="ij"))
     coupled = any(name in schema.ON_REQUEST for name in task.outputs)
-    solved, _ = columns.point_columns(model, e_grid, l_grid, chunk_size=e_grid.size, coupled=coupled)
+    try:
+        solved, _ = columns.point_columns(model, e_grid, l_grid, chunk_size=e_grid.size, coupled=coupled)
+    except ModelError as exc:  # e.g. K = 1e308 overflows the reflex columns: say which combination
+        values = ", ".join(f"{name} = {show(value)}" for name, value in task.overrides.items())
+        raise ModelError(f"{exc} (study combination {values})" if values else str(exc)) from None
     return task.index, store.encode(solved, task.outputs, (task.eccentricity.size, task.lordosis.size))
 
 
