@@ -106,9 +106,18 @@ def _named(target: str | Path) -> Path:
     that name the outputs, and the command line that a preset's header records.
     """
     text = str(target)
-    if not text.isprintable():
+    if not _as_utf8(text).isprintable():
         raise OutputError(f"cannot write {show(text)}: the name must be printable (no line breaks or control codes)")
     return Path(target)
+
+
+def _as_utf8(text: str) -> str:
+    """A name as its bytes read as UTF-8: under a C locale Python keeps the bytes of ``Λ.png`` as
+    surrogate escapes (``'\\udcce\\udc9b.png'``), which are not printable though the name is."""
+    try:
+        return os.fsencode(text).decode("utf-8")
+    except UnicodeError:  # not UTF-8 (e.g. Latin-1 bytes): judged as Python holds it
+        return text
 
 
 DEVICE_ERRORS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EROFS, errno.EIO})

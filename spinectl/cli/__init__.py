@@ -13,9 +13,11 @@ stderr and exit code 2, without a traceback.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import difflib
 import importlib
 import logging
+import os
 import re
 import shlex
 import sys
@@ -220,27 +222,85 @@ def main(argv: list[str] | None = None) -> int:
     Returns
     -------
     int
-        0 on success, 2 for an error the user can fix (one line on stderr), 130 on Ctrl-C.
+        0 on success, 2 for an error the user can fix (one line on stderr; also standard output that
+        cannot be written, e.g. a full device), 130 on Ctrl-C; 0 when the reader of a pipe stops reading.
     """
     _printable_streams()
     # matplotlib logs two warnings when it cannot make its configuration folder (a HOME that is not
     # writable, as in many containers) and uses a temporary one: harmless, yet they broke "nothing on stderr"
     logging.getLogger("matplotlib").setLevel(logging.ERROR)
+    stdout, sys.stdout = sys.stdout, _Stdout(sys.stdout)
+    try:
+        return _run(argv)
+    except _StdoutError as exc:
+        return _stdout_failed(exc.error, stdout)
+    finally:
+        sys.stdout = stdout
+
+
+def _run(argv) -> int:
+    """Parse, run the command, flush standard output: the exit code, or :class:`_StdoutError`."""
     try:
         with warnings.catch_warnings():
             warnings.showwarning = _one_line_warning
             args = build_parser(lazy=True).parse_args(argv)
-            return int(args.func(args) or 0)
+            code = int(args.func(args) or 0)
     except _ParserExit as exc:
-        return exc.status
+        code = exc.status
     except (_UsageError, SpinectlError) as exc:  # argparse's and the library's errors read alike
         print(f"spinectl: error: {printable(str(exc))}", file=sys.stderr)
         return EXIT_USAGE
     except KeyboardInterrupt:
         print("spinectl: interrupted", file=sys.stderr)
         return 130
-    except BrokenPipeError:
+    sys.stdout.flush()  # a full device shows here, not in the interpreter's exit (a traceback, exit 120)
+    return code
+
+
+class _StdoutError(Exception):
+    """Writing standard output failed (a full device, a closed pipe): not an ``OSError``, which argparse swallows."""
+
+    def __init__(self, error: OSError):
+        super().__init__(error)
+        self.error = error
+
+
+class _Stdout:
+    """``sys.stdout`` whose failed writes raise :class:`_StdoutError`, told apart from a file's ``OSError``."""
+
+    def __init__(self, stream):
+        self._stream = stream
+
+    def write(self, text):
+        try:
+            return self._stream.write(text)
+        except OSError as exc:
+            raise _StdoutError(exc) from None
+
+    def flush(self):
+        try:
+            return self._stream.flush()
+        except OSError as exc:
+            raise _StdoutError(exc) from None
+
+    def __getattr__(self, name):
+        return getattr(self._stream, name)
+
+
+def _stdout_failed(error: OSError, stream) -> int:
+    """One line and exit 2 for standard output that cannot be written; a closed pipe (``| head``) ends quietly, 0.
+
+    What could not be written is dropped (standard output pointed at the null device), so that
+    the interpreter's own flush at exit has nothing left to fail on.
+    """
+    with contextlib.suppress(OSError, ValueError, AttributeError):  # a replaced stream has no descriptor
+        null = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(null, stream.fileno())
+        os.close(null)
+    if isinstance(error, BrokenPipeError):  # the reader stopped reading: it had what it wanted
         return 0
+    print(f"spinectl: error: cannot write to standard output: {error.strerror or error}", file=sys.stderr)
+    return EXIT_USAGE
 
 
 def _one_line_warning(message, category, filename, lineno, file=None, line=None) -> None:

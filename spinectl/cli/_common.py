@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import sys
 
 from .. import jsondoc
-from .._validate import printable
+from .._validate import printable, show
 from ..atomic import atomic_write_text
 from ..errors import ParameterError
 from ..model.config import DEFAULT_PRESET, PRESET_GUIDANCE, apply_overrides, load_config, set_parameters
@@ -341,3 +342,36 @@ def require(condition: bool, field: str, message: str) -> None:
     """
     if not condition:
         raise ParameterError(field, message)
+
+
+def input_name(text: str) -> str:
+    """An argparse type: a file or folder name that the system can look up (it need not exist).
+
+    A name too long for the file system (``ENAMETOOLONG``), a loop of symbolic links, a folder
+    that cannot be searched or a NUL byte end as argparse's one line naming the argument
+    (``argument RESULTS: cannot read '...': File name too long``); a missing file is left to the
+    library, which says so in its own words.
+
+    Parameters
+    ----------
+    text : str
+        The name as given.
+
+    Returns
+    -------
+    str
+        ``text``, unchanged.
+
+    Raises
+    ------
+    argparse.ArgumentTypeError
+        The name cannot be looked up.
+    """
+    try:
+        os.stat(text)
+    except (FileNotFoundError, NotADirectoryError):
+        pass
+    except (OSError, ValueError) as exc:  # ValueError: a NUL byte in the name
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+        raise argparse.ArgumentTypeError(f"cannot read {show(text)}: {reason}") from None
+    return text

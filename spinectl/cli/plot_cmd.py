@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ._common import add_dpi_option, finite_float
+from ._common import add_dpi_option, finite_float, input_name
 
 
 def register(sub) -> None:
@@ -35,12 +35,14 @@ def _options(parser) -> None:
     parser.add_argument(
         "results",
         metavar="RESULTS",
+        type=input_name,
         help="a NetCDF file written by 'spinectl sweep' or 'reproduce', or a study's Zarr store (a folder: "
         "each E x Lambda slice's minimum PCSA and ||CT||)",
     )
     parser.add_argument(
         "--vs",
         metavar="OTHER.nc",
+        type=input_name,
         help="compare with this landscape on the same grid: difference and ratio maps (RESULTS minus, over, OTHER)",
     )
     parser.add_argument("--out", required=True, metavar="DIR", help="folder for the figure files")

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 import time
 
 from ..atomic import check_distinct
@@ -76,6 +77,7 @@ def run(args) -> int:
     e_axis = sweep.parse_grid(args.E, "--E", geometry.eccentricity_range)
     l_axis = sweep.parse_grid(args.Lambda, "--Lambda", geometry.lordosis_range)
     options = {"stiffnesses": args.K, "method": args.method, "chunk_size": args.chunk_size, "coupled": args.coupled}
+    options["notify"] = lambda line: print(line, file=sys.stderr)
     start = time.perf_counter()
     dataset = sweep.write_sweep(model, e_axis, l_axis, args.out, **options)
     print(f"wrote {args.out}: {sweep.describe(dataset)} in {time.perf_counter() - start:.1f} s")

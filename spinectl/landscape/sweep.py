@@ -10,19 +10,21 @@ resolved configuration; docs/optimisation.md lists the schema with units.
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 import numpy as np
 import xarray as xr
 from tqdm import tqdm
 
+from .._validate import show
 from ..atomic import check_writable
-from ..errors import ParameterError
+from ..errors import ModelError, OutputError, ParameterError
 from ..model import config, source
 from ..model.checks import check_axis_range
 from ..model.params import Model
 from ..units import CM_PER_M
-from . import netcdf
+from . import budget, columns, netcdf
 from .columns import DEFAULT_CHUNK, passive_columns
 from .schema import landscape_dataset
 
@@ -31,9 +33,11 @@ METHODS = ("fast", "per-point")
 Clarabel blocks); 'per-point': the cvxpy reference."""
 
 MAX_GRID_POINTS = 1_000_000
-"""Largest grid of one sweep: the answer alone takes about 1.2 kB a point (1.2 GB here),
-and at about 0.2 ms a point the fast path needs some minutes. A larger request is more
-likely a typo (a step count in place of a point count) than a plan."""
+"""Most points of one sweep, every axis counted (E x Lambda x the K values): the answer alone takes
+about 1.2 kB a point (1.2 GB here, 3 GB at its peak), and at about 40 us a point the fast path needs
+some minutes. A larger request is more likely a typo (a step count in place of a point count) than a
+plan. Below it, a sweep must also fit in the available memory and its file on the free disk
+(:func:`spinectl.landscape.budget.check`)."""
 
 
 def parse_grid(spec: str, name: str, bounds: tuple[float, float] | None = None) -> np.ndarray:
@@ -98,6 +102,8 @@ def sweep(
     chunk_size: int = DEFAULT_CHUNK,
     progress: bool | None = None,
     coupled: bool = False,
+    out=None,
+    notify=None,
 ) -> xr.Dataset:
     """Minimum PCSA and counter torques on the grid E x Lambda (Figures 3 and 4).
 
@@ -114,6 +120,8 @@ def sweep(
         Show a progress bar on stderr; None: only on a terminal.
     coupled : bool
         Also the coupled chain's SDP variables (:data:`spinectl.landscape.schema.ON_REQUEST`, docs/chain.md).
+    out, notify
+        As for :func:`passive_sweeps`: where the answer goes (its free disk checked), who hears a long sweep's estimate.
 
     Returns
     -------
@@ -121,6 +129,7 @@ def sweep(
         Dimensions ``E``, ``Lambda``, ``segment``, ``muscle``; schema in docs/optimisation.md.
     """
     options = {"method": method, "chunk_size": chunk_size, "progress": progress, "coupled": coupled}
+    options |= {"out": out, "notify": notify}
     return passive_sweeps([model], eccentricity, lordosis, **options)[0]
 
 
@@ -133,6 +142,8 @@ def passive_sweeps(
     chunk_size: int = DEFAULT_CHUNK,
     progress: bool | None = None,
     coupled: bool = False,
+    out=None,
+    notify=None,
 ) -> list[xr.Dataset]:
     """:func:`sweep` of several models that differ in their passive stiffness alone (K, its convention), in one pass.
 
@@ -148,6 +159,10 @@ def passive_sweeps(
         Grid axes E and Lambda [m].
     method, chunk_size, progress, coupled
         As for :func:`sweep`; one progress bar for all models.
+    out : str or Path, optional
+        Where the answer will be written: the estimate of its file must fit on that file system.
+    notify : callable, optional
+        Told the estimate (:meth:`spinectl.landscape.budget.Estimate.line`) of work long enough to deserve it.
 
     Returns
     -------
@@ -157,7 +172,10 @@ def passive_sweeps(
     Raises
     ------
     ParameterError
-        A bad option or grid (as :func:`sweep`), or models that differ in more than ``passive``.
+        A bad option or grid (as :func:`sweep`), models that differ in more than ``passive``, or
+        more points than the available memory holds (:func:`spinectl.landscape.budget.check`).
+    OutputError
+        The file estimated would not fit on the free disk at ``out``.
     """
     if method not in METHODS:
         raise ParameterError("method", f"must be one of {', '.join(map(repr, METHODS))} (got {method!r})")
@@ -170,6 +188,15 @@ def passive_sweeps(
     for name, axis in (("E", e_axis), ("Lambda", l_axis)):
         distinct(name, axis)
     e_grid, l_grid = (a.ravel() for a in np.meshgrid(e_axis, l_axis, indexing="ij"))
+    columns._check_passive_only(models)  # before the estimate, which solves the first model at one point
+    try:
+        cost = estimate(models[0], e_grid[:1], l_grid[:1], e_grid.size * len(models), chunk_size, coupled)
+    except ModelError:  # the sweep itself says so, naming the grid rather than its first point
+        cost = None
+    if cost is not None:
+        budget.check(cost, out)
+        if cost.long and notify is not None:
+            notify(cost.line())
     disable = None if progress is None else not progress  # None: tqdm shows it on a terminal only
     with tqdm(total=e_grid.size * len(models), disable=disable, unit="pt", desc="sweep") as bar:
         options = {"method": method, "chunk_size": chunk_size, "update": bar.update, "coupled": coupled}
@@ -180,6 +207,41 @@ def passive_sweeps(
         arrays = {name: values.reshape(shape + values.shape[1:]) for name, values in arrays.items()}
         datasets.append(landscape_dataset(model, e_axis, l_axis, arrays, method, per_point))
     return datasets
+
+
+def estimate(model: Model, eccentricity, lordosis, points: int, chunk_size: int, coupled: bool) -> budget.Estimate:
+    """What a sweep of ``points`` points costs, from the answer at one point (its variables' bytes).
+
+    Parameters
+    ----------
+    model : Model
+        The model (its segments and muscles fix the bytes of a point).
+    eccentricity, lordosis : numpy.ndarray, shape (1,)
+        One point of the grid [m], solved to measure the answer's bytes.
+    points : int
+        Points of the whole sweep, every K counted.
+    chunk_size : int
+        Points per stacked problem (its working memory).
+    coupled : bool
+        The coupled chain's SDPs too.
+
+    Returns
+    -------
+    spinectl.landscape.budget.Estimate
+        Memory (answer times :data:`~spinectl.landscape.budget.SWEEP_MEMORY_PER_BYTE`, plus one chunk's
+        working memory), the NetCDF file and the CPU time (the benchmark's cost per point).
+    """
+    arrays, _ = passive_columns([model], eccentricity, lordosis, coupled=coupled)[0]
+    per_point = sum(values.nbytes for values in arrays.values())
+    seconds = budget.SWEEP_SECONDS_PER_POINT + coupled * budget.COUPLED_SECONDS_PER_POINT
+    return budget.Estimate(
+        "sweep",
+        points,
+        memory=points * per_point * budget.SWEEP_MEMORY_PER_BYTE
+        + min(points, chunk_size) * budget.WORKING_BYTES_PER_POINT,
+        disk=points * per_point * budget.NETCDF_BYTES_PER_BYTE,
+        seconds=points * seconds,
+    )
 
 
 def distinct(name: str, axis: np.ndarray) -> None:
@@ -256,7 +318,7 @@ def stack_stiffnesses(parts, model: Model) -> xr.Dataset:
     return combined
 
 
-def write_sweep(model: Model, eccentricity, lordosis, path, *, stiffnesses=None, **options) -> xr.Dataset:
+def write_sweep(model: Model, eccentricity, lordosis, path, *, stiffnesses=None, notify=None, **options) -> xr.Dataset:
     """:func:`sweep` for one K, :func:`stiffness_sweep` for several, saved as NetCDF: ``spinectl sweep``.
 
     Parameters
@@ -270,6 +332,8 @@ def write_sweep(model: Model, eccentricity, lordosis, path, *, stiffnesses=None,
     stiffnesses : sequence of float, optional
         Passive stiffnesses K [N m/rad]; one gives a landscape with a scalar ``K``, several a
         ``K`` dimension. Default (None or empty): the model's K.
+    notify : callable, optional
+        Told the estimate of a long sweep in one line before it starts (:func:`passive_sweeps`).
     **options
         Passed to :func:`sweep` (``method``, ``chunk_size``, ``progress``).
 
@@ -281,14 +345,25 @@ def write_sweep(model: Model, eccentricity, lordosis, path, *, stiffnesses=None,
     Raises
     ------
     OutputError
-        ``path`` cannot be written.
+        ``path`` cannot be written (or named to the NetCDF library, :func:`_check_netcdf_name`), or the
+        file estimated would not fit on its file system.
     ParameterError
-        A bad option or K, or ``path`` not ending in ``.nc`` (named ``--out``, as the CLI's option).
+        A bad option or K, ``path`` not ending in ``.nc`` (named ``--out``, as the CLI's option), more
+        than :data:`MAX_GRID_POINTS` points (E x Lambda x K), or more than the memory holds.
     """
     if Path(path).suffix.lower() != ".nc":  # NetCDF under another name (x.csv) misleads every reader
         raise ParameterError("--out", f"must end in .nc: the sweep is written as NetCDF (got {str(path)!r})")
-    check_writable(path)
     stiffnesses = list(stiffnesses or [model.passive.stiffness])
+    points = np.size(eccentricity) * np.size(lordosis) * len(stiffnesses)
+    if points > MAX_GRID_POINTS:  # every K is a landscape of its own: 10 values of K cost 10 grids
+        raise ParameterError(
+            "grid",
+            f"E x Lambda x K must have at most {MAX_GRID_POINTS:,} points in all (got {np.size(eccentricity):,} x "
+            f"{np.size(lordosis):,} x {len(stiffnesses):,} = {points:,})",
+        )
+    _check_netcdf_name(path)
+    check_writable(path)
+    options |= {"out": path, "notify": notify}
     if len(stiffnesses) == 1:
         if stiffnesses[0] != model.passive.stiffness:  # else the model's own K, not an override
             model = config.set_parameter(model, "passive.stiffness", stiffnesses[0])
@@ -297,6 +372,21 @@ def write_sweep(model: Model, eccentricity, lordosis, path, *, stiffnesses=None,
         dataset = stiffness_sweep(model, stiffnesses, eccentricity, lordosis, **options)
     netcdf.save(dataset, path)
     return dataset
+
+
+def _check_netcdf_name(path) -> None:
+    """Refuse at once a name that the NetCDF library cannot open: it encodes names strictly in the file
+    system's encoding, and under the C locale without Python's UTF-8 mode that is ASCII, so ``Λ.nc`` (which
+    Python itself keeps as surrogate escapes and writes as its UTF-8 bytes) failed after the whole sweep."""
+    encoding = sys.getfilesystemencoding()
+    try:
+        str(path).encode(encoding)
+    except UnicodeEncodeError:
+        raise OutputError(
+            f"cannot write {show(str(path))}: the NetCDF library takes only names in the file system's encoding "
+            f"({encoding} here), which cannot hold this one: run under a UTF-8 locale (LC_ALL=C.UTF-8) or with "
+            "PYTHONUTF8=1, or choose an ASCII name"
+        ) from None
 
 
 def describe(dataset: xr.Dataset) -> str:

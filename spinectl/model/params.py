@@ -40,6 +40,20 @@ MAX_FIBRES = 1000
 uses 5); the bound keeps the per-fibre arrays of a sweep within memory."""
 
 
+MAX_MUSCLE_PAIRS = 20
+"""Most antagonistic pairs of a model. The fast path's active sets grow combinatorially with the
+muscles: a 3 x 3 sweep took about 1.7 s a point with 20 pairs and 25 CoRs and 13 s a point with 100
+pairs (the paper's 3 pairs: well under 1 ms); the trunk models of the literature have a few dozen muscles."""
+
+MAX_CORS = 24
+"""Most centres of rotation: the joints of the whole vertebral column, C1 to S1 (the paper models the
+five lumbar ones). Every analysis is per segment or a chain of this many degrees of freedom."""
+
+MAX_FIBRE_TERMS = 30_000
+"""Most fibre-CoR terms of a model (fibres of every muscle times the CoRs): the per-fibre arrays of a
+sweep hold this many per point and chunk point (240 MB a chunk of 1024 points here), the bound that
+:data:`MAX_FIBRES` sets for the paper's 6 muscles and 5 CoRs."""
+
 MAX_PADE_ORDER = 10
 """Highest Padé order of the reflex delay. Order 6 is already exact to rounding for the
 spine's loops (docs/reflex.md); from order 9 python-control's polynomial margins overflow
@@ -239,6 +253,7 @@ class Geometry:
         heights = v.real_vector("cor_heights", self.cor_heights)
         if not heights:
             raise ParameterError("cor_heights", "must name at least one centre of rotation")
+
         names = v.labels("cor_names", self.cor_names)
         if len(names) != len(heights):
             raise ParameterError(
@@ -675,12 +690,31 @@ class Model:
             raise ParameterError("muscles", f"must be a list of MusclePair (got {v.show(muscles)})")
         if not muscles:
             raise ParameterError("muscles", "must list at least one muscle pair")
+        n_cors = len(self.geometry.cor_heights)  # the model's bound: a bare Geometry may sample a line finely
+        if n_cors > MAX_CORS:
+            raise ParameterError(
+                "geometry.cor_heights",
+                f"must have at most {MAX_CORS} centres of rotation, the joints of the whole spine (got {n_cors})",
+            )
+        if len(muscles) > MAX_MUSCLE_PAIRS:  # before the pairwise checks: their cost grows with the square
+            raise ParameterError(
+                "muscles",
+                f"must list at most {MAX_MUSCLE_PAIRS} pairs: the optimisation's cost grows combinatorially "
+                f"with the muscles (got {len(muscles)})",
+            )
         for i, pair in enumerate(muscles):
             if not isinstance(pair, MusclePair):
                 raise ParameterError(f"muscles.{i}", f"must be a MusclePair (got {v.show(pair)})")
             if pair.name in [m.name for m in muscles[:i]]:
                 raise ParameterError(f"muscles.{i}.name", f"must be unique among the pairs (repeated: {pair.name!r})")
         _store(self, muscles=tuple(muscles))
+        terms = len(SIDES) * sum(pair.fibres for pair in muscles) * n_cors
+        if terms > MAX_FIBRE_TERMS:
+            raise ParameterError(
+                "muscles",
+                f"must have at most {MAX_FIBRE_TERMS:,} fibre-CoR terms (fibres of every muscle x the "
+                f"{n_cors} CoRs; got {terms:,}): use fewer fibres",
+            )
         top = self.geometry.cor_heights[0]
         if self.body.mass_height <= top:
             # every segment is an inverted pendulum: the mass above the joint (docs/model.md, Gravity)

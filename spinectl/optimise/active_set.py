@@ -412,7 +412,7 @@ def _step(problem, trial: _Trial, todo, point):
     dropping = trial.solved & ~moving & ~trial.ok & (trial.negative < 0).any(axis=1)
     rows = np.flatnonzero(dropping)
     working[rows, np.argmin(trial.negative[rows], axis=1)] = False
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # over: a bound too far to reach, inf
         rate = _mv(lhs, direction)
         room = np.maximum(rhs - _mv(lhs, point), 0.0)
         blocking = ~working & (rate > RANK_RTOL * size[:, None])  # rows the step moves towards their bound

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 import tomllib
@@ -410,3 +411,104 @@ def test_no_cm_hint_for_a_plain_value_beyond_a_narrow_range(capsys):
     assert "--E: must be in [-0.001, 0.001] m" in err and "if you meant" not in err
     assert main(["stability", "--E", "3", "--Lambda", "0.04"]) == 2
     assert "if you meant 3 cm, give 0.03" in capsys.readouterr().err
+
+
+class _FailingStdout:
+    """A standard output whose every write fails with ``error`` (a full device, a closed pipe)."""
+
+    def __init__(self, error: OSError):
+        self.error = error
+
+    def write(self, text):
+        raise self.error
+
+    def flush(self):
+        pass
+
+
+@pytest.mark.parametrize("argv", [["config", "show"], ["--help"], ["--version"]])
+def test_standard_output_on_a_full_device_is_one_line_exit_2(argv, capsys, monkeypatch):
+    """ENOSPC on stdout: one line naming standard output, exit 2, no traceback (before: a traceback, or for
+    --help and --version nothing at all and exit 0, argparse swallowing the OSError)."""
+    import errno
+
+    capsys.readouterr()
+    monkeypatch.setattr(sys, "stdout", _FailingStdout(OSError(errno.ENOSPC, "No space left on device")))
+    assert main(argv) == 2
+    assert capsys.readouterr().err == "spinectl: error: cannot write to standard output: No space left on device\n"
+
+
+def test_a_closed_pipe_ends_quietly(capsys, monkeypatch):
+    """The reader of a pipe stopped reading (``spinectl config show | head -1``): exit 0, nothing on stderr."""
+    monkeypatch.setattr(sys, "stdout", _FailingStdout(BrokenPipeError(32, "Broken pipe")))
+    assert main(["config", "show"]) == 0
+    assert capsys.readouterr().err == ""
+
+
+def test_dev_full_as_standard_output_in_a_real_process():
+    """``spinectl stability ... > /dev/full``, as a shell does it: one line, exit 2, and nothing from the
+    interpreter's own flush at exit ("Exception ignored", exit 120)."""
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2]
+    env = os.environ | {"PYTHONPATH": str(root)}
+    command = [sys.executable, "-m", "spinectl", "stability", "--E", "0.03", "--Lambda", "0.04"]
+    with open("/dev/full", "w") as full:
+        done = subprocess.run(command, stdout=full, stderr=subprocess.PIPE, text=True, env=env, cwd=root)
+    assert (done.returncode, done.stderr) == (
+        2,
+        "spinectl: error: cannot write to standard output: No space left on device\n",
+    )
+
+
+def test_a_plot_input_name_too_long_is_one_line(capsys):
+    """A RESULTS or --vs name longer than the file system takes (ENAMETOOLONG): argparse's one line, exit 2
+    (before: an OSError traceback from the first stat)."""
+    long = "a" * 5000 + ".nc"
+    for argv in (["plot", long, "--out", "o"], ["plot", "x.nc", "--vs", long, "--out", "o"]):
+        assert main(argv) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and "cannot read 'aaa" in err and err.endswith("File name too long\n")
+
+
+def test_a_utf8_output_name_under_the_c_locale(tmp_path):
+    """LC_ALL=C without Python's UTF-8 mode: ``Λ.png`` arrives as surrogate escapes, which were refused as
+    not printable; its bytes are UTF-8, so it is written. A NetCDF name the library cannot encode (it takes
+    the file system's encoding, ASCII here) is refused in one line saying why, before the sweep."""
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2]
+    env = os.environ | {"PYTHONPATH": str(root), "LC_ALL": "C", "LANG": "C", "PYTHONUTF8": "0"}
+    env.pop("PYTHONIOENCODING", None)
+    base = [sys.executable, "-m", "spinectl"]
+    draw = subprocess.run(
+        [*base, "draw", "--E", "0.03", "--Lambda", "0.04", "--out", "Λ.png"], cwd=tmp_path, env=env, capture_output=True
+    )
+    assert (draw.returncode, draw.stderr) == (0, b"") and (tmp_path / "Λ.png").is_file()
+    sweep = subprocess.run(
+        [*base, "sweep", "--E", "0", "--Lambda", "0", "--out", "Λ.nc"], cwd=tmp_path, env=env, capture_output=True
+    )
+    assert sweep.returncode == 2 and sweep.stderr.count(b"\n") == 1 and b"UTF-8 locale" in sweep.stderr
+    assert not (tmp_path / "Λ.nc").exists()
+
+
+def test_the_largest_stiffness_in_a_sweep_is_one_line(tmp_path, capsys):
+    """``sweep --K 1e308``: the arithmetic of the reflex columns overflows (as for K = 1.3e154), one line,
+    exit 2, no file; before, the solver's "overflow encountered in divide" warning came first, a second line."""
+    out = tmp_path / "k.nc"
+    assert main(["sweep", "--E", "0:0.08:3", "--Lambda", "0:0.08:3", "--K", "1e308", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "the model's arithmetic fails on the grid" in err and not out.exists()
+
+
+def test_sweep_states_its_estimate_on_stderr_before_long_work(tmp_path, capsys, monkeypatch):
+    """The command prints the library's estimate line on stderr when the work is long (NOTICE_SECONDS = 0
+    here), before the solves: 2 x 2 points at 2 values of K are 8 points; stdout keeps the one result line."""
+    from spinectl.landscape import budget
+
+    monkeypatch.setattr(budget, "NOTICE_SECONDS", 0.0)
+    out = tmp_path / "x.nc"
+    assert main(["sweep", "--E", "0:0.08:2", "--Lambda", "0:0.08:2", "--K", "0,15", "--out", str(out)]) == 0
+    captured = capsys.readouterr()
+    assert captured.err.startswith("sweep: 8 points, about ") and captured.err.count("\n") == 1
+    assert captured.out.startswith(f"wrote {out}")

@@ -24,7 +24,7 @@ import zarr
 
 from spinectl.cli import main
 from spinectl.errors import ConfigError, ModelError, OutputError, ParameterError
-from spinectl.landscape import schema, study, sweep
+from spinectl.landscape import budget, schema, study, sweep
 from spinectl.landscape.study import run, spec
 from spinectl.landscape.study import store as study_store
 from spinectl.model import config
@@ -894,3 +894,97 @@ def test_one_lock_per_store_however_it_is_named(tmp_path):
                 with study_store.locked(name):
                     pass
     assert sorted(p.name for p in tmp_path.iterdir()) == ["link.zarr", "s.zarr", "sub"]  # the lock removed
+
+
+# --- resources: bounded by cost, estimated before the work ---------------------------------------
+
+
+def test_too_many_chunks_are_refused_before_the_combinations_are_checked(monkeypatch):
+    """The test study has 12 chunks (4 combinations x 3 tiles): with at most 11 allowed it is refused, naming
+    chunk_size (each chunk is a file of every output: a million chunks of 1 point would be millions of files)."""
+    monkeypatch.setattr(spec, "MAX_CHUNKS", 11)
+    with pytest.raises(ParameterError, match="gives 12 chunks, more than the 11") as info:
+        study.parse_study(STUDY)
+    assert info.value.field == "study.chunk_size"
+
+
+def test_the_store_template_is_one_dask_task_per_array_whatever_the_chunks():
+    """Making the store built a dask graph of one task per study chunk and output (324,000 chunks of two
+    outputs: 2.3 GB and 153 s before the first chunk): each array is now one dask chunk, its Zarr chunks the
+    study's through its encoding. Counted: 12 chunks, yet one task per variable."""
+    parsed = study.parse_study(STUDY)
+    probe = run._probe(parsed)
+    template = study_store.template(parsed, probe)
+    for name in (*probe, study_store.DONE, study_store.CHECKSUM):
+        variable = template[name]
+        assert variable.data.npartitions == 1 and len(variable.data.__dask_graph__()) == 1
+    assert template["min_pcsa_cm2"].encoding["chunks"] == (1, 1, *parsed.tile)
+
+
+def test_a_study_beyond_the_free_disk_is_refused_before_the_store_is_made(tmp_path, monkeypatch):
+    """With 100 bytes free, the store (about 1 kB a point, compressed) cannot fit: one line, no store, no lock."""
+    monkeypatch.setattr(budget, "free_disk", lambda path: 100.0)
+    out = tmp_path / "s.zarr"
+    with pytest.raises(OutputError, match=r"240 points need about .*, and its file system has 100 B free"):
+        study.run_study(study.parse_study(STUDY), out, scheduler="synchronous", progress=False)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_long_study_states_its_estimate_first(tmp_path, monkeypatch):
+    """Work estimated to take NOTICE_SECONDS or more (0 here) is announced in one line: the study's 240
+    points (4 combinations x 60 grid points), disk, memory and CPU time, from the benchmark's cost a point."""
+    monkeypatch.setattr(budget, "NOTICE_SECONDS", 0.0)
+    lines = []
+    parsed = study.parse_study(STUDY)
+    study.run_study(parsed, tmp_path / "s.zarr", scheduler="synchronous", progress=False, notify=lines.append)
+    assert [line for line in lines if line.startswith("study: 240 points, about ")] == lines and len(lines) == 1
+    cost = run.estimate(parsed, parsed.n_chunks, run._probe(parsed))
+    assert cost.seconds == pytest.approx(240 * budget.STUDY_SECONDS_PER_POINT)
+
+
+@pytest.mark.parametrize(
+    ("dtype", "problem"), [('"<f4"', "its dtype is <f4, not <f8"), ('"<i2"', "its metadata cannot be read")]
+)
+def test_an_edited_dtype_is_one_line_at_open_and_resume(tmp_path, dtype, problem):
+    """A store whose array metadata says another dtype (edited by hand): reading and --resume name the array
+    and the problem in one line, exit 2 (before: a reshape ValueError, or zarr's TypeError for a NaN fill value
+    of an integer dtype, as tracebacks)."""
+    path = write(tmp_path)
+    out = tmp_path / "s.zarr"
+    assert main(["study", str(path), "--out", str(out), "--scheduler", "synchronous", "--max-chunks", "2"]) == 0
+    metadata = out / "min_pcsa_cm2" / ".zarray"
+    metadata.write_text(metadata.read_text().replace('"<f8"', dtype))
+    with pytest.raises(ParameterError, match=f"array 'min_pcsa_cm2': {problem}"):
+        study.load(out)
+    with pytest.raises(ParameterError, match=f"array 'min_pcsa_cm2': {problem}"):
+        study.run_study(study.parse_study(STUDY), out, scheduler="synchronous", resume=True, progress=False)
+
+
+def test_a_folder_in_place_of_a_chunk_file_gets_advice_that_works(tmp_path):
+    """A folder where a done chunk's file belongs: the resume used to compute the chunk, fail to write it
+    ("Is a directory") and advise --resume again, for ever. Now it names the folder to remove at once, and
+    once it is removed the resume finishes the study."""
+    out = tmp_path / "s.zarr"
+    parsed = study.parse_study(STUDY)
+    study.run_study(parsed, out, scheduler="synchronous", max_chunks=2, progress=False)
+    chunk = out / "min_pcsa_cm2" / "0.0.0.0"
+    chunk.unlink()
+    chunk.mkdir()
+    with pytest.raises(ParameterError, match=f"remove '{chunk}', which is not a file"):
+        study.load(out)
+    for _ in range(2):  # the same advice each time, and no chunk computed
+        with pytest.raises(OutputError, match=f"cannot write '{chunk}': a folder .* remove it, then run again"):
+            study.run_study(parsed, out, scheduler="synchronous", resume=True, progress=False)
+    chunk.rmdir()
+    result = study.run_study(parsed, out, scheduler="synchronous", resume=True, progress=False)
+    assert result.complete and result.computed == 11
+
+
+def test_a_combination_whose_arithmetic_fails_is_named(tmp_path):
+    """K = 1e308 passes validation (a finite stiffness) but overflows the reflex columns of its chunks: the one
+    line names the combination, as validation errors do, so the user knows which value to change."""
+    text = study_with(axes="K = [0.0, 1e308]\n")
+    with pytest.raises(
+        ModelError, match=r"the model's arithmetic fails .*\(study combination passive\.stiffness = 1e\+308\)"
+    ):
+        study.run_study(study.parse_study(text), tmp_path / "s.zarr", scheduler="synchronous", progress=False)

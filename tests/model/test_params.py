@@ -65,3 +65,31 @@ def test_the_cli_refuses_a_mass_height_in_cm(tmp_path, capsys):
 def test_model_level_check_still_names_the_top_cor():
     with pytest.raises(ParameterError, match="body.mass_height: must lie above the top centre of rotation"):
         Model(body=dataclasses.replace(Body(), mass_height=0.1))
+
+
+def _pairs(count: int, fibres: int = 5) -> tuple[MusclePair, ...]:
+    base = MusclePair()
+    return tuple(dataclasses.replace(base, name=f"p{i}", fibres=fibres) for i in range(count))
+
+
+def test_the_number_of_pairs_cors_and_fibre_terms_is_bounded():
+    """A model of many pairs or CoRs took the whole machine (100 pairs: 13 s a point) or aborted in native
+    code; each count has a documented bound (params.MAX_MUSCLE_PAIRS, MAX_CORS, MAX_FIBRE_TERMS), checked
+    before the pairwise checks, and the bounds themselves are accepted."""
+    from spinectl.model import params
+
+    Model(muscles=_pairs(params.MAX_MUSCLE_PAIRS))
+    with pytest.raises(ParameterError, match=f"must list at most {params.MAX_MUSCLE_PAIRS} pairs") as info:
+        Model(muscles=_pairs(params.MAX_MUSCLE_PAIRS + 1))
+    assert info.value.field == "muscles"
+    top = Model().body.mass_height
+    heights = tuple(0.15 * (1 - i / params.MAX_CORS) for i in range(params.MAX_CORS + 1))
+    names = tuple(f"c{i}" for i in range(len(heights)))
+    many = Geometry(cor_heights=heights, cor_names=names)  # a bare geometry may sample a line finely
+    with pytest.raises(ParameterError, match=f"at most {params.MAX_CORS} centres of rotation") as info:
+        Model(geometry=many, body=dataclasses.replace(Body(), mass_height=max(top, 0.2)))
+    assert info.value.field == "geometry.cor_heights"
+    # 6 muscles x 1000 fibres x 5 CoRs = 30,000 terms: the bound; one more pair of 1000 fibres exceeds it
+    Model(muscles=_pairs(3, fibres=1000))
+    with pytest.raises(ParameterError, match=r"at most 30,000 fibre-CoR terms .* got 40,000"):
+        Model(muscles=_pairs(4, fibres=1000))

@@ -41,10 +41,11 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm  # plain: tqdm.auto warns in kernels without ipywidgets (as the sweep)
 
-from ...errors import ParameterError
+from ..._validate import show
+from ...errors import ModelError, ParameterError
 from ...model import config
 from ...model.params import Model
-from .. import columns, schema
+from .. import budget, columns, schema
 from . import store
 from .spec import Study
 
@@ -133,11 +134,20 @@ def solve_chunk(task: Task) -> tuple[int, dict[str, np.ndarray]]:
         ``task.index``.
     outputs : dict of str to numpy.ndarray
         On the tile, as :func:`spinectl.landscape.study.store.encode` gives them.
+
+    Raises
+    ------
+    ModelError
+        The model's arithmetic fails on the tile; the message names the chunk's combination.
     """
     model = config.set_parameters(task.model, task.overrides)
     e_grid, l_grid = (a.ravel() for a in np.meshgrid(task.eccentricity, task.lordosis, indexing="ij"))
     coupled = any(name in schema.ON_REQUEST for name in task.outputs)
-    solved, _ = columns.point_columns(model, e_grid, l_grid, chunk_size=e_grid.size, coupled=coupled)
+    try:
+        solved, _ = columns.point_columns(model, e_grid, l_grid, chunk_size=e_grid.size, coupled=coupled)
+    except ModelError as exc:  # e.g. K = 1e308 overflows the reflex columns: say which combination
+        values = ", ".join(f"{name} = {show(value)}" for name, value in task.overrides.items())
+        raise ModelError(f"{exc} (study combination {values})" if values else str(exc)) from None
     return task.index, store.encode(solved, task.outputs, (task.eccentricity.size, task.lordosis.size))
 
 
@@ -240,7 +250,7 @@ def run_study(
         worker again once every worker of the cluster has gone mid-run [s].
     notify : callable or None
         Called with a line of text for what the user should know while it runs (a
-        remote scheduler's worker count, a wait for a worker, chunks found missing).
+        remote scheduler's worker count, a wait for a worker, chunks found missing, the estimate of a long run).
 
     Returns
     -------
@@ -253,9 +263,10 @@ def run_study(
     ParameterError
         Bad ``scheduler``, ``workers`` or ``max_chunks``; an unreachable scheduler, something
         else than a scheduler at its address, or no worker within ``worker_timeout``;
-        ``resume`` of a foreign store.
+        ``resume`` of a foreign store; more than the available memory holds (:func:`estimate`).
     OutputError
-        ``out`` exists and ``resume`` is false, it cannot be written, or another run holds it.
+        ``out`` exists and ``resume`` is false, it cannot be written, another run holds it, or the
+        store estimated would not fit on its file system's free space.
     """
     timeouts = {"connect_timeout": connect_timeout, "worker_timeout": worker_timeout}
     _check_options(scheduler, workers, max_chunks, timeouts)
@@ -265,17 +276,62 @@ def run_study(
         done = store.existing(study, out, resume, notify)  # before the cluster starts: a refusal costs nothing
         indices = np.arange(study.n_chunks) if done is None else np.flatnonzero(done == 0)
         todo = indices[: None if max_chunks is None else max_chunks]
+        probe = _probe(study)
+        cost = estimate(study, todo.size, probe, _processes(scheduler, workers, todo.size))
+        budget.check(cost, out)  # before any cluster or store: what cannot fit is refused at once
+        if cost.long:
+            notify(cost.line())
         with _executor(scheduler, workers, todo.size, tuple(timeouts.values()), notify) as executor:
             # a cluster's first chunks are submitted now: its workers start on them while the store is made
             results = executor.run(tasks(study, todo), f"spinectl-{study.digest()[:16]}")
             if done is None:  # after connecting: an unreachable scheduler leaves no store behind
-                done = store.create(study, out, _probe(study))
+                done = store.create(study, out, probe)
             done_before = int(np.count_nonzero(done))
             _run_chunks(study, out, done, results, progress)
         if np.all(done > 0):
             store.consolidate(out)
     seconds = time.perf_counter() - start
     return StudyResult(Path(out), study.n_chunks, done_before, todo.size, seconds, executor.where, executor.addresses)
+
+
+def estimate(study: Study, n_todo: int, probe: dict[str, np.ndarray], processes: int = 1) -> budget.Estimate:
+    """What running ``n_todo`` chunks of ``study`` costs: points, memory, disk and CPU time.
+
+    Parameters
+    ----------
+    study : Study
+        The study.
+    n_todo : int
+        Chunks to run (all of a new store, those left of a resumed one).
+    probe : dict of str to numpy.ndarray
+        The outputs at one point as stored (:func:`spinectl.landscape.study.store.encode`): their bytes.
+    processes : int
+        Processes solving chunks on this machine (the local workers; 1 in-process or for a remote cluster).
+
+    Returns
+    -------
+    spinectl.landscape.budget.Estimate
+        Memory: each process's interpreter and one chunk's working memory, the client's window of
+        two finished chunks per process and the store's per-chunk counts; disk: the chunks' files after
+        compression (:data:`~spinectl.landscape.budget.STORE_BYTES_PER_BYTE`); time: the benchmark's cost
+        per point, on one core.
+    """
+    per_chunk = math.prod(study.grid_shape) / math.prod(study.tiles)  # points, on average over the tiles
+    points = round(n_todo * per_chunk)
+    per_point = sum(values.nbytes for values in probe.values())
+    chunk = math.prod(study.tile)
+    coupled = any(name in schema.ON_REQUEST for name in study.outputs)
+    memory = processes * (budget.PROCESS_BYTES + chunk * (budget.WORKING_BYTES_PER_POINT + 2 * per_point))
+    seconds = points * (budget.STUDY_SECONDS_PER_POINT + coupled * budget.COUPLED_SECONDS_PER_POINT)
+    disk = points * per_point * budget.STORE_BYTES_PER_BYTE
+    return budget.Estimate("study", points, memory + 24 * study.n_chunks, disk, seconds)
+
+
+def _processes(scheduler: str | None, workers: int | None, n_todo: int) -> int:
+    """Processes of this machine that will solve chunks (as :func:`_executor` starts them)."""
+    if scheduler is None and n_todo > 1:
+        return min(workers or _cores(), n_todo)
+    return 1
 
 
 def _run_chunks(study: Study, out, done: np.ndarray, results, progress: bool | None) -> None:

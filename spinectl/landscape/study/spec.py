@@ -59,6 +59,11 @@ MAX_COMBINATIONS = 10_000
 """Most combinations of the parameter axes and samples: each is validated before any work
 starts (a few ms each: half a minute at most), and each needs at least one chunk."""
 
+MAX_CHUNKS = 1_000_000
+"""Most chunks of a study: each chunk is a file of every output plus its count and CRC-32 (23 million
+files here with every output), and the client keeps three integers a chunk; a study of more is one of
+tiny chunks (raise ``chunk_size``) or beyond what a store on one machine holds."""
+
 STORE_FORMAT = 1
 """Version of the store layout (:mod:`spinectl.landscape.study.store`); part of :meth:`Study.digest`."""
 
@@ -304,8 +309,8 @@ class Study:
     ConfigError
         An axis or draw names no parameter of the model ("did you mean"), or an unknown output.
     ParameterError
-        A value is invalid alone, or with the others of its combination; too many points or
-        combinations.
+        A value is invalid alone, or with the others of its combination; too many points,
+        combinations or chunks (:data:`MAX_CHUNKS`).
     ModelError
         A combination cannot be evaluated at a point of the grid.
     """
@@ -340,6 +345,12 @@ class Study:
         self._check_parameters()
         if math.prod(self.shape) > MAX_COMBINATIONS:
             raise ParameterError("axes", f"at most {MAX_COMBINATIONS:,} combinations of axes and samples")
+        if self.n_chunks > MAX_CHUNKS:  # before the combinations' checks, which take a few ms each
+            raise ParameterError(
+                "study.chunk_size",
+                f"gives {self.n_chunks:,} chunks, more than the {MAX_CHUNKS:,} a store can hold (a file of every "
+                f"output each): raise chunk_size (at most {MAX_CHUNK_POINTS:,}) or use fewer points",
+            )
         checked_shapes: set = set()  # geometry and muscles whose attachments passed on the whole grid
         for combination in np.ndindex(*self.shape):
             self._check_combination(combination, checked_shapes)

@@ -66,8 +66,9 @@ STRING_WIDTH = 32
 
 ZARR_FORMAT = 2
 
-OPEN_ERRORS = (zarr.errors.BaseZarrError, OSError, ValueError, KeyError)
-"""What opening something that is not a Zarr store raises."""
+OPEN_ERRORS = (zarr.errors.BaseZarrError, OSError, ValueError, KeyError, TypeError)
+"""What opening something that is not a Zarr store raises (TypeError: metadata of the wrong types,
+e.g. a fill value NaN for an integer dtype)."""
 
 
 def encode(columns: dict, outputs, tile: tuple[int, int]) -> dict[str, np.ndarray]:
@@ -128,22 +129,34 @@ def template(study: Study, probe: dict[str, np.ndarray]) -> xr.Dataset:
         values chunked by the study's tiles, the chunk counts (``chunk_done``), the
         coordinates with units and the study's attributes.
     """
-    import dask.array as da  # only where a store is made: the other commands need no dask
-
     lead = study.shape + study.grid_shape
     chunks = (1,) * len(study.shape) + study.tile
     data_vars = {}
     for name, values in probe.items():
         dims = study.dims + schema.dims_of(name, values.ndim)
         shape, fill = lead + values.shape[2:], _fill(values.dtype)
-        array = da.full(shape, fill, dtype=values.dtype, chunks=chunks + values.shape[2:])
         units, long_name = schema.VARIABLES[name]
-        data_vars[name] = xr.Variable(dims, array, {"units": units, "long_name": long_name})
-    done = da.zeros(study.n_chunks, dtype="int16", chunks=1)
-    data_vars[DONE] = xr.Variable(("chunk",), done, {"long_name": "times the chunk was written: 0 not yet, 1 done"})
-    crc = da.zeros(study.n_chunks, dtype="int64", chunks=1)
-    data_vars[CHECKSUM] = xr.Variable(("chunk",), crc, {"long_name": "CRC-32 of the chunk's files, once done"})
+        data_vars[name] = _lazy(dims, shape, fill, values.dtype, chunks + values.shape[2:])
+        data_vars[name].attrs.update(units=units, long_name=long_name)
+    data_vars[DONE] = _lazy(("chunk",), (study.n_chunks,), 0, "int16", (1,))
+    data_vars[DONE].attrs["long_name"] = "times the chunk was written: 0 not yet, 1 done"
+    data_vars[CHECKSUM] = _lazy(("chunk",), (study.n_chunks,), 0, "int64", (1,))
+    data_vars[CHECKSUM].attrs["long_name"] = "CRC-32 of the chunk's files, once done"
     return xr.Dataset(data_vars, _coordinates(study), _attributes(study))
+
+
+def _lazy(dims, shape, fill, dtype, chunks) -> xr.Variable:
+    """A variable of fill values, one dask chunk, whose Zarr chunks are ``chunks`` (its encoding).
+
+    One dask chunk, not one per Zarr chunk: the store is made with ``compute=False`` (metadata
+    only), and a dask graph of one task per study chunk and output took about 7 kB and 0.5 ms
+    each (324,000 chunks of two outputs: 2.3 GB and 153 s before the first chunk).
+    """
+    import dask.array as da  # only where a store is made: the other commands need no dask
+
+    variable = xr.Variable(dims, da.full(shape, fill, dtype=dtype, chunks=-1))
+    variable.encoding["chunks"] = tuple(chunks)
+    return variable
 
 
 def _coordinates(study: Study) -> dict:
@@ -223,10 +236,33 @@ def existing(
     counts = _done_counts(study, path)
     missing = damaged_chunks(path, counts)
     _check_writable(path)  # before any work: a read-only store would fail at its first chunk
+    _check_unblocked(path, missing)
     if missing.size:
         notify(f"study: {_missing_text(path, missing)}; computing {'it' if missing.size == 1 else 'them'} again")
         counts[missing] = 0
     return counts
+
+
+def _check_unblocked(path: Path, chunks) -> None:
+    """Raise :class:`OutputError` if something other than a file (a folder) stands where a chunk of ``chunks`` goes.
+
+    zarr cannot replace it, so every resume would find the chunk missing, compute it and fail
+    to write it: the advice to resume would loop. The user removes it, then resumes.
+    """
+    if len(chunks) == 0:
+        return
+    files = _ChunkFiles(path, _checked_group(path))
+    for index in chunks:
+        blocked = files.blocked(index)
+        if blocked is not None:
+            raise OutputError(_blocked_text(blocked))
+
+
+def _blocked_text(blocked: Path) -> str:
+    return (
+        f"cannot write {str(blocked)!r}: a folder (or other non-file) stands where a chunk file of the store "
+        "belongs; remove it, then run again with --resume"
+    )
 
 
 def _check_writable(path: Path) -> None:
@@ -345,6 +381,9 @@ class Writer:
             self._crc[chunk.index] = self._files.checksum(chunk.index)
             self._flags[chunk.index] = self.done[chunk.index] + 1
         except OSError as exc:  # a full disk, a quota, a store made read-only meanwhile: the chunk counts 0
+            blocked = self._files.blocked(chunk.index)
+            if blocked is not None:  # "resume" would fail here again: say what to remove
+                raise OutputError(_blocked_text(blocked)) from None
             raise OutputError(
                 f"cannot write {str(self.path)!r}: {exc.strerror or exc.__class__.__name__}; the store holds every "
                 "chunk finished: run again with --resume once it can be written"
@@ -403,7 +442,12 @@ def open_store(path: str | Path) -> xr.Dataset:
         raise ParameterError("store", f"{str(path)!r} is not a spinectl study store")
     missing = damaged_chunks(path, dataset[DONE].values)
     if missing.size:
-        raise ParameterError("store", f"{_missing_text(path, missing)}: run the study again with --resume")
+        files = _ChunkFiles(path, _checked_group(path))
+        blocked = next((b for b in map(files.blocked, missing) if b is not None), None)
+        advice = "run the study again with --resume"
+        if blocked is not None:  # a resume alone cannot replace a folder there
+            advice = f"remove {str(blocked)!r}, which is not a file, then {advice}"
+        raise ParameterError("store", f"{_missing_text(path, missing)}: {advice}")
     return dataset
 
 
@@ -530,22 +574,36 @@ class _ChunkFiles:
             lead = list(dims).index("Lambda") + 1
             self.arrays.append((Path(path, name), array.metadata.dimension_separator, grid, lead))
 
+    def paths(self, index: int) -> list[Path]:
+        """The files of chunk ``index``, one per array, in array name order."""
+        out = []
+        for folder, separator, grid, lead in self.arrays:
+            position = np.unravel_index(index, grid[:lead]) + (0,) * (len(grid) - lead)
+            out.append(Path(folder, separator.join(str(int(i)) for i in position)))
+        return out
+
     def checksum(self, index: int) -> int | None:
         """CRC-32 of chunk ``index``'s files, in array name order; None if one is missing."""
         crc = 0
-        for folder, separator, grid, lead in self.arrays:
-            position = np.unravel_index(index, grid[:lead]) + (0,) * (len(grid) - lead)
+        for path in self.paths(index):
             try:
-                crc = zlib.crc32(Path(folder, separator.join(str(int(i)) for i in position)).read_bytes(), crc)
+                crc = zlib.crc32(path.read_bytes(), crc)
             except (FileNotFoundError, IsADirectoryError, NotADirectoryError):
                 return None
         return crc
+
+    def blocked(self, index: int) -> Path | None:
+        """The first name of chunk ``index`` taken by something other than a file (a folder), or None."""
+        for path in self.paths(index):
+            if (path.exists() or path.is_symlink()) and not path.is_file():
+                return path
+        return None
 
 
 def _layout_entry(array) -> dict:
     """An array's shape; for one written once at creation (not over E and Lambda, not a counter) its values' CRC-32."""
     dims = array.attrs.get("_ARRAY_DIMENSIONS")
-    entry = {"shape": list(array.shape), "dims": dims}
+    entry = {"shape": list(array.shape), "dims": dims, "dtype": np.dtype(array.dtype).str}
     if not {"E", "Lambda"} <= set(dims or ()) and array.basename not in (DONE, CHECKSUM):
         entry["crc32"] = zlib.crc32(np.ascontiguousarray(array[...]).tobytes())
     return entry
@@ -561,11 +619,25 @@ def _check_layout(path, group) -> None:
         layout = None
     if not isinstance(layout, dict) or not all(isinstance(entry, dict) for entry in layout.values()):
         raise ParameterError("store", f"{str(path)!r} is damaged: its attribute {LAYOUT!r} is not as written")
-    arrays = dict(group.arrays())
+    arrays = {}
+    for name in layout:  # one by one: an array whose metadata cannot be read is named
+        try:
+            arrays[name] = group[name]
+        except KeyError:
+            pass  # lost: said below
+        except OPEN_ERRORS as exc:
+            reason = (str(exc).splitlines() or [type(exc).__name__])[0][:120]  # the CLI escapes what is not printable
+            raise ParameterError(
+                "store",
+                f"{str(path)!r} is damaged: array {name!r}: its metadata cannot be read ({reason}); remove it "
+                "and run the study afresh",
+            ) from None
     for name, entry in layout.items():
         problem = None
         if name not in arrays:
             problem = "its metadata is lost"
+        elif "dtype" in entry and np.dtype(arrays[name].dtype).str != entry["dtype"]:
+            problem = f"its dtype is {np.dtype(arrays[name].dtype).str}, not {entry['dtype']} (its metadata edited)"
         elif list(arrays[name].shape) != entry.get("shape"):
             problem = f"its shape is {list(arrays[name].shape)}, not {entry.get('shape')}"
         elif arrays[name].attrs.get("_ARRAY_DIMENSIONS") != entry.get("dims"):
