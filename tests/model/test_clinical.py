@@ -40,14 +40,14 @@ def test_angle_is_the_turn_of_the_spine_lines_tangents(model, bc, lordosis):
 
 @pytest.mark.parametrize("bc", ["natural", "clamped", "not-a-knot"])
 def test_end_slopes_are_scipys_spline_derivative(bc):
-    """END_SLOPES is phi'(0) of scipy's CubicSpline through (0, 0), (1/2, 1), (1, 0), rescaled to s (a second method)."""
+    """END_SLOPES is phi'(0) of scipy's CubicSpline through (0, 0), (1/2, 1), (1, 0), rescaled to s."""
     spline = CubicSpline([0.0, 0.5, 1.0], [0.0, 1.0, 0.0], bc_type=bc)
     # s = 2 y on the lower half, so dphi/ds = (dphi/dy) / 2
     assert clinical.END_SLOPES[bc] == pytest.approx(spline(0.0, 1) / 2, abs=1e-12)
 
 
 def test_the_papers_optimum_is_about_69_degrees(model):
-    """Lambda = 4 cm with natural ends and L = 176 mm: 2 atan(3 * 0.04 / 0.176) = 2 * 34.287 = 68.57 deg (closed form by hand)."""
+    """Lambda = 4 cm, natural ends, L = 176 mm: 2 atan(3 * 0.04 / 0.176) = 2 * 34.287 = 68.57 deg (by hand)."""
     assert model.geometry.spline_bc == "natural" and model.geometry.spine_length == 0.176
     assert clinical.lordosis_angle(0.04, model) == pytest.approx(68.574, abs=1e-3)
 
