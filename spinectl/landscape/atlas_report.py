@@ -1,0 +1,90 @@
+"""The atlas's report (Markdown) and its figure: the cohort's density over the E x Lambda landscape of min PCSA."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..canvas import new_figure
+from .priors import AtlasSpec
+
+
+def report_text(result, spec: AtlasSpec) -> str:
+    """The atlas's report: the priors with their sources, the verdicts' probabilities, the Sobol' indices.
+
+    Parameters
+    ----------
+    result : spinectl.landscape.atlas.AtlasResult
+    spec : AtlasSpec
+
+    Returns
+    -------
+    str
+        Markdown.
+    """
+    from .atlas import VERDICTS
+
+    lines = [
+        "# Population stability atlas",
+        "",
+        f"{result.n_evaluations} model evaluations: Saltelli's design on a scrambled Sobol' sequence "
+        f"(N = {spec.samples}, seed {spec.seed}); probabilities over the 2 N = {2 * spec.samples} draws of "
+        f"its A and B matrices, with Wilson intervals at {spec.confidence:g}.",
+        "",
+        "## Priors",
+        "",
+        "| parameter | distribution | mean | sd | bounds | source |",
+        "|---|---|---|---|---|---|",
+    ]
+    for p in spec.priors:
+        lines.append(
+            f"| `{p.parameter}` | {p.distribution} | {p.mean:g} | {p.sd:g} | "
+            f"[{p.bounds[0]:g}, {p.bounds[1]:g}] | {p.source} |"
+        )
+    lines += ["", "## Verdicts", "", "| verdict | criterion | p | interval |", "|---|---|---|---|"]
+    for name, v in result.probabilities.items():
+        lines.append(f"| {name} | {VERDICTS[name]} | {v['p']:.3f} | [{v['low']:.3f}, {v['high']:.3f}] |")
+    lines += ["", "## Sobol' indices (first order S1, total ST, with bootstrap intervals)", ""]
+    for output, table in result.sobol.items():
+        lines += [f"### `{output}`", ""]
+        if table is None:
+            lines += [f"Not finite at {result.nonfinite[output]} draws (infeasible): no indices.", ""]
+            continue
+        lines += ["| parameter | S1 | ST |", "|---|---|---|"]
+        for name, s in table.items():
+            lines.append(f"| `{name}` | {s['S1']:.3f} ± {s['S1_conf']:.3f} | {s['ST']:.3f} ± {s['ST_conf']:.3f} |")
+        lines.append("")
+    return "\n".join(lines) + "\n"
+
+
+def density_figure(landscape: dict, draws: dict, optimum: tuple[float, float]):
+    """The cohort's density of (E, Lambda) drawn over the landscape of min PCSA, with the paper's optimum.
+
+    Parameters
+    ----------
+    landscape : dict
+        ``eccentricity_m`` (nE,), ``lordosis_m`` (nL,) and ``min_pcsa_cm2`` (nE, nL) of the base model.
+    draws : dict of str to numpy.ndarray
+        ``eccentricity_m`` and ``lordosis_m`` of every draw [m].
+    optimum : tuple of float
+        (E, Lambda) to mark [m].
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Drawn on :func:`spinectl.canvas.new_figure`; axes in cm.
+    """
+    fig = new_figure(figsize=(6.0, 4.8), layout="constrained")
+    ax = fig.add_subplot()
+    e, lam = 100 * np.asarray(landscape["eccentricity_m"]), 100 * np.asarray(landscape["lordosis_m"])
+    mesh = ax.pcolormesh(e, lam, np.asarray(landscape["min_pcsa_cm2"]).T, shading="nearest", cmap="viridis")
+    fig.colorbar(mesh, ax=ax, label="min PCSA [cm²] (joint by joint)")
+    counts, xe, ye = np.histogram2d(100 * draws["eccentricity_m"], 100 * draws["lordosis_m"], bins=24)
+    if counts.max() > 0:
+        centres = (xe[:-1] + xe[1:]) / 2, (ye[:-1] + ye[1:]) / 2
+        ax.contour(*centres, counts.T / counts.max(), levels=(0.1, 0.3, 0.5, 0.7, 0.9), colors="white")
+    ax.plot(100 * optimum[0], 100 * optimum[1], "r*", markersize=14, label="the paper's optimum C")
+    ax.set_xlabel("eccentricity E [cm]")
+    ax.set_ylabel("lordosis Λ [cm]")
+    ax.set_title("cohort density (white: 10 % to 90 % of its peak)")
+    ax.legend(loc="lower right")
+    return fig
