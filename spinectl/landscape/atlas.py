@@ -18,13 +18,13 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
-import json
 from pathlib import Path
 
 import numpy as np
 
 from ..atomic import atomic_path, atomic_write_text
 from ..errors import SpinectlError
+from ..jsondoc import dumps
 from ..model import chain
 from ..model.checks import arithmetic_guard, checked_coefficients
 from ..model.clinical import lordosis_angle, lordosis_from_angle
@@ -34,7 +34,7 @@ from ..optimise.problem import OK_STATUSES, problem_data
 from ..reflex.inputs import guarded
 from ..reflex.maps import landscape
 from ..units import M2_PER_CM2, m2_to_cm2
-from .priors import PAPER_OPTIMUM, AtlasSpec
+from .priors import PAPER_OPTIMUM, VERDICTS, AtlasSpec
 
 INSTALL_HINT = "pip install 'spinectl[atlas]' (SALib)"
 
@@ -44,14 +44,6 @@ body's mass (gravity and inertia), K enters as -K_pas, and the delay margin does
 
 OUTPUTS = ("min_pcsa_cm2", "counter_torque_norm_Nm", "local_stiffness_total_Nm_per_rad", "spine_delay_margin_s")
 """The outputs whose Sobol' indices the atlas reports, named as the sweep's variables."""
-
-VERDICTS = {
-    "self_stable_joint_by_joint": "a feasible minimum PCSA, within optimisation.pcsa_max (joint by joint)",
-    "counter_torque_within_limit": "every |CT_k| within counter_torque_limit_Nm (joint by joint)",
-    "chain_stabilisable_locally": "the chain (all CoRs free) stabilised by local muscle within local_pcsa_limit_cm2",
-    "stable_at_delay": "the reflex loop of every segment stable at the drawn delay (joint by joint)",
-}
-"""The verdicts and the criterion each names."""
 
 
 class AtlasUnavailable(SpinectlError, ImportError):
@@ -97,6 +89,25 @@ class AtlasResult:
     sobol: dict
     nonfinite: dict
     draws: dict = dataclasses.field(repr=False, compare=False)
+
+    def table(self) -> str:
+        """The verdicts' probabilities and the largest total-order index of each output, as text.
+
+        Returns
+        -------
+        str
+            One line per verdict and per output.
+        """
+        lines = [f"{self.n_evaluations} evaluations"]
+        for name, v in self.probabilities.items():
+            lines.append(f"P({name}) = {v['p']:.3f}  [{v['low']:.3f}, {v['high']:.3f}]  ({VERDICTS[name]})")
+        for output, table in self.sobol.items():
+            if table is None:
+                lines.append(f"{output}: not finite at {self.nonfinite[output]} draws, no Sobol' indices")
+                continue
+            top = max(table, key=lambda name: table[name]["ST"])
+            lines.append(f"{output}: largest ST {table[top]['ST']:.3f} +- {table[top]['ST_conf']:.3f} ({top})")
+        return "\n".join(lines)
 
     def to_dict(self) -> dict:
         """The JSON answer: ``n_evaluations``, ``probabilities``, ``sobol``, ``nonfinite``, ``criteria``.
@@ -382,7 +393,7 @@ def sobol_indices(spec: AtlasSpec, y: np.ndarray) -> dict | None:
         num_resamples=spec.bootstrap,
         conf_level=spec.confidence,
         print_to_console=False,
-        seed=spec.seed,
+        seed=spec.seed + 1,  # SALib 1.6 seeds its bootstrap only `if seed:`, so seed 0 was no seed at all
     )
     keys = ("S1", "S1_conf", "ST", "ST_conf")
     return {name: {k: float(found[k][i]) for k in keys} for i, name in enumerate(spec.names)}
@@ -446,6 +457,43 @@ def fingerprint(spec: AtlasSpec) -> str:
     return hashlib.sha256(repr((spec, __version__)).encode()).hexdigest()[:16]
 
 
+def atlas_file(path, out, *, lordosis_angle: float | None = None, progress: bool | None = None) -> AtlasResult:
+    """The atlas of an atlas file (``spinectl atlas``), the lordosis optionally fixed as an angle.
+
+    Parameters
+    ----------
+    path : str or Path
+        The atlas file (:func:`spinectl.landscape.priors.load_atlas`).
+    out : str or Path
+        Output folder (:func:`run_atlas`).
+    lordosis_angle : float, optional
+        The lordosis angle [deg] where no prior varies the lordosis
+        (:func:`spinectl.model.clinical.lordosis_from_angle`).
+    progress : bool or None
+        As for :func:`run_atlas`.
+
+    Returns
+    -------
+    AtlasResult
+
+    Raises
+    ------
+    ConfigError
+        The file is invalid.
+    ParameterError
+        ``lordosis_angle`` is given and a prior varies the lordosis, or it is out of range.
+    """
+    from ..errors import ParameterError
+    from .priors import load_atlas
+
+    spec = load_atlas(path)
+    if lordosis_angle is not None:
+        if {"lordosis_angle_deg", "lordosis_m"} & set(spec.names):
+            raise ParameterError("--lordosis-angle", "a prior varies the lordosis already")
+        spec = dataclasses.replace(spec, lordosis=float(lordosis_from_angle(lordosis_angle, spec.model)))
+    return run_atlas(spec, out, progress=progress)
+
+
 def run_atlas(spec: AtlasSpec, out: str | Path | None = None, *, progress: bool | None = None) -> AtlasResult:
     """The atlas of a validated spec, resumable through the chunks saved in ``out/chunks``.
 
@@ -498,7 +546,7 @@ def _chunk(spec: AtlasSpec, part: dict, folder: Path | None, name: str) -> dict:
 
 
 def _write(result: AtlasResult, out: Path, spec: AtlasSpec) -> None:
-    atomic_write_text(out / "atlas.json", json.dumps(result.to_dict(), indent=2) + "\n")
+    atomic_write_text(out / "atlas.json", dumps(result.to_dict()))
     with atomic_path(out / "draws.npz") as tmp, open(tmp, "wb") as handle:
         np.savez(handle, **{k: np.asarray(v) for k, v in result.draws.items()})
     from ..canvas import save_file

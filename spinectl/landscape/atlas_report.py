@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..canvas import new_figure
-from .priors import AtlasSpec
+from .priors import VERDICTS, AtlasSpec
 
 
 def report_text(result, spec: AtlasSpec) -> str:
@@ -21,8 +21,6 @@ def report_text(result, spec: AtlasSpec) -> str:
     str
         Markdown.
     """
-    from .atlas import VERDICTS
-
     lines = [
         "# Population stability atlas",
         "",
@@ -78,10 +76,13 @@ def density_figure(landscape: dict, draws: dict, optimum: tuple[float, float]):
     e, lam = 100 * np.asarray(landscape["eccentricity_m"]), 100 * np.asarray(landscape["lordosis_m"])
     mesh = ax.pcolormesh(e, lam, np.asarray(landscape["min_pcsa_cm2"]).T, shading="nearest", cmap="viridis")
     fig.colorbar(mesh, ax=ax, label="min PCSA [cm²] (joint by joint)")
-    counts, xe, ye = np.histogram2d(100 * draws["eccentricity_m"], 100 * draws["lordosis_m"], bins=24)
-    if counts.max() > 0:
-        centres = (xe[:-1] + xe[1:]) / 2, (ye[:-1] + ye[1:]) / 2
-        ax.contour(*centres, counts.T / counts.max(), levels=(0.1, 0.3, 0.5, 0.7, 0.9), colors="white")
+    points = 100 * np.stack([draws["eccentricity_m"], draws["lordosis_m"]])
+    if np.all(np.ptp(points, axis=1) > 0):  # a kernel density needs spread in both
+        from scipy.stats import gaussian_kde
+
+        x, y = np.meshgrid(e, lam, indexing="ij")
+        density = gaussian_kde(points)(np.stack([x.ravel(), y.ravel()])).reshape(x.shape)
+        ax.contour(e, lam, density.T / density.max(), levels=(0.1, 0.3, 0.5, 0.7, 0.9), colors="white")
     ax.plot(100 * optimum[0], 100 * optimum[1], "r*", markersize=14, label="the paper's optimum C")
     ax.set_xlabel("eccentricity E [cm]")
     ax.set_ylabel("lordosis Λ [cm]")
