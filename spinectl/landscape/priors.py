@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import ConfigError
+from ..errors import ConfigError, ParameterError
 from ..model import _toml
 from ..model.config import load_model_spec
 from ..model.params import Model
@@ -284,7 +284,33 @@ def _prior(index: int, row, model: Model) -> Prior:
         raise ConfigError(
             f"{where}.bounds", f"{list(prior.bounds)} hold no mass of the {family} distribution (below {LEAST_MASS:g})"
         )
+    _check_range(f"{where}.bounds", prior, model)
     return prior
+
+
+def _check_range(where: str, prior: Prior, model: Model) -> None:
+    """Every draw must be a valid parameter: the prior's extreme quantiles, those of the open cube's ends, are tried."""
+    from ..model.clinical import lordosis_from_angle
+    from ..model.config import set_parameter
+
+    tiny = np.finfo(float).eps  # the atlas draws on (eps, 1 - eps): these quantiles bound every draw
+    ends = [float(x) for x in prior.ppf([tiny, 1.0 - tiny])]
+    try:
+        if prior.parameter in GEOMETRY:
+            values = lordosis_from_angle(ends, model) if prior.parameter == "lordosis_angle_deg" else ends
+            name = "eccentricity_range" if prior.parameter == "eccentricity_m" else "lordosis_range"
+            low, high = getattr(model.geometry, name)
+            if not all(low <= v <= high for v in values):
+                raise ConfigError(
+                    where, f"draws from {ends[0]:g} to {ends[1]:g} leave geometry.{name} [{low:g}, {high:g}] m"
+                )
+        else:
+            for value in ends:
+                set_parameter(model, prior.parameter, value)
+    except ConfigError:
+        raise
+    except ParameterError as exc:
+        raise ConfigError(where, f"draws from {ends[0]:g} to {ends[1]:g}: {exc}") from None
 
 
 def _parameter(where: str, name: str, model: Model) -> str:

@@ -74,3 +74,18 @@ def test_the_shipped_priors_load_and_cite():
     spec = load_atlas(Path(__file__).parents[2] / "examples" / "atlas.toml")
     assert spec.names[0] == "lordosis_angle_deg" and spec.samples == 1024
     assert all("doi:" in p.source or p.source.startswith("unverified") for p in spec.priors)
+
+
+@pytest.mark.parametrize(
+    ("fields", "words"),
+    [
+        ({"parameter": "lordosis_angle_deg", "bounds": [20.0, 170.0]}, "geometry.lordosis_range"),
+        ({"parameter": "eccentricity_m", "distribution": "normal", "mean": 0.03, "sd": 0.01, "bounds": None}, "range"),
+        ({"parameter": "body.mass", "bounds": [-10.0, 50.0]}, "mass"),
+    ],
+)
+def test_priors_whose_draws_leave_the_model_are_refused(fields, words):
+    """Every draw must be a valid model: a prior reaching beyond a parameter's range is refused when read."""
+    with pytest.raises(ConfigError) as raised:
+        parse_atlas(HEAD + _prior(**fields))
+    assert raised.value.field == "prior[0].bounds" and words in str(raised.value)
