@@ -78,6 +78,8 @@ class AtlasResult:
     sobol : dict
         {output: {parameter: {S1, S1_conf, ST, ST_conf}}}; None where an output is not finite
         at some draw (counted in ``nonfinite``).
+    sobol_verdicts : dict
+        The same for each verdict's indicator (1 where it holds): which parameter decides it.
     nonfinite : dict
         {output: number of draws where it is NaN or infinite}.
     draws : dict of str to numpy.ndarray
@@ -87,6 +89,7 @@ class AtlasResult:
     n_evaluations: int
     probabilities: dict
     sobol: dict
+    sobol_verdicts: dict
     nonfinite: dict
     draws: dict = dataclasses.field(repr=False, compare=False)
 
@@ -110,7 +113,7 @@ class AtlasResult:
         return "\n".join(lines)
 
     def to_dict(self) -> dict:
-        """The JSON answer: ``n_evaluations``, ``probabilities``, ``sobol``, ``nonfinite``, ``criteria``.
+        """The JSON answer: n_evaluations, probabilities, sobol, sobol_verdicts, nonfinite, criteria.
 
         Returns
         -------
@@ -121,6 +124,7 @@ class AtlasResult:
             "n_evaluations": self.n_evaluations,
             "probabilities": self.probabilities,
             "sobol": self.sobol,
+            "sobol_verdicts": self.sobol_verdicts,
             "nonfinite": self.nonfinite,
             "criteria": dict(VERDICTS),
         }
@@ -436,8 +440,9 @@ def analyse(spec: AtlasSpec, values: dict, outputs: dict) -> AtlasResult:
     probabilities = {name: wilson(int(v[rows].sum()), rows.size, spec.confidence) for name, v in found.items()}
     names = [o for o in OUTPUTS if o in outputs]
     sobol = {o: sobol_indices(spec, outputs[o]) for o in names}
+    by_verdict = {name: sobol_indices(spec, v.astype(float)) for name, v in found.items()}
     nonfinite = {o: int(np.sum(~np.isfinite(outputs[o]))) for o in names}
-    return AtlasResult(n, probabilities, sobol, nonfinite, values | outputs)
+    return AtlasResult(n, probabilities, sobol, by_verdict, nonfinite, values | outputs)
 
 
 def fingerprint(spec: AtlasSpec) -> str:

@@ -35,23 +35,29 @@ def report_text(result, spec: AtlasSpec) -> str:
     ]
     for p in spec.priors:
         lines.append(
-            f"| `{p.parameter}` | {p.distribution} | {p.mean:g} | {p.sd:g} | "
+            f"| `{p.parameter}` | {p.distribution} | {_shown(p.mean)} | {_shown(p.sd)} | "
             f"[{p.bounds[0]:g}, {p.bounds[1]:g}] | {p.source} |"
         )
     lines += ["", "## Verdicts", "", "| verdict | criterion | p | interval |", "|---|---|---|---|"]
     for name, v in result.probabilities.items():
         lines.append(f"| {name} | {VERDICTS[name]} | {v['p']:.3f} | [{v['low']:.3f}, {v['high']:.3f}] |")
     lines += ["", "## Sobol' indices (first order S1, total ST, with bootstrap intervals)", ""]
-    for output, table in result.sobol.items():
+    tables = result.sobol | {f"{name} (indicator)": t for name, t in result.sobol_verdicts.items()}
+    for output, table in tables.items():
         lines += [f"### `{output}`", ""]
         if table is None:
-            lines += [f"Not finite at {result.nonfinite[output]} draws (infeasible): no indices.", ""]
+            lines += [f"Not finite at {result.nonfinite.get(output, 0)} draws (infeasible): no indices.", ""]
             continue
         lines += ["| parameter | S1 | ST |", "|---|---|---|"]
         for name, s in table.items():
             lines.append(f"| `{name}` | {s['S1']:.3f} ± {s['S1_conf']:.3f} | {s['ST']:.3f} ± {s['ST_conf']:.3f} |")
         lines.append("")
     return "\n".join(lines) + "\n"
+
+
+def _shown(value: float) -> str:
+    """A prior's moment for the table: a dash where its family has none (uniform)."""
+    return "–" if np.isnan(value) else f"{value:g}"
 
 
 def density_figure(landscape: dict, draws: dict, optimum: tuple[float, float]):

@@ -46,7 +46,7 @@ PAPER_OPTIMUM = (0.03, 0.04)
 
 VERDICTS = {
     "self_stable_joint_by_joint": "a feasible minimum PCSA, within optimisation.pcsa_max (joint by joint)",
-    "counter_torque_within_limit": "every |CT_k| within counter_torque_limit_Nm (joint by joint)",
+    "counter_torque_within_limit": "every counter torque CT_k within +-counter_torque_limit_Nm (joint by joint)",
     "chain_stabilisable_locally": "the chain (all CoRs free) stabilised by local muscle within local_pcsa_limit_cm2",
     "stable_at_delay": "the reflex loop of every segment stable at the drawn delay (joint by joint)",
 }
