@@ -44,3 +44,12 @@ def test_lordosis_angle_with_a_lordosis_prior_is_refused(tmp_path, capsys):
     path.write_text(path.read_text().replace("[30.0, 50.0]", "[0.0, 0.05]"))
     assert main(["atlas", str(path), "--out", str(tmp_path / "o"), "--lordosis-angle", "50"]) == 2
     assert "--lordosis-angle" in capsys.readouterr().err
+
+
+def test_an_out_that_is_a_file_is_one_line_exit_2(tmp_path, capsys):
+    """--out naming a file: exit 2 and one line before any draw is solved (it was a traceback after them)."""
+    out = tmp_path / "a_file"
+    out.write_text("")
+    assert main(["atlas", str(_file(tmp_path)), "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "cannot write" in err and "\n" not in err
