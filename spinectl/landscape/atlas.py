@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..atomic import atomic_path, atomic_write_text, check_folder, output_errors
+from ..atomic import atomic_path, atomic_write_text, output_errors
 from ..errors import SpinectlError
 from ..jsondoc import dumps
 from ..model import chain
@@ -35,9 +35,6 @@ from ..reflex.inputs import guarded
 from ..reflex.maps import landscape
 from ..units import M2_PER_CM2, m2_to_cm2
 from .priors import PAPER_OPTIMUM, VERDICTS, AtlasSpec
-
-OUT_FILES = ("atlas.json", "draws.npz", "report.md", "density.png", "chunks")
-"""What :func:`run_atlas` writes into its folder."""
 
 INSTALL_HINT = "pip install 'spinectl[atlas]' (SALib)"
 
@@ -525,8 +522,7 @@ def run_atlas(spec: AtlasSpec, out: str | Path | None = None, *, progress: bool 
     n = values["eccentricity_m"].size
     folder = Path(out) / "chunks" if out is not None else None
     if folder is not None:  # an unwritable --out is one line now, not a traceback after the solving
-        check_folder(out, OUT_FILES)
-        with output_errors(folder):
+        with output_errors(out):
             folder.mkdir(parents=True, exist_ok=True)
     key = fingerprint(spec)
     disable = (not sys.stderr.isatty()) if progress is None else not progress
