@@ -1,4 +1,5 @@
-"""Landscapes on disk: NetCDF written atomically, read back checked, and the model they used."""
+"""Landscapes on disk: NetCDF written atomically, read back checked, and the model they used.
+"""
 
 from __future__ import annotations
 
