@@ -39,6 +39,7 @@ COMMANDS = (
     "study_cmd",
     "calibrate_cmd",
     "anatomy_cmd",
+    "atlas_cmd",
 )
 """Modules of :mod:`spinectl.cli` that each register one sub-command."""
 

@@ -1,0 +1,592 @@
+"""The population stability atlas: cohort priors drawn, every draw solved, verdicts and Sobol' indices.
+
+Draws of the priors (:mod:`spinectl.landscape.priors`) on a scrambled Sobol' sequence in
+Saltelli's design (SALib), and for each draw the joint-by-joint optimum (the fast path of
+:mod:`spinectl.optimise.active_set`, the paper's criterion: each CoR alone, the others fixed),
+the exact delay margin at the chosen activation (:mod:`spinectl.reflex.maps`) and, with
+``chain``, the chain's least local stiffness (all CoRs free; one stacked SDP per chunk,
+:func:`spinectl.optimise.coupled.least_local_stiffness_stacked`). Then the probability of each
+verdict with its Wilson interval and the first- and total-order Sobol' indices with SALib's
+bootstrap intervals (docs/atlas.md).
+
+The draws are solved in-process, chunk by chunk, each chunk saved in ``DIR/chunks`` as it
+finishes, so that an interrupted atlas resumes where it stopped (the study engine takes an
+E x Lambda grid, not a list of points).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+from pathlib import Path
+
+import numpy as np
+
+from ..atomic import atomic_path, atomic_write_text, output_errors
+from ..errors import SpinectlError
+from ..jsondoc import dumps
+from ..model import chain
+from ..model.checks import arithmetic_guard, checked_coefficients
+from ..model.clinical import lordosis_angle, lordosis_from_angle
+from ..model.config import set_parameters
+from ..optimise import active_set
+from ..optimise.problem import OK_STATUSES, problem_data
+from ..reflex.inputs import guarded
+from ..reflex.maps import landscape
+from ..units import M2_PER_CM2, m2_to_cm2
+from .priors import PAPER_OPTIMUM, VERDICTS, AtlasSpec
+
+INSTALL_HINT = "pip install 'spinectl[atlas]' (SALib)"
+
+FAST = ("body.mass", "passive.stiffness", "reflex.delay")
+"""Fields that the fast path varies within one stacked problem: the segment mechanics are affine in the
+body's mass (gravity and inertia), K enters as -K_pas, and the delay margin does not depend on the delay."""
+
+OUTPUTS = ("min_pcsa_cm2", "counter_torque_norm_Nm", "local_stiffness_total_Nm_per_rad", "spine_delay_margin_s")
+"""The outputs whose Sobol' indices the atlas reports, named as the sweep's variables."""
+
+
+class AtlasUnavailable(SpinectlError, ImportError):
+    """SALib, the atlas's sampling and sensitivity analysis, is not installed."""
+
+
+def require_salib():
+    """Import and return :mod:`SALib`, or raise one line saying what to install.
+
+    Returns
+    -------
+    module
+        :mod:`SALib`.
+    """
+    try:
+        import SALib
+    except ImportError:
+        raise AtlasUnavailable(f"the atlas needs SALib: {INSTALL_HINT}") from None
+    return SALib
+
+
+@dataclasses.dataclass(frozen=True)
+class AtlasResult:
+    """The atlas's answer: probabilities of the verdicts and Sobol' indices of the outputs.
+
+    Attributes
+    ----------
+    n_evaluations : int
+        Model evaluations, N (D + 2).
+    probabilities : dict
+        {verdict: {p, low, high}} over the 2 N independent draws (Saltelli's A and B) [1].
+    sobol : dict
+        {output: {parameter: {S1, S1_conf, ST, ST_conf}}}; None where an output is not finite
+        at some draw (counted in ``nonfinite``).
+    sobol_verdicts : dict
+        The same for each verdict's indicator (1 where it holds): which parameter decides it.
+    nonfinite : dict
+        {output: number of draws where it is NaN or infinite}.
+    draws : dict of str to numpy.ndarray
+        Every draw's parameters and outputs, shape (n_evaluations,).
+    """
+
+    n_evaluations: int
+    probabilities: dict
+    sobol: dict
+    sobol_verdicts: dict
+    nonfinite: dict
+    draws: dict = dataclasses.field(repr=False, compare=False)
+
+    def table(self) -> str:
+        """The verdicts' probabilities and the largest total-order index of each output, as text.
+
+        Returns
+        -------
+        str
+            One line per verdict and per output.
+        """
+        lines = [f"{self.n_evaluations} evaluations"]
+        for name, v in self.probabilities.items():
+            lines.append(f"P({name}) = {v['p']:.3f}  [{v['low']:.3f}, {v['high']:.3f}]  ({VERDICTS[name]})")
+        for output, table in self.sobol.items():
+            if table is None:
+                lines.append(f"{output}: not finite at {self.nonfinite[output]} draws, no Sobol' indices")
+                continue
+            top = max(table, key=lambda name: table[name]["ST"])
+            lines.append(f"{output}: largest ST {table[top]['ST']:.3f} +- {table[top]['ST_conf']:.3f} ({top})")
+        return "\n".join(lines)
+
+    def to_dict(self) -> dict:
+        """The JSON answer: n_evaluations, probabilities, sobol, sobol_verdicts, nonfinite, criteria.
+
+        Returns
+        -------
+        dict
+            Plain floats and strings.
+        """
+        return {
+            "n_evaluations": self.n_evaluations,
+            "probabilities": self.probabilities,
+            "sobol": self.sobol,
+            "sobol_verdicts": self.sobol_verdicts,
+            "nonfinite": self.nonfinite,
+            "criteria": dict(VERDICTS),
+        }
+
+
+def saltelli_unit(spec: AtlasSpec) -> np.ndarray:
+    """Saltelli's design on the unit cube from SALib's scrambled Sobol' sequence, seeded.
+
+    Parameters
+    ----------
+    spec : AtlasSpec
+        Supplies ``samples`` N, ``seed`` and the D priors.
+
+    Returns
+    -------
+    numpy.ndarray, shape (N (D + 2), D)
+        Probabilities in (0, 1), rows in SALib's order (A, AB_1 ... AB_D, B per base sample).
+    """
+    require_salib()
+    from SALib.sample import sobol as sobol_sample
+
+    problem = _problem(len(spec.priors))
+    u = sobol_sample.sample(problem, spec.samples, calc_second_order=False, scramble=True, seed=spec.seed)
+    tiny = np.finfo(float).eps  # an open cube: an unbounded normal has no quantile at 0 or 1
+    return np.clip(u, tiny, 1.0 - tiny)
+
+
+def _problem(n: int) -> dict:
+    return {"num_vars": n, "names": [f"x{i}" for i in range(n)], "bounds": [[0.0, 1.0]] * n}
+
+
+def draw(spec: AtlasSpec, unit: np.ndarray) -> dict[str, np.ndarray]:
+    """The parameters of every draw from probabilities, through each prior's truncated quantiles.
+
+    Parameters
+    ----------
+    spec : AtlasSpec
+    unit : numpy.ndarray, shape (n, D)
+        Probabilities, one column per prior.
+
+    Returns
+    -------
+    dict of str to numpy.ndarray
+        Each prior's parameter (its unit), and ``eccentricity_m``, ``lordosis_m`` and
+        ``lordosis_angle_deg`` of every draw, shape (n,).
+    """
+    values = {p.parameter: p.ppf(unit[:, i]) for i, p in enumerate(spec.priors)}
+    n = unit.shape[0]
+    values.setdefault("eccentricity_m", np.full(n, spec.eccentricity))
+    if "lordosis_angle_deg" in values:
+        values["lordosis_m"] = lordosis_from_angle(values["lordosis_angle_deg"], spec.model)
+    values.setdefault("lordosis_m", np.full(n, spec.lordosis))
+    values.setdefault("lordosis_angle_deg", lordosis_angle(values["lordosis_m"], spec.model))
+    return values
+
+
+def evaluate(spec: AtlasSpec, values: dict, *, method: str = "auto", update=None) -> dict[str, np.ndarray]:
+    """The outputs at every draw, chunk by chunk.
+
+    Parameters
+    ----------
+    spec : AtlasSpec
+    values : dict of str to numpy.ndarray
+        :func:`draw`'s answer for n draws.
+    method : {'auto', 'fast', 'per-draw'}
+        'fast': one stacked problem per chunk with the fields of :data:`FAST` varied inside it;
+        'per-draw': one model per draw (:func:`spinectl.model.config.set_parameters`), the reference;
+        'auto': 'fast' unless a prior varies another field.
+    update : callable, optional
+        Called with the number of draws solved after each chunk.
+
+    Returns
+    -------
+    dict of str to numpy.ndarray
+        ``min_pcsa_cm2``, ``counter_torque_norm_Nm``, ``counter_torque_max_Nm``, ``status``,
+        ``spine_delay_margin_s``, ``local_stiffness_total_Nm_per_rad``, ``local_stiffness_max_Nm_per_rad``
+        and ``local_stiffness_limit_Nm_per_rad``, shape (n,); NaN where infeasible.
+    """
+    fields = [name for name in values if "." in name]
+    if method == "auto":
+        method = "fast" if set(fields) <= set(FAST) else "per-draw"
+    solve = _fast_chunk if method == "fast" else _per_draw_chunk
+    n = values["eccentricity_m"].size
+    parts = []
+    for start in range(0, n, spec.chunk_size):
+        part = {k: v[start : start + spec.chunk_size] for k, v in values.items()}
+        parts.append(solve(spec, part))
+        if update:
+            update(len(part["eccentricity_m"]))
+    return {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
+
+
+def _base(spec: AtlasSpec, mass_factor: float):
+    """The model with K = 1 (so K_pas is per unit K) and the body's mass times ``mass_factor``."""
+    m0 = spec.model.body.mass
+    return set_parameters(spec.model, {"passive.stiffness": 1.0, "body.mass": mass_factor * m0})
+
+
+def _fast_chunk(spec: AtlasSpec, part: dict) -> dict[str, np.ndarray]:
+    """One chunk in one stacked problem: mass-dependent terms interpolated between the body's mass and twice it."""
+    model = spec.model
+    e, lam = part["eccentricity_m"], part["lordosis_m"]
+    n = e.size
+    t = part.get("body.mass", np.full(n, model.body.mass)) / model.body.mass - 1.0  # affine in the mass: exact
+    k = part.get("passive.stiffness", np.full(n, model.passive.stiffness))
+    delay = part.get("reflex.delay", np.full(n, model.reflex.delay))
+    one, two = _base(spec, 1.0), _base(spec, 2.0)
+    c1, c2 = checked_coefficients(one, e, lam), checked_coefficients(two, e, lam)
+
+    def mix(a, b, scale=1.0):
+        return (a + t.reshape((n,) + (1,) * (a.ndim - 1)) * (b - a)) * scale
+
+    coeffs = dataclasses.replace(
+        c1,
+        gravity_torque=mix(c1.gravity_torque, c2.gravity_torque),
+        gravity_stiffness=mix(c1.gravity_stiffness, c2.gravity_stiffness),
+        inertia=mix(c1.inertia, c2.inertia),
+        passive_stiffness=mix(c1.passive_stiffness, c2.passive_stiffness, k[:, None]),
+    )
+    result = active_set.solve_block(problem_data(model, coeffs), model.optimisation.ct_tolerance)
+    out = _segment_outputs(model, coeffs, result, delay)
+    if spec.chain:
+        with arithmetic_guard(e, lam):
+            h1, h2 = chain.chain_coefficients(one, e, lam), chain.chain_coefficients(two, e, lam)
+        hk = dataclasses.replace(
+            h1,
+            gravity_stiffness=mix(h1.gravity_stiffness, h2.gravity_stiffness),
+            passive_stiffness=mix(h1.passive_stiffness, h2.passive_stiffness, k[:, None]),
+        )
+        out |= _chain_outputs(spec, model, hk, result.pcsa)
+    return out
+
+
+def _per_draw_chunk(spec: AtlasSpec, part: dict) -> dict[str, np.ndarray]:
+    """One chunk, one model per draw: the reference for the fast path, and the path for any other field."""
+    fields = [name for name in part if "." in name]
+    rows = []
+    for i in range(part["eccentricity_m"].size):
+        model = set_parameters(spec.model, {f: float(part[f][i]) for f in fields})
+        e, lam = part["eccentricity_m"][i : i + 1], part["lordosis_m"][i : i + 1]
+        coeffs = checked_coefficients(model, e, lam)
+        result = active_set.solve_block(problem_data(model, coeffs), model.optimisation.ct_tolerance)
+        row = _segment_outputs(model, coeffs, result, np.array([model.reflex.delay]))
+        if spec.chain:
+            with arithmetic_guard(e, lam):
+                row |= _chain_outputs(spec, model, chain.chain_coefficients(model, e, lam), result.pcsa)
+        rows.append(row)
+    return {k: np.concatenate([r[k] for r in rows]) for k in rows[0]}
+
+
+def _segment_outputs(model, coeffs, result, delay) -> dict[str, np.ndarray]:
+    """The joint-by-joint outputs of a block: min PCSA, counter torques, the exact delay margin."""
+    active = model.reflex.activation * result.pcsa
+    with arithmetic_guard(0.0, 0.0), guarded():
+        maps = landscape(coeffs.stiffness(active), coeffs.damping(active), coeffs.inertia, model.reflex)
+    margin = np.min(maps.delay_margin, axis=-1)
+    return {
+        "min_pcsa_cm2": m2_to_cm2(result.min_pcsa),
+        "counter_torque_norm_Nm": np.linalg.norm(result.counter_torque, axis=-1),
+        "counter_torque_max_Nm": np.max(np.abs(result.counter_torque), axis=-1),
+        "status": result.status.astype(str),
+        "spine_delay_margin_s": margin,
+        "delay_s": np.asarray(delay, float),
+    }
+
+
+def _chain_outputs(spec: AtlasSpec, model, coefficients, pcsa) -> dict[str, np.ndarray]:
+    """The chain's least local stiffness at the chosen activation (problem (a), docs/chain.md), and its limit."""
+    from ..optimise import coupled  # cvxpy only where the chain's SDP is asked for
+
+    stiffness = coefficients.stiffness(np.nan_to_num(pcsa))
+    stiffness = np.where(np.isnan(pcsa).any(axis=-1)[:, None, None], np.nan, stiffness)
+    opt = model.optimisation
+    _, k = coupled.least_local_stiffness_stacked(stiffness, opt.stability_margin, opt.solver_tolerance)
+    limit = chain.local_stiffness_per_pcsa(model) * spec.local_pcsa_limit * M2_PER_CM2
+    return {
+        "local_stiffness_total_Nm_per_rad": np.sum(k, axis=-1),
+        "local_stiffness_max_Nm_per_rad": np.max(k, axis=-1),
+        "local_stiffness_limit_Nm_per_rad": np.full(k.shape[0], limit),
+    }
+
+
+def verdicts(spec: AtlasSpec, outputs: dict) -> dict[str, np.ndarray]:
+    """Each verdict of :data:`VERDICTS` at every draw.
+
+    Parameters
+    ----------
+    spec : AtlasSpec
+        Supplies the limits.
+    outputs : dict of str to numpy.ndarray
+        :func:`evaluate`'s answer.
+
+    Returns
+    -------
+    dict of str to numpy.ndarray of bool
+        NaN outputs (infeasible) count as False.
+    """
+    feasible = np.isin(outputs["status"], OK_STATUSES)
+    out = {
+        "self_stable_joint_by_joint": feasible,
+        "counter_torque_within_limit": feasible & (outputs["counter_torque_max_Nm"] <= spec.counter_torque_limit),
+        "stable_at_delay": outputs["spine_delay_margin_s"] > outputs["delay_s"],
+    }
+    if "local_stiffness_max_Nm_per_rad" in outputs:
+        k, limit = outputs["local_stiffness_max_Nm_per_rad"], outputs["local_stiffness_limit_Nm_per_rad"]
+        out["chain_stabilisable_locally"] = np.isfinite(k) & (k <= limit)
+    return out
+
+
+def wilson(successes: int, n: int, confidence: float) -> dict[str, float]:
+    """The proportion and its Wilson score interval.
+
+    Parameters
+    ----------
+    successes, n : int
+        Draws where the verdict holds, and all draws.
+    confidence : float
+        Level of the interval.
+
+    Returns
+    -------
+    dict
+        ``p``, ``low``, ``high`` [1].
+
+    References
+    ----------
+    Wilson EB (1927). Probable inference, the law of succession, and statistical inference.
+    J Am Stat Assoc 22(158):209-212. doi:10.1080/01621459.1927.10502953.
+    """
+    from scipy.stats import binomtest
+
+    ci = binomtest(int(successes), int(n)).proportion_ci(confidence_level=confidence, method="wilson")
+    return {"p": successes / n, "low": float(ci.low), "high": float(ci.high)}
+
+
+def sobol_indices(spec: AtlasSpec, y: np.ndarray) -> dict | None:
+    """First- and total-order Sobol' indices of one output with SALib's bootstrap intervals.
+
+    Parameters
+    ----------
+    spec : AtlasSpec
+        Supplies the priors, ``bootstrap``, ``confidence`` and ``seed``.
+    y : numpy.ndarray, shape (N (D + 2),)
+        The output at Saltelli's design, in SALib's row order.
+
+    Returns
+    -------
+    dict or None
+        {parameter: {S1, S1_conf, ST, ST_conf}}; None if ``y`` is not finite everywhere.
+
+    References
+    ----------
+    Saltelli A, Annoni P, Azzini I, Campolongo F, Ratto M, Tarantola S (2010). Variance based
+    sensitivity analysis of model output. Comput Phys Commun 181(2):259-270.
+    doi:10.1016/j.cpc.2009.09.018. Herman J, Usher W (2017). SALib: an open-source Python library
+    for sensitivity analysis. J Open Source Softw 2(9):97. doi:10.21105/joss.00097.
+    """
+    require_salib()
+    from SALib.analyze import sobol
+
+    y = np.asarray(y, float)
+    if not np.all(np.isfinite(y)):
+        return None
+    if np.ptp(y) == 0:  # no variance to share out
+        return {name: {"S1": 0.0, "S1_conf": 0.0, "ST": 0.0, "ST_conf": 0.0} for name in spec.names}
+    found = sobol.analyze(
+        _problem(len(spec.priors)),
+        y,
+        calc_second_order=False,
+        num_resamples=spec.bootstrap,
+        conf_level=spec.confidence,
+        print_to_console=False,
+        seed=spec.seed + 1,  # SALib 1.6 seeds its bootstrap only `if seed:`, so seed 0 was no seed at all
+    )
+    keys = ("S1", "S1_conf", "ST", "ST_conf")
+    return {name: {k: float(found[k][i]) for k in keys} for i, name in enumerate(spec.names)}
+
+
+def independent_rows(spec: AtlasSpec, n_rows: int) -> np.ndarray:
+    """Rows of Saltelli's A and B matrices: 2 N independent draws, for the probabilities.
+
+    Parameters
+    ----------
+    spec : AtlasSpec
+    n_rows : int
+        N (D + 2).
+
+    Returns
+    -------
+    numpy.ndarray of int, shape (2 N,)
+    """
+    step = len(spec.priors) + 2
+    starts = np.arange(0, n_rows, step)
+    return np.sort(np.concatenate([starts, starts + step - 1]))
+
+
+def analyse(spec: AtlasSpec, values: dict, outputs: dict) -> AtlasResult:
+    """Probabilities and Sobol' indices from the outputs at Saltelli's design.
+
+    Parameters
+    ----------
+    spec : AtlasSpec
+    values, outputs : dict of str to numpy.ndarray
+        :func:`draw`'s and :func:`evaluate`'s answers.
+
+    Returns
+    -------
+    AtlasResult
+    """
+    n = outputs["status"].size
+    rows = independent_rows(spec, n)
+    found = verdicts(spec, outputs)
+    probabilities = {name: wilson(int(v[rows].sum()), rows.size, spec.confidence) for name, v in found.items()}
+    names = [o for o in OUTPUTS if o in outputs]
+    sobol = {o: sobol_indices(spec, outputs[o]) for o in names}
+    by_verdict = {name: sobol_indices(spec, v.astype(float)) for name, v in found.items()}
+    nonfinite = {o: int(np.sum(~np.isfinite(outputs[o]))) for o in names}
+    return AtlasResult(n, probabilities, sobol, by_verdict, nonfinite, values | outputs)
+
+
+def fingerprint(spec: AtlasSpec) -> str:
+    """A short hash of everything that decides the draws and their outputs: resume only the same atlas.
+
+    Parameters
+    ----------
+    spec : AtlasSpec
+
+    Returns
+    -------
+    str
+        16 hex digits.
+    """
+    from .. import __version__
+
+    return hashlib.sha256(repr((spec, __version__)).encode()).hexdigest()[:16]
+
+
+def atlas_file(path, out, *, lordosis_angle: float | None = None, progress: bool | None = None) -> AtlasResult:
+    """The atlas of an atlas file (``spinectl atlas``), the lordosis optionally fixed as an angle.
+
+    Parameters
+    ----------
+    path : str or Path
+        The atlas file (:func:`spinectl.landscape.priors.load_atlas`).
+    out : str or Path
+        Output folder (:func:`run_atlas`).
+    lordosis_angle : float, optional
+        The lordosis angle [deg] where no prior varies the lordosis
+        (:func:`spinectl.model.clinical.lordosis_from_angle`).
+    progress : bool or None
+        As for :func:`run_atlas`.
+
+    Returns
+    -------
+    AtlasResult
+
+    Raises
+    ------
+    ConfigError
+        The file is invalid.
+    ParameterError
+        ``lordosis_angle`` is given and a prior varies the lordosis, or it is out of range.
+    """
+    from ..errors import ParameterError
+    from .priors import load_atlas
+
+    spec = load_atlas(path)
+    if lordosis_angle is not None:
+        if {"lordosis_angle_deg", "lordosis_m"} & set(spec.names):
+            raise ParameterError("--lordosis-angle", "a prior varies the lordosis already")
+        spec = dataclasses.replace(spec, lordosis=float(lordosis_from_angle(lordosis_angle, spec.model)))
+    return run_atlas(spec, out, progress=progress)
+
+
+def run_atlas(spec: AtlasSpec, out: str | Path | None = None, *, progress: bool | None = None) -> AtlasResult:
+    """The atlas of a validated spec, resumable through the chunks saved in ``out/chunks``.
+
+    Parameters
+    ----------
+    spec : AtlasSpec
+    out : str or Path, optional
+        Output folder: chunks as they finish, then ``atlas.json``, ``draws.npz`` and ``report.md``.
+    progress : bool or None
+        A progress bar of draws on stderr; None: only on a terminal.
+
+    Returns
+    -------
+    AtlasResult
+    """
+    import sys
+
+    from tqdm import tqdm
+
+    values = draw(spec, saltelli_unit(spec))
+    n = values["eccentricity_m"].size
+    folder = Path(out) / "chunks" if out is not None else None
+    if folder is not None:  # an unwritable --out is one line now, not a traceback after the solving
+        with output_errors(out):
+            folder.mkdir(parents=True, exist_ok=True)
+    key = fingerprint(spec)
+    disable = (not sys.stderr.isatty()) if progress is None else not progress
+    parts = []
+    with tqdm(total=n, unit="draw", disable=disable, desc="atlas") as bar:
+        for index, start in enumerate(range(0, n, spec.chunk_size)):
+            part = {k: v[start : start + spec.chunk_size] for k, v in values.items()}
+            parts.append(_chunk(spec, part, folder, f"{key}-{index:06d}.npz"))
+            bar.update(part["eccentricity_m"].size)
+    outputs = {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
+    result = analyse(spec, values, outputs)
+    if out is not None:
+        _write(result, Path(out), spec)
+    return result
+
+
+def _chunk(spec: AtlasSpec, part: dict, folder: Path | None, name: str) -> dict:
+    """One chunk's outputs: read back if an earlier run saved it, else solved and saved atomically."""
+    if folder is not None and (folder / name).is_file():
+        with np.load(folder / name, allow_pickle=False) as saved:
+            return {k: saved[k] for k in saved.files}
+    found = evaluate(spec, part)
+    if folder is not None:
+        with atomic_path(folder / name) as tmp, open(tmp, "wb") as handle:
+            np.savez(handle, **found)
+    return found
+
+
+def _write(result: AtlasResult, out: Path, spec: AtlasSpec) -> None:
+    atomic_write_text(out / "atlas.json", dumps(result.to_dict()))
+    with atomic_path(out / "draws.npz") as tmp, open(tmp, "wb") as handle:
+        np.savez(handle, **{k: np.asarray(v) for k, v in result.draws.items()})
+    from ..canvas import save_file
+    from .atlas_report import density_figure, report_text
+
+    atomic_write_text(out / "report.md", report_text(result, spec))
+    save_file(density_figure(base_landscape(spec, result.draws), result.draws, PAPER_OPTIMUM), out / "density.png", 120)
+
+
+def base_landscape(spec: AtlasSpec, draws: dict, n: int = 41) -> dict[str, np.ndarray]:
+    """Min PCSA of the base model on an E x Lambda grid spanning the draws (the fast path of the sweep).
+
+    Parameters
+    ----------
+    spec : AtlasSpec
+    draws : dict of str to numpy.ndarray
+        ``eccentricity_m`` and ``lordosis_m`` of the draws [m].
+    n : int
+        Grid points per axis.
+
+    Returns
+    -------
+    dict
+        ``eccentricity_m`` (n,), ``lordosis_m`` (n,) [m] and ``min_pcsa_cm2`` (n, n) [cm^2].
+    """
+    from .columns import point_columns
+
+    def axis(values, point):
+        low, high = min(values.min(), point), max(values.max(), point)
+        pad = 0.05 * (high - low) or 0.01
+        return np.linspace(low - pad, high + pad, n)
+
+    e = axis(draws["eccentricity_m"], PAPER_OPTIMUM[0])
+    lam = axis(draws["lordosis_m"], PAPER_OPTIMUM[1])
+    grid_e, grid_l = np.meshgrid(e, lam, indexing="ij")
+    columns, _ = point_columns(spec.model, grid_e.ravel(), grid_l.ravel())
+    return {"eccentricity_m": e, "lordosis_m": lam, "min_pcsa_cm2": columns["min_pcsa_cm2"].reshape(n, n)}

@@ -1,0 +1,97 @@
+"""The atlas's report (Markdown) and its figure: the cohort's density over the E x Lambda landscape of min PCSA."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..canvas import new_figure
+from .priors import VERDICTS, AtlasSpec
+
+
+def report_text(result, spec: AtlasSpec) -> str:
+    """The atlas's report: the priors with their sources, the verdicts' probabilities, the Sobol' indices.
+
+    Parameters
+    ----------
+    result : spinectl.landscape.atlas.AtlasResult
+    spec : AtlasSpec
+
+    Returns
+    -------
+    str
+        Markdown.
+    """
+    lines = [
+        "# Population stability atlas",
+        "",
+        f"{result.n_evaluations} model evaluations: Saltelli's design on a scrambled Sobol' sequence "
+        f"(N = {spec.samples}, seed {spec.seed}); probabilities over the 2 N = {2 * spec.samples} draws of "
+        f"its A and B matrices, with Wilson intervals at {spec.confidence:g}.",
+        "",
+        "## Priors",
+        "",
+        "| parameter | distribution | mean | sd | bounds | source |",
+        "|---|---|---|---|---|---|",
+    ]
+    for p in spec.priors:
+        lines.append(
+            f"| `{p.parameter}` | {p.distribution} | {_shown(p.mean)} | {_shown(p.sd)} | "
+            f"[{p.bounds[0]:g}, {p.bounds[1]:g}] | {p.source} |"
+        )
+    lines += ["", "## Verdicts", "", "| verdict | criterion | p | interval |", "|---|---|---|---|"]
+    for name, v in result.probabilities.items():
+        lines.append(f"| {name} | {VERDICTS[name]} | {v['p']:.3f} | [{v['low']:.3f}, {v['high']:.3f}] |")
+    lines += ["", "## Sobol' indices (first order S1, total ST, with bootstrap intervals)", ""]
+    tables = result.sobol | {f"{name} (indicator)": t for name, t in result.sobol_verdicts.items()}
+    for output, table in tables.items():
+        lines += [f"### `{output}`", ""]
+        if table is None:
+            lines += [f"Not finite at {result.nonfinite.get(output, 0)} draws (infeasible): no indices.", ""]
+            continue
+        lines += ["| parameter | S1 | ST |", "|---|---|---|"]
+        for name, s in table.items():
+            lines.append(f"| `{name}` | {s['S1']:.3f} ± {s['S1_conf']:.3f} | {s['ST']:.3f} ± {s['ST_conf']:.3f} |")
+        lines.append("")
+    return "\n".join(lines) + "\n"
+
+
+def _shown(value: float) -> str:
+    """A prior's moment for the table: a dash where its family has none (uniform)."""
+    return "–" if np.isnan(value) else f"{value:g}"
+
+
+def density_figure(landscape: dict, draws: dict, optimum: tuple[float, float]):
+    """The cohort's density of (E, Lambda) drawn over the landscape of min PCSA, with the paper's optimum.
+
+    Parameters
+    ----------
+    landscape : dict
+        ``eccentricity_m`` (nE,), ``lordosis_m`` (nL,) and ``min_pcsa_cm2`` (nE, nL) of the base model.
+    draws : dict of str to numpy.ndarray
+        ``eccentricity_m`` and ``lordosis_m`` of every draw [m].
+    optimum : tuple of float
+        (E, Lambda) to mark [m].
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Drawn on :func:`spinectl.canvas.new_figure`; axes in cm.
+    """
+    fig = new_figure(figsize=(6.0, 4.8), layout="constrained")
+    ax = fig.add_subplot()
+    e, lam = 100 * np.asarray(landscape["eccentricity_m"]), 100 * np.asarray(landscape["lordosis_m"])
+    mesh = ax.pcolormesh(e, lam, np.asarray(landscape["min_pcsa_cm2"]).T, shading="nearest", cmap="viridis")
+    fig.colorbar(mesh, ax=ax, label="min PCSA [cm²] (joint by joint)")
+    points = 100 * np.stack([draws["eccentricity_m"], draws["lordosis_m"]])
+    if np.all(np.ptp(points, axis=1) > 0):  # a kernel density needs spread in both
+        from scipy.stats import gaussian_kde
+
+        x, y = np.meshgrid(e, lam, indexing="ij")
+        density = gaussian_kde(points)(np.stack([x.ravel(), y.ravel()])).reshape(x.shape)
+        ax.contour(e, lam, density.T / density.max(), levels=(0.1, 0.3, 0.5, 0.7, 0.9), colors="white")
+    ax.plot(100 * optimum[0], 100 * optimum[1], "r*", markersize=14, label="the paper's optimum C")
+    ax.set_xlabel("eccentricity E [cm]")
+    ax.set_ylabel("lordosis Λ [cm]")
+    ax.set_title("cohort density (white: 10 % to 90 % of its peak)")
+    ax.legend(loc="lower right")
+    return fig

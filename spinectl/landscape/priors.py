@@ -1,0 +1,365 @@
+"""Cohort priors for the atlas: the file's schema, its distributions and their draws (docs/atlas.md).
+
+An atlas file has one ``[atlas]`` table (the sampling and the verdicts' limits) and one
+``[[prior]]`` table per varied parameter: its distribution family, the family's parameters,
+its bounds and its published source. Read with the project's TOML schema engine
+(:mod:`spinectl.model._toml`), so unknown keys, parameters and families are one line that names
+the field, with a "did you mean".
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import ConfigError, ParameterError
+from ..model import _toml
+from ..model.config import load_model_spec
+from ..model.params import Model
+
+FAMILIES = ("normal", "lognormal", "uniform", "truncated normal")
+"""Distribution families of a prior; every draw is truncated to the prior's bounds."""
+
+GEOMETRY = ("lordosis_angle_deg", "lordosis_m", "eccentricity_m")
+"""Parameters of a prior that are no field of the model: the position (E, Lambda), Lambda also as an angle."""
+
+PRIOR_KEYS = ("parameter", "distribution", "mean", "sd", "bounds", "source")
+ATLAS_KEYS = (
+    "samples",
+    "seed",
+    "model",
+    "eccentricity_m",
+    "lordosis_m",
+    "counter_torque_limit_Nm",
+    "local_pcsa_limit_cm2",
+    "chain",
+    "chunk_size",
+    "bootstrap",
+    "confidence",
+)
+
+PAPER_OPTIMUM = (0.03, 0.04)
+"""(E, Lambda) of the paper's optimum C [m] (paper, Discussion: E ~ 3 cm, Lambda ~ 4 cm; Figure 4, position C)."""
+
+VERDICTS = {
+    "self_stable_joint_by_joint": "a feasible minimum PCSA, within optimisation.pcsa_max (joint by joint)",
+    "counter_torque_within_limit": "every counter torque CT_k within +-counter_torque_limit_Nm (joint by joint)",
+    "chain_stabilisable_locally": "the chain (all CoRs free) stabilised by local muscle within local_pcsa_limit_cm2",
+    "stable_at_delay": "the reflex loop of every segment stable at the drawn delay (joint by joint)",
+}
+"""The verdicts and the criterion each names."""
+
+LEAST_MASS = 1e-9
+"""Smallest share of a distribution's mass that its bounds may hold: less is 'no mass' (a typo)."""
+
+
+@dataclasses.dataclass(frozen=True)
+class Prior:
+    """One varied parameter: a distribution truncated to bounds, with its source.
+
+    Attributes
+    ----------
+    parameter : str
+        A name of :data:`GEOMETRY` or a dotted field of the model (``config show``), in its unit.
+    distribution : str
+        One of :data:`FAMILIES`. 'lognormal' takes the mean and sd of the quantity itself.
+    mean, sd : float
+        Of the untruncated distribution (not used by 'uniform').
+    bounds : tuple of float
+        (low, high); the range of 'uniform'; +-inf where unbounded (normal, lognormal only).
+    source : str
+        The published source (author, year, journal, doi), or 'unverified: ...'.
+    """
+
+    parameter: str
+    distribution: str
+    mean: float = math.nan
+    sd: float = math.nan
+    bounds: tuple[float, float] = (-math.inf, math.inf)
+    source: str = ""
+
+    def _frozen(self):
+        """The untruncated scipy.stats distribution."""
+        from scipy import stats
+
+        if self.distribution == "uniform":
+            return stats.uniform(self.bounds[0], self.bounds[1] - self.bounds[0])
+        if self.distribution == "lognormal":  # mean m, sd s of X: log X ~ N(mu, sigma^2)
+            sigma2 = math.log1p((self.sd / self.mean) ** 2)
+            return stats.lognorm(math.sqrt(sigma2), scale=self.mean / math.exp(sigma2 / 2))
+        return stats.norm(self.mean, self.sd)
+
+    def mass(self) -> float:
+        """The share of the distribution's mass within the bounds [1].
+
+        Returns
+        -------
+        float
+            F(high) - F(low).
+        """
+        dist = self._frozen()
+        return float(dist.cdf(self.bounds[1]) - dist.cdf(self.bounds[0]))
+
+    def ppf(self, u) -> np.ndarray:
+        """The truncated distribution's quantiles: F^-1(F(low) + u (F(high) - F(low))).
+
+        Parameters
+        ----------
+        u : array_like
+            Probabilities in (0, 1).
+
+        Returns
+        -------
+        numpy.ndarray
+            Values of the parameter in its unit, the shape of ``u``, within the bounds.
+        """
+        dist = self._frozen()
+        low, high = dist.cdf(self.bounds[0]), dist.cdf(self.bounds[1])
+        return np.clip(dist.ppf(low + np.asarray(u, float) * (high - low)), *self.bounds)
+
+
+@dataclasses.dataclass(frozen=True)
+class AtlasSpec:
+    """An atlas file, validated: the base model, the priors and the settings of ``[atlas]``.
+
+    Attributes
+    ----------
+    model : Model
+        The parameters that no prior varies.
+    priors : tuple of Prior
+        One per varied parameter, in the file's order.
+    samples : int
+        Saltelli base samples N, a power of 2; N (D + 2) evaluations for D priors.
+    seed : int
+        Seeds the scrambled Sobol' sequence and SALib's bootstrap.
+    eccentricity, lordosis : float
+        E and Lambda [m] where no prior varies them (default: the paper's optimum, 3 and 4 cm).
+    counter_torque_limit : float
+        |CT_k| limit of the local muscles [N m] (paper, Discussion: +-30 N m).
+    local_pcsa_limit : float
+        The local muscles' PCSA limit per joint [cm^2] (paper, Discussion: 17 cm^2).
+    chain : bool
+        Also the chain's least local stiffness (one stacked SDP per chunk).
+    chunk_size : int
+        Draws per chunk.
+    bootstrap : int
+        SALib's bootstrap resamples for the confidence intervals.
+    confidence : float
+        Level of every confidence interval (Wilson and bootstrap).
+    """
+
+    model: Model
+    priors: tuple[Prior, ...]
+    samples: int = 4096
+    seed: int = 0
+    eccentricity: float = PAPER_OPTIMUM[0]
+    lordosis: float = PAPER_OPTIMUM[1]
+    counter_torque_limit: float = 30.0
+    local_pcsa_limit: float = 17.0
+    chain: bool = True
+    chunk_size: int = 1024
+    bootstrap: int = 100
+    confidence: float = 0.95
+
+    @property
+    def names(self) -> list[str]:
+        """The varied parameters, in order."""
+        return [p.parameter for p in self.priors]
+
+
+def load_atlas(path: str | Path) -> AtlasSpec:
+    """Read and validate an atlas file (docs/atlas.md).
+
+    Parameters
+    ----------
+    path : str or Path
+        The TOML file.
+
+    Returns
+    -------
+    AtlasSpec
+
+    Raises
+    ------
+    ConfigError
+        Unreadable, not TOML, or any field invalid: one line naming the field.
+    """
+    path = Path(path)
+    return parse_atlas(_toml.read_text(path), source=str(path), base_dir=path.parent)
+
+
+def parse_atlas(text: str, source: str = "atlas", base_dir: str | Path = ".") -> AtlasSpec:
+    """Validate the text of an atlas file into an :class:`AtlasSpec`.
+
+    Parameters
+    ----------
+    text : str
+        TOML with ``[atlas]`` and ``[[prior]]`` tables.
+    source : str
+        Named in a syntax error.
+    base_dir : str or Path
+        Where a relative ``model`` path is looked for.
+
+    Returns
+    -------
+    AtlasSpec
+
+    Raises
+    ------
+    ConfigError
+        An unknown key, family or parameter (with a "did you mean"), bounds that exclude all
+        the mass, a value of the wrong type: one line naming the field.
+    """
+    data = _toml.parse(text, source)
+    _toml.check_keys(data, ("atlas", "prior"))
+    head = data.get("atlas", {})
+    _toml.check_table(head, "atlas")
+    _toml.check_keys(head, ATLAS_KEYS, "atlas")
+    model = _model(head.get("model"), Path(base_dir))
+    rows = data.get("prior", [])
+    if not isinstance(rows, list) or not rows:
+        raise ConfigError("prior", "must be one or more [[prior]] tables")
+    priors = tuple(_prior(i, row, model) for i, row in enumerate(rows))
+    _check_distinct(priors)
+    settings = _settings(head)
+    return AtlasSpec(model=model, priors=priors, **settings)
+
+
+def _model(spec, base_dir: Path) -> Model:
+    if spec is None:
+        return Model()
+    if not isinstance(spec, str):
+        raise ConfigError("atlas.model", "must be a preset name or a path to a model file")
+    candidate = base_dir / spec
+    return load_model_spec(str(candidate) if candidate.is_file() else spec)
+
+
+def _number(where: str, value, low=-math.inf, high=math.inf, integer=False):
+    ok = isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
+    if integer:
+        ok = ok and isinstance(value, int)
+    if not ok or not low <= value <= high:
+        kind = "an integer" if integer else "a finite number"
+        raise ConfigError(where, f"must be {kind} in [{low:g}, {high:g}] (got {value!r})")
+    return value
+
+
+def _settings(head: dict) -> dict:
+    out = {}
+    samples = _number("atlas.samples", head.get("samples", 4096), 2, 2**24, integer=True)
+    if samples & (samples - 1):
+        raise ConfigError("atlas.samples", f"must be a power of 2, for the balance of Sobol' points (got {samples})")
+    out["samples"] = samples
+    out["seed"] = _number("atlas.seed", head.get("seed", 0), 0, 2**32 - 1, integer=True)
+    out["eccentricity"] = _number("atlas.eccentricity_m", head.get("eccentricity_m", PAPER_OPTIMUM[0]), -0.1, 0.1)
+    out["lordosis"] = _number("atlas.lordosis_m", head.get("lordosis_m", PAPER_OPTIMUM[1]), -0.1, 0.1)
+    out["counter_torque_limit"] = _number("atlas.counter_torque_limit_Nm", head.get("counter_torque_limit_Nm", 30.0), 0)
+    out["local_pcsa_limit"] = _number("atlas.local_pcsa_limit_cm2", head.get("local_pcsa_limit_cm2", 17.0), 0)
+    chain = head.get("chain", True)
+    if not isinstance(chain, bool):
+        raise ConfigError("atlas.chain", f"must be true or false (got {chain!r})")
+    out["chain"] = chain
+    out["chunk_size"] = _number("atlas.chunk_size", head.get("chunk_size", 1024), 1, 2**20, integer=True)
+    out["bootstrap"] = _number("atlas.bootstrap", head.get("bootstrap", 100), 2, 10**5, integer=True)
+    out["confidence"] = _number("atlas.confidence", head.get("confidence", 0.95), 0.5, 0.999)
+    return out
+
+
+def _prior(index: int, row, model: Model) -> Prior:
+    where = f"prior[{index}]"
+    _toml.check_table(row, where)
+    _toml.check_keys(row, PRIOR_KEYS, where)
+    for key in ("parameter", "distribution", "source"):
+        if not isinstance(row.get(key), str) or not row[key].strip():
+            raise ConfigError(f"{where}.{key}", "is required, a non-empty string")
+    parameter = _parameter(f"{where}.parameter", row["parameter"], model)
+    family = row["distribution"]
+    if family not in FAMILIES:
+        raise ConfigError(f"{where}.distribution", _toml.unknown_message(family, FAMILIES).replace("key", "family"))
+    prior = Prior(parameter, family, *_moments(where, row, family), _bounds(where, row, family), row["source"])
+    if prior.mass() < LEAST_MASS:
+        raise ConfigError(
+            f"{where}.bounds", f"{list(prior.bounds)} hold no mass of the {family} distribution (below {LEAST_MASS:g})"
+        )
+    _check_range(f"{where}.bounds", prior, model)
+    return prior
+
+
+def _check_range(where: str, prior: Prior, model: Model) -> None:
+    """Every draw must be a valid parameter: the prior's extreme quantiles, those of the open cube's ends, are tried."""
+    from ..model.clinical import lordosis_from_angle
+    from ..model.config import set_parameter
+
+    tiny = np.finfo(float).eps  # the atlas draws on (eps, 1 - eps): these quantiles bound every draw
+    ends = [float(x) for x in prior.ppf([tiny, 1.0 - tiny])]
+    try:
+        if prior.parameter in GEOMETRY:
+            values = lordosis_from_angle(ends, model) if prior.parameter == "lordosis_angle_deg" else ends
+            name = "eccentricity_range" if prior.parameter == "eccentricity_m" else "lordosis_range"
+            low, high = getattr(model.geometry, name)
+            if not all(low <= v <= high for v in values):
+                raise ConfigError(
+                    where, f"draws from {ends[0]:g} to {ends[1]:g} leave geometry.{name} [{low:g}, {high:g}] m"
+                )
+        else:
+            for value in ends:
+                set_parameter(model, prior.parameter, value)
+    except ConfigError:
+        raise
+    except ParameterError as exc:
+        raise ConfigError(where, f"draws from {ends[0]:g} to {ends[1]:g}: {exc}") from None
+
+
+def _parameter(where: str, name: str, model: Model) -> str:
+    """The prior's parameter: a name of GEOMETRY or a numeric dotted field of the model."""
+    if name in GEOMETRY:
+        return name
+    tree = _toml.to_dict(model)
+    if "." not in name:
+        raise ConfigError(where, _toml.unknown_message(name, (*GEOMETRY, *tree)).replace("key", "parameter"))
+    holder, key = _toml.locate(tree, name)  # unknown parts: "did you mean"
+    value = holder[key]
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise ConfigError(where, f"{name!r} is not a number; a prior varies a numeric parameter")
+    return name
+
+
+def _moments(where: str, row: dict, family: str) -> tuple[float, float]:
+    if family == "uniform":
+        for key in ("mean", "sd"):
+            if key in row:
+                raise ConfigError(f"{where}.{key}", "is not a parameter of 'uniform' (its range is its bounds)")
+        return math.nan, math.nan
+    mean = _number(f"{where}.mean", row.get("mean"))
+    sd = _number(f"{where}.sd", row.get("sd"), 0)
+    if sd == 0:
+        raise ConfigError(f"{where}.sd", "must be > 0")
+    if family == "lognormal" and mean <= 0:
+        raise ConfigError(f"{where}.mean", f"must be > 0 for 'lognormal' (got {mean!r})")
+    return float(mean), float(sd)
+
+
+def _bounds(where: str, row: dict, family: str) -> tuple[float, float]:
+    if "bounds" not in row:
+        if family in ("uniform", "truncated normal"):
+            raise ConfigError(f"{where}.bounds", f"is required for '{family}'")
+        return (0.0 if family == "lognormal" else -math.inf, math.inf)
+    bounds = row["bounds"]
+    if not isinstance(bounds, list) or len(bounds) != 2:
+        raise ConfigError(f"{where}.bounds", "must be [low, high]")
+    low, high = (float(_number(f"{where}.bounds", b)) for b in bounds)
+    if not low < high:
+        raise ConfigError(f"{where}.bounds", f"must have low < high (got {bounds})")
+    return low, high
+
+
+def _check_distinct(priors) -> None:
+    names = [p.parameter for p in priors]
+    for i, name in enumerate(names):
+        if name in names[:i]:
+            raise ConfigError(f"prior[{i}].parameter", f"{name!r} has a prior already")
+    if {"lordosis_angle_deg", "lordosis_m"} <= set(names):
+        raise ConfigError("prior", "give the lordosis once: lordosis_angle_deg or lordosis_m, not both")

@@ -1,0 +1,122 @@
+"""The atlas: Sobol' indices against a closed form, the fast path against one model per draw, the seed."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+from scipy import stats
+
+from spinectl.landscape import atlas
+from spinectl.landscape.priors import parse_atlas
+from spinectl.model.clinical import lordosis_from_angle
+
+PRIORS = """
+[[prior]]
+parameter = "lordosis_angle_deg"
+distribution = "truncated normal"
+mean = 49.8
+sd = 11.2
+bounds = [20.0, 90.0]
+source = "s"
+[[prior]]
+parameter = "eccentricity_m"
+distribution = "uniform"
+bounds = [0.0, 0.08]
+source = "s"
+[[prior]]
+parameter = "body.mass"
+distribution = "uniform"
+bounds = [30.0, 50.0]
+source = "s"
+[[prior]]
+parameter = "passive.stiffness"
+distribution = "uniform"
+bounds = [0.0, 30.0]
+source = "s"
+[[prior]]
+parameter = "reflex.delay"
+distribution = "uniform"
+bounds = [0.053, 0.1]
+source = "s"
+"""
+
+
+def _spec(samples=4, seed=0, chain="true", chunk=16):
+    return parse_atlas(f"[atlas]\nsamples = {samples}\nseed = {seed}\nchain = {chain}\nchunk_size = {chunk}\n" + PRIORS)
+
+
+def test_sobol_indices_of_a_linear_output_are_its_variance_shares():
+    """Y = sum a_i X_i: S1_i = ST_i = a_i^2 Var X_i / sum_j a_j^2 Var X_j (closed form), through draw and SALib.
+
+    Var X_i: (b - a)^2 / 12 for the uniforms, scipy's truncnorm variance for the lordosis angle.
+    """
+    spec = _spec(samples=4096)
+    values = atlas.draw(spec, atlas.saltelli_unit(spec))
+    weights = np.array([0.01, 5.0, 0.02, 0.01, 3.0])
+    variances = np.array(
+        [
+            stats.truncnorm((20 - 49.8) / 11.2, (90 - 49.8) / 11.2, loc=49.8, scale=11.2).var(),
+            0.08**2 / 12,
+            20.0**2 / 12,
+            30.0**2 / 12,
+            0.047**2 / 12,
+        ]
+    )
+    y = sum(w * values[name] for w, name in zip(weights, spec.names, strict=True))
+    found = atlas.sobol_indices(spec, y)
+    share = weights**2 * variances / np.sum(weights**2 * variances)
+    for name, expected in zip(spec.names, share, strict=True):
+        assert found[name]["S1"] == pytest.approx(expected, abs=0.03)
+        assert found[name]["ST"] == pytest.approx(expected, abs=0.03)
+
+
+def test_the_fast_path_is_one_model_per_draw():
+    """Mass, K and delay varied inside one stacked problem give the outputs of one model per draw (a second method)."""
+    spec = _spec()
+    values = atlas.draw(spec, atlas.saltelli_unit(spec))
+    fast, reference = atlas.evaluate(spec, values, method="fast"), atlas.evaluate(spec, values, method="per-draw")
+    for name in ("min_pcsa_cm2", "counter_torque_norm_Nm", "spine_delay_margin_s", "delay_s"):
+        np.testing.assert_allclose(fast[name], reference[name], rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(  # the stacked SDP holds each point's optimum to its tolerance (stacked_sdp)
+        fast["local_stiffness_total_Nm_per_rad"], reference["local_stiffness_total_Nm_per_rad"], rtol=1e-4
+    )
+
+
+def test_draws_convert_the_angle_with_the_spline():
+    """Each draw's Lambda is lordosis_from_angle of its angle; its E and mass lie within the bounds."""
+    spec = _spec()
+    values = atlas.draw(spec, atlas.saltelli_unit(spec))
+    np.testing.assert_array_equal(values["lordosis_m"], lordosis_from_angle(values["lordosis_angle_deg"], spec.model))
+    assert np.all((values["body.mass"] >= 30) & (values["body.mass"] <= 50))
+
+
+def test_wilson_interval_is_the_closed_form():
+    """p = 30/100 at 95 %: (p + z^2/2n -+ z sqrt(p(1-p)/n + z^2/4n^2)) / (1 + z^2/n), z = 1.959964 (Wilson 1927)."""
+    z, n, p = stats.norm.ppf(0.975), 100, 0.3
+    centre, half = p + z**2 / (2 * n), z * np.sqrt(p * (1 - p) / n + z**2 / (4 * n**2))
+    found = atlas.wilson(30, 100, 0.95)
+    assert found["low"] == pytest.approx((centre - half) / (1 + z**2 / n), rel=1e-9)
+    assert found["high"] == pytest.approx((centre + half) / (1 + z**2 / n), rel=1e-9)
+
+
+def test_same_seed_same_numbers_and_resume(tmp_path, monkeypatch):
+    """The same seed gives the same JSON; another seed other draws; a second run reads its saved chunks."""
+    spec = _spec(chain="false")
+    first = atlas.run_atlas(spec, tmp_path / "a", progress=False).to_dict()
+    assert atlas.run_atlas(spec, tmp_path / "b", progress=False).to_dict() == first
+    other = atlas.run_atlas(dataclasses.replace(spec, seed=1), None, progress=False).to_dict()
+    assert other["sobol"] != first["sobol"]
+    assert {p.name for p in (tmp_path / "a").iterdir()} >= {"atlas.json", "report.md", "density.png", "draws.npz"}
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("solved a chunk that was saved")
+
+    monkeypatch.setattr(atlas, "evaluate", refuse)
+    assert atlas.run_atlas(spec, tmp_path / "a", progress=False).to_dict() == first
+
+
+def test_verdicts_name_their_criteria():
+    """Every verdict the atlas reports names joint by joint or the chain."""
+    assert all("joint by joint" in text or "the chain" in text for text in atlas.VERDICTS.values())

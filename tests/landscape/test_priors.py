@@ -1,0 +1,91 @@
+"""The atlas file's schema: its priors, their truncated distributions and the one-line errors."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy import stats
+
+from spinectl.errors import ConfigError
+from spinectl.landscape.priors import parse_atlas
+
+HEAD = "[atlas]\nsamples = 8\n"
+
+
+def _prior(**fields) -> str:
+    row = {"parameter": "body.mass", "distribution": "uniform", "bounds": [30.0, 50.0], "source": "s"} | fields
+    lines = ["[[prior]]"]
+    for key, value in row.items():
+        if value is not None:
+            lines.append(f"{key} = {value!r}".replace("'", '"'))
+    return "\n".join(lines) + "\n"
+
+
+@pytest.mark.parametrize(
+    ("text", "field", "words"),
+    [
+        (HEAD + _prior(distribution="gamma"), "prior[0].distribution", "unknown family 'gamma'"),
+        (HEAD + _prior(distribution="normal", mean=40.0, sd=1.0, bounds=[60.0, 70.0]), "prior[0].bounds", "no mass"),
+        (HEAD + _prior(parameter="lordosis_angle"), "prior[0].parameter", "did you mean 'lordosis_angle_deg'"),
+        (HEAD + _prior(parameter="body.mas"), "body.mas", "did you mean 'mass'"),
+        (HEAD + _prior(parameter="geometry.spline_bc"), "prior[0].parameter", "not a number"),
+        (HEAD + _prior(bounds=[50.0, 30.0]), "prior[0].bounds", "low < high"),
+        (HEAD + _prior(source=None), "prior[0].source", "required"),
+        (HEAD + _prior(colour=1), "prior[0].colour", "unknown key"),
+        ("[atlas]\nsamples = 12\n" + _prior(), "atlas.samples", "power of 2"),
+        (HEAD + _prior() + _prior(), "prior[1].parameter", "has a prior already"),
+        (HEAD, "prior", "one or more"),
+    ],
+)
+def test_bad_atlas_files_are_one_error_naming_the_field(text, field, words):
+    """Each mistake is a ConfigError naming its field, with the words of the rule (and a 'did you mean')."""
+    with pytest.raises(ConfigError) as raised:
+        parse_atlas(text)
+    assert raised.value.field == field and words in str(raised.value)
+    assert "\n" not in str(raised.value)
+
+
+def test_truncated_normal_quantiles_are_scipys_truncnorm():
+    """Prior.ppf of a truncated normal equals scipy.stats.truncnorm's quantiles (a second implementation)."""
+    text = HEAD + _prior(
+        parameter="lordosis_angle_deg", distribution="truncated normal", mean=49.8, sd=11.2, bounds=[20.0, 90.0]
+    )
+    prior = parse_atlas(text).priors[0]
+    u = np.linspace(0.01, 0.99, 25)
+    reference = stats.truncnorm((20.0 - 49.8) / 11.2, (90.0 - 49.8) / 11.2, loc=49.8, scale=11.2).ppf(u)
+    np.testing.assert_allclose(prior.ppf(u), reference, rtol=1e-9)
+
+
+def test_lognormal_takes_the_quantitys_mean_and_sd():
+    """'lognormal' with mean m and sd s: the untruncated draws have mean m and sd s (scipy's moments)."""
+    prior = parse_atlas(HEAD + _prior(distribution="lognormal", mean=40.0, sd=8.0, bounds=None)).priors[0]
+    mean, var = prior._frozen().stats("mv")
+    assert float(mean) == pytest.approx(40.0) and math.sqrt(float(var)) == pytest.approx(8.0)
+
+
+def test_the_shipped_priors_load_and_cite():
+    """examples/atlas.toml parses; every row has a DOI or says 'unverified'."""
+    from pathlib import Path
+
+    from spinectl.landscape.priors import load_atlas
+
+    spec = load_atlas(Path(__file__).parents[2] / "examples" / "atlas.toml")
+    assert spec.names[0] == "lordosis_angle_deg" and spec.samples == 1024
+    assert all("doi:" in p.source or p.source.startswith("unverified") for p in spec.priors)
+
+
+@pytest.mark.parametrize(
+    ("fields", "words"),
+    [
+        ({"parameter": "lordosis_angle_deg", "bounds": [20.0, 170.0]}, "geometry.lordosis_range"),
+        ({"parameter": "eccentricity_m", "distribution": "normal", "mean": 0.03, "sd": 0.01, "bounds": None}, "range"),
+        ({"parameter": "body.mass", "bounds": [-10.0, 50.0]}, "mass"),
+    ],
+)
+def test_priors_whose_draws_leave_the_model_are_refused(fields, words):
+    """Every draw must be a valid model: a prior reaching beyond a parameter's range is refused when read."""
+    with pytest.raises(ConfigError) as raised:
+        parse_atlas(HEAD + _prior(**fields))
+    assert raised.value.field == "prior[0].bounds" and words in str(raised.value)
