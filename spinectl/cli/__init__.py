@@ -35,6 +35,7 @@ COMMANDS = (
     "study_cmd",
     "calibrate_cmd",
     "anatomy_cmd",
+    "export_cmd",
 )
 """Modules of :mod:`spinectl.cli` that each register one sub-command."""
 
