@@ -12,7 +12,7 @@ rest of it is cancelled by a ``PrescribedForce`` at the level's centre of mass, 
 the ground frame.
 
 OpenSim has no muscle with the paper's curves: the fibres are ``Millard2012EquilibriumMuscle``
-s with a rigid tendon, no activation dynamics, no pennation, the paper's optimal length
+s with a rigid tendon, no activation dynamics, no pennation, no fibre damping, the paper's optimal length
 (1.2 l0) and maximal velocity, and Millard's own curves, so the tension and its slopes at
 the posture differ from spinectl's (docs/interchange.md, "What is lost"); the geometry, the
 masses, gravity and the springs are the same.
@@ -155,6 +155,7 @@ def paper_osim(solution: PaperSolution):
         )
         muscle.set_ignore_tendon_compliance(True)
         muscle.set_ignore_activation_dynamics(True)
+        muscle.set_fiber_damping(0.0)  # the paper's fibres have no damping of their own
         muscle.set_max_contraction_velocity(float(max_velocity(l_opt[f], model.fibre) / l_opt[f]))
         muscle.addNewPathPoint(f"{name}_upper", bodies[0], _vec(osim, fibres.upper[f]))
         muscle.addNewPathPoint(f"{name}_lower", out.getGround(), _vec(osim, fibres.lower[f]))
