@@ -319,7 +319,7 @@ def paper_spec(solution: PaperSolution):
         actuator.biastype = mujoco.mjtBias.mjBIAS_NONE
         actuator.gainprm[:3] = gains[f]
         actuator.ctrllimited = mujoco.mjtLimited.mjLIMITED_FALSE
-    for k, joint in enumerate(model.geometry.cor_names):
+    for joint in model.geometry.cor_names:
         motor = spec.add_actuator(name=f"counter_{joint}", target=joint, trntype=mujoco.mjtTrn.mjTRN_JOINT)
         motor.gainprm[0] = 1.0
         motor.ctrllimited = mujoco.mjtLimited.mjLIMITED_FALSE

@@ -1,4 +1,4 @@
-"""The paper's model and its solution as an OpenSim model (``.osim``), built with OpenSim's own API (docs/interchange.md).
+"""The paper's model and its solution as an OpenSim model (``.osim``), built with OpenSim's API (docs/interchange.md).
 
 The same chain as the MJCF export (:mod:`spinectl.anatomy.export_mjcf`): a pin joint at every
 CoR (OpenSim's frame: spinectl's x and y, rotation about z), each body with the mass it

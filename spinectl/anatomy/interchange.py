@@ -38,7 +38,9 @@ def format_of(out, fmt: str | None = None) -> str:
     for name, suffixes in FORMATS.items():
         if suffix in suffixes:
             return name
-    raise ParameterError("format", f"not given, and the suffix of {printable(str(out))} names none of {sorted(FORMATS)}")
+    raise ParameterError(
+        "format", f"not given, and the suffix of {printable(str(out))} names none of {sorted(FORMATS)}"
+    )
 
 
 def export_model(
@@ -80,4 +82,6 @@ def export_model(
         from .export_mjcf import export_mjcf as write
     else:
         from .export_osim import export_osim as write
-    return write(model, eccentricity, lordosis, out, pcsa=pcsa, with_local_stiffness=with_local_stiffness, inputs=inputs)
+    return write(
+        model, eccentricity, lordosis, out, pcsa=pcsa, with_local_stiffness=with_local_stiffness, inputs=inputs
+    )

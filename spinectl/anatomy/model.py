@@ -203,8 +203,7 @@ def load(model: str | Path = "myotorso", mapping: str | Path | Mapping | None = 
     Parameters
     ----------
     model : str or pathlib.Path
-        ``"myotorso"`` (from the installed myo-sim), an MJCF file, or an ``.osim`` file (OpenSim as the
-        engine, :func:`spinectl.anatomy.opensim_engine.load_osim`).
+        ``"myotorso"`` (from the installed myo-sim) or an MJCF file.
     mapping : str, pathlib.Path or Mapping, optional
         A mapping TOML file; default the built-in one of the model's name.
 
@@ -219,10 +218,6 @@ def load(model: str | Path = "myotorso", mapping: str | Path | Mapping | None = 
     >>> torso.chain("sagittal").joints  # doctest: +SKIP
     ('flex_extension', 'L4_L5_FE', 'L3_L4_FE', 'L2_L3_FE', 'L1_L2_FE')
     """
-    if Path(str(model)).suffix.lower() == ".osim":  # OpenSim as the engine (docs/interchange.md)
-        from .opensim_engine import load_osim
-
-        return load_osim(model, mapping)
     engine = load_engine(model)
     if mapping is None:
         mapping = default_mapping(engine.name)

@@ -1,4 +1,4 @@
-"""OpenSim as the engine of an anatomical model (``.osim``): the same mapping, classes and LinearChain (docs/interchange.md).
+"""OpenSim as the engine of an ``.osim`` model: the same mapping, classes and LinearChain (docs/interchange.md).
 
 Everything is OpenSim's: the model is read and built by :class:`opensim.Model` (spinectl
 parses no ``.osim`` of its own), the muscles' path lengths and moment arms
@@ -63,11 +63,26 @@ class OsimEngine:
     couplers: tuple = field(default=())
 
     def coordinate(self, name: str):
-        """The coordinate of that name."""
+        """The coordinate of that name.
+
+        Parameters
+        ----------
+        name : str
+
+        Returns
+        -------
+        opensim.Coordinate
+        """
         return self.model.getCoordinateSet().get(name)
 
     def set_posture(self, values: dict) -> None:
-        """Set coordinates (name -> value [rad]) at zero speed, the others at their defaults, and realise positions."""
+        """Set coordinates at zero speed, the others at their defaults, and realise positions.
+
+        Parameters
+        ----------
+        values : dict
+            Coordinate name -> value [rad].
+        """
         coords = self.model.getCoordinateSet()
         for i in range(coords.getSize()):
             c = coords.get(i)
@@ -194,7 +209,10 @@ def _arms_and_passive(engine: OsimEngine, names, values: dict):
     model, state = engine.model, engine.state
     muscles = model.getMuscles()
     arms = np.array(
-        [[-muscles.get(i).computeMomentArm(state, engine.coordinate(c)) for c in names] for i in range(muscles.getSize())]
+        [
+            [-muscles.get(i).computeMomentArm(state, engine.coordinate(c)) for c in names]
+            for i in range(muscles.getSize())
+        ]
     )
     forces = model.getForceSet()
     for i in range(forces.getSize()):  # gravity and the passive forces only: muscles and actuators off
@@ -289,10 +307,29 @@ class OsimAnatomy(Anatomy):
 
     The chain is free (coordinate couplers left out, named in ``engine.couplers``): the
     constrained chain is the free one. MuJoCo's referee (``--check``) and the optimum need MJCF.
+
+    Parameters
+    ----------
+    engine : OsimEngine
+    mapping : Mapping
+    muscles : tuple of str
+        The muscles' names.
+    classes : tuple of str
+        Each muscle's class.
     """
 
     def posture(self, posture=None) -> dict:
-        """The coordinates' default values (the model's posture), or the given dict of name -> value [rad]."""
+        """The posture: the coordinates' default values, or those given.
+
+        Parameters
+        ----------
+        posture : dict, optional
+            Coordinate name -> value [rad]; the others at their defaults.
+
+        Returns
+        -------
+        dict
+        """
         if posture is None:
             return {}
         if not isinstance(posture, dict):
@@ -300,12 +337,40 @@ class OsimAnatomy(Anatomy):
         return dict(posture)
 
     def linearise(self, plane: str = "sagittal", posture=None) -> tuple:
-        """The linearisation over the plane's coordinates, no rhythm, and the coordinates' names."""
+        """The linearisation over the plane's coordinates (no rhythm).
+
+        Parameters
+        ----------
+        plane : str
+            One of the mapping's planes.
+        posture : dict, optional
+            Coordinate name -> value [rad].
+
+        Returns
+        -------
+        tuple
+            (Linearisation, None, the coordinates' names).
+        """
         names = self.plane_joints(plane)
         return linearise(self.engine, names, self.posture(posture)), None, list(names)
 
     def chains(self, plane: str = "sagittal", posture=None, joint_stiffness="none") -> tuple:
-        """(free chain, the same as the constrained one, linearisation): coordinate couplers are left out."""
+        """The free chain (coordinate couplers left out), also as the constrained one, and the linearisation.
+
+        Parameters
+        ----------
+        plane : str
+            One of the mapping's planes.
+        posture : dict, optional
+            Coordinate name -> value [rad].
+        joint_stiffness : {"none", "mapped"} or float
+            Added at each chain joint [N m/rad].
+
+        Returns
+        -------
+        tuple
+            (free LinearChain, the same, Linearisation).
+        """
         lin, _, names = self.linearise(plane, posture)
         added = self.added_stiffness(joint_stiffness, lin.n)
         left = f"; coupler constraints left out: {', '.join(self.engine.couplers)}" if self.engine.couplers else ""

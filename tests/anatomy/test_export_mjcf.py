@@ -45,7 +45,9 @@ def _loaded(path):
 
 def _dofs(m, model):
     """MuJoCo's dof of each CoR, in spinectl's order (top to bottom)."""
-    return np.array([m.jnt_dofadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, j)] for j in model.geometry.cor_names])
+    return np.array(
+        [m.jnt_dofadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, j)] for j in model.geometry.cor_names]
+    )
 
 
 def _at(m, d, dofs, q):

@@ -56,7 +56,10 @@ def test_path_lengths_and_moment_arms_are_opensims(exported):
         lengths = np.array([muscles.get(f).getLength(state) for f in range(muscles.getSize())])
         arms = np.array(
             [
-                [muscles.get(f).computeMomentArm(state, loaded.getCoordinateSet().get(j)) for j in model.geometry.cor_names]
+                [
+                    muscles.get(f).computeMomentArm(state, loaded.getCoordinateSet().get(j))
+                    for j in model.geometry.cor_names
+                ]
                 for f in range(muscles.getSize())
             ]
         )
@@ -104,7 +107,7 @@ def test_springs_and_controls_hold_the_solution(exported):
 
 
 def test_cli_writes_osim_and_refuses_to_overwrite_its_input(tmp_path, capsys):
-    """``spinectl export --format osim`` writes the model and its controls; --out equal to --config: one line, exit 2."""
+    """``spinectl export`` to .osim writes the model and its controls; --out equal to --config: one line, exit 2."""
     out = tmp_path / "chain.osim"
     assert main(["export", "--E", "0.03", "--Lambda", "0.04", "--out", str(out)]) == 0
     assert out.exists() and controls_path(out).exists()

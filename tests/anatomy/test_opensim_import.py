@@ -50,7 +50,7 @@ def test_geometry_masses_and_gravity_are_the_chains(imported):
 
 
 def _millard_values(path, model):
-    """Millard's active force-length value and slope [1/m] and force-velocity slope [s/m] at the upright fibre length."""
+    """Millard's active force-length value and slope [1/m], force-velocity slope [s/m], at the upright fibre length."""
     built = osim.Model(str(path))
     muscle = osim.Millard2012EquilibriumMuscle.safeDownCast(built.getMuscles().get(0))
     l_opt = muscle.getOptimalFiberLength()
@@ -62,7 +62,8 @@ def _millard_values(path, model):
 
 
 def test_muscle_matrices_differ_by_millards_curves_exactly(imported):
-    """Per fibre of the first muscle (straight_ventral), OpenSim's K_i and D_i are spinectl's with Millard's curve values:
+    """Per fibre of the first muscle (straight_ventral), OpenSim's K_i and D_i are spinectl's with
+    Millard's curve values:
 
     spinectl per unit f_iso: D = f_l f_H' h h', K = -f_l' h h' - f_l H (docs/chain.md), so from spinectl's K and D
     of the fibre sum, Sigma h h' = D / (f_l f_H') and Sigma H = -(K + f_l' Sigma h h') / f_l; OpenSim per unit
