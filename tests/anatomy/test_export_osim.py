@@ -117,3 +117,14 @@ def test_cli_writes_osim_and_refuses_to_overwrite_its_input(tmp_path, capsys):
     assert main(["export", "--config", str(config), "--out", str(config)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and config.read_text() == ""
+
+
+def test_without_opensim_the_export_says_what_to_install(tmp_path, monkeypatch, capsys):
+    """With ``opensim`` not importable (None in sys.modules), ``spinectl export`` to .osim is one line naming the
+    extra, exit 2, and writes nothing."""
+    monkeypatch.setitem(__import__("sys").modules, "opensim", None)
+    out = tmp_path / "chain.osim"
+    assert main(["export", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "spinectl[opensim]" in err
+    assert not out.exists()
