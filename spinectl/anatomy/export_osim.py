@@ -4,7 +4,8 @@ The same chain as the MJCF export (:mod:`spinectl.anatomy.export_mjcf`): a pin j
 CoR (OpenSim's frame: spinectl's x and y, rotation about z), each body with the mass it
 carries, every fibre as a muscle on a straight path from its upper attachment (thorax) to
 its lower one (ground = pelvis), the intervertebral stiffness as a ``SpringGeneralizedForce``
-per joint, the per-segment counter torques as ``CoordinateActuator`` s, and the solution held
+per joint, the counter torques as ``CoordinateActuator`` s (those that hold the posture against
+OpenSim's own forces, :func:`opensim_counter_torque`), and the solution held
 by a ``PrescribedController`` of constant controls (also written beside the model as a
 controls ``.sto``). A lumbar level's weight enters spinectl's gravity only by
 ``levels.weight_in_gravity`` (docs/chain.md): OpenSim has no gravity compensation, so the
@@ -93,12 +94,14 @@ def _vec(osim, point):
     return osim.Vec3(float(point[0]), float(point[1]), 0.0)
 
 
-def paper_osim(solution: PaperSolution):
+def paper_osim(solution: PaperSolution, counter_torque=None):
     """The OpenSim model (:class:`opensim.Model`) of the paper's chain with the solution's controls.
 
     Parameters
     ----------
     solution : PaperSolution
+    counter_torque : array_like, shape (n_cor,), optional
+        The counter torques' controls [N m]; default the solution's (those of spinectl's tension).
 
     Returns
     -------
@@ -176,13 +179,46 @@ def paper_osim(solution: PaperSolution):
         actuator.setMaxControl(np.inf)
         out.addForce(actuator)
         labels.append(f"counter_{coordinate}")
-        values.append(float(solution.counter_torque[k]))
+        values.append(float((solution.counter_torque if counter_torque is None else counter_torque)[k]))
     for label, value in zip(labels, values, strict=True):
         controller.addActuator(out.getComponent(f"forceset/{label}"))
         controller.prescribeControlForActuator(label, osim.Constant(value))
     out.addController(controller)
     out.finalizeConnections()
     return out, labels, values
+
+
+def opensim_counter_torque(solution: PaperSolution) -> np.ndarray:
+    """The counter torques that hold the posture against OpenSim's own forces [N m].
+
+    Millard's tension at the posture is not the paper's (docs/interchange.md), so spinectl's
+    counter torques -tau_0 leave a net torque in OpenSim. These are OpenSim's inverse dynamics
+    at rest of the model with the solution's activations and no counter torque: the posture is
+    then an equilibrium of the exported model.
+
+    Parameters
+    ----------
+    solution : PaperSolution
+
+    Returns
+    -------
+    numpy.ndarray, shape (n_cor,)
+        Top to bottom, as ``model.geometry.cor_names``.
+    """
+    osim = require_opensim()
+    built, _, _ = paper_osim(solution, np.zeros(len(solution.counter_torque)))
+    state = built.initSystem()
+    built.equilibrateMuscles(state)
+    built.realizeDynamics(state)
+    needed = osim.InverseDynamicsSolver(built).solve(state, osim.Vector(state.getNU(), 0.0))
+    coords = built.getCoordinateSet()
+    speeds = {}
+    for i in range(coords.getSize()):  # the mobility of each coordinate, read off the state
+        for j in range(coords.getSize()):
+            coords.get(j).setSpeedValue(state, float(i == j))
+        u = state.getU()
+        speeds[coords.get(i).getName()] = int(np.argmax([abs(u.get(k)) for k in range(u.size())]))
+    return np.array([needed.get(speeds[name]) for name in coordinate_names(solution.model)])
 
 
 def controls_path(out) -> Path:
@@ -234,7 +270,7 @@ def export_osim(
     sto = controls_path(out)
     check_distinct({"--out": str(out), "controls": str(sto)}, inputs)
     solution = paper_solution(model, eccentricity, lordosis, pcsa, with_local_stiffness)
-    built, labels, values = paper_osim(solution)
+    built, labels, values = paper_osim(solution, opensim_counter_torque(solution))
     built.initSystem()  # refuse to write what OpenSim cannot build
     table = osim.TimeSeriesTable()
     table.setColumnLabels(labels)

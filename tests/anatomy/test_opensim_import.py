@@ -105,3 +105,38 @@ def test_cli_analyses_the_osim_and_refuses_unmapped_coordinates(imported, tmp_pa
     assert main(["anatomy", str(path), "--mapping", str(mapping)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "L9L10" in err
+
+
+def test_opensims_simulation_grows_at_the_rate_the_imported_chain_predicts(imported):
+    """OpenSim's own forward simulation (Manager.integrate, accuracy 1e-10) of the exported model, displaced
+    1e-5 rad along the imported chain's fastest growing mode, grows at that mode's eigenvalue to 5 %.
+
+    The chain is linearised at OpenSim's activations (Millard floors them at 0.01, so the optimum's idle
+    muscles are at 0.01 there), and the file's counter torques hold the posture against OpenSim's forces
+    (export_osim.opensim_counter_torque): the posture is an equilibrium, so the growth is the mode's.
+    """
+    _, loaded, free, _, path = imported
+    model = osim.Model(str(path))
+    state = model.initSystem()
+    model.equilibrateMuscles(state)
+    model.realizeDynamics(state)
+    muscles = model.getMuscles()
+    act = np.array([muscles.get(i).getActivation(state) for i in range(muscles.getSize())])
+    values, vectors = np.linalg.eig(chain.state_matrix(free.mass_matrix, free.stiffness(act), free.damping(act)))
+    top = np.argmax(values.real)
+    rate, mode = values[top].real, np.real(vectors[:, top])
+    mode = mode / np.linalg.norm(mode[:5])
+    coords = model.getCoordinateSet()
+    for k, name in enumerate(free.joints):
+        coords.get(name).setValue(state, 1e-5 * mode[k], False)
+        coords.get(name).setSpeedValue(state, 1e-5 * mode[5 + k])
+    manager = osim.Manager(model)
+    manager.setIntegratorAccuracy(1e-10)
+    manager.initialize(state)
+    times = 0.001 * np.arange(1, 51)
+    amplitude = []
+    for time in times:
+        s = manager.integrate(float(time))
+        amplitude.append(abs(np.array([coords.get(n).getValue(s) for n in free.joints]) @ mode[:5]))
+    fitted = np.polyfit(times, np.log(amplitude), 1)[0]
+    assert rate > 0 and abs(fitted - rate) <= 0.05 * rate
