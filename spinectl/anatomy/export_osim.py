@@ -72,6 +72,7 @@ def require_opensim():
     except ImportError:
         raise OpenSimUnavailable(f"OpenSim models need OpenSim: {INSTALL_HINT}") from None
     opensim.Logger.setLevelString("warn")  # OpenSim's [info] lines are not spinectl's output
+    opensim.Logger.removeFileSink()  # nor its opensim.log in the working folder
     return opensim
 
 
