@@ -40,6 +40,7 @@ COMMANDS = (
     "calibrate_cmd",
     "anatomy_cmd",
     "atlas_cmd",
+    "export_cmd",
 )
 """Modules of :mod:`spinectl.cli` that each register one sub-command."""
 

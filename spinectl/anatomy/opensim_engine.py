@@ -1,0 +1,406 @@
+"""OpenSim as the engine of an ``.osim`` model: the same mapping, classes and LinearChain (docs/interchange.md).
+
+Everything is OpenSim's: the model is read and built by :class:`opensim.Model` (spinectl
+parses no ``.osim`` of its own), the muscles' path lengths and moment arms
+(``Muscle.getLength``, ``computeMomentArm``, wrapping and conditional points included), the
+muscle curves (Millard 2012's active and passive force-length and force-velocity curves,
+``calcValue``/``calcDerivative``), the generalised gravity and every passive force (minus the
+inverse dynamics at rest with the muscles and actuators off) and the mass matrix
+(``SimbodyMatterSubsystem.calcM``). The linearisation is that of
+:mod:`spinectl.anatomy.linearise`: K_i = H_i gain_i + gain_i' r_i r_i^T, with the Hessians H_i
+by central differences of OpenSim's moment arms, K_0 by central differences of the passive
+torques, so the chain is a :class:`~spinectl.model.linear_chain.LinearChain` like MuJoCo's.
+
+Supported muscles: ``Millard2012EquilibriumMuscle`` with a rigid tendon (fibre length = path
+length - tendon slack length, no pennation), its activation the control. The chain is free:
+coordinate coupler constraints (Christophy's lumbar rhythm) are reported by name and left out.
+
+References
+----------
+Seth A, Hicks JL, Uchida TK, et al. (2018). OpenSim: Simulating musculoskeletal dynamics and
+neuromuscular control to study human and animal movement. PLoS Comput Biol 14(7):e1006223.
+doi:10.1371/journal.pcbi.1006223.
+
+Millard M, Uchida T, Seth A, Delp SL (2013). Flexing computational muscle: modeling and
+simulation of musculotendon dynamics. J Biomech Eng 135(2):021005. doi:10.1115/1.4023390.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .._validate import printable
+from ..errors import ModelError, ParameterError
+from .export_osim import require_opensim
+from .linearise import STEP, Linearisation, free_chain
+from .mapping import Mapping, default_mapping, read_mapping
+from .model import Anatomy
+
+
+@dataclass
+class OsimEngine:
+    """An OpenSim model built from a ``.osim`` file, with its working state.
+
+    Attributes
+    ----------
+    model : opensim.Model
+    state : SimTK.State
+    name, source, sha256 : str
+        The model's name, the file's path and the SHA-256 of its bytes.
+    couplers : tuple of str
+        Names of the model's ``CoordinateCouplerConstraint`` s (left out of the free chain).
+    """
+
+    model: object
+    state: object
+    name: str
+    source: str
+    sha256: str
+    couplers: tuple = field(default=())
+
+    def coordinate(self, name: str):
+        """The coordinate of that name.
+
+        Parameters
+        ----------
+        name : str
+
+        Returns
+        -------
+        opensim.Coordinate
+        """
+        return self.model.getCoordinateSet().get(name)
+
+    def set_posture(self, values: dict) -> None:
+        """Set coordinates at zero speed, the others at their defaults, and realise positions.
+
+        Parameters
+        ----------
+        values : dict
+            Coordinate name -> value [rad].
+        """
+        coords = self.model.getCoordinateSet()
+        for i in range(coords.getSize()):
+            c = coords.get(i)
+            c.setValue(self.state, float(values.get(c.getName(), c.getDefaultValue())), False)
+            c.setSpeedValue(self.state, 0.0)
+        self.model.realizePosition(self.state)
+
+
+def load_engine(path) -> OsimEngine:
+    """Build an ``.osim`` file with OpenSim.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+
+    Returns
+    -------
+    OsimEngine
+    """
+    osim = require_opensim()
+    path = Path(path)
+    if not path.is_file():
+        raise ParameterError("model", f"no such .osim file: {printable(str(path))}")
+    try:
+        model = osim.Model(str(path))
+        state = model.initSystem()
+    except Exception as exc:  # OpenSim raises its own exception types, one line each
+        raise ParameterError("model", f"OpenSim cannot build {path}: {str(exc).splitlines()[0]}") from None
+    constraints = model.getConstraintSet()
+    couplers = tuple(
+        constraints.get(i).getName()
+        for i in range(constraints.getSize())
+        if constraints.get(i).getConcreteClassName() == "CoordinateCouplerConstraint"
+    )
+    digest = hashlib.sha256(path.read_bytes()).hexdigest()
+    return OsimEngine(model, state, model.getName() or path.stem, str(path.resolve()), digest, couplers)
+
+
+def _base_body(frame) -> str:
+    """The body (or ground) a frame is fixed to."""
+    return frame.findBaseFrame().getName()
+
+
+def _check_mapping(engine: OsimEngine, mapping: Mapping) -> None:
+    """Every mapped body and coordinate exists, and the model has muscles: else one line."""
+    bodies = {engine.model.getGround().getName()} | {
+        engine.model.getBodySet().get(i).getName() for i in range(engine.model.getBodySet().getSize())
+    }
+    for group, names in mapping.bodies.items():
+        missing = [n for n in names if n not in bodies]
+        if missing:
+            raise ParameterError(f"mapping.bodies.{group}", f"names bodies that {engine.name} lacks: {missing}")
+    coords = engine.model.getCoordinateSet()
+    for plane, names in mapping.planes.items():
+        missing = [n for n in names if not coords.contains(n)]
+        if missing:
+            raise ParameterError(f"mapping.planes.{plane}", f"names coordinates that {engine.name} lacks: {missing}")
+    if engine.model.getMuscles().getSize() == 0:
+        raise ParameterError("model", f"{engine.name} has no muscles")
+
+
+def _classify(engine: OsimEngine, mapping: Mapping) -> tuple:
+    """Each muscle's class by the bodies its path points are fixed to (spinectl.anatomy.mapping's rule)."""
+    group_of = {body: group for group, names in mapping.bodies.items() for body in names}
+    muscles = engine.model.getMuscles()
+    classes = []
+    for i in range(muscles.getSize()):
+        points = muscles.get(i).getGeometryPath().getPathPointSet()
+        groups = {group_of.get(_base_body(points.get(k).getParentFrame()), "other") for k in range(points.getSize())}
+        if "vertebrae" in groups:
+            classes.append("local")
+        elif groups <= {"pelvis", "thorax"}:
+            classes.append("global")
+        else:
+            classes.append("between")
+    return tuple(classes)
+
+
+def _millard(engine: OsimEngine, muscle):
+    """The Millard muscle behind ``muscle``, rigid tendon, or one line saying what is not supported."""
+    osim = require_opensim()
+    millard = osim.Millard2012EquilibriumMuscle.safeDownCast(muscle)
+    if millard is None or not millard.get_ignore_tendon_compliance():
+        raise ModelError(
+            f"{engine.name}: muscle {muscle.getName()} ({muscle.getConcreteClassName()}) is not supported: "
+            "the OpenSim import reads Millard2012EquilibriumMuscle with a rigid tendon"
+        )
+    return millard
+
+
+def _curves(engine: OsimEngine, lengths, velocities) -> np.ndarray:
+    """gain, dgain/dl, dgain/dv, bias, dbias/dl, dbias/dv of every muscle (force along its length, negative pulls).
+
+    Millard, rigid tendon, no pennation: with l~ = (L - L_s) / l_opt and v~ = V / (l_opt v_max),
+    the tension is F_max (a f_AL(l~) f_V(v~) + f_PE(l~) + beta v~), beta the fibre damping.
+    """
+    muscles = engine.model.getMuscles()
+    out = np.zeros((6, muscles.getSize()))
+    for i in range(muscles.getSize()):
+        m = _millard(engine, muscles.get(i))
+        f_max, l_opt = m.getMaxIsometricForce(), m.getOptimalFiberLength()
+        v_unit = l_opt * m.getMaxContractionVelocity()
+        lt = (lengths[i] - m.getTendonSlackLength()) / l_opt
+        vt = velocities[i] / v_unit
+        active, fv, passive = m.getActiveForceLengthCurve(), m.getForceVelocityCurve(), m.getFiberForceLengthCurve()
+        beta = m.get_fiber_damping()
+        out[:, i] = -f_max * np.array(
+            [
+                active.calcValue(lt) * fv.calcValue(vt),
+                active.calcDerivative(lt, 1) * fv.calcValue(vt) / l_opt,
+                active.calcValue(lt) * fv.calcDerivative(vt, 1) / v_unit,
+                passive.calcValue(lt) + beta * vt,
+                passive.calcDerivative(lt, 1) / l_opt,
+                beta / v_unit,
+            ]
+        )
+    return out
+
+
+def _arms_and_passive(engine: OsimEngine, names, values: dict):
+    """dl/dq of every muscle over the chain's coordinates (-computeMomentArm) and the passive torques [N m]."""
+    osim = require_opensim()
+    engine.set_posture(values)
+    model, state = engine.model, engine.state
+    muscles = model.getMuscles()
+    arms = np.array(
+        [
+            [-muscles.get(i).computeMomentArm(state, engine.coordinate(c)) for c in names]
+            for i in range(muscles.getSize())
+        ]
+    )
+    forces = model.getForceSet()
+    for i in range(forces.getSize()):  # gravity and the passive forces only: muscles and actuators off
+        force = forces.get(i)
+        force.setAppliesForce(state, osim.Actuator.safeDownCast(force) is None)
+    model.realizeDynamics(state)
+    needed = osim.InverseDynamicsSolver(model).solve(state, osim.Vector(state.getNU(), 0.0))
+    order = _mobility_order(engine)
+    passive = -np.array([needed.get(order[c]) for c in names])
+    for i in range(forces.getSize()):
+        forces.get(i).setAppliesForce(state, True)
+    return arms, passive
+
+
+def _mobility_order(engine: OsimEngine) -> dict:
+    """Coordinate name -> its index among the system's mobilities (the order of calcM and the inverse dynamics).
+
+    Read off the state (OpenSim's Python bindings do not wrap the tree order): the entry of U
+    that each coordinate's speed sets. One speed per coordinate (no ball or free joints).
+    """
+    coords, state = engine.model.getCoordinateSet(), engine.state
+    order = {}
+    for i in range(coords.getSize()):  # the one speed that a coordinate's speed sets
+        for j in range(coords.getSize()):
+            coords.get(j).setSpeedValue(state, float(i == j))
+        u = state.getU()
+        order[coords.get(i).getName()] = int(np.argmax([abs(u.get(k)) for k in range(u.size())]))
+    for j in range(coords.getSize()):
+        coords.get(j).setSpeedValue(state, 0.0)
+    return order
+
+
+def linearise(engine: OsimEngine, names, values: dict) -> Linearisation:
+    """K_i, K_0, D_i, D_0, M over the chain's coordinates at a posture (module docstring).
+
+    Parameters
+    ----------
+    engine : OsimEngine
+    names : sequence of str
+        The chain's coordinates.
+    values : dict
+        Coordinate name -> value [rad] of the posture (others at their defaults).
+
+    Returns
+    -------
+    Linearisation
+        Over the chain's coordinates only (``dofs`` = 0 ... n - 1), the other coordinates held.
+    """
+    osim = require_opensim()
+    names = list(names)
+    n = len(names)
+    arms, passive = _arms_and_passive(engine, names, values)
+    muscles = engine.model.getMuscles()
+    engine.set_posture(values)
+    lengths = np.array([muscles.get(i).getLength(engine.state) for i in range(muscles.getSize())])
+    gain, dgain_dl, dgain_dv, bias, dbias_dl, dbias_dv = _curves(engine, lengths, np.zeros_like(lengths))
+    mass = osim.Matrix()
+    engine.model.getMatterSubsystem().calcM(engine.state, mass)
+    order = _mobility_order(engine)
+    index = [order[c] for c in names]
+    full = np.array([[mass.get(i, j) for j in range(mass.ncol())] for i in range(mass.nrow())])
+    hessian = np.zeros((len(lengths), n, n))
+    dpassive = np.zeros((n, n))
+    for k, name in enumerate(names):
+        sides = []
+        for sign in (1.0, -1.0):
+            moved = dict(values)
+            moved[name] = values.get(name, engine.coordinate(name).getDefaultValue()) + sign * STEP
+            sides.append(_arms_and_passive(engine, names, moved))
+        hessian[:, :, k] = (sides[0][0] - sides[1][0]) / (2 * STEP)
+        dpassive[:, k] = (sides[0][1] - sides[1][1]) / (2 * STEP)
+    engine.set_posture(values)
+    hessian = 0.5 * (hessian + hessian.transpose(0, 2, 1))
+    rr = np.einsum("ij,ik->jki", arms, arms)
+    return Linearisation(
+        dofs=tuple(range(n)),
+        n=n,
+        stiffness_per_muscle=hessian.transpose(1, 2, 0) * gain + rr * dgain_dl,
+        stiffness_offset=0.5 * (dpassive + dpassive.T) + np.einsum("ijk,i->jk", hessian, bias) + rr @ dbias_dl,
+        damping_per_muscle=rr * dgain_dv,
+        damping_offset=rr @ dbias_dv,  # the fibres' damping (Millard's fiber_damping)
+        mass=full[np.ix_(index, index)],
+        torque_per_muscle=arms.T * gain,
+        torque_offset=passive + arms.T @ bias,
+        moment_arms=arms,
+    )
+
+
+@dataclass
+class OsimAnatomy(Anatomy):
+    """An OpenSim model mapped onto the chain: :class:`~spinectl.anatomy.model.Anatomy` with OpenSim as the engine.
+
+    The chain is free (coordinate couplers left out, named in ``engine.couplers``): the
+    constrained chain is the free one. MuJoCo's referee (``--check``) and the optimum need MJCF.
+
+    Parameters
+    ----------
+    engine : OsimEngine
+    mapping : Mapping
+    muscles : tuple of str
+        The muscles' names.
+    classes : tuple of str
+        Each muscle's class.
+    """
+
+    def posture(self, posture=None) -> dict:
+        """The posture: the coordinates' default values, or those given.
+
+        Parameters
+        ----------
+        posture : dict, optional
+            Coordinate name -> value [rad]; the others at their defaults.
+
+        Returns
+        -------
+        dict
+        """
+        if posture is None:
+            return {}
+        if not isinstance(posture, dict):
+            raise ParameterError("posture", "of an OpenSim model: a dict of coordinate name -> value [rad]")
+        return dict(posture)
+
+    def linearise(self, plane: str = "sagittal", posture=None) -> tuple:
+        """The linearisation over the plane's coordinates (no rhythm).
+
+        Parameters
+        ----------
+        plane : str
+            One of the mapping's planes.
+        posture : dict, optional
+            Coordinate name -> value [rad].
+
+        Returns
+        -------
+        tuple
+            (Linearisation, None, the coordinates' names).
+        """
+        names = self.plane_joints(plane)
+        return linearise(self.engine, names, self.posture(posture)), None, list(names)
+
+    def chains(self, plane: str = "sagittal", posture=None, joint_stiffness="none") -> tuple:
+        """The free chain (coordinate couplers left out), also as the constrained one, and the linearisation.
+
+        Parameters
+        ----------
+        plane : str
+            One of the mapping's planes.
+        posture : dict, optional
+            Coordinate name -> value [rad].
+        joint_stiffness : {"none", "mapped"} or float
+            Added at each chain joint [N m/rad].
+
+        Returns
+        -------
+        tuple
+            (free LinearChain, the same, Linearisation).
+        """
+        lin, _, names = self.linearise(plane, posture)
+        added = self.added_stiffness(joint_stiffness, lin.n)
+        left = f"; coupler constraints left out: {', '.join(self.engine.couplers)}" if self.engine.couplers else ""
+        free = free_chain(lin, tuple(names), self.muscles, self.classes, added, f"{self.engine.source}, {plane}{left}")
+        return free, free, lin
+
+
+def load_osim(path, mapping=None) -> OsimAnatomy:
+    """Load an ``.osim`` model with OpenSim and map it onto the chain.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The ``.osim`` file.
+    mapping : str, pathlib.Path or Mapping, optional
+        A mapping TOML (names of OpenSim bodies and coordinates); default the built-in one of the
+        model's name (``wagner2012_chain`` for spinectl's own export).
+
+    Returns
+    -------
+    OsimAnatomy
+    """
+    engine = load_engine(path)
+    if mapping is None:
+        mapping = default_mapping(engine.name)
+    elif not isinstance(mapping, Mapping):
+        mapping = read_mapping(mapping)
+    _check_mapping(engine, mapping)
+    muscles = engine.model.getMuscles()
+    for i in range(muscles.getSize()):
+        _millard(engine, muscles.get(i))
+    names = tuple(muscles.get(i).getName() for i in range(muscles.getSize()))
+    return OsimAnatomy(engine, mapping, names, _classify(engine, mapping))

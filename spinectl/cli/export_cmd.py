@@ -1,0 +1,76 @@
+"""``spinectl export``: the paper's model and its solution as an MJCF (MuJoCo) or ``.osim`` (OpenSim) file."""
+
+from __future__ import annotations
+
+from ._common import add_model_options, add_position_options, check_position, float_list, load_model, pcsa_option
+
+
+def register(sub) -> None:
+    """Add the ``export`` sub-command to the ``spinectl`` parser.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The sub-command action of :func:`spinectl.cli.build_parser`.
+    """
+    parser = sub.add_parser(
+        "export",
+        help="write the paper's model and its solution for MuJoCo (MJCF) or OpenSim (.osim)",
+        description="Write the paper's chain at (E, Lambda): pin joints at the CoRs, every fibre as a muscle "
+        "with its attachments, the masses, the joints' stiffness and the per-segment optimum's activation "
+        "(docs/interchange.md).",
+    )
+    add_position_options(parser)
+    parser.add_argument("--format", choices=("mjcf", "osim"), help="file format (default: from the suffix of --out)")
+    parser.add_argument(
+        "--pcsa",
+        type=float_list("--pcsa"),
+        metavar="CM2,...",
+        help="PCSA [cm^2], one per pair or per muscle (default: the per-segment optimum)",
+    )
+    parser.add_argument(
+        "--with-local-stiffness",
+        action="store_true",
+        help="add the chain's least local stiffness as joint springs (docs/chain.md)",
+    )
+    parser.add_argument("--out", required=True, metavar="FILE", help="the file to write (atomically)")
+    add_model_options(parser)
+    parser.set_defaults(func=run)
+
+
+def run(args) -> int:
+    """Run ``spinectl export``: write the file and print one line saying what it holds.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments: ``E``, ``Lambda`` [m], ``format``, ``pcsa`` [cm^2], ``with_local_stiffness``,
+        ``out`` and the model options.
+
+    Returns
+    -------
+    int
+        Exit code 0.
+    """
+    from ..anatomy.interchange import export_model, format_of
+
+    fmt = format_of(args.out, args.format)
+    model = load_model(args)
+    check_position(model, args)
+    solution = export_model(
+        model,
+        args.E,
+        args.Lambda,
+        args.out,
+        fmt,
+        pcsa=pcsa_option(args.pcsa),
+        with_local_stiffness=args.with_local_stiffness,
+        inputs={"--config": args.config},
+    )
+    growth = max(solution.eigenvalues.real)
+    verdict = "stable" if growth < 0 else "unstable"
+    print(
+        f"wrote {args.out} ({fmt}): E = {args.E:g} m, Lambda = {args.Lambda:g} m; the chain (all CoRs free) is "
+        f"{verdict}, largest real part of its eigenvalues {growth:.6g} 1/s"
+    )
+    return 0

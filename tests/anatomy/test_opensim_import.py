@@ -1,0 +1,142 @@
+"""``.osim`` import with OpenSim as the engine, on spinectl's own export of the paper's chain.
+
+OpenSim computes everything on the import's side (spinectl.anatomy.opensim_engine); spinectl's
+side is docs/chain.md's matrices (spinectl.model.chain). Where the curves are the same (geometry,
+masses, gravity) the chains agree to rounding; the muscles are Millard's in OpenSim, and the
+tests derive the difference from Millard's curve values (OpenSim's calcValue / calcDerivative).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+osim = pytest.importorskip("opensim", reason="needs the opensim extra: pip install 'spinectl[opensim]'")
+
+from spinectl import anatomy  # noqa: E402
+from spinectl.anatomy.export_mjcf import fibre_gains  # noqa: E402
+from spinectl.anatomy.export_osim import REFERENCE_PCSA_CM2, TENDON_SLACK_RATIO, export_osim  # noqa: E402
+from spinectl.cli import main  # noqa: E402
+from spinectl.model import chain  # noqa: E402
+from spinectl.model.config import load_preset  # noqa: E402
+from spinectl.units import M2_PER_CM2  # noqa: E402
+
+E, LAMBDA = 0.03, 0.04
+REVERSED = slice(None, None, -1)  # the mapping's chain runs L5S1 up, spinectl's top down
+
+
+@pytest.fixture(scope="module")
+def imported(tmp_path_factory):
+    """The wagner2012 preset exported as .osim and imported back: (model, anatomy, free chain, linearisation, path)."""
+    model = load_preset("wagner2012")
+    path = tmp_path_factory.mktemp("osim") / "chain.osim"
+    export_osim(model, E, LAMBDA, path)
+    loaded = anatomy.load(path)
+    free, _, lin = loaded.chains("sagittal")
+    return model, loaded, free, lin, path
+
+
+def test_geometry_masses_and_gravity_are_the_chains(imported):
+    """Moment arms (dl/dq), M and K_0 (gravity, no passive stiffness in the preset) equal chain_coefficients'
+    length_gradient, mass_matrix and K_g to 1e-9 (K_0 by central differences of OpenSim's torques: 1e-8)."""
+    model, loaded, free, lin, _ = imported
+    coefficients = chain.chain_coefficients(model, E, LAMBDA)
+    mass = chain.mass_matrix(model, chain.geometry.cor_positions(E, LAMBDA, model.geometry))
+    assert loaded.classes == ("global",) * 30
+    assert np.max(np.abs(lin.moment_arms[:, REVERSED] - coefficients.length_gradient)) <= 1e-9 * 0.1
+    np.testing.assert_allclose(free.mass_matrix[REVERSED, REVERSED], mass, rtol=1e-9, atol=1e-12)
+    k0 = coefficients.stiffness(np.zeros(6))
+    assert np.max(np.abs(free.stiffness_offset[REVERSED, REVERSED] - k0)) <= 1e-8 * np.max(np.abs(k0))
+
+
+def _millard_values(path, model):
+    """Millard's active force-length value and slope [1/m], force-velocity slope [s/m], at the upright fibre length."""
+    built = osim.Model(str(path))
+    muscle = osim.Millard2012EquilibriumMuscle.safeDownCast(built.getMuscles().get(0))
+    l_opt = muscle.getOptimalFiberLength()
+    lengths = fibre_gains(model).length
+    lt = lengths[0] * (1 - TENDON_SLACK_RATIO) / l_opt
+    active, fv = muscle.getActiveForceLengthCurve(), muscle.getForceVelocityCurve()
+    v_unit = l_opt * muscle.getMaxContractionVelocity()
+    return active.calcValue(lt), active.calcDerivative(lt, 1) / l_opt, fv.calcDerivative(0.0, 1) / v_unit
+
+
+def test_muscle_matrices_differ_by_millards_curves_exactly(imported):
+    """Per fibre of the first muscle (straight_ventral), OpenSim's K_i and D_i are spinectl's with
+    Millard's curve values:
+
+    spinectl per unit f_iso: D = f_l f_H' h h', K = -f_l' h h' - f_l H (docs/chain.md), so from spinectl's K and D
+    of the fibre sum, Sigma h h' = D / (f_l f_H') and Sigma H = -(K + f_l' Sigma h h') / f_l; OpenSim per unit
+    activation: F_max (-f_AL' Sigma h h' - f_AL Sigma H) and F_max f_AL (-f_V') Sigma h h' (v lengthening)."""
+    model, loaded, free, lin, path = imported
+    f_al, f_al_slope, f_v_slope = _millard_values(path, model)
+    fibres = fibre_gains(model)
+    f_iso = model.fibre.specific_tension / 5  # per m^2 of the muscle, per fibre
+    f_l = fibres.force[0] / f_iso
+    f_l_slope = fibres.length_slope[0] / f_iso
+    f_h_slope = fibres.velocity_slope[0] / fibres.force[0]
+    coefficients = chain.chain_coefficients(model, E, LAMBDA)
+    k_sp = coefficients.stiffness_per_pcsa[..., 0] / f_iso  # sum over the 5 fibres, per unit f_iso of each
+    d_sp = coefficients.damping_per_pcsa[..., 0] / f_iso
+    hh = d_sp / (f_l * f_h_slope)
+    hessian = -(k_sp + f_l_slope * hh) / f_l
+    f_max = model.fibre.specific_tension * REFERENCE_PCSA_CM2 * M2_PER_CM2 / 5
+    k_osim = f_max * (-f_al_slope * hh - f_al * hessian)
+    d_osim = f_max * f_al * (-f_v_slope) * hh
+    k_import = free.stiffness_per_control[REVERSED, REVERSED, :5].sum(axis=-1)
+    d_import = free.damping_per_control[REVERSED, REVERSED, :5].sum(axis=-1)
+    assert np.max(np.abs(k_import - k_osim)) <= 1e-6 * np.max(np.abs(k_osim))
+    assert np.max(np.abs(d_import - d_osim)) <= 1e-9 * np.max(np.abs(d_osim))
+    assert abs(f_al / f_l - 1) > 0.05  # Millard's curve is not the paper's: the difference is real
+
+
+def test_cli_analyses_the_osim_and_refuses_unmapped_coordinates(imported, tmp_path, capsys):
+    """``spinectl anatomy exported.osim`` prints the verdicts with their criteria; a mapping that names
+    coordinates the model lacks is one line, exit 2."""
+    _, _, _, _, path = imported
+    assert main(["anatomy", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "joint by joint (others fixed)" in out and "the chain, free" in out
+    mapping = tmp_path / "bad.toml"
+    mapping.write_text(
+        '[bodies]\npelvis = ["ground"]\nvertebrae = ["vertebra_above_L5S1"]\nthorax = ["thorax"]\n'
+        '[planes]\nsagittal = ["L5S1", "L9L10"]\n'
+    )
+    assert main(["anatomy", str(path), "--mapping", str(mapping)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "L9L10" in err
+
+
+def test_opensims_simulation_grows_at_the_rate_the_imported_chain_predicts(imported):
+    """OpenSim's own forward simulation (Manager.integrate, accuracy 1e-10) of the exported model, displaced
+    1e-5 rad along the imported chain's fastest growing mode, grows at that mode's eigenvalue to 5 %.
+
+    The chain is linearised at OpenSim's activations (Millard floors them at 0.01, so the optimum's idle
+    muscles are at 0.01 there), and the file's counter torques hold the posture against OpenSim's forces
+    (export_osim.opensim_counter_torque): the posture is an equilibrium, so the growth is the mode's.
+    """
+    _, loaded, free, _, path = imported
+    model = osim.Model(str(path))
+    state = model.initSystem()
+    model.equilibrateMuscles(state)
+    model.realizeDynamics(state)
+    muscles = model.getMuscles()
+    act = np.array([muscles.get(i).getActivation(state) for i in range(muscles.getSize())])
+    values, vectors = np.linalg.eig(chain.state_matrix(free.mass_matrix, free.stiffness(act), free.damping(act)))
+    top = np.argmax(values.real)
+    rate, mode = values[top].real, np.real(vectors[:, top])
+    mode = mode / np.linalg.norm(mode[:5])
+    coords = model.getCoordinateSet()
+    for k, name in enumerate(free.joints):
+        coords.get(name).setValue(state, 1e-5 * mode[k], False)
+        coords.get(name).setSpeedValue(state, 1e-5 * mode[5 + k])
+    manager = osim.Manager(model)
+    manager.setIntegratorAccuracy(1e-10)
+    manager.initialize(state)
+    times = 0.001 * np.arange(1, 51)
+    amplitude = []
+    for time in times:
+        s = manager.integrate(float(time))
+        amplitude.append(abs(np.array([coords.get(n).getValue(s) for n in free.joints]) @ mode[:5]))
+    fitted = np.polyfit(times, np.log(amplitude), 1)[0]
+    assert rate > 0 and abs(fitted - rate) <= 0.05 * rate
