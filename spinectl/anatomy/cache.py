@@ -162,7 +162,7 @@ def read(key: str):
             raise ValueError("its key or its checksum does not match")
         # read again by MuJoCo: a file replaced meanwhile is a whole one (atomic rename) of the same key
         model = mujoco.MjModel.from_binary_path(str(binary))
-    except FileNotFoundError:
+    except (FileNotFoundError, NotADirectoryError):  # none cached (yet), or no folder to hold one
         return None
     except (OSError, ValueError, TypeError, UnicodeDecodeError) as exc:
         log.debug("ignoring the compiled-model cache %s (rebuilt): %s", binary, exc)
