@@ -65,7 +65,10 @@ def per_muscle_reference(anatomy, dofs):
 def first_load(joint_stiffness: float) -> dict:
     """In this (fresh) process: the import, then load + K + optimum, timed [s]."""
     start = time.perf_counter()
-    import cvxpy  # noqa: F401  (imported by the optimum: its import is no part of the timing)
+    # imported by load and the optimum: their imports are no part of the timing
+    import cvxpy  # noqa: F401
+    import mujoco  # noqa: F401
+    import myo_sim  # noqa: F401
 
     from spinectl import anatomy
     from spinectl.anatomy.optimum import optimise
@@ -114,7 +117,7 @@ def main() -> None:
         runs["warm"] = in_fresh_process(args.joint_stiffness, cache)
     cold = runs["cold"]
     print(f"MyoTorso ({cold['source']}), {cold['muscles']} muscles, {args.joint_stiffness:g} N m/rad added")
-    print(f"  import of spinectl.anatomy, mujoco, cvxpy (not counted): {cold['import']:8.3f} s")
+    print(f"  import of spinectl.anatomy, mujoco, myo-sim, cvxpy (not counted): {cold['import']:8.3f} s")
     for name, run in runs.items():
         what = "compiled, cache written" if name == "cold" else "read from the cache"
         print(f"  {name} process, the model {what}:")
