@@ -49,8 +49,11 @@ CANDIDATE_TOLERANCE = 1e-3
 UNIT_TOLERANCE = 1e-9
 """A refined candidate is a crossing where some abs(z) is 1 to this (abs(log abs(z)))."""
 
-TINY_LAG = 1e-6
-"""T_a times the highest crossing below this: the unsquared pencil (QZ), not E^-1 A (its 1/T_a would swamp w^2)."""
+SQUARED_ACCURACY = 1e-4
+"""The squared problem is used where its relative error at the floor, eps rho^2 / w^2 (rho^2 its largest abs(s^2)), is below this."""
+
+FLOOR = 1e-7
+"""Crossings are sought above this fraction of :func:`highest_crossing` (w -> 0 is a root at s = 0 for every tau)."""
 
 
 def _matrices(mass, stiffness, damping, kp, kd):
@@ -191,8 +194,8 @@ def descriptor(mass, stiffness, damping, kp, kd, lag=0.0):
     return e, a0, a1
 
 
-def axis_candidates(e, a0, a1, squared: bool = True) -> np.ndarray:
-    """Every w > 0 at which det(j w E - A_0 - z A_1) = 0 for some abs(z) = 1, among others [rad/s].
+def axis_candidates(e, a0, a1, floor: float = 0.0) -> np.ndarray:
+    """Every w > ``floor`` at which det(j w E - A_0 - z A_1) = 0 for some abs(z) = 1, among others [rad/s].
 
     If E v j w = (A_0 + z A_1) v with abs(z) = 1, the conjugate gives -j w E conj(v) =
     (A_0 + A_1 / z) conj(v) (A_0, A_1, E real), so x_1 = v (x) conj(v), x_2 = z x_1 solve
@@ -201,23 +204,24 @@ def axis_candidates(e, a0, a1, squared: bool = True) -> np.ndarray:
     spectrum is symmetric, s and -s: J = [[0, Pi], [Pi, 0]] (Pi the vec-transpose permutation)
     anticommutes with it, so its square maps the vectors (y, Pi y) to themselves, where it is
     G H with H = B_0 (x) I + (B_1 (x) I) Pi, G = B_0 (x) I - (B_1 (x) I) Pi, B_i = E^-1 A_i: an
-    m^2 eigenvalue problem for s^2 = -w^2, eight times cheaper. Where T_a is tiny beside the
-    crossings (:data:`TINY_LAG`), or with ``squared`` False, the pencil itself by QZ. Candidates
-    are the eigenvalues within :data:`CANDIDATE_TOLERANCE` of the axis; not every one is a
-    crossing (the pencil holds every s with s and -s eigenvalues of A_0 + z A_1 and of
-    A_0 + A_1 / z for any complex z), which :func:`_crossings` checks.
+    m^2 eigenvalue problem for s^2 = -w^2, about ten times cheaper. Squaring squares the
+    relative error, eps rho^2 / w^2; where that exceeds :data:`SQUARED_ACCURACY` at ``floor``
+    (a tiny T_a: rho >= 1/T_a), the pencil itself by QZ (error eps rho / w). Candidates are the
+    eigenvalues within :data:`CANDIDATE_TOLERANCE` of the axis; not every one is a crossing
+    (the pencil holds every s with s and -s eigenvalues of A_0 + z A_1 and A_0 + A_1 / z for
+    any complex z), which :func:`_crossings` checks.
 
     Parameters
     ----------
     e, a0, a1 : array_like, shape (m, m)
         E (nonsingular), A_0, A_1 of :func:`descriptor`.
-    squared : bool, optional
-        The m^2 problem of the square (default) or the 2 m^2 pencil.
+    floor : float, optional
+        The lowest frequency sought [rad/s].
 
     Returns
     -------
     numpy.ndarray
-        Candidate frequencies w > 0 [rad/s], ascending.
+        Candidate frequencies w > ``floor`` [rad/s], ascending.
 
     References
     ----------
@@ -227,18 +231,19 @@ def axis_candidates(e, a0, a1, squared: bool = True) -> np.ndarray:
     e, a0, a1 = (np.asarray(x, float) for x in (e, a0, a1))
     m = e.shape[0]
     one = np.eye(m)
-    if squared:
-        b0, b1 = np.linalg.solve(e, a0), np.linalg.solve(e, a1)
-        flip = np.arange(m * m).reshape(m, m).T.ravel()  # Pi: vec(X) -> vec(X^T)
-        k0, k1 = np.kron(b0, one), np.kron(b1, one)[:, flip]
-        mu = np.linalg.eigvals((k0 - k1) @ (k0 + k1))
+    b0, b1 = np.linalg.solve(e, a0), np.linalg.solve(e, a1)
+    flip = np.arange(m * m).reshape(m, m).T.ravel()  # Pi: vec(X) -> vec(X^T)
+    k0, k1 = np.kron(b0, one), np.kron(b1, one)[:, flip]
+    mu = np.linalg.eigvals((k0 - k1) @ (k0 + k1))
+    if np.finfo(float).eps * np.max(np.abs(mu)) <= SQUARED_ACCURACY * floor**2:
         keep = (mu.real < 0) & (np.abs(mu.imag) <= CANDIDATE_TOLERANCE * np.abs(mu))
-        return np.sort(np.sqrt(-mu[keep].real))
-    pencil = np.block([[np.kron(a0, one), np.kron(a1, one)], [-np.kron(one, a1), -np.kron(one, a0)]])
-    s = scipy.linalg.eigvals(pencil, scipy.linalg.block_diag(np.kron(e, one), np.kron(one, e)))
-    s = s[np.isfinite(s)]
-    keep = (s.imag > 0) & (np.abs(s.real) <= 0.5 * CANDIDATE_TOLERANCE * np.abs(s))
-    return np.sort(s[keep].imag)
+        w = np.sqrt(-mu[keep].real)
+    else:
+        pencil = np.block([[np.kron(a0, one), np.kron(a1, one)], [-np.kron(one, a1), -np.kron(one, a0)]])
+        s = scipy.linalg.eigvals(pencil, scipy.linalg.block_diag(np.kron(e, one), np.kron(one, e)))
+        s = s[np.isfinite(s)]
+        w = s[(s.imag > 0) & (np.abs(s.real) <= 0.5 * CANDIDATE_TOLERANCE * np.abs(s))].imag
+    return np.sort(w[w > floor])
 
 
 def _refine(moduli, w, target, steps: int = 12):
@@ -266,10 +271,8 @@ def _refine(moduli, w, target, steps: int = 12):
 
 def _crossings(mass, stiffness, damping, kp, kd, lag):
     """Every (w, z) with det(P(jw) + Q(jw) z) = 0, abs(z) = 1, w > 0: Louisell's candidates, each refined."""
-    top = highest_crossing(mass, stiffness, damping, kp, kd)
-    squared = not 0 < lag * top < TINY_LAG
-    candidates = axis_candidates(*descriptor(mass, stiffness, damping, kp, kd, lag), squared=squared)
-    candidates = candidates[candidates > 1e-12 * top]  # w = 0: a root at s = 0 for every tau, no crossing
+    floor = FLOOR * highest_crossing(mass, stiffness, damping, kp, kd)
+    candidates = axis_candidates(*descriptor(mass, stiffness, damping, kp, kd, lag), floor)
 
     def moduli(w):
         p, q = characteristic_matrices(mass, stiffness, damping, kp, kd, [w], lag)

@@ -236,3 +236,15 @@ def test_the_narrow_band_of_a_lightly_reflexed_paper_chain_is_found():
     assert exact.status == "finite" and 380.0 < exact.frequency < 383.0
     for delay, side in ((0.98 * exact.margin, -1), (1.02 * exact.margin, 1), (0.12, 1)):
         assert np.sign(rightmost_root(mass, k, damping, kp, kd, delay, lag, 40).real) == side
+
+
+def test_a_tiny_lag_keeps_every_crossing_of_the_lagless_loop():
+    """T_a = 1e-7 s puts an eigenvalue -1/T_a = -1e7 1/s beside crossings at 1.6 to 29 rad/s; the
+    squared Louisell problem would lose the lowest (relative error eps 1e14 / 2.4 = 1e-2), so the
+    pencil is solved by QZ there. Its crossings and margin are the lagless loop's to the lag's
+    own effect, a relative 1e-5 (phase lag w T_a <= 3e-6 rad)."""
+    chain = _coupled()
+    tiny, none = chain_delay_margin(*chain, 1e-7), chain_delay_margin(*chain, 0.0)
+    assert len(tiny.crossovers) == len(none.crossovers) == 3
+    np.testing.assert_allclose(tiny.crossovers, none.crossovers, rtol=1e-5)
+    np.testing.assert_allclose(tiny.margin, none.margin, rtol=1e-5)
