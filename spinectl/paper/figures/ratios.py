@@ -110,7 +110,7 @@ def coupled_ratio(dataset: xr.Dataset) -> xr.DataArray:
 
 
 def coupled_ratio_figure(dataset: xr.Dataset) -> Figure:
-    """:func:`coupled_ratio` as a map: the coupled chain's global PCSA over the per-segment minimum.
+    """:func:`~.ratios.coupled_ratio` as a map: the coupled chain's global PCSA over the per-segment minimum.
 
     Parameters
     ----------

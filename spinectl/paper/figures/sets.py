@@ -1,8 +1,8 @@
-"""The figures of a landscape as a set: which are drawn (:class:`FigureOptions`), and saved all or none.
+"""The figures of a landscape as a set: which are drawn, and saved all or none.
 
 :func:`figure_set` draws Figures 3 and 4 for every K of a sweep (Figure S1 for K > 0), the coupled
-ratio where the sweep has it and, on request, the ratio S1 / 3; :func:`draw_figures` saves the set
-into one folder as a whole (:func:`spinectl.canvas.save_figures`).
+ratio where the sweep has it and, on request, the ratio S1 / 3 (:class:`FigureOptions` says how);
+:func:`draw_figures` saves the set into one folder as a whole (:func:`spinectl.canvas.save_figures`).
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ from .ratios import COUPLED_VARIABLE, coupled_ratio_figure, ratio_figure
 
 @dataclass(frozen=True)
 class FigureOptions:
-    """How :func:`draw_figures` draws and saves.
+    """How :func:`~spinectl.paper.figures.sets.draw_figures` draws and saves.
 
     Attributes
     ----------
@@ -126,7 +126,8 @@ def draw_figures(
     specific_tension: float | None = None,
     options: FigureOptions | None = None,
 ) -> list[Path]:
-    """Draw :func:`figure_set` and save it into ``out_dir``: all or none (:func:`spinectl.canvas.save_figures`).
+    """Draw :func:`~spinectl.paper.figures.sets.figure_set` and save it into ``out_dir``: all or none
+    (:func:`spinectl.canvas.save_figures`).
 
     Parameters
     ----------
