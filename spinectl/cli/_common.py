@@ -123,7 +123,7 @@ def add_position_options(parser: argparse.ArgumentParser) -> None:
 
 
 def add_dpi_option(parser: argparse.ArgumentParser) -> None:
-    """``--dpi``, the resolution of PNG figures, on the commands that draw (:data:`spinectl.paper.figures.DPI`).
+    """``--dpi``, the resolution of PNG figures, on the commands that draw (:data:`~spinectl.paper.figures.files.DPI`).
 
     Parameters
     ----------
