@@ -254,7 +254,7 @@ def _refine(moduli, w, target, steps: int = 12):
         nearest = values[np.argmin(np.abs(values - target))]
         return np.log(max(abs(nearest), 1e-300)), nearest
 
-    x0, (g0, v0) = w, g(w)
+    x0, (g0, _) = w, g(w)
     x1 = w * (1.0 + 1e-9)
     g1, v1 = g(x1)
     for _ in range(steps):
