@@ -140,3 +140,62 @@ def test_opensims_simulation_grows_at_the_rate_the_imported_chain_predicts(impor
         amplitude.append(abs(np.array([coords.get(n).getValue(s) for n in free.joints]) @ mode[:5]))
     fitted = np.polyfit(times, np.log(amplitude), 1)[0]
     assert rate > 0 and abs(fitted - rate) <= 0.05 * rate
+
+
+SLOPE = 0.5  # the test coupler: L1L2 = SLOPE * L2L3
+
+
+@pytest.fixture(scope="module")
+def coupled(imported, tmp_path_factory):
+    """spinectl's export with a CoordinateCouplerConstraint (built with OpenSim's API) tying L1L2 = 0.5 L2L3."""
+    path = tmp_path_factory.mktemp("coupled") / "coupled.osim"
+    built = osim.Model(str(imported[4]))
+    coupler = osim.CoordinateCouplerConstraint()
+    coupler.setName("rhythm_L1L2")
+    independent = osim.ArrayStr()
+    independent.append("L2L3")
+    coupler.setIndependentCoordinateNames(independent)
+    coupler.setDependentCoordinateName("L1L2")
+    coupler.setFunction(osim.LinearFunction(SLOPE, 0.0))
+    built.addConstraint(coupler)
+    built.finalizeConnections()
+    built.printToXML(str(path))
+    return path
+
+
+def test_couplers_are_off_in_the_free_chain_and_reduce_the_constrained_one(imported, coupled):
+    """With the coupler, the free chain is the uncoupled export's chain (to rounding), and the constrained chain is
+    T^T K T, T^T D T, T^T M T of it in closed form, T = dq/dq_ind: the identity on L5S1..L2L3 plus the row
+    L1L2 = 0.5 L2L3 (a linear function: no curvature term). The source line names the coupler and its slope."""
+    _, _, free0, _, _ = imported
+    loaded = anatomy.load(coupled)
+    free, constrained, _ = loaded.chains("sagittal")
+    a = np.full(free.n_controls, 0.3)
+    np.testing.assert_allclose(free.stiffness(a), free0.stiffness(a), rtol=1e-9, atol=1e-9)
+    T = np.zeros((5, 4))
+    T[:4, :4] = np.eye(4)
+    T[4, 3] = SLOPE  # the chain runs L5S1, L4L5, L3L4, L2L3, L1L2
+    assert free.joints[3:] == ("L2L3", "L1L2") and constrained.joints == free.joints[:4]
+    for ours, full in ((constrained.stiffness(a), free.stiffness(a)), (constrained.damping(a), free.damping(a))):
+        np.testing.assert_allclose(ours, T.T @ full @ T, rtol=1e-12, atol=1e-12 * np.max(np.abs(full)))
+    np.testing.assert_allclose(constrained.mass_matrix, T.T @ free.mass_matrix @ T, rtol=1e-12, atol=1e-15)
+    assert "rhythm_L1L2 (L1L2 on L2L3 slope 0.5)" in free.source
+
+
+def test_the_coupled_coordinate_moves_in_opensim_as_the_reduction_says(imported, coupled):
+    """OpenSim's own simulation (Manager.integrate) of the coupled file, started with L2L3 moving: L1L2 follows
+    at the slope the import reads off the coupler's function (its T), to the integrator's accuracy."""
+    loaded = anatomy.load(coupled)
+    slope = loaded.linearise("sagittal")[1].transform[4, 3]
+    model = osim.Model(str(coupled))
+    state = model.initSystem()
+    coords = model.getCoordinateSet()
+    coords.get("L2L3").setSpeedValue(state, 0.1)
+    coords.get("L1L2").setSpeedValue(state, 0.1 * SLOPE)
+    manager = osim.Manager(model)
+    manager.setIntegratorAccuracy(1e-10)
+    manager.initialize(state)
+    state = manager.integrate(0.02)
+    moved = coords.get("L2L3").getValue(state)
+    assert abs(moved) > 1e-4
+    assert abs(coords.get("L1L2").getValue(state) - slope * moved) <= 1e-6 * abs(moved)
