@@ -157,6 +157,22 @@ class OsimEngine:
         """
         return self.model.getCoordinateSet().get(name)
 
+    def spec_factory(self):
+        """MuJoCo's referee (``check``) rebuilds an MJCF spec; an OpenSim model has none: one line.
+
+        OpenSim offers no linearisation of its own to compare the chain with, so ``--check`` is
+        MuJoCo's, for MJCF models only.
+
+        Raises
+        ------
+        ParameterError
+            Always.
+        """
+        raise ParameterError(
+            "check",
+            f"MuJoCo is the referee, for MJCF models only; OpenSim has no linearisation to compare {self.name}'s with",
+        )
+
     def set_posture(self, values: dict) -> None:
         """Set coordinates at zero speed, the others at their defaults, and realise positions.
 
@@ -243,7 +259,9 @@ def coupler_rhythm(engine: OsimEngine, chain, values: dict) -> tuple:
         if name in slaved:
             involved += [n for n in slaved[name].independent if n not in involved]
     independent = [n for n in involved if n not in slaved]
-    involved += [c.dependent for c in engine.couplers if c.dependent not in involved and set(c.independent) <= set(independent)]
+    involved += [
+        c.dependent for c in engine.couplers if c.dependent not in involved and set(c.independent) <= set(independent)
+    ]
     used = [slaved[n] for n in involved if n in slaved]
     T = np.zeros((len(involved), len(independent)))
     C = np.zeros_like(T)
@@ -537,7 +555,9 @@ class OsimAnatomy(Anatomy):
         source = f"{self.engine.source}, {plane}"
         described = self.couplers(plane, posture)
         if described:
-            source += f"; coupler constraints off in the free chain, linearised in the constrained: {'; '.join(described)}"
+            source += (
+                f"; coupler constraints off in the free chain, linearised in the constrained: {'; '.join(described)}"
+            )
         free = free_chain(lin, tuple(involved[:n]), self.muscles, self.classes, added, source)
         full_added = np.concatenate([added, np.zeros(len(involved) - n)])
         constrained = constrained_chain(
@@ -572,3 +592,123 @@ def load_osim(path, mapping=None) -> OsimAnatomy:
         _millard(engine, muscles.get(i))
     names = tuple(muscles.get(i).getName() for i in range(muscles.getSize()))
     return OsimAnatomy(engine, mapping, names, _classify(engine, mapping))
+
+
+def volume_weights(anatomy: OsimAnatomy) -> np.ndarray:
+    """w_i proportional to F_max,i l_opt,i (the Millard muscle's volume), normalised to mean 1.
+
+    Parameters
+    ----------
+    anatomy : OsimAnatomy
+
+    Returns
+    -------
+    numpy.ndarray, shape (m,)
+    """
+    muscles = anatomy.engine.model.getMuscles()
+    volume = np.array(
+        [
+            muscles.get(i).getMaxIsometricForce() * muscles.get(i).getOptimalFiberLength()
+            for i in range(muscles.getSize())
+        ]
+    )
+    return volume / volume.mean()
+
+
+def optimise(
+    anatomy: OsimAnatomy, plane="sagittal", stability="chain", margin=1.0, joint_stiffness="none", equilibrium="rhythm"
+):
+    """The least-effort activations on OpenSim's chain (:func:`spinectl.anatomy.optimum.optimise`'s problem).
+
+    Equilibrium holds on the chain's coordinates (``"free"``) or on the couplers' independent
+    ones, the couplers carrying the rest (``"rhythm"``); stability ``"rhythm"`` is imposed on the
+    chain constrained by the couplers. The problem is solved on the LinearChain by
+    :func:`spinectl.anatomy.optimum.solve_on_chain`, as for MJCF.
+
+    Parameters
+    ----------
+    anatomy : OsimAnatomy
+    plane : str
+    stability : str
+        One of :data:`spinectl.anatomy.optimum.STABILITY`.
+    margin : float
+        mu [N m/rad], >= 0.
+    joint_stiffness : {"none", "mapped"} or float
+    equilibrium : str
+        One of :data:`spinectl.anatomy.optimum.EQUILIBRIUM`.
+
+    Returns
+    -------
+    spinectl.anatomy.optimum.Optimum
+    """
+    from .optimum import EQUILIBRIUM, STABILITY, Optimum, solve_on_chain
+
+    if stability not in STABILITY:
+        raise ParameterError("stability", f"must be one of {STABILITY} (got {stability!r})")
+    if equilibrium not in EQUILIBRIUM:
+        raise ParameterError("equilibrium", f"must be one of {EQUILIBRIUM} (got {equilibrium!r})")
+    if not (np.isfinite(margin) and margin >= 0):
+        raise ParameterError("margin", f"must be >= 0 [N m/rad] (got {margin!r})")
+    free, constrained, lin = anatomy.chains(plane, None, joint_stiffness)
+    _, rhy, _ = anatomy.linearise(plane)
+    rows = list(range(lin.n))
+    if equilibrium == "free":
+        tau_per, tau_0 = lin.torque_per_muscle[rows], lin.torque_offset[rows]
+    else:
+        tau_per, tau_0 = rhy.transform.T @ lin.torque_per_muscle, rhy.transform.T @ lin.torque_offset
+    w = volume_weights(anatomy)
+    chain, criterion = (constrained, "chain") if stability == "rhythm" else (free, stability)
+    status, a = solve_on_chain(chain, tau_per, tau_0, w, criterion, margin)
+    k = free.stiffness(a) if np.all(np.isfinite(a)) else np.full((free.n_joints,) * 2, np.nan)
+    ok = np.all(np.isfinite(k))
+    return Optimum(
+        stability=stability,
+        status=status,
+        activations=a,
+        cost=float(w @ a**2),
+        equilibrium=equilibrium,
+        net_torque=tau_per @ a + tau_0,
+        lumbar_torque=lin.torque_per_muscle[rows] @ a + lin.torque_offset[rows],
+        eigenvalues=np.linalg.eigvalsh(-0.5 * (k + k.T)) if ok else np.full(free.n_joints, np.nan),
+        joint_stiffness=-np.diag(k),
+    )
+
+
+def optimised(
+    anatomy: OsimAnatomy,
+    plane="sagittal",
+    stability="chain",
+    margin=1.0,
+    joint_stiffness="none",
+    equilibrium="rhythm",
+    check=False,
+    reflex=None,
+):
+    """The optimum with a criterion and without on OpenSim's chain, and the analysis at it.
+
+    Parameters
+    ----------
+    anatomy : OsimAnatomy
+    plane, stability, margin, joint_stiffness, equilibrium
+        As :func:`optimise`.
+    check : bool
+        Refused: MuJoCo is the referee, for MJCF only (:meth:`OsimEngine.spec_factory`).
+    reflex : tuple, optional
+        ``(kp, kd, lag)`` (:func:`spinectl.anatomy.analyses.reflex_margin`).
+
+    Returns
+    -------
+    spinectl.anatomy.optimum.OptimisedResult
+    """
+    from .analyses import analyse
+    from .optimum import OptimisedResult
+
+    if check:
+        anatomy.engine.spec_factory()
+    kwargs = {"plane": plane, "margin": margin, "joint_stiffness": joint_stiffness, "equilibrium": equilibrium}
+    opt = optimise(anatomy, stability=stability, **kwargs)
+    classic = opt if stability == "none" else optimise(anatomy, stability="none", **kwargs)
+    analysis = None
+    if opt.ok:
+        analysis = analyse(anatomy, plane, opt.activations, joint_stiffness=joint_stiffness, reflex=reflex)
+    return OptimisedResult(anatomy, opt, classic, float(margin), plane, analysis)

@@ -199,3 +199,60 @@ def test_the_coupled_coordinate_moves_in_opensim_as_the_reduction_says(imported,
     moved = coords.get("L2L3").getValue(state)
     assert abs(moved) > 1e-4
     assert abs(coords.get("L1L2").getValue(state) - slope * moved) <= 1e-6 * abs(moved)
+
+
+@pytest.fixture(scope="module")
+def lowest_joint(imported, tmp_path_factory):
+    """The export mapped onto a chain of its lowest joint alone (L5S1; the others held): a posture its muscles
+    hold without the file's counter torques. The full chain's does not (test_upright_optimum_is_infeasible...)."""
+    mapping = tmp_path_factory.mktemp("lowest") / "lowest.toml"
+    mapping.write_text(
+        '[bodies]\npelvis = ["ground"]\nthorax = ["thorax"]\nvertebrae = ["vertebra_above_L2L3", '
+        '"vertebra_above_L3L4", "vertebra_above_L4L5", "vertebra_above_L5S1"]\n[planes]\nsagittal = ["L5S1"]\n'
+    )
+    return anatomy.load(imported[4], mapping)
+
+
+def test_optimum_on_opensims_chain_is_the_least_effort_and_stable(lowest_joint):
+    """`optimised` on an .osim: the classic optimum's cost equals SciPy's SLSQP on the same problem (min sum w a^2,
+    OpenSim's torques tau_per a + tau_0 = 0 on the chain, 0 <= a <= 1) to 1e-4; the chain optimum holds the
+    posture (net torque <= 1e-6 of the gravity torque), its free chain has -K >= mu, and it costs at least the
+    classic one."""
+    from scipy.optimize import minimize
+
+    from spinectl.anatomy.opensim_engine import optimised, volume_weights
+
+    result = optimised(lowest_joint, equilibrium="free", margin=1.0)
+    _, _, lin = lowest_joint.chains()
+    tau_per, tau_0 = lin.torque_per_muscle[:1], lin.torque_offset[:1]
+    w = volume_weights(lowest_joint)
+    ref = minimize(
+        lambda a: w @ a**2,
+        np.full(w.size, 0.01),
+        jac=lambda a: 2 * w * a,
+        method="SLSQP",
+        bounds=[(0, 1)] * w.size,
+        constraints={"type": "eq", "fun": lambda a: tau_per @ a + tau_0, "jac": lambda a: tau_per},
+        options={"ftol": 1e-14, "maxiter": 500},
+    )
+    assert ref.success and result.classic.ok and result.optimum.ok
+    assert abs(result.classic.cost - ref.fun) <= 1e-4 * ref.fun
+    assert np.max(np.abs(result.optimum.net_torque)) <= 1e-6 * np.max(np.abs(tau_0))
+    assert np.min(result.optimum.eigenvalues) >= 1.0 - 1e-4
+    assert result.optimum.cost >= result.classic.cost * (1 - 1e-6)
+
+
+def test_upright_optimum_is_infeasible_and_check_is_refused(imported, capsys):
+    """The upright export without its counter torques: no activations in [0, 1] hold it (SciPy's bounded least
+    squares leaves a residual > 1 N m), so `spinectl anatomy chain.osim --optimise` answers infeasible (exit 0);
+    `--check` (MuJoCo's referee) is one line, exit 2."""
+    from scipy.optimize import lsq_linear
+
+    _, _, _, lin, path = imported
+    fit = lsq_linear(lin.torque_per_muscle[:5], -lin.torque_offset[:5], bounds=(0, 1))
+    assert np.linalg.norm(lin.torque_per_muscle[:5] @ fit.x + lin.torque_offset[:5]) > 1.0
+    assert main(["anatomy", str(path), "--optimise", "--equilibrium", "free"]) == 0
+    assert "infeasible" in capsys.readouterr().out
+    assert main(["anatomy", str(path), "--check"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "MJCF" in err
