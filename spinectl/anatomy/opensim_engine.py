@@ -206,12 +206,34 @@ def load_engine(path) -> OsimEngine:
         raise ParameterError("model", f"no such .osim file: {printable(str(path))}")
     try:
         model = osim.Model(str(path))
+        schema = _schema(osim, model, path)
         couplers = _couplers(osim, model)
         state = model.initSystem()
     except Exception as exc:  # OpenSim raises its own exception types, one line each
+        if isinstance(exc, ParameterError):
+            raise
         raise ParameterError("model", f"OpenSim cannot build {path}: {str(exc).splitlines()[0]}") from None
     digest = hashlib.sha256(path.read_bytes()).hexdigest()
-    return OsimEngine(model, state, model.getName() or path.stem, str(path.resolve()), digest, couplers)
+    source = str(path.resolve()) + schema
+    return OsimEngine(model, state, model.getName() or path.stem, source, digest, couplers)
+
+
+def _schema(osim, model, path) -> str:
+    """What OpenSim did with the file's schema (its ``Version`` attribute): "" if current, else a note.
+
+    OpenSim upgrades older schemas as it reads them; a schema newer than this OpenSim's may hold
+    what it silently ignores, so it is refused in one line.
+    """
+    major, minor = (int(p) for p in osim.__version__.split(".")[:2])
+    latest = 10000 * major + 100 * minor  # OpenSim's XMLDocument::LatestVersion of this release
+    version = model.getDocumentFileVersion()
+    if version > latest:
+        raise ParameterError(
+            "model",
+            f"{printable(str(path))} has OpenSim schema {version}, newer than OpenSim {osim.__version__}'s "
+            f"({latest}); open it with that OpenSim",
+        )
+    return f" (schema {version}, upgraded by OpenSim {osim.__version__} to {latest})" if version < latest else ""
 
 
 def _couplers(osim, model) -> tuple:

@@ -256,3 +256,22 @@ def test_upright_optimum_is_infeasible_and_check_is_refused(imported, capsys):
     assert main(["anatomy", str(path), "--check"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "MJCF" in err
+
+
+def test_schema_versions_older_are_reported_and_newer_refused(imported, tmp_path, capsys):
+    """The file's OpenSim schema (its Version attribute, OpenSim's getDocumentFileVersion): an older one is read
+    as OpenSim upgrades it, and the chain's source says so; one newer than this OpenSim's, or one OpenSim cannot
+    read, is one line, exit 2."""
+    text = imported[4].read_text()
+    current = osim.Model(str(imported[4])).getDocumentFileVersion()
+    assert f'Version="{current}"' in text
+    files = {}
+    for version in (current - 1, current + 10000, 20000):
+        files[version] = tmp_path / f"v{version}.osim"
+        files[version].write_text(text.replace(f'Version="{current}"', f'Version="{version}"', 1))
+    free, _, _ = anatomy.load(files[current - 1]).chains()
+    assert f"(schema {current - 1}, upgraded by OpenSim {osim.__version__} to {current})" in free.source
+    for version in (current + 10000, 20000):  # 20000: OpenSim's 2.x upgrade cannot read a 4.x document
+        assert main(["anatomy", str(files[version])]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and str(files[version].name) in err
