@@ -456,12 +456,15 @@ def linearise(engine: OsimEngine, names, values: dict, n=None) -> Linearisation:
     full = np.array([[mass.get(i, j) for j in range(mass.ncol())] for i in range(mass.nrow())])
     hessian = np.zeros((len(lengths), s, s))
     dpassive = np.zeros((s, s))
+    wrapped = _wrapped(engine)
+    touching = _contacts(engine, wrapped)
     for k, name in enumerate(names):
         sides = []
         for sign in (1.0, -1.0):
             moved = dict(values)
             moved[name] = values.get(name, engine.coordinate(name).getDefaultValue()) + sign * STEP
             sides.append(_arms_and_passive(engine, names, moved))
+            _same_contacts(engine, wrapped, touching, _contacts(engine, wrapped), name)
         hessian[:, :, k] = (sides[0][0] - sides[1][0]) / (2 * STEP)
         dpassive[:, k] = (sides[0][1] - sides[1][1]) / (2 * STEP)
     engine.set_posture(values)
@@ -479,6 +482,36 @@ def linearise(engine: OsimEngine, names, values: dict, n=None) -> Linearisation:
         torque_offset=passive + arms.T @ bias,
         moment_arms=arms,
     )
+
+
+def _wrapped(engine: OsimEngine) -> dict:
+    """Muscle index -> the names of the wrap objects on its path, for the muscles that have any."""
+    muscles = engine.model.getMuscles()
+    out = {}
+    for i in range(muscles.getSize()):
+        wraps = muscles.get(i).getGeometryPath().getWrapSet()
+        if wraps.getSize():
+            out[i] = [wraps.get(k).getWrapObject().getName() for k in range(wraps.getSize())]
+    return out
+
+
+def _contacts(engine: OsimEngine, wrapped: dict) -> dict:
+    """Muscle index -> how many points its current path has (2 more per wrap it touches), at the set posture."""
+    muscles = engine.model.getMuscles()
+    engine.model.realizePosition(engine.state)
+    return {i: muscles.get(i).getGeometryPath().getCurrentPath(engine.state).getSize() for i in wrapped}
+
+
+def _same_contacts(engine: OsimEngine, wrapped: dict, before: dict, after: dict, coordinate: str) -> None:
+    """A muscle that touches a wrap on one side of the posture only has a kinked moment arm there: one line."""
+    for i, count in before.items():
+        if after[i] != count:
+            muscle = engine.model.getMuscles().get(i).getName()
+            raise ModelError(
+                f"{engine.name}: muscle {muscle} starts or stops wrapping over {', '.join(wrapped[i])} within "
+                f"{STEP:g} rad of the posture ({coordinate}): its moment arm has a kink there, which the "
+                "linearisation cannot differentiate; nothing was linearised (move the posture off the contact)"
+            )
 
 
 @dataclass

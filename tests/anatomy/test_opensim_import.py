@@ -275,3 +275,29 @@ def test_schema_versions_older_are_reported_and_newer_refused(imported, tmp_path
         assert main(["anatomy", str(files[version])]) == 2
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and str(files[version].name) in err
+
+
+def test_a_wrap_touched_at_the_posture_is_named_and_refused(imported, tmp_path, capsys):
+    """A WrapCylinder (OpenSim's API) tangent to straight_ventral_0's path at the upright posture: the path wraps
+    on one side of L5S1 = 0 only (OpenSim's current path has 4 points there, 2 on the other), so its moment arm
+    has a kink at the posture. `spinectl anatomy` names the muscle, the wrap and the coordinate: one line, exit 2."""
+    built = osim.Model(str(imported[4]))
+    state = built.initSystem()
+    path = built.getMuscles().get(0).getGeometryPath()
+    points = path.getPathPointSet()
+    top, bottom = (np.array(points.get(k).getLocationInGround(state).to_numpy()) for k in range(2))
+    along = (bottom - top) / np.linalg.norm(bottom - top)
+    radius = 0.01
+    cylinder = osim.WrapCylinder()
+    cylinder.setName("belly")
+    cylinder.set_radius(radius)
+    cylinder.set_length(0.2)
+    cylinder.set_translation(osim.Vec3(*(0.5 * (top + bottom) + radius * np.array([-along[1], along[0], 0.0]))))
+    built.updGround().addWrapObject(cylinder)
+    path.addPathWrap(cylinder)
+    built.finalizeConnections()
+    out = tmp_path / "wrapped.osim"
+    built.printToXML(str(out))
+    assert main(["anatomy", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "straight_ventral_0" in err and "belly" in err and "L5S1" in err
