@@ -608,11 +608,8 @@ class OsimAnatomy(Anatomy):
         n = lin.n
         added = self.added_stiffness(joint_stiffness, n)
         source = f"{self.engine.source}, {plane}"
-        described = self.couplers(plane, posture)
-        if described:
-            source += (
-                f"; coupler constraints off in the free chain, linearised in the constrained: {'; '.join(described)}"
-            )
+        if posture and self.engine.couplers:  # the engine's source gives the slopes at the default posture
+            source += f"; the couplers at this posture: {'; '.join(self.couplers(plane, posture)) or 'none'}"
         free = free_chain(lin, tuple(involved[:n]), self.muscles, self.classes, added, source)
         full_added = np.concatenate([added, np.zeros(len(involved) - n)])
         constrained = constrained_chain(
@@ -646,6 +643,9 @@ def load_osim(path, mapping=None) -> OsimAnatomy:
     for i in range(muscles.getSize()):
         _millard(engine, muscles.get(i))
     names = tuple(muscles.get(i).getName() for i in range(muscles.getSize()))
+    if engine.couplers:  # in the model's source line, which every table and JSON prints
+        described = "; ".join(c.describe({}, engine) for c in engine.couplers)
+        engine.source += f"; coupler constraints (off in the free chain, linearised in the constrained): {described}"
     return OsimAnatomy(engine, mapping, names, _classify(engine, mapping))
 
 

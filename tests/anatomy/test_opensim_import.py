@@ -182,6 +182,14 @@ def test_couplers_are_off_in_the_free_chain_and_reduce_the_constrained_one(impor
     assert "rhythm_L1L2 (L1L2 on L2L3 slope 0.5)" in free.source
 
 
+def test_the_cli_names_the_couplers_with_their_slopes(coupled, capsys):
+    """`spinectl anatomy coupled.osim` prints the coupler, the coordinate it slaves and its slope, and the chain
+    constrained by it in the independent coordinates."""
+    assert main(["anatomy", str(coupled)]) == 0
+    out = capsys.readouterr().out
+    assert "rhythm_L1L2 (L1L2 on L2L3 slope 0.5)" in out and "(4 coordinate(s): L5S1, L4L5, L3L4, L2L3)" in out
+
+
 def test_the_coupled_coordinate_moves_in_opensim_as_the_reduction_says(imported, coupled):
     """OpenSim's own simulation (Manager.integrate) of the coupled file, started with L2L3 moving: L1L2 follows
     at the slope the import reads off the coupler's function (its T), to the integrator's accuracy."""
