@@ -15,7 +15,7 @@ from matplotlib.figure import Figure
 
 from ..canvas import new_figure, save_figures
 from ..units import m2_to_cm2
-from .design import PAPER_PASSIVE, PassiveCurve
+from .design import PAPER_PASSIVE, REACTION_TIMES, DesignCurve, PassiveCurve
 
 DPI = 110
 """Resolution of the PNG files [dots per inch]."""
@@ -60,7 +60,49 @@ def passive_figure(curve: PassiveCurve) -> Figure:
         ax.grid(alpha=0.3)
     top.legend(fontsize=8, loc="upper right")
     fig.suptitle(
-        f"{curve.model.get('header', '')}; E = {curve.eccentricity * 100:.1f} cm, "
+        f"{curve.model.get('header', '')}\nE = {curve.eccentricity * 100:.1f} cm, "
+        f"Λ = {curve.lordosis * 100:.1f} cm",
+        fontsize=9,
+    )
+    return fig
+
+
+def delay_figure(curve: DesignCurve) -> Figure:
+    """The design curve: required co-contraction (joint by joint) and local stiffness (chain) against the delay.
+
+    One line per lag T_a; the trunk muscles' reaction times of Radebold et al. (2000) marked
+    (:data:`spinectl.reflex.design.REACTION_TIMES`).
+
+    Parameters
+    ----------
+    curve : DesignCurve
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig = new_figure(figsize=(7.0, 6.5), layout="constrained")
+    top, bottom = fig.subplots(2, 1, sharex=True)
+    ms = curve.delays * 1000.0
+    for i, lag in enumerate(curve.lags):
+        label = f"T_a = {lag * 1000:.4g} ms"
+        top.plot(ms, curve.activation[i], "o-", ms=3, color=f"C{i}", label=label)
+        bottom.plot(ms, curve.local_stiffness[i].sum(axis=1), "o-", ms=3, color=f"C{i}", label=label)
+    top.set_ylabel("least activation [x minimum PCSA]")
+    top.set_title("joint by joint (each CoR alone, the others fixed): every segment's margin >= delay", fontsize=10)
+    bottom.set_ylabel("least local stiffness, sum [N m/rad]")
+    bottom.set_title(
+        f"chain (all CoRs free), global activation {curve.chain_activation:.3g}: stable at the delay", fontsize=10
+    )
+    bottom.set_xlabel("reflex delay [ms]")
+    for ax in (top, bottom):
+        for j, (t, text) in enumerate(REACTION_TIMES):
+            ax.axvline(t * 1000.0, color="0.4", ls=(0, (4, 2 + 2 * j)), lw=1, label=f"{t * 1000:.0f} ms: {text}")
+        ax.grid(alpha=0.3)
+        ax.set_ylim(bottom=0)
+    top.legend(fontsize=7, loc="upper left")
+    fig.suptitle(
+        f"{curve.model.get('header', '')}\nE = {curve.eccentricity * 100:.1f} cm, "
         f"Λ = {curve.lordosis * 100:.1f} cm",
         fontsize=9,
     )
