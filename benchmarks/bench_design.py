@@ -3,6 +3,9 @@
 Run once: ``PYTHONPATH=. python benchmarks/bench_design.py``. The target: the curve in <= 10 s on the 2-core
 machine. The brute force answers the joint-by-joint half alone by scanning the activation in steps of 1e-3
 (1001 exact margins per delay, every segment) and checks that the curve's activations agree to that step.
+
+Measured once (2-core machine shared with other jobs): default 5.53 s (brute force 183.6 s, largest difference
+9.5e-4); the 35 kg subject with K = 10 N m/rad (wagner2012) 3.55 s (brute force 235.0 s, 9.8e-4).
 """
 
 from __future__ import annotations
