@@ -2,7 +2,15 @@
 
 from __future__ import annotations
 
-from ._common import add_model_options, add_position_options, check_position, emit_json, finite_float, float_list, load_model
+from ._common import (
+    add_model_options,
+    add_position_options,
+    check_position,
+    emit_json,
+    finite_float,
+    float_list,
+    load_model,
+)
 
 
 def register(sub) -> None:

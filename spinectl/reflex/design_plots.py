@@ -60,8 +60,7 @@ def passive_figure(curve: PassiveCurve) -> Figure:
         ax.grid(alpha=0.3)
     top.legend(fontsize=8, loc="upper right")
     fig.suptitle(
-        f"{curve.model.get('header', '')}\nE = {curve.eccentricity * 100:.1f} cm, "
-        f"Λ = {curve.lordosis * 100:.1f} cm",
+        f"{curve.model.get('header', '')}\nE = {curve.eccentricity * 100:.1f} cm, Λ = {curve.lordosis * 100:.1f} cm",
         fontsize=9,
     )
     return fig
@@ -102,8 +101,7 @@ def delay_figure(curve: DesignCurve) -> Figure:
         ax.set_ylim(bottom=0)
     top.legend(fontsize=7, loc="upper left")
     fig.suptitle(
-        f"{curve.model.get('header', '')}\nE = {curve.eccentricity * 100:.1f} cm, "
-        f"Λ = {curve.lordosis * 100:.1f} cm",
+        f"{curve.model.get('header', '')}\nE = {curve.eccentricity * 100:.1f} cm, Λ = {curve.lordosis * 100:.1f} cm",
         fontsize=9,
     )
     return fig

@@ -68,7 +68,8 @@ def test_delays_prints_the_curves_dict_and_plots_it(capsys, tmp_path):
     argv = ["design", "--preset", "wagner2012", "--delays", "0:0.1:2", "--lags", "0,0.05", "--json"]
     assert main([*argv, "--plot", str(tmp_path)]) == 0
     out = capsys.readouterr().out
-    assert out == jsondoc.dumps(delay_curve(config.load_preset("wagner2012"), 0.0, 0.0, [0.0, 0.1], [0.0, 0.05]).to_dict())
+    expected = delay_curve(config.load_preset("wagner2012"), 0.0, 0.0, [0.0, 0.1], [0.0, 0.05]).to_dict()
+    assert out == jsondoc.dumps(expected)
     doc = json.loads(out, parse_constant=lambda word: pytest.fail(f"{word} in strict JSON"))
     assert [c["activation_time_constant_s"] for c in doc["curves"]] == [0.0, 0.05]
     assert doc["curves"][0]["joint"]["criterion"].startswith("joint by joint")

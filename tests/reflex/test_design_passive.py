@@ -39,7 +39,11 @@ def test_the_top_load_is_the_spines_top_not_the_upper_bodys_mass():
     k = dz.crisco_stiffness(model, 0.0, 0.0)
     y = np.asarray(model.geometry.cor_heights)
     hi = np.minimum.outer(np.arange(y.size), np.arange(y.size))
-    at = lambda h: np.linalg.eigvalsh(dz.CRISCO_LOAD * (h - y[hi]))[-1]  # K_g of docs/chain.md, own formula
+
+    def at(h):
+        """lambda_max of K_g = W (h - y_hi) (docs/chain.md), with the load at height h."""
+        return np.linalg.eigvalsh(dz.CRISCO_LOAD * (h - y[hi]))[-1]
+
     assert k == pytest.approx(at(model.geometry.spine_length), rel=1e-12)
     assert at(y[0]) < k < at(model.body.mass_height)
 
