@@ -696,14 +696,9 @@ def optimise(
     -------
     spinectl.anatomy.optimum.Optimum
     """
-    from .optimum import EQUILIBRIUM, STABILITY, Optimum, solve_on_chain
+    from .optimum import check_choices, optimum_on_chains
 
-    if stability not in STABILITY:
-        raise ParameterError("stability", f"must be one of {STABILITY} (got {stability!r})")
-    if equilibrium not in EQUILIBRIUM:
-        raise ParameterError("equilibrium", f"must be one of {EQUILIBRIUM} (got {equilibrium!r})")
-    if not (np.isfinite(margin) and margin >= 0):
-        raise ParameterError("margin", f"must be >= 0 [N m/rad] (got {margin!r})")
+    check_choices(stability, equilibrium, margin)
     free, constrained, lin = anatomy.chains(plane, None, joint_stiffness)
     _, rhy, _ = anatomy.linearise(plane)
     rows = list(range(lin.n))
@@ -712,21 +707,7 @@ def optimise(
     else:
         tau_per, tau_0 = rhy.transform.T @ lin.torque_per_muscle, rhy.transform.T @ lin.torque_offset
     w = volume_weights(anatomy)
-    chain, criterion = (constrained, "chain") if stability == "rhythm" else (free, stability)
-    status, a = solve_on_chain(chain, tau_per, tau_0, w, criterion, margin)
-    k = free.stiffness(a) if np.all(np.isfinite(a)) else np.full((free.n_joints,) * 2, np.nan)
-    ok = np.all(np.isfinite(k))
-    return Optimum(
-        stability=stability,
-        status=status,
-        activations=a,
-        cost=float(w @ a**2),
-        equilibrium=equilibrium,
-        net_torque=tau_per @ a + tau_0,
-        lumbar_torque=lin.torque_per_muscle[rows] @ a + lin.torque_offset[rows],
-        eigenvalues=np.linalg.eigvalsh(-0.5 * (k + k.T)) if ok else np.full(free.n_joints, np.nan),
-        joint_stiffness=-np.diag(k),
-    )
+    return optimum_on_chains(free, constrained, lin, rows, tau_per, tau_0, w, stability, equilibrium, margin)
 
 
 def optimised(

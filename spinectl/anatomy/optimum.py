@@ -184,14 +184,7 @@ def optimise(
     -------
     Optimum
     """
-    if stability not in STABILITY:
-        raise ParameterError("stability", f"must be one of {STABILITY} (got {stability!r})")
-    if weights not in WEIGHTS:
-        raise ParameterError("weights", f"must be one of {WEIGHTS} (got {weights!r})")
-    if equilibrium not in EQUILIBRIUM:
-        raise ParameterError("equilibrium", f"must be one of {EQUILIBRIUM} (got {equilibrium!r})")
-    if not (np.isfinite(margin) and margin >= 0):
-        raise ParameterError("margin", f"must be >= 0 [N m/rad] (got {margin!r})")
+    check_choices(stability, equilibrium, margin, weights)
     free, constrained, lin = anatomy.chains(plane, posture, joint_stiffness)
     lumbar = anatomy.mapping.planes.get("3d", anatomy.plane_joints(plane))
     model = anatomy.engine.model
@@ -204,10 +197,68 @@ def optimise(
         dofs = list(rhy.dofs)
         tau_per, tau_0 = rhy.transform.T @ lin.torque_per_muscle[dofs], rhy.transform.T @ lin.torque_offset[dofs]
     w = volume_weights(anatomy) if weights == "volume" else np.ones(free.n_controls)
-    if stability == "rhythm":
-        status, a = solve_on_chain(constrained, tau_per, tau_0, w, "chain", margin)
-    else:
-        status, a = solve_on_chain(free, tau_per, tau_0, w, stability, margin)
+    return optimum_on_chains(free, constrained, lin, rows, tau_per, tau_0, w, stability, equilibrium, margin)
+
+
+def check_choices(stability, equilibrium, margin, weights="volume"):
+    """Refuse a stability criterion, weighting, equilibrium or margin outside what :func:`optimise` takes.
+
+    Parameters
+    ----------
+    stability : str
+        One of :data:`STABILITY`.
+    equilibrium : str
+        One of :data:`EQUILIBRIUM`.
+    margin : float
+        mu [N m/rad], >= 0.
+    weights : str
+        One of :data:`WEIGHTS`.
+
+    Returns
+    -------
+    None
+
+    Raises
+    ------
+    ParameterError
+        Naming the field and what is allowed.
+    """
+    if stability not in STABILITY:
+        raise ParameterError("stability", f"must be one of {STABILITY} (got {stability!r})")
+    if weights not in WEIGHTS:
+        raise ParameterError("weights", f"must be one of {WEIGHTS} (got {weights!r})")
+    if equilibrium not in EQUILIBRIUM:
+        raise ParameterError("equilibrium", f"must be one of {EQUILIBRIUM} (got {equilibrium!r})")
+    if not (np.isfinite(margin) and margin >= 0):
+        raise ParameterError("margin", f"must be >= 0 [N m/rad] (got {margin!r})")
+
+
+def optimum_on_chains(free, constrained, lin, rows, tau_per, tau_0, w, stability, equilibrium, margin):
+    """Solve the optimum on the linearised chains and summarise it; shared by both engines.
+
+    Parameters
+    ----------
+    free, constrained : chain
+        The chain with every joint free and the one with the rhythm imposed.
+    lin : linearisation
+        Its ``torque_per_muscle`` [N m] and ``torque_offset`` [N m] over all dofs.
+    rows : list of int
+        The lumbar dofs in ``lin``'s rows.
+    tau_per, tau_0 : numpy.ndarray
+        The equilibrium's torque per activation [N m] and offset [N m].
+    w : numpy.ndarray
+        Cost weights per muscle.
+    stability, equilibrium : str
+        As :func:`optimise`; ``"rhythm"`` solves the chain criterion on ``constrained``.
+    margin : float
+        mu [N m/rad].
+
+    Returns
+    -------
+    Optimum
+    """
+    chain, criterion = (constrained, "chain") if stability == "rhythm" else (free, stability)
+    status, a = solve_on_chain(chain, tau_per, tau_0, w, criterion, margin)
     k = free.stiffness(a) if np.all(np.isfinite(a)) else np.full((free.n_joints,) * 2, np.nan)
     ok = np.all(np.isfinite(k))
     return Optimum(
