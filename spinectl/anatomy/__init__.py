@@ -13,7 +13,7 @@ from . import model as _model
 from .model import Anatomy
 
 
-def load(model="myotorso", mapping=None) -> Anatomy:
+def load(model="myotorso", mapping=None, cache: bool = True) -> Anatomy:
     """Load an anatomical model and map it onto the chain: MuJoCo's, or OpenSim's for an ``.osim`` file.
 
     Parameters
@@ -23,6 +23,9 @@ def load(model="myotorso", mapping=None) -> Anatomy:
         (:func:`spinectl.anatomy.opensim_engine.load_osim`).
     mapping : str, pathlib.Path or Mapping, optional
         A mapping TOML file; default the built-in one of the model's name.
+    cache : bool
+        For MuJoCo's models: read the compiled model from the cache of compiled models, and write
+        it there (:mod:`spinectl.anatomy.cache`); False compiles it anew. An ``.osim`` file is not cached.
 
     Returns
     -------
@@ -32,7 +35,7 @@ def load(model="myotorso", mapping=None) -> Anatomy:
         from .opensim_engine import load_osim
 
         return load_osim(model, mapping)
-    return _model.load(model, mapping)
+    return _model.load(model, mapping, cache=cache)
 
 
 __all__ = ["Anatomy", "load"]
