@@ -349,3 +349,32 @@ def test_the_design_button_shows_the_answer_for_its_state_and_marks_it_when_the_
     explorer.run_design()
     assert explorer.design.object == "<p><b>design not found:</b> levels.mass: must be &gt; 0 for the chain</p>"
     assert not explorer.design_button.disabled and not explorer.design_spinner.value
+
+
+def test_in_a_session_the_design_runs_in_a_worker_and_the_sliders_stay_free(monkeypatch):
+    """In a server session the button starts a task (a worker thread) and shows a spinner, the button disabled;
+    a slider moved meanwhile updates the point at once; the task answers for the state of the press and ends
+    with the spinner stopped and the button enabled, also when the library refuses (its one-line error)."""
+    tasks, asked = [], []
+    monkeypatch.setattr(app, "in_session", lambda: True)
+    monkeypatch.setattr(app.pn.state, "onload", lambda callback, **options: None)
+    monkeypatch.setattr(app.pn.state, "execute", lambda function, **options: tasks.append(function))
+
+    def refused(base, state):
+        asked.append(state)
+        raise ModelError("levels.mass: must be > 0 for the chain")
+
+    monkeypatch.setattr(app, "design_numbers", refused)
+    explorer = app.Explorer(load_preset("default"), "default")
+    pressed = explorer.state
+    explorer.design_button.clicks += 1
+    (solve,) = tasks
+    assert explorer.design_spinner.value and explorer.design_spinner.visible and explorer.design_button.disabled
+    table = explorer.table.object
+    _drag(explorer.sliders["activation_lag"], 100.0)  # moves every delay margin (test_the_delay_redraws_...)
+    assert explorer.table.object != table  # the point follows the slider while the design is pending
+    asyncio.run(solve())
+    assert asked == [pressed]
+    assert explorer.design.object == "<p><b>design not found:</b> levels.mass: must be &gt; 0 for the chain</p>"
+    assert not explorer.design_spinner.value and not explorer.design_spinner.visible
+    assert not explorer.design_button.disabled
