@@ -321,7 +321,8 @@ def state_figure(numbers: PointNumbers, dataset: xr.Dataset | None) -> Figure:
     Returns
     -------
     matplotlib.figure.Figure
-        The model drawing, eigenvalues, counter torques, delay margins and both landscapes.
+        The model drawing, eigenvalues, counter torques, delay margins (joint by joint) and both landscapes;
+        the title gives the chain's verdict (:func:`chain_caption`).
     """
     fig = new_figure(figsize=STATE_FIGURE_SIZE, layout="constrained")
     axes = fig.subplots(2, 3)
@@ -337,6 +338,27 @@ def state_figure(numbers: PointNumbers, dataset: xr.Dataset | None) -> Figure:
             landscape_plot(dataset, variable, numbers, ax)
     fig.suptitle(
         f"spinectl explore: mass {state.mass:g} kg, K {state.stiffness:g} N m/rad, delay {state.delay * 1000:g} ms, "
-        f"activation {state.activation:g} × minimum PCSA, lag {state.activation_lag * 1000:g} ms"
+        f"activation {state.activation:g} × minimum PCSA, lag {state.activation_lag * 1000:g} ms\n"
+        + chain_caption(numbers)
     )
     return fig
+
+
+def chain_caption(numbers: PointNumbers) -> str:
+    """The chain's verdict in one line, its criterion named: what the PNG export says beside the segments' views.
+
+    Parameters
+    ----------
+    numbers : PointNumbers
+
+    Returns
+    -------
+    str
+        E.g. 'chain (all 5 CoRs free), the same reflex: stable at τ: no, delay margin 4.787e-05 s;
+        without reflex 5 of 10 modes grow'.
+    """
+    row = numbers.chain_row()
+    return (
+        f"{row['criterion']}, the same reflex: stable at τ: {row['stable_at_delay']}, delay margin "
+        f"{row['delay_margin_s']} s; without reflex {row['modes']}"
+    )
