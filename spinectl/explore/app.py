@@ -244,6 +244,7 @@ class Explorer:
         self.base, self.current = base, preset
         self.state = initial_state(base)
         self.numbers: PointNumbers | None = None
+        self._numbers_base: Model | None = None
         self.dataset: xr.Dataset | None = None
         self._generation = 0
         self._pictures_key = None
@@ -397,8 +398,9 @@ class Explorer:
             at this point; the views then keep the last point).
         """
         start = time.perf_counter()
-        try:
-            numbers = point_numbers(self.base, self.state)
+        same_base = self.numbers is not None and self._numbers_base is self.base
+        try:  # the chain's margin of the last point is reused where only the delay moved
+            numbers = point_numbers(self.base, self.state, previous=self.numbers if same_base else None)
         except SpinectlError as exc:  # e.g. a fibre attachment on a CoR of a --config model: say so, keep the views
             self.errors["point"] = printable(str(exc))
             self._show_status()
@@ -408,7 +410,7 @@ class Explorer:
         changed = key != self._pictures_key  # the delay and the lag move the margins only: redraw the rest if needed
         drawing = drawing_svg(numbers) if changed else None
         with pn.io.hold():
-            self.numbers, self._pictures_key = numbers, key
+            self.numbers, self._numbers_base, self._pictures_key = numbers, self.base, key
             if changed:
                 self.drawing.object = drawing
             for view in self.views.values():

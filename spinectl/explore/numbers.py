@@ -15,6 +15,7 @@ solved on the stacked fast path (:func:`spinectl.landscape.sweep.sweep`, docs/op
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -24,9 +25,10 @@ from ..landscape.sweep import sweep
 from ..model.params import Model
 from ..model.stability import criterion, segment_stability
 from ..paper import grid
+from ..reflex.chain_margins import stable_at
 from ..reflex.chain_verdict import ChainVerdict, margins_with_chain
 from ..reflex.design import Design, design
-from ..reflex.margins import MarginsReport
+from ..reflex.margins import MarginsReport, analyse
 from ..units import m2_to_cm2
 from .state import ExploreState, model_at
 
@@ -165,14 +167,20 @@ def shown(value) -> str:
     return f"{value.real:.{DIGITS}g}{value.imag:+.{DIGITS}g}j"
 
 
-def point_numbers(base: Model, state: ExploreState) -> PointNumbers:
-    """Every number the explorer shows at ``state``: margins, eigenvalues, counter torques.
+def point_numbers(base: Model, state: ExploreState, previous: PointNumbers | None = None) -> PointNumbers:
+    """Every number the explorer shows at ``state``: margins, eigenvalues, counter torques, the chain's verdict.
 
     Parameters
     ----------
     base : Model
         The preset or configuration the explorer started from.
     state : ExploreState
+    previous : PointNumbers, optional
+        The numbers of the same ``base`` at an earlier state. Where that state differs from ``state`` in
+        the delay alone, its chain's exact delay margin is reused, compared with the new delay: the
+        margin, the rule's gains and the modes do not depend on the delay
+        (:func:`spinectl.reflex.chain_verdict.chain_verdict`), and the margin's frequency sweep is
+        two thirds of the time of a point.
 
     Returns
     -------
@@ -192,7 +200,12 @@ def point_numbers(base: Model, state: ExploreState) -> PointNumbers:
     doi:10.1186/1742-4682-9-13.
     """
     model = model_at(base, state)
-    report = margins_with_chain(model, state.eccentricity, state.lordosis)
+    if previous is not None and dataclasses.replace(previous.state, delay=state.delay) == state:
+        chain = previous.chain
+        chain = dataclasses.replace(chain, delay=state.delay, stable_at_delay=stable_at(chain.exact, state.delay))
+        report = dataclasses.replace(analyse(model, state.eccentricity, state.lordosis), chain=chain)
+    else:
+        report = margins_with_chain(model, state.eccentricity, state.lordosis)
     n_cor = len(model.geometry.cor_names)
     eigenvalues = np.full((n_cor, 2), np.nan, complex)
     counter_torque = np.full(n_cor, np.nan)

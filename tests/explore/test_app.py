@@ -104,7 +104,7 @@ def test_a_model_invalid_at_the_point_is_a_message_not_a_crash(explorer, monkeyp
     """An error the user can cause (a SpinectlError) shows in the status line; the views keep the last point."""
     shown = explorer.table.object
 
-    def invalid(base, state):
+    def invalid(base, state, previous=None):
         raise ModelError("fibre attachment on a centre of rotation")
 
     monkeypatch.setattr(app, "point_numbers", invalid)

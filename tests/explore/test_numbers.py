@@ -12,7 +12,7 @@ from spinectl.model import chain, geometry
 from spinectl.model.config import load_preset, set_parameters
 from spinectl.model.stability import segment_stability
 from spinectl.optimise.reference import solve_point
-from spinectl.reflex.chain_verdict import chain_verdict
+from spinectl.reflex.chain_verdict import chain_verdict, margins_with_chain
 from spinectl.reflex.margins import analyse, operating_point
 
 
@@ -184,3 +184,19 @@ def test_design_rows_show_both_criteria_and_the_certificate(answer):
     assert rows["local_stiffness_Nm_per_rad"] == ", ".join(
         f"{name} {nb.shown(k)}" for name, k in zip(names, design.chain.local_stiffness, strict=True)
     )
+
+
+@pytest.mark.parametrize("change", [{"delay": 0.0}, {"delay": 0.2}, {"activation_lag": 0.1}, {"activation": 0.3}])
+def test_the_previous_points_chain_is_reused_only_where_the_delay_alone_moved(state, change):
+    """point_numbers(..., previous=): the chain's verdict equals the one computed afresh at the new state
+    (margins_with_chain), for a delay moved (reused: the margin does not depend on the delay; 0 and 0.2 s judge
+    it on both sides) and for the lag or the activation moved (computed again: both move the chain's margin)."""
+    base = load_preset("default")
+    previous = nb.point_numbers(base, state)
+    moved = ExploreState(**{**state.__dict__, **change})
+    got = nb.point_numbers(base, moved, previous=previous)
+    fresh = margins_with_chain(_library_model(base, moved), moved.eccentricity, moved.lordosis).chain
+    assert got.chain.to_dict() == fresh.to_dict() and got.chain.delay == moved.delay
+    assert got.chain_row()["stable_at_delay"] == ("yes" if fresh.stable_at_delay else "no")
+    reused = got.chain.exact is previous.chain.exact
+    assert reused == ("delay" in change)
