@@ -25,6 +25,12 @@
 # the loop without delay (docs: *Delayed reflexes*; `reflex.gain_factor`, `reflex.damping_ratio`). The **delay margin**
 # $\tau_m$ is the largest delay with the loop stable for every delay below it, computed exactly from the characteristic
 # quasi-polynomial; it is infinite where no delay can destabilise the joint.
+#
+# Every verdict here names its criterion. Most of the notebook judges **joint by joint** (each CoR alone, the others
+# fixed; the paper's criterion): "the spine" then means its five joints, each judged alone, and its delay margin is the
+# least of theirs. The section *The chain at the same delays* judges the **chain** (all 5 CoRs free) under the same
+# reflex, which can give the opposite answer (docs: *The lumbar chain*); the last sections answer the design
+# question for both criteria.
 
 # %% tags=["parameters"]
 import os
@@ -46,6 +52,8 @@ from spinectl.landscape import sweep
 from spinectl.model import config
 from spinectl.paper import grid, landmarks
 from spinectl.reflex import loops, margins, simulate
+from spinectl.reflex.chain_verdict import margins_with_chain
+from spinectl.reflex.design import design
 
 preset = PRESET or spinectl.DEFAULT_PRESET  # the preset of every command and of spinectl.load_preset()
 model = spinectl.load_preset(preset)
@@ -139,23 +147,63 @@ for a in (0.0, 0.25, 0.5, 0.75, 1.0):
 pd.DataFrame(rows).set_index(["activation", "segment"]).round(2)
 
 # %% [markdown]
-# How much co-contraction does each delay need, when the reflex does the rest? The spine tolerates the smallest
-# delay margin of its five joints.
+# How much co-contraction does each delay need, when the reflex does the rest? Joint by joint (each CoR alone, the
+# others fixed; the paper's criterion) the spine tolerates the smallest delay margin of its five joints.
 
 # %%
 spine_margin = exact.margin.min(axis=1)
 for tau in DELAYS:
     enough = spine_margin > tau
     needed = f"a = {activation[np.argmax(enough)]:.2f}" if enough.any() else "none up to a = 1"
-    print(f"delay {tau * 1e3:3.0f} ms: least activation with the whole spine stable: {needed} (steps of 0.01)")
-print(f"reflex only (a = 0): the spine tolerates {spine_margin[0] * 1e3:.0f} ms")
-print(f"every joint self-stable, so any delay is tolerated: a >= {self_stable_from.max():.3f}")
+    print(f"delay {tau * 1e3:3.0f} ms: least activation, every joint stable joint by joint: {needed} (steps of 0.01)")
+print(f"reflex only (a = 0), joint by joint: the spine tolerates {spine_margin[0] * 1e3:.0f} ms")
+print(f"every joint self-stable alone, so any delay is tolerated joint by joint: a >= {self_stable_from.max():.3f}")
+
+# %% [markdown]
+# ## The chain at the same delays
+#
+# The same operating point and the same reflex rule on the whole chain, every CoR free at once
+# (`spinectl margins` prints it beside the segments' verdict;
+# `spinectl.reflex.chain_verdict.margins_with_chain`). The rule on the chain makes up the chain's stiffness deficit,
+# the least local stiffness for static stability (docs: *The lumbar chain*), and the exact multivariable delay margin
+# says which delays it holds. Side by side with the joint-by-joint verdict, at the three delays:
+
+# %%
+verdicts = []
+for a in (0.0, 0.25, 0.5, 1.0):
+    for tau in DELAYS:
+        settings = config.set_parameters(model, {"reflex.activation": a, "reflex.delay": tau})
+        both = margins_with_chain(settings, *POSITION)
+        verdicts.append(
+            {
+                "activation": a,
+                "delay [ms]": tau * 1e3,
+                "joint by joint: τ_m [ms]": min(s.delay_margin for s in both.segments) * 1e3,
+                "joint by joint: stable": all(s.stable_at_delay for s in both.segments),
+                "chain: τ_m [ms]": both.chain.exact.margin * 1e3,
+                "chain: stable": both.chain.stable_at_delay,
+                "chain without reflex: growing modes": both.chain.modes.growth_times.size,
+                "fastest growth [ms]": both.chain.modes.growth_times[0] * 1e3
+                if both.chain.modes.growth_times.size
+                else np.nan,
+            }
+        )
+print("\n".join(both.chain.lines()))
+pd.DataFrame(verdicts).set_index(["activation", "delay [ms]"]).round(3)
+
+# %% [markdown]
+# Joint by joint the spine is stable at each of these delays once the co-contraction is high enough; the chain, with
+# every CoR free, is stable at none of them, at any of these activations: its delay margin is at most a fraction of a
+# millisecond (0 where the rule's reflex leaves it unstable even without delay). The modes that limit it bend the
+# joints against each other and grow, without reflex, within tens of milliseconds: faster than a delayed reflex can
+# act. What holds them is intrinsic stiffness at each joint, the local muscles: the design question below.
 
 # %% [markdown]
 # ## Delay-margin maps over E × Λ
 #
 # Every sweep carries the delay margins of every joint at the model's reflex settings (`delay_margin_s`) and the
-# spine's, the least over the joints (`spine_delay_margin_s`). The margin does not depend on the delay itself, so
+# spine's, the least over the joints (`spine_delay_margin_s`), joint by joint (each CoR alone, the others fixed; the
+# paper's criterion; the chain's margin is not in these maps). The margin does not depend on the delay itself, so
 # one sweep per activation answers "stable at delay $\tau$?" for every $\tau$: `spine_delay_margin_s > tau`.
 # Over the grid the answer changes little with E and Λ (the table below the maps gives the share of the grid
 # that tolerates each delay), so the figure below shows what does change it, the activation: for each activation
@@ -178,7 +226,7 @@ inertia = ds["inertia_kgm2"].values
 
 
 def spine_margin_ms(a, reflex_settings):
-    """The spine's exact delay margin [ms] at activation ``a`` at every grid point (inf: any delay)."""
+    """The spine's exact delay margin [ms], joint by joint, at activation ``a`` at every grid point (inf: any delay)."""
     joints = reflex.landscape(a * muscular + rigid, a * damping_full, inertia, reflex_settings)
     return joints.delay_margin.min(axis=-1) * 1e3
 
@@ -199,21 +247,21 @@ ax.plot(FINE, np.where(median_ms < TOP, median_ms, np.nan), label="median over t
 for tau in DELAYS:
     ax.axhline(tau * 1e3, color="grey", lw=0.8, ls="--")
     ax.annotate(f"τ = {tau * 1e3:g} ms", (FINE[-1], tau * 1e3), ha="right", va="bottom", fontsize=8, color="grey")
-ax.set(xlabel="activation a (fraction of the minimum stabilising PCSA)", ylabel="spine delay margin [ms]")
+ax.set(xlabel="activation a (fraction of the minimum stabilising PCSA)", ylabel="spine τ_m, joint by joint [ms]")
 ax.set_ylim(0, TOP)
 ax.set_title(f"force-generation lag T_a = {model.reflex.activation_time_constant * 1e3:g} ms", fontsize=10)
 ax.legend(loc="upper left")
 plt.show()
 
 # %% [markdown]
-# The same sweeps as continuous maps: the spine's delay margin, with the three delays as contours.
+# The same sweeps as continuous maps: the spine's delay margin, joint by joint, with the three delays as contours.
 
 # %%
 fig, axes = plt.subplots(1, len(ACTIVATIONS), figsize=(12, 3.9), sharey=True, layout="constrained")
 for ax, (a, ds) in zip(axes, maps.items(), strict=True):
     margin_ms = ds["spine_delay_margin_s"].transpose("Lambda", "E").values * 1e3
     filled = ax.contourf(axis * 100, axis * 100, np.ma.masked_invalid(margin_ms), levels=12, cmap="viridis")
-    fig.colorbar(filled, ax=ax, label="spine delay margin [ms]")
+    fig.colorbar(filled, ax=ax, label="spine delay margin, joint by joint [ms]")
     if np.nanmin(margin_ms) < max(DELAYS) * 1e3 and np.nanmax(margin_ms) > min(DELAYS) * 1e3:
         lines = ax.contour(axis * 100, axis * 100, margin_ms, levels=[t * 1e3 for t in DELAYS], colors="white")
         ax.clabel(lines, fmt="%g ms", fontsize=8)
@@ -229,7 +277,7 @@ pd.DataFrame(
         "spine τ_m, least [ms]": [float(ds.spine_delay_margin_s.min()) * 1e3 for ds in maps.values()],
         "spine τ_m, largest [ms]": [float(ds.spine_delay_margin_s.max()) * 1e3 for ds in maps.values()],
         **{
-            f"stable at {tau * 1e3:g} ms [% of grid]": [
+            f"stable joint by joint at {tau * 1e3:g} ms [% of grid]": [
                 100 * float((ds.spine_delay_margin_s > tau).mean()) for ds in maps.values()
             ]
             for tau in DELAYS
@@ -245,9 +293,10 @@ pd.DataFrame(
 # a first-order lag $1/(T_a s + 1)$ between the delayed reflex command and the torque
 # (`reflex.activation_time_constant`, default 50 ms; 0 is the pure delay above). For every point of the grid:
 # the least activation $a$ (in steps of 0.05) at which every joint is stable with a 100 ms delay and the lag
-# $T_a$. Where it is 0 the reflex alone suffices; where it reaches the activation at which every joint is
-# self-stable, only self-stability works. The figure shows the spine's delay margin against the activation for
-# each lag, as a band over the grid; the table counts the regimes.
+# $T_a$, joint by joint (each CoR alone, the others fixed; the paper's criterion). Where it is 0 the reflex alone
+# suffices; where it reaches the activation at which every joint is self-stable, only self-stability works. The
+# figure shows the spine's delay margin against the activation for each lag, as a band over the grid; the table
+# counts the regimes.
 
 # %%
 LEVELS = np.round(np.arange(0.0, 1.0001, 0.05), 2)
@@ -270,9 +319,9 @@ for lag in LAGS:
     ax.fill_between(FINE, low_ms, np.minimum(high_ms, TOP), alpha=0.35, label=f"T_a = {lag * 1e3:g} ms")
 ax.axhline(TAU_LAG * 1e3, color="grey", lw=0.8, ls="--")
 ax.annotate(f"τ = {TAU_LAG * 1e3:g} ms", (FINE[-1], TAU_LAG * 1e3), ha="right", va="bottom", fontsize=8, color="grey")
-ax.set(xlabel="activation a (fraction of the minimum stabilising PCSA)", ylabel="spine delay margin [ms]")
+ax.set(xlabel="activation a (fraction of the minimum stabilising PCSA)", ylabel="spine τ_m, joint by joint [ms]")
 ax.set_ylim(0, TOP)
-ax.set_title("spread of the spine's delay margin over the E × Λ grid, by force-generation lag", fontsize=10)
+ax.set_title("spread of the spine's delay margin (joint by joint) over the E × Λ grid, by lag", fontsize=10)
 ax.legend(loc="upper left")
 plt.show()
 
@@ -288,9 +337,9 @@ pd.DataFrame(
 ).round(2)
 
 # %% [markdown]
-# With the pure delay the reflex alone holds the spine at 100 ms wherever its margin is just above 100 ms; 50 ms
-# of force generation lowers the reflex-only margin by about a third, so the reflex-only regime shrinks or
-# vanishes, co-contraction is needed instead, and the least activation grows with the lag. The self-stable
+# Joint by joint: with the pure delay the reflex alone holds the spine at 100 ms wherever its margin is just above
+# 100 ms; 50 ms of force generation lowers the reflex-only margin by about a third, so the reflex-only regime shrinks
+# or vanishes, co-contraction is needed instead, and the least activation grows with the lag. The self-stable
 # activation does not depend on the lag: the closer the needed activation comes to it, the more the paper's
 # argument holds, that a self-stable spine makes the reflex delays "much less problematic".
 
@@ -298,7 +347,8 @@ pd.DataFrame(
 # ## Time-domain responses
 #
 # The nonlinear equation of motion of one joint (paper, Methods) with the reflex and its true delay, released from
-# a small tilt. At half the minimum PCSA, the joint with the least delay margin. Left: below self-stability, with
+# a small tilt, that joint alone with the others fixed (the paper's criterion). At half the minimum PCSA, the joint with
+# the least delay margin. Left: below self-stability, with
 # the reflex at 0.8 $\tau_m$ and at 1.2 $\tau_m$, and without it. Right: the same joint with the muscles a quarter
 # above the self-stable minimum, with the same reflex at the longer delay, and without it.
 
@@ -317,12 +367,12 @@ high_no_reflex = simulate.simulate(high_plant, 0.0, 0.0, 0.0, model.reflex)
 labels = [f"reflex, τ = 0.8 τ_m = {0.8 * tau_m * 1e3:.0f} ms", f"reflex, τ = 1.2 τ_m = {1.2 * tau_m * 1e3:.0f} ms"]
 fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4), sharey=True, layout="constrained")
 for i, label in enumerate([*labels, "no reflex"]):
-    left.plot(low.time, low.alpha[i] * 1e3, label=f"{label} ({'stable' if low.stable[i] else 'unstable'})")
-right.plot(high.time, high.alpha[1] * 1e3, label=f"{labels[1]} ({'stable' if high.stable[1] else 'unstable'})")
+    left.plot(low.time, low.alpha[i] * 1e3, label=f"{label} ({'stable' if low.stable[i] else 'unstable'} alone)")
+right.plot(high.time, high.alpha[1] * 1e3, label=f"{labels[1]} ({'stable' if high.stable[1] else 'unstable'} alone)")
 right.plot(
     high_no_reflex.time,
     high_no_reflex.alpha[0] * 1e3,
-    label=f"no reflex ({'stable' if high_no_reflex.stable[0] else 'unstable'})",
+    label=f"no reflex ({'stable' if high_no_reflex.stable[0] else 'unstable'} alone)",
 )
 limit = 3 * model.reflex.sim_perturbation * 1e3
 left.set_title(f"{limiting.name}, a = {report.point.activation:g}: τ_m = {tau_m * 1e3:.0f} ms", fontsize=10)
@@ -363,7 +413,8 @@ nyquist.axes[0, 0].set_ylabel("Im L(jω) [1]")
 plt.show()
 
 # %% [markdown]
-# Every joint's margins at this configuration (`spinectl margins` prints the same): the exact delay margin and its
+# Every joint's margins at this configuration, joint by joint (`spinectl margins` prints the same, and the chain's
+# verdict beside them): the exact delay margin and its
 # Padé estimate, the phase margin at the delay, the range of a common factor on both gains that keeps the loop
 # stable (python-control's gain margins, read for an open-loop unstable plant), and the stabilising $k_p$.
 
@@ -381,7 +432,39 @@ pd.DataFrame(
         "gain factor, lower [1]": s.gain_margin_lower,
         "gain factor, upper [1]": s.gain_margin,
         f"k_p range at {delay * 1e3:g} ms [N m/rad]": f"{s.kp_min:.1f} to {s.kp_max:.1f}",
-        "stable": s.stable_at_delay,
+        "stable at τ, joint by joint": s.stable_at_delay,
     }
     for s in report.segments
 ).set_index(pd.Index(names, name="segment")).round(3)
+
+# %% [markdown]
+# ## The design question: how much intrinsic stiffness does a delay need?
+#
+# `spinectl design` (`spinectl.reflex.design.design`) answers it at one point for both criteria: joint by joint, the
+# least co-contraction (a fraction of the minimum stabilising PCSA) for which every joint's exact delay margin is at
+# least the delay; for the chain, at the model's global activation, the least local stiffness per joint for which the
+# chain under the delayed reflex is stable at the delay, with its certificate (the exact multivariable delay margin
+# at the design and the rightmost characteristic root at the delay). At the paper's optimum, for 40 ms and 120 ms:
+
+# %%
+answers = {tau: design(config.set_parameter(model, "reflex.delay", tau), *POSITION) for tau in (0.04, 0.12)}
+for answer in answers.values():
+    print(answer.table(), end="\n\n")
+pd.DataFrame(
+    {
+        "status": [d.status for d in answers.values()],
+        "joint by joint: least activation": [d.activation for d in answers.values()],
+        "joint by joint: PCSA [cm²]": [d.pcsa * 1e4 for d in answers.values()],
+        "chain: local stiffness, total [N m/rad]": [float(np.sum(d.chain.local_stiffness)) for d in answers.values()],
+        "chain: × least for static stability": [d.chain.fraction for d in answers.values()],
+        "chain: τ_m at the design [ms]": [d.chain.delay_margin * 1e3 for d in answers.values()],
+        "chain: rightmost root [1/s]": [d.chain.max_root_real for d in answers.values()],
+    },
+    index=pd.Index([tau * 1e3 for tau in answers], name="delay [ms]"),
+).round(4)
+
+# %% [markdown]
+# Joint by joint, the longer delay needs more co-contraction: the reflex does less and the muscles more. For the
+# chain the answer is of another kind: the local stiffness it needs is about the least for static stability, the
+# stiffness that the global muscles cannot give, at either delay; with it the reflex has almost nothing left to do,
+# and the margin at the design is long. The chain's margin is then set by the local muscles, not the reflex's delay.

@@ -6,7 +6,8 @@
 # control the chain, but not the individual joints". This notebook frees all five joints at once
 # (docs: *The coupled chain*) and asks, at the paper's own optimum,
 #
-# 1. is the **chain** statically and dynamically stable, although every joint is?
+# 1. is the **chain** (all 5 CoRs free) statically and dynamically stable, although every joint is, joint by joint
+#    (each CoR alone, the others fixed; the paper's criterion)?
 # 2. how much **local-muscle stiffness** does it need, and where over $E \times \Lambda$ is that least, beside the
 #    counter torques of Figure 4?
 # 3. what would the **joint optimum** of global and local muscle use?
@@ -46,7 +47,7 @@ CM, CM2 = 100.0, 1e4  # cm per m, cm^2 per m^2
 print(f"preset {preset!r}: mass {model.body.mass:g} kg, K = {model.passive.stiffness:g} N m/rad")
 
 # %% [markdown]
-# ## 1. Every joint stable, the chain not
+# ## 1. Every joint stable alone, the chain not
 #
 # At the paper's optimum (the minimum-PCSA activation of each point) every $S_k$ is negative: each joint is
 # self-stable alone. The eigenvalues of $-K$ tell the chain's story.

@@ -39,10 +39,19 @@ from ..errors import SpinectlError
 from ..model.config import DEFAULT_PRESET, list_presets, load_preset
 from ..model.params import Model
 from ..paper.landmarks import CT_LIMIT
+from ..reflex.design import Design
 from ..units import CM_PER_M, m2_to_cm2
 from . import views
 from .hosts import allowed_hosts, request_allowed, url_host
-from .numbers import LANDSCAPE_POINTS, PointNumbers, landscape_axis, landscapes, point_numbers
+from .numbers import (
+    LANDSCAPE_POINTS,
+    PointNumbers,
+    design_numbers,
+    design_rows,
+    landscape_axis,
+    landscapes,
+    point_numbers,
+)
 from .state import (
     LANDSCAPE_PARAMETERS,
     SLIDERS,
@@ -69,8 +78,28 @@ CONFIG_CHOICE = "--config"
 """The preset selector's entry for the model of ``--config``."""
 ROW_KEYS = ("segment", "eigenvalue_1", "eigenvalue_2", "counter_torque_Nm", "delay_margin_s", "stable_at_delay")
 """The columns of the numbers table, keys of :meth:`PointNumbers.rows`."""
-ROW_HEADERS = ("segment", "λ₁ [1/s]", "λ₂ [1/s]", "CT [N m]", "delay margin [s]", "stable at τ")
+ROW_HEADERS = ("segment", "λ₁ [1/s]", "λ₂ [1/s]", "CT [N m]", "delay margin [s]", "stable at τ, joint by joint")
 """Their headers."""
+CHAIN_KEYS = (
+    "stable_at_delay",
+    "delay_margin_s",
+    "frequency_rad_s",
+    "modes",
+    "growth_times_s",
+    "slowest_time_constant_s",
+)
+"""The cells of the chain's row, keys of :meth:`PointNumbers.chain_row` (its criterion heads the row)."""
+CHAIN_HEADERS = (
+    "stable at τ",
+    "delay margin [s]",
+    "at [rad/s]",
+    "modes without reflex",
+    "growth times [s]",
+    "slowest time constant [s]",
+)
+"""Their headers."""
+DESIGN_LABEL = "design for this delay"
+"""The button that answers the design question at the sliders' delay (seconds: on request only)."""
 
 
 def png_bytes(fig, dpi: float = DPI) -> bytes:
@@ -123,7 +152,9 @@ def table_html(numbers: PointNumbers) -> str:
     Returns
     -------
     str
-        A ``<table>`` with one row per segment (:meth:`PointNumbers.rows`) and a status line.
+        A status line; a ``<table>`` with one row per segment (:meth:`PointNumbers.rows`), judged
+        joint by joint (captioned with its criterion); and the chain's verdict under the same reflex
+        (:meth:`PointNumbers.chain_row`, its cells keyed by ``data-chain``).
     """
     head = "".join(f"<th>{h}</th>" for h in ROW_HEADERS)
     body = "".join(
@@ -136,7 +167,65 @@ def table_html(numbers: PointNumbers) -> str:
         f'<p data-key="status">E = {point.eccentricity * CM_PER_M:.3g} cm, Λ = {point.lordosis * CM_PER_M:.3g} cm; '
         f"optimum: {html.escape(point.status)}; PCSA at this activation: {total:.4g} cm² in all</p>"
     )
-    return f'{status}<table class="spinectl-numbers"><tr>{head}</tr>{body}</table>'
+    caption = f"<caption>{html.escape(numbers.criterion)}</caption>"
+    return f'{status}<table class="spinectl-numbers">{caption}<tr>{head}</tr>{body}</table>{chain_html(numbers)}'
+
+
+def chain_html(numbers: PointNumbers) -> str:
+    """The chain's verdict under the same reflex, every CoR free, as a one-row HTML table captioned with its criterion.
+
+    Parameters
+    ----------
+    numbers : PointNumbers
+
+    Returns
+    -------
+    str
+        A ``<table>`` whose cells carry their key of :meth:`PointNumbers.chain_row` (``data-chain``).
+    """
+    row = numbers.chain_row()
+    head = "".join(f"<th>{h}</th>" for h in CHAIN_HEADERS)
+    cells = "".join(f'<td data-chain="{key}">{html.escape(row[key])}</td>' for key in CHAIN_KEYS)
+    words = html.escape(row["criterion"])
+    caption = f'<caption data-chain="criterion">{words}, the same reflex at every joint</caption>'
+    return f'<table class="spinectl-chain">{caption}<tr>{head}</tr><tr>{cells}</tr></table>'
+
+
+def design_html(answer: Design, current: bool) -> str:
+    """The design answer of :func:`spinectl.explore.numbers.design_rows` as HTML, one line per criterion.
+
+    Parameters
+    ----------
+    answer : Design
+    current : bool
+        Whether the answer is for the sliders' state; if not, it says so.
+
+    Returns
+    -------
+    str
+        Each value in a ``<span data-design="key">``.
+    """
+    row = {key: html.escape(value) for key, value in design_rows(answer).items()}
+
+    def value(key: str) -> str:
+        return f'<span data-design="{key}">{row[key]}</span>'
+
+    stale = "" if current else " <b>(the sliders have moved since: press again)</b>"
+
+    def unmet(met: float, key: str) -> str:  # the largest delay met, where none meets the delay
+        return "" if np.isfinite(met) else f"; none meets it, the largest delay met {value(key)} s"
+
+    return (
+        f"<p>design for τ = {answer.delay * 1000:.4g} ms, lag {answer.activation_time_constant * 1000:.4g} ms: "
+        f"status {value('status')}{stale}</p><ul>"
+        f"<li>{value('joint_criterion')}: least co-contraction {value('activation')} × minimum PCSA "
+        f"({value('pcsa_cm2')} cm² in all){unmet(answer.activation, 'joint_largest_delay_s')}</li>"
+        f"<li>{value('chain_criterion')}: at activation {value('chain_activation')}, least local stiffness "
+        f"[N m/rad] {value('local_stiffness_Nm_per_rad')} ({value('local_stiffness_fraction')} × the least "
+        f"for static stability); certificate: exact delay margin {value('chain_delay_margin_s')} s, rightmost "
+        f"root Re s = {value('max_root_real_per_s')} 1/s{unmet(answer.chain.fraction, 'chain_largest_delay_s')}</li>"
+        "</ul>"
+    )
 
 
 class Explorer:
@@ -155,11 +244,12 @@ class Explorer:
         self.base, self.current = base, preset
         self.state = initial_state(base)
         self.numbers: PointNumbers | None = None
+        self._numbers_base: Model | None = None
         self.dataset: xr.Dataset | None = None
         self._generation = 0
         self._pictures_key = None
         self.seconds = {"point": np.nan, "landscapes": np.nan}
-        self.errors: dict[str, str | None] = {"input": None, "point": None, "landscapes": None}
+        self.errors: dict[str, str | None] = {"input": None, "point": None, "landscapes": None, "design": None}
         self.preset = pn.widgets.Select(
             label="preset", value=preset, options=[*self.models, *list_presets()], width=260
         )
@@ -169,6 +259,12 @@ class Explorer:
         self.table = pn.pane.HTML("", name="numbers")
         self.status = pn.pane.Markdown("", name="status")
         self.progress = pn.indicators.Progress(active=False, visible=False, width=200)
+        self.design_button = pn.widgets.Button(label=DESIGN_LABEL, width=260)
+        self.design_spinner = pn.indicators.LoadingSpinner(value=False, visible=False, width=24, height=24)
+        self.design = pn.pane.HTML("", name="design")
+        self.design_answer: tuple[ExploreState, Model, Design] | None = None
+        self._design_generation = 0
+        self.design_button.on_click(lambda event: self.run_design())
         self.maps = {variable: _LandscapeView(variable, self.move_to) for variable in views.LANDSCAPE_LABELS}
         self.preset.param.watch(self._on_preset, "value")
         self.layout = self._layout()
@@ -208,11 +304,19 @@ class Explorer:
             width=260,
         )
         controls = pn.Column(
-            "## spinectl explore", self.preset, *self.sliders.values(), toml, png, self.progress, self.status, width=290
+            "## spinectl explore",
+            self.preset,
+            *self.sliders.values(),
+            toml,
+            png,
+            self.progress,
+            self.status,
+            pn.Row(self.design_button, self.design_spinner),
+            width=290,
         )
         point = pn.Row(self.drawing, self.views["eigenvalues"].pane, self.views["counter_torques"].pane)
         below = pn.Row(self.views["delay_margins"].pane, *(view.pane for view in self.maps.values()))
-        return pn.Row(controls, pn.Column(point, below, self.table))
+        return pn.Row(controls, pn.Column(point, below, self.table, self.design))
 
     # --- events ---------------------------------------------------------------------------
 
@@ -294,8 +398,9 @@ class Explorer:
             at this point; the views then keep the last point).
         """
         start = time.perf_counter()
-        try:
-            numbers = point_numbers(self.base, self.state)
+        same_base = self.numbers is not None and self._numbers_base is self.base
+        try:  # the chain's margin of the last point is reused where only the delay moved
+            numbers = point_numbers(self.base, self.state, previous=self.numbers if same_base else None)
         except SpinectlError as exc:  # e.g. a fibre attachment on a CoR of a --config model: say so, keep the views
             self.errors["point"] = printable(str(exc))
             self._show_status()
@@ -305,13 +410,14 @@ class Explorer:
         changed = key != self._pictures_key  # the delay and the lag move the margins only: redraw the rest if needed
         drawing = drawing_svg(numbers) if changed else None
         with pn.io.hold():
-            self.numbers, self._pictures_key = numbers, key
+            self.numbers, self._numbers_base, self._pictures_key = numbers, self.base, key
             if changed:
                 self.drawing.object = drawing
             for view in self.views.values():
                 if changed or view.name == "delay_margins":
                     view.show(numbers)
             self.table.object = table_html(numbers)
+            self._show_design()
             for view in self.maps.values():
                 view.mark(self.state)
             self.seconds["point"] = time.perf_counter() - start
@@ -345,6 +451,46 @@ class Explorer:
             return
         self._show_status()
         pn.state.execute(solve)
+
+    def run_design(self) -> None:
+        """Answer the design question at the sliders' state: in a server session in a worker thread, with a spinner.
+
+        Seconds (:func:`spinectl.explore.numbers.design_numbers`): the sliders stay free; an answer for
+        a state the sliders have left is shown as such. Outside a session it is computed at once.
+        """
+        self._design_generation += 1
+        generation, state, base = self._design_generation, self.state, self.base
+        self.design_spinner.param.update(value=True, visible=True)
+        self.design_button.disabled = True
+
+        async def solve():
+            answer, error = None, "internal error (the server's log has the traceback)"
+            try:
+                answer, error = await asyncio.to_thread(_designed, base, state)
+            finally:  # a bug too stops the spinner
+                if generation == self._design_generation:
+                    self._design_done(state, base, answer, error)
+
+        if not in_session():
+            self._design_done(state, base, *_designed(base, state))
+            return
+        pn.state.execute(solve)
+
+    def _design_done(self, state: ExploreState, base: Model, answer: Design | None, error: str | None) -> None:
+        with pn.io.hold():
+            self.design_spinner.param.update(value=False, visible=False)
+            self.design_button.disabled = False
+            self.design_answer = None if answer is None else (state, base, answer)
+            self.errors["design"] = error
+            self._show_design()
+
+    def _show_design(self) -> None:
+        """The last design answer, marked when the sliders have left its state; or its one-line error."""
+        if self.errors["design"]:
+            self.design.object = f"<p><b>design not found:</b> {html.escape(self.errors['design'])}</p>"
+        elif self.design_answer is not None:
+            state, base, answer = self.design_answer
+            self.design.object = design_html(answer, state == self.state and base is self.base)
 
     def _show_landscapes(self, dataset: xr.Dataset | None, elapsed: float, error: str | None = None) -> None:
         """Show the landscapes solved, or keep the last ones (each titled with its own mass and K) and the error."""
@@ -399,6 +545,14 @@ def status_text(seconds: dict[str, float], errors: dict[str, str | None], solvin
         maps = f"**not solved:** {html.escape(errors['landscapes'])}"
     text = f"{point}; landscapes ({LANDSCAPE_POINTS} × {LANDSCAPE_POINTS}) {maps}"
     return f"**refused:** {html.escape(errors['input'])}; {text}" if errors["input"] else text
+
+
+def _designed(base: Model, state: ExploreState) -> tuple[Design | None, str | None]:
+    """The design answer of :func:`spinectl.explore.numbers.design_numbers`, or its one-line error."""
+    try:
+        return design_numbers(base, state), None
+    except SpinectlError as exc:
+        return None, printable(str(exc))
 
 
 def _solved(base: Model, state: ExploreState) -> tuple[xr.Dataset | None, str | None]:
@@ -462,7 +616,7 @@ class _EigenvalueView:
         self.source.data = _hex(data.columns)
         for axis in (self.figure.x_range, self.figure.y_range):
             axis.update(start=data.limits[0], end=data.limits[1])
-        self.figure.title.text = data.title
+        self.figure.title.text = data.title.replace(" (", "\n(", 1)  # two lines: one is wider than the view
 
 
 class _BarView:

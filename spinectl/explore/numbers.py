@@ -4,12 +4,18 @@
 (the chosen activation = ``activation`` x the optimum's PCSA, docs/reflex.md) and, at that
 PCSA, each segment's eigenvalues and counter torque (paper eq. 1 and Methods, "Stability
 analysis and calculation of counter torques"; :func:`spinectl.model.stability.segment_stability`).
+:attr:`PointNumbers.chain` is the chain's verdict under the same reflex, every CoR free
+(:func:`spinectl.reflex.chain_verdict.margins_with_chain`, docs/chain.md), beside the segments', each
+judged alone (the paper's criterion); :func:`design_numbers` answers the design question at the
+state's delay (:func:`spinectl.reflex.design.design`, docs/reflex.md, "The design question"), which
+takes seconds, so the explorer runs it only on request.
 :func:`landscapes` is the minimum PCSA and ||CT|| over the paper's range on a coarse grid,
 solved on the stacked fast path (:func:`spinectl.landscape.sweep.sweep`, docs/optimisation.md).
 """
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -17,9 +23,13 @@ import xarray as xr
 
 from ..landscape.sweep import sweep
 from ..model.params import Model
-from ..model.stability import segment_stability
+from ..model.stability import criterion, segment_stability
 from ..paper import grid
+from ..reflex.chain_margins import stable_at
+from ..reflex.chain_verdict import ChainVerdict, margins_with_chain
+from ..reflex.design import Design, design
 from ..reflex.margins import MarginsReport, analyse
+from ..units import m2_to_cm2
 from .state import ExploreState, model_at
 
 LANDSCAPE_POINTS = 41
@@ -40,7 +50,8 @@ class PointNumbers:
     model : Model
         The model of the state (:func:`spinectl.explore.state.model_at`).
     report : MarginsReport
-        Margins of every segment at the chosen activation; ``report.point.pcsa`` is that PCSA [m^2].
+        Margins of every segment at the chosen activation; ``report.point.pcsa`` is that PCSA [m^2];
+        ``report.chain`` the chain's verdict under the same reflex (:attr:`chain`).
     eigenvalues : numpy.ndarray, shape (n_cor, 2), complex
         Eigenvalues of each segment at that PCSA [1/s] (paper eq. 1); NaN without an optimum.
     counter_torque : numpy.ndarray, shape (n_cor,)
@@ -70,8 +81,44 @@ class PointNumbers:
 
     @property
     def stable_at_delay(self) -> np.ndarray:
-        """Whether each segment's closed loop is stable at the delay, shape (n_cor,)."""
+        """Whether each segment's closed loop is stable at the delay, each CoR alone, shape (n_cor,)."""
         return np.array([s.stable_at_delay for s in self.report.segments])
+
+    @property
+    def criterion(self) -> str:
+        """The words of the segments' criterion: joint by joint, each CoR alone (the paper's)."""
+        return criterion("joint", len(self.segment_names))
+
+    @property
+    def chain(self) -> ChainVerdict:
+        """The chain under the same reflex, every CoR free (:func:`spinectl.reflex.chain_verdict.chain_verdict`)."""
+        return self.report.chain
+
+    def chain_row(self) -> dict[str, str]:
+        """The chain's verdict as shown beside the segments' table (:func:`shown`).
+
+        Returns
+        -------
+        dict
+            ``criterion``; ``stable_at_delay`` ('yes', 'no', or 'undefined' without an optimum or
+            with massless levels); ``delay_margin_s`` (the exact multivariable delay margin [s]) and
+            ``frequency_rad_s`` (its crossing [rad/s]); without reflex: ``modes`` (how many of how many
+            grow), ``growth_times_s`` (by e, fastest and slowest growing mode [s]) and
+            ``slowest_time_constant_s`` (-1 / max Re lambda [s]; 'inf' while a mode grows).
+        """
+        verdict, modes = self.chain, self.chain.modes
+        growth = modes.growth_times  # fastest first
+        word = ("yes" if verdict.stable_at_delay else "no") if modes.defined else "undefined"
+        extremes = dict.fromkeys(shown(t) for t in growth[[0, -1]]) if growth.size else {"none": None}
+        return {
+            "criterion": verdict.criterion,
+            "stable_at_delay": word,
+            "delay_margin_s": shown(verdict.exact.margin),
+            "frequency_rad_s": shown(verdict.exact.frequency),
+            "modes": f"{growth.size} of {modes.eigenvalues.size} grow" if modes.defined else "undefined",
+            "growth_times_s": " to ".join(extremes),
+            "slowest_time_constant_s": shown(modes.slowest_time_constant),
+        }
 
     def rows(self) -> list[dict[str, str]]:
         """One row per segment, every number as shown (:func:`shown`), for the explorer's table.
@@ -120,20 +167,26 @@ def shown(value) -> str:
     return f"{value.real:.{DIGITS}g}{value.imag:+.{DIGITS}g}j"
 
 
-def point_numbers(base: Model, state: ExploreState) -> PointNumbers:
-    """Every number the explorer shows at ``state``: margins, eigenvalues, counter torques.
+def point_numbers(base: Model, state: ExploreState, previous: PointNumbers | None = None) -> PointNumbers:
+    """Every number the explorer shows at ``state``: margins, eigenvalues, counter torques, the chain's verdict.
 
     Parameters
     ----------
     base : Model
         The preset or configuration the explorer started from.
     state : ExploreState
+    previous : PointNumbers, optional
+        The numbers of the same ``base`` at an earlier state. Where that state differs from ``state`` in
+        the delay alone, its chain's exact delay margin is reused, compared with the new delay: the
+        margin, the rule's gains and the modes do not depend on the delay
+        (:func:`spinectl.reflex.chain_verdict.chain_verdict`), and the margin's frequency sweep is
+        two thirds of the time of a point.
 
     Returns
     -------
     PointNumbers
         An infeasible optimum is an answer: the report's status says so and the eigenvalues and
-        counter torques are NaN.
+        counter torques are NaN; the chain's verdict is then 'undefined'.
 
     Raises
     ------
@@ -147,7 +200,12 @@ def point_numbers(base: Model, state: ExploreState) -> PointNumbers:
     doi:10.1186/1742-4682-9-13.
     """
     model = model_at(base, state)
-    report = analyse(model, state.eccentricity, state.lordosis)
+    if previous is not None and dataclasses.replace(previous.state, delay=state.delay) == state:
+        chain = previous.chain
+        chain = dataclasses.replace(chain, delay=state.delay, stable_at_delay=stable_at(chain.exact, state.delay))
+        report = dataclasses.replace(analyse(model, state.eccentricity, state.lordosis), chain=chain)
+    else:
+        report = margins_with_chain(model, state.eccentricity, state.lordosis)
     n_cor = len(model.geometry.cor_names)
     eigenvalues = np.full((n_cor, 2), np.nan, complex)
     counter_torque = np.full(n_cor, np.nan)
@@ -155,6 +213,66 @@ def point_numbers(base: Model, state: ExploreState) -> PointNumbers:
         at = segment_stability(model, state.eccentricity, state.lordosis, report.point.pcsa)
         eigenvalues, counter_torque = at.eigenvalues, at.counter_torque
     return PointNumbers(state, model, report, eigenvalues, counter_torque)
+
+
+def design_numbers(base: Model, state: ExploreState) -> Design:
+    """The design answer at the state's delay: least co-contraction joint by joint, least local stiffness for the chain.
+
+    :func:`spinectl.reflex.design.design` of the state's model at its point, as ``spinectl design``
+    computes it; seconds (a scan and bisection per criterion), so the explorer runs it on request.
+
+    Parameters
+    ----------
+    base : Model
+    state : ExploreState
+
+    Returns
+    -------
+    Design
+        Infeasible designs are answers (NaN and the status, with the largest delay met).
+
+    Raises
+    ------
+    ParameterError
+        A state outside the model's allowed ranges.
+    """
+    return design(model_at(base, state), state.eccentricity, state.lordosis)
+
+
+def design_rows(answer: Design) -> dict[str, str]:
+    """The design answer as the explorer shows it (:func:`shown`), one entry per criterion and its certificate.
+
+    Parameters
+    ----------
+    answer : Design
+
+    Returns
+    -------
+    dict
+        ``status``; joint by joint: ``joint_criterion``, ``activation`` (the least for every segment
+        at once [1]), ``pcsa_cm2`` (the total PCSA there [cm^2]), ``joint_largest_delay_s`` (the
+        largest delay met on the scan [s]); the chain: ``chain_criterion``, ``chain_activation`` (its
+        global activation [1]), ``local_stiffness_Nm_per_rad`` (per joint, comma-separated),
+        ``local_stiffness_fraction`` (of the least for static stability), ``chain_delay_margin_s``
+        and ``max_root_real_per_s`` (the certificate), ``chain_largest_delay_s``.
+    """
+    chain = answer.chain
+    return {
+        "status": answer.status,
+        "joint_criterion": criterion("joint", len(answer.segments)),
+        "activation": shown(answer.activation),
+        "pcsa_cm2": shown(m2_to_cm2(answer.pcsa)),
+        "joint_largest_delay_s": shown(answer.largest_delay),
+        "chain_criterion": criterion("chain", len(chain.local_stiffness)),
+        "chain_activation": shown(chain.activation),
+        "local_stiffness_Nm_per_rad": ", ".join(
+            f"{s.name} {shown(k)}" for s, k in zip(answer.segments, chain.local_stiffness, strict=True)
+        ),
+        "local_stiffness_fraction": shown(chain.fraction),
+        "chain_delay_margin_s": shown(chain.delay_margin),
+        "max_root_real_per_s": shown(chain.max_root_real),
+        "chain_largest_delay_s": shown(chain.largest_delay),
+    }
 
 
 def landscape_axis(points: int = LANDSCAPE_POINTS) -> np.ndarray:

@@ -67,7 +67,7 @@ class ViewData:
 
 
 def eigenvalue_data(numbers: PointNumbers) -> ViewData:
-    """Both eigenvalues of each segment (paper eq. 1) as markers.
+    """Both eigenvalues of each segment alone, the others fixed (paper eq. 1), as markers.
 
     Parameters
     ----------
@@ -92,7 +92,7 @@ def eigenvalue_data(numbers: PointNumbers) -> ViewData:
         "re": eigs.real.ravel().tolist(),
         "im": eigs.imag.ravel().tolist(),
     }
-    return ViewData(columns, (-reach, reach), "eigenvalues per segment (shaded: unstable)")
+    return ViewData(columns, (-reach, reach), "eigenvalues, joint by joint (shaded: unstable)")
 
 
 def _bar_columns(names, values, colours) -> dict:
@@ -127,7 +127,10 @@ def counter_torque_data(numbers: PointNumbers) -> ViewData:
 
 
 def delay_margin_data(numbers: PointNumbers) -> ViewData:
-    """The exact delay margin of each segment [ms] as bars, green where stable at the delay, and the delay.
+    """The exact delay margin of each segment alone [ms] as bars, green where stable at the delay, and the delay.
+
+    Joint by joint (each CoR alone, the others fixed; the paper's criterion); the chain's margin,
+    every CoR free, is in the explorer's table (:meth:`~spinectl.explore.numbers.PointNumbers.chain_row`).
 
     Parameters
     ----------
@@ -144,7 +147,7 @@ def delay_margin_data(numbers: PointNumbers) -> ViewData:
     colours = ["tab:green" if ok else "tab:red" for ok in numbers.stable_at_delay]
     top = 1.2 * max(delay, float(np.max(margins[np.isfinite(margins)], initial=0.0)), 1.0)
     columns = _bar_columns(numbers.segment_names, margins, colours)
-    return ViewData(columns, (0.0, top), f"delay margins (red: unstable at τ = {delay:g} ms)", delay)
+    return ViewData(columns, (0.0, top), f"delay margins, joint by joint (red: unstable at τ = {delay:g} ms)", delay)
 
 
 def _axes(ax):
@@ -199,7 +202,7 @@ def eigenvalue_plot(numbers: PointNumbers, ax=None) -> Figure:
     Returns
     -------
     matplotlib.figure.Figure
-        Re lambda [1/s] across, Im lambda [1/s] up; the unstable half plane shaded.
+        Re lambda [1/s] across, Im lambda [1/s] up; the unstable half plane shaded (each segment alone).
     """
     data = eigenvalue_data(numbers)
     ax = _axes(ax)
@@ -264,7 +267,8 @@ def delay_margin_plot(numbers: PointNumbers, ax=None) -> Figure:
     Returns
     -------
     matplotlib.figure.Figure
-        Bars [ms]; a dashed line at the delay tau: a segment whose bar ends below it is unstable.
+        Bars [ms]; a dashed line at the delay tau: a segment whose bar ends below it is unstable,
+        joint by joint (each CoR alone, the others fixed).
     """
     ax = _axes(ax)
     data = delay_margin_data(numbers)
@@ -317,7 +321,8 @@ def state_figure(numbers: PointNumbers, dataset: xr.Dataset | None) -> Figure:
     Returns
     -------
     matplotlib.figure.Figure
-        The model drawing, eigenvalues, counter torques, delay margins and both landscapes.
+        The model drawing, eigenvalues, counter torques, delay margins (joint by joint) and both landscapes;
+        the title gives the chain's verdict (:func:`chain_caption`).
     """
     fig = new_figure(figsize=STATE_FIGURE_SIZE, layout="constrained")
     axes = fig.subplots(2, 3)
@@ -333,6 +338,27 @@ def state_figure(numbers: PointNumbers, dataset: xr.Dataset | None) -> Figure:
             landscape_plot(dataset, variable, numbers, ax)
     fig.suptitle(
         f"spinectl explore: mass {state.mass:g} kg, K {state.stiffness:g} N m/rad, delay {state.delay * 1000:g} ms, "
-        f"activation {state.activation:g} × minimum PCSA, lag {state.activation_lag * 1000:g} ms"
+        f"activation {state.activation:g} × minimum PCSA, lag {state.activation_lag * 1000:g} ms\n"
+        + chain_caption(numbers)
     )
     return fig
+
+
+def chain_caption(numbers: PointNumbers) -> str:
+    """The chain's verdict in one line, its criterion named: what the PNG export says beside the segments' views.
+
+    Parameters
+    ----------
+    numbers : PointNumbers
+
+    Returns
+    -------
+    str
+        E.g. 'chain (all 5 CoRs free), the same reflex: stable at τ: no, delay margin 4.787e-05 s;
+        without reflex 5 of 10 modes grow'.
+    """
+    row = numbers.chain_row()
+    return (
+        f"{row['criterion']}, the same reflex: stable at τ: {row['stable_at_delay']}, delay margin "
+        f"{row['delay_margin_s']} s; without reflex {row['modes']}"
+    )

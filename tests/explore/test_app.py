@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import asyncio
+import html
 import xml.etree.ElementTree as ET
 from types import SimpleNamespace
 
@@ -103,7 +104,7 @@ def test_a_model_invalid_at_the_point_is_a_message_not_a_crash(explorer, monkeyp
     """An error the user can cause (a SpinectlError) shows in the status line; the views keep the last point."""
     shown = explorer.table.object
 
-    def invalid(base, state):
+    def invalid(base, state, previous=None):
         raise ModelError("fibre attachment on a centre of rotation")
 
     monkeypatch.setattr(app, "point_numbers", invalid)
@@ -304,3 +305,76 @@ def test_values_show_the_digits_their_slider_steps_mean():
     assert explorer.sliders["mass"].format == "0.0" and explorer.sliders["activation"].format == "0.00"
     assert explorer.sliders["delay"].format == "0"
     assert explorer.maps["min_pcsa_cm2"].figure.title.text == "minimum PCSA [cm²]\nmass 24.1 kg, K 0.0 N m/rad"
+
+
+def test_the_table_gives_the_chains_verdict_beside_the_segments():
+    """Under the segments' table, captioned with their criterion (joint by joint), the chain's row: its criterion
+    and every cell of PointNumbers.chain_row at the state; the header of the segments' verdict names its criterion."""
+    explorer = app.Explorer(load_preset("default"), "default")
+    expected = nb.point_numbers(explorer.base, explorer.state)
+    table = explorer.table.object
+    assert "<caption>joint by joint (each CoR alone, the others fixed; the paper&#x27;s criterion)</caption>" in table
+    assert "<th>stable at τ, joint by joint</th>" in table
+    row = expected.chain_row()
+    assert '<caption data-chain="criterion">chain (all 5 CoRs free), the same reflex at every joint</caption>' in table
+    for key in app.CHAIN_KEYS:
+        assert f'<td data-chain="{key}">{row[key]}</td>' in table
+    assert row["stable_at_delay"] == "no"  # at the README's point the chain is not (docs/chain.md), the segments are
+    assert all(r["stable_at_delay"] == "yes" for r in expected.rows())
+
+
+def test_the_design_button_shows_the_answer_for_its_state_and_marks_it_when_the_sliders_move(monkeypatch):
+    """The button runs numbers.design_numbers at the sliders' state (here outside a server session, at once) and
+    shows design_rows of its answer (the largest delay met only where none meets the delay); a moved slider
+    marks it as for another state; an error is one line."""
+    explorer = app.Explorer(load_preset("default"), "default")
+    assert explorer.design.object == ""  # seconds of work: only on request
+    explorer.design_button.clicks += 1
+    state, base, answer = explorer.design_answer
+    assert state == explorer.state and base is explorer.base
+    shown = nb.design_rows(answer)
+    met = {key: shown.pop(key) for key in ("joint_largest_delay_s", "chain_largest_delay_s")}
+    for key, value in shown.items():
+        assert f'<span data-design="{key}">{html.escape(value)}</span>' in explorer.design.object
+    assert answer.status == "ok" and "largest delay met" not in explorer.design.object  # said where none meets it
+    assert met == {"joint_largest_delay_s": "inf", "chain_largest_delay_s": "inf"}
+    assert "press again" not in explorer.design.object and not explorer.design_spinner.visible
+    _drag(explorer.sliders["delay"], 40.0)
+    assert "the sliders have moved since: press again" in explorer.design.object
+
+    def refused(base, state):
+        raise ModelError("levels.mass: must be > 0 for the chain")
+
+    monkeypatch.setattr(app, "design_numbers", refused)
+    explorer.run_design()
+    assert explorer.design.object == "<p><b>design not found:</b> levels.mass: must be &gt; 0 for the chain</p>"
+    assert not explorer.design_button.disabled and not explorer.design_spinner.value
+
+
+def test_in_a_session_the_design_runs_in_a_worker_and_the_sliders_stay_free(monkeypatch):
+    """In a server session the button starts a task (a worker thread) and shows a spinner, the button disabled;
+    a slider moved meanwhile updates the point at once; the task answers for the state of the press and ends
+    with the spinner stopped and the button enabled, also when the library refuses (its one-line error)."""
+    tasks, asked = [], []
+    monkeypatch.setattr(app, "in_session", lambda: True)
+    monkeypatch.setattr(app.pn.state, "onload", lambda callback, **options: None)
+    monkeypatch.setattr(app.pn.state, "execute", lambda function, **options: tasks.append(function))
+
+    def refused(base, state):
+        asked.append(state)
+        raise ModelError("levels.mass: must be > 0 for the chain")
+
+    monkeypatch.setattr(app, "design_numbers", refused)
+    explorer = app.Explorer(load_preset("default"), "default")
+    pressed = explorer.state
+    explorer.design_button.clicks += 1
+    (solve,) = tasks
+    assert explorer.design_spinner.value and explorer.design_spinner.visible and explorer.design_button.disabled
+    table = explorer.table.object
+    _drag(explorer.sliders["activation_lag"], 100.0)  # moves every delay margin (test_the_delay_redraws_...)
+    assert explorer.table.object != table  # the point follows the slider while the design is pending
+    asyncio.run(solve())
+    assert asked == [pressed]
+    assert explorer.design.object == "<p><b>design not found:</b> levels.mass: must be &gt; 0 for the chain</p>"
+    assert not explorer.design_spinner.value and not explorer.design_spinner.visible
+    assert not explorer.design_button.disabled

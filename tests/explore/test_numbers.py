@@ -4,13 +4,16 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import scipy.linalg
 
 from spinectl.explore import numbers as nb
-from spinectl.explore.state import ExploreState
+from spinectl.explore.state import ExploreState, initial_state, model_at
+from spinectl.model import chain, geometry
 from spinectl.model.config import load_preset, set_parameters
 from spinectl.model.stability import segment_stability
 from spinectl.optimise.reference import solve_point
-from spinectl.reflex.margins import analyse
+from spinectl.reflex.chain_verdict import chain_verdict, margins_with_chain
+from spinectl.reflex.margins import analyse, operating_point
 
 
 @pytest.fixture
@@ -91,3 +94,109 @@ def test_landscapes_match_the_reference_solver_at_grid_points(state):
         assert float(dataset.counter_torque_norm_Nm[i, j]) == pytest.approx(
             np.linalg.norm(reference.counter_torque), rel=1e-4, abs=1e-6
         )
+
+
+def _chain_matrices(model, state, pcsa):
+    """M, K and D of the chain at the state's point (docs/chain.md), built here from spinectl.model.chain."""
+    coefficients = chain.chain_coefficients(model, state.eccentricity, state.lordosis)
+    mass = chain.mass_matrix(model, geometry.cor_positions(state.eccentricity, state.lordosis, model.geometry))
+    return mass, coefficients.stiffness(pcsa), coefficients.damping(pcsa)
+
+
+def test_chain_row_is_the_chain_verdict_at_the_same_point(state):
+    """The chain's row: its criterion, and the verdict and exact delay margin of reflex.chain_verdict.chain_verdict
+    called directly at the operating point of reflex.margins.operating_point (not through margins_with_chain)."""
+    base = load_preset("default")
+    got = nb.point_numbers(base, state).chain_row()
+    model = _library_model(base, state)
+    point = operating_point(model, state.eccentricity, state.lordosis, state.activation)
+    verdict = chain_verdict(model, point, state.delay, state.activation_lag)
+    assert got["criterion"] == "chain (all 5 CoRs free)"
+    assert got["stable_at_delay"] == ("yes" if verdict.stable_at_delay else "no")
+    assert got["delay_margin_s"] == nb.shown(verdict.exact.margin)
+    assert got["frequency_rad_s"] == nb.shown(verdict.exact.frequency)
+
+
+def test_chain_modes_are_the_roots_of_the_quadratic_eigenproblem(state):
+    """Second method for the modes without reflex: the generalised eigenvalues of the linearisation
+    [[0, I], [K, D]] x = s [[I, 0], [0, M]] x of M s^2 - D s - K (scipy.linalg.eig, no M^-1), at
+    activation x the optimum's PCSA; growth times are 1 / Re s of the growing modes."""
+    base = load_preset("default")
+    got = nb.point_numbers(base, state)
+    mass, stiffness, damping = _chain_matrices(got.model, state, got.pcsa)
+    n = mass.shape[0]
+    left = np.block([[np.zeros((n, n)), np.eye(n)], [stiffness, damping]])
+    right = np.block([[np.eye(n), np.zeros((n, n))], [np.zeros((n, n)), mass]])
+    roots = scipy.linalg.eigvals(left, right)
+    growing = np.sort(roots.real[roots.real >= 0])[::-1]
+    row = got.chain_row()
+    assert growing.size > 0  # at this point the chain without reflex is unstable (docs/chain.md)
+    assert row["modes"] == f"{growing.size} of {2 * n} grow"
+    assert row["growth_times_s"] == f"{nb.shown(1 / growing[0])} to {nb.shown(1 / growing[-1])}"
+    assert row["slowest_time_constant_s"] == "inf"
+
+
+def test_levels_without_mass_leave_the_chain_undefined():
+    """levels.mass = 0 makes the chain's mass matrix singular (docs/chain.md): no modes and no margin to judge,
+    shown as 'undefined' and nan, never as a verdict; the segments, judged alone, keep theirs."""
+    base = set_parameters(load_preset("default"), {"levels.mass": 0.0})
+    got = nb.point_numbers(base, initial_state(base))
+    row = got.chain_row()
+    assert row["stable_at_delay"] == "undefined" and row["modes"] == "undefined"
+    assert row["delay_margin_s"] == "nan" and row["growth_times_s"] == "none"
+    assert all(r["stable_at_delay"] in ("yes", "no") for r in got.rows())
+
+
+@pytest.fixture(scope="module")
+def answer():
+    """The design answer at the README's point of 'default' (40 kg, K 0, tau 100 ms, T_a 50 ms)."""
+    base = load_preset("default")
+    return base, initial_state(base), nb.design_numbers(base, initial_state(base))
+
+
+def test_design_meets_the_delay_checked_by_the_margins_report(answer):
+    """Joint by joint, second route: reflex.margins.analyse with reflex.activation = the answer gives every
+    segment an exact delay margin >= tau, and 1 % less activation leaves one below (the least); the chain's
+    least static local stiffness is the chain verdict's (margins_with_chain at the same operating point)."""
+    base, state, design = answer
+    assert design.status == "ok"
+    model = model_at(base, state)
+    at = analyse(set_parameters(model, {"reflex.activation": design.activation}), state.eccentricity, state.lordosis)
+    assert min(s.delay_margin for s in at.segments) >= state.delay * (1 - 1e-9)
+    below = set_parameters(model, {"reflex.activation": 0.99 * design.activation})
+    assert min(s.delay_margin for s in analyse(below, state.eccentricity, state.lordosis).segments) < state.delay
+    verdict = nb.point_numbers(base, state).chain
+    np.testing.assert_allclose(design.chain.least_static, verdict.local_stiffness, rtol=1e-9)
+    assert design.chain.delay_margin >= state.delay and design.chain.max_root_real < 0
+
+
+def test_design_rows_show_both_criteria_and_the_certificate(answer):
+    """design_rows: each criterion named, every number as shown() writes the Design's own field."""
+    _, _, design = answer
+    rows = nb.design_rows(design)
+    assert rows["joint_criterion"].startswith("joint by joint (each CoR alone")
+    assert rows["chain_criterion"] == "chain (all 5 CoRs free)"
+    assert rows["activation"] == nb.shown(design.activation)
+    assert rows["pcsa_cm2"] == nb.shown(design.pcsa * 1e4)
+    assert rows["chain_delay_margin_s"] == nb.shown(design.chain.delay_margin)
+    assert rows["max_root_real_per_s"] == nb.shown(design.chain.max_root_real)
+    names = design.model.get("cor_names", ("L1L2", "L2L3", "L3L4", "L4L5", "L5S1"))
+    assert rows["local_stiffness_Nm_per_rad"] == ", ".join(
+        f"{name} {nb.shown(k)}" for name, k in zip(names, design.chain.local_stiffness, strict=True)
+    )
+
+
+@pytest.mark.parametrize("change", [{"delay": 0.0}, {"delay": 0.2}, {"activation_lag": 0.1}, {"activation": 0.3}])
+def test_the_previous_points_chain_is_reused_only_where_the_delay_alone_moved(state, change):
+    """point_numbers(..., previous=): the chain's verdict equals the one computed afresh at the new state
+    (margins_with_chain), for a delay moved (reused: the margin does not depend on the delay; 0 and 0.2 s judge
+    it on both sides) and for the lag or the activation moved (computed again: both move the chain's margin)."""
+    base = load_preset("default")
+    previous = nb.point_numbers(base, state)
+    moved = ExploreState(**{**state.__dict__, **change})
+    got = nb.point_numbers(base, moved, previous=previous)
+    fresh = margins_with_chain(_library_model(base, moved), moved.eccentricity, moved.lordosis).chain
+    assert got.chain.to_dict() == fresh.to_dict() and got.chain.delay == moved.delay
+    assert got.chain_row()["stable_at_delay"] == ("yes" if fresh.stable_at_delay else "no")
+    reused = got.chain.exact is previous.chain.exact
+    assert reused == ("delay" in change)

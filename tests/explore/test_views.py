@@ -58,3 +58,16 @@ def test_state_figure_png_has_six_panels_and_content(numbers):
     assert image.std() > 0.05 and len(np.unique(image.reshape(-1, image.shape[-1]), axis=0)) > 50
     blank = views.state_figure(numbers, None)
     assert sum(ax.axison for ax in blank.axes) == 4  # the landscapes' places empty while they are solved
+
+
+def test_the_png_export_names_both_criteria(numbers):
+    """The PNG export's delay margins are titled joint by joint; its title gives the chain's verdict with its
+    criterion, from PointNumbers.chain_row (itself checked against reflex.chain_verdict in test_numbers)."""
+    fig = views.state_figure(numbers, None)
+    row = numbers.chain_row()
+    title = fig.get_suptitle().splitlines()[-1]
+    assert title == (
+        f"chain (all 5 CoRs free), the same reflex: stable at τ: {row['stable_at_delay']}, delay margin "
+        f"{row['delay_margin_s']} s; without reflex {row['modes']}"
+    )
+    assert any(ax.get_title().startswith("delay margins, joint by joint") for ax in fig.axes)
