@@ -2,7 +2,15 @@
 
 from __future__ import annotations
 
-from ._common import add_model_options, add_position_options, check_position, emit_json, finite_float, load_model
+from ._common import (
+    add_model_options,
+    add_position_options,
+    check_position,
+    emit_json,
+    finite_float,
+    load_model,
+    with_lordosis_angle,
+)
 
 
 def register(sub) -> None:
@@ -74,7 +82,7 @@ def run(args) -> int:
     kd = None if args.kd is None else non_negative("--kd", args.kd)
     result = design(model, args.E, args.Lambda, kp=kp, kd=kd)
     if args.json:
-        emit_json(result.to_dict())
+        emit_json(with_lordosis_angle(result.to_dict(), model))
     else:
         print(result.table())
     return 0
