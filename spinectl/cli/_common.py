@@ -17,6 +17,9 @@ from ..model.config import DEFAULT_PRESET, PRESET_GUIDANCE, apply_overrides, loa
 from ..model.params import Model
 from ..units import CM_PER_M, centimetre_slip, cm2_to_m2, square_metre_slip
 
+BOTH_LORDOSIS = "is not allowed with --Lambda (both give the lordosis): give one of them"
+"""The error of ``--lordosis-angle`` given with ``--Lambda`` (:func:`lordosis_option`, :func:`lordosis_grid`)."""
+
 
 def add_model_options(parser: argparse.ArgumentParser) -> None:
     """``--config FILE``, ``--preset NAME`` and ``--set SECTION.FIELD=VALUE``, on every command that takes a model.
@@ -163,7 +166,7 @@ def lordosis_option(model: Model, angle: float | None, lordosis: float | None, o
     if angle is None:
         return 0.0 if lordosis is None else lordosis
     if lordosis is not None:
-        raise ParameterError(option, "is not allowed with --Lambda (both give the lordosis): give one of them")
+        raise ParameterError(option, BOTH_LORDOSIS)
     try:
         lordosis = lordosis_from_angle(angle, model)
     except ParameterError as exc:
@@ -204,11 +207,12 @@ def lordosis_grid(model: Model, spec: str | None, angle_spec: str | None, defaul
     if angle_spec is None:
         return parse_grid(default if spec is None else spec, "--Lambda", bounds)
     if spec is not None:
-        raise ParameterError("--lordosis-angle", "is not allowed with --Lambda (both give the lordosis): give one of them")
+        raise ParameterError("--lordosis-angle", BOTH_LORDOSIS)
     try:
         angles = parse_grid(angle_spec, "--lordosis-angle")
     except ParameterError as exc:
-        raise ParameterError(exc.field, exc.message.replace("in metres, e.g. 0:0.08:81", "in degrees, e.g. 20:80:61"))
+        message = exc.message.replace("in metres, e.g. 0:0.08:81", "in degrees, e.g. 20:80:61")
+        raise ParameterError(exc.field, message) from None
     axis = lordosis_option(model, angles, None)
     low, high = bounds
     if not (np.all(axis >= low) and np.all(axis <= high)):
@@ -223,7 +227,7 @@ def lordosis_grid(model: Model, spec: str | None, angle_spec: str | None, defaul
 
 
 def with_lordosis_angle(payload: dict, model: Model) -> dict:
-    """``payload`` with ``lordosis_angle_deg`` just after its ``Lambda_m`` (:func:`spinectl.model.clinical.lordosis_angle`).
+    """``payload`` with ``lordosis_angle_deg`` [deg] just after its ``Lambda_m`` (:mod:`spinectl.model.clinical`).
 
     Parameters
     ----------

@@ -173,7 +173,8 @@ def _lordosis_axis(axes: dict, model) -> tuple[float, ...]:
     if min(values) < low or max(values) > high:
         a_low, a_high = lordosis_angle([low, high], model)
         raise ParameterError(
-            where, f"must be within [{a_low:.6g}, {a_high:.6g}] deg, the modelled range of Lambda (got {_toml_axis(written)})"
+            where,
+            f"must be within [{a_low:.6g}, {a_high:.6g}] deg, the modelled range of Lambda (got {_toml_axis(written)})",
         )
     return values
 
