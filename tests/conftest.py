@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import tempfile
 
 import numpy as np
 import pytest
@@ -13,6 +14,10 @@ from spinectl.model.params import Geometry, Model, MusclePair
 settings.register_profile("repeatable", derandomize=True, database=None, print_blob=True)
 settings.register_profile("explore", derandomize=False, print_blob=True)
 settings.load_profile(os.environ.get("SPINECTL_HYPOTHESIS", "repeatable"))
+
+# The anatomy layer caches compiled MuJoCo models (docs/anatomy.md, "Speed"): the suite, and the commands it
+# runs as subprocesses, keep theirs in a folder of their own, never in the user's cache.
+os.environ.setdefault("SPINECTL_CACHE_DIR", tempfile.mkdtemp(prefix="spinectl-test-cache-"))
 # The README's test command (and CI) draws the same examples on every run, so a
 # merge is never blocked by a random new find; SPINECTL_HYPOTHESIS=explore draws
 # fresh ones and keeps failures in .hypothesis/ (CONTRIBUTING.md, "Commands").

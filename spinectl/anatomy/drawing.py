@@ -158,7 +158,7 @@ class ModeShapes:
 def mode_shapes(anatomy: Anatomy, chain_verdict, posture=None, angle_deg: float = MODE_ANGLE) -> ModeShapes:
     """The sagittal chain at the posture and bent along each mode of -K, by MuJoCo's kinematics.
 
-    Each mode v (unit) is scaled so that sum_j |q_j| = ``angle_deg`` and added to the chain's
+    Each mode v (unit) is scaled so that ``sum_j abs(q_j) = angle_deg`` and added to the chain's
     angles (the other joints held, equality constraints ignored: the free chain's modes).
 
     Parameters

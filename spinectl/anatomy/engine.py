@@ -166,37 +166,55 @@ class Engine:
         return d.qfrc_actuator + d.qfrc_passive - d.qfrc_bias
 
 
-def _compile(spec_factory, name: str, source: str, digest: str | None = None) -> Engine:
+def _compile(spec, spec_factory, name: str, source: str, digest: str, key: str | None) -> Engine:
+    """Compile ``spec`` (or read its compiled model from the cache under ``key``) into an Engine."""
+    from . import cache
+
     mujoco = require_mujoco()
-    spec = spec_factory()
     try:
         model = spec.compile()
     except ValueError as exc:
         raise ParameterError("model", f"MuJoCo cannot compile {source}: {str(exc).splitlines()[0]}") from None
-    # a file: its bytes; a composed model: the MJCF text MuJoCo writes of it
-    digest = digest or hashlib.sha256(spec.to_xml().encode()).hexdigest()
-    return Engine(
-        model=model,
-        data=mujoco.MjData(model),
-        name=name,
-        source=source,
-        sha256=digest,
-        spec_factory=spec_factory,
-    )
+    if key is not None:
+        cache.write(key, model, {"sha256": digest})
+    return Engine(model, mujoco.MjData(model), name, source, digest, spec_factory)
 
 
-def load_engine(model: str | Path) -> Engine:
-    """Compile a built-in model (``"myotorso"``) or an MJCF file with MuJoCo.
+def _cached(key: str | None, spec_factory, name: str, source: str, digest: str | None = None) -> Engine | None:
+    """The Engine of a cached compiled model, or None (no key, no file, or a file that cannot be read).
+
+    ``digest``, where given, is the reported SHA-256 (a file's bytes, read anew); else the
+    one stored with the compiled model (the MJCF text of a composed model).
+    """
+    from . import cache
+
+    hit = None if key is None else cache.read(key)
+    if hit is None:
+        return None
+    model, meta = hit
+    digest = digest or meta.get("sha256")
+    if not isinstance(digest, str):
+        return None
+    return Engine(model, require_mujoco().MjData(model), name, source, digest, spec_factory)
+
+
+def load_engine(model: str | Path, cache: bool = True) -> Engine:
+    """Compile a built-in model (``"myotorso"``) or an MJCF file with MuJoCo, or read it from the cache.
 
     Parameters
     ----------
     model : str or pathlib.Path
         A name of :data:`BUILTIN` or the path of an MJCF (``.xml``) file.
+    cache : bool
+        Read and write the compiled model in the cache (:mod:`spinectl.anatomy.cache`);
+        False compiles it anew and leaves the cache alone.
 
     Returns
     -------
     Engine
     """
+    from . import cache as compiled
+
     mujoco = require_mujoco()
     text = str(model)
     if text in BUILTIN:
@@ -204,7 +222,18 @@ def load_engine(model: str | Path) -> Engine:
             import myo_sim
         except ImportError:
             raise AnatomyUnavailable(f"the built-in model {text!r} comes with myo-sim: {INSTALL_HINT}") from None
-        return _compile(lambda: myo_sim.load_spec(text), text, f"myo-sim {myo_sim.__version__}, {text}")
+        source = f"myo-sim {myo_sim.__version__}, {text}"
+
+        def builtin():
+            return myo_sim.load_spec(text)
+
+        key = compiled.builtin_key(text, myo_sim) if cache else None
+        engine = _cached(key, builtin, text, source)
+        if engine is not None:
+            return engine
+        spec = builtin()
+        # a composed model: the SHA-256 of the MJCF text MuJoCo writes of it
+        return _compile(spec, builtin, text, source, hashlib.sha256(spec.to_xml().encode()).hexdigest(), key)
     path = Path(text)
     if not path.is_file():
         raise ParameterError("model", f"must be one of {BUILTIN} or an MJCF file (got {text!r})")
@@ -215,4 +244,8 @@ def load_engine(model: str | Path) -> Engine:
         except ValueError as exc:
             raise ParameterError("model", f"{text} is not a valid MJCF file: {str(exc).splitlines()[0]}") from None
 
-    return _compile(factory, path.stem, str(path.resolve()), hashlib.sha256(path.read_bytes()).hexdigest())
+    spec = factory()
+    key = compiled.file_key(spec) if cache else None
+    source = str(path.resolve())
+    digest = hashlib.sha256(path.read_bytes()).hexdigest()  # a file: the SHA-256 of its bytes
+    return _cached(key, factory, path.stem, source, digest) or _compile(spec, factory, path.stem, source, digest, key)

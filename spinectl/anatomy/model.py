@@ -197,7 +197,7 @@ class Anatomy:
         return con if constrained else free
 
 
-def load(model: str | Path = "myotorso", mapping: str | Path | Mapping | None = None) -> Anatomy:
+def load(model: str | Path = "myotorso", mapping: str | Path | Mapping | None = None, cache: bool = True) -> Anatomy:
     """Load an anatomical model with MuJoCo and map it onto the chain.
 
     Parameters
@@ -206,6 +206,9 @@ def load(model: str | Path = "myotorso", mapping: str | Path | Mapping | None = 
         ``"myotorso"`` (from the installed myo-sim) or an MJCF file.
     mapping : str, pathlib.Path or Mapping, optional
         A mapping TOML file; default the built-in one of the model's name.
+    cache : bool
+        Read the compiled model from the cache of compiled models, and write it there
+        (:mod:`spinectl.anatomy.cache`); False compiles it anew and leaves the cache alone.
 
     Returns
     -------
@@ -218,7 +221,7 @@ def load(model: str | Path = "myotorso", mapping: str | Path | Mapping | None = 
     >>> torso.chain("sagittal").joints  # doctest: +SKIP
     ('flex_extension', 'L4_L5_FE', 'L3_L4_FE', 'L2_L3_FE', 'L1_L2_FE')
     """
-    engine = load_engine(model)
+    engine = load_engine(model, cache=cache)
     if mapping is None:
         mapping = default_mapping(engine.name)
     elif not isinstance(mapping, Mapping):

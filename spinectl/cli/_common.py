@@ -252,7 +252,7 @@ def with_lordosis_angle(payload: dict, model: Model) -> dict:
 
 
 def add_dpi_option(parser: argparse.ArgumentParser) -> None:
-    """``--dpi``, the resolution of PNG figures, on the commands that draw (:data:`spinectl.paper.figures.DPI`).
+    """``--dpi``, the resolution of PNG figures, on the commands that draw (:data:`~spinectl.paper.figures.files.DPI`).
 
     Parameters
     ----------

@@ -98,6 +98,12 @@ def register(sub) -> None:
         help="write sagittal.png (the model, muscles by class, CoRs), modes.png (each mode of -K as a bent "
         "spine, sagittal plane) and, with --lordosis, lordosis.png into DIR",
     )
+    parser.add_argument(
+        "--no-cache",
+        action="store_true",
+        help="compile the model anew, neither reading nor writing the cache of compiled models "
+        "($SPINECTL_CACHE_DIR, else $XDG_CACHE_HOME/spinectl, else ~/.cache/spinectl)",
+    )
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     parser.set_defaults(func=run)
 
@@ -109,7 +115,8 @@ def run(args) -> int:
     ----------
     args : argparse.Namespace
         Parsed arguments: ``model``, ``mapping``, ``plane``, ``activation``, ``joint_stiffness``,
-        ``check``, ``optimise``, ``stability``, ``equilibrium``, ``margin``, ``lordosis``, ``plot``, ``json``.
+        ``check``, ``optimise``, ``stability``, ``equilibrium``, ``margin``, ``lordosis``, ``plot``, ``no_cache``,
+        ``json``.
 
     Returns
     -------
@@ -119,7 +126,7 @@ def run(args) -> int:
     from ..anatomy import load
     from ..anatomy.analyses import analyse
 
-    anatomy = load(args.model, args.mapping)
+    anatomy = load(args.model, args.mapping, cache=not args.no_cache)
     reflex = None if args.kp is None else (args.kp, args.kd, args.activation_lag)
     if args.optimise:
         from ..anatomy.optimum import optimised

@@ -90,7 +90,7 @@ def comparison_set(first: xr.Dataset, second: xr.Dataset, labels=("first", "seco
     labels : tuple of str
         How the titles name the two (e.g. their file names).
     format : str
-        File format of the names, one of :data:`spinectl.paper.figures.FORMATS`.
+        File format of the names, one of :data:`~spinectl.paper.figures.files.FORMATS`.
 
     Returns
     -------
@@ -166,7 +166,7 @@ def draw_comparison(first, second, out_dir, format: str = "png", dpi: float = fi
     out_dir : str or Path
         Folder for the figures.
     format : str
-        One of :data:`spinectl.paper.figures.FORMATS`.
+        One of :data:`~spinectl.paper.figures.files.FORMATS`.
     dpi : float
         Resolution of PNG files.
 

@@ -2,7 +2,7 @@
 
 A study store (:mod:`spinectl.landscape.study`) holds one landscape per value of each parameter axis
 and per Monte-Carlo draw. Each slice is drawn as the landscape figures are
-(:func:`spinectl.paper.figures.landscape_figure`): its minimum PCSA and its ‖CT‖ with the ±30 N m
+(:func:`~spinectl.paper.figures.landscape.landscape_figure`): its minimum PCSA and its ‖CT‖ with the ±30 N m
 limit, the title naming the slice's parameter values with their units. A store with more slices than
 :data:`MAX_SLICES` is refused with the way to select from it.
 """
@@ -31,7 +31,7 @@ def slice_figures(dataset: xr.Dataset, format: str = "png", computed: xr.DataArr
     dataset : xarray.Dataset
         A study store as :func:`spinectl.landscape.study.load` reads it.
     format : str
-        One of :data:`spinectl.paper.figures.FORMATS`.
+        One of :data:`~spinectl.paper.figures.files.FORMATS`.
     computed : xarray.DataArray of bool, optional
         Which points are computed (:func:`spinectl.landscape.study.store.computed`); the others are
         drawn white as not computed, counted apart from infeasible points. Default: every point.
@@ -129,7 +129,7 @@ def draw_study(path, out_dir, format: str = "png", dpi: float = figures.DPI) -> 
     out_dir : str or Path
         Folder for the figures.
     format : str
-        One of :data:`spinectl.paper.figures.FORMATS`.
+        One of :data:`~spinectl.paper.figures.files.FORMATS`.
     dpi : float
         Resolution of PNG files.
 

@@ -23,6 +23,7 @@ import numpy as np
 from ..model.checks import arithmetic_guard
 from ..model.linear_chain import LinearChain
 from ..model.params import Model
+from ..model.stability import criterion
 from ..optimise.coupled import CoupledStability, coupled_stability_at
 from .chain_system import DiskMargins, chain_disk_margins, linear_chain_loop
 from .gains import chain_gains
@@ -188,7 +189,8 @@ class CoupledMargins:
             ``delay_margin_pade_s``, ``disk_margin``, ``disk_gain_margin`` (a factor),
             ``disk_phase_margin_deg``, ``disk_loop_at_a_time`` (per joint: ``disk_margin``,
             ``disk_gain_margin``, ``disk_phase_margin_deg``) and ``stable_at_delay``; the disk
-            margins NaN where the loop is unstable at the delay; ``pcsa_source`` is 'activation'
+            margins NaN where the loop is unstable at the delay; ``criterion``, the chain's (all CoRs
+            free), names these verdicts too; ``pcsa_source`` is 'activation'
             (``activation`` x the minimum stabilising PCSA per segment).
         """
         out = self.chain.to_dict(model, pcsa_source="activation")
@@ -228,7 +230,7 @@ class CoupledMargins:
         Returns
         -------
         str
-            Text, no final newline.
+            Text, no final newline; the verdict at the delay starts with its criterion, the chain's.
         """
         exact, disk = self.exact, self.disk
         margin = {np.inf: "unbounded"}.get(exact.margin, f"{exact.margin * 1000:.4g} ms")
@@ -246,7 +248,7 @@ class CoupledMargins:
         lines += [
             f"exact delay margin {margin}{where} ({exact.status}); Pade order {self.pade_order}: "
             f"{self.delay_margin_pade * 1000:.4g} ms",
-            f"stable at the delay: {'yes' if self.stable_at_delay else 'NO'}",
+            f"{criterion('chain', len(self.kp))}: stable at the delay: {'yes' if self.stable_at_delay else 'NO'}",
             "multiloop disk margin: "
             + (
                 "none (the loop is unstable at the delay)"

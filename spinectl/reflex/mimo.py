@@ -9,9 +9,10 @@ T_a u' + u = command at every joint, has the characteristic equation
 the matrix form of the segment's P + Q exp(-s tau) (:mod:`spinectl.reflex.delay`); T_a = 0 is
 the issue's det(M s^2 - D s - K + (K_p + K_d s) exp(-s tau)). A root lies on the imaginary
 axis, s = j w, exactly where z = exp(-j w tau) is a generalised eigenvalue of the pencil
-(P(jw), -Q(jw)) on the unit circle. The frequency sweep finds every such (w, z) independently
-of tau: the number of eigenvalues w' = 1/z of -P(jw)^-1 Q(jw) outside the unit circle changes
-exactly at a crossing, so bisection on that count brackets each crossing to rounding. The
+(P(jw), -Q(jw)) on the unit circle. Every such w is an eigenvalue of an eigenvalue problem
+that does not involve tau (Louisell 2001 [2]_, :func:`axis_candidates`): no frequency grid, so
+no crossing band is too narrow to be found; each candidate is checked and refined on the
+n x n pencil (an eigenvalue 1/z of -P(jw)^-1 Q(jw) of modulus 1 to :data:`UNIT_TOLERANCE`). The
 delays are then tau = (-arg z + 2 pi k) / w, and the direction of each crossing is the sign
 of Re ds/dtau from the null vectors of the characteristic matrix (implicit differentiation;
 Michiels and Niculescu 2014, ch. 4 [1]_). The delay margin is the first destabilising critical
@@ -27,6 +28,8 @@ References
 .. [1] Michiels W, Niculescu S-I (2014). Stability, Control, and Computation for Time-Delay
    Systems. An Eigenvalue-Based Approach. 2nd ed., SIAM, Philadelphia.
    doi:10.1137/1.9781611973631.
+.. [2] Louisell J (2001). A matrix method for determining the imaginary axis eigenvalues of a
+   delay system. IEEE Trans Autom Control 46(12):2008-2012. doi:10.1109/9.975511.
 """
 
 from __future__ import annotations
@@ -40,11 +43,17 @@ from .delay import STATUS, UNDEFINED, UNSTABLE_WITHOUT_DELAY
 from .pade import pade_inverse_lag
 from .siso import LoopDelayMargin, from_crossings
 
-DECADES = 7
-"""Decades of frequency the sweep spans below the highest possible crossing (:func:`highest_crossing`)."""
+CANDIDATE_TOLERANCE = 1e-3
+"""Eigenvalues s^2 of the squared Louisell matrix kept as candidates -w^2: abs(Im) <= this times abs(s^2), Re < 0."""
 
-POINTS_PER_DECADE = 1500
-"""Sweep points per decade: 0.15 % apart, finer than the resonance of a mode with damping ratio 0.001."""
+UNIT_TOLERANCE = 1e-9
+"""A refined candidate is a crossing where some abs(z) is 1 to this (abs(log abs(z)))."""
+
+SQUARED_ACCURACY = 1e-4
+"""The squared problem is used where its relative error at the floor, eps rho^2 / w^2 (rho^2 its largest abs(s^2)), is below this."""
+
+FLOOR = 1e-7
+"""Crossings are sought above this fraction of :func:`highest_crossing` (w -> 0 is a root at s = 0 for every tau)."""
 
 
 def _matrices(mass, stiffness, damping, kp, kd):
@@ -151,30 +160,135 @@ def _inverse_eigenvalues(p, q):
     return np.linalg.eigvals(-np.linalg.solve(p, q))
 
 
+def descriptor(mass, stiffness, damping, kp, kd, lag=0.0):
+    """E, A_0, A_1 of the delayed chain E x' = A_0 x(t) + A_1 x(t - tau), x = (q, q', u) (u only if T_a > 0).
+
+    M q'' = K q + D q' + u with T_a u' = -u - K_p q(t - tau) - K_d q'(t - tau); without the lag
+    u = -K_p q(t - tau) - K_d q'(t - tau) and x = (q, q').
+
+    Parameters
+    ----------
+    mass, stiffness, damping : array_like, shape (n, n)
+        M [kg m^2], K [N m/rad], D [N m s/rad].
+    kp, kd : array_like, shape (n,)
+        Diagonal reflex gains [N m/rad], [N m s/rad].
+    lag : float, optional
+        Activation time constant T_a [s].
+
+    Returns
+    -------
+    e, a0, a1 : numpy.ndarray, shape (3 n, 3 n) or (2 n, 2 n)
+        E [1, kg m^2, s], A_0 and A_1 [1/s, N m/rad, N m s/rad] by block.
+    """
+    mass, stiffness, damping, kp, kd = _matrices(mass, stiffness, damping, kp, kd)
+    n = mass.shape[0]
+    zero, one = np.zeros((n, n)), np.eye(n)
+    if lag > 0:
+        e = np.block([[one, zero, zero], [zero, mass, zero], [zero, zero, lag * one]])
+        a0 = np.block([[zero, one, zero], [stiffness, damping, one], [zero, zero, -one]])
+        a1 = np.block([[zero, zero, zero], [zero, zero, zero], [-kp, -kd, zero]])
+    else:
+        e = np.block([[one, zero], [zero, mass]])
+        a0 = np.block([[zero, one], [stiffness, damping]])
+        a1 = np.block([[zero, zero], [-kp, -kd]])
+    return e, a0, a1
+
+
+def axis_candidates(e, a0, a1, floor: float = 0.0) -> np.ndarray:
+    """Every w > ``floor`` at which det(j w E - A_0 - z A_1) = 0 for some abs(z) = 1, among others [rad/s].
+
+    If E v j w = (A_0 + z A_1) v with abs(z) = 1, the conjugate gives -j w E conj(v) =
+    (A_0 + A_1 / z) conj(v) (A_0, A_1, E real), so x_1 = v (x) conj(v), x_2 = z x_1 solve
+    s (E (x) I) x_1 = (A_0 (x) I) x_1 + (A_1 (x) I) x_2 and s (I (x) E) x_2 = -(I (x) A_1) x_1 - (I (x) A_0) x_2
+    at s = j w: j w is an eigenvalue of Louisell's 2 m^2 pencil (Louisell 2001, [1]_). Its
+    spectrum is symmetric, s and -s: J = [[0, Pi], [Pi, 0]] (Pi the vec-transpose permutation)
+    anticommutes with it, so its square maps the vectors (y, Pi y) to themselves, where it is
+    G H with H = B_0 (x) I + (B_1 (x) I) Pi, G = B_0 (x) I - (B_1 (x) I) Pi, B_i = E^-1 A_i: an
+    m^2 eigenvalue problem for s^2 = -w^2, about ten times cheaper. Squaring squares the
+    relative error, eps rho^2 / w^2; where that exceeds :data:`SQUARED_ACCURACY` at ``floor``
+    (a tiny T_a: rho >= 1/T_a), the pencil itself by QZ (error eps rho / w). Candidates are the
+    eigenvalues within :data:`CANDIDATE_TOLERANCE` of the axis; not every one is a crossing
+    (the pencil holds every s with s and -s eigenvalues of A_0 + z A_1 and A_0 + A_1 / z for
+    any complex z), which :func:`_crossings` checks.
+
+    Parameters
+    ----------
+    e, a0, a1 : array_like, shape (m, m)
+        E (nonsingular), A_0, A_1 of :func:`descriptor`.
+    floor : float, optional
+        The lowest frequency sought [rad/s].
+
+    Returns
+    -------
+    numpy.ndarray
+        Candidate frequencies w > ``floor`` [rad/s], ascending.
+
+    References
+    ----------
+    .. [1] Louisell J (2001). A matrix method for determining the imaginary axis eigenvalues of a
+       delay system. IEEE Trans Autom Control 46(12):2008-2012. doi:10.1109/9.975511.
+    """
+    e, a0, a1 = (np.asarray(x, float) for x in (e, a0, a1))
+    m = e.shape[0]
+    one = np.eye(m)
+    b0, b1 = np.linalg.solve(e, a0), np.linalg.solve(e, a1)
+    flip = np.arange(m * m).reshape(m, m).T.ravel()  # Pi: vec(X) -> vec(X^T)
+    k0, k1 = np.kron(b0, one), np.kron(b1, one)[:, flip]
+    mu = np.linalg.eigvals((k0 - k1) @ (k0 + k1))
+    if np.finfo(float).eps * np.max(np.abs(mu)) <= SQUARED_ACCURACY * floor**2:
+        keep = (mu.real < 0) & (np.abs(mu.imag) <= CANDIDATE_TOLERANCE * np.abs(mu))
+        w = np.sqrt(-mu[keep].real)
+    else:
+        pencil = np.block([[np.kron(a0, one), np.kron(a1, one)], [-np.kron(one, a1), -np.kron(one, a0)]])
+        s = scipy.linalg.eigvals(pencil, scipy.linalg.block_diag(np.kron(e, one), np.kron(one, e)))
+        s = s[np.isfinite(s)]
+        w = s[(s.imag > 0) & (np.abs(s.real) <= 0.5 * CANDIDATE_TOLERANCE * np.abs(s))].imag
+    return np.sort(w[w > floor])
+
+
+def _refine(moduli, w, target, steps: int = 12):
+    """Secant on log abs(w') of the eigenvalue nearest ``target`` from w: (w, w') or None if it does not reach 1."""
+    def g(x):
+        values = moduli(x)
+        nearest = values[np.argmin(np.abs(values - target))]
+        return np.log(max(abs(nearest), 1e-300)), nearest
+
+    x0, (g0, v0) = w, g(w)
+    x1 = w * (1.0 + 1e-9)
+    g1, v1 = g(x1)
+    for _ in range(steps):
+        if g1 == g0 or abs(g1) < 1e-15:
+            break
+        x2 = x1 - g1 * (x1 - x0) / (g1 - g0)
+        if not abs(x2 - w) <= 1e-3 * w:  # left the candidate's neighbourhood
+            return None
+        x0, g0 = x1, g1
+        x1 = x2
+        g1, v1 = g(x1)
+        target = v1
+    return (x1, v1) if abs(g1) <= UNIT_TOLERANCE else None
+
+
 def _crossings(mass, stiffness, damping, kp, kd, lag):
-    """Every (w, z) with det(P(jw) + Q(jw) z) = 0, abs(z) = 1, w > 0: bisection on the count outside the circle."""
-    top = highest_crossing(mass, stiffness, damping, kp, kd)
-    grid = np.logspace(np.log10(top) - DECADES, np.log10(top), DECADES * POINTS_PER_DECADE + 1)
+    """Every (w, z) with det(P(jw) + Q(jw) z) = 0, abs(z) = 1, w > 0: Louisell's candidates, each refined."""
+    floor = FLOOR * highest_crossing(mass, stiffness, damping, kp, kd)
+    candidates = axis_candidates(*descriptor(mass, stiffness, damping, kp, kd, lag), floor)
 
-    def outside(omega):
-        p, q = characteristic_matrices(mass, stiffness, damping, kp, kd, omega, lag)
-        return np.sum(np.abs(_inverse_eigenvalues(p, q)) > 1.0, axis=-1)
-
-    counts = outside(grid)
-    found = []
-    for i in np.flatnonzero(np.diff(counts)):
-        lo, hi, below = grid[i], grid[i + 1], counts[i]
-        while hi - lo > 4.0 * np.finfo(float).eps * hi:  # to rounding: about 50 halvings
-            mid = 0.5 * (lo + hi)
-            lo, hi = (mid, hi) if outside(np.array([mid]))[0] == below else (lo, mid)
-        w = 0.5 * (lo + hi)
+    def moduli(w):
         p, q = characteristic_matrices(mass, stiffness, damping, kp, kd, [w], lag)
-        inverse = _inverse_eigenvalues(p, q)[0]
-        near = np.abs(np.abs(inverse) - 1.0)
-        # as many eigenvalues as the count changed by, nearest the circle first
-        for j in np.argsort(near)[: max(1, abs(int(counts[i + 1]) - int(below)))]:
-            found.append((w, 1.0 / inverse[j]))
-    return found
+        return _inverse_eigenvalues(p, q)[0]
+
+    found = []
+    for w in candidates[np.r_[True, np.diff(candidates) > 1e-9 * candidates[1:]]]:
+        values = moduli(w)
+        for v in values[np.abs(np.abs(values) - 1.0) < 0.05]:  # near the circle (0 where a joint has no reflex)
+            hit = _refine(moduli, w, v)
+            if hit is None or any(abs(hit[0] - f[0]) <= 1e-9 * f[0] and abs(hit[1] - f[1]) <= 1e-6 for f in found):
+                continue
+            # as many root pairs as eigenvalues there (a repeated crossing, e.g. two equal joints)
+            copies = int(np.sum(np.abs(moduli(hit[0]) - hit[1]) <= 1e-6))
+            found.extend([hit] * max(copies, 1))
+    return [(w, 1.0 / v) for w, v in found]
 
 
 def _direction(mass, stiffness, damping, kp, kd, lag, w, z) -> int:

@@ -34,12 +34,12 @@ def cached(monkeypatch):
     import spinectl.anatomy as package
 
     real = package.load
-    cache = {}
+    loaded = {}
 
-    def load(model="myotorso", mapping=None):
+    def load(model="myotorso", mapping=None, cache=True):
         if model == "myotorso" and mapping is None:
-            return cache.setdefault("torso", real("myotorso"))
-        return real(model, mapping)
+            return loaded.setdefault("torso", real("myotorso", cache=cache))
+        return real(model, mapping, cache=cache)
 
     monkeypatch.setattr(package, "load", load)
 

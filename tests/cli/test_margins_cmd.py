@@ -147,3 +147,15 @@ def test_activation_lag_option_and_toml_key(tmp_path, capsys):
     assert code == 0 and json.loads(out)["activation_time_constant_s"] == 0.08
     code, _, err = run(["margins", "--activation-lag", "5"], capsys)
     assert code == 2 and "activation_time_constant" in err and len(err.strip().splitlines()) == 1
+
+
+def test_coupled_margins_name_the_chain_criterion(capsys):
+    """margins --coupled: the chain under the reflex, all CoRs free; ``coupled.criterion`` in the JSON
+    and the table's verdict at the delay starts with it (wagner2012 has 5 CoRs)."""
+    argv = ["margins", "--coupled", "--E", "0.03", "--Lambda", "0.04", "--preset", "wagner2012"]
+    name = "chain (all 5 CoRs free)"
+    assert main([*argv, "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["coupled"]["criterion"] == name
+    assert main(argv) == 0
+    out = capsys.readouterr().out
+    assert f"{name}: stable at the delay: NO" in out

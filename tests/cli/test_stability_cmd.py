@@ -58,3 +58,15 @@ def test_no_stabilising_activation_names_the_option_on_the_command_line(tmp_path
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "no activation stabilises every segment" in err
     assert err.rstrip().endswith("give the PCSA with --pcsa [cm2]")
+
+
+def test_coupled_verdicts_name_the_chain_criterion(capsys):
+    """stability --coupled judges the whole chain, every CoR free (docs/chain.md): the JSON says so
+    in ``coupled.criterion`` and each verdict line of the table starts with it (5 CoRs in default)."""
+    name = "chain (all 5 CoRs free)"
+    assert main(["stability", "--coupled", "--E", "0.03", "--Lambda", "0.04", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["coupled"]["criterion"] == name
+    assert main(["stability", "--coupled", "--E", "0.03", "--Lambda", "0.04"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    verdicts = [line for line in lines if "stable" in line.lower()]
+    assert len(verdicts) == 3 and all(line.startswith(f"{name}: ") for line in verdicts)

@@ -161,7 +161,7 @@ def test_shared_scale_and_given_range(results, tmp_path, monkeypatch):
         seen.append((vmin, vmax))
         return original(part, vmin, vmax, insets)
 
-    monkeypatch.setattr(figures, "min_pcsa_figure", spy)
+    monkeypatch.setattr(figures.sets, "min_pcsa_figure", spy)  # where figure_set looks it up
     figures.draw_figures(dataset, tmp_path, options=figures.FigureOptions(shared_scale=True))
     values = dataset["min_pcsa_cm2"].values
     assert seen == [(np.nanmin(values), np.nanmax(values))] * 2

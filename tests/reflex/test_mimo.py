@@ -177,3 +177,74 @@ def test_the_delay_margin_of_a_chain_built_by_hand_is_that_of_its_modes():
         np.concatenate([np.roots([m, beta, -lam]) for lam in np.linalg.eigvalsh(chain.stiffness(u))])
     )
     np.testing.assert_allclose(poles, modes, rtol=1e-9)
+
+
+def _narrow_band(epsilon=1e-9):
+    """One joint whose crossing band is 4.5e-5 wide in w, beside a joint without reflex.
+
+    Joint 1 (T_a = 0, k_d = 0): abs(P(jw))^2 = abs(Q(jw))^2 is theta^2 w^4 + b w^2 + S^2 - k_p^2 = 0 with
+    b = 2 theta S + beta^2 (tests above); b = -2 theta sqrt(S^2 - k_p^2) (1 + epsilon) puts its two
+    roots w^2 = 86.6 (1 +- 1.41 sqrt(epsilon)) next to each other: 9.30584 and 9.30626 rad/s, 30
+    times narrower than a 0.15 % step. S = -100 < 0 < k_p: stable without delay. Joint 2 holds
+    itself (S < 0, D < 0) and has no reflex, so no crossing."""
+    theta, stiffness, kp = 1.0, -100.0, 50.0
+    b = -2.0 * theta * np.sqrt(stiffness**2 - kp**2) * (1.0 + epsilon)
+    beta = np.sqrt(b - 2.0 * theta * stiffness)
+    chain = (np.diag([theta, 2.0]), np.diag([stiffness, -10.0]), np.diag([-beta, -1.0]), [kp, 0.0], [0.0, 0.0])
+    return chain, (np.array([stiffness]), np.array([-beta]), np.array([theta]), np.array([kp]), np.array([0.0]))
+
+
+def test_a_crossing_band_narrower_than_any_sweep_step_is_found():
+    """The crossings come from Louisell's eigenvalue problem, not a frequency grid: both edges of a
+    band 4.5e-5 wide (_narrow_band) are found, and the margin is the segment's closed form
+    (reflex.delay_margin, the polynomial roots of abs(P)^2 = abs(Q)^2) to 1e-9. The former
+    0.15 % sweep stepped over the band and reported the loop delay-independent."""
+    chain, segment = _narrow_band()
+    exact = chain_delay_margin(*chain, 0.0)
+    closed = reflex.delay_margin(*segment, 0.0)
+    assert exact.status == "finite"
+    np.testing.assert_allclose(exact.margin, closed.margin[0], rtol=1e-9)
+    np.testing.assert_allclose(exact.frequency, closed.frequency[0], rtol=1e-9)
+    assert sorted(exact.directions.tolist()) == [-1.0, 1.0]
+    assert abs(exact.crossovers[0] - exact.crossovers[1]) < 5e-5 * exact.frequency
+
+
+def test_the_narrow_band_of_a_lightly_reflexed_paper_chain_is_found():
+    """wagner2012 with a 35 kg body and passive stiffness 10 at E = 0.03, Lambda = 0.04, the global
+    muscles at 0.189 of the minimum PCSA, local stiffness 0.9999 k* and the chain rule's reflex times
+    1 - 0.9999 (the case spinectl design's chain search meets): the crossings lie 0.035 % apart
+    near 381 rad/s, and the former sweep called the loop delay-independent. A second method,
+    the rightmost root by Newton from a Chebyshev discretisation of the delay equation
+    (reflex.design.rightmost_root, Breda et al. 2005), is left of the axis 2 % below the exact
+    margin and right of it 2 % above and at 0.12 s."""
+    from spinectl.model import chain, geometry
+    from spinectl.model.config import set_parameters
+    from spinectl.optimise.coupled import least_local_stiffness_stacked
+    from spinectl.optimise.reference import solve_point
+    from spinectl.reflex.design import rightmost_root
+
+    model = set_parameters(load_preset("wagner2012"), {"body.mass": 35, "passive.stiffness": 10})
+    e, lam, f, r = 0.03, 0.04, 0.9999, model.reflex
+    pcsa = 0.189 * np.asarray(solve_point(model, e, lam).pcsa, float)
+    coefficients = chain.chain_coefficients(model, e, lam)
+    mass = chain.mass_matrix(model, geometry.cor_positions(e, lam, model.geometry))
+    stiffness, damping = coefficients.stiffness(pcsa), coefficients.damping(pcsa)
+    least = least_local_stiffness_stacked(stiffness[None], model.optimisation.stability_margin)[1][0]
+    kp, kd = chain_gains(mass, stiffness, damping, least, r.gain_factor, r.damping_ratio, r.activation_time_constant)
+    k, kp, kd, lag = stiffness - f * np.diag(least), (1 - f) * kp, (1 - f) * kd, r.activation_time_constant
+    exact = chain_delay_margin(mass, k, damping, kp, kd, lag)
+    assert exact.status == "finite" and 380.0 < exact.frequency < 383.0
+    for delay, side in ((0.98 * exact.margin, -1), (1.02 * exact.margin, 1), (0.12, 1)):
+        assert np.sign(rightmost_root(mass, k, damping, kp, kd, delay, lag, 40).real) == side
+
+
+def test_a_tiny_lag_keeps_every_crossing_of_the_lagless_loop():
+    """T_a = 1e-7 s puts an eigenvalue -1/T_a = -1e7 1/s beside crossings at 1.6 to 29 rad/s; the
+    squared Louisell problem would lose the lowest (relative error eps 1e14 / 2.4 = 1e-2), so the
+    pencil is solved by QZ there. Its crossings and margin are the lagless loop's to the lag's
+    own effect, a relative 1e-5 (phase lag w T_a <= 3e-6 rad)."""
+    chain = _coupled()
+    tiny, none = chain_delay_margin(*chain, 1e-7), chain_delay_margin(*chain, 0.0)
+    assert len(tiny.crossovers) == len(none.crossovers) == 3
+    np.testing.assert_allclose(tiny.crossovers, none.crossovers, rtol=1e-5)
+    np.testing.assert_allclose(tiny.margin, none.margin, rtol=1e-5)

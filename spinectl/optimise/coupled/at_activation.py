@@ -16,7 +16,7 @@ from ...model.checks import arithmetic_guard, expand_pcsa
 from ...model.linear_chain import LinearChain
 from ...model.params import Model
 from ...model.source import header, provenance
-from ...model.stability import self_stable
+from ...model.stability import criterion, self_stable
 from ...units import m2_to_cm2
 from ..stabilising import minimum_stabilising_pcsa
 from .data import CoupledOptimum, coupled_data
@@ -121,7 +121,8 @@ class CoupledStability:
             The model's :func:`~spinectl.model.source.provenance` (``preset``, ``config``, ``config_sha256``,
             ``overridden``, ``K_Nm_per_rad`` or ``K_per_s2``, ``K_convention``), ``E_m``, ``Lambda_m``,
             ``pcsa_source`` and
-            ``coupled``: ``segments``, ``decision_variables``, ``pcsa_cm2`` (muscle -> cm^2),
+            ``coupled``: ``criterion`` (of its verdicts: the chain, all CoRs free,
+            :func:`spinectl.model.stability.criterion`), ``segments``, ``decision_variables``, ``pcsa_cm2`` (muscle -> cm^2),
             ``stiffness_matrix_Nm_per_rad``, ``gravity_stiffness_matrix_Nm_per_rad``,
             ``stiffness_matrix_per_cm2`` (n_var x n_cor x n_cor, N m/rad per cm^2),
             ``damping_matrix_Nms_per_rad``, ``mass_matrix_kgm2``, ``local_stiffness_Nm_per_rad``
@@ -136,6 +137,7 @@ class CoupledStability:
             "Lambda_m": self.lordosis,
             "pcsa_source": pcsa_source,
             "coupled": {
+                "criterion": criterion("chain", len(self.segment_names)),
                 "segments": list(self.segment_names),
                 "decision_variables": list(self.variable_names),
                 "pcsa_cm2": dict(zip(model.muscle_names, m2_to_cm2(self.pcsa).tolist(), strict=True)),
@@ -172,7 +174,8 @@ class CoupledStability:
         Returns
         -------
         str
-            The text ``spinectl stability --coupled`` prints (no final newline).
+            The text ``spinectl stability --coupled`` prints (no final newline); each verdict line
+            starts with its criterion, the chain's (:func:`spinectl.model.stability.criterion`).
         """
         pcsa = m2_to_cm2(self.pcsa)
         names = self.segment_names
@@ -196,19 +199,20 @@ class CoupledStability:
             lines += ["", title, " " * 8 + "".join(f"{n:>10}" for n in names)]
             lines += [f"{n:8}" + "".join(f"{v:{fmt}}" for v in row) for n, row in zip(names, matrix, strict=True)]
         local = self.local.local_stiffness
+        name = criterion("chain", len(names))
         lines += [
             "",
-            f"static margin (smallest eigenvalue of -K) = {self.margin:.3f} N m/rad "
+            f"{name}: static margin (smallest eigenvalue of -K) = {self.margin:.3f} N m/rad "
             f"({'stable' if self.margin > 0 else 'UNSTABLE'})",
             "eigenvalues [1/s]: " + ", ".join(f"{z.real:.3f}{z.imag:+.3f}j" for z in self.eigenvalues),
-            "global muscles alone: "
+            f"{name}: global muscles alone: "
             + (
                 "eigenvalues undefined, the mass matrix is singular (levels.mass = 0)"
                 if np.isnan(self.eigenvalues).any()
                 else f"{'dynamically stable' if self.self_stable else 'NOT stable'} "
                 f"({int(np.sum(self.eigenvalues.real >= 0))} of {self.eigenvalues.size} eigenvalues with Re >= 0)"
             ),
-            "least local stiffness [N m/rad]: "
+            f"{name}: least local stiffness [N m/rad]: "
             + ", ".join(f"{n} {k:.2f}" for n, k in zip(names, local, strict=True))
             + f"  (total {np.sum(local):.2f}; local PCSA {m2_to_cm2(self.local.total_local_pcsa):.2f} cm^2; "
             f"{self.local.status}); with it: {'dynamically stable' if self.stable_with_local else 'NOT stable'}, "
