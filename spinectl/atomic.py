@@ -158,7 +158,9 @@ def _temporary(target: Path, directory: bool) -> Path:
     marker = f".~{Owner.me().token()}~"
     tail = ".tmp" + (target.suffix if not directory else "")
     room = NAME_MAX - len(os.fsencode(marker + tail)) - 8 - 1  # 8: mkstemp's random part; 1: the leading dot
-    name = os.fsencode(target.name)[: max(room, 1)].decode(errors="ignore") or "out"  # a long name: its start
+    # a long name: its first bytes, decoded as the file system encodes (under a C locale a UTF-8 name is held
+    # as surrogate escapes, which only os.fsdecode gives back; a cut character round-trips the same way)
+    name = os.fsdecode(os.fsencode(target.name)[: max(room, 1)]) or "out"
     prefix = f".{name}{marker}"
     if directory:
         return Path(tempfile.mkdtemp(prefix=prefix, suffix=tail, dir=target.parent))

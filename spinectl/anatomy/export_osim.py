@@ -278,8 +278,8 @@ def export_osim(
     for time in (0.0, 1.0):
         table.appendRow(time, osim.RowVector(values))
     table.addTableMetaDataString("inDegrees", "no")
-    with atomic_path(sto) as tmp:
-        osim.STOFileAdapter.write(table, str(tmp))
-    with atomic_path(out) as tmp:
-        built.printToXML(str(tmp))
+    # both written before either is renamed: a model that cannot be written leaves no controls behind
+    with atomic_path(sto) as tmp_sto, atomic_path(out) as tmp_out:
+        osim.STOFileAdapter.write(table, str(tmp_sto))
+        built.printToXML(str(tmp_out))
     return solution

@@ -12,8 +12,15 @@ by central differences of OpenSim's moment arms, K_0 by central differences of t
 torques, so the chain is a :class:`~spinectl.model.linear_chain.LinearChain` like MuJoCo's.
 
 Supported muscles: ``Millard2012EquilibriumMuscle`` with a rigid tendon (fibre length = path
-length - tendon slack length, no pennation), its activation the control. The chain is free:
-coordinate coupler constraints (Christophy's lumbar rhythm) are reported by name and left out.
+length - tendon slack length, no pennation), its activation the control.
+
+Coordinate coupler constraints (``CoordinateCouplerConstraint``, e.g. the lumbar rhythm of
+Christophy et al. 2012) are switched off in the engine, so the **free** chain is the chain with
+them off. The **constrained** chain is the free linearisation reduced to the independent
+coordinates by the couplers' linearised relations, q_dep = f(q_ind): T = dq/dq_ind from the
+functions' first derivatives at the posture (OpenSim's ``Function.calcDerivative``) and their
+second derivatives as the curvature, by :func:`spinectl.anatomy.linearise.constrained_chain`
+(the reduction of MuJoCo's joint equalities).
 
 References
 ----------
@@ -23,6 +30,9 @@ doi:10.1371/journal.pcbi.1006223.
 
 Millard M, Uchida T, Seth A, Delp SL (2013). Flexing computational muscle: modeling and
 simulation of musculotendon dynamics. J Biomech Eng 135(2):021005. doi:10.1115/1.4023390.
+
+Christophy M, Faruk Senan NA, Lotz JC, O'Reilly OM (2012). A musculoskeletal model for the lumbar
+spine. Biomech Model Mechanobiol 11(1-2):19-34. doi:10.1007/s10237-011-0290-6.
 """
 
 from __future__ import annotations
@@ -36,9 +46,81 @@ import numpy as np
 from .._validate import printable
 from ..errors import ModelError, ParameterError
 from .export_osim import require_opensim
-from .linearise import STEP, Linearisation, free_chain
+from .linearise import STEP, Linearisation, Rhythm, constrained_chain, free_chain
 from .mapping import Mapping, default_mapping, read_mapping
 from .model import Anatomy
+
+
+@dataclass(frozen=True)
+class Coupler:
+    """One ``CoordinateCouplerConstraint``: q_dependent = function(q_independent...).
+
+    Attributes
+    ----------
+    name, dependent : str
+        The constraint's and its dependent coordinate's names.
+    independent : tuple of str
+        Its independent coordinates.
+    function : opensim.Function
+        The model's own function of the independent coordinates.
+    """
+
+    name: str
+    dependent: str
+    independent: tuple
+    function: object
+
+    def derivatives(self, values: dict, engine) -> tuple:
+        """The function's first and second derivatives in each independent coordinate at a posture.
+
+        Parameters
+        ----------
+        values : dict
+            Coordinate name -> value [rad] (others at their defaults).
+        engine : OsimEngine
+
+        Returns
+        -------
+        tuple
+            (slopes, curvatures), numpy.ndarray of shape (len(independent),) [1] and [1/rad].
+        """
+        osim = require_opensim()
+        x = osim.Vector(len(self.independent), 0.0)
+        for k, name in enumerate(self.independent):
+            x.set(k, float(values.get(name, engine.coordinate(name).getDefaultValue())))
+        slopes, curvatures, mixed = [], [], []
+        for k in range(len(self.independent)):
+            slopes.append(self.function.calcDerivative(_orders(osim, k), x))
+            curvatures.append(self.function.calcDerivative(_orders(osim, k, k), x))
+            mixed += [self.function.calcDerivative(_orders(osim, k, j), x) for j in range(k)]
+        if any(abs(v) > 0 for v in mixed):  # the reduction carries each coordinate's own curvature only
+            raise ModelError(f"{engine.name}: coupler {self.name} has mixed second derivatives, not supported")
+        return np.array(slopes), np.array(curvatures)
+
+    def describe(self, values: dict, engine) -> str:
+        """One phrase: the dependent coordinate, what it follows and the slopes at the posture.
+
+        Parameters
+        ----------
+        values : dict
+            Coordinate name -> value [rad].
+        engine : OsimEngine
+
+        Returns
+        -------
+        str
+        """
+        slopes, _ = self.derivatives(values, engine)
+        on = ", ".join(f"{n} slope {v:.4g}" for n, v in zip(self.independent, slopes, strict=True))
+        return f"{self.name} ({self.dependent} on {on})"
+
+
+def _orders(osim, *orders):
+    """OpenSim's derivative-order argument: the indices of the variables differentiated."""
+    out = osim.StdVectorInt()
+    for k in orders:
+        out.append(int(k))
+    return out
 
 
 @dataclass
@@ -51,8 +133,8 @@ class OsimEngine:
     state : SimTK.State
     name, source, sha256 : str
         The model's name, the file's path and the SHA-256 of its bytes.
-    couplers : tuple of str
-        Names of the model's ``CoordinateCouplerConstraint`` s (left out of the free chain).
+    couplers : tuple of Coupler
+        The model's ``CoordinateCouplerConstraint`` s, switched off in ``model`` (the free chain).
     """
 
     model: object
@@ -74,6 +156,22 @@ class OsimEngine:
         opensim.Coordinate
         """
         return self.model.getCoordinateSet().get(name)
+
+    def spec_factory(self):
+        """MuJoCo's referee (``check``) rebuilds an MJCF spec; an OpenSim model has none: one line.
+
+        OpenSim offers no linearisation of its own to compare the chain with, so ``--check`` is
+        MuJoCo's, for MJCF models only.
+
+        Raises
+        ------
+        ParameterError
+            Always.
+        """
+        raise ParameterError(
+            "check",
+            f"MuJoCo is the referee, for MJCF models only; OpenSim has no linearisation to compare {self.name}'s with",
+        )
 
     def set_posture(self, values: dict) -> None:
         """Set coordinates at zero speed, the others at their defaults, and realise positions.
@@ -108,17 +206,96 @@ def load_engine(path) -> OsimEngine:
         raise ParameterError("model", f"no such .osim file: {printable(str(path))}")
     try:
         model = osim.Model(str(path))
+        schema = _schema(osim, model, path)
+        couplers = _couplers(osim, model)
         state = model.initSystem()
     except Exception as exc:  # OpenSim raises its own exception types, one line each
+        if isinstance(exc, ParameterError):
+            raise
         raise ParameterError("model", f"OpenSim cannot build {path}: {str(exc).splitlines()[0]}") from None
-    constraints = model.getConstraintSet()
-    couplers = tuple(
-        constraints.get(i).getName()
-        for i in range(constraints.getSize())
-        if constraints.get(i).getConcreteClassName() == "CoordinateCouplerConstraint"
-    )
     digest = hashlib.sha256(path.read_bytes()).hexdigest()
-    return OsimEngine(model, state, model.getName() or path.stem, str(path.resolve()), digest, couplers)
+    source = str(path.resolve()) + schema
+    return OsimEngine(model, state, model.getName() or path.stem, source, digest, couplers)
+
+
+def _schema(osim, model, path) -> str:
+    """What OpenSim did with the file's schema (its ``Version`` attribute): "" if current, else a note.
+
+    OpenSim upgrades older schemas as it reads them; a schema newer than this OpenSim's may hold
+    what it silently ignores, so it is refused in one line.
+    """
+    major, minor = (int(p) for p in osim.__version__.split(".")[:2])
+    latest = 10000 * major + 100 * minor  # OpenSim's XMLDocument::LatestVersion of this release
+    version = model.getDocumentFileVersion()
+    if version > latest:
+        raise ParameterError(
+            "model",
+            f"{printable(str(path))} has OpenSim schema {version}, newer than OpenSim {osim.__version__}'s "
+            f"({latest}); open it with that OpenSim",
+        )
+    return f" (schema {version}, upgraded by OpenSim {osim.__version__} to {latest})" if version < latest else ""
+
+
+def _couplers(osim, model) -> tuple:
+    """The model's coordinate couplers, each switched off (before ``initSystem``: the free chain)."""
+    constraints = model.updConstraintSet()
+    out = []
+    for i in range(constraints.getSize()):
+        coupler = osim.CoordinateCouplerConstraint.safeDownCast(constraints.get(i))
+        if coupler is None:
+            continue
+        names = coupler.getIndependentCoordinateNames()
+        independent = tuple(names.get(k) for k in range(names.getSize()))
+        coupler.set_isEnforced(False)
+        out.append(Coupler(coupler.getName(), coupler.getDependentCoordinateName(), independent, coupler.getFunction()))
+    return tuple(out)
+
+
+def coupler_rhythm(engine: OsimEngine, chain, values: dict) -> tuple:
+    """The couplers as a :class:`~spinectl.anatomy.linearise.Rhythm` over the chain and the coordinates they tie.
+
+    A chain coordinate that a coupler slaves is replaced by the coupler's independent
+    coordinates (added if off the chain); a coordinate off the chain slaved to the chain's
+    independent ones is added as a dependent one. Only couplers whose dependent coordinate is
+    itself independent of the others are supported.
+
+    Parameters
+    ----------
+    engine : OsimEngine
+    chain : sequence of str
+        The chain's coordinates.
+    values : dict
+        Coordinate name -> value [rad] of the posture.
+
+    Returns
+    -------
+    tuple
+        (Rhythm, the involved coordinates' names, the couplers involved).
+    """
+    slaved = {c.dependent: c for c in engine.couplers}
+    if any(name in slaved for c in engine.couplers for name in c.independent):
+        raise ModelError(f"{engine.name}: a coupler on a coordinate that another coupler slaves is not supported")
+    chain = list(chain)
+    involved = list(chain)
+    for name in chain:
+        if name in slaved:
+            involved += [n for n in slaved[name].independent if n not in involved]
+    independent = [n for n in involved if n not in slaved]
+    involved += [
+        c.dependent for c in engine.couplers if c.dependent not in involved and set(c.independent) <= set(independent)
+    ]
+    used = [slaved[n] for n in involved if n in slaved]
+    T = np.zeros((len(involved), len(independent)))
+    C = np.zeros_like(T)
+    for row, name in enumerate(involved):
+        if name in slaved:
+            slopes, curvatures = slaved[name].derivatives(values, engine)
+            cols = [independent.index(n) for n in slaved[name].independent]
+            T[row, cols], C[row, cols] = slopes, curvatures
+        else:
+            T[row, independent.index(name)] = 1.0
+    rhy = Rhythm(tuple(involved.index(n) for n in independent), tuple(range(len(involved))), T, C)
+    return rhy, involved, tuple(used)
 
 
 def _base_body(frame) -> str:
@@ -245,25 +422,28 @@ def _mobility_order(engine: OsimEngine) -> dict:
     return order
 
 
-def linearise(engine: OsimEngine, names, values: dict) -> Linearisation:
-    """K_i, K_0, D_i, D_0, M over the chain's coordinates at a posture (module docstring).
+def linearise(engine: OsimEngine, names, values: dict, n=None) -> Linearisation:
+    """K_i, K_0, D_i, D_0, M over the given coordinates at a posture (module docstring).
 
     Parameters
     ----------
     engine : OsimEngine
     names : sequence of str
-        The chain's coordinates.
+        The coordinates involved, the chain's first.
     values : dict
         Coordinate name -> value [rad] of the posture (others at their defaults).
+    n : int, optional
+        How many of ``names`` are the chain's (default all).
 
     Returns
     -------
     Linearisation
-        Over the chain's coordinates only (``dofs`` = 0 ... n - 1), the other coordinates held.
+        Over ``names`` (``dofs`` = 0 ... len(names) - 1), the other coordinates held.
     """
     osim = require_opensim()
     names = list(names)
-    n = len(names)
+    s = len(names)
+    n = s if n is None else int(n)
     arms, passive = _arms_and_passive(engine, names, values)
     muscles = engine.model.getMuscles()
     engine.set_posture(values)
@@ -274,21 +454,24 @@ def linearise(engine: OsimEngine, names, values: dict) -> Linearisation:
     order = _mobility_order(engine)
     index = [order[c] for c in names]
     full = np.array([[mass.get(i, j) for j in range(mass.ncol())] for i in range(mass.nrow())])
-    hessian = np.zeros((len(lengths), n, n))
-    dpassive = np.zeros((n, n))
+    hessian = np.zeros((len(lengths), s, s))
+    dpassive = np.zeros((s, s))
+    wrapped = _wrapped(engine)
+    touching = _contacts(engine, wrapped)
     for k, name in enumerate(names):
         sides = []
         for sign in (1.0, -1.0):
             moved = dict(values)
             moved[name] = values.get(name, engine.coordinate(name).getDefaultValue()) + sign * STEP
             sides.append(_arms_and_passive(engine, names, moved))
+            _same_contacts(engine, wrapped, touching, _contacts(engine, wrapped), name)
         hessian[:, :, k] = (sides[0][0] - sides[1][0]) / (2 * STEP)
         dpassive[:, k] = (sides[0][1] - sides[1][1]) / (2 * STEP)
     engine.set_posture(values)
     hessian = 0.5 * (hessian + hessian.transpose(0, 2, 1))
     rr = np.einsum("ij,ik->jki", arms, arms)
     return Linearisation(
-        dofs=tuple(range(n)),
+        dofs=tuple(range(s)),
         n=n,
         stiffness_per_muscle=hessian.transpose(1, 2, 0) * gain + rr * dgain_dl,
         stiffness_offset=0.5 * (dpassive + dpassive.T) + np.einsum("ijk,i->jk", hessian, bias) + rr @ dbias_dl,
@@ -301,12 +484,42 @@ def linearise(engine: OsimEngine, names, values: dict) -> Linearisation:
     )
 
 
+def _wrapped(engine: OsimEngine) -> dict:
+    """Muscle index -> the names of the wrap objects on its path, for the muscles that have any."""
+    muscles = engine.model.getMuscles()
+    out = {}
+    for i in range(muscles.getSize()):
+        wraps = muscles.get(i).getGeometryPath().getWrapSet()
+        if wraps.getSize():
+            out[i] = [wraps.get(k).getWrapObject().getName() for k in range(wraps.getSize())]
+    return out
+
+
+def _contacts(engine: OsimEngine, wrapped: dict) -> dict:
+    """Muscle index -> how many points its current path has (2 more per wrap it touches), at the set posture."""
+    muscles = engine.model.getMuscles()
+    engine.model.realizePosition(engine.state)
+    return {i: muscles.get(i).getGeometryPath().getCurrentPath(engine.state).getSize() for i in wrapped}
+
+
+def _same_contacts(engine: OsimEngine, wrapped: dict, before: dict, after: dict, coordinate: str) -> None:
+    """A muscle that touches a wrap on one side of the posture only has a kinked moment arm there: one line."""
+    for i, count in before.items():
+        if after[i] != count:
+            muscle = engine.model.getMuscles().get(i).getName()
+            raise ModelError(
+                f"{engine.name}: muscle {muscle} starts or stops wrapping over {', '.join(wrapped[i])} within "
+                f"{STEP:g} rad of the posture ({coordinate}): its moment arm has a kink there, which the "
+                "linearisation cannot differentiate; nothing was linearised (move the posture off the contact)"
+            )
+
+
 @dataclass
 class OsimAnatomy(Anatomy):
     """An OpenSim model mapped onto the chain: :class:`~spinectl.anatomy.model.Anatomy` with OpenSim as the engine.
 
-    The chain is free (coordinate couplers left out, named in ``engine.couplers``): the
-    constrained chain is the free one. MuJoCo's referee (``--check``) and the optimum need MJCF.
+    The free chain has the coordinate couplers off; the constrained chain applies their
+    linearised relations (module docstring). MuJoCo's referee (``--check``) needs MJCF.
 
     Parameters
     ----------
@@ -337,7 +550,7 @@ class OsimAnatomy(Anatomy):
         return dict(posture)
 
     def linearise(self, plane: str = "sagittal", posture=None) -> tuple:
-        """The linearisation over the plane's coordinates (no rhythm).
+        """The linearisation over the plane's coordinates and those its couplers tie.
 
         Parameters
         ----------
@@ -349,13 +562,33 @@ class OsimAnatomy(Anatomy):
         Returns
         -------
         tuple
-            (Linearisation, None, the coordinates' names).
+            (Linearisation, Rhythm of the couplers (:func:`coupler_rhythm`), the involved coordinates' names).
         """
         names = self.plane_joints(plane)
-        return linearise(self.engine, names, self.posture(posture)), None, list(names)
+        values = self.posture(posture)
+        rhy, involved, _ = coupler_rhythm(self.engine, names, values)
+        return linearise(self.engine, involved, values, len(names)), rhy, involved
+
+    def couplers(self, plane: str = "sagittal", posture=None) -> list:
+        """The couplers that tie the plane's chain, each as one phrase with its slopes at the posture.
+
+        Parameters
+        ----------
+        plane : str
+            One of the mapping's planes.
+        posture : dict, optional
+            Coordinate name -> value [rad].
+
+        Returns
+        -------
+        list of str
+        """
+        values = self.posture(posture)
+        _, _, used = coupler_rhythm(self.engine, self.plane_joints(plane), values)
+        return [c.describe(values, self.engine) for c in used]
 
     def chains(self, plane: str = "sagittal", posture=None, joint_stiffness="none") -> tuple:
-        """The free chain (coordinate couplers left out), also as the constrained one, and the linearisation.
+        """The free chain (couplers off) and the chain constrained by the couplers, and the linearisation.
 
         Parameters
         ----------
@@ -369,13 +602,20 @@ class OsimAnatomy(Anatomy):
         Returns
         -------
         tuple
-            (free LinearChain, the same, Linearisation).
+            (free LinearChain, constrained LinearChain, Linearisation).
         """
-        lin, _, names = self.linearise(plane, posture)
-        added = self.added_stiffness(joint_stiffness, lin.n)
-        left = f"; coupler constraints left out: {', '.join(self.engine.couplers)}" if self.engine.couplers else ""
-        free = free_chain(lin, tuple(names), self.muscles, self.classes, added, f"{self.engine.source}, {plane}{left}")
-        return free, free, lin
+        lin, rhy, involved = self.linearise(plane, posture)
+        n = lin.n
+        added = self.added_stiffness(joint_stiffness, n)
+        source = f"{self.engine.source}, {plane}"
+        if posture and self.engine.couplers:  # the engine's source gives the slopes at the default posture
+            source += f"; the couplers at this posture: {'; '.join(self.couplers(plane, posture)) or 'none'}"
+        free = free_chain(lin, tuple(involved[:n]), self.muscles, self.classes, added, source)
+        full_added = np.concatenate([added, np.zeros(len(involved) - n)])
+        constrained = constrained_chain(
+            lin, rhy, involved, self.muscles, self.classes, full_added, source + ", constrained by the couplers"
+        )
+        return free, constrained, lin
 
 
 def load_osim(path, mapping=None) -> OsimAnatomy:
@@ -403,4 +643,127 @@ def load_osim(path, mapping=None) -> OsimAnatomy:
     for i in range(muscles.getSize()):
         _millard(engine, muscles.get(i))
     names = tuple(muscles.get(i).getName() for i in range(muscles.getSize()))
+    if engine.couplers:  # in the model's source line, which every table and JSON prints
+        described = "; ".join(c.describe({}, engine) for c in engine.couplers)
+        engine.source += f"; coupler constraints (off in the free chain, linearised in the constrained): {described}"
     return OsimAnatomy(engine, mapping, names, _classify(engine, mapping))
+
+
+def volume_weights(anatomy: OsimAnatomy) -> np.ndarray:
+    """w_i proportional to F_max,i l_opt,i (the Millard muscle's volume), normalised to mean 1.
+
+    Parameters
+    ----------
+    anatomy : OsimAnatomy
+
+    Returns
+    -------
+    numpy.ndarray, shape (m,)
+    """
+    muscles = anatomy.engine.model.getMuscles()
+    volume = np.array(
+        [
+            muscles.get(i).getMaxIsometricForce() * muscles.get(i).getOptimalFiberLength()
+            for i in range(muscles.getSize())
+        ]
+    )
+    return volume / volume.mean()
+
+
+def optimise(
+    anatomy: OsimAnatomy, plane="sagittal", stability="chain", margin=1.0, joint_stiffness="none", equilibrium="rhythm"
+):
+    """The least-effort activations on OpenSim's chain (:func:`spinectl.anatomy.optimum.optimise`'s problem).
+
+    Equilibrium holds on the chain's coordinates (``"free"``) or on the couplers' independent
+    ones, the couplers carrying the rest (``"rhythm"``); stability ``"rhythm"`` is imposed on the
+    chain constrained by the couplers. The problem is solved on the LinearChain by
+    :func:`spinectl.anatomy.optimum.solve_on_chain`, as for MJCF.
+
+    Parameters
+    ----------
+    anatomy : OsimAnatomy
+    plane : str
+    stability : str
+        One of :data:`spinectl.anatomy.optimum.STABILITY`.
+    margin : float
+        mu [N m/rad], >= 0.
+    joint_stiffness : {"none", "mapped"} or float
+    equilibrium : str
+        One of :data:`spinectl.anatomy.optimum.EQUILIBRIUM`.
+
+    Returns
+    -------
+    spinectl.anatomy.optimum.Optimum
+    """
+    from .optimum import EQUILIBRIUM, STABILITY, Optimum, solve_on_chain
+
+    if stability not in STABILITY:
+        raise ParameterError("stability", f"must be one of {STABILITY} (got {stability!r})")
+    if equilibrium not in EQUILIBRIUM:
+        raise ParameterError("equilibrium", f"must be one of {EQUILIBRIUM} (got {equilibrium!r})")
+    if not (np.isfinite(margin) and margin >= 0):
+        raise ParameterError("margin", f"must be >= 0 [N m/rad] (got {margin!r})")
+    free, constrained, lin = anatomy.chains(plane, None, joint_stiffness)
+    _, rhy, _ = anatomy.linearise(plane)
+    rows = list(range(lin.n))
+    if equilibrium == "free":
+        tau_per, tau_0 = lin.torque_per_muscle[rows], lin.torque_offset[rows]
+    else:
+        tau_per, tau_0 = rhy.transform.T @ lin.torque_per_muscle, rhy.transform.T @ lin.torque_offset
+    w = volume_weights(anatomy)
+    chain, criterion = (constrained, "chain") if stability == "rhythm" else (free, stability)
+    status, a = solve_on_chain(chain, tau_per, tau_0, w, criterion, margin)
+    k = free.stiffness(a) if np.all(np.isfinite(a)) else np.full((free.n_joints,) * 2, np.nan)
+    ok = np.all(np.isfinite(k))
+    return Optimum(
+        stability=stability,
+        status=status,
+        activations=a,
+        cost=float(w @ a**2),
+        equilibrium=equilibrium,
+        net_torque=tau_per @ a + tau_0,
+        lumbar_torque=lin.torque_per_muscle[rows] @ a + lin.torque_offset[rows],
+        eigenvalues=np.linalg.eigvalsh(-0.5 * (k + k.T)) if ok else np.full(free.n_joints, np.nan),
+        joint_stiffness=-np.diag(k),
+    )
+
+
+def optimised(
+    anatomy: OsimAnatomy,
+    plane="sagittal",
+    stability="chain",
+    margin=1.0,
+    joint_stiffness="none",
+    equilibrium="rhythm",
+    check=False,
+    reflex=None,
+):
+    """The optimum with a criterion and without on OpenSim's chain, and the analysis at it.
+
+    Parameters
+    ----------
+    anatomy : OsimAnatomy
+    plane, stability, margin, joint_stiffness, equilibrium
+        As :func:`optimise`.
+    check : bool
+        Refused: MuJoCo is the referee, for MJCF only (:meth:`OsimEngine.spec_factory`).
+    reflex : tuple, optional
+        ``(kp, kd, lag)`` (:func:`spinectl.anatomy.analyses.reflex_margin`).
+
+    Returns
+    -------
+    spinectl.anatomy.optimum.OptimisedResult
+    """
+    from .analyses import analyse
+    from .optimum import OptimisedResult
+
+    if check:
+        anatomy.engine.spec_factory()
+    kwargs = {"plane": plane, "margin": margin, "joint_stiffness": joint_stiffness, "equilibrium": equilibrium}
+    opt = optimise(anatomy, stability=stability, **kwargs)
+    classic = opt if stability == "none" else optimise(anatomy, stability="none", **kwargs)
+    analysis = None
+    if opt.ok:
+        analysis = analyse(anatomy, plane, opt.activations, joint_stiffness=joint_stiffness, reflex=reflex)
+    return OptimisedResult(anatomy, opt, classic, float(margin), plane, analysis)

@@ -131,6 +131,8 @@ def run(args) -> int:
     if args.optimise:
         from ..anatomy.optimum import optimised
 
+        if str(args.model).lower().endswith(".osim"):
+            from ..anatomy.opensim_engine import optimised  # the same problem on OpenSim's chain
         result = optimised(
             anatomy,
             plane=args.plane,

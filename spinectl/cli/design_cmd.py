@@ -8,6 +8,7 @@ from ._common import (
     check_position,
     emit_json,
     finite_float,
+    float_list,
     load_model,
     with_lordosis_angle,
 )
@@ -46,6 +47,26 @@ def register(sub) -> None:
     )
     parser.add_argument("--kp", type=finite_float("--kp"), help="proportional gain [N m/rad] (default: the rule)")
     parser.add_argument("--kd", type=finite_float("--kd"), help="derivative gain [N m s/rad] (default: the rule)")
+    parser.add_argument(
+        "--passive",
+        metavar="START:STOP:N",
+        help="instead: the chain's least global PCSA alone and least local stiffness against the passive "
+        "stiffness per joint [N m/rad], e.g. 0:80:41, with Crisco et al. 1992's buckling stiffness marked",
+    )
+    parser.add_argument(
+        "--delays",
+        metavar="START:STOP:N",
+        help="instead: the design curve, both criteria's required design against the delay [s], e.g. 0:0.2:41",
+    )
+    parser.add_argument(
+        "--lags",
+        type=float_list("--lags"),
+        metavar="T_A,...",
+        help="with --delays: one curve per activation lag [s], e.g. 0,0.05,0.1 (default: config)",
+    )
+    parser.add_argument(
+        "--plot", metavar="DIR", help="with --passive: write passive.png; with --delays: design_curve.png, into DIR"
+    )
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     add_model_options(parser)
     parser.set_defaults(func=run)
@@ -73,6 +94,7 @@ def run(args) -> int:
         Exit code 0 (also for a delay no design meets: status 'infeasible').
     """
     from .._validate import non_negative
+    from ..errors import ParameterError
     from ..reflex.design import design
 
     aliases = {dotted: ("--" + option.replace("_", "-"), getattr(args, option)) for option, dotted in OVERRIDES}
@@ -80,9 +102,68 @@ def run(args) -> int:
     check_position(model, args)
     kp = None if args.kp is None else non_negative("--kp", args.kp)
     kd = None if args.kd is None else non_negative("--kd", args.kd)
+    if args.plot is not None and args.passive is None and args.delays is None:
+        raise ParameterError("--plot", "needs --passive or --delays")
+    if args.lags is not None and args.delays is None:
+        raise ParameterError("--lags", "needs --delays")
+    if args.passive is not None and args.delays is not None:
+        raise ParameterError("--passive", "cannot go with --delays (one curve at a time)")
+    if args.passive is not None:
+        return _passive(model, args)
+    if args.delays is not None:
+        return _delays(model, args, kp, kd)
     result = design(model, args.E, args.Lambda, kp=kp, kd=kd)
     if args.json:
         emit_json(with_lordosis_angle(result.to_dict(), model))
     else:
         print(result.table())
+    return 0
+
+
+def _axis(option: str, text: str, low: float, high: float):
+    """START:STOP:N as N evenly spaced values in [low, high]; one line naming ``option`` otherwise."""
+    import numpy as np
+
+    from ..errors import ParameterError
+
+    try:
+        start, stop, count = text.split(":")
+        start, stop, count = float(start), float(stop), int(count)
+    except ValueError:
+        raise ParameterError(option, f"must be START:STOP:N, e.g. 0:80:41 (got {text!r})") from None
+    inside = all(np.isfinite(v) and low <= v <= high for v in (start, stop))
+    if not (inside and 1 <= count <= 1000):
+        raise ParameterError(option, f"needs {low:g} <= START, STOP <= {high:g} and 1 <= N <= 1000 (got {text!r})")
+    return np.linspace(start, stop, count)
+
+
+def _passive(model, args) -> int:
+    """``--passive``: the chain's verdicts against the passive stiffness; the figure with ``--plot``."""
+    from ..reflex.design import passive_curve
+
+    curve = passive_curve(model, args.E, args.Lambda, _axis("--passive", args.passive, 0.0, 1e4))
+    if args.plot is not None:
+        from ..reflex.design_plots import passive_figure, write_figures
+
+        write_figures({"passive.png": passive_figure(curve)}, args.plot)
+    if args.json:
+        emit_json(curve.to_dict())
+    else:
+        print(curve.table())
+    return 0
+
+
+def _delays(model, args, kp, kd) -> int:
+    """``--delays``: the design curve against the delay (one per lag); the figure with ``--plot``."""
+    from ..reflex.design import delay_curve
+
+    curve = delay_curve(model, args.E, args.Lambda, _axis("--delays", args.delays, 0.0, 10.0), args.lags, kp, kd)
+    if args.plot is not None:
+        from ..reflex.design_plots import delay_figure, write_figures
+
+        write_figures({"design_curve.png": delay_figure(curve)}, args.plot)
+    if args.json:
+        emit_json(curve.to_dict())
+    else:
+        print(curve.table())
     return 0

@@ -653,3 +653,565 @@ def design(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None)
         method=method,
         model=provenance(model) | {"header": header(model)},
     )
+
+
+CRISCO_LOAD = 88.0
+"""The critical load of the ligamentous lumbar spine (L1 to the sacrum, no muscles) measured by Crisco et al.
+(1992) [N]; the load stood on L1, at the top of the modelled spine."""
+
+PAPER_PASSIVE = 15.0
+"""The paper's passive stiffness per joint [N m/rad] (Wagner et al. 2012), marked on the passive-stiffness curve."""
+
+THRESHOLD_TOLERANCE = 0.01
+"""Width of the bracket of the least passive stiffness at which global muscles alone suffice [N m/rad]."""
+
+
+def crisco_stiffness(model: Model, eccentricity: float, lordosis: float, load: float = CRISCO_LOAD) -> float:
+    """The passive stiffness per joint at which the chain without muscles buckles under ``load`` at the spine's top.
+
+    The passive chain (no muscles, no other weight) under a vertical load W on the top of the spine
+    (y = ``geometry.spine_length``, L1, where Crisco et al. 1992 loaded their specimens) has
+    K = K_g(W) - k I with the gravity stiffness K_g of docs/chain.md; it is statically stable
+    iff k I - K_g is positive definite, so it buckles at k = lambda_max(K_g(W)), the same k at
+    every joint (the physical convention).
+
+    Parameters
+    ----------
+    model : Model
+        Supplies the geometry and the gravity sign.
+    eccentricity, lordosis : float
+        E and Lambda [m].
+    load : float
+        W [N].
+
+    Returns
+    -------
+    float
+        [N m/rad] per joint.
+
+    References
+    ----------
+    Crisco JJ, Panjabi MM, Yamamoto I, Oxland TR (1992). Euler stability of the human ligamentous
+    lumbar spine. Part II: Experiment. Clin Biomech 7(1):27-32. doi:10.1016/0268-0033(92)90004-N.
+    """
+    loaded = passive_chain_model(model, load)
+    gravity = chain.chain_coefficients(loaded, float(eccentricity), float(lordosis)).gravity_stiffness
+    return float(np.linalg.eigvalsh(gravity)[-1])
+
+
+def passive_chain_model(model: Model, load: float = CRISCO_LOAD, stiffness: float = 0.0) -> Model:
+    """The model of Crisco's specimen: the load W on the spine's top, the levels weightless, passive stiffness k.
+
+    Parameters
+    ----------
+    model : Model
+    load : float
+        W [N].
+    stiffness : float
+        k per joint [N m/rad], physical convention.
+
+    Returns
+    -------
+    Model
+    """
+    from ..model import config
+
+    return config.set_parameters(
+        model,
+        {
+            "body.mass": load / model.body.gravity,
+            "body.mass_height": model.geometry.spine_length,
+            "levels.weight_in_gravity": 0.0,
+            "passive.stiffness": stiffness,
+            "passive.convention": "physical",
+        },
+    )
+
+
+@dataclass(frozen=True)
+class PassiveCurve:
+    """The chain's verdicts against the passive stiffness per joint, at one (E, Lambda).
+
+    Attributes
+    ----------
+    eccentricity, lordosis : float
+        E and Lambda [m].
+    passive_stiffness : numpy.ndarray, shape (m,)
+        K per joint [N m/rad] (``passive.stiffness``, physical convention).
+    global_pcsa : numpy.ndarray, shape (m,)
+        The least total global PCSA for the chain's static stability without local muscles,
+        problem (b) of docs/chain.md [m^2]; NaN where none can.
+    global_status : tuple of str
+    local_stiffness : numpy.ndarray, shape (m, n_cor)
+        The least local stiffness per joint at the fixed global PCSA ``paper_pcsa``, problem (a)
+        [N m/rad]; NaN without an optimum or a solution.
+    paper_pcsa : float
+        The global PCSA held fixed: the paper's (joint-by-joint) minimum at the model's own passive
+        stiffness [m^2], so that the curve shows the passive stiffness alone.
+    threshold : float
+        The least K at which global muscles alone stabilise the chain [N m/rad], by bisection on
+        the feasibility of (b) to :data:`THRESHOLD_TOLERANCE`; NaN if not in the scanned range.
+    crisco : float
+        The K at which the passive chain buckles under Crisco et al.'s 88 N (:func:`crisco_stiffness`) [N m/rad].
+    crisco_global_pcsa : float
+        The least global PCSA alone at K = ``crisco`` [m^2]; NaN if none.
+    model : dict
+        Provenance and header line.
+    """
+
+    eccentricity: float
+    lordosis: float
+    passive_stiffness: np.ndarray
+    global_pcsa: np.ndarray
+    global_status: tuple[str, ...]
+    local_stiffness: np.ndarray
+    paper_pcsa: float
+    threshold: float
+    crisco: float
+    crisco_global_pcsa: float
+    model: dict
+
+    def to_dict(self) -> dict:
+        """The document of ``spinectl design --passive ... --json``.
+
+        Returns
+        -------
+        dict
+            Provenance, ``criterion`` (the chain), ``E_m``, ``Lambda_m``, ``passive_stiffness_Nm_per_rad``,
+            ``global_pcsa_cm2``, ``global_status``, ``local_stiffness_Nm_per_rad`` (per point, per joint),
+            ``local_stiffness_total_Nm_per_rad``, ``local_at_global_pcsa_cm2``, ``global_alone_from_Nm_per_rad``,
+            ``crisco_stiffness_Nm_per_rad``, ``crisco_load_N``, ``crisco_global_pcsa_cm2``.
+        """
+        model = {k: v for k, v in self.model.items() if k != "header"}
+        return model | {
+            "criterion": criterion("chain", self.local_stiffness.shape[1]),
+            "E_m": self.eccentricity,
+            "Lambda_m": self.lordosis,
+            "passive_stiffness_Nm_per_rad": self.passive_stiffness.tolist(),
+            "global_pcsa_cm2": m2_to_cm2(self.global_pcsa).tolist(),
+            "global_status": list(self.global_status),
+            "local_stiffness_Nm_per_rad": self.local_stiffness.tolist(),
+            "local_stiffness_total_Nm_per_rad": self.local_stiffness.sum(axis=1).tolist(),
+            "local_at_global_pcsa_cm2": float(m2_to_cm2(self.paper_pcsa)),
+            "global_alone_from_Nm_per_rad": self.threshold,
+            "crisco_stiffness_Nm_per_rad": self.crisco,
+            "crisco_load_N": CRISCO_LOAD,
+            "crisco_global_pcsa_cm2": float(m2_to_cm2(self.crisco_global_pcsa)),
+        }
+
+    def table(self) -> str:
+        """The curve as rows, with the threshold and Crisco's stiffness.
+
+        Returns
+        -------
+        str
+            No final newline.
+        """
+        n = self.local_stiffness.shape[1]
+        lines = [
+            self.model.get("header", "preset unknown"),
+            f"{criterion('chain', n)}: static stability against the passive stiffness per joint, "
+            f"E = {self.eccentricity * 100:.2f} cm, Lambda = {self.lordosis * 100:.2f} cm",
+            f"least local stiffness at a fixed global PCSA of {_word(m2_to_cm2(self.paper_pcsa), 0, '.2f')} cm^2 "
+            "(the paper's minimum at the model's passive stiffness)",
+            f"{'K[N m/rad]':>10} {'global alone[cm2]':>17} {'sum local k[N m/rad]':>20}",
+        ]
+        lines += [
+            f"{k:10.2f} {_word(m2_to_cm2(g), 17, '.2f')} {_word(float(np.sum(loc)), 20, '.1f')}"
+            for k, g, loc in zip(self.passive_stiffness, self.global_pcsa, self.local_stiffness, strict=True)
+        ]
+        lines += [
+            f"global muscles alone stabilise the chain from K = {_word(self.threshold, 0, '.2f')} N m/rad per joint"
+            + ("" if np.isfinite(self.threshold) else " (not in the scanned range)"),
+            f"Crisco et al. 1992 ({CRISCO_LOAD:g} N buckles the passive chain): K = {self.crisco:.2f} N m/rad per "
+            f"joint; there global muscles alone need {_word(m2_to_cm2(self.crisco_global_pcsa), 0, '.2f')} cm^2",
+        ]
+        return "\n".join(lines)
+
+
+def passive_curve(model: Model, eccentricity: float, lordosis: float, stiffnesses) -> PassiveCurve:
+    """The least global PCSA and the least local stiffness for the chain against the passive stiffness.
+
+    Parameters
+    ----------
+    model : Model
+    eccentricity, lordosis : float
+        E and Lambda [m].
+    stiffnesses : array_like, shape (m,)
+        Passive stiffness per joint [N m/rad], >= 0 (physical convention).
+
+    Returns
+    -------
+    PassiveCurve
+
+    Raises
+    ------
+    ParameterError
+        A stiffness negative or not finite; E or Lambda out of range.
+    """
+    from ..errors import ParameterError
+    from ..model.source import header, provenance
+
+    ks = np.asarray(stiffnesses, float).ravel()
+    if ks.size == 0 or not np.all(np.isfinite(ks) & (ks >= 0)):
+        raise ParameterError("--passive", f"must be finite stiffnesses >= 0 N m/rad (got {ks.tolist()})")
+    e, lam = float(eccentricity), float(lordosis)
+    optimum = np.asarray(solve_point(model, e, lam).pcsa, float)
+    points = [_passive_point(model, e, lam, k, optimum) for k in ks]
+    feasible = np.array([np.isfinite(p[0]) for p in points])
+    threshold = _threshold(model, e, lam, ks, feasible)
+    crisco = crisco_stiffness(model, e, lam)
+    return PassiveCurve(
+        eccentricity=e,
+        lordosis=lam,
+        passive_stiffness=ks,
+        global_pcsa=np.array([p[0] for p in points]),
+        global_status=tuple(p[1] for p in points),
+        local_stiffness=np.array([p[2] for p in points]),
+        paper_pcsa=float(np.sum(optimum)),
+        threshold=threshold,
+        crisco=crisco,
+        crisco_global_pcsa=_global_alone(model, e, lam, crisco).total_pcsa,
+        model=provenance(model) | {"header": header(model)},
+    )
+
+
+def _physical(model: Model, k: float) -> Model:
+    """``model`` with passive stiffness k per joint, physical convention."""
+    from ..model import config
+
+    return config.set_parameters(model, {"passive.stiffness": float(k), "passive.convention": "physical"})
+
+
+def _global_alone(model: Model, e: float, lam: float, k: float):
+    """Problem (b) at passive stiffness k."""
+    from ..optimise.coupled.global_pcsa import min_global_pcsa
+
+    return min_global_pcsa(_physical(model, k), e, lam)
+
+
+def _passive_point(model: Model, e: float, lam: float, k: float, optimum: np.ndarray):
+    """(global PCSA alone [m^2], its status, least local stiffness at the global PCSA ``optimum`` [N m/rad])."""
+    from ..optimise.coupled.local import least_local_stiffness
+
+    alone = _global_alone(model, e, lam, k)
+    local = np.full(len(model.geometry.cor_names), np.nan)
+    if np.all(np.isfinite(optimum)):
+        local = least_local_stiffness(_physical(model, k), e, lam, optimum, given=False).local_stiffness
+    return alone.total_pcsa, alone.status, np.asarray(local, float)
+
+
+def _threshold(model: Model, e: float, lam: float, ks: np.ndarray, feasible: np.ndarray) -> float:
+    """The least K where (b) is feasible: bisection between the scan's last infeasible and first feasible K."""
+    order = np.argsort(ks)
+    ks, feasible = ks[order], feasible[order]
+    if not feasible.any():
+        return np.nan
+    i = int(np.argmax(feasible))
+    if i == 0:
+        return float(ks[0])
+    lo, hi = float(ks[i - 1]), float(ks[i])
+    while hi - lo > THRESHOLD_TOLERANCE:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (lo, mid) if np.isfinite(_global_alone(model, e, lam, mid).total_pcsa) else (mid, hi)
+    return hi
+
+
+REACTION_TIMES = (
+    (0.053, "healthy, agonists off (Radebold et al. 2000)"),
+    (0.070, "healthy, antagonists on; patients, agonists off"),
+)
+"""Trunk muscles' reaction times after a sudden load release [s], with labels: Radebold et al. (2000), 17 healthy
+subjects (shut-off of the agonists 53 ms, switch-on of the antagonists 70 ms) and 17 patients with chronic low back
+pain (shut-off 70 ms), averaged over trials and directions; doi:10.1097/00007632-200004150-00009."""
+
+
+@dataclass(frozen=True)
+class DesignCurve:
+    """The design question against the delay (and the lag), both criteria, at one (E, Lambda).
+
+    Leading dimensions (n_lags, n_delays); NaN where no design meets the delay.
+
+    Attributes
+    ----------
+    eccentricity, lordosis : float
+        E and Lambda [m].
+    delays : numpy.ndarray, shape (n_delays,)
+        tau, ascending [s].
+    lags : numpy.ndarray, shape (n_lags,)
+        T_a [s].
+    activation : numpy.ndarray
+        Joint by joint: the least activation for every segment at once [1].
+    segment_activation : numpy.ndarray, shape (n_lags, n_delays, n_cor)
+        Each segment's own least activation [1].
+    pcsa : numpy.ndarray
+        The total PCSA at ``activation`` [m^2].
+    chain_activation : float
+        The chain's global activation (``reflex.activation``) [1].
+    local_fraction : numpy.ndarray
+        The chain: the least local stiffness as a multiple f of k* [1].
+    local_stiffness : numpy.ndarray, shape (n_lags, n_delays, n_cor)
+        f k* per joint [N m/rad].
+    chain_margin : numpy.ndarray
+        The exact multivariable delay margin at the chain's design [s] (>= the delay: the certificate).
+    max_root_real : numpy.ndarray
+        Re of the rightmost characteristic root found at the delay from the poles' seeds [1/s]
+        (:func:`rightmost_root` with ``nodes`` = 0).
+    names : tuple of str
+    model : dict
+    """
+
+    eccentricity: float
+    lordosis: float
+    delays: np.ndarray
+    lags: np.ndarray
+    activation: np.ndarray
+    segment_activation: np.ndarray
+    pcsa: np.ndarray
+    chain_activation: float
+    local_fraction: np.ndarray
+    local_stiffness: np.ndarray
+    chain_margin: np.ndarray
+    max_root_real: np.ndarray
+    names: tuple[str, ...]
+    model: dict
+
+    def to_dict(self) -> dict:
+        """The document of ``spinectl design --delays ... --json``.
+
+        Returns
+        -------
+        dict
+            Provenance, ``E_m``, ``Lambda_m``, ``delays_s``, ``reaction_times_s``, and ``curves``: one per lag
+            with ``activation_time_constant_s``, ``joint`` (``criterion``, ``activation``, ``pcsa_cm2``,
+            ``segments``: name and activation per delay) and ``chain`` (``criterion``, ``activation``,
+            ``local_stiffness_fraction``, ``local_stiffness_Nm_per_rad``, ``local_stiffness_total_Nm_per_rad``,
+            ``delay_margin_s``, ``max_root_real_per_s``).
+        """
+        model = {k: v for k, v in self.model.items() if k != "header"}
+        n = len(self.names)
+        curves = []
+        for i, lag in enumerate(self.lags):
+            joint = {
+                "criterion": criterion("joint", n),
+                "activation": self.activation[i].tolist(),
+                "pcsa_cm2": m2_to_cm2(self.pcsa[i]).tolist(),
+                "segments": [
+                    {"name": name, "activation": self.segment_activation[i, :, k].tolist()}
+                    for k, name in enumerate(self.names)
+                ],
+            }
+            chain_part = {
+                "criterion": criterion("chain", n),
+                "activation": self.chain_activation,
+                "local_stiffness_fraction": self.local_fraction[i].tolist(),
+                "local_stiffness_Nm_per_rad": self.local_stiffness[i].tolist(),
+                "local_stiffness_total_Nm_per_rad": self.local_stiffness[i].sum(axis=1).tolist(),
+                "delay_margin_s": self.chain_margin[i].tolist(),
+                "max_root_real_per_s": self.max_root_real[i].tolist(),
+            }
+            curves.append({"activation_time_constant_s": float(lag), "joint": joint, "chain": chain_part})
+        return model | {
+            "E_m": self.eccentricity,
+            "Lambda_m": self.lordosis,
+            "delays_s": self.delays.tolist(),
+            "reaction_times_s": [{"delay_s": t, "label": label} for t, label in REACTION_TIMES],
+            "curves": curves,
+        }
+
+    def table(self) -> str:
+        """The curves as rows per lag: both criteria's required design per delay.
+
+        Returns
+        -------
+        str
+            No final newline.
+        """
+        n = len(self.names)
+        lines = [
+            self.model.get("header", "preset unknown"),
+            f"E = {self.eccentricity * 100:.2f} cm, Lambda = {self.lordosis * 100:.2f} cm; joint by joint: "
+            f"{criterion('joint', n)}; chain: {criterion('chain', n)} at activation {self.chain_activation:.4g}",
+        ]
+        for i, lag in enumerate(self.lags):
+            lines += [
+                "",
+                f"activation lag T_a = {lag * 1000:.4g} ms",
+                f"{'delay[ms]':>9} {'joint: activation':>17} {'PCSA[cm2]':>10} {'chain: sum k[N m/rad]':>21} "
+                f"{'x k*':>7} {'tau_m[ms]':>10}",
+            ]
+            lines += [
+                f"{d * 1000:9.4g} {_word(self.activation[i, j], 17, '.4f')} "
+                f"{_word(m2_to_cm2(self.pcsa[i, j]), 10, '.2f')} "
+                f"{_word(float(np.sum(self.local_stiffness[i, j])), 21, '.1f')} "
+                f"{_word(self.local_fraction[i, j], 7, '.4f')} {_word(self.chain_margin[i, j] * 1000, 10, '.4g')}"
+                for j, d in enumerate(self.delays)
+            ]
+        return "\n".join(lines)
+
+
+def delay_curve(model: Model, eccentricity: float, lordosis: float, delays, lags=None, kp=None, kd=None) -> DesignCurve:
+    """Both criteria's required design against the delay, for each lag: the design curve.
+
+    Joint by joint, each delay's least activations are bisected together (one vectorised margin call per
+    halving for all delays) in the brackets of the activation scan, whose margins do not depend on the
+    delay. The chain's least local stiffness is nondecreasing in the delay (a design that meets a delay
+    meets every shorter one), so each delay starts from the previous delay's answer: if that meets the
+    delay it is the answer; otherwise the bracket from it to the top of the search is bisected. The exact
+    delay margin at each fraction is computed once (it does not depend on the delay), and a root in the
+    right half-plane found from the poles' seeds rejects a fraction without it.
+
+    Parameters
+    ----------
+    model : Model
+    eccentricity, lordosis : float
+        E and Lambda [m].
+    delays : array_like, shape (n_delays,)
+        tau in [0, 10] s; sorted ascending in the result.
+    lags : array_like, optional
+        T_a values [s], >= 0; default: ``reflex.activation_time_constant``.
+    kp, kd : float, optional
+        Explicit gains [N m/rad], [N m s/rad].
+
+    Returns
+    -------
+    DesignCurve
+
+    Raises
+    ------
+    ParameterError
+        A delay or lag out of range; E or Lambda out of range.
+    """
+    from ..errors import ParameterError
+    from ..model import config
+    from ..model.source import header, provenance
+
+    ds = np.sort(np.asarray(delays, float).ravel())
+    if ds.size == 0 or not np.all(np.isfinite(ds) & (ds >= 0) & (ds <= 10)):
+        raise ParameterError("--delays", f"must be delays in [0, 10] s (got {np.asarray(delays).tolist()})")
+    lag_values = np.asarray([model.reflex.activation_time_constant] if lags is None else lags, float).ravel()
+    if lag_values.size == 0 or not np.all(np.isfinite(lag_values) & (lag_values >= 0) & (lag_values <= 10)):
+        raise ParameterError("--lags", f"must be lags in [0, 10] s (got {np.asarray(lags).tolist()})")
+    e, lam = float(eccentricity), float(lordosis)
+    coefficients = checked_coefficients(model, e, lam)
+    optimum = np.asarray(solve_point(model, e, lam).pcsa, float)
+    names = model.geometry.cor_names
+    rows = []
+    for lag in lag_values:
+        at = config.set_parameters(model, {"reflex.activation_time_constant": float(lag)})
+        rows.append(_curve_at_lag(at, e, lam, coefficients, optimum, ds, kp, kd))
+    stack = [np.array([r[i] for r in rows]) for i in range(6)]
+    activation, segment_activation, local_fraction, least, chain_margin, roots = stack
+    return DesignCurve(
+        eccentricity=e,
+        lordosis=lam,
+        delays=ds,
+        lags=lag_values,
+        activation=activation,
+        segment_activation=segment_activation,
+        pcsa=activation * np.sum(optimum),
+        chain_activation=model.reflex.activation,
+        local_fraction=local_fraction,
+        local_stiffness=local_fraction[..., None] * least,
+        chain_margin=chain_margin,
+        max_root_real=roots,
+        names=tuple(names),
+        model=provenance(model) | {"header": header(model)},
+    )
+
+
+def _curve_at_lag(model, e, lam, coefficients, optimum, delays, kp, kd):
+    """(activation, segment activations, chain fraction, k* per delay, chain margin, root) at the model's lag."""
+    n = len(model.geometry.cor_names)
+    if not np.all(np.isfinite(optimum)):
+        nan = np.full(delays.size, np.nan)
+        return nan, np.full((delays.size, n), np.nan), nan, np.full((delays.size, n), np.nan), nan, nan
+    with arithmetic_guard(e, lam):
+        common, each = _joint_curve(model, coefficients, optimum, delays, kp, kd)
+    fraction, least, margin, roots = _chain_curve(model, e, lam, model.reflex.activation * optimum, delays, kp, kd)
+    return common, each, fraction, np.broadcast_to(least, (delays.size, n)), margin, roots
+
+
+def _joint_curve(model, coefficients, optimum, delays, kp, kd):
+    """Joint by joint at every delay: the common least activation (n_delays,) and each segment's (n_delays, n)."""
+    scan = np.linspace(0.0, 1.0, SCAN)
+    margins = segment_margins_at(model, coefficients, optimum, scan, kp, kd)  # (SCAN, n)
+    n = margins.shape[1]
+    pick = [lambda m, k=k: m[:, k] for k in range(n)] + [lambda m: np.min(m, axis=1)]
+    answers = []
+    for value in pick:
+        ok = value(margins)[None, :] >= delays[:, None]  # (n_delays, SCAN)
+        first = np.argmax(ok, axis=1)
+        found = ok.any(axis=1)
+        hi = scan[first]
+        lo = np.where(first > 0, scan[np.maximum(first - 1, 0)], hi)
+        active = found & (first > 0)
+        for _ in range(BISECTIONS if active.any() else 0):
+            mid = 0.5 * (lo + hi)
+            meets = value(segment_margins_at(model, coefficients, optimum, mid, kp, kd)) >= delays
+            hi = np.where(active & meets, mid, hi)
+            lo = np.where(active & ~meets, mid, lo)
+        answers.append(np.where(found, hi, np.nan))
+    return answers[-1], np.stack(answers[:-1], axis=1)
+
+
+def _chain_curve(model, e, lam, pcsa, delays, kp, kd):
+    """The chain at every delay, warm-started: (fraction, k*, exact margin at it, rightmost root's Re) per delay."""
+    mass, stiffness, damping = chain_matrices(model, e, lam, pcsa)
+    _, least = least_local_stiffness_stacked(stiffness[None], model.optimisation.stability_margin)
+    least, lag = least[0], model.reflex.activation_time_constant
+    margins: dict[float, object] = {}
+    fails_from: dict[float, float] = {}  # f -> a delay at which f is unstable, so f fails every longer delay
+
+    def loop(f):
+        return chain_loop_at(model, mass, stiffness, damping, least, f, kp, kd)
+
+    def exact(f):
+        """The exact margin at f, once per f (it does not depend on the delay)."""
+        if f not in margins:
+            k, p, dd = loop(f)
+            if not (np.any(p) or np.any(dd)):
+                margins[f] = from_crossings(np.empty(0), np.empty(0), np.empty(0), chain.coupled_margin(k) > 0)
+            else:
+                margins[f] = chain_delay_margin(mass, k, damping, p, dd, lag)
+        return margins[f]
+
+    def met(f, d):
+        m = margins[f]
+        return bool(stable_at(m, d) and m.margin >= d)
+
+    def meets(f, d):
+        if f in fails_from and fails_from[f] <= d:
+            return False
+        if f not in margins:
+            k, p, dd = loop(f)
+            with arithmetic_guard(e, lam):
+                if d > 0 and rightmost_root(mass, k, damping, p, dd, d, lag).real >= 0:  # a true root: unstable
+                    fails_from[f] = d
+                    return False
+                exact(f)
+        return met(f, d)
+
+    top = 1.0 if model.reflex.gains == "rule" and kp is None and kd is None else LOCAL_MAX
+    width = top / 2**BISECTIONS  # the single design's precision
+    f, out = 0.0, []
+    for d in delays:
+        if np.isfinite(f) and not meets(f, d):
+            if not meets(top, d):
+                f = np.nan  # no design meets this delay, nor (by monotonicity) any longer one
+            else:  # bisect, the bracket first narrowed by every fraction already judged
+                lo = max([f] + [g for g, at in fails_from.items() if at <= d] + [g for g in margins if not met(g, d)])
+                hi = min([top] + [g for g in margins if g > lo and met(g, d)])
+                while hi - lo > width:
+                    mid = 0.5 * (lo + hi)
+                    lo, hi = (lo, mid) if meets(mid, d) else (mid, hi)
+                f = hi
+        if np.isnan(f):
+            out.append((np.nan, np.nan, np.nan))
+            continue
+        k, p, dd = loop(f)
+        with arithmetic_guard(e, lam):
+            root = rightmost_root(mass, k, damping, p, dd, d, lag)
+        out.append((f, float(exact(f).margin), float(root.real)))
+    fraction, margin, roots = (np.array(x) for x in zip(*out, strict=True))
+    return fraction, least, margin, roots

@@ -50,7 +50,8 @@ UNIT_TOLERANCE = 1e-9
 """A refined candidate is a crossing where some abs(z) is 1 to this (abs(log abs(z)))."""
 
 SQUARED_ACCURACY = 1e-4
-"""The squared problem is used where its relative error at the floor, eps rho^2 / w^2 (rho^2 its largest abs(s^2)), is below this."""
+"""The squared problem is used where its relative error at the floor, eps rho^2 / w^2 (rho^2 its largest
+abs(s^2)), is below this."""
 
 FLOOR = 1e-7
 """Crossings are sought above this fraction of :func:`highest_crossing` (w -> 0 is a root at s = 0 for every tau)."""
@@ -253,7 +254,7 @@ def _refine(moduli, w, target, steps: int = 12):
         nearest = values[np.argmin(np.abs(values - target))]
         return np.log(max(abs(nearest), 1e-300)), nearest
 
-    x0, (g0, v0) = w, g(w)
+    x0, (g0, _) = w, g(w)
     x1 = w * (1.0 + 1e-9)
     g1, v1 = g(x1)
     for _ in range(steps):

@@ -134,3 +134,13 @@ def test_without_opensim_the_export_says_what_to_install(tmp_path, monkeypatch, 
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "spinectl[opensim]" in err
     assert not out.exists()
+
+
+def test_an_unwritable_model_leaves_no_controls_behind(tmp_path, capsys):
+    """--out naming a folder: one line, exit 2, and neither the model nor its controls .sto is written (the
+    controls were written first and left behind before both went through one atomic step)."""
+    out = tmp_path / "taken.osim"
+    out.mkdir()
+    assert main(["export", "--format", "osim", "--E", "0.03", "--Lambda", "0.04", "--out", str(out)]) == 2
+    assert capsys.readouterr().err.count("\n") == 1
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["taken.osim"] and not any(out.iterdir())

@@ -140,3 +140,172 @@ def test_opensims_simulation_grows_at_the_rate_the_imported_chain_predicts(impor
         amplitude.append(abs(np.array([coords.get(n).getValue(s) for n in free.joints]) @ mode[:5]))
     fitted = np.polyfit(times, np.log(amplitude), 1)[0]
     assert rate > 0 and abs(fitted - rate) <= 0.05 * rate
+
+
+SLOPE = 0.5  # the test coupler: L1L2 = SLOPE * L2L3
+
+
+@pytest.fixture(scope="module")
+def coupled(imported, tmp_path_factory):
+    """spinectl's export with a CoordinateCouplerConstraint (built with OpenSim's API) tying L1L2 = 0.5 L2L3."""
+    path = tmp_path_factory.mktemp("coupled") / "coupled.osim"
+    built = osim.Model(str(imported[4]))
+    coupler = osim.CoordinateCouplerConstraint()
+    coupler.setName("rhythm_L1L2")
+    independent = osim.ArrayStr()
+    independent.append("L2L3")
+    coupler.setIndependentCoordinateNames(independent)
+    coupler.setDependentCoordinateName("L1L2")
+    coupler.setFunction(osim.LinearFunction(SLOPE, 0.0))
+    built.addConstraint(coupler)
+    built.finalizeConnections()
+    built.printToXML(str(path))
+    return path
+
+
+def test_couplers_are_off_in_the_free_chain_and_reduce_the_constrained_one(imported, coupled):
+    """With the coupler, the free chain is the uncoupled export's chain (to rounding), and the constrained chain is
+    T^T K T, T^T D T, T^T M T of it in closed form, T = dq/dq_ind: the identity on L5S1..L2L3 plus the row
+    L1L2 = 0.5 L2L3 (a linear function: no curvature term). The source line names the coupler and its slope."""
+    _, _, free0, _, _ = imported
+    loaded = anatomy.load(coupled)
+    free, constrained, _ = loaded.chains("sagittal")
+    a = np.full(free.n_controls, 0.3)
+    np.testing.assert_allclose(free.stiffness(a), free0.stiffness(a), rtol=1e-9, atol=1e-9)
+    T = np.zeros((5, 4))
+    T[:4, :4] = np.eye(4)
+    T[4, 3] = SLOPE  # the chain runs L5S1, L4L5, L3L4, L2L3, L1L2
+    assert free.joints[3:] == ("L2L3", "L1L2") and constrained.joints == free.joints[:4]
+    for ours, full in ((constrained.stiffness(a), free.stiffness(a)), (constrained.damping(a), free.damping(a))):
+        np.testing.assert_allclose(ours, T.T @ full @ T, rtol=1e-12, atol=1e-12 * np.max(np.abs(full)))
+    np.testing.assert_allclose(constrained.mass_matrix, T.T @ free.mass_matrix @ T, rtol=1e-12, atol=1e-15)
+    assert "rhythm_L1L2 (L1L2 on L2L3 slope 0.5)" in free.source
+
+
+def test_the_cli_names_the_couplers_with_their_slopes(coupled, capsys):
+    """`spinectl anatomy coupled.osim` prints the coupler, the coordinate it slaves and its slope, and the chain
+    constrained by it in the independent coordinates."""
+    assert main(["anatomy", str(coupled)]) == 0
+    out = capsys.readouterr().out
+    assert "rhythm_L1L2 (L1L2 on L2L3 slope 0.5)" in out and "(4 coordinate(s): L5S1, L4L5, L3L4, L2L3)" in out
+
+
+def test_the_coupled_coordinate_moves_in_opensim_as_the_reduction_says(imported, coupled):
+    """OpenSim's own simulation (Manager.integrate) of the coupled file, started with L2L3 moving: L1L2 follows
+    at the slope the import reads off the coupler's function (its T), to the integrator's accuracy."""
+    loaded = anatomy.load(coupled)
+    slope = loaded.linearise("sagittal")[1].transform[4, 3]
+    model = osim.Model(str(coupled))
+    state = model.initSystem()
+    coords = model.getCoordinateSet()
+    coords.get("L2L3").setSpeedValue(state, 0.1)
+    coords.get("L1L2").setSpeedValue(state, 0.1 * SLOPE)
+    manager = osim.Manager(model)
+    manager.setIntegratorAccuracy(1e-10)
+    manager.initialize(state)
+    state = manager.integrate(0.02)
+    moved = coords.get("L2L3").getValue(state)
+    assert abs(moved) > 1e-4
+    assert abs(coords.get("L1L2").getValue(state) - slope * moved) <= 1e-6 * abs(moved)
+
+
+@pytest.fixture(scope="module")
+def lowest_joint(imported, tmp_path_factory):
+    """The export mapped onto a chain of its lowest joint alone (L5S1; the others held): a posture its muscles
+    hold without the file's counter torques. The full chain's does not (test_upright_optimum_is_infeasible...)."""
+    mapping = tmp_path_factory.mktemp("lowest") / "lowest.toml"
+    mapping.write_text(
+        '[bodies]\npelvis = ["ground"]\nthorax = ["thorax"]\nvertebrae = ["vertebra_above_L2L3", '
+        '"vertebra_above_L3L4", "vertebra_above_L4L5", "vertebra_above_L5S1"]\n[planes]\nsagittal = ["L5S1"]\n'
+    )
+    return anatomy.load(imported[4], mapping)
+
+
+def test_optimum_on_opensims_chain_is_the_least_effort_and_stable(lowest_joint):
+    """`optimised` on an .osim: the classic optimum's cost equals SciPy's SLSQP on the same problem (min sum w a^2,
+    OpenSim's torques tau_per a + tau_0 = 0 on the chain, 0 <= a <= 1) to 1e-4; the chain optimum holds the
+    posture (net torque <= 1e-6 of the gravity torque), its free chain has -K >= mu, and it costs at least the
+    classic one."""
+    from scipy.optimize import minimize
+
+    from spinectl.anatomy.opensim_engine import optimised, volume_weights
+
+    result = optimised(lowest_joint, equilibrium="free", margin=1.0)
+    _, _, lin = lowest_joint.chains()
+    tau_per, tau_0 = lin.torque_per_muscle[:1], lin.torque_offset[:1]
+    w = volume_weights(lowest_joint)
+    ref = minimize(
+        lambda a: w @ a**2,
+        np.full(w.size, 0.01),
+        jac=lambda a: 2 * w * a,
+        method="SLSQP",
+        bounds=[(0, 1)] * w.size,
+        constraints={"type": "eq", "fun": lambda a: tau_per @ a + tau_0, "jac": lambda a: tau_per},
+        options={"ftol": 1e-14, "maxiter": 500},
+    )
+    assert ref.success and result.classic.ok and result.optimum.ok
+    assert abs(result.classic.cost - ref.fun) <= 1e-4 * ref.fun
+    assert np.max(np.abs(result.optimum.net_torque)) <= 1e-6 * np.max(np.abs(tau_0))
+    assert np.min(result.optimum.eigenvalues) >= 1.0 - 1e-4
+    assert result.optimum.cost >= result.classic.cost * (1 - 1e-6)
+
+
+def test_upright_optimum_is_infeasible_and_check_is_refused(imported, capsys):
+    """The upright export without its counter torques: no activations in [0, 1] hold it (SciPy's bounded least
+    squares leaves a residual > 1 N m), so `spinectl anatomy chain.osim --optimise` answers infeasible (exit 0);
+    `--check` (MuJoCo's referee) is one line, exit 2."""
+    from scipy.optimize import lsq_linear
+
+    _, _, _, lin, path = imported
+    fit = lsq_linear(lin.torque_per_muscle[:5], -lin.torque_offset[:5], bounds=(0, 1))
+    assert np.linalg.norm(lin.torque_per_muscle[:5] @ fit.x + lin.torque_offset[:5]) > 1.0
+    assert main(["anatomy", str(path), "--optimise", "--equilibrium", "free"]) == 0
+    assert "infeasible" in capsys.readouterr().out
+    assert main(["anatomy", str(path), "--check"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "MJCF" in err
+
+
+def test_schema_versions_older_are_reported_and_newer_refused(imported, tmp_path, capsys):
+    """The file's OpenSim schema (its Version attribute, OpenSim's getDocumentFileVersion): an older one is read
+    as OpenSim upgrades it, and the chain's source says so; one newer than this OpenSim's, or one OpenSim cannot
+    read, is one line, exit 2."""
+    text = imported[4].read_text()
+    current = osim.Model(str(imported[4])).getDocumentFileVersion()
+    assert f'Version="{current}"' in text
+    files = {}
+    for version in (current - 1, current + 10000, 20000):
+        files[version] = tmp_path / f"v{version}.osim"
+        files[version].write_text(text.replace(f'Version="{current}"', f'Version="{version}"', 1))
+    free, _, _ = anatomy.load(files[current - 1]).chains()
+    assert f"(schema {current - 1}, upgraded by OpenSim {osim.__version__} to {current})" in free.source
+    for version in (current + 10000, 20000):  # 20000: OpenSim's 2.x upgrade cannot read a 4.x document
+        assert main(["anatomy", str(files[version])]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and str(files[version].name) in err
+
+
+def test_a_wrap_touched_at_the_posture_is_named_and_refused(imported, tmp_path, capsys):
+    """A WrapCylinder (OpenSim's API) tangent to straight_ventral_0's path at the upright posture: the path wraps
+    on one side of L5S1 = 0 only (OpenSim's current path has 4 points there, 2 on the other), so its moment arm
+    has a kink at the posture. `spinectl anatomy` names the muscle, the wrap and the coordinate: one line, exit 2."""
+    built = osim.Model(str(imported[4]))
+    state = built.initSystem()
+    path = built.getMuscles().get(0).getGeometryPath()
+    points = path.getPathPointSet()
+    top, bottom = (np.array(points.get(k).getLocationInGround(state).to_numpy()) for k in range(2))
+    along = (bottom - top) / np.linalg.norm(bottom - top)
+    radius = 0.01
+    cylinder = osim.WrapCylinder()
+    cylinder.setName("belly")
+    cylinder.set_radius(radius)
+    cylinder.set_length(0.2)
+    cylinder.set_translation(osim.Vec3(*(0.5 * (top + bottom) + radius * np.array([-along[1], along[0], 0.0]))))
+    built.updGround().addWrapObject(cylinder)
+    path.addPathWrap(cylinder)
+    built.finalizeConnections()
+    out = tmp_path / "wrapped.osim"
+    built.printToXML(str(out))
+    assert main(["anatomy", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "straight_ventral_0" in err and "belly" in err and "L5S1" in err

@@ -335,12 +335,18 @@ def test_an_optimum_beyond_any_muscle_can_be_fed_back_to_pcsa(capsys):
 def test_k_1e308_is_answered(capsys):
     """docs/robustness.md, "extreme but harmless values": --K 1e308 gives a table, exit 0 (before: the
     discriminant D^2 + 4 theta S overflowed, a ModelError). S = -1e308 N m/rad at every CoR, printed as such
-    (not 309 digits); the eigenvalues are D / (2 theta) +- j sqrt(-S / theta) to rounding (closed form)."""
+    (not 309 digits); the eigenvalues are D / (2 theta) +- j sqrt(-S / theta) to rounding (closed form). Their
+    real part gives the segment's time constant 2 theta / |D|: "marginal" where it exceeds the threshold
+    (:data:`spinectl.model.stability.MARGINAL_TIME_CONSTANT`), "yes" below it."""
+    from spinectl.model.stability import MARGINAL_TIME_CONSTANT
+
     code, out, err = run(["stability", "--E", "0.03", "--Lambda", "0.04", "--K", "1e308"], capsys)
     assert code == 0 and err == ""
     row = out.splitlines()[5].split()  # L1L2: S, D, theta, lambda_1, lambda_2, stable, CT
-    assert row[0] == "L1L2" and row[1] == "-1.000e+308" and row[-2] == "yes"
-    theta, imag = float(row[3]), float(row[4].split("+", 1)[1].rstrip("j"))
+    damping, theta = float(row[2]), float(row[3])
+    expected = "marginal" if 2 * theta / abs(damping) > MARGINAL_TIME_CONSTANT else "yes"
+    assert row[0] == "L1L2" and row[1] == "-1.000e+308" and row[-2] == expected
+    imag = float(row[4].split("+", 1)[1].rstrip("j"))
     assert imag == pytest.approx((1e308 / theta) ** 0.5, rel=1e-3)  # theta as printed, to 4 decimals
     assert max(len(line) for line in out.splitlines()[4:10]) < 120  # the header and rows of the table
 

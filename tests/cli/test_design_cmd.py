@@ -37,3 +37,53 @@ def test_a_negative_or_absurd_delay_is_one_line_exit_2(delay, capsys):
     assert main(["design", f"--delay={delay}"]) == 2
     out, err = capsys.readouterr()
     assert out == "" and err.count("\n") == 1 and "delay" in err
+
+
+def test_passive_prints_the_curves_dict_and_plots_it(capsys, tmp_path):
+    """``--passive 30:40:2 --json --plot DIR`` prints PassiveCurve.to_dict() (strict JSON, the chain's criterion,
+    the computed Crisco stiffness) and writes passive.png, a PNG."""
+    from spinectl.reflex.design import passive_curve
+
+    argv = ["design", "--preset", "wagner2012", "--passive", "30:40:2", "--json", "--plot", str(tmp_path)]
+    assert main(argv) == 0
+    out = capsys.readouterr().out
+    expected = passive_curve(config.load_preset("wagner2012"), 0.0, 0.0, [30.0, 40.0]).to_dict()
+    assert out == jsondoc.dumps(expected)
+    doc = json.loads(out, parse_constant=lambda word: pytest.fail(f"{word} in strict JSON"))
+    assert doc["criterion"].startswith("chain") and doc["crisco_stiffness_Nm_per_rad"] > 0
+    assert (tmp_path / "passive.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.parametrize("argv", [["--passive", "0:80"], ["--passive", "-5:80:3"], ["--plot", "out"]])
+def test_a_bad_passive_axis_or_a_plot_without_it_is_one_line_exit_2(argv, capsys, tmp_path):
+    """Not START:STOP:N, a negative stiffness, or --plot without --passive: one line naming the option, exit 2."""
+    assert main(["design", *argv]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err.count("\n") == 1 and argv[0] in err
+
+
+def test_delays_prints_the_curves_dict_and_plots_it(capsys, tmp_path):
+    """``--delays 0:0.1:2 --lags 0,0.05 --json --plot DIR`` prints DesignCurve.to_dict() (strict JSON, both criteria
+    per lag, the reaction times marked) and writes design_curve.png, a PNG."""
+    from spinectl.reflex.design import delay_curve
+
+    argv = ["design", "--preset", "wagner2012", "--delays", "0:0.1:2", "--lags", "0,0.05", "--json"]
+    assert main([*argv, "--plot", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    expected = delay_curve(config.load_preset("wagner2012"), 0.0, 0.0, [0.0, 0.1], [0.0, 0.05]).to_dict()
+    assert out == jsondoc.dumps(expected)
+    doc = json.loads(out, parse_constant=lambda word: pytest.fail(f"{word} in strict JSON"))
+    assert [c["activation_time_constant_s"] for c in doc["curves"]] == [0.0, 0.05]
+    assert doc["curves"][0]["joint"]["criterion"].startswith("joint by joint")
+    assert doc["curves"][0]["chain"]["criterion"].startswith("chain") and doc["reaction_times_s"]
+    assert (tmp_path / "design_curve.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.parametrize(
+    "argv", [["--delays", "0:11:3"], ["--lags", "0.05"], ["--passive", "0:80:3", "--delays", "0:0.2:3"]]
+)
+def test_a_bad_delay_axis_or_a_lone_lags_is_one_line_exit_2(argv, capsys):
+    """Delays beyond 10 s, --lags without --delays, or two curves at once: one line naming the option, exit 2."""
+    assert main(["design", *argv]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err.count("\n") == 1 and argv[0] in err

@@ -122,7 +122,8 @@ class CoupledStability:
             ``overridden``, ``K_Nm_per_rad`` or ``K_per_s2``, ``K_convention``), ``E_m``, ``Lambda_m``,
             ``pcsa_source`` and
             ``coupled``: ``criterion`` (of its verdicts: the chain, all CoRs free,
-            :func:`spinectl.model.stability.criterion`), ``segments``, ``decision_variables``, ``pcsa_cm2`` (muscle -> cm^2),
+            :func:`spinectl.model.stability.criterion`), ``segments``, ``decision_variables``,
+            ``pcsa_cm2`` (muscle -> cm^2),
             ``stiffness_matrix_Nm_per_rad``, ``gravity_stiffness_matrix_Nm_per_rad``,
             ``stiffness_matrix_per_cm2`` (n_var x n_cor x n_cor, N m/rad per cm^2),
             ``damping_matrix_Nms_per_rad``, ``mass_matrix_kgm2``, ``local_stiffness_Nm_per_rad``

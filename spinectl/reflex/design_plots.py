@@ -1,0 +1,123 @@
+"""Figures of the design question: the chain's verdicts against the passive stiffness, the design curve.
+
+Compute and draw are separate: :func:`spinectl.reflex.design.passive_curve` and
+:func:`spinectl.reflex.design.delay_curve` compute, the figure functions here draw on new
+figures with the Agg canvas (:func:`spinectl.canvas.new_figure`) and write nothing, and
+:func:`write_figures` saves them atomically (:func:`spinectl.canvas.save_figures`).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from ..canvas import new_figure, save_figures
+from ..units import m2_to_cm2
+from .design import PAPER_PASSIVE, REACTION_TIMES, DesignCurve, PassiveCurve
+
+DPI = 110
+"""Resolution of the PNG files [dots per inch]."""
+
+
+def passive_figure(curve: PassiveCurve) -> Figure:
+    """The least global PCSA alone and the least local stiffness for the chain against the passive stiffness.
+
+    Marked: the least passive stiffness at which global muscles alone suffice, Crisco et al.'s
+    88 N buckling stiffness (computed, :func:`spinectl.reflex.design.crisco_stiffness`) and the
+    paper's 15 N m/rad.
+
+    Parameters
+    ----------
+    curve : PassiveCurve
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig = new_figure(figsize=(7.0, 6.0), layout="constrained")
+    top, bottom = fig.subplots(2, 1, sharex=True)
+    k = curve.passive_stiffness
+    top.plot(k, m2_to_cm2(curve.global_pcsa), "o-", ms=3, color="C0")
+    top.set_ylabel("least global PCSA alone [cm²]")
+    top.set_title("chain (all CoRs free): static stability without local muscles", fontsize=10)
+    bottom.plot(k, curve.local_stiffness.sum(axis=1), "o-", ms=3, color="C1")
+    bottom.set_ylabel("least local stiffness, sum [N m/rad]")
+    bottom.set_title(
+        f"least local stiffness at a fixed global PCSA of {m2_to_cm2(curve.paper_pcsa):.1f} cm²", fontsize=10
+    )
+    bottom.set_xlabel("passive stiffness per joint K [N m/rad]")
+    marks = [
+        (curve.crisco, "C3", f"Crisco et al. 1992: 88 N buckles, K = {curve.crisco:.1f}"),
+        (PAPER_PASSIVE, "0.5", f"the paper's K = {PAPER_PASSIVE:g}"),
+    ]
+    if np.isfinite(curve.threshold):
+        marks.append((curve.threshold, "C2", f"global alone suffice from K = {curve.threshold:.1f}"))
+    for ax in (top, bottom):
+        for x, colour, label in marks:
+            ax.axvline(x, color=colour, ls="--", lw=1, label=label)
+        ax.grid(alpha=0.3)
+    top.legend(fontsize=8, loc="upper right")
+    fig.suptitle(
+        f"{curve.model.get('header', '')}\nE = {curve.eccentricity * 100:.1f} cm, Λ = {curve.lordosis * 100:.1f} cm",
+        fontsize=9,
+    )
+    return fig
+
+
+def delay_figure(curve: DesignCurve) -> Figure:
+    """The design curve: required co-contraction (joint by joint) and local stiffness (chain) against the delay.
+
+    One line per lag T_a; the trunk muscles' reaction times of Radebold et al. (2000) marked
+    (:data:`spinectl.reflex.design.REACTION_TIMES`).
+
+    Parameters
+    ----------
+    curve : DesignCurve
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig = new_figure(figsize=(7.0, 6.5), layout="constrained")
+    top, bottom = fig.subplots(2, 1, sharex=True)
+    ms = curve.delays * 1000.0
+    for i, lag in enumerate(curve.lags):
+        label = f"T_a = {lag * 1000:.4g} ms"
+        top.plot(ms, curve.activation[i], "o-", ms=3, color=f"C{i}", label=label)
+        bottom.plot(ms, curve.local_stiffness[i].sum(axis=1), "o-", ms=3, color=f"C{i}", label=label)
+    top.set_ylabel("least activation [x minimum PCSA]")
+    top.set_title("joint by joint (each CoR alone, the others fixed): every segment's margin >= delay", fontsize=10)
+    bottom.set_ylabel("least local stiffness, sum [N m/rad]")
+    bottom.set_title(
+        f"chain (all CoRs free), global activation {curve.chain_activation:.3g}: stable at the delay", fontsize=10
+    )
+    bottom.set_xlabel("reflex delay [ms]")
+    for ax in (top, bottom):
+        for j, (t, text) in enumerate(REACTION_TIMES):
+            ax.axvline(t * 1000.0, color="0.4", ls=(0, (4, 2 + 2 * j)), lw=1, label=f"{t * 1000:.0f} ms: {text}")
+        ax.grid(alpha=0.3)
+        ax.set_ylim(bottom=0)
+    top.legend(fontsize=7, loc="upper left")
+    fig.suptitle(
+        f"{curve.model.get('header', '')}\nE = {curve.eccentricity * 100:.1f} cm, Λ = {curve.lordosis * 100:.1f} cm",
+        fontsize=9,
+    )
+    return fig
+
+
+def write_figures(figures: dict[str, Figure], folder: str | Path) -> list[Path]:
+    """Save the figures into ``folder``, all or none (:func:`spinectl.canvas.save_figures`) at :data:`DPI`.
+
+    Parameters
+    ----------
+    figures : dict of str to Figure
+        File name -> figure.
+    folder : str or Path
+
+    Returns
+    -------
+    list of Path
+    """
+    return save_figures(figures, folder, DPI)
