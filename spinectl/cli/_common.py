@@ -7,6 +7,8 @@ import math
 import os
 import sys
 
+import numpy as np
+
 from .. import jsondoc
 from .._validate import printable, show
 from ..atomic import atomic_write_text
@@ -14,6 +16,9 @@ from ..errors import ParameterError
 from ..model.config import DEFAULT_PRESET, PRESET_GUIDANCE, apply_overrides, load_config, set_parameters
 from ..model.params import Model
 from ..units import CM_PER_M, centimetre_slip, cm2_to_m2, square_metre_slip
+
+BOTH_LORDOSIS = "is not allowed with --Lambda (both give the lordosis): give one of them"
+"""The error of ``--lordosis-angle`` given with ``--Lambda`` (:func:`lordosis_option`, :func:`lordosis_grid`)."""
 
 
 def add_model_options(parser: argparse.ArgumentParser) -> None:
@@ -111,7 +116,9 @@ def body_aliases(args: argparse.Namespace) -> dict:
 
 
 def add_position_options(parser: argparse.ArgumentParser) -> None:
-    """``--E`` and ``--Lambda`` in metres.
+    """``--E`` and ``--Lambda`` in metres, or ``--lordosis-angle`` in degrees instead of ``--Lambda``.
+
+    :func:`check_position` turns the angle into ``args.Lambda`` (docs/atlas.md, "Clinical geometry").
 
     Parameters
     ----------
@@ -119,7 +126,129 @@ def add_position_options(parser: argparse.ArgumentParser) -> None:
         The sub-command's parser.
     """
     parser.add_argument("--E", type=finite_float("--E"), default=0.0, help="eccentricity E [m] (default 0)")
-    parser.add_argument("--Lambda", type=finite_float("--Lambda"), default=0.0, help="lordosis Lambda [m] (default 0)")
+    # not an argparse exclusive group: check_position's one-line error says which to give
+    parser.add_argument("--Lambda", type=finite_float("--Lambda"), help="lordosis Lambda [m] (default 0)")
+    parser.add_argument(
+        "--lordosis-angle",
+        type=finite_float("--lordosis-angle"),
+        metavar="DEG",
+        help="lordosis as the angle between the spine line's end tangents [deg], instead of --Lambda "
+        "(theta = 2 atan(2 phi'(0) Lambda / L); docs/atlas.md)",
+    )
+
+
+def lordosis_option(model: Model, angle: float | None, lordosis: float | None, option: str = "--lordosis-angle"):
+    """Lambda [m] from ``--Lambda`` or ``--lordosis-angle`` (exactly one or neither; neither: 0).
+
+    Parameters
+    ----------
+    model : Model
+        Its spine length and end conditions convert the angle (:func:`spinectl.model.clinical.lordosis_from_angle`).
+    angle : float or numpy.ndarray or None
+        The lordosis angle [deg] as given (an array: a grid axis), or None.
+    lordosis : float or None
+        Lambda [m] as given, or None.
+    option : str, optional
+        The angle's option, as named in errors.
+
+    Returns
+    -------
+    float or numpy.ndarray
+        Lambda [m], the shape of ``angle`` if given.
+
+    Raises
+    ------
+    ParameterError
+        Both given, or an angle not within (-180, 180) deg, or clamped ends (no angle to convert).
+    """
+    from ..model.clinical import lordosis_from_angle
+
+    if angle is None:
+        return 0.0 if lordosis is None else lordosis
+    if lordosis is not None:
+        raise ParameterError(option, BOTH_LORDOSIS)
+    try:
+        lordosis = lordosis_from_angle(angle, model)
+    except ParameterError as exc:
+        raise ParameterError(option, exc.message) from None
+    return float(lordosis) if np.ndim(lordosis) == 0 else lordosis
+
+
+def lordosis_grid(model: Model, spec: str | None, angle_spec: str | None, default: str):
+    """The Lambda axis [m] of a grid from ``--Lambda START:STOP:NUM`` [m] or ``--lordosis-angle START:STOP:NUM`` [deg].
+
+    The angle's axis is even in degrees, so its Lambda is not (Lambda = L tan(theta / 2) / (2 phi'(0)),
+    :func:`spinectl.model.clinical.lordosis_from_angle`).
+
+    Parameters
+    ----------
+    model : Model
+        Its geometry gives the range and converts the angle.
+    spec : str or None
+        ``--Lambda`` as typed, or None.
+    angle_spec : str or None
+        ``--lordosis-angle`` as typed, or None.
+    default : str
+        The ``--Lambda`` axis [m] when neither is given.
+
+    Returns
+    -------
+    numpy.ndarray, shape (num,)
+        Lambda [m].
+
+    Raises
+    ------
+    ParameterError
+        Both given, a malformed spec, or an axis beyond the modelled range (the angle's in degrees).
+    """
+    from ..landscape.sweep import parse_grid
+
+    bounds = model.geometry.lordosis_range
+    if angle_spec is None:
+        return parse_grid(default if spec is None else spec, "--Lambda", bounds)
+    if spec is not None:
+        raise ParameterError("--lordosis-angle", BOTH_LORDOSIS)
+    try:
+        angles = parse_grid(angle_spec, "--lordosis-angle")
+    except ParameterError as exc:
+        message = exc.message.replace("in metres, e.g. 0:0.08:81", "in degrees, e.g. 20:80:61")
+        raise ParameterError(exc.field, message) from None
+    axis = lordosis_option(model, angles, None)
+    low, high = bounds
+    if not (np.all(axis >= low) and np.all(axis <= high)):
+        from ..model.clinical import lordosis_angle
+
+        a_low, a_high = lordosis_angle([low, high], model)
+        raise ParameterError(
+            "--lordosis-angle",
+            f"must be within [{a_low:.6g}, {a_high:.6g}] deg, the modelled range of Lambda (got {angle_spec!r})",
+        )
+    return axis
+
+
+def with_lordosis_angle(payload: dict, model: Model) -> dict:
+    """``payload`` with ``lordosis_angle_deg`` [deg] just after its ``Lambda_m`` (:mod:`spinectl.model.clinical`).
+
+    Parameters
+    ----------
+    payload : dict
+        A command's JSON document; unchanged if it has no ``Lambda_m``.
+    model : Model
+        Converts Lambda to the angle.
+
+    Returns
+    -------
+    dict
+        A new dict, keys in the same order.
+    """
+    from ..model.clinical import lordosis_angle
+
+    out = {}
+    for key, value in payload.items():
+        out[key] = value
+        if key == "Lambda_m" and value is not None:
+            out["lordosis_angle_deg"] = float(lordosis_angle(value, model))
+    return out
 
 
 def add_dpi_option(parser: argparse.ArgumentParser) -> None:
@@ -136,7 +265,7 @@ def add_dpi_option(parser: argparse.ArgumentParser) -> None:
 
 
 def check_position(model: Model, args: argparse.Namespace) -> None:
-    """``--E`` and ``--Lambda`` within the model's range, or an error naming the option and a cm slip.
+    """``--E`` and ``--Lambda`` (or ``--lordosis-angle``, set into ``args.Lambda``) within the model's range.
 
     The library refuses them too (:mod:`spinectl.model.checks`), but names its argument; the
     command line says which option, and ``--E 3`` gets "if you meant 3 cm, give 0.03".
@@ -146,17 +275,28 @@ def check_position(model: Model, args: argparse.Namespace) -> None:
     model : Model
         Its ``geometry`` gives the ranges [m].
     args : argparse.Namespace
-        With ``E`` and ``Lambda`` [m] (:func:`add_position_options`).
+        With ``E`` and ``Lambda`` [m] and possibly ``lordosis_angle`` [deg] (:func:`add_position_options`);
+        ``args.Lambda`` becomes the Lambda [m] to analyse.
 
     Raises
     ------
     ParameterError
-        A value out of range, naming ``--E`` or ``--Lambda``.
+        A value out of range, naming ``--E``, ``--Lambda`` or ``--lordosis-angle`` (its range in degrees).
     """
+    angle = getattr(args, "lordosis_angle", None)
+    args.Lambda = lordosis_option(model, angle, args.Lambda)
     for option, value, (low, high) in (
         ("--E", args.E, model.geometry.eccentricity_range),
         ("--Lambda", args.Lambda, model.geometry.lordosis_range),
     ):
+        if angle is not None and option == "--Lambda" and not low <= value <= high:
+            from ..model.clinical import lordosis_angle
+
+            a_low, a_high = lordosis_angle([low, high], model)
+            raise ParameterError(
+                "--lordosis-angle",
+                f"must be in [{a_low:.6g}, {a_high:.6g}] deg, the modelled range of Lambda (got {angle:g})",
+            )
         if not low <= value <= high:
             hint = centimetre_slip(value, low, high, f"{value:g}", f"{value / CM_PER_M:g}")
             raise ParameterError(option, f"must be in [{low:g}, {high:g}] m, the modelled range (got {value:g}){hint}")

@@ -10,6 +10,7 @@ from ._common import (
     finite_float,
     float_list,
     load_model,
+    with_lordosis_angle,
 )
 
 
@@ -113,7 +114,7 @@ def run(args) -> int:
         return _delays(model, args, kp, kd)
     result = design(model, args.E, args.Lambda, kp=kp, kd=kd)
     if args.json:
-        emit_json(result.to_dict())
+        emit_json(with_lordosis_angle(result.to_dict(), model))
     else:
         print(result.table())
     return 0

@@ -17,6 +17,7 @@ from ._common import (
     emit_json,
     finite_float,
     load_model,
+    with_lordosis_angle,
 )
 
 
@@ -113,7 +114,7 @@ def run(args) -> int:
         if skipped:
             print(f"spinectl: note: not written (nothing to draw): {', '.join(skipped)}", file=sys.stderr)
     if args.json:
-        emit_json(report.to_dict())
+        emit_json(with_lordosis_angle(report.to_dict(), model))
     else:
         print(report.table())
     return 0
@@ -127,7 +128,7 @@ def _coupled(model, args) -> int:
 
     result = coupled_margins(model, args.E, args.Lambda, kp=args.kp, kd=args.kd)
     if args.json:
-        emit_json(result.to_dict(model))
+        emit_json(with_lordosis_angle(result.to_dict(model), model))
     else:
         print(result.table(model))
     return 0

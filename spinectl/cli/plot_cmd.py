@@ -58,6 +58,12 @@ def _options(parser) -> None:
     extra.add_argument(
         "--ratio", action="store_true", help="also the minimum PCSA at K > 0 over K = 0 (the paper's halving)"
     )
+    parser.add_argument(
+        "--lordosis-axis",
+        choices=figures.LORDOSIS_AXES,
+        default="lambda",
+        help="the landscapes' lordosis axis: Lambda [cm] or the lordosis angle [deg] (docs/atlas.md)",
+    )
     extra.add_argument(
         "--insets", action="store_true", help="the model drawn at the grid's corners around Figures 3 and S1"
     )
@@ -103,5 +109,6 @@ def _draw_figures(args):
         shared_scale=args.shared_scale,
         ratio=args.ratio,
         insets=args.insets,
+        lordosis_axis=args.lordosis_axis,
     )
     return figures.draw_figures(netcdf.load(args.results), args.out, options=options)

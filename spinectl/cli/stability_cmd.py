@@ -14,6 +14,7 @@ from ._common import (
     load_model,
     note_pcsa_slip,
     pcsa_option,
+    with_lordosis_angle,
 )
 
 
@@ -86,7 +87,7 @@ def run(args) -> int:
         raise NoStabilisingActivation(str(exc).replace("(argument pcsa, [m^2])", "with --pcsa [cm2]")) from None
     source = "given" if given else "min_pcsa"
     if args.json:
-        emit_json(result.to_dict(model, pcsa_source=source))
+        emit_json(with_lordosis_angle(result.to_dict(model, pcsa_source=source), model))
     else:
         print(result.table(model, pcsa_source=source))
     note_pcsa_slip(args.pcsa)

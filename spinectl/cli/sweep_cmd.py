@@ -6,7 +6,15 @@ import sys
 import time
 
 from ..atomic import check_distinct
-from ._common import add_mass_option, add_model_options, body_aliases, float_list, load_model, refuse_set_twice
+from ._common import (
+    add_mass_option,
+    add_model_options,
+    body_aliases,
+    float_list,
+    load_model,
+    lordosis_grid,
+    refuse_set_twice,
+)
 
 DEFAULT_AXIS = "0:0.08:81"
 """The paper's grid: 0 to 8 cm in 1 mm steps (paper, Methods)."""
@@ -35,7 +43,13 @@ def _options(parser) -> None:
     from ..landscape import sweep
 
     parser.add_argument("--E", default=DEFAULT_AXIS, metavar="START:STOP:NUM", help="eccentricity axis [m]")
-    parser.add_argument("--Lambda", default=DEFAULT_AXIS, metavar="START:STOP:NUM", help="lordosis axis [m]")
+    parser.add_argument("--Lambda", metavar="START:STOP:NUM", help=f"lordosis axis [m] (default {DEFAULT_AXIS})")
+    parser.add_argument(
+        "--lordosis-angle",
+        metavar="START:STOP:NUM",
+        help="lordosis axis as the angle between the spine line's end tangents [deg], instead of --Lambda "
+        "(even in degrees; docs/atlas.md)",
+    )
     parser.add_argument(
         "--K",
         type=float_list("--K"),
@@ -75,7 +89,7 @@ def run(args) -> int:
     model = load_model(args, body_aliases(args))
     geometry = model.geometry
     e_axis = sweep.parse_grid(args.E, "--E", geometry.eccentricity_range)
-    l_axis = sweep.parse_grid(args.Lambda, "--Lambda", geometry.lordosis_range)
+    l_axis = lordosis_grid(model, args.Lambda, args.lordosis_angle, DEFAULT_AXIS)
     options = {"stiffnesses": args.K, "method": args.method, "chunk_size": args.chunk_size, "coupled": args.coupled}
     options["notify"] = lambda line: print(line, file=sys.stderr)
     start = time.perf_counter()

@@ -12,6 +12,7 @@ import pytest
 
 from spinectl import jsondoc, optimise
 from spinectl.cli import main
+from spinectl.cli._common import with_lordosis_angle
 from spinectl.model import config
 from spinectl.model.stability import segment_stability
 
@@ -29,13 +30,13 @@ def test_stability_table(capsys):
 
 
 def test_stability_prints_the_results_dict_and_table(capsys):
-    """``--json`` prints :meth:`StabilityResult.to_dict`, the table :meth:`StabilityResult.table`
-    (their schema and values: tests/model/test_stability.py)."""
+    """``--json`` prints :meth:`StabilityResult.to_dict` (and ``lordosis_angle_deg``), the table
+    :meth:`StabilityResult.table` (their schema and values: tests/model/test_stability.py)."""
     argv = ["stability", "--E", "0.03", "--Lambda", "0.04", "--pcsa", "10,10,10", "--K", "15"]
     model = config.set_parameter(config.load_preset(config.DEFAULT_PRESET), "passive.stiffness", 15.0)
     result = segment_stability(model, 0.03, 0.04, [10e-4, 10e-4, 10e-4])
     code, out, _ = run([*argv, "--json"], capsys)
-    assert code == 0 and out == jsondoc.dumps(result.to_dict(model))
+    assert code == 0 and out == jsondoc.dumps(with_lordosis_angle(result.to_dict(model), model))
     code, out, _ = run(argv, capsys)
     assert code == 0 and out == result.table(model) + "\n"
 

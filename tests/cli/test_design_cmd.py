@@ -8,6 +8,7 @@ import pytest
 
 from spinectl import jsondoc
 from spinectl.cli import main
+from spinectl.cli._common import with_lordosis_angle
 from spinectl.model import config
 from spinectl.reflex.design import design
 
@@ -15,13 +16,14 @@ KEYS = ("activation", "segments", "chain", "delay_s", "activation_time_constant_
 
 
 def test_json_is_the_designs_dict_with_the_keys_for_scripts(capsys):
-    """``--json`` prints Design.to_dict(): the keys scripts read, strict JSON (no NaN), each segment's and the
+    """``--json`` prints Design.to_dict() with ``lordosis_angle_deg`` beside ``Lambda_m``:
+    the keys scripts read, strict JSON (no NaN), each segment's and the
     chain's answer with its criterion."""
     argv = ["design", "--preset", "wagner2012", "--delay", "0.04", "--E", "0.03", "--Lambda", "0.04", "--json"]
     assert main(argv) == 0
     out = capsys.readouterr().out
     model = config.set_parameters(config.load_preset("wagner2012"), {"reflex.delay": 0.04})
-    assert out == jsondoc.dumps(design(model, 0.03, 0.04).to_dict())
+    assert out == jsondoc.dumps(with_lordosis_angle(design(model, 0.03, 0.04).to_dict(), model))
     doc = json.loads(out, parse_constant=lambda word: pytest.fail(f"{word} in strict JSON"))
     assert all(key in doc for key in KEYS) and doc["delay_s"] == 0.04
     assert all({"name", "activation", "pcsa_cm2", "delay_margin_s"} <= set(s) for s in doc["segments"])

@@ -8,6 +8,7 @@ import pytest
 
 from spinectl import jsondoc
 from spinectl.cli import main
+from spinectl.cli._common import with_lordosis_angle
 from spinectl.model import config
 from spinectl.reflex.chain_verdict import margins_with_chain
 
@@ -39,13 +40,14 @@ def _model(**reflex):
 
 
 def test_json_is_the_reports_dict(capsys):
-    """``--json`` prints :meth:`MarginsReport.to_dict` (its schema and values: tests/reflex/test_margins.py)."""
+    """``--json`` prints :meth:`MarginsReport.to_dict` with ``lordosis_angle_deg`` beside ``Lambda_m``
+    (its schema and values: tests/reflex/test_margins.py)."""
     code, out, _ = run(
         ["margins", "--preset", "default", "--delay", "0.1", "--activation", "0", "--pade-order", "3", "--json"], capsys
     )
     assert code == 0
     report = margins_with_chain(_model(delay=0.1, activation=0.0, pade_order=3), 0.0, 0.0)
-    assert out == jsondoc.dumps(report.to_dict())
+    assert out == jsondoc.dumps(with_lordosis_angle(report.to_dict(), _model(delay=0.1, activation=0.0, pade_order=3)))
     doc = json.loads(out)
     assert doc["delay_s"] == 0.1 and doc["optimum_status"] == "skipped"
     assert all(all(key in seg for key in REQUIRED) for seg in doc["segments"])

@@ -8,18 +8,20 @@ import numpy as np
 
 from spinectl import jsondoc
 from spinectl.cli import main
+from spinectl.cli._common import with_lordosis_angle
 from spinectl.model import config
 from spinectl.optimise.coupled import coupled_stability_at
 
 
 def test_coupled_json_is_the_results_dict(capsys):
-    """--coupled --json prints CoupledStability.to_dict of the library call (values: tests/optimise)."""
+    """--coupled --json prints CoupledStability.to_dict of the library call, with
+    ``lordosis_angle_deg`` (values: tests/optimise)."""
     argv = ["stability", "--coupled", "--E", "0.03", "--Lambda", "0.04", "--preset", "wagner2012", "--json"]
     assert main(argv) == 0
     printed = json.loads(capsys.readouterr().out)
     model = config.load_preset("wagner2012")
     expected = coupled_stability_at(model, 0.03, 0.04).to_dict(model, pcsa_source="min_pcsa")
-    assert printed == json.loads(jsondoc.dumps(expected))
+    assert printed == json.loads(jsondoc.dumps(with_lordosis_angle(expected, model)))
     assert printed["coupled"]["self_stable"] is False and printed["coupled"]["stable_with_local"] is True
 
 

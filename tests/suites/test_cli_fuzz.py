@@ -28,7 +28,19 @@ CONFIG_FILES = {
 }
 """Files in the fuzzing folder; on_cor.toml puts an attachment on L5S1 at E = Lambda = 0."""
 
-OPTIONS = ["--E", "--Lambda", "--pcsa", "--K", "--json", "--config", "--preset", "--help", "-h", "--version"]
+OPTIONS = [
+    "--E",
+    "--Lambda",
+    "--lordosis-angle",
+    "--pcsa",
+    "--K",
+    "--json",
+    "--config",
+    "--preset",
+    "--help",
+    "-h",
+    "--version",
+]
 WORDS = ["stability", "config", "show", "presets", "default", "--", "-", "=", *CONFIG_FILES]
 PREFIXES = [[], ["stability"], ["stability", "--pcsa", "10,10,10"], ["config", "show"], ["config", "presets"]]
 
@@ -58,6 +70,7 @@ pcsa_lists = st.lists(st.floats(0, 100).map(repr), min_size=3, max_size=3).map("
 values = {
     "--E": mostly(st.floats(-0.12, 0.12).map(repr)),
     "--Lambda": mostly(st.floats(-0.12, 0.12).map(repr)),
+    "--lordosis-angle": mostly(st.floats(-200, 200).map(repr)),
     "--K": mostly(st.floats(0, 100).map(repr)),
     "--pcsa": mostly(pcsa_lists, st.lists(number_texts, max_size=7).map(",".join)),
     "--config": st.one_of(st.sampled_from(sorted(CONFIG_FILES)), st.text(max_size=8)),
@@ -215,8 +228,19 @@ def test_random_arguments_to_the_analysis_commands_never_raise(analysis_folder, 
         ["sweep", "--out", "out.nc", "--E", "0:0.0625:1", "--Lambda", "0:0.0625:1", "--K", "1.3407807929942597e+154"],
         # equilibrated stability rows (docs/robustness.md): a subnormal singular value of the polishing's KKT
         # system made 1/sigma overflow, "overflow encountered in divide" (optimise/polish.py).
-        ["sweep", "--out", "out.nc", "--E", "0.03125:0.0625:1", "--Lambda", "0.0:0.0625:1", "--K", "127.0",
-         "--config", "on_cor.toml"],
+        [
+            "sweep",
+            "--out",
+            "out.nc",
+            "--E",
+            "0.03125:0.0625:1",
+            "--Lambda",
+            "0.0:0.0625:1",
+            "--K",
+            "127.0",
+            "--config",
+            "on_cor.toml",
+        ],
         # a delay of 3.5e62 s: python-control's poles raised LinAlgError (now beyond spinectl.model.params.MAX_DELAY).
         ["margins", "--delay", "3.524191256302076e+62"],
     ],

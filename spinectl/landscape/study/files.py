@@ -27,6 +27,8 @@ from .. import sweep
 from .spec import GRID, Axis, Sampled, Samples, Study, grid_axis
 
 SECTIONS = ("study", "model", "axes", "samples")
+ANGLE_AXIS = "lordosis_angle_deg"
+"""The lordosis grid axis as an angle [deg], instead of ``axes.Lambda`` [m] (docs/atlas.md)."""
 """The sections of a study file."""
 
 STUDY_KEYS = ("preset", "config", "outputs", "chunk_size", "description")
@@ -110,14 +112,14 @@ def parse_study(text: str, base_dir: str | Path = ".", source: str = "study", ov
     check_keys(head, STUDY_KEYS, "study")
     axes = flatten(data.get("axes", {}), "axes", lambda x: any(k in x for k in RANGE_KEYS))
     for name in GRID:
-        if name not in axes:
+        if name not in axes and not (name == "Lambda" and ANGLE_AXIS in axes):
             raise ParameterError(f"axes.{name}", "is required: a list of values or { start, stop, num } [m]")
     options = {k: head[k] for k in ("outputs", "chunk_size", "description") if k in head}
     model = config.apply_overrides(_base_model(head, data.get("model"), Path(base_dir)), overrides)
     return Study(
         model=model,
         eccentricity=_grid_axis("E", axes.pop("E"), model.geometry.eccentricity_range),
-        lordosis=_grid_axis("Lambda", axes.pop("Lambda"), model.geometry.lordosis_range),
+        lordosis=_lordosis_axis(axes, model),
         axes=tuple(Axis(name, _axis_values(quoted_key("axes", name), value)) for name, value in axes.items()),
         samples=_samples(data["samples"]) if "samples" in data else None,
         text=text,
@@ -144,6 +146,36 @@ def _grid_axis(name: str, written, bounds) -> tuple[float, ...]:
     """A grid axis, refused beyond ``bounds`` [m] as written in the file: its range or its values, not a point."""
     values = grid_axis(name, _axis_values(f"axes.{name}", written))
     check_axis_range(f"axes.{name}", values, bounds, _toml_axis(written), _toml_axis(written, CM_PER_M))
+    return values
+
+
+def _lordosis_axis(axes: dict, model) -> tuple[float, ...]:
+    """``axes.Lambda`` [m], or ``axes.lordosis_angle_deg`` [deg] converted to Lambda (popped from ``axes``).
+
+    The angle is the one between the spine line's end tangents, Lambda = L tan(theta / 2) / (2 phi'(0))
+    (:func:`spinectl.model.clinical.lordosis_from_angle`; docs/atlas.md): evenly spaced in degrees, so not in Lambda.
+    """
+    from ...model.clinical import lordosis_angle, lordosis_from_angle
+
+    bounds = model.geometry.lordosis_range
+    if ANGLE_AXIS not in axes:
+        return _grid_axis("Lambda", axes.pop("Lambda"), bounds)
+    where = f"axes.{ANGLE_AXIS}"
+    if "Lambda" in axes:
+        raise ParameterError(where, "and axes.Lambda both give the lordosis: give one of them")
+    written = axes.pop(ANGLE_AXIS)
+    angles = np.array(grid_axis(ANGLE_AXIS, _axis_values(where, written)))
+    try:
+        values = tuple(lordosis_from_angle(angles, model).tolist())
+    except ParameterError as exc:
+        raise ParameterError(where, exc.message) from None
+    low, high = bounds
+    if min(values) < low or max(values) > high:
+        a_low, a_high = lordosis_angle([low, high], model)
+        raise ParameterError(
+            where,
+            f"must be within [{a_low:.6g}, {a_high:.6g}] deg, the modelled range of Lambda (got {_toml_axis(written)})",
+        )
     return values
 
 

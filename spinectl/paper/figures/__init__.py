@@ -51,7 +51,7 @@ from .landscape import grid_marks, landscape_figure
 from .min_pcsa import INSET_FIGURE_SIZE, min_pcsa_figure
 from .pareto import pareto_figure
 from .ratios import COUPLED_VARIABLE, HALVING, RATIO_MARKS, coupled_ratio, coupled_ratio_figure, ratio_figure
-from .sets import FigureOptions, draw_figures, figure_set
+from .sets import LORDOSIS_AXES, FigureOptions, angle_ticks, draw_figures, figure_set
 from .style import (
     COLOUR_BAR,
     EQUAL_ASPECT,
@@ -83,6 +83,8 @@ __all__ = [
     "RATIO_MARKS",
     "TITLE_CHARS",
     "FigureOptions",
+    "LORDOSIS_AXES",
+    "angle_ticks",
     "check_dpi",
     "counter_torque_figure",
     "coupled_ratio",

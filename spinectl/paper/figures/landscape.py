@@ -34,11 +34,15 @@ _TOLERANCE = 1e-9
 """[m] A position on a grid's edge counts as inside."""
 
 
+LAMBDA_LABEL = "lordosis Λ [cm]"
+"""The y label of every landscape, which ``FigureOptions(lordosis_axis='angle')`` ticks in degrees."""
+
+
 def _axes(title: str, fig=None, spec=None):
     fig = fig or new_figure(figsize=FIGURE_SIZE, layout="constrained")
     ax = fig.add_subplot(spec) if spec is not None else fig.add_subplot()
     ax.set_xlabel("eccentricity E [cm]")
-    ax.set_ylabel("lordosis Λ [cm]")
+    ax.set_ylabel(LAMBDA_LABEL)
     ax.set_title(_wrap(title, TITLE_CHARS[spec is not None]), fontsize=9)  # wider, it crowded the top tick label
     return fig, ax
 

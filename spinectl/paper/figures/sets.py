@@ -19,8 +19,12 @@ from ...errors import ParameterError
 from ...landscape import netcdf
 from .counter_torque import counter_torque_figure
 from .files import DPI, FORMATS, check_dpi, coupled_ratio_name, figure_names, ratio_name
+from .landscape import LAMBDA_LABEL
 from .min_pcsa import min_pcsa_figure
 from .ratios import COUPLED_VARIABLE, coupled_ratio_figure, ratio_figure
+
+LORDOSIS_AXES = ("lambda", "angle")
+"""The lordosis axis of the landscapes: Lambda [cm], or the lordosis angle [deg] (:class:`FigureOptions`)."""
 
 
 @dataclass(frozen=True)
@@ -41,6 +45,9 @@ class FigureOptions:
         Also the map of minimum PCSA at K > 0 over K = 0 (the paper's "halving").
     insets : bool
         The model drawn at the grid's four corners around Figure 3 and S1.
+    lordosis_axis : {'lambda', 'angle'}
+        The lordosis axis in cm of Lambda, or ticked in degrees of the lordosis angle
+        (:func:`spinectl.model.clinical.lordosis_angle`, with the dataset's model; docs/atlas.md).
     """
 
     format: str = "png"
@@ -50,8 +57,13 @@ class FigureOptions:
     shared_scale: bool = False
     ratio: bool = False
     insets: bool = False
+    lordosis_axis: str = "lambda"
 
     def __post_init__(self):
+        if self.lordosis_axis not in LORDOSIS_AXES:
+            raise ParameterError(
+                "--lordosis-axis", f"must be one of {', '.join(LORDOSIS_AXES)} (got {self.lordosis_axis!r})"
+            )
         if self.format not in FORMATS:
             raise ParameterError("--format", f"must be one of {', '.join(FORMATS)} (got {self.format!r})")
         check_dpi(self.dpi)
@@ -117,7 +129,44 @@ def figure_set(
             drawn[coupled_ratio_name(float(part["K"]), options.format)] = coupled_ratio_figure(part)
     for k in stiffnesses:
         drawn[ratio_name(k, options.format)] = ratio_figure(dataset, k)
+    if options.lordosis_axis == "angle":
+        model = netcdf.model_of(dataset)
+        for fig in drawn.values():
+            angle_ticks(fig, model)
     return drawn
+
+
+def angle_ticks(fig: Figure, model, step: float = 10.0) -> None:
+    """Tick the lordosis axes of ``fig`` (y label :data:`LAMBDA_LABEL`) in degrees of the lordosis angle.
+
+    The data stay in cm of Lambda; the ticks sit at the Lambda of whole multiples of ``step`` degrees,
+    Lambda = L tan(theta / 2) / (2 phi'(0)) (:func:`spinectl.model.clinical.lordosis_from_angle`).
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        Changed in place; axes with another y label are left alone.
+    model : Model
+        Its spine length and end conditions convert.
+    step : float
+        Degrees between ticks.
+
+    Raises
+    ------
+    ParameterError
+        Clamped end conditions, which have no angle (field ``geometry.spline_bc``).
+    """
+    from ...model.clinical import lordosis_angle, lordosis_from_angle
+
+    for ax in fig.axes:
+        if ax.get_ylabel() != LAMBDA_LABEL:
+            continue
+        low, high = sorted(ax.get_ylim())
+        theta = lordosis_angle(np.array([low, high]) / 100.0, model)  # cm -> m
+        ticks = np.arange(np.ceil(theta[0] / step), np.floor(theta[1] / step) + 1) * step
+        ax.set_yticks(100.0 * lordosis_from_angle(ticks, model), [f"{t:g}" for t in ticks])
+        ax.set_ylim(low, high)
+        ax.set_ylabel("lordosis angle θ [deg]")
 
 
 def draw_figures(
