@@ -280,7 +280,8 @@ def _crossings(mass, stiffness, damping, kp, kd, lag):
         return _inverse_eigenvalues(p, q)[0]
 
     found = []
-    for w in candidates[np.r_[True, np.diff(candidates) > 1e-9 * candidates[1:]]]:
+    distinct = candidates[np.r_[True, np.diff(candidates) > 1e-9 * candidates[1:]]] if candidates.size else candidates
+    for w in distinct:
         values = moduli(w)
         for v in values[np.abs(np.abs(values) - 1.0) < 0.05]:  # near the circle (0 where a joint has no reflex)
             hit = _refine(moduli, w, v)

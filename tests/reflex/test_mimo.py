@@ -248,3 +248,12 @@ def test_a_tiny_lag_keeps_every_crossing_of_the_lagless_loop():
     assert len(tiny.crossovers) == len(none.crossovers) == 3
     np.testing.assert_allclose(tiny.crossovers, none.crossovers, rtol=1e-5)
     np.testing.assert_allclose(tiny.margin, none.margin, rtol=1e-5)
+
+
+def test_a_loop_without_reflex_has_no_crossing_and_is_delay_independent():
+    """One joint, M = 1 kg m^2, K = -10 N m/rad, D = -1 N m s/rad, no reflex (kp = kd = 0): the delayed term
+    vanishes, so the characteristic equation s^2 + s + 10 = 0 has no root on the imaginary axis (closed form:
+    both roots have real part -1/2) and no delay can destabilise it. Louisell's problem then has no candidate
+    crossing at all (before: an empty candidate list raised an IndexError)."""
+    result = chain_delay_margin(np.array([[1.0]]), np.array([[-10.0]]), np.array([[-1.0]]), np.zeros(1), np.zeros(1))
+    assert result.status == "delay_independent" and result.margin == np.inf
