@@ -307,7 +307,7 @@ def expand_pcsa(model: Model, pcsa, *, given: bool = True) -> np.ndarray:
     -------
     numpy.ndarray, shape (..., 2 n)
         PCSA of each muscle [m^2], in the order of
-        :attr:`~spinectl.model.params.Model.muscle_names`.
+        :attr:`~spinectl.model.params.model.Model.muscle_names`.
 
     Raises
     ------
