@@ -51,12 +51,12 @@ def chunks(model, points: int):
 @contextlib.contextmanager
 def reference_forms():
     """The companion matrix and the bisection in place of the closed form and Newton's method."""
-    cubic, inverse = delay._cubic_roots, pade.pade_inverse_lag
-    delay._cubic_roots, pade.pade_inverse_lag = delay._cubic_roots_companion, pade._inverse_lag_bisection
+    cubic, inverse = delay.frequencies._cubic_roots, pade.pade_inverse_lag
+    delay.frequencies._cubic_roots, pade.pade_inverse_lag = delay._cubic_roots_companion, pade._inverse_lag_bisection
     try:
         yield
     finally:
-        delay._cubic_roots, pade.pade_inverse_lag = cubic, inverse
+        delay.frequencies._cubic_roots, pade.pade_inverse_lag = cubic, inverse
 
 
 def interleaved(new, old, repeats: int):

@@ -282,8 +282,8 @@ API means m^2 (``pcsa=[10, 10, 10]``)."""
 
 MAX_PCSA = 1e100
 """Largest PCSA of one muscle [m^2] that any analysis takes, given or computed: its force (at most 1e7 N/m^2,
-:data:`spinectl.model.params.SPECIFIC_TENSION_RANGE`) on a lever of at most 1 m
-(:data:`spinectl.model.params.MAX_BODY_LENGTH`) is a torque of at most 1e107 N m, whose sums and squares
+:data:`spinectl.model.params.bounds.SPECIFIC_TENSION_RANGE`) on a lever of at most 1 m
+(:data:`spinectl.model.params.bounds.MAX_BODY_LENGTH`) is a torque of at most 1e107 N m, whose sums and squares
 (‖CT‖) stay far from overflow. Far beyond any optimum a valid model has; a larger value is no PCSA."""
 
 
@@ -307,7 +307,7 @@ def expand_pcsa(model: Model, pcsa, *, given: bool = True) -> np.ndarray:
     -------
     numpy.ndarray, shape (..., 2 n)
         PCSA of each muscle [m^2], in the order of
-        :attr:`~spinectl.model.params.Model.muscle_names`.
+        :attr:`~spinectl.model.params.model.Model.muscle_names`.
 
     Raises
     ------

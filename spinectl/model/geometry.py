@@ -160,7 +160,7 @@ def all_fibres(model: Model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         Upper (moving) and lower (fixed) attachment points [m].
     share : numpy.ndarray, shape (n_fibres_total, n_muscles)
         share[f, j] = 1 / n_fibres(j) if fibre f belongs to muscle j, else 0 [1].
-        Muscles are ordered as :attr:`~spinectl.model.params.Model.muscle_names`.
+        Muscles are ordered as :attr:`~spinectl.model.params.model.Model.muscle_names`.
     """
     uppers, lowers, shares = [], [], []
     n_muscles = 2 * len(model.muscles)
@@ -191,6 +191,6 @@ def pairing_matrix(n_pairs: int) -> np.ndarray:
     -------
     numpy.ndarray, shape (2 n_pairs, n_pairs)
         P[2 j + side, j] = 1, else 0 [1]; rows in the order of
-        :attr:`~spinectl.model.params.Model.muscle_names`.
+        :attr:`~spinectl.model.params.model.Model.muscle_names`.
     """
     return np.repeat(np.eye(n_pairs), 2, axis=0)

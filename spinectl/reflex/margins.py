@@ -51,7 +51,7 @@ class OperatingPoint:
     stiffness, damping, inertia : numpy.ndarray, shape (n_cor,)
         S [N m/rad], D [N m s/rad], theta [kg m^2] per segment.
     muscle_names : tuple of str
-        The muscle of each entry of ``pcsa`` (:attr:`spinectl.model.params.Model.muscle_names`).
+        The muscle of each entry of ``pcsa`` (:attr:`spinectl.model.params.model.Model.muscle_names`).
     """
 
     eccentricity: float
@@ -297,11 +297,12 @@ class MarginsReport:
     delay : float
         Reflex delay tau [s].
     activation_time_constant : float
-        T_a [s] of the force generation after the delay (:attr:`spinectl.model.params.Reflex.activation_time_constant`).
+        T_a [s] of the force generation after the delay
+        (:attr:`spinectl.model.params.reflex.Reflex.activation_time_constant`).
     pade_order : int
     segments : tuple of SegmentMargins
     gains : str
-        How the gains were chosen: 'rule' or 'explicit' (:attr:`spinectl.model.params.Reflex.gains`),
+        How the gains were chosen: 'rule' or 'explicit' (:attr:`spinectl.model.params.reflex.Reflex.gains`),
         'explicit' when both were given to :func:`analyse`, e.g. 'explicit kp, rule kd' when one was.
     model : dict
         The model's :func:`~spinectl.model.source.provenance` and its :func:`~spinectl.model.source.header`

@@ -176,7 +176,7 @@ def _inverse_lag_newton(target, roots):
 
 def _inverse_lag_bisection(phase, order: int):
     """:func:`pade_inverse_lag` by a vectorised bisection on u = (2/pi) atan(y) in [0, 1), where the lag is
-    monotone, :data:`~spinectl.reflex.delay.BISECTIONS` halvings: the form Newton's method replaced, kept as
+    monotone, :data:`~spinectl.reflex.delay.critical.BISECTIONS` halvings: the form Newton's method replaced, kept as
     the reference of its tests and of ``benchmarks/bench_reflex.py``."""
     phase = np.asarray(phase, float)
     reached = phase < order * np.pi

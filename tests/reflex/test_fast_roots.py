@@ -310,7 +310,7 @@ def reference_paths(monkeypatch):
     """Switch the reflex functions to the companion matrix and the bisection."""
 
     def use():
-        monkeypatch.setattr(delay, "_cubic_roots", delay._cubic_roots_companion)
+        monkeypatch.setattr(delay.frequencies, "_cubic_roots", delay._cubic_roots_companion)
         monkeypatch.setattr(pade, "pade_inverse_lag", pade._inverse_lag_bisection)
 
     return use
