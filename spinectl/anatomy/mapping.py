@@ -70,7 +70,7 @@ def read_mapping(path: str | Path) -> Mapping:
     """
     path = Path(path)
     try:
-        doc = tomllib.loads(path.read_text())
+        doc = tomllib.loads(path.read_text(encoding="utf-8"))
     except (OSError, tomllib.TOMLDecodeError) as exc:
         raise ConfigError("mapping", f"cannot read {path}: {exc}") from None
     bodies, planes, stiff = doc.get("bodies", {}), doc.get("planes", {}), doc.get("joint_stiffness", {})
