@@ -27,6 +27,8 @@ SLOW = {
     "study": "starts a local Dask cluster; tests/suites/test_examples.py runs examples/study.toml in-process",
     "calibrate": "about a minute; tests/paper/test_calibration.py runs a short fit",
     "explore": "serves until interrupted; tests/explore/test_browser.py serves it and drives it in Chromium",
+    "design": "tens of seconds for the chain's certified design; tests/cli/test_design_cmd.py runs it",
+    "atlas": "thousands of model evaluations; tests/cli/test_atlas_cmd.py runs a small prior file",
 }
 """README commands not run here (too long, or a server), and where they are tested."""
 
