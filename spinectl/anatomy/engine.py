@@ -236,7 +236,8 @@ def load_engine(model: str | Path, cache: bool = True) -> Engine:
         return _compile(spec, builtin, text, source, hashlib.sha256(spec.to_xml().encode()).hexdigest(), key)
     path = Path(text)
     if not path.is_file():
-        raise ParameterError("model", f"must be one of {BUILTIN} or an MJCF file (got {text!r})")
+        what = "no such MJCF file" if path.suffix.lower() in (".xml", ".mjcf") else "not an MJCF file"
+        raise ParameterError("model", f"must be one of {BUILTIN} or an MJCF file ({what}: {text!r})")
 
     def factory():
         try:

@@ -372,9 +372,18 @@ class OptimisedResult:
                 f"eigenvalues of -K (free chain) {eig} N m/rad"
             )
         lines.append(f"price of stability (cost ratio): {self.price:.4g}")
+        if not np.isfinite(self.optimum.cost):
+            lines.append(INFEASIBLE_HINT)
         if self.analysis is not None:
             lines += ["", "at the optimum's activations:", self.analysis.table()]
         return "\n".join(lines)
+
+
+INFEASIBLE_HINT = (
+    "no activations in [0, 1] meet the criterion: the model's joints have no stiffness of their own; "
+    "--joint-stiffness mapped or a value in N m/rad adds it (docs/anatomy.md, 'The optimum')"
+)
+"""What an infeasible stability-constrained optimum's table adds: what would make it feasible."""
 
 
 def optimised(

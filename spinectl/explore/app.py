@@ -187,7 +187,8 @@ def chain_html(numbers: PointNumbers) -> str:
     head = "".join(f"<th>{h}</th>" for h in CHAIN_HEADERS)
     cells = "".join(f'<td data-chain="{key}">{html.escape(row[key])}</td>' for key in CHAIN_KEYS)
     words = html.escape(row["criterion"])
-    caption = f'<caption data-chain="criterion">{words}, the same reflex at every joint</caption>'
+    rule = "the same reflex rule at every joint (gains from each joint's own stiffness)"
+    caption = f'<caption data-chain="criterion">{words}, {rule}</caption>'
     return f'<table class="spinectl-chain">{caption}<tr>{head}</tr><tr>{cells}</tr></table>'
 
 

@@ -103,7 +103,8 @@ class ChainVerdict:
         where = f" at {exact.frequency:.4g} rad/s" if np.isfinite(exact.frequency) else ""
         word = "stable" if self.stable_at_delay else "NOT stable"
         lines = [
-            f"{self.criterion}, the same reflex at every joint: {word} at the delay {self.delay * 1000:.4g} ms "
+            f"{self.criterion}, the same reflex rule at every joint (gains from each joint's own stiffness): "
+            f"{word} at the delay {self.delay * 1000:.4g} ms "
             f"(exact delay margin {margin}{where})",
             "  without reflex: " + self.modes.summary().split(": ", 1)[1],
         ]

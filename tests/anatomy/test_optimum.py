@@ -127,3 +127,15 @@ def test_the_delay_margin_at_the_optimum_is_a_root_on_the_imaginary_axis(torso):
     ) * np.exp(-s * tau)
     sv = np.linalg.svd(matrix, compute_uv=False)
     assert sv[-1] / sv[0] < 1e-6
+
+
+def test_an_infeasible_chain_optimum_says_what_would_make_it_feasible(torso):
+    """MyoTorso's joints have no stiffness of their own (docs/anatomy.md, "The stiffness added"): with none added,
+    no activation stabilises the free chain (the global muscles leave a mode unstable, test_linearise.py), so the
+    chain optimum is infeasible and its table points to --joint-stiffness; at 50 N m/rad added it is feasible and
+    the hint is gone."""
+    from spinectl.anatomy.optimum import INFEASIBLE_HINT
+
+    bare = optimised(torso, stability="chain")
+    assert bare.optimum.status == "infeasible" and INFEASIBLE_HINT in bare.table()
+    assert INFEASIBLE_HINT not in optimised(torso, stability="chain", joint_stiffness=50).table()

@@ -316,7 +316,8 @@ def test_the_table_gives_the_chains_verdict_beside_the_segments():
     assert "<caption>joint by joint (each CoR alone, the others fixed; the paper&#x27;s criterion)</caption>" in table
     assert "<th>stable at τ, joint by joint</th>" in table
     row = expected.chain_row()
-    assert '<caption data-chain="criterion">chain (all 5 CoRs free), the same reflex at every joint</caption>' in table
+    rule = "the same reflex rule at every joint (gains from each joint's own stiffness)"
+    assert f'<caption data-chain="criterion">chain (all 5 CoRs free), {rule}</caption>' in table
     for key in app.CHAIN_KEYS:
         assert f'<td data-chain="{key}">{row[key]}</td>' in table
     assert row["stable_at_delay"] == "no"  # at the README's point the chain is not (docs/chain.md), the segments are
