@@ -443,7 +443,7 @@ class AnatomyResult:
             "mass_matrix_kgm2": free.mass.tolist(),
             "joint_stiffness_Nm_per_rad": self.joint_stiffness_added.tolist(),
             "joint_stiffness_source": self.stiffness_source,
-            "diagonal_stiffness_Nm_per_rad": free.joint_stiffness.tolist(),
+            "restoring_stiffness_Nm_per_rad": free.joint_stiffness.tolist(),
             "eigenvalues": free.eigenvalues.tolist(),
             "modes": free.modes.T.tolist(),
             "dynamic_eigenvalues": cplx(free.dynamic_eigenvalues),

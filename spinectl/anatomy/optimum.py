@@ -282,7 +282,7 @@ def _optimum_dict(anatomy: Anatomy, opt: Optimum) -> dict:
         "cost": opt.cost,
         "activation_sum": float(np.sum(opt.activations)),
         "eigenvalues": opt.eigenvalues.tolist(),
-        "diagonal_stiffness_Nm_per_rad": opt.joint_stiffness.tolist(),
+        "restoring_stiffness_Nm_per_rad": opt.joint_stiffness.tolist(),
         "net_torque_Nm": opt.net_torque.tolist(),
         "lumbar_torque_Nm": opt.lumbar_torque.tolist(),
     }
