@@ -119,7 +119,7 @@ class AtlasResult:
         return "\n".join(lines)
 
     def to_dict(self) -> dict:
-        """The JSON answer: the base model's provenance, n_evaluations, probabilities, sobol, sobol_verdicts, nonfinite, criteria.
+        """The JSON answer: the model's provenance, n_evaluations, probabilities, sobol(_verdicts), nonfinite, criteria.
 
         Returns
         -------

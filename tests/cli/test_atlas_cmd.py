@@ -58,7 +58,7 @@ def test_an_out_that_is_a_file_is_one_line_exit_2(tmp_path, capsys):
 
 
 def test_json_names_the_default_preset(tmp_path, capsys):
-    """Without --preset, --config or a model key the atlas starts from DEFAULT_PRESET, named as every command names it."""
+    """No --preset, --config or model key: the atlas starts from DEFAULT_PRESET, named as every command names it."""
     from spinectl import DEFAULT_PRESET
 
     assert main(["atlas", str(_file(tmp_path)), "--out", str(tmp_path / "out"), "--json"]) == 0
@@ -92,7 +92,9 @@ def test_preset_default_and_the_default_differ_as_stability_says(tmp_path, capsy
         assert main(["atlas", str(_file(tmp_path)), "--out", str(out), "--json", *extra]) == 0
         capsys.readouterr()
         with np.load(out / "draws.npz") as draws:
-            e, lam, mass, pcsa = (float(draws[k][0]) for k in ("eccentricity_m", "lordosis_m", "body.mass", "min_pcsa_cm2"))
+            e, lam, mass, pcsa = (
+                float(draws[k][0]) for k in ("eccentricity_m", "lordosis_m", "body.mass", "min_pcsa_cm2")
+            )
         point = ["stability", "--E", str(e), "--Lambda", str(lam), "--set", f"body.mass={mass!r}", "--json", *extra]
         assert main(point) == 0
         reading = json.loads(capsys.readouterr().out)
