@@ -29,6 +29,8 @@ from ..model import chain
 from ..model.checks import arithmetic_guard, checked_coefficients
 from ..model.clinical import lordosis_angle, lordosis_from_angle
 from ..model.config import set_parameters
+from ..model.params import Model
+from ..model.source import header, provenance
 from ..optimise import active_set
 from ..optimise.problem import OK_STATUSES, problem_data
 from ..reflex.inputs import guarded
@@ -84,6 +86,8 @@ class AtlasResult:
         {output: number of draws where it is NaN or infinite}.
     draws : dict of str to numpy.ndarray
         Every draw's parameters and outputs, shape (n_evaluations,).
+    model : Model or None
+        The base model (the parameters no prior varies), named in :meth:`table` and :meth:`to_dict`.
     """
 
     n_evaluations: int
@@ -92,6 +96,7 @@ class AtlasResult:
     sobol_verdicts: dict
     nonfinite: dict
     draws: dict = dataclasses.field(repr=False, compare=False)
+    model: Model | None = dataclasses.field(default=None, repr=False, compare=False)
 
     def table(self) -> str:
         """The verdicts' probabilities and the largest total-order index of each output, as text.
@@ -99,9 +104,10 @@ class AtlasResult:
         Returns
         -------
         str
-            One line per verdict and per output.
+            The base model's :func:`~spinectl.model.source.header` line, then one line per verdict and per output.
         """
-        lines = [f"{self.n_evaluations} evaluations"]
+        lines = [header(self.model)] if self.model is not None else []
+        lines.append(f"{self.n_evaluations} evaluations")
         for name, v in self.probabilities.items():
             lines.append(f"P({name}) = {v['p']:.3f}  [{v['low']:.3f}, {v['high']:.3f}]  ({VERDICTS[name]})")
         for output, table in self.sobol.items():
@@ -113,14 +119,16 @@ class AtlasResult:
         return "\n".join(lines)
 
     def to_dict(self) -> dict:
-        """The JSON answer: n_evaluations, probabilities, sobol, sobol_verdicts, nonfinite, criteria.
+        """The JSON answer: the model's provenance, n_evaluations, probabilities, sobol(_verdicts), nonfinite, criteria.
 
         Returns
         -------
         dict
-            Plain floats and strings.
+            Plain floats and strings; ``preset``, ``config``, ``config_sha256``, ``overridden``, K and its
+            convention as every command's (:func:`~spinectl.model.source.provenance`).
         """
-        return {
+        named = provenance(self.model) if self.model is not None else {}
+        return named | {
             "n_evaluations": self.n_evaluations,
             "probabilities": self.probabilities,
             "sobol": self.sobol,
@@ -442,7 +450,7 @@ def analyse(spec: AtlasSpec, values: dict, outputs: dict) -> AtlasResult:
     sobol = {o: sobol_indices(spec, outputs[o]) for o in names}
     by_verdict = {name: sobol_indices(spec, v.astype(float)) for name, v in found.items()}
     nonfinite = {o: int(np.sum(~np.isfinite(outputs[o]))) for o in names}
-    return AtlasResult(n, probabilities, sobol, by_verdict, nonfinite, values | outputs)
+    return AtlasResult(n, probabilities, sobol, by_verdict, nonfinite, values | outputs, spec.model)
 
 
 def fingerprint(spec: AtlasSpec) -> str:
@@ -462,7 +470,15 @@ def fingerprint(spec: AtlasSpec) -> str:
     return hashlib.sha256(repr((spec, __version__)).encode()).hexdigest()[:16]
 
 
-def atlas_file(path, out, *, lordosis_angle: float | None = None, progress: bool | None = None) -> AtlasResult:
+def atlas_file(
+    path,
+    out,
+    *,
+    lordosis_angle: float | None = None,
+    model: Model | None = None,
+    assignments=(),
+    progress: bool | None = None,
+) -> AtlasResult:
     """The atlas of an atlas file (``spinectl atlas``), the lordosis optionally fixed as an angle.
 
     Parameters
@@ -474,6 +490,11 @@ def atlas_file(path, out, *, lordosis_angle: float | None = None, progress: bool
     lordosis_angle : float, optional
         The lordosis angle [deg] where no prior varies the lordosis
         (:func:`spinectl.model.clinical.lordosis_from_angle`).
+    model : Model, optional
+        The base model (``--preset``, ``--config``), instead of the file's ``[atlas] model``; neither:
+        the preset :data:`~spinectl.model.config.DEFAULT_PRESET`.
+    assignments : sequence of str
+        ``SECTION.FIELD=VALUE`` over the base model (``--set``).
     progress : bool or None
         As for :func:`run_atlas`.
 
@@ -491,7 +512,7 @@ def atlas_file(path, out, *, lordosis_angle: float | None = None, progress: bool
     from ..errors import ParameterError
     from .priors import load_atlas
 
-    spec = load_atlas(path)
+    spec = load_atlas(path, model=model, assignments=assignments)
     if lordosis_angle is not None:
         if {"lordosis_angle_deg", "lordosis_m"} & set(spec.names):
             raise ParameterError("--lordosis-angle", "a prior varies the lordosis already")

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..canvas import new_figure
+from ..model.source import header
 from .priors import VERDICTS, AtlasSpec
 
 
@@ -23,6 +24,8 @@ def report_text(result, spec: AtlasSpec) -> str:
     """
     lines = [
         "# Population stability atlas",
+        "",
+        f"Model: {header(spec.model)} (the parameters no prior varies).",
         "",
         f"{result.n_evaluations} model evaluations: Saltelli's design on a scrambled Sobol' sequence "
         f"(N = {spec.samples}, seed {spec.seed}); probabilities over the 2 N = {2 * spec.samples} draws of "

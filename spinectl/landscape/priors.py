@@ -17,7 +17,7 @@ import numpy as np
 
 from ..errors import ConfigError, ParameterError
 from ..model import _toml
-from ..model.config import load_model_spec
+from ..model.config import DEFAULT_PRESET, apply_overrides, load_model_spec, load_preset
 from ..model.params import Model
 
 FAMILIES = ("normal", "lognormal", "uniform", "truncated normal")
@@ -128,7 +128,8 @@ class AtlasSpec:
     Attributes
     ----------
     model : Model
-        The parameters that no prior varies.
+        The parameters that no prior varies; its source names its preset, file and overridden fields
+        (:mod:`spinectl.model.source`).
     priors : tuple of Prior
         One per varied parameter, in the file's order.
     samples : int
@@ -170,13 +171,17 @@ class AtlasSpec:
         return [p.parameter for p in self.priors]
 
 
-def load_atlas(path: str | Path) -> AtlasSpec:
+def load_atlas(path: str | Path, model: Model | None = None, assignments=()) -> AtlasSpec:
     """Read and validate an atlas file (docs/atlas.md).
 
     Parameters
     ----------
     path : str or Path
         The TOML file.
+    model : Model, optional
+        The base model (``--preset``, ``--config``), instead of the file's ``[atlas] model``.
+    assignments : sequence of str
+        ``SECTION.FIELD=VALUE`` laid over the base model (``--set``).
 
     Returns
     -------
@@ -188,10 +193,13 @@ def load_atlas(path: str | Path) -> AtlasSpec:
         Unreadable, not TOML, or any field invalid: one line naming the field.
     """
     path = Path(path)
-    return parse_atlas(_toml.read_text(path), source=str(path), base_dir=path.parent)
+    text = _toml.read_text(path)
+    return parse_atlas(text, source=str(path), base_dir=path.parent, model=model, assignments=assignments)
 
 
-def parse_atlas(text: str, source: str = "atlas", base_dir: str | Path = ".") -> AtlasSpec:
+def parse_atlas(
+    text: str, source: str = "atlas", base_dir: str | Path = ".", model: Model | None = None, assignments=()
+) -> AtlasSpec:
     """Validate the text of an atlas file into an :class:`AtlasSpec`.
 
     Parameters
@@ -202,6 +210,12 @@ def parse_atlas(text: str, source: str = "atlas", base_dir: str | Path = ".") ->
         Named in a syntax error.
     base_dir : str or Path
         Where a relative ``model`` path is looked for.
+    model : Model, optional
+        The base model, instead of the file's ``[atlas] model`` (the command line's ``--preset`` or
+        ``--config`` wins over the file). Neither: the preset :data:`~spinectl.model.config.DEFAULT_PRESET`,
+        as for every command.
+    assignments : sequence of str
+        ``SECTION.FIELD=VALUE`` laid over the base model (``--set``), named in its source as overridden.
 
     Returns
     -------
@@ -218,7 +232,8 @@ def parse_atlas(text: str, source: str = "atlas", base_dir: str | Path = ".") ->
     head = data.get("atlas", {})
     _toml.check_table(head, "atlas")
     _toml.check_keys(head, ATLAS_KEYS, "atlas")
-    model = _model(head.get("model"), Path(base_dir))
+    base = model if model is not None else _model(head.get("model"), Path(base_dir))
+    model = apply_overrides(base, list(assignments))
     rows = data.get("prior", [])
     if not isinstance(rows, list) or not rows:
         raise ConfigError("prior", "must be one or more [[prior]] tables")
@@ -229,8 +244,9 @@ def parse_atlas(text: str, source: str = "atlas", base_dir: str | Path = ".") ->
 
 
 def _model(spec, base_dir: Path) -> Model:
+    """The file's ``model`` key: a preset or a model file; none, the default preset, as every command starts from."""
     if spec is None:
-        return Model()
+        return load_preset(DEFAULT_PRESET)
     if not isinstance(spec, str):
         raise ConfigError("atlas.model", "must be a preset name or a path to a model file")
     candidate = base_dir / spec

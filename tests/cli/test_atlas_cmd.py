@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import json
 
+import pytest
+
 from spinectl.cli import main
 
 PRIOR = """
@@ -53,3 +55,49 @@ def test_an_out_that_is_a_file_is_one_line_exit_2(tmp_path, capsys):
     assert main(["atlas", str(_file(tmp_path)), "--out", str(out)]) == 2
     err = capsys.readouterr().err.strip()
     assert "cannot write" in err and "\n" not in err
+
+
+def test_json_names_the_default_preset(tmp_path, capsys):
+    """No --preset, --config or model key: the atlas starts from DEFAULT_PRESET, named as every command names it."""
+    from spinectl import DEFAULT_PRESET
+
+    assert main(["atlas", str(_file(tmp_path)), "--out", str(tmp_path / "out"), "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["preset"] == DEFAULT_PRESET and doc["config"] is None and doc["overridden"] == []
+    saved = json.loads((tmp_path / "out" / "atlas.json").read_text())
+    assert saved["preset"] == DEFAULT_PRESET
+    assert f"preset {DEFAULT_PRESET}" in (tmp_path / "out" / "report.md").read_text()
+
+
+def test_preset_and_set_reach_the_atlas(tmp_path, capsys):
+    """--preset default and --set are named in the JSON and the table's first line."""
+    args = ["atlas", str(_file(tmp_path)), "--out", str(tmp_path / "out"), "--preset", "default"]
+    assert main([*args, "--set", "passive.stiffness=15"]) == 0
+    first = capsys.readouterr().out.splitlines()[0]
+    assert first.startswith("preset default, K = 15 N m/rad") and "overridden: passive.stiffness" in first
+
+
+def test_preset_default_and_the_default_differ_as_stability_says(tmp_path, capsys):
+    """--preset default vs the default preset: the atlas's min PCSA at a drawn point equals `spinectl stability` there.
+
+    Second reading: `spinectl stability --E --Lambda --mass` with the same preset at the first draw; the two
+    presets (40 kg and 24 kg upper body, different muscle geometry) give different minima.
+    """
+    import numpy as np
+
+    found = {}
+    for preset in ("default", None):
+        out = tmp_path / f"out-{preset}"
+        extra = ["--preset", preset] if preset else []
+        assert main(["atlas", str(_file(tmp_path)), "--out", str(out), "--json", *extra]) == 0
+        capsys.readouterr()
+        with np.load(out / "draws.npz") as draws:
+            e, lam, mass, pcsa = (
+                float(draws[k][0]) for k in ("eccentricity_m", "lordosis_m", "body.mass", "min_pcsa_cm2")
+            )
+        point = ["stability", "--E", str(e), "--Lambda", str(lam), "--set", f"body.mass={mass!r}", "--json", *extra]
+        assert main(point) == 0
+        reading = json.loads(capsys.readouterr().out)
+        found[preset] = pcsa
+        assert pcsa == pytest.approx(reading["min_pcsa_cm2"], rel=1e-6)
+    assert found["default"] != pytest.approx(found[None], rel=1e-3)

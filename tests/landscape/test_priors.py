@@ -89,3 +89,21 @@ def test_priors_whose_draws_leave_the_model_are_refused(fields, words):
     with pytest.raises(ConfigError) as raised:
         parse_atlas(HEAD + _prior(**fields))
     assert raised.value.field == "prior[0].bounds" and words in str(raised.value)
+
+
+def test_the_base_model_is_the_default_preset_or_the_files_or_the_callers():
+    """No model key: spinectl.DEFAULT_PRESET as every command; the file's key; a given model wins; --set is named."""
+    from spinectl import DEFAULT_PRESET
+    from spinectl.model.config import load_preset
+    from spinectl.model.source import source_of
+
+    assert source_of(parse_atlas(HEAD + _prior()).model).preset == DEFAULT_PRESET
+    from_file = parse_atlas('[atlas]\nsamples = 8\nmodel = "default"\n' + _prior()).model
+    assert source_of(from_file).preset == "default" and from_file == load_preset("default")
+    given = parse_atlas(
+        '[atlas]\nsamples = 8\nmodel = "default"\n' + _prior(),
+        model=load_preset(DEFAULT_PRESET),
+        assignments=["passive.stiffness=15"],
+    ).model
+    assert source_of(given).preset == DEFAULT_PRESET and source_of(given).overridden == ("passive.stiffness",)
+    assert given.passive.stiffness == 15.0
