@@ -143,7 +143,9 @@ def test_the_chains_largest_delay_met_is_the_largest_any_tried_design_meets(monk
     result = dz.chain_design(model, 0.03, 0.04, 0.5 * optimum, 0.5)
     mass, stiffness, damping = dz.chain_matrices(model, 0.03, 0.04, 0.5 * optimum)
     scanned = [
-        dz._chain_margin(model, mass, stiffness, damping, result.least_static, f, None, None, model.reflex.activation_time_constant)
+        dz._chain_margin(
+            model, mass, stiffness, damping, result.least_static, f, None, None, model.reflex.activation_time_constant
+        )
         for f in np.linspace(0.0, 1.0, dz.CHAIN_SCAN)
     ]
     assert np.isfinite(result.delay_margin) and result.delay_margin >= 0.12
