@@ -127,7 +127,9 @@ class ChainDesign:
     max_root_real : float
         Re of the rightmost characteristic root at the delay [1/s] (:func:`rightmost_root`).
     largest_delay : float
-        The largest delay met on the scan [s] (the margin at its best fraction).
+        The largest delay met by any local stiffness the search tried [s]: the largest exact margin
+        there (with the design's own); inf (JSON null, "unbounded") when one is stable at every delay, e.g. the
+        rule's f = 1, which has no reflex. The same meaning as :attr:`Design.largest_delay` joint by joint.
     method : str
     """
 
@@ -182,7 +184,9 @@ class Design:
         'ok'; 'infeasible' (joint by joint: no activation in [0, 1] meets the delay); 'chain_infeasible'
         (no local stiffness up to :data:`LOCAL_MAX` k*); or the optimum's status.
     largest_delay : float
-        Joint by joint, the largest delay met on the scan [s].
+        Joint by joint, the largest delay met by any activation on the scan of [0, 1] [s]: the largest over
+        the scan of the smallest segment margin; inf (JSON null, "unbounded") when every segment is stable at
+        every delay there. The chain's is :attr:`ChainDesign.largest_delay`.
     method : str
         How the activation was searched (see the module).
     model : dict
@@ -255,7 +259,7 @@ class Design:
         lines += [
             f"every segment at once: activation {_word(self.activation, 0, '.4f')} x minimum PCSA "
             f"({_word(m2_to_cm2(self.pcsa), 0, '.2f')} cm^2)"
-            + ("" if np.isfinite(self.activation) else f"; the largest delay met: {self.largest_delay * 1000:.4g} ms"),
+            + ("" if np.isfinite(self.activation) else f"; the largest delay met: {_delay(self.largest_delay)}"),
             "",
             f"{criterion('chain', len(c.local_stiffness))}: least local stiffness at activation "
             f"{_word(c.activation, 0, '.4f')} ({c.method})",
@@ -263,10 +267,10 @@ class Design:
             + ", ".join(f"{s.name} {_word(k, 0, '.2f')}" for s, k in zip(self.segments, c.local_stiffness, strict=True))
             + f"  ({_word(c.fraction, 0, '.4f')} x the least for static stability, total "
             f"{_word(float(np.sum(c.local_stiffness)), 0, '.1f')})",
-            f"certificate: exact delay margin {_word(c.delay_margin * 1000, 0, '.4g')} ms "
+            f"certificate: exact delay margin {_delay(c.delay_margin)} "
             f">= {self.delay * 1000:.4g} ms; "
             f"rightmost root at the delay Re s = {_word(c.max_root_real, 0, '.4g')} 1/s"
-            + ("" if np.isfinite(c.fraction) else f"; the largest delay met: {c.largest_delay * 1000:.4g} ms"),
+            + ("" if np.isfinite(c.fraction) else f"; the largest delay met: {_delay(c.largest_delay)}"),
         ]
         return "\n".join(lines)
 
@@ -275,6 +279,15 @@ def _word(value: float, width: int, fmt: str) -> str:
     """A number, or 'none' (NaN) / 'unbounded' (inf), right-aligned in ``width``."""
     text = "none" if np.isnan(value) else ("unbounded" if np.isinf(value) else format(value, fmt))
     return f"{text:>{width}}"
+
+
+def _delay(seconds: float) -> str:
+    """A delay with its unit: ms below 1 s, s from 1 s; 'unbounded (delay-independent)' (inf), 'none' (NaN)."""
+    if np.isnan(seconds):
+        return "none"
+    if np.isinf(seconds):
+        return "unbounded (delay-independent)"
+    return f"{seconds:.4g} s" if seconds >= 1.0 else f"{seconds * 1000:.4g} ms"
 
 
 def segment_margins_at(model: Model, coefficients, optimum_pcsa, activations, kp=None, kd=None) -> np.ndarray:
@@ -563,17 +576,23 @@ def chain_design(model: Model, eccentricity: float, lordosis: float, pcsa, activ
     mass, stiffness, damping = chain_matrices(model, eccentricity, lordosis, pcsa)
     _, least = least_local_stiffness_stacked(stiffness[None], model.optimisation.stability_margin)
     least = least[0]
+    margins = []  # the exact margins judge finds; a design that fails the delay has one below it
 
     def judge(f):
-        """(meets, rightmost root, exact margin or None): the spectral root first, the exact margin where it is left."""
+        """(meets, rightmost root, exact margin or None): the spectral root first, the exact margin where it is left.
+
+        Each exact margin found is kept in ``margins`` for the largest delay met.
+        """
         k, p, dd = chain_loop_at(model, mass, stiffness, damping, least, f, kp, kd)
         with arithmetic_guard(eccentricity, lordosis):
             root = rightmost_root(mass, k, damping, p, dd, delay, lag)
             if not root.real < 0:
                 return False, root, None
             if not (np.any(p) or np.any(dd)):  # no reflex: stable at every delay (no crossing to find)
+                margins.append(np.inf)
                 return True, root, from_crossings(np.empty(0), np.empty(0), np.empty(0), True)
             exact = chain_delay_margin(mass, k, damping, p, dd, lag)
+        margins.append(float(exact.margin))
         return bool(stable_at(exact, delay) and exact.margin >= delay), root, exact
 
     top = 1.0 if model.reflex.gains == "rule" and kp is None and kd is None else LOCAL_MAX  # f >= 1: no reflex
@@ -596,7 +615,7 @@ def chain_design(model: Model, eccentricity: float, lordosis: float, pcsa, activ
         least,
         float(exact.margin),
         float(root.real),
-        float(exact.margin),
+        float(max(margins)),  # met at the design, so at least its margin; larger fractions may meet more
         method,
     )
 
@@ -748,6 +767,9 @@ class PassiveCurve:
     paper_pcsa : float
         The global PCSA held fixed: the paper's (joint-by-joint) minimum at the model's own passive
         stiffness [m^2], so that the curve shows the passive stiffness alone.
+    fixed_pcsa : numpy.ndarray, shape (n_muscles,)
+        Its distribution over the muscles [m^2]. ``global_pcsa`` has another, problem (b)'s own at each K:
+        the two columns are not at the same muscles (:meth:`columns_note`).
     threshold : float
         The least K at which global muscles alone stabilise the chain [N m/rad], by bisection on
         the feasibility of (b) to :data:`THRESHOLD_TOLERANCE`; NaN if not in the scanned range.
@@ -766,6 +788,7 @@ class PassiveCurve:
     global_status: tuple[str, ...]
     local_stiffness: np.ndarray
     paper_pcsa: float
+    fixed_pcsa: np.ndarray
     threshold: float
     crisco: float
     crisco_global_pcsa: float
@@ -780,9 +803,10 @@ class PassiveCurve:
             Provenance, ``criterion`` (the chain), ``E_m``, ``Lambda_m``, ``passive_stiffness_Nm_per_rad``,
             ``global_pcsa_cm2``, ``global_status``, ``local_stiffness_Nm_per_rad`` (per point, per joint),
             ``local_stiffness_total_Nm_per_rad``, ``local_at_global_pcsa_cm2``, ``global_alone_from_Nm_per_rad``,
-            ``crisco_stiffness_Nm_per_rad``, ``crisco_load_N``, ``crisco_global_pcsa_cm2``.
+            ``crisco_stiffness_Nm_per_rad``, ``crisco_load_N``, ``crisco_global_pcsa_cm2``,
+            ``local_at_pcsa_per_muscle_cm2`` (muscle name -> PCSA) and ``columns_note`` (:meth:`columns_note`).
         """
-        model = {k: v for k, v in self.model.items() if k != "header"}
+        model = {k: v for k, v in self.model.items() if k not in ("header", "muscles")}
         return model | {
             "criterion": criterion("chain", self.local_stiffness.shape[1]),
             "E_m": self.eccentricity,
@@ -797,7 +821,27 @@ class PassiveCurve:
             "crisco_stiffness_Nm_per_rad": self.crisco,
             "crisco_load_N": CRISCO_LOAD,
             "crisco_global_pcsa_cm2": float(m2_to_cm2(self.crisco_global_pcsa)),
+            "local_at_pcsa_per_muscle_cm2": dict(
+                zip(self.model.get("muscles", ()), m2_to_cm2(self.fixed_pcsa).tolist(), strict=False)
+            ),
+            "columns_note": self.columns_note(),
         }
+
+    def columns_note(self) -> str:
+        """Which global PCSA, in which distribution, each column is at.
+
+        Returns
+        -------
+        str
+            One line: the global-alone column is problem (b)'s least distribution at each K, the local
+            column the paper's joint-by-joint minimum held fixed, which is not the chain's best.
+        """
+        return (
+            "note: 'global alone' is problem (b)'s own least distribution at each K (its total); 'sum local k' "
+            f"is at the paper's joint-by-joint minimum, {_word(m2_to_cm2(self.paper_pcsa), 0, '.2f')} cm^2 held "
+            "fixed in its own distribution, which is not the chain's best: a larger total can need local stiffness "
+            "where a smaller one alone suffices"
+        )
 
     def table(self) -> str:
         """The curve as rows, with the threshold and Crisco's stiffness.
@@ -814,6 +858,7 @@ class PassiveCurve:
             f"E = {self.eccentricity * 100:.2f} cm, Lambda = {self.lordosis * 100:.2f} cm",
             f"least local stiffness at a fixed global PCSA of {_word(m2_to_cm2(self.paper_pcsa), 0, '.2f')} cm^2 "
             "(the paper's minimum at the model's passive stiffness)",
+            self.columns_note(),
             f"{'K[N m/rad]':>10} {'global alone[cm2]':>17} {'sum local k[N m/rad]':>20}",
         ]
         lines += [
@@ -850,7 +895,7 @@ def passive_curve(model: Model, eccentricity: float, lordosis: float, stiffnesse
         A stiffness negative or not finite; E or Lambda out of range.
     """
     from ..errors import ParameterError
-    from ..model.source import header, provenance
+    from ..model.source import origin, provenance
 
     ks = np.asarray(stiffnesses, float).ravel()
     if ks.size == 0 or not np.all(np.isfinite(ks) & (ks >= 0)):
@@ -869,10 +914,13 @@ def passive_curve(model: Model, eccentricity: float, lordosis: float, stiffnesse
         global_status=tuple(p[1] for p in points),
         local_stiffness=np.array([p[2] for p in points]),
         paper_pcsa=float(np.sum(optimum)),
+        fixed_pcsa=optimum,
         threshold=threshold,
         crisco=crisco,
         crisco_global_pcsa=_global_alone(model, e, lam, crisco).total_pcsa,
-        model=provenance(model) | {"header": header(model)},
+        # K is swept: the header names the origin, not the model's own K
+        model=provenance(model)
+        | {"header": f"{origin(model)}; K swept, physical convention", "muscles": tuple(model.muscle_names)},
     )
 
 

@@ -36,34 +36,81 @@ def passive_figure(curve: PassiveCurve) -> Figure:
     -------
     matplotlib.figure.Figure
     """
-    fig = new_figure(figsize=(7.0, 6.0), layout="constrained")
+    fig = new_figure(figsize=(7.0, 6.4), layout="constrained")
     top, bottom = fig.subplots(2, 1, sharex=True)
     k = curve.passive_stiffness
     top.plot(k, m2_to_cm2(curve.global_pcsa), "o-", ms=3, color="C0")
     top.set_ylabel("least global PCSA alone [cm²]")
-    top.set_title("chain (all CoRs free): static stability without local muscles", fontsize=10)
+    top.set_title(
+        "chain (all CoRs free): static stability without local muscles\n"
+        "at problem (b)'s own least distribution at each K",
+        fontsize=9,
+    )
     bottom.plot(k, curve.local_stiffness.sum(axis=1), "o-", ms=3, color="C1")
     bottom.set_ylabel("least local stiffness, sum [N m/rad]")
     bottom.set_title(
-        f"least local stiffness at a fixed global PCSA of {m2_to_cm2(curve.paper_pcsa):.1f} cm²", fontsize=10
+        f"least local stiffness at the paper's joint-by-joint minimum, {m2_to_cm2(curve.paper_pcsa):.1f} cm² "
+        "held fixed\n(its own distribution, not the chain's best: not comparable with the top's totals)",
+        fontsize=9,
     )
     bottom.set_xlabel("passive stiffness per joint K [N m/rad]")
-    marks = [
-        (curve.crisco, "C3", f"Crisco et al. 1992: 88 N buckles, K = {curve.crisco:.1f}"),
-        (PAPER_PASSIVE, "0.5", f"the paper's K = {PAPER_PASSIVE:g}"),
-    ]
-    if np.isfinite(curve.threshold):
-        marks.append((curve.threshold, "C2", f"global alone suffice from K = {curve.threshold:.1f}"))
     for ax in (top, bottom):
-        for x, colour, label in marks:
-            ax.axvline(x, color=colour, ls="--", lw=1, label=label)
+        for mark in _marks(curve):
+            ax.axvline(mark["x"], label=mark["label"], **mark["line"])
         ax.grid(alpha=0.3)
-    top.legend(fontsize=8, loc="upper right")
+    # the marks can lie 0.2 N m/rad apart (Crisco 37.6, threshold 37.5): each value is written at its own height,
+    # on its own side of the line, so both stay readable where the lines overlap
+    for j, mark in enumerate(_marks(curve)):
+        side = mark["side"]
+        top.annotate(
+            f"K = {mark['x']:.1f}",
+            xy=(mark["x"], 0.9 - 0.12 * j),
+            xycoords=("data", "axes fraction"),
+            xytext=(4 * side, 0),
+            textcoords="offset points",
+            ha="left" if side > 0 else "right",
+            va="center",
+            fontsize=8,
+            color=mark["line"]["color"],
+        )
+    top.legend(fontsize=8, loc="center right")
     fig.suptitle(
         f"{curve.model.get('header', '')}\nE = {curve.eccentricity * 100:.1f} cm, Λ = {curve.lordosis * 100:.1f} cm",
         fontsize=9,
     )
     return fig
+
+
+def _marks(curve: PassiveCurve) -> list[dict]:
+    """The marked stiffnesses: ``x`` [N m/rad], the legend ``label``, ``line`` (axvline's style) and ``side``.
+
+    Crisco's is a wide pale band and the threshold a thin dotted line on it, so that both show where they
+    nearly coincide; ``side`` (+1 right, -1 left) places each value's text apart from the other's.
+    """
+    marks = [
+        {
+            "x": curve.crisco,
+            "label": f"Crisco et al. 1992: 88 N buckles, K = {curve.crisco:.1f}",
+            "line": {"color": "C3", "ls": "-", "lw": 4.0, "alpha": 0.35},
+            "side": 1,
+        },
+        {
+            "x": PAPER_PASSIVE,
+            "label": f"the paper's K = {PAPER_PASSIVE:g}",
+            "line": {"color": "0.4", "ls": "-.", "lw": 1.2},
+            "side": 1,
+        },
+    ]
+    if np.isfinite(curve.threshold):
+        marks.append(
+            {
+                "x": curve.threshold,
+                "label": f"global alone suffice from K = {curve.threshold:.1f}",
+                "line": {"color": "C2", "ls": ":", "lw": 1.6},
+                "side": -1 if curve.threshold <= curve.crisco else 1,
+            }
+        )
+    return marks
 
 
 def delay_figure(curve: DesignCurve) -> Figure:

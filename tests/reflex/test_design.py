@@ -114,3 +114,40 @@ def test_a_delay_no_activation_meets_is_an_answer():
         for a in scan[::10]
     ]
     assert max(min(s.delay_margin for s in r.segments) for r in at) <= largest + 1e-12
+
+
+def test_a_delay_prints_with_its_unit_or_unbounded_without_one():
+    """The table's delays: 120 ms in ms, 329.8 s (the plain case's chain margin) in s, an infinite margin as
+    'unbounded (delay-independent)' with no unit (not 'unbounded ms'), NaN as 'none'; and so in the certificate
+    of a Design's table."""
+    assert dz._delay(0.12) == "120 ms" and dz._delay(329.847) == "329.8 s" and dz._delay(np.nan) == "none"
+    assert dz._delay(np.inf) == "unbounded (delay-independent)"
+    n = 5
+    chain = dz.ChainDesign(0.5, 0.9, np.ones(n), np.ones(n), np.inf, -1.0, np.inf, "test")
+    seg = tuple(dz.SegmentDesign(f"S{i}", 0.1, 1e-4, 0.2, True) for i in range(n))
+    d = dz.Design(0.0, 0.0, 0.12, 0.05, 0.1, 5e-4, seg, chain, "ok", np.inf, "test", {"header": "h"})
+    certificate = next(line for line in d.table().splitlines() if line.startswith("certificate"))
+    assert "exact delay margin unbounded (delay-independent) >= 120 ms" in certificate
+    assert "unbounded ms" not in d.table()
+
+
+def test_the_chains_largest_delay_met_is_the_largest_any_tried_design_meets(monkeypatch):
+    """chain.largest_delay_met_s means what the top-level (joint-by-joint) one means: the largest delay met by any
+    design tried, not the margin of the least design. Under the rule's gains the scan reaches f = 1, which has no
+    reflex and is stable at every delay, so it is unbounded (inf); the least design's own margin is finite. The
+    second method: each scanned fraction's exact margin recomputed (_chain_margin), whose largest is inf too."""
+    monkeypatch.setattr(dz, "CHAIN_SCAN", 5)
+    monkeypatch.setattr(dz, "BISECTIONS", 12)
+    model = config.set_parameters(config.load_preset("wagner2012"), {"reflex.delay": 0.12})
+    optimum = margins.solve_point(model, 0.03, 0.04).pcsa
+    result = dz.chain_design(model, 0.03, 0.04, 0.5 * optimum, 0.5)
+    mass, stiffness, damping = dz.chain_matrices(model, 0.03, 0.04, 0.5 * optimum)
+    scanned = [
+        dz._chain_margin(
+            model, mass, stiffness, damping, result.least_static, f, None, None, model.reflex.activation_time_constant
+        )
+        for f in np.linspace(0.0, 1.0, dz.CHAIN_SCAN)
+    ]
+    assert np.isfinite(result.delay_margin) and result.delay_margin >= 0.12
+    assert result.largest_delay == max(scanned) == np.inf
+    assert result.to_dict()["largest_delay_met_s"] == np.inf

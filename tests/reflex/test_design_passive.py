@@ -99,3 +99,55 @@ def test_a_negative_or_missing_stiffness_is_refused(bad):
     """A passive stiffness below 0 or not a number, or none: ParameterError naming --passive."""
     with pytest.raises(ParameterError, match="--passive"):
         dz.passive_curve(config.load_preset("wagner2012"), 0.0, 0.0, bad)
+
+
+@pytest.fixture(scope="module")
+def near_crisco():
+    """wagner2012 at A, K = 30 and 40 N m/rad: the threshold (37.45) is bisected next to Crisco's 37.64."""
+    return dz.passive_curve(config.load_preset("wagner2012"), 0.0, 0.0, [30.0, 40.0])
+
+
+def test_the_two_columns_are_at_different_distributions_and_the_note_says_so(near_crisco):
+    """At K = 40 global muscles alone need 23.9 cm^2, yet the fixed 36.3 cm^2 still needs about 64 N m/rad of local
+    stiffness: the fixed PCSA is the joint-by-joint optimum's distribution (solve_point, mostly outer obliques),
+    not problem (b)'s. Recomputed with least_local_stiffness, problem (b)'s own distribution at K = 40 needs no
+    local stiffness (< 1e-3 N m/rad), so the columns differ by distribution; the curve keeps the fixed
+    distribution (JSON per muscle) and its table and JSON carry a note naming both."""
+    from spinectl.optimise.coupled.local import least_local_stiffness
+    from spinectl.optimise.reference import solve_point
+
+    model = config.load_preset("wagner2012")
+    curve = near_crisco
+    optimum = np.asarray(solve_point(model, 0.0, 0.0).pcsa, float)
+    alone = dz._global_alone(model, 0.0, 0.0, 40.0)
+    own = least_local_stiffness(dz._physical(model, 40.0), 0.0, 0.0, alone.pcsa, given=False).local_stiffness
+    assert np.sum(own) < 1e-3 and curve.local_stiffness[1].sum() > 50.0
+    assert alone.total_pcsa < curve.paper_pcsa
+    np.testing.assert_allclose(curve.fixed_pcsa, optimum)
+    doc = curve.to_dict()
+    assert list(doc["local_at_pcsa_per_muscle_cm2"]) == list(model.muscle_names)
+    assert sum(doc["local_at_pcsa_per_muscle_cm2"].values()) == pytest.approx(doc["local_at_global_pcsa_cm2"])
+    note = curve.columns_note()
+    assert doc["columns_note"] == note and note in curve.table().splitlines()
+    assert "problem (b)" in note and "joint-by-joint minimum, 36.30 cm^2" in note
+
+
+def test_the_figure_draws_crisco_and_the_threshold_apart_and_names_no_swept_k(near_crisco):
+    """Crisco's 37.64 and the threshold 37.45 are 0.2 N m/rad apart: their lines differ in style and width, and
+    each value is written at its own height on the top axes. The titles do not state the model's own K (0 here)
+    since the x-axis sweeps K; the bottom title names the fixed PCSA's distribution."""
+    from spinectl.reflex.design_plots import passive_figure
+
+    curve = near_crisco
+    assert abs(curve.threshold - curve.crisco) < 0.5
+    fig = passive_figure(curve)
+    top, bottom = fig.axes
+    lines = {line.get_label(): line for line in top.get_lines() if line.get_label().startswith(("Crisco", "global"))}
+    crisco, threshold = (next(v for k, v in lines.items() if k.startswith(w)) for w in ("Crisco", "global"))
+    assert (crisco.get_linestyle(), crisco.get_linewidth()) != (threshold.get_linestyle(), threshold.get_linewidth())
+    texts = {t.get_text(): t.xy[1] for t in top.texts}
+    assert {f"K = {curve.crisco:.1f}", f"K = {curve.threshold:.1f}"} <= set(texts)
+    assert texts[f"K = {curve.crisco:.1f}"] != texts[f"K = {curve.threshold:.1f}"]
+    titles = [fig.get_suptitle(), top.get_title(), bottom.get_title()]
+    assert not any("K = 0" in t for t in titles) and "K swept" in titles[0]
+    assert "joint-by-joint minimum" in titles[2]
