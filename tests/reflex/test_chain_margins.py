@@ -9,6 +9,7 @@ import numpy as np
 
 from spinectl import jsondoc
 from spinectl.cli import main
+from spinectl.cli._common import with_lordosis_angle
 from spinectl.model import config
 from spinectl.reflex.chain_margins import coupled_margins
 from spinectl.reflex.chain_system import chain_loop
@@ -56,7 +57,9 @@ def test_at_the_papers_delay_the_chain_is_unstable(capsys):
     assert set(KEYS) <= set(printed["coupled"])
     model = _model(delay=0.1)
     result = coupled_margins(model, 0.0, 0.0)
-    assert printed == json.loads(jsondoc.dumps(result.to_dict(model)))  # NaN: null with its reason
+    # NaN: null with its reason; the command adds the lordosis angle beside Lambda (0 deg at Lambda = 0)
+    assert printed == json.loads(jsondoc.dumps(with_lordosis_angle(result.to_dict(model), model)))
+    assert printed["lordosis_angle_deg"] == 0.0
     assert result.stable_at_delay is False and result.exact.margin < 0.1
     assert _pade_closed_loop_stable(result, model) is False
     assert printed["coupled"]["disk_gain_margin"] is None and printed["coupled"]["disk_gain_margin_reason"] == "none"
