@@ -14,6 +14,7 @@ loads with a :class:`ChecksumWarning` saying that it could not be checked.
 from __future__ import annotations
 
 import os
+import sys
 import tomllib
 import warnings
 import zlib
@@ -62,6 +63,36 @@ def model_of(dataset: xr.Dataset) -> Model:
         raise ParameterError("config_toml", f"is not a valid model ({printable(str(exc))})") from None
 
 
+def check_name(path, error=OutputError) -> None:
+    """Refuse at once a name that the NetCDF library cannot open.
+
+    netCDF4 encodes names strictly in the file system's encoding, and under the C locale without
+    Python's UTF-8 mode that is ASCII, so ``Λ.nc`` or ``Λdir/k0.nc`` (which Python itself keeps as
+    surrogate escapes and writes as their UTF-8 bytes) failed in a traceback, after the work.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file to write or read.
+    error : type
+        :class:`~spinectl.errors.OutputError` for an output, or a callable taking the message for an input.
+
+    Raises
+    ------
+    OutputError
+        (or ``error``) The name cannot be encoded in the file system's encoding.
+    """
+    encoding = sys.getfilesystemencoding()
+    try:
+        str(path).encode(encoding)
+    except UnicodeEncodeError:
+        raise error(
+            f"cannot open {show(str(path))}: the NetCDF library takes only names in the file system's encoding "
+            f"({encoding} here), which cannot hold this one: run under a UTF-8 locale (LC_ALL=C.UTF-8) or with "
+            "PYTHONUTF8=1, or choose an ASCII name"
+        ) from None
+
+
 def save(dataset: xr.Dataset, path: str | Path) -> Path:
     """Write a Dataset to NetCDF atomically (:func:`spinectl.atomic.atomic_path`).
 
@@ -80,6 +111,7 @@ def save(dataset: xr.Dataset, path: str | Path) -> Path:
     OutputError
         ``path`` cannot be written (a folder in the way, a full disk); the previous file is left intact.
     """
+    check_name(path)
     with atomic_path(path) as tmp:
         try:
             _unstamped(dataset).to_netcdf(tmp, engine="netcdf4")
@@ -237,7 +269,8 @@ def load(path: str | Path) -> xr.Dataset:
     """
     path = Path(path)
     if not path.is_file():
-        raise ParameterError("results", f"file not found: {path}")
+        raise ParameterError("results", f"file not found: {show(str(path))}")
+    check_name(path, lambda message: ParameterError("results", message))
     checked = _verify_or_foreign(path)
     try:
         dataset = _unstamped(xr.load_dataset(path, engine="netcdf4"))

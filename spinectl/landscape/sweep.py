@@ -10,16 +10,14 @@ resolved configuration; docs/optimisation.md lists the schema with units.
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import numpy as np
 import xarray as xr
 from tqdm import tqdm
 
-from .._validate import show
 from ..atomic import check_writable
-from ..errors import ModelError, OutputError, ParameterError
+from ..errors import ModelError, ParameterError
 from ..model import config, source
 from ..model.checks import check_axis_range
 from ..model.params import Model
@@ -345,7 +343,7 @@ def write_sweep(model: Model, eccentricity, lordosis, path, *, stiffnesses=None,
     Raises
     ------
     OutputError
-        ``path`` cannot be written (or named to the NetCDF library, :func:`_check_netcdf_name`), or the
+        ``path`` cannot be written (or named to the NetCDF library, :func:`.netcdf.check_name`), or the
         file estimated would not fit on its file system.
     ParameterError
         A bad option or K, ``path`` not ending in ``.nc`` (named ``--out``, as the CLI's option), more
@@ -361,7 +359,7 @@ def write_sweep(model: Model, eccentricity, lordosis, path, *, stiffnesses=None,
             f"E x Lambda x K must have at most {MAX_GRID_POINTS:,} points in all (got {np.size(eccentricity):,} x "
             f"{np.size(lordosis):,} x {len(stiffnesses):,} = {points:,})",
         )
-    _check_netcdf_name(path)
+    netcdf.check_name(path)
     check_writable(path)
     options |= {"out": path, "notify": notify}
     if len(stiffnesses) == 1:
@@ -372,21 +370,6 @@ def write_sweep(model: Model, eccentricity, lordosis, path, *, stiffnesses=None,
         dataset = stiffness_sweep(model, stiffnesses, eccentricity, lordosis, **options)
     netcdf.save(dataset, path)
     return dataset
-
-
-def _check_netcdf_name(path) -> None:
-    """Refuse at once a name that the NetCDF library cannot open: it encodes names strictly in the file
-    system's encoding, and under the C locale without Python's UTF-8 mode that is ASCII, so ``Λ.nc`` (which
-    Python itself keeps as surrogate escapes and writes as its UTF-8 bytes) failed after the whole sweep."""
-    encoding = sys.getfilesystemencoding()
-    try:
-        str(path).encode(encoding)
-    except UnicodeEncodeError:
-        raise OutputError(
-            f"cannot write {show(str(path))}: the NetCDF library takes only names in the file system's encoding "
-            f"({encoding} here), which cannot hold this one: run under a UTF-8 locale (LC_ALL=C.UTF-8) or with "
-            "PYTHONUTF8=1, or choose an ASCII name"
-        ) from None
 
 
 def describe(dataset: xr.Dataset) -> str:

@@ -101,3 +101,22 @@ def test_a_loaded_and_edited_dataset_is_saved_with_fresh_checksums(written, tmp_
         warnings.simplefilter("error")
         back = netcdf.load(netcdf.save(edited, tmp_path / "edited.nc"))
     xr.testing.assert_identical(back, edited)
+
+
+def test_a_name_the_netcdf_library_cannot_encode_is_one_line_both_ways(tmp_path, monkeypatch):
+    """Under the C locale without Python's UTF-8 mode the file system's encoding is ASCII, and netCDF4 encodes
+    names strictly in it: ``Λdir/k0.nc`` (as ``reproduce --out Λdir`` writes) ended in a UnicodeEncodeError
+    traceback. Saving is refused before anything is written, loading in one line naming the input."""
+    import sys
+
+    from spinectl.errors import OutputError
+
+    folder = tmp_path / "Λdir"
+    folder.mkdir()
+    (folder / "k0.nc").write_bytes(b"")  # only its name matters to the check
+    monkeypatch.setattr(sys, "getfilesystemencoding", lambda: "ascii")
+    with pytest.raises(OutputError, match="NetCDF library takes only names in the file system's encoding"):
+        netcdf.save(xr.Dataset(), folder / "new.nc")
+    assert not (folder / "new.nc").exists()
+    with pytest.raises(ParameterError, match="^results: cannot open"):
+        netcdf.load(folder / "k0.nc")
