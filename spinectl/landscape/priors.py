@@ -139,7 +139,7 @@ class AtlasSpec:
     eccentricity, lordosis : float
         E and Lambda [m] where no prior varies them (default: the paper's optimum, 3 and 4 cm).
     counter_torque_limit : float
-        |CT_k| limit of the local muscles [N m] (paper, Discussion: +-30 N m).
+        ``abs(CT_k)`` limit of the local muscles [N m] (paper, Discussion: +-30 N m).
     local_pcsa_limit : float
         The local muscles' PCSA limit per joint [cm^2] (paper, Discussion: 17 cm^2).
     chain : bool

@@ -2,7 +2,7 @@
 
 F is quadratic in w^2 without the activation lag and cubic with it; its roots come from
 the closed form polished by Newton steps (the companion matrix kept as the reference),
-and the sign of F'(w^2) is the direction of the crossing (docs/reflex.md, "Crossing
+and the sign of F'(w^2) is the direction of the crossing [1]_ (docs/reflex.md, "Crossing
 frequencies and the exact delay margin").
 
 References
