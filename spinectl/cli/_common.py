@@ -226,31 +226,6 @@ def lordosis_grid(model: Model, spec: str | None, angle_spec: str | None, defaul
     return axis
 
 
-def with_lordosis_angle(payload: dict, model: Model) -> dict:
-    """``payload`` with ``lordosis_angle_deg`` [deg] just after its ``Lambda_m`` (:mod:`spinectl.model.clinical`).
-
-    Parameters
-    ----------
-    payload : dict
-        A command's JSON document; unchanged if it has no ``Lambda_m``.
-    model : Model
-        Converts Lambda to the angle.
-
-    Returns
-    -------
-    dict
-        A new dict, keys in the same order.
-    """
-    from ..model.clinical import lordosis_angle
-
-    out = {}
-    for key, value in payload.items():
-        out[key] = value
-        if key == "Lambda_m" and value is not None:
-            out["lordosis_angle_deg"] = float(lordosis_angle(value, model))
-    return out
-
-
 def add_dpi_option(parser: argparse.ArgumentParser) -> None:
     """``--dpi``, the resolution of PNG figures, on the commands that draw (:data:`~spinectl.paper.figures.files.DPI`).
 

@@ -10,7 +10,6 @@ from ._common import (
     finite_float,
     float_list,
     load_model,
-    with_lordosis_angle,
 )
 
 
@@ -95,6 +94,7 @@ def run(args) -> int:
     """
     from .._validate import non_negative
     from ..errors import ParameterError
+    from ..model import clinical
     from ..reflex.design import design
 
     aliases = {dotted: ("--" + option.replace("_", "-"), getattr(args, option)) for option, dotted in OVERRIDES}
@@ -114,7 +114,7 @@ def run(args) -> int:
         return _delays(model, args, kp, kd)
     result = design(model, args.E, args.Lambda, kp=kp, kd=kd)
     if args.json:
-        emit_json(with_lordosis_angle(result.to_dict(), model))
+        emit_json(clinical.with_lordosis_angle(result.to_dict(), model))
     else:
         print(result.table())
     return 0

@@ -17,7 +17,6 @@ from ._common import (
     emit_json,
     finite_float,
     load_model,
-    with_lordosis_angle,
 )
 
 
@@ -93,6 +92,7 @@ def run(args) -> int:
     int
         Exit code 0 (also for an infeasible optimum, reported as a status).
     """
+    from ..model import clinical
     from ..reflex.chain_verdict import margins_with_chain
 
     if args.plot:
@@ -114,7 +114,7 @@ def run(args) -> int:
         if skipped:
             print(f"spinectl: note: not written (nothing to draw): {', '.join(skipped)}", file=sys.stderr)
     if args.json:
-        emit_json(with_lordosis_angle(report.to_dict(), model))
+        emit_json(clinical.with_lordosis_angle(report.to_dict(), model))
     else:
         print(report.table())
     return 0
@@ -124,11 +124,12 @@ def _coupled(model, args) -> int:
     """``--coupled``: the chain's margins (:func:`spinectl.reflex.chain_margins.coupled_margins`)."""
     if args.plot:
         raise ParameterError("--plot", "is not available with --coupled")
+    from ..model import clinical
     from ..reflex.chain_margins import coupled_margins
 
     result = coupled_margins(model, args.E, args.Lambda, kp=args.kp, kd=args.kd)
     if args.json:
-        emit_json(with_lordosis_angle(result.to_dict(model), model))
+        emit_json(clinical.with_lordosis_angle(result.to_dict(model), model))
     else:
         print(result.table(model))
     return 0

@@ -14,7 +14,6 @@ from ._common import (
     load_model,
     note_pcsa_slip,
     pcsa_option,
-    with_lordosis_angle,
 )
 
 
@@ -73,6 +72,7 @@ def run(args) -> int:
     int
         Exit code 0.
     """
+    from ..model import clinical
     from ..optimise.stabilising import NoStabilisingActivation, stability_at
 
     model = load_model(args, body_aliases(args))
@@ -87,7 +87,7 @@ def run(args) -> int:
         raise NoStabilisingActivation(str(exc).replace("(argument pcsa, [m^2])", "with --pcsa [cm2]")) from None
     source = "given" if given else "min_pcsa"
     if args.json:
-        emit_json(with_lordosis_angle(result.to_dict(model, pcsa_source=source), model))
+        emit_json(clinical.with_lordosis_angle(result.to_dict(model, pcsa_source=source), model))
     else:
         print(result.table(model, pcsa_source=source))
     note_pcsa_slip(args.pcsa)

@@ -123,3 +123,26 @@ def gravity_line_distance(eccentricity, lordosis, model: Model) -> np.ndarray:
     """
     e, lam = np.broadcast_arrays(np.asarray(eccentricity, float), np.asarray(lordosis, float))
     return e[..., None] - lam[..., None] * lordosis_shape(model.geometry)
+
+
+def with_lordosis_angle(payload: dict, model: Model) -> dict:
+    """``payload`` with ``lordosis_angle_deg`` [deg] just after its ``Lambda_m``: a JSON document's clinical angle.
+
+    Parameters
+    ----------
+    payload : dict
+        A command's JSON document; unchanged if it has no ``Lambda_m``.
+    model : Model
+        Converts Lambda to the angle.
+
+    Returns
+    -------
+    dict
+        A new dict, keys in the same order.
+    """
+    out = {}
+    for key, value in payload.items():
+        out[key] = value
+        if key == "Lambda_m" and value is not None:
+            out["lordosis_angle_deg"] = float(lordosis_angle(value, model))
+    return out

@@ -12,8 +12,8 @@ import pytest
 
 from spinectl import jsondoc, optimise
 from spinectl.cli import main
-from spinectl.cli._common import with_lordosis_angle
 from spinectl.model import config
+from spinectl.model.clinical import with_lordosis_angle
 from spinectl.model.stability import segment_stability
 
 

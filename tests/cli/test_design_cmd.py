@@ -8,8 +8,8 @@ import pytest
 
 from spinectl import jsondoc
 from spinectl.cli import main
-from spinectl.cli._common import with_lordosis_angle
 from spinectl.model import config
+from spinectl.model.clinical import with_lordosis_angle
 from spinectl.reflex.design import design
 
 KEYS = ("activation", "segments", "chain", "delay_s", "activation_time_constant_s", "status")

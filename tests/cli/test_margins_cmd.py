@@ -8,8 +8,8 @@ import pytest
 
 from spinectl import jsondoc
 from spinectl.cli import main
-from spinectl.cli._common import with_lordosis_angle
 from spinectl.model import config
+from spinectl.model.clinical import with_lordosis_angle
 from spinectl.reflex.chain_verdict import margins_with_chain
 
 REQUIRED = (

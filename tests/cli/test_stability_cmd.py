@@ -8,8 +8,8 @@ import numpy as np
 
 from spinectl import jsondoc
 from spinectl.cli import main
-from spinectl.cli._common import with_lordosis_angle
 from spinectl.model import config
+from spinectl.model.clinical import with_lordosis_angle
 from spinectl.optimise.coupled import coupled_stability_at
 
 
