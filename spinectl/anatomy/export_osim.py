@@ -46,11 +46,11 @@ from pathlib import Path
 import numpy as np
 
 from ..atomic import atomic_path, check_distinct
+from ..errors import ParameterError
 from ..model import chain, geometry
 from ..model.mechanics import gravity_sign
 from ..model.muscle import hill_constants, max_velocity
 from ..units import M2_PER_CM2
-from ..errors import ParameterError
 from .engine import SpinectlError
 from .export_mjcf import PaperSolution, body_names, fibre_gains, paper_solution
 

@@ -72,7 +72,10 @@ def _replay(path, names, x0, times):
     out = []
     for time in times:
         state = manager.integrate(float(time))
-        out.append([coordinates.get(n).getValue(state) for n in names] + [coordinates.get(n).getSpeedValue(state) for n in names])
+        out.append(
+            [coordinates.get(n).getValue(state) for n in names]
+            + [coordinates.get(n).getSpeedValue(state) for n in names]
+        )
     return np.array(out)
 
 
@@ -160,7 +163,9 @@ def _millard_chain(model, solution, path):
         x = fibres.length[f] * (1 - TENDON_SLACK_RATIO) / l_opt
         f_al = millard.getActiveForceLengthCurve().calcValue(x)
         f_al_slope = millard.getActiveForceLengthCurve().calcDerivative(x, 1) / l_opt
-        f_v_slope = millard.getForceVelocityCurve().calcDerivative(0.0, 1) / (l_opt * millard.getMaxContractionVelocity())
+        f_v_slope = millard.getForceVelocityCurve().calcDerivative(0.0, 1) / (
+            l_opt * millard.getMaxContractionVelocity()
+        )
         iso = model.fibre.specific_tension * share[f]  # f_iso of the fibre per unit PCSA of its muscle
         f_l, f_l_slope = fibres.force[f] / iso, fibres.length_slope[f] / iso
         f_h_slope = fibres.velocity_slope[f] / fibres.force[f]
@@ -169,7 +174,9 @@ def _millard_chain(model, solution, path):
         hh = d_m / (f_l * f_h_slope)
         hessian = -(k_m + f_l_slope * hh) / f_l
         force = millard.getMaxIsometricForce() * millard.getActivation(state)
-        stiffness += force * (-f_al_slope * hh - f_al * hessian) - solution.pcsa[m] * coefficients.stiffness_per_pcsa[..., m]
+        stiffness += (
+            force * (-f_al_slope * hh - f_al * hessian) - solution.pcsa[m] * coefficients.stiffness_per_pcsa[..., m]
+        )
         damping += force * f_al * (-f_v_slope) * hh - solution.pcsa[m] * coefficients.damping_per_pcsa[..., m]
     return stiffness, damping
 
