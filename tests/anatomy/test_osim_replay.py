@@ -27,9 +27,11 @@ from spinectl.anatomy.export_osim import (  # noqa: E402
     export_osim,
     opensim_counter_torque,
     opensim_linearisation,
+    paper_curves,
 )
 from spinectl.cli import main  # noqa: E402
 from spinectl.model import chain, geometry  # noqa: E402
+from spinectl.model import muscle as fibre_law  # noqa: E402
 from spinectl.model.config import load_preset  # noqa: E402
 
 E, LAMBDA = 0.03, 0.04  # a point of docs/chain.md's table ("Dynamic stability"), as the MJCF tests
@@ -77,6 +79,41 @@ def _replay(path, names, x0, times):
             + [coordinates.get(n).getSpeedValue(state) for n in names]
         )
     return np.array(out)
+
+
+def _values(function, points):
+    """OpenSim's value of a one-argument Function at each point."""
+    return np.array([function.calcValue(osim.Vector(1, float(p))) for p in points])
+
+
+def test_the_papers_curves_in_the_file_are_spinectls_formulas(exported):
+    """The ``paper`` file's curves, evaluated by OpenSim (calcValue of the RigidTendonMuscle's curves), are the
+    paper's force_length and force_velocity (spinectl.model.muscle) over the whole range to 1e-14: x = l / l_opt in
+    [0.5, 1.5], w = V / v_max from -0.9 (shortening) to 2 (lengthening), 0 included; and with the printed eccentric
+    constant C (its branches do not meet at v = 0) OpenSim takes the concentric branch at w = 0, as spinectl does."""
+    import dataclasses
+
+    model, files = exported
+    built = osim.Model(str(files["paper", False][0]))
+    fibre = osim.RigidTendonMuscle.safeDownCast(built.getMuscles().get(0))
+    assert fibre.getTendonSlackLength() == 0.0 and fibre.getPennationAngleAtOptimalFiberLength() == 0.0
+    l_opt = fibre.getOptimalFiberLength()
+    x, w = np.linspace(0.5, 1.5, 21), np.array([-0.9, -0.3, -1e-6, 0.0, 1e-6, 0.3, 2.0])
+    for errata in ("corrected", "printed"):  # the printed C last: the assertion after the loop
+        variant = dataclasses.replace(model, errata=dataclasses.replace(model.errata, eccentric_constant=errata))
+        if errata == model.errata.eccentric_constant:  # the file's own curves
+            length, velocity = fibre.get_active_force_length_curve(), fibre.get_force_velocity_curve()
+        else:
+            expressions = paper_curves(variant)
+            length = osim.ExpressionBasedFunction(expressions[0], "x")
+            velocity = osim.ExpressionBasedFunction(expressions[1], "w")
+        hill = fibre_law.hill_constants(np.asarray(l_opt), variant.fibre, variant.errata)
+        v_max = fibre_law.max_velocity(l_opt, variant.fibre)
+        np.testing.assert_allclose(
+            _values(length, x), fibre_law.force_length(x * l_opt, l_opt, variant.fibre), atol=1e-14
+        )
+        np.testing.assert_allclose(_values(velocity, w), fibre_law.force_velocity(-w * v_max, hill), atol=1e-14)
+    assert abs(_values(velocity, [1e-12])[0] - 1) > 0.1  # the printed C: the branches differ
 
 
 @pytest.mark.parametrize("local", [False, True], ids=["plain", "local"])
