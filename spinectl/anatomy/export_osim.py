@@ -12,11 +12,20 @@ controls ``.sto``). A lumbar level's weight enters spinectl's gravity only by
 rest of it is cancelled by a ``PrescribedForce`` at the level's centre of mass, constant in
 the ground frame.
 
-OpenSim has no muscle with the paper's curves: the fibres are ``Millard2012EquilibriumMuscle``
-s with a rigid tendon, no activation dynamics, no pennation, no fibre damping, the paper's optimal length
-(1.2 l0) and maximal velocity, and Millard's own curves, so the tension and its slopes at
-the posture differ from spinectl's (docs/interchange.md, "What is lost"); the geometry, the
-masses, gravity and the springs are the same.
+The fibres are OpenSim muscles of one of two kinds (``muscle``, :data:`MUSCLES`):
+
+- ``"millard"`` (default, what ``spinectl anatomy`` re-imports): ``Millard2012EquilibriumMuscle`` s
+  with a rigid tendon, no activation dynamics, no pennation, no fibre damping, the paper's optimal
+  length (1.2 l0) and maximal velocity, and Millard's own curves, so the tension and its slopes at
+  the posture differ from spinectl's (docs/interchange.md, "What is lost"), and Millard floors the
+  activation at 0.01;
+- ``"paper"``: ``RigidTendonMuscle`` s (no tendon length, no pennation, the activation is the
+  control, unclamped) whose force-length and force-velocity curves are the paper's own formulas
+  as OpenSim ``ExpressionBasedFunction`` s (:func:`paper_curves`), no passive curve: OpenSim's
+  tension is then spinectl's at every length and velocity, so OpenSim's linearisation of the file
+  is the chain's K and D.
+
+The geometry, the masses, gravity and the springs are the same either way.
 
 OpenSim is the optional extra ``spinectl[opensim]``.
 
@@ -37,9 +46,10 @@ from pathlib import Path
 import numpy as np
 
 from ..atomic import atomic_path, check_distinct
+from ..errors import ParameterError
 from ..model import chain, geometry
 from ..model.mechanics import gravity_sign
-from ..model.muscle import max_velocity
+from ..model.muscle import hill_constants, max_velocity
 from ..units import M2_PER_CM2
 from .engine import SpinectlError
 from .export_mjcf import PaperSolution, body_names, fibre_gains, paper_solution
@@ -51,8 +61,13 @@ REFERENCE_PCSA_CM2 = 100.0
 muscle's PCSA over this (OpenSim's activations lie in [0, 1]; the paper bounds no PCSA)."""
 
 TENDON_SLACK_RATIO = 1e-4
-"""Tendon slack length over the upright fibre length: a rigid tendon of (almost) no length, so that the
-fibre's length is the path's (OpenSim requires a positive slack length)."""
+"""Tendon slack length over the upright fibre length of a Millard muscle: a rigid tendon of (almost) no
+length, so that the fibre's length is the path's (Millard's muscle requires a positive slack length;
+the ``"paper"`` muscles have none)."""
+
+MUSCLES = ("millard", "paper")
+"""The exported fibres' muscle models: Millard's (re-imported by ``spinectl anatomy``) or the paper's
+curves on OpenSim's ``RigidTendonMuscle``."""
 
 
 class OpenSimUnavailable(SpinectlError, ImportError):
@@ -95,7 +110,83 @@ def _vec(osim, point):
     return osim.Vec3(float(point[0]), float(point[1]), 0.0)
 
 
-def paper_osim(solution: PaperSolution, counter_torque=None):
+def check_muscle(muscle: str) -> str:
+    """``muscle`` if it names one of :data:`MUSCLES`, else one line saying what is allowed.
+
+    Parameters
+    ----------
+    muscle : str
+
+    Returns
+    -------
+    str
+    """
+    if muscle not in MUSCLES:
+        raise ParameterError("muscle", f"must be one of {list(MUSCLES)} (got {muscle!r})")
+    return muscle
+
+
+def paper_curves(model) -> tuple:
+    """The paper's force-length and force-velocity factors as OpenSim expressions of the normalised fibre state.
+
+    OpenSim's ``RigidTendonMuscle`` evaluates its active force-length curve at x = l / l_opt and its
+    force-velocity curve at w = V / (l_opt v_hat), V the lengthening velocity and v_hat its
+    ``max_contraction_velocity`` [l_opt/s]. With v_max = v_hat l_opt (:func:`~spinectl.model.muscle.max_velocity`)
+    and the shortening velocity v = -w v_max, the paper's factors (:mod:`spinectl.model.muscle`) are
+    f_l = exp(-((x^k1 - 1) / k2)^2), and f_H = c~ / (b~ - w) - a for w <= 0 (concentric, v >= 0),
+    A - C~ / (w + B~) for w > 0, with b~, c~, B~, C~ the Hill constants over v_max (the same for every
+    fibre, since b and B scale with l_opt). Numbers are written with ``repr``: the shortest decimal
+    that reads back to the same double.
+
+    Parameters
+    ----------
+    model : Model
+
+    Returns
+    -------
+    tuple of str
+        (force-length expression in x, force-velocity expression in w).
+
+    References
+    ----------
+    Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012). Spinal lordosis optimizes the
+    requirements for a stable erect posture. Theor Biol Med Model 9:13. doi:10.1186/1742-4682-9-13.
+    """
+    fibre = model.fibre
+    unit = float(max_velocity(1.0, fibre))  # v_max of a fibre with l_opt = 1 m: the Hill constants over v_max
+    hill = hill_constants(np.asarray(1.0), fibre, model.errata)
+    a, b, c = float(hill.a), float(hill.b) / unit, float(hill.c) / unit
+    big_a, big_b, big_c = float(hill.A), float(hill.B) / unit, float(hill.C) / unit
+    length = f"exp(-((x^{float(fibre.k1)!r} - 1) / {float(fibre.k2)!r})^2)"
+    # step(-w) is 1 at w = 0: the concentric branch there, as spinectl's; min/max keep each branch off its pole
+    velocity = (
+        f"step(-w) * ({c!r} / ({b!r} - min(w, 0)) - {a!r})"
+        f" + (1 - step(-w)) * ({big_a!r} - {big_c!r} / (max(w, 0) + {big_b!r}))"
+    )
+    return length, velocity
+
+
+def _millard_fibre(osim, name, f_max, l_opt, length, v_hat):
+    """One fibre as a rigid-tendon ``Millard2012EquilibriumMuscle`` with Millard's curves."""
+    out = osim.Millard2012EquilibriumMuscle(name, f_max, l_opt, TENDON_SLACK_RATIO * length, 0.0)
+    out.set_ignore_tendon_compliance(True)
+    out.set_ignore_activation_dynamics(True)
+    out.set_fiber_damping(0.0)  # the paper's fibres have no damping of their own
+    out.set_max_contraction_velocity(v_hat)
+    return out
+
+
+def _paper_fibre(osim, name, f_max, l_opt, curves, v_hat):
+    """One fibre as a ``RigidTendonMuscle`` with the paper's curves (:func:`paper_curves`) and no tendon length."""
+    out = osim.RigidTendonMuscle(name, f_max, l_opt, 0.0, 0.0)
+    out.set_max_contraction_velocity(v_hat)
+    out.set_active_force_length_curve(osim.ExpressionBasedFunction(curves[0], "x"))
+    out.set_force_velocity_curve(osim.ExpressionBasedFunction(curves[1], "w"))
+    out.set_passive_force_length_curve(osim.Constant(0.0))  # the paper's fibres have no passive force
+    return out
+
+
+def paper_osim(solution: PaperSolution, counter_torque=None, muscle: str = "millard"):
     """The OpenSim model (:class:`opensim.Model`) of the paper's chain with the solution's controls.
 
     Parameters
@@ -103,6 +194,8 @@ def paper_osim(solution: PaperSolution, counter_torque=None):
     solution : PaperSolution
     counter_torque : array_like, shape (n_cor,), optional
         The counter torques' controls [N m]; default the solution's (those of spinectl's tension).
+    muscle : {"millard", "paper"}
+        The fibres' muscle model (:data:`MUSCLES`).
 
     Returns
     -------
@@ -110,6 +203,7 @@ def paper_osim(solution: PaperSolution, counter_torque=None):
         (opensim.Model, control names, control values): activations of the fibres [1], then the
         counter torques [N m].
     """
+    check_muscle(muscle)
     osim = require_opensim()
     model, cor = solution.model, solution.cor
     n = cor.shape[0]
@@ -152,18 +246,17 @@ def paper_osim(solution: PaperSolution, counter_torque=None):
     fibres = fibre_gains(model)
     l_opt = model.fibre.optimal_length_ratio * fibres.length
     reference = REFERENCE_PCSA_CM2 * M2_PER_CM2
+    curves = paper_curves(model)
     for f, name in enumerate(fibres.names):
-        f_max = model.fibre.specific_tension * reference / np.sum(fibres.muscle == fibres.muscle[f])
-        muscle = osim.Millard2012EquilibriumMuscle(
-            name, float(f_max), float(l_opt[f]), float(TENDON_SLACK_RATIO * fibres.length[f]), 0.0
-        )
-        muscle.set_ignore_tendon_compliance(True)
-        muscle.set_ignore_activation_dynamics(True)
-        muscle.set_fiber_damping(0.0)  # the paper's fibres have no damping of their own
-        muscle.set_max_contraction_velocity(float(max_velocity(l_opt[f], model.fibre) / l_opt[f]))
-        muscle.addNewPathPoint(f"{name}_upper", bodies[0], _vec(osim, fibres.upper[f]))
-        muscle.addNewPathPoint(f"{name}_lower", out.getGround(), _vec(osim, fibres.lower[f]))
-        out.addForce(muscle)
+        f_max = float(model.fibre.specific_tension * reference / np.sum(fibres.muscle == fibres.muscle[f]))
+        v_hat = float(max_velocity(l_opt[f], model.fibre) / l_opt[f])
+        if muscle == "paper":
+            fibre = _paper_fibre(osim, name, f_max, float(l_opt[f]), curves, v_hat)
+        else:
+            fibre = _millard_fibre(osim, name, f_max, float(l_opt[f]), float(fibres.length[f]), v_hat)
+        fibre.addNewPathPoint(f"{name}_upper", bodies[0], _vec(osim, fibres.upper[f]))
+        fibre.addNewPathPoint(f"{name}_lower", out.getGround(), _vec(osim, fibres.lower[f]))
+        out.addForce(fibre)
         labels.append(name)
         values.append(float(solution.pcsa[fibres.muscle[f]] / reference))
     for k, coordinate in enumerate(model.geometry.cor_names):
@@ -189,17 +282,19 @@ def paper_osim(solution: PaperSolution, counter_torque=None):
     return out, labels, values
 
 
-def opensim_counter_torque(solution: PaperSolution) -> np.ndarray:
+def opensim_counter_torque(solution: PaperSolution, muscle: str = "millard") -> np.ndarray:
     """The counter torques that hold the posture against OpenSim's own forces [N m].
 
     Millard's tension at the posture is not the paper's (docs/interchange.md), so spinectl's
     counter torques -tau_0 leave a net torque in OpenSim. These are OpenSim's inverse dynamics
     at rest of the model with the solution's activations and no counter torque: the posture is
-    then an equilibrium of the exported model.
+    then an equilibrium of the exported model. With the ``"paper"`` muscles they are spinectl's
+    -tau_0 to rounding.
 
     Parameters
     ----------
     solution : PaperSolution
+    muscle : {"millard", "paper"}
 
     Returns
     -------
@@ -207,7 +302,7 @@ def opensim_counter_torque(solution: PaperSolution) -> np.ndarray:
         Top to bottom, as ``model.geometry.cor_names``.
     """
     osim = require_opensim()
-    built, _, _ = paper_osim(solution, np.zeros(len(solution.counter_torque)))
+    built, _, _ = paper_osim(solution, np.zeros(len(solution.counter_torque)), muscle)
     state = built.initSystem()
     built.equilibrateMuscles(state)
     built.realizeDynamics(state)
@@ -246,6 +341,7 @@ def export_osim(
     pcsa=None,
     with_local_stiffness: bool = False,
     inputs: dict | None = None,
+    muscle: str = "millard",
 ) -> PaperSolution:
     """Write the paper's model and its solution as ``.osim`` and its controls ``.sto`` beside it, atomically.
 
@@ -262,16 +358,20 @@ def export_osim(
         The chain's least local stiffness in the joints' springs.
     inputs : dict, optional
         Option name -> every file read; neither output may be one of them.
+    muscle : {"millard", "paper"}
+        The fibres' muscle model (:data:`MUSCLES`): Millard's (re-imported by ``spinectl anatomy``) or
+        the paper's curves, with which OpenSim's linearisation is the chain's.
 
     Returns
     -------
     PaperSolution
     """
+    check_muscle(muscle)
     osim = require_opensim()
     sto = controls_path(out)
     check_distinct({"--out": str(out), "controls": str(sto)}, inputs)
     solution = paper_solution(model, eccentricity, lordosis, pcsa, with_local_stiffness)
-    built, labels, values = paper_osim(solution, opensim_counter_torque(solution))
+    built, labels, values = paper_osim(solution, opensim_counter_torque(solution, muscle), muscle)
     built.initSystem()  # refuse to write what OpenSim cannot build
     table = osim.TimeSeriesTable()
     table.setColumnLabels(labels)
@@ -283,3 +383,60 @@ def export_osim(
         osim.STOFileAdapter.write(table, str(tmp_sto))
         built.printToXML(str(tmp_out))
     return solution
+
+
+STEP = (1e-6, 1e-7)
+"""Central-difference steps of :func:`opensim_linearisation`: in the angles [rad] and in the speeds [rad/s].
+The speeds' is smaller because the paper's force-velocity curve changes branch at v = 0 (its two
+curvatures differ, which leaves an error of the order of the step in a central difference)."""
+
+
+def opensim_linearisation(path, names) -> tuple:
+    """OpenSim's own linearisation of a model file about its default posture at rest, controls held.
+
+    The generalised force of every force element (muscles, springs, counter torques, gravity) is
+    minus OpenSim's inverse dynamics at zero acceleration (``InverseDynamicsSolver``); K and D are its
+    central differences in the coordinates and their speeds (:data:`STEP`), M is ``calcM``. The
+    exported muscles have no state (rigid tendon, activation = control), so (q, q') is the whole
+    state and M q'' = f0 + K q + D q' to first order (docs/chain.md's sign convention: stable when
+    the state matrix [[0, I], [M^-1 K, M^-1 D]] has only eigenvalues of negative real part).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        An ``.osim`` file.
+    names : sequence of str
+        The coordinates, in the order of the matrices' rows.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        (f0 [N m], K [N m/rad], D [N m s/rad], M [kg m^2]) over ``names``.
+    """
+    osim = require_opensim()
+    model = osim.Model(str(path))
+    state = model.initSystem()
+    coordinates = model.getCoordinateSet()
+    order = [coordinates.getIndex(name) for name in names]  # a chain of pin joints: coordinate i is mobility i
+    solver = osim.InverseDynamicsSolver(model)
+    n = len(order)
+
+    def force(q, u):
+        for k, name in enumerate(names):
+            coordinates.get(name).setValue(state, float(q[k]), False)
+            coordinates.get(name).setSpeedValue(state, float(u[k]))
+        model.realizeDynamics(state)
+        needed = solver.solve(state, osim.Vector(state.getNU(), 0.0))
+        return -np.array([needed.get(i) for i in order])
+
+    zero = np.zeros(n)
+    stiffness, damping = np.zeros((n, n)), np.zeros((n, n))
+    for j in range(n):
+        dq, du = STEP[0] * np.eye(n)[j], STEP[1] * np.eye(n)[j]
+        stiffness[:, j] = (force(dq, zero) - force(-dq, zero)) / (2 * STEP[0])
+        damping[:, j] = (force(zero, du) - force(zero, -du)) / (2 * STEP[1])
+    f0 = force(zero, zero)
+    mass = osim.Matrix()
+    model.getMatterSubsystem().calcM(state, mass)
+    full = np.array([[mass.get(i, j) for j in range(mass.ncol())] for i in range(mass.nrow())])
+    return f0, stiffness, damping, full[np.ix_(order, order)]

@@ -53,6 +53,7 @@ def export_model(
     pcsa=None,
     with_local_stiffness: bool = False,
     inputs: dict | None = None,
+    osim_muscle: str = "millard",
 ):
     """Write the paper's model at (E, Lambda) with its solution as MJCF or OpenSim.
 
@@ -71,6 +72,8 @@ def export_model(
         The chain's least local stiffness as joint springs.
     inputs : dict, optional
         Option name -> every file read; ``out`` must be none of them.
+    osim_muscle : {"millard", "paper"}
+        OpenSim only: the fibres' muscle model (:data:`spinectl.anatomy.export_osim.MUSCLES`).
 
     Returns
     -------
@@ -78,10 +81,13 @@ def export_model(
         What was exported.
     """
     kind = format_of(out, fmt)
+    options = {"pcsa": pcsa, "with_local_stiffness": with_local_stiffness, "inputs": inputs}
     if kind == "mjcf":
-        from .export_mjcf import export_mjcf as write
-    else:
-        from .export_osim import export_osim as write
-    return write(
-        model, eccentricity, lordosis, out, pcsa=pcsa, with_local_stiffness=with_local_stiffness, inputs=inputs
-    )
+        if osim_muscle != "millard":
+            raise ParameterError("osim_muscle", f"applies to the osim format only (got {printable(osim_muscle)})")
+        from .export_mjcf import export_mjcf
+
+        return export_mjcf(model, eccentricity, lordosis, out, **options)
+    from .export_osim import export_osim
+
+    return export_osim(model, eccentricity, lordosis, out, muscle=osim_muscle, **options)

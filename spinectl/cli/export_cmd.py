@@ -33,6 +33,13 @@ def register(sub) -> None:
         action="store_true",
         help="add the chain's least local stiffness as joint springs (docs/chain.md)",
     )
+    parser.add_argument(
+        "--osim-muscle",
+        choices=("millard", "paper"),
+        default="millard",
+        help="OpenSim's fibres: Millard's muscle (re-imported by spinectl anatomy) or the paper's curves "
+        "on a RigidTendonMuscle, with which OpenSim's linearisation is the chain's (default: millard)",
+    )
     parser.add_argument("--out", required=True, metavar="FILE", help="the file to write (atomically)")
     add_model_options(parser)
     parser.set_defaults(func=run)
@@ -45,7 +52,7 @@ def run(args) -> int:
     ----------
     args : argparse.Namespace
         Parsed arguments: ``E``, ``Lambda`` [m], ``format``, ``pcsa`` [cm^2], ``with_local_stiffness``,
-        ``out`` and the model options.
+        ``osim_muscle``, ``out`` and the model options.
 
     Returns
     -------
@@ -66,6 +73,7 @@ def run(args) -> int:
         pcsa=pcsa_option(args.pcsa),
         with_local_stiffness=args.with_local_stiffness,
         inputs={"--config": args.config},
+        osim_muscle=args.osim_muscle,
     )
     growth = max(solution.eigenvalues.real)
     verdict = "stable" if growth < 0 else "unstable"
