@@ -17,6 +17,7 @@ E x Lambda grid, not a list of points).
 from __future__ import annotations
 
 import dataclasses
+import functools
 import hashlib
 from pathlib import Path
 
@@ -249,23 +250,20 @@ def _field(spec: AtlasSpec, part: dict, name: str) -> np.ndarray:
 def _body_bases(spec: AtlasSpec, mass: np.ndarray, height: np.ndarray):
     """Models at which the body's terms are evaluated, and every draw's weights on them (exact for A + m q(y)).
 
-    The bases are the base mass m0 at the heights y_j (the draws' extremes and their middle, or the
-    one height of the chunk), then m0 / 2 at y_0, each with K = 1 so that K_pas is per unit K. With
-    t = m / m0 and L_j(y) the Lagrange polynomials of the heights, A + m q(y) = (1 - t) A + t sum_j
-    L_j(y) (A + m0 q(y_j)) and A = 2 f(m0 / 2, y_0) - f(m0, y_0): the weights t L_j, with 1 - t
-    taken off the first and 2 (1 - t) on the last. Within the heights the L_j lie in [-1/8, 1], so
-    the mix loses no precision.
+    The bases are the base mass m0 at the heights y_j (:func:`_heights`), then m0 / 2 at y_0, each
+    with K = 1 so that K_pas is per unit K. With t = m / m0 and L_j(y) the Lagrange polynomials of
+    the heights, A + m q(y) = (1 - t) A + t sum_j L_j(y) (A + m0 q(y_j)) and
+    A = 2 f(m0 / 2, y_0) - f(m0, y_0): the weights t L_j, with 1 - t taken off the first and
+    2 (1 - t) on the last. Within the heights the L_j lie in [-1/8, 1], so the mix loses no precision.
 
     Returns
     -------
-    bases : list of Model
+    bases : tuple of Model
     weights : numpy.ndarray, shape (n, len(bases))
         Sum to 1 in every row.
     """
-    m0 = spec.model.body.mass
-    low, high = float(height.min()), float(height.max())
-    heights = (low,) if low == high else (low, (low + high) / 2, high)
-    t = mass / m0
+    heights = _heights(spec, height)
+    t = mass / spec.model.body.mass
     weights = []
     for j, node in enumerate(heights):
         lagrange = np.ones_like(height)
@@ -275,10 +273,23 @@ def _body_bases(spec: AtlasSpec, mass: np.ndarray, height: np.ndarray):
         weights.append(t * lagrange)
     weights[0] = weights[0] - (1.0 - t)
     weights.append(2.0 * (1.0 - t))
-    fixed = {"passive.stiffness": 1.0}
-    bases = [set_parameters(spec.model, fixed | {"body.mass": m0, "body.mass_height": y}) for y in heights]
-    bases.append(set_parameters(spec.model, fixed | {"body.mass": m0 / 2, "body.mass_height": heights[0]}))
-    return bases, np.stack(weights, axis=-1)
+    return _bases(spec.model, heights), np.stack(weights, axis=-1)
+
+
+def _heights(spec: AtlasSpec, height: np.ndarray) -> tuple[float, ...]:
+    """The bases' heights: the prior's extreme draws and their middle (one set for every chunk), else the chunk's."""
+    prior = next((p for p in spec.priors if p.parameter == "body.mass_height"), None)
+    tiny = np.finfo(float).eps  # saltelli_unit's open cube: these quantiles bound every draw (and are valid heights)
+    low, high = (float(y) for y in prior.ppf([tiny, 1.0 - tiny])) if prior else (height.min(), height.max())
+    return (float(low),) if low == high else (float(low), (low + high) / 2, float(high))
+
+
+@functools.lru_cache(maxsize=4)
+def _bases(model: Model, heights: tuple[float, ...]) -> tuple[Model, ...]:
+    """The base models of :func:`_body_bases`, built once per atlas (set_parameters validates, which costs ms)."""
+    m0, fixed = model.body.mass, {"passive.stiffness": 1.0}
+    bases = [set_parameters(model, fixed | {"body.mass": m0, "body.mass_height": y}) for y in heights]
+    return (*bases, set_parameters(model, fixed | {"body.mass": m0 / 2, "body.mass_height": heights[0]}))
 
 
 def _mixed(found: list, weights: np.ndarray, k: np.ndarray):
