@@ -305,7 +305,8 @@ def _mixed(found: list, weights: np.ndarray, k: np.ndarray):
     return dataclasses.replace(found[0], **mixed)
 
 
-_LAG = "activation_time_constant"
+_REFLEX_TERMS = ("delay", "activation", "activation_time_constant")
+"""The fields of the reflex that the fast path takes per draw: tau, the activation and T_a."""
 
 _BODY_TERMS = ("gravity_torque", "gravity_stiffness", "inertia", "passive_stiffness")
 """The fields of the segment and chain coefficients that hold the body's mass or height, or K."""
@@ -319,7 +320,7 @@ def _fast_chunk(spec: AtlasSpec, part: dict) -> dict[str, np.ndarray]:
     k = _field(spec, part, "passive.stiffness")
     coeffs = _mixed([checked_coefficients(b, e, lam) for b in bases], weights, k)
     result = active_set.solve_block(problem_data(model, coeffs), model.optimisation.ct_tolerance)
-    delay, activation, lag = (_field(spec, part, f"reflex.{f}") for f in ("delay", "activation", _LAG))
+    delay, activation, lag = (_field(spec, part, f"reflex.{name}") for name in _REFLEX_TERMS)
     out = _segment_outputs(model, coeffs, result, delay, activation, lag)
     if spec.chain:
         with arithmetic_guard(e, lam):
