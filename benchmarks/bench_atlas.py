@@ -1,7 +1,7 @@
 """Benchmark: the atlas's draws on the fast path against one model per draw, over eight parameters.
 
     python benchmarks/bench_atlas.py                                  # the speed target: 8 priors, 73 728 draws
-    python benchmarks/bench_atlas.py --priors examples/atlas.toml --samples 1024 --evaluations 0
+    python benchmarks/bench_atlas.py --only-file --samples 1024 --evaluations 0   # the shipped atlas as it is
     python benchmarks/bench_atlas.py --sample 20 --chain-draws 1024   # quicker
 
 The speed target: 4096 Saltelli base samples over 8 parameters, 73 728 model evaluations (N (2D + 2),
@@ -19,7 +19,7 @@ difference of each output on the sample. Then the chain's least local stiffness 
 ``--chain-draws`` draws: the stacked SDP's cost per draw (the atlas with the chain less without),
 against the per-point reference, one cvxpy SDP per draw
 (:func:`spinectl.optimise.coupled.sdp.least_local_stiffness_at`) at the same K, on ``--sample``
-draws. Timings on a shared machine are noisy: the ratio is what matters.
+draws. Timings on a shared machine are noisy (wall-clock and CPU time are printed): the ratio is what matters.
 """
 
 from __future__ import annotations
