@@ -17,6 +17,7 @@ E x Lambda grid, not a list of points).
 from __future__ import annotations
 
 import dataclasses
+import functools
 import hashlib
 from pathlib import Path
 
@@ -40,9 +41,23 @@ from .priors import PAPER_OPTIMUM, VERDICTS, AtlasSpec
 
 INSTALL_HINT = "pip install 'spinectl[atlas]' (SALib)"
 
-FAST = ("body.mass", "passive.stiffness", "reflex.delay")
-"""Fields that the fast path varies within one stacked problem: the segment mechanics are affine in the
-body's mass (gravity and inertia), K enters as -K_pas, and the delay margin does not depend on the delay."""
+FAST = (
+    "body.mass",
+    "body.mass_height",
+    "passive.stiffness",
+    "reflex.delay",
+    "reflex.activation_time_constant",
+    "reflex.activation",
+)
+"""Fields that the fast path varies within one stacked problem (docs/atlas.md, "What each draw solves").
+
+Every term of the segment and chain mechanics that holds the body's mass m or its height y_m is
+A + m q(y_m), q a quadratic in y_m (gravity's torque m g x_k and stiffness m g (y_m - y_k), the
+inertia m ((y_m - y_k)^2 + x_k^2 + rho^2), K_pas = K theta_k in the paper's convention; A the
+levels' weight in the chain), so four models (two masses, three heights) give it exactly; K enters as
+-K_pas, linear in K; the delay margin does not depend on the delay; the activation scales the
+chosen PCSA and T_a enters the reflex loops, whose margins are computed per segment anyway, so
+both are arrays over the stack."""
 
 OUTPUTS = ("min_pcsa_cm2", "counter_torque_norm_Nm", "local_stiffness_total_Nm_per_rad", "spine_delay_margin_s")
 """The outputs whose Sobol' indices the atlas reports, named as the sweep's variables."""
@@ -225,44 +240,92 @@ def evaluate(spec: AtlasSpec, values: dict, *, method: str = "auto", update=None
     return {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
 
 
-def _base(spec: AtlasSpec, mass_factor: float):
-    """The model with K = 1 (so K_pas is per unit K) and the body's mass times ``mass_factor``."""
-    m0 = spec.model.body.mass
-    return set_parameters(spec.model, {"passive.stiffness": 1.0, "body.mass": mass_factor * m0})
+def _field(spec: AtlasSpec, part: dict, name: str) -> np.ndarray:
+    """A dotted field's value at every draw of the chunk: the drawn one, else the base model's."""
+    n = part["eccentricity_m"].size
+    section, key = name.split(".")
+    return np.asarray(part.get(name, np.full(n, getattr(getattr(spec.model, section), key))), float)
+
+
+def _body_bases(spec: AtlasSpec, mass: np.ndarray, height: np.ndarray):
+    """Models at which the body's terms are evaluated, and every draw's weights on them (exact for A + m q(y)).
+
+    The bases are the base mass m0 at the heights y_j (:func:`_heights`), then m0 / 2 at y_0, each
+    with K = 1 so that K_pas is per unit K. With t = m / m0 and L_j(y) the Lagrange polynomials of
+    the heights, A + m q(y) = (1 - t) A + t sum_j L_j(y) (A + m0 q(y_j)) and
+    A = 2 f(m0 / 2, y_0) - f(m0, y_0): the weights t L_j, with 1 - t taken off the first and
+    2 (1 - t) on the last. Within the heights the L_j lie in [-1/8, 1], so the mix loses no precision.
+
+    Returns
+    -------
+    bases : tuple of Model
+    weights : numpy.ndarray, shape (n, len(bases))
+        Sum to 1 in every row.
+    """
+    heights = _heights(spec, height)
+    t = mass / spec.model.body.mass
+    weights = []
+    for j, node in enumerate(heights):
+        lagrange = np.ones_like(height)
+        for i, other in enumerate(heights):
+            if i != j:
+                lagrange = lagrange * (height - other) / (node - other)
+        weights.append(t * lagrange)
+    weights[0] = weights[0] - (1.0 - t)
+    weights.append(2.0 * (1.0 - t))
+    return _bases(spec.model, heights), np.stack(weights, axis=-1)
+
+
+def _heights(spec: AtlasSpec, height: np.ndarray) -> tuple[float, ...]:
+    """The bases' heights: the prior's extreme draws and their middle (one set for every chunk), else the chunk's."""
+    prior = next((p for p in spec.priors if p.parameter == "body.mass_height"), None)
+    tiny = np.finfo(float).eps  # saltelli_unit's open cube: these quantiles bound every draw (and are valid heights)
+    low, high = (float(y) for y in prior.ppf([tiny, 1.0 - tiny])) if prior else (height.min(), height.max())
+    return (float(low),) if low == high else (float(low), (low + high) / 2, float(high))
+
+
+@functools.lru_cache(maxsize=4)
+def _bases(model: Model, heights: tuple[float, ...]) -> tuple[Model, ...]:
+    """The base models of :func:`_body_bases`, built once per atlas (set_parameters validates, which costs ms)."""
+    m0, fixed = model.body.mass, {"passive.stiffness": 1.0}
+    bases = [set_parameters(model, fixed | {"body.mass": m0, "body.mass_height": y}) for y in heights]
+    return (*bases, set_parameters(model, fixed | {"body.mass": m0 / 2, "body.mass_height": heights[0]}))
+
+
+def _mixed(found: list, weights: np.ndarray, k: np.ndarray):
+    """The first of ``found`` with its body's terms the weighted sums over all, and K_pas times K."""
+
+    def mix(name):
+        arrays = [getattr(c, name) for c in found]
+        w = weights.reshape(weights.shape[:1] + (1,) * (arrays[0].ndim - 1) + weights.shape[1:])
+        return sum(w[..., j] * a for j, a in enumerate(arrays))
+
+    mixed = {f.name: mix(f.name) for f in dataclasses.fields(found[0]) if f.name in _BODY_TERMS}
+    mixed["passive_stiffness"] = mixed["passive_stiffness"] * k[:, None]  # (n, n_cor) in both kinds of coefficients
+    return dataclasses.replace(found[0], **mixed)
+
+
+_REFLEX_TERMS = ("delay", "activation", "activation_time_constant")
+"""The fields of the reflex that the fast path takes per draw: tau, the activation and T_a."""
+
+_BODY_TERMS = ("gravity_torque", "gravity_stiffness", "inertia", "passive_stiffness")
+"""The fields of the segment and chain coefficients that hold the body's mass or height, or K."""
 
 
 def _fast_chunk(spec: AtlasSpec, part: dict) -> dict[str, np.ndarray]:
-    """One chunk in one stacked problem: mass-dependent terms interpolated between the body's mass and twice it."""
+    """One chunk in one stacked problem: the body's terms mixed from four models (:func:`_body_bases`), exactly."""
     model = spec.model
     e, lam = part["eccentricity_m"], part["lordosis_m"]
-    n = e.size
-    t = part.get("body.mass", np.full(n, model.body.mass)) / model.body.mass - 1.0  # affine in the mass: exact
-    k = part.get("passive.stiffness", np.full(n, model.passive.stiffness))
-    delay = part.get("reflex.delay", np.full(n, model.reflex.delay))
-    one, two = _base(spec, 1.0), _base(spec, 2.0)
-    c1, c2 = checked_coefficients(one, e, lam), checked_coefficients(two, e, lam)
-
-    def mix(a, b, scale=1.0):
-        return (a + t.reshape((n,) + (1,) * (a.ndim - 1)) * (b - a)) * scale
-
-    coeffs = dataclasses.replace(
-        c1,
-        gravity_torque=mix(c1.gravity_torque, c2.gravity_torque),
-        gravity_stiffness=mix(c1.gravity_stiffness, c2.gravity_stiffness),
-        inertia=mix(c1.inertia, c2.inertia),
-        passive_stiffness=mix(c1.passive_stiffness, c2.passive_stiffness, k[:, None]),
-    )
+    bases, weights = _body_bases(spec, _field(spec, part, "body.mass"), _field(spec, part, "body.mass_height"))
+    k = _field(spec, part, "passive.stiffness")
+    coeffs = _mixed([checked_coefficients(b, e, lam) for b in bases], weights, k)
     result = active_set.solve_block(problem_data(model, coeffs), model.optimisation.ct_tolerance)
-    out = _segment_outputs(model, coeffs, result, delay)
+    delay, activation, lag = (_field(spec, part, f"reflex.{name}") for name in _REFLEX_TERMS)
+    out = _segment_outputs(model, coeffs, result, delay, activation, lag)
     if spec.chain:
         with arithmetic_guard(e, lam):
-            h1, h2 = chain.chain_coefficients(one, e, lam), chain.chain_coefficients(two, e, lam)
-        hk = dataclasses.replace(
-            h1,
-            gravity_stiffness=mix(h1.gravity_stiffness, h2.gravity_stiffness),
-            passive_stiffness=mix(h1.passive_stiffness, h2.passive_stiffness, k[:, None]),
-        )
-        out |= _chain_outputs(spec, model, hk, result.pcsa)
+            found = [chain.chain_coefficients(b, e, lam) for b in bases]
+        out |= _chain_outputs(spec, model, _mixed(found, weights, k), result.pcsa)
     return out
 
 
@@ -283,11 +346,16 @@ def _per_draw_chunk(spec: AtlasSpec, part: dict) -> dict[str, np.ndarray]:
     return {k: np.concatenate([r[k] for r in rows]) for k in rows[0]}
 
 
-def _segment_outputs(model, coeffs, result, delay) -> dict[str, np.ndarray]:
-    """The joint-by-joint outputs of a block: min PCSA, counter torques, the exact delay margin."""
-    active = model.reflex.activation * result.pcsa
+def _segment_outputs(model, coeffs, result, delay, activation=None, lag=None) -> dict[str, np.ndarray]:
+    """The joint-by-joint outputs of a block: min PCSA, counter torques, the exact delay margin.
+
+    ``activation`` and ``lag`` (T_a [s]), one per row, in place of the model's reflex; None: the model's.
+    """
+    activation = model.reflex.activation if activation is None else np.asarray(activation, float)[:, None]
+    lag = None if lag is None else np.asarray(lag, float)[:, None]
+    active = activation * result.pcsa
     with arithmetic_guard(0.0, 0.0), guarded():
-        maps = landscape(coeffs.stiffness(active), coeffs.damping(active), coeffs.inertia, model.reflex)
+        maps = landscape(coeffs.stiffness(active), coeffs.damping(active), coeffs.inertia, model.reflex, lag=lag)
     margin = np.min(maps.delay_margin, axis=-1)
     return {
         "min_pcsa_cm2": m2_to_cm2(result.min_pcsa),

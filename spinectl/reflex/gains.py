@@ -106,7 +106,7 @@ def chain_gains(mass, stiffness, damping, local_stiffness, gain_factor, damping_
 
 
 @validated
-def resolve_gains(stiffness, damping, inertia, reflex, kp=None, kd=None):
+def resolve_gains(stiffness, damping, inertia, reflex, kp=None, kd=None, lag=None):
     """Gains per segment from the reflex settings, each optionally overridden.
 
     Parameters
@@ -118,6 +118,9 @@ def resolve_gains(stiffness, damping, inertia, reflex, kp=None, kd=None):
         ``"explicit"`` its ``kp`` and ``kd``.
     kp, kd : float, optional
         Explicit gains [N m/rad], [N m s/rad] that replace the configured ones.
+    lag : array_like, optional
+        Activation time constant T_a [s] in place of ``reflex.activation_time_constant``
+        (:func:`default_gains`'s ``lag``); None: the reflex's.
 
     Returns
     -------
@@ -126,8 +129,9 @@ def resolve_gains(stiffness, damping, inertia, reflex, kp=None, kd=None):
         one of them is NaN.
     """
     s, d, theta = as_arrays(stiffness, damping, inertia)
+    lag = reflex.activation_time_constant if lag is None else lag
     if reflex.gains == "rule":
-        kp0, kd0 = default_gains(s, d, theta, reflex.gain_factor, reflex.damping_ratio, reflex.activation_time_constant)
+        kp0, kd0 = default_gains(s, d, theta, reflex.gain_factor, reflex.damping_ratio, lag)
     else:
         kp0, kd0 = np.full(s.shape, reflex.kp), np.full(s.shape, reflex.kd)
     kp_out = kp0 if kp is None else np.full(s.shape, float(kp))

@@ -47,7 +47,7 @@ class ReflexLandscape:
 
 
 @validated
-def landscape(stiffness, damping, inertia, reflex, kp=None, kd=None) -> ReflexLandscape:
+def landscape(stiffness, damping, inertia, reflex, kp=None, kd=None, lag=None) -> ReflexLandscape:
     """Gains, exact and Padé delay margins and the stability verdict for arrays of segments.
 
     The vectorised entry point for sweeps over E x Lambda: pass S, D, theta of every
@@ -61,6 +61,9 @@ def landscape(stiffness, damping, inertia, reflex, kp=None, kd=None) -> ReflexLa
         Delay, activation time constant, Padé order and gains.
     kp, kd : float, optional
         Explicit gains overriding ``reflex``.
+    lag : array_like, optional
+        Activation time constant T_a [s] in place of ``reflex.activation_time_constant``, broadcast
+        against S (e.g. one per row of a stack of models, as the atlas's draws); None: the reflex's.
 
     Returns
     -------
@@ -70,8 +73,8 @@ def landscape(stiffness, damping, inertia, reflex, kp=None, kd=None) -> ReflexLa
         broadcast shape of S, D and theta.
     """
     s, d, theta = as_arrays(stiffness, damping, inertia)
-    lag = reflex.activation_time_constant
-    kp_, kd_ = resolve_gains(s, d, theta, reflex, kp, kd)
+    lag = reflex.activation_time_constant if lag is None else lag
+    kp_, kd_ = resolve_gains(s, d, theta, reflex, kp, kd, lag=lag)
     check_retarded(theta, d, kd_, lag)
     s, d, theta, kp_, kd_, lag = as_arrays(s, d, theta, kp_, kd_, lag)
     free = without_delay(s, d, theta, kp_, kd_, lag)  # the delay-free loop and the crossings, once for all three

@@ -72,13 +72,46 @@ def test_sobol_indices_of_a_linear_output_are_its_variance_shares():
         assert found[name]["ST"] == pytest.approx(expected, abs=0.03)
 
 
-def test_the_fast_path_is_one_model_per_draw():
-    """Mass, K and delay varied inside one stacked problem give the outputs of one model per draw (a second method)."""
-    spec = _spec()
+MORE_PRIORS = """
+[[prior]]
+parameter = "body.mass_height"
+distribution = "uniform"
+bounds = [0.28, 0.38]
+source = "s"
+[[prior]]
+parameter = "reflex.activation_time_constant"
+distribution = "uniform"
+bounds = [0.03, 0.1]
+source = "s"
+[[prior]]
+parameter = "reflex.activation"
+distribution = "uniform"
+bounds = [0.3, 0.9]
+source = "s"
+"""
+"""The three fields beyond the shipped five, so that a draw varies every field of FAST."""
+
+OTHER_PHYSICS = ("passive.convention=paper", "body.radius_of_gyration=0.05", "levels.weight_in_gravity=1")
+"""K_pas = K theta_k, a gyration radius in theta_k and the levels' weight in the chain's gravity: every body term."""
+
+
+@pytest.mark.parametrize("priors", [PRIORS, PRIORS + MORE_PRIORS], ids=["five", "eight"])
+@pytest.mark.parametrize("assignments", [(), OTHER_PHYSICS], ids=["base", "other-physics"])
+def test_the_fast_path_is_one_model_per_draw(priors, assignments):
+    """Every field of FAST varied inside one stacked problem gives the outputs of one model per draw (a second method).
+
+    The eight priors vary all of FAST at once (the mass and its height mixed from four models,
+    the activation and T_a as arrays); the other physics puts every term of the body in play.
+    Agreement to rtol 1e-9 (rounding of the mix); the chain's SDP to its tolerance.
+    """
+    head = "[atlas]\nsamples = 4\nseed = 0\nchain = true\nchunk_size = 16\n"
+    spec = parse_atlas(head + priors, assignments=assignments)
+    assert {p.parameter for p in spec.priors if "." in p.parameter} <= set(atlas.FAST)
     values = atlas.draw(spec, atlas.saltelli_unit(spec))
     fast, reference = atlas.evaluate(spec, values, method="fast"), atlas.evaluate(spec, values, method="per-draw")
     for name in ("min_pcsa_cm2", "counter_torque_norm_Nm", "spine_delay_margin_s", "delay_s"):
         np.testing.assert_allclose(fast[name], reference[name], rtol=1e-9, atol=1e-12)
+    np.testing.assert_array_equal(fast["status"], reference["status"])
     np.testing.assert_allclose(  # the stacked SDP holds each point's optimum to its tolerance (stacked_sdp)
         fast["local_stiffness_total_Nm_per_rad"], reference["local_stiffness_total_Nm_per_rad"], rtol=1e-4
     )
