@@ -325,7 +325,8 @@ def _fast_chunk(spec: AtlasSpec, part: dict) -> dict[str, np.ndarray]:
     if spec.chain:
         with arithmetic_guard(e, lam):
             found = [chain.chain_coefficients(b, e, lam) for b in bases]
-        out |= _chain_outputs(spec, model, _mixed(found, weights, k), result.pcsa)
+        active = activation[:, None] * result.pcsa
+        out |= _chain_outputs(spec, model, _mixed(found, weights, k), active)
     return out
 
 
@@ -341,7 +342,8 @@ def _per_draw_chunk(spec: AtlasSpec, part: dict) -> dict[str, np.ndarray]:
         row = _segment_outputs(model, coeffs, result, np.array([model.reflex.delay]))
         if spec.chain:
             with arithmetic_guard(e, lam):
-                row |= _chain_outputs(spec, model, chain.chain_coefficients(model, e, lam), result.pcsa)
+                active = model.reflex.activation * result.pcsa
+                row |= _chain_outputs(spec, model, chain.chain_coefficients(model, e, lam), active)
         rows.append(row)
     return {k: np.concatenate([r[k] for r in rows]) for k in rows[0]}
 
@@ -368,7 +370,11 @@ def _segment_outputs(model, coeffs, result, delay, activation=None, lag=None) ->
 
 
 def _chain_outputs(spec: AtlasSpec, model, coefficients, pcsa) -> dict[str, np.ndarray]:
-    """The chain's least local stiffness at the chosen activation (problem (a), docs/chain.md), and its limit."""
+    """The chain's least local stiffness with the global muscles at ``pcsa`` (problem (a), docs/chain.md); its limit.
+
+    The callers pass the draw's chosen activation times its minimum PCSA: the co-contraction the draw holds, which
+    its delay margin also uses, so that the local muscles supply what that activation leaves.
+    """
     from ..optimise import coupled  # cvxpy only where the chain's SDP is asked for
 
     stiffness = coefficients.stiffness(np.nan_to_num(pcsa))

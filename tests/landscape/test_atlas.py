@@ -10,7 +10,11 @@ from scipy import stats
 
 from spinectl.landscape import atlas
 from spinectl.landscape.priors import parse_atlas
+from spinectl.model import chain
 from spinectl.model.clinical import lordosis_from_angle
+from spinectl.model.config import set_parameters
+from spinectl.optimise.coupled.sdp import least_local_stiffness_at
+from spinectl.optimise.reference import solve_point
 
 PRIORS = """
 [[prior]]
@@ -115,6 +119,28 @@ def test_the_fast_path_is_one_model_per_draw(priors, assignments):
     np.testing.assert_allclose(  # the stacked SDP holds each point's optimum to its tolerance (stacked_sdp)
         fast["local_stiffness_total_Nm_per_rad"], reference["local_stiffness_total_Nm_per_rad"], rtol=1e-4
     )
+
+
+def test_the_chains_local_stiffness_is_at_the_drawn_activation():
+    """A draw's least local stiffness is problem (a) with the global muscles at its activation x its minimum PCSA.
+
+    The second method: the per-point reference optimum (solve_point) of the draw's own model, scaled by
+    the drawn activation, in the chain's K of that model, solved by the per-point SDP (least_local_stiffness_at).
+    With the activation a prior, the minimum PCSA alone (activation 1) gives another answer.
+    """
+    head = "[atlas]\nsamples = 2\nseed = 3\nchain = true\nchunk_size = 16\n"
+    spec = parse_atlas(head + PRIORS + MORE_PRIORS)
+    values = atlas.draw(spec, atlas.saltelli_unit(spec))
+    found = atlas.evaluate(spec, values, method="fast")["local_stiffness_total_Nm_per_rad"]
+    fields = [name for name in values if "." in name]
+    for i in range(3):
+        model = set_parameters(spec.model, {f: float(values[f][i]) for f in fields})
+        e, lam = float(values["eccentricity_m"][i]), float(values["lordosis_m"][i])
+        active = model.reflex.activation * solve_point(model, e, lam).pcsa  # per muscle [m^2]
+        stiffness = chain.chain_coefficients(model, e, lam).stiffness(active)
+        status, k = least_local_stiffness_at(stiffness, model.optimisation.stability_margin)
+        assert status == "optimal"
+        assert found[i] == pytest.approx(np.sum(k), rel=1e-4)  # the SDPs' tolerance (stacked_sdp)
 
 
 def test_draws_convert_the_angle_with_the_spline():
