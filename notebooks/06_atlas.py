@@ -2,10 +2,11 @@
 # # A population stability atlas: how likely is a person's spine self-stable?
 #
 # The paper answers for one geometry, its optimum at $E \approx 3$ cm and $\Lambda \approx 4$ cm; its discussion is
-# about people ("hypo- or hyperlordosis"). This notebook draws a cohort from the published distributions of
-# `examples/atlas.toml` (the lordosis angle of 627 adults, the gravity line's distance, the upper body's mass, the
-# passive stiffness, the reflex delay), solves every draw joint by joint (each CoR alone, the others fixed: the
-# paper's criterion) and for the chain (all CoRs free), and asks
+# about people ("hypo- or hyperlordosis"). This notebook draws a cohort from the eight priors of
+# `examples/atlas.toml` (the lordosis angle of 627 adults, the gravity line's distance, the upper body's mass and
+# its height, the passive stiffness, the reflex delay, the activation lag, the co-contraction; each row names its
+# source, and five say why they are not yet cohort distributions), solves every draw joint by joint (each CoR
+# alone, the others fixed: the paper's criterion) and for the chain (all CoRs free), and asks
 #
 # - how likely each verdict is, with Wilson intervals;
 # - which parameter decides each output: Sobol' first- and total-order indices (SALib, Saltelli's design);

@@ -19,6 +19,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import hashlib
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -472,15 +473,19 @@ def sobol_indices(spec: AtlasSpec, y: np.ndarray) -> dict | None:
         return None
     if np.ptp(y) == 0:  # no variance to share out
         return {name: {"S1": 0.0, "S1_conf": 0.0, "ST": 0.0, "ST_conf": 0.0} for name in spec.names}
-    found = sobol.analyze(
-        _problem(len(spec.priors)),
-        y,
-        calc_second_order=False,
-        num_resamples=spec.bootstrap,
-        conf_level=spec.confidence,
-        print_to_console=False,
-        seed=spec.seed + 1,  # SALib 1.6 seeds its bootstrap only `if seed:`, so seed 0 was no seed at all
-    )
+    with warnings.catch_warnings():
+        # y itself varies (above); SALib also warns when a bootstrap resample of a rare verdict holds no
+        # variance. Those resamples widen the interval, which is the answer: a rare verdict is poorly resolved.
+        warnings.filterwarnings("ignore", "Constant values encountered", UserWarning)
+        found = sobol.analyze(
+            _problem(len(spec.priors)),
+            y,
+            calc_second_order=False,
+            num_resamples=spec.bootstrap,
+            conf_level=spec.confidence,
+            print_to_console=False,
+            seed=spec.seed + 1,  # SALib 1.6 seeds its bootstrap only `if seed:`, so seed 0 was no seed at all
+        )
     keys = ("S1", "S1_conf", "ST", "ST_conf")
     return {name: {k: float(found[k][i]) for k in keys} for i, name in enumerate(spec.names)}
 
