@@ -531,6 +531,30 @@ class OsimAnatomy(Anatomy):
         Each muscle's class.
     """
 
+    def control_bounds(self) -> tuple:
+        """Each muscle's control bounds: [0, 1] (OpenSim's activations).
+
+        Returns
+        -------
+        tuple
+            (lower, upper), numpy.ndarray of shape (m,).
+        """
+        return np.zeros(len(self.muscles)), np.ones(len(self.muscles))
+
+    @property
+    def control_unit(self) -> str:
+        """The muscles' control unit: ``1`` (activations)."""
+        return "1"
+
+    def default_controls(self) -> np.ndarray:
+        """The activations analysed when none are given: 0.
+
+        Returns
+        -------
+        numpy.ndarray, shape (m,)
+        """
+        return np.zeros(len(self.muscles))
+
     def posture(self, posture=None) -> dict:
         """The posture: the coordinates' default values, or those given.
 

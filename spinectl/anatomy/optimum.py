@@ -38,8 +38,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ParameterError
+from ..errors import ModelError, ParameterError
 from ..model.linear_chain import LinearChain
+from .engine import require_mujoco
 from .linearise import rhythm
 from .model import Anatomy
 
@@ -62,12 +63,18 @@ def volume_weights(anatomy: Anatomy) -> np.ndarray:
     -------
     numpy.ndarray, shape (m,)
     """
-    model = anatomy.engine.model
-    gain = model.actuator_gainprm
-    lr = model.actuator_lengthrange
+    mujoco = require_mujoco()
+    model, ids = anatomy.engine.model, anatomy.engine.muscle_ids()
+    if np.any(model.actuator_dyntype[ids] != mujoco.mjtDyn.mjDYN_MUSCLE):
+        raise ModelError(
+            f"{anatomy.name}: the optimum's volume weights need MuJoCo muscles (their F0 and L0); its muscles "
+            "are general actuators (spinectl's export: analyse it without --optimise and --lordosis)"
+        )
+    gain = model.actuator_gainprm[ids]
+    lr = model.actuator_lengthrange[ids]
     # MuJoCo's muscle: L0 = (lengthrange span) / (operating range span); F0 = force, or scale / acc0 if force < 0
     length0 = (lr[:, 1] - lr[:, 0]) / (gain[:, 1] - gain[:, 0])
-    force0 = np.where(gain[:, 2] > 0, gain[:, 2], gain[:, 3] / model.actuator_acc0)
+    force0 = np.where(gain[:, 2] > 0, gain[:, 2], gain[:, 3] / model.actuator_acc0[ids])
     volume = force0 * length0
     return volume / volume.mean()
 

@@ -29,9 +29,11 @@ def register(sub) -> None:
     parser.add_argument(
         "--activation",
         type=finite_float("--activation"),
-        default=0.0,
+        default=None,
         metavar="A",
-        help="activation of every muscle, in [0, 1] (default: 0)",
+        help="activation of every muscle, in [0, 1] (or its control, e.g. a PCSA in cm^2 in spinectl's "
+        "export) (default: the controls of the model's keyframe 0 if it has one, the solution of "
+        "spinectl's export; else 0)",
     )
     parser.add_argument(
         "--joint-stiffness",
