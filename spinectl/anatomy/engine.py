@@ -96,7 +96,12 @@ class Engine:
         """
         mujoco = require_mujoco()
         obj = getattr(mujoco.mjtObj, f"mjOBJ_{kind.upper()}")
-        count = {"joint": self.model.njnt, "body": self.model.nbody, "actuator": self.model.nu}[kind]
+        count = {
+            "joint": self.model.njnt,
+            "body": self.model.nbody,
+            "actuator": self.model.nu,
+            "geom": self.model.ngeom,
+        }[kind]
         return [mujoco.mj_id2name(self.model, obj, int(i)) or "" for i in (range(count) if ids is None else ids)]
 
     @property

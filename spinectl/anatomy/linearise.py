@@ -254,12 +254,14 @@ def linearise(engine: Engine, qpos, dofs, n: int) -> Linearisation:
     mass = engine.mass_matrix()
     hessian = np.zeros((nu, s, s))
     dgravity = np.zeros((s, s))
+    contacts = d.ten_wrapnum.copy()  # path points of every tendon: 2 more per wrap geom it touches
     for k, dof in enumerate(dofs):
         sides = []
         for sign in (1.0, -1.0):
             q = qpos.copy()
             q[model.dof_jntid[dof]] += sign * STEP
             engine.set_state(q)
+            _same_contacts(engine, contacts, int(model.dof_jntid[dof]))
             # gravity and every passive force: joint and tendon springs, gravity compensation (mj_passive)
             sides.append((engine.moment_arms()[:, dofs], (d.qfrc_passive - d.qfrc_bias)[dofs].copy()))
         hessian[:, :, k] = (sides[0][0] - sides[1][0]) / (2 * STEP)
@@ -288,7 +290,29 @@ def linearise(engine: Engine, qpos, dofs, n: int) -> Linearisation:
     )
 
 
-def _chain(lin: Linearisation, rows, T, joints, controls, classes, added, source, curvature=None, bounds=None, unit="1"):
+def _same_contacts(engine: Engine, contacts, joint: int) -> None:
+    """A muscle's tendon that touches a wrap geom on one side of the posture only has a kinked moment arm: one line."""
+    mujoco = require_mujoco()
+    model, d = engine.model, engine.data
+    for i in engine.muscle_ids():
+        t = int(model.actuator_trnid[i, 0])
+        if d.ten_wrapnum[t] == contacts[t]:
+            continue
+        span = range(model.tendon_adr[t], model.tendon_adr[t] + model.tendon_num[t])
+        wraps = (int(mujoco.mjtWrap.mjWRAP_SPHERE), int(mujoco.mjtWrap.mjWRAP_CYLINDER))
+        geoms = [int(model.wrap_objid[w]) for w in span if int(model.wrap_type[w]) in wraps]
+        engine.set_state(model.qpos0)  # leave the engine at a posture of the model
+        raise ModelError(
+            f"{engine.name}: muscle {engine.names('actuator', [i])[0]} starts or stops wrapping over "
+            f"{', '.join(engine.names('geom', geoms)) or 'a wrap geom'} within {STEP:g} rad of the posture "
+            f"({engine.names('joint', [joint])[0]}): its moment arm has a kink there, which the linearisation "
+            "cannot differentiate; nothing was linearised (move the posture off the contact)"
+        )
+
+
+def _chain(
+    lin: Linearisation, rows, T, joints, controls, classes, added, source, curvature=None, bounds=None, unit="1"
+):
     """A LinearChain of the linearisation reduced by T (the free chain: T selects the chain's rows)."""
     k_per = np.einsum("ai,abm,bj->ijm", T, lin.stiffness_per_muscle[np.ix_(rows, rows)], T)
     k_0 = T.T @ lin.stiffness_offset[np.ix_(rows, rows)] @ T - T.T @ np.diag(added) @ T

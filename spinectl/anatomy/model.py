@@ -91,7 +91,7 @@ class Anatomy:
 
     @property
     def control_unit(self) -> str:
-        """The muscles' control unit: the model's custom text ``control_unit`` (spinectl's export: ``cm^2``), else ``1``."""
+        """The muscles' control unit: the model's custom text ``control_unit`` (the export's ``cm^2``), else ``1``."""
         mujoco = require_mujoco()
         model = self.engine.model
         t = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXT, CONTROL_UNIT)
@@ -213,7 +213,14 @@ class Anatomy:
         free = free_chain(lin, involved[:n], self.muscles, self.classes, added, source, **controls)
         full_added = np.concatenate([added, np.zeros(len(involved) - n)])
         constrained = constrained_chain(
-            lin, rhy, involved, self.muscles, self.classes, full_added, source + ", constrained by the rhythm", **controls
+            lin,
+            rhy,
+            involved,
+            self.muscles,
+            self.classes,
+            full_added,
+            source + ", constrained by the rhythm",
+            **controls,
         )
         return free, constrained, lin
 

@@ -115,3 +115,49 @@ def test_cli_analyses_the_export_and_refuses_what_it_cannot(imported, capsys):
         assert main(["anatomy", str(path), "--no-cache", *extra]) == 2
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and err.startswith("spinectl: error:")
+
+
+def _with_wrap(path, out, offset):
+    """The export with a cylinder (axis along the hinges, radius 1 cm) on the pelvis, its centre ``offset`` beside
+    straight_ventral_0's straight path at mid-height, in that fibre's tendon: MuJoCo's own wrapping."""
+    text = path.read_text()
+    m = mujoco.MjModel.from_xml_path(str(path))
+    d = mujoco.MjData(m)
+    mujoco.mj_forward(m, d)
+    top, bottom = (
+        d.site_xpos[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, f"straight_ventral_0_{s}")]
+        for s in ("upper", "lower")
+    )
+    centre = 0.5 * (top + bottom) + np.array([offset, 0.0, 0.0])  # the fibre runs along z
+    geom = (
+        f'<geom name="belly" type="cylinder" size="0.01 0.1" pos="{" ".join(repr(float(v)) for v in centre)}" '
+        'euler="1.5707963267948966 0 0" contype="0" conaffinity="0"/>'
+    )
+    text = text.replace('<body name="ground">', f'<body name="ground">\n{geom}', 1)
+    text = text.replace(
+        '<site site="straight_ventral_0_upper" />', '<site site="straight_ventral_0_upper" />\n<geom geom="belly" />', 1
+    )
+    out.write_text(text)
+    return out
+
+
+def test_a_wrap_touched_at_the_posture_is_named_and_refused(imported, tmp_path, capsys):
+    """A wrap cylinder tangent to straight_ventral_0's path at the posture (centre one radius beside it): MuJoCo's
+    tendon wraps on one side of L5S1 = 0 only (ten_wrapnum changes), so the moment arm has a kink there; the CLI
+    names the muscle, the geom and the joint, one line, exit 2, nothing on stdout. The same cylinder pushed into
+    the path (half a radius beside it) is wrapped on both sides and linearised: the fibre's moment arm about L5S1
+    is then MuJoCo's (ten_J) at the posture."""
+    *_, path = imported
+    tangent = _with_wrap(path, tmp_path / "tangent.xml", 0.01)
+    assert main(["anatomy", str(tangent), "--no-cache"]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == "" and captured.err.count("\n") == 1
+    assert all(word in captured.err for word in ("straight_ventral_0", "belly", "L5S1"))
+    inside = anatomy.load(_with_wrap(path, tmp_path / "inside.xml", 0.005), cache=False)
+    _, _, lin = inside.chains()
+    m, d = inside.engine.model, inside.engine.data
+    inside.engine.set_state(m.qpos0)
+    jacobian = np.zeros((m.ntendon, m.nv))
+    mujoco.mju_sparse2dense(jacobian, d.ten_J, m.ten_J_rownnz, m.ten_J_rowadr, m.ten_J_colind)
+    assert d.ten_wrapnum[0] == 4  # wrapped: two tangent points beside the two sites
+    np.testing.assert_allclose(lin.moment_arms[0], jacobian[0], rtol=1e-12)
