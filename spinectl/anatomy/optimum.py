@@ -461,10 +461,40 @@ def lordosis_posture(anatomy: Anatomy, degrees: float, plane: str = "sagittal") 
     numpy.ndarray, shape (nq,)
     """
     lin, rhy, _ = anatomy.linearise(plane)
-    direction = rhy.transform[:, 0]
     q = anatomy.posture()
-    q[list(rhy.dofs)] += direction * np.radians(degrees) / direction[: lin.n].sum()
+    q[list(rhy.dofs)] += lordosis_direction(anatomy, rhy, lin.n, degrees)
     return q
+
+
+def lordosis_direction(anatomy: Anatomy, rhy, n: int, degrees: float) -> np.ndarray:
+    """The change of the involved joints' angles [rad] that moves the chain by ``degrees`` along the rhythm.
+
+    The rhythm's first independent coordinate and the joints it slaves move as its column of T;
+    a chain whose first joint no rhythm ties to another has no lordosis to move along (one line).
+
+    Parameters
+    ----------
+    anatomy : Anatomy
+        The model (for its name).
+    rhy : spinectl.anatomy.linearise.Rhythm
+        The rhythm over the involved joints, the chain's n first.
+    n : int
+        The number of chain joints.
+    degrees : float
+        The change of the chain's summed angle [deg].
+
+    Returns
+    -------
+    numpy.ndarray, shape (len(rhy.dofs),)
+    """
+    direction = rhy.transform[:, 0]
+    if n > 1 and np.count_nonzero(direction[:n]) < 2:
+        raise ModelError(
+            f"lordosis: {anatomy.name} has no rhythm (joint equality or coordinate coupler) that ties its chain's "
+            "first joint to the others, so the chain has no lordosis to move along; give the model one "
+            "(spinectl's export: export it at another Lambda)"
+        )
+    return direction * np.radians(degrees) / direction[:n].sum()
 
 
 def lordosis_curve(
@@ -477,10 +507,13 @@ def lordosis_curve(
 ) -> dict:
     """The three optima (classic, joint by joint, the chain) over the lordosis.
 
+    On an OpenSim model the postures are :func:`spinectl.anatomy.opensim_engine.lordosis_posture`'s
+    (its couplers as the rhythm) and the optima :func:`spinectl.anatomy.opensim_engine.optimise`'s.
+
     Parameters
     ----------
     anatomy : Anatomy
-        The model.
+        The model (MuJoCo's or OpenSim's).
     degrees : array_like
         Changes of the chain's summed angle about the reference posture [deg].
     plane, margin, joint_stiffness, equilibrium
@@ -492,20 +525,28 @@ def lordosis_curve(
         ``lordosis_deg`` and, per criterion (``none``, ``joints``, ``chain``), ``cost``,
         ``status`` and ``margin_Nm_per_rad`` (the least eigenvalue of -K) lists.
     """
+    from .opensim_engine import OsimAnatomy
+
     degrees = np.asarray(degrees, float)
+    if isinstance(anatomy, OsimAnatomy):  # the same curve on OpenSim's chain, its couplers as the rhythm
+        from .opensim_engine import lordosis_posture as posture_at
+        from .opensim_engine import optimise as optimise_at
+    else:
+        posture_at, optimise_at = lordosis_posture, optimise
+    postures = [posture_at(anatomy, d, plane) for d in degrees]
     out = {"lordosis_deg": degrees.tolist()}
     for criterion in ("none", "joints", "chain"):
         rows = [
-            optimise(
+            optimise_at(
                 anatomy,
-                plane,
-                criterion,
-                margin,
-                lordosis_posture(anatomy, d, plane),
-                joint_stiffness,
+                plane=plane,
+                stability=criterion,
+                margin=margin,
+                posture=posture,
+                joint_stiffness=joint_stiffness,
                 equilibrium=equilibrium,
             )
-            for d in degrees
+            for posture in postures
         ]
         out[criterion] = {
             "cost": [r.cost for r in rows],
