@@ -770,6 +770,29 @@ def lordosis_posture(anatomy: OsimAnatomy, degrees: float, plane: str = "sagitta
     return {n: anatomy.engine.coordinate(n).getDefaultValue() + float(v) for n, v in zip(involved, step, strict=True)}
 
 
+def lordosis_curve(anatomy: OsimAnatomy, degrees, **options) -> dict:
+    """The three optima over the lordosis on OpenSim's chain (:func:`spinectl.anatomy.optimum.lordosis_curve`).
+
+    The postures are :func:`lordosis_posture`'s (the couplers as the rhythm), the optima :func:`optimise`'s.
+
+    Parameters
+    ----------
+    anatomy : OsimAnatomy
+    degrees : array_like
+        Changes of the chain's summed angle [deg].
+    **options
+        ``plane``, ``margin``, ``joint_stiffness``, ``equilibrium``.
+
+    Returns
+    -------
+    dict
+        As :func:`spinectl.anatomy.optimum.lordosis_curve`.
+    """
+    from .optimum import lordosis_curve as curve
+
+    return curve(anatomy, degrees, posture_at=lordosis_posture, optimise_at=optimise, **options)
+
+
 def optimised(
     anatomy: OsimAnatomy,
     plane="sagittal",

@@ -504,20 +504,23 @@ def lordosis_curve(
     margin: float = MARGIN,
     joint_stiffness="none",
     equilibrium: str = "rhythm",
+    posture_at=None,
+    optimise_at=None,
 ) -> dict:
     """The three optima (classic, joint by joint, the chain) over the lordosis.
-
-    On an OpenSim model the postures are :func:`spinectl.anatomy.opensim_engine.lordosis_posture`'s
-    (its couplers as the rhythm) and the optima :func:`spinectl.anatomy.opensim_engine.optimise`'s.
 
     Parameters
     ----------
     anatomy : Anatomy
-        The model (MuJoCo's or OpenSim's).
+        The model.
     degrees : array_like
         Changes of the chain's summed angle about the reference posture [deg].
     plane, margin, joint_stiffness, equilibrium
         As in :func:`optimise`.
+    posture_at, optimise_at : callable, optional
+        The engine's posture at a lordosis and its optimum there; default MuJoCo's,
+        :func:`lordosis_posture` and :func:`optimise` (OpenSim's:
+        :func:`spinectl.anatomy.opensim_engine.lordosis_curve`).
 
     Returns
     -------
@@ -525,14 +528,9 @@ def lordosis_curve(
         ``lordosis_deg`` and, per criterion (``none``, ``joints``, ``chain``), ``cost``,
         ``status`` and ``margin_Nm_per_rad`` (the least eigenvalue of -K) lists.
     """
-    from .opensim_engine import OsimAnatomy
-
     degrees = np.asarray(degrees, float)
-    if isinstance(anatomy, OsimAnatomy):  # the same curve on OpenSim's chain, its couplers as the rhythm
-        from .opensim_engine import lordosis_posture as posture_at
-        from .opensim_engine import optimise as optimise_at
-    else:
-        posture_at, optimise_at = lordosis_posture, optimise
+    posture_at = lordosis_posture if posture_at is None else posture_at
+    optimise_at = optimise if optimise_at is None else optimise_at
     postures = [posture_at(anatomy, d, plane) for d in degrees]
     out = {"lordosis_deg": degrees.tolist()}
     for criterion in ("none", "joints", "chain"):
