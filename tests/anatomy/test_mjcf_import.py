@@ -161,3 +161,16 @@ def test_a_wrap_touched_at_the_posture_is_named_and_refused(imported, tmp_path, 
     mujoco.mju_sparse2dense(jacobian, d.ten_J, m.ten_J_rownnz, m.ten_J_rowadr, m.ten_J_colind)
     assert d.ten_wrapnum[0] == 4  # wrapped: two tangent points beside the two sites
     np.testing.assert_allclose(lin.moment_arms[0], jacobian[0], rtol=1e-12)
+
+
+def test_a_mapping_naming_joints_the_export_lacks_is_one_line(imported, tmp_path, capsys):
+    """A mapping whose chain names a joint the MJCF lacks (L9L10): one line naming it, exit 2, nothing on stdout."""
+    *_, path = imported
+    mapping = tmp_path / "bad.toml"
+    mapping.write_text(
+        '[bodies]\npelvis = ["ground"]\nvertebrae = ["vertebra_above_L5S1"]\nthorax = ["thorax"]\n'
+        '[planes]\nsagittal = ["L5S1", "L9L10"]\n'
+    )
+    assert main(["anatomy", str(path), "--mapping", str(mapping), "--no-cache"]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == "" and captured.err.count("\n") == 1 and "L9L10" in captured.err
