@@ -173,7 +173,7 @@ def body_groups(engine: Engine, mapping: Mapping) -> dict:
 
 
 def muscle_bodies(engine: Engine) -> list:
-    """For each muscle (:meth:`Engine.muscle_ids`), the set of body ids its tendon's sites are fixed to.
+    """The bodies each muscle's tendon sites are fixed to (:meth:`~spinectl.anatomy.engine.Engine.muscle_ids`).
 
     Parameters
     ----------
@@ -213,7 +213,7 @@ def classify(engine: Engine, mapping: Mapping) -> tuple:
     Returns
     -------
     tuple of str
-        One class per muscle (:meth:`Engine.muscle_ids`).
+        One class per muscle (:meth:`~spinectl.anatomy.engine.Engine.muscle_ids`).
     """
     groups = body_groups(engine, mapping)
     out = []
