@@ -44,15 +44,22 @@ def activations(anatomy: Anatomy, activation) -> np.ndarray:
     ----------
     anatomy : Anatomy
         The model.
-    activation : float, array_like or dict
-        Activations in [0, 1].
+    activation : float, array_like, dict or None
+        Activations in [0, 1] (MuJoCo's muscles; other muscles' controls within
+        :meth:`~spinectl.anatomy.model.Anatomy.control_bounds`, e.g. a PCSA [cm^2] of spinectl's
+        export); None: the model's keyframe 0 (:meth:`~spinectl.anatomy.model.Anatomy.default_controls`).
 
     Returns
     -------
     numpy.ndarray, shape (m,)
     """
     m = len(anatomy.muscles)
-    if isinstance(activation, dict):
+    lower, upper = anatomy.control_bounds()
+    unit = anatomy.control_unit
+    allowed = "[0, 1]" if unit == "1" else f"[{lower.min():g}, {upper.max():g}] {unit}"
+    if activation is None:
+        a = anatomy.default_controls()
+    elif isinstance(activation, dict):
         unknown = sorted(set(activation) - set(anatomy.muscles))
         if unknown:
             raise ParameterError("activation", f"names muscles that {anatomy.name} lacks: {unknown[:5]}")
@@ -61,9 +68,9 @@ def activations(anatomy: Anatomy, activation) -> np.ndarray:
         try:
             a = np.broadcast_to(np.asarray(activation, float), (m,)).copy()
         except (TypeError, ValueError):
-            raise ParameterError("activation", f"must be one number or {m} numbers in [0, 1]") from None
-    if not np.all(np.isfinite(a)) or np.any(a < 0) or np.any(a > 1):
-        raise ParameterError("activation", f"must be in [0, 1] (got {a.min():g} ... {a.max():g})")
+            raise ParameterError("activation", f"must be one number or {m} numbers in {allowed}") from None
+    if not np.all(np.isfinite(a)) or np.any(a < lower) or np.any(a > upper):
+        raise ParameterError("activation", f"must be in {allowed} (got {a.min():g} ... {a.max():g})")
     return a
 
 
@@ -254,8 +261,11 @@ def referee_model(anatomy: Anatomy, chain: LinearChain, a, added) -> tuple:
     model.opt.disableflags |= flags.mjDSBL_EULERDAMP
     model.opt.integrator = mujoco.mjtIntegrator.mjINT_EULER
     data = mujoco.MjData(model)
-    data.act[:] = a
-    data.ctrl[:] = a  # muscle dynamics drive act to ctrl: held
+    ctrl = anatomy.engine.held_controls()  # the actuators that are no muscle at their held controls
+    ctrl[anatomy.engine.muscle_ids()] = a
+    data.ctrl[:] = ctrl
+    stateful = model.actuator_actadr >= 0
+    data.act[model.actuator_actadr[stateful]] = ctrl[stateful]  # muscle dynamics drive act to ctrl: held
     mujoco.mj_forward(model, data)
     # held by constant torques where the posture is no equilibrium: off one, a step's
     # derivative would also hold dM^-1/dq times the net torque, which K = dtau/dq leaves out
@@ -384,6 +394,8 @@ class AnatomyResult:
     simulated_rate : float
         With ``check``: the rate fitted to MuJoCo's simulation started along the free chain's
         mode of largest real eigenvalue (:func:`mujoco_growth_rate`; NaN if that is complex) [1/s].
+    control_unit : str
+        The unit of ``activations``: ``"1"``, or e.g. ``"cm^2"`` (a PCSA, spinectl's export).
     """
 
     model: dict
@@ -398,6 +410,7 @@ class AnatomyResult:
     mujoco_eigenvalues: np.ndarray | None = field(default=None)
     simulated_rate: float = float("nan")
     reflex: dict | None = None
+    control_unit: str = "1"
 
     def referee_error(self) -> float:
         """Largest relative difference between spinectl's and MuJoCo's eigenvalues, matched one to one.
@@ -438,6 +451,7 @@ class AnatomyResult:
             "global_null_space": cert.null_space.T.tolist(),
             "null_space_stiffness_Nm_per_rad": cert.null_space_stiffness.tolist(),
             "activation_mean": float(self.activations.mean()),
+            "control_unit": self.control_unit,
             "stiffness_matrix_Nm_per_rad": free.stiffness.tolist(),
             "damping_matrix_Nms_per_rad": free.damping.tolist(),
             "mass_matrix_kgm2": free.mass.tolist(),
@@ -483,7 +497,11 @@ class AnatomyResult:
         counts = ", ".join(f"{len(v)} {k}" for k, v in self.muscles.items())
         lines = [
             f"{self.model['name']} ({self.model['source']}), {self.plane} plane, "
-            f"mean activation {self.activations.mean():.3g}",
+            + (
+                f"mean activation {self.activations.mean():.3g}"
+                if self.control_unit == "1"
+                else f"mean control {self.activations.mean():.4g} {self.control_unit}"
+            ),
             f"muscles: {counts}; global muscles' moment-arm rank {cert.rank} of {len(free.joints)} "
             f"(singular values {', '.join(f'{s:.3g}' for s in cert.singular_values)} m/rad)",
             f"joint stiffness added: {self.joint_stiffness_added[0]:.4g} N m/rad per joint",
@@ -579,8 +597,8 @@ def analyse(
         From :func:`spinectl.anatomy.load`.
     plane : str
         One of the mapping's planes.
-    activation : float, array_like or dict
-        Activations in [0, 1] (:func:`activations`).
+    activation : float, array_like, dict or None
+        Activations in [0, 1] (:func:`activations`); None: the model's keyframe 0's, else 0.
     posture : array_like, optional
         Full qpos; default the model's reference posture.
     joint_stiffness : {"none", "mapped"} or float
@@ -625,4 +643,5 @@ def analyse(
         mujoco_eigenvalues=referee,
         simulated_rate=rate,
         reflex=None if reflex is None else reflex_margin(free, a, *reflex),
+        control_unit=anatomy.control_unit,
     )

@@ -108,7 +108,7 @@ def sagittal_projection(anatomy: Anatomy, posture=None) -> SagittalProjection:
     points = data.wrap_xpos.reshape(-1, 3) @ basis.T
     objects = data.wrap_obj.reshape(-1)
     segments = []
-    for i in range(model.nu):
+    for i in anatomy.engine.muscle_ids():
         tendon = int(model.actuator_trnid[i, 0])
         start, count = int(data.ten_wrapadr[tendon]), int(data.ten_wrapnum[tendon])
         pts, obj = points[start : start + count], objects[start : start + count]

@@ -30,6 +30,9 @@ BUILTIN = ("myotorso",)
 
 INSTALL_HINT = "pip install 'spinectl[anatomy]'"
 
+CONTROL_UNIT = "control_unit"
+"""Name of the MJCF custom text (``<custom><text>``) giving the muscles' control unit (spinectl's export: ``cm^2``)."""
+
 
 class AnatomyUnavailable(SpinectlError, ImportError):
     """MuJoCo (or myo-sim, for a built-in model) is not installed."""
@@ -93,8 +96,47 @@ class Engine:
         """
         mujoco = require_mujoco()
         obj = getattr(mujoco.mjtObj, f"mjOBJ_{kind.upper()}")
-        count = {"joint": self.model.njnt, "body": self.model.nbody, "actuator": self.model.nu}[kind]
+        count = {
+            "joint": self.model.njnt,
+            "body": self.model.nbody,
+            "actuator": self.model.nu,
+            "geom": self.model.ngeom,
+        }[kind]
         return [mujoco.mj_id2name(self.model, obj, int(i)) or "" for i in (range(count) if ids is None else ids)]
+
+    @property
+    def model_name(self) -> str:
+        """The model's own name (MJCF ``<mujoco model="...">``, MuJoCo's first name in ``names``)."""
+        return bytes(self.model.names).split(b"\0", 1)[0].decode()
+
+    def muscle_ids(self) -> np.ndarray:
+        """The actuators that are the chain's muscles: a tendon transmission, muscle or no activation dynamics.
+
+        MuJoCo's muscles, and the ``general`` actuators of spinectl's export (an affine gain on a
+        spatial tendon, the control a PCSA). Any other actuator (a joint motor such as the export's
+        ``counter_*``) is held at its control of :meth:`held_controls`.
+
+        Returns
+        -------
+        numpy.ndarray of int
+        """
+        mujoco = require_mujoco()
+        m = self.model
+        tendon = m.actuator_trntype == mujoco.mjtTrn.mjTRN_TENDON
+        dyn = np.isin(m.actuator_dyntype, [mujoco.mjtDyn.mjDYN_MUSCLE, mujoco.mjtDyn.mjDYN_NONE])
+        return np.flatnonzero(tendon & dyn)
+
+    def held_controls(self) -> np.ndarray:
+        """Every actuator's control, held: keyframe 0's if the model has one, else 0; the muscles' set to 0.
+
+        Returns
+        -------
+        numpy.ndarray, shape (nu,)
+            [the actuator's control unit].
+        """
+        ctrl = self.model.key_ctrl[0].copy() if self.model.nkey else np.zeros(self.model.nu)
+        ctrl[self.muscle_ids()] = 0.0
+        return ctrl
 
     def set_state(self, qpos, act=None) -> None:
         """Set qpos, zero velocity and the activations, and run the position and velocity stages.

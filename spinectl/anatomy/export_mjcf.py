@@ -1,7 +1,7 @@
 """The paper's model and its solution as a MuJoCo model (MJCF), built with MuJoCo's own spec API (docs/interchange.md).
 
-The chain of docs/chain.md becomes a tree of hinge joints at the CoRs (the pelvis is the
-world body), each body holding the mass it carries: the body above the top CoR the upper
+The chain of docs/chain.md becomes a tree of hinge joints at the CoRs (the pelvis is a
+body ``ground`` fixed to the world), each body holding the mass it carries: the body above the top CoR the upper
 body's point mass, every other one the lumbar level above its joint (:func:`spinectl.model.chain.mass_matrix`).
 Every fibre is a spatial tendon between two sites (its upper attachment on the thorax, its
 lower one on the pelvis) driven by a ``general`` actuator whose affine gain reproduces, at
@@ -39,11 +39,14 @@ from ..model.mechanics import gravity_sign, inertia, passive_stiffness
 from ..model.params import Model
 from ..model.source import header
 from ..units import M2_PER_CM2
-from .engine import require_mujoco
+from .engine import CONTROL_UNIT, require_mujoco
 
 HINGE_AXIS = (0.0, -1.0, 0.0)
 """The joints' axis in MuJoCo's frame: spinectl's (x, y) is MuJoCo's (x, z), and a rotation about -y
 turns x towards z, counter-clockwise in spinectl's plane (docs/model.md, "Frame and units")."""
+
+GROUND = "ground"
+"""Name of the pelvis's body, fixed to MuJoCo's world (OpenSim's name of the ground)."""
 
 KEYFRAME = "solution"
 """Name of keyframe 0: the exported posture and the controls of the solution."""
@@ -287,7 +290,9 @@ def paper_spec(solution: PaperSolution):
     levels = chain.level_positions(np.zeros(n), cor)
     centres = [geometry.mass_position(model)] + list(levels)  # body k: level k - 1 lies between CoRs k - 1 and k
     names = body_names(model)
-    parent = spec.worldbody
+    # the pelvis: a body fixed to the world, named as OpenSim's ground, so that one mapping
+    # (mappings/wagner2012_chain.toml) maps both exports
+    ground = parent = spec.worldbody.add_body(name=GROUND)
     bodies = {}
     for k in range(n - 1, -1, -1):  # from the pelvis up: the bottom joint carries everything
         body = parent.add_body(name=names[k])
@@ -309,7 +314,7 @@ def paper_spec(solution: PaperSolution):
     gains = affine_gain(fibres)
     for f, name in enumerate(fibres.names):
         bodies[0].add_site(name=f"{name}_upper", pos=_xz(fibres.upper[f]))
-        spec.worldbody.add_site(name=f"{name}_lower", pos=_xz(fibres.lower[f]))
+        ground.add_site(name=f"{name}_lower", pos=_xz(fibres.lower[f]))
         tendon = spec.add_tendon(name=name)
         tendon.wrap_site(f"{name}_upper")
         tendon.wrap_site(f"{name}_lower")
@@ -323,6 +328,7 @@ def paper_spec(solution: PaperSolution):
         motor = spec.add_actuator(name=f"counter_{joint}", target=joint, trntype=mujoco.mjtTrn.mjTRN_JOINT)
         motor.gainprm[0] = 1.0
         motor.ctrllimited = mujoco.mjtLimited.mjLIMITED_FALSE
+    spec.add_text(name=CONTROL_UNIT, data="cm^2")  # read back by spinectl.anatomy.model.Anatomy.control_unit
     controls = np.concatenate([solution.pcsa[fibres.muscle] / M2_PER_CM2, solution.counter_torque])
     spec.add_key(name=KEYFRAME, qpos=np.zeros(n), ctrl=controls)
     return spec

@@ -6,15 +6,23 @@ At zero velocity the generalised force on the joints is
     f_i = a_i gain_i(l_i, v_i) + bias_i(l_i),
 
 with r_i = dl_i/dq MuJoCo's moment arms (``actuator_moment``), gain and bias MuJoCo's muscle
-curves and g gravity (``qfrc_bias`` at zero velocity). It is affine in the activations a,
+curves, or for an actuator without activation dynamics (the ``general`` fibres of spinectl's
+export, their control a PCSA) MuJoCo's own force at controls 0 and 1 (:func:`mujoco.mj_fwdActuation`),
+g gravity (``qfrc_bias`` at zero velocity) and tau_passive every passive force (``qfrc_passive``:
+joint and tendon springs, gravity compensation). It is affine in the activations a,
 so K(a) = dtau/dq = K_0 + sum_i a_i K_i with
 
-    K_i = H_i gain_i + gain_i' r_i r_i^T,    K_0 = -dg/dq + sum_i (H_i bias_i + bias_i' r_i r_i^T),
+    K_i = H_i gain_i + gain_i' r_i r_i^T,
+    K_0 = d(tau_passive - g)/dq + sum_i (H_i bias_i + bias_i' r_i r_i^T),
 
 H_i = d^2 l_i/dq^2 the Hessian of the muscle's length (central differences of MuJoCo's
 moment arms: MuJoCo has no tendon Hessian), gain' and bias' the curves' slopes in length
 (central differences of the scalar curves, exact on their quadratic pieces). Likewise
-D_i = (d gain_i/dv) r_i r_i^T and D_0 = -diag(joint damping). One pass of 2 s position
+D_i = (d gain_i/dv) r_i r_i^T and D_0 = -diag(joint damping) + sum_i (d bias_i/dv) r_i r_i^T.
+An actuator that is no muscle (not on a tendon, e.g. the export's ``counter_*`` joint motors)
+is held at its control of keyframe 0 (:meth:`~spinectl.anatomy.engine.Engine.held_controls`):
+its terms enter K_0, D_0 and the torque offset, none a control of the chain; a joint motor's
+force is constant, so it changes the equilibrium only, not K or D. One pass of 2 s position
 evaluations over the s joints involved gives every K_i, whatever a.
 
 Two chains: the **free** chain, every chain joint its own degree of freedom and the model's
@@ -142,12 +150,19 @@ class Linearisation:
 
 
 def _curves(engine: Engine):
-    """Each muscle's gain and bias at the set state and their slopes in length and velocity."""
+    """Each actuator's gain and bias at the set state and their slopes in length and velocity.
+
+    MuJoCo's muscles by its muscle curves (:func:`mujoco.mju_muscleGain`, :func:`mujoco.mju_muscleBias`);
+    any other actuator by MuJoCo's own force (:func:`mujoco.mj_fwdActuation`, at control 0 and 1,
+    its tendon's length and velocity moved by central differences), e.g. the affine gain of
+    spinectl's export (:func:`spinectl.anatomy.export_mjcf.affine_gain`).
+    """
     mujoco = require_mujoco()
     model, d = engine.model, engine.data
     m = model.nu
-    out = np.zeros((5, m))  # gain, dgain/dl, dgain/dv, bias, dbias/dl
-    for i in range(m):
+    out = np.zeros((6, m))  # gain, dgain/dl, dgain/dv, bias, dbias/dl, dbias/dv
+    muscle = model.actuator_dyntype == mujoco.mjtDyn.mjDYN_MUSCLE
+    for i in np.flatnonzero(muscle):
         lr, acc0 = model.actuator_lengthrange[i], model.actuator_acc0[i]
         gp, bp = model.actuator_gainprm[i][:9], model.actuator_biasprm[i][:9]  # the curves read 9
         length, vel = d.actuator_length[i], d.actuator_velocity[i]
@@ -159,14 +174,49 @@ def _curves(engine: Engine):
         def bias(dl=0.0, lr=lr, acc0=acc0, bp=bp, length=length):
             return mujoco.mju_muscleBias(length + dl, lr, acc0, bp)
 
-        out[:, i] = (
+        out[:5, i] = (
             gain(),
             (gain(h) - gain(-h)) / (2 * h),
             (gain(dv=h) - gain(dv=-h)) / (2 * h),
             bias(),
             (bias(h) - bias(-h)) / (2 * h),
         )
+    if not np.all(muscle):
+        out[:, ~muscle] = _actuator_curves(engine)[:, ~muscle]
     return out
+
+
+def _actuator_curves(engine: Engine) -> np.ndarray:
+    """gain, its slopes, bias and its slopes of every actuator without activation dynamics, by MuJoCo's force.
+
+    The force is gain(l, v) u + bias(l, v) at control u (:func:`mujoco.mj_fwdActuation`, the
+    controls unclamped): bias at u = 0, gain = force(1) - force(0); the slopes by central
+    differences of MuJoCo's ``actuator_length`` and ``actuator_velocity`` (exact for an affine gain).
+    """
+    mujoco = require_mujoco()
+    model, d = engine.model, engine.data
+    length, vel, ctrl = d.actuator_length.copy(), d.actuator_velocity.copy(), d.ctrl.copy()
+    span = model.actuator_lengthrange[:, 1] - model.actuator_lengthrange[:, 0]
+    h = 1e-6 * np.maximum(np.maximum(span, np.abs(length)), 1e-3)
+    flags = model.opt.disableflags
+    model.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CLAMPCTRL
+
+    def force(u, dl=0.0, dv=0.0):
+        d.ctrl[:] = u
+        d.actuator_length[:] = length + dl
+        d.actuator_velocity[:] = vel + dv
+        mujoco.mj_fwdActuation(model, d)
+        return d.actuator_force.copy()
+
+    try:
+        values = []
+        for u in (1.0, 0.0):
+            values += [force(u), (force(u, h) - force(u, -h)) / (2 * h), (force(u, dv=h) - force(u, dv=-h)) / (2 * h)]
+    finally:
+        model.opt.disableflags = flags
+        d.ctrl[:], d.actuator_length[:], d.actuator_velocity[:] = ctrl, length, vel
+    at_one, at_zero = np.array(values[:3]), np.array(values[3:])
+    return np.concatenate([at_one - at_zero, at_zero])
 
 
 def linearise(engine: Engine, qpos, dofs, n: int) -> Linearisation:
@@ -191,8 +241,8 @@ def linearise(engine: Engine, qpos, dofs, n: int) -> Linearisation:
     model, d = engine.model, engine.data
     if model.nq != model.nv:
         raise ModelError(f"{engine.name}: free or ball joints are not supported (nq != nv)")
-    if np.any(model.actuator_dyntype != mujoco.mjtDyn.mjDYN_MUSCLE):
-        raise ModelError(f"{engine.name}: every actuator must be a muscle (muscle dynamics)")
+    if np.any(~np.isin(model.actuator_dyntype, [mujoco.mjtDyn.mjDYN_MUSCLE, mujoco.mjtDyn.mjDYN_NONE])):
+        raise ModelError(f"{engine.name}: every actuator must be a muscle or have no activation dynamics")
     dofs = list(dofs)
     s, nu = len(dofs), model.nu
     qpos = np.asarray(qpos, float)
@@ -204,37 +254,65 @@ def linearise(engine: Engine, qpos, dofs, n: int) -> Linearisation:
     mass = engine.mass_matrix()
     hessian = np.zeros((nu, s, s))
     dgravity = np.zeros((s, s))
+    contacts = d.ten_wrapnum.copy()  # path points of every tendon: 2 more per wrap geom it touches
     for k, dof in enumerate(dofs):
         sides = []
         for sign in (1.0, -1.0):
             q = qpos.copy()
             q[model.dof_jntid[dof]] += sign * STEP
             engine.set_state(q)
-            sides.append((engine.moment_arms()[:, dofs], -d.qfrc_bias[dofs].copy()))
+            _same_contacts(engine, contacts, int(model.dof_jntid[dof]))
+            # gravity and every passive force: joint and tendon springs, gravity compensation (mj_passive)
+            sides.append((engine.moment_arms()[:, dofs], (d.qfrc_passive - d.qfrc_bias)[dofs].copy()))
         hessian[:, :, k] = (sides[0][0] - sides[1][0]) / (2 * STEP)
         dgravity[:, k] = (sides[0][1] - sides[1][1]) / (2 * STEP)
     engine.set_state(qpos)
     hessian = 0.5 * (hessian + hessian.transpose(0, 2, 1))  # a Hessian: symmetric up to rounding
     rr = np.einsum("ij,ik->jki", r, r)  # (s, s, m): r_i r_i^T
-    gain, dgain_dl, dgain_dv, bias, dbias_dl = curves
+    gain, dgain_dl, dgain_dv, bias, dbias_dl, dbias_dv = curves
+    # the actuators that are no muscle (engine.held_controls) add to the offsets at their held controls
+    held = engine.held_controls()
+    bias, dbias_dl, dbias_dv = bias + held * gain, dbias_dl + held * dgain_dl, dbias_dv + held * dgain_dv
     k_per = hessian.transpose(1, 2, 0) * gain + rr * dgain_dl
     k_0 = 0.5 * (dgravity + dgravity.T) + np.einsum("ijk,i->jk", hessian, bias) + rr @ dbias_dl
-    k_0 -= np.diag(model.jnt_stiffness[model.dof_jntid[dofs]])
+    muscles = engine.muscle_ids()
     return Linearisation(
         dofs=tuple(dofs),
         n=n,
-        stiffness_per_muscle=k_per,
+        stiffness_per_muscle=k_per[..., muscles],
         stiffness_offset=k_0,
-        damping_per_muscle=rr * dgain_dv,
-        damping_offset=-np.diag(model.dof_damping[dofs]),
+        damping_per_muscle=(rr * dgain_dv)[..., muscles],
+        damping_offset=rr @ dbias_dv - np.diag(model.dof_damping[dofs]),
         mass=mass[np.ix_(dofs, dofs)],
-        torque_per_muscle=arms.T * gain,
+        torque_per_muscle=(arms.T * gain)[:, muscles],
         torque_offset=gravity + d.qfrc_passive + arms.T @ bias,
-        moment_arms=arms,
+        moment_arms=arms[muscles],
     )
 
 
-def _chain(lin: Linearisation, rows, T, joints, controls, classes, added, source, curvature=None):
+def _same_contacts(engine: Engine, contacts, joint: int) -> None:
+    """A muscle's tendon that touches a wrap geom on one side of the posture only has a kinked moment arm: one line."""
+    mujoco = require_mujoco()
+    model, d = engine.model, engine.data
+    for i in engine.muscle_ids():
+        t = int(model.actuator_trnid[i, 0])
+        if d.ten_wrapnum[t] == contacts[t]:
+            continue
+        span = range(model.tendon_adr[t], model.tendon_adr[t] + model.tendon_num[t])
+        wraps = (int(mujoco.mjtWrap.mjWRAP_SPHERE), int(mujoco.mjtWrap.mjWRAP_CYLINDER))
+        geoms = [int(model.wrap_objid[w]) for w in span if int(model.wrap_type[w]) in wraps]
+        engine.set_state(model.qpos0)  # leave the engine at a posture of the model
+        raise ModelError(
+            f"{engine.name}: muscle {engine.names('actuator', [i])[0]} starts or stops wrapping over "
+            f"{', '.join(engine.names('geom', geoms)) or 'a wrap geom'} within {STEP:g} rad of the posture "
+            f"({engine.names('joint', [joint])[0]}): its moment arm has a kink there, which the linearisation "
+            "cannot differentiate; nothing was linearised (move the posture off the contact)"
+        )
+
+
+def _chain(
+    lin: Linearisation, rows, T, joints, controls, classes, added, source, curvature=None, bounds=None, unit="1"
+):
     """A LinearChain of the linearisation reduced by T (the free chain: T selects the chain's rows)."""
     k_per = np.einsum("ai,abm,bj->ijm", T, lin.stiffness_per_muscle[np.ix_(rows, rows)], T)
     k_0 = T.T @ lin.stiffness_offset[np.ix_(rows, rows)] @ T - T.T @ np.diag(added) @ T
@@ -252,14 +330,14 @@ def _chain(lin: Linearisation, rows, T, joints, controls, classes, added, source
         stiffness_offset=k_0,
         damping_offset=T.T @ lin.damping_offset[np.ix_(rows, rows)] @ T,
         mass_matrix=T.T @ lin.mass[np.ix_(rows, rows)] @ T,
-        lower=np.zeros(len(controls)),
-        upper=np.ones(len(controls)),
-        control_unit="1",
+        lower=np.zeros(len(controls)) if bounds is None else bounds[0],
+        upper=np.ones(len(controls)) if bounds is None else bounds[1],
+        control_unit=unit,
         source=source,
     )
 
 
-def free_chain(lin: Linearisation, joints, controls, classes, added, source) -> LinearChain:
+def free_chain(lin: Linearisation, joints, controls, classes, added, source, bounds=None, unit="1") -> LinearChain:
     """The free chain: every chain joint free, the model's equalities off, the other joints held.
 
     Parameters
@@ -272,16 +350,23 @@ def free_chain(lin: Linearisation, joints, controls, classes, added, source) -> 
         Joint stiffness added at each chain joint [N m/rad].
     source : str
         For outputs.
+    bounds : tuple, optional
+        (lower, upper) of each control; default [0, 1] (activations).
+    unit : str
+        The controls' unit (``"1"``: activations).
 
     Returns
     -------
     LinearChain
     """
     n = lin.n
-    return _chain(lin, list(range(n)), np.eye(n), joints, controls, classes, np.asarray(added, float), source)
+    added = np.asarray(added, float)
+    return _chain(lin, list(range(n)), np.eye(n), joints, controls, classes, added, source, bounds=bounds, unit=unit)
 
 
-def constrained_chain(lin: Linearisation, rhy: Rhythm, joint_names, controls, classes, added, source) -> LinearChain:
+def constrained_chain(
+    lin: Linearisation, rhy: Rhythm, joint_names, controls, classes, added, source, bounds=None, unit="1"
+) -> LinearChain:
     """The chain constrained by the model's rhythm, in its independent coordinates.
 
     Parameters
@@ -298,6 +383,10 @@ def constrained_chain(lin: Linearisation, rhy: Rhythm, joint_names, controls, cl
         Joint stiffness added at each involved joint [N m/rad] (0 off the chain).
     source : str
         For outputs.
+    bounds : tuple, optional
+        (lower, upper) of each control; default [0, 1] (activations).
+    unit : str
+        The controls' unit (``"1"``: activations).
 
     Returns
     -------
@@ -307,6 +396,7 @@ def constrained_chain(lin: Linearisation, rhy: Rhythm, joint_names, controls, cl
         raise ParameterError("rhythm", "must be over the linearisation's dofs")
     rows = list(range(len(rhy.dofs)))
     joints = tuple(joint_names[i] for i in rhy.independent)
+    added = np.asarray(added, float)
     return _chain(
-        lin, rows, rhy.transform, joints, controls, classes, np.asarray(added, float), source, curvature=rhy.curvature
+        lin, rows, rhy.transform, joints, controls, classes, added, source, rhy.curvature, bounds=bounds, unit=unit
     )

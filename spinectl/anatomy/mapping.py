@@ -91,23 +91,27 @@ def read_mapping(path: str | Path) -> Mapping:
     )
 
 
-def default_mapping(name: str) -> Mapping:
-    """The built-in mapping of a model, ``mappings/<name>.toml``.
+def default_mapping(name: str, *aliases: str) -> Mapping:
+    """The built-in mapping of a model, ``mappings/<name>.toml``: the first of its names that has one.
 
     Parameters
     ----------
     name : str
         The model's name (``"myotorso"``).
+    *aliases : str
+        Other names of the same model, tried in turn (an MJCF file's own model name, e.g.
+        ``"wagner2012_chain"`` for spinectl's export, whatever the file is called).
 
     Returns
     -------
     Mapping
     """
-    path = MAPPINGS / f"{name}.toml"
-    if not path.is_file():
-        known = sorted(p.stem for p in MAPPINGS.glob("*.toml"))
-        raise ParameterError("mapping", f"a model other than {known} needs a mapping file (--mapping FILE)")
-    return read_mapping(path)
+    for candidate in (name, *aliases):
+        path = MAPPINGS / f"{candidate}.toml"
+        if candidate and "/" not in candidate and path.is_file():
+            return read_mapping(path)
+    known = sorted(p.stem for p in MAPPINGS.glob("*.toml"))
+    raise ParameterError("mapping", f"a model other than {known} needs a mapping file (--mapping FILE)")
 
 
 def check_mapping(engine: Engine, mapping: Mapping) -> None:
@@ -130,8 +134,10 @@ def check_mapping(engine: Engine, mapping: Mapping) -> None:
         missing = [n for n in names if mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, n) < 0]
         if missing:
             raise ParameterError(f"mapping.planes.{plane}", f"names joints that {engine.name} lacks: {missing}")
-    if not any(model.actuator_dyntype == mujoco.mjtDyn.mjDYN_MUSCLE):
-        raise ParameterError("model", f"{engine.name} has no muscles (no actuator with muscle dynamics)")
+    if not engine.muscle_ids().size:
+        raise ParameterError(
+            "model", f"{engine.name} has no muscles (no tendon actuator with muscle or no activation dynamics)"
+        )
 
 
 def body_groups(engine: Engine, mapping: Mapping) -> dict:
@@ -167,7 +173,7 @@ def body_groups(engine: Engine, mapping: Mapping) -> dict:
 
 
 def muscle_bodies(engine: Engine) -> list:
-    """For each actuator, the set of body ids its tendon's sites are fixed to (empty for non-tendon actuators).
+    """The bodies each muscle's tendon sites are fixed to (:meth:`~spinectl.anatomy.engine.Engine.muscle_ids`).
 
     Parameters
     ----------
@@ -181,13 +187,12 @@ def muscle_bodies(engine: Engine) -> list:
     mujoco = require_mujoco()
     model = engine.model
     out = []
-    for i in range(model.nu):
+    for i in engine.muscle_ids():
         bodies = set()
-        if model.actuator_trntype[i] == mujoco.mjtTrn.mjTRN_TENDON:
-            t = model.actuator_trnid[i, 0]
-            for w in range(model.tendon_adr[t], model.tendon_adr[t] + model.tendon_num[t]):
-                if model.wrap_type[w] == mujoco.mjtWrap.mjWRAP_SITE:
-                    bodies.add(int(model.site_bodyid[model.wrap_objid[w]]))
+        t = model.actuator_trnid[i, 0]
+        for w in range(model.tendon_adr[t], model.tendon_adr[t] + model.tendon_num[t]):
+            if model.wrap_type[w] == mujoco.mjtWrap.mjWRAP_SITE:
+                bodies.add(int(model.site_bodyid[model.wrap_objid[w]]))
         out.append(bodies)
     return out
 
@@ -208,7 +213,7 @@ def classify(engine: Engine, mapping: Mapping) -> tuple:
     Returns
     -------
     tuple of str
-        One class per actuator.
+        One class per muscle (:meth:`~spinectl.anatomy.engine.Engine.muscle_ids`).
     """
     groups = body_groups(engine, mapping)
     out = []

@@ -10,7 +10,7 @@ import numpy as np
 from .._validate import printable
 from ..errors import ParameterError
 from ..model.linear_chain import LinearChain
-from .engine import Engine, load_engine, require_mujoco
+from .engine import CONTROL_UNIT, Engine, load_engine, require_mujoco
 from .linearise import Linearisation, constrained_chain, free_chain, linearise, rhythm
 from .mapping import Mapping, check_mapping, classify, default_mapping, read_mapping
 
@@ -71,6 +71,47 @@ class Anatomy:
         """
         mujoco = require_mujoco()
         return [mujoco.mj_name2id(self.engine.model, mujoco.mjtObj.mjOBJ_JOINT, n) for n in names]
+
+    def control_bounds(self) -> tuple:
+        """Each muscle's control bounds: [0, 1] for MuJoCo's muscles (activations), else its ``ctrlrange``
+        if limited, [0, inf) if not (spinectl's export: a PCSA in cm^2).
+
+        Returns
+        -------
+        tuple
+            (lower, upper), numpy.ndarray of shape (m,) [:attr:`control_unit`].
+        """
+        mujoco = require_mujoco()
+        model, ids = self.engine.model, self.engine.muscle_ids()
+        muscle = model.actuator_dyntype[ids] == mujoco.mjtDyn.mjDYN_MUSCLE
+        limited = model.actuator_ctrllimited[ids].astype(bool) & ~muscle
+        lower = np.where(limited, model.actuator_ctrlrange[ids, 0], 0.0)
+        upper = np.where(limited, model.actuator_ctrlrange[ids, 1], np.where(muscle, 1.0, np.inf))
+        return lower, upper
+
+    @property
+    def control_unit(self) -> str:
+        """The muscles' control unit: the model's custom text ``control_unit`` (the export's ``cm^2``), else ``1``."""
+        mujoco = require_mujoco()
+        model = self.engine.model
+        t = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_TEXT, CONTROL_UNIT)
+        if t < 0:
+            return "1"
+        start = model.text_adr[t]
+        return bytes(model.text_data[start : start + model.text_size[t] - 1]).decode()
+
+    def default_controls(self) -> np.ndarray:
+        """The muscles' controls of the model's keyframe 0 (spinectl's export: the solution), else 0.
+
+        Returns
+        -------
+        numpy.ndarray, shape (m,)
+            [:attr:`control_unit`].
+        """
+        model = self.engine.model
+        if not model.nkey:
+            return np.zeros(len(self.muscles))
+        return model.key_ctrl[0][self.engine.muscle_ids()].copy()
 
     def posture(self, posture=None) -> np.ndarray:
         """The full qpos: the model's reference posture (``qpos0``) or the one given.
@@ -168,10 +209,18 @@ class Anatomy:
         n = lin.n
         added = self.added_stiffness(joint_stiffness, n)
         source = f"{self.engine.source}, {plane}"
-        free = free_chain(lin, involved[:n], self.muscles, self.classes, added, source)
+        controls = {"bounds": self.control_bounds(), "unit": self.control_unit}
+        free = free_chain(lin, involved[:n], self.muscles, self.classes, added, source, **controls)
         full_added = np.concatenate([added, np.zeros(len(involved) - n)])
         constrained = constrained_chain(
-            lin, rhy, involved, self.muscles, self.classes, full_added, source + ", constrained by the rhythm"
+            lin,
+            rhy,
+            involved,
+            self.muscles,
+            self.classes,
+            full_added,
+            source + ", constrained by the rhythm",
+            **controls,
         )
         return free, constrained, lin
 
@@ -222,12 +271,12 @@ def load(model: str | Path = "myotorso", mapping: str | Path | Mapping | None = 
     ('flex_extension', 'L4_L5_FE', 'L3_L4_FE', 'L2_L3_FE', 'L1_L2_FE')
     """
     engine = load_engine(model, cache=cache)
-    if mapping is None:
-        mapping = default_mapping(engine.name)
+    if mapping is None:  # by the file's name, else the model's own (spinectl's export: wagner2012_chain)
+        mapping = default_mapping(engine.name, engine.model_name)
     elif not isinstance(mapping, Mapping):
         mapping = read_mapping(mapping)
     check_mapping(engine, mapping)
-    return Anatomy(engine, mapping, tuple(engine.names("actuator")), classify(engine, mapping))
+    return Anatomy(engine, mapping, tuple(engine.names("actuator", engine.muscle_ids())), classify(engine, mapping))
 
 
 __all__ = ["Anatomy", "Linearisation", "load"]

@@ -531,6 +531,30 @@ class OsimAnatomy(Anatomy):
         Each muscle's class.
     """
 
+    def control_bounds(self) -> tuple:
+        """Each muscle's control bounds: [0, 1] (OpenSim's activations).
+
+        Returns
+        -------
+        tuple
+            (lower, upper), numpy.ndarray of shape (m,).
+        """
+        return np.zeros(len(self.muscles)), np.ones(len(self.muscles))
+
+    @property
+    def control_unit(self) -> str:
+        """The muscles' control unit: ``1`` (activations)."""
+        return "1"
+
+    def default_controls(self) -> np.ndarray:
+        """The activations analysed when none are given: 0.
+
+        Returns
+        -------
+        numpy.ndarray, shape (m,)
+        """
+        return np.zeros(len(self.muscles))
+
     def posture(self, posture=None) -> dict:
         """The posture: the coordinates' default values, or those given.
 
@@ -671,7 +695,13 @@ def volume_weights(anatomy: OsimAnatomy) -> np.ndarray:
 
 
 def optimise(
-    anatomy: OsimAnatomy, plane="sagittal", stability="chain", margin=1.0, joint_stiffness="none", equilibrium="rhythm"
+    anatomy: OsimAnatomy,
+    plane="sagittal",
+    stability="chain",
+    margin=1.0,
+    joint_stiffness="none",
+    equilibrium="rhythm",
+    posture=None,
 ):
     """The least-effort activations on OpenSim's chain (:func:`spinectl.anatomy.optimum.optimise`'s problem).
 
@@ -691,6 +721,8 @@ def optimise(
     joint_stiffness : {"none", "mapped"} or float
     equilibrium : str
         One of :data:`spinectl.anatomy.optimum.EQUILIBRIUM`.
+    posture : dict, optional
+        Coordinate name -> value [rad] (e.g. :func:`lordosis_posture`); default the coordinates' defaults.
 
     Returns
     -------
@@ -699,8 +731,8 @@ def optimise(
     from .optimum import check_choices, optimum_on_chains
 
     check_choices(stability, equilibrium, margin)
-    free, constrained, lin = anatomy.chains(plane, None, joint_stiffness)
-    _, rhy, _ = anatomy.linearise(plane)
+    free, constrained, lin = anatomy.chains(plane, posture, joint_stiffness)
+    rhy, _, _ = coupler_rhythm(anatomy.engine, anatomy.plane_joints(plane), anatomy.posture(posture))
     rows = list(range(lin.n))
     if equilibrium == "free":
         tau_per, tau_0 = lin.torque_per_muscle[rows], lin.torque_offset[rows]
@@ -708,6 +740,57 @@ def optimise(
         tau_per, tau_0 = rhy.transform.T @ lin.torque_per_muscle, rhy.transform.T @ lin.torque_offset
     w = volume_weights(anatomy)
     return optimum_on_chains(free, constrained, lin, rows, tau_per, tau_0, w, stability, equilibrium, margin)
+
+
+def lordosis_posture(anatomy: OsimAnatomy, degrees: float, plane: str = "sagittal") -> dict:
+    """The default posture with the chain moved along the model's couplers by ``degrees`` in total.
+
+    :func:`spinectl.anatomy.optimum.lordosis_posture` on OpenSim's model: the couplers' first
+    independent coordinate and the coordinates they slave to it move as the couplers' slopes at
+    the default posture distribute them (:func:`coupler_rhythm`), the chain's angles summing to
+    ``degrees``; the engine sets them through OpenSim's coordinates (:meth:`OsimEngine.set_posture`).
+
+    Parameters
+    ----------
+    anatomy : OsimAnatomy
+    degrees : float
+        The change of the chain's summed angle [deg].
+    plane : str
+
+    Returns
+    -------
+    dict
+        Coordinate name -> value [rad].
+    """
+    from .optimum import lordosis_direction
+
+    names = anatomy.plane_joints(plane)
+    rhy, involved, _ = coupler_rhythm(anatomy.engine, names, {})
+    step = lordosis_direction(anatomy, rhy, len(names), degrees)
+    return {n: anatomy.engine.coordinate(n).getDefaultValue() + float(v) for n, v in zip(involved, step, strict=True)}
+
+
+def lordosis_curve(anatomy: OsimAnatomy, degrees, **options) -> dict:
+    """The three optima over the lordosis on OpenSim's chain (:func:`spinectl.anatomy.optimum.lordosis_curve`).
+
+    The postures are :func:`lordosis_posture`'s (the couplers as the rhythm), the optima :func:`optimise`'s.
+
+    Parameters
+    ----------
+    anatomy : OsimAnatomy
+    degrees : array_like
+        Changes of the chain's summed angle [deg].
+    **options
+        ``plane``, ``margin``, ``joint_stiffness``, ``equilibrium``.
+
+    Returns
+    -------
+    dict
+        As :func:`spinectl.anatomy.optimum.lordosis_curve`.
+    """
+    from .optimum import lordosis_curve as curve
+
+    return curve(anatomy, degrees, posture_at=lordosis_posture, optimise_at=optimise, **options)
 
 
 def optimised(

@@ -38,8 +38,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ParameterError
+from ..errors import ModelError, ParameterError
 from ..model.linear_chain import LinearChain
+from .engine import require_mujoco
 from .linearise import rhythm
 from .model import Anatomy
 
@@ -62,12 +63,18 @@ def volume_weights(anatomy: Anatomy) -> np.ndarray:
     -------
     numpy.ndarray, shape (m,)
     """
-    model = anatomy.engine.model
-    gain = model.actuator_gainprm
-    lr = model.actuator_lengthrange
+    mujoco = require_mujoco()
+    model, ids = anatomy.engine.model, anatomy.engine.muscle_ids()
+    if np.any(model.actuator_dyntype[ids] != mujoco.mjtDyn.mjDYN_MUSCLE):
+        raise ModelError(
+            f"{anatomy.name}: the optimum's volume weights need MuJoCo muscles (their F0 and L0); its muscles "
+            "are general actuators (spinectl's export: analyse it without --optimise and --lordosis)"
+        )
+    gain = model.actuator_gainprm[ids]
+    lr = model.actuator_lengthrange[ids]
     # MuJoCo's muscle: L0 = (lengthrange span) / (operating range span); F0 = force, or scale / acc0 if force < 0
     length0 = (lr[:, 1] - lr[:, 0]) / (gain[:, 1] - gain[:, 0])
-    force0 = np.where(gain[:, 2] > 0, gain[:, 2], gain[:, 3] / model.actuator_acc0)
+    force0 = np.where(gain[:, 2] > 0, gain[:, 2], gain[:, 3] / model.actuator_acc0[ids])
     volume = force0 * length0
     return volume / volume.mean()
 
@@ -454,10 +461,40 @@ def lordosis_posture(anatomy: Anatomy, degrees: float, plane: str = "sagittal") 
     numpy.ndarray, shape (nq,)
     """
     lin, rhy, _ = anatomy.linearise(plane)
-    direction = rhy.transform[:, 0]
     q = anatomy.posture()
-    q[list(rhy.dofs)] += direction * np.radians(degrees) / direction[: lin.n].sum()
+    q[list(rhy.dofs)] += lordosis_direction(anatomy, rhy, lin.n, degrees)
     return q
+
+
+def lordosis_direction(anatomy: Anatomy, rhy, n: int, degrees: float) -> np.ndarray:
+    """The change of the involved joints' angles [rad] that moves the chain by ``degrees`` along the rhythm.
+
+    The rhythm's first independent coordinate and the joints it slaves move as its column of T;
+    a chain whose first joint no rhythm ties to another has no lordosis to move along (one line).
+
+    Parameters
+    ----------
+    anatomy : Anatomy
+        The model (for its name).
+    rhy : spinectl.anatomy.linearise.Rhythm
+        The rhythm over the involved joints, the chain's n first.
+    n : int
+        The number of chain joints.
+    degrees : float
+        The change of the chain's summed angle [deg].
+
+    Returns
+    -------
+    numpy.ndarray, shape (len(rhy.dofs),)
+    """
+    direction = rhy.transform[:, 0]
+    if n > 1 and np.count_nonzero(direction[:n]) < 2:
+        raise ModelError(
+            f"lordosis: {anatomy.name} has no rhythm (joint equality or coordinate coupler) that ties its chain's "
+            "first joint to the others, so the chain has no lordosis to move along; give the model one "
+            "(spinectl's export: export it at another Lambda)"
+        )
+    return direction * np.radians(degrees) / direction[:n].sum()
 
 
 def lordosis_curve(
@@ -467,6 +504,8 @@ def lordosis_curve(
     margin: float = MARGIN,
     joint_stiffness="none",
     equilibrium: str = "rhythm",
+    posture_at=None,
+    optimise_at=None,
 ) -> dict:
     """The three optima (classic, joint by joint, the chain) over the lordosis.
 
@@ -478,6 +517,10 @@ def lordosis_curve(
         Changes of the chain's summed angle about the reference posture [deg].
     plane, margin, joint_stiffness, equilibrium
         As in :func:`optimise`.
+    posture_at, optimise_at : callable, optional
+        The engine's posture at a lordosis and its optimum there; default MuJoCo's,
+        :func:`lordosis_posture` and :func:`optimise` (OpenSim's:
+        :func:`spinectl.anatomy.opensim_engine.lordosis_curve`).
 
     Returns
     -------
@@ -486,19 +529,22 @@ def lordosis_curve(
         ``status`` and ``margin_Nm_per_rad`` (the least eigenvalue of -K) lists.
     """
     degrees = np.asarray(degrees, float)
+    posture_at = lordosis_posture if posture_at is None else posture_at
+    optimise_at = optimise if optimise_at is None else optimise_at
+    postures = [posture_at(anatomy, d, plane) for d in degrees]
     out = {"lordosis_deg": degrees.tolist()}
     for criterion in ("none", "joints", "chain"):
         rows = [
-            optimise(
+            optimise_at(
                 anatomy,
-                plane,
-                criterion,
-                margin,
-                lordosis_posture(anatomy, d, plane),
-                joint_stiffness,
+                plane=plane,
+                stability=criterion,
+                margin=margin,
+                posture=posture,
+                joint_stiffness=joint_stiffness,
                 equilibrium=equilibrium,
             )
-            for d in degrees
+            for posture in postures
         ]
         out[criterion] = {
             "cost": [r.cost for r in rows],

@@ -29,9 +29,11 @@ def register(sub) -> None:
     parser.add_argument(
         "--activation",
         type=finite_float("--activation"),
-        default=0.0,
+        default=None,
         metavar="A",
-        help="activation of every muscle, in [0, 1] (default: 0)",
+        help="activation of every muscle, in [0, 1] (or its control, e.g. a PCSA in cm^2 in spinectl's "
+        "export) (default: the controls of the model's keyframe 0 if it has one, the solution of "
+        "spinectl's export; else 0)",
     )
     parser.add_argument(
         "--joint-stiffness",
@@ -89,8 +91,8 @@ def register(sub) -> None:
         "--lordosis",
         metavar="START:STOP:N",
         help="also the three optima (classic, joint by joint, the chain) at N changes of the chain's summed "
-        "angle from START to STOP [deg] along the model's rhythm (positive: the model's positive "
-        "flex_extension, extension for MyoTorso), e.g. -20:20:41",
+        "angle from START to STOP [deg] along the model's rhythm (MuJoCo's joint equalities, OpenSim's "
+        "coordinate couplers; positive: the model's positive flex_extension, extension for MyoTorso), e.g. -20:20:41",
     )
     parser.add_argument(
         "--plot",
@@ -156,6 +158,8 @@ def run(args) -> int:
     if args.lordosis:
         from ..anatomy.optimum import lordosis_curve
 
+        if str(args.model).lower().endswith(".osim"):
+            from ..anatomy.opensim_engine import lordosis_curve  # along the model's couplers
         curve = lordosis_curve(
             anatomy,
             _degrees(args.lordosis),
