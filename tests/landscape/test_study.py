@@ -826,7 +826,7 @@ def test_schemes_spinectl_cannot_use_are_refused_with_the_reason(tmp_path, capsy
     code = main(["study", str(write(tmp_path)), "--out", str(tmp_path / "s.zarr"), "--scheduler", address])
     err = capsys.readouterr().err
     assert code == 2 and len(err.strip().splitlines()) == 1
-    assert f"(got '{address}'): {scheme}:// {study.run.UNUSABLE_SCHEMES[scheme]}" in err
+    assert f"(got '{address}'): {scheme}:// {study.executor.UNUSABLE_SCHEMES[scheme]}" in err
 
 
 def test_ctrl_c_while_the_local_cluster_starts_is_one_line(tmp_path):
