@@ -29,6 +29,20 @@ STUDY_SECONDS_PER_POINT = 90e-6
 COUPLED_SECONDS_PER_POINT = 2.7e-3
 """Added per point by the coupled chain's SDPs [s] (:data:`spinectl.landscape.schema.ON_REQUEST`, docs/chain.md)."""
 
+ATLAS_SECONDS_PER_DRAW = 177e-6
+"""CPU time of an atlas draw on the fast path, joint by joint [s]: 73 728 draws in 13.0 s
+(``benchmarks/bench_atlas.py --no-chain``, docs/atlas.md "Speed")."""
+
+ATLAS_PER_DRAW_SECONDS = 25.3e-3
+"""CPU time of an atlas draw solved as one model (a prior outside ``atlas.FAST``) [s] (same benchmark)."""
+
+ATLAS_CHAIN_SECONDS_PER_DRAW = 0.7e-3
+"""Added per atlas draw by the chain's stacked SDP [s] (docs/atlas.md, "What the shipped atlas finds")."""
+
+ATLAS_BYTES_PER_DRAW = 240
+"""An atlas's files per draw [B]: its chunk in ``DIR/chunks`` and its row of ``draws.npz`` (measured:
+the shipped atlas's five priors with the chain, N = 256: 94 B a draw in its chunk, 142 B in ``draws.npz``)."""
+
 SWEEP_MEMORY_PER_BYTE = 2.5
 """Peak memory of a sweep per byte of its answer: the chunks' columns, their concatenation and the
 Dataset (tracemalloc peak of ``write_sweep`` over 101 x 101 x 4 K: 3.1 kB a point for 1.22 kB of answer)."""
