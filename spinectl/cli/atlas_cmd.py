@@ -19,8 +19,9 @@ def register(sub) -> None:
         description="Draw the priors of PRIORS.toml (docs/atlas.md) in Saltelli's design, solve the "
         "joint-by-joint optimum, the exact delay margin and the chain's least local stiffness at every "
         "draw, and report the probability of each verdict (Wilson intervals) and the first- and "
-        "total-order Sobol' indices (SALib, bootstrap intervals). The chunks of draws run where the study's "
-        "do (--scheduler, --workers), each saved in --out as it finishes: a second run resumes from them. "
+        "total-order Sobol' indices (SALib, bootstrap intervals). The chunks of draws run as spinectl study's "
+        "do: on a local Dask cluster (the default, --workers), an existing one (--scheduler tcp://...) or "
+        "in-process (--scheduler synchronous), each saved in --out as it finishes: a second run resumes from them. "
         "The model is --preset/--config if given, else the file's [atlas] model, else the default preset; "
         "--set goes on top.",
     )
