@@ -331,9 +331,9 @@ class _Watch:
 
 @contextlib.contextmanager
 def executor(
-    scheduler: str | None = None,
-    workers: int | None = None,
-    n_chunks: int = 2,
+    scheduler: str | None,
+    workers: int | None,
+    n_chunks: int,
     *,
     connect_timeout: float = CONNECT_TIMEOUT,
     worker_timeout: float = WORKER_TIMEOUT,
@@ -352,7 +352,7 @@ def executor(
     workers : int or None
         Local worker processes (default: one per core, at most one per chunk); local cluster only.
     n_chunks : int
-        Chunks the run will map: no more local workers than that.
+        Chunks the run will map: no more local workers than that, and none for at most one.
     connect_timeout : float
         Seconds to wait for a remote ``scheduler``'s answer, connection and handshake [s].
     worker_timeout : float
