@@ -29,15 +29,16 @@ STUDY_SECONDS_PER_POINT = 90e-6
 COUPLED_SECONDS_PER_POINT = 2.7e-3
 """Added per point by the coupled chain's SDPs [s] (:data:`spinectl.landscape.schema.ON_REQUEST`, docs/chain.md)."""
 
-ATLAS_SECONDS_PER_DRAW = 177e-6
-"""CPU time of an atlas draw on the fast path, joint by joint [s]: 73 728 draws in 13.0 s
-(``benchmarks/bench_atlas.py --no-chain``, docs/atlas.md "Speed")."""
+ATLAS_SECONDS_PER_DRAW = 53e-6
+"""CPU time of an atlas draw on the fast path, joint by joint [s]: 73 728 draws of eight priors in 3.9 s
+of CPU (``benchmarks/bench_atlas.py``, docs/atlas.md "Speed")."""
 
-ATLAS_PER_DRAW_SECONDS = 25.3e-3
-"""CPU time of an atlas draw solved as one model (a prior outside ``atlas.FAST``) [s] (same benchmark)."""
+ATLAS_PER_DRAW_SECONDS = 29.3e-3
+"""Time of an atlas draw solved as one model (a prior outside ``atlas.FAST``) [s] (same benchmark,
+wall-clock at a load of 11: an upper bound of its CPU time)."""
 
-ATLAS_CHAIN_SECONDS_PER_DRAW = 0.7e-3
-"""Added per atlas draw by the chain's stacked SDP [s] (docs/atlas.md, "What the shipped atlas finds")."""
+ATLAS_CHAIN_SECONDS_PER_DRAW = 0.55e-3
+"""CPU time added per atlas draw by the chain's stacked SDP [s] (same benchmark)."""
 
 ATLAS_BYTES_PER_DRAW = 240
 """An atlas's files per draw [B]: its chunk in ``DIR/chunks`` and its row of ``draws.npz`` (measured:
