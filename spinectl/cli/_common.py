@@ -490,3 +490,60 @@ def input_name(text: str) -> str:
         reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
         raise argparse.ArgumentTypeError(f"cannot read {show(text)}: {reason}") from None
     return text
+
+
+def add_scheduler_options(parser: argparse.ArgumentParser) -> None:
+    """``--scheduler``, ``--workers`` and ``--worker-timeout``: where the chunks run (``study``, ``atlas``).
+
+    Read back by :func:`scheduler_options`; the library checks them
+    (:func:`spinectl.landscape.study.executor.check_options`).
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        The sub-command's parser.
+    """
+    parser.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        help="an existing dask.distributed scheduler, e.g. tcp://host:8786, or 'synchronous' for "
+        "in-process (default: a local cluster on 127.0.0.1, started and closed by the command)",
+    )
+    parser.add_argument(
+        "--worker-timeout",
+        type=finite_float("--worker-timeout"),
+        metavar="SECONDS",
+        help="how long to wait for a first worker of --scheduler if it has none, and for a worker again "
+        "once every worker has gone mid-run (default: spinectl.landscape.study.executor.WORKER_TIMEOUT)",
+    )
+    parser.add_argument("--workers", type=_workers, metavar="N", help="local worker processes (default: cores)")
+
+
+def _workers(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"--workers must be an integer (got {text!r})") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"--workers must be >= 1 (got {text!r})")
+    return value
+
+
+def scheduler_options(args: argparse.Namespace) -> dict:
+    """The options of :func:`add_scheduler_options` as keywords of the library, and a ``notify`` to stderr.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments.
+
+    Returns
+    -------
+    dict
+        ``scheduler``, ``workers``, ``worker_timeout`` (only if given) and ``notify`` (prints a line on stderr).
+    """
+    options = {"scheduler": args.scheduler, "workers": args.workers}
+    options["notify"] = lambda line: print(line, file=sys.stderr)
+    if args.worker_timeout is not None:
+        options["worker_timeout"] = args.worker_timeout
+    return options

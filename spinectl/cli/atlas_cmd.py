@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ._common import add_model_options, emit_json, finite_float
+from ._common import add_model_options, add_scheduler_options, emit_json, finite_float, scheduler_options
 
 
 def register(sub) -> None:
@@ -19,7 +19,9 @@ def register(sub) -> None:
         description="Draw the priors of PRIORS.toml (docs/atlas.md) in Saltelli's design, solve the "
         "joint-by-joint optimum, the exact delay margin and the chain's least local stiffness at every "
         "draw, and report the probability of each verdict (Wilson intervals) and the first- and "
-        "total-order Sobol' indices (SALib, bootstrap intervals). Resumes from the chunks in --out. "
+        "total-order Sobol' indices (SALib, bootstrap intervals). The chunks of draws run as spinectl study's "
+        "do: on a local Dask cluster (the default, --workers), an existing one (--scheduler tcp://...) or "
+        "in-process (--scheduler synchronous), each saved in --out as it finishes: a second run resumes from them. "
         "The model is --preset/--config if given, else the file's [atlas] model, else the default preset; "
         "--set goes on top.",
     )
@@ -32,6 +34,7 @@ def register(sub) -> None:
         help="the lordosis angle [deg] where no prior varies it (default: [atlas] lordosis_m, 4 cm)",
     )
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    add_scheduler_options(parser)
     add_model_options(parser)
     parser.set_defaults(func=run)
 
@@ -55,7 +58,12 @@ def run(args) -> int:
     # --preset or --config replaces the file's [atlas] model; --set goes over whichever it is
     model = load_config(args.config, preset=args.preset) if args.preset or args.config else None
     result = atlas.atlas_file(
-        args.priors, args.out, lordosis_angle=args.lordosis_angle, model=model, assignments=args.assignments
+        args.priors,
+        args.out,
+        lordosis_angle=args.lordosis_angle,
+        model=model,
+        assignments=args.assignments,
+        **scheduler_options(args),
     )
     if args.json:
         emit_json(result.to_dict())

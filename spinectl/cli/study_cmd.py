@@ -3,9 +3,8 @@
 from __future__ import annotations
 
 import argparse
-import sys
 
-from ._common import add_set_option, finite_float
+from ._common import add_scheduler_options, add_set_option, scheduler_options
 
 
 def register(sub) -> None:
@@ -25,20 +24,7 @@ def register(sub) -> None:
     )
     parser.add_argument("study", metavar="STUDY.toml", help="the study file")
     parser.add_argument("--out", required=True, metavar="STORE.zarr", help="the Zarr store (a folder)")
-    parser.add_argument(
-        "--scheduler",
-        metavar="ADDRESS",
-        help="an existing dask.distributed scheduler, e.g. tcp://host:8786, or 'synchronous' for "
-        "in-process (default: a local cluster on 127.0.0.1, started and closed by the command)",
-    )
-    parser.add_argument(
-        "--worker-timeout",
-        type=finite_float("--worker-timeout"),
-        metavar="SECONDS",
-        help="how long to wait for a first worker of --scheduler if it has none, and for a worker again "
-        "once every worker has gone mid-run (default: spinectl.landscape.study.run.WORKER_TIMEOUT)",
-    )
-    parser.add_argument("--workers", type=_positive_int, metavar="N", help="local worker processes (default: cores)")
+    add_scheduler_options(parser)
     parser.add_argument("--resume", action="store_true", help="continue the study in --out, skipping chunks done")
     parser.add_argument(
         "--max-chunks", type=_count, metavar="N", help="stop after N chunks (continue later with --resume)"
@@ -55,10 +41,6 @@ def _integer(text: str, low: int, name: str) -> int:
     if value < low:
         raise argparse.ArgumentTypeError(f"{name} must be >= {low} (got {text!r})")
     return value
-
-
-def _positive_int(text: str) -> int:
-    return _integer(text, 1, "--workers")
 
 
 def _count(text: str) -> int:
@@ -81,10 +63,7 @@ def run(args) -> int:
     from ..landscape import study  # dask and zarr only for this command
 
     spec = study.load_study(args.study, overrides=args.assignments)
-    options = {"scheduler": args.scheduler, "workers": args.workers, "resume": args.resume}
-    options["notify"] = lambda line: print(line, file=sys.stderr)
-    if args.worker_timeout is not None:
-        options["worker_timeout"] = args.worker_timeout
-    result = study.run_study(spec, args.out, max_chunks=args.max_chunks, **options)
+    options = scheduler_options(args)
+    result = study.run_study(spec, args.out, resume=args.resume, max_chunks=args.max_chunks, **options)
     print(study.describe(result))
     return 0

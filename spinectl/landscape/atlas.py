@@ -9,9 +9,10 @@ the exact delay margin at the chosen activation (:mod:`spinectl.reflex.maps`) an
 verdict with its Wilson interval and the first- and total-order Sobol' indices with SALib's
 bootstrap intervals (docs/atlas.md).
 
-The draws are solved in-process, chunk by chunk, each chunk saved in ``DIR/chunks`` as it
-finishes, so that an interrupted atlas resumes where it stopped (the study engine takes an
-E x Lambda grid, not a list of points).
+The draws are solved chunk by chunk on the study engine's executor
+(:func:`spinectl.landscape.study.executor.executor`: in-process, a local Dask cluster or an
+existing one, as ``spinectl study`` chooses), each chunk saved in ``DIR/chunks`` as it
+finishes, so that an interrupted atlas resumes where it stopped.
 """
 
 from __future__ import annotations
@@ -38,6 +39,7 @@ from ..optimise.problem import OK_STATUSES, problem_data
 from ..reflex.inputs import guarded
 from ..reflex.maps import landscape
 from ..units import M2_PER_CM2, m2_to_cm2
+from . import budget
 from .priors import PAPER_OPTIMUM, VERDICTS, AtlasSpec
 
 INSTALL_HINT = "pip install 'spinectl[atlas]' (SALib)"
@@ -557,6 +559,7 @@ def atlas_file(
     model: Model | None = None,
     assignments=(),
     progress: bool | None = None,
+    **where,
 ) -> AtlasResult:
     """The atlas of an atlas file (``spinectl atlas``), the lordosis optionally fixed as an angle.
 
@@ -576,6 +579,8 @@ def atlas_file(
         ``SECTION.FIELD=VALUE`` over the base model (``--set``).
     progress : bool or None
         As for :func:`run_atlas`.
+    **where
+        ``scheduler``, ``workers``, ``connect_timeout``, ``worker_timeout`` and ``notify``, as for :func:`run_atlas`.
 
     Returns
     -------
@@ -586,7 +591,7 @@ def atlas_file(
     ConfigError
         The file is invalid.
     ParameterError
-        ``lordosis_angle`` is given and a prior varies the lordosis, or it is out of range.
+        ``lordosis_angle`` is given and a prior varies the lordosis, or it is out of range; bad scheduler options.
     """
     from ..errors import ParameterError
     from .priors import load_atlas
@@ -596,11 +601,63 @@ def atlas_file(
         if {"lordosis_angle_deg", "lordosis_m"} & set(spec.names):
             raise ParameterError("--lordosis-angle", "a prior varies the lordosis already")
         spec = dataclasses.replace(spec, lordosis=float(lordosis_from_angle(lordosis_angle, spec.model)))
-    return run_atlas(spec, out, progress=progress)
+    return run_atlas(spec, out, progress=progress, **where)
 
 
-def run_atlas(spec: AtlasSpec, out: str | Path | None = None, *, progress: bool | None = None) -> AtlasResult:
-    """The atlas of a validated spec, resumable through the chunks saved in ``out/chunks``.
+@dataclasses.dataclass(frozen=True)
+class ChunkTask:
+    """What a worker needs for one chunk of the atlas: the spec and the chunk's draws (no folder, no file).
+
+    Attributes
+    ----------
+    index : int
+        The chunk: its draws start at ``index * spec.chunk_size``.
+    spec : AtlasSpec
+        The atlas.
+    part : dict of str to numpy.ndarray
+        The chunk's draws (:func:`draw`'s answer for them).
+    """
+
+    index: int
+    spec: AtlasSpec
+    part: dict
+
+
+def solve_chunk(task: ChunkTask) -> tuple[int, dict[str, np.ndarray]]:
+    """Solve one chunk of the atlas (:func:`evaluate`); picklable, for the study engine's executor.
+
+    The answer depends only on the chunk, so in-process and any number of workers give the same bits.
+
+    Parameters
+    ----------
+    task : ChunkTask
+        The chunk.
+
+    Returns
+    -------
+    index : int
+        ``task.index``.
+    outputs : dict of str to numpy.ndarray
+        :func:`evaluate`'s answer for the chunk's draws.
+    """
+    return task.index, evaluate(task.spec, task.part)
+
+
+def run_atlas(
+    spec: AtlasSpec,
+    out: str | Path | None = None,
+    *,
+    progress: bool | None = None,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    connect_timeout: float | None = None,
+    worker_timeout: float | None = None,
+    notify=None,
+) -> AtlasResult:
+    """The atlas of a validated spec, its chunks on the study engine's executor, resumable through ``out/chunks``.
+
+    Each chunk is saved (atomically) as it finishes; a run of the same atlas (the same
+    :func:`fingerprint`) reads the chunks saved and solves only the others.
 
     Parameters
     ----------
@@ -609,46 +666,115 @@ def run_atlas(spec: AtlasSpec, out: str | Path | None = None, *, progress: bool 
         Output folder: chunks as they finish, then ``atlas.json``, ``draws.npz`` and ``report.md``.
     progress : bool or None
         A progress bar of draws on stderr; None: only on a terminal.
+    scheduler : str or None
+        Where the chunks run, as for ``spinectl study`` (:func:`spinectl.landscape.study.executor.executor`):
+        None, a local Dask cluster (in-process for at most one chunk to solve); ``'synchronous'``,
+        in-process; ``'tcp://host:port'``, an existing ``dask.distributed`` scheduler.
+    workers : int or None
+        Local worker processes (default: one per core, at most one per chunk); local cluster only.
+    connect_timeout, worker_timeout : float or None
+        Seconds for a remote scheduler's answer, and to wait for a worker [s]; None: the engine's defaults.
+    notify : callable or None
+        Called with a line of text for the user: the estimate of a long run, the chunks read back,
+        a remote scheduler's worker count.
 
     Returns
     -------
     AtlasResult
+
+    Raises
+    ------
+    ParameterError
+        Bad scheduler options (before anything is written), an unreachable scheduler; more than the
+        available memory holds (:func:`spinectl.landscape.budget.check`).
+    OutputError
+        ``out`` cannot be written.
     """
-    import sys
+    from .study.executor import check_options
 
-    from tqdm import tqdm
-
+    timeouts = {"connect_timeout": connect_timeout, "worker_timeout": worker_timeout}
+    timeouts = {k: v for k, v in timeouts.items() if v is not None}
+    check_options(scheduler, workers, **timeouts)  # before anything is drawn or written
     values = draw(spec, saltelli_unit(spec))
-    n = values["eccentricity_m"].size
     folder = Path(out) / "chunks" if out is not None else None
-    if folder is not None:  # an unwritable --out is one line now, not a traceback after the solving
-        with output_errors(out):
-            folder.mkdir(parents=True, exist_ok=True)
-    key = fingerprint(spec)
-    disable = (not sys.stderr.isatty()) if progress is None else not progress
-    parts = []
-    with tqdm(total=n, unit="draw", disable=disable, desc="atlas") as bar:
-        for index, start in enumerate(range(0, n, spec.chunk_size)):
-            part = {k: v[start : start + spec.chunk_size] for k, v in values.items()}
-            parts.append(_chunk(spec, part, folder, f"{key}-{index:06d}.npz"))
-            bar.update(part["eccentricity_m"].size)
-    outputs = {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
+    where = {"scheduler": scheduler, "workers": workers, **timeouts}
+    outputs = _solve(spec, values, folder, progress, where, notify or (lambda line: None))
     result = analyse(spec, values, outputs)
     if out is not None:
         _write(result, Path(out), spec)
     return result
 
 
-def _chunk(spec: AtlasSpec, part: dict, folder: Path | None, name: str) -> dict:
-    """One chunk's outputs: read back if an earlier run saved it, else solved and saved atomically."""
-    if folder is not None and (folder / name).is_file():
-        with np.load(folder / name, allow_pickle=False) as saved:
-            return {k: saved[k] for k in saved.files}
-    found = evaluate(spec, part)
-    if folder is not None:
-        with atomic_path(folder / name) as tmp, open(tmp, "wb") as handle:
-            np.savez(handle, **found)
-    return found
+def _solve(spec: AtlasSpec, values: dict, folder: Path | None, progress, where: dict, notify) -> dict:
+    """Every chunk's outputs: those saved in ``folder`` read back, the others solved on the executor and saved."""
+    from tqdm import tqdm  # plain: tqdm.auto warns in kernels without ipywidgets (as the study)
+
+    from .study.executor import executor
+
+    n, key = values["eccentricity_m"].size, fingerprint(spec)
+    names = [f"{key}-{index:06d}.npz" for index in range(-(-n // spec.chunk_size))]
+    parts = {index: _saved(folder, name) for index, name in enumerate(names)}
+    parts = {index: part for index, part in parts.items() if part is not None}
+    todo = [index for index in range(len(names)) if index not in parts]
+    if parts:
+        notify(f"atlas: {len(parts)} of {len(names)} chunks read from {str(folder)!r}, saved by an earlier run")
+    done = sum(part["status"].size for part in parts.values())
+    _check_cost(spec, n - done, len(todo), where, folder, notify)
+    if folder is not None:  # an unwritable --out is one line now, not a traceback after the solving
+        with output_errors(folder.parent):
+            folder.mkdir(parents=True, exist_ok=True)
+    tasks = (ChunkTask(index, spec, _part(values, spec, index)) for index in todo)
+    kept = f"every chunk finished is saved in {str(folder)!r}" if folder else "no folder, nothing saved"
+    options = {"notify": notify, "name": "atlas", "again": f"{kept}; start a worker and run the atlas again"}
+    with (
+        tqdm(total=n, initial=done, unit="draw", disable=_no_bar(progress), desc="atlas") as bar,
+        executor(n_chunks=len(todo), **where, **options) as chunks,
+    ):
+        for index, found in chunks.as_completed(solve_chunk, tasks, key=lambda task: f"atlas-{key}-{task.index}"):
+            if folder is not None:
+                _save(folder / names[index], found)
+            parts[index] = found
+            bar.update(found["status"].size)
+    return {k: np.concatenate([parts[i][k] for i in range(len(names))]) for k in parts[0]}
+
+
+def _part(values: dict, spec: AtlasSpec, index: int) -> dict:
+    """The draws of chunk ``index``."""
+    start = index * spec.chunk_size
+    return {k: v[start : start + spec.chunk_size] for k, v in values.items()}
+
+
+def _no_bar(progress: bool | None) -> bool | None:
+    return None if progress is None else not progress  # None: tqdm shows it on a terminal only (as the study)
+
+
+def _saved(folder: Path | None, name: str) -> dict | None:
+    """A chunk's outputs as an earlier run saved them, or None."""
+    if folder is None or not (folder / name).is_file():
+        return None
+    with np.load(folder / name, allow_pickle=False) as saved:
+        return {k: saved[k] for k in saved.files}
+
+
+def _save(path: Path, found: dict) -> None:
+    """Save a chunk atomically (a temporary name, then a rename): an interrupted save leaves no chunk."""
+    with atomic_path(path) as tmp, open(tmp, "wb") as handle:
+        np.savez(handle, **found)
+
+
+def _check_cost(spec: AtlasSpec, n_todo: int, n_chunks: int, where: dict, folder: Path | None, notify) -> None:
+    """Refuse what cannot fit (:func:`spinectl.landscape.budget.check`); announce a long run, as the study does."""
+    from .study.executor import local_processes
+
+    processes = local_processes(where["scheduler"], where["workers"], n_chunks)
+    fast = {p.parameter for p in spec.priors if "." in p.parameter} <= set(FAST)  # as evaluate's 'auto'
+    per_draw = budget.ATLAS_SECONDS_PER_DRAW if fast else budget.ATLAS_PER_DRAW_SECONDS
+    seconds = n_todo * (per_draw + spec.chain * budget.ATLAS_CHAIN_SECONDS_PER_DRAW)
+    memory = processes * (budget.PROCESS_BYTES + spec.chunk_size * budget.WORKING_BYTES_PER_POINT)
+    cost = budget.Estimate("atlas", n_todo, memory, n_todo * budget.ATLAS_BYTES_PER_DRAW, seconds)
+    budget.check(cost, folder)
+    if cost.long:
+        notify(cost.line())
 
 
 def _write(result: AtlasResult, out: Path, spec: AtlasSpec) -> None:

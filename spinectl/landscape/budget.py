@@ -29,6 +29,21 @@ STUDY_SECONDS_PER_POINT = 90e-6
 COUPLED_SECONDS_PER_POINT = 2.7e-3
 """Added per point by the coupled chain's SDPs [s] (:data:`spinectl.landscape.schema.ON_REQUEST`, docs/chain.md)."""
 
+ATLAS_SECONDS_PER_DRAW = 53e-6
+"""CPU time of an atlas draw on the fast path, joint by joint [s]: 73 728 draws of eight priors in 3.9 s
+of CPU (``benchmarks/bench_atlas.py``, docs/atlas.md "Speed")."""
+
+ATLAS_PER_DRAW_SECONDS = 29.3e-3
+"""Time of an atlas draw solved as one model (a prior outside ``atlas.FAST``) [s] (same benchmark,
+wall-clock at a load of 11: an upper bound of its CPU time)."""
+
+ATLAS_CHAIN_SECONDS_PER_DRAW = 0.55e-3
+"""CPU time added per atlas draw by the chain's stacked SDP [s] (same benchmark)."""
+
+ATLAS_BYTES_PER_DRAW = 240
+"""An atlas's files per draw [B]: its chunk in ``DIR/chunks`` and its row of ``draws.npz`` (measured:
+the shipped atlas's five priors with the chain, N = 256: 94 B a draw in its chunk, 142 B in ``draws.npz``)."""
+
 SWEEP_MEMORY_PER_BYTE = 2.5
 """Peak memory of a sweep per byte of its answer: the chunks' columns, their concatenation and the
 Dataset (tracemalloc peak of ``write_sweep`` over 101 x 101 x 4 K: 3.1 kB a point for 1.22 kB of answer)."""

@@ -101,3 +101,31 @@ def test_preset_default_and_the_default_differ_as_stability_says(tmp_path, capsy
         found[preset] = pcsa
         assert pcsa == pytest.approx(reading["min_pcsa_cm2"], rel=1e-6)
     assert found["default"] != pytest.approx(found[None], rel=1e-3)
+
+
+@pytest.mark.parametrize(
+    ("options", "words"),
+    [
+        (["--scheduler", "ftp://127.0.0.1:8786"], "scheduler: must be 'synchronous' or a dask.distributed address"),
+        (["--scheduler", "synchronous", "--workers", "2"], "workers: sets the size of the local cluster"),
+        (["--scheduler", "tcp://127.0.0.1:0"], "scheduler: must be tcp://HOST:PORT with a host and a port"),
+        (["--workers", "0"], "--workers must be >= 1"),
+    ],
+)
+def test_bad_scheduler_options_are_one_line_exit_2(tmp_path, capsys, options, words):
+    """--scheduler and --workers as `spinectl study` checks them: one line, exit 2, before --out is made."""
+    code = main(["atlas", str(_file(tmp_path)), "--out", str(tmp_path / "out"), *options])
+    err = capsys.readouterr().err
+    assert code == 2 and words in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "out").exists()
+
+
+def test_two_local_workers_give_the_synchronous_json(tmp_path, capsys):
+    """`--workers 2` (a local Dask cluster; two chunks of 3 draws) prints the JSON of `--scheduler synchronous`."""
+    path = _file(tmp_path)
+    path.write_text(path.read_text().replace("chain = false", "chain = false\nchunk_size = 3"))
+    docs = []
+    for options in (["--scheduler", "synchronous"], ["--workers", "2"]):
+        assert main(["atlas", str(path), "--out", str(tmp_path / options[0]), "--json", *options]) == 0
+        docs.append(json.loads(capsys.readouterr().out))
+    assert docs[0] == docs[1] and len(list((tmp_path / "--workers" / "chunks").iterdir())) == 2

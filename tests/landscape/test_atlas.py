@@ -162,10 +162,10 @@ def test_wilson_interval_is_the_closed_form():
 
 def test_same_seed_same_numbers_and_resume(tmp_path, monkeypatch):
     """The same seed gives the same JSON; another seed other draws; a second run reads its saved chunks."""
-    spec = _spec(chain="false")
-    first = atlas.run_atlas(spec, tmp_path / "a", progress=False).to_dict()
-    assert atlas.run_atlas(spec, tmp_path / "b", progress=False).to_dict() == first
-    other = atlas.run_atlas(dataclasses.replace(spec, seed=1), None, progress=False).to_dict()
+    spec, here = _spec(chain="false"), {"progress": False, "scheduler": "synchronous"}
+    first = atlas.run_atlas(spec, tmp_path / "a", **here).to_dict()
+    assert atlas.run_atlas(spec, tmp_path / "b", **here).to_dict() == first
+    other = atlas.run_atlas(dataclasses.replace(spec, seed=1), None, **here).to_dict()
     assert other["sobol"] != first["sobol"]
     assert {p.name for p in (tmp_path / "a").iterdir()} >= {"atlas.json", "report.md", "density.png", "draws.npz"}
 
@@ -173,9 +173,92 @@ def test_same_seed_same_numbers_and_resume(tmp_path, monkeypatch):
         raise AssertionError("solved a chunk that was saved")
 
     monkeypatch.setattr(atlas, "evaluate", refuse)
-    assert atlas.run_atlas(spec, tmp_path / "a", progress=False).to_dict() == first
+    assert atlas.run_atlas(spec, tmp_path / "a", progress=False).to_dict() == first  # nothing to solve: no cluster
+
+
+def _draws(folder):
+    with np.load(folder / "draws.npz") as saved:
+        return {k: saved[k] for k in saved.files}
+
+
+def _same_bits(found, expected):
+    assert found.keys() == expected.keys()
+    for name, values in expected.items():
+        assert found[name].dtype == values.dtype and found[name].tobytes() == values.tobytes(), name
+
+
+@pytest.fixture(scope="module")
+def in_process(tmp_path_factory):
+    """N = 64 (448 draws of the five priors, the chain's SDP too) in chunks of 64, in this process: the reference."""
+    spec = _spec(samples=64, chunk=64)
+    out = tmp_path_factory.mktemp("atlas") / "ref"
+    return spec, atlas.run_atlas(spec, out, scheduler="synchronous", progress=False).to_dict(), _draws(out)
+
+
+def test_two_local_workers_give_the_in_process_bits(in_process, tmp_path):
+    """A local Dask cluster of two worker processes solves the 7 chunks to the same bits as this process.
+
+    Every draw's parameters and outputs (draws.npz) byte for byte, and the JSON answer equal: a chunk's
+    answer depends only on the chunk (:func:`spinectl.landscape.atlas.solve_chunk`), not on where it ran.
+    """
+    spec, answer, draws = in_process
+    notes = []
+    result = atlas.run_atlas(spec, tmp_path / "two", workers=2, progress=False, notify=notes.append)
+    _same_bits(_draws(tmp_path / "two"), draws)
+    assert result.to_dict() == answer and notes == []  # nothing read back, nothing long to announce
+
+
+def test_an_interrupted_cluster_run_resumes_to_the_same_bits(in_process, tmp_path, monkeypatch):
+    """Ctrl-C after three chunks saved on two local workers: three chunk files, nothing else; the run
+    again (in-process) solves only the four others and gives the reference's bits."""
+    spec, answer, draws = in_process
+    save, saved = atlas._save, []
+
+    def interrupted(path, found):
+        if len(saved) == 3:
+            raise KeyboardInterrupt
+        save(path, found)
+        saved.append(path.name)
+
+    monkeypatch.setattr(atlas, "_save", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        atlas.run_atlas(spec, tmp_path / "cut", workers=2, progress=False)
+    assert sorted(p.name for p in (tmp_path / "cut" / "chunks").iterdir()) == sorted(saved)
+    assert sorted(p.name for p in (tmp_path / "cut").iterdir()) == ["chunks"]  # no temporaries, no answer
+
+    monkeypatch.setattr(atlas, "_save", save)
+    evaluate, solved, notes = atlas.evaluate, [], []
+    monkeypatch.setattr(atlas, "evaluate", lambda spec, part: solved.append(1) or evaluate(spec, part))
+    result = atlas.run_atlas(spec, tmp_path / "cut", scheduler="synchronous", progress=False, notify=notes.append)
+    assert len(solved) == 7 - 3 and notes == [
+        f"atlas: 3 of 7 chunks read from {str(tmp_path / 'cut' / 'chunks')!r}, saved by an earlier run"
+    ]
+    _same_bits(_draws(tmp_path / "cut"), draws)
+    assert result.to_dict() == answer
 
 
 def test_verdicts_name_their_criteria():
     """Every verdict the atlas reports names joint by joint or the chain."""
     assert all("joint by joint" in text or "the chain" in text for text in atlas.VERDICTS.values())
+
+
+def test_a_long_atlas_is_announced_and_what_cannot_fit_refused(tmp_path, monkeypatch):
+    """As the study's: the estimate's line before a run of at least NOTICE_SECONDS (here 0), with the draws
+    to solve and their CPU time from the benchmark's costs per draw; a memory estimate above what is
+    available is one error naming the atlas, before --out is made."""
+    from spinectl.errors import ParameterError
+    from spinectl.landscape import budget
+
+    spec, notes = _spec(chain="false"), []
+    monkeypatch.setattr(budget, "NOTICE_SECONDS", 0.0)
+    atlas.run_atlas(spec, None, scheduler="synchronous", progress=False, notify=notes.append)
+    seconds = 28 * budget.ATLAS_SECONDS_PER_DRAW  # N (D + 2) = 4 x 7 draws on the fast path, no chain
+    memory = budget.size(budget.PROCESS_BYTES + 16 * budget.WORKING_BYTES_PER_POINT)  # one process, chunks of 16
+    disk = budget.size(28 * budget.ATLAS_BYTES_PER_DRAW)
+    assert notes == [
+        f"atlas: 28 points, about {disk} on disk, {memory} of memory, {budget.duration(seconds)} of CPU (estimated)"
+    ]
+    monkeypatch.setattr(budget, "available_memory", lambda: 1e6)
+    with pytest.raises(ParameterError, match=f"^atlas: 28 points need about {memory} of memory"):
+        atlas.run_atlas(spec, tmp_path / "out", scheduler="synchronous", progress=False)
+    assert not (tmp_path / "out").exists()

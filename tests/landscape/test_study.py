@@ -305,6 +305,23 @@ def test_two_local_workers_on_loopback_give_the_same_bits(reference, tmp_path, m
     xr.testing.assert_identical(study.load(tmp_path / "two.zarr"), reference)
 
 
+def test_the_executor_maps_any_picklable_function():
+    """The engine's public executor, outside a study: ``operator.neg`` over 0..4 is -0..-4 (the closed form),
+    in order in-process, in some order on two local workers; bad options are refused before a cluster starts."""
+    import operator
+
+    from spinectl.landscape.study import executor
+
+    with executor.executor("synchronous", None, 5) as here:
+        assert list(here.as_completed(operator.neg, range(5))) == [0, -1, -2, -3, -4] and here.where == "in-process"
+    with executor.executor(None, 2, 5) as there:
+        found = sorted(there.as_completed(operator.neg, range(5), key=lambda i: f"neg-{i}"))
+        assert found == [-4, -3, -2, -1, 0] and there.where == "2 local workers" and len(there.addresses) == 3
+    with pytest.raises(ParameterError, match="^workers: sets the size of the local cluster"):
+        with executor.executor("synchronous", 2, 5):
+            pass
+
+
 def test_an_existing_cluster_by_its_address(reference, tmp_path):
     """``scheduler='tcp://...'``: the study connects to a cluster it did not start, and leaves it running."""
     from distributed import LocalCluster
@@ -826,7 +843,7 @@ def test_schemes_spinectl_cannot_use_are_refused_with_the_reason(tmp_path, capsy
     code = main(["study", str(write(tmp_path)), "--out", str(tmp_path / "s.zarr"), "--scheduler", address])
     err = capsys.readouterr().err
     assert code == 2 and len(err.strip().splitlines()) == 1
-    assert f"(got '{address}'): {scheme}:// {study.run.UNUSABLE_SCHEMES[scheme]}" in err
+    assert f"(got '{address}'): {scheme}:// {study.executor.UNUSABLE_SCHEMES[scheme]}" in err
 
 
 def test_ctrl_c_while_the_local_cluster_starts_is_one_line(tmp_path):

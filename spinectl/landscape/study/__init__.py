@@ -9,7 +9,9 @@ into a Zarr store that it can resume; :func:`load` reads the store back.
 - :mod:`spinectl.landscape.study.spec`: the study, its validation and the plan of chunks;
 - :mod:`spinectl.landscape.study.files`: the study file, read and checked against its schema;
 - :mod:`spinectl.landscape.study.store`: the Zarr store's layout, creation, resume check and writes;
-- :mod:`spinectl.landscape.study.run`: the chunks on a scheduler, written as they finish.
+- :mod:`spinectl.landscape.study.executor`: where chunks run (in-process, a local or an existing Dask
+  cluster), a picklable function mapped over them; shared with the atlas;
+- :mod:`spinectl.landscape.study.run`: the study's chunks on the executor, written as they finish.
 """
 
 from __future__ import annotations

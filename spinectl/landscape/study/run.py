@@ -1,6 +1,6 @@
 """Running a study: chunks solved in-process or on a ``dask.distributed`` cluster, written as they finish.
 
-Where the chunks run (:func:`run_study`):
+Where the chunks run (:func:`run_study`; :func:`spinectl.landscape.study.executor.executor`):
 
 - ``scheduler=None``: a local cluster started for the run, one single-threaded
   process per worker (cvxpy model building is pure Python and not
@@ -23,16 +23,7 @@ study; an interrupted run loses at most those.
 
 from __future__ import annotations
 
-import contextlib
-import itertools
-import logging
 import math
-import multiprocessing
-import os
-import re
-import signal
-import sys
-import tempfile
 import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
@@ -47,47 +38,8 @@ from ...model import config
 from ...model.params import Model
 from .. import budget, columns, schema
 from . import store
+from .executor import CONNECT_TIMEOUT, WORKER_TIMEOUT, check_options, executor, local_processes
 from .spec import Study
-
-SYNCHRONOUS = "synchronous"
-"""The ``scheduler`` that runs every chunk in this process, one after another."""
-
-ADDRESS = re.compile(r"^tcp://\S+$")
-"""A ``dask.distributed`` scheduler address that spinectl can use: plain TCP."""
-
-UNUSABLE_SCHEMES = {
-    "tls": "needs certificates, which spinectl does not configure",
-    "wss": "needs certificates, which spinectl does not configure",
-    "ws": "is not tested with spinectl (its listener binds every interface): use tcp://",
-    "ucx": "needs ucx-py, which spinectl does not install",
-    "inproc": "reaches only a scheduler inside this process",
-}
-"""The other schemes of ``dask.distributed`` addresses, and why a study cannot use them."""
-
-CONNECT_TIMEOUT = 10.0
-"""Seconds to wait for a remote scheduler's answer (connection and handshake) before giving up [s]."""
-
-WORKER_TIMEOUT = 60.0
-"""Seconds to wait for the first worker of a remote scheduler that has none, or for a worker again once
-every worker of the run has gone [s]."""
-
-POLL = 1.0
-"""Seconds between looks at the workers while no chunk finishes [s]."""
-
-MALLOC_TRIM_SETTING = "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_"
-"""Dask sets ``MALLOC_TRIM_THRESHOLD_=65536`` in its workers so that glibc hands freed memory back at
-once; the fast path allocates and frees many arrays of a few hundred kB per chunk and then runs about
-15 % slower (measured on one chunk of 4010 points). Local workers keep glibc's own threshold; a chunk's
-memory is bounded anyway (the benchmark's peak, docs/studies.md)."""
-
-START_METHOD = "forkserver" if "forkserver" in multiprocessing.get_all_start_methods() else "spawn"
-"""How local worker processes start: forked from a fresh server process where the platform allows
-(Linux, macOS), rather than dask's default, a new interpreter each (``spawn``). Both start from a clean
-process (never a fork of the client and its threads); a forked worker ends with ``os._exit``, without the
-interpreter's shutdown, which took 1.2 s of a closing cluster of two workers (0.05 s now; load 5)."""
-
-WORKERS_PER_CORE = 4
-"""Most local workers per core: the solver is CPU-bound, more only costs memory."""
 
 
 @dataclass(frozen=True)
@@ -269,7 +221,9 @@ def run_study(
         store estimated would not fit on its file system's free space.
     """
     timeouts = {"connect_timeout": connect_timeout, "worker_timeout": worker_timeout}
-    _check_options(scheduler, workers, max_chunks, timeouts)
+    check_options(scheduler, workers, **timeouts)
+    if max_chunks is not None and (isinstance(max_chunks, bool) or not isinstance(max_chunks, int) or max_chunks < 0):
+        raise ParameterError("max_chunks", f"must be an integer >= 0 (got {max_chunks!r})")
     start = time.perf_counter()
     notify = notify or (lambda line: None)
     with store.locked(out):  # before the existence check: two runs cannot both pass it
@@ -277,13 +231,15 @@ def run_study(
         indices = np.arange(study.n_chunks) if done is None else np.flatnonzero(done == 0)
         todo = indices[: None if max_chunks is None else max_chunks]
         probe = _probe(study)
-        cost = estimate(study, todo.size, probe, _processes(scheduler, workers, todo.size))
+        cost = estimate(study, todo.size, probe, local_processes(scheduler, workers, todo.size))
         budget.check(cost, out)  # before any cluster or store: what cannot fit is refused at once
         if cost.long:
             notify(cost.line())
-        with _executor(scheduler, workers, todo.size, tuple(timeouts.values()), notify) as executor:
+        again = "the store holds every chunk finished; start a worker and run again with --resume"
+        with executor(scheduler, workers, todo.size, **timeouts, notify=notify, again=again) as chunks:
             # a cluster's first chunks are submitted now: its workers start on them while the store is made
-            results = executor.run(tasks(study, todo), f"spinectl-{study.digest()[:16]}")
+            prefix = f"spinectl-{study.digest()[:16]}"
+            results = chunks.as_completed(solve_chunk, tasks(study, todo), key=lambda task: f"{prefix}-{task.index}")
             if done is None:  # after connecting: an unreachable scheduler leaves no store behind
                 done = store.create(study, out, probe)
             done_before = int(np.count_nonzero(done))
@@ -291,7 +247,7 @@ def run_study(
         if np.all(done > 0):
             store.consolidate(out)
     seconds = time.perf_counter() - start
-    return StudyResult(Path(out), study.n_chunks, done_before, todo.size, seconds, executor.where, executor.addresses)
+    return StudyResult(Path(out), study.n_chunks, done_before, todo.size, seconds, chunks.where, chunks.addresses)
 
 
 def estimate(study: Study, n_todo: int, probe: dict[str, np.ndarray], processes: int = 1) -> budget.Estimate:
@@ -327,13 +283,6 @@ def estimate(study: Study, n_todo: int, probe: dict[str, np.ndarray], processes:
     return budget.Estimate("study", points, memory + 24 * study.n_chunks, disk, seconds)
 
 
-def _processes(scheduler: str | None, workers: int | None, n_todo: int) -> int:
-    """Processes of this machine that will solve chunks (as :func:`_executor` starts them)."""
-    if scheduler is None and n_todo > 1:
-        return min(workers or _cores(), n_todo)
-    return 1
-
-
 def _run_chunks(study: Study, out, done: np.ndarray, results, progress: bool | None) -> None:
     """Write each chunk of ``results`` as it comes, with a progress bar of the whole study."""
     writer = store.Writer(study, out, done)
@@ -353,299 +302,6 @@ def _probe(study: Study) -> dict[str, np.ndarray]:
 
 def _disabled(progress: bool | None) -> bool | None:
     return None if progress is None else not progress  # None: tqdm shows it on a terminal only
-
-
-def _check_options(scheduler, workers, max_chunks, timeouts: dict) -> None:
-    if scheduler is not None and not (scheduler == SYNCHRONOUS or ADDRESS.match(str(scheduler))):
-        allowed = f"{SYNCHRONOUS!r} or a dask.distributed address such as tcp://host:8786"
-        scheme = str(scheduler).partition("://")[0]
-        why = f": {scheme}:// {UNUSABLE_SCHEMES[scheme]}" if scheme in UNUSABLE_SCHEMES else ""
-        raise ParameterError("scheduler", f"must be {allowed} (got {scheduler!r}){why}")
-    if scheduler is not None and scheduler != SYNCHRONOUS:
-        _check_host_port(scheduler)
-    if workers is not None:
-        if scheduler is not None:
-            raise ParameterError("workers", "sets the size of the local cluster: not with a scheduler")
-        most = WORKERS_PER_CORE * _cores()
-        if isinstance(workers, bool) or not isinstance(workers, int) or not 1 <= workers <= most:
-            allowed = f"an integer in [1, {most}] ({WORKERS_PER_CORE} per core)"
-            raise ParameterError("workers", f"must be {allowed} (got {workers!r})")
-    if max_chunks is not None and (isinstance(max_chunks, bool) or not isinstance(max_chunks, int) or max_chunks < 0):
-        raise ParameterError("max_chunks", f"must be an integer >= 0 (got {max_chunks!r})")
-    for name, seconds in timeouts.items():
-        if isinstance(seconds, bool) or not isinstance(seconds, int | float) or not 0 < seconds < math.inf:
-            raise ParameterError(name, f"must be a number of seconds > 0 (got {seconds!r})")
-
-
-def _check_host_port(scheduler: str) -> None:
-    """Refuse at once an address without a host, or with a port that is not an integer in [1, 65535]:
-    such an address used to fail only after the connection's timeout, or with Python's own words."""
-    from distributed.comm.addressing import parse_host_port
-
-    try:
-        host, port = parse_host_port(scheduler.removeprefix("tcp://"))
-    except ValueError as exc:
-        host, port = None, str(exc)
-    if not host or isinstance(port, str) or not 1 <= port <= 65535:
-        raise ParameterError(
-            "scheduler",
-            "must be tcp://HOST:PORT with a host and a port in [1, 65535], e.g. tcp://127.0.0.1:8786 "
-            f"(got {scheduler!r})",
-        )
-
-
-def _cores() -> int:
-    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
-
-
-class _InProcess:
-    """Every chunk in this process, in order."""
-
-    where = "in-process"
-    addresses: tuple[str, ...] = ()
-
-    @staticmethod
-    def run(chunks: Iterator[Task], prefix: str):
-        for task in chunks:
-            yield solve_chunk(task)
-
-
-class _Distributed:
-    """Chunks on a ``dask.distributed`` cluster, at most two per worker thread in flight.
-
-    While no chunk finishes, the workers are counted every :data:`POLL` seconds: once
-    the cluster has had none for ``worker_timeout`` seconds (they were stopped, or lost
-    their network), the run stops with one line; the store holds every chunk written.
-    """
-
-    def __init__(self, client, where: str, worker_timeout: float = WORKER_TIMEOUT):
-        self.client, self.where, self.worker_timeout = client, where, worker_timeout
-        info = client.scheduler_info()
-        self.addresses = (info["address"], *sorted(info["workers"]))
-
-    def run(self, chunks: Iterator[Task], prefix: str) -> Iterator[tuple[int, dict[str, np.ndarray]]]:
-        """Submit the first chunks at once; return the chunks' results as they finish, submitting one as one ends."""
-        from distributed import as_completed
-
-        window = 2 * max(1, sum(self.client.nthreads().values()))
-
-        def submit(task: Task):
-            return self.client.submit(solve_chunk, task, key=f"{prefix}-{task.index}")
-
-        pending = as_completed([submit(task) for task in itertools.islice(chunks, window)], loop=self.client.loop)
-        return self._results(pending, chunks, submit)
-
-    def _results(self, pending, chunks: Iterator[Task], submit):
-        watch = _Watch(self.client, self.where, self.worker_timeout)  # one for the run
-        while not pending.is_empty():
-            self._wait_for_one(pending, watch)
-            for future in pending.next_batch(block=False):
-                result = self._result(future, watch)  # a chunk's error ends the run here; the cluster is closed after
-                future.release()
-                watch.alive()
-                yield result
-                task = next(chunks, None)
-                if task is not None:
-                    pending.add(submit(task))
-
-    @staticmethod
-    def _wait_for_one(pending, watch: _Watch) -> None:
-        """Return once a future of ``pending`` has finished, as long as the cluster has a worker."""
-        while not pending.has_ready():
-            time.sleep(0.01)
-            watch()
-
-    @staticmethod
-    def _result(future, watch: _Watch):
-        """The chunk of a finished future. Its data lives on the worker that solved it: a worker gone
-        before the data came back leaves the scheduler waiting for another, so this wait is bounded too."""
-        while True:
-            try:
-                return future.result(timeout=POLL)
-            except TimeoutError:
-                watch()
-
-
-class _Watch:
-    """Call while waiting: every :data:`POLL` seconds without a finished chunk it counts the
-    cluster's workers, and raises once there has been none for ``worker_timeout`` seconds.
-
-    A finished chunk (:meth:`alive`) shows a worker: no question to the scheduler while chunks come.
-    """
-
-    def __init__(self, client, where: str, worker_timeout: float):
-        self.client, self.where, self.worker_timeout = client, where, worker_timeout
-        self.idle_since, self.looked = None, time.monotonic()
-
-    def alive(self) -> None:
-        """A chunk has just finished: the cluster had a worker now."""
-        self.idle_since, self.looked = None, time.monotonic()
-
-    def __call__(self) -> None:
-        if time.monotonic() - self.looked < POLL:
-            return
-        self.looked = time.monotonic()
-        if self.client.scheduler_info(n_workers=0).get("n_workers", 1) > 0:
-            self.idle_since = None
-        elif self.idle_since is None:
-            self.idle_since = self.looked
-        elif self.looked - self.idle_since > self.worker_timeout:
-            raise ParameterError(
-                "scheduler",
-                f"{self.where}: every worker has gone, and none joined within {self.worker_timeout:g} s: the "
-                "store holds every chunk finished; start a worker and run again with --resume",
-            )
-
-
-@contextlib.contextmanager
-def _executor(scheduler: str | None, workers: int | None, n_todo: int, timeouts: tuple[float, float], notify):
-    if scheduler == SYNCHRONOUS or (scheduler is None and n_todo <= 1):
-        yield _InProcess()
-        return
-    if scheduler is not None:
-        with _remote(scheduler, *timeouts, notify) as client:
-            n_workers = len(client.scheduler_info()["workers"])
-            yield _Distributed(client, _where(scheduler, n_workers), timeouts[1])
-        return
-    n = min(workers or _cores(), n_todo)
-    with _local_cluster(n) as client:
-        yield _Distributed(client, f"{n} local worker{'s' * (n != 1)}", timeouts[1])
-
-
-def _where(scheduler: str, n_workers: int) -> str:
-    return f"{scheduler} ({n_workers} worker{'s' * (n_workers != 1)})"
-
-
-@contextlib.contextmanager
-def _local_cluster(n: int):
-    """A client of a new local cluster of ``n`` single-threaded worker processes on 127.0.0.1, closed after.
-
-    Ctrl-C is held (SIGINT blocked) while the cluster starts and while it closes, and acts
-    in between: the worker processes inherit the blocked signal, so they print no
-    tracebacks of their own, and distributed is never asked to close a half-started
-    cluster (it asserts then).
-    """
-    import dask
-    from distributed import Client, LocalCluster
-
-    previous = _block_interrupts()
-    try:
-        settings = {MALLOC_TRIM_SETTING: None, "distributed.worker.multiprocessing-method": START_METHOD}
-        with dask.config.set(settings), _workers_stderr():  # see there for all three
-            cluster = LocalCluster(
-                n_workers=n,
-                threads_per_worker=1,  # cvxpy is not thread-safe; one process per worker
-                processes=True,
-                host="127.0.0.1",  # loopback only: nothing listens on another address
-                dashboard_address=None,
-                # no dashboard, but the scheduler's HTTP server (health routes) would take port 8787 and
-                # warn on stderr when another cluster has it: a free loopback port instead
-                scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
-                silence_logs=logging.ERROR,
-            )
-        try:
-            client = Client(cluster, set_as_default=False)
-            try:
-                _restore_interrupts(previous)  # a Ctrl-C of the start-up acts here
-                yield client
-            finally:
-                _block_interrupts()
-                client.close()
-        finally:
-            cluster.close()
-    finally:
-        _restore_interrupts(previous)
-
-
-@contextlib.contextmanager
-def _workers_stderr():
-    """Start worker processes with a temporary file as their standard error, not the terminal.
-
-    The worker processes (or their fork server, :data:`START_METHOD`) are started from distributed's
-    own threads, which do not share the blocked SIGINT; a Ctrl-C that reaches a new interpreter while it
-    starts makes CPython print "Fatal Python error: init_import_site" and a traceback there. The workers log at
-    error level only (``silence_logs``) and their failures reach the client as exceptions.
-    """
-    sys.stderr.flush()
-    saved = os.dup(2)
-    with tempfile.TemporaryFile() as log:
-        os.dup2(log.fileno(), 2)
-        try:
-            yield
-        finally:
-            os.dup2(saved, 2)
-            os.close(saved)
-
-
-def _block_interrupts():
-    """Block SIGINT in this thread (and so in the threads and processes it starts); return the previous mask."""
-    return signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT}) if hasattr(signal, "pthread_sigmask") else None
-
-
-def _restore_interrupts(previous) -> None:
-    """Restore the mask from :func:`_block_interrupts`: a SIGINT that came meanwhile is delivered now."""
-    if previous is not None:
-        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
-
-
-@contextlib.contextmanager
-def _remote(scheduler: str, connect_timeout: float, worker_timeout: float, notify):
-    """A client of the scheduler at ``scheduler``, once it has answered and has a worker."""
-    from distributed import Client
-
-    n_workers = _handshake(scheduler, connect_timeout)
-    notify(f"study: {_where(scheduler, n_workers)}")
-    try:
-        client = Client(scheduler, timeout=connect_timeout, set_as_default=False)
-    except (OSError, TimeoutError) as exc:
-        raise ParameterError("scheduler", f"cannot connect to {scheduler}: {exc}") from None
-    with client:
-        if not n_workers:
-            notify(f"study: waiting up to {worker_timeout:g} s for a worker of {scheduler}")
-            try:
-                client.wait_for_workers(1, timeout=worker_timeout)
-            except TimeoutError:
-                raise ParameterError(
-                    "scheduler",
-                    f"{scheduler} has no worker, and none joined within {worker_timeout:g} s: start one "
-                    f"(dask worker {scheduler}) or wait longer (--worker-timeout)",
-                ) from None
-        yield client
-
-
-def _handshake(scheduler: str, timeout: float) -> int:
-    """Ask the scheduler who it is, within ``timeout`` [s] in all; return its number of workers.
-
-    ``distributed.Client`` bounds the TCP connection but not every read of the
-    handshake after it: something that listens but is no Dask scheduler (an HTTP
-    server) would keep it waiting for ever.
-    """
-    import asyncio
-    import socket
-    import struct
-
-    from distributed.comm.addressing import parse_host_port
-    from distributed.core import rpc
-
-    async def identity():
-        host, port = parse_host_port(scheduler.removeprefix("tcp://"))
-        # a name that does not resolve: said so (socket.gaierror), not "no answer within 10 s" after retries
-        await asyncio.get_running_loop().getaddrinfo(host, port, type=socket.SOCK_STREAM)
-        async with rpc(scheduler, timeout=timeout) as remote:
-            return await remote.identity()
-
-    try:
-        info = asyncio.run(asyncio.wait_for(identity(), timeout))
-    except TimeoutError:
-        reason = f"no answer of a Dask scheduler within {timeout:g} s (is it one?)"
-        raise ParameterError("scheduler", f"cannot connect to {scheduler}: {reason}") from None
-    except (OSError, ValueError, TypeError, struct.error) as exc:  # refused, unreachable, garbage for a handshake
-        raise ParameterError("scheduler", f"cannot connect to {scheduler}: {exc}") from None
-    except MemoryError:  # a frame length of exabytes: something else's protocol
-        info = None
-    if not isinstance(info, dict) or info.get("type") != "Scheduler":
-        raise ParameterError("scheduler", f"cannot connect to {scheduler}: it answers, but is no Dask scheduler")
-    return int(info.get("n_workers", len(info.get("workers", ()))))
 
 
 def describe(result: StudyResult) -> str:
