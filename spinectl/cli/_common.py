@@ -492,7 +492,9 @@ def input_name(text: str) -> str:
     return text
 
 
-def add_scheduler_options(parser: argparse.ArgumentParser) -> None:
+def add_scheduler_options(
+    parser: argparse.ArgumentParser, default: str = "a local cluster on 127.0.0.1, started and closed by the command"
+) -> None:
     """``--scheduler``, ``--workers`` and ``--worker-timeout``: where the chunks run (``study``, ``atlas``).
 
     Read back by :func:`scheduler_options`; the library checks them
@@ -502,12 +504,14 @@ def add_scheduler_options(parser: argparse.ArgumentParser) -> None:
     ----------
     parser : argparse.ArgumentParser
         The sub-command's parser.
+    default : str
+        Where the chunks run without ``--scheduler``, for the help.
     """
     parser.add_argument(
         "--scheduler",
         metavar="ADDRESS",
         help="an existing dask.distributed scheduler, e.g. tcp://host:8786, or 'synchronous' for "
-        "in-process (default: a local cluster on 127.0.0.1, started and closed by the command)",
+        f"in-process (default: {default})",
     )
     parser.add_argument(
         "--worker-timeout",

@@ -20,8 +20,9 @@ def register(sub) -> None:
         "joint-by-joint optimum, the exact delay margin and the chain's least local stiffness at every "
         "draw, and report the probability of each verdict (Wilson intervals) and the first- and "
         "total-order Sobol' indices (SALib, bootstrap intervals). The chunks of draws run as spinectl study's "
-        "do: on a local Dask cluster (the default, --workers), an existing one (--scheduler tcp://...) or "
-        "in-process (--scheduler synchronous), each saved in --out as it finishes: a second run resumes from them. "
+        "do, but in this process by default (a local cluster pays only where cores are free): on a local Dask "
+        "cluster with --workers N, an existing one (--scheduler tcp://...), each saved in --out as it finishes: "
+        "a second run resumes from them. "
         "The model is --preset/--config if given, else the file's [atlas] model, else the default preset; "
         "--set goes on top.",
     )
@@ -34,7 +35,7 @@ def register(sub) -> None:
         help="the lordosis angle [deg] where no prior varies it (default: [atlas] lordosis_m, 4 cm)",
     )
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
-    add_scheduler_options(parser)
+    add_scheduler_options(parser, default="in this process; with --workers N a local cluster")
     add_model_options(parser)
     parser.set_defaults(func=run)
 

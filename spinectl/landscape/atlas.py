@@ -668,10 +668,10 @@ def run_atlas(
         A progress bar of draws on stderr; None: only on a terminal.
     scheduler : str or None
         Where the chunks run, as for ``spinectl study`` (:func:`spinectl.landscape.study.executor.executor`):
-        None, a local Dask cluster (in-process for at most one chunk to solve); ``'synchronous'``,
+        None, in-process unless ``workers`` is given, then a local Dask cluster; ``'synchronous'``,
         in-process; ``'tcp://host:port'``, an existing ``dask.distributed`` scheduler.
     workers : int or None
-        Local worker processes (default: one per core, at most one per chunk); local cluster only.
+        Local worker processes of a local Dask cluster (at most one per chunk).
     connect_timeout, worker_timeout : float or None
         Seconds for a remote scheduler's answer, and to wait for a worker [s]; None: the engine's defaults.
     notify : callable or None
@@ -692,6 +692,8 @@ def run_atlas(
     """
     from .study.executor import check_options
 
+    if scheduler is None and workers is None:  # a local cluster cost twice in-process's time on 2 cores (docs/atlas.md)
+        scheduler = "synchronous"
     timeouts = {"connect_timeout": connect_timeout, "worker_timeout": worker_timeout}
     timeouts = {k: v for k, v in timeouts.items() if v is not None}
     check_options(scheduler, workers, **timeouts)  # before anything is drawn or written

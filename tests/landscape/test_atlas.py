@@ -242,6 +242,24 @@ def test_verdicts_name_their_criteria():
     assert all("joint by joint" in text or "the chain" in text for text in atlas.VERDICTS.values())
 
 
+def test_the_atlas_runs_in_process_unless_dask_is_asked_for(monkeypatch):
+    """Without --scheduler or --workers the executor is asked for 'synchronous' (in-process, no cluster).
+
+    docs/atlas.md, "Where the chunks run": a local cluster cost twice in-process's time on two cores.
+    """
+    from spinectl.landscape.study import executor as engine
+
+    asked, real = [], engine.executor
+
+    def recording(*args, **kwargs):
+        asked.append((kwargs.get("scheduler"), kwargs.get("workers")))
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(engine, "executor", recording)
+    atlas.run_atlas(_spec(chain="false"), None, progress=False)
+    assert asked == [("synchronous", None)]
+
+
 def test_a_long_atlas_is_announced_and_what_cannot_fit_refused(tmp_path, monkeypatch):
     """As the study's: the estimate's line before a run of at least NOTICE_SECONDS (here 0), with the draws
     to solve and their CPU time from the benchmark's costs per draw; a memory estimate above what is
