@@ -6,10 +6,19 @@ machine. The brute force answers the joint-by-joint half alone by scanning the a
 
 Measured once (2-core machine shared with other jobs): default 5.53 s (brute force 183.6 s, largest difference
 9.5e-4); the 35 kg subject with K = 10 N m/rad (wagner2012) 3.55 s (brute force 235.0 s, 9.8e-4).
+
+Position A (E = Lambda = 0), the curve alone (no brute force; the chain's answer changes with the delay more often
+there), measured with the same call outside this script: wagner2012 1.32 s and default 0.83 s at a load of 0.5
+(with three lags, 0, 50 and 100 ms: 15.1 s and 4.8 s); at a load of 6, 20.9 s and 13.1 s, but 3.1 s and 1.1 s with
+``OPENBLAS_NUM_THREADS=1``. The curve makes thousands of small LAPACK calls (the chain's frequency sweep, the
+characteristic roots), and OpenBLAS's threads, on a machine whose cores other jobs hold, wait for a core at each
+call: on a loaded machine (load 6 to 10) one BLAS thread made the curve 7 to 25 times faster (at E = 3 cm,
+Lambda = 4 cm too). The script prints the load and the setting.
 """
 
 from __future__ import annotations
 
+import os
 import time
 
 import numpy as np
@@ -20,6 +29,8 @@ from spinectl.optimise.reference import solve_point
 from spinectl.reflex.design import delay_curve, segment_margins_at
 
 POINT = (0.03, 0.04)
+A = (0.0, 0.0)
+"""Position A, the corner E = Lambda = 0 (:data:`spinectl.paper.grid.POSITIONS`)."""
 DELAYS = np.linspace(0.0, 0.2, 41)
 
 
@@ -37,6 +48,12 @@ def brute_force(model, e, lam, delays):
 
 
 def main() -> None:
+    threads = os.environ.get("OPENBLAS_NUM_THREADS", "unset")
+    print(f"load average at start: {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores; OPENBLAS_NUM_THREADS {threads}")
+    for preset in ("wagner2012", "default"):
+        start = time.perf_counter()
+        delay_curve(config.load_preset(preset), *A, DELAYS)
+        print(f"{preset} at A: design curve, 41 delays, both criteria {time.perf_counter() - start:.2f} s (<= 10 s)")
     for preset, extra in (("default", {}), ("wagner2012", {"body.mass": 35.0, "passive.stiffness": 10.0})):
         model = config.set_parameters(config.load_preset(preset), extra)
         start = time.perf_counter()

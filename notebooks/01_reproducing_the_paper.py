@@ -11,7 +11,8 @@
 # Two landscapes carry the argument:
 #
 # - **Figure 3**, the minimum PCSA of the global muscles that makes every joint *self-stable*, "the stable
-#   performance of a musculoskeletal system without neuronal feedback";
+#   performance of a musculoskeletal system without neuronal feedback", joint by joint (each CoR alone, the others
+#   fixed; the paper's criterion; notebook 04 frees all five CoRs at once, the chain);
 # - **Figure 4**, the norm $\|CT\|$ of the local counter torques "to guarantee for an equilibrium" at that activation;
 # - and **Figure S1**, Figure 3 with a passive stiffness $K = 15$ N m/rad of the ligamentous sheath.
 #
@@ -230,9 +231,10 @@ print(
 
 # %% [markdown]
 # What the printed $C$ changes is the muscle away from rest: a lengthening fibre loses force at once and then
-# damps with a steeper slope. The nonlinear equation of motion shows it. One segment at the paper's optimum, with
-# the muscles a quarter above the minimum PCSA (self-stable, no reflex), released from a 1 mrad tilt (a run stops
-# once the tilt exceeds `reflex.sim_divergence`):
+# damps with a steeper slope. The nonlinear equation of motion shows it. One segment at the paper's optimum, that
+# joint alone with the others fixed (joint by joint, the paper's criterion), with the muscles a quarter above the
+# minimum PCSA (self-stable joint by joint, no reflex), released from a 1 mrad tilt (a run stops once the tilt
+# exceeds `reflex.sim_divergence`):
 
 # %%
 SEGMENT = "L3L4"
@@ -243,11 +245,11 @@ fig, ax = plt.subplots(figsize=(6.4, 3.6))
 for label, variant in [("corrected", model), ("printed", printed_errata)]:
     plant = simulate.segment_plant(variant, *landmarks.OPTIMUM, SEGMENT, pcsa)
     run = simulate.simulate(plant, 0.0, 0.0, 0.0, variant.reflex)  # kp = kd = 0: no reflex
-    verdicts[label] = "stable" if run.stable[0] else "unstable"
+    verdicts[label] = ("stable" if run.stable[0] else "unstable") + " joint by joint"  # this CoR alone
     ax.semilogy(run.time, np.abs(run.alpha[0]) * 1e3, label=f"{label} C ({verdicts[label]})")
 ax.set_xlabel("time [s]")
 ax.set_ylabel("tilt |α| [mrad]")
-ax.set_title(f"{SEGMENT} at E = 3 cm, Λ = 4 cm, 1.25 × minimum PCSA, no reflex")
+ax.set_title(f"{SEGMENT} alone (the others fixed), E = 3 cm, Λ = 4 cm, 1.25 × minimum PCSA, no reflex")
 ax.legend()
 plt.show()
 
@@ -301,11 +303,11 @@ display(figures.min_pcsa_figure(k15_other))
 largest = {name: float(land.min_pcsa_cm2.max()) for name, land in gravity_lands.items()}
 ridge_ratio = {c: float(by_convention[c].min_pcsa_cm2.max() / k0.min_pcsa_cm2.max()) for c in by_convention}
 gravity, hill, spring = "M_ext = −m g r sin α", "C = (A − f_iso) b", "K subtracted from ∂ω'/∂α"
-ridge = "largest min PCSA [cm²]"
+ridge, run_alone = "largest min PCSA [cm²]", f"{SEGMENT} alone, 1.25 × min PCSA, no reflex"
 errata_rows = [
     ("gravity sign", gravity, ridge, largest["printed sign"], largest["corrected sign"]),
     ("Hill constant C", hill, ridge, float(c_printed.min_pcsa_cm2.max()), largest["corrected sign"]),
-    ("Hill constant C", hill, f"{SEGMENT}, 1.25 × min PCSA, no reflex", verdicts["printed"], verdicts["corrected"]),
+    ("Hill constant C", hill, run_alone, verdicts["printed"], verdicts["corrected"]),
     ("K in eq. 2", spring, f"ridge at K = {K_PAPER:g} / at K = 0 [1]", ridge_ratio["paper"], ridge_ratio["physical"]),
 ]
 pd.DataFrame(errata_rows, columns=["erratum", "printed form", "quantity", "printed", "corrected"]).set_index(

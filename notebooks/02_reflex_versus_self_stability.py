@@ -45,6 +45,7 @@ import control as ct
 import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
+from IPython.display import display
 
 import spinectl
 from spinectl import optimise, reflex
@@ -53,7 +54,8 @@ from spinectl.model import config
 from spinectl.paper import grid, landmarks
 from spinectl.reflex import loops, margins, simulate
 from spinectl.reflex.chain_verdict import margins_with_chain
-from spinectl.reflex.design import design
+from spinectl.reflex.design import CRISCO_LOAD, REACTION_TIMES, crisco_stiffness, delay_curve, design, passive_curve
+from spinectl.reflex.design_plots import delay_figure, passive_figure
 
 preset = PRESET or spinectl.DEFAULT_PRESET  # the preset of every command and of spinectl.load_preset()
 model = spinectl.load_preset(preset)
@@ -468,3 +470,105 @@ pd.DataFrame(
 # chain the answer is of another kind: the local stiffness it needs is about the least for static stability, the
 # stiffness that the global muscles cannot give, at either delay; with it the reflex has almost nothing left to do,
 # and the margin at the design is long. The chain's margin is then set by the local muscles, not the reflex's delay.
+
+# %% [markdown]
+# ## The design curve: against the delay and the lag
+#
+# The same two answers at every delay from 0 to 200 ms, for three force-generation lags $T_a$ (none, the default
+# 50 ms, the Discussion's 100 ms): `spinectl.reflex.design.delay_curve` computes, `design_plots.delay_figure`
+# draws (the command line: `spinectl design --delays 0:0.2:41 --lags 0,0.05,0.1 --plot DIR`). Top, joint by joint
+# (each CoR alone, the others fixed; the paper's criterion): the least co-contraction for which every joint's exact
+# delay margin is at least the delay. Bottom, the chain (all 5 CoRs free), at the model's global activation: the
+# least local stiffness, summed over the joints, for which the chain under the delayed reflex is stable at the delay.
+# The dashed lines are the trunk muscles' reaction times after a sudden load release measured by Radebold et al.
+# (2000), the library's marks (`REACTION_TIMES`).
+
+# %%
+CURVE_DELAYS = np.linspace(0.0, 0.2, 41 if GRID >= 81 else 21)  # s: 5 ms steps (10 ms on a coarse test grid)
+CURVE_LAGS = (0.0, 0.05, 0.10)  # s: T_a
+curve = delay_curve(model, *POSITION, CURVE_DELAYS, lags=CURVE_LAGS)
+display(delay_figure(curve))
+
+# %% [markdown]
+# The figure read with its numbers; at the reaction times, the joint-by-joint answer computed there (not read
+# between the curve's delays):
+
+# %%
+ms = curve.delays * 1e3
+REACTION = [t for t, _ in REACTION_TIMES]  # s
+at_reaction = delay_curve(model, *POSITION, REACTION, lags=CURVE_LAGS)
+rows = {}
+for i, lag in enumerate(curve.lags):
+    joint, fraction, total = curve.activation[i], curve.local_fraction[i], curve.local_stiffness[i].sum(axis=1)
+    free = ms[joint == 0]  # the delays that need no co-contraction, joint by joint
+    delayed = curve.delays > 0
+    rows[lag * 1e3] = {
+        "joint: reflex alone up to [ms]": free.max() if free.size else np.nan,
+        **{f"joint: activation at {t * 1e3:.0f} ms": at_reaction.activation[i, j] for j, t in enumerate(REACTION)},
+        **{f"joint: activation at {d:.0f} ms": joint[np.isclose(ms, d)][0] for d in (120, 200)},
+        "chain: sum of local k, least [N m/rad]": total[delayed].min(),
+        "chain: sum of local k, largest [N m/rad]": total[delayed].max(),
+        "chain: × k*, least": fraction[delayed].min(),
+        "chain: × k*, largest": fraction[delayed].max(),
+        "chain: τ_m at the design / delay, least": np.min(curve.chain_margin[i][delayed] / ms[delayed] * 1e3),
+    }
+reading = pd.DataFrame(rows).rename_axis(columns="activation lag T_a [ms]")
+print("joint: joint by joint (each CoR alone, the others fixed; the paper's criterion); chain: all 5 CoRs free")
+for t, label in REACTION_TIMES:
+    print(f"{t * 1e3:.0f} ms: {label}")
+LAG_READ = CURVE_LAGS.index(0.05)  # the default lag's curve, read aloud below
+lag_50 = reading.iloc[:, LAG_READ]
+print(
+    f"joint by joint, T_a = 50 ms: the reflex alone holds every joint up to "
+    f"{lag_50['joint: reflex alone up to [ms]']:.0f} ms on the curve; at 120 ms it needs "
+    f"{lag_50['joint: activation at 120 ms']:.3f} of the minimum PCSA "
+    f"({curve.pcsa[LAG_READ][np.isclose(ms, 120)][0] * 1e4:.1f} cm²)"
+)
+print(
+    f"the chain, all lags: {reading.loc['chain: sum of local k, least [N m/rad]'].min():.1f} to "
+    f"{reading.loc['chain: sum of local k, largest [N m/rad]'].max():.1f} N m/rad of local stiffness in all at "
+    f"every delay from {ms[1]:g} ms to {ms[-1]:g} ms, at global activation {curve.chain_activation:g}"
+)
+display(reading.round(4))
+
+# %% [markdown]
+# Joint by joint, the delay and the lag both matter: the reflex alone suffices up to a delay that the lag
+# shortens, and beyond it the co-contraction grows with the delay, and more with a longer lag; the table gives it at
+# Radebold et al.'s reaction times for each lag. The chain's answer hardly moves with either: from the first delay
+# above zero it needs close to the least local stiffness for static stability $k^*$ (the `× k*` row), the stiffness
+# that the global muscles cannot give; its delay margin at the design is at least the delay everywhere (the
+# certificate, the last row: at least 1). The chain's need is set by the intervertebral modes, which grow faster
+# than any reflex acts, not by the delay.
+#
+# ## The chain's verdict against the passive stiffness
+#
+# That need is a function of the joints' own passive stiffness $K$, which the paper leaves open
+# (`spinectl design --passive 0:80:41`; docs: *The lumbar chain*). `passive_curve` gives, for the chain (all 5 CoRs
+# free, static stability), the least global PCSA that alone stabilises it at each $K$ and the least local stiffness
+# at the paper's minimum PCSA held fixed; `passive_figure` draws both, with the stiffness at which the passive chain
+# buckles under the 88 N that Crisco et al. (1992) measured for the ligamentous lumbar spine, computed from the
+# model's geometry by `crisco_stiffness`, and the paper's $K = 15$ N m/rad.
+
+# %%
+passive = passive_curve(model, *POSITION, np.linspace(0.0, 80.0, 41))  # K per joint [N m/rad], physical convention
+crisco = crisco_stiffness(model, *POSITION)  # the passive_curve's mark: the same function
+display(passive_figure(passive))
+no_local = passive.passive_stiffness[passive.local_stiffness.sum(axis=1) == 0]
+print(
+    f"Crisco et al.: {CRISCO_LOAD:g} N buckles the passive chain at K = {crisco:.2f} N m/rad per joint; "
+    f"there global muscles alone stabilise the chain with {passive.crisco_global_pcsa * 1e4:.2f} cm²"
+)
+print(f"the chain, global muscles alone: stable from K = {passive.threshold:.2f} N m/rad per joint")
+alone = "stabilise" if passive.threshold <= crisco else "do not stabilise"
+print(f"so at Crisco et al.'s K the global muscles alone {alone} the chain (statically, all 5 CoRs free)")
+print(
+    f"the chain at the paper's minimum ({passive.paper_pcsa * 1e4:.1f} cm² held fixed): "
+    f"{passive.local_stiffness[0].sum():.1f} N m/rad of local stiffness in all at K = 0, none from "
+    + (f"K = {no_local.min():g} N m/rad on this scan" if no_local.size else "no K on this scan")
+)
+
+# %% [markdown]
+# "Global muscles alone cannot stabilise the chain" holds below the printed threshold only, and the local muscles'
+# share at the paper's minimum PCSA falls with $K$ to nothing; whether Crisco et al.'s measurement puts these joints
+# above or below the threshold is the printed verdict. The chain's verdict is a function of the passive stiffness one
+# assumes, not a property of the spine's geometry alone.

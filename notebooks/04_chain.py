@@ -61,9 +61,9 @@ for name, c in chains.items():
             "position": name,
             "largest S_k [N m/rad]": np.diag(c.stiffness).max(),
             "eigenvalues of -K [N m/rad]": np.round(np.linalg.eigvalsh(-c.stiffness), 1),
-            "unstable modes (static)": int(np.sum(np.linalg.eigvalsh(-c.stiffness) < 0)),
-            "growing modes (dynamic)": int(np.sum(c.eigenvalues.real > 0)),
-            "fastest growth [1/s]": c.eigenvalues.real.max(),
+            "chain: unstable modes (static)": int(np.sum(np.linalg.eigvalsh(-c.stiffness) < 0)),
+            "chain: growing modes (dynamic)": int(np.sum(c.eigenvalues.real > 0)),
+            "chain: fastest growth [1/s]": c.eigenvalues.real.max(),
         }
     )
 display(pd.DataFrame(rows).set_index("position"))
@@ -172,7 +172,7 @@ for name, where in POINTS.items():
     rows.append(
         {
             "position": name,
-            "smallest per-joint delay margin [ms]": min(s.delay_margin for s in per_joint.segments) * 1e3,
+            "joint by joint: least delay margin [ms]": min(s.delay_margin for s in per_joint.segments) * 1e3,
             "chain's delay margin [ms]": chain_margin.exact.margin * 1e3,
             "Pade estimate [ms]": chain_margin.delay_margin_pade * 1e3,
             "chain stable at 100 ms": chain_margin.stable_at_delay,

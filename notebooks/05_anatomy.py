@@ -65,7 +65,7 @@ for a in (0.0, 0.05, 0.2):
             "activation": a,
             "-K_jj, joint by joint [N m/rad]": np.round(r.free.joint_stiffness, 1),
             "eigenvalues of -K, the chain (free) [N m/rad]": np.round(r.free.eigenvalues, 1),
-            "unstable modes": int(np.sum(r.free.eigenvalues <= 0)),
+            "the chain (free): unstable modes": int(np.sum(r.free.eigenvalues <= 0)),
             "-K_c, constrained by the rhythm": np.round(r.constrained.eigenvalues, 1),
         }
     )

@@ -84,7 +84,8 @@ def reproduce(
     ConfigError
         An unknown preset or a bad configuration file.
     OutputError
-        ``out_dir`` cannot take the output (:func:`spinectl.atomic.check_folder`), before any solve.
+        ``out_dir`` cannot take the output (:func:`spinectl.atomic.check_folder`), or its landscapes'
+        names cannot reach the NetCDF library (:func:`spinectl.landscape.netcdf.check_name`), before any solve.
     """
     check_points(points)
     model = apply_overrides(load_config(config, preset=preset), overrides)
@@ -168,13 +169,16 @@ def reproduce_model(
     Raises
     ------
     OutputError
-        ``out_dir`` cannot take the output (:func:`spinectl.atomic.check_folder`), before any solve.
+        ``out_dir`` cannot take the output (:func:`spinectl.atomic.check_folder`), or its landscapes'
+        names cannot reach the NetCDF library (:func:`spinectl.landscape.netcdf.check_name`), before any solve.
     """
     start = time.perf_counter()
     k15 = grid.PAPER_STIFFNESS
     other_convention = grid.other_convention(model)
     names = output_names(model)
     other_name = names[1]
+    for name in (LANDSCAPES, other_name):  # as the user named them: the staging folder, in the message, is not
+        netcdf.check_name(Path(out_dir) / name)
     check_folder(out_dir, names)  # before minutes of solving
     both, other = grid.paper_landscapes(model, points, progress)
     measured = landmarks.measure(landmarks.Landmarks(both.sel(K=0.0), both.sel(K=k15), other))

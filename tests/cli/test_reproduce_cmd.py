@@ -231,3 +231,21 @@ def test_a_process_with_other_threads_draws_its_figures_itself():
     finally:
         release.set()
         thread.join()
+
+
+def test_a_folder_name_the_netcdf_library_cannot_take_is_named_as_typed(tmp_path, monkeypatch, capsys):
+    """``reproduce --out Λdir`` under the C locale without Python's UTF-8 mode (file system encoding ASCII, set
+    here by hand): one line, exit 2, naming the folder the user typed, before any solve, nothing written.
+    Before, the same check met the name at the save, after the solve, and named the staging folder beside it
+    (``.Λdir.~<pid>-...``), a folder the user never typed and that was gone by the time they read it."""
+    import sys
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(sys, "getfilesystemencoding", lambda: "ascii")
+    solved, solve = [], grid.paper_landscapes
+    monkeypatch.setattr(grid, "paper_landscapes", lambda *a, **k: solved.append(a) or solve(*a, **k))
+    assert main(["reproduce", "--out", "Λdir", "--points", "3"]) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+    assert "cannot open 'Λdir/landscapes.nc': the NetCDF library takes only names" in err, err
+    assert not solved and list(tmp_path.iterdir()) == []
