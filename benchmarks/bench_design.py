@@ -48,7 +48,7 @@ def brute_force(model, e, lam, delays):
 
 
 def main() -> None:
-    threads = os.environ.get("OPENBLAS_NUM_THREADS", "unset")
+    threads = os.environ.get("OPENBLAS_NUM_THREADS", "unset (delay_curve then uses one BLAS thread: spinectl._threads)")
     print(f"load average at start: {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores; OPENBLAS_NUM_THREADS {threads}")
     for preset in ("wagner2012", "default"):
         start = time.perf_counter()

@@ -23,6 +23,7 @@ import shlex
 import sys
 import warnings
 
+from .._threads import one_blas_thread
 from .._validate import printable
 from ..errors import SpinectlError
 
@@ -233,7 +234,8 @@ def main(argv: list[str] | None = None) -> int:
     logging.getLogger("matplotlib").setLevel(logging.ERROR)
     stdout, sys.stdout = sys.stdout, _Stdout(sys.stdout)
     try:
-        return _run(argv)
+        with one_blas_thread():  # many small matrices: one BLAS thread is faster (spinectl._threads)
+            return _run(argv)
     except _StdoutError as exc:
         return _stdout_failed(exc.error, stdout)
     finally:

@@ -38,6 +38,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._threads import with_one_blas_thread
 from ..model import chain, geometry
 from ..model.checks import arithmetic_guard, checked_coefficients
 from ..model.params import Model
@@ -627,6 +628,7 @@ def _chain_margin(model, mass, stiffness, damping, least, fraction, kp, kd, lag)
     return float(exact.margin) if exact.stable_without_delay else 0.0
 
 
+@with_one_blas_thread
 def design(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None) -> Design:
     """Both answers to the design question at ``model.reflex.delay`` (see the module).
 
@@ -874,6 +876,7 @@ class PassiveCurve:
         return "\n".join(lines)
 
 
+@with_one_blas_thread
 def passive_curve(model: Model, eccentricity: float, lordosis: float, stiffnesses) -> PassiveCurve:
     """The least global PCSA and the least local stiffness for the chain against the passive stiffness.
 
@@ -1098,6 +1101,7 @@ class DesignCurve:
         return "\n".join(lines)
 
 
+@with_one_blas_thread
 def delay_curve(model: Model, eccentricity: float, lordosis: float, delays, lags=None, kp=None, kd=None) -> DesignCurve:
     """Both criteria's required design against the delay, for each lag: the design curve.
 
