@@ -12,10 +12,11 @@ Two answers at one (E, Lambda), one per criterion (docs/reflex.md, "The design q
    so ('bisection: monotone on the scan'); otherwise the same bracket is refined by bisection and
    the method is 'scan and refine: not monotone'.
 2. **the chain** (every CoR free): at the global activation ``reflex.activation`` (the
-   operating point of ``spinectl margins``; ``--activation``; its muscles give the chain's
-   only damping, so activation 0 leaves the chain undamped), the
+   operating point of ``spinectl margins``; ``--activation``), the
    least local stiffness f k* (k* the least local stiffness for static stability,
-   problem (a) of docs/chain.md; the local muscles of "Local muscles as joint stiffness")
+   problem (a) of docs/chain.md; the local muscles of "Local muscles as joint stiffness and
+   damping", which damp the joint by c_loc f k*: with ``local.damping`` = 0 the global muscles
+   give the chain's only damping, and activation 0 leaves it undamped)
    for which the chain under the delayed reflex is stable at the delay. The reflex is the
    rule on the chain (:func:`spinectl.reflex.gains.chain_gains`) scaled by the deficit left,
    (1 - f)+ times its gains (:func:`chain_loop_at`), or the explicit gains. The certificate:
@@ -421,17 +422,19 @@ def chain_matrices(model: Model, eccentricity: float, lordosis: float, pcsa):
 
 
 def chain_loop_at(model: Model, mass, stiffness, damping, least_static, fraction, kp=None, kd=None):
-    """The chain's stiffness with local stiffness f k*, and its reflex gains: (1 - f)+ times the rule's.
+    """The chain with local stiffness f k* and its damping, and its reflex gains: (1 - f)+ times the rule's.
 
     The rule on the chain (:func:`spinectl.reflex.gains.chain_gains`) at f = 0 compensates the
     whole deficit k*; as the local muscles take over a fraction f of it, the reflex keeps the
     rest, (1 - f)+ times both gains, so that at f >= 1 the chain holds itself without reflex.
+    The local muscles damp what they stiffen: c_loc f k* on the diagonal of D
+    (:func:`spinectl.model.chain.local_damping_per_stiffness`; docs/chain.md).
 
     Parameters
     ----------
     model : Model
     mass, stiffness, damping : numpy.ndarray, shape (n, n)
-        M, K (global muscles, gravity, passive), D.
+        M, K (global muscles, gravity, passive), D (global muscles).
     least_static : numpy.ndarray, shape (n,)
         k* [N m/rad].
     fraction : float
@@ -443,11 +446,14 @@ def chain_loop_at(model: Model, mass, stiffness, damping, least_static, fraction
     -------
     stiffness : numpy.ndarray, shape (n, n)
         K - f diag(k*) [N m/rad].
+    damping : numpy.ndarray, shape (n, n)
+        D - c_loc f diag(k*) [N m s/rad].
     kp, kd : numpy.ndarray, shape (n,)
         [N m/rad], [N m s/rad].
     """
     r, n = model.reflex, len(least_static)
     k = stiffness - fraction * np.diag(least_static)
+    d = damping - np.diag(chain.local_damping(fraction * np.asarray(least_static, float), model))
     if r.gains == "rule":  # the reflex hands over to the local muscles: (1 - f)+ times the rule's gains at f = 0
         kp0, kd0 = gains.chain_gains(
             mass, stiffness, damping, least_static, r.gain_factor, r.damping_ratio, r.activation_time_constant
@@ -456,7 +462,7 @@ def chain_loop_at(model: Model, mass, stiffness, damping, least_static, fraction
         kp0, kd0 = scale * kp0, scale * kd0
     else:
         kp0, kd0 = np.full(n, r.kp), np.full(n, r.kd)
-    return k, kp0 if kp is None else np.full(n, float(kp)), kd0 if kd is None else np.full(n, float(kd))
+    return k, d, kp0 if kp is None else np.full(n, float(kp)), kd0 if kd is None else np.full(n, float(kd))
 
 
 def rightmost_root(mass, stiffness, damping, kp, kd, delay: float, lag: float = 0.0, nodes: int = 0) -> complex:
@@ -583,15 +589,15 @@ def chain_design(model: Model, eccentricity: float, lordosis: float, pcsa, activ
 
         Each exact margin found is kept in ``margins`` for the largest delay met.
         """
-        k, p, dd = chain_loop_at(model, mass, stiffness, damping, least, f, kp, kd)
+        k, dl, p, dd = chain_loop_at(model, mass, stiffness, damping, least, f, kp, kd)
         with arithmetic_guard(eccentricity, lordosis):
-            root = rightmost_root(mass, k, damping, p, dd, delay, lag)
+            root = rightmost_root(mass, k, dl, p, dd, delay, lag)
             if not root.real < 0:
                 return False, root, None
             if not (np.any(p) or np.any(dd)):  # no reflex: stable at every delay (no crossing to find)
                 margins.append(np.inf)
                 return True, root, from_crossings(np.empty(0), np.empty(0), np.empty(0), True)
-            exact = chain_delay_margin(mass, k, damping, p, dd, lag)
+            exact = chain_delay_margin(mass, k, dl, p, dd, lag)
         margins.append(float(exact.margin))
         return bool(stable_at(exact, delay) and exact.margin >= delay), root, exact
 
@@ -606,8 +612,8 @@ def chain_design(model: Model, eccentricity: float, lordosis: float, pcsa, activ
         nan = np.full(n, np.nan)
         return ChainDesign(activation, np.nan, nan, least, np.nan, np.nan, float(largest), method)
     _, _, exact = judge(fraction)
-    k, p, dd = chain_loop_at(model, mass, stiffness, damping, least, fraction, kp, kd)
-    root = rightmost_root(mass, k, damping, p, dd, delay, lag, SPECTRAL_NODES)
+    k, dl, p, dd = chain_loop_at(model, mass, stiffness, damping, least, fraction, kp, kd)
+    root = rightmost_root(mass, k, dl, p, dd, delay, lag, SPECTRAL_NODES)
     return ChainDesign(
         activation,
         fraction,
@@ -622,8 +628,8 @@ def chain_design(model: Model, eccentricity: float, lordosis: float, pcsa, activ
 
 def _chain_margin(model, mass, stiffness, damping, least, fraction, kp, kd, lag) -> float:
     """The chain's exact delay margin at local stiffness f k* [s]; 0 if unstable without delay."""
-    k, p, dd = chain_loop_at(model, mass, stiffness, damping, least, fraction, kp, kd)
-    exact = chain_delay_margin(mass, k, damping, p, dd, lag)
+    k, dl, p, dd = chain_loop_at(model, mass, stiffness, damping, least, fraction, kp, kd)
+    exact = chain_delay_margin(mass, k, dl, p, dd, lag)
     return float(exact.margin) if exact.stable_without_delay else 0.0
 
 
@@ -1217,11 +1223,11 @@ def _chain_curve(model, e, lam, pcsa, delays, kp, kd):
     def exact(f):
         """The exact margin at f, once per f (it does not depend on the delay)."""
         if f not in margins:
-            k, p, dd = loop(f)
+            k, dl, p, dd = loop(f)
             if not (np.any(p) or np.any(dd)):
                 margins[f] = from_crossings(np.empty(0), np.empty(0), np.empty(0), chain.coupled_margin(k) > 0)
             else:
-                margins[f] = chain_delay_margin(mass, k, damping, p, dd, lag)
+                margins[f] = chain_delay_margin(mass, k, dl, p, dd, lag)
         return margins[f]
 
     def met(f, d):
@@ -1232,9 +1238,9 @@ def _chain_curve(model, e, lam, pcsa, delays, kp, kd):
         if f in fails_from and fails_from[f] <= d:
             return False
         if f not in margins:
-            k, p, dd = loop(f)
+            k, dl, p, dd = loop(f)
             with arithmetic_guard(e, lam):
-                if d > 0 and rightmost_root(mass, k, damping, p, dd, d, lag).real >= 0:  # a true root: unstable
+                if d > 0 and rightmost_root(mass, k, dl, p, dd, d, lag).real >= 0:  # a true root: unstable
                     fails_from[f] = d
                     return False
                 exact(f)
@@ -1257,9 +1263,9 @@ def _chain_curve(model, e, lam, pcsa, delays, kp, kd):
         if np.isnan(f):
             out.append((np.nan, np.nan, np.nan))
             continue
-        k, p, dd = loop(f)
+        k, dl, p, dd = loop(f)
         with arithmetic_guard(e, lam):
-            root = rightmost_root(mass, k, damping, p, dd, d, lag)
+            root = rightmost_root(mass, k, dl, p, dd, d, lag)
         out.append((f, float(exact(f).margin), float(root.real)))
     fraction, margin, roots = (np.array(x) for x in zip(*out, strict=True))
     return fraction, least, margin, roots
