@@ -26,7 +26,7 @@ Two answers at one (E, Lambda), one per criterion (docs/reflex.md, "The design q
    equation) lies in the left half-plane. Both are required: the margin's frequency sweep
    (0.15 % steps) can step over the band of a crossing of a nearly undamped mode under a weak
    reflex (0.05 % wide at f = 0.9999 for the subject of docs/reflex.md, "The design
-   question"), which the spectral root does not miss. The search scans f, then bisects the
+   question", without the local muscles' damping), which the spectral root does not miss. The search scans f, then bisects the
    bracket of the first f that meets the delay (exact for a set of designs that, once met,
    stays met for every larger f; the method says whether the scan showed that).
 

@@ -143,9 +143,9 @@ def test_a_delay_no_activation_meets_is_an_answer():
 
 
 def test_a_delay_prints_with_its_unit_or_unbounded_without_one():
-    """The table's delays: 120 ms in ms, 329.8 s (the plain case's chain margin) in s, an infinite margin as
-    'unbounded (delay-independent)' with no unit (not 'unbounded ms'), NaN as 'none'; and so in the certificate
-    of a Design's table."""
+    """The table's delays: 120 ms in ms, 329.8 s (the plain case's chain margin, stiffness only) in s, an infinite
+    margin as 'unbounded (delay-independent)' with no unit (not 'unbounded ms'), NaN as 'none'; and so in the
+    certificate of a Design's table."""
     assert dz._delay(0.12) == "120 ms" and dz._delay(329.847) == "329.8 s" and dz._delay(np.nan) == "none"
     assert dz._delay(np.inf) == "unbounded (delay-independent)"
     n = 5
