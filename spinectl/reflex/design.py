@@ -26,9 +26,10 @@ Two answers at one (E, Lambda), one per criterion (docs/reflex.md, "The design q
    equation) lies in the left half-plane. Both are required: the margin's frequency sweep
    (0.15 % steps) can step over the band of a crossing of a nearly undamped mode under a weak
    reflex (0.05 % wide at f = 0.9999 for the subject of docs/reflex.md, "The design
-   question", without the local muscles' damping), which the spectral root does not miss. The search scans f, then bisects the
-   bracket of the first f that meets the delay (exact for a set of designs that, once met,
-   stays met for every larger f; the method says whether the scan showed that).
+   question", without the local muscles' damping), which the spectral root does not miss. The
+   search scans f, then bisects the bracket of the first f that meets the delay (exact for a set
+   of designs that, once met, stays met for every larger f; the method says whether the scan
+   showed that).
 
 No design meets the delay: status 'infeasible' and the largest delay that the scan meets.
 """
@@ -57,6 +58,10 @@ SCAN = 41
 
 BISECTIONS = 20
 """Halvings of the bracket: the answer to 1e-6 of the scanned step above the least design."""
+
+MAX_EXPONENT = 700.0
+"""Largest -Re(s) tau at which Newton's method on the characteristic determinant goes on: e^700 is near the
+largest float (e^709.8); a root further left is never the rightmost."""
 
 LOCAL_MAX = 2.0
 """Largest local stiffness searched with explicit gains, as a multiple of the least for static stability k*
@@ -539,8 +544,14 @@ def _chebyshev(n: int) -> np.ndarray:
 
 
 def _newton(m, k, d, kp, kd, tau, lag, s, steps: int = 30):
-    """Newton's method on det T(s) from ``s``; NaN if it does not converge."""
+    """Newton's method on det T(s) from ``s``; NaN if it does not converge.
+
+    NaN too where it runs so far left that e^{-s tau} would overflow (Re s < -700 / tau): such a root,
+    from a fast seed (the heavily damped modes of local muscles), is never the rightmost.
+    """
     for _ in range(steps):
+        if (-s * tau).real > MAX_EXPONENT:
+            return complex(np.nan, np.nan)
         e = np.exp(-s * tau)
         plant = m * s**2 - d * s - k
         t = (lag * s + 1.0) * plant + (kp + kd * s) * e

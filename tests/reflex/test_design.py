@@ -128,6 +128,21 @@ def test_the_rightmost_root_is_a_root_and_agrees_with_the_exact_margin_on_one_jo
         assert abs(residual) < 1e-9 and np.sign(s.real) == sign
 
 
+def test_a_fast_seed_does_not_overflow_the_rightmost_root(monkeypatch):
+    """One joint with a fast and a slow pole (theta = 1e-3, S = -1, D = -10: about -1e4 and -0.1 1/s, as the local
+    muscles' damping gives the light modes), kp = 0.5, a 0.1 s delay, under numpy's raise-on-overflow (the models'
+    arithmetic guard): e^{-s tau} of the fast seed would overflow (e^1000). The rightmost root is the slow one, a
+    root of (theta s^2 - D s - S) + kp e^{-s tau} (residual < 1e-9), left of the axis; without the bound on the
+    exponent (MAX_EXPONENT = inf) the same call raises."""
+    m, k, d, kp, kd = 1e-3 * np.eye(1), -np.eye(1), -10.0 * np.eye(1), [0.5], [0.0]
+    with np.errstate(over="raise", invalid="raise", divide="raise"):
+        s = dz.rightmost_root(m, k, d, kp, kd, 0.1)
+        assert abs(1e-3 * s**2 + 10.0 * s + 1.0 + 0.5 * np.exp(-0.1 * s)) < 1e-9 and s.real < 0
+        monkeypatch.setattr(dz, "MAX_EXPONENT", np.inf)
+        with pytest.raises(FloatingPointError):
+            dz.rightmost_root(m, k, d, kp, kd, 0.1)
+
+
 def test_a_delay_no_activation_meets_is_an_answer():
     """Explicit gains too strong for a 50 ms delay (kp = 300 N m/rad, kd = 0) at every activation: status
     'infeasible', NaN activation, and the largest delay met on the scan, which is below 50 ms."""
