@@ -10,7 +10,8 @@ velocity (:func:`fibre_gains`); the control of a fibre's actuator is its muscle'
 The per-segment model's counter torques (docs/chain.md: tau_0 is the per-segment torque)
 are motors on the joints, so that the posture is an equilibrium. The intervertebral stiffness
 (``passive``, and with ``with_local_stiffness`` the chain's least local stiffness) is the
-joints' ``stiffness``. Keyframe 0 holds the solution: the posture and every control.
+joints' ``stiffness``, and the local muscles' damping (docs/chain.md) the joints' ``damping``.
+Keyframe 0 holds the solution: the posture and every control.
 
 The XML is MuJoCo's own (:meth:`mujoco.MjSpec.to_xml`), with its numbers, which MuJoCo writes to
 six significant digits, rewritten from the spec to the last bit (:func:`exact_xml`); written atomically.
@@ -68,13 +69,16 @@ class PaperSolution:
         Local stiffness added as joint springs [N m/rad] (0 without ``with_local_stiffness``).
     joint_stiffness : numpy.ndarray, shape (n_cor,)
         The joints' stiffness in the file: passive plus local [N m/rad].
+    joint_damping : numpy.ndarray, shape (n_cor,)
+        The joints' damping in the file: the local muscles' c_loc k
+        (:func:`spinectl.model.chain.local_damping`) [N m s/rad].
     counter_torque : numpy.ndarray, shape (n_cor,)
         -tau_0, the constant torque that makes the posture an equilibrium [N m].
     eigenvalues : numpy.ndarray, shape (2 n_cor,)
         The chain's eigenvalues at this solution (``stability --coupled``), with the exported
         joint stiffness [1/s], largest real part first.
     stiffness, damping, mass : numpy.ndarray, shape (n_cor, n_cor)
-        The chain's K (with the joint stiffness), D and M [N m/rad, N m s/rad, kg m^2].
+        The chain's K (with the joint stiffness), D (with the joint damping) and M [N m/rad, N m s/rad, kg m^2].
     """
 
     model: Model
@@ -83,6 +87,7 @@ class PaperSolution:
     pcsa: np.ndarray
     local_stiffness: np.ndarray
     joint_stiffness: np.ndarray
+    joint_damping: np.ndarray
     counter_torque: np.ndarray
     eigenvalues: np.ndarray
     stiffness: np.ndarray
@@ -108,7 +113,8 @@ def paper_solution(model: Model, eccentricity: float, lordosis: float, pcsa=None
         (:func:`spinectl.optimise.stabilising.minimum_stabilising_pcsa`).
     with_local_stiffness : bool
         Add the chain's least local stiffness
-        (:func:`spinectl.optimise.coupled.least_local_stiffness`) as joint springs.
+        (:func:`spinectl.optimise.coupled.least_local_stiffness`) as joint springs, with the local
+        muscles' damping (:func:`spinectl.model.chain.local_damping`) as joint dampers.
 
     Returns
     -------
@@ -135,6 +141,8 @@ def paper_solution(model: Model, eccentricity: float, lordosis: float, pcsa=None
     tau0 = chain.chain_muscle_torque_per_pcsa(model, cor, zero, zero) @ result.pcsa
     tau0 = tau0 + chain.chain_gravity_torque(model, cor, zero)
     stiffness = result.stiffness - np.diag(local)
+    joint_damping = chain.local_damping(local, model)  # the local muscles damp what they stiffen
+    damping = result.damping - np.diag(joint_damping)
     return PaperSolution(
         model=model,
         eccentricity=e,
@@ -142,10 +150,11 @@ def paper_solution(model: Model, eccentricity: float, lordosis: float, pcsa=None
         pcsa=np.asarray(result.pcsa, float),
         local_stiffness=local,
         joint_stiffness=passive + local,
+        joint_damping=joint_damping,
         counter_torque=-tau0,
-        eigenvalues=chain.dynamic_eigenvalues(result.mass, stiffness, result.damping),
+        eigenvalues=chain.dynamic_eigenvalues(result.mass, stiffness, damping),
         stiffness=stiffness,
-        damping=result.damping,
+        damping=damping,
         mass=result.mass,
     )
 
@@ -308,6 +317,7 @@ def paper_spec(solution: PaperSolution):
             pos=_xz(cor[k]),
             axis=list(HINGE_AXIS),
             stiffness=float(solution.joint_stiffness[k]),
+            damping=float(solution.joint_damping[k]),
         )
         bodies[k] = parent = body
     fibres = fibre_gains(model)

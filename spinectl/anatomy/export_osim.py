@@ -264,7 +264,7 @@ def paper_osim(solution: PaperSolution, counter_torque=None, muscle: str = "mill
         spring.setName(f"{coordinate}_stiffness")
         spring.setStiffness(float(solution.joint_stiffness[k]))
         spring.setRestLength(0.0)
-        spring.setViscosity(0.0)
+        spring.setViscosity(float(solution.joint_damping[k]))  # the local muscles' damping, 0 without them
         out.addForce(spring)
         actuator = osim.CoordinateActuator(coordinate)
         actuator.setName(f"counter_{coordinate}")

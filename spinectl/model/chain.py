@@ -412,6 +412,9 @@ class ChainCoefficients:
         K_pas per joint as a physical stiffness [N m/rad], entering K as -diag(K_pas).
     length_gradient : numpy.ndarray, shape (..., n_fibres, n_cor)
         dl/dq of every fibre [m/rad], = -h; rank <= 3 for fibres from thorax to pelvis.
+    local_damping_per_stiffness : float
+        c_loc [s]: the local muscles' damping per unit of their joint stiffness
+        (:func:`local_damping_per_stiffness`); 0: stiffness only.
     """
 
     stiffness_per_pcsa: np.ndarray
@@ -419,6 +422,7 @@ class ChainCoefficients:
     gravity_stiffness: np.ndarray
     passive_stiffness: np.ndarray
     length_gradient: np.ndarray
+    local_damping_per_stiffness: float = 0.0
 
     def stiffness(self, pcsa, local_stiffness=0.0):
         """K - diag(k) [N m/rad]: muscles, gravity, passive and local stiffness.
@@ -439,20 +443,25 @@ class ChainCoefficients:
         diagonal = self.passive_stiffness + np.asarray(local_stiffness, float)
         return muscular + self.gravity_stiffness - diagonal[..., None] * np.eye(diagonal.shape[-1])
 
-    def damping(self, pcsa):
-        """D [N m s/rad] of the global muscles.
+    def damping(self, pcsa, local_stiffness=0.0):
+        """D - c_loc diag(k) [N m s/rad]: the global muscles and the local muscles of stiffness k.
 
         Parameters
         ----------
         pcsa : array_like, shape (..., n_muscles)
             PCSA of each global muscle [m^2].
+        local_stiffness : array_like, shape (..., n_cor)
+            Stiffness k_j >= 0 of the local muscles at each joint [N m/rad], whose force-velocity
+            slope damps the joint by c_loc k_j (:func:`local_damping_per_stiffness`); 0: none.
 
         Returns
         -------
         numpy.ndarray, shape (..., n_cor, n_cor)
-            Symmetric, negative semidefinite [N m s/rad]; its diagonal is D_k.
+            Symmetric, negative semidefinite [N m s/rad]; its diagonal is D_k - c_loc k_k.
         """
-        return np.einsum("...jkm,...m->...jk", self.damping_per_pcsa, np.asarray(pcsa, float))
+        muscular = np.einsum("...jkm,...m->...jk", self.damping_per_pcsa, np.asarray(pcsa, float))
+        local = self.local_damping_per_stiffness * np.asarray(local_stiffness, float)
+        return muscular - local[..., None] * np.eye(muscular.shape[-1])
 
 
 CHAIN_MONOMIALS = ("1", "x_j + x_k", "y_j + y_k", "x_j x_k", "x_j y_k + y_j x_k", "y_j y_k", "x_hi", "y_hi")
@@ -571,6 +580,7 @@ def chain_coefficients(model: Model, eccentricity, lordosis) -> ChainCoefficient
         gravity_stiffness=_gravity_stiffness(model, cor[..., 1]),
         passive_stiffness=passive_stiffness(model, inertia(cor, model)),
         length_gradient=length_gradient,
+        local_damping_per_stiffness=local_damping_per_stiffness(model),
     )
 
 
@@ -583,7 +593,8 @@ def linear_chain(model: Model, eccentricity: float, lordosis: float, coefficient
     is twice it); with ``"independent"`` one per muscle; in cm^2, class ``"global"`` (thorax to
     pelvis), bounds 0 <= x <= ``optimisation.pcsa_max``. Per unit x, K_i and D_i are those of
     :func:`chain_coefficients` per m^2 of the muscles it sets; K_0 = K_g - diag(K_pas) (gravity and
-    the passive stiffness), D_0 = 0 (the model has no passive damping), M of :func:`mass_matrix`.
+    the passive stiffness), D_0 = 0 (the model has no passive damping), M of :func:`mass_matrix`;
+    local joint stiffness brings the damping of its force-velocity slope (:func:`local_damping_per_stiffness`).
 
     Parameters
     ----------
@@ -625,6 +636,7 @@ def linear_chain(model: Model, eccentricity: float, lordosis: float, coefficient
         upper=np.full(m, model.optimisation.pcsa_max / M2_PER_CM2),
         control_unit="cm^2",
         source=f"{header(model)}; E = {e:g} m, Lambda = {lam:g} m",
+        local_damping_per_stiffness=coeffs.local_damping_per_stiffness,
     )
 
 
@@ -714,6 +726,64 @@ def local_stiffness_per_pcsa(model: Model) -> float:
     """
     local = model.local
     return local.stiffness_gain * model.fibre.specific_tension * local.lever_arm**2 / local.length
+
+
+def local_damping_per_stiffness(model: Model) -> float:
+    """c_loc [s]: the joint damping of a local muscle per unit of its joint stiffness, from its Hill slope.
+
+    A local muscle at force F with the global fibres' Hill curve (:func:`spinectl.model.muscle.force_velocity`,
+    the force scaled by F/f_iso) has dF/dv = F f_H'(0) at rest, v its shortening velocity. At the lever
+    arm r, v = r omega, so the joint damping is r^2 F |f_H'(0)|; its stiffness is k = q F r^2 / l
+    (:func:`local_stiffness_per_pcsa`). Both are proportional to F r^2, so
+
+        d = c_loc k,   c_loc = ``local.damping`` * l |f_H'(0)| / q,
+
+    whatever the PCSA, activation or lever arm: f_H'(0) = -(1 + a) / b is that of a fibre of optimal
+    length l_opt = ``fibre.optimal_length_ratio`` * l (the local muscle all fibre, on the ascending limb
+    like the global ones). docs/chain.md, "Local muscles as joint stiffness and damping".
+
+    Parameters
+    ----------
+    model : Model
+        Supplies ``local`` (q, l [m], the factor ``damping``), ``fibre`` (the Hill constants) and
+        ``errata`` (their eccentric constant, which does not change the slope at rest).
+
+    Returns
+    -------
+    float
+        c_loc [s]; 0 with ``local.damping`` = 0 (the stiffness-only model).
+
+    References
+    ----------
+    Hill AV (1938). The heat of shortening and the dynamic constants of muscle. Proc R Soc Lond B
+    126:136-195. doi:10.1098/rspb.1938.0050.
+
+    Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012). Spinal lordosis optimizes
+    the requirements for a stable erect posture. Theor Biol Med Model 9:13. doi:10.1186/1742-4682-9-13.
+    """
+    local = model.local
+    hill = muscle.hill_constants(model.fibre.optimal_length_ratio * local.length, model.fibre, model.errata)
+    slope = float(muscle.force_velocity_slope(0.0, hill))  # d(f_H / f_iso)/dv [s/m], < 0
+    return local.damping * local.length * -slope / local.stiffness_gain
+
+
+def local_damping(local_stiffness, model: Model):
+    """The joint damping of local muscles of stiffness ``local_stiffness``: c_loc k [N m s/rad].
+
+    Positive (it enters D as -c_loc diag(k)); :func:`local_damping_per_stiffness`.
+
+    Parameters
+    ----------
+    local_stiffness : array_like
+        k [N m/rad].
+    model : Model
+
+    Returns
+    -------
+    numpy.ndarray
+        c_loc k [N m s/rad], the shape of ``local_stiffness``.
+    """
+    return local_damping_per_stiffness(model) * np.asarray(local_stiffness, float)
 
 
 def local_pcsa(local_stiffness, model: Model):

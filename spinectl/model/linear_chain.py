@@ -61,6 +61,9 @@ class LinearChain:
         The unit of u: ``"cm^2"`` (PCSA) or ``"1"`` (activation).
     source : str
         What produced it (a preset and posture, a model file), for outputs.
+    local_damping_per_stiffness : float
+        c_loc [s]: the damping c_loc k_j that local joint stiffness k_j brings with it (the paper's
+        local muscles, :func:`spinectl.model.chain.local_damping_per_stiffness`); 0: stiffness only.
     """
 
     joints: tuple
@@ -75,6 +78,7 @@ class LinearChain:
     upper: np.ndarray
     control_unit: str = "1"
     source: str = field(default="", compare=False)
+    local_damping_per_stiffness: float = 0.0
 
     def __post_init__(self):
         n, m = len(self.joints), len(self.controls)
@@ -96,6 +100,10 @@ class LinearChain:
             object.__setattr__(self, name, value)
         if len(self.control_class) != m or not set(self.control_class) <= set(CONTROL_CLASSES):
             raise ParameterError("LinearChain.control_class", f"must give one of {CONTROL_CLASSES} per control")
+        c = float(self.local_damping_per_stiffness)
+        if not (np.isfinite(c) and c >= 0):
+            raise ParameterError("LinearChain.local_damping_per_stiffness", f"must be finite and >= 0 (got {c:g})")
+        object.__setattr__(self, "local_damping_per_stiffness", c)
         if np.any(self.lower > self.upper):
             raise ParameterError("LinearChain.lower", "must not exceed upper")
         object.__setattr__(self, "joints", tuple(self.joints))
@@ -130,23 +138,28 @@ class LinearChain:
         k = np.broadcast_to(np.asarray(local_stiffness, float), (self.n_joints,))
         return self.stiffness_offset + self.stiffness_per_control @ np.asarray(u, float) - np.diag(k)
 
-    def damping(self, u) -> np.ndarray:
-        """D(u) = D_0 + sum_i u_i D_i [N m s/rad].
+    def damping(self, u, local_stiffness=0.0) -> np.ndarray:
+        """D(u) - c_loc diag(k) [N m s/rad]: D_0 + sum_i u_i D_i, and the damping of local joint stiffness k.
 
         Parameters
         ----------
         u : array_like, shape (m,)
             The controls [control unit].
+        local_stiffness : array_like, shape (n,)
+            k_j >= 0 added at each joint [N m/rad], damped by c_loc k_j
+            (``local_damping_per_stiffness``); 0: none.
 
         Returns
         -------
         numpy.ndarray, shape (n, n)
             [N m s/rad].
         """
-        return self.damping_offset + self.damping_per_control @ np.asarray(u, float)
+        k = np.broadcast_to(np.asarray(local_stiffness, float), (self.n_joints,))
+        d = self.damping_offset + self.damping_per_control @ np.asarray(u, float)
+        return d - np.diag(self.local_damping_per_stiffness * k)
 
     def at(self, u, local_stiffness=0.0) -> LinearChain:
-        """The chain with its controls fixed at ``u``: no controls, K_0 = K(u) - diag(k), D_0 = D(u).
+        """The chain with its controls fixed at ``u``: no controls, K_0 = K(u) - diag(k), D_0 = D(u) - c_loc diag(k).
 
         The linear system at one activation, which the reflex analyses take
         (:mod:`spinectl.reflex.mimo`, :mod:`spinectl.reflex.chain_system`).
@@ -156,7 +169,7 @@ class LinearChain:
         u : array_like, shape (m,)
             The controls [control unit].
         local_stiffness : array_like, shape (n,)
-            k_j >= 0 added at each joint [N m/rad]; 0: none.
+            k_j >= 0 added at each joint [N m/rad], with its damping c_loc k_j; 0: none.
 
         Returns
         -------
@@ -171,12 +184,13 @@ class LinearChain:
             stiffness_per_control=np.zeros((n, n, 0)),
             damping_per_control=np.zeros((n, n, 0)),
             stiffness_offset=self.stiffness(u, local_stiffness),
-            damping_offset=self.damping(u),
+            damping_offset=self.damping(u, local_stiffness),
             mass_matrix=self.mass_matrix,
             lower=np.zeros(0),
             upper=np.zeros(0),
             control_unit=self.control_unit,
             source=self.source,
+            local_damping_per_stiffness=self.local_damping_per_stiffness,
         )
 
     def fix(self, values: dict) -> LinearChain:
@@ -219,6 +233,7 @@ class LinearChain:
             upper=self.upper[keep],
             control_unit=self.control_unit,
             source=self.source,
+            local_damping_per_stiffness=self.local_damping_per_stiffness,
         )
 
     def bound_rows(self) -> tuple[np.ndarray, np.ndarray]:
@@ -261,4 +276,5 @@ class LinearChain:
             upper=self.upper[keep],
             control_unit=self.control_unit,
             source=self.source,
+            local_damping_per_stiffness=self.local_damping_per_stiffness,
         )

@@ -543,7 +543,8 @@ def chain_modes(model: Model, eccentricity: float, lordosis: float, pcsa, local_
     pcsa : array_like, shape (n_muscles,)
         Global PCSA of each muscle [m^2].
     local_stiffness : array_like, shape (n_cor,), optional
-        Stiffness of the local muscles at each joint [N m/rad] (docs/chain.md, "Local muscles as joint stiffness").
+        Stiffness of the local muscles at each joint [N m/rad], with the damping of their force-velocity slope
+        (docs/chain.md, "Local muscles as joint stiffness and damping").
 
     Returns
     -------
@@ -560,7 +561,7 @@ def chain_modes(model: Model, eccentricity: float, lordosis: float, pcsa, local_
         coefficients = chain.chain_coefficients(model, e, lam)
         mass = chain.mass_matrix(model, geometry.cor_positions(e, lam, model.geometry))
         stiffness = coefficients.stiffness(pcsa, local_stiffness)
-        eigs = chain.dynamic_eigenvalues(mass, stiffness, coefficients.damping(pcsa))
+        eigs = chain.dynamic_eigenvalues(mass, stiffness, coefficients.damping(pcsa, local_stiffness))
     return ChainModes(segment_names=model.geometry.cor_names, eigenvalues=eigs)
 
 

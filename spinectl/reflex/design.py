@@ -12,10 +12,11 @@ Two answers at one (E, Lambda), one per criterion (docs/reflex.md, "The design q
    so ('bisection: monotone on the scan'); otherwise the same bracket is refined by bisection and
    the method is 'scan and refine: not monotone'.
 2. **the chain** (every CoR free): at the global activation ``reflex.activation`` (the
-   operating point of ``spinectl margins``; ``--activation``; its muscles give the chain's
-   only damping, so activation 0 leaves the chain undamped), the
+   operating point of ``spinectl margins``; ``--activation``), the
    least local stiffness f k* (k* the least local stiffness for static stability,
-   problem (a) of docs/chain.md; the local muscles of "Local muscles as joint stiffness")
+   problem (a) of docs/chain.md; the local muscles of "Local muscles as joint stiffness and
+   damping", which damp the joint by c_loc f k*: with ``local.damping`` = 0 the global muscles
+   give the chain's only damping, and activation 0 leaves it undamped)
    for which the chain under the delayed reflex is stable at the delay. The reflex is the
    rule on the chain (:func:`spinectl.reflex.gains.chain_gains`) scaled by the deficit left,
    (1 - f)+ times its gains (:func:`chain_loop_at`), or the explicit gains. The certificate:
@@ -25,9 +26,10 @@ Two answers at one (E, Lambda), one per criterion (docs/reflex.md, "The design q
    equation) lies in the left half-plane. Both are required: the margin's frequency sweep
    (0.15 % steps) can step over the band of a crossing of a nearly undamped mode under a weak
    reflex (0.05 % wide at f = 0.9999 for the subject of docs/reflex.md, "The design
-   question"), which the spectral root does not miss. The search scans f, then bisects the
-   bracket of the first f that meets the delay (exact for a set of designs that, once met,
-   stays met for every larger f; the method says whether the scan showed that).
+   question", without the local muscles' damping), which the spectral root does not miss. The
+   search scans f, then bisects the bracket of the first f that meets the delay (exact for a set
+   of designs that, once met, stays met for every larger f; the method says whether the scan
+   showed that).
 
 No design meets the delay: status 'infeasible' and the largest delay that the scan meets.
 """
@@ -57,6 +59,10 @@ SCAN = 41
 
 BISECTIONS = 20
 """Halvings of the bracket: the answer to 1e-6 of the scanned step above the least design."""
+
+MAX_EXPONENT = 700.0
+"""Largest -Re(s) tau at which Newton's method on the characteristic determinant goes on: e^700 is near the
+largest float (e^709.8); a root further left is never the rightmost."""
 
 LOCAL_MAX = 2.0
 """Largest local stiffness searched with explicit gains, as a multiple of the least for static stability k*
@@ -422,17 +428,19 @@ def chain_matrices(model: Model, eccentricity: float, lordosis: float, pcsa):
 
 
 def chain_loop_at(model: Model, mass, stiffness, damping, least_static, fraction, kp=None, kd=None):
-    """The chain's stiffness with local stiffness f k*, and its reflex gains: (1 - f)+ times the rule's.
+    """The chain with local stiffness f k* and its damping, and its reflex gains: (1 - f)+ times the rule's.
 
     The rule on the chain (:func:`spinectl.reflex.gains.chain_gains`) at f = 0 compensates the
     whole deficit k*; as the local muscles take over a fraction f of it, the reflex keeps the
     rest, (1 - f)+ times both gains, so that at f >= 1 the chain holds itself without reflex.
+    The local muscles damp what they stiffen: c_loc f k* on the diagonal of D
+    (:func:`spinectl.model.chain.local_damping_per_stiffness`; docs/chain.md).
 
     Parameters
     ----------
     model : Model
     mass, stiffness, damping : numpy.ndarray, shape (n, n)
-        M, K (global muscles, gravity, passive), D.
+        M, K (global muscles, gravity, passive), D (global muscles).
     least_static : numpy.ndarray, shape (n,)
         k* [N m/rad].
     fraction : float
@@ -444,11 +452,14 @@ def chain_loop_at(model: Model, mass, stiffness, damping, least_static, fraction
     -------
     stiffness : numpy.ndarray, shape (n, n)
         K - f diag(k*) [N m/rad].
+    damping : numpy.ndarray, shape (n, n)
+        D - c_loc f diag(k*) [N m s/rad].
     kp, kd : numpy.ndarray, shape (n,)
         [N m/rad], [N m s/rad].
     """
     r, n = model.reflex, len(least_static)
     k = stiffness - fraction * np.diag(least_static)
+    d = damping - np.diag(chain.local_damping(fraction * np.asarray(least_static, float), model))
     if r.gains == "rule":  # the reflex hands over to the local muscles: (1 - f)+ times the rule's gains at f = 0
         kp0, kd0 = gains.chain_gains(
             mass, stiffness, damping, least_static, r.gain_factor, r.damping_ratio, r.activation_time_constant
@@ -457,7 +468,7 @@ def chain_loop_at(model: Model, mass, stiffness, damping, least_static, fraction
         kp0, kd0 = scale * kp0, scale * kd0
     else:
         kp0, kd0 = np.full(n, r.kp), np.full(n, r.kd)
-    return k, kp0 if kp is None else np.full(n, float(kp)), kd0 if kd is None else np.full(n, float(kd))
+    return k, d, kp0 if kp is None else np.full(n, float(kp)), kd0 if kd is None else np.full(n, float(kd))
 
 
 def rightmost_root(mass, stiffness, damping, kp, kd, delay: float, lag: float = 0.0, nodes: int = 0) -> complex:
@@ -534,8 +545,14 @@ def _chebyshev(n: int) -> np.ndarray:
 
 
 def _newton(m, k, d, kp, kd, tau, lag, s, steps: int = 30):
-    """Newton's method on det T(s) from ``s``; NaN if it does not converge."""
+    """Newton's method on det T(s) from ``s``; NaN if it does not converge.
+
+    NaN too where it runs so far left that e^{-s tau} would overflow (Re s < -700 / tau): such a root,
+    from a fast seed (the heavily damped modes of local muscles), is never the rightmost.
+    """
     for _ in range(steps):
+        if (-s * tau).real > MAX_EXPONENT:
+            return complex(np.nan, np.nan)
         e = np.exp(-s * tau)
         plant = m * s**2 - d * s - k
         t = (lag * s + 1.0) * plant + (kp + kd * s) * e
@@ -584,15 +601,15 @@ def chain_design(model: Model, eccentricity: float, lordosis: float, pcsa, activ
 
         Each exact margin found is kept in ``margins`` for the largest delay met.
         """
-        k, p, dd = chain_loop_at(model, mass, stiffness, damping, least, f, kp, kd)
+        k, dl, p, dd = chain_loop_at(model, mass, stiffness, damping, least, f, kp, kd)
         with arithmetic_guard(eccentricity, lordosis):
-            root = rightmost_root(mass, k, damping, p, dd, delay, lag)
+            root = rightmost_root(mass, k, dl, p, dd, delay, lag)
             if not root.real < 0:
                 return False, root, None
             if not (np.any(p) or np.any(dd)):  # no reflex: stable at every delay (no crossing to find)
                 margins.append(np.inf)
                 return True, root, from_crossings(np.empty(0), np.empty(0), np.empty(0), True)
-            exact = chain_delay_margin(mass, k, damping, p, dd, lag)
+            exact = chain_delay_margin(mass, k, dl, p, dd, lag)
         margins.append(float(exact.margin))
         return bool(stable_at(exact, delay) and exact.margin >= delay), root, exact
 
@@ -607,8 +624,8 @@ def chain_design(model: Model, eccentricity: float, lordosis: float, pcsa, activ
         nan = np.full(n, np.nan)
         return ChainDesign(activation, np.nan, nan, least, np.nan, np.nan, float(largest), method)
     _, _, exact = judge(fraction)
-    k, p, dd = chain_loop_at(model, mass, stiffness, damping, least, fraction, kp, kd)
-    root = rightmost_root(mass, k, damping, p, dd, delay, lag, SPECTRAL_NODES)
+    k, dl, p, dd = chain_loop_at(model, mass, stiffness, damping, least, fraction, kp, kd)
+    root = rightmost_root(mass, k, dl, p, dd, delay, lag, SPECTRAL_NODES)
     return ChainDesign(
         activation,
         fraction,
@@ -623,8 +640,8 @@ def chain_design(model: Model, eccentricity: float, lordosis: float, pcsa, activ
 
 def _chain_margin(model, mass, stiffness, damping, least, fraction, kp, kd, lag) -> float:
     """The chain's exact delay margin at local stiffness f k* [s]; 0 if unstable without delay."""
-    k, p, dd = chain_loop_at(model, mass, stiffness, damping, least, fraction, kp, kd)
-    exact = chain_delay_margin(mass, k, damping, p, dd, lag)
+    k, dl, p, dd = chain_loop_at(model, mass, stiffness, damping, least, fraction, kp, kd)
+    exact = chain_delay_margin(mass, k, dl, p, dd, lag)
     return float(exact.margin) if exact.stable_without_delay else 0.0
 
 
@@ -1221,11 +1238,11 @@ def _chain_curve(model, e, lam, pcsa, delays, kp, kd):
     def exact(f):
         """The exact margin at f, once per f (it does not depend on the delay)."""
         if f not in margins:
-            k, p, dd = loop(f)
+            k, dl, p, dd = loop(f)
             if not (np.any(p) or np.any(dd)):
                 margins[f] = from_crossings(np.empty(0), np.empty(0), np.empty(0), chain.coupled_margin(k) > 0)
             else:
-                margins[f] = chain_delay_margin(mass, k, damping, p, dd, lag)
+                margins[f] = chain_delay_margin(mass, k, dl, p, dd, lag)
         return margins[f]
 
     def met(f, d):
@@ -1236,9 +1253,9 @@ def _chain_curve(model, e, lam, pcsa, delays, kp, kd):
         if f in fails_from and fails_from[f] <= d:
             return False
         if f not in margins:
-            k, p, dd = loop(f)
+            k, dl, p, dd = loop(f)
             with arithmetic_guard(e, lam):
-                if d > 0 and rightmost_root(mass, k, damping, p, dd, d, lag).real >= 0:  # a true root: unstable
+                if d > 0 and rightmost_root(mass, k, dl, p, dd, d, lag).real >= 0:  # a true root: unstable
                     fails_from[f] = d
                     return False
                 exact(f)
@@ -1261,9 +1278,9 @@ def _chain_curve(model, e, lam, pcsa, delays, kp, kd):
         if np.isnan(f):
             out.append((np.nan, np.nan, np.nan))
             continue
-        k, p, dd = loop(f)
+        k, dl, p, dd = loop(f)
         with arithmetic_guard(e, lam):
-            root = rightmost_root(mass, k, damping, p, dd, d, lag)
+            root = rightmost_root(mass, k, dl, p, dd, d, lag)
         out.append((f, float(exact(f).margin), float(root.real)))
     fraction, margin, roots = (np.array(x) for x in zip(*out, strict=True))
     return fraction, least, margin, roots

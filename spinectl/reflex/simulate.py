@@ -463,7 +463,9 @@ class NonlinearChainPlant:
     nonlinear fibre lengths, lever arms and Hill forces
     (:func:`~spinectl.model.chain.chain_muscle_torque_per_pcsa`), gravity
     (:func:`~spinectl.model.chain.chain_gravity_torque`), the passive and local stiffness
-    -(K_pas + k) q, and the constant counter torques that make upright an equilibrium (as
+    -(K_pas + k) q, the local muscles' damping -c_loc k q' (their Hill slope at rest,
+    :func:`~spinectl.model.chain.local_damping`; linear, like their stiffness), and the
+    constant counter torques that make upright an equilibrium (as
     :class:`SegmentPlant`'s). M(q) is the posture's mass matrix
     (:func:`~spinectl.model.chain.mass_matrix`) and c the Coriolis and centripetal terms
     (:func:`~spinectl.model.chain.velocity_torque`). Runs as :class:`ChainPlant`'s.
@@ -479,6 +481,8 @@ class NonlinearChainPlant:
         K_pas + k per joint [N m/rad]: passive and local.
     counter_torque : numpy.ndarray, shape (n,)
         Constant torques [N m] making tau(0, 0) = 0.
+    local_damping : numpy.ndarray or float, shape (n,)
+        c_loc k per joint [N m s/rad]: the local muscles' damping; 0: none.
     """
 
     model: Model
@@ -486,6 +490,7 @@ class NonlinearChainPlant:
     pcsa: np.ndarray
     stiffness: np.ndarray
     counter_torque: np.ndarray
+    local_damping: np.ndarray | float = 0.0
 
     @property
     def joints(self) -> int:
@@ -527,10 +532,11 @@ class NonlinearChainPlant:
 
 
 def _chain_torque_without_ct(plant: NonlinearChainPlant, q, qdot):
-    """Muscles, gravity and -(K_pas + k) q [N m]."""
+    """Muscles, gravity, -(K_pas + k) q and the local damping -c_loc k q' [N m]."""
     m, q = plant.model, np.asarray(q, float)
     muscles = chain.chain_muscle_torque_per_pcsa(m, plant.cor, q, qdot) @ plant.pcsa
-    return muscles + chain.chain_gravity_torque(m, plant.cor, q) - plant.stiffness * q
+    springs = muscles + chain.chain_gravity_torque(m, plant.cor, q) - plant.stiffness * q
+    return springs - plant.local_damping * np.asarray(qdot, float)
 
 
 def nonlinear_chain_plant(model: Model, eccentricity: float, lordosis: float, pcsa, local_stiffness=0.0):
@@ -544,7 +550,7 @@ def nonlinear_chain_plant(model: Model, eccentricity: float, lordosis: float, pc
     pcsa : array_like, shape (n_muscles,)
         Global PCSA of each muscle [m^2].
     local_stiffness : array_like, shape (n,)
-        k_j of the local muscles [N m/rad]; 0: none.
+        k_j of the local muscles [N m/rad], with their damping c_loc k_j; 0: none.
 
     Returns
     -------
@@ -557,7 +563,8 @@ def nonlinear_chain_plant(model: Model, eccentricity: float, lordosis: float, pc
     n = cor.shape[0]
     passive = mechanics.passive_stiffness(model, mechanics.inertia(cor, model))  # as chain_coefficients
     stiffness = np.broadcast_to(passive + np.asarray(local_stiffness, float), (n,)).copy()
-    plant = NonlinearChainPlant(model, cor, np.asarray(pcsa, float), stiffness, np.zeros(n))
+    damping = np.broadcast_to(chain.local_damping(local_stiffness, model), (n,)).copy()
+    plant = NonlinearChainPlant(model, cor, np.asarray(pcsa, float), stiffness, np.zeros(n), damping)
     return dataclasses.replace(plant, counter_torque=-_chain_torque_without_ct(plant, np.zeros(n), np.zeros(n)))
 
 

@@ -179,6 +179,65 @@ def test_local_muscle_stiffness_per_pcsa_by_hand():
     assert float(chain.local_pcsa(595.0, halved)) == pytest.approx(34e-4)
 
 
+def test_local_damping_per_stiffness_is_the_hill_slope_at_rest():
+    """c_loc = l |f_H'(0)| / q (docs/chain.md, "Local muscles as joint stiffness and damping"), three ways:
+    the closed form of the Hill slope, (1 + a) / b with b = hill_b (vmax_slow + vmax_fast_gain FT) l_opt and
+    l_opt = 1.2 l (docs/model.md), so (1 + 0.25) / (0.25 * 11 * 1.2) / 10 = 0.03788 s at the defaults; a central
+    difference of the Hill force at v = +-h (muscle.force_velocity, both branches); and a central difference in
+    omega of the joint torque r F f_H(r omega) of a local muscle at force F, whose stiffness is q F r^2 / l."""
+    model = Model()
+    fibre, local = model.fibre, model.local
+    b = fibre.hill_b * (fibre.vmax_slow + fibre.vmax_fast_gain * fibre.fast_twitch) * 1.2 * local.length
+    closed = local.length * (1.0 + fibre.hill_a) / b / local.stiffness_gain
+    assert closed == pytest.approx(1.25 / 3.3 / 10, rel=1e-12)
+    assert chain.local_damping_per_stiffness(model) == pytest.approx(closed, rel=1e-12)
+    hill = muscle.hill_constants(1.2 * local.length, fibre, model.errata)
+    h = 1e-9  # the branches' curvatures differ at 0, so the central difference is first order in h
+    slope = (muscle.force_velocity(h, hill) - muscle.force_velocity(-h, hill)) / (2 * h)  # [s/m], < 0
+    by_difference = local.length * -slope / local.stiffness_gain
+    assert chain.local_damping_per_stiffness(model) == pytest.approx(by_difference, rel=1e-6)
+    force, r = 80.0, local.lever_arm  # N; any force: both stiffness and damping are proportional to it
+    k = local.stiffness_gain * force * r**2 / local.length
+    torque = lambda w: r * force * muscle.force_velocity(r * w, hill)  # noqa: E731
+    damping = -(torque(h) - torque(-h)) / (2 * h)  # N m s/rad, damping the motion
+    assert float(chain.local_damping(k, model)) == pytest.approx(damping, rel=1e-5)
+    slow = Model(fibre=Fibre(fast_twitch=0.0))  # all slow-twitch: v_max 6 instead of 11 l_opt/s
+    assert chain.local_damping_per_stiffness(slow) == pytest.approx(closed * 11 / 6, rel=1e-12)
+    assert chain.local_damping_per_stiffness(Model(local=Local(damping=0.0))) == 0.0
+    assert chain.local_damping_per_stiffness(Model(local=Local(damping=0.5))) == pytest.approx(closed / 2)
+
+
+@pytest.mark.parametrize("preset", ["default", "wagner2012"])
+def test_damping_with_local_muscles_is_the_hand_built_matrix(rng, preset):
+    """D with local stiffness k: the global muscles' D (sum_i x_i D_i, built here from damping_per_pcsa) minus
+    c_loc diag(k), c_loc = l |f_H'(0)| / q by hand; the same from LinearChain.damping and LinearChain.at. The
+    stiffness-only model (local.damping = 0) gives the former D bit for bit, whatever k."""
+    model = load_preset(preset)
+    e, lam = rng.uniform(-0.06, 0.06, 2)
+    coefficients = chain.chain_coefficients(model, e, lam)
+    pcsa = rng.uniform(0.0, 20e-4, len(model.muscle_names))
+    k = rng.uniform(0.0, 100.0, N_COR)
+    fibre = model.fibre
+    b = fibre.hill_b * (fibre.vmax_slow + fibre.vmax_fast_gain * fibre.fast_twitch) * fibre.optimal_length_ratio
+    c_loc = (1.0 + fibre.hill_a) / b / model.local.stiffness_gain  # l cancels: b is per l_opt = 1.2 l
+    global_only = np.einsum("jkm,m->jk", coefficients.damping_per_pcsa, pcsa)
+    expected = global_only - c_loc * np.diag(k)
+    np.testing.assert_allclose(coefficients.damping(pcsa, k), expected, rtol=1e-12, atol=1e-12 * np.abs(expected).max())
+    np.testing.assert_array_equal(coefficients.damping(pcsa), global_only)
+    linear = chain.linear_chain(model, e, lam, coefficients)
+    x = pcsa[::2] * 1e4 if model.optimisation.activation == "paired" else pcsa * 1e4
+    pcsa_x = np.repeat(pcsa[::2], 2) if model.optimisation.activation == "paired" else pcsa
+    at_x = coefficients.damping(pcsa_x, k)
+    np.testing.assert_allclose(linear.damping(x, k), at_x, rtol=1e-12, atol=1e-12 * np.abs(at_x).max())
+    np.testing.assert_allclose(linear.at(x, k).damping(()), at_x, rtol=1e-12, atol=1e-12 * np.abs(at_x).max())
+    off = model.replace(local=dataclasses.replace(model.local, damping=0.0))
+    off_coefficients = chain.chain_coefficients(off, e, lam)
+    np.testing.assert_array_equal(off_coefficients.damping(pcsa, k), coefficients.damping(pcsa))
+    off_linear = chain.linear_chain(off, e, lam, off_coefficients)
+    np.testing.assert_array_equal(off_linear.damping(x, k), linear.damping(x))
+    np.testing.assert_array_equal(off_linear.at(x, k).damping(()), linear.damping(x))
+
+
 def test_coefficients_broadcast_over_a_grid(model):
     E, L = np.meshgrid(np.linspace(0, 0.08, 3), np.linspace(0, 0.08, 2), indexing="ij")
     grid = chain.chain_coefficients(model, E, L)

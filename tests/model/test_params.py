@@ -93,3 +93,24 @@ def test_the_number_of_pairs_cors_and_fibre_terms_is_bounded():
     Model(muscles=_pairs(3, fibres=1000))
     with pytest.raises(ParameterError, match=r"at most 30,000 fibre-CoR terms .* got 40,000"):
         Model(muscles=_pairs(4, fibres=1000))
+
+
+@pytest.mark.parametrize(("value", "shown"), [(-0.5, "-0.5"), (11.0, "11"), (float("nan"), "nan")])
+def test_local_damping_outside_its_range_is_one_line_naming_the_field(capsys, value, shown):
+    """local.damping, the factor on the local muscles' force-velocity damping: [0, 10] (MAX_LOCAL_DAMPING;
+    docs/chain.md), refused by the dataclass and by the CLI in one line naming the field, exit 2; the
+    edges 0 (stiffness only) and 10 are accepted, and config show prints the field with its unit."""
+    from spinectl.cli import main
+    from spinectl.model.params import MAX_LOCAL_DAMPING
+
+    with pytest.raises(ParameterError, match="damping"):
+        Local(damping=value)
+    assert main(["stability", "--coupled", "--set", f"local.damping={value}"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "local.damping" in err and shown in err
+    assert "Traceback" not in err
+    Local(damping=0.0), Local(damping=MAX_LOCAL_DAMPING)
+    assert main(["config", "show"]) == 0
+    out = capsys.readouterr().out
+    section = out[out.index("[local]") :]
+    assert "# [1] Factor on the local muscles' damping" in section and "\ndamping = 1.0" in section

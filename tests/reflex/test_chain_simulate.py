@@ -10,6 +10,7 @@ from scipy.integrate import solve_ivp
 
 from spinectl import load_preset, optimise
 from spinectl.model import chain, geometry
+from spinectl.model.config import set_parameters
 from spinectl.model.mechanics import gravity_sign
 from spinectl.optimise.coupled import least_local_stiffness
 from spinectl.reflex.mimo import chain_delay_margin
@@ -28,7 +29,8 @@ def _central_difference(func, step=STEP):
 @pytest.mark.parametrize("preset", ["default", "wagner2012"])
 def test_torques_linearise_to_the_chains_k_and_d(rng, preset):
     """Central differences of the plant's nonlinear torques at upright are the linear chain's K - diag(k)
-    and D (chain_coefficients), with local stiffness k; upright is an equilibrium (counter torques)."""
+    and D - c_loc diag(k) (chain_coefficients), with local stiffness k and its damping; upright is an
+    equilibrium (counter torques)."""
     model = load_preset(preset)
     E, L = rng.uniform(-0.06, 0.06, 2)
     pcsa = optimise.solve_point(model, E, L).pcsa
@@ -36,7 +38,7 @@ def test_torques_linearise_to_the_chains_k_and_d(rng, preset):
     plant = nonlinear_chain_plant(model, E, L, pcsa, k)
     zero = np.zeros(N)
     coefficients = chain.chain_coefficients(model, E, L)
-    stiffness, damping = coefficients.stiffness(pcsa, k), coefficients.damping(pcsa)
+    stiffness, damping = coefficients.stiffness(pcsa, k), coefficients.damping(pcsa, k)
     np.testing.assert_allclose(
         _central_difference(lambda dq: plant.torque(dq, zero)), stiffness, atol=1e-7 * np.abs(stiffness).max()
     )
@@ -74,10 +76,11 @@ def _swing(plant, velocity_torque=True):
 
 
 def test_energy_is_conserved_without_muscles(monkeypatch):
-    """Gravity, passive and local springs only (conservative): T + V is constant along a large motion to
-    the integrator's tolerance, while the kinetic energy swings by tens of joules. Dropping the
-    Coriolis and centripetal terms c(q, q') breaks it: the check can fail."""
-    model = load_preset("wagner2012")
+    """Gravity, passive and local springs only (conservative; the local muscles' damping off,
+    local.damping = 0): T + V is constant along a large motion to the integrator's tolerance, while the
+    kinetic energy swings by tens of joules. Dropping the Coriolis and centripetal terms c(q, q') breaks
+    it: the check can fail."""
+    model = set_parameters(load_preset("wagner2012"), {"local.damping": 0.0})
     plant = nonlinear_chain_plant(model, 0.02, 0.03, np.zeros(len(model.muscle_names)), np.full(N, 40.0))
     drift, swing = _swing(plant)
     assert swing > 1.0 and drift < 1e-9 * swing
@@ -86,10 +89,32 @@ def test_energy_is_conserved_without_muscles(monkeypatch):
     assert drift > 1e-3 * swing
 
 
+def test_the_local_muscles_damping_dissipates_what_it_should():
+    """With the local muscles' damping on (no global muscles, local springs of 40 N m/rad and their damping
+    c_loc k per joint), the energy T + V of the motion of the conservative test falls, and by exactly the
+    work of the dampers: E(0) - E(t) = integral of sum_j c_loc k_j q'_j^2 dt, integrated here as an extra
+    state beside the motion (a second route to the same number), to 1e-6 of the loss."""
+    model = load_preset("wagner2012")
+    k = np.full(N, 40.0)
+    plant = nonlinear_chain_plant(model, 0.02, 0.03, np.zeros(len(model.muscle_names)), k)
+    d = chain.local_damping_per_stiffness(model) * k
+
+    def rates(_, x):
+        return np.concatenate(
+            [x[N : 2 * N], plant.acceleration(x[:N], x[N : 2 * N], np.zeros(N)), [d @ x[N : 2 * N] ** 2]]
+        )
+
+    start = np.array([0.15, -0.2, 0.1, 0.05, -0.1, 1.0, -2.0, 0.5, 1.5, -1.0, 0.0])
+    end = solve_ivp(rates, (0.0, 0.3), start, method="DOP853", rtol=1e-11, atol=1e-12).y[:, -1]
+    loss = _energy(plant, start[: 2 * N]) - _energy(plant, end[: 2 * N])
+    assert loss > 0.1 and loss == pytest.approx(end[-1], rel=1e-6)
+
+
 def test_small_motions_turn_unstable_at_the_exact_coupled_delay_margin():
     """A statically stable chain (wagner2012 at the per-segment optimum plus 30 N m/rad more than the least
     local stiffness; heavy levels, 10 kg and rho = 0.5 m, so that its modes are slow and its margin of
-    53 ms is cheap to simulate) under kp = 20 N m/rad, kd = 10 N m s/rad and the 50 ms activation lag.
+    79 ms is cheap to simulate) under kp = 20 N m/rad, kd = 10 N m s/rad and the 50 ms activation lag; the
+    local muscles damp the joints (c_loc k, in the plant and in D).
     A bisection of 4 delays by 2 rounds on the nonlinear simulation (1e-4 rad) brackets reflex.mimo's
     exact delay margin within 1 %."""
     model = load_preset("wagner2012")
@@ -100,7 +125,7 @@ def test_small_motions_turn_unstable_at_the_exact_coupled_delay_margin():
     coefficients = chain.chain_coefficients(model, 0.0, 0.0)
     kp, kd, lag = np.full(N, 20.0), np.full(N, 10.0), 0.05
     mass, stiffness = chain.mass_matrix(model, plant.cor), coefficients.stiffness(pcsa, k)
-    exact = chain_delay_margin(mass, stiffness, coefficients.damping(pcsa), kp, kd, lag).margin
+    exact = chain_delay_margin(mass, stiffness, coefficients.damping(pcsa, k), kp, kd, lag).margin
     settings = dataclasses.replace(model.reflex, sim_duration=6.0, sim_time_step=0.005, activation_time_constant=lag)
     perturbation = 1e-4 * np.array([1.0, -2.0, 1.5, 0.5, -1.0])
     low, high = simulated_chain_delay_margin(plant, kp, kd, settings, perturbation, 0.9 * exact, 1.1 * exact, 4, 2)

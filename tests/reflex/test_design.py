@@ -58,34 +58,60 @@ def test_a_segment_at_its_least_activation_has_the_closed_form_margin_equal_to_t
     assert tau == pytest.approx(0.12, rel=1e-6)
 
 
-def test_the_chain_design_has_its_certificate_and_a_little_less_fails(monkeypatch):
+@pytest.mark.parametrize("local_damping", [1.0, 0.0])
+def test_the_chain_design_has_its_certificate_and_a_little_less_fails(monkeypatch, local_damping):
     """The chain at activation 0.5: the returned local stiffness f k* gives an exact multivariable margin >= the
     delay and a rightmost root in the left half-plane (recomputed here); one bisection step below it (the scan step
-    halved BISECTIONS times) the exact margin falls short of the delay. That loop is stable at the delay itself
-    (its rightmost root there is on the left) but not on all of [0, delay]: delay systems switch stability, and
-    a narrow crossing band at about 217 rad/s opens unstable windows well below the delay (near 5-10 ms and
-    34-39 ms), and just past the exact margin the rightmost root (a second method) lies on the right. The
-    rule's reflex vanishes at f = 1, so f <= 1."""
+    halved BISECTIONS times) the exact margin falls short of the delay, and just past that margin the rightmost
+    root (a second method) lies on the right. With the local muscles' damping (local.damping = 1) the design is
+    f = 0.734 and the loop loses stability at its first crossing, 12.2 rad/s. Stiffness only (0), f = 0.9997, and
+    the loop one step below is stable at the delay itself but not on all of [0, delay]: delay systems switch
+    stability, and a narrow crossing band at about 217 rad/s opens unstable windows well below the delay (near
+    5-10 ms and 34-39 ms). The rule's reflex vanishes at f = 1, so f <= 1."""
     monkeypatch.setattr(dz, "CHAIN_SCAN", 5)
     monkeypatch.setattr(dz, "BISECTIONS", 12)
-    model = _subject(**{"reflex.activation": 0.5})
+    model = _subject(**{"reflex.activation": 0.5, "local.damping": local_damping})
     optimum = margins.solve_point(model, 0.03, 0.04).pcsa
     result = dz.chain_design(model, 0.03, 0.04, 0.5 * optimum, 0.5)
     assert 0 < result.fraction <= 1 and result.delay_margin >= 0.12 and result.max_root_real < 0
+    assert result.fraction < 0.75 if local_damping else result.fraction > 0.999  # the damping lets the reflex help
     mass, stiffness, damping = dz.chain_matrices(model, 0.03, 0.04, 0.5 * optimum)
 
     def loop(f):
         return dz.chain_loop_at(model, mass, stiffness, damping, result.least_static, f)
 
-    k, kp, kd = loop(result.fraction)
-    exact = chain_delay_margin(mass, k, damping, kp, kd, 0.05)
+    k, d, kp, kd = loop(result.fraction)
+    exact = chain_delay_margin(mass, k, d, kp, kd, 0.05)
     assert stable_at(exact, 0.12) and exact.margin >= 0.12
-    assert dz.rightmost_root(mass, k, damping, kp, kd, 0.12, 0.05, dz.SPECTRAL_NODES).real < 0
+    assert dz.rightmost_root(mass, k, d, kp, kd, 0.12, 0.05, dz.SPECTRAL_NODES).real < 0
     step = 1.0 / (dz.CHAIN_SCAN - 1) / 2**dz.BISECTIONS
-    k, kp, kd = loop(result.fraction - step)
-    less = chain_delay_margin(mass, k, damping, kp, kd, 0.05)
+    k, d, kp, kd = loop(result.fraction - step)
+    less = chain_delay_margin(mass, k, d, kp, kd, 0.05)
     assert less.margin < 0.12
-    assert dz.rightmost_root(mass, k, damping, kp, kd, less.margin * 1.02, 0.05, dz.SPECTRAL_NODES).real > 0
+    assert dz.rightmost_root(mass, k, d, kp, kd, less.margin * 1.02, 0.05, dz.SPECTRAL_NODES).real > 0
+
+
+def test_the_chains_loop_carries_the_local_muscles_damping():
+    """chain_loop_at at local stiffness f k*: the stiffness K - f diag(k*) and the damping D - c_loc f diag(k*),
+    c_loc = (1 + a) / (q hill_b (vmax_slow + vmax_fast_gain FT) l_opt/l) by hand (docs/chain.md); the rule's
+    gains do not depend on the local damping (they are set at f = 0). With local.damping = 0 the damping is the
+    global muscles' D bit for bit, the stiffness-only model."""
+    on = _subject(**{"reflex.activation": 0.5})
+    off = _subject(**{"reflex.activation": 0.5, "local.damping": 0.0})
+    optimum = margins.solve_point(on, 0.03, 0.04).pcsa
+    mass, stiffness, damping = dz.chain_matrices(on, 0.03, 0.04, 0.5 * optimum)
+    least, f = np.array([60.0, 90.0, 95.0, 66.0, 19.0]), 0.7
+    fibre = on.fibre
+    b = fibre.hill_b * (fibre.vmax_slow + fibre.vmax_fast_gain * fibre.fast_twitch) * fibre.optimal_length_ratio
+    c_loc = (1.0 + fibre.hill_a) / b / on.local.stiffness_gain
+    k, d, kp, kd = dz.chain_loop_at(on, mass, stiffness, damping, least, f)
+    np.testing.assert_array_equal(k, stiffness - f * np.diag(least))
+    np.testing.assert_allclose(d, damping - c_loc * f * np.diag(least), rtol=1e-12, atol=1e-12)
+    k0, d0, kp0, kd0 = dz.chain_loop_at(off, mass, stiffness, damping, least, f)
+    np.testing.assert_array_equal(d0, damping)
+    np.testing.assert_array_equal(k0, k)
+    np.testing.assert_array_equal(kp0, kp)
+    np.testing.assert_array_equal(kd0, kd)
 
 
 def test_the_rightmost_root_is_a_root_and_agrees_with_the_exact_margin_on_one_joint():
@@ -100,6 +126,21 @@ def test_the_rightmost_root_is_a_root_and_agrees_with_the_exact_margin_on_one_jo
         s = dz.rightmost_root(m, k, d, kp, kd, tau, lag, dz.SPECTRAL_NODES)
         residual = (lag * s + 1) * (s**2 + 0.5 * s - 2.0) + (6.0 + 1.5 * s) * np.exp(-s * tau)
         assert abs(residual) < 1e-9 and np.sign(s.real) == sign
+
+
+def test_a_fast_seed_does_not_overflow_the_rightmost_root(monkeypatch):
+    """One joint with a fast and a slow pole (theta = 1e-3, S = -1, D = -10: about -1e4 and -0.1 1/s, as the local
+    muscles' damping gives the light modes), kp = 0.5, a 0.1 s delay, under numpy's raise-on-overflow (the models'
+    arithmetic guard): e^{-s tau} of the fast seed would overflow (e^1000). The rightmost root is the slow one, a
+    root of (theta s^2 - D s - S) + kp e^{-s tau} (residual < 1e-9), left of the axis; without the bound on the
+    exponent (MAX_EXPONENT = inf) the same call raises."""
+    m, k, d, kp, kd = 1e-3 * np.eye(1), -np.eye(1), -10.0 * np.eye(1), [0.5], [0.0]
+    with np.errstate(over="raise", invalid="raise", divide="raise"):
+        s = dz.rightmost_root(m, k, d, kp, kd, 0.1)
+        assert abs(1e-3 * s**2 + 10.0 * s + 1.0 + 0.5 * np.exp(-0.1 * s)) < 1e-9 and s.real < 0
+        monkeypatch.setattr(dz, "MAX_EXPONENT", np.inf)
+        with pytest.raises(FloatingPointError):
+            dz.rightmost_root(m, k, d, kp, kd, 0.1)
 
 
 def test_a_delay_no_activation_meets_is_an_answer():
@@ -117,9 +158,9 @@ def test_a_delay_no_activation_meets_is_an_answer():
 
 
 def test_a_delay_prints_with_its_unit_or_unbounded_without_one():
-    """The table's delays: 120 ms in ms, 329.8 s (the plain case's chain margin) in s, an infinite margin as
-    'unbounded (delay-independent)' with no unit (not 'unbounded ms'), NaN as 'none'; and so in the certificate
-    of a Design's table."""
+    """The table's delays: 120 ms in ms, 329.8 s (the plain case's chain margin, stiffness only) in s, an infinite
+    margin as 'unbounded (delay-independent)' with no unit (not 'unbounded ms'), NaN as 'none'; and so in the
+    certificate of a Design's table."""
     assert dz._delay(0.12) == "120 ms" and dz._delay(329.847) == "329.8 s" and dz._delay(np.nan) == "none"
     assert dz._delay(np.inf) == "unbounded (delay-independent)"
     n = 5

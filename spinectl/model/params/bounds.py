@@ -51,6 +51,11 @@ body comes near 1000 kg. A mass of 1e6 kg (grams typed as kilograms) made every 
 ``infeasible`` without a reason: the solvers fail on constraints scaled that far, although the
 answer scales linearly with the mass."""
 
+MAX_LOCAL_DAMPING = 10.0
+"""Largest factor on the local muscles' force-velocity damping (``local.damping``): slow-twitch fibres alone
+(``fibre.fast_twitch`` = 0, v_max = 6 instead of 11 l_opt/s, docs/model.md) have 1.8 times the default slope,
+so 10 is beyond any fibre mix; a larger value is a typo, not a muscle."""
+
 MAX_DELAY = 10.0
 """Longest reflex delay [s]: fifty times the slowest loop the paper names (100 ms plus
 50-100 ms of force generation). A delay of 1e62 s, a unit typo, made the Padé

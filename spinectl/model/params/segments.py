@@ -8,7 +8,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ... import _validate as v
-from .bounds import _length, _store, param
+from .bounds import MAX_LOCAL_DAMPING, _length, _store, param
 
 
 @dataclass(frozen=True)
@@ -30,11 +30,13 @@ class Passive:
 
 @dataclass(frozen=True)
 class Local:
-    """Local (intersegmental) muscles as a joint stiffness of the coupled chain (docs/chain.md).
+    """Local (intersegmental) muscles as a joint stiffness and damping of the coupled chain (docs/chain.md).
 
     A local muscle of PCSA A at full activation pulls with F = specific_tension * A at the
     lever arm r of one joint; its short-range stiffness q F / l (Bergmark 1989,
-    doi:10.3109/17453678909154177) gives the joint the rotational stiffness q F r^2 / l.
+    doi:10.3109/17453678909154177) gives the joint the rotational stiffness q F r^2 / l. The
+    slope of the global fibres' Hill curve at rest, F f_H'(0), gives it the rotational damping
+    r^2 F |f_H'(0)| (Hill 1938, doi:10.1098/rspb.1938.0050), ``damping`` times that.
     """
 
     stiffness_gain: float = param(
@@ -63,6 +65,16 @@ class Local:
         "Weight w of the local PCSA against the global PCSA in the joint optimum of the coupled chain "
         "(docs/chain.md): 1 counts a cm^2 of local muscle like a cm^2 of global muscle.",
     )
+    damping: float = param(
+        1.0,
+        "1",
+        "Factor on the local muscles' damping from the force-velocity slope (docs/chain.md, 'Local muscles as "
+        "joint stiffness and damping'): a joint of local stiffness k_j gets the damping damping * c_loc * k_j "
+        "[N m s/rad], c_loc = l |f_H'(0)| / q [s] from the global fibres' Hill curve (section fibre; Hill "
+        "1938, doi:10.1098/rspb.1938.0050), 0.038 s at the defaults. 1 (default): that slope; 0: no damping, "
+        f"the stiffness-only model. At most {MAX_LOCAL_DAMPING:g}: all slow-twitch fibres (fibre.fast_twitch "
+        "= 0) give 1.8.",
+    )
 
     def __post_init__(self):
         _store(
@@ -71,6 +83,7 @@ class Local:
             lever_arm=_length("lever_arm", self.lever_arm),
             length=_length("length", self.length),
             cost_weight=v.non_negative("cost_weight", self.cost_weight),
+            damping=v.in_range("damping", self.damping, 0.0, MAX_LOCAL_DAMPING),
         )
 
 

@@ -275,7 +275,8 @@ def coupled_stability_at(
         damping = coefficients.damping(pcsa)
         mass = data.chain.mass_matrix
         eigenvalues = chain.dynamic_eigenvalues(mass, stiffness, damping)
-        with_local = chain.dynamic_eigenvalues(mass, stiffness - np.diag(local.local_stiffness), damping)
+        k = local.local_stiffness  # its stiffness and the damping of its force-velocity slope
+        with_local = chain.dynamic_eigenvalues(mass, stiffness - np.diag(k), coefficients.damping(pcsa, k))
     return CoupledStability(
         eccentricity=e,
         lordosis=lam,
