@@ -64,6 +64,7 @@ def run(args) -> int:
         lordosis_angle=args.lordosis_angle,
         model=model,
         assignments=args.assignments,
+        config=args.config,
         **scheduler_options(args),
     )
     if args.json:

@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..atomic import atomic_path, atomic_write_text, output_errors
+from ..atomic import atomic_path, atomic_write_text, check_distinct, output_errors
 from ..errors import SpinectlError
 from ..jsondoc import dumps
 from ..model import chain
@@ -559,6 +559,7 @@ def atlas_file(
     model: Model | None = None,
     assignments=(),
     progress: bool | None = None,
+    config=None,
     **where,
 ) -> AtlasResult:
     """The atlas of an atlas file (``spinectl atlas``), the lordosis optionally fixed as an angle.
@@ -579,6 +580,8 @@ def atlas_file(
         ``SECTION.FIELD=VALUE`` over the base model (``--set``).
     progress : bool or None
         As for :func:`run_atlas`.
+    config : str or Path, optional
+        The ``--config`` file the model was read from, protected like the atlas file.
     **where
         ``scheduler``, ``workers``, ``connect_timeout``, ``worker_timeout`` and ``notify``, as for :func:`run_atlas`.
 
@@ -591,11 +594,13 @@ def atlas_file(
     ConfigError
         The file is invalid.
     ParameterError
-        ``lordosis_angle`` is given and a prior varies the lordosis, or it is out of range; bad scheduler options.
+        ``lordosis_angle`` is given and a prior varies the lordosis, or it is out of range; bad scheduler
+        options; a file that ``out`` would be written over is the atlas file or ``config``.
     """
     from ..errors import ParameterError
     from .priors import load_atlas
 
+    check_distinct({"--out": _outputs(out)}, {"PRIORS.toml": path, "--config": config})
     spec = load_atlas(path, model=model, assignments=assignments)
     if lordosis_angle is not None:
         if {"lordosis_angle_deg", "lordosis_m"} & set(spec.names):
@@ -777,6 +782,16 @@ def _check_cost(spec: AtlasSpec, n_todo: int, n_chunks: int, where: dict, folder
     budget.check(cost, folder)
     if cost.long:
         notify(cost.line())
+
+
+OUTPUT_FILES = ("atlas.json", "draws.npz", "report.md", "density.png")
+"""The files of an atlas's output folder, beside its ``chunks`` folder."""
+
+
+def _outputs(out) -> list[Path]:
+    """Every file an atlas run into ``out`` may write: :data:`OUTPUT_FILES` and the chunks there already."""
+    chunks = Path(out) / "chunks"
+    return [Path(out) / name for name in OUTPUT_FILES] + (sorted(chunks.iterdir()) if chunks.is_dir() else [])
 
 
 def _write(result: AtlasResult, out: Path, spec: AtlasSpec) -> None:

@@ -33,15 +33,27 @@ def report_text(result, spec: AtlasSpec) -> str:
         "",
         "## Priors",
         "",
-        "| parameter | distribution | mean | sd | bounds | source |",
-        "|---|---|---|---|---|---|",
+        "| parameter | distribution | mean | sd | bounds | checked | source |",
+        "|---|---|---|---|---|---|---|",
     ]
     for p in spec.priors:
         lines.append(
             f"| `{p.parameter}` | {p.distribution} | {_shown(p.mean)} | {_shown(p.sd)} | "
-            f"[{p.bounds[0]:g}, {p.bounds[1]:g}] | {p.source} |"
+            f"[{p.bounds[0]:g}, {p.bounds[1]:g}] | {_checked(p.source)} | {p.source} |"
         )
-    lines += ["", "## Verdicts", "", "| verdict | criterion | p | interval |", "|---|---|---|---|"]
+    unverified = sum(_checked(p.source) == "unverified" for p in spec.priors)
+    lines += [
+        "",
+        f"{unverified} of {len(spec.priors)} priors are unverified as cohort distributions (their source says why).",
+        "",
+        "## Verdicts",
+        "",
+        f"Limits: counter torques within ±{spec.counter_torque_limit:g} N m; local muscle within "
+        f"{spec.local_pcsa_limit:g} cm² per joint.",
+        "",
+        "| verdict | criterion | p | interval |",
+        "|---|---|---|---|",
+    ]
     for name, v in result.probabilities.items():
         lines.append(f"| {name} | {VERDICTS[name]} | {v['p']:.3f} | [{v['low']:.3f}, {v['high']:.3f}] |")
     lines += ["", "## Sobol' indices (first order S1, total ST, with bootstrap intervals)", ""]
@@ -49,13 +61,27 @@ def report_text(result, spec: AtlasSpec) -> str:
     for output, table in tables.items():
         lines += [f"### `{output}`", ""]
         if table is None:
-            lines += [f"Not finite at {result.nonfinite.get(output, 0)} draws (infeasible): no indices.", ""]
+            lines += [_not_finite(result.draws.get(output)), ""]
             continue
         lines += ["| parameter | S1 | ST |", "|---|---|---|"]
         for name, s in table.items():
             lines.append(f"| `{name}` | {s['S1']:.3f} ± {s['S1_conf']:.3f} | {s['ST']:.3f} ± {s['ST_conf']:.3f} |")
         lines.append("")
     return "\n".join(lines) + "\n"
+
+
+def _checked(source: str) -> str:
+    """'unverified' where a prior's source says so (examples/atlas.toml's convention), else 'cited'."""
+    return "unverified" if "unverified" in source.lower() else "cited"
+
+
+def _not_finite(values) -> str:
+    """Why an output has no indices: its unbounded draws (a margin of a spine stable without the reflex) and NaNs."""
+    values = np.asarray(values, float)
+    unbounded, infeasible = int(np.sum(np.isinf(values))), int(np.sum(np.isnan(values)))
+    parts = [f"{unbounded} unbounded (stable at every delay: no reflex needed)"] if unbounded else []
+    parts += [f"{infeasible} not a number (infeasible)"] if infeasible else []
+    return f"Not finite at {unbounded + infeasible} draws ({'; '.join(parts)}): no indices."
 
 
 def _shown(value: float) -> str:

@@ -129,3 +129,22 @@ def test_two_local_workers_give_the_synchronous_json(tmp_path, capsys):
         assert main(["atlas", str(path), "--out", str(tmp_path / options[0]), "--json", *options]) == 0
         docs.append(json.loads(capsys.readouterr().out))
     assert docs[0] == docs[1] and len(list((tmp_path / "--workers" / "chunks").iterdir())) == 2
+
+
+@pytest.mark.parametrize("where", ["priors", "config", "chunk"])
+def test_an_out_that_would_overwrite_an_input_is_refused(tmp_path, capsys, where):
+    """The atlas file saved as DIR/report.md, a --config saved as DIR/atlas.json, or either as a chunk of DIR:
+    exit 2, one line naming the input, the input unchanged (it was overwritten, exit 0)."""
+    out = tmp_path / "d"
+    (out / "chunks").mkdir(parents=True)
+    priors = _file(tmp_path).read_text()
+    config = 'preset = "default"\n'
+    victim = {"priors": out / "report.md", "config": out / "atlas.json", "chunk": out / "chunks" / "c.npz"}[where]
+    victim.write_text(config if where == "config" else priors)
+    argv = ["atlas", str(victim if where != "config" else _file(tmp_path)), "--out", str(out)]
+    argv += ["--config", str(victim)] if where == "config" else []
+    before = victim.read_text()
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert "is the same file as" in err and "\n" not in err
+    assert victim.read_text() == before

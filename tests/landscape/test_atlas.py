@@ -280,3 +280,27 @@ def test_a_long_atlas_is_announced_and_what_cannot_fit_refused(tmp_path, monkeyp
     with pytest.raises(ParameterError, match=f"^atlas: 28 points need about {memory} of memory"):
         atlas.run_atlas(spec, tmp_path / "out", scheduler="synchronous", progress=False)
     assert not (tmp_path / "out").exists()
+
+
+def test_the_report_tells_an_unbounded_margin_from_an_infeasible_draw():
+    """An output with +inf (a spine stable without the reflex) and NaN (infeasible) draws: the report counts each
+    by name; it called every non-finite draw infeasible. The limits and the unverified priors are stated."""
+    from types import SimpleNamespace
+
+    from spinectl.landscape.atlas_report import report_text
+
+    spec = _spec(chain="false")
+    margin = np.array([0.1, np.inf, np.inf, np.nan])
+    result = SimpleNamespace(
+        n_evaluations=4,
+        probabilities={},
+        sobol={"spine_delay_margin_s": None},
+        sobol_verdicts={},
+        nonfinite={"spine_delay_margin_s": 3},
+        draws={"spine_delay_margin_s": margin},
+    )
+    text = report_text(result, spec)
+    assert "Not finite at 3 draws (2 unbounded (stable at every delay: no reflex needed); 1 not a number" in text
+    assert "within ±30 N m" in text and "within 17 cm² per joint" in text
+    unverified = sum("unverified" in p.source.lower() for p in spec.priors)
+    assert f"{unverified} of {len(spec.priors)} priors are unverified" in text
