@@ -468,10 +468,11 @@ pd.DataFrame(
 # %% [markdown]
 # Joint by joint, the longer delay needs more co-contraction: the reflex does less and the muscles more. For the
 # chain the answer is of another kind: a fraction of the least local stiffness for static stability (the column
-# "× least for static stability"), the stiffness that the global muscles cannot give. The local muscles damp what
-# they stiffen (docs: *The lumbar chain*, "Local muscles as joint stiffness and damping"), so part of that stiffness can be left to the
-# delayed reflex; how much shrinks as the delay grows, and the fraction rises towards the static least. Without the
-# local damping (`local.damping = 0`) the chain needed practically all of it at either delay.
+# "× least for static stability"), the stiffness that the global muscles cannot give. The local muscles damp
+# what they stiffen (docs: *The lumbar chain*, "Local muscles as joint stiffness and damping"), so part of that
+# stiffness can be left to the delayed reflex; how much shrinks as the delay grows, and the fraction rises
+# towards the static least. Without the local damping (`local.damping = 0`) the chain needed practically all of
+# it at either delay.
 
 # %% [markdown]
 # ## The design curve: against the delay and the lag

@@ -23,6 +23,17 @@ os.environ.setdefault("SPINECTL_CACHE_DIR", tempfile.mkdtemp(prefix="spinectl-te
 # fresh ones and keeps failures in .hypothesis/ (CONTRIBUTING.md, "Commands").
 
 
+@pytest.fixture(autouse=True, scope="session")
+def _one_blas_thread():
+    """The library's calls in the tests run as the commands run them, with one BLAS thread (spinectl._threads):
+    a multi-threaded BLAS may round differently, and tests compare a command's output with the library's bit
+    for bit. tests/test_threads.py raises the threads itself to check the limit."""
+    from spinectl._threads import one_blas_thread
+
+    with one_blas_thread():
+        yield
+
+
 @pytest.fixture
 def model() -> Model:
     """The built-in default model (dataclass defaults = preset 'default')."""

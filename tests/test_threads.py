@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from threadpoolctl import threadpool_info
+from threadpoolctl import threadpool_info, threadpool_limits
 
 from spinectl import _threads
 from spinectl.cli import main
@@ -16,18 +16,20 @@ def _blas_threads() -> list[int]:
 
 @pytest.fixture
 def no_choice(monkeypatch):
+    """No thread count in the environment, and two BLAS threads to start from (the suite runs with one)."""
     for name in _threads.CHOICE_VARIABLES:
         monkeypatch.delenv(name, raising=False)
+    with threadpool_limits(limits=2, user_api="blas"):
+        yield
 
 
 def test_one_thread_inside_and_restored_after(no_choice):
     """threadpoolctl's own report: 1 thread per BLAS inside the block, the process's number again after.
 
-    Where the machine gives the BLAS one thread anyway (one core), the first check cannot fail; the
-    project's machines have two cores, where OpenBLAS starts two.
+    The fixture starts from two threads, so the first check fails without the limit on any machine.
     """
     before = _blas_threads()
-    assert before, "numpy's BLAS is loaded"
+    assert before and set(before) == {2}, "numpy's BLAS is loaded, at the fixture's two threads"
     with _threads.one_blas_thread():
         assert _blas_threads() == [1] * len(before)
     assert _blas_threads() == before
@@ -36,9 +38,8 @@ def test_one_thread_inside_and_restored_after(no_choice):
 def test_a_users_choice_is_kept(monkeypatch):
     """OPENBLAS_NUM_THREADS set: the block changes nothing (the user's number stands)."""
     monkeypatch.setenv("OPENBLAS_NUM_THREADS", "2")
-    before = _blas_threads()
-    with _threads.one_blas_thread():
-        assert _blas_threads() == before
+    with threadpool_limits(limits=2, user_api="blas"), _threads.one_blas_thread():
+        assert set(_blas_threads()) == {2}
 
 
 class _Seen(Exception):
