@@ -396,6 +396,9 @@ class AnatomyResult:
         mode of largest real eigenvalue (:func:`mujoco_growth_rate`; NaN if that is complex) [1/s].
     control_unit : str
         The unit of ``activations``: ``"1"``, or e.g. ``"cm^2"`` (a PCSA, spinectl's export).
+    activation_source : str
+        Where ``activations`` come from: ``"given"``, or the model's defaults
+        (:meth:`~spinectl.anatomy.model.Anatomy.default_controls_source`).
     """
 
     model: dict
@@ -411,6 +414,7 @@ class AnatomyResult:
     simulated_rate: float = float("nan")
     reflex: dict | None = None
     control_unit: str = "1"
+    activation_source: str = "given"
 
     def referee_error(self) -> float:
         """Largest relative difference between spinectl's and MuJoCo's eigenvalues, matched one to one.
@@ -452,6 +456,7 @@ class AnatomyResult:
             "null_space_stiffness_Nm_per_rad": cert.null_space_stiffness.tolist(),
             "activation_mean": float(self.activations.mean()),
             "control_unit": self.control_unit,
+            "activation_source": self.activation_source,
             "stiffness_matrix_Nm_per_rad": free.stiffness.tolist(),
             "damping_matrix_Nms_per_rad": free.damping.tolist(),
             "mass_matrix_kgm2": free.mass.tolist(),
@@ -501,7 +506,8 @@ class AnatomyResult:
                 f"mean activation {self.activations.mean():.3g}"
                 if self.control_unit == "1"
                 else f"mean control {self.activations.mean():.4g} {self.control_unit}"
-            ),
+            )
+            + f" ({self.activation_source})",
             f"muscles: {counts}; global muscles' moment-arm rank {cert.rank} of {len(free.joints)} "
             f"(singular values {', '.join(f'{s:.3g}' for s in cert.singular_values)} m/rad)",
             f"joint stiffness added: {self.joint_stiffness_added[0]:.4g} N m/rad per joint",
@@ -644,4 +650,10 @@ def analyse(
         simulated_rate=rate,
         reflex=None if reflex is None else reflex_margin(free, a, *reflex),
         control_unit=anatomy.control_unit,
+        activation_source=_activation_source(anatomy, activation),
     )
+
+
+def _activation_source(anatomy: Anatomy, activation) -> str:
+    """Where the analysed activations come from: given, or the model's own default controls."""
+    return "given" if activation is not None else anatomy.default_controls_source()

@@ -113,6 +113,17 @@ class Anatomy:
             return np.zeros(len(self.muscles))
         return model.key_ctrl[0][self.engine.muscle_ids()].copy()
 
+    def default_controls_source(self) -> str:
+        """Where :meth:`default_controls` come from, as one phrase.
+
+        Returns
+        -------
+        str
+        """
+        if not self.engine.model.nkey:
+            return "0: the model has no keyframe"
+        return "the controls of the model's keyframe 0"
+
     def posture(self, posture=None) -> np.ndarray:
         """The full qpos: the model's reference posture (``qpos0``) or the one given.
 

@@ -547,13 +547,42 @@ class OsimAnatomy(Anatomy):
         return "1"
 
     def default_controls(self) -> np.ndarray:
-        """The activations analysed when none are given: 0.
+        """The activations analysed when none are given: the model's own controls at t = 0, else 0.
+
+        The model's controllers (spinectl's export: the ``PrescribedController`` of the solution)
+        evaluated by OpenSim at the posture's time t = 0 (``Model.realizeVelocity``, then each
+        muscle's ``getControl``), as MuJoCo's import takes keyframe 0's; 0 without a controller.
+        Clipped to [0, 1], the muscles' control bounds (round-off of the export's near-zero controls).
 
         Returns
         -------
         numpy.ndarray, shape (m,)
         """
-        return np.zeros(len(self.muscles))
+        if not self._controllers():
+            return np.zeros(len(self.muscles))
+        model, state = self.engine.model, self.engine.state
+        state.setTime(0.0)
+        model.realizeVelocity(state)
+        muscles = model.getMuscles()
+        return np.clip([muscles.get(i).getControl(state) for i in range(muscles.getSize())], 0.0, 1.0)
+
+    def default_controls_source(self) -> str:
+        """Where :meth:`default_controls` come from, as one phrase.
+
+        Returns
+        -------
+        str
+        """
+        names = self._controllers()
+        if not names:
+            return "0: the model has no controller"
+        return f"the model's controls at t = 0 ({', '.join(names)})"
+
+    def _controllers(self) -> list:
+        """The model's enabled controllers, each as ``class name``."""
+        controllers = self.engine.model.getControllerSet()
+        found = (controllers.get(i) for i in range(controllers.getSize()))
+        return [f"{c.getConcreteClassName()} {c.getName()}" for c in found if c.isEnabled()]
 
     def posture(self, posture=None) -> dict:
         """The posture: the coordinates' default values, or those given.

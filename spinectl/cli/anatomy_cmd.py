@@ -32,8 +32,8 @@ def register(sub) -> None:
         default=None,
         metavar="A",
         help="activation of every muscle, in [0, 1] (or its control, e.g. a PCSA in cm^2 in spinectl's "
-        "export) (default: the controls of the model's keyframe 0 if it has one, the solution of "
-        "spinectl's export; else 0)",
+        "export) (default: the model's own controls: an MJCF's keyframe 0, an .osim's controllers at t = 0, "
+        "spinectl's export's solution in both; else 0)",
     )
     parser.add_argument(
         "--joint-stiffness",

@@ -180,3 +180,27 @@ def test_an_export_whose_controls_would_overwrite_its_config_is_refused(tmp_path
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "--config" in err
     assert config.read_text() == "" and not out.exists()
+
+
+def test_the_default_activations_of_an_export_are_its_prescribed_controls(exported, capsys):
+    """`spinectl anatomy chain.osim` analyses the model at its own PrescribedController's controls at t = 0: the
+    same -K as the exported activations given explicitly (each fibre's muscle PCSA / 100 cm^2, as the export
+    writes them) to 1e-12, not activation 0; its -K_jj are docs/interchange.md's "chain at the solution"
+    (L1L2 ... L5S1: -51.3, -57.3, -54.5, -43.0, -25.6 N m/rad, to 0.05), and the header and JSON say where the
+    activations come from."""
+    from spinectl.anatomy.analyses import analyse
+
+    model, solution, path, _ = exported
+    loaded = anatomy.load(path)
+    fibres = fibre_gains(model)
+    given = solution.pcsa[fibres.muscle] / (REFERENCE_PCSA_CM2 * M2_PER_CM2)
+    default, explicit = analyse(loaded, activation=None), analyse(loaded, activation=given)
+    assert np.max(np.abs(default.activations - given)) <= 1e-12
+    assert np.allclose(default.free.stiffness, explicit.free.stiffness, rtol=0, atol=1e-9)
+    documented = [-51.3, -57.3, -54.5, -43.0, -25.6]  # L1L2 ... L5S1
+    assert np.allclose(default.free.joint_stiffness[REVERSED], documented, rtol=0, atol=0.05)
+    assert "PrescribedController solution" in default.table().splitlines()[0]
+    assert main(["anatomy", str(path), "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert "PrescribedController" in doc["activation_source"] and doc["activation_mean"] > 0
+    assert explicit.activation_source == "given"
