@@ -849,7 +849,7 @@ def optimised(
     spinectl.anatomy.optimum.OptimisedResult
     """
     from .analyses import analyse
-    from .optimum import OptimisedResult
+    from .optimum import OptimisedResult, skeleton
 
     if check:
         anatomy.engine.spec_factory()
@@ -859,4 +859,5 @@ def optimised(
     analysis = None
     if opt.ok:
         analysis = analyse(anatomy, plane, opt.activations, joint_stiffness=joint_stiffness, reflex=reflex)
-    return OptimisedResult(anatomy, opt, classic, float(margin), plane, analysis)
+    empty = skeleton(anatomy, opt, reflex=reflex, **kwargs)
+    return OptimisedResult(anatomy, opt, classic, float(margin), plane, analysis, empty)
