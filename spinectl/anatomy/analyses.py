@@ -399,6 +399,9 @@ class AnatomyResult:
     activation_source : str
         Where ``activations`` come from: ``"given"``, or the model's defaults
         (:meth:`~spinectl.anatomy.model.Anatomy.default_controls_source`).
+    rhythm_size : int
+        How many coordinates the model's rhythm ties to the chain; 0: no rhythm (no joint
+        equality or coupler), the constrained chain is the free one.
     """
 
     model: dict
@@ -415,6 +418,7 @@ class AnatomyResult:
     reflex: dict | None = None
     control_unit: str = "1"
     activation_source: str = "given"
+    rhythm_size: int = 1
 
     def referee_error(self) -> float:
         """Largest relative difference between spinectl's and MuJoCo's eigenvalues, matched one to one.
@@ -477,7 +481,12 @@ class AnatomyResult:
                 "eigenvalues": con.eigenvalues.tolist(),
                 "dynamic_eigenvalues": cplx(con.dynamic_eigenvalues),
                 "chain_stable": con.chain_stable,
-                "chain_stable_criterion": "the chain constrained by the model's lumbar rhythm",
+                "chain_stable_criterion": (
+                    "the chain constrained by the model's lumbar rhythm"
+                    if self.rhythm_size
+                    else "no rhythm (no joint equality or coupler): the same as the free chain"
+                ),
+                "rhythm": bool(self.rhythm_size),
                 "modes_removed": free.stiffness.shape[0] - con.stiffness.shape[0],
             },
         }
@@ -522,10 +531,19 @@ class AnatomyResult:
             f"the chain, free (every joint free, equality constraints off): eigenvalues of -K {eig} N m/rad: "
             f"{word[free.chain_stable]} ({int(np.sum(free.eigenvalues <= 0))} of {len(free.eigenvalues)} modes "
             "unstable)",
-            f"the chain constrained by the model's rhythm ({len(con.joints)} coordinate(s): {', '.join(con.joints)}): "
-            f"eigenvalues of -K {', '.join(f'{v:.4g}' for v in con.eigenvalues)} N m/rad: "
-            f"{word[con.chain_stable]}; the rhythm removes {len(free.joints) - len(con.joints)} modes",
         ]
+        if not self.rhythm_size:
+            lines.append(
+                "the model has no rhythm (no joint equality or coupler ties the chain): the free chain's verdict "
+                "is the only one"
+            )
+        else:
+            lines.append(
+                f"the chain constrained by the model's rhythm ({len(con.joints)} coordinate(s): "
+                f"{', '.join(con.joints)}): "
+                f"eigenvalues of -K {', '.join(f'{v:.4g}' for v in con.eigenvalues)} N m/rad: "
+                f"{word[con.chain_stable]}; the rhythm removes {len(free.joints) - len(con.joints)} modes"
+            )
         if cert.null_space.size:
             lines.append(
                 f"global muscles' null space ({cert.null_space.shape[1]} modes): -K there "
@@ -651,6 +669,7 @@ def analyse(
         reflex=None if reflex is None else reflex_margin(free, a, *reflex),
         control_unit=anatomy.control_unit,
         activation_source=_activation_source(anatomy, activation),
+        rhythm_size=anatomy.rhythm_size(plane, posture),
     )
 
 

@@ -198,6 +198,25 @@ class Anatomy:
         involved = self.engine.names("joint", [model.dof_jntid[d] for d in rhy.dofs])
         return lin, rhy, involved
 
+    def rhythm_size(self, plane: str = "sagittal", posture=None) -> int:
+        """How many coordinates the model's rhythm (its joint equalities) ties to the chain: 0 without one.
+
+        Parameters
+        ----------
+        plane : str
+            One of the mapping's planes.
+        posture : array_like, optional
+            Full qpos; default the model's reference posture.
+
+        Returns
+        -------
+        int
+            The dependent coordinates involved (the constrained chain's dofs minus its independent ones).
+        """
+        self.engine.set_state(self.posture(posture))
+        rhy = rhythm(self.engine, self.joint_ids(self.plane_joints(plane)))
+        return len(rhy.dofs) - len(rhy.independent)
+
     def chains(self, plane: str = "sagittal", posture=None, joint_stiffness="none") -> tuple:
         """The free chain and the chain constrained by the model's rhythm, as LinearChain objects.
 

@@ -622,6 +622,23 @@ class OsimAnatomy(Anatomy):
         rhy, involved, _ = coupler_rhythm(self.engine, names, values)
         return linearise(self.engine, involved, values, len(names)), rhy, involved
 
+    def rhythm_size(self, plane: str = "sagittal", posture=None) -> int:
+        """How many coordinates the model's couplers tie to the chain: 0 without one.
+
+        Parameters
+        ----------
+        plane : str
+            One of the mapping's planes.
+        posture : dict, optional
+            Coordinate name -> value [rad].
+
+        Returns
+        -------
+        int
+        """
+        rhy, _, _ = coupler_rhythm(self.engine, self.plane_joints(plane), self.posture(posture))
+        return len(rhy.dofs) - len(rhy.independent)
+
     def couplers(self, plane: str = "sagittal", posture=None) -> list:
         """The couplers that tie the plane's chain, each as one phrase with its slopes at the posture.
 

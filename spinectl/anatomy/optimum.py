@@ -321,6 +321,7 @@ KEPT_WHERE_INFEASIBLE = (
     "global_singular_values_m_per_rad",
     "global_null_space",
     "modes_removed",
+    "rhythm",
     "kp_Nm_per_rad",
     "kd_Nms_per_rad",
     "activation_lag_s",

@@ -204,3 +204,22 @@ def test_the_default_activations_of_an_export_are_its_prescribed_controls(export
     doc = json.loads(capsys.readouterr().out)
     assert "PrescribedController" in doc["activation_source"] and doc["activation_mean"] > 0
     assert explicit.activation_source == "given"
+
+
+def test_a_model_without_a_rhythm_says_so(exported, capsys):
+    """spinectl's export has no coupler: `spinectl anatomy chain.osim` says the model has no rhythm and gives the
+    free chain's verdict only (no "the rhythm removes 0 modes"), its JSON's constrained criterion says so and
+    `rhythm` is false; the same export with four couplers (rhythm.osim) still reports the constrained chain, the
+    rhythm removing its four dependent coordinates (L4L5 ... L1L2)."""
+    *_, path, coupled = exported
+    assert main(["anatomy", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "the model has no rhythm" in out and "rhythm removes" not in out
+    assert main(["anatomy", str(path), "--json"]) == 0
+    constrained = json.loads(capsys.readouterr().out)["constrained"]
+    assert constrained["rhythm"] is False and constrained["chain_stable_criterion"].startswith("no rhythm")
+    assert main(["anatomy", str(coupled)]) == 0
+    out = capsys.readouterr().out
+    assert "the rhythm removes 4 modes" in out and "no rhythm" not in out
+    assert main(["anatomy", str(coupled), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["constrained"]["rhythm"] is True
