@@ -30,6 +30,7 @@ from ..errors import ParameterError
 from ..model.chain import dynamic_eigenvalues
 from ..model.chain import state_matrix as chain_state_matrix
 from ..model.linear_chain import LinearChain
+from ..model.stability import MARGINAL_TIME_CONSTANT, slowest_time_constant
 from .engine import require_mujoco
 from .model import Anatomy
 
@@ -126,6 +127,22 @@ class ChainVerdict:
     def joint_self_stable(self) -> tuple:
         """Each joint self-stable, joint by joint (the paper's criterion)."""
         return tuple(bool(s > 0) for s in self.joint_stiffness)
+
+    @property
+    def joint_time_constants(self) -> np.ndarray:
+        """Each joint's slowest time constant alone, the others fixed (K_jj, D_jj, M_jj) [s]; inf where unstable.
+
+        :func:`spinectl.model.stability.slowest_time_constant`, the rule of ``spinectl stability``.
+        """
+        diag = [np.diag(x) for x in (self.stiffness, self.damping, self.mass)]
+        return slowest_time_constant(diag[0][:, None], diag[1][:, None], diag[2][:, None])
+
+    @property
+    def joint_marginal(self) -> tuple:
+        """Each joint self-stable but slower than :data:`~spinectl.model.stability.MARGINAL_TIME_CONSTANT`
+        (stable in name only), as ``spinectl stability`` reports it."""
+        slow = self.joint_time_constants > MARGINAL_TIME_CONSTANT
+        return tuple(bool(ok and s) for ok, s in zip(self.joint_self_stable, slow, strict=True))
 
     @property
     def chain_stable(self) -> bool:
@@ -472,6 +489,8 @@ class AnatomyResult:
             "dynamic_eigenvalues": cplx(free.dynamic_eigenvalues),
             "joint_self_stable": list(free.joint_self_stable),
             "joint_self_stable_criterion": "joint by joint: each joint alone, the others fixed (free chain)",
+            "joint_marginal": list(free.joint_marginal),
+            "slowest_time_constant_s": free.joint_time_constants.tolist(),
             "chain_stable": free.chain_stable,
             "chain_stable_criterion": "the chain: every chain joint free at once, equality constraints off",
             "constrained": {
@@ -523,8 +542,10 @@ class AnatomyResult:
             "",
             f"{'joint':<16}{'-K_jj [N m/rad]':>16}  joint by joint (others fixed)",
         ]
-        for name, s, ok in zip(free.joints, free.joint_stiffness, free.joint_self_stable, strict=True):
-            lines.append(f"{name:<16}{s:>16.4g}  {'self-' + word[ok]}")
+        verdicts = zip(free.joints, free.joint_stiffness, free.joint_self_stable, free.joint_marginal, strict=True)
+        for (name, s, ok, slow), tau in zip(verdicts, free.joint_time_constants, strict=True):
+            marginal = f", marginal: slowest time constant {tau:.4g} s > {MARGINAL_TIME_CONSTANT:g} s" if slow else ""
+            lines.append(f"{name:<16}{s:>16.4g}  {'self-' + word[ok]}{marginal}")
         eig = ", ".join(f"{v:.4g}" for v in free.eigenvalues)
         lines += [
             "",
