@@ -38,6 +38,7 @@ spine. Biomech Model Mechanobiol 11(1-2):19-34. doi:10.1007/s10237-011-0290-6.
 from __future__ import annotations
 
 import hashlib
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -212,10 +213,18 @@ def load_engine(path) -> OsimEngine:
     except Exception as exc:  # OpenSim raises its own exception types, one line each
         if isinstance(exc, ParameterError):
             raise
-        raise ParameterError("model", f"OpenSim cannot build {path}: {str(exc).splitlines()[0]}") from None
+        raise ParameterError("model", f"OpenSim cannot build {path}: {_one_line(exc)}") from None
     digest = hashlib.sha256(path.read_bytes()).hexdigest()
     source = str(path.resolve()) + schema
     return OsimEngine(model, state, model.getName() or path.stem, source, digest, couplers)
+
+
+def _one_line(exc) -> str:
+    """OpenSim's message on one line: its lines joined, the C++ wrapper's prefix dropped, so that the reason
+    (e.g. Simbody's "The given Node was not an Element", on a later line) is kept."""
+    lines = [line.strip() for line in str(exc).splitlines() if line.strip()]
+    text = " ".join(lines) or type(exc).__name__
+    return re.sub(r"^std::exception in '[^']*': ", "", text)
 
 
 def _schema(osim, model, path) -> str:

@@ -332,3 +332,22 @@ def test_an_infeasible_equilibrium_is_named_with_its_residual(imported, capsys):
     assert doc["infeasible_constraint"] == "equilibrium"
     assert doc["classic"]["equilibrium_residual_Nm"] == pytest.approx(residual, rel=1e-6)
     assert doc["eigenvalues"] is None and doc["eigenvalues_reason"] == "not_computed" and "constrained" in doc
+
+
+def test_a_file_that_is_not_xml_gives_opensims_reason_on_one_line(tmp_path, capsys):
+    """A .osim that is not XML: OpenSim's exception spans several lines, the reason (Simbody's "The given Node
+    was not an Element") after the first; `spinectl anatomy` keeps it on its one line (exit 2), the C++ wrapper's
+    "std::exception in ..." prefix dropped."""
+    bad = tmp_path / "bad.osim"
+    bad.write_text("not xml at all\n")
+    assert main(["anatomy", str(bad)]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == "" and captured.err.count("\n") == 1
+    assert "bad.osim" in captured.err and "not an Element" in captured.err and "std::exception" not in captured.err
+
+
+def test_the_help_names_osim_files(capsys):
+    """`spinectl anatomy --help` names the three kinds of model the positional takes: myotorso, MJCF and .osim."""
+    assert main(["anatomy", "--help"]) == 0
+    out = " ".join(capsys.readouterr().out.split())
+    assert "'myotorso', an MJCF file or an OpenSim .osim file" in out
