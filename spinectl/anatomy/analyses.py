@@ -30,6 +30,7 @@ from ..errors import ParameterError
 from ..model.chain import dynamic_eigenvalues
 from ..model.chain import state_matrix as chain_state_matrix
 from ..model.linear_chain import LinearChain
+from ..model.stability import MARGINAL_TIME_CONSTANT, slowest_time_constant
 from .engine import require_mujoco
 from .model import Anatomy
 
@@ -126,6 +127,22 @@ class ChainVerdict:
     def joint_self_stable(self) -> tuple:
         """Each joint self-stable, joint by joint (the paper's criterion)."""
         return tuple(bool(s > 0) for s in self.joint_stiffness)
+
+    @property
+    def joint_time_constants(self) -> np.ndarray:
+        """Each joint's slowest time constant alone, the others fixed (K_jj, D_jj, M_jj) [s]; inf where unstable.
+
+        :func:`spinectl.model.stability.slowest_time_constant`, the rule of ``spinectl stability``.
+        """
+        diag = [np.diag(x) for x in (self.stiffness, self.damping, self.mass)]
+        return slowest_time_constant(diag[0][:, None], diag[1][:, None], diag[2][:, None])
+
+    @property
+    def joint_marginal(self) -> tuple:
+        """Each joint self-stable but slower than :data:`~spinectl.model.stability.MARGINAL_TIME_CONSTANT`
+        (stable in name only), as ``spinectl stability`` reports it."""
+        slow = self.joint_time_constants > MARGINAL_TIME_CONSTANT
+        return tuple(bool(ok and s) for ok, s in zip(self.joint_self_stable, slow, strict=True))
 
     @property
     def chain_stable(self) -> bool:
@@ -396,6 +413,12 @@ class AnatomyResult:
         mode of largest real eigenvalue (:func:`mujoco_growth_rate`; NaN if that is complex) [1/s].
     control_unit : str
         The unit of ``activations``: ``"1"``, or e.g. ``"cm^2"`` (a PCSA, spinectl's export).
+    activation_source : str
+        Where ``activations`` come from: ``"given"``, or the model's defaults
+        (:meth:`~spinectl.anatomy.model.Anatomy.default_controls_source`).
+    rhythm_size : int
+        How many coordinates the model's rhythm ties to the chain; 0: no rhythm (no joint
+        equality or coupler), the constrained chain is the free one.
     """
 
     model: dict
@@ -411,6 +434,8 @@ class AnatomyResult:
     simulated_rate: float = float("nan")
     reflex: dict | None = None
     control_unit: str = "1"
+    activation_source: str = "given"
+    rhythm_size: int = 1
 
     def referee_error(self) -> float:
         """Largest relative difference between spinectl's and MuJoCo's eigenvalues, matched one to one.
@@ -452,6 +477,7 @@ class AnatomyResult:
             "null_space_stiffness_Nm_per_rad": cert.null_space_stiffness.tolist(),
             "activation_mean": float(self.activations.mean()),
             "control_unit": self.control_unit,
+            "activation_source": self.activation_source,
             "stiffness_matrix_Nm_per_rad": free.stiffness.tolist(),
             "damping_matrix_Nms_per_rad": free.damping.tolist(),
             "mass_matrix_kgm2": free.mass.tolist(),
@@ -463,6 +489,8 @@ class AnatomyResult:
             "dynamic_eigenvalues": cplx(free.dynamic_eigenvalues),
             "joint_self_stable": list(free.joint_self_stable),
             "joint_self_stable_criterion": "joint by joint: each joint alone, the others fixed (free chain)",
+            "joint_marginal": list(free.joint_marginal),
+            "slowest_time_constant_s": free.joint_time_constants.tolist(),
             "chain_stable": free.chain_stable,
             "chain_stable_criterion": "the chain: every chain joint free at once, equality constraints off",
             "constrained": {
@@ -472,7 +500,12 @@ class AnatomyResult:
                 "eigenvalues": con.eigenvalues.tolist(),
                 "dynamic_eigenvalues": cplx(con.dynamic_eigenvalues),
                 "chain_stable": con.chain_stable,
-                "chain_stable_criterion": "the chain constrained by the model's lumbar rhythm",
+                "chain_stable_criterion": (
+                    "the chain constrained by the model's lumbar rhythm"
+                    if self.rhythm_size
+                    else "no rhythm (no joint equality or coupler): the same as the free chain"
+                ),
+                "rhythm": bool(self.rhythm_size),
                 "modes_removed": free.stiffness.shape[0] - con.stiffness.shape[0],
             },
         }
@@ -501,25 +534,37 @@ class AnatomyResult:
                 f"mean activation {self.activations.mean():.3g}"
                 if self.control_unit == "1"
                 else f"mean control {self.activations.mean():.4g} {self.control_unit}"
-            ),
+            )
+            + f" ({self.activation_source})",
             f"muscles: {counts}; global muscles' moment-arm rank {cert.rank} of {len(free.joints)} "
             f"(singular values {', '.join(f'{s:.3g}' for s in cert.singular_values)} m/rad)",
             f"joint stiffness added: {self.joint_stiffness_added[0]:.4g} N m/rad per joint",
             "",
             f"{'joint':<16}{'-K_jj [N m/rad]':>16}  joint by joint (others fixed)",
         ]
-        for name, s, ok in zip(free.joints, free.joint_stiffness, free.joint_self_stable, strict=True):
-            lines.append(f"{name:<16}{s:>16.4g}  {'self-' + word[ok]}")
+        verdicts = zip(free.joints, free.joint_stiffness, free.joint_self_stable, free.joint_marginal, strict=True)
+        for (name, s, ok, slow), tau in zip(verdicts, free.joint_time_constants, strict=True):
+            marginal = f", marginal: slowest time constant {tau:.4g} s > {MARGINAL_TIME_CONSTANT:g} s" if slow else ""
+            lines.append(f"{name:<16}{s:>16.4g}  {'self-' + word[ok]}{marginal}")
         eig = ", ".join(f"{v:.4g}" for v in free.eigenvalues)
         lines += [
             "",
             f"the chain, free (every joint free, equality constraints off): eigenvalues of -K {eig} N m/rad: "
             f"{word[free.chain_stable]} ({int(np.sum(free.eigenvalues <= 0))} of {len(free.eigenvalues)} modes "
             "unstable)",
-            f"the chain constrained by the model's rhythm ({len(con.joints)} coordinate(s): {', '.join(con.joints)}): "
-            f"eigenvalues of -K {', '.join(f'{v:.4g}' for v in con.eigenvalues)} N m/rad: "
-            f"{word[con.chain_stable]}; the rhythm removes {len(free.joints) - len(con.joints)} modes",
         ]
+        if not self.rhythm_size:
+            lines.append(
+                "the model has no rhythm (no joint equality or coupler ties the chain): the free chain's verdict "
+                "is the only one"
+            )
+        else:
+            lines.append(
+                f"the chain constrained by the model's rhythm ({len(con.joints)} coordinate(s): "
+                f"{', '.join(con.joints)}): "
+                f"eigenvalues of -K {', '.join(f'{v:.4g}' for v in con.eigenvalues)} N m/rad: "
+                f"{word[con.chain_stable]}; the rhythm removes {len(free.joints) - len(con.joints)} modes"
+            )
         if cert.null_space.size:
             lines.append(
                 f"global muscles' null space ({cert.null_space.shape[1]} modes): -K there "
@@ -644,4 +689,11 @@ def analyse(
         simulated_rate=rate,
         reflex=None if reflex is None else reflex_margin(free, a, *reflex),
         control_unit=anatomy.control_unit,
+        activation_source=_activation_source(anatomy, activation),
+        rhythm_size=anatomy.rhythm_size(plane, posture),
     )
+
+
+def _activation_source(anatomy: Anatomy, activation) -> str:
+    """Where the analysed activations come from: given, or the model's own default controls."""
+    return "given" if activation is not None else anatomy.default_controls_source()

@@ -113,6 +113,17 @@ class Anatomy:
             return np.zeros(len(self.muscles))
         return model.key_ctrl[0][self.engine.muscle_ids()].copy()
 
+    def default_controls_source(self) -> str:
+        """Where :meth:`default_controls` come from, as one phrase.
+
+        Returns
+        -------
+        str
+        """
+        if not self.engine.model.nkey:
+            return "0: the model has no keyframe"
+        return "the controls of the model's keyframe 0"
+
     def posture(self, posture=None) -> np.ndarray:
         """The full qpos: the model's reference posture (``qpos0``) or the one given.
 
@@ -186,6 +197,25 @@ class Anatomy:
         model = self.engine.model
         involved = self.engine.names("joint", [model.dof_jntid[d] for d in rhy.dofs])
         return lin, rhy, involved
+
+    def rhythm_size(self, plane: str = "sagittal", posture=None) -> int:
+        """How many coordinates the model's rhythm (its joint equalities) ties to the chain: 0 without one.
+
+        Parameters
+        ----------
+        plane : str
+            One of the mapping's planes.
+        posture : array_like, optional
+            Full qpos; default the model's reference posture.
+
+        Returns
+        -------
+        int
+            The dependent coordinates involved (the constrained chain's dofs minus its independent ones).
+        """
+        self.engine.set_state(self.posture(posture))
+        rhy = rhythm(self.engine, self.joint_ids(self.plane_joints(plane)))
+        return len(rhy.dofs) - len(rhy.independent)
 
     def chains(self, plane: str = "sagittal", posture=None, joint_stiffness="none") -> tuple:
         """The free chain and the chain constrained by the model's rhythm, as LinearChain objects.

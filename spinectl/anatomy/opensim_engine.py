@@ -38,6 +38,7 @@ spine. Biomech Model Mechanobiol 11(1-2):19-34. doi:10.1007/s10237-011-0290-6.
 from __future__ import annotations
 
 import hashlib
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -212,10 +213,18 @@ def load_engine(path) -> OsimEngine:
     except Exception as exc:  # OpenSim raises its own exception types, one line each
         if isinstance(exc, ParameterError):
             raise
-        raise ParameterError("model", f"OpenSim cannot build {path}: {str(exc).splitlines()[0]}") from None
+        raise ParameterError("model", f"OpenSim cannot build {path}: {_one_line(exc)}") from None
     digest = hashlib.sha256(path.read_bytes()).hexdigest()
     source = str(path.resolve()) + schema
     return OsimEngine(model, state, model.getName() or path.stem, source, digest, couplers)
+
+
+def _one_line(exc) -> str:
+    """OpenSim's message on one line: its lines joined, the C++ wrapper's prefix dropped, so that the reason
+    (e.g. Simbody's "The given Node was not an Element", on a later line) is kept."""
+    lines = [line.strip() for line in str(exc).splitlines() if line.strip()]
+    text = " ".join(lines) or type(exc).__name__
+    return re.sub(r"^std::exception in '[^']*': ", "", text)
 
 
 def _schema(osim, model, path) -> str:
@@ -547,13 +556,42 @@ class OsimAnatomy(Anatomy):
         return "1"
 
     def default_controls(self) -> np.ndarray:
-        """The activations analysed when none are given: 0.
+        """The activations analysed when none are given: the model's own controls at t = 0, else 0.
+
+        The model's controllers (spinectl's export: the ``PrescribedController`` of the solution)
+        evaluated by OpenSim at the posture's time t = 0 (``Model.realizeVelocity``, then each
+        muscle's ``getControl``), as MuJoCo's import takes keyframe 0's; 0 without a controller.
+        Clipped to [0, 1], the muscles' control bounds (round-off of the export's near-zero controls).
 
         Returns
         -------
         numpy.ndarray, shape (m,)
         """
-        return np.zeros(len(self.muscles))
+        if not self._controllers():
+            return np.zeros(len(self.muscles))
+        model, state = self.engine.model, self.engine.state
+        state.setTime(0.0)
+        model.realizeVelocity(state)
+        muscles = model.getMuscles()
+        return np.clip([muscles.get(i).getControl(state) for i in range(muscles.getSize())], 0.0, 1.0)
+
+    def default_controls_source(self) -> str:
+        """Where :meth:`default_controls` come from, as one phrase.
+
+        Returns
+        -------
+        str
+        """
+        names = self._controllers()
+        if not names:
+            return "0: the model has no controller"
+        return f"the model's controls at t = 0 ({', '.join(names)})"
+
+    def _controllers(self) -> list:
+        """The model's enabled controllers, each as ``class name``."""
+        controllers = self.engine.model.getControllerSet()
+        found = (controllers.get(i) for i in range(controllers.getSize()))
+        return [f"{c.getConcreteClassName()} {c.getName()}" for c in found if c.isEnabled()]
 
     def posture(self, posture=None) -> dict:
         """The posture: the coordinates' default values, or those given.
@@ -592,6 +630,23 @@ class OsimAnatomy(Anatomy):
         values = self.posture(posture)
         rhy, involved, _ = coupler_rhythm(self.engine, names, values)
         return linearise(self.engine, involved, values, len(names)), rhy, involved
+
+    def rhythm_size(self, plane: str = "sagittal", posture=None) -> int:
+        """How many coordinates the model's couplers tie to the chain: 0 without one.
+
+        Parameters
+        ----------
+        plane : str
+            One of the mapping's planes.
+        posture : dict, optional
+            Coordinate name -> value [rad].
+
+        Returns
+        -------
+        int
+        """
+        rhy, _, _ = coupler_rhythm(self.engine, self.plane_joints(plane), self.posture(posture))
+        return len(rhy.dofs) - len(rhy.independent)
 
     def couplers(self, plane: str = "sagittal", posture=None) -> list:
         """The couplers that tie the plane's chain, each as one phrase with its slopes at the posture.
@@ -820,7 +875,7 @@ def optimised(
     spinectl.anatomy.optimum.OptimisedResult
     """
     from .analyses import analyse
-    from .optimum import OptimisedResult
+    from .optimum import OptimisedResult, skeleton
 
     if check:
         anatomy.engine.spec_factory()
@@ -830,4 +885,5 @@ def optimised(
     analysis = None
     if opt.ok:
         analysis = analyse(anatomy, plane, opt.activations, joint_stiffness=joint_stiffness, reflex=reflex)
-    return OptimisedResult(anatomy, opt, classic, float(margin), plane, analysis)
+    empty = skeleton(anatomy, opt, reflex=reflex, **kwargs)
+    return OptimisedResult(anatomy, opt, classic, float(margin), plane, analysis, empty)

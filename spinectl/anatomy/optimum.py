@@ -137,6 +137,9 @@ class Optimum:
         Of -K(a) of the free chain [N m/rad]: the least is the margin.
     joint_stiffness : numpy.ndarray, shape (n,)
         Diagonal of -K(a) [N m/rad].
+    residual : float
+        Where infeasible: the bounded least-squares residual of the equilibrium, min ||tau_per a +
+        tau_0|| over the bounds (SciPy's ``lsq_linear``) [N m]; NaN where solved.
     """
 
     stability: str
@@ -148,6 +151,7 @@ class Optimum:
     lumbar_torque: np.ndarray
     eigenvalues: np.ndarray
     joint_stiffness: np.ndarray
+    residual: float = float("nan")
 
     @property
     def ok(self) -> bool:
@@ -278,7 +282,15 @@ def optimum_on_chains(free, constrained, lin, rows, tau_per, tau_0, w, stability
         lumbar_torque=lin.torque_per_muscle[rows] @ a + lin.torque_offset[rows],
         eigenvalues=np.linalg.eigvalsh(-0.5 * (k + k.T)) if ok else np.full(free.n_joints, np.nan),
         joint_stiffness=-np.diag(k),
+        residual=float("nan") if status in ("optimal", "optimal_inaccurate") else _residual(chain, tau_per, tau_0),
     )
+
+
+def _residual(chain, tau_per, tau_0) -> float:
+    """min ||tau_per a + tau_0|| over the chain's bounds [N m]: how far the equilibrium is from holding."""
+    from scipy.optimize import lsq_linear
+
+    return float(np.linalg.norm(lsq_linear(tau_per, -tau_0, bounds=(chain.lower, chain.upper)).fun))
 
 
 def _optimum_dict(anatomy: Anatomy, opt: Optimum) -> dict:
@@ -292,7 +304,46 @@ def _optimum_dict(anatomy: Anatomy, opt: Optimum) -> dict:
         "restoring_stiffness_Nm_per_rad": opt.joint_stiffness.tolist(),
         "net_torque_Nm": opt.net_torque.tolist(),
         "lumbar_torque_Nm": opt.lumbar_torque.tolist(),
+        "equilibrium_residual_Nm": opt.residual,
     }
+
+
+KEPT_WHERE_INFEASIBLE = (
+    "model",
+    "plane",
+    "joints",
+    "muscles",
+    "control_unit",
+    "mass_matrix_kgm2",
+    "joint_stiffness_Nm_per_rad",
+    "joint_stiffness_source",
+    "global_rank",
+    "global_singular_values_m_per_rad",
+    "global_null_space",
+    "modes_removed",
+    "rhythm",
+    "kp_Nm_per_rad",
+    "kd_Nms_per_rad",
+    "activation_lag_s",
+)
+"""The analysis's keys that do not depend on the activations: kept in the JSON of an infeasible optimum."""
+
+
+def _not_computed(doc: dict) -> dict:
+    """The analysis's keys with every value that depends on the activations null, its ``<key>_reason`` beside it.
+
+    The strict-JSON convention of :mod:`spinectl.jsondoc`: an infeasible optimum has the same keys as a
+    feasible one, the numbers it has no activations for ``null`` with the reason ``not_computed``.
+    """
+    out = {}
+    for key, value in doc.items():
+        if key in KEPT_WHERE_INFEASIBLE or key.endswith("_criterion"):
+            out[key] = value
+        elif isinstance(value, dict):
+            out[key] = _not_computed(value)
+        else:
+            out[key], out[f"{key}_reason"] = None, "not_computed"
+    return out
 
 
 @dataclass(frozen=True)
@@ -313,6 +364,9 @@ class OptimisedResult:
         The chain's plane.
     analysis : AnatomyResult or None
         :func:`~spinectl.anatomy.analyses.analyse` at the optimum's activations; None where infeasible.
+    skeleton : AnatomyResult or None
+        Where infeasible: the analysis at the lower control bounds, whose keys (the numbers
+        nulled) the JSON keeps (:func:`_not_computed`).
     """
 
     anatomy: Anatomy
@@ -321,6 +375,15 @@ class OptimisedResult:
     margin: float
     plane: str
     analysis: object
+    skeleton: object = None
+
+    @property
+    def infeasible_constraint(self) -> str:
+        """Which constraint fails: ``"none"`` (solved), ``"equilibrium"`` (classic static optimisation,
+        without a stability criterion, is infeasible too) or ``"stability"`` (only the criterion fails)."""
+        if self.optimum.ok:
+            return "none"
+        return "equilibrium" if not self.classic.ok else "stability"
 
     @property
     def price(self) -> float:
@@ -334,9 +397,15 @@ class OptimisedResult:
         -------
         dict
         """
-        out = self.analysis.to_dict() if self.analysis is not None else self._header()
+        if self.analysis is not None:
+            out = self.analysis.to_dict()
+        elif self.skeleton is not None:
+            out = _not_computed(self.skeleton.to_dict())
+        else:
+            out = self._header()
         out.update(
             {
+                "infeasible_constraint": self.infeasible_constraint,
                 "activations": dict(zip(self.anatomy.muscles, self.optimum.activations.tolist(), strict=True)),
                 "cost": self.optimum.cost,
                 "net_torque_Nm": self.optimum.net_torque.tolist(),
@@ -379,7 +448,9 @@ class OptimisedResult:
                 f"eigenvalues of -K (free chain) {eig} N m/rad"
             )
         lines.append(f"price of stability (cost ratio): {self.price:.4g}")
-        if not np.isfinite(self.optimum.cost):
+        if self.infeasible_constraint == "equilibrium":
+            lines.append(EQUILIBRIUM_HINT.format(residual=self.classic.residual, rows=self.classic.net_torque.size))
+        elif self.infeasible_constraint == "stability":
             lines.append(INFEASIBLE_HINT)
         if self.analysis is not None:
             lines += ["", "at the optimum's activations:", self.analysis.table()]
@@ -390,7 +461,16 @@ INFEASIBLE_HINT = (
     "no activations in [0, 1] meet the criterion: the model's joints have no stiffness of their own; "
     "--joint-stiffness mapped or a value in N m/rad adds it (docs/anatomy.md, 'The optimum')"
 )
-"""What an infeasible stability-constrained optimum's table adds: what would make it feasible."""
+"""What the table adds where only the stability criterion fails (the classic optimum solved): what would make it
+feasible."""
+
+EQUILIBRIUM_HINT = (
+    "the equilibrium fails, not the stability criterion: no activations in [0, 1] hold the posture even without "
+    "a criterion (the classic optimum is infeasible too); the bounded least-squares residual of the net torque "
+    "is {residual:.3g} N m over the {rows} equilibrium rows: the posture needs torques besides the muscles' "
+    "(spinectl's export: its counter torques, actuators that the optimum does not hold)"
+)
+"""What the table adds where the classic optimum is infeasible too: the equilibrium's residual."""
 
 
 def optimised(
@@ -437,7 +517,36 @@ def optimised(
     analysis = None
     if opt.ok:
         analysis = analyse(anatomy, plane, opt.activations, joint_stiffness=joint_stiffness, check=check, reflex=reflex)
-    return OptimisedResult(anatomy, opt, classic, float(margin), plane, analysis)
+    empty = skeleton(anatomy, opt, reflex=reflex, **kwargs)
+    return OptimisedResult(anatomy, opt, classic, float(margin), plane, analysis, empty)
+
+
+def skeleton(anatomy: Anatomy, opt: Optimum, plane: str, joint_stiffness, reflex=None, **_):
+    """Where the optimum is infeasible, the analysis at the lower control bounds (its JSON's keys); else None.
+
+    Parameters
+    ----------
+    anatomy : Anatomy
+        The model.
+    opt : Optimum
+        The optimum.
+    plane : str
+        The chain.
+    joint_stiffness : {"none", "mapped"} or float
+        Added at each chain joint [N m/rad].
+    reflex : tuple, optional
+        ``(kp, kd, lag)``.
+
+    Returns
+    -------
+    AnatomyResult or None
+    """
+    from .analyses import analyse
+
+    if opt.ok:
+        return None
+    lower = anatomy.control_bounds()[0]
+    return analyse(anatomy, plane, lower, joint_stiffness=joint_stiffness, reflex=reflex)
 
 
 def lordosis_posture(anatomy: Anatomy, degrees: float, plane: str = "sagittal") -> np.ndarray:

@@ -15,15 +15,22 @@ def register(sub) -> None:
     """
     parser = sub.add_parser(
         "anatomy",
-        help="stability of an anatomical model's lumbar chain (MuJoCo; MyoTorso built in)",
-        description="Load a MuJoCo musculoskeletal model (the built-in 'myotorso' from myo-sim, or an MJCF "
-        "file with --mapping), linearise its lumbar chain at the reference posture and uniform muscle "
-        "activation, and report each joint's stiffness (joint by joint, the others fixed), the chain's "
+        help="stability of an anatomical model's lumbar chain (MuJoCo or OpenSim; MyoTorso built in)",
+        description="Load a musculoskeletal model (the built-in 'myotorso' from myo-sim, an MJCF file read by "
+        "MuJoCo or an .osim file read by OpenSim, with --mapping), linearise its lumbar chain at the reference "
+        "posture and the model's own controls (or --activation), and report each joint's stiffness (joint by "
+        "joint, the others fixed), the chain's "
         "eigenvalues (every joint free, equality constraints off), the chain constrained by the model's "
-        "lumbar rhythm, and the global muscles' rank. Needs pip install 'spinectl[anatomy]'. "
+        "lumbar rhythm (if it has one), and the global muscles' rank. Needs pip install 'spinectl[anatomy]' "
+        "(and 'spinectl[opensim]' for .osim). "
         "See docs/anatomy.md.",
     )
-    parser.add_argument("model", nargs="?", default="myotorso", help="'myotorso' or an MJCF file (default: myotorso)")
+    parser.add_argument(
+        "model",
+        nargs="?",
+        default="myotorso",
+        help="'myotorso', an MJCF file or an OpenSim .osim file (default: myotorso)",
+    )
     parser.add_argument("--mapping", metavar="FILE", help="mapping TOML (default: the built-in one of the model)")
     parser.add_argument("--plane", default="sagittal", help="sagittal, coronal or 3d (default: sagittal)")
     parser.add_argument(
@@ -32,8 +39,8 @@ def register(sub) -> None:
         default=None,
         metavar="A",
         help="activation of every muscle, in [0, 1] (or its control, e.g. a PCSA in cm^2 in spinectl's "
-        "export) (default: the controls of the model's keyframe 0 if it has one, the solution of "
-        "spinectl's export; else 0)",
+        "export) (default: the model's own controls: an MJCF's keyframe 0, an .osim's controllers at t = 0, "
+        "spinectl's export's solution in both; else 0)",
     )
     parser.add_argument(
         "--joint-stiffness",

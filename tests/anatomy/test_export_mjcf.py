@@ -229,3 +229,30 @@ def test_cli_writes_the_file_and_refuses_to_overwrite_its_input(tmp_path, capsys
     assert main(["export", "--out", str(tmp_path / "chain.txt")]) == 2
     assert "format" in capsys.readouterr().err
     assert not (tmp_path / "chain.txt").exists()
+
+
+def test_a_joint_stiff_in_name_only_is_marginal_as_in_stability(exported, capsys):
+    """At (E, Lambda) = (3, 4) cm spinectl's L1L2 has -S = 0.1 N m/rad: `spinectl stability` calls it marginal
+    (slowest time constant above spinectl.model.stability.MARGINAL_TIME_CONSTANT). `spinectl anatomy chain.xml`
+    at keyframe 0 (the solution) uses the same rule on K_jj, D_jj, M_jj of the re-imported chain: L1L2 marginal
+    with the time constant of segment_stability (to 1e-6 relative: at the top joint the chain's M_jj is the
+    segment's theta), the stiffer joints not, their time constants within 3 % (the chain's M_jj below the top
+    differs from the segment model's theta by up to 3 %, S and D agree)."""
+    import json
+
+    from spinectl.model.stability import segment_stability
+
+    model, files = exported
+    path, solution = files["plain"]
+    reference = segment_stability(model, E, LAMBDA, solution.pcsa)
+    assert main(["anatomy", str(path), "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    order = [doc["joints"].index(name) for name in reference.segment_names]
+    marginal = [doc["joint_marginal"][k] for k in order]
+    assert marginal == list(reference.marginal) and marginal.count(True) == 1
+    taus = np.array([doc["slowest_time_constant_s"][k] for k in order])
+    assert abs(taus[0] - reference.time_constants[0]) <= 1e-6 * reference.time_constants[0]
+    assert np.allclose(taus, reference.time_constants, rtol=0.03)
+    assert main(["anatomy", str(path)]) == 0
+    row = next(line for line in capsys.readouterr().out.splitlines() if line.startswith("L1L2"))
+    assert "marginal" in row

@@ -180,3 +180,46 @@ def test_an_export_whose_controls_would_overwrite_its_config_is_refused(tmp_path
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "--config" in err
     assert config.read_text() == "" and not out.exists()
+
+
+def test_the_default_activations_of_an_export_are_its_prescribed_controls(exported, capsys):
+    """`spinectl anatomy chain.osim` analyses the model at its own PrescribedController's controls at t = 0: the
+    same -K as the exported activations given explicitly (each fibre's muscle PCSA / 100 cm^2, as the export
+    writes them) to 1e-12, not activation 0; its -K_jj are docs/interchange.md's "chain at the solution"
+    (L1L2 ... L5S1: -51.3, -57.3, -54.5, -43.0, -25.6 N m/rad, to 0.05), and the header and JSON say where the
+    activations come from."""
+    from spinectl.anatomy.analyses import analyse
+
+    model, solution, path, _ = exported
+    loaded = anatomy.load(path)
+    fibres = fibre_gains(model)
+    given = solution.pcsa[fibres.muscle] / (REFERENCE_PCSA_CM2 * M2_PER_CM2)
+    default, explicit = analyse(loaded, activation=None), analyse(loaded, activation=given)
+    assert np.max(np.abs(default.activations - given)) <= 1e-12
+    assert np.allclose(default.free.stiffness, explicit.free.stiffness, rtol=0, atol=1e-9)
+    documented = [-51.3, -57.3, -54.5, -43.0, -25.6]  # L1L2 ... L5S1
+    assert np.allclose(default.free.joint_stiffness[REVERSED], documented, rtol=0, atol=0.05)
+    assert "PrescribedController solution" in default.table().splitlines()[0]
+    assert main(["anatomy", str(path), "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert "PrescribedController" in doc["activation_source"] and doc["activation_mean"] > 0
+    assert explicit.activation_source == "given"
+
+
+def test_a_model_without_a_rhythm_says_so(exported, capsys):
+    """spinectl's export has no coupler: `spinectl anatomy chain.osim` says the model has no rhythm and gives the
+    free chain's verdict only (no "the rhythm removes 0 modes"), its JSON's constrained criterion says so and
+    `rhythm` is false; the same export with four couplers (rhythm.osim) still reports the constrained chain, the
+    rhythm removing its four dependent coordinates (L4L5 ... L1L2)."""
+    *_, path, coupled = exported
+    assert main(["anatomy", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "the model has no rhythm" in out and "rhythm removes" not in out
+    assert main(["anatomy", str(path), "--json"]) == 0
+    constrained = json.loads(capsys.readouterr().out)["constrained"]
+    assert constrained["rhythm"] is False and constrained["chain_stable_criterion"].startswith("no rhythm")
+    assert main(["anatomy", str(coupled)]) == 0
+    out = capsys.readouterr().out
+    assert "the rhythm removes 4 modes" in out and "no rhythm" not in out
+    assert main(["anatomy", str(coupled), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["constrained"]["rhythm"] is True

@@ -139,3 +139,25 @@ def test_plot_into_an_unwritable_folder_is_one_line(cached, capsys, tmp_path):
     captured = capsys.readouterr()
     assert captured.out == "" and len(captured.err.strip().splitlines()) == 1 and "file" in captured.err
     assert blocker.read_text() == ""
+
+
+def test_an_infeasible_optimum_keeps_the_json_keys(cached, capsys):
+    """``--optimise --json`` on MyoTorso (no joint stiffness): the chain criterion is infeasible, the classic one
+    solved (so the stability criterion fails, not the equilibrium). Its JSON has every key of a solved optimum's
+    (``--stability none``), the nested ``constrained`` ones too, the numbers it has no activations for null with
+    ``<key>_reason`` "not_computed" (spinectl.jsondoc's convention)."""
+
+    def keys(doc):
+        return {k for k in doc if not k.endswith("_reason")}
+
+    assert main(["anatomy", "--optimise", "--json"]) == 0
+    infeasible = json.loads(capsys.readouterr().out)
+    assert main(["anatomy", "--optimise", "--stability", "none", "--json"]) == 0
+    solved = json.loads(capsys.readouterr().out)
+    assert infeasible["optimum"]["status"] == "infeasible" and solved["optimum"]["status"] == "optimal"
+    assert infeasible["infeasible_constraint"] == "stability" and solved["infeasible_constraint"] == "none"
+    assert keys(infeasible) == keys(solved) and set(KEYS) <= keys(infeasible)
+    assert keys(infeasible["constrained"]) == keys(solved["constrained"])
+    for key in ("eigenvalues", "joint_self_stable", "chain_stable"):
+        assert infeasible[key] is None and infeasible[f"{key}_reason"] == "not_computed"
+    assert infeasible["muscles"] == solved["muscles"] and infeasible["joints"] == solved["joints"]
