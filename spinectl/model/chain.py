@@ -733,10 +733,10 @@ def local_damping_per_stiffness(model: Model) -> float:
 
     A local muscle at force F with the global fibres' Hill curve (:func:`spinectl.model.muscle.force_velocity`,
     the force scaled by F/f_iso) has dF/dv = F f_H'(0) at rest, v its shortening velocity. At the lever
-    arm r, v = r omega, so the joint damping is r^2 F |f_H'(0)|; its stiffness is k = q F r^2 / l
+    arm r, v = r omega, so the joint damping is r^2 F abs(f_H'(0)); its stiffness is k = q F r^2 / l
     (:func:`local_stiffness_per_pcsa`). Both are proportional to F r^2, so
 
-        d = c_loc k,   c_loc = ``local.damping`` * l |f_H'(0)| / q,
+        d = c_loc k,   c_loc = ``local.damping`` * l abs(f_H'(0)) / q,
 
     whatever the PCSA, activation or lever arm: f_H'(0) = -(1 + a) / b is that of a fibre of optimal
     length l_opt = ``fibre.optimal_length_ratio`` * l (the local muscle all fibre, on the ascending limb

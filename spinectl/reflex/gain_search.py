@@ -5,18 +5,18 @@ search over the gains with the best found and a bound (docs/chain.md, "The delay
 :func:`search_chain_gains` searches the ten (n = 5) diagonal gains k_p,j, k_d,j > 0 of the
 joint-wise reflex, the physiological family (each joint's muscles respond to that joint's angle
 and angular velocity; full gain matrices would need inter-joint reflex pathways, not searched),
-for the largest exact multivariable delay margin (:func:`spinectl.reflex.mimo.chain_delay_margin`):
+for the largest exact multivariable delay margin (:func:`spinectl.reflex.mimo.chain_delay_margin` [2]_):
 
-1. differential evolution from the rule's gains (:func:`spinectl.reflex.gains.chain_gains`) and a
+1. differential evolution [3]_ from the rule's gains (:func:`spinectl.reflex.gains.chain_gains`) and a
    seeded Latin hypercube of log gains in a box of four decades around the chain's own scales
    (:func:`gain_box`);
-2. Nelder-Mead from its best, restarted while it gains, in log gains, bounded by the box.
+2. Nelder-Mead [4]_ from its best, restarted while it gains, in log gains, bounded by the box.
 
 The margin is 0 wherever the delay-free loop is unstable, so an objective of the margin alone
 is flat there; :func:`objective` grades it by the rightmost delay-free root instead (the
 search moves toward stability first), and the rule is kept if nothing beats it.
 
-The bound beside it, :func:`single_mode_bound`, is Stépán's (1989) for one inverted pendulum,
+The bound beside it, :func:`single_mode_bound`, is Stépán's (1989) [1]_ for one inverted pendulum,
 with the activation lag and the mode's damping (:func:`pendulum_delay_bound`), at each
 unstable mode of the chain: the longest delay with which any delayed PD on that mode alone
 holds it. It bounds the chain's margin under modal feedback where the modes decouple

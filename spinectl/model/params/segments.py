@@ -36,7 +36,7 @@ class Local:
     lever arm r of one joint; its short-range stiffness q F / l (Bergmark 1989,
     doi:10.3109/17453678909154177) gives the joint the rotational stiffness q F r^2 / l. The
     slope of the global fibres' Hill curve at rest, F f_H'(0), gives it the rotational damping
-    r^2 F |f_H'(0)| (Hill 1938, doi:10.1098/rspb.1938.0050), ``damping`` times that.
+    r^2 F abs(f_H'(0)) (Hill 1938, doi:10.1098/rspb.1938.0050), ``damping`` times that.
     """
 
     stiffness_gain: float = param(
@@ -70,7 +70,7 @@ class Local:
         "1",
         "Factor on the local muscles' damping from the force-velocity slope (docs/chain.md, 'Local muscles as "
         "joint stiffness and damping'): a joint of local stiffness k_j gets the damping damping * c_loc * k_j "
-        "[N m s/rad], c_loc = l |f_H'(0)| / q [s] from the global fibres' Hill curve (section fibre; Hill "
+        "[N m s/rad], c_loc = l abs(f_H'(0)) / q [s] from the global fibres' Hill curve (section fibre; Hill "
         "1938, doi:10.1098/rspb.1938.0050), 0.038 s at the defaults. 1 (default): that slope; 0: no damping, "
         f"the stiffness-only model. At most {MAX_LOCAL_DAMPING:g}: all slow-twitch fibres (fibre.fast_twitch "
         "= 0) give 1.8.",
