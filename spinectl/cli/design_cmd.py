@@ -3,8 +3,11 @@
 from __future__ import annotations
 
 from ._common import (
+    add_mass_option,
     add_model_options,
     add_position_options,
+    add_stiffness_option,
+    body_aliases,
     check_position,
     emit_json,
     finite_float,
@@ -66,6 +69,8 @@ def register(sub) -> None:
     parser.add_argument(
         "--plot", metavar="DIR", help="with --passive: write passive.png; with --delays: design_curve.png, into DIR"
     )
+    add_stiffness_option(parser)
+    add_mass_option(parser)
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     add_model_options(parser)
     parser.set_defaults(func=run)
@@ -98,6 +103,9 @@ def run(args) -> int:
     from ..reflex.design import design
 
     aliases = {dotted: ("--" + option.replace("_", "-"), getattr(args, option)) for option, dotted in OVERRIDES}
+    aliases |= body_aliases(args)  # --K and --mass, as on stability and margins
+    if args.passive is not None and args.K is not None:
+        raise ParameterError("--K", "cannot go with --passive, which varies K")
     model = load_model(args, aliases)
     check_position(model, args)
     kp = None if args.kp is None else non_negative("--kp", args.kp)

@@ -252,7 +252,7 @@ class Design:
         lines = [
             self.model.get("header", "preset unknown"),
             f"E = {self.eccentricity * 100:.2f} cm, Lambda = {self.lordosis * 100:.2f} cm, delay "
-            f"{self.delay * 1000:.4g} ms, activation lag {self.activation_time_constant * 1000:.4g} ms; "
+            f"{_delay(self.delay)}, activation lag {self.activation_time_constant * 1000:.4g} ms; "
             f"status {self.status}",
             "",
             f"{criterion('joint', len(self.segments))}: least co-contraction ({self.method})",
@@ -264,22 +264,34 @@ class Design:
             for s in self.segments
         ]
         lines += [
-            f"every segment at once: activation {_word(self.activation, 0, '.4f')} x minimum PCSA "
-            f"({_word(m2_to_cm2(self.pcsa), 0, '.2f')} cm^2)"
-            + ("" if np.isfinite(self.activation) else f"; the largest delay met: {_delay(self.largest_delay)}"),
+            (
+                f"every segment at once: activation {self.activation:.4f} x minimum PCSA "
+                f"({m2_to_cm2(self.pcsa):.2f} cm^2)"
+                if np.isfinite(self.activation)
+                else f"no activation in [0, 1] meets the delay at every segment; the largest delay met: "
+                f"{_delay(self.largest_delay)}"
+            ),
             "",
             f"{criterion('chain', len(c.local_stiffness))}: least local stiffness at activation "
             f"{_word(c.activation, 0, '.4f')} ({c.method})",
-            "local stiffness [N m/rad]: "
-            + ", ".join(f"{s.name} {_word(k, 0, '.2f')}" for s, k in zip(self.segments, c.local_stiffness, strict=True))
-            + f"  ({_word(c.fraction, 0, '.4f')} x the least for static stability, total "
-            f"{_word(float(np.sum(c.local_stiffness)), 0, '.1f')})",
-            f"certificate: exact delay margin {_delay(c.delay_margin)} "
-            f">= {self.delay * 1000:.4g} ms; "
-            f"rightmost root at the delay Re s = {_word(c.max_root_real, 0, '.4g')} 1/s"
-            + ("" if np.isfinite(c.fraction) else f"; the largest delay met: {_delay(c.largest_delay)}"),
         ]
+        if np.isfinite(c.fraction):
+            lines += [
+                "local stiffness [N m/rad]: "
+                + ", ".join(f"{s.name} {k:.2f}" for s, k in zip(self.segments, c.local_stiffness, strict=True))
+                + f"  ({c.fraction:.4f} x the least for static stability, total {np.sum(c.local_stiffness):.1f})",
+                f"certificate: exact delay margin {_delay(c.delay_margin)} >= {_delay(self.delay)}; "
+                f"rightmost root at the delay Re s = {_word(c.max_root_real, 0, '.4g')} 1/s",
+            ]
+        else:
+            lines.append(f"no local stiffness meets the delay; the largest delay met: {_delay(c.largest_delay)}")
         return "\n".join(lines)
+
+    def __bool__(self):
+        raise TypeError(
+            "the truth value of a Design is ambiguous: use design.status == 'ok' (both criteria met), or "
+            "design.activation / design.chain.fraction (NaN where none meets the delay)"
+        )
 
 
 def _word(value: float, width: int, fmt: str) -> str:
@@ -620,6 +632,7 @@ def chain_design(model: Model, eccentricity: float, lordosis: float, pcsa, activ
     method = "bisection: met for every larger fraction on the scan" if upper else "scan and refine: not monotone"
     fraction = _least(lambda f: judge(f)[0], scan, ok)
     if np.isnan(fraction):
+        method = f"no fraction up to {top:g} met on the scan"
         largest = max(_chain_margin(model, mass, stiffness, damping, least, f, kp, kd, lag) for f in scan)
         nan = np.full(n, np.nan)
         return ChainDesign(activation, np.nan, nan, least, np.nan, np.nan, float(largest), method)
@@ -888,7 +901,12 @@ class PassiveCurve:
             f"global muscles alone stabilise the chain from K = {_word(self.threshold, 0, '.2f')} N m/rad per joint"
             + ("" if np.isfinite(self.threshold) else " (not in the scanned range)"),
             f"Crisco et al. 1992 ({CRISCO_LOAD:g} N buckles the passive chain): K = {self.crisco:.2f} N m/rad per "
-            f"joint; there global muscles alone need {_word(m2_to_cm2(self.crisco_global_pcsa), 0, '.2f')} cm^2",
+            f"joint; there "
+            + (
+                f"global muscles alone need {m2_to_cm2(self.crisco_global_pcsa):.2f} cm^2"
+                if np.isfinite(self.crisco_global_pcsa)
+                else "no global PCSA alone stabilises the chain"
+            ),
         ]
         return "\n".join(lines)
 

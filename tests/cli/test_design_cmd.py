@@ -87,3 +87,44 @@ def test_a_bad_delay_axis_or_a_lone_lags_is_one_line_exit_2(argv, capsys):
     assert main(["design", *argv]) == 2
     out, err = capsys.readouterr()
     assert out == "" and err.count("\n") == 1 and argv[0] in err
+
+
+def test_mass_and_K_are_the_aliases_they_are_on_margins(capsys):
+    """``--mass 35 --K 10`` prints what ``--set body.mass=35 --set passive.stiffness=10`` prints (the issue's
+    subject); with --passive, which varies K, --K is one line, exit 2."""
+    point = ["design", "--delay", "0.04", "--preset", "wagner2012", "--json"]
+    assert main([*point, "--mass", "35", "--K", "10"]) == 0
+    aliased = json.loads(capsys.readouterr().out)
+    assert main([*point, "--set", "body.mass=35", "--set", "passive.stiffness=10"]) == 0
+    assigned = json.loads(capsys.readouterr().out)
+    for key in ("activation", "segments", "chain", "status"):  # the provenance lists the options as given
+        assert aliased[key] == assigned[key]
+    assert (
+        aliased["chain"]["local_stiffness_Nm_per_rad"]
+        != json.loads(_default_json(capsys))["chain"]["local_stiffness_Nm_per_rad"]
+    )
+    assert main(["design", "--passive", "0:80:3", "--K", "3"]) == 2
+    assert "--K: cannot go with --passive" in capsys.readouterr().err
+
+
+def test_a_delay_nothing_meets_says_so_in_words(capsys):
+    """No activation and no local stiffness meet 50 ms with kp = 300, kd = 0 (docs/reflex.md's example): the table
+    says so with the largest delays met, instead of 'none x ...' and a bisection's method; a 5 s delay is in s."""
+    assert main(["design", "--delay", "0.05", "--kp", "300", "--kd", "0"]) == 0
+    out = capsys.readouterr().out
+    assert "no activation in [0, 1] meets the delay" in out and "no local stiffness meets the delay" in out
+    assert "none x" not in out and "met for every larger fraction" not in out  # the chain's search found none
+    assert main(["design", "--delay", "5", "--E", "0.03", "--Lambda", "0.04", "--mass", "35", "--K", "10"]) == 0
+    assert ">= 5 s;" in capsys.readouterr().out
+
+
+def test_a_design_has_no_truth_value():
+    """``if design(...)`` would read an infeasible design as true: TypeError naming what to test instead."""
+    answer = design(config.set_parameters(config.load_preset("wagner2012"), {"reflex.delay": 0.04}), 0.03, 0.04)
+    with pytest.raises(TypeError, match="status == 'ok'"):
+        bool(answer)
+
+
+def _default_json(capsys) -> str:
+    assert main(["design", "--delay", "0.04", "--preset", "wagner2012", "--json"]) == 0
+    return capsys.readouterr().out
