@@ -4,16 +4,20 @@ Run once: ``PYTHONPATH=. python benchmarks/bench_design.py``. The target: the cu
 machine. The brute force answers the joint-by-joint half alone by scanning the activation in steps of 1e-3
 (1001 exact margins per delay, every segment) and checks that the curve's activations agree to that step.
 
-Measured once (2-core machine shared with other jobs): default 5.53 s (brute force 183.6 s, largest difference
-9.5e-4); the 35 kg subject with K = 10 N m/rad (wagner2012) 3.55 s (brute force 235.0 s, 9.8e-4).
+The chain's half: at each delay the least local-stiffness fraction, by a safeguarded inverse interpolation of
+the exact margins already computed (spinectl.reflex.design._bracket_root), 3.5-3.9 exact margins per delay where
+a bisection needed 13-14 (to the same width 2^-20, with the same certificate).
 
-Position A (E = Lambda = 0), the curve alone (no brute force; the chain's answer changes with the delay more often
-there), measured with the same call outside this script: wagner2012 1.32 s and default 0.83 s at a load of 0.5
-(with three lags, 0, 50 and 100 ms: 15.1 s and 4.8 s); at a load of 6, 20.9 s and 13.1 s, but 3.1 s and 1.1 s with
-``OPENBLAS_NUM_THREADS=1``. The curve makes thousands of small LAPACK calls (the chain's frequency sweep, the
-characteristic roots), and OpenBLAS's threads, on a machine whose cores other jobs hold, wait for a core at each
-call: on a loaded machine (load 6 to 10) one BLAS thread made the curve 7 to 25 times faster (at E = 3 cm,
-Lambda = 4 cm too). The script prints the load and the setting.
+Measured with one BLAS thread, the curve alone (this script's calls without the brute force, at a load of 1.9):
+default 5.7 s and the 35 kg subject with K = 10 N m/rad (wagner2012) 4.0 s at E = 3 cm, Lambda = 4 cm; at position A
+(E = Lambda = 0) wagner2012 5.1 s and default 5.7 s; with the bisection 22.5-33 s (141-154 exact margins for the
+curve against 517-573). The brute force, last run with the local muscles' stiffness only (the joint-by-joint half is
+unchanged since): default 183.6 s (largest difference 9.5e-4), the subject 235.0 s (9.8e-4).
+
+The curve makes thousands of small LAPACK calls (the chain's frequency sweep, the characteristic roots), and
+OpenBLAS's threads, on a machine whose cores other jobs hold, wait for a core at each call: on a loaded machine
+(load 6 to 10) one BLAS thread made the curve 7 to 25 times faster (stiffness only). The script prints the load
+and the setting.
 """
 
 from __future__ import annotations

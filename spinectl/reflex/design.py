@@ -1144,9 +1144,10 @@ def delay_curve(model: Model, eccentricity: float, lordosis: float, delays, lags
     halving for all delays) in the brackets of the activation scan, whose margins do not depend on the
     delay. The chain's least local stiffness is nondecreasing in the delay (a design that meets a delay
     meets every shorter one), so each delay starts from the previous delay's answer: if that meets the
-    delay it is the answer; otherwise the bracket from it to the top of the search is bisected. The exact
-    delay margin at each fraction is computed once (it does not depend on the delay), and a root in the
-    right half-plane found from the poles' seeds rejects a fraction without it.
+    delay it is the answer; otherwise the bracket from it to the top of the search is narrowed by a
+    safeguarded inverse interpolation of the exact margins (:func:`_bracket_root`), to the bisection's
+    precision and with its certificate. The exact delay margin at each fraction is computed once (it does
+    not depend on the delay), and the rightmost root once per fraction that the margin admits.
 
     Parameters
     ----------
@@ -1249,9 +1250,19 @@ def _chain_curve(model, e, lam, pcsa, delays, kp, kd):
     least, lag = least[0], model.reflex.activation_time_constant
     margins: dict[float, object] = {}
     fails_from: dict[float, float] = {}  # f -> a delay at which f is unstable, so f fails every longer delay
+    rooted: set[float] = set()  # the fractions whose rightmost root has been checked (at the first delay met)
+    roots: dict[float, tuple[float, complex]] = {}  # f -> (a delay, the rightmost root there)
 
     def loop(f):
         return chain_loop_at(model, mass, stiffness, damping, least, f, kp, kd)
+
+    def root(f, d):
+        """The rightmost characteristic root at f and d, once per (f, d)."""
+        if f not in roots or roots[f][0] != d:
+            k, dl, p, dd = loop(f)
+            with arithmetic_guard(e, lam):
+                roots[f] = (d, rightmost_root(mass, k, dl, p, dd, d, lag))
+        return roots[f][1]
 
     def exact(f):
         """The exact margin at f, once per f (it does not depend on the delay)."""
@@ -1260,7 +1271,8 @@ def _chain_curve(model, e, lam, pcsa, delays, kp, kd):
             if not (np.any(p) or np.any(dd)):
                 margins[f] = from_crossings(np.empty(0), np.empty(0), np.empty(0), chain.coupled_margin(k) > 0)
             else:
-                margins[f] = chain_delay_margin(mass, k, dl, p, dd, lag)
+                with arithmetic_guard(e, lam):
+                    margins[f] = chain_delay_margin(mass, k, dl, p, dd, lag)
         return margins[f]
 
     def met(f, d):
@@ -1268,16 +1280,17 @@ def _chain_curve(model, e, lam, pcsa, delays, kp, kd):
         return bool(stable_at(m, d) and m.margin >= d)
 
     def meets(f, d):
+        """The exact margin at f meets d, and (once per f) no root at d in the right half-plane."""
         if f in fails_from and fails_from[f] <= d:
             return False
-        if f not in margins:
-            k, dl, p, dd = loop(f)
-            with arithmetic_guard(e, lam):
-                if d > 0 and rightmost_root(mass, k, dl, p, dd, d, lag).real >= 0:  # a true root: unstable
-                    fails_from[f] = d
-                    return False
-                exact(f)
-        return met(f, d)
+        exact(f)
+        if not met(f, d):
+            return False  # the margin alone rejects f: no root needed
+        if f not in rooted and d > 0 and root(f, d).real >= 0:  # a true root: unstable
+            fails_from[f] = d
+            return False
+        rooted.add(f)
+        return True
 
     top = 1.0 if model.reflex.gains == "rule" and kp is None and kd is None else LOCAL_MAX
     width = top / 2**BISECTIONS  # the single design's precision
@@ -1286,19 +1299,95 @@ def _chain_curve(model, e, lam, pcsa, delays, kp, kd):
         if np.isfinite(f) and not meets(f, d):
             if not meets(top, d):
                 f = np.nan  # no design meets this delay, nor (by monotonicity) any longer one
-            else:  # bisect, the bracket first narrowed by every fraction already judged
+            else:  # the bracket first narrowed by every fraction already judged
                 lo = max([f] + [g for g, at in fails_from.items() if at <= d] + [g for g in margins if not met(g, d)])
-                hi = min([top] + [g for g in margins if g > lo and met(g, d)])
-                while hi - lo > width:
-                    mid = 0.5 * (lo + hi)
-                    lo, hi = (lo, mid) if meets(mid, d) else (mid, hi)
-                f = hi
+                hi = min([top] + [g for g in rooted if g > lo and met(g, d)])
+                f = _bracket_root(lambda x, d=d: meets(x, d), _inverse_interpolant(margins, d, met), lo, hi, width)
         if np.isnan(f):
             out.append((np.nan, np.nan, np.nan))
             continue
-        k, dl, p, dd = loop(f)
-        with arithmetic_guard(e, lam):
-            root = rightmost_root(mass, k, dl, p, dd, d, lag)
-        out.append((f, float(exact(f).margin), float(root.real)))
-    fraction, margin, roots = (np.array(x) for x in zip(*out, strict=True))
-    return fraction, least, margin, roots
+        out.append((f, float(exact(f).margin), float(root(f, d).real)))
+    fraction, margin, rights = (np.array(x) for x in zip(*out, strict=True))
+    return fraction, least, margin, rights
+
+
+def _inverse_interpolant(margins, d, met):
+    """An estimate of the fraction whose exact margin is d, from the margins already found, or None.
+
+    Inverse interpolation: the fraction as a polynomial in the margin through the (up to) three fractions
+    whose margins are nearest to d, among those whose margin is finite and agrees with the verdict at d (a
+    margin that a crossing count overrules says nothing about where the verdict changes). Inverse quadratic
+    interpolation is the step of Brent's method [1]_; the margin does not depend on the delay, so the
+    fractions judged at shorter delays serve too.
+
+    Returns
+    -------
+    callable
+        () -> the estimate [1] or None (fewer than two such margins).
+
+    References
+    ----------
+    .. [1] Brent RP (1973). Algorithms for Minimization without Derivatives, ch. 4. Prentice-Hall.
+    """
+
+    def estimate():
+        known = [
+            (abs(m.margin - d), g, m.margin)
+            for g, m in margins.items()
+            if m.stable_without_delay and np.isfinite(m.margin) and met(g, d) == (m.margin >= d)
+        ]
+        near: dict[float, float] = {}  # margin -> fraction, the nearest first, one fraction per margin
+        for _, g, t in sorted(known):
+            if len(near) < 3:
+                near.setdefault(t, g)
+        if len(near) < 2:
+            return None
+        # Lagrange's polynomial in the margin through the nearest (margin, fraction) pairs, at d
+        return sum(g * np.prod([(d - u) / (t - u) for u in near if u != t]) for t, g in near.items())
+
+    return estimate
+
+
+def _bracket_root(meets, estimate, lo, hi, width):
+    """The least f in (lo, hi] that meets, to ``width``: a safeguarded interpolation search on a bracket.
+
+    ``lo`` fails and ``hi`` meets; each step judges one fraction strictly inside the bracket and keeps the
+    part that still brackets the change, so the answer is certified exactly as by bisection: it meets, and
+    a fraction within ``width`` below it fails (``hi - lo <= width`` on return). The step is the estimate
+    (:func:`_inverse_interpolant`), kept at least 0.45 ``width`` inside each end so that, once the estimate
+    is accurate, the next step lands on the other side of the change and closes the bracket; where the
+    estimate is missing or outside the bracket, or the last three steps did not halve the bracket (a margin
+    that jumps or bends, when the crossing that limits it changes), the step is the midpoint, as in
+    bisection. Brent's method keeps its steps inside the bracket the same way [1]_. Correctness does not
+    depend on the estimate, only the number of steps: at most four per halving.
+
+    Parameters
+    ----------
+    meets : callable
+        f -> bool, the verdict at the delay.
+    estimate : callable
+        () -> the estimated change [1] or None, from the fractions judged so far.
+    lo, hi : float
+        A failing and a meeting fraction [1], lo < hi.
+    width : float
+        The precision [1].
+
+    Returns
+    -------
+    float
+        ``hi`` at the end [1].
+
+    References
+    ----------
+    .. [1] Brent RP (1973). Algorithms for Minimization without Derivatives, ch. 4. Prentice-Hall.
+    """
+    spans = [hi - lo]
+    while hi - lo > width:
+        x = estimate()
+        if x is None or not lo < x < hi or (len(spans) > 3 and spans[-1] > 0.5 * spans[-4]):
+            x = 0.5 * (lo + hi)
+        else:
+            x = min(max(x, lo + 0.45 * width), hi - 0.45 * width)
+        lo, hi = (lo, x) if meets(x) else (x, hi)
+        spans.append(hi - lo)
+    return hi
