@@ -1,9 +1,11 @@
 """Atomic output: write to a temporary name beside the target, then rename.
 
 An interrupted run leaves either the previous file or the new one, never a
-half-written file. A folder replaces a folder in one step where the OS can
-(Linux's ``renameat2`` with ``RENAME_EXCHANGE``), else in two (the old one moved
-aside, the new one in), so that a set of files changes as a whole.
+half-written file; a power cut too: the new file (a folder: every file in it, and
+itself) is written to disk (``fsync``) before the rename, its folder after it. A
+folder replaces a folder in one step where the OS can (Linux's ``renameat2`` with
+``RENAME_EXCHANGE``), else in two (the old one moved aside, the new one in), so
+that a set of files changes as a whole.
 
 The folder swap moves only what it can move back and remove. Before it, the old
 folder is read whole (:func:`_inventory`): a mount point inside it (another
@@ -88,6 +90,7 @@ def atomic_path(target: str | Path, *, directory: bool = False) -> Iterator[Path
             # an old folder: refused if a swap could not move or remove it all, before anything moves
             seen = _inventory(target) if directory and target.is_dir() else {}
             written = frozenset(os.listdir(tmp)) if directory else frozenset()
+            _synced(tmp)
             old = _swap(tmp, target, directory)
     except BaseException:
         if tmp.is_dir():
@@ -97,6 +100,8 @@ def atomic_path(target: str | Path, *, directory: bool = False) -> Iterator[Path
         raise
     if old is not None:  # the old folder, now at the temporary's name: only what was read goes
         _settle(old, target, seen, written)
+    with output_errors(target):
+        _synced(target.parent, tree=False)  # the rename itself (after the swap: a failure must not undo it)
 
 
 def _named(target: str | Path) -> Path:
@@ -317,6 +322,38 @@ def _set_mode(tmp: Path, target: Path, directory: bool) -> None:
         os.umask(umask)
         mode = (0o777 if directory else 0o666) & ~umask
     os.chmod(tmp, mode & 0o7777)
+
+
+def _synced(path: str | Path, tree: bool = True) -> None:
+    """Write ``path`` to disk (``fsync``): a file, or a folder and (``tree``) every entry below it.
+
+    A rename survives a power cut whole only if the bytes it names were on disk first: the
+    new file (or folder, and all in it) is synced before its rename, the folder holding the
+    new name after it.
+    """
+    if tree and os.path.isdir(path) and not os.path.islink(path):
+        for folder, _, files in os.walk(path, topdown=False):  # each folder after what it holds
+            for name in files:
+                _fsync(os.path.join(folder, name))
+            _fsync(folder)
+    else:
+        _fsync(path)
+
+
+def _fsync(path: str | Path) -> None:
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NOCTTY", 0))
+    except OSError as exc:  # a symbolic link or socket (no bytes of its own), a file this user cannot read
+        if exc.errno in (errno.ELOOP, errno.EACCES, errno.EPERM, errno.ENXIO):
+            return
+        raise
+    try:
+        os.fsync(fd)
+    except OSError as exc:  # a file system or kind of file that takes no fsync (a folder on some, a pipe)
+        if exc.errno not in (errno.EINVAL, errno.ENOTSUP, errno.EBADF):
+            raise
+    finally:
+        os.close(fd)
 
 
 def _swap(tmp: Path, target: Path, directory: bool) -> Path | None:
@@ -578,12 +615,15 @@ def staged_directory(target: str | Path, names=(), replaces=()) -> Iterator[Path
             written = frozenset(os.listdir(stage))
             seen = _keep_the_others(target, stage, set(replaces)) if target.is_dir() else {}
             _set_mode(stage, target, directory=True)
+            _synced(stage)
             old = _swap(stage, target, directory=True)
     finally:
         if old is None:  # not swapped: the staging folder holds this run's files and links only
             shutil.rmtree(stage, ignore_errors=True)
     if old is not None:
         _settle(old, target, seen, written)
+    with output_errors(target):
+        _synced(target.parent, tree=False)  # the rename itself
 
 
 def _keep_the_others(target: Path, stage: Path, replaced: set[str]) -> dict[str, tuple]:
@@ -663,8 +703,10 @@ def _filled_in_place(target: Path, replaced: set[str]) -> Iterator[Path]:
             written = set()
             for item in sorted(stage.iterdir()):
                 _set_mode(item, target / item.name, item.is_dir())
+                _synced(item)
                 os.replace(item, target / item.name)
                 written.add(item.name)
+            _synced(target, tree=False)
             for name in sorted(replaced - written):
                 with contextlib.suppress(FileNotFoundError, IsADirectoryError):
                     (target / name).unlink()
