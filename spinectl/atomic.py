@@ -104,8 +104,9 @@ def atomic_path(target: str | Path, *, directory: bool = False) -> Iterator[Path
         _synced(target.parent, tree=False)  # the rename itself (after the swap: a failure must not undo it)
 
 
-def _named(target: str | Path) -> Path:
-    """``target`` as a Path, or :class:`OutputError` if its name has a line break or control character.
+def _named(target: str | Path, resolve: bool = True) -> Path:
+    """``target`` as a Path (``resolve``: a symbolic link as the file it leads to, which is written), or
+    :class:`OutputError` if its name has a line break or control character, or its path cannot lead to it.
 
     Such a name is valid on POSIX, but it breaks the one-line listings and messages
     that name the outputs, and the command line that a preset's header records.
@@ -113,7 +114,34 @@ def _named(target: str | Path) -> Path:
     text = str(target)
     if not _as_utf8(text).isprintable():
         raise OutputError(f"cannot write {show(text)}: the name must be printable (no line breaks or control codes)")
-    return Path(target)
+    path = Path(target)
+    _check_way(path)
+    return Path(os.path.realpath(path)) if resolve and path.is_symlink() else path
+
+
+def _check_way(path: Path) -> None:
+    """:class:`OutputError` if ``path`` is a symbolic link loop, or a component above it is a loop, a
+    symbolic link to nothing, or not a folder (a file, or a link to a file); a missing folder is made later."""
+    parts = path.parts
+    for depth in range(1, len(parts) + 1):
+        step, above = Path(*parts[:depth]), depth < len(parts)
+        try:
+            info = os.stat(step)
+        except FileNotFoundError:
+            if above and os.path.islink(step):
+                raise _no_way(path, step, f"is a symbolic link to {os.readlink(step)!r}, which does not exist")
+            return  # missing: made by the write (a link to nothing as the output itself: written through)
+        except OSError as exc:
+            if exc.errno == errno.ELOOP:
+                raise _no_way(path, step, "is a symbolic link loop (following it leads back to it)")
+            return  # e.g. no permission: the write says so
+        if above and not stat.S_ISDIR(info.st_mode):
+            kind = f"a symbolic link to a file ({os.readlink(step)!r})" if os.path.islink(step) else "a file"
+            raise _no_way(path, step, f"is {kind}, not a folder")
+
+
+def _no_way(path: Path, step: Path, why: str) -> OutputError:
+    return OutputError(f"cannot write {str(path)!r}: {show(str(step))} {why}")
 
 
 def _as_utf8(text: str) -> str:
@@ -539,7 +567,7 @@ def check_folder(target: str | Path, names=()) -> Path:
         immutable or append-only entry, a folder whose entries cannot be removed), one of
         ``names`` is a folder in it, or its folder cannot be created or written.
     """
-    target = _named(target)
+    target = _named(target, resolve=False)  # a link to a folder: the folder is replaced (staged_directory)
     with output_errors(target):
         if (target.exists() or target.is_symlink()) and not target.is_dir():
             raise NotADirectoryError(errno.ENOTDIR, "Not a directory")
