@@ -9,7 +9,7 @@ that a set of files changes as a whole.
 
 The folder swap moves only what it can move back and remove. Before it, the old
 folder is read whole (:func:`_inventory`): a mount point inside it (another
-device, or a mount point of ``/proc/self/mountinfo``: a rename would carry the
+device, or one of the system's table of mounts: a rename would carry the
 mounted file system into the hidden old folder, whose removal would empty it), an
 immutable or append-only entry (``chattr +i``: it could be swapped away but never
 removed) or a folder whose entries this user cannot remove is refused with one line,
@@ -26,6 +26,9 @@ process id, its start time (``/proc/<pid>/stat`` field 22, clock ticks after boo
 removes the temporaries beside its output whose process has ended (a SIGKILL's
 litter; :func:`remove_stale`): a process id that runs again with another start
 time is another process; one of another host is never judged.
+
+The operating system's own calls (``renameat2``, ``fsync``, file attributes, the table of
+mounts, process start times) are in :mod:`spinectl._oscalls`.
 """
 
 from __future__ import annotations
@@ -39,13 +42,19 @@ import re
 import shutil
 import socket
 import stat
-import struct
 import tempfile
 import warnings
 import zlib
 from collections.abc import Iterator
 from pathlib import Path
 
+from ._oscalls import FS_IOC_GETFLAGS, PINNED_FLAGS, RENAME_EXCHANGE, RENAME_NOREPLACE  # noqa: F401 (public here)
+from ._oscalls import check_way as _check_way
+from ._oscalls import exchange as _exchange
+from ._oscalls import mount_points_below as _mount_points_below
+from ._oscalls import pinned as _pinned
+from ._oscalls import start_time as _start_time
+from ._oscalls import synced as _synced
 from ._validate import show
 from .errors import OutputError, ParameterError
 
@@ -117,31 +126,6 @@ def _named(target: str | Path, resolve: bool = True) -> Path:
     path = Path(target)
     _check_way(path)
     return Path(os.path.realpath(path)) if resolve and path.is_symlink() else path
-
-
-def _check_way(path: Path) -> None:
-    """:class:`OutputError` if ``path`` is a symbolic link loop, or a component above it is a loop, a
-    symbolic link to nothing, or not a folder (a file, or a link to a file); a missing folder is made later."""
-    parts = path.parts
-    for depth in range(1, len(parts) + 1):
-        step, above = Path(*parts[:depth]), depth < len(parts)
-        try:
-            info = os.stat(step)
-        except FileNotFoundError:
-            if above and os.path.islink(step):
-                raise _no_way(path, step, f"is a symbolic link to {os.readlink(step)!r}, which does not exist")
-            return  # missing: made by the write (a link to nothing as the output itself: written through)
-        except OSError as exc:
-            if exc.errno == errno.ELOOP:
-                raise _no_way(path, step, "is a symbolic link loop (following it leads back to it)")
-            return  # e.g. no permission: the write says so
-        if above and not stat.S_ISDIR(info.st_mode):
-            kind = f"a symbolic link to a file ({os.readlink(step)!r})" if os.path.islink(step) else "a file"
-            raise _no_way(path, step, f"is {kind}, not a folder")
-
-
-def _no_way(path: Path, step: Path, why: str) -> OutputError:
-    return OutputError(f"cannot write {str(path)!r}: {show(str(step))} {why}")
 
 
 def _as_utf8(text: str) -> str:
@@ -285,18 +269,6 @@ class Owner:
         return bool(self.start) and now is not None and now != self.start
 
 
-def _start_time(pid: int) -> int | None:
-    """The start time of process ``pid`` [clock ticks after boot] (Linux's ``/proc``), or None."""
-    try:
-        text = Path(f"/proc/{pid}/stat").read_bytes()
-    except OSError:
-        return None
-    try:  # the name (field 2) is in parentheses and may hold spaces: count from the last ')'
-        return int(text.rsplit(b")", 1)[1].split()[19])
-    except (IndexError, ValueError):
-        return None
-
-
 def _host_hash(host: str) -> str:
     return f"{zlib.crc32(host.encode()):08x}"
 
@@ -352,38 +324,6 @@ def _set_mode(tmp: Path, target: Path, directory: bool) -> None:
     os.chmod(tmp, mode & 0o7777)
 
 
-def _synced(path: str | Path, tree: bool = True) -> None:
-    """Write ``path`` to disk (``fsync``): a file, or a folder and (``tree``) every entry below it.
-
-    A rename survives a power cut whole only if the bytes it names were on disk first: the
-    new file (or folder, and all in it) is synced before its rename, the folder holding the
-    new name after it.
-    """
-    if tree and os.path.isdir(path) and not os.path.islink(path):
-        for folder, _, files in os.walk(path, topdown=False):  # each folder after what it holds
-            for name in files:
-                _fsync(os.path.join(folder, name))
-            _fsync(folder)
-    else:
-        _fsync(path)
-
-
-def _fsync(path: str | Path) -> None:
-    try:
-        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NOCTTY", 0))
-    except OSError as exc:  # a symbolic link or socket (no bytes of its own), a file this user cannot read
-        if exc.errno in (errno.ELOOP, errno.EACCES, errno.EPERM, errno.ENXIO):
-            return
-        raise
-    try:
-        os.fsync(fd)
-    except OSError as exc:  # a file system or kind of file that takes no fsync (a folder on some, a pipe)
-        if exc.errno not in (errno.EINVAL, errno.ENOTSUP, errno.EBADF):
-            raise
-    finally:
-        os.close(fd)
-
-
 def _swap(tmp: Path, target: Path, directory: bool) -> Path | None:
     """Put ``tmp`` in the place of ``target``; return where the old folder went (None: no old folder).
 
@@ -405,44 +345,6 @@ def _swap(tmp: Path, target: Path, directory: bool) -> Path | None:
         os.replace(old, target)
         raise
     return old
-
-
-RENAME_EXCHANGE = 2
-"""Linux's ``renameat2`` flag that swaps two paths in one step (<linux/fs.h>)."""
-
-RENAME_NOREPLACE = 1
-"""Linux's ``renameat2`` flag that fails (EEXIST) rather than replace the destination (<linux/fs.h>)."""
-
-
-@functools.cache
-def _renameat2():
-    """The C library's ``renameat2``, or None; looked up once (``find_library`` may start ``ldconfig``)."""
-    import ctypes
-    import ctypes.util
-
-    try:
-        return ctypes.CDLL(ctypes.util.find_library("c"), use_errno=True).renameat2
-    except (OSError, AttributeError, TypeError):  # no C library by that name, or no renameat2 in it
-        return None
-
-
-def _exchange(a: Path, b: Path, flags: int = RENAME_EXCHANGE) -> bool:
-    """Swap the paths ``a`` and ``b`` atomically (Linux >= 3.15); False where the OS or file system cannot.
-
-    With ``flags=RENAME_NOREPLACE``: rename ``a`` to ``b`` unless ``b`` exists (then ``FileExistsError``).
-    """
-    import ctypes
-
-    renameat2 = _renameat2()
-    if renameat2 is None:
-        return False
-    at_cwd = -100  # AT_FDCWD: paths relative to the working directory
-    if renameat2(at_cwd, os.fsencode(a), at_cwd, os.fsencode(b), flags) == 0:
-        return True
-    error = ctypes.get_errno()
-    if error in (errno.ENOSYS, errno.EINVAL, errno.ENOTSUP):
-        return False  # not supported here: the caller renames in two steps
-    raise OSError(error, os.strerror(error), str(b))
 
 
 def check_writable(target: str | Path) -> Path:
@@ -749,19 +651,12 @@ class OutputWarning(UserWarning):
     """Files that another process wrote into an output folder while it was replaced were kept aside."""
 
 
-FS_IOC_GETFLAGS = 0x80086601 if struct.calcsize("l") == 8 else 0x80046601
-"""Linux's ioctl that reads a file's attributes (``lsattr``; <linux/fs.h>, ``_IOR('f', 1, long)``)."""
-
-PINNED_FLAGS = {0x10: "immutable (chattr +i)", 0x20: "append-only (chattr +a)"}
-"""Linux's FS_IMMUTABLE_FL and FS_APPEND_FL: such an entry cannot be removed, nor one inside such a folder."""
-
-
 def _inventory(root: Path, files: bool = True) -> dict[str, tuple]:
     """Every entry below ``root`` (path relative to it) -> its :func:`_identity`, read now.
 
     Raises :class:`OutputError` for what a swap of ``root`` cannot move or remove: a
     mount point inside (an entry on another device, or a mount point of
-    ``/proc/self/mountinfo``, e.g. a bind mount on the same device), an immutable or
+    system's table of mounts, e.g. a bind mount on the same device), an immutable or
     append-only entry, or a folder (``root`` too) whose entries this user cannot remove.
     With ``files=False`` the attributes of regular files are not read (one ``open`` each):
     for a caller that links every file, which Linux refuses for such a file.
@@ -809,48 +704,6 @@ def _refused(root: Path, entry, why: str) -> OutputError:
         "replaced as a whole when the "
         "run ends, and that entry could not go with it safely: move it out, or write to another folder"
     )
-
-
-def _pinned(path: Path, info: os.stat_result) -> str | None:
-    """'immutable (...)' or 'append-only (...)' if the entry carries such a flag (Linux, BSD, macOS), else None."""
-    flags = getattr(info, "st_flags", 0)  # BSD and macOS: chflags
-    if flags & (stat.UF_IMMUTABLE | stat.SF_IMMUTABLE):
-        return "immutable (chflags uchg)"
-    if flags & (stat.UF_APPEND | stat.SF_APPEND):
-        return "append-only (chflags uappnd)"
-    if not (stat.S_ISREG(info.st_mode) or stat.S_ISDIR(info.st_mode)):
-        return None  # devices and pipes are not opened (an open may act); symbolic links carry no flags
-    flags = _linux_flags(path)
-    return next((what for flag, what in PINNED_FLAGS.items() if flags & flag), None)
-
-
-def _linux_flags(path: Path) -> int:
-    """The attributes of ``path`` (``lsattr``), or 0 where they cannot be read (not Linux, no permission)."""
-    try:
-        import fcntl
-    except ImportError:  # not POSIX
-        return 0
-    try:
-        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NOCTTY", 0))
-    except OSError:
-        return 0
-    try:
-        return struct.unpack("i", fcntl.ioctl(fd, FS_IOC_GETFLAGS, bytes(8))[:4])[0]  # the kernel writes an int
-    except OSError:  # not Linux, or a file system without attributes
-        return 0
-    finally:
-        os.close(fd)
-
-
-def _mount_points_below(root: Path) -> list[str]:
-    """The mount points strictly inside ``root`` (Linux's ``/proc/self/mountinfo``; [] elsewhere)."""
-    try:
-        lines = Path("/proc/self/mountinfo").read_text(encoding="utf-8", errors="surrogateescape").splitlines()
-    except OSError:
-        return []
-    inside = os.path.realpath(root) + os.sep
-    points = (re.sub(r"\\([0-7]{3})", lambda m: chr(int(m[1], 8)), line.split(" ")[4]) for line in lines if line)
-    return sorted(point for point in points if point.startswith(inside))
 
 
 def _settle(old: Path, new: Path, seen: dict[str, tuple], written: frozenset) -> None:

@@ -78,7 +78,7 @@ def test_a_mount_point_inside_the_output_folder_is_refused_and_kept(mounted):
 
 
 def test_a_bind_mount_on_the_same_device_is_refused(tmp_path):
-    """A bind mount has the device of its parent: it is found in /proc/self/mountinfo, not by st_dev."""
+    """A bind mount has the device of its parent: it is found in the table of mounts, not by st_dev."""
     out, elsewhere = tmp_path / "out", tmp_path / "elsewhere"
     (out / "bound").mkdir(parents=True)
     elsewhere.mkdir()

@@ -619,7 +619,8 @@ def test_check_writable_fails_where_the_write_would_and_leaves_nothing(tmp_path)
 def _links(folder) -> None:
     """Symbolic links of every kind that can stand in an output's way, in ``folder``."""
     (folder / "a_file").write_text("keep")
-    for name, to in [("loop.nc", "loop.nc"), ("l1", "l2"), ("l2", "l1"), ("dangling", "nowhere"), ("to_file", "a_file")]:
+    links = {"loop.nc": "loop.nc", "l1": "l2", "l2": "l1", "dangling": "nowhere", "to_file": "a_file"}
+    for name, to in links.items():
         (folder / name).symlink_to(to)
 
 
