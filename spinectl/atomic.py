@@ -1,13 +1,15 @@
 """Atomic output: write to a temporary name beside the target, then rename.
 
 An interrupted run leaves either the previous file or the new one, never a
-half-written file. A folder replaces a folder in one step where the OS can
-(Linux's ``renameat2`` with ``RENAME_EXCHANGE``), else in two (the old one moved
-aside, the new one in), so that a set of files changes as a whole.
+half-written file; a power cut too: the new file (a folder: every file in it, and
+itself) is written to disk (``fsync``) before the rename, its folder after it. A
+folder replaces a folder in one step where the OS can (Linux's ``renameat2`` with
+``RENAME_EXCHANGE``), else in two (the old one moved aside, the new one in), so
+that a set of files changes as a whole.
 
 The folder swap moves only what it can move back and remove. Before it, the old
 folder is read whole (:func:`_inventory`): a mount point inside it (another
-device, or a mount point of ``/proc/self/mountinfo``: a rename would carry the
+device, or one of the system's table of mounts: a rename would carry the
 mounted file system into the hidden old folder, whose removal would empty it), an
 immutable or append-only entry (``chattr +i``: it could be swapped away but never
 removed) or a folder whose entries this user cannot remove is refused with one line,
@@ -24,6 +26,9 @@ process id, its start time (``/proc/<pid>/stat`` field 22, clock ticks after boo
 removes the temporaries beside its output whose process has ended (a SIGKILL's
 litter; :func:`remove_stale`): a process id that runs again with another start
 time is another process; one of another host is never judged.
+
+The operating system's own calls (``renameat2``, ``fsync``, file attributes, the table of
+mounts, process start times) are in :mod:`spinectl._oscalls`.
 """
 
 from __future__ import annotations
@@ -37,13 +42,19 @@ import re
 import shutil
 import socket
 import stat
-import struct
 import tempfile
 import warnings
 import zlib
 from collections.abc import Iterator
 from pathlib import Path
 
+from ._oscalls import FS_IOC_GETFLAGS, PINNED_FLAGS, RENAME_EXCHANGE, RENAME_NOREPLACE  # noqa: F401 (public here)
+from ._oscalls import check_way as _check_way
+from ._oscalls import exchange as _exchange
+from ._oscalls import mount_points_below as _mount_points_below
+from ._oscalls import pinned as _pinned
+from ._oscalls import start_time as _start_time
+from ._oscalls import synced as _synced
 from ._validate import show
 from .errors import OutputError, ParameterError
 
@@ -88,6 +99,7 @@ def atomic_path(target: str | Path, *, directory: bool = False) -> Iterator[Path
             # an old folder: refused if a swap could not move or remove it all, before anything moves
             seen = _inventory(target) if directory and target.is_dir() else {}
             written = frozenset(os.listdir(tmp)) if directory else frozenset()
+            _synced(tmp)
             old = _swap(tmp, target, directory)
     except BaseException:
         if tmp.is_dir():
@@ -97,10 +109,13 @@ def atomic_path(target: str | Path, *, directory: bool = False) -> Iterator[Path
         raise
     if old is not None:  # the old folder, now at the temporary's name: only what was read goes
         _settle(old, target, seen, written)
+    with output_errors(target):
+        _synced(target.parent, tree=False)  # the rename itself (after the swap: a failure must not undo it)
 
 
-def _named(target: str | Path) -> Path:
-    """``target`` as a Path, or :class:`OutputError` if its name has a line break or control character.
+def _named(target: str | Path, resolve: bool = True) -> Path:
+    """``target`` as a Path (``resolve``: a symbolic link as the file it leads to, which is written), or
+    :class:`OutputError` if its name has a line break or control character, or its path cannot lead to it.
 
     Such a name is valid on POSIX, but it breaks the one-line listings and messages
     that name the outputs, and the command line that a preset's header records.
@@ -108,7 +123,9 @@ def _named(target: str | Path) -> Path:
     text = str(target)
     if not _as_utf8(text).isprintable():
         raise OutputError(f"cannot write {show(text)}: the name must be printable (no line breaks or control codes)")
-    return Path(target)
+    path = Path(target)
+    _check_way(path)
+    return Path(os.path.realpath(path)) if resolve and path.is_symlink() else path
 
 
 def _as_utf8(text: str) -> str:
@@ -252,18 +269,6 @@ class Owner:
         return bool(self.start) and now is not None and now != self.start
 
 
-def _start_time(pid: int) -> int | None:
-    """The start time of process ``pid`` [clock ticks after boot] (Linux's ``/proc``), or None."""
-    try:
-        text = Path(f"/proc/{pid}/stat").read_bytes()
-    except OSError:
-        return None
-    try:  # the name (field 2) is in parentheses and may hold spaces: count from the last ')'
-        return int(text.rsplit(b")", 1)[1].split()[19])
-    except (IndexError, ValueError):
-        return None
-
-
 def _host_hash(host: str) -> str:
     return f"{zlib.crc32(host.encode()):08x}"
 
@@ -340,44 +345,6 @@ def _swap(tmp: Path, target: Path, directory: bool) -> Path | None:
         os.replace(old, target)
         raise
     return old
-
-
-RENAME_EXCHANGE = 2
-"""Linux's ``renameat2`` flag that swaps two paths in one step (<linux/fs.h>)."""
-
-RENAME_NOREPLACE = 1
-"""Linux's ``renameat2`` flag that fails (EEXIST) rather than replace the destination (<linux/fs.h>)."""
-
-
-@functools.cache
-def _renameat2():
-    """The C library's ``renameat2``, or None; looked up once (``find_library`` may start ``ldconfig``)."""
-    import ctypes
-    import ctypes.util
-
-    try:
-        return ctypes.CDLL(ctypes.util.find_library("c"), use_errno=True).renameat2
-    except (OSError, AttributeError, TypeError):  # no C library by that name, or no renameat2 in it
-        return None
-
-
-def _exchange(a: Path, b: Path, flags: int = RENAME_EXCHANGE) -> bool:
-    """Swap the paths ``a`` and ``b`` atomically (Linux >= 3.15); False where the OS or file system cannot.
-
-    With ``flags=RENAME_NOREPLACE``: rename ``a`` to ``b`` unless ``b`` exists (then ``FileExistsError``).
-    """
-    import ctypes
-
-    renameat2 = _renameat2()
-    if renameat2 is None:
-        return False
-    at_cwd = -100  # AT_FDCWD: paths relative to the working directory
-    if renameat2(at_cwd, os.fsencode(a), at_cwd, os.fsencode(b), flags) == 0:
-        return True
-    error = ctypes.get_errno()
-    if error in (errno.ENOSYS, errno.EINVAL, errno.ENOTSUP):
-        return False  # not supported here: the caller renames in two steps
-    raise OSError(error, os.strerror(error), str(b))
 
 
 def check_writable(target: str | Path) -> Path:
@@ -502,7 +469,7 @@ def check_folder(target: str | Path, names=()) -> Path:
         immutable or append-only entry, a folder whose entries cannot be removed), one of
         ``names`` is a folder in it, or its folder cannot be created or written.
     """
-    target = _named(target)
+    target = _named(target, resolve=False)  # a link to a folder: the folder is replaced (staged_directory)
     with output_errors(target):
         if (target.exists() or target.is_symlink()) and not target.is_dir():
             raise NotADirectoryError(errno.ENOTDIR, "Not a directory")
@@ -578,12 +545,15 @@ def staged_directory(target: str | Path, names=(), replaces=()) -> Iterator[Path
             written = frozenset(os.listdir(stage))
             seen = _keep_the_others(target, stage, set(replaces)) if target.is_dir() else {}
             _set_mode(stage, target, directory=True)
+            _synced(stage)
             old = _swap(stage, target, directory=True)
     finally:
         if old is None:  # not swapped: the staging folder holds this run's files and links only
             shutil.rmtree(stage, ignore_errors=True)
     if old is not None:
         _settle(old, target, seen, written)
+    with output_errors(target):
+        _synced(target.parent, tree=False)  # the rename itself
 
 
 def _keep_the_others(target: Path, stage: Path, replaced: set[str]) -> dict[str, tuple]:
@@ -663,8 +633,10 @@ def _filled_in_place(target: Path, replaced: set[str]) -> Iterator[Path]:
             written = set()
             for item in sorted(stage.iterdir()):
                 _set_mode(item, target / item.name, item.is_dir())
+                _synced(item)
                 os.replace(item, target / item.name)
                 written.add(item.name)
+            _synced(target, tree=False)
             for name in sorted(replaced - written):
                 with contextlib.suppress(FileNotFoundError, IsADirectoryError):
                     (target / name).unlink()
@@ -679,19 +651,12 @@ class OutputWarning(UserWarning):
     """Files that another process wrote into an output folder while it was replaced were kept aside."""
 
 
-FS_IOC_GETFLAGS = 0x80086601 if struct.calcsize("l") == 8 else 0x80046601
-"""Linux's ioctl that reads a file's attributes (``lsattr``; <linux/fs.h>, ``_IOR('f', 1, long)``)."""
-
-PINNED_FLAGS = {0x10: "immutable (chattr +i)", 0x20: "append-only (chattr +a)"}
-"""Linux's FS_IMMUTABLE_FL and FS_APPEND_FL: such an entry cannot be removed, nor one inside such a folder."""
-
-
 def _inventory(root: Path, files: bool = True) -> dict[str, tuple]:
     """Every entry below ``root`` (path relative to it) -> its :func:`_identity`, read now.
 
     Raises :class:`OutputError` for what a swap of ``root`` cannot move or remove: a
     mount point inside (an entry on another device, or a mount point of
-    ``/proc/self/mountinfo``, e.g. a bind mount on the same device), an immutable or
+    system's table of mounts, e.g. a bind mount on the same device), an immutable or
     append-only entry, or a folder (``root`` too) whose entries this user cannot remove.
     With ``files=False`` the attributes of regular files are not read (one ``open`` each):
     for a caller that links every file, which Linux refuses for such a file.
@@ -739,48 +704,6 @@ def _refused(root: Path, entry, why: str) -> OutputError:
         "replaced as a whole when the "
         "run ends, and that entry could not go with it safely: move it out, or write to another folder"
     )
-
-
-def _pinned(path: Path, info: os.stat_result) -> str | None:
-    """'immutable (...)' or 'append-only (...)' if the entry carries such a flag (Linux, BSD, macOS), else None."""
-    flags = getattr(info, "st_flags", 0)  # BSD and macOS: chflags
-    if flags & (stat.UF_IMMUTABLE | stat.SF_IMMUTABLE):
-        return "immutable (chflags uchg)"
-    if flags & (stat.UF_APPEND | stat.SF_APPEND):
-        return "append-only (chflags uappnd)"
-    if not (stat.S_ISREG(info.st_mode) or stat.S_ISDIR(info.st_mode)):
-        return None  # devices and pipes are not opened (an open may act); symbolic links carry no flags
-    flags = _linux_flags(path)
-    return next((what for flag, what in PINNED_FLAGS.items() if flags & flag), None)
-
-
-def _linux_flags(path: Path) -> int:
-    """The attributes of ``path`` (``lsattr``), or 0 where they cannot be read (not Linux, no permission)."""
-    try:
-        import fcntl
-    except ImportError:  # not POSIX
-        return 0
-    try:
-        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NOCTTY", 0))
-    except OSError:
-        return 0
-    try:
-        return struct.unpack("i", fcntl.ioctl(fd, FS_IOC_GETFLAGS, bytes(8))[:4])[0]  # the kernel writes an int
-    except OSError:  # not Linux, or a file system without attributes
-        return 0
-    finally:
-        os.close(fd)
-
-
-def _mount_points_below(root: Path) -> list[str]:
-    """The mount points strictly inside ``root`` (Linux's ``/proc/self/mountinfo``; [] elsewhere)."""
-    try:
-        lines = Path("/proc/self/mountinfo").read_text(encoding="utf-8", errors="surrogateescape").splitlines()
-    except OSError:
-        return []
-    inside = os.path.realpath(root) + os.sep
-    points = (re.sub(r"\\([0-7]{3})", lambda m: chr(int(m[1], 8)), line.split(" ")[4]) for line in lines if line)
-    return sorted(point for point in points if point.startswith(inside))
 
 
 def _settle(old: Path, new: Path, seen: dict[str, tuple], written: frozenset) -> None:

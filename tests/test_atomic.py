@@ -78,7 +78,7 @@ def test_a_mount_point_inside_the_output_folder_is_refused_and_kept(mounted):
 
 
 def test_a_bind_mount_on_the_same_device_is_refused(tmp_path):
-    """A bind mount has the device of its parent: it is found in /proc/self/mountinfo, not by st_dev."""
+    """A bind mount has the device of its parent: it is found in the table of mounts, not by st_dev."""
     out, elsewhere = tmp_path / "out", tmp_path / "elsewhere"
     (out / "bound").mkdir(parents=True)
     elsewhere.mkdir()
@@ -271,3 +271,68 @@ def test_a_killed_run_s_staging_folder_is_removed_by_the_next_run(tmp_path):
         warnings.simplefilter("error")
         _write(out)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]
+
+
+def _recording_syncs_and_renames(monkeypatch) -> list[tuple]:
+    """Record, in order, every ``os.fsync`` (as the path of its file descriptor) and every rename of
+    ``atomic`` (``os.replace``, and ``renameat2`` through ``atomic._exchange``), as ``(what, path...)``."""
+    if not os.path.isdir("/proc/self/fd"):
+        pytest.skip("needs /proc/self/fd to name the file a descriptor is open on (Linux)")
+    events: list[tuple] = []
+    fsync, replace, exchange = os.fsync, os.replace, atomic._exchange
+
+    def recorded_fsync(fd):
+        events.append(("fsync", os.readlink(f"/proc/self/fd/{fd}")))
+        return fsync(fd)
+
+    def recorded_replace(a, b, *args, **kwargs):
+        events.append(("rename", os.fspath(a), os.fspath(b)))
+        return replace(a, b, *args, **kwargs)
+
+    def recorded_exchange(a, b, *args):
+        done = exchange(a, b, *args)
+        if done:
+            events.append(("rename", os.fspath(a), os.fspath(b)))
+        return done
+
+    monkeypatch.setattr(os, "fsync", recorded_fsync)
+    monkeypatch.setattr(os, "replace", recorded_replace)
+    monkeypatch.setattr(atomic, "_exchange", recorded_exchange)
+    return events
+
+
+def test_a_file_is_on_disk_before_its_rename_and_the_rename_after(tmp_path, monkeypatch):
+    """A file write: the temporary's descriptor is fsynced, then it is renamed onto the target, then the
+    folder holding the new name is fsynced, so that a power cut leaves the old file or the whole new
+    one (before: no fsync at all, a rename could reach the disk before the bytes it names)."""
+    events = _recording_syncs_and_renames(monkeypatch)
+    target = tmp_path / "x.json"
+    target.write_text("old")
+    with atomic_path(target) as tmp:
+        tmp.write_text("new")
+    assert events == [("fsync", str(tmp)), ("rename", str(tmp), str(target)), ("fsync", str(tmp_path))]
+    assert target.read_text() == "new"
+
+
+@pytest.mark.parametrize("exchange", [True, False], ids=["renameat2", "two renames"])
+@pytest.mark.parametrize("writer", ["atomic_path", "staged_directory"])
+def test_a_folder_and_its_files_are_on_disk_before_the_swap(tmp_path, monkeypatch, exchange, writer):
+    """A folder swap (a study store, a folder of figures), in one step or in two: every file written and
+    the new folder itself are fsynced before the rename that swaps it in, and the folder holding it after."""
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "notes.txt").write_text("old")
+    if not exchange:  # no renameat2 here: the old folder is moved aside, the new one in
+        real = atomic._exchange
+        refused = atomic.RENAME_EXCHANGE
+        monkeypatch.setattr(atomic, "_exchange", lambda a, b, flags=refused: flags != refused and real(a, b, flags))
+    events = _recording_syncs_and_renames(monkeypatch)
+    writing = atomic_path(out, directory=True) if writer == "atomic_path" else staged_directory(out, ["fig.png"])
+    with writing as tmp:
+        (tmp / "sub").mkdir()
+        (tmp / "sub" / "fig.png").write_text("new")
+    swap = next(i for i, e in enumerate(events) if e[0] == "rename" and e[1:] == (str(tmp), str(out)))
+    synced = [e[1] for e in events[:swap] if e[0] == "fsync"]
+    assert synced.index(str(tmp / "sub" / "fig.png")) < synced.index(str(tmp / "sub")) < synced.index(str(tmp))
+    assert ("fsync", str(tmp_path)) in events[swap + 1 :]
+    assert (out / "sub" / "fig.png").read_text() == "new"

@@ -16,8 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .params import Model
-
-_ATTRIBUTE = "_spinectl_source"
+from .params.model import SOURCE_ATTRIBUTE as _ATTRIBUTE
 
 
 @dataclass(frozen=True)

@@ -2,16 +2,22 @@
 
 from __future__ import annotations
 
+import copy
+import dataclasses
 import hashlib
 import math
+import pickle
 import warnings
 
+import numpy as np
 import pytest
 
 from spinectl.errors import ConfigError, ParameterError
 from spinectl.model import config, source
 from spinectl.model._toml import to_dict
 from spinectl.model.params import Model
+from spinectl.model.stability import segment_stability
+from spinectl.paper.grid import with_stiffness
 
 BASE = config.load_preset(config.DEFAULT_PRESET)
 
@@ -213,6 +219,51 @@ def test_the_source_names_preset_file_hash_and_overrides(tmp_path):
     assert line.startswith("preset default, K = 0 N m/rad, convention physical; config ")
     assert line.endswith(f"(sha256 {origin.config_sha256[:12]}); overridden: reflex.delay")
     assert source.provenance(model)["config_sha256"] == origin.config_sha256
+
+
+def _first_line_and_keys(model: Model) -> tuple[str, str | None, list]:
+    """What ``spinectl stability`` prints first, and its JSON's ``preset`` and ``overridden``, for ``model``."""
+    result = segment_stability(model, 0.0, 0.0, np.full(len(model.muscle_names), 1e-4))
+    document = result.to_dict(model)
+    return result.table(model).splitlines()[0], document["preset"], document["overridden"]
+
+
+def test_replace_keeps_the_preset_and_lists_the_fields_it_changed():
+    """``load_preset('wagner2012').replace(body=...)``: the outputs name the preset and the field, as
+    ``--set body.mass=60`` would (before: ``preset none (a Model built in Python)``, no field)."""
+    model = config.load_preset("wagner2012")
+    heavier = model.replace(body=dataclasses.replace(model.body, mass=60.0))
+    line, preset, overridden = _first_line_and_keys(heavier)
+    assert line == "preset wagner2012, K = 0 N m/rad, convention physical; overridden: body.mass"
+    assert (preset, overridden) == ("wagner2012", ["body.mass"])
+    assert source.source_of(heavier) == source.source_of(config.set_parameter(model, "body.mass", 60.0))
+
+
+def test_the_source_survives_every_transformation_in_turn(tmp_path):
+    """A file's model through replace (two fields of one section, a pair by its name), set_parameters,
+    with_stiffness, a copy and a pickle (a Dask worker's model): the file and its SHA-256 stay, and each
+    changed field is listed once, in order; a section replaced by an equal one lists nothing."""
+    path = tmp_path / "m.toml"
+    path.write_text('preset = "default"\n[body]\nmass = 50.0\n', encoding="utf-8")
+    model = config.load_config(path)
+    pair = model.muscles[1]
+    model = model.replace(reflex=dataclasses.replace(model.reflex, delay=0.05, kp=2.0), body=model.body)
+    model = model.replace(muscles=model.muscles[:1] + (dataclasses.replace(pair, spread=0.02),) + model.muscles[2:])
+    model = with_stiffness(config.set_parameters(model, {"reflex.delay": 0.06, "body.mass": 55.0}), 15.0)
+    model = pickle.loads(pickle.dumps(copy.deepcopy(model)))
+    expected = ["reflex.delay", "reflex.kp", f"muscles.{pair.name}.spread", "body.mass", "passive.stiffness"]
+    line, preset, overridden = _first_line_and_keys(model)
+    assert (preset, overridden) == ("default", expected)
+    digest = hashlib.sha256(path.read_bytes()).hexdigest()[:12]
+    assert line.startswith(f"preset default, K = 15 N m/rad, convention physical; config {path} (sha256 {digest})")
+    fewer = model.replace(muscles=model.muscles[:1])  # the pairs themselves differ
+    assert source.source_of(fewer).overridden[-1] == "muscles"
+
+
+def test_a_model_built_in_python_stays_one_when_replaced():
+    """No preset to keep: ``Model().replace(...)`` still says so, and lists no override of a preset."""
+    model = Model().replace(body=dataclasses.replace(Model().body, mass=60.0))
+    assert _first_line_and_keys(model)[1:] == (None, [])
 
 
 def test_the_source_is_no_parameter():

@@ -10,6 +10,7 @@ import datetime
 import importlib
 import math
 import os
+import re
 import warnings
 
 import cvxpy as cp
@@ -18,7 +19,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from spinectl.atomic import atomic_path, atomic_write_text, check_writable
+from spinectl.atomic import atomic_path, atomic_write_text, check_folder, check_writable
 from spinectl.cli import main
 from spinectl.errors import ConfigError, ModelError, OutputError, ParameterError, SpinectlError
 from spinectl.model import config, geometry, muscle
@@ -613,6 +614,53 @@ def test_check_writable_fails_where_the_write_would_and_leaves_nothing(tmp_path)
     assert check_writable(tmp_path / "a_file") == tmp_path / "a_file"
     assert (tmp_path / "a_file").read_text() == "keep"
     assert sorted(p.name for p in tmp_path.rglob("*")) == ["a_file", "new", "taken"]  # no file made
+
+
+def _links(folder) -> None:
+    """Symbolic links of every kind that can stand in an output's way, in ``folder``."""
+    (folder / "a_file").write_text("keep")
+    links = {"loop.nc": "loop.nc", "l1": "l2", "l2": "l1", "dangling": "nowhere", "to_file": "a_file"}
+    for name, to in links.items():
+        (folder / name).symlink_to(to)
+
+
+@pytest.mark.parametrize(
+    ("out", "needle"),
+    [
+        ("loop.nc", "'loop.nc' is a symbolic link loop"),  # the case of the issue
+        ("loop.nc/x.nc", "'loop.nc' is a symbolic link loop"),
+        ("sub/../l1/deeper/x.nc", "'sub/../l1' is a symbolic link loop"),  # two links, further down
+        ("dangling/x.nc", "'dangling' is a symbolic link to 'nowhere', which does not exist"),
+        ("to_file/x.nc", "'to_file' is a symbolic link to a file ('a_file'), not a folder"),
+        ("a_file/x.nc", "'a_file' is a file, not a folder"),
+    ],
+)
+def test_a_path_that_cannot_lead_to_an_output_says_which_part_and_why(tmp_path, monkeypatch, capsys, out, needle):
+    """A symbolic link loop, a link to nothing or to a file where a folder is wanted, anywhere on the
+    output's path: one line naming that part, exit 2, before the job, nothing written (before: ``File
+    exists``, or the loop's link silently replaced by the output)."""
+    _links(tmp_path)
+    (tmp_path / "sub").mkdir()
+    monkeypatch.setattr(importlib.import_module("spinectl.landscape.sweep"), "sweep", lambda *a, **k: pytest.fail())
+    monkeypatch.chdir(tmp_path)
+    before = sorted((p.name, p.is_symlink()) for p in tmp_path.iterdir())
+    assert main(["sweep", "--E", "0:0.08:3", "--Lambda", "0:0.08:3", "--out", out]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"spinectl: error: cannot write {out!r}: {needle}") and err.count("\n") == 1
+    for write in (check_writable, lambda p: atomic_write_text(p, "new"), check_folder):  # every writer's check
+        with pytest.raises(OutputError, match=re.escape(needle)):
+            write(out)
+    assert sorted((p.name, p.is_symlink()) for p in tmp_path.iterdir()) == before
+
+
+def test_an_output_that_is_a_symbolic_link_is_written_where_it_leads(tmp_path):
+    """A link to a file, or to a file yet to be made: the output replaces the file it leads to and the
+    link stays (as a link to a folder does for folder outputs) (before: the link itself was replaced)."""
+    _links(tmp_path)
+    (tmp_path / "later.json").symlink_to("made/later.json")
+    for link, real in [("to_file", "a_file"), ("later.json", "made/later.json")]:
+        atomic_write_text(tmp_path / link, "new")
+        assert (tmp_path / link).is_symlink() and (tmp_path / real).read_text() == "new"
 
 
 @pytest.mark.parametrize(

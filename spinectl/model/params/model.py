@@ -89,9 +89,58 @@ class Model:
     def replace(self, **changes) -> Model:
         """Return a copy with top-level sections replaced (see :func:`dataclasses.replace`).
 
+        The copy keeps where ``self`` came from (:mod:`spinectl.model.source`: its preset, its
+        file) and lists the fields that differ as overridden, as ``--set`` does: its outputs say
+        e.g. ``preset wagner2012; overridden: body.mass``.
+
+        Parameters
+        ----------
+        **changes
+            New sections by name, e.g. ``body=Body(mass=60.0)``.
+
         Returns
         -------
         Model
             A new, validated model; ``self`` is unchanged.
         """
-        return dataclasses.replace(self, **changes)
+        new = dataclasses.replace(self, **changes)  # a new instance: the source, no field, is carried below
+        source = getattr(self, SOURCE_ATTRIBUTE, None)
+        if source is not None:
+            object.__setattr__(new, SOURCE_ATTRIBUTE, source.with_overridden(changed_fields(self, new)))
+        return new
+
+
+SOURCE_ATTRIBUTE = "_spinectl_source"
+"""The private attribute of a :class:`Model` that holds its :class:`~spinectl.model.source.ModelSource`."""
+
+
+def changed_fields(old: Model, new: Model) -> list[str]:
+    """The dotted fields whose values differ between two models, e.g. ``["body.mass"]``.
+
+    Parameters
+    ----------
+    old, new : Model
+
+    Returns
+    -------
+    list of str
+        In the order of the sections and fields; a muscle pair's fields by the pair's name
+        (``muscles.straight.spread``), or ``muscles`` where the pairs themselves differ.
+    """
+    out = []
+    for section in dataclasses.fields(old):
+        before, after = getattr(old, section.name), getattr(new, section.name)
+        if before == after:
+            continue
+        if section.name != "muscles":
+            out += _differing(section.name, before, after)
+        elif [m.name for m in before] == [m.name for m in after]:
+            for a, b in zip(before, after, strict=True):
+                out += _differing(f"muscles.{a.name}", a, b)
+        else:
+            out.append("muscles")
+    return out
+
+
+def _differing(prefix: str, a, b) -> list[str]:
+    return [f"{prefix}.{f.name}" for f in dataclasses.fields(a) if getattr(a, f.name) != getattr(b, f.name)]
