@@ -214,10 +214,10 @@ def test_an_interrupted_cluster_run_resumes_to_the_same_bits(in_process, tmp_pat
     spec, answer, draws = in_process
     save, saved = atlas._save, []
 
-    def interrupted(path, found):
+    def interrupted(path, found, *marks):
         if len(saved) == 3:
             raise KeyboardInterrupt
-        save(path, found)
+        save(path, found, *marks)
         saved.append(path.name)
 
     monkeypatch.setattr(atlas, "_save", interrupted)
@@ -263,7 +263,7 @@ def test_the_atlas_runs_in_process_unless_dask_is_asked_for(monkeypatch):
 def test_a_long_atlas_is_announced_and_what_cannot_fit_refused(tmp_path, monkeypatch):
     """As the study's: the estimate's line before a run of at least NOTICE_SECONDS (here 0), with the draws
     to solve and their CPU time from the benchmark's costs per draw; a memory estimate above what is
-    available is one error naming the atlas, before --out is made."""
+    available is one error naming atlas.samples, before --out is made."""
     from spinectl.errors import ParameterError
     from spinectl.landscape import budget
 
@@ -271,15 +271,78 @@ def test_a_long_atlas_is_announced_and_what_cannot_fit_refused(tmp_path, monkeyp
     monkeypatch.setattr(budget, "NOTICE_SECONDS", 0.0)
     atlas.run_atlas(spec, None, scheduler="synchronous", progress=False, notify=notes.append)
     seconds = 28 * budget.ATLAS_SECONDS_PER_DRAW  # N (D + 2) = 4 x 7 draws on the fast path, no chain
-    memory = budget.size(budget.PROCESS_BYTES + 16 * budget.WORKING_BYTES_PER_POINT)  # one process, chunks of 16
+    # one process, chunks of 16, and the atlas's arrays: N = 4, D = 5, 100 bootstrap resamples
+    memory = budget.PROCESS_BYTES + 16 * budget.WORKING_BYTES_PER_POINT + budget.atlas_memory(4, 5, 100)
     disk = budget.size(28 * budget.ATLAS_BYTES_PER_DRAW)
+    shown = budget.size(memory)
     assert notes == [
-        f"atlas: 28 points, about {disk} on disk, {memory} of memory, {budget.duration(seconds)} of CPU (estimated)"
+        f"atlas: 28 draws, about {disk} on disk, {shown} of memory, {budget.duration(seconds)} of CPU (estimated)"
     ]
     monkeypatch.setattr(budget, "available_memory", lambda: 1e6)
-    with pytest.raises(ParameterError, match=f"^atlas: 28 points need about {memory} of memory"):
+    with pytest.raises(ParameterError, match=f"^atlas.samples: 28 draws need about {shown} of memory"):
         atlas.run_atlas(spec, tmp_path / "out", scheduler="synchronous", progress=False)
     assert not (tmp_path / "out").exists()
+
+
+EIGHT = "[atlas]\nsamples = {samples}\nchain = false\nbootstrap = {bootstrap}\n" + PRIORS + MORE_PRIORS
+
+
+@pytest.mark.parametrize(
+    ("samples", "bootstrap", "available"),
+    [
+        (2**24, 100, 16 * 2**30),  # the issue's: the design alone 2^24 x 10 x 8 doubles = 10 GiB; 16 GiB available
+        (2**20, 2, 2**30),  # a variant: the design (1.34 GB with its copy) alone tips it; the bootstrap is small
+    ],
+)
+def test_the_design_is_counted_before_it_is_built(tmp_path, monkeypatch, samples, bootstrap, available):
+    """An atlas whose design does not fit is refused naming atlas.samples before the design is built.
+
+    The design of N base samples and D = 8 priors is N (D + 2) x D doubles (SALib's, and its clipped copy);
+    the estimate used to count only the workers' chunks (150 MB + 16 MB), and the design was built first.
+    tracemalloc: the refusal allocates no design (its peak stays below a MB).
+    """
+    import tracemalloc
+
+    from spinectl.errors import ParameterError
+    from spinectl.landscape import budget
+
+    spec = parse_atlas(EIGHT.format(samples=samples, bootstrap=bootstrap))
+    design = samples * 10 * 8 * 8  # one copy, in bytes
+    assert budget.atlas_memory(samples, 8, bootstrap) >= 2 * design
+    monkeypatch.setattr(budget, "available_memory", lambda: float(available))
+
+    def built(spec):
+        raise AssertionError("the design was built before the memory check")
+
+    monkeypatch.setattr(atlas, "saltelli_unit", built)
+    tracemalloc.start()
+    try:
+        with pytest.raises(ParameterError) as raised:
+            atlas.run_atlas(spec, tmp_path / "out", progress=False)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert raised.value.field == "atlas.samples" and f"{samples * 10:,} draws need about" in str(raised.value)
+    assert f"{budget.size(available)} is available" in str(raised.value) and peak < 1e6
+    assert not (tmp_path / "out").exists()
+
+
+def test_the_memory_estimate_bounds_the_design_and_draws():
+    """tracemalloc's peak of building the design and the draws (N = 4096, the eight priors: 7.7 MB) stays within the
+    estimate of the atlas's arrays (budget.atlas_memory): the constants are measured, this keeps them honest."""
+    import tracemalloc
+
+    from spinectl.landscape import budget
+
+    spec = parse_atlas(EIGHT.format(samples=4096, bootstrap=2))  # few resamples: the design and draws decide
+    atlas.saltelli_unit(spec)  # SALib's and scipy's imports, not the design's memory
+    tracemalloc.start()
+    try:
+        atlas.draw(spec, atlas.saltelli_unit(spec))
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak <= budget.atlas_memory(4096, 8, 2)
 
 
 def test_the_report_tells_an_unbounded_margin_from_an_infeasible_draw():
