@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from ..atomic import atomic_path
+from ..errors import OutputError
 
 ATLAS, INDEX, CRC = "_atlas", "_index", "_crc32"
 """The entries of a chunk file beside its outputs: its atlas's fingerprint, its index, its outputs' CRC-32."""
@@ -105,7 +106,18 @@ def read(path: Path, key: str, index: int, size: int) -> tuple[dict | None, str 
     problem : str or None
         What is wrong with the file (to be solved again), e.g. ``"holds chunk 2 (a copy from another
         position)"``; None if it is good or absent.
+
+    Raises
+    ------
+    OutputError
+        Something other than a file (a folder) stands at the chunk's name: it could not be saved
+        again, so the run is refused before any chunk is solved.
     """
+    if (path.exists() or path.is_symlink()) and not path.is_file():
+        raise OutputError(
+            f"cannot write {str(path)!r}: a folder (or other non-file) stands where a chunk of the atlas belongs; "
+            "remove it, then run the atlas again"
+        )
     if not path.is_file():
         return None, None
     try:

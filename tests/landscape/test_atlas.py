@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import dataclasses
+import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -367,3 +369,151 @@ def test_the_report_tells_an_unbounded_margin_from_an_infeasible_draw():
     assert "within ±30 N m" in text and "within 17 cm² per joint" in text
     unverified = sum("unverified" in p.source.lower() for p in spec.priors)
     assert f"{unverified} of {len(spec.priors)} priors are unverified" in text
+
+
+def test_damaged_copied_and_foreign_chunks_are_solved_again(in_process, tmp_path, monkeypatch):
+    """The reference's seven chunks, then: chunk 1 cut short, chunk 2's file copied over chunk 4's, another atlas's
+    chunk renamed as chunk 5, chunk 6 re-saved with other outputs under its old checksum, and another atlas's
+    chunk under its own name. Those four are solved again (4 of 7, one line naming them), the answer is the
+    reference's to the bit (it read chunk 4 as chunk 2's draws and ended with a traceback on chunk 1), and the
+    other atlas's chunk is gone at the end."""
+    import shutil
+
+    from spinectl.landscape import atlas_chunks
+
+    spec, answer, draws = in_process
+    reference = tmp_path / "ref"
+    atlas.run_atlas(spec, reference, scheduler="synchronous", progress=False)
+    other = dataclasses.replace(spec, seed=1, chain=False)
+    atlas.run_atlas(other, tmp_path / "other", scheduler="synchronous", progress=False)
+    out = tmp_path / "out"
+    shutil.copytree(reference / "chunks", out / "chunks")
+    key, foreign = atlas.fingerprint(spec), atlas.fingerprint(other)
+    chunk = {i: out / "chunks" / atlas_chunks.name(key, i) for i in range(7)}
+    chunk[1].write_bytes(chunk[1].read_bytes()[:500])
+    shutil.copyfile(chunk[2], chunk[4])
+    shutil.copyfile(tmp_path / "other" / "chunks" / atlas_chunks.name(foreign, 0), chunk[5])
+    with np.load(chunk[6]) as saved:
+        edited = {k: saved[k] for k in saved.files}
+    edited["min_pcsa_cm2"] = edited["min_pcsa_cm2"] + 1.0
+    np.savez(chunk[6], **edited)
+    stray = out / "chunks" / atlas_chunks.name(foreign, 0)
+    shutil.copyfile(tmp_path / "other" / "chunks" / stray.name, stray)
+
+    evaluate, solved, notes = atlas.evaluate, [], []
+    monkeypatch.setattr(atlas, "evaluate", lambda spec, part: solved.append(1) or evaluate(spec, part))
+    result = atlas.run_atlas(spec, out, scheduler="synchronous", progress=False, notify=notes.append)
+    assert len(solved) == 4 and len(notes) == 2 and notes[0].startswith("atlas: 3 of 7 chunks read")
+    line = notes[1]
+    assert line.startswith(f"atlas: 4 chunk(s) in {str(out / 'chunks')!r} not used, computing them again: ")
+    assert "cannot be read" in line and "holds chunk 2 (a copy from another position)" in line
+    assert "is a chunk of another atlas" in line and "1 more" in line and "\n" not in line
+    _same_bits(_draws(out), draws)
+    assert result.to_dict() == answer
+    assert sorted(p.name for p in (out / "chunks").iterdir()) == sorted(p.name for p in chunk.values())
+    for index, path in chunk.items():  # every chunk saved again passes its checks
+        assert atlas_chunks.read(path, key, index, 64)[1] is None
+
+
+def test_an_edited_chunk_is_caught_by_its_checksum(in_process, tmp_path):
+    """A chunk re-saved with one output changed but its marks kept: read refuses it by the CRC-32."""
+    from spinectl.landscape import atlas_chunks
+
+    spec, _, _ = in_process
+    key = atlas.fingerprint(spec)
+    found = {"status": np.array(["optimal"] * 3), "min_pcsa_cm2": np.array([1.0, 2.0, 3.0])}
+    path = tmp_path / atlas_chunks.name(key, 0)
+    atlas_chunks.save(path, found, key, 0)
+    read, problem = atlas_chunks.read(path, key, 0, 3)
+    assert problem is None and read.keys() == found.keys()
+    assert all(np.array_equal(read[k], found[k]) for k in found)
+    with np.load(path) as saved:
+        edited = {k: saved[k] for k in saved.files}
+    edited["min_pcsa_cm2"][1] = 2.5
+    np.savez(path, **edited)
+    assert atlas_chunks.read(path, key, 0, 3) == (None, "holds other outputs than were saved (its checksum differs)")
+    assert atlas_chunks.read(path, key, 0, 4)[0] is None  # and a chunk of another size
+
+
+def test_a_folder_at_a_chunks_name_is_one_line_before_any_solve(tmp_path, monkeypatch):
+    """A folder where a chunk belongs could never be saved again: refused at once, naming it (not after the solve)."""
+    from spinectl.errors import OutputError
+    from spinectl.landscape import atlas_chunks
+
+    spec = _spec(chain="false")
+    blocked = tmp_path / "out" / "chunks" / atlas_chunks.name(atlas.fingerprint(spec), 1)
+    blocked.mkdir(parents=True)
+    monkeypatch.setattr(atlas, "evaluate", lambda *a: (_ for _ in ()).throw(AssertionError("solved")))
+    with pytest.raises(OutputError, match="a folder .* stands where a chunk of the atlas belongs"):
+        atlas.run_atlas(spec, tmp_path / "out", scheduler="synchronous", progress=False)
+
+
+def _files(folder):
+    """Every output file of an atlas folder (not its chunks) -> its bytes."""
+    return {p.name: p.read_bytes() for p in folder.iterdir() if p.is_file()}
+
+
+@pytest.mark.parametrize("before", [True, False], ids=["previous-set", "fresh"])
+def test_an_interrupted_write_leaves_the_previous_set_or_none(tmp_path, monkeypatch, before):
+    """Ctrl-C between atlas.json and report.md: the folder holds the previous atlas's four files, byte for byte
+    (they were written one by one: a new atlas.json beside the old report.md), or none of them; no temporary
+    beside or inside it. The second atlas's chunks stay, to resume it."""
+    spec, here = _spec(chain="false"), {"scheduler": "synchronous", "progress": False}
+    out = tmp_path / "out"
+    if before:
+        atlas.run_atlas(spec, out, **here)
+    previous = _files(out) if before else {}
+    write = atlas.atomic_write_text
+
+    def interrupted(target, text):
+        if Path(target).name == "report.md":
+            raise KeyboardInterrupt
+        return write(target, text)
+
+    monkeypatch.setattr(atlas, "atomic_write_text", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        atlas.run_atlas(dataclasses.replace(spec, seed=1), out, **here)
+    assert _files(out) == previous and set(previous) in ({"atlas.json", "draws.npz", "report.md", "density.png"}, set())
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]  # no staging folder left
+    assert {p.name for p in out.iterdir()} == set(previous) | {"chunks"}
+
+
+def test_a_killed_write_leaves_the_previous_set_and_the_next_run_the_new(tmp_path):
+    """SIGKILL of a subprocess between atlas.json and report.md: the previous four files stand; the next run (of
+    the killed atlas) removes the dead run's staging folder, writes its four files and drops the other atlas's
+    chunks from out/chunks."""
+    import os
+    import signal
+    import subprocess
+    import sys
+
+    from spinectl.landscape import atlas_chunks
+
+    spec, here = _spec(chain="false"), {"scheduler": "synchronous", "progress": False}
+    out = tmp_path / "out"
+    atlas.run_atlas(spec, out, **here)
+    previous = _files(out)
+    script = f"""
+import dataclasses, os, signal, sys
+sys.path.insert(0, {str(Path(__file__).parent)!r})
+from test_atlas import _spec
+from spinectl.landscape import atlas
+write = atlas.atomic_write_text
+def killed(target, text):
+    if str(target).endswith("report.md"):
+        os.kill(os.getpid(), signal.SIGKILL)
+    return write(target, text)
+atlas.atomic_write_text = killed
+spec = dataclasses.replace(_spec(chain="false"), seed=1)
+atlas.run_atlas(spec, {str(out)!r}, scheduler="synchronous", progress=False)
+"""
+    done = subprocess.run([sys.executable, "-c", script], env=os.environ, capture_output=True, timeout=600)
+    assert done.returncode == -signal.SIGKILL, done.stderr.decode()[-2000:]
+    assert _files(out) == previous
+    assert [p.name for p in tmp_path.iterdir() if p.name != "out"]  # the dead run's staging folder, for now
+    second = dataclasses.replace(spec, seed=1)
+    result = atlas.run_atlas(second, out, **here)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]
+    assert json.loads((out / "atlas.json").read_text())["sobol"] == json.loads(json.dumps(result.to_dict()))["sobol"]
+    key = atlas.fingerprint(second)
+    assert {atlas_chunks.NAME.fullmatch(p.name)["atlas"] for p in (out / "chunks").iterdir()} == {key}
