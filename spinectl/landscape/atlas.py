@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..atomic import atomic_path, atomic_write_text, check_distinct, output_errors
+from ..atomic import atomic_path, atomic_write_text, check_distinct, check_folder, output_errors, staged_directory
 from ..errors import SpinectlError
 from ..jsondoc import dumps
 from ..model import chain
@@ -39,7 +39,7 @@ from ..optimise.problem import OK_STATUSES, problem_data
 from ..reflex.inputs import guarded
 from ..reflex.maps import landscape
 from ..units import M2_PER_CM2, m2_to_cm2
-from . import budget
+from . import atlas_chunks, budget
 from .priors import PAPER_OPTIMUM, VERDICTS, AtlasSpec
 
 INSTALL_HINT = "pip install 'spinectl[atlas]' (SALib)"
@@ -668,7 +668,10 @@ def run_atlas(
     ----------
     spec : AtlasSpec
     out : str or Path, optional
-        Output folder: chunks as they finish, then ``atlas.json``, ``draws.npz`` and ``report.md``.
+        Output folder: chunks in ``out/chunks`` as they finish (each with its atlas, position and checksum,
+        checked when read back: :mod:`spinectl.landscape.atlas_chunks`), then ``atlas.json``, ``draws.npz``,
+        ``report.md`` and ``density.png`` together (a staging folder swapped in), then the chunks of
+        other atlases removed.
     progress : bool or None
         A progress bar of draws on stderr; None: only on a terminal.
     scheduler : str or None
@@ -691,7 +694,8 @@ def run_atlas(
     ------
     ParameterError
         Bad scheduler options (before anything is written), an unreachable scheduler; more than the
-        available memory holds (:func:`spinectl.landscape.budget.check`).
+        available memory holds (:func:`spinectl.landscape.budget.check`, field ``atlas.samples``; the
+        design, the draws, their outputs and the bootstrap counted before the design is built).
     OutputError
         ``out`` cannot be written.
     """
@@ -702,13 +706,18 @@ def run_atlas(
     timeouts = {"connect_timeout": connect_timeout, "worker_timeout": worker_timeout}
     timeouts = {k: v for k, v in timeouts.items() if v is not None}
     check_options(scheduler, workers, **timeouts)  # before anything is drawn or written
+    where = {"scheduler": scheduler, "workers": workers, **timeouts}
+    n = spec.samples * (len(spec.priors) + 2)
+    budget.check(_estimate(spec, n, -(-n // spec.chunk_size), where), out)  # before the design is built
+    if out is not None:
+        check_folder(out, OUTPUT_FILES)  # an output folder that cannot take the files: one line, before the work
     values = draw(spec, saltelli_unit(spec))
     folder = Path(out) / "chunks" if out is not None else None
-    where = {"scheduler": scheduler, "workers": workers, **timeouts}
     outputs = _solve(spec, values, folder, progress, where, notify or (lambda line: None))
     result = analyse(spec, values, outputs)
     if out is not None:
         _write(result, Path(out), spec)
+        atlas_chunks.remove_others(Path(out) / "chunks", fingerprint(spec))  # the folder is this atlas's now
     return result
 
 
@@ -719,14 +728,13 @@ def _solve(spec: AtlasSpec, values: dict, folder: Path | None, progress, where: 
     from .study.executor import executor
 
     n, key = values["eccentricity_m"].size, fingerprint(spec)
-    names = [f"{key}-{index:06d}.npz" for index in range(-(-n // spec.chunk_size))]
-    parts = {index: _saved(folder, name) for index, name in enumerate(names)}
-    parts = {index: part for index, part in parts.items() if part is not None}
+    names = [atlas_chunks.name(key, index) for index in range(-(-n // spec.chunk_size))]
+    parts = _read_saved(spec, folder, names, n, notify)
     todo = [index for index in range(len(names)) if index not in parts]
-    if parts:
-        notify(f"atlas: {len(parts)} of {len(names)} chunks read from {str(folder)!r}, saved by an earlier run")
     done = sum(part["status"].size for part in parts.values())
-    _check_cost(spec, n - done, len(todo), where, folder, notify)
+    cost = _estimate(spec, n - done, len(todo), where)
+    if cost.long:
+        notify(cost.line())
     if folder is not None:  # an unwritable --out is one line now, not a traceback after the solving
         with output_errors(folder.parent):
             folder.mkdir(parents=True, exist_ok=True)
@@ -739,7 +747,7 @@ def _solve(spec: AtlasSpec, values: dict, folder: Path | None, progress, where: 
     ):
         for index, found in chunks.as_completed(solve_chunk, tasks, key=lambda task: f"atlas-{key}-{task.index}"):
             if folder is not None:
-                _save(folder / names[index], found)
+                _save(folder / names[index], found, key, index)
             parts[index] = found
             bar.update(found["status"].size)
     return {k: np.concatenate([parts[i][k] for i in range(len(names))]) for k in parts[0]}
@@ -755,22 +763,37 @@ def _no_bar(progress: bool | None) -> bool | None:
     return None if progress is None else not progress  # None: tqdm shows it on a terminal only (as the study)
 
 
-def _saved(folder: Path | None, name: str) -> dict | None:
-    """A chunk's outputs as an earlier run saved them, or None."""
-    if folder is None or not (folder / name).is_file():
-        return None
-    with np.load(folder / name, allow_pickle=False) as saved:
-        return {k: saved[k] for k in saved.files}
+def _read_saved(spec: AtlasSpec, folder: Path | None, names: list[str], n: int, notify) -> dict[int, dict]:
+    """The chunks an earlier run of this atlas saved in ``folder``, each checked (:func:`atlas_chunks.read`).
+
+    A chunk that fails its checks is left to be solved again, with one line for the user naming it and why.
+    """
+    if folder is None:
+        return {}
+    key, parts, bad = fingerprint(spec), {}, []
+    for index, name in enumerate(names):
+        size = min(spec.chunk_size, n - index * spec.chunk_size)
+        found, problem = atlas_chunks.read(folder / name, key, index, size)
+        if found is not None:
+            parts[index] = found
+        elif problem:
+            bad.append(f"{name} {problem}")
+    if parts:
+        notify(f"atlas: {len(parts)} of {len(names)} chunks read from {str(folder)!r}, saved by an earlier run")
+    if bad:
+        more = f"; and {len(bad) - 3} more" if len(bad) > 3 else ""
+        listed = "; ".join(bad[:3]) + more
+        notify(f"atlas: {len(bad)} chunk(s) in {str(folder)!r} not used, computing them again: {listed}")
+    return parts
 
 
-def _save(path: Path, found: dict) -> None:
-    """Save a chunk atomically (a temporary name, then a rename): an interrupted save leaves no chunk."""
-    with atomic_path(path) as tmp, open(tmp, "wb") as handle:
-        np.savez(handle, **found)
+def _save(path: Path, found: dict, key: str, index: int) -> None:
+    """Save a chunk atomically with its atlas, index and checksum (:func:`atlas_chunks.save`)."""
+    atlas_chunks.save(path, found, key, index)
 
 
-def _check_cost(spec: AtlasSpec, n_todo: int, n_chunks: int, where: dict, folder: Path | None, notify) -> None:
-    """Refuse what cannot fit (:func:`spinectl.landscape.budget.check`); announce a long run, as the study does."""
+def _estimate(spec: AtlasSpec, n_todo: int, n_chunks: int, where: dict) -> budget.Estimate:
+    """What the atlas will cost: its arrays in this process (the design first), the workers, the files, the CPU."""
     from .study.executor import local_processes
 
     processes = local_processes(where["scheduler"], where["workers"], n_chunks)
@@ -778,10 +801,9 @@ def _check_cost(spec: AtlasSpec, n_todo: int, n_chunks: int, where: dict, folder
     per_draw = budget.ATLAS_SECONDS_PER_DRAW if fast else budget.ATLAS_PER_DRAW_SECONDS
     seconds = n_todo * (per_draw + spec.chain * budget.ATLAS_CHAIN_SECONDS_PER_DRAW)
     memory = processes * (budget.PROCESS_BYTES + spec.chunk_size * budget.WORKING_BYTES_PER_POINT)
-    cost = budget.Estimate("atlas", n_todo, memory, n_todo * budget.ATLAS_BYTES_PER_DRAW, seconds)
-    budget.check(cost, folder)
-    if cost.long:
-        notify(cost.line())
+    memory += budget.atlas_memory(spec.samples, len(spec.priors), spec.bootstrap)
+    disk, fewer = n_todo * budget.ATLAS_BYTES_PER_DRAW, "samples, or bootstrap resamples (atlas.bootstrap)"
+    return budget.Estimate("atlas", n_todo, memory, disk, seconds, field="atlas.samples", fewer=fewer, unit="draws")
 
 
 OUTPUT_FILES = ("atlas.json", "draws.npz", "report.md", "density.png")
@@ -795,14 +817,18 @@ def _outputs(out) -> list[Path]:
 
 
 def _write(result: AtlasResult, out: Path, spec: AtlasSpec) -> None:
-    atomic_write_text(out / "atlas.json", dumps(result.to_dict()))
-    with atomic_path(out / "draws.npz") as tmp, open(tmp, "wb") as handle:
-        np.savez(handle, **{k: np.asarray(v) for k, v in result.draws.items()})
+    """The four files, written into a staging folder that then replaces ``out`` as a whole (its chunks kept):
+    an interruption leaves the previous atlas's four files or this one's, never a mix."""
     from ..canvas import save_file
     from .atlas_report import density_figure, report_text
 
-    atomic_write_text(out / "report.md", report_text(result, spec))
-    save_file(density_figure(base_landscape(spec, result.draws), result.draws, PAPER_OPTIMUM), out / "density.png", 120)
+    figure = density_figure(base_landscape(spec, result.draws), result.draws, PAPER_OPTIMUM)
+    with staged_directory(out, OUTPUT_FILES, replaces=OUTPUT_FILES) as stage:
+        atomic_write_text(stage / "atlas.json", dumps(result.to_dict()))
+        with atomic_path(stage / "draws.npz") as tmp, open(tmp, "wb") as handle:
+            np.savez(handle, **{k: np.asarray(v) for k, v in result.draws.items()})
+        atomic_write_text(stage / "report.md", report_text(result, spec))
+        save_file(figure, stage / "density.png", 120)
 
 
 def base_landscape(spec: AtlasSpec, draws: dict, n: int = 41) -> dict[str, np.ndarray]:

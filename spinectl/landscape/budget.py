@@ -44,6 +44,22 @@ ATLAS_BYTES_PER_DRAW = 240
 """An atlas's files per draw [B]: its chunk in ``DIR/chunks`` and its row of ``draws.npz`` (measured:
 the shipped atlas's five priors with the chain, N = 256: 94 B a draw in its chunk, 142 B in ``draws.npz``)."""
 
+ATLAS_DESIGN_BYTES_PER_VALUE = 16
+"""Peak memory of Saltelli's design per value, N (D + 2) x D of them [B]: SALib's array and its clipped copy
+(tracemalloc peak of ``atlas.saltelli_unit``, N = 4096, five priors: 16.0 B)."""
+
+ATLAS_DRAW_BYTES_PER_VALUE = 16
+"""Peak memory of the draws' parameters per draw and column (D priors and the three of the position) [B]:
+the array and a quantile's temporary (tracemalloc peak of ``atlas.draw``: 107 B a draw for 8 columns)."""
+
+ATLAS_OUTPUT_BYTES_PER_DRAW = 200
+"""Memory of a draw's outputs while the chunks are joined [B]: the chunks' and their concatenation's
+(measured: 68 B a draw without the chain, 92 B with it, times two)."""
+
+ATLAS_BOOTSTRAP_BYTES = 72
+"""Peak memory of SALib's Sobol' analysis per base sample and bootstrap resample [B]: its resampled
+indices and the outputs they pick (tracemalloc peak of ``atlas.sobol_indices``: 64-66 B)."""
+
 SWEEP_MEMORY_PER_BYTE = 2.5
 """Peak memory of a sweep per byte of its answer: the chunks' columns, their concatenation and the
 Dataset (tracemalloc peak of ``write_sweep`` over 101 x 101 x 4 K: 3.1 kB a point for 1.22 kB of answer)."""
@@ -84,6 +100,12 @@ class Estimate:
         Bytes to be written [B].
     seconds : float
         CPU time on one core [s].
+    field : str
+        The field a memory refusal names (default: ``what``).
+    fewer : str
+        What a memory refusal advises to use fewer of.
+    unit : str
+        What ``points`` counts, in the lines (an atlas's draws).
     """
 
     what: str
@@ -91,6 +113,9 @@ class Estimate:
     memory: float
     disk: float
     seconds: float
+    field: str = ""
+    fewer: str = "points (a coarser grid, fewer K values or axis values)"
+    unit: str = "points"
 
     @property
     def long(self) -> bool:
@@ -106,9 +131,43 @@ class Estimate:
             Without a newline.
         """
         return (
-            f"{self.what}: {self.points:,} points, about {size(self.disk)} on disk, {size(self.memory)} of memory, "
-            f"{duration(self.seconds)} of CPU (estimated)"
+            f"{self.what}: {self.points:,} {self.unit}, about {size(self.disk)} on disk, "
+            f"{size(self.memory)} of memory, {duration(self.seconds)} of CPU (estimated)"
         )
+
+
+def atlas_memory(samples: int, priors: int, bootstrap: int) -> float:
+    """Peak memory of an atlas's arrays in the main process [B], before its design is built.
+
+    The stages follow one another, each holding what the next needs: the design (Saltelli's
+    N (D + 2) x D probabilities), the draws' parameters made from it, the outputs joined beside
+    them, and SALib's bootstrap of the Sobol' indices beside both. The workers' own memory
+    (their chunks) is not in it.
+
+    Parameters
+    ----------
+    samples : int
+        Saltelli's base samples N.
+    priors : int
+        The priors D.
+    bootstrap : int
+        SALib's bootstrap resamples.
+
+    Returns
+    -------
+    float
+        [B].
+    """
+    draws = samples * (priors + 2)
+    parameters = draws * (priors + 3) * ATLAS_DRAW_BYTES_PER_VALUE  # the priors' and E, Lambda, the angle
+    design = draws * priors * ATLAS_DESIGN_BYTES_PER_VALUE
+    stages = (
+        design,
+        design / 2 + parameters,  # the design (one copy) while the draws are made
+        parameters / 2 + draws * ATLAS_OUTPUT_BYTES_PER_DRAW,
+        parameters / 2 + draws * ATLAS_OUTPUT_BYTES_PER_DRAW / 2 + samples * bootstrap * ATLAS_BOOTSTRAP_BYTES,
+    )
+    return float(max(stages))
 
 
 def size(nbytes: float) -> str:
@@ -212,9 +271,9 @@ def check(estimate: Estimate, path: str | Path | None = None) -> None:
     available = available_memory()  # looked up here, so that tests can give tiny limits
     if available is not None and estimate.memory > available:
         raise ParameterError(
-            estimate.what,
-            f"{estimate.points:,} points need about {size(estimate.memory)} of memory, and "
-            f"{size(available)} is available: use fewer points (a coarser grid, fewer K values or axis values)",
+            estimate.field or estimate.what,
+            f"{estimate.points:,} {estimate.unit} need about {size(estimate.memory)} of memory, and "
+            f"{size(available)} is available: use fewer {estimate.fewer}",
         )
     free = None if path is None else free_disk(path)
     if free is not None and estimate.disk > free:

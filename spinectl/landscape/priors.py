@@ -88,8 +88,8 @@ class Prior:
         if self.distribution == "uniform":
             return stats.uniform(self.bounds[0], self.bounds[1] - self.bounds[0])
         if self.distribution == "lognormal":  # mean m, sd s of X: log X ~ N(mu, sigma^2)
-            sigma2 = math.log1p((self.sd / self.mean) ** 2)
-            return stats.lognorm(math.sqrt(sigma2), scale=self.mean / math.exp(sigma2 / 2))
+            sigma2 = _log_variance(self.mean, self.sd)
+            return stats.lognorm(math.sqrt(sigma2), scale=math.exp(math.log(self.mean) - sigma2 / 2))
         return stats.norm(self.mean, self.sd)
 
     def mass(self) -> float:
@@ -119,6 +119,20 @@ class Prior:
         dist = self._frozen()
         low, high = dist.cdf(self.bounds[0]), dist.cdf(self.bounds[1])
         return np.clip(dist.ppf(low + np.asarray(u, float) * (high - low)), *self.bounds)
+
+
+def _log_variance(mean: float, sd: float) -> float:
+    """sigma^2 = log(1 + (sd / mean)^2) of a lognormal of that mean and sd, without overflow or underflow.
+
+    In logarithms: the ratio of 1e300 to 40 squared overflows, and that of 1e-300 to 40 squared
+    underflows to 0, a lognormal of no spread whose quantiles scipy gives as NaN.
+    """
+    log_ratio = math.log(sd) - math.log(mean)
+    if log_ratio > 300:  # (sd/mean)^2 would overflow: log(1 + r^2) = 2 log r + log(1 + r^-2), the last below 1e-260
+        return 2 * log_ratio
+    if log_ratio < -20:  # log(1 + r^2) = r^2 to double precision (r^2 < 1e-17); r^2 may underflow, kept as sigma^2
+        return math.exp(2 * log_ratio) or math.ulp(0.0)
+    return math.log1p(math.exp(2 * log_ratio))
 
 
 @dataclasses.dataclass(frozen=True)
@@ -296,12 +310,37 @@ def _prior(index: int, row, model: Model) -> Prior:
     if family not in FAMILIES:
         raise ConfigError(f"{where}.distribution", _toml.unknown_message(family, FAMILIES).replace("key", "family"))
     prior = Prior(parameter, family, *_moments(where, row, family), _bounds(where, row, family), row["source"])
+    _check_quantiles(where, prior)
     if prior.mass() < LEAST_MASS:
         raise ConfigError(
             f"{where}.bounds", f"{list(prior.bounds)} hold no mass of the {family} distribution (below {LEAST_MASS:g})"
         )
     _check_range(f"{where}.bounds", prior, model)
     return prior
+
+
+def _check_quantiles(where: str, prior: Prior) -> None:
+    """The prior's extreme quantiles must be finite numbers: moments or bounds beyond double precision are refused.
+
+    A normal of sd 1e308 has its quantile at eps below -8e308 (infinite), a uniform over [-1e308, 1e308] a
+    width of infinity, a lognormal of sd 1e300 about a mean of 1e-300 a scale below the smallest double:
+    their draws would be infinite or NaN.
+    """
+    tiny = np.finfo(float).eps  # the atlas draws on (eps, 1 - eps), as in _check_range
+    with np.errstate(all="ignore"):
+        ends = prior.ppf([tiny, 1.0 - tiny])
+    if np.all(np.isfinite(ends)):
+        return
+    if prior.distribution == "uniform":
+        field, given = "bounds", f"bounds {list(prior.bounds)}"
+    else:
+        field, given = "sd", f"mean {prior.mean:g} and sd {prior.sd:g}"
+    span = "" if np.isnan(ends).any() else f" (from {ends[0]:g} to {ends[1]:g})"  # NaN: no numbers at all
+    raise ConfigError(
+        f"{where}.{field}",
+        f"{given} give a {prior.distribution} distribution whose draws are not finite in double precision{span}: "
+        "give the moments or bounds of the quantity in its unit",
+    )
 
 
 def _check_range(where: str, prior: Prior, model: Model) -> None:
@@ -340,6 +379,12 @@ def _parameter(where: str, name: str, model: Model) -> str:
     value = holder[key]
     if isinstance(value, bool) or not isinstance(value, int | float):
         raise ConfigError(where, f"{name!r} is not a number; a prior varies a numeric parameter")
+    if isinstance(value, int):  # the model's real fields hold floats (validated), its counts ints
+        raise ConfigError(
+            where,
+            f"{name!r} is an integer (a count, {value} in this model), and a prior draws real numbers from a "
+            "continuous distribution: vary a real-valued parameter, or set this one with --set or the model file",
+        )
     return name
 
 

@@ -249,6 +249,7 @@ def axis_candidates(e, a0, a1, floor: float = 0.0) -> np.ndarray:
 
 def _refine(moduli, w, target, steps: int = 12):
     """Secant on log abs(w') of the eigenvalue nearest ``target`` from w: (w, w') or None if it does not reach 1."""
+
     def g(x):
         values = moduli(x)
         nearest = values[np.argmin(np.abs(values - target))]

@@ -148,3 +148,18 @@ def test_an_out_that_would_overwrite_an_input_is_refused(tmp_path, capsys, where
     err = capsys.readouterr().err.strip()
     assert "is the same file as" in err and "\n" not in err
     assert victim.read_text() == before
+
+
+def test_a_cut_chunk_is_one_line_on_stderr_and_solved_again(tmp_path, capsys):
+    """A chunk file cut short after a run: the next run says so in one line on stderr, solves it again and
+    prints the first run's JSON, exit 0 (it was a BadZipFile traceback)."""
+    argv = ["atlas", str(_file(tmp_path)), "--out", str(tmp_path / "out"), "--json"]
+    assert main(argv) == 0
+    first = json.loads(capsys.readouterr().out)
+    (chunk,) = (tmp_path / "out" / "chunks").iterdir()
+    chunk.write_bytes(chunk.read_bytes()[:-40])
+    assert main(argv) == 0
+    captured = capsys.readouterr()
+    lines = [line for line in captured.err.splitlines() if line.startswith("atlas:")]
+    assert len(lines) == 1 and "cannot be read (cut short" in lines[0] and "computing them again" in lines[0]
+    assert json.loads(captured.out) == first

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import dataclasses
+import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -214,10 +216,10 @@ def test_an_interrupted_cluster_run_resumes_to_the_same_bits(in_process, tmp_pat
     spec, answer, draws = in_process
     save, saved = atlas._save, []
 
-    def interrupted(path, found):
+    def interrupted(path, found, *marks):
         if len(saved) == 3:
             raise KeyboardInterrupt
-        save(path, found)
+        save(path, found, *marks)
         saved.append(path.name)
 
     monkeypatch.setattr(atlas, "_save", interrupted)
@@ -263,7 +265,7 @@ def test_the_atlas_runs_in_process_unless_dask_is_asked_for(monkeypatch):
 def test_a_long_atlas_is_announced_and_what_cannot_fit_refused(tmp_path, monkeypatch):
     """As the study's: the estimate's line before a run of at least NOTICE_SECONDS (here 0), with the draws
     to solve and their CPU time from the benchmark's costs per draw; a memory estimate above what is
-    available is one error naming the atlas, before --out is made."""
+    available is one error naming atlas.samples, before --out is made."""
     from spinectl.errors import ParameterError
     from spinectl.landscape import budget
 
@@ -271,15 +273,78 @@ def test_a_long_atlas_is_announced_and_what_cannot_fit_refused(tmp_path, monkeyp
     monkeypatch.setattr(budget, "NOTICE_SECONDS", 0.0)
     atlas.run_atlas(spec, None, scheduler="synchronous", progress=False, notify=notes.append)
     seconds = 28 * budget.ATLAS_SECONDS_PER_DRAW  # N (D + 2) = 4 x 7 draws on the fast path, no chain
-    memory = budget.size(budget.PROCESS_BYTES + 16 * budget.WORKING_BYTES_PER_POINT)  # one process, chunks of 16
+    # one process, chunks of 16, and the atlas's arrays: N = 4, D = 5, 100 bootstrap resamples
+    memory = budget.PROCESS_BYTES + 16 * budget.WORKING_BYTES_PER_POINT + budget.atlas_memory(4, 5, 100)
     disk = budget.size(28 * budget.ATLAS_BYTES_PER_DRAW)
+    shown = budget.size(memory)
     assert notes == [
-        f"atlas: 28 points, about {disk} on disk, {memory} of memory, {budget.duration(seconds)} of CPU (estimated)"
+        f"atlas: 28 draws, about {disk} on disk, {shown} of memory, {budget.duration(seconds)} of CPU (estimated)"
     ]
     monkeypatch.setattr(budget, "available_memory", lambda: 1e6)
-    with pytest.raises(ParameterError, match=f"^atlas: 28 points need about {memory} of memory"):
+    with pytest.raises(ParameterError, match=f"^atlas.samples: 28 draws need about {shown} of memory"):
         atlas.run_atlas(spec, tmp_path / "out", scheduler="synchronous", progress=False)
     assert not (tmp_path / "out").exists()
+
+
+EIGHT = "[atlas]\nsamples = {samples}\nchain = false\nbootstrap = {bootstrap}\n" + PRIORS + MORE_PRIORS
+
+
+@pytest.mark.parametrize(
+    ("samples", "bootstrap", "available"),
+    [
+        (2**24, 100, 16 * 2**30),  # the issue's: the design alone 2^24 x 10 x 8 doubles = 10 GiB; 16 GiB available
+        (2**20, 2, 2**30),  # a variant: the design (1.34 GB with its copy) alone tips it; the bootstrap is small
+    ],
+)
+def test_the_design_is_counted_before_it_is_built(tmp_path, monkeypatch, samples, bootstrap, available):
+    """An atlas whose design does not fit is refused naming atlas.samples before the design is built.
+
+    The design of N base samples and D = 8 priors is N (D + 2) x D doubles (SALib's, and its clipped copy);
+    the estimate used to count only the workers' chunks (150 MB + 16 MB), and the design was built first.
+    tracemalloc: the refusal allocates no design (its peak stays below a MB).
+    """
+    import tracemalloc
+
+    from spinectl.errors import ParameterError
+    from spinectl.landscape import budget
+
+    spec = parse_atlas(EIGHT.format(samples=samples, bootstrap=bootstrap))
+    design = samples * 10 * 8 * 8  # one copy, in bytes
+    assert budget.atlas_memory(samples, 8, bootstrap) >= 2 * design
+    monkeypatch.setattr(budget, "available_memory", lambda: float(available))
+
+    def built(spec):
+        raise AssertionError("the design was built before the memory check")
+
+    monkeypatch.setattr(atlas, "saltelli_unit", built)
+    tracemalloc.start()
+    try:
+        with pytest.raises(ParameterError) as raised:
+            atlas.run_atlas(spec, tmp_path / "out", progress=False)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert raised.value.field == "atlas.samples" and f"{samples * 10:,} draws need about" in str(raised.value)
+    assert f"{budget.size(available)} is available" in str(raised.value) and peak < 1e6
+    assert not (tmp_path / "out").exists()
+
+
+def test_the_memory_estimate_bounds_the_design_and_draws():
+    """tracemalloc's peak of building the design and the draws (N = 4096, the eight priors: 7.7 MB) stays within the
+    estimate of the atlas's arrays (budget.atlas_memory): the constants are measured, this keeps them honest."""
+    import tracemalloc
+
+    from spinectl.landscape import budget
+
+    spec = parse_atlas(EIGHT.format(samples=4096, bootstrap=2))  # few resamples: the design and draws decide
+    atlas.saltelli_unit(spec)  # SALib's and scipy's imports, not the design's memory
+    tracemalloc.start()
+    try:
+        atlas.draw(spec, atlas.saltelli_unit(spec))
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak <= budget.atlas_memory(4096, 8, 2)
 
 
 def test_the_report_tells_an_unbounded_margin_from_an_infeasible_draw():
@@ -304,3 +369,151 @@ def test_the_report_tells_an_unbounded_margin_from_an_infeasible_draw():
     assert "within ±30 N m" in text and "within 17 cm² per joint" in text
     unverified = sum("unverified" in p.source.lower() for p in spec.priors)
     assert f"{unverified} of {len(spec.priors)} priors are unverified" in text
+
+
+def test_damaged_copied_and_foreign_chunks_are_solved_again(in_process, tmp_path, monkeypatch):
+    """The reference's seven chunks, then: chunk 1 cut short, chunk 2's file copied over chunk 4's, another atlas's
+    chunk renamed as chunk 5, chunk 6 re-saved with other outputs under its old checksum, and another atlas's
+    chunk under its own name. Those four are solved again (4 of 7, one line naming them), the answer is the
+    reference's to the bit (it read chunk 4 as chunk 2's draws and ended with a traceback on chunk 1), and the
+    other atlas's chunk is gone at the end."""
+    import shutil
+
+    from spinectl.landscape import atlas_chunks
+
+    spec, answer, draws = in_process
+    reference = tmp_path / "ref"
+    atlas.run_atlas(spec, reference, scheduler="synchronous", progress=False)
+    other = dataclasses.replace(spec, seed=1, chain=False)
+    atlas.run_atlas(other, tmp_path / "other", scheduler="synchronous", progress=False)
+    out = tmp_path / "out"
+    shutil.copytree(reference / "chunks", out / "chunks")
+    key, foreign = atlas.fingerprint(spec), atlas.fingerprint(other)
+    chunk = {i: out / "chunks" / atlas_chunks.name(key, i) for i in range(7)}
+    chunk[1].write_bytes(chunk[1].read_bytes()[:500])
+    shutil.copyfile(chunk[2], chunk[4])
+    shutil.copyfile(tmp_path / "other" / "chunks" / atlas_chunks.name(foreign, 0), chunk[5])
+    with np.load(chunk[6]) as saved:
+        edited = {k: saved[k] for k in saved.files}
+    edited["min_pcsa_cm2"] = edited["min_pcsa_cm2"] + 1.0
+    np.savez(chunk[6], **edited)
+    stray = out / "chunks" / atlas_chunks.name(foreign, 0)
+    shutil.copyfile(tmp_path / "other" / "chunks" / stray.name, stray)
+
+    evaluate, solved, notes = atlas.evaluate, [], []
+    monkeypatch.setattr(atlas, "evaluate", lambda spec, part: solved.append(1) or evaluate(spec, part))
+    result = atlas.run_atlas(spec, out, scheduler="synchronous", progress=False, notify=notes.append)
+    assert len(solved) == 4 and len(notes) == 2 and notes[0].startswith("atlas: 3 of 7 chunks read")
+    line = notes[1]
+    assert line.startswith(f"atlas: 4 chunk(s) in {str(out / 'chunks')!r} not used, computing them again: ")
+    assert "cannot be read" in line and "holds chunk 2 (a copy from another position)" in line
+    assert "is a chunk of another atlas" in line and "1 more" in line and "\n" not in line
+    _same_bits(_draws(out), draws)
+    assert result.to_dict() == answer
+    assert sorted(p.name for p in (out / "chunks").iterdir()) == sorted(p.name for p in chunk.values())
+    for index, path in chunk.items():  # every chunk saved again passes its checks
+        assert atlas_chunks.read(path, key, index, 64)[1] is None
+
+
+def test_an_edited_chunk_is_caught_by_its_checksum(in_process, tmp_path):
+    """A chunk re-saved with one output changed but its marks kept: read refuses it by the CRC-32."""
+    from spinectl.landscape import atlas_chunks
+
+    spec, _, _ = in_process
+    key = atlas.fingerprint(spec)
+    found = {"status": np.array(["optimal"] * 3), "min_pcsa_cm2": np.array([1.0, 2.0, 3.0])}
+    path = tmp_path / atlas_chunks.name(key, 0)
+    atlas_chunks.save(path, found, key, 0)
+    read, problem = atlas_chunks.read(path, key, 0, 3)
+    assert problem is None and read.keys() == found.keys()
+    assert all(np.array_equal(read[k], found[k]) for k in found)
+    with np.load(path) as saved:
+        edited = {k: saved[k] for k in saved.files}
+    edited["min_pcsa_cm2"][1] = 2.5
+    np.savez(path, **edited)
+    assert atlas_chunks.read(path, key, 0, 3) == (None, "holds other outputs than were saved (its checksum differs)")
+    assert atlas_chunks.read(path, key, 0, 4)[0] is None  # and a chunk of another size
+
+
+def test_a_folder_at_a_chunks_name_is_one_line_before_any_solve(tmp_path, monkeypatch):
+    """A folder where a chunk belongs could never be saved again: refused at once, naming it (not after the solve)."""
+    from spinectl.errors import OutputError
+    from spinectl.landscape import atlas_chunks
+
+    spec = _spec(chain="false")
+    blocked = tmp_path / "out" / "chunks" / atlas_chunks.name(atlas.fingerprint(spec), 1)
+    blocked.mkdir(parents=True)
+    monkeypatch.setattr(atlas, "evaluate", lambda *a: (_ for _ in ()).throw(AssertionError("solved")))
+    with pytest.raises(OutputError, match="a folder .* stands where a chunk of the atlas belongs"):
+        atlas.run_atlas(spec, tmp_path / "out", scheduler="synchronous", progress=False)
+
+
+def _files(folder):
+    """Every output file of an atlas folder (not its chunks) -> its bytes."""
+    return {p.name: p.read_bytes() for p in folder.iterdir() if p.is_file()}
+
+
+@pytest.mark.parametrize("before", [True, False], ids=["previous-set", "fresh"])
+def test_an_interrupted_write_leaves_the_previous_set_or_none(tmp_path, monkeypatch, before):
+    """Ctrl-C between atlas.json and report.md: the folder holds the previous atlas's four files, byte for byte
+    (they were written one by one: a new atlas.json beside the old report.md), or none of them; no temporary
+    beside or inside it. The second atlas's chunks stay, to resume it."""
+    spec, here = _spec(chain="false"), {"scheduler": "synchronous", "progress": False}
+    out = tmp_path / "out"
+    if before:
+        atlas.run_atlas(spec, out, **here)
+    previous = _files(out) if before else {}
+    write = atlas.atomic_write_text
+
+    def interrupted(target, text):
+        if Path(target).name == "report.md":
+            raise KeyboardInterrupt
+        return write(target, text)
+
+    monkeypatch.setattr(atlas, "atomic_write_text", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        atlas.run_atlas(dataclasses.replace(spec, seed=1), out, **here)
+    assert _files(out) == previous and set(previous) in ({"atlas.json", "draws.npz", "report.md", "density.png"}, set())
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]  # no staging folder left
+    assert {p.name for p in out.iterdir()} == set(previous) | {"chunks"}
+
+
+def test_a_killed_write_leaves_the_previous_set_and_the_next_run_the_new(tmp_path):
+    """SIGKILL of a subprocess between atlas.json and report.md: the previous four files stand; the next run (of
+    the killed atlas) removes the dead run's staging folder, writes its four files and drops the other atlas's
+    chunks from out/chunks."""
+    import os
+    import signal
+    import subprocess
+    import sys
+
+    from spinectl.landscape import atlas_chunks
+
+    spec, here = _spec(chain="false"), {"scheduler": "synchronous", "progress": False}
+    out = tmp_path / "out"
+    atlas.run_atlas(spec, out, **here)
+    previous = _files(out)
+    script = f"""
+import dataclasses, os, signal, sys
+sys.path.insert(0, {str(Path(__file__).parent)!r})
+from test_atlas import _spec
+from spinectl.landscape import atlas
+write = atlas.atomic_write_text
+def killed(target, text):
+    if str(target).endswith("report.md"):
+        os.kill(os.getpid(), signal.SIGKILL)
+    return write(target, text)
+atlas.atomic_write_text = killed
+spec = dataclasses.replace(_spec(chain="false"), seed=1)
+atlas.run_atlas(spec, {str(out)!r}, scheduler="synchronous", progress=False)
+"""
+    done = subprocess.run([sys.executable, "-c", script], env=os.environ, capture_output=True, timeout=600)
+    assert done.returncode == -signal.SIGKILL, done.stderr.decode()[-2000:]
+    assert _files(out) == previous
+    assert [p.name for p in tmp_path.iterdir() if p.name != "out"]  # the dead run's staging folder, for now
+    second = dataclasses.replace(spec, seed=1)
+    result = atlas.run_atlas(second, out, **here)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]
+    assert json.loads((out / "atlas.json").read_text())["sobol"] == json.loads(json.dumps(result.to_dict()))["sobol"]
+    key = atlas.fingerprint(second)
+    assert {atlas_chunks.NAME.fullmatch(p.name)["atlas"] for p in (out / "chunks").iterdir()} == {key}

@@ -107,3 +107,45 @@ def test_the_base_model_is_the_default_preset_or_the_files_or_the_callers():
     ).model
     assert source_of(given).preset == DEFAULT_PRESET and source_of(given).overridden == ("passive.stiffness",)
     assert given.passive.stiffness == 15.0
+
+
+@pytest.mark.parametrize(
+    ("fields", "field", "words"),
+    [
+        # sd / mean = 2.5e298: (sd / mean)^2 overflowed math's float power (an OverflowError traceback); in logarithms
+        # the lognormal is valid, and so wide that every draw lies below 1e-166 kg, which body.mass refuses
+        ({"distribution": "lognormal", "mean": 40.0, "sd": 1e300, "bounds": None}, "prior[0].bounds", "must be > 0"),
+        # a median of 1e-600 kg: below the smallest double, its quantiles NaN (they were, with the same traceback)
+        ({"distribution": "lognormal", "mean": 1e-300, "sd": 1e300, "bounds": None}, "prior[0].sd", "not finite"),
+        ({"distribution": "lognormal", "mean": 1e-300, "sd": 1.0, "bounds": None}, "prior[0].sd", "not finite"),
+        # the quantile at eps of N(40, 1e308) is -8.1e308, beyond the largest double
+        ({"distribution": "normal", "mean": 40.0, "sd": 1e308, "bounds": None}, "prior[0].sd", "from -inf to inf"),
+        # the uniform's width 2e308 overflows to infinity: scipy's quantiles NaN
+        ({"bounds": [-1e308, 1e308]}, "prior[0].bounds", "not finite in double precision"),
+        # a lognormal of mean 1e300 kg: its draws are 1e300 (it said 'draws from nan to nan', the spread lost)
+        ({"distribution": "lognormal", "mean": 1e300, "sd": 1.0, "bounds": None}, "prior[0].bounds", "at most 1000 kg"),
+    ],
+)
+def test_moments_beyond_double_precision_are_one_line(fields, field, words):
+    """Huge or tiny moments of a prior: one ConfigError naming the field, never a traceback or 'nan'."""
+    with pytest.raises(ConfigError) as raised:
+        parse_atlas(HEAD + _prior(**fields))
+    assert raised.value.field == field and words in str(raised.value) and "nan to nan" not in str(raised.value)
+
+
+@pytest.mark.parametrize("sd", [1e-300, 1e-12])
+def test_a_lognormal_of_tiny_sd_draws_its_mean(sd):
+    """sd / mean below 1e-154: (sd / mean)^2 underflowed to 0, a lognormal of no spread whose quantiles were NaN
+    (refused as 'must be finite (got nan)'); the draws are the mean to double precision (sigma = sd / mean)."""
+    prior = parse_atlas(HEAD + _prior(distribution="lognormal", mean=40.0, sd=sd, bounds=None)).priors[0]
+    np.testing.assert_allclose(prior.ppf([1e-9, 0.5, 1 - 1e-9]), 40.0, rtol=1e-9)
+
+
+@pytest.mark.parametrize("parameter", ["reflex.pade_order", "muscles.1.fibres"])
+def test_a_prior_on_an_integer_field_says_it_is_a_count(parameter):
+    """An integer field (a count): the reason is that priors draw real numbers (it was 'must be an integer
+    (got 2.0000000000000004)' against the bounds, blaming the draws)."""
+    with pytest.raises(ConfigError) as raised:
+        parse_atlas(HEAD + _prior(parameter=parameter, bounds=[2.0, 4.0]))
+    assert raised.value.field == "prior[0].parameter" and "is an integer" in str(raised.value)
+    assert "real numbers" in str(raised.value)
