@@ -7,6 +7,7 @@ import time
 import numpy as np
 
 from ...model.config import dump_toml
+from ...quoting import toml_comment
 from ..verdicts import RELATION
 from .fit import CalibrationResult
 
@@ -67,7 +68,7 @@ def preset_toml(result: CalibrationResult, command: str, date: str | None = None
     best = result.best
     header = [
         "# spinectl preset calibrated against the landmarks of Wagner et al. (2012); docs/reproduction.md.",
-        f"# Produced by: {command}",
+        toml_comment(f"Produced by: {command}"),  # the user's paths: one comment line whatever they hold
         f"# Date: {date}; wall time {result.seconds:.0f} s, {result.evaluations} loss evaluations.",
         f"# Loss: {best.loss:.4g} on the {result.settings['verify_points']}-point grid "
         f"({best.fit_loss:.4g} on the {result.settings['points']}-point fitting grid); "
@@ -78,7 +79,7 @@ def preset_toml(result: CalibrationResult, command: str, date: str | None = None
         "# Free parameters (value; bounds):",
     ]
     for p, v in zip(result.parameters, best.vector, strict=True):
-        header.append(f"#   {p.name} = {v:.6g} {p.unit}; [{p.lower:g}, {p.upper:g}]")
+        header.append(toml_comment(f"  {p.name} = {v:.6g} {p.unit}; [{p.lower:g}, {p.upper:g}]"))
     return "\n".join(header) + "\n" + dump_toml(result.model, _fitted(result))
 
 
