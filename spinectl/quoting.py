@@ -23,6 +23,7 @@ from urllib.parse import unquote
 
 from ._validate import printable
 
+
 def _percent(char: str) -> str:
     """``char`` as percent-encoded UTF-8 (a lone surrogate, e.g. an undecodable byte of a path, too)."""
     return "".join(f"%{byte:02X}" for byte in char.encode("utf-8", "surrogatepass"))

@@ -1,4 +1,4 @@
-"""spinectl.quoting: user text quoted for XML comments, TOML and Markdown reads back as the text, and as nothing else."""
+"""spinectl.quoting: user text quoted for XML comments, TOML and Markdown reads back as the text, nothing else."""
 
 from __future__ import annotations
 

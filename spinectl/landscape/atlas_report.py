@@ -66,7 +66,8 @@ def report_text(result, spec: AtlasSpec) -> str:
             continue
         lines += ["| parameter | S1 | ST |", "|---|---|---|"]
         for name, s in table.items():
-            lines.append(f"| {markdown_cell_code(name)} | {s['S1']:.3f} ± {s['S1_conf']:.3f} | {s['ST']:.3f} ± {s['ST_conf']:.3f} |")
+            first, total = f"{s['S1']:.3f} ± {s['S1_conf']:.3f}", f"{s['ST']:.3f} ± {s['ST_conf']:.3f}"
+            lines.append(f"| {markdown_cell_code(name)} | {first} | {total} |")
         lines.append("")
     return "\n".join(lines) + "\n"
 

@@ -203,4 +203,3 @@ def test_shown_toml_names_a_hostile_config_path_only_in_comments(tmp_path, folde
     shown.write_text(text, encoding="utf-8")
     assert config.load_config(str(shown)) == model
     assert sum(printable(str(path)) in line for line in text.splitlines()) >= 2  # the header and the note
-
