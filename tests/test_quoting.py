@@ -98,3 +98,32 @@ def test_a_markdown_cell_code_span_is_not_closed_by_the_text(text):
     inner = out[fence:-fence]
     assert "`" * fence not in inner and "|" not in inner.replace("\\|", "")
     assert inner.strip(" ").replace("\\|", "|") == text
+
+
+def test_no_writer_formats_a_comment_itself():
+    """Every comment spinectl formats goes through spinectl.quoting: no one-line f-string in the package outside it
+    starts a TOML comment ('# ...{x}'), none holds an XML comment ('<!--'), and every MuJoCo spec's ``comment`` is
+    assigned the result of xml_comment. A writer added later that formats user text into a comment fails here (the
+    header's --config path made TOML lines and live XML that way)."""
+    import ast
+    import pathlib
+
+    import spinectl
+
+    offenders = []
+    for path in pathlib.Path(spinectl.__file__).parent.rglob("*.py"):
+        if path.name == "quoting.py":
+            continue
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.JoinedStr) and any(isinstance(v, ast.FormattedValue) for v in node.values):
+                first = node.values[0]
+                text = "".join(v.value for v in node.values if isinstance(v, ast.Constant))
+                one_line = "\n" not in text.rstrip("\n")  # a Markdown document's f-string starts with '# ' too
+                comment = isinstance(first, ast.Constant) and first.value.startswith("# ") and one_line
+                if comment or "<!--" in text:
+                    offenders.append(f"{path.name}:{node.lineno}")
+            if isinstance(node, ast.Assign) and any(getattr(t, "attr", None) == "comment" for t in node.targets):
+                call = node.value
+                if not (isinstance(call, ast.Call) and getattr(call.func, "id", None) == "xml_comment"):
+                    offenders.append(f"{path.name}:{node.lineno}")
+    assert offenders == []
