@@ -143,6 +143,30 @@ large, read-only, failing): a writer's ``OSError`` with one of these is an :clas
 its other exceptions (e.g. a missing input) propagate unchanged."""
 
 
+FULL_BELOW = 1 << 20
+"""Free bytes below which a library's failed write names the full disk [B]: netCDF-C and OpenSim report it
+in their own words, without the error number."""
+
+
+def full_disk_note(target: str | Path) -> str:
+    """``'; No space left on device'`` if the file system of ``target`` has (almost) no space left, else ``''``.
+
+    Parameters
+    ----------
+    target : str or Path
+        An output whose writer (a library that hides the error number) failed.
+
+    Returns
+    -------
+    str
+    """
+    try:
+        stats = os.statvfs(Path(target).resolve().parent)
+    except OSError:
+        return ""
+    return "; No space left on device" if stats.f_bavail * stats.f_frsize < FULL_BELOW else ""
+
+
 @contextlib.contextmanager
 def output_errors(target: str | Path, errnos=None) -> Iterator[None]:
     """Turn an :class:`OSError` of the block into an :class:`OutputError` naming ``target``.

@@ -39,6 +39,7 @@ from ..model import chain, geometry, muscle
 from ..model.mechanics import gravity_sign, inertia, passive_stiffness
 from ..model.params import Model
 from ..model.source import header
+from ..quoting import xml_comment
 from ..units import M2_PER_CM2
 from .engine import CONTROL_UNIT, require_mujoco
 
@@ -286,7 +287,7 @@ def paper_spec(solution: PaperSolution):
     n = cor.shape[0]
     spec = mujoco.MjSpec()
     spec.modelname = "wagner2012_chain"
-    spec.comment = (
+    spec.comment = xml_comment(  # the header holds the user's --config path: never live XML (spinectl.quoting)
         f" spinectl export of {header(model)}; E = {solution.eccentricity:g} m, Lambda = {solution.lordosis:g} m. "
         "Fibre actuators: affine gain = spinectl's tension and its slopes at the upright posture, control = "
         "the muscle's PCSA [cm^2]; counter_* motors hold the per-segment counter torques [N m]. "

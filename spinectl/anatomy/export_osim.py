@@ -41,12 +41,14 @@ simulation of musculotendon dynamics. J Biomech Eng 135(2):021005. doi:10.1115/1
 
 from __future__ import annotations
 
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
 
-from ..atomic import atomic_path, check_distinct
-from ..errors import ParameterError
+from .._validate import printable
+from ..atomic import atomic_path, check_distinct, full_disk_note
+from ..errors import OutputError, ParameterError
 from ..model import chain, geometry
 from ..model.mechanics import gravity_sign
 from ..model.muscle import hill_constants, max_velocity
@@ -68,6 +70,11 @@ the ``"paper"`` muscles have none)."""
 MUSCLES = ("millard", "paper")
 """The exported fibres' muscle models: Millard's (re-imported by ``spinectl anatomy``) or the paper's
 curves on OpenSim's ``RigidTendonMuscle``."""
+
+
+INVALID_NAME_CHARACTERS = "\\/*+ \t\n"
+"""Characters OpenSim refuses in a component's name (``Component::finalizeFromProperties``: "contains invalid
+characters"): the segments' and pairs' names become coordinates, joints, muscles and path points."""
 
 
 class OpenSimUnavailable(SpinectlError, ImportError):
@@ -124,6 +131,29 @@ def check_muscle(muscle: str) -> str:
     if muscle not in MUSCLES:
         raise ParameterError("muscle", f"must be one of {list(MUSCLES)} (got {muscle!r})")
     return muscle
+
+
+def check_names(model) -> None:
+    """Refuse, in one line naming the field, a segment or pair name that OpenSim cannot take.
+
+    Parameters
+    ----------
+    model : Model
+
+    Raises
+    ------
+    ParameterError
+        A name holding one of :data:`INVALID_NAME_CHARACTERS` (OpenSim would throw while the model is built).
+    """
+    named = [(f"geometry.cor_names[{k}]", name) for k, name in enumerate(model.geometry.cor_names)]
+    named += [(f"muscles.{k}.name", pair.name) for k, pair in enumerate(model.muscles)]
+    for field, name in named:
+        if any(char in INVALID_NAME_CHARACTERS for char in name):
+            raise ParameterError(
+                field,
+                f"must hold no space, tab, line break nor any of \\ / * + in an OpenSim model: OpenSim refuses "
+                f"them in a name (got {printable(repr(name))})",
+            )
 
 
 def paper_curves(model) -> tuple:
@@ -367,6 +397,7 @@ def export_osim(
     PaperSolution
     """
     check_muscle(muscle)
+    check_names(model)
     osim = require_opensim()
     sto = controls_path(out)
     check_distinct({"--out": str(out), "controls": str(sto)}, inputs)
@@ -380,9 +411,33 @@ def export_osim(
     table.addTableMetaDataString("inDegrees", "no")
     # both written before either is renamed: a model that cannot be written leaves no controls behind
     with atomic_path(sto) as tmp_sto, atomic_path(out) as tmp_out:
-        osim.STOFileAdapter.write(table, str(tmp_sto))
-        built.printToXML(str(tmp_out))
+        with _opensim_writes(sto):
+            osim.STOFileAdapter.write(table, str(tmp_sto))
+            read = osim.TimeSeriesTable(str(tmp_sto))  # OpenSim writes a truncated .sto onto a full disk, silently
+            if list(read.getColumnLabels()) != labels or read.getNumRows() != 2:
+                raise RuntimeError("the file read back is not what was written")
+        with _opensim_writes(out):
+            built.printToXML(str(tmp_out))
+            osim.Model(str(tmp_out))  # read back: whole, and a model OpenSim loads
     return solution
+
+
+@contextmanager
+def _opensim_writes(target):
+    """An error of OpenSim's writer (or of reading its file back) as one line naming ``target``.
+
+    OpenSim reports a full disk as a ``RuntimeError`` of SimTK's ``Xml::writeToFile`` with neither the
+    error number nor the output's name (the temporary's instead); the free space says which it was
+    (:func:`spinectl.atomic.full_disk_note`).
+    """
+    try:
+        yield
+    except RuntimeError as exc:
+        if isinstance(exc, SpinectlError):
+            raise
+        full = full_disk_note(target)
+        detail = printable(str(exc).strip().splitlines()[0]) if str(exc).strip() else type(exc).__name__
+        raise OutputError(f"cannot write {str(target)!r}: OpenSim's writer failed{full or f' ({detail})'}") from None
 
 
 STEP = (1e-6, 1e-7)

@@ -9,6 +9,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from .._validate import printable
+from ..atomic import check_distinct, check_writable
 from ..errors import ParameterError
 from ..model.params import Model
 
@@ -41,6 +42,71 @@ def format_of(out, fmt: str | None = None) -> str:
     raise ParameterError(
         "format", f"not given, and the suffix of {printable(str(out))} names none of {sorted(FORMATS)}"
     )
+
+
+def outputs_of(out, fmt: str | None = None) -> dict:
+    """Every file an export to ``out`` writes, by the name a message gives it.
+
+    Parameters
+    ----------
+    out : str or pathlib.Path
+    fmt : {"mjcf", "osim"}, optional
+        Default: from ``out``'s suffix.
+
+    Returns
+    -------
+    dict
+        ``{"--out": out}``, and for OpenSim ``"controls"``: the ``.sto`` beside it
+        (:func:`spinectl.anatomy.export_osim.controls_path`).
+    """
+    from .export_osim import controls_path  # a light module: OpenSim itself is imported when it writes
+
+    files = {"--out": str(out)}
+    if format_of(out, fmt) == "osim":
+        files["controls"] = str(controls_path(out))
+    return files
+
+
+def check_output(out, fmt: str | None = None, inputs: dict | None = None) -> str:
+    """The export's format, once its outputs are known to be writable: called before any work.
+
+    ``out``'s suffix must be one of the format's (:data:`FORMATS`: ``spinectl anatomy`` reads a model by
+    its suffix), no output may be an input or the other output (:func:`spinectl.atomic.check_distinct`),
+    and each must be writable (:func:`spinectl.atomic.check_writable`): a mistake in ``--out`` costs no solve.
+
+    Parameters
+    ----------
+    out : str or pathlib.Path
+    fmt : {"mjcf", "osim"}, optional
+        Default: from ``out``'s suffix.
+    inputs : dict, optional
+        Option name -> every file read.
+
+    Returns
+    -------
+    str
+        The format.
+
+    Raises
+    ------
+    ParameterError
+        An unknown format, a suffix of another format, an output that is an input.
+    OutputError
+        An output that cannot be written (a folder in the way, a folder that cannot be written).
+    """
+    kind = format_of(out, fmt)
+    suffix = Path(out).suffix.lower()
+    if suffix not in FORMATS[kind]:
+        raise ParameterError(
+            "--out",
+            f"an {kind} file ends in {' or '.join(FORMATS[kind])}, which is how spinectl anatomy reads it back "
+            f"(got {printable(str(out))})",
+        )
+    outputs = outputs_of(out, kind)
+    check_distinct(outputs, inputs)
+    for path in outputs.values():
+        check_writable(path)
+    return kind
 
 
 def export_model(
@@ -80,7 +146,7 @@ def export_model(
     spinectl.anatomy.export_mjcf.PaperSolution
         What was exported.
     """
-    kind = format_of(out, fmt)
+    kind = check_output(out, fmt, inputs)
     options = {"pcsa": pcsa, "with_local_stiffness": with_local_stiffness, "inputs": inputs}
     if kind == "mjcf":
         if osim_muscle != "millard":

@@ -59,9 +59,9 @@ def run(args) -> int:
     int
         Exit code 0.
     """
-    from ..anatomy.interchange import export_model, format_of
+    from ..anatomy.interchange import check_output, export_model
 
-    fmt = format_of(args.out, args.format)
+    fmt = check_output(args.out, args.format, {"--config": args.config})  # before the model and its solve
     model = load_model(args)
     check_position(model, args)
     solution = export_model(

@@ -15,6 +15,7 @@ from .._validate import in_range
 from ..model.config import dump_toml, set_parameters
 from ..model.params import Model
 from ..paper import grid
+from ..quoting import toml_comment
 from ..units import CM_PER_M
 
 MS_PER_S = 1000.0
@@ -174,8 +175,8 @@ def state_toml(base: Model, state: ExploreState) -> str:
         TOML text that ``spinectl ... --config`` reads back to ``model_at(base, state)``; its first
         line gives E and Lambda [m], which are no model parameters but the point shown.
     """
-    point = f"# spinectl explore: E = {state.eccentricity!r} m, Lambda = {state.lordosis!r} m\n"
-    return point + dump_toml(model_at(base, state))
+    point = toml_comment(f"spinectl explore: E = {state.eccentricity!r} m, Lambda = {state.lordosis!r} m")
+    return point + "\n" + dump_toml(model_at(base, state))
 
 
 def from_shown(slider: Slider, shown: float) -> float:

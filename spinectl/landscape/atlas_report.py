@@ -6,6 +6,7 @@ import numpy as np
 
 from ..canvas import new_figure
 from ..model.source import header
+from ..quoting import markdown_cell_code, markdown_text
 from .priors import VERDICTS, AtlasSpec
 
 
@@ -25,7 +26,7 @@ def report_text(result, spec: AtlasSpec) -> str:
     lines = [
         "# Population stability atlas",
         "",
-        f"Model: {header(spec.model)} (the parameters no prior varies).",
+        f"Model: {markdown_text(header(spec.model))} (the parameters no prior varies).",
         "",
         f"{result.n_evaluations} model evaluations: Saltelli's design on a scrambled Sobol' sequence "
         f"(N = {spec.samples}, seed {spec.seed}); probabilities over the 2 N = {2 * spec.samples} draws of "
@@ -38,8 +39,8 @@ def report_text(result, spec: AtlasSpec) -> str:
     ]
     for p in spec.priors:
         lines.append(
-            f"| `{p.parameter}` | {p.distribution} | {_shown(p.mean)} | {_shown(p.sd)} | "
-            f"[{p.bounds[0]:g}, {p.bounds[1]:g}] | {_checked(p.source)} | {p.source} |"
+            f"| {markdown_cell_code(p.parameter)} | {p.distribution} | {_shown(p.mean)} | {_shown(p.sd)} | "
+            f"[{p.bounds[0]:g}, {p.bounds[1]:g}] | {_checked(p.source)} | {markdown_text(p.source)} |"
         )
     unverified = sum(_checked(p.source) == "unverified" for p in spec.priors)
     lines += [
@@ -65,7 +66,8 @@ def report_text(result, spec: AtlasSpec) -> str:
             continue
         lines += ["| parameter | S1 | ST |", "|---|---|---|"]
         for name, s in table.items():
-            lines.append(f"| `{name}` | {s['S1']:.3f} ± {s['S1_conf']:.3f} | {s['ST']:.3f} ± {s['ST_conf']:.3f} |")
+            first, total = f"{s['S1']:.3f} ± {s['S1_conf']:.3f}", f"{s['ST']:.3f} ± {s['ST_conf']:.3f}"
+            lines.append(f"| {markdown_cell_code(name)} | {first} | {total} |")
         lines.append("")
     return "\n".join(lines) + "\n"
 

@@ -24,7 +24,7 @@ import numpy as np
 import xarray as xr
 
 from .._validate import printable, show
-from ..atomic import atomic_path
+from ..atomic import atomic_path, full_disk_note
 from ..errors import OutputError, ParameterError, SpinectlError
 from ..model import config
 from ..model.params import Model
@@ -119,7 +119,7 @@ def save(dataset: xr.Dataset, path: str | Path) -> Path:
         except (OSError, RuntimeError) as exc:  # netCDF-C reports a full disk as e.g. "NetCDF: HDF error"
             if isinstance(exc, SpinectlError):
                 raise
-            raise OutputError(f"cannot write {str(path)!r}: {printable(str(exc))}{_full(path)}") from None
+            raise OutputError(f"cannot write {str(path)!r}: {printable(str(exc))}{full_disk_note(path)}") from None
     return Path(path)
 
 
@@ -226,19 +226,6 @@ def _verify(path: Path) -> bool:
 def _reason(exc: Exception) -> str:
     text = printable(str(exc).splitlines()[0] if str(exc) else "")
     return f"{exc.__class__.__name__}: {text}" if text else exc.__class__.__name__
-
-
-FULL_BELOW = 1 << 20
-"""Free bytes below which a failed write names the full disk [B]: netCDF-C reports it in HDF5's words."""
-
-
-def _full(path: str | Path) -> str:
-    """``'; No space left on device'`` if the file system of ``path`` has (almost) no space left, else ''."""
-    try:
-        stats = os.statvfs(Path(path).resolve().parent)
-    except OSError:
-        return ""
-    return "; No space left on device" if stats.f_bavail * stats.f_frsize < FULL_BELOW else ""
 
 
 def load(path: str | Path) -> xr.Dataset:

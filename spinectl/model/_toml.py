@@ -18,6 +18,7 @@ from pathlib import Path
 
 from .._validate import escaped, show
 from ..errors import ConfigError, ParameterError
+from ..quoting import toml_comment, toml_string
 
 
 def read_text(path: Path) -> str:
@@ -410,9 +411,9 @@ def table_lines(obj, notes: dict | None = None) -> list[str]:
         unit = f.metadata.get("unit", "")
         doc = f.metadata.get("doc", "")
         comment = f"[{unit}] {doc}" if unit else doc
-        lines.append(f"# {comment}")
-        if notes and f.name in notes:
-            lines.append(f"# {notes[f.name]}")
+        lines.append(toml_comment(comment))
+        if notes and f.name in notes:  # a note may name a file: one comment line whatever the path holds
+            lines.append(toml_comment(notes[f.name]))
         lines.append(f"{f.name} = {_toml_value(getattr(obj, f.name))}")
     return lines
 
@@ -421,7 +422,7 @@ def _toml_value(value) -> str:
     if isinstance(value, bool):
         return "true" if value else "false"
     if isinstance(value, str):
-        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+        return toml_string(value)
     if isinstance(value, int):
         return str(value)
     if isinstance(value, float):

@@ -21,6 +21,7 @@ from pathlib import Path
 
 from .._validate import show
 from ..errors import ConfigError, ParameterError
+from ..quoting import toml_comment
 from ._toml import from_dict, locate, parse, read_text, table_lines, to_dict
 from .params import Model, MusclePair
 from .source import ModelSource, header, source_of, with_source
@@ -575,7 +576,7 @@ def show_toml(model: Model) -> str:
     """
     return "\n".join(
         [
-            f"# model: {header(model)}",
+            toml_comment(f"model: {header(model)}"),  # the header names the --config path
             *textwrap.wrap(f"Presets: {PRESET_GUIDANCE}.", 110, initial_indent="# ", subsequent_indent="# "),
             '# A --config file gives any subset of these parameters, over its preset (preset = "NAME").',
             "# Its [[muscles]] tables merge with the preset's pairs by name: a known name changes the keys",

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..model.source import stiffness_unit
+from ..quoting import markdown_text
 from ..units import m2_to_cm2
 from . import grid, landmarks, verdicts
 from .landmarks import Measurement
@@ -270,7 +271,7 @@ def render(measurements: Sequence[Measurement], run: Run) -> str:
 Minimum PCSA for self-stability (Figure 3), local counter torques (Figure 4) and
 the effect of passive stiffness (Figure S1) on the paper's grid: E and Λ from 0
 to 8 cm, {run.points} × {run.points} points, K = 0 and K = {grid.PAPER_STIFFNESS:g} N m/rad.
-Parameters: {run.preset}; K = 0 and {k} {own} with the `{run.convention}` convention,
+Parameters: {markdown_text(run.preset)}; K = 0 and {k} {own} with the `{run.convention}` convention,
 {k} {other} also with the `{run.other_convention}` convention. Wall time: {run.seconds:.1f} s.
 
 ## Read this first

@@ -256,3 +256,69 @@ def test_a_joint_stiff_in_name_only_is_marginal_as_in_stability(exported, capsys
     assert main(["anatomy", str(path)]) == 0
     row = next(line for line in capsys.readouterr().out.splitlines() if line.startswith("L1L2"))
     assert "marginal" in row
+
+
+INCLUDED = '<mujoco><worldbody><body name="injected"/></worldbody></mujoco>'
+"""A model that an include made live by a path would add: a body named ``injected``."""
+
+
+@pytest.mark.parametrize(
+    "folder",
+    [
+        'a--><include file="x.xml"/><!--',  # ends the comment: MuJoCo followed the include
+        "runs/2026-12--a",  # an ordinary '--': the export failed with an XML parse error after the solve
+        "ctl\x01\x1b",  # characters XML allows nowhere
+        "undecodable\udcff",  # a byte of the path that is not UTF-8, as Python holds it
+        "b--->\n<include file='x.xml'/>",  # a line break and three dashes
+        "pct%2D%2D&amp;<!--",  # percent signs (the encoding's own escape) and an entity
+    ],
+)
+def test_a_config_path_is_data_in_the_exported_file(tmp_path, capsys, folder):
+    """``spinectl export --config PATH`` names PATH in the file's comment (spinectl.quoting.xml_comment): the file
+    parses as one <mujoco> root whose only comment is spinectl's, holds no <include>, MuJoCo loads it with none of
+    x.xml's bodies, and the comment decodes to text naming PATH exactly."""
+    import xml.etree.ElementTree as ET
+
+    from spinectl.quoting import from_xml_comment
+
+    (tmp_path / "x.xml").write_text(INCLUDED, encoding="utf-8")
+    config = tmp_path / folder / "model.toml"
+    config.parent.mkdir(parents=True)
+    config.write_text('preset = "wagner2012"\n', encoding="utf-8")
+    out = tmp_path / "chain.xml"
+    assert main(["export", "--config", str(config), "--out", str(out)]) == 0, capsys.readouterr().err
+    root = ET.parse(out, parser=ET.XMLParser(target=ET.TreeBuilder(insert_comments=True))).getroot()
+    assert root.tag == "mujoco" and not list(root.iter("include"))
+    comments = [element.text for element in root.iter(ET.Comment)]
+    assert len(comments) == 1 and f"config {config} (sha256 " in from_xml_comment(comments[0])
+    m = mujoco.MjModel.from_xml_path(str(out))
+    assert mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "injected") == -1 and m.nbody == 7  # world, ground, 5
+
+
+@pytest.mark.parametrize(
+    ("argv", "expected"),
+    [
+        (["--out", "{tmp}/taken.xml"], "cannot write '{tmp}/taken.xml': Is a directory"),  # a folder in the way
+        (["--out", "{tmp}/file/chain.xml"], "cannot write '{tmp}/file/chain.xml': "),  # a file where a folder goes
+        (["--format", "osim", "--out", "{tmp}/chain.xml"], "--out: an osim file ends in .osim"),  # suffix of another
+        (["--format", "mjcf", "--out", "{tmp}/chain.osim"], "--out: an mjcf file ends in .xml or .mjcf"),
+        (["--config", "{tmp}/m_controls.sto", "--out", "{tmp}/m.osim"], "controls: is the same file as --config"),
+    ],
+)
+def test_the_output_is_checked_before_the_model_is_solved(tmp_path, monkeypatch, capsys, argv, expected):
+    """An output that cannot be written, of the wrong suffix or an input (the .osim's controls .sto too): one line,
+    exit 2, nothing written, and no solve: paper_solution raises if reached (before: found after the solve)."""
+    import spinectl.anatomy.export_mjcf as export_mjcf
+
+    def solved(*args, **kwargs):
+        raise AssertionError("the model was solved before the output was checked")
+
+    monkeypatch.setattr(export_mjcf, "paper_solution", solved)
+    (tmp_path / "taken.xml").mkdir()
+    (tmp_path / "file").write_text("")
+    (tmp_path / "m_controls.sto").write_text('preset = "wagner2012"\n')
+    before = sorted(p.name for p in tmp_path.iterdir())
+    assert main(["export", *(word.format(tmp=tmp_path) for word in argv)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and expected.format(tmp=tmp_path) in err, err
+    assert sorted(p.name for p in tmp_path.iterdir()) == before

@@ -144,3 +144,76 @@ def test_an_unwritable_model_leaves_no_controls_behind(tmp_path, capsys):
     assert main(["export", "--format", "osim", "--E", "0.03", "--Lambda", "0.04", "--out", str(out)]) == 2
     assert capsys.readouterr().err.count("\n") == 1
     assert sorted(p.name for p in tmp_path.iterdir()) == ["taken.osim"] and not any(out.iterdir())
+
+
+def test_names_opensim_refuses_are_one_line_and_others_read_back(tmp_path, capsys):
+    """A pair named with a space, '"', '<', '&', '--', ']]' and '|' (a printable label): the MJCF export writes it
+    as MuJoCo's escaped attributes (MuJoCo finds the actuator by its exact name); the OpenSim export refuses it in
+    one line naming the field, exit 2, nothing written, before the solve (before: OpenSim's 20-line traceback and
+    a segmentation fault). The same name without the space is exported and OpenSim finds its muscle."""
+    import mujoco
+
+    from spinectl.quoting import toml_string
+
+    def config(name):
+        path = tmp_path / f"{len(name)}.toml"
+        path.write_text(
+            f'preset = "wagner2012"\n[[muscles]]\nname = {toml_string(name)}\nupper = [0.04, 0.26]\n'
+            "lower = [0.04, 0.035]\n",
+            encoding="utf-8",
+        )
+        return str(path)
+
+    spaced, plain = 'st"r<a>&--ight]] |`x`', 'st"r<a>&--ight]]|`x`'
+    assert main(["export", "--config", config(spaced), "--out", str(tmp_path / "n.xml")]) == 0
+    m = mujoco.MjModel.from_xml_path(str(tmp_path / "n.xml"))
+    assert mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, f"{spaced}_ventral_0") >= 0
+    capsys.readouterr()
+    assert main(["export", "--config", config(spaced), "--out", str(tmp_path / "n.osim")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "muscles.3.name: must hold no space" in err  # appended after the preset's 3
+    assert not (tmp_path / "n.osim").exists() and not controls_path(tmp_path / "n.osim").exists()
+    assert main(["export", "--config", config(plain), "--out", str(tmp_path / "p.osim")]) == 0
+    assert osim.Model(str(tmp_path / "p.osim")).getMuscles().contains(f"{plain}_ventral_0")
+
+
+def _full_fs(path):
+    """os.statvfs of a file system with no byte free."""
+    import types
+
+    return types.SimpleNamespace(f_bavail=0, f_frsize=4096)
+
+
+def _opensims_full_disk_error(self, path):
+    """What Model.printToXML raises onto a full disk (OpenSim 4.6 on a 64 kB tmpfs, tried by hand)."""
+    raise RuntimeError(
+        "std::exception in 'bool OpenSim::Object::print(std::string const &) const': SimTK Exception thrown at "
+        f"Xml.cpp:113:\n  Error detected by Simbody method Xml::writeToFile(): Failed to write to the Xml file "
+        f"'{path}' with error ' (line=1, col=1)'.\n  (Required condition 'saveOK' was not met.)\n"
+    )
+
+
+def _truncating_sto_writer(table, path):
+    """What STOFileAdapter.write does onto a full disk: an empty file, and no error (OpenSim 4.6, tried by hand)."""
+    open(path, "w", encoding="utf-8").close()
+
+
+@pytest.mark.parametrize(
+    ("owner", "method", "fake", "expected"),
+    [
+        ("Model", "printToXML", _opensims_full_disk_error, "chain.osim': OpenSim's writer failed; No space left"),
+        ("STOFileAdapter", "write", staticmethod(_truncating_sto_writer), "chain_controls.sto': OpenSim's writer"),
+    ],
+)
+def test_a_full_disk_is_one_line_and_leaves_nothing(tmp_path, monkeypatch, capsys, owner, method, fake, expected):
+    """OpenSim's writers on a full disk (simulated: the error or the silent empty file OpenSim gives there, and a
+    file system with no space): one line naming the output and the full disk, exit 2, neither file nor a
+    temporary left, the previous model intact (before: a 24-line traceback; an empty controls .sto passed)."""
+    out = tmp_path / "chain.osim"
+    out.write_text("old", encoding="utf-8")
+    monkeypatch.setattr(getattr(osim, owner), method, fake)
+    monkeypatch.setattr("os.statvfs", _full_fs)
+    assert main(["export", "--E", "0.03", "--Lambda", "0.04", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and expected in err and "No space left on device" in err, err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["chain.osim"] and out.read_text(encoding="utf-8") == "old"

@@ -517,3 +517,28 @@ atlas.run_atlas(spec, {str(out)!r}, scheduler="synchronous", progress=False)
     assert json.loads((out / "atlas.json").read_text())["sobol"] == json.loads(json.dumps(result.to_dict()))["sobol"]
     key = atlas.fingerprint(second)
     assert {atlas_chunks.NAME.fullmatch(p.name)["atlas"] for p in (out / "chunks").iterdir()} == {key}
+
+
+def test_the_reports_user_text_cannot_add_markup():
+    """A prior's source and the model's --config path (atlas files and paths are the user's) with '|', a line
+    break, a heading and HTML: each table row keeps its 7 cells, no line is a heading or a tag the text made, and
+    the text reads back escapes aside. Before, a '|' in a source split its row into more cells."""
+    from types import SimpleNamespace
+
+    from spinectl.landscape.atlas_report import report_text
+    from spinectl.model.source import ModelSource, with_source
+
+    spec = _spec(chain="false")
+    hostile = "Doe 2020 | n = 40\n# Injected <b>bold</b> `x`"
+    model = with_source(spec.model, ModelSource("wagner2012", "runs/a\n## Injected.toml", "0" * 64))
+    priors = tuple(dataclasses.replace(p, source=hostile) for p in spec.priors)
+    spec = dataclasses.replace(spec, priors=priors, model=model)
+    result = SimpleNamespace(n_evaluations=4, probabilities={}, sobol={}, sobol_verdicts={}, draws={})
+    lines = report_text(result, spec).splitlines()
+    assert not any(line.startswith(("# Injected", "## Injected", "<b>")) for line in lines)
+    start = lines.index("| parameter | distribution | mean | sd | bounds | checked | source |")
+    rows = lines[start + 2 : start + 2 + len(priors)]
+    for row in rows:  # 8 unescaped pipes: 7 cells
+        assert sum(1 for i, c in enumerate(row) if c == "|" and row[i - 1] != "\\") == 8, row
+        assert row.endswith("Doe 2020 \\| n = 40\\\\n\\# Injected \\<b\\>bold\\</b\\> \\`x\\` |")
+    assert any(line.startswith("Model: ") and "runs/a\\\\n\\#\\# Injected.toml" in line for line in lines)

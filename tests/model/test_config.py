@@ -176,3 +176,30 @@ def test_show_names_a_value_set_on_the_command_line_and_the_presets_to_choose_fr
 def test_dump_toml_without_origins_names_no_source(model):
     """What a study's digest hashes depends on the parameters alone: no value notes without ``origins``."""
     assert "This value" not in config.dump_toml(config.apply_overrides(model, ["body.mass=35"]))
+
+
+@pytest.mark.parametrize(
+    "folder",
+    [
+        "runs/a\n[body]\nmass = 1.0\n#",  # a line break ends a comment: the rest would be parameters
+        "runs/a\r\nmuscles_mode = 'merge'",  # CR LF, and a key of the file's top level
+    ],
+)
+def test_shown_toml_names_a_hostile_config_path_only_in_comments(tmp_path, folder):
+    """``config show`` of a model from a file under a hostile path: the path is in the header's comment and in the
+    comment of every value that the file changed ("from FILE"), and nowhere else: the text reads back (tomllib,
+    then load_config) to exactly the model shown, whose mass is the file's 30 kg, not the path's 1 kg. Before, the
+    line break in the header and in the notes made the path's next lines TOML."""
+    from spinectl._validate import printable
+
+    path = tmp_path / folder / "model.toml"
+    path.parent.mkdir(parents=True)
+    path.write_text('preset = "wagner2012"\n[body]\nmass = 30.0\n', encoding="utf-8")
+    model = config.load_config(str(path))
+    text = config.show_toml(model)
+    data = __import__("tomllib").loads(text)
+    assert data["body"]["mass"] == 30.0 and set(data) == {"muscles_mode", *config.to_dict(model)}
+    shown = tmp_path / "shown.toml"
+    shown.write_text(text, encoding="utf-8")
+    assert config.load_config(str(shown)) == model
+    assert sum(printable(str(path)) in line for line in text.splitlines()) >= 2  # the header and the note

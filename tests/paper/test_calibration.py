@@ -297,3 +297,32 @@ def test_coarse_landmarks_share_the_coefficients_bit_for_bit(preset):
     )
     for together, own in zip((shared.k0, shared.k15, shared.k15_other), alone, strict=True):
         xr.testing.assert_identical(together, own)
+
+
+def test_the_presets_header_keeps_a_hostile_command_line_in_comments():
+    """preset_toml's "Produced by" line holds the command line, whose --config path is the user's: with a line break
+    and a table header in it, the header stays comments (one per line, the line break as \\n) and the file reads
+    back to the calibrated model, its mass the preset's, not the path's 1 kg (before: the path's next lines were
+    TOML). The result is built by hand: preset_toml only reads these attributes."""
+    import tomllib
+    from types import SimpleNamespace
+
+    from spinectl.paper.calibration.output import preset_toml
+
+    model = config.load_preset("wagner2012")
+    best = SimpleNamespace(loss=0.5, fit_loss=0.4, residuals=(), convention="physical", vector=(30.0,))
+    result = SimpleNamespace(
+        best=best,
+        settings={"verify_points": 41, "points": 9},
+        seconds=1.0,
+        evaluations=2,
+        fits={},
+        parameters=calibration.parameter_set(["mass"]),
+        model=model,
+    )
+    command = "spinectl calibrate --config 'runs/a\n[body]\nmass = 1.0\n#.toml'"
+    text = preset_toml(result, command, date="2026-12-03")
+    header = text.split("# spinectl model parameters")[0].splitlines()
+    assert all(line.startswith("#") for line in header)
+    assert "# Produced by: spinectl calibrate --config 'runs/a\\n[body]\\nmass = 1.0\\n#.toml'" in header
+    assert tomllib.loads(text)["body"]["mass"] == model.body.mass

@@ -22,7 +22,7 @@ def _measurements(axis=AXIS):
     return landmarks.measure(landmarks.Landmarks(ds, half, ds))
 
 
-RUN = report.Run("preset `default`", "physical", "paper", 9, 1.0, ("landscapes.nc", "report.md"), 25e4)
+RUN = report.Run("preset default", "physical", "paper", 9, 1.0, ("landscapes.nc", "report.md"), 25e4)
 
 
 def test_report_is_honest_and_complete():
@@ -109,7 +109,7 @@ def test_the_header_names_both_stiffnesses_and_the_table_its_own_grid():
     presets = (("wagner2012", 24.06, measured), ("wagner2012_mass_free", 10.2, measured))
     text = report.render(measured, dataclasses.replace(RUN, presets=presets, preset_points=41))
     assert (
-        "Parameters: preset `default`; K = 0 and K = 15 N m/rad with the `physical` convention,\n"
+        "Parameters: preset default; K = 0 and K = 15 N m/rad with the `physical` convention,\n"
         "K = 15 1/s² also with the `paper` convention." in text  # eq. 2 as printed reads K in 1/s^2
     )
     head = next(line for line in text.splitlines() if line.startswith("| landmark | paper | `wagner2012`"))
@@ -127,3 +127,18 @@ def test_the_landmark_table_names_this_runs_grid():
     text = report.render(_measurements(), RUN)
     head = next(line for line in text.splitlines() if line.startswith("| landmark | paper | spinectl"))
     assert f"| spinectl ({RUN.points} × {RUN.points} grid) |" in head
+
+
+def test_a_config_path_in_the_report_is_text_not_markdown():
+    """Run.preset names the --config path (source.origin): a path with a line break, a heading, a table row, HTML
+    and a link adds no block, no row and no tag to report.md; it reads as the text (line breaks as \\n). Before,
+    the path was written as it is: its '# Injected' line became a heading."""
+    from spinectl._validate import printable
+
+    path = "runs/a\n# Injected\n| x | y |\n<script>x</script> [l](http://e) `c` *e*.toml"
+    text = report.render(_measurements(), dataclasses.replace(RUN, preset=f"preset default; config {path}"))
+    assert not any(line.startswith(("# Injected", "| x |", "<script>")) for line in text.splitlines())
+    line = next(line for line in text.splitlines() if line.startswith("Parameters:")).split("; K = 0 and")[0]
+    for markup in "`*[]<>|#":
+        assert all(line[i - 1] == "\\" for i, char in enumerate(line) if char == markup), markup
+    assert printable(path).replace("\\", "") in line.replace("\\", "")  # the text itself, escapes aside

@@ -3,7 +3,7 @@
 The layers and their order are those of CONTRIBUTING.md ("Architecture", "Layers"; a test
 checks that its table and :data:`LAYERS` agree, and that its tree names every module):
 
-    _version _aliases _threads errors units _validate _oscalls atomic jsondoc canvas presets  <  model  <  optimise
+    _version _aliases _threads errors units _validate _oscalls quoting atomic jsondoc canvas presets  <  model  <  optimise
     <  reflex  <  anatomy  <  landscape  <  paper  <  explore  <  cli
 
 A module may import modules of its own layer and of the layers before it, never
@@ -47,6 +47,7 @@ LAYERS = (
         "units",
         "_validate",
         "_oscalls",
+        "quoting",
         "atomic",
         "jsondoc",
         "canvas",

@@ -7,6 +7,7 @@ import time
 import numpy as np
 
 from ...model.config import dump_toml
+from ...quoting import toml_comment
 from ..verdicts import RELATION
 from .fit import CalibrationResult
 
@@ -65,21 +66,22 @@ def preset_toml(result: CalibrationResult, command: str, date: str | None = None
     """
     date = date or time.strftime("%Y-%m-%d")
     best = result.best
+    losses = ", ".join(
+        f"{f.convention} {f.loss:.4g} with the vector found with {f.origin}" for f in result.fits.values()
+    )
     header = [
-        "# spinectl preset calibrated against the landmarks of Wagner et al. (2012); docs/reproduction.md.",
-        f"# Produced by: {command}",
-        f"# Date: {date}; wall time {result.seconds:.0f} s, {result.evaluations} loss evaluations.",
-        f"# Loss: {best.loss:.4g} on the {result.settings['verify_points']}-point grid "
+        "spinectl preset calibrated against the landmarks of Wagner et al. (2012); docs/reproduction.md.",
+        f"Produced by: {command}",  # the user's paths: toml_comment keeps each line one comment whatever they hold
+        f"Date: {date}; wall time {result.seconds:.0f} s, {result.evaluations} loss evaluations.",
+        f"Loss: {best.loss:.4g} on the {result.settings['verify_points']}-point grid "
         f"({best.fit_loss:.4g} on the {result.settings['points']}-point fitting grid); "
         f"{sum(r.agrees for r in best.residuals)} of {len(best.residuals)} landmarks agree.",
-        f"# Passive-stiffness convention: {best.convention}, picked at the final vector (losses: "
-        + ", ".join(f"{f.convention} {f.loss:.4g} with the vector found with {f.origin}" for f in result.fits.values())
-        + ").",
-        "# Free parameters (value; bounds):",
+        f"Passive-stiffness convention: {best.convention}, picked at the final vector (losses: {losses}).",
+        "Free parameters (value; bounds):",
     ]
     for p, v in zip(result.parameters, best.vector, strict=True):
-        header.append(f"#   {p.name} = {v:.6g} {p.unit}; [{p.lower:g}, {p.upper:g}]")
-    return "\n".join(header) + "\n" + dump_toml(result.model, _fitted(result))
+        header.append(f"  {p.name} = {v:.6g} {p.unit}; [{p.lower:g}, {p.upper:g}]")
+    return "\n".join(map(toml_comment, header)) + "\n" + dump_toml(result.model, _fitted(result))
 
 
 def _fitted(result: CalibrationResult) -> dict:
