@@ -634,6 +634,26 @@ FIXED_LIMIT = 1e9
 in fixed notation is 309 digits wide."""
 
 
+def eigenvalue_text(z: complex, decimals: int = 3) -> str:
+    """An eigenvalue as text: a real one (imaginary part exactly 0, as LAPACK returns for a real root) as a
+    real number, a complex one as ``a+bj``.
+
+    Parameters
+    ----------
+    z : complex
+        The eigenvalue [1/s].
+    decimals : int, optional
+        Decimals of each part.
+
+    Returns
+    -------
+    str
+        E.g. ``'68.321'`` or ``'-3.653+1.204j'``.
+    """
+    real = f"{z.real:.{decimals}f}"
+    return f"{real}{z.imag:+.{decimals}f}j" if z.imag else real
+
+
 def _fixed(value: float, width: str, decimals: int) -> str:
     """``value`` in fixed notation of ``width`` (a format width, e.g. ``'12'`` or ``'+9'``), or as ``1.000e+308``."""
     kind = "f" if abs(value) < FIXED_LIMIT or not math.isfinite(value) else "e"
