@@ -88,4 +88,17 @@ def test_coupled_table_prints_real_eigenvalues_as_real_numbers(capsys):
 def test_a_complex_eigenvalue_keeps_its_imaginary_part():
     from spinectl.model.stability import eigenvalue_text
 
-    assert eigenvalue_text(complex(-3.6531, 1.2)) == "-3.653+1.200j" and eigenvalue_text(complex(68.3214, 0)) == "68.321"
+    assert (
+        eigenvalue_text(complex(-3.6531, 1.2)) == "-3.653+1.200j" and eigenvalue_text(complex(68.3214, 0)) == "68.321"
+    )
+
+
+def test_the_table_says_the_sign_of_s_and_d(capsys):
+    """eq. 1 (theta phi'' = S phi + D phi') makes a restoring S and a damping D negative; the table says so
+    right below its rows, where spinectl anatomy's -K_jj column is > 0 restoring."""
+    from spinectl.model.stability import SIGN_NOTE
+
+    assert main(["stability", "--E", "0.03", "--Lambda", "0.04", "--pcsa", "10,10,10"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    last_row = max(i for i, line in enumerate(lines) if line.startswith("L5S1"))
+    assert lines[last_row + 1] == SIGN_NOTE and "S < 0 restores" in SIGN_NOTE and "D < 0 damps" in SIGN_NOTE
