@@ -53,7 +53,8 @@ def test_the_coronal_plane_runs_at_e_0_and_refuses_a_sagittal_e(capsys):
     path = str(EXAMPLES / "coronal.toml")
     assert main(["stability", "--config", path, "--E", "0", "--Lambda", "0.02"]) == 0
     out, err = capsys.readouterr()
-    assert "lateral_straight_ventral" in out and "all segments" in out
+    assert "lateral_straight_right" in out and "lateral_straight_left" in out and "all segments" in out
+    assert "ventral" not in out and "dorsal" not in out  # geometry.side_names: right and left
     assert err == ""
     assert main(["stability", "--config", path, "--E", "0.03"]) == 2
     assert "E: must be in" in capsys.readouterr().err
