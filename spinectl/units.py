@@ -88,6 +88,39 @@ def centimetre_slip(values, low: float, high: float, typed: str, corrected: str)
     return ""
 
 
+LEAST_PLAUSIBLE_LORDOSIS_DEG = 5.0
+"""Smallest non-zero lordosis angle [deg] taken without a warning at the command line. The standing lumbar
+lordosis of asymptomatic adults is tens of degrees (160 volunteers: Roussouly et al. 2005, Spine 30:346-353,
+doi:10.1097/01.brs.0000152379.54463.65); a value below 5 deg is far more likely radians typed where the
+option takes degrees (0.7 rad = 40.1 deg), which the model accepts silently as a nearly straight spine."""
+
+
+def radian_slip(angles_deg) -> str:
+    """The warning for a lordosis angle in radians typed where degrees are meant, or ``""``.
+
+    Parameters
+    ----------
+    angles_deg : array_like
+        The angles as given [deg].
+
+    Returns
+    -------
+    str
+        E.g. ``"0.7 deg is a nearly straight spine (standing lordosis is tens of degrees); angles are in
+        degrees here: if you meant 0.7 rad, give 40.107"``, for the largest non-zero value if every non-zero value
+        lies below :data:`LEAST_PLAUSIBLE_LORDOSIS_DEG` and within pi; ``""`` otherwise (0 stays silent).
+    """
+    values = np.abs(np.asarray(angles_deg, float)).ravel()
+    values = values[values > 0]
+    if values.size == 0 or values.max() >= min(LEAST_PLAUSIBLE_LORDOSIS_DEG, np.pi):
+        return ""
+    value = float(values.max())
+    return (
+        f"{value:g} deg is a nearly straight spine (standing lordosis is tens of degrees); angles are in degrees "
+        f"here: if you meant {value:g} rad, give {np.degrees(value):.5g}"
+    )
+
+
 def square_metre_slip(pcsa_cm2) -> str:
     """The warning for a PCSA in m^2 typed where cm^2 are meant, or ``""`` (see :data:`CM2_LEAST_PLAUSIBLE`).
 

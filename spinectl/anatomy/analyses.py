@@ -94,6 +94,12 @@ def state_matrix(chain: LinearChain, a) -> np.ndarray:
     return chain_state_matrix(chain.mass_matrix, chain.stiffness(a), chain.damping(a))
 
 
+def plane_text(plane: str) -> str:
+    """A mapping's plane as a table's first line names it: ``'sagittal plane'``, ``'coronal plane'``, and
+    ``'3d'`` (every chain joint of every plane at once) as ``'all three planes (3-D)'``."""
+    return "all three planes (3-D)" if plane == "3d" else f"{plane} plane"
+
+
 @dataclass(frozen=True)
 class ChainVerdict:
     """One chain at one activation: its matrices, joint-by-joint and chain verdicts.
@@ -529,7 +535,7 @@ class AnatomyResult:
         word = {True: "stable", False: "unstable"}
         counts = ", ".join(f"{len(v)} {k}" for k, v in self.muscles.items())
         lines = [
-            f"{self.model['name']} ({self.model['source']}), {self.plane} plane, "
+            f"{self.model['name']} ({self.model['source']}), {plane_text(self.plane)}, "
             + (
                 f"mean activation {self.activations.mean():.3g}"
                 if self.control_unit == "1"
@@ -541,6 +547,7 @@ class AnatomyResult:
             f"joint stiffness added: {self.joint_stiffness_added[0]:.4g} N m/rad per joint",
             "",
             f"{'joint':<16}{'-K_jj [N m/rad]':>16}  joint by joint (others fixed)",
+            f"{'':<16}{'(> 0 restores)':>16}",
         ]
         verdicts = zip(free.joints, free.joint_stiffness, free.joint_self_stable, free.joint_marginal, strict=True)
         for (name, s, ok, slow), tau in zip(verdicts, free.joint_time_constants, strict=True):

@@ -875,7 +875,7 @@ def optimised(
     spinectl.anatomy.optimum.OptimisedResult
     """
     from .analyses import analyse
-    from .optimum import OptimisedResult, skeleton
+    from .optimum import OptimisedResult, remedy, skeleton
 
     if check:
         anatomy.engine.spec_factory()
@@ -886,4 +886,5 @@ def optimised(
     if opt.ok:
         analysis = analyse(anatomy, plane, opt.activations, joint_stiffness=joint_stiffness, reflex=reflex)
     empty = skeleton(anatomy, opt, reflex=reflex, **kwargs)
-    return OptimisedResult(anatomy, opt, classic, float(margin), plane, analysis, empty)
+    fix = remedy(anatomy, optimise, opt, classic, joint_stiffness, kwargs)
+    return OptimisedResult(anatomy, opt, classic, float(margin), plane, analysis, empty, fix)

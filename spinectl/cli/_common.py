@@ -6,6 +6,7 @@ import argparse
 import math
 import os
 import sys
+import warnings
 
 import numpy as np
 
@@ -15,7 +16,7 @@ from ..atomic import atomic_write_text
 from ..errors import ParameterError
 from ..model.config import DEFAULT_PRESET, PRESET_GUIDANCE, apply_overrides, load_config, set_parameters
 from ..model.params import Model
-from ..units import CM_PER_M, centimetre_slip, cm2_to_m2, square_metre_slip
+from ..units import CM_PER_M, centimetre_slip, cm2_to_m2, radian_slip, square_metre_slip
 
 BOTH_LORDOSIS = "is not allowed with --Lambda (both give the lordosis): give one of them"
 """The error of ``--lordosis-angle`` given with ``--Lambda`` (:func:`lordosis_option`, :func:`lordosis_grid`)."""
@@ -171,6 +172,9 @@ def lordosis_option(model: Model, angle: float | None, lordosis: float | None, o
         lordosis = lordosis_from_angle(angle, model)
     except ParameterError as exc:
         raise ParameterError(option, exc.message) from None
+    slip = radian_slip(angle)
+    if slip:  # a valid angle, analysed as given: said, as the --pcsa slip is (the CLI prints it in one line)
+        warnings.warn(f"{option}: {slip}", stacklevel=2)
     return float(lordosis) if np.ndim(lordosis) == 0 else lordosis
 
 

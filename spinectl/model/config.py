@@ -15,7 +15,6 @@ import difflib
 import hashlib
 import textwrap
 import tomllib
-import warnings
 from importlib import resources
 from pathlib import Path
 
@@ -44,11 +43,8 @@ PRESET_GUIDANCE = (
 MUSCLES_MODES = ("merge", "replace")
 """How a file's ``[[muscles]]`` tables combine with the preset's pairs (its key ``muscles_mode``):
 ``"merge"`` (the default) updates the pair of the same ``name`` with the keys given and appends a
-pair whose name is new; ``"replace"`` puts the file's pairs in place of the preset's, with a warning."""
-
-
-class ConfigWarning(UserWarning):
-    """A configuration that is valid but may not do what its author meant (e.g. replaces the muscle set)."""
+pair whose name is new; ``"replace"`` puts the file's pairs in place of the preset's. Replacing is only
+ever the file author's written choice, so it is silent: the outputs name the file, and ``config show`` its pairs."""
 
 
 def list_presets() -> list[str]:
@@ -122,12 +118,12 @@ def load_config(path: str | Path | None = None, preset: str | None = None) -> Mo
     mode = data.pop("muscles_mode", "merge")
     if preset is None:  # an empty name is an error of load_preset, not the default
         preset = DEFAULT_PRESET if base_name is None else base_name
-    model = merge(load_preset(preset), data, muscles_mode=mode, source=str(path))
+    model = merge(load_preset(preset), data, muscles_mode=mode)
     digest = hashlib.sha256(path.read_bytes()).hexdigest()
     return with_source(model, ModelSource(preset=preset, config=str(path), config_sha256=digest))
 
 
-def merge(base: Model, data: dict, muscles_mode: str = "merge", source: str = "config") -> Model:
+def merge(base: Model, data: dict, muscles_mode: str = "merge") -> Model:
     """``base`` with the (partial, nested) parameters in ``data`` replacing its own.
 
     Sections merge key by key; ``muscles`` merge by name or replace the set (``muscles_mode``).
@@ -140,8 +136,6 @@ def merge(base: Model, data: dict, muscles_mode: str = "merge", source: str = "c
         Nested parameters as read from TOML, e.g. ``{"body": {"mass": 50.0}}`` (SI units).
     muscles_mode : {'merge', 'replace'}
         See :data:`MUSCLES_MODES`.
-    source : str
-        Where ``data`` came from, named in the warning when it replaces the muscle set.
 
     Returns
     -------
@@ -152,35 +146,21 @@ def merge(base: Model, data: dict, muscles_mode: str = "merge", source: str = "c
     ------
     ConfigError
         ``muscles_mode`` unknown, or a merged ``[[muscles]]`` table without a ``name``.
-
-    Warns
-    -----
-    ConfigWarning
-        ``muscles_mode = "replace"`` drops some of the preset's pairs.
     """
     if muscles_mode not in MUSCLES_MODES:
         allowed = ", ".join(map(repr, MUSCLES_MODES))
         raise ConfigError("muscles_mode", f"must be one of {allowed} (got {show(muscles_mode)})")
     merged = _deep_merge(to_dict(base), {k: v for k, v in data.items() if k != "muscles"})
     if "muscles" in data:
-        merged["muscles"] = _muscles(merged["muscles"], data["muscles"], muscles_mode, source)
+        merged["muscles"] = _muscles(merged["muscles"], data["muscles"], muscles_mode)
     return with_source(from_dict(Model, merged), source_of(base))
 
 
-def _muscles(base: list, given, mode: str, source: str) -> list:
+def _muscles(base: list, given, mode: str) -> list:
     """The muscle pairs of ``base`` combined with a file's ``[[muscles]]`` (:data:`MUSCLES_MODES`)."""
     if not isinstance(given, list) or not given:
         return given  # from_dict names the error: must be an array of tables, with at least one pair
-    if mode == "replace":
-        kept = {pair.get("name") for pair in given if isinstance(pair, dict)}
-        dropped = [pair["name"] for pair in base if pair["name"] not in kept]
-        if dropped:  # a complete file (config show's output) keeps every name: no warning
-            warnings.warn(
-                f"{source} replaces the preset's muscle pairs (muscles_mode = 'replace'): "
-                f"{', '.join(dropped)} dropped, {len(given)} pair(s) given",
-                ConfigWarning,
-                stacklevel=3,
-            )
+    if mode == "replace":  # the file says so in words: no warning for a choice its author wrote
         return given
     out = [dict(pair) for pair in base]
     names = [pair["name"] for pair in out]

@@ -429,6 +429,7 @@ class StabilityResult:
                 f"{_stable_word(self.self_stable[k], self.marginal[k]):>8} {_fixed(self.counter_torque[k], '10', 3)}"
             )
         lines += [
+            SIGN_NOTE,
             "",
             f"||CT|| = {self.counter_torque_norm:.3f} N m; slowest time constant "
             f"{_time_constant_text(self.slowest_time_constant)}",
@@ -436,6 +437,11 @@ class StabilityResult:
             self.chain(model).summary(),
         ]
         return "\n".join(lines)
+
+
+SIGN_NOTE = "S < 0 restores and D < 0 damps (eq. 1: theta phi'' = S phi + D phi'; spinectl anatomy prints -K, > 0)"
+"""The sign of S and D, under every table that prints them: the paper's eq. 1 makes a restoring stiffness and
+a damping negative, where ``spinectl anatomy`` prints -K (docs/model.md, "One segment: the Jacobian and eq. 1")."""
 
 
 CHAIN_DEPENDS_ON = (
@@ -632,6 +638,26 @@ def segment_stability(
 FIXED_LIMIT = 1e9
 """Magnitude from which a table prints a number in exponent notation: a stiffness of 1e308 (``--K 1e308``)
 in fixed notation is 309 digits wide."""
+
+
+def eigenvalue_text(z: complex, decimals: int = 3) -> str:
+    """An eigenvalue as text: a real one (imaginary part exactly 0, as LAPACK returns for a real root) as a
+    real number, a complex one as ``a+bj``.
+
+    Parameters
+    ----------
+    z : complex
+        The eigenvalue [1/s].
+    decimals : int, optional
+        Decimals of each part.
+
+    Returns
+    -------
+    str
+        E.g. ``'68.321'`` or ``'-3.653+1.204j'``.
+    """
+    real = f"{z.real:.{decimals}f}"
+    return f"{real}{z.imag:+.{decimals}f}j" if z.imag else real
 
 
 def _fixed(value: float, width: str, decimals: int) -> str:

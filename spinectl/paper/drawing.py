@@ -28,7 +28,7 @@ from ..canvas import laid_out, new_figure
 from ..errors import ParameterError
 from ..model import geometry
 from ..model.checks import expand_pcsa
-from ..model.params import SIDES, Model
+from ..model.params import Model
 from ..model.stability import segment_stability
 from ..optimise.reference import solve_point
 from ..units import CM_PER_M, m2_to_cm2
@@ -206,7 +206,7 @@ def _draw_fibres(ax, model: Model, pcsa: np.ndarray | None) -> None:
     for p, pair in enumerate(model.muscles):
         ups, lows = geometry.pair_fibres(pair)
         colour = PAIR_COLOURS[p % len(PAIR_COLOURS)]
-        for side, side_name in enumerate(SIDES):
+        for side, side_name in enumerate(model.geometry.side_names):
             muscle = 2 * p + side
             idle = pcsa is not None and widths[muscle] == 0
             for i, (up, low) in enumerate(zip(ups[side], lows[side], strict=True)):
@@ -469,7 +469,8 @@ def draw_model(
         ax.set_ylabel("y [cm] (above P2)")
         lines = [f"E = {eccentricity * CM_PER_M:g} cm, Λ = {lordosis * CM_PER_M:g} cm; {source}"]
         if pcsa_used is not None:
-            lines.append(f"line width ∝ PCSA (widest: {_cm2(pcsa_used.max())} cm² per muscle); paler: dorsal")
+            widest = _cm2(pcsa_used.max())
+            lines.append(f"line width ∝ PCSA (widest: {widest} cm² per muscle); paler: {model.geometry.side_names[1]}")
         if counter_torque and torques is not None:
             lines.append(f"arrows: counter torques CT_k, {TORQUE_SCALE * CM_PER_M:g} cm per N m (+: counter-clockwise)")
         ax.set_title("\n".join(lines), fontsize=7)

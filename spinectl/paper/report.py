@@ -136,6 +136,45 @@ def _local_pcsa(measurements: Sequence[Measurement], specific_tension: float) ->
     )
 
 
+QUESTION = (
+    "The paper asks whether the lumbar lordosis makes the erect posture easier to hold: at the eccentricity "
+    "E ≈ 3 cm of the physiological posture, does a lordosis of Λ ≈ 4 cm minimise the counter torque the "
+    "local muscles must add, and keep it within what they can give (±30 N m)?"
+)
+"""The paper's question, in the words of its Discussion (Wagner et al. 2012), as the report opens with it."""
+
+
+def answer(measurements: Sequence[Measurement]) -> str:
+    """The paper's question and spinectl's answer, in two sentences, from the two landmarks that carry the claim.
+
+    The claim is the Discussion's: at E ≈ 3 cm the least counter torque lies at Λ ≈ 4 cm
+    (landmark ``optimum_lordosis``) and is inside the local muscles' ±30 N m (landmark ``ct_optimum``).
+
+    Parameters
+    ----------
+    measurements : sequence of Measurement
+        From :func:`spinectl.paper.landmarks.measure`.
+
+    Returns
+    -------
+    str
+        Markdown: the question, then whether this run reproduces it, with both numbers and their paper values.
+    """
+    lordosis, torque = _find(measurements, "optimum_lordosis"), _find(measurements, "ct_optimum")
+    e_cm, lam_cm = (100 * v for v in landmarks.OPTIMUM)
+    found = (
+        f"at E = {e_cm:g} cm the least ‖CT‖ lies at Λ = {_number(lordosis.value)} cm "
+        f"(paper: about {_number(lordosis.landmark.paper)} cm), and at E = {e_cm:g} cm, Λ = {lam_cm:g} cm "
+        f"‖CT‖ is {_number(torque.value)} N m (paper: inside ±{_number(torque.landmark.paper)} N m)"
+    )
+    if lordosis.agrees and torque.agrees:
+        verdict = f"**The paper's main claim is reproduced:** {found}."
+    else:
+        failed = " and ".join(f"`{m.landmark.name}`" for m in (lordosis, torque) if not m.agrees)
+        verdict = f"**The paper's main claim is not reproduced with these parameters** ({failed} disagree): {found}."
+    return f"{QUESTION}\n\n{verdict}"
+
+
 def _k_unit(convention: str) -> str:
     """K's unit under ``convention`` as the report writes it (docs/model.md, "Passive stiffness: two conventions")."""
     return stiffness_unit(convention).replace("^2", "²")
@@ -260,8 +299,9 @@ def render(measurements: Sequence[Measurement], run: Run) -> str:
     Returns
     -------
     str
-        The whole ``report.md``: the run's facts, the landmark table, the halving by K,
-        the local-muscle equivalent of the counter torques, the figures (embedded) and the files written.
+        The whole ``report.md``: the run's facts, the paper's question and this run's answer, the landmark
+        table, the halving by K, the local-muscle equivalent of the counter torques, the figures (embedded) and
+        the files written.
     """
     agree = sum(m.agrees for m in measurements)
     files = "\n".join(f"- [`{name}`]({name})" for name in run.files)
@@ -273,6 +313,10 @@ the effect of passive stiffness (Figure S1) on the paper's grid: E and Λ from 0
 to 8 cm, {run.points} × {run.points} points, K = 0 and K = {grid.PAPER_STIFFNESS:g} N m/rad.
 Parameters: {markdown_text(run.preset)}; K = 0 and {k} {own} with the `{run.convention}` convention,
 {k} {other} also with the `{run.other_convention}` convention. Wall time: {run.seconds:.1f} s.
+
+## The paper's question and spinectl's answer
+
+{answer(measurements)}
 
 ## Read this first
 

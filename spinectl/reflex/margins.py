@@ -405,6 +405,7 @@ class MarginsReport:
             "S, kp in N m/rad; D, kd in N m s/rad; theta in kg m^2; w_c in rad/s. T_slow: slowest time constant",
             "of the segment without reflex. GM: stable range of a common factor on kp and kd. tau_m: exact delay",
             "margin (unbounded: any delay; 0: unstable without delay).",
+            stability.SIGN_NOTE,
             "",
             self.verdict(),
         ]

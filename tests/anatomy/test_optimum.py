@@ -139,3 +139,39 @@ def test_an_infeasible_chain_optimum_says_what_would_make_it_feasible(torso):
     bare = optimised(torso, stability="chain")
     assert bare.optimum.status == "infeasible" and INFEASIBLE_HINT in bare.table()
     assert INFEASIBLE_HINT not in optimised(torso, stability="chain", joint_stiffness=50).table()
+
+
+def test_the_remedy_is_the_least_joint_stiffness_that_makes_the_optimum_feasible(torso):
+    """The remedy's bracket, checked by the optimum itself (a second call per side, not the search): feasible
+    at the value named, infeasible 2 rtol below it; the table names a --joint-stiffness that is feasible and
+    the JSON carries the value. MyoTorso (myo-sim 0.2.4) needs about 40 N m/rad at each joint (docs/anatomy.md)."""
+    from spinectl.anatomy.optimum import REMEDY_RTOL
+
+    bare = optimised(torso, stability="chain")
+    value = bare.remedy
+    assert 1.0 < value < 1e3
+    assert optimise(torso, stability="chain", joint_stiffness=value).ok
+    assert not optimise(torso, stability="chain", joint_stiffness=value * (1 - 2 * REMEDY_RTOL)).ok
+    named = float(bare.table().split("--joint-stiffness ")[-1].split()[0])
+    assert named >= value and optimise(torso, stability="chain", joint_stiffness=named).ok
+    assert bare.to_dict()["feasible_from_joint_stiffness_Nm_per_rad"] == value
+    assert np.isnan(optimised(torso, stability="chain", joint_stiffness=50).remedy)  # solved: nothing to remedy
+
+
+def test_the_remedy_search_brackets_a_known_threshold():
+    """A feasibility that switches at c* = 39.87 (and at none): the bracket's upper end within rtol of c*,
+    and inf where nothing up to MAX_REMEDY is feasible."""
+    from spinectl.anatomy.optimum import MAX_REMEDY, REMEDY_RTOL, least_joint_stiffness
+
+    calls = []
+
+    def feasible(c):
+        calls.append(c)
+        return c >= 39.87
+
+    found = least_joint_stiffness(feasible)
+    assert 39.87 <= found <= 39.87 * (1 + REMEDY_RTOL) and len(calls) < 30
+    assert least_joint_stiffness(feasible, start=10.0) == pytest.approx(found, rel=REMEDY_RTOL)
+    assert (
+        least_joint_stiffness(lambda c: False) == np.inf and least_joint_stiffness(lambda c: c > MAX_REMEDY) == np.inf
+    )

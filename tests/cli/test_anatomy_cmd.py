@@ -64,6 +64,16 @@ def test_the_table_names_every_criterion(cached, capsys):
     assert "joint by joint (others fixed)" in out
     assert "the chain, free (every joint free, equality constraints off)" in out
     assert "the chain constrained by the model's rhythm" in out
+    lines = out.splitlines()
+    title = next(i for i, line in enumerate(lines) if "-K_jj [N m/rad]" in line)
+    assert lines[title + 1].strip() == "(> 0 restores)"  # the sign, where stability's S is < 0 restoring
+
+
+def test_the_3d_mapping_is_named_all_three_planes(cached, capsys):
+    """--plane 3d analyses every chain joint at once: the first line says "all three planes (3-D)", not "3d plane"."""
+    assert main(["anatomy", "--plane", "3d"]) == 0
+    first = capsys.readouterr().out.splitlines()[0]
+    assert "all three planes (3-D)" in first and "3d plane" not in first
 
 
 @pytest.mark.parametrize(

@@ -193,15 +193,14 @@ def test_config_diff_prints_every_difference_with_its_unit(capsys):
     assert code == 0 and out.splitlines()[-1] == "no parameter differs"
 
 
-def test_a_file_that_replaces_the_muscles_warns_in_one_line(tmp_path, capsys):
+def test_a_file_that_replaces_the_muscles_is_silent_and_shows_its_pairs(tmp_path, capsys):
+    """muscles_mode = "replace" is the author's written choice: no warning (before: one on every command),
+    and config show lists the file's pair alone."""
     path = tmp_path / "one.toml"
     path.write_text('muscles_mode = "replace"\n[[muscles]]\nname = "only"\nupper = [0.1, 0.25]\nlower = [0.1, 0.0]\n')
-    code, _, err = run(["config", "show", "--config", str(path)], capsys)
-    assert code == 0
-    assert (
-        err == f"spinectl: warning: {path} replaces the preset's muscle pairs (muscles_mode = 'replace'): "
-        "straight, oblique_outer, oblique_inner dropped, 1 pair(s) given\n"
-    )
+    code, out, err = run(["config", "show", "--config", str(path)], capsys)
+    assert code == 0 and err == ""
+    assert out.splitlines().count("[[muscles]]") == 1 and 'name = "only"' in out and 'name = "straight"' not in out
 
 
 def test_a_home_that_cannot_be_written_leaves_stderr_empty(tmp_path):

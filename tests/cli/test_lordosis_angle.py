@@ -165,3 +165,20 @@ def test_study_angle_axis_errors(axes, says):
     with pytest.raises(ParameterError, match=says) as caught:
         _study(axes)
     assert caught.value.field == "axes.lordosis_angle_deg"
+
+
+@pytest.mark.parametrize(("typed", "hint"), [("0.7", "give 40.107"), ("-1.2", "give 68.755")])
+def test_an_angle_in_radians_gets_a_hint_and_is_analysed_as_given(typed, hint, capsys):
+    """0.7 (radians typed for degrees) is a valid, nearly straight spine: analysed as 0.7 deg, with one line
+    on stderr naming the option and the degrees meant (0.7 rad = 0.7 * 180 / pi = 40.107 deg)."""
+    argv = ["stability", "--E", "0.03", "--pcsa", "10,10,10", "--json"]
+    assert main([*argv, "--lordosis-angle", typed]) == 0
+    out, err = capsys.readouterr()
+    assert json.loads(out)["Lambda_m"] == pytest.approx(_closed_form(float(typed)), rel=1e-12)
+    assert err.count("\n") == 1 and err.startswith("spinectl: warning: --lordosis-angle: ") and hint in err
+
+
+@pytest.mark.parametrize("typed", ["0", "5", str(ANGLE)])
+def test_a_plausible_angle_or_zero_is_silent(typed, capsys):
+    assert main(["stability", "--E", "0.03", "--pcsa", "10,10,10", "--lordosis-angle", typed]) == 0
+    assert capsys.readouterr().err == ""

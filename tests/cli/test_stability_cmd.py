@@ -70,3 +70,35 @@ def test_coupled_verdicts_name_the_chain_criterion(capsys):
     lines = capsys.readouterr().out.splitlines()
     verdicts = [line for line in lines if "stable" in line.lower()]
     assert len(verdicts) == 3 and all(line.startswith(f"{name}: ") for line in verdicts)
+
+
+def test_coupled_table_prints_real_eigenvalues_as_real_numbers(capsys):
+    """The chain's eigenvalues at E = 3 cm, Lambda = 4 cm (wagner2012) are all real (LAPACK returns an exact 0
+    imaginary part for a real root of the real 10 x 10 state matrix): printed as reals, never ``68.321+0.000j``."""
+    assert main(["stability", "--coupled", "--E", "0.03", "--Lambda", "0.04", "--preset", "wagner2012"]) == 0
+    out = capsys.readouterr().out
+    model = config.load_preset("wagner2012")
+    result = coupled_stability_at(model, 0.03, 0.04)
+    assert np.all(result.eigenvalues.imag == 0)  # the premise, so the assertion below can fail
+    line = next(row for row in out.splitlines() if row.startswith("eigenvalues [1/s]: "))
+    assert "j" not in line and line.endswith(", ".join(f"{z.real:.3f}" for z in result.eigenvalues))
+    assert "+0.000j" not in out
+
+
+def test_a_complex_eigenvalue_keeps_its_imaginary_part():
+    from spinectl.model.stability import eigenvalue_text
+
+    assert (
+        eigenvalue_text(complex(-3.6531, 1.2)) == "-3.653+1.200j" and eigenvalue_text(complex(68.3214, 0)) == "68.321"
+    )
+
+
+def test_the_table_says_the_sign_of_s_and_d(capsys):
+    """eq. 1 (theta phi'' = S phi + D phi') makes a restoring S and a damping D negative; the table says so
+    right below its rows, where spinectl anatomy's -K_jj column is > 0 restoring."""
+    from spinectl.model.stability import SIGN_NOTE
+
+    assert main(["stability", "--E", "0.03", "--Lambda", "0.04", "--pcsa", "10,10,10"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    last_row = max(i for i, line in enumerate(lines) if line.startswith("L5S1"))
+    assert lines[last_row + 1] == SIGN_NOTE and "S < 0 restores" in SIGN_NOTE and "D < 0 damps" in SIGN_NOTE

@@ -182,10 +182,11 @@ def test_a_nameless_pair_in_merge_mode_is_an_error(tmp_path):
         config.load_config(path)
 
 
-def test_replace_mode_replaces_the_set_with_a_warning(tmp_path):
+def test_replace_mode_replaces_the_set_silently(tmp_path):
     path = tmp_path / "m.toml"
     path.write_text('muscles_mode = "replace"\n[[muscles]]\nname = "only"\n')
-    with pytest.warns(config.ConfigWarning, match="straight, oblique_outer, oblique_inner dropped"):
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # the author chose it: no warning
         model = config.load_config(path)
     assert model.pair_names == ("only",)
 

@@ -114,3 +114,14 @@ def test_local_damping_outside_its_range_is_one_line_naming_the_field(capsys, va
     out = capsys.readouterr().out
     section = out[out.index("[local]") :]
     assert "# [1] Factor on the local muscles' damping" in section and "\ndamping = 1.0" in section
+
+
+def test_side_names_name_every_muscle_and_are_validated():
+    """geometry.side_names (the +x side first) names each pair's muscles: right and left in the coronal plane."""
+    model = Model(geometry=Geometry(side_names=("right", "left")))
+    assert model.muscle_names[:2] == (f"{model.pair_names[0]}_right", f"{model.pair_names[0]}_left")
+    assert Model().muscle_names[:2] == (f"{model.pair_names[0]}_ventral", f"{model.pair_names[0]}_dorsal")
+    with pytest.raises(ParameterError, match=r"side_names: must name 2 sides, the \+x side first \(got 1\)"):
+        Geometry(side_names=("right",))
+    with pytest.raises(ParameterError, match=r"side_names: must be unique \(repeated: 'left'\)"):
+        Geometry(side_names=("left", "left"))

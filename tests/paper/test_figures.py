@@ -581,3 +581,11 @@ def test_a_wrapped_title_keeps_settings_units_and_short_parentheses_whole(width)
     for whole in ("body.mass = 24 kg", "K = 15 N m/rad", "(K convention: physical, -K in dM/dα)"):
         assert any(whole in line for line in lines), (whole, lines)
     assert " ".join(lines) == title
+
+
+def test_a_corner_read_from_an_angle_axis_is_labelled_to_three_digits():
+    """An axis even in degrees (sweep --lordosis-angle) puts its corners at Lambda values such as
+    0.0699162 m: the label reads 6.99 cm (3 significant digits), not 6.99162 cm."""
+    e, lam = np.array([0.02, 0.1]), np.array([0.0123456, 0.0699162])
+    labels = [label for label, _ in figures.grid_marks(e, lam)]
+    assert labels == ["C", "2, 1.23 cm", "10, 1.23 cm", "10, 6.99 cm", "2, 6.99 cm"]  # C = (3, 4) cm inside

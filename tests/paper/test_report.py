@@ -142,3 +142,24 @@ def test_a_config_path_in_the_report_is_text_not_markdown():
     for markup in "`*[]<>|#":
         assert all(line[i - 1] == "\\" for i, char in enumerate(line) if char == markup), markup
     assert printable(path).replace("\\", "") in line.replace("\\", "")  # the text itself, escapes aside
+
+
+def test_the_report_opens_with_the_papers_question_and_the_answer():
+    """The synthetic landscape's ‖CT‖ = 1000 E N m grows with E alone: at E = 3 cm it is 30 N m everywhere
+    (not inside the 30 N m limit), and its least lies at the first Lambda of the column (0 cm, not about
+    4 cm): the claim is not reproduced, and both landmarks are named."""
+    text = report.render(_measurements(), RUN)
+    head = text.split("## Read this first")[0]
+    assert "## The paper's question and spinectl's answer" in head and "±30 N m" in head
+    assert "**The paper's main claim is not reproduced with these parameters**" in head
+    assert "(`optimum_lordosis` and `ct_optimum` disagree)" in head
+    assert "‖CT‖ is 30 N m" in head and "at Λ = 0 cm" in head
+
+
+def test_the_answer_says_reproduced_when_both_landmarks_agree():
+    measured = [
+        dataclasses.replace(m, agrees=True) if m.landmark.name in ("optimum_lordosis", "ct_optimum") else m
+        for m in _measurements()
+    ]
+    text = report.answer(measured)
+    assert "**The paper's main claim is reproduced:**" in text and "not reproduced" not in text

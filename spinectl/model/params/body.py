@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 from ... import _validate as v
 from ...errors import ParameterError
-from .bounds import _gravity, _length, _mass, _store, param
+from .bounds import SIDES, _gravity, _length, _mass, _store, param
 
 
 @dataclass(frozen=True)
@@ -65,6 +65,12 @@ class Geometry:
     lordosis_range: tuple[float, ...] = param(
         (-0.10, 0.10), "m", "Modelled range of the lordosis Lambda; the paper studies 0 to 0.08 m."
     )
+    side_names: tuple[str, ...] = param(
+        SIDES,
+        "",
+        "Names of the two sides of every pair, the +x muscle first: ventral and dorsal in the sagittal plane, "
+        "right and left in the coronal plane (docs/model.md, 'Frame and units'); each muscle is <pair>_<side>.",
+    )
 
     def __post_init__(self):
         heights = v.real_vector("cor_heights", self.cor_heights)
@@ -89,3 +95,7 @@ class Geometry:
             if lo >= hi:
                 raise ParameterError(name, f"must be [low, high] with low < high (got [{lo:g}, {hi:g}])")
             _store(self, **{name: (lo, hi)})
+        sides = v.labels("side_names", self.side_names)
+        if len(sides) != len(SIDES):  # distinct already (labels)
+            raise ParameterError("side_names", f"must name 2 sides, the +x side first (got {len(sides)})")
+        _store(self, side_names=sides)

@@ -78,8 +78,8 @@ class Model:
 
     @property
     def muscle_names(self) -> tuple[str, ...]:
-        """Names of the individual muscles, ``<pair>_<side>``, in column order."""
-        return tuple(f"{m.name}_{side}" for m in self.muscles for side in SIDES)
+        """Names of the individual muscles, ``<pair>_<side>`` (``geometry.side_names``), in column order."""
+        return tuple(f"{m.name}_{side}" for m in self.muscles for side in self.geometry.side_names)
 
     @property
     def pair_names(self) -> tuple[str, ...]:

@@ -16,7 +16,7 @@ from ...model.checks import arithmetic_guard, expand_pcsa
 from ...model.linear_chain import LinearChain
 from ...model.params import Model
 from ...model.source import header, provenance
-from ...model.stability import criterion, self_stable
+from ...model.stability import criterion, eigenvalue_text, self_stable
 from ...units import m2_to_cm2
 from ..stabilising import minimum_stabilising_pcsa
 from .data import CoupledOptimum, coupled_data
@@ -205,7 +205,7 @@ class CoupledStability:
             "",
             f"{name}: static margin (smallest eigenvalue of -K) = {self.margin:.3f} N m/rad "
             f"({'stable' if self.margin > 0 else 'UNSTABLE'})",
-            "eigenvalues [1/s]: " + ", ".join(f"{z.real:.3f}{z.imag:+.3f}j" for z in self.eigenvalues),
+            "eigenvalues [1/s]: " + ", ".join(eigenvalue_text(z) for z in self.eigenvalues),
             f"{name}: global muscles alone: "
             + (
                 "eigenvalues undefined, the mass matrix is singular (levels.mass = 0)"
@@ -217,7 +217,7 @@ class CoupledStability:
             + ", ".join(f"{n} {k:.2f}" for n, k in zip(names, local, strict=True))
             + f"  (total {np.sum(local):.2f}; local PCSA {m2_to_cm2(self.local.total_local_pcsa):.2f} cm^2; "
             f"{self.local.status}); with it: {'dynamically stable' if self.stable_with_local else 'NOT stable'}, "
-            f"slowest eigenvalue {self.local_eigenvalues[0].real:.3f}{self.local_eigenvalues[0].imag:+.3f}j 1/s",
+            f"slowest eigenvalue {eigenvalue_text(self.local_eigenvalues[0])} 1/s",
         ]
         return "\n".join(lines)
 

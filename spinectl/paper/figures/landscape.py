@@ -28,6 +28,7 @@ from .style import (
     TITLE_CHARS,
     _round_levels,
     _wrap,
+    cm_text,
 )
 
 _TOLERANCE = 1e-9
@@ -70,7 +71,7 @@ def grid_marks(e: np.ndarray, lam: np.ndarray) -> list[tuple[str, tuple[float, f
     marks = [(name, p) for name, p in landmarks.FIGURE_POSITIONS.items() if _inside(p, e, lam)]
     for corner in ((e.min(), lam.min()), (e.max(), lam.min()), (e.max(), lam.max()), (e.min(), lam.max())):
         if not any(np.allclose(corner, p, atol=_TOLERANCE) for _, p in marks):
-            marks.append((f"{corner[0] * CM_PER_M:g}, {corner[1] * CM_PER_M:g} cm", corner))
+            marks.append((f"{cm_text(corner[0])}, {cm_text(corner[1])} cm", corner))
     return marks
 
 

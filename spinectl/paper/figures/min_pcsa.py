@@ -12,11 +12,11 @@ from matplotlib.figure import Figure
 
 from ...canvas import new_figure
 from ...landscape import netcdf
-from ...units import CM_PER_M, M2_PER_CM2
+from ...units import M2_PER_CM2
 from .. import drawing
 from .labels import _label_lines
 from .landscape import _TOLERANCE, _landscape, grid_marks
-from .style import _k_label
+from .style import _k_label, cm_text
 
 INSET_FIGURE_SIZE = (8.4, 8.0)
 """Inches, Figure 3 with the model drawn at its four corners."""
@@ -72,5 +72,5 @@ def _draw_corners(fig, spec, dataset: xr.Dataset) -> None:
         ax = fig.add_subplot(spec[row, col])
         drawing.draw_model(model, *position, pcsa=pcsa if np.all(np.isfinite(pcsa)) else None, ax=ax, annotate=False)
         label = next(name for p, name in labels.items() if np.allclose(p, position, atol=_TOLERANCE))
-        coordinates = f"E = {position[0] * CM_PER_M:g}, Λ = {position[1] * CM_PER_M:g} cm"
+        coordinates = f"E = {cm_text(position[0])}, Λ = {cm_text(position[1])} cm"
         ax.set_title(coordinates if label[0].isdigit() else f"{label}: {coordinates}", fontsize=7)

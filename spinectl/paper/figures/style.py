@@ -15,6 +15,7 @@ import xarray as xr
 from matplotlib.ticker import MaxNLocator
 
 from ...model.source import stiffness_unit
+from ...units import CM_PER_M
 
 FIGURE_SIZE = (6.4, 5.2)
 """Inches."""
@@ -34,6 +35,27 @@ Figure 3 with the model drawn at its corners (about 3.4 in)."""
 
 _CONVENTION = {"paper": "eq. 2 as printed", "physical": "physical, -K in dM/dα"}
 """How a title names the passive-stiffness convention (docs/model.md, "Passive stiffness: two conventions")."""
+
+
+CM_DIGITS = 3
+"""Significant digits of a position in cm on a figure: a grid corner read from an angle axis is 6.99 cm,
+not 6.99162 cm (a figure's label is read, not computed with)."""
+
+
+def cm_text(value: float) -> str:
+    """A length [m] as a figure labels it in cm, to :data:`CM_DIGITS` significant digits (``0.0699162`` -> ``'6.99'``).
+
+    Parameters
+    ----------
+    value : float
+        The length [m].
+
+    Returns
+    -------
+    str
+        The number in cm, without the unit.
+    """
+    return f"{value * CM_PER_M:.{CM_DIGITS}g}"
 
 
 COLOUR_BAR = (1.03, 0.0, 0.045, 1.0)
