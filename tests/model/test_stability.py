@@ -297,8 +297,8 @@ def test_the_header_names_k_in_the_unit_its_convention_gives_and_what_it_adds():
     physical = paper.replace(passive=Passive(15.0, "physical"))
     assert "K = 15 N m/rad, convention physical" in source.header(physical)
     assert "theta" not in source.header(physical)
-    assert source.header(paper.replace(passive=Passive(15.0, "paper"))).endswith(
-        "K = 15 1/s^2, convention paper (K theta_k [N m/rad] at each CoR)"
+    assert source.header(paper.replace(passive=Passive(15.0, "paper"))).endswith(  # Model.replace keeps the source
+        "K = 15 1/s^2, convention paper (K theta_k [N m/rad] at each CoR); overridden: passive.stiffness"
     )
 
 
