@@ -90,6 +90,22 @@ its lower end with the heaviest, tallest bodies the optimiser's statuses are not
 MAX_GRAVITY = 30.0
 """Largest gravitational acceleration [m/s^2]: above Jupiter's 24.8; cm/s^2 (981) typed for m/s^2 is far beyond."""
 
+MAX_STABILITY_MARGIN = MAX_MASS * MAX_GRAVITY * MAX_BODY_LENGTH
+"""Largest required stiffness margin ``optimisation.stability_margin`` [N m/rad]: the gravity stiffness m g r of
+the heaviest, tallest body the bounds allow (1000 kg, 30 m/s^2, 1 m: 3e4 N m/rad), more than any segment must
+overcome. A margin of 1e308 overflowed the problem's equilibration (numpy's overflow warnings, then a false
+"no activation stabilises")."""
+
+MAX_DAMPING_MARGIN = 2.0 * math.sqrt(MAX_MASS * MAX_BODY_LENGTH**2 * MAX_STABILITY_MARGIN)
+"""Largest required damping ``optimisation.damping_margin`` [N m s/rad]: the critical damping 2 sqrt(theta S) of
+the same body (theta = m r^2 = 1000 kg m^2, S = 3e4 N m/rad: 1.1e4 N m s/rad). The paper's segments need about
+0.4 N m s/rad per cm^2 of PCSA (a margin of 100 took 247 cm^2 at E = Lambda = 0), so the bound already asks for
+some 27,000 cm^2; a margin of 1e308 overflowed the arithmetic (four warning lines before the error)."""
+
+MAX_CT_TOLERANCE = 1.0
+"""Largest ``optimisation.ct_tolerance`` [1]: a slack of 100 % lets the counter-torque problem take twice the
+minimum PCSA, which no longer minimises it; 1e308 overflowed the slackened bound (numpy's warnings)."""
+
 
 def _length(name: str, value, *, allow_zero: bool = False, signed: bool = False) -> float:
     """A length of the trunk [m], at most :data:`MAX_BODY_LENGTH` in size, with the cm-for-m hint."""
