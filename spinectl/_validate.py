@@ -330,5 +330,7 @@ def range_spec(name: str, spec: str, limit: int, example: str, bounds=None, unit
     axis = linear_range(name, start, stop, num, repr(spec), limit)
     if bounds is not None and not (bounds[0] <= start and stop <= bounds[1]):
         low, high = bounds
-        raise ParameterError(name, f"must be in [{low:g}, {high:g}] {unit} (got {spec!r}: {start:g} to {stop:g} {unit})")
+        raise ParameterError(
+            name, f"must be in [{low:g}, {high:g}] {unit} (got {spec!r}: {start:g} to {stop:g} {unit})"
+        )
     return axis

@@ -193,11 +193,13 @@ def run(args) -> int:
 
 
 def _degrees(text: str):
-    """START:STOP:NUM as NUM evenly spaced values [deg], by the rule of every range (:func:`spinectl._validate.range_spec`)."""
+    """START:STOP:NUM as NUM evenly spaced values [deg], by the rule of every range (``_validate.range_spec``)."""
     from .._validate import range_spec
     from ..model.params.bounds import MAX_CURVE_POINTS
 
-    return range_spec("--lordosis", text, MAX_CURVE_POINTS, "in degrees, e.g. -20:20:41", bounds=(-90.0, 90.0), unit="deg")
+    return range_spec(
+        "--lordosis", text, MAX_CURVE_POINTS, "in degrees, e.g. -20:20:41", bounds=(-90.0, 90.0), unit="deg"
+    )
 
 
 def _curve_table(curve: dict) -> str:

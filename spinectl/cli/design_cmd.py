@@ -135,7 +135,7 @@ def run(args) -> int:
 
 
 def _axis(option: str, text: str, high: float, unit: str, example: str):
-    """START:STOP:NUM (or one value) in [0, high], by the rule of every range (:func:`spinectl._validate.range_spec`)."""
+    """START:STOP:NUM (or one value) in [0, high], by the rule of every range (``_validate.range_spec``)."""
     from .._validate import range_spec
     from ..model.params.bounds import MAX_CURVE_POINTS
 
@@ -153,9 +153,8 @@ def _announce(designs: int, passive: bool = False) -> None:
 
 def _passive(model, args) -> int:
     """``--passive``: the chain's verdicts against the passive stiffness; the figure with ``--plot``."""
-    from ..reflex.design import passive_curve
-
     from ..model.params.bounds import MAX_PASSIVE_STIFFNESS, passive_axis
+    from ..reflex.design import passive_curve
 
     stiffnesses = passive_axis(_axis("--passive", args.passive, MAX_PASSIVE_STIFFNESS, "N m/rad", PASSIVE_EXAMPLE))
     _announce(len(stiffnesses), passive=True)
@@ -173,10 +172,9 @@ def _passive(model, args) -> int:
 
 def _delays(model, args, kp, kd) -> int:
     """``--delays``: the design curve against the delay (one per lag); the figure with ``--plot``."""
-    from ..reflex.design import delay_curve
-
     from ..model.params import MAX_DELAY
     from ..model.params.bounds import design_axes
+    from ..reflex.design import delay_curve
 
     lags = [model.reflex.activation_time_constant] if args.lags is None else args.lags
     delays, lags = design_axes(_axis("--delays", args.delays, MAX_DELAY, "s", DELAYS_EXAMPLE).tolist(), lags)

@@ -116,7 +116,10 @@ class Estimate:
         str
             Without a newline.
         """
-        parts = [f"{size(self.disk)} on disk" if self.disk else "", f"{size(self.memory)} of memory" if self.memory else ""]
+        parts = [
+            f"{size(self.disk)} on disk" if self.disk else "",
+            f"{size(self.memory)} of memory" if self.memory else "",
+        ]
         costs = ", ".join([p for p in parts if p] + [f"{duration(self.seconds)} of CPU (estimated)"])
         return f"{self.what}: {self.points:,} {self.unit}, about {costs}"
 

@@ -233,7 +233,8 @@ def sample_count(count) -> int:
         return v.integer("samples.count", count, 1, MAX_COMBINATIONS)
     except ParameterError as exc:
         raise ParameterError(
-            "samples.count", exc.message.replace(" (got", ": each draw is a combination, all checked before any work (got")
+            "samples.count",
+            exc.message.replace(" (got", ": each draw is a combination, all checked before any work (got"),
         ) from None
 
 

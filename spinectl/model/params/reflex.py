@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 from ... import _validate as v
 from ...errors import ParameterError
-from .bounds import MAX_ACTIVATION, MAX_ACTIVATION_TIME_CONSTANT, MAX_DELAY, MAX_PADE_ORDER, seconds, _store, param
+from .bounds import MAX_ACTIVATION, MAX_ACTIVATION_TIME_CONSTANT, MAX_DELAY, MAX_PADE_ORDER, _store, param, seconds
 
 
 @dataclass(frozen=True)

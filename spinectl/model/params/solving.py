@@ -21,7 +21,10 @@ from .bounds import (
 
 MARGIN_REASONS = {
     "stability_margin": ("N m/rad", "the gravity stiffness m g r of the heaviest, tallest body the bounds allow"),
-    "damping_margin": ("N m s/rad", "the critical damping 2 sqrt(theta S) of the heaviest, tallest body the bounds allow"),
+    "damping_margin": (
+        "N m s/rad",
+        "the critical damping 2 sqrt(theta S) of the heaviest, tallest body the bounds allow",
+    ),
     "ct_tolerance": ("", "a slack of 100 %: twice the minimum PCSA"),
 }
 """The unit and the reason of each bounded setting, for its message (``params.bounds.MAX_DAMPING_MARGIN`` etc.)."""
@@ -113,4 +116,3 @@ class Optimisation:
             ct_tolerance=_bounded("ct_tolerance", self.ct_tolerance, MAX_CT_TOLERANCE),
             solver_tolerance=v.in_range("solver_tolerance", self.solver_tolerance, *SOLVER_TOLERANCE_RANGE),
         )
-
