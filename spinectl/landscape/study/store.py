@@ -455,11 +455,8 @@ def open_store(path: str | Path) -> xr.Dataset:
 
 
 def _check_consolidated(path) -> None:
-    """A finished store's consolidated metadata (``.zmetadata``), if any, must be what its files say.
-
-    It is only a copy, for readers that open the store in one read (``xarray.open_zarr``): the resume
-    of a finished store writes it again, so a damaged one is reported with that remedy.
-    """
+    """A finished store's ``.zmetadata``, if any, must be what its files say: a copy for ``xarray.open_zarr``,
+    which the resume of a finished store writes again (the remedy the error gives)."""
     file = Path(path) / ".zmetadata"
     if not (file.exists() or file.is_symlink()):
         return
@@ -480,12 +477,8 @@ def _consolidated_fault(path: Path, document) -> str:
     entries = document.get("metadata") if isinstance(document, dict) else None
     if not isinstance(entries, dict) or document.get("zarr_consolidated_format") != 1:
         return "is not Zarr's consolidated metadata (a table of 'metadata' with 'zarr_consolidated_format' = 1)"
-    files = {  # the metadata of the root and its arrays: the store has no nested groups
-        f"{folder}{name}" if folder else name
-        for folder in ["", *(f"{d.name}/" for d in path.iterdir() if d.is_dir())]
-        for name in (".zgroup", ".zattrs", ".zarray")
-        if (path / folder / name).is_file()
-    }
+    folders = ["", *(f"{d.name}/" for d in path.iterdir() if d.is_dir())]  # the root and its arrays: no subgroups
+    files = {f"{f}{name}" for f in folders for name in (".zgroup", ".zattrs", ".zarray") if (path / f / name).is_file()}
     if set(entries) != files:
         return f"does not list the store's metadata files (lists {len(entries)}, the store has {len(files)})"
     for name, entry in sorted(entries.items()):
