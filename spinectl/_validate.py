@@ -167,13 +167,12 @@ def integer(name: str, value, low: int, high: int | None = None) -> int:
     high : int, optional
         Largest accepted value; no bound if None.
     """
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
-        raise ParameterError(name, f"must be an integer (got {show(value)})")
-    value = int(value)
-    if value < low or (high is not None and value > high):
-        allowed = f">= {low}" if high is None else f"in [{low}, {high}]"
+    allowed = f">= {low}" if high is None else f"in [{low}, {high}]"
+    # the range in both messages: a float such as 1e9 is refused for its size as much as for its type
+    integral = isinstance(value, numbers.Integral) and not isinstance(value, bool)
+    if not integral or value < low or (high is not None and value > high):
         raise ParameterError(name, f"must be an integer {allowed} (got {show(value)})")
-    return value
+    return int(value)
 
 
 def label(field: str, value) -> str:
@@ -233,3 +232,105 @@ def _sequence(name: str, value, what: str) -> Sequence:
     if isinstance(value, (str, bytes)) or not isinstance(value, Sequence):
         raise ParameterError(name, f"must be {what} (got {show(value)})")
     return value
+
+
+def linear_range(name: str, start: float, stop: float, num: int, typed: str, limit: int, *, table: bool = False):
+    """``num`` evenly spaced values from ``start`` to ``stop``, inclusive: every range of an axis or a curve.
+
+    One rule for every such range (``sweep --E``, ``design --delays`` and ``--passive``, ``anatomy
+    --lordosis``, a study file's ``{ start, stop, num }``): ``start <= stop``, ``1 <= num <= limit``,
+    and one value exactly when ``start = stop``. numpy's ``linspace`` would keep START alone for
+    ``num = 1`` (silently dropping STOP), and repeat one value ``num`` times for ``start = stop``.
+
+    Parameters
+    ----------
+    name : str
+        The option or field, e.g. ``"--E"`` or ``"axes.E"``, as named in errors.
+    start, stop : float
+        The ends, finite, in the axis's unit.
+    num : int
+        The number of values.
+    typed : str
+        The range as the user wrote it, quoted in errors (``"'0:0.08:81'"``).
+    limit : int
+        The most values allowed (the caller's bound, with its reason).
+    table : bool, optional
+        Name the parts as a study file does (``start``, ``stop``, ``num``) rather than the command
+        line (``START:STOP:NUM``).
+
+    Returns
+    -------
+    numpy.ndarray, shape (num,)
+        The values, ``numpy.linspace(start, stop, num)``.
+
+    Raises
+    ------
+    ParameterError
+        Naming ``name``, the rule broken and ``typed``.
+    """
+    import numpy as np
+
+    s, t, n = ("start", "stop", "num") if table else ("START", "STOP", "NUM")
+    form = "{ start, stop, num }" if table else "START:STOP:NUM"
+    if not (math.isfinite(start) and math.isfinite(stop) and start <= stop and 1 <= num <= limit):
+        raise ParameterError(name, f"must be {form} with {s} <= {t} and 1 <= {n} <= {limit:,} (got {typed})")
+    if num == 1 and start != stop:
+        raise ParameterError(
+            name, f"with {n} = 1 must have {s} = {t}, or give the single value alone, e.g. {start:g} (got {typed})"
+        )
+    if num > 1 and start == stop:
+        raise ParameterError(
+            name, f"with {s} = {t} must have {n} = 1: {num} values would all be {start:g} (got {typed})"
+        )
+    return np.linspace(start, stop, num)
+
+
+def range_spec(name: str, spec: str, limit: int, example: str, bounds=None, unit: str = ""):
+    """A range typed on the command line, ``START:STOP:NUM`` or a single value, by :func:`linear_range`'s rule.
+
+    Parameters
+    ----------
+    name : str
+        The option, e.g. ``"--delays"``, as named in errors.
+    spec : str
+        As typed, e.g. ``"0:0.2:41"`` or ``"0.1"``.
+    limit : int
+        The most values allowed.
+    example : str
+        The unit in words and an example, for the malformed spec: ``"in metres, e.g. 0:0.08:81"``.
+    bounds : (float, float), optional
+        The allowed interval, in ``unit``; a range beyond it is refused naming the spec as typed.
+    unit : str, optional
+        The unit of ``bounds``, e.g. ``"s"``.
+
+    Returns
+    -------
+    numpy.ndarray, shape (num,)
+        The values.
+
+    Raises
+    ------
+    ParameterError
+        Naming ``name``: a malformed spec, a range that breaks :func:`linear_range`'s rule, or one beyond ``bounds``.
+    """
+    import numpy as np
+
+    parts = spec.split(":")
+    try:
+        if len(parts) == 1:
+            axis = np.array([float(parts[0])])
+            start = stop = float(axis[0])
+            num = 1
+        elif len(parts) == 3:
+            start, stop, num = float(parts[0]), float(parts[1]), int(parts[2])
+        else:
+            raise ValueError(spec)
+    except ValueError:
+        raise ParameterError(name, f"must be START:STOP:NUM {example} (got {spec!r})") from None
+    axis = linear_range(name, start, stop, num, repr(spec), limit)
+    if bounds is not None and not (bounds[0] <= start and stop <= bounds[1]):
+        low, high = bounds
+        raise ParameterError(
+            name, f"must be in [{low:g}, {high:g}] {unit} (got {spec!r}: {start:g} to {stop:g} {unit})"
+        )
+    return axis

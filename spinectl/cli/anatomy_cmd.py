@@ -193,19 +193,13 @@ def run(args) -> int:
 
 
 def _degrees(text: str):
-    """START:STOP:N as N evenly spaced values [deg]; one line naming --lordosis otherwise."""
-    import numpy as np
+    """START:STOP:NUM as NUM evenly spaced values [deg], by the rule of every range (``_validate.range_spec``)."""
+    from .._validate import range_spec
+    from ..model.params.bounds import MAX_CURVE_POINTS
 
-    from ..errors import ParameterError
-
-    try:
-        start, stop, count = text.split(":")
-        start, stop, count = float(start), float(stop), int(count)
-    except ValueError:
-        raise ParameterError("--lordosis", f"must be START:STOP:N, e.g. -20:20:41 (got {text!r})") from None
-    if not (np.isfinite(start) and np.isfinite(stop) and 1 <= count <= 1000 and abs(start) <= 90 and abs(stop) <= 90):
-        raise ParameterError("--lordosis", f"needs |START|, |STOP| <= 90 deg and 1 <= N <= 1000 (got {text!r})")
-    return np.linspace(start, stop, count)
+    return range_spec(
+        "--lordosis", text, MAX_CURVE_POINTS, "in degrees, e.g. -20:20:41", bounds=(-90.0, 90.0), unit="deg"
+    )
 
 
 def _curve_table(curve: dict) -> str:

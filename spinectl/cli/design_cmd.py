@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import sys
+
 from ._common import (
     add_mass_option,
     add_model_options,
@@ -51,13 +53,13 @@ def register(sub) -> None:
     parser.add_argument("--kd", type=finite_float("--kd"), help="derivative gain [N m s/rad] (default: the rule)")
     parser.add_argument(
         "--passive",
-        metavar="START:STOP:N",
+        metavar="START:STOP:NUM",
         help="instead: the chain's least global PCSA alone and least local stiffness against the passive "
         "stiffness per joint [N m/rad], e.g. 0:80:41, with Crisco et al. 1992's buckling stiffness marked",
     )
     parser.add_argument(
         "--delays",
-        metavar="START:STOP:N",
+        metavar="START:STOP:NUM",
         help="instead: the design curve, both criteria's required design against the delay [s], e.g. 0:0.2:41",
     )
     parser.add_argument(
@@ -75,6 +77,10 @@ def register(sub) -> None:
     add_model_options(parser)
     parser.set_defaults(func=run)
 
+
+PASSIVE_EXAMPLE = "in N m/rad, e.g. 0:80:41"
+DELAYS_EXAMPLE = "in seconds, e.g. 0:0.2:41"
+"""The forms of ``--passive`` and ``--delays``, for a malformed one."""
 
 OVERRIDES = (
     ("delay", "reflex.delay"),
@@ -128,28 +134,31 @@ def run(args) -> int:
     return 0
 
 
-def _axis(option: str, text: str, low: float, high: float):
-    """START:STOP:N as N evenly spaced values in [low, high]; one line naming ``option`` otherwise."""
-    import numpy as np
+def _axis(option: str, text: str, high: float, unit: str, example: str):
+    """START:STOP:NUM (or one value) in [0, high], by the rule of every range (``_validate.range_spec``)."""
+    from .._validate import range_spec
+    from ..model.params.bounds import MAX_CURVE_POINTS
 
-    from ..errors import ParameterError
+    return range_spec(option, text, MAX_CURVE_POINTS, example, bounds=(0.0, high), unit=unit)
 
-    try:
-        start, stop, count = text.split(":")
-        start, stop, count = float(start), float(stop), int(count)
-    except ValueError:
-        raise ParameterError(option, f"must be START:STOP:N, e.g. 0:80:41 (got {text!r})") from None
-    inside = all(np.isfinite(v) and low <= v <= high for v in (start, stop))
-    if not (inside and 1 <= count <= 1000):
-        raise ParameterError(option, f"needs {low:g} <= START, STOP <= {high:g} and 1 <= N <= 1000 (got {text!r})")
-    return np.linspace(start, stop, count)
+
+def _announce(designs: int, passive: bool = False) -> None:
+    """A curve estimated to take long is announced on stderr first, as a sweep or a study is."""
+    from ..landscape.budget import design_estimate
+
+    cost = design_estimate(designs, passive)
+    if cost.long:
+        print(cost.line(), file=sys.stderr)
 
 
 def _passive(model, args) -> int:
     """``--passive``: the chain's verdicts against the passive stiffness; the figure with ``--plot``."""
+    from ..model.params.bounds import MAX_PASSIVE_STIFFNESS, passive_axis
     from ..reflex.design import passive_curve
 
-    curve = passive_curve(model, args.E, args.Lambda, _axis("--passive", args.passive, 0.0, 1e4))
+    stiffnesses = passive_axis(_axis("--passive", args.passive, MAX_PASSIVE_STIFFNESS, "N m/rad", PASSIVE_EXAMPLE))
+    _announce(len(stiffnesses), passive=True)
+    curve = passive_curve(model, args.E, args.Lambda, stiffnesses)
     if args.plot is not None:
         from ..reflex.design_plots import passive_figure, write_figures
 
@@ -163,9 +172,14 @@ def _passive(model, args) -> int:
 
 def _delays(model, args, kp, kd) -> int:
     """``--delays``: the design curve against the delay (one per lag); the figure with ``--plot``."""
+    from ..model.params import MAX_DELAY
+    from ..model.params.bounds import design_axes
     from ..reflex.design import delay_curve
 
-    curve = delay_curve(model, args.E, args.Lambda, _axis("--delays", args.delays, 0.0, 10.0), args.lags, kp, kd)
+    lags = [model.reflex.activation_time_constant] if args.lags is None else args.lags
+    delays, lags = design_axes(_axis("--delays", args.delays, MAX_DELAY, "s", DELAYS_EXAMPLE).tolist(), lags)
+    _announce(len(delays) * len(lags))
+    curve = delay_curve(model, args.E, args.Lambda, delays, args.lags, kp, kd)
     if args.plot is not None:
         from ..reflex.design_plots import delay_figure, write_figures
 

@@ -60,6 +60,14 @@ ATLAS_BOOTSTRAP_BYTES = 72
 """Peak memory of SALib's Sobol' analysis per base sample and bootstrap resample [B]: its resampled
 indices and the outputs they pick (tracemalloc peak of ``atlas.sobol_indices``: 64-66 B)."""
 
+DESIGN_SECONDS = 50e-3
+"""CPU time of one design of ``spinectl design --delays`` (one delay at one lag, both criteria) [s]: 201 delays
+took 9.9 s of CPU beyond the command's start, 101 delays at 2 lags 6.8 s (one BLAS thread, E = Lambda = 0)."""
+
+PASSIVE_SECONDS = 12e-3
+"""CPU time of one point of ``spinectl design --passive`` [s]: 201 stiffnesses took 2.5 s of CPU beyond the
+command's start, from 0 to 80 as from 0 to 1e4 N m/rad (one BLAS thread, E = Lambda = 0)."""
+
 SWEEP_MEMORY_PER_BYTE = 2.5
 """Peak memory of a sweep per byte of its answer: the chunks' columns, their concatenation and the
 Dataset (tracemalloc peak of ``write_sweep`` over 101 x 101 x 4 K: 3.1 kB a point for 1.22 kB of answer)."""
@@ -91,13 +99,13 @@ class Estimate:
     Attributes
     ----------
     what : str
-        ``"sweep"`` or ``"study"``: the line's prefix.
+        ``"sweep"``, ``"study"``, ``"atlas"`` or ``"design"``: the line's prefix.
     points : int
         Points to solve (every axis multiplied).
     memory : float
-        Peak memory [B].
+        Peak memory [B]; 0: not estimated (not stated by :meth:`line`).
     disk : float
-        Bytes to be written [B].
+        Bytes to be written [B]; 0: not stated by :meth:`line`.
     seconds : float
         CPU time on one core [s].
     field : str
@@ -105,7 +113,7 @@ class Estimate:
     fewer : str
         What a memory refusal advises to use fewer of.
     unit : str
-        What ``points`` counts, in the lines (an atlas's draws).
+        What ``points`` counts, in the lines: ``"points"``, an atlas's ``"draws"``, ``"designs"``.
     """
 
     what: str
@@ -130,10 +138,31 @@ class Estimate:
         str
             Without a newline.
         """
-        return (
-            f"{self.what}: {self.points:,} {self.unit}, about {size(self.disk)} on disk, "
-            f"{size(self.memory)} of memory, {duration(self.seconds)} of CPU (estimated)"
-        )
+        parts = [
+            f"{size(self.disk)} on disk" if self.disk else "",
+            f"{size(self.memory)} of memory" if self.memory else "",
+        ]
+        costs = ", ".join([p for p in parts if p] + [f"{duration(self.seconds)} of CPU (estimated)"])
+        return f"{self.what}: {self.points:,} {self.unit}, about {costs}"
+
+
+def design_estimate(designs: int, passive: bool = False) -> Estimate:
+    """What a curve of ``spinectl design`` costs: its CPU time (it writes one figure at most, and holds little).
+
+    Parameters
+    ----------
+    designs : int
+        Delays times lags (``--delays``), or the stiffnesses of ``--passive``.
+    passive : bool, optional
+        ``--passive``'s points (:data:`PASSIVE_SECONDS` each) rather than designs (:data:`DESIGN_SECONDS`).
+
+    Returns
+    -------
+    Estimate
+        ``what`` ``"design"``; its :meth:`Estimate.line` reads ``design: 10,000 designs, about 8.3 min of CPU``.
+    """
+    each = PASSIVE_SECONDS if passive else DESIGN_SECONDS
+    return Estimate("design", designs, 0.0, 0.0, designs * each, unit="points" if passive else "designs")
 
 
 def atlas_memory(samples: int, priors: int, bootstrap: int) -> float:

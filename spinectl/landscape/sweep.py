@@ -16,6 +16,7 @@ import numpy as np
 import xarray as xr
 from tqdm import tqdm
 
+from .._validate import range_spec
 from ..atomic import check_writable
 from ..errors import ModelError, ParameterError
 from ..model import config, source
@@ -62,22 +63,7 @@ def parse_grid(spec: str, name: str, bounds: tuple[float, float] | None = None) 
         Naming ``name`` (e.g. ``"--E"``) and the allowed form (NUM = 1 only with START = STOP), or the
         range and the spec as typed.
     """
-    parts = spec.split(":")
-    try:
-        if len(parts) == 1:
-            return np.array([float(parts[0])])
-        start, stop, num = float(parts[0]), float(parts[1]), int(parts[2])
-    except (ValueError, IndexError):
-        raise ParameterError(name, f"must be START:STOP:NUM in metres, e.g. 0:0.08:81 (got {spec!r})") from None
-    if len(parts) != 3 or not 1 <= num <= MAX_GRID_POINTS or not start <= stop or not np.isfinite([start, stop]).all():
-        raise ParameterError(
-            name, f"must be START:STOP:NUM with START <= STOP and 1 <= NUM <= {MAX_GRID_POINTS:,} (got {spec!r})"
-        )
-    if num == 1 and start != stop:  # linspace would keep START alone, silently dropping STOP
-        raise ParameterError(
-            name, f"with NUM = 1 must have START = STOP, or give the single value alone, e.g. {start:g} (got {spec!r})"
-        )
-    axis = np.linspace(start, stop, num)
+    axis = range_spec(name, spec, MAX_GRID_POINTS, "in metres, e.g. 0:0.08:81")
     _check_bounds(axis, spec, name, bounds)
     return axis
 

@@ -932,12 +932,10 @@ def passive_curve(model: Model, eccentricity: float, lordosis: float, stiffnesse
     ParameterError
         A stiffness negative or not finite; E or Lambda out of range.
     """
-    from ..errors import ParameterError
+    from ..model.params.bounds import passive_axis
     from ..model.source import origin, provenance
 
-    ks = np.asarray(stiffnesses, float).ravel()
-    if ks.size == 0 or not np.all(np.isfinite(ks) & (ks >= 0)):
-        raise ParameterError("--passive", f"must be finite stiffnesses >= 0 N m/rad (got {ks.tolist()})")
+    ks = np.array(passive_axis(np.asarray(stiffnesses, float).ravel().tolist()))
     e, lam = float(eccentricity), float(lordosis)
     optimum = np.asarray(solve_point(model, e, lam).pcsa, float)
     points = [_passive_point(model, e, lam, k, optimum) for k in ks]
@@ -1170,16 +1168,15 @@ def delay_curve(model: Model, eccentricity: float, lordosis: float, delays, lags
     ParameterError
         A delay or lag out of range; E or Lambda out of range.
     """
-    from ..errors import ParameterError
     from ..model import config
+    from ..model.params.bounds import design_axes
     from ..model.source import header, provenance
 
-    ds = np.sort(np.asarray(delays, float).ravel())
-    if ds.size == 0 or not np.all(np.isfinite(ds) & (ds >= 0) & (ds <= 10)):
-        raise ParameterError("--delays", f"must be delays in [0, 10] s (got {np.asarray(delays).tolist()})")
-    lag_values = np.asarray([model.reflex.activation_time_constant] if lags is None else lags, float).ravel()
-    if lag_values.size == 0 or not np.all(np.isfinite(lag_values) & (lag_values >= 0) & (lag_values <= 10)):
-        raise ParameterError("--lags", f"must be lags in [0, 10] s (got {np.asarray(lags).tolist()})")
+    ds, lag_values = design_axes(  # the bounds of reflex.delay and reflex.activation_time_constant
+        np.asarray(delays, float).ravel().tolist(),
+        np.asarray([model.reflex.activation_time_constant] if lags is None else lags, float).ravel().tolist(),
+    )
+    ds, lag_values = np.sort(ds), np.array(lag_values)
     e, lam = float(eccentricity), float(lordosis)
     coefficients = checked_coefficients(model, e, lam)
     optimum = np.asarray(solve_point(model, e, lam).pcsa, float)

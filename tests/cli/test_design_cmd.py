@@ -128,3 +128,91 @@ def test_a_design_has_no_truth_value():
 def _default_json(capsys) -> str:
     assert main(["design", "--delay", "0.04", "--preset", "wagner2012", "--json"]) == 0
     return capsys.readouterr().out
+
+
+def _refusal(argv: list[str], capsys) -> str:
+    """The one line of an argument list refused with exit 2, after its field (``spinectl: error: FIELD: ``)."""
+    assert main(argv) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err.count("\n") == 1, err
+    return err.split(": ", 3)[3].rstrip("\n")
+
+
+@pytest.mark.parametrize(
+    ("option", "spec", "sweep_spec", "needle"),
+    [
+        ("--delays", "0:0.2:1", "0:0.08:1", "with NUM = 1 must have START = STOP"),  # before: tau = 0 alone, exit 0
+        ("--delays", "0.1:0.1:3", "0.01:0.01:3", "with START = STOP must have NUM = 1: 3 values would all be"),
+        ("--passive", "5:1:0", "0.05:0.01:0", "must be START:STOP:NUM with START <= STOP and 1 <= NUM <="),
+        ("--passive", "30:40:1", "0.03:0.04:1", "with NUM = 1 must have START = STOP"),
+    ],
+)
+def test_a_range_is_refused_as_sweep_refuses_it(capsys, option, spec, sweep_spec, needle):
+    """``design --delays``/``--passive`` and ``sweep --E`` follow one START:STOP:NUM rule (``_validate.range_spec``):
+    the same words, naming the option and the spec as typed (only the bound of NUM differs)."""
+    mine = _refusal(["design", option, spec], capsys)
+    theirs = _refusal(["sweep", "--E", sweep_spec, "--out", "x.nc"], capsys)
+    assert needle in mine and needle in theirs and f"(got {spec!r})" in mine
+
+
+@pytest.mark.parametrize(
+    ("argv", "needle"),
+    [
+        (["--delays", "0:20:3"], "--delays: must be in [0, 10] s (got '0:20:3': 0 to 20 s)"),  # params.MAX_DELAY
+        (["--passive", "0:1e5:3"], "--passive: must be in [0, 10000] N m/rad (got '0:1e5:3'"),
+        (["--passive", "0:80:1001"], "1 <= NUM <= 1,000 (got '0:80:1001')"),  # bounds.MAX_CURVE_POINTS
+        (["--delays", "0:0.2:41", "--lags", "0.05,0.05"], "--lags: must not repeat a value (repeated: 0.05)"),
+    ],
+)
+def test_a_curve_beyond_its_bounds_is_one_line(capsys, argv, needle):
+    """Each curve's bound, with its unit, naming the option and the spec as typed."""
+    assert main(["design", *argv]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err.count("\n") == 1 and needle in err
+
+
+@pytest.mark.parametrize("lag", ["5", "1.5"])
+def test_lags_have_the_bound_of_activation_lag(capsys, lag):
+    """``--lags`` and ``--activation-lag`` are one quantity, T_a, with one bound (params.MAX_ACTIVATION_TIME_CONSTANT,
+    1 s) and one message (before: --lags took up to 10 s, the curve computed at its first lag before the
+    refusal named reflex.activation_time_constant)."""
+    lags = _refusal(["design", "--delays", "0:0.2:3", "--lags", f"0.05,{lag}"], capsys)
+    single = _refusal(["design", "--activation-lag", lag], capsys)
+    assert lags == single and lags.startswith(f"must be in [0, 1] s (got {lag})")
+
+
+@pytest.mark.parametrize(("delays", "lags", "product"), [("0:0.2:1000", 200, "1,000 x 200 = 200,000"),
+                                                         ("0:0.2:101", 100, "101 x 100 = 10,100")])  # fmt: skip
+def test_too_many_designs_are_refused_before_any_work(capsys, monkeypatch, delays, lags, product):
+    """Delays times lags is bounded (params.bounds.MAX_DESIGNS = 10,000, about 50 ms each): 1000 delays at 200 lags
+    (the issue's 200,000 designs, some 3 hours) and 101 delays at 100 lags, one above the bound, are one line,
+    before any design is solved (before: accepted, with no estimate)."""
+    import spinectl.reflex.design as design
+
+    monkeypatch.setattr(design, "checked_coefficients", lambda *a: pytest.fail("solved before the refusal"))
+    values = ",".join(f"{i / 1000:g}" for i in range(lags))
+    message = _refusal(["design", "--delays", delays, "--lags", values], capsys)
+    assert message == f"must give at most 10,000 designs, delays times lags, about 50 ms each (got {product})"
+
+
+@pytest.mark.parametrize(
+    ("argv", "constant", "line"),
+    [
+        (["--delays", "0:0.1:2", "--lags", "0,0.05"], "DESIGN_SECONDS", "design: 4 designs, about 6.7 min of CPU"),
+        (["--passive", "30:40:2"], "PASSIVE_SECONDS", "design: 2 points, about 3.3 min of CPU"),
+    ],
+)
+def test_a_long_curve_is_announced_on_stderr_first(capsys, monkeypatch, argv, constant, line):
+    """A curve estimated at NOTICE_SECONDS (10 s) or more says so first, as a sweep does (``budget.design_estimate``).
+
+    With the time of one design set to 100 s, 2 delays x 2 lags are 400 s = 6.7 min, 2 stiffnesses 200 s =
+    3.3 min; the real curve is short and runs. At the measured costs the same curves are not announced.
+    """
+    from spinectl.landscape import budget
+
+    argv = ["design", "--preset", "wagner2012", *argv, "--json"]
+    assert main(argv) == 0
+    assert capsys.readouterr().err == ""  # 4 x 50 ms, 2 x 12 ms: far below 10 s
+    monkeypatch.setattr(budget, constant, 100.0)
+    assert main(argv) == 0
+    assert capsys.readouterr().err == f"{line} (estimated)\n"

@@ -85,3 +85,15 @@ def test_available_memory_and_free_disk_are_read_from_the_system(tmp_path):
     total = os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
     assert 0 < budget.available_memory() <= total
     assert budget.free_disk(tmp_path / "new" / "x.nc") == pytest.approx(shutil.disk_usage(tmp_path).free, rel=0.01)
+
+
+def test_a_design_curve_is_estimated_from_its_designs():
+    """``design_estimate``: the designs times the measured cost each (DESIGN_SECONDS, 50 ms; PASSIVE_SECONDS, 12 ms),
+    and a line without the disk or memory it does not estimate: 10,000 designs x 50 ms = 500 s = 8.3 min; 1000
+    stiffnesses x 12 ms = 12 s, over NOTICE_SECONDS (10 s); 41 delays x 50 ms = 2 s, under it."""
+    long = budget.design_estimate(10_000)
+    assert long.line() == "design: 10,000 designs, about 8.3 min of CPU (estimated)" and long.long
+    assert budget.design_estimate(1000, passive=True).line() == "design: 1,000 points, about 12 s of CPU (estimated)"
+    assert not budget.design_estimate(41).long
+    sweep_line = budget.Estimate("sweep", 4, 2e6, 3e3, 20.0).line()  # the others' lines keep every part
+    assert sweep_line == "sweep: 4 points, about 3 kB on disk, 2 MB of memory, 20 s of CPU (estimated)"

@@ -8,6 +8,7 @@ the very same stacked problems: the answers must agree bit for bit.
 from __future__ import annotations
 
 import contextlib
+import json
 import os
 import re
 import signal
@@ -87,7 +88,13 @@ BAD_STUDIES = [
     (study_with('"body.mass" = [1.0]\nbody.mass = [2.0]'), ParameterError, 'axes."body.mass"', "is given twice"),
     ("[axes]\nLambda = [0.0]\n", ParameterError, "axes.E", "is required"),
     ("[axes]\nE = { start = 0.0, stop = 0.08 }\nLambda = [0.0]\n", ParameterError, "axes.E", "missing num"),
-    ("[axes]\nE = { start = 0.08, stop = 0.0, num = 3 }\nLambda = [0.0]\n", ParameterError, "axes.E.stop", ">= start"),
+    ("[axes]\nE = { start = 0.08, stop = 0.0, num = 3 }\nLambda = [0.0]\n", ParameterError, "axes.E",
+     "must be { start, stop, num } with start <= stop"),
+    # the one rule of every range (_validate.linear_range): before, linspace kept 0 alone, or 0.01 three times
+    ("[axes]\nE = { start = 0.0, stop = 0.08, num = 1 }\nLambda = [0.0]\n", ParameterError, "axes.E",
+     "with num = 1 must have start = stop"),
+    (study_with('"body.mass" = { start = 40.0, stop = 40.0, num = 3 }'), ParameterError, 'axes."body.mass"',
+     "with start = stop must have num = 1: 3 values would all be 40"),
     ("[axes]\nE = [0.5]\nLambda = [0.0]\n", ParameterError, "axes.E", "must be in [-0.1, 0.1] m"),
     (study_with(more=NORMAL_MASS.format('distribution = "gauss", mean = 40.0, std = 1.0')), ParameterError,
      'samples.parameters."body.mass".distribution', "must be one of 'normal'"),
@@ -96,6 +103,18 @@ BAD_STUDIES = [
     (study_with(more=NORMAL_MASS.format('distribution = "normal", mean = 40.0, sd = 1.0')), ConfigError,
      'samples.parameters."body.mass".sd', "did you mean 'std'"),
     (study_with(more="[samples]\nseed = 1\n"), ParameterError, "samples.count", "is required"),
+    # a count too large or not an integer is the fault named, also when the parameters are missing (before:
+    # "samples.parameters: is required"); the bound is spec.MAX_COMBINATIONS, the message says why
+    (study_with(more="[samples]\ncount = 1e9\n"), ParameterError, "samples.count",
+     "must be an integer in [1, 10000]: each draw is a combination"),
+    (study_with(more="[samples]\ncount = 1000000000\n"), ParameterError, "samples.count",
+     "must be an integer in [1, 10000]: each draw is a combination, all checked before any work (got 1000000000)"),
+    (study_with(more="[samples]\ncount = 3.0\n" + NORMAL_MASS.format('distribution = "normal", mean = 40.0, std = 1.0')
+     .replace("[samples]\ncount = 3\n", "")), ParameterError, "samples.count",
+     "must be an integer in [1, 10000]: each draw is a combination, all checked before any work (got 3.0)"),
+    # a repeated output, also one after others (before: accepted, silently one array)
+    (study_with(head='outputs = ["status", "min_pcsa_cm2", "status"]'), ParameterError, "study.outputs[2]",
+     "must name each output once (repeated: 'status')"),
     (study_with(more="[samples]\ncount = 2\nsed = 1\nparameters = {}\n"), ConfigError, "samples.sed", "'seed'"),
 ]  # fmt: skip
 """(file, error class, field, part of the message): each class of mistake in a study file."""
@@ -1005,3 +1024,38 @@ def test_a_combination_whose_arithmetic_fails_is_named(tmp_path):
         ModelError, match=r"the model's arithmetic fails .*\(study combination passive\.stiffness = 1e\+308\)"
     ):
         study.run_study(study.parse_study(text), tmp_path / "s.zarr", scheduler="synchronous", progress=False)
+
+
+@pytest.mark.parametrize(
+    ("damage", "needle"),
+    [
+        (lambda text: "{not json", "cannot be read as JSON (Expecting property name"),  # garbage (the issue's case)
+        (lambda text: text[: len(text) // 2], "cannot be read as JSON ("),  # truncated, as by a full disk
+        (lambda text: "[1, 2]", "is not Zarr's consolidated metadata"),  # JSON of the wrong shape
+        (lambda text: '{"metadata": {}, "zarr_consolidated_format": 1}', "does not list the store's metadata files"),
+        (lambda text: text.replace('"study_digest": "', '"study_digest": "0'), "does not hold what '.zattrs'"),
+    ],
+)
+def test_a_damaged_zmetadata_is_named_with_its_remedy(tmp_path, capsys, damage, needle):
+    """A finished store whose consolidated metadata is damaged: loading and ``--resume`` say so in one line, naming
+    the file and the remedy, which works: without the file, --resume writes it again (before: "'s.zarr' is not a
+    spinectl study store" for garbage; an empty listing gave a KeyError traceback; an edited one passed)."""
+    text = STUDY.replace('"body.mass" = [35.0, 45.0]\n', "")  # 6 chunks
+    path, out = write(tmp_path, text), tmp_path / "s.zarr"
+    arguments = ["study", str(path), "--out", str(out), "--scheduler", "synchronous"]
+    assert main(arguments) == 0
+    file = out / ".zmetadata"
+    written = file.read_text()
+    file.write_text(damage(written))
+    with pytest.raises(ParameterError, match=re.escape(needle)) as info:
+        study.load(out)
+    assert info.value.field == "store" and repr(str(file)) in info.value.message
+    capsys.readouterr()
+    assert main([*arguments, "--resume"]) == 2
+    err = capsys.readouterr().err
+    assert (
+        len(err.splitlines()) == 1 and needle in err and "remove that file and run the study again with --resume" in err
+    )
+    file.unlink()
+    assert main([*arguments, "--resume"]) == 0
+    assert json.loads(file.read_text()) == json.loads(written)

@@ -144,7 +144,10 @@ def test_plot_of_a_one_point_sweep_is_one_line(tmp_path, capsys):
 
 @pytest.mark.parametrize(
     ("axes", "needle"),
-    [(["--K", "15,15"], "K: must not repeat a value (repeated: 15)"), (["--E", "0:0:3"], "E: must not repeat")],
+    [
+        (["--K", "15,15"], "K: must not repeat a value (repeated: 15)"),
+        (["--E", "0:0:3"], "--E: with START = STOP must have NUM = 1"),
+    ],
 )
 def test_a_repeated_coordinate_is_refused_before_the_sweep(tmp_path, monkeypatch, capsys, axes, needle):
     """Before: `--K 15,15` wrote a file with K = [15, 15] that plot could not read."""

@@ -171,11 +171,11 @@ OUT_OF_RANGE = {
     "levels.mass": [-1.8],
     "levels.radius_of_gyration": [-0.06],
     "levels.weight_in_gravity": [-0.5, 1.5],
-    "optimisation.stability_margin": [-0.1],
+    "optimisation.stability_margin": [-0.1, 3.1e4, 1e308],  # above m g r = 1000 kg x 30 m/s^2 x 1 m
     "optimisation.relative_margin": [-0.1, 1.5],
-    "optimisation.damping_margin": [-0.1],
+    "optimisation.damping_margin": [-0.1, 1.1e4, 1e308],  # above 2 sqrt(1000 kg m^2 x 3e4 N m/rad) = 10954
     "optimisation.pcsa_max": [0.0, -1.0, -math.inf],
-    "optimisation.ct_tolerance": [-1e-3],
+    "optimisation.ct_tolerance": [-1e-3, 1.5, 1e308],  # above 1: a slack beyond twice the minimum
     "optimisation.solver_tolerance": [0.0, 1e-13, 1e-3],
     "reflex.delay": [-0.1, 10.5],
     "reflex.activation_time_constant": [-0.05, 50.0],  # 50: milliseconds typed as seconds
@@ -786,3 +786,30 @@ def test_a_mass_beyond_any_human_upper_body_is_refused_with_the_reason(tmp_path,
     )
     err = capsys.readouterr().err
     assert code == 2 and err.count("\n") == 1 and "body.mass: must be at most 1000 kg" in err
+
+
+@pytest.mark.parametrize(
+    ("assignment", "needle"),
+    [
+        (
+            "optimisation.damping_margin=1e308",
+            "damping_margin: must be at most 1.1e+04 N m s/rad, the critical damping",
+        ),
+        ("optimisation.damping_margin=2e4", "damping_margin: must be at most 1.1e+04 N m s/rad"),
+        (
+            "optimisation.stability_margin=1e308",
+            "stability_margin: must be at most 3e+04 N m/rad, the gravity stiffness",
+        ),
+        ("optimisation.ct_tolerance=1e308", "ct_tolerance: must be at most 1, a slack of 100 %"),
+    ],
+)
+def test_a_margin_beyond_any_body_is_one_line_at_the_validator(capsys, assignment, needle):
+    """A required margin beyond any body the bounds allow is refused where it is read: one line, exit 2.
+
+    The bounds follow from the other bounds (``params.bounds``): m g r = 1000 kg x 30 m/s^2 x 1 m = 3e4 N m/rad,
+    its critical damping 2 sqrt(m r^2 x m g r) = 2 sqrt(1000 x 3e4) = 1.1e4 N m s/rad. Before, 1e308 gave four
+    lines of numpy's overflow warnings and then a false "no activation stabilises".
+    """
+    assert main(["stability", "--set", assignment]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err.count("\n") == 1 and err.startswith("spinectl: error: optimisation.") and needle in err

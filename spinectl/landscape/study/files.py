@@ -24,7 +24,7 @@ from ...model.checks import check_axis_range
 from ...model.params import Model
 from ...units import CM_PER_M
 from .. import sweep
-from .spec import GRID, Axis, Sampled, Samples, Study, grid_axis
+from .spec import GRID, Axis, Sampled, Samples, Study, grid_axis, sample_count
 
 SECTIONS = ("study", "model", "axes", "samples")
 ANGLE_AXIS = "lordosis_angle_deg"
@@ -137,9 +137,7 @@ def _axis_values(where: str, value) -> tuple:
         raise ParameterError(where, f"a range needs start, stop and num (missing {', '.join(missing)})")
     start, stop = v.real(f"{where}.start", value["start"]), v.real(f"{where}.stop", value["stop"])
     num = v.integer(f"{where}.num", value["num"], 1, sweep.MAX_GRID_POINTS)
-    if start > stop:
-        raise ParameterError(f"{where}.stop", f"must be >= start = {start:g} (got {stop:g})")
-    return tuple(np.linspace(start, stop, num).tolist())
+    return tuple(v.linear_range(where, start, stop, num, _toml_axis(value), sweep.MAX_GRID_POINTS, table=True).tolist())
 
 
 def _grid_axis(name: str, written, bounds) -> tuple[float, ...]:
@@ -214,6 +212,8 @@ def _base_model(head: dict, overrides, base_dir: Path) -> Model:
 def _samples(table: dict) -> Samples:
     """The ``[samples]`` section: its count, seed and one distribution per (dotted) parameter."""
     check_keys(table, SAMPLE_KEYS, "samples")
+    if "count" in table:  # a bad count is the fault named, even when the parameters are missing too
+        sample_count(table["count"])
     for key in ("count", "parameters"):
         if key not in table:
             raise ParameterError(f"samples.{key}", "is required")

@@ -211,6 +211,33 @@ class Sampled:
         return a + b * z if self.distribution == "normal" else a * np.exp(b * z)
 
 
+def sample_count(count) -> int:
+    """``samples.count``, validated: each draw is a combination, so at most :data:`MAX_COMBINATIONS`.
+
+    Parameters
+    ----------
+    count : object
+        As written in the study file.
+
+    Returns
+    -------
+    int
+        The number of draws.
+
+    Raises
+    ------
+    ParameterError
+        Not an integer, or not in [1, :data:`MAX_COMBINATIONS`]; the message gives the bound and its reason.
+    """
+    try:
+        return v.integer("samples.count", count, 1, MAX_COMBINATIONS)
+    except ParameterError as exc:
+        raise ParameterError(
+            "samples.count",
+            exc.message.replace(" (got", ": each draw is a combination, all checked before any work (got"),
+        ) from None
+
+
 @dataclass(frozen=True)
 class Samples:
     """Monte-Carlo draws: one ``sample`` dimension of ``count`` draws of several parameters.
@@ -230,7 +257,7 @@ class Samples:
     parameters: tuple[Sampled, ...]
 
     def __post_init__(self):
-        object.__setattr__(self, "count", v.integer("samples.count", self.count, 1, MAX_COMBINATIONS))
+        object.__setattr__(self, "count", sample_count(self.count))
         object.__setattr__(self, "seed", v.integer("samples.seed", self.seed, 0))
         if not self.parameters:
             raise ParameterError("samples.parameters", "must name at least one parameter to draw")
@@ -363,7 +390,9 @@ class Study:
         for i, name in enumerate(names):
             if not isinstance(name, str) or name not in schema.VARIABLES:
                 raise ConfigError(f"study.outputs[{i}]", unknown_message(str(name), schema.VARIABLES))
-        return tuple(dict.fromkeys(names))
+            if name in names[:i]:  # a typo for another output, most likely: not silently one array
+                raise ParameterError(f"study.outputs[{i}]", f"must name each output once (repeated: {show(name)})")
+        return tuple(names)
 
     def _check_parameters(self) -> None:
         """Each axis value and draw alone; no parameter twice; no change of the outputs' shape."""

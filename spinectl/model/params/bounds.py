@@ -7,6 +7,7 @@ memory); :func:`param` gives a field its unit and doc, the metadata docs/paramet
 from __future__ import annotations
 
 import math
+from collections import Counter
 from dataclasses import field
 
 from ... import _validate as v
@@ -66,6 +67,19 @@ MAX_ACTIVATION_TIME_CONSTANT = 1.0
 """Longest force-generation time constant of the reflex [s]: ten times the 100 ms the paper names as
 the upper end of force generation; a value beyond it is more likely milliseconds typed as seconds."""
 
+MAX_CURVE_POINTS = 1000
+"""Most points of one curve of ``spinectl design`` (``--delays``, ``--passive``): a figure a thousand pixels wide
+shows no more, and the table has a row each."""
+
+MAX_DESIGNS = 10_000
+"""Most designs of a design curve, delays times lags: each takes about 50 ms
+(:data:`spinectl.landscape.budget.DESIGN_SECONDS`), so some 8 minutes here; more (1000 delays for 200 lags
+took 200,000 designs, some 3 hours) is likelier a list typed wrong than a plan."""
+
+MAX_PASSIVE_STIFFNESS = 1e4
+"""Largest passive stiffness of ``design --passive`` [N m/rad]: some 650 times the paper's 15 N m/rad and far
+beyond the stiffness from which the chain needs no muscle at all, where the curve is flat."""
+
 MAX_ACTIVATION = 10.0
 """Largest activation of the reflex section, a sanity bound: ten times the co-contraction that
 self-stability needs (a larger value is more likely a PCSA typed in place of a fraction)."""
@@ -89,6 +103,22 @@ its lower end with the heaviest, tallest bodies the optimiser's statuses are not
 
 MAX_GRAVITY = 30.0
 """Largest gravitational acceleration [m/s^2]: above Jupiter's 24.8; cm/s^2 (981) typed for m/s^2 is far beyond."""
+
+MAX_STABILITY_MARGIN = MAX_MASS * MAX_GRAVITY * MAX_BODY_LENGTH
+"""Largest required stiffness margin ``optimisation.stability_margin`` [N m/rad]: the gravity stiffness m g r of
+the heaviest, tallest body the bounds allow (1000 kg, 30 m/s^2, 1 m: 3e4 N m/rad), more than any segment must
+overcome. A margin of 1e308 overflowed the problem's equilibration (numpy's overflow warnings, then a false
+"no activation stabilises")."""
+
+MAX_DAMPING_MARGIN = 2.0 * math.sqrt(MAX_MASS * MAX_BODY_LENGTH**2 * MAX_STABILITY_MARGIN)
+"""Largest required damping ``optimisation.damping_margin`` [N m s/rad]: the critical damping 2 sqrt(theta S) of
+the same body (theta = m r^2 = 1000 kg m^2, S = 3e4 N m/rad: 1.1e4 N m s/rad). The paper's segments need about
+0.4 N m s/rad per cm^2 of PCSA (a margin of 100 took 247 cm^2 at E = Lambda = 0), so the bound already asks for
+some 27,000 cm^2; a margin of 1e308 overflowed the arithmetic (four warning lines before the error)."""
+
+MAX_CT_TOLERANCE = 1.0
+"""Largest ``optimisation.ct_tolerance`` [1]: a slack of 100 % lets the counter-torque problem take twice the
+minimum PCSA, which no longer minimises it; 1e308 overflowed the slackened bound (numpy's warnings)."""
 
 
 def _length(name: str, value, *, allow_zero: bool = False, signed: bool = False) -> float:
@@ -133,8 +163,31 @@ def _gravity(value) -> float:
     return value
 
 
-def _seconds(name: str, value, high: float) -> float:
-    """A time in [0, high] s, with the hint for milliseconds typed as seconds."""
+def seconds(name: str, value, high: float) -> float:
+    """A time in [0, high] s, with the hint for milliseconds typed as seconds.
+
+    The one check of a delay or an activation lag, whether a parameter (``reflex.delay``) or a
+    design curve's axis (``design --delays``, ``--lags``), so the same quantity has the same bound.
+
+    Parameters
+    ----------
+    name : str
+        The field or option, as named in the error.
+    value : object
+        The time [s].
+    high : float
+        The bound [s], e.g. :data:`MAX_ACTIVATION_TIME_CONSTANT`.
+
+    Returns
+    -------
+    float
+        The time [s].
+
+    Raises
+    ------
+    ParameterError
+        Not a finite number, or outside [0, high], with ``if you meant ... ms`` where that fits.
+    """
     value = v.real(name, value)
     if not 0.0 <= value <= high:
         hint = f"; if you meant {value:g} ms, give {value / 1e3:g}" if 0.0 < value / 1e3 <= high else ""
@@ -180,3 +233,79 @@ def _mass(mass) -> float:
     if mass > MAX_MASS:
         raise ParameterError("mass", f"must be at most {MAX_MASS:g} kg, more than any human upper body (got {mass:g})")
     return mass
+
+
+def _curve(name: str, values, check) -> tuple[float, ...]:
+    """A design curve's axis: each value checked by ``check``, at least one, none repeated."""
+    items = tuple(check(name, x) for x in values)
+    if not items:
+        raise ParameterError(name, "must name at least one value")
+    repeated = sorted(x for x, n in Counter(items).items() if n > 1)
+    if repeated:
+        raise ParameterError(name, f"must not repeat a value (repeated: {', '.join(f'{x:g}' for x in repeated)})")
+    return items
+
+
+def design_axes(delays, lags) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """The delays and lags of a design curve, checked as ``reflex.delay`` and ``reflex.activation_time_constant``.
+
+    Parameters
+    ----------
+    delays : iterable of float
+        tau [s], each in [0, :data:`MAX_DELAY`].
+    lags : iterable of float
+        T_a [s], each in [0, :data:`MAX_ACTIVATION_TIME_CONSTANT`], the bound of ``--activation-lag``.
+
+    Returns
+    -------
+    (tuple of float, tuple of float)
+        The delays and the lags [s], as given.
+
+    Raises
+    ------
+    ParameterError
+        Named ``--delays`` or ``--lags``: a value out of its bound, none, a repeated value, or more than
+        :data:`MAX_DESIGNS` designs (delays times lags) in all.
+    """
+    delays = _curve("--delays", delays, lambda name, x: seconds(name, x, MAX_DELAY))
+    lags = _curve("--lags", lags, lambda name, x: seconds(name, x, MAX_ACTIVATION_TIME_CONSTANT))
+    if len(delays) > MAX_CURVE_POINTS:
+        raise ParameterError("--delays", f"must have at most {MAX_CURVE_POINTS:,} values (got {len(delays):,})")
+    if len(delays) * len(lags) > MAX_DESIGNS:
+        raise ParameterError(
+            "--lags" if len(lags) > 1 else "--delays",
+            f"must give at most {MAX_DESIGNS:,} designs, delays times lags, about 50 ms each "
+            f"(got {len(delays):,} x {len(lags):,} = {len(delays) * len(lags):,})",
+        )
+    return delays, lags
+
+
+def passive_axis(stiffnesses) -> tuple[float, ...]:
+    """The passive stiffnesses of ``design --passive`` [N m/rad], each in [0, :data:`MAX_PASSIVE_STIFFNESS`].
+
+    Parameters
+    ----------
+    stiffnesses : iterable of float
+        K per joint [N m/rad].
+
+    Returns
+    -------
+    tuple of float
+        The stiffnesses [N m/rad].
+
+    Raises
+    ------
+    ParameterError
+        Named ``--passive``: a value out of range, none, repeated, or more than :data:`MAX_CURVE_POINTS`.
+    """
+
+    def check(name: str, value) -> float:
+        value = v.non_negative(name, value)
+        if value > MAX_PASSIVE_STIFFNESS:
+            raise ParameterError(name, f"must be at most {MAX_PASSIVE_STIFFNESS:g} N m/rad per joint (got {value:g})")
+        return value
+
+    values = _curve("--passive", stiffnesses, check)
+    if len(values) > MAX_CURVE_POINTS:
+        raise ParameterError("--passive", f"must have at most {MAX_CURVE_POINTS:,} values (got {len(values):,})")
+    return values

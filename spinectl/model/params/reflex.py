@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 from ... import _validate as v
 from ...errors import ParameterError
-from .bounds import MAX_ACTIVATION, MAX_ACTIVATION_TIME_CONSTANT, MAX_DELAY, MAX_PADE_ORDER, _seconds, _store, param
+from .bounds import MAX_ACTIVATION, MAX_ACTIVATION_TIME_CONSTANT, MAX_DELAY, MAX_PADE_ORDER, _store, param, seconds
 
 
 @dataclass(frozen=True)
@@ -100,8 +100,8 @@ class Reflex:
             raise ParameterError("sim_perturbation", f"must be < sim_divergence = {limit:g} rad (got {kick:g})")
         _store(
             self,
-            delay=_seconds("delay", self.delay, MAX_DELAY),
-            activation_time_constant=_seconds(
+            delay=seconds("delay", self.delay, MAX_DELAY),
+            activation_time_constant=seconds(
                 "activation_time_constant", self.activation_time_constant, MAX_ACTIVATION_TIME_CONSTANT
             ),
             pade_order=v.integer("pade_order", self.pade_order, 1, MAX_PADE_ORDER),

@@ -10,7 +10,33 @@ from dataclasses import dataclass
 
 from ... import _validate as v
 from ...errors import ParameterError
-from .bounds import SOLVER_TOLERANCE_RANGE, _store, param
+from .bounds import (
+    MAX_CT_TOLERANCE,
+    MAX_DAMPING_MARGIN,
+    MAX_STABILITY_MARGIN,
+    SOLVER_TOLERANCE_RANGE,
+    _store,
+    param,
+)
+
+MARGIN_REASONS = {
+    "stability_margin": ("N m/rad", "the gravity stiffness m g r of the heaviest, tallest body the bounds allow"),
+    "damping_margin": (
+        "N m s/rad",
+        "the critical damping 2 sqrt(theta S) of the heaviest, tallest body the bounds allow",
+    ),
+    "ct_tolerance": ("", "a slack of 100 %: twice the minimum PCSA"),
+}
+"""The unit and the reason of each bounded setting, for its message (``params.bounds.MAX_DAMPING_MARGIN`` etc.)."""
+
+
+def _bounded(name: str, value, high: float) -> float:
+    """A number in [0, high], the bound's unit and reason in the message (:data:`MARGIN_REASONS`)."""
+    value = v.non_negative(name, value)
+    if value > high:
+        unit, why = MARGIN_REASONS[name]
+        raise ParameterError(name, f"must be at most {high:.3g}{' ' + unit if unit else ''}, {why} (got {value:g})")
+    return value
 
 
 @dataclass(frozen=True)
@@ -83,10 +109,10 @@ class Optimisation:
             raise ParameterError("pcsa_max", "must be > 0 (got 0)")
         _store(
             self,
-            stability_margin=v.non_negative("stability_margin", self.stability_margin),
+            stability_margin=_bounded("stability_margin", self.stability_margin, MAX_STABILITY_MARGIN),
             relative_margin=v.in_range("relative_margin", self.relative_margin, 0.0, 1.0),
-            damping_margin=v.non_negative("damping_margin", self.damping_margin),
+            damping_margin=_bounded("damping_margin", self.damping_margin, MAX_DAMPING_MARGIN),
             pcsa_max=pmax,
-            ct_tolerance=v.non_negative("ct_tolerance", self.ct_tolerance),
+            ct_tolerance=_bounded("ct_tolerance", self.ct_tolerance, MAX_CT_TOLERANCE),
             solver_tolerance=v.in_range("solver_tolerance", self.solver_tolerance, *SOLVER_TOLERANCE_RANGE),
         )
