@@ -3,8 +3,8 @@
 The layers and their order are those of CONTRIBUTING.md ("Architecture", "Layers"; a test
 checks that its table and :data:`LAYERS` agree, and that its tree names every module):
 
-    _version _aliases _threads errors units _validate _oscalls quoting atomic jsondoc canvas presets  <  model  <  optimise
-    <  reflex  <  anatomy  <  landscape  <  paper  <  explore  <  cli
+    _version _aliases _threads errors units _validate _oscalls quoting atomic jsondoc canvas presets
+    <  model  <  optimise  <  reflex  <  anatomy  <  landscape  <  paper  <  explore  <  cli
 
 A module may import modules of its own layer and of the layers before it, never
 of a later one (:data:`LAYERS`). ``spinectl/__init__.py`` is exempt as an
