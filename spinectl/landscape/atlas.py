@@ -94,7 +94,8 @@ class AtlasResult:
     n_evaluations : int
         Model evaluations, N (D + 2).
     probabilities : dict
-        {verdict: {p, low, high}} over the 2 N independent draws (Saltelli's A and B) [1].
+        {verdict: {p, low, high}} over the 2 N draws of Saltelli's A and B [1] (quasi-random, so the
+        Wilson intervals, which assume independent draws, are conservative).
     sobol : dict
         {output: {parameter: {S1, S1_conf, ST, ST_conf}}}; None where an output is not finite
         at some draw (counted in ``nonfinite``).
@@ -409,7 +410,7 @@ def verdicts(spec: AtlasSpec, outputs: dict) -> dict[str, np.ndarray]:
     """
     feasible = np.isin(outputs["status"], OK_STATUSES)
     out = {
-        "self_stable_joint_by_joint": feasible,
+        "stabilisable_joint_by_joint": feasible,
         "counter_torque_within_limit": feasible & (outputs["counter_torque_max_Nm"] <= spec.counter_torque_limit),
         "stable_at_delay": outputs["spine_delay_margin_s"] > outputs["delay_s"],
     }
@@ -492,8 +493,9 @@ def sobol_indices(spec: AtlasSpec, y: np.ndarray) -> dict | None:
     return {name: {k: float(found[k][i]) for k in keys} for i, name in enumerate(spec.names)}
 
 
-def independent_rows(spec: AtlasSpec, n_rows: int) -> np.ndarray:
-    """Rows of Saltelli's A and B matrices: 2 N independent draws, for the probabilities.
+def probability_rows(spec: AtlasSpec, n_rows: int) -> np.ndarray:
+    """Rows of Saltelli's A and B matrices: the 2 N draws the probabilities count (the rows between them
+    recombine A's and B's columns, so they are not draws of the cohort).
 
     Parameters
     ----------
@@ -524,7 +526,7 @@ def analyse(spec: AtlasSpec, values: dict, outputs: dict) -> AtlasResult:
     AtlasResult
     """
     n = outputs["status"].size
-    rows = independent_rows(spec, n)
+    rows = probability_rows(spec, n)
     found = verdicts(spec, outputs)
     probabilities = {name: wilson(int(v[rows].sum()), rows.size, spec.confidence) for name, v in found.items()}
     names = [o for o in OUTPUTS if o in outputs]

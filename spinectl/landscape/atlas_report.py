@@ -26,11 +26,13 @@ def report_text(result, spec: AtlasSpec) -> str:
     lines = [
         "# Population stability atlas",
         "",
-        f"Model: {markdown_text(header(spec.model))} (the parameters no prior varies).",
+        f"Model: {markdown_text(model_line(spec))} (the parameters no prior varies).",
         "",
         f"{result.n_evaluations} model evaluations: Saltelli's design on a scrambled Sobol' sequence "
         f"(N = {spec.samples}, seed {spec.seed}); probabilities over the 2 N = {2 * spec.samples} draws of "
-        f"its A and B matrices, with Wilson intervals at {spec.confidence:g}.",
+        f"its A and B matrices, with Wilson intervals at {spec.confidence:g}. The draws are quasi-random, "
+        "spread more evenly than independent ones, so these intervals, which assume independent draws, are "
+        "conservative: wider than the spread of the probabilities over seeds.",
         "",
         "## Priors",
         "",
@@ -56,7 +58,7 @@ def report_text(result, spec: AtlasSpec) -> str:
         "|---|---|---|---|",
     ]
     for name, v in result.probabilities.items():
-        lines.append(f"| {name} | {VERDICTS[name]} | {v['p']:.3f} | [{v['low']:.3f}, {v['high']:.3f}] |")
+        lines.append(f"| {name} | {criterion(name, spec)} | {v['p']:.3f} | [{v['low']:.3f}, {v['high']:.3f}] |")
     lines += ["", "## Sobol' indices (first order S1, total ST, with bootstrap intervals)", ""]
     tables = result.sobol | {f"{name} (indicator)": t for name, t in result.sobol_verdicts.items()}
     for output, table in tables.items():
@@ -70,6 +72,45 @@ def report_text(result, spec: AtlasSpec) -> str:
             lines.append(f"| {markdown_cell_code(name)} | {first} | {total} |")
         lines.append("")
     return "\n".join(lines) + "\n"
+
+
+def model_line(spec: AtlasSpec) -> str:
+    """The base model as the report names it: its origin, and K only where no prior draws it.
+
+    Parameters
+    ----------
+    spec : AtlasSpec
+
+    Returns
+    -------
+    str
+        :func:`~spinectl.model.source.header` of the base model, with "K drawn from its prior" in place
+        of its K where ``passive.stiffness`` has a prior (the base model's K is no draw's).
+    """
+    if "passive.stiffness" not in spec.names:
+        return header(spec.model)
+    return header(spec.model, stiffness=f"K drawn from its prior, convention {spec.model.passive.convention}")
+
+
+def criterion(verdict: str, spec: AtlasSpec) -> str:
+    """A verdict's criterion as the report states it: :data:`VERDICTS`, with the delay it was judged at.
+
+    Parameters
+    ----------
+    verdict : str
+        A key of :data:`VERDICTS`.
+    spec : AtlasSpec
+
+    Returns
+    -------
+    str
+    """
+    text = VERDICTS[verdict]
+    if verdict != "stable_at_delay":
+        return text
+    if "reflex.delay" in spec.names:
+        return f"{text}, each draw's delay drawn from its prior"
+    return f"{text}, the model's {spec.model.reflex.delay * 1e3:g} ms at every draw (no prior draws it)"
 
 
 def _checked(source: str) -> str:

@@ -45,10 +45,11 @@ PAPER_OPTIMUM = (0.03, 0.04)
 """(E, Lambda) of the paper's optimum C [m] (paper, Discussion: E ~ 3 cm, Lambda ~ 4 cm; Figure 4, position C)."""
 
 VERDICTS = {
-    "self_stable_joint_by_joint": "a feasible minimum PCSA, within optimisation.pcsa_max (joint by joint)",
+    "stabilisable_joint_by_joint": "some global activation within optimisation.pcsa_max makes every segment "
+    "self-stable (a feasible minimum PCSA; joint by joint)",
     "counter_torque_within_limit": "every counter torque CT_k within +-counter_torque_limit_Nm (joint by joint)",
     "chain_stabilisable_locally": "the chain (all CoRs free) stabilised by local muscle within local_pcsa_limit_cm2",
-    "stable_at_delay": "the reflex loop of every segment stable at the drawn delay (joint by joint)",
+    "stable_at_delay": "the reflex loop of every segment stable at the reflex delay (joint by joint)",
 }
 """The verdicts and the criterion each names."""
 

@@ -139,7 +139,7 @@ def stiffness_text(stiffness, convention: str, inertia=None) -> str:
     return f"{text}: K theta_k = {', '.join(f'{values[0] * th:.4g}' for th in inertia)} N m/rad"
 
 
-def header(model: Model, inertia=None) -> str:
+def header(model: Model, inertia=None, stiffness: str | None = None) -> str:
     """One line naming the model: ``preset wagner2012, K = 15 N m/rad, convention physical``, then file and overrides.
 
     Parameters
@@ -148,6 +148,8 @@ def header(model: Model, inertia=None) -> str:
     inertia : sequence of float, optional
         theta_k [kg m^2] of each CoR at the table's posture: under the ``"paper"`` convention the
         stiffness K theta_k [N m/rad] that K adds there is named (:func:`stiffness_text`).
+    stiffness : str, optional
+        What to say of K instead of its value, where the model's K is not the one used (an atlas draws it).
 
     Returns
     -------
@@ -156,7 +158,9 @@ def header(model: Model, inertia=None) -> str:
         overridden: passive.stiffness``.
     """
     first, *rest = _origin_parts(model)
-    passive = stiffness_text(model.passive.stiffness, model.passive.convention, inertia)
+    passive = stiffness if stiffness is not None else stiffness_text(
+        model.passive.stiffness, model.passive.convention, inertia
+    )
     return "; ".join([f"{first}, {passive}", *rest])
 
 

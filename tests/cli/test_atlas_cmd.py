@@ -28,7 +28,7 @@ def test_json_has_the_issues_keys(tmp_path, capsys):
     assert main(["atlas", str(_file(tmp_path)), "--out", str(tmp_path / "out"), "--json"]) == 0
     doc = json.loads(capsys.readouterr().out)
     assert doc["n_evaluations"] == 2 * (1 + 2)
-    assert set(doc["probabilities"]["self_stable_joint_by_joint"]) == {"p", "low", "high"}
+    assert set(doc["probabilities"]["stabilisable_joint_by_joint"]) == {"p", "low", "high"}
     assert set(doc["sobol"]["min_pcsa_cm2"]["body.mass"]) == {"S1", "S1_conf", "ST", "ST_conf"}
 
 

@@ -542,3 +542,30 @@ def test_the_reports_user_text_cannot_add_markup():
         assert sum(1 for i, c in enumerate(row) if c == "|" and row[i - 1] != "\\") == 8, row
         assert row.endswith("Doe 2020 \\| n = 40\\\\n\\# Injected \\<b\\>bold\\</b\\> \\`x\\` |")
     assert any(line.startswith("Model: ") and "runs/a\\\\n\\#\\# Injected.toml" in line for line in lines)
+
+
+def test_the_report_says_what_each_verdict_and_interval_rests_on():
+    """K and the delay are priors of _spec: the model line says K is drawn (not the base model's 'K = 0'), the
+    delay verdict says each draw's delay; without those priors, the model's K and its delay in ms. The
+    probabilities' draws are called quasi-random and the intervals conservative, never independent."""
+    from types import SimpleNamespace
+
+    from spinectl.landscape.atlas_report import report_text
+    from spinectl.landscape.priors import VERDICTS
+
+    band = {"p": 0.5, "low": 0.4, "high": 0.6}
+    result = SimpleNamespace(
+        n_evaluations=4, probabilities=dict.fromkeys(VERDICTS, band), sobol={}, sobol_verdicts={}, draws={}
+    )
+    spec = _spec(chain="false")
+    text = report_text(result, spec)
+    model = next(line for line in text.splitlines() if line.startswith("Model: "))
+    assert "K drawn from its prior" in model and "K = " not in model
+    assert "each draw's delay drawn from its prior" in text and "independent draws" in text
+    assert "are quasi-random" in text and "conservative" in text and "independent draws of" not in text
+    assert "| stabilisable_joint_by_joint | some global activation" in text
+    fixed = dataclasses.replace(spec, priors=spec.priors[:3])  # the angle, E and the mass: K and the delay fixed
+    text = report_text(result, fixed)
+    delay_ms = f"{fixed.model.reflex.delay * 1e3:g} ms"
+    assert f"the model's {delay_ms} at every draw (no prior draws it)" in text
+    assert f"K = {fixed.model.passive.stiffness:g} N m/rad" in text and "K drawn" not in text
