@@ -158,8 +158,10 @@ def header(model: Model, inertia=None, stiffness: str | None = None) -> str:
         overridden: passive.stiffness``.
     """
     first, *rest = _origin_parts(model)
-    passive = stiffness if stiffness is not None else stiffness_text(
-        model.passive.stiffness, model.passive.convention, inertia
+    passive = (
+        stiffness
+        if stiffness is not None
+        else stiffness_text(model.passive.stiffness, model.passive.convention, inertia)
     )
     return "; ".join([f"{first}, {passive}", *rest])
 
