@@ -17,7 +17,12 @@ EXTRA = "pip install 'spinectl[explore]'"
 
 
 def serve_explorer(
-    model: Model, preset: str, port: int, address: str = "127.0.0.1", show: bool = True, max_sessions: int = MAX_SESSIONS
+    model: Model,
+    preset: str,
+    port: int,
+    address: str = "127.0.0.1",
+    show: bool = True,
+    max_sessions: int = MAX_SESSIONS,
 ) -> None:
     """Serve the explorer (:func:`spinectl.explore.server.serve`) until interrupted.
 

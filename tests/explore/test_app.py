@@ -182,7 +182,10 @@ def test_a_select_value_from_the_page_not_among_its_options_is_refused_in_one_li
     state = explorer.state
     explorer.preset._process_events({"value": value})
     status = html.unescape(explorer.status.object)
-    assert status.startswith("**refused:** preset: must be one of 'default', 'wagner2012', ") and f"(got {value!r})" in status
+    assert (
+        status.startswith("**refused:** preset: must be one of 'default', 'wagner2012', ")
+        and f"(got {value!r})" in status
+    )
     assert explorer.state == state and explorer.preset.value == "wagner2012" and explorer.current == "wagner2012"
     explorer.preset._process_events({"value": "default"})  # an option is taken
     assert explorer.current == "default" and not explorer.status.object.startswith("**refused:**")
