@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 
+from ..explore.hosts import MAX_SESSIONS, SESSIONS_RANGE, UNUSED_SESSION_S
 from ..model.config import DEFAULT_PRESET
 from ._common import add_model_options, load_model
 
@@ -17,15 +18,19 @@ ADDRESS = "127.0.0.1"
 """Default interface: the loopback one, reachable from this machine only."""
 
 
-def _port(text: str) -> int:
-    """An argparse ``type``: a TCP port, 1 to 65535."""
-    try:
-        port = int(text)
-    except ValueError:
-        port = -1
-    if not 1 <= port <= 65535:
-        raise argparse.ArgumentTypeError(f"--port must be an integer from 1 to 65535 (got {text!r})")
-    return port
+def _integer(option: str, low: int, high: int):
+    """An argparse ``type``: an integer from ``low`` to ``high``, or one line naming ``option``."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            value = low - 1
+        if not low <= value <= high:
+            raise argparse.ArgumentTypeError(f"{option} must be an integer from {low} to {high} (got {text!r})")
+        return value
+
+    return parse
 
 
 def register(sub) -> None:
@@ -44,9 +49,16 @@ def register(sub) -> None:
         "current point; the minimum-PCSA and ||CT|| landscapes, clickable. Export the state as a TOML config "
         "or a PNG. Needs pip install 'spinectl[explore]'. See docs/explore.md.",
     )
-    parser.add_argument("--port", type=_port, default=PORT, help=f"TCP port (default {PORT})")
+    parser.add_argument("--port", type=_integer("--port", 1, 65535), default=PORT, help=f"TCP port (default {PORT})")
     parser.add_argument(
         "--address", default=ADDRESS, help=f"interface to listen on (default {ADDRESS}: this machine only)"
+    )
+    parser.add_argument(
+        "--max-sessions",
+        type=_integer("--max-sessions", *SESSIONS_RANGE),
+        default=MAX_SESSIONS,
+        help=f"browser tabs served at once, each a session (default {MAX_SESSIONS}); one more gets 503 until one "
+        f"ends, {UNUSED_SESSION_S:g} s after its tab is closed",
     )
     parser.add_argument("--no-browser", action="store_true", help="do not open a browser; print the address only")
     add_model_options(parser)
@@ -59,7 +71,7 @@ def run(args) -> int:
     Parameters
     ----------
     args : argparse.Namespace
-        Parsed arguments: ``port``, ``address``, ``no_browser`` and the model options.
+        Parsed arguments: ``port``, ``address``, ``max_sessions``, ``no_browser`` and the model options.
 
     Returns
     -------
@@ -70,5 +82,5 @@ def run(args) -> int:
     from ..explore.launch import serve_explorer
 
     preset = "--config" if args.config else (args.preset or DEFAULT_PRESET)
-    serve_explorer(model, preset, args.port, args.address, show=not args.no_browser)
+    serve_explorer(model, preset, args.port, args.address, show=not args.no_browser, max_sessions=args.max_sessions)
     return 0

@@ -2,7 +2,7 @@
 
 docs/explore.md. :class:`Explorer` holds one session's state and its views;
 :func:`explorer` returns its layout, which shows itself inline in a Jupyter notebook
-(after ``panel.extension()``), and :func:`serve` serves it on the loopback interface
+(after ``panel.extension()``), and :func:`spinectl.explore.server.serve` serves it on the loopback interface
 (``spinectl explore``). Every number comes from :mod:`spinectl.explore.numbers`. The model
 drawing is matplotlib's (:func:`spinectl.explore.views.model_drawing`, as SVG); the
 eigenvalues, counter torques and delay margins are Bokeh plots whose data
@@ -20,7 +20,6 @@ import asyncio
 import html
 import io
 import time
-import webbrowser
 
 import matplotlib
 import numpy as np
@@ -30,11 +29,8 @@ from bokeh.events import Tap
 from bokeh.models import BoxAnnotation, ColorBar, ColumnDataSource, FactorRange, LinearColorMapper, Range1d, Span
 from bokeh.plotting import figure as bokeh_figure
 from matplotlib.colors import to_hex
-from tornado.log import app_log
-from tornado.routing import Matcher, Rule
-from tornado.web import RequestHandler
 
-from .._validate import printable, real
+from .._validate import choice, printable, real
 from ..errors import SpinectlError
 from ..model.config import DEFAULT_PRESET, list_presets, load_preset
 from ..model.params import Model
@@ -42,7 +38,6 @@ from ..paper.landmarks import CT_LIMIT
 from ..reflex.design import Design
 from ..units import CM_PER_M, m2_to_cm2
 from . import views
-from .hosts import allowed_hosts, request_allowed, url_host
 from .numbers import (
     LANDSCAPE_POINTS,
     PointNumbers,
@@ -251,8 +246,8 @@ class Explorer:
         self._pictures_key = None
         self.seconds = {"point": np.nan, "landscapes": np.nan}
         self.errors: dict[str, str | None] = {"input": None, "point": None, "landscapes": None, "design": None}
-        self.preset = pn.widgets.Select(
-            label="preset", value=preset, options=[*self.models, *list_presets()], width=260
+        self.preset = ClientSelect(
+            self._refuse, label="preset", value=preset, options=[*self.models, *list_presets()], width=260
         )
         self.sliders = {s.field: self._slider(s) for s in SLIDERS}
         self.drawing = pn.pane.SVG(None, width=int(views.DRAWING_SIZE[0] * DPI), name="drawing")
@@ -591,6 +586,35 @@ def _hex(columns: dict) -> dict:
     return {**columns, "colour": [to_hex(c) for c in columns["colour"]]}
 
 
+class ClientSelect(pn.widgets.Select):
+    """Panel's ``Select`` that takes from the page only one of its options; anything else is refused in one line.
+
+    Panel maps the page's value to an option where it takes it (``_process_property_change``) and
+    raises there on any other, a traceback in the server's log (a forged message can send anything).
+    Here such a value is dropped before that and given to ``on_refused``; the widget keeps its value.
+
+    Parameters
+    ----------
+    on_refused : callable
+        Called with the :class:`~spinectl.errors.ParameterError` that names the field and the options.
+    **params
+        Those of ``panel.widgets.Select``; ``label`` names the field in the message.
+    """
+
+    def __init__(self, on_refused, **params):
+        super().__init__(**params)
+        self._on_refused = on_refused
+
+    def _process_property_change(self, props: dict) -> dict:
+        if "value" in props:
+            try:
+                choice(self.label or self.name, props["value"], self.labels)
+            except SpinectlError as exc:
+                props = {key: value for key, value in props.items() if key != "value"}
+                self._on_refused(exc)
+        return super()._process_property_change(props)
+
+
 class _EigenvalueView:
     """Both eigenvalues of each segment as markers in the complex plane (Bokeh), the unstable half shaded."""
 
@@ -726,108 +750,3 @@ def explorer(preset: str | None = None, config=None) -> pn.viewable.Viewable:
 
     model = load_config(config, preset)
     return Explorer(model, CONFIG_CHOICE if config else (preset or DEFAULT_PRESET)).layout
-
-
-def serve(model: Model, preset: str, port: int, address: str = "127.0.0.1", show: bool = True) -> None:
-    """Serve the explorer at ``http://address:port/`` until interrupted; one :class:`Explorer` per browser tab.
-
-    Every request, the websocket's included, must address the server by the address bound
-    (:func:`spinectl.explore.hosts.request_allowed`; others get 403): a DNS-rebinding page,
-    served under another site's name that resolves to this machine, gets no session.
-
-    Parameters
-    ----------
-    model : Model
-        The model to start from.
-    preset : str
-        Its entry in the preset selector (a preset's name or :data:`CONFIG_CHOICE`).
-    port : int
-        TCP port.
-    address : str
-        Interface to bind; the loopback interface by default, so that no other machine can connect.
-    show : bool
-        Open the app in the default browser.
-
-    Raises
-    ------
-    ParameterError
-        An address that names no one interface (:func:`spinectl.explore.hosts.allowed_hosts`).
-    """
-    allowed = allowed_hosts(address, port)
-    url = f"http://{url_host(address)}:{port}/"
-    print(f"spinectl explore: {url} (Ctrl+C stops)", flush=True)
-    server = pn.serve(
-        {"/": lambda: Explorer(model, preset).layout},
-        port=port,
-        address=address.strip().strip("[]"),
-        websocket_origin=bokeh_origins(allowed),
-        show=False,  # Bokeh's own opener writes an IPv6 address without brackets
-        start=False,
-        title="spinectl explore",
-        location=False,  # the app reads no URL; Panel's Location cannot parse an IPv6 Host
-        verbose=False,
-    )
-    guard(server._tornado, allowed)  # Bokeh's Tornado application (Panel reads it by this name too)
-    server.start()
-    if show:
-        server.io_loop.add_callback(webbrowser.open_new_tab, url)
-    server.io_loop.start()
-
-
-def bokeh_origins(allowed: frozenset[tuple[str, int]]) -> list[str]:
-    """The allowed pairs as Bokeh's websocket origins, ``host:port``, sorted.
-
-    Bokeh's list cannot hold an IPv6 address (it splits at every colon); for those the guard
-    (:func:`guard`) is the only check, as Tornado skips Bokeh's for a same-origin websocket.
-
-    Parameters
-    ----------
-    allowed : frozenset of (str, int)
-        :func:`spinectl.explore.hosts.allowed_hosts`.
-
-    Returns
-    -------
-    list of str
-        E.g. ``['127.0.0.1:5006', 'localhost:5006']``.
-    """
-    return sorted(f"{host}:{port}" for host, port in allowed if ":" not in host)
-
-
-class _ForeignRequest(Matcher):
-    """Tornado's routing: matches a request whose Host or Origin is not the address bound."""
-
-    def __init__(self, allowed: frozenset[tuple[str, int]]):
-        self.allowed = allowed
-
-    def match(self, request) -> dict | None:
-        headers = request.headers
-        return None if request_allowed(headers.get("Host"), headers.get("Origin"), self.allowed) else {}
-
-
-class _Refused(RequestHandler):
-    """Answers 403, whatever the method, and says why in one line (in the page and the server's log)."""
-
-    def prepare(self) -> None:
-        host, origin = (self.request.headers.get(h) for h in ("Host", "Origin"))
-        reason = f"refused: Host {host!r}, Origin {origin!r} is not the address the explorer is bound to"
-        app_log.warning("spinectl explore: %s", reason)
-        self.set_status(403)
-        self.finish(reason + "\n")
-
-
-def guard(application, allowed: frozenset[tuple[str, int]]) -> None:
-    """Route every request that does not address ``allowed`` to a 403, before any of Bokeh's handlers.
-
-    The first rule of the Tornado application's router (Tornado's own ``add_handlers`` inserts its
-    host rules into the same list): it sees each request, the websocket's upgrade included, before
-    Bokeh's handlers. Tornado lets a websocket whose Origin equals its Host skip Bokeh's origin list,
-    so a DNS-rebinding page would pass that list; the Host check stops it.
-
-    Parameters
-    ----------
-    application : tornado.web.Application
-        The Bokeh server's Tornado application.
-    allowed : frozenset of (str, int)
-        :func:`spinectl.explore.hosts.allowed_hosts`.
-    """
-    application.default_router.rules.insert(0, Rule(_ForeignRequest(allowed), _Refused))

@@ -19,6 +19,9 @@ ROOT = Path(__file__).resolve().parents[2]
     [
         (["--port", "0"], "--port must be an integer from 1 to 65535 (got '0')"),
         (["--port", "http"], "--port must be an integer from 1 to 65535 (got 'http')"),
+        (["--max-sessions", "0"], "--max-sessions must be an integer from 1 to 64 (got '0')"),
+        (["--max-sessions", "65"], "--max-sessions must be an integer from 1 to 64 (got '65')"),
+        (["--max-sessions", "2.5"], "--max-sessions must be an integer from 1 to 64 (got '2.5')"),
         (["--preset", "nope"], "preset"),
         (["--address", ""], "--address: must name the interface to listen on, e.g. 127.0.0.1 or ::1 (got '')"),
         (["--address", "0.0.0.0"], "--address: must name one interface"),
@@ -44,11 +47,13 @@ def test_without_panel_it_says_how_to_install_it():
 
 
 def test_a_port_in_use_is_one_line(capsys):
-    """Another program listens on the port: an error naming it, no traceback, no server left running."""
+    """Another program listens on the port: an error naming it, no traceback, no server left running, and no URL
+    announced (before: the URL was printed, then the error)."""
     with socket.socket() as taken:
         taken.bind(("127.0.0.1", 0))
         taken.listen()
         port = taken.getsockname()[1]
         assert main(["explore", "--no-browser", "--port", str(port)]) == 2
-    err = capsys.readouterr().err
+    out, err = capsys.readouterr()
     assert err.startswith(f"spinectl: error: --port: cannot listen on 127.0.0.1:{port}") and err.count("\n") == 1
+    assert out == ""

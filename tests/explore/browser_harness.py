@@ -13,6 +13,7 @@ import shutil
 import socket
 import subprocess
 import sys
+import threading
 import time
 import urllib.request
 from pathlib import Path
@@ -50,9 +51,10 @@ def free_port(address: str = "127.0.0.1", family: int = socket.AF_INET) -> int:
 
 
 @contextlib.contextmanager
-def served(*options: str, address: str = "127.0.0.1"):
+def served(*options: str, address: str = "127.0.0.1", log: list[str] | None = None):
     """``python -m spinectl explore --no-browser`` from this checkout on a free port of ``address`` (a loopback
-    one); yields its URL."""
+    one); yields its URL. Its output (standard output and error) is read as it comes, line by line into ``log``
+    if given (the sessions it opens and ends, the requests it refuses), so that it never fills the pipe."""
     family = socket.AF_INET6 if ":" in address else socket.AF_INET
     port = free_port(address, family)
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")]))}
@@ -60,12 +62,16 @@ def served(*options: str, address: str = "127.0.0.1"):
     process = subprocess.Popen(
         [*argv, *options], cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True
     )
+    lines = [] if log is None else log
+    reader = threading.Thread(target=_read_lines, args=(process.stdout, lines), daemon=True)
+    reader.start()
     url = f"http://[{address}]:{port}/" if family == socket.AF_INET6 else f"http://{address}:{port}/"
     deadline = time.monotonic() + TIMEOUT_S
     try:
         while True:
             if process.poll() is not None:
-                raise RuntimeError(f"spinectl explore exited with {process.returncode}: {process.stdout.read()}")
+                reader.join(timeout=5)
+                raise RuntimeError(f"spinectl explore exited with {process.returncode}: {''.join(lines)}")
             try:
                 urllib.request.urlopen(url, timeout=5).close()
                 break
@@ -81,6 +87,24 @@ def served(*options: str, address: str = "127.0.0.1"):
         except subprocess.TimeoutExpired:
             process.kill()
             process.wait()
+        reader.join(timeout=5)
+
+
+def _read_lines(stream, lines: list[str]) -> None:
+    for line in stream:  # one at a time, so that a test sees each line as it comes
+        lines.append(line)
+
+
+def wait_for_line(log: list[str], text: str, start: int = 0) -> int:
+    """Wait until a line of ``log`` from index ``start`` on holds ``text``; its index (AssertionError after
+    :data:`TIMEOUT_S`)."""
+    deadline = time.monotonic() + TIMEOUT_S
+    while True:
+        found = [i for i in range(start, len(log)) if text in log[i]]
+        if found:
+            return found[0]
+        assert time.monotonic() < deadline, f"no line with {text!r} in the server's output: {log[start:]}"
+        time.sleep(0.1)
 
 
 @contextlib.contextmanager

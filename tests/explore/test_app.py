@@ -5,12 +5,10 @@ from __future__ import annotations
 import asyncio
 import html
 import xml.etree.ElementTree as ET
-from types import SimpleNamespace
 
 import numpy as np
 import param
 import pytest
-from tornado.web import Application
 
 from spinectl.errors import ModelError
 from spinectl.explore import app
@@ -170,9 +168,27 @@ def test_a_forged_click_or_preset_is_refused_in_one_line():
     state = explorer.state
     explorer.move_to(float("nan"), 0.02)
     assert explorer.status.object.startswith("**refused:** E [cm]: must be finite (got nan); ")
-    explorer.preset.value = "nope"  # Panel's Select takes a value outside its options, as a forged message sends
+    explorer.preset.value = "nope"  # set in Python, past the widget's check: the explorer's own refuses it
     assert explorer.status.object.startswith("**refused:** preset: must be one of ")
     assert explorer.state == state and explorer.preset.value == "default"
+
+
+@pytest.mark.parametrize("value", ["nope", 5, None, ""])
+def test_a_select_value_from_the_page_not_among_its_options_is_refused_in_one_line(value):
+    """What Panel does with a message from the page (``_process_events``): a value that is no option, a number, null,
+    empty (Panel's "first option"), is refused in the status line, the preset kept (before: Panel's ValueError "nope
+    not in list" and its traceback in the server's log; "" silently chose the first option)."""
+    explorer = app.Explorer(load_preset("wagner2012"), "wagner2012")
+    state = explorer.state
+    explorer.preset._process_events({"value": value})
+    status = html.unescape(explorer.status.object)
+    assert (
+        status.startswith("**refused:** preset: must be one of 'default', 'wagner2012', ")
+        and f"(got {value!r})" in status
+    )
+    assert explorer.state == state and explorer.preset.value == "wagner2012" and explorer.current == "wagner2012"
+    explorer.preset._process_events({"value": "default"})  # an option is taken
+    assert explorer.current == "default" and not explorer.status.object.startswith("**refused:**")
 
 
 def test_explorer_for_a_notebook_reads_the_config_named(tmp_path):
@@ -184,50 +200,6 @@ def test_explorer_for_a_notebook_reads_the_config_named(tmp_path):
     sliders = [w for w in layout.select(app.pn.widgets.FloatSlider) if w.label == "mass [kg]"]
     assert [s.value for s in sliders] == [33.0]
     assert [w.value for w in layout.select(app.pn.widgets.Select)] == [app.CONFIG_CHOICE]
-
-
-class _Server:
-    """What ``pn.serve(start=False)`` returns, as far as serve() uses it: Bokeh's Tornado application, a loop."""
-
-    def __init__(self):
-        self._tornado = Application()
-        self.calls = []
-        self.io_loop = SimpleNamespace(start=lambda: self.calls.append("loop"), add_callback=self._callback)
-
-    def start(self):
-        self.calls.append("start")
-
-    def _callback(self, function, *args):
-        self.calls.append((function, *args))
-
-
-def test_serve_binds_the_loopback_interface_by_default(monkeypatch, capsys):
-    """serve() asks Panel for 127.0.0.1 (no other machine can connect), accepts websockets from there only, and
-    puts the guard of Host and Origin first in Tornado's routing (so that it sees every request)."""
-    calls, server = [], _Server()
-    monkeypatch.setattr(app.pn, "serve", lambda panels, **options: calls.append(options) or server)
-    app.serve(load_preset("default"), "default", 5999, show=False)
-    (options,) = calls
-    assert options["address"] == "127.0.0.1" and options["port"] == 5999 and options["start"] is False
-    assert options["websocket_origin"] == ["127.0.0.1:5999", "localhost:5999"]
-    first = server._tornado.default_router.rules[0]
-    assert isinstance(first.matcher, app._ForeignRequest) and first.target is app._Refused
-    assert first.matcher.allowed == {("127.0.0.1", 5999), ("localhost", 5999)}
-    assert server.calls == ["start", "loop"]  # no browser opened
-    assert capsys.readouterr().out == "spinectl explore: http://127.0.0.1:5999/ (Ctrl+C stops)\n"
-
-
-def test_serve_on_ipv6_loopback_writes_the_url_with_brackets(monkeypatch, capsys):
-    """--address ::1: Panel binds ::1; the URL printed and opened is http://[::1]:P/ (RFC 3986, 3.2.2); Bokeh's
-    origin list, which cannot hold an IPv6 address, gets localhost only; the guard allows [::1] and localhost."""
-    calls, server = [], _Server()
-    monkeypatch.setattr(app.pn, "serve", lambda panels, **options: calls.append(options) or server)
-    app.serve(load_preset("default"), "default", 5999, address="::1", show=True)
-    (options,) = calls
-    assert options["address"] == "::1" and options["websocket_origin"] == ["localhost:5999"]
-    assert server._tornado.default_router.rules[0].matcher.allowed == {("::1", 5999), ("localhost", 5999)}
-    assert server.calls == ["start", (app.webbrowser.open_new_tab, "http://[::1]:5999/"), "loop"]
-    assert capsys.readouterr().out == "spinectl explore: http://[::1]:5999/ (Ctrl+C stops)\n"
 
 
 def test_the_delay_redraws_the_margins_only():

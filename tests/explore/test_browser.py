@@ -13,8 +13,11 @@ without it can set ``SPINECTL_SKIP_BROWSER=1`` (CI never does).
 from __future__ import annotations
 
 import base64
+import contextlib
+import http.server
 import os
 import re
+import threading
 import time
 import urllib.parse
 
@@ -165,3 +168,50 @@ def test_a_dns_rebinding_page_gets_no_session(served_url, browser_tab):
         assert sockets == [] and tab.locator("td[data-key]").count() == 0
     finally:
         tab.close()
+
+
+@contextlib.contextmanager
+def _page_of_another_site(body: str):
+    """A page served on a free loopback port of its own, to be opened as http://evil.example:Q/ (:data:`REBINDING`:
+    another site to the browser, a local address, so that Chromium lets it load from the loopback interface)."""
+    page = body.encode()
+
+    class Page(http.server.BaseHTTPRequestHandler):
+        def do_GET(self):  # noqa: N802 (the standard library's name)
+            self.send_response(200)
+            self.send_header("Content-Type", "text/html")
+            self.end_headers()
+            self.wfile.write(page)
+
+        def log_message(self, *args):
+            pass
+
+    with http.server.ThreadingHTTPServer(("127.0.0.1", 0), Page) as site:
+        thread = threading.Thread(target=site.serve_forever, daemon=True)
+        thread.start()
+        try:
+            yield f"http://evil.example:{site.server_address[1]}/"
+        finally:
+            site.shutdown()
+
+
+def test_a_page_of_another_site_cannot_load_the_explorer(served_url, served_log, browser_tab):
+    """A page of another site embeds the explorer as an image and in a frame, as any page the user visits could:
+    Chromium sends Sec-Fetch-Site: cross-site (and no Origin); both loads get 403 and the server builds no session
+    for them (before: 200 each and a session, a core busy for one to two seconds, for every such page). The
+    explorer's own page keeps working (:func:`test_slider_and_click_move_the_point_to_the_librarys_numbers`)."""
+    start = len(served_log)
+    html = f'<img src="{served_url}?img"><iframe src="{served_url}?frame"></iframe>'
+    tab = browser_tab.context.new_page()
+    tab.set_default_timeout(browser_harness.TIMEOUT_S * 1000)
+    statuses = {}
+    tab.on("response", lambda response: statuses.update({response.url: response.status}))
+    try:
+        with _page_of_another_site(html) as evil:
+            tab.goto(evil)
+            for kind in ("image", "iframe"):
+                browser_harness.wait_for_line(served_log, f"'cross-site' (Sec-Fetch-Dest '{kind}')", start)
+    finally:
+        tab.close()
+    assert statuses[f"{served_url}?img"] == 403 and statuses[f"{served_url}?frame"] == 403
+    assert [line for line in served_log[start:] if "session opened" in line] == []

@@ -1,4 +1,4 @@
-"""What the served explorer lets in (spinectl.explore.launch): the names of the address bound, nothing else.
+"""What the served explorer lets in (spinectl.explore.hosts): the names of the address bound, the own pages' loads.
 
 No server here: the guard's decisions as a pure function of the ``Host`` and ``Origin``
 headers (RFC 9110, 7.2: ``Host`` is ``host[:port]``, 80 when omitted for http; RFC 6454:
@@ -10,7 +10,7 @@ from __future__ import annotations
 import pytest
 
 from spinectl.errors import ParameterError
-from spinectl.explore.hosts import allowed_hosts, request_allowed, url_host
+from spinectl.explore.hosts import allowed_hosts, fetch_allowed, refusal, request_allowed, url_host
 
 P = 5006
 
@@ -73,3 +73,48 @@ def test_ipv6_hosts_are_matched_in_brackets():
     assert request_allowed(f"[::1]:{P}", f"http://[::1]:{P}", six)
     assert not request_allowed(f"::1:{P}", None, six) and not request_allowed(f"127.0.0.1:{P}", None, six)
     assert (url_host("::1"), url_host("[::1]"), url_host("127.0.0.1")) == ("[::1]", "[::1]", "127.0.0.1")
+
+
+@pytest.mark.parametrize(
+    ("site", "allowed"),
+    [
+        ("same-origin", True),  # the explorer's own page: its scripts, its websocket
+        ("none", True),  # the address typed, a bookmark
+        (None, True),  # an older browser, a non-browser client: Host and Origin alone decide
+        ("cross-site", False),  # <img src=...> on any page, a link, an <iframe>, window.open
+        ("same-site", False),  # a page of another port of this machine
+        ("Cross-Site", False),
+        ("anything", False),  # no browser sends it: a forgery
+    ],
+)
+def test_only_the_explorers_own_pages_and_the_user_load_it(site, allowed):
+    """W3C Fetch Metadata: the values a browser sends in Sec-Fetch-Site."""
+    assert fetch_allowed(site) is allowed
+
+
+def test_a_refusal_says_why_in_one_line():
+    """Host first (DNS rebinding), then Sec-Fetch-Site with the destination the browser gave."""
+    own = {"Host": f"127.0.0.1:{P}"}
+    assert refusal(own, ALLOWED) is None and refusal({**own, "Sec-Fetch-Site": "none"}, ALLOWED) is None
+    image = {**own, "Sec-Fetch-Site": "cross-site", "Sec-Fetch-Mode": "no-cors", "Sec-Fetch-Dest": "image"}
+    assert refusal(image, ALLOWED) == (
+        "Sec-Fetch-Site 'cross-site' (Sec-Fetch-Dest 'image'): a page of another site made this request; "
+        "open the explorer's address in the browser yourself"
+    )
+    rebinding = {"Host": f"evil.example:{P}", "Sec-Fetch-Site": "same-origin"}  # same origin: the rebound name's
+    assert (
+        refusal(rebinding, ALLOWED)
+        == f"Host 'evil.example:{P}', Origin None is not the address the explorer is bound to"
+    )
+    long = refusal({**own, "Sec-Fetch-Site": "x" * 1000 + "\n"}, ALLOWED)
+    assert "\n" not in long and len(long) < 250  # a forged header is quoted shortened, on one line
+
+
+@pytest.mark.parametrize("bound", [0, 65, 2.0, True])
+def test_a_bound_of_sessions_out_of_range_is_one_line(bound):
+    """serve_explorer() as a library call: refused before Panel is imported or a port bound."""
+    from spinectl.explore.launch import serve_explorer
+    from spinectl.model.config import load_preset
+
+    with pytest.raises(ParameterError, match=r"^--max-sessions: must be an integer"):
+        serve_explorer(load_preset(), "default", P, max_sessions=bound)
