@@ -26,7 +26,7 @@ from ..model.params import Model
 from ..model.stability import criterion
 from ..optimise.coupled import CoupledStability, coupled_stability_at
 from .chain_system import DiskMargins, chain_disk_margins, linear_chain_loop
-from .gains import chain_gains
+from .gains import resolve_chain_gains
 from .margins import _num, operating_point
 from .mimo import delay_margin_of, highest_crossing, pade_margin
 from .siso import LoopDelayMargin
@@ -292,16 +292,9 @@ def coupled_margins(model: Model, eccentricity: float, lordosis: float, kp=None,
     pcsa = point.pcsa if point.ok else None  # None: coupled_stability_at says why there is no optimum
     chain = coupled_stability_at(model, eccentricity, lordosis, pcsa)
     lag = settings.activation_time_constant
-    n = len(chain.segment_names)
-    if settings.gains == "rule":
-        kp0, kd0 = chain_gains(
-            chain.mass, chain.stiffness, chain.damping, chain.local.local_stiffness,
-            settings.gain_factor, settings.damping_ratio, lag,
-        )  # fmt: skip
-    else:
-        kp0, kd0 = np.full(n, settings.kp), np.full(n, settings.kd)
-    kp = kp0 if kp is None else np.full(n, float(kp))
-    kd = kd0 if kd is None else np.full(n, float(kd))
+    kp, kd = resolve_chain_gains(
+        settings, chain.mass, chain.stiffness, chain.damping, chain.local.local_stiffness, kp, kd
+    )
     margins = chain_reflex_margins(
         chain.linear_chain, kp, kd, settings.delay, settings.pade_order, lag,
         guard=lambda: arithmetic_guard(eccentricity, lordosis),
@@ -313,8 +306,8 @@ def coupled_margins(model: Model, eccentricity: float, lordosis: float, kp=None,
         activation_time_constant=lag,
         pade_order=settings.pade_order,
         gains=settings.gains,
-        kp=np.asarray(kp, float),
-        kd=np.asarray(kd, float),
+        kp=kp,
+        kd=kd,
         exact=margins.exact,
         delay_margin_pade=margins.delay_margin_pade,
         stable_at_delay=margins.stable_at_delay,

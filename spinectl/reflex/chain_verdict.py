@@ -23,7 +23,7 @@ from ..model.params import Model
 from ..model.stability import CHAIN_DEPENDS_ON, ChainModes, chain_modes, criterion
 from ..optimise.coupled import least_local_stiffness_stacked
 from .chain_margins import stable_at
-from .gains import chain_gains
+from .gains import resolve_chain_gains
 from .margins import MarginsReport, OperatingPoint, analyse
 from .mimo import chain_delay_margin
 from .siso import LoopDelayMargin
@@ -151,17 +151,10 @@ def chain_verdict(model: Model, point: OperatingPoint, delay: float, lag: float,
         return ChainVerdict(delay, nan, nan, nan, exact, False, modes)
     _, local = least_local_stiffness_stacked(stiffness[None], model.optimisation.stability_margin)
     local = local[0]
-    if settings.gains == "rule":
-        kp0, kd0 = chain_gains(mass, stiffness, damping, local, settings.gain_factor, settings.damping_ratio, lag)
-    else:
-        kp0, kd0 = np.full(n, settings.kp), np.full(n, settings.kd)
-    kp = kp0 if kp is None else np.full(n, float(kp))
-    kd = kd0 if kd is None else np.full(n, float(kd))
+    kp, kd = resolve_chain_gains(settings, mass, stiffness, damping, local, kp, kd)
     with arithmetic_guard(e, lam):
         exact = chain_delay_margin(mass, stiffness, damping, kp, kd, lag)
-    return ChainVerdict(
-        delay, np.asarray(kp, float), np.asarray(kd, float), local, exact, stable_at(exact, delay), modes
-    )
+    return ChainVerdict(delay, kp, kd, local, exact, stable_at(exact, delay), modes)
 
 
 def margins_with_chain(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None) -> MarginsReport:

@@ -469,18 +469,11 @@ def chain_loop_at(model: Model, mass, stiffness, damping, least_static, fraction
     kp, kd : numpy.ndarray, shape (n,)
         [N m/rad], [N m s/rad].
     """
-    r, n = model.reflex, len(least_static)
     k = stiffness - fraction * np.diag(least_static)
     d = damping - np.diag(chain.local_damping(fraction * np.asarray(least_static, float), model))
-    if r.gains == "rule":  # the reflex hands over to the local muscles: (1 - f)+ times the rule's gains at f = 0
-        kp0, kd0 = gains.chain_gains(
-            mass, stiffness, damping, least_static, r.gain_factor, r.damping_ratio, r.activation_time_constant
-        )
-        scale = max(1.0 - fraction, 0.0)
-        kp0, kd0 = scale * kp0, scale * kd0
-    else:
-        kp0, kd0 = np.full(n, r.kp), np.full(n, r.kd)
-    return k, d, kp0 if kp is None else np.full(n, float(kp)), kd0 if kd is None else np.full(n, float(kd))
+    scale = max(1.0 - fraction, 0.0)  # the reflex hands over to the local muscles: (1 - f)+ times the rule's gains
+    p, dd = gains.resolve_chain_gains(model.reflex, mass, stiffness, damping, least_static, kp, kd, scale)
+    return k, d, p, dd
 
 
 def rightmost_root(mass, stiffness, damping, kp, kd, delay: float, lag: float = 0.0, nodes: int = 0) -> complex:

@@ -51,8 +51,7 @@ def test_explicit_gains_replace_the_rule(model):
     report = margins.analyse(_with_reflex(model, activation=0.0), E, LAMBDA, kp=200.0)
     assert all(s.kp == 200.0 for s in report.segments)
     s = report.segments[2]
-    lag = model.reflex.activation_time_constant
-    assert s.kd == pytest.approx(float(reflex.default_gains(s.stiffness, 0.0, s.inertia, 1.5, 1.0, lag)[1]))
+    assert s.kd == pytest.approx(float(reflex.default_gains(s.stiffness, 0.0, s.inertia, 1.5, 1.0)[1]))
     configured = margins.analyse(_with_reflex(model, activation=0.0, gains="explicit", kp=150.0, kd=20.0), E, LAMBDA)
     assert all((s.kp, s.kd) == (150.0, 20.0) for s in configured.segments)
 

@@ -100,8 +100,8 @@ def test_simulation_with_the_true_delay_turns_unstable_at_the_margin():
 
 def test_chain_rule_is_the_segment_rule_on_a_diagonal_chain():
     """With k = max(S, 0), the segment's deficit, chain_gains gives default_gains of every segment."""
-    kp, kd = chain_gains(np.diag(THETA), np.diag(S), np.diag(D), np.maximum(S, 0.0), 1.5, 1.0, 0.05)
-    kp0, kd0 = default_gains(S, D, THETA, 1.5, 1.0, 0.05)
+    kp, kd = chain_gains(np.diag(THETA), np.diag(S), np.diag(D), np.maximum(S, 0.0), 1.5, 1.0)
+    kp0, kd0 = default_gains(S, D, THETA, 1.5, 1.0)
     np.testing.assert_allclose(kp, kp0, rtol=1e-15)
     np.testing.assert_allclose(kd, kd0, rtol=1e-15)
 
@@ -230,7 +230,7 @@ def test_the_narrow_band_of_a_lightly_reflexed_paper_chain_is_found():
     mass = chain.mass_matrix(model, geometry.cor_positions(e, lam, model.geometry))
     stiffness, damping = coefficients.stiffness(pcsa), coefficients.damping(pcsa)
     least = least_local_stiffness_stacked(stiffness[None], model.optimisation.stability_margin)[1][0]
-    kp, kd = chain_gains(mass, stiffness, damping, least, r.gain_factor, r.damping_ratio, r.activation_time_constant)
+    kp, kd = chain_gains(mass, stiffness, damping, least, r.gain_factor, r.damping_ratio)
     k, kp, kd, lag = stiffness - f * np.diag(least), (1 - f) * kp, (1 - f) * kd, r.activation_time_constant
     exact = chain_delay_margin(mass, k, damping, kp, kd, lag)
     assert exact.status == "finite" and 380.0 < exact.frequency < 383.0

@@ -47,7 +47,7 @@ def test_agrees_with_the_segments_closed_form(rng):
     for _ in range(60):
         s, d, theta = rng.uniform(-50, 150), -rng.uniform(0, 30), rng.uniform(0.5, 5)
         lag = rng.choice([0.0, rng.uniform(0.01, 0.2)])
-        kp, kd = reflex.default_gains(s, d, theta, rng.uniform(1.1, 3), rng.uniform(0.3, 2), lag)
+        kp, kd = reflex.default_gains(s, d, theta, rng.uniform(1.1, 3), rng.uniform(0.3, 2))
         segment = reflex.delay_margin(s, d, theta, kp, kd, lag)
         general = spinectl.delay_margin(ct.tf([float(kd), float(kp)], np.polymul([lag, 1], [theta, -d, -s])))
         assert general.status == reflex.STATUS[int(segment.status)]
