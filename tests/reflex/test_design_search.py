@@ -5,7 +5,6 @@ delay by a safeguarded inverse interpolation of the exact margins on the bisecti
 from __future__ import annotations
 
 import numpy as np
-import pytest
 
 from spinectl.model import config
 from spinectl.optimise.coupled import least_local_stiffness_stacked

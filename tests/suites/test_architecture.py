@@ -17,9 +17,9 @@ Every module is parsed with :mod:`ast`, nothing is imported: relative and
 absolute imports are resolved to modules of spinectl, those inside functions
 included for the layers. Imports by :func:`importlib.import_module` are not
 seen; the package has two, both by design: its subpackages imported on first
-use (``spinectl/__init__.py``) and the CLI's sub-commands. The cycle check uses every import, those inside functions too: a
-cycle at import time means a module can be half-initialised when another reads
-it, and one closed inside a function (deferred to break the first kind) still
+use (``spinectl/__init__.py``) and the CLI's sub-commands. The cycle check uses
+every import, those inside functions too: a cycle at import time means a module
+can be half-initialised when another reads it, and one closed inside a function (deferred to break the first kind) still
 means two modules that each need the other, so neither is the lower part.
 """
 
