@@ -26,6 +26,7 @@ from ..model.params import Model
 from ..model.stability import criterion
 from ..optimise.coupled import CoupledStability, coupled_stability_at
 from .chain_system import DiskMargins, chain_disk_margins, linear_chain_loop
+from .delay import delay_text
 from .gains import resolve_chain_gains
 from .margins import _num, operating_point
 from .mimo import delay_margin_of, highest_crossing, pade_margin
@@ -233,7 +234,7 @@ class CoupledMargins:
             Text, no final newline; the verdict at the delay starts with its criterion, the chain's.
         """
         exact, disk = self.exact, self.disk
-        margin = {np.inf: "unbounded"}.get(exact.margin, f"{exact.margin * 1000:.4g} ms")
+        margin = delay_text(exact.margin)
         where = f" at {exact.frequency:.4g} rad/s" if np.isfinite(exact.frequency) else ""
         lines = [
             self.chain.table(model, pcsa_source="activation", activation=self.activation),
@@ -247,7 +248,7 @@ class CoupledMargins:
             lines.append(f"{name:8} {kp:13.3f} {kd:15.4f} {_num(a, 11, 3)} {_num(g, 9, 3)} {_num(p, 8, 2)}")
         lines += [
             f"exact delay margin {margin}{where} ({exact.status}); Pade order {self.pade_order}: "
-            f"{self.delay_margin_pade * 1000:.4g} ms",
+            f"{delay_text(self.delay_margin_pade)}",
             f"{criterion('chain', len(self.kp))}: stable at the delay: {'yes' if self.stable_at_delay else 'NO'}",
             "multiloop disk margin: "
             + (

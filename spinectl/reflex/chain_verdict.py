@@ -23,6 +23,7 @@ from ..model.params import Model
 from ..model.stability import CHAIN_DEPENDS_ON, ChainModes, chain_modes, criterion
 from ..optimise.coupled import least_local_stiffness_stacked
 from .chain_margins import stable_at
+from .delay import delay_text
 from .gains import resolve_chain_gains
 from .margins import MarginsReport, OperatingPoint, analyse
 from .mimo import chain_delay_margin
@@ -99,12 +100,12 @@ class ChainVerdict:
         exact = self.exact
         if not self.modes.defined:
             return [self.modes.summary()]
-        margin = "unbounded" if exact.margin == np.inf else f"{exact.margin * 1000:.4g} ms"
+        margin = delay_text(exact.margin)
         where = f" at {exact.frequency:.4g} rad/s" if np.isfinite(exact.frequency) else ""
         word = "stable" if self.stable_at_delay else "NOT stable"
         lines = [
             f"{self.criterion}, the same reflex rule at every joint (gains from each joint's own stiffness): "
-            f"{word} at the delay {self.delay * 1000:.4g} ms "
+            f"{word} at the delay {delay_text(self.delay)} "
             f"(exact delay margin {margin}{where})",
             "  without reflex: " + self.modes.summary().split(": ", 1)[1],
         ]

@@ -25,6 +25,7 @@ from matplotlib.ticker import MultipleLocator
 
 from ..canvas import new_figure, save_figures, save_file
 from ..model.params import Model
+from .delay import delay_text
 from .loops import ignoring_underflow
 from .margins import MarginsReport, ReportResponses, report_responses
 from .simulate import Simulation
@@ -122,7 +123,7 @@ def _margin_label(name: str, seg) -> str:
     """The legend entry of a segment: its name and, if known, its delay, phase and upper gain margins."""
     if seg is None or np.isnan(seg.delay_margin):
         return name
-    parts = [f"tau_m {'unbounded' if np.isinf(seg.delay_margin) else f'{seg.delay_margin:.3g} s'}"]
+    parts = [f"tau_m {delay_text(seg.delay_margin, 3)}"]
     if np.isfinite(seg.phase_margin_deg):
         parts.append(f"PM {seg.phase_margin_deg:.0f} deg")
     if np.isfinite(seg.gain_margin):
