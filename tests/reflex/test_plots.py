@@ -12,6 +12,7 @@ from matplotlib.figure import Figure
 
 from spinectl.model.params import Optimisation, Reflex
 from spinectl.reflex import loops, margins, plots, simulate
+from spinectl.reflex.delay import delay_text
 
 PNG = b"\x89PNG\r\n\x1a\n"
 
@@ -131,7 +132,9 @@ def test_bode_marks_the_margins_of_a_report(model):
     fig = plots.report_figures(report, responses)["bode.png"]
     magnitude, phase = fig.axes[:2]
     labels = [text.get_text() for text in phase.get_legend().get_texts()][: len(report.segments)]  # then the keys
-    assert all(f"tau_m {s.delay_margin:.3g} s" in label for s, label in zip(report.segments, labels, strict=True))
+    assert all(
+        f"tau_m {delay_text(s.delay_margin, 3)}" in label for s, label in zip(report.segments, labels, strict=True)
+    )
     n = len(report.segments)
     bars = phase.get_lines()[n:]
     assert len(bars) == n
