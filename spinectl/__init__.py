@@ -8,7 +8,7 @@ per subpackage, is in CONTRIBUTING.md ("Architecture"):
 
 - :mod:`spinectl.model`: parameters, configuration, the physics and eq. 1;
 - :mod:`spinectl.optimise`: minimum PCSA and counter torques at every point;
-- :mod:`spinectl.reflex`: delayed reflexes and their margins; :func:`delay_margin`, the exact
+- :mod:`spinectl.reflex`: delayed reflexes and their margins; :func:`loop_delay_margin`, the exact
   delay margin of any SISO python-control loop, is here at the top;
 - :mod:`spinectl.landscape`: sweeps, NetCDF and parameter studies;
 - :mod:`spinectl.paper`: the paper's study, its landmarks and verdicts;
@@ -27,7 +27,7 @@ from .model.config import DEFAULT_PRESET, apply_overrides, dump_toml, list_prese
 from .model.mechanics import SegmentCoefficients, segment_coefficients
 from .model.params import Model
 from .model.stability import StabilityResult, segment_stability
-from .reflex.siso import LoopDelayMargin, delay_margin
+from .reflex.siso import LoopDelayMargin, loop_delay_margin
 
 __all__ = [
     "DEFAULT_PRESET",
@@ -40,7 +40,7 @@ __all__ = [
     "SpinectlError",
     "StabilityResult",
     "apply_overrides",
-    "delay_margin",
+    "loop_delay_margin",
     "dump_toml",
     "list_presets",
     "load_config",

@@ -1,6 +1,6 @@
 """What the explorer's views show, as pure functions of its state (no Panel, no browser).
 
-:func:`point_numbers` is the point: the margins report of :func:`spinectl.reflex.margins.analyse`
+:func:`point_numbers` is the point: the margins report of :func:`spinectl.reflex.margins.margins_report`
 (the chosen activation = ``activation`` x the optimum's PCSA, docs/reflex.md) and, at that
 PCSA, each segment's eigenvalues and counter torque (paper eq. 1 and Methods, "Stability
 analysis and calculation of counter torques"; :func:`spinectl.model.stability.segment_stability`).
@@ -26,9 +26,9 @@ from ..model.params import Model
 from ..model.stability import criterion, segment_stability
 from ..paper import grid
 from ..reflex.chain_margins import stable_at
-from ..reflex.chain_verdict import ChainVerdict, margins_with_chain
+from ..reflex.chain_verdict import ChainReflexVerdict, margins_with_chain
 from ..reflex.design import Design, design
-from ..reflex.margins import MarginsReport, analyse
+from ..reflex.margins import MarginsReport, margins_report
 from ..units import m2_to_cm2
 from .state import ExploreState, model_at
 
@@ -90,7 +90,7 @@ class PointNumbers:
         return criterion("joint", len(self.segment_names))
 
     @property
-    def chain(self) -> ChainVerdict:
+    def chain(self) -> ChainReflexVerdict:
         """The chain under the same reflex, every CoR free (:func:`spinectl.reflex.chain_verdict.chain_verdict`)."""
         return self.report.chain
 
@@ -203,7 +203,7 @@ def point_numbers(base: Model, state: ExploreState, previous: PointNumbers | Non
     if previous is not None and dataclasses.replace(previous.state, delay=state.delay) == state:
         chain = previous.chain
         chain = dataclasses.replace(chain, delay=state.delay, stable_at_delay=stable_at(chain.exact, state.delay))
-        report = dataclasses.replace(analyse(model, state.eccentricity, state.lordosis), chain=chain)
+        report = dataclasses.replace(margins_report(model, state.eccentricity, state.lordosis), chain=chain)
     else:
         report = margins_with_chain(model, state.eccentricity, state.lordosis)
     n_cor = len(model.geometry.cor_names)

@@ -408,4 +408,3 @@ def pareto_front(model: Model, eccentricity: float, lordosis: float, n_points: i
             norm = np.linalg.norm(data.counter_torque(polished(data, "counter_torque", x.value, value)[0]))
         norms.append(norm)
     return ParetoFront(float(eccentricity), float(lordosis), budgets * M2_PER_CM2, np.asarray(norms), tuple(statuses))
-

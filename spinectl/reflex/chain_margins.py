@@ -29,7 +29,7 @@ from .chain_system import DiskMargins, chain_disk_margins, linear_chain_loop
 from .delay import delay_text
 from .gains import resolve_chain_gains
 from .margins import _num, operating_point
-from .mimo import delay_margin_of, highest_crossing, pade_margin
+from .mimo import highest_crossing, linear_chain_delay_margin, pade_margin
 from .siso import LoopDelayMargin
 
 DISK_POINTS = 600
@@ -120,7 +120,7 @@ def chain_reflex_margins(
     Systems Magazine 40(5):78-95. doi:10.1109/MCS.2020.3005277.
     """
     with guard():  # gains or delays orders of magnitude off: the caller's error
-        exact = delay_margin_of(chain, kp, kd, lag, u)
+        exact = linear_chain_delay_margin(chain, kp, kd, lag, u)
     stable = stable_at(exact, delay)
     disk = None
     if stable:

@@ -25,13 +25,13 @@ from ..optimise.coupled import least_local_stiffness_stacked
 from .chain_margins import stable_at
 from .delay import delay_text
 from .gains import resolve_chain_gains
-from .margins import MarginsReport, OperatingPoint, analyse
+from .margins import MarginsReport, OperatingPoint, margins_report
 from .mimo import chain_delay_margin
 from .siso import LoopDelayMargin
 
 
 @dataclass(frozen=True)
-class ChainVerdict:
+class ChainReflexVerdict:
     """The chain under the delayed reflex at the operating point of :class:`~spinectl.reflex.margins.MarginsReport`.
 
     Attributes
@@ -118,7 +118,9 @@ class ChainVerdict:
         return lines
 
 
-def chain_verdict(model: Model, point: OperatingPoint, delay: float, lag: float, kp=None, kd=None) -> ChainVerdict:
+def chain_verdict(
+    model: Model, point: OperatingPoint, delay: float, lag: float, kp=None, kd=None
+) -> ChainReflexVerdict:
     """The chain at ``point`` under the delayed reflex: the rule on the chain, or the explicit gains.
 
     Parameters
@@ -134,7 +136,7 @@ def chain_verdict(model: Model, point: OperatingPoint, delay: float, lag: float,
 
     Returns
     -------
-    ChainVerdict
+    ChainReflexVerdict
         NaN margins (status 'undefined') where the point has no optimum or the mass matrix is singular.
     """
     e, lam = point.eccentricity, point.lordosis
@@ -149,17 +151,17 @@ def chain_verdict(model: Model, point: OperatingPoint, delay: float, lag: float,
         nan = np.full(n, np.nan)
         modes = dataclasses.replace(modes, eigenvalues=np.full(2 * n, complex(np.nan, np.nan)))  # no optimum: undefined
         exact = chain_delay_margin(np.eye(n), np.full((n, n), np.nan), np.zeros((n, n)), nan, nan, lag)
-        return ChainVerdict(delay, nan, nan, nan, exact, False, modes)
+        return ChainReflexVerdict(delay, nan, nan, nan, exact, False, modes)
     _, local = least_local_stiffness_stacked(stiffness[None], model.optimisation.stability_margin)
     local = local[0]
     kp, kd = resolve_chain_gains(settings, mass, stiffness, damping, local, kp, kd)
     with arithmetic_guard(e, lam):
         exact = chain_delay_margin(mass, stiffness, damping, kp, kd, lag)
-    return ChainVerdict(delay, kp, kd, local, exact, stable_at(exact, delay), modes)
+    return ChainReflexVerdict(delay, kp, kd, local, exact, stable_at(exact, delay), modes)
 
 
 def margins_with_chain(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None) -> MarginsReport:
-    """Every segment's margins (:func:`spinectl.reflex.margins.analyse`) and the chain's verdict beside them.
+    """Every segment's margins (:func:`spinectl.reflex.margins.margins_report`) and the chain's verdict beside them.
 
     Parameters
     ----------
@@ -173,15 +175,15 @@ def margins_with_chain(model: Model, eccentricity: float, lordosis: float, kp=No
     Returns
     -------
     MarginsReport
-        With ``chain`` a :class:`ChainVerdict`.
+        With ``chain`` a :class:`ChainReflexVerdict`.
 
     Raises
     ------
     ParameterError
-        As :func:`~spinectl.reflex.margins.analyse`.
+        As :func:`~spinectl.reflex.margins.margins_report`.
     ModelError
-        As :func:`~spinectl.reflex.margins.analyse`.
+        As :func:`~spinectl.reflex.margins.margins_report`.
     """
-    report = analyse(model, eccentricity, lordosis, kp=kp, kd=kd)
+    report = margins_report(model, eccentricity, lordosis, kp=kp, kd=kd)
     verdict = chain_verdict(model, report.point, report.delay, report.activation_time_constant, kp=kp, kd=kd)
     return dataclasses.replace(report, chain=verdict)

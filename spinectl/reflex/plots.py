@@ -224,7 +224,7 @@ def frequency_range(report: MarginsReport) -> tuple[float, float]:
     Parameters
     ----------
     report : MarginsReport
-        Output of :func:`spinectl.reflex.margins.analyse`.
+        Output of :func:`spinectl.reflex.margins.margins_report`.
 
     Returns
     -------
@@ -248,7 +248,7 @@ def report_figures(report: MarginsReport, responses: ReportResponses) -> dict[st
     Parameters
     ----------
     report : MarginsReport
-        Output of :func:`spinectl.reflex.margins.analyse` (titles, frequency range).
+        Output of :func:`spinectl.reflex.margins.margins_report` (titles, frequency range).
     responses : ReportResponses
         Its loops and simulations.
 
@@ -318,7 +318,7 @@ def write_plots(report: MarginsReport, folder: str | Path, model: Model) -> list
     Parameters
     ----------
     report : MarginsReport
-        Output of :func:`spinectl.reflex.margins.analyse` for ``model``.
+        Output of :func:`spinectl.reflex.margins.margins_report` for ``model``.
     folder : str or Path
         Folder for the PNG files (created if missing).
     model : Model

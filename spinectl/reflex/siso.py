@@ -235,7 +235,7 @@ def _positive_roots(f):
     return x[keep], np.where(tangent[keep], 0.0, np.sign(np.polyval(slope, x[keep])))
 
 
-def delay_margin(loop) -> LoopDelayMargin:
+def loop_delay_margin(loop) -> LoopDelayMargin:
     """Exact delay margin of a SISO loop L(s) in the loop L(s) exp(-s tau), unity negative feedback.
 
     Every gain crossover from F(x) = abs(D(jw))^2 - abs(N(jw))^2 = 0, the phase

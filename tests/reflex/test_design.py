@@ -23,16 +23,16 @@ def _subject(**extra):
 
 
 def test_the_least_activation_meets_the_delay_and_a_little_less_does_not():
-    """Joint by joint, checked through margins.analyse (the operating point re-solved, the rule's gains, the exact
-    margins): at the returned activation every segment's margin is >= 120 ms; 1e-4 below it L1L2's is not. About
+    """Joint by joint, checked through margins.margins_report (the operating point re-solved, the rule's gains, the
+    exact margins): at the returned activation every segment's margin is >= 120 ms; 1e-4 below it L1L2's is not. About
     31 % of the minimum PCSA, 13.7 cm^2 (19 %, 8.3 cm^2, under the former rule that cancelled the lag, as found by
     looping over ``margins --activation`` by hand)."""
     model = _subject()
     activation, segments, optimum, status, _, method = dz.joint_design(model, 0.03, 0.04)
     assert status == "ok" and method.startswith("bisection")
-    at = margins.analyse(config.set_parameters(model, {"reflex.activation": activation}), 0.03, 0.04)
+    at = margins.margins_report(config.set_parameters(model, {"reflex.activation": activation}), 0.03, 0.04)
     assert all(s.delay_margin >= 0.12 for s in at.segments) and at.all_stable_at_delay
-    below = margins.analyse(config.set_parameters(model, {"reflex.activation": activation - 1e-4}), 0.03, 0.04)
+    below = margins.margins_report(config.set_parameters(model, {"reflex.activation": activation - 1e-4}), 0.03, 0.04)
     assert min(s.delay_margin for s in below.segments) < 0.12
     assert activation == pytest.approx(max(s.activation for s in segments))  # monotone: the slowest segment's
     assert activation == pytest.approx(0.3145, abs=1e-3)
@@ -151,7 +151,7 @@ def test_a_delay_no_activation_meets_is_an_answer():
     assert status == "infeasible" and np.isnan(activation) and 0 < largest < 0.05
     scan = np.linspace(0, 1, dz.SCAN)
     at = [
-        margins.analyse(config.set_parameters(model, {"reflex.activation": a}), 0.0, 0.0, kp=300.0, kd=0.0)
+        margins.margins_report(config.set_parameters(model, {"reflex.activation": a}), 0.0, 0.0, kp=300.0, kd=0.0)
         for a in scan[::10]
     ]
     assert max(min(s.delay_margin for s in r.segments) for r in at) <= largest + 1e-12

@@ -189,7 +189,7 @@ def test_the_margins_at_the_default_operating_point_change_with_the_lag():
     found = []
     for lag in (0.0, 0.05, 0.1):
         model = config.set_parameters(config.load_preset("wagner2012"), {"reflex.activation_time_constant": lag})
-        seg = margins.analyse(model, 0.0, 0.0).segments[0]
+        seg = margins.margins_report(model, 0.0, 0.0).segments[0]
         tau, _ = _crossing_by_bisection(seg.stiffness, seg.damping, seg.inertia, seg.kp, seg.kd, lag)
         assert seg.delay_margin == pytest.approx(tau, rel=1e-9)
         found.append(seg.delay_margin)

@@ -144,7 +144,7 @@ def test_the_delay_margin_of_a_chain_built_by_hand_is_that_of_its_modes():
     chain's margin is the smallest of the two modes' (u = (1, 2, 0.5), g = 3: lambda = 1 +- sqrt(6.5))."""
     from spinectl.model.linear_chain import LinearChain
     from spinectl.reflex.chain_system import linear_chain_system
-    from spinectl.reflex.mimo import delay_margin_of
+    from spinectl.reflex.mimo import linear_chain_delay_margin
 
     g, m, beta, kp, kd = 3.0, 2.0, 0.5, 10.0, 2.0
     e1, e2, one = np.diag([1.0, 0.0]), np.diag([0.0, 1.0]), np.ones((2, 2))
@@ -167,11 +167,11 @@ def test_the_delay_margin_of_a_chain_built_by_hand_is_that_of_its_modes():
         w = np.sqrt((-b + np.sqrt(b * b - 4 * m**2 * (lam**2 - kp**2))) / (2 * m**2))
         p, q = -m * w**2 + 1j * beta * w - lam, kp + 1j * kd * w
         taus.append(np.mod(-np.angle(-p / q), 2 * np.pi) / w)
-    exact = delay_margin_of(chain, np.full(2, kp), np.full(2, kd), 0.0, u)
+    exact = linear_chain_delay_margin(chain, np.full(2, kp), np.full(2, kd), 0.0, u)
     assert exact.status == "finite" and exact.stable_without_delay
     np.testing.assert_allclose(exact.margin, min(taus), rtol=1e-9)
     # the same on the chain fixed at u (no controls), and its state-space poles are eq. 1's of each mode
-    assert delay_margin_of(chain.at(u), np.full(2, kp), np.full(2, kd)).margin == exact.margin
+    assert linear_chain_delay_margin(chain.at(u), np.full(2, kp), np.full(2, kd)).margin == exact.margin
     poles = np.sort_complex(linear_chain_system(chain, u).poles())
     modes = np.sort_complex(
         np.concatenate([np.roots([m, beta, -lam]) for lam in np.linalg.eigvalsh(chain.stiffness(u))])
