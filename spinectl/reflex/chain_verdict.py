@@ -5,8 +5,8 @@ same operating point and the same reflex rule on the whole chain, every CoR free
 opposite answer; so the report carries both. The chain's matrices cost milliseconds
 (:func:`spinectl.model.stability.chain_modes`), its least local stiffness one small Clarabel
 problem (:func:`spinectl.optimise.coupled.least_local_stiffness_stacked`, the deficit the
-rule :func:`spinectl.reflex.gains.chain_gains` compensates) and its exact delay margin a
-frequency sweep (:func:`spinectl.reflex.mimo.chain_delay_margin`); ``--coupled`` keeps the
+rule :func:`spinectl.reflex.gains.chain_gains` compensates) and its exact delay margin one
+delay-free eigenvalue problem (:func:`spinectl.reflex.mimo.chain_delay_margin`); ``--coupled`` keeps the
 full report (disk margins, Padé loop: :mod:`spinectl.reflex.chain_margins`).
 """
 
