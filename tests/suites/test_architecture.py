@@ -3,7 +3,7 @@
 The layers and their order are those of CONTRIBUTING.md ("Architecture", "Layers"; a test
 checks that its table and :data:`LAYERS` agree, and that its tree names every module):
 
-    _version _threads errors units _validate atomic jsondoc canvas presets  <  model  <  optimise  <  reflex
+    _version _threads errors _optional units _validate atomic jsondoc canvas presets  <  model  <  optimise  <  reflex
     <  anatomy  <  landscape  <  paper  <  explore  <  cli
 
 A module may import modules of its own layer and of the layers before it, never
@@ -38,7 +38,7 @@ ROOT = Path(__file__).resolve().parents[2]
 PACKAGE = ROOT / "spinectl"
 
 LAYERS = (
-    ("_version", "_threads", "errors", "units", "_validate", "atomic", "jsondoc", "canvas", "presets"),
+    ("_version", "_threads", "errors", "_optional", "units", "_validate", "atomic", "jsondoc", "canvas", "presets"),
     ("model",),
     ("optimise",),
     ("reflex",),
