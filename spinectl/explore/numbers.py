@@ -179,8 +179,7 @@ def point_numbers(base: Model, state: ExploreState, previous: PointNumbers | Non
         The numbers of the same ``base`` at an earlier state. Where that state differs from ``state`` in
         the delay alone, its chain's exact delay margin is reused, compared with the new delay: the
         margin, the rule's gains and the modes do not depend on the delay
-        (:func:`spinectl.reflex.chain_verdict.chain_verdict`), and the exact margin is the chain's
-        largest part of the time of a point.
+        (:func:`spinectl.reflex.chain_verdict.chain_verdict`), so it is not computed again.
 
     Returns
     -------
