@@ -7,7 +7,7 @@ analysis and calculation of counter torques"; :func:`spinectl.model.stability.se
 :attr:`PointNumbers.chain` is the chain's verdict under the same reflex, every CoR free
 (:func:`spinectl.reflex.chain_verdict.margins_with_chain`, docs/chain.md), beside the segments', each
 judged alone (the paper's criterion); :func:`design_numbers` answers the design question at the
-state's delay (:func:`spinectl.reflex.design.design`, docs/reflex.md, "The design question"), which
+state's delay (:func:`spinectl.reflex.design.curve.design`, docs/reflex.md, "The design question"), which
 takes seconds, so the explorer runs it only on request.
 :func:`landscapes` is the minimum PCSA and ||CT|| over the paper's range on a coarse grid,
 solved on the stacked fast path (:func:`spinectl.landscape.sweep.sweep`, docs/optimisation.md).
@@ -217,7 +217,7 @@ def point_numbers(base: Model, state: ExploreState, previous: PointNumbers | Non
 def design_numbers(base: Model, state: ExploreState) -> Design:
     """The design answer at the state's delay: least co-contraction joint by joint, least local stiffness for the chain.
 
-    :func:`spinectl.reflex.design.design` of the state's model at its point, as ``spinectl design``
+    :func:`spinectl.reflex.design.curve.design` of the state's model at its point, as ``spinectl design``
     computes it; seconds (a scan and bisection per criterion), so the explorer runs it on request.
 
     Parameters

@@ -1,4 +1,4 @@
-"""The design curve (spinectl.reflex.design.delay_curve): both criteria's required design against the delay."""
+"""The design curve (spinectl.reflex.design.curve.delay_curve): both criteria's required design against the delay."""
 
 from __future__ import annotations
 
@@ -18,7 +18,7 @@ def _subject():
 
 
 def test_the_curve_equals_the_single_design_at_each_delay():
-    """spinectl.reflex.design.design at each delay is the curve's search at that delay alone (one product
+    """spinectl.reflex.design.curve.design at each delay is the curve's search at that delay alone (one product
     algorithm): the joint activations (each segment's and the common one) and the chain's least local stiffness,
     its exact margin and k* are the curve's exactly (before, the single design had its own scan and bisection and
     stopped at other certified points: 0.76223392 against the curve's 0.76223388 at 120 ms). The chain's search

@@ -1,4 +1,4 @@
-"""The chain's verdicts against the passive stiffness (spinectl.reflex.design.passive_curve, crisco_stiffness)."""
+"""The chain against the passive stiffness (spinectl.reflex.design.passive: passive_curve, crisco_stiffness)."""
 
 from __future__ import annotations
 

@@ -215,7 +215,7 @@ def test_the_narrow_band_of_a_lightly_reflexed_paper_chain_is_found():
     1 - 0.9999 (the case spinectl design's chain search meets): the crossings lie 0.035 % apart
     near 381 rad/s, and the former sweep called the loop delay-independent. A second method,
     the rightmost root by Newton from a Chebyshev discretisation of the delay equation
-    (reflex.design.rightmost_root, Breda et al. 2005), is left of the axis 2 % below the exact
+    (reflex.design.roots.rightmost_root, Breda et al. 2005), is left of the axis 2 % below the exact
     margin and right of it 2 % above and at 0.12 s."""
     from spinectl.model import chain, geometry
     from spinectl.model.config import set_parameters
