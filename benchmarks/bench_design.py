@@ -5,7 +5,7 @@ machine. The brute force answers the joint-by-joint half alone by scanning the a
 (1001 exact margins per delay, every segment) and checks that the curve's activations agree to that step.
 
 The chain's half: at each delay the least local-stiffness fraction, by a safeguarded inverse interpolation of
-the exact margins already computed (spinectl.reflex.design._bracket_root), 3.5-3.9 exact margins per delay where
+the exact margins already computed (spinectl.reflex.design.chain._bracket_root), 3.5-3.9 exact margins per delay where
 a bisection needed 13-14 (to the same width 2^-20, with the same certificate).
 
 Measured with one BLAS thread, the curve alone (this script's calls without the brute force, at a load of 1.9):

@@ -356,7 +356,7 @@ pd.DataFrame(
 
 # %%
 HALF = 0.5  # activation [fraction of the minimum PCSA]
-report = margins.analyse(config.set_parameter(model, "reflex.activation", HALF), *POSITION)
+report = margins.margins_report(config.set_parameter(model, "reflex.activation", HALF), *POSITION)
 limiting = min(report.segments, key=lambda s: s.delay_margin)
 tau_m = limiting.delay_margin
 low_plant = simulate.segment_plant(model, *POSITION, limiting.name, report.point.pcsa)

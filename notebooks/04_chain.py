@@ -37,7 +37,7 @@ from spinectl.landscape import sweep
 from spinectl.optimise.coupled import coupled_stability_at, joint_optimum
 from spinectl.paper import grid, landmarks
 from spinectl.reflex.chain_margins import coupled_margins
-from spinectl.reflex.margins import analyse
+from spinectl.reflex.margins import margins_report
 
 preset = PRESET or ("wagner2012" if "wagner2012" in spinectl.list_presets() else "default")
 model = spinectl.load_preset(preset)
@@ -167,7 +167,7 @@ display(pd.DataFrame(rows).set_index("position").round(2))
 # %%
 rows = []
 for name, where in POINTS.items():
-    per_joint = analyse(model, *where)
+    per_joint = margins_report(model, *where)
     chain_margin = coupled_margins(model, *where)
     rows.append(
         {

@@ -120,7 +120,8 @@ for key in ("none", "joints", "chain"):
 # %% [markdown]
 # ## 5. A delayed reflex at the classic optimum
 #
-# The chain's exact delay margin (`spinectl.reflex.mimo.delay_margin_of`) under a diagonal PD reflex at every joint,
+# The chain's exact delay margin (`spinectl.reflex.mimo.linear_chain_delay_margin`)
+# under a diagonal PD reflex at every joint,
 # $k_p$ = 120 N m/rad, $k_d$ = 5 N m s/rad, its torque lagged by 50 ms, without added stiffness:
 
 # %%

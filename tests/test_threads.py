@@ -53,6 +53,7 @@ def test_the_cli_and_the_design_run_with_one_thread(no_choice, monkeypatch):
     from spinectl.cli import config_cmd
     from spinectl.model import config
     from spinectl.reflex import design
+    from spinectl.reflex.design import curve
 
     seen = []
 
@@ -63,7 +64,7 @@ def test_the_cli_and_the_design_run_with_one_thread(no_choice, monkeypatch):
     monkeypatch.setattr(config_cmd, "_presets", record)
     with pytest.raises(_Seen):
         main(["config", "presets"])
-    monkeypatch.setattr(design, "_curve_at_lag", record)
+    monkeypatch.setattr(curve, "_curve_at_lag", record)
     with pytest.raises(_Seen):
         design.delay_curve(config.load_preset("default"), 0.03, 0.04, np.array([0.1]))
     assert seen == [{1}, {1}]

@@ -17,7 +17,7 @@ tissue and reflexes.
 All on the :class:`~spinectl.model.linear_chain.LinearChain` of the model, through the chain's
 own functions: its state matrix and dynamic eigenvalues (:mod:`spinectl.model.chain`), its
 programmes (:mod:`spinectl.optimise.coupled.sdp`) and its exact delay margin
-(:func:`spinectl.reflex.mimo.delay_margin_of`).
+(:func:`spinectl.reflex.mimo.linear_chain_delay_margin`).
 """
 
 from __future__ import annotations
@@ -615,13 +615,13 @@ def reflex_margin(chain: LinearChain, a, kp: float, kd: float, lag: float) -> di
         ``kp_Nm_per_rad``, ``kd_Nms_per_rad``, ``activation_lag_s``, ``delay_margin_s`` (inf:
         any delay; 0: unstable without delay), ``delay_margin_status``, ``delay_margin_frequency_rad_s``.
     """
-    from ..reflex.mimo import delay_margin_of
+    from ..reflex.mimo import linear_chain_delay_margin
 
     for name, value in (("kp", kp), ("kd", kd), ("activation_lag", lag)):
         if not (np.isfinite(value) and value >= 0):
             raise ParameterError(name, f"must be a finite number >= 0 (got {value!r})")
     n = chain.n_joints
-    margin = delay_margin_of(chain, np.full(n, kp), np.full(n, kd), lag, u=a)
+    margin = linear_chain_delay_margin(chain, np.full(n, kp), np.full(n, kd), lag, u=a)
     return {
         "kp_Nm_per_rad": float(kp),
         "kd_Nms_per_rad": float(kd),

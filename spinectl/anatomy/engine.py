@@ -23,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._optional import require_module
 from ..errors import ParameterError, SpinectlError
 
 BUILTIN = ("myotorso",)
@@ -46,11 +47,7 @@ def require_mujoco():
     module
         :mod:`mujoco`.
     """
-    try:
-        import mujoco
-    except ImportError:
-        raise AnatomyUnavailable(f"anatomical models need MuJoCo: {INSTALL_HINT}") from None
-    return mujoco
+    return require_module("mujoco", AnatomyUnavailable, f"anatomical models need MuJoCo: {INSTALL_HINT}")
 
 
 @dataclass
@@ -260,10 +257,9 @@ def load_engine(model: str | Path, cache: bool = True) -> Engine:
     mujoco = require_mujoco()
     text = str(model)
     if text in BUILTIN:
-        try:
-            import myo_sim
-        except ImportError:
-            raise AnatomyUnavailable(f"the built-in model {text!r} comes with myo-sim: {INSTALL_HINT}") from None
+        myo_sim = require_module(
+            "myo_sim", AnatomyUnavailable, f"the built-in model {text!r} comes with myo-sim: {INSTALL_HINT}"
+        )
         source = f"myo-sim {myo_sim.__version__}, {text}"
 
         def builtin():

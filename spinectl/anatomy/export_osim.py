@@ -46,6 +46,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._optional import require_module
 from .._validate import printable
 from ..atomic import atomic_path, check_distinct, full_disk_note
 from ..errors import OutputError, ParameterError
@@ -89,10 +90,7 @@ def require_opensim():
     module
         :mod:`opensim`.
     """
-    try:
-        import opensim
-    except ImportError:
-        raise OpenSimUnavailable(f"OpenSim models need OpenSim: {INSTALL_HINT}") from None
+    opensim = require_module("opensim", OpenSimUnavailable, f"OpenSim models need OpenSim: {INSTALL_HINT}")
     opensim.Logger.setLevelString("warn")  # OpenSim's [info] lines are not spinectl's output
     opensim.Logger.removeFileSink()  # nor its opensim.log in the working folder
     return opensim

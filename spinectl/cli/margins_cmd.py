@@ -75,7 +75,7 @@ OVERRIDES = (
     ("pade_order", "reflex.pade_order"),
 )
 """Command-line options that are aliases of ``--set reflex.FIELD=VALUE`` (``--kp`` and ``--kd`` are no
-parameters of the model: :func:`spinectl.reflex.margins.analyse` takes and checks them)."""
+parameters of the model: :func:`spinectl.reflex.margins.margins_report` takes and checks them)."""
 
 
 def run(args) -> int:
@@ -101,7 +101,7 @@ def run(args) -> int:
         check_distinct({"--plot": [Path(args.plot, name) for name in PLOT_FILES]}, {"--config": args.config})
     aliases = {dotted: ("--" + option.replace("_", "-"), getattr(args, option)) for option, dotted in OVERRIDES}
     aliases |= body_aliases(args)  # --K and --mass, as on stability and sweep
-    model = load_model(args, aliases)  # --kp and --kd go to analyse, which checks them
+    model = load_model(args, aliases)  # --kp and --kd go to margins_report, which checks them
     check_position(model, args)
     if args.coupled:
         return _coupled(model, args)

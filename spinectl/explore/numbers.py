@@ -1,13 +1,13 @@
 """What the explorer's views show, as pure functions of its state (no Panel, no browser).
 
-:func:`point_numbers` is the point: the margins report of :func:`spinectl.reflex.margins.analyse`
+:func:`point_numbers` is the point: the margins report of :func:`spinectl.reflex.margins.margins_report`
 (the chosen activation = ``activation`` x the optimum's PCSA, docs/reflex.md) and, at that
 PCSA, each segment's eigenvalues and counter torque (paper eq. 1 and Methods, "Stability
 analysis and calculation of counter torques"; :func:`spinectl.model.stability.segment_stability`).
 :attr:`PointNumbers.chain` is the chain's verdict under the same reflex, every CoR free
 (:func:`spinectl.reflex.chain_verdict.margins_with_chain`, docs/chain.md), beside the segments', each
 judged alone (the paper's criterion); :func:`design_numbers` answers the design question at the
-state's delay (:func:`spinectl.reflex.design.design`, docs/reflex.md, "The design question"), which
+state's delay (:func:`spinectl.reflex.design.curve.design`, docs/reflex.md, "The design question"), which
 takes seconds, so the explorer runs it only on request.
 :func:`landscapes` is the minimum PCSA and ||CT|| over the paper's range on a coarse grid,
 solved on the stacked fast path (:func:`spinectl.landscape.sweep.sweep`, docs/optimisation.md).
@@ -26,9 +26,9 @@ from ..model.params import Model
 from ..model.stability import criterion, segment_stability
 from ..paper import grid
 from ..reflex.chain_margins import stable_at
-from ..reflex.chain_verdict import ChainVerdict, margins_with_chain
+from ..reflex.chain_verdict import ChainReflexVerdict, margins_with_chain
 from ..reflex.design import Design, design
-from ..reflex.margins import MarginsReport, analyse
+from ..reflex.margins import MarginsReport, margins_report
 from ..units import m2_to_cm2
 from .state import ExploreState, model_at
 
@@ -90,7 +90,7 @@ class PointNumbers:
         return criterion("joint", len(self.segment_names))
 
     @property
-    def chain(self) -> ChainVerdict:
+    def chain(self) -> ChainReflexVerdict:
         """The chain under the same reflex, every CoR free (:func:`spinectl.reflex.chain_verdict.chain_verdict`)."""
         return self.report.chain
 
@@ -179,8 +179,7 @@ def point_numbers(base: Model, state: ExploreState, previous: PointNumbers | Non
         The numbers of the same ``base`` at an earlier state. Where that state differs from ``state`` in
         the delay alone, its chain's exact delay margin is reused, compared with the new delay: the
         margin, the rule's gains and the modes do not depend on the delay
-        (:func:`spinectl.reflex.chain_verdict.chain_verdict`), and the margin's frequency sweep is
-        two thirds of the time of a point.
+        (:func:`spinectl.reflex.chain_verdict.chain_verdict`), so it is not computed again.
 
     Returns
     -------
@@ -203,7 +202,7 @@ def point_numbers(base: Model, state: ExploreState, previous: PointNumbers | Non
     if previous is not None and dataclasses.replace(previous.state, delay=state.delay) == state:
         chain = previous.chain
         chain = dataclasses.replace(chain, delay=state.delay, stable_at_delay=stable_at(chain.exact, state.delay))
-        report = dataclasses.replace(analyse(model, state.eccentricity, state.lordosis), chain=chain)
+        report = dataclasses.replace(margins_report(model, state.eccentricity, state.lordosis), chain=chain)
     else:
         report = margins_with_chain(model, state.eccentricity, state.lordosis)
     n_cor = len(model.geometry.cor_names)
@@ -218,7 +217,7 @@ def point_numbers(base: Model, state: ExploreState, previous: PointNumbers | Non
 def design_numbers(base: Model, state: ExploreState) -> Design:
     """The design answer at the state's delay: least co-contraction joint by joint, least local stiffness for the chain.
 
-    :func:`spinectl.reflex.design.design` of the state's model at its point, as ``spinectl design``
+    :func:`spinectl.reflex.design.curve.design` of the state's model at its point, as ``spinectl design``
     computes it; seconds (a scan and bisection per criterion), so the explorer runs it on request.
 
     Parameters

@@ -25,6 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._optional import require_module
 from ..atomic import atomic_path, atomic_write_text, check_distinct, check_folder, output_errors, staged_directory
 from ..errors import SpinectlError
 from ..jsondoc import dumps
@@ -78,11 +79,7 @@ def require_salib():
     module
         :mod:`SALib`.
     """
-    try:
-        import SALib
-    except ImportError:
-        raise AtlasUnavailable(f"the atlas needs SALib: {INSTALL_HINT}") from None
-    return SALib
+    return require_module("SALib", AtlasUnavailable, f"the atlas needs SALib: {INSTALL_HINT}")
 
 
 @dataclasses.dataclass(frozen=True)

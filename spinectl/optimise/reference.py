@@ -29,8 +29,7 @@ exceptions: NaN values and a ``status``. cvxpy is imported only where a problem 
 (about 2 s). :mod:`spinectl.optimise.stacked` and :mod:`spinectl.optimise.active_set` solve the
 same problems for a block of points at once, fall back on this module and are checked against
 it; this module imports neither. The stability at one point with its minimum stabilising PCSA,
-solved by the fast path, is :mod:`spinectl.optimise.stabilising` (its names here are deprecated
-aliases, :data:`MOVED`).
+solved by the fast path, is :mod:`spinectl.optimise.stabilising`.
 """
 
 from __future__ import annotations
@@ -41,7 +40,6 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .._aliases import moved_names
 from ..model.params import Model
 from ..units import M2_PER_CM2
 from .problem import (
@@ -410,12 +408,3 @@ def pareto_front(model: Model, eccentricity: float, lordosis: float, n_points: i
             norm = np.linalg.norm(data.counter_torque(polished(data, "counter_torque", x.value, value)[0]))
         norms.append(norm)
     return ParetoFront(float(eccentricity), float(lordosis), budgets * M2_PER_CM2, np.asarray(norms), tuple(statuses))
-
-
-MOVED = dict.fromkeys(
-    ("NoStabilisingActivation", "minimum_stabilising_pcsa", "stability_at"), "spinectl.optimise.stabilising"
-)
-"""Names that lived here until the fast path answered them (it falls back on this module, so they
-moved above both): their module now; the old names warn until the next release."""
-
-__getattr__ = moved_names(__name__, MOVED)

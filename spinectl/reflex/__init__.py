@@ -5,7 +5,7 @@ docs/reflex.md. Pure vectorised numpy functions for the exact delay margin
 the gains (:mod:`~spinectl.reflex.gains`) and their maps over a landscape
 (:mod:`~spinectl.reflex.maps`); above them the python-control objects
 (:mod:`~spinectl.reflex.loops`), the exact delay margin of any SISO loop
-(:mod:`~spinectl.reflex.siso`, also ``spinectl.delay_margin``), the exact delay margin of the
+(:mod:`~spinectl.reflex.siso`, also ``spinectl.loop_delay_margin``), the exact delay margin of the
 coupled chain under a diagonal reflex (:mod:`~spinectl.reflex.mimo`; the chain's loop and disk
 margins in :mod:`~spinectl.reflex.chain_system`, its report in :mod:`~spinectl.reflex.chain_margins`),
 the nonlinear simulation

@@ -26,9 +26,10 @@ from ..model.params import Model
 from ..model.stability import criterion
 from ..optimise.coupled import CoupledStability, coupled_stability_at
 from .chain_system import DiskMargins, chain_disk_margins, linear_chain_loop
-from .gains import chain_gains
+from .delay import delay_text
+from .gains import resolve_chain_gains
 from .margins import _num, operating_point
-from .mimo import delay_margin_of, highest_crossing, pade_margin
+from .mimo import highest_crossing, linear_chain_delay_margin, pade_margin
 from .siso import LoopDelayMargin
 
 DISK_POINTS = 600
@@ -119,7 +120,7 @@ def chain_reflex_margins(
     Systems Magazine 40(5):78-95. doi:10.1109/MCS.2020.3005277.
     """
     with guard():  # gains or delays orders of magnitude off: the caller's error
-        exact = delay_margin_of(chain, kp, kd, lag, u)
+        exact = linear_chain_delay_margin(chain, kp, kd, lag, u)
     stable = stable_at(exact, delay)
     disk = None
     if stable:
@@ -233,7 +234,7 @@ class CoupledMargins:
             Text, no final newline; the verdict at the delay starts with its criterion, the chain's.
         """
         exact, disk = self.exact, self.disk
-        margin = {np.inf: "unbounded"}.get(exact.margin, f"{exact.margin * 1000:.4g} ms")
+        margin = delay_text(exact.margin)
         where = f" at {exact.frequency:.4g} rad/s" if np.isfinite(exact.frequency) else ""
         lines = [
             self.chain.table(model, pcsa_source="activation", activation=self.activation),
@@ -247,7 +248,7 @@ class CoupledMargins:
             lines.append(f"{name:8} {kp:13.3f} {kd:15.4f} {_num(a, 11, 3)} {_num(g, 9, 3)} {_num(p, 8, 2)}")
         lines += [
             f"exact delay margin {margin}{where} ({exact.status}); Pade order {self.pade_order}: "
-            f"{self.delay_margin_pade * 1000:.4g} ms",
+            f"{delay_text(self.delay_margin_pade)}",
             f"{criterion('chain', len(self.kp))}: stable at the delay: {'yes' if self.stable_at_delay else 'NO'}",
             "multiloop disk margin: "
             + (
@@ -292,16 +293,9 @@ def coupled_margins(model: Model, eccentricity: float, lordosis: float, kp=None,
     pcsa = point.pcsa if point.ok else None  # None: coupled_stability_at says why there is no optimum
     chain = coupled_stability_at(model, eccentricity, lordosis, pcsa)
     lag = settings.activation_time_constant
-    n = len(chain.segment_names)
-    if settings.gains == "rule":
-        kp0, kd0 = chain_gains(
-            chain.mass, chain.stiffness, chain.damping, chain.local.local_stiffness,
-            settings.gain_factor, settings.damping_ratio, lag,
-        )  # fmt: skip
-    else:
-        kp0, kd0 = np.full(n, settings.kp), np.full(n, settings.kd)
-    kp = kp0 if kp is None else np.full(n, float(kp))
-    kd = kd0 if kd is None else np.full(n, float(kd))
+    kp, kd = resolve_chain_gains(
+        settings, chain.mass, chain.stiffness, chain.damping, chain.local.local_stiffness, kp, kd
+    )
     margins = chain_reflex_margins(
         chain.linear_chain, kp, kd, settings.delay, settings.pade_order, lag,
         guard=lambda: arithmetic_guard(eccentricity, lordosis),
@@ -313,8 +307,8 @@ def coupled_margins(model: Model, eccentricity: float, lordosis: float, kp=None,
         activation_time_constant=lag,
         pade_order=settings.pade_order,
         gains=settings.gains,
-        kp=np.asarray(kp, float),
-        kd=np.asarray(kd, float),
+        kp=kp,
+        kd=kd,
         exact=margins.exact,
         delay_margin_pade=margins.delay_margin_pade,
         stable_at_delay=margins.stable_at_delay,

@@ -5,8 +5,8 @@ same operating point and the same reflex rule on the whole chain, every CoR free
 opposite answer; so the report carries both. The chain's matrices cost milliseconds
 (:func:`spinectl.model.stability.chain_modes`), its least local stiffness one small Clarabel
 problem (:func:`spinectl.optimise.coupled.least_local_stiffness_stacked`, the deficit the
-rule :func:`spinectl.reflex.gains.chain_gains` compensates) and its exact delay margin a
-frequency sweep (:func:`spinectl.reflex.mimo.chain_delay_margin`); ``--coupled`` keeps the
+rule :func:`spinectl.reflex.gains.chain_gains` compensates) and its exact delay margin one
+delay-free eigenvalue problem (:func:`spinectl.reflex.mimo.chain_delay_margin`); ``--coupled`` keeps the
 full report (disk margins, Padé loop: :mod:`spinectl.reflex.chain_margins`).
 """
 
@@ -23,14 +23,15 @@ from ..model.params import Model
 from ..model.stability import CHAIN_DEPENDS_ON, ChainModes, chain_modes, criterion
 from ..optimise.coupled import least_local_stiffness_stacked
 from .chain_margins import stable_at
-from .gains import chain_gains
-from .margins import MarginsReport, OperatingPoint, analyse
+from .delay import delay_text
+from .gains import resolve_chain_gains
+from .margins import MarginsReport, OperatingPoint, margins_report
 from .mimo import chain_delay_margin
 from .siso import LoopDelayMargin
 
 
 @dataclass(frozen=True)
-class ChainVerdict:
+class ChainReflexVerdict:
     """The chain under the delayed reflex at the operating point of :class:`~spinectl.reflex.margins.MarginsReport`.
 
     Attributes
@@ -99,12 +100,12 @@ class ChainVerdict:
         exact = self.exact
         if not self.modes.defined:
             return [self.modes.summary()]
-        margin = "unbounded" if exact.margin == np.inf else f"{exact.margin * 1000:.4g} ms"
+        margin = delay_text(exact.margin)
         where = f" at {exact.frequency:.4g} rad/s" if np.isfinite(exact.frequency) else ""
         word = "stable" if self.stable_at_delay else "NOT stable"
         lines = [
             f"{self.criterion}, the same reflex rule at every joint (gains from each joint's own stiffness): "
-            f"{word} at the delay {self.delay * 1000:.4g} ms "
+            f"{word} at the delay {delay_text(self.delay)} "
             f"(exact delay margin {margin}{where})",
             "  without reflex: " + self.modes.summary().split(": ", 1)[1],
         ]
@@ -117,7 +118,9 @@ class ChainVerdict:
         return lines
 
 
-def chain_verdict(model: Model, point: OperatingPoint, delay: float, lag: float, kp=None, kd=None) -> ChainVerdict:
+def chain_verdict(
+    model: Model, point: OperatingPoint, delay: float, lag: float, kp=None, kd=None
+) -> ChainReflexVerdict:
     """The chain at ``point`` under the delayed reflex: the rule on the chain, or the explicit gains.
 
     Parameters
@@ -133,7 +136,7 @@ def chain_verdict(model: Model, point: OperatingPoint, delay: float, lag: float,
 
     Returns
     -------
-    ChainVerdict
+    ChainReflexVerdict
         NaN margins (status 'undefined') where the point has no optimum or the mass matrix is singular.
     """
     e, lam = point.eccentricity, point.lordosis
@@ -148,24 +151,17 @@ def chain_verdict(model: Model, point: OperatingPoint, delay: float, lag: float,
         nan = np.full(n, np.nan)
         modes = dataclasses.replace(modes, eigenvalues=np.full(2 * n, complex(np.nan, np.nan)))  # no optimum: undefined
         exact = chain_delay_margin(np.eye(n), np.full((n, n), np.nan), np.zeros((n, n)), nan, nan, lag)
-        return ChainVerdict(delay, nan, nan, nan, exact, False, modes)
+        return ChainReflexVerdict(delay, nan, nan, nan, exact, False, modes)
     _, local = least_local_stiffness_stacked(stiffness[None], model.optimisation.stability_margin)
     local = local[0]
-    if settings.gains == "rule":
-        kp0, kd0 = chain_gains(mass, stiffness, damping, local, settings.gain_factor, settings.damping_ratio, lag)
-    else:
-        kp0, kd0 = np.full(n, settings.kp), np.full(n, settings.kd)
-    kp = kp0 if kp is None else np.full(n, float(kp))
-    kd = kd0 if kd is None else np.full(n, float(kd))
+    kp, kd = resolve_chain_gains(settings, mass, stiffness, damping, local, kp, kd)
     with arithmetic_guard(e, lam):
         exact = chain_delay_margin(mass, stiffness, damping, kp, kd, lag)
-    return ChainVerdict(
-        delay, np.asarray(kp, float), np.asarray(kd, float), local, exact, stable_at(exact, delay), modes
-    )
+    return ChainReflexVerdict(delay, kp, kd, local, exact, stable_at(exact, delay), modes)
 
 
 def margins_with_chain(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None) -> MarginsReport:
-    """Every segment's margins (:func:`spinectl.reflex.margins.analyse`) and the chain's verdict beside them.
+    """Every segment's margins (:func:`spinectl.reflex.margins.margins_report`) and the chain's verdict beside them.
 
     Parameters
     ----------
@@ -179,15 +175,15 @@ def margins_with_chain(model: Model, eccentricity: float, lordosis: float, kp=No
     Returns
     -------
     MarginsReport
-        With ``chain`` a :class:`ChainVerdict`.
+        With ``chain`` a :class:`ChainReflexVerdict`.
 
     Raises
     ------
     ParameterError
-        As :func:`~spinectl.reflex.margins.analyse`.
+        As :func:`~spinectl.reflex.margins.margins_report`.
     ModelError
-        As :func:`~spinectl.reflex.margins.analyse`.
+        As :func:`~spinectl.reflex.margins.margins_report`.
     """
-    report = analyse(model, eccentricity, lordosis, kp=kp, kd=kd)
+    report = margins_report(model, eccentricity, lordosis, kp=kp, kd=kd)
     verdict = chain_verdict(model, report.point, report.delay, report.activation_time_constant, kp=kp, kd=kd)
     return dataclasses.replace(report, chain=verdict)

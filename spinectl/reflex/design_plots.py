@@ -1,7 +1,7 @@
 """Figures of the design question: the chain's verdicts against the passive stiffness, the design curve.
 
-Compute and draw are separate: :func:`spinectl.reflex.design.passive_curve` and
-:func:`spinectl.reflex.design.delay_curve` compute, the figure functions here draw on new
+Compute and draw are separate: :func:`spinectl.reflex.design.passive.passive_curve` and
+:func:`spinectl.reflex.design.curve.delay_curve` compute, the figure functions here draw on new
 figures with the Agg canvas (:func:`spinectl.canvas.new_figure`) and write nothing, and
 :func:`write_figures` saves them atomically (:func:`spinectl.canvas.save_figures`).
 """
@@ -25,7 +25,7 @@ def passive_figure(curve: PassiveCurve) -> Figure:
     """The least global PCSA alone and the least local stiffness for the chain against the passive stiffness.
 
     Marked: the least passive stiffness at which global muscles alone suffice, Crisco et al.'s
-    88 N buckling stiffness (computed, :func:`spinectl.reflex.design.crisco_stiffness`) and the
+    88 N buckling stiffness (computed, :func:`spinectl.reflex.design.passive.crisco_stiffness`) and the
     paper's 15 N m/rad.
 
     Parameters
@@ -117,7 +117,7 @@ def delay_figure(curve: DesignCurve) -> Figure:
     """The design curve: required co-contraction (joint by joint) and local stiffness (chain) against the delay.
 
     One line per lag T_a; the trunk muscles' reaction times of Radebold et al. (2000) marked
-    (:data:`spinectl.reflex.design.REACTION_TIMES`).
+    (:data:`spinectl.reflex.design.result.REACTION_TIMES`).
 
     Parameters
     ----------

@@ -462,6 +462,6 @@ def search_gains_at(
     chain = coupled_stability_at(model, eccentricity, lordosis, point.pcsa if point.ok else None)
     kp, kd = chain_gains(
         chain.mass, chain.stiffness, chain.damping, chain.local.local_stiffness,
-        settings.gain_factor, settings.damping_ratio, lag,
+        settings.gain_factor, settings.damping_ratio,
     )  # fmt: skip
     return search_chain_gains(chain.linear_chain, kp, kd, lag, seed=seed, **budget)

@@ -1,6 +1,8 @@
 """Reflex gains: the default rule from the segment's stiffness and inertia, or gains given by the user.
 
-The rule and its reasons are in docs/reflex.md, "The default reflex, and the activation level".
+The rule and its reasons are in docs/reflex.md, "The default reflex, and the activation level". The
+choice between the rule and the configured gains, then the per-option overrides, is made here once
+(:func:`resolve_gains` for segments, :func:`resolve_chain_gains` for the chain's joints) and only here.
 """
 
 from __future__ import annotations
@@ -12,7 +14,7 @@ from .inputs import validated
 
 
 @validated
-def default_gains(stiffness, damping, inertia, gain_factor, damping_ratio, lag=0.0):
+def default_gains(stiffness, damping, inertia, gain_factor, damping_ratio):
     """The default reflex rule (docs/reflex.md, "The default reflex, and the activation level").
 
     kp = gain_factor * max(S, 0): the stiffness deficit below self-stability
@@ -21,8 +23,8 @@ def default_gains(stiffness, damping, inertia, gain_factor, damping_ratio, lag=0
     reflex. kd = max(0, 2 zeta sqrt(theta (kp - S)) + D): the delay-free closed loop
     theta s^2 + (kd - D) s + (kp - S) gets the damping ratio zeta, counting the
     muscles' own damping -D >= 0 first (kd = 0 when they already damp enough).
-    The rule is the lag-free segment's: the activation lag 1/(T_a s + 1) acts on the reflex's
-    torque after it, as the muscles' force generation does, and the gains do not undo it. (Before, the
+    The rule is the lag-free segment's and takes no T_a: the activation lag 1/(T_a s + 1) acts on the
+    reflex's torque after it, as the muscles' force generation does, and the gains do not undo it. (Before, the
     rule added kp T_a to kd; where the damping part is 0, at the default operating point,
     that made the reflex kp (T_a s + 1), which cancels the lag exactly, so that the margins did
     not depend on T_a.) Trunk reflexes are identified so: delayed gains on the trunk's angle and
@@ -40,9 +42,6 @@ def default_gains(stiffness, damping, inertia, gain_factor, damping_ratio, lag=0
         Factor on the stiffness deficit [1], > 1.
     damping_ratio : float
         zeta [1], > 0.
-    lag : array_like, optional
-        Activation time constant T_a [s]; the rule does not use it (the lag acts after the reflex),
-        kept for the callers that pass it.
 
     Returns
     -------
@@ -59,19 +58,18 @@ def default_gains(stiffness, damping, inertia, gain_factor, damping_ratio, lag=0
        intrinsic muscle stiffness alone is insufficient for stability. J Biomech 40:1058-1065.
        doi:10.1016/j.jbiomech.2006.04.018.
     """
-    s, d, theta, lag = as_arrays(stiffness, damping, inertia, lag)
+    s, d, theta = as_arrays(stiffness, damping, inertia)
     kp = gain_factor * np.maximum(s, 0.0)
-    return kp, _derivative_gain(kp, s, d, theta, damping_ratio, lag)
+    return kp, _derivative_gain(kp, s, d, theta, damping_ratio)
 
 
-def _derivative_gain(kp, stiffness, damping, inertia, damping_ratio, lag):
-    """kd = max(0, 2 zeta sqrt(theta (kp - S)) + D): the rule's damping (see :func:`default_gains`; T_a unused)."""
+def _derivative_gain(kp, stiffness, damping, inertia, damping_ratio):
+    """kd = max(0, 2 zeta sqrt(theta (kp - S)) + D): the rule's damping (see :func:`default_gains`)."""
     net = np.maximum(kp - stiffness, 0.0)
-    kd = np.maximum(2.0 * damping_ratio * np.sqrt(inertia * net) + damping, 0.0)
-    return kd + 0.0 * np.asarray(lag, float)  # the broadcast shape of the inputs, lag included
+    return np.maximum(2.0 * damping_ratio * np.sqrt(inertia * net) + damping, 0.0)
 
 
-def chain_gains(mass, stiffness, damping, local_stiffness, gain_factor, damping_ratio, lag=0.0):
+def chain_gains(mass, stiffness, damping, local_stiffness, gain_factor, damping_ratio):
     """The default rule on the chain: diagonal gains from the chain's stiffness deficit (docs/chain.md).
 
     A joint's deficit is the least local stiffness k_j of
@@ -91,8 +89,6 @@ def chain_gains(mass, stiffness, damping, local_stiffness, gain_factor, damping_
         k [N m/rad], the least local stiffness.
     gain_factor, damping_ratio : float
         As in :func:`default_gains` [1].
-    lag : float, optional
-        Activation time constant T_a [s]; unused, as in :func:`default_gains`.
 
     Returns
     -------
@@ -102,11 +98,67 @@ def chain_gains(mass, stiffness, damping, local_stiffness, gain_factor, damping_
     diagonal = (np.diagonal(np.asarray(x, float)) for x in (mass, stiffness, damping))
     theta, s, d = diagonal
     kp = gain_factor * np.maximum(np.asarray(local_stiffness, float), 0.0)
-    return kp, _derivative_gain(kp, s, d, theta, damping_ratio, lag)
+    return kp, _derivative_gain(kp, s, d, theta, damping_ratio)
+
+
+def _configured(reflex, rule, shape, kp=None, kd=None):
+    """The rule's gains (``rule()``, called only for ``gains = "rule"``) or the configured ones, then the overrides.
+
+    Parameters
+    ----------
+    reflex : spinectl.model.params.Reflex
+        ``gains`` ('rule' or 'explicit'), ``kp`` and ``kd``.
+    rule : callable
+        () -> (kp, kd) of ``shape``: the rule's gains [N m/rad], [N m s/rad].
+    shape : tuple of int
+        The gains' shape.
+    kp, kd : float, optional
+        One gain for every element [N m/rad], [N m s/rad], replacing the rule's or configured one.
+
+    Returns
+    -------
+    kp, kd : numpy.ndarray
+        [N m/rad], [N m s/rad], of ``shape``.
+    """
+    kp0, kd0 = rule() if reflex.gains == "rule" else (np.full(shape, reflex.kp), np.full(shape, reflex.kd))
+    kp_out = kp0 if kp is None else np.full(shape, float(kp))
+    kd_out = kd0 if kd is None else np.full(shape, float(kd))
+    return np.asarray(kp_out, float), np.asarray(kd_out, float)
+
+
+def resolve_chain_gains(reflex, mass, stiffness, damping, local_stiffness, kp=None, kd=None, scale=1.0):
+    """The chain's diagonal gains from the reflex settings, each optionally overridden.
+
+    Parameters
+    ----------
+    reflex : spinectl.model.params.Reflex
+        ``gains = "rule"`` uses :func:`chain_gains` (with its ``gain_factor`` and ``damping_ratio``),
+        ``"explicit"`` its ``kp`` and ``kd`` at every joint.
+    mass, stiffness, damping : array_like, shape (n, n)
+        M [kg m^2], K [N m/rad], D [N m s/rad].
+    local_stiffness : array_like, shape (n,)
+        k [N m/rad], the least local stiffness (the deficit the rule compensates).
+    kp, kd : float, optional
+        One gain for every joint [N m/rad], [N m s/rad], replacing the rule's or configured one.
+    scale : float, optional
+        A factor [1] on the rule's gains alone (the design's hand-over to the local muscles,
+        :func:`spinectl.reflex.design.chain.chain_loop_at`); 1 by default.
+
+    Returns
+    -------
+    kp, kd : numpy.ndarray, shape (n,)
+        [N m/rad], [N m s/rad].
+    """
+
+    def rule():
+        kp0, kd0 = chain_gains(mass, stiffness, damping, local_stiffness, reflex.gain_factor, reflex.damping_ratio)
+        return scale * kp0, scale * kd0
+
+    return _configured(reflex, rule, (len(local_stiffness),), kp, kd)
 
 
 @validated
-def resolve_gains(stiffness, damping, inertia, reflex, kp=None, kd=None, lag=None):
+def resolve_gains(stiffness, damping, inertia, reflex, kp=None, kd=None):
     """Gains per segment from the reflex settings, each optionally overridden.
 
     Parameters
@@ -114,13 +166,10 @@ def resolve_gains(stiffness, damping, inertia, reflex, kp=None, kd=None, lag=Non
     stiffness, damping, inertia : array_like
         S [N m/rad], D [N m s/rad], theta [kg m^2].
     reflex : spinectl.model.params.Reflex
-        ``gains = "rule"`` uses :func:`default_gains` (with its ``activation_time_constant``),
+        ``gains = "rule"`` uses :func:`default_gains` (with its ``gain_factor`` and ``damping_ratio``),
         ``"explicit"`` its ``kp`` and ``kd``.
     kp, kd : float, optional
         Explicit gains [N m/rad], [N m s/rad] that replace the configured ones.
-    lag : array_like, optional
-        Activation time constant T_a [s] in place of ``reflex.activation_time_constant``
-        (:func:`default_gains`'s ``lag``); None: the reflex's.
 
     Returns
     -------
@@ -129,12 +178,7 @@ def resolve_gains(stiffness, damping, inertia, reflex, kp=None, kd=None, lag=Non
         one of them is NaN.
     """
     s, d, theta = as_arrays(stiffness, damping, inertia)
-    lag = reflex.activation_time_constant if lag is None else lag
-    if reflex.gains == "rule":
-        kp0, kd0 = default_gains(s, d, theta, reflex.gain_factor, reflex.damping_ratio, lag)
-    else:
-        kp0, kd0 = np.full(s.shape, reflex.kp), np.full(s.shape, reflex.kd)
-    kp_out = kp0 if kp is None else np.full(s.shape, float(kp))
-    kd_out = kd0 if kd is None else np.full(s.shape, float(kd))
+    rule = lambda: default_gains(s, d, theta, reflex.gain_factor, reflex.damping_ratio)  # noqa: E731
+    kp_out, kd_out = _configured(reflex, rule, s.shape, kp, kd)
     nan = np.isnan(s) | np.isnan(d) | np.isnan(theta)
     return np.where(nan, np.nan, kp_out), np.where(nan, np.nan, kd_out)

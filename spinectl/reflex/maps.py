@@ -74,7 +74,7 @@ def landscape(stiffness, damping, inertia, reflex, kp=None, kd=None, lag=None) -
     """
     s, d, theta = as_arrays(stiffness, damping, inertia)
     lag = reflex.activation_time_constant if lag is None else lag
-    kp_, kd_ = resolve_gains(s, d, theta, reflex, kp, kd, lag=lag)
+    kp_, kd_ = resolve_gains(s, d, theta, reflex, kp, kd)  # the rule takes no lag: it acts after the reflex
     check_retarded(theta, d, kd_, lag)
     s, d, theta, kp_, kd_, lag = as_arrays(s, d, theta, kp_, kd_, lag)
     free = without_delay(s, d, theta, kp_, kd_, lag)  # the delay-free loop and the crossings, once for all three

@@ -303,11 +303,11 @@ class MarginsReport:
     segments : tuple of SegmentMargins
     gains : str
         How the gains were chosen: 'rule' or 'explicit' (:attr:`spinectl.model.params.reflex.Reflex.gains`),
-        'explicit' when both were given to :func:`analyse`, e.g. 'explicit kp, rule kd' when one was.
+        'explicit' when both were given to :func:`margins_report`, e.g. 'explicit kp, rule kd' when one was.
     model : dict
         The model's :func:`~spinectl.model.source.provenance` and its :func:`~spinectl.model.source.header`
         line (key ``header``).
-    chain : spinectl.reflex.chain_verdict.ChainVerdict or None
+    chain : spinectl.reflex.chain_verdict.ChainReflexVerdict or None
         The chain's verdict at the same point (every CoR free), where it was computed
         (:func:`spinectl.reflex.chain_verdict.margins_with_chain`); None: the segments' alone.
     """
@@ -350,7 +350,7 @@ class MarginsReport:
             ``activation``, ``optimum_status``, ``gains``, ``pcsa_cm2`` (muscle name -> PCSA [cm^2]), ``segments`` (one
             :meth:`SegmentMargins.to_dict` each), ``criterion`` (of the segments' verdicts: joint by
             joint), ``all_stable_at_delay`` and, where computed, ``chain`` (the chain's verdict,
-            :meth:`spinectl.reflex.chain_verdict.ChainVerdict.to_dict`, with its own ``criterion``);
+            :meth:`spinectl.reflex.chain_verdict.ChainReflexVerdict.to_dict`, with its own ``criterion``);
             the unit is in each key's name.
         """
         point = self.point
@@ -440,7 +440,7 @@ def _num(value: float, width: int, digits: int, inf: str = "unbounded", nan: str
     return f"{value:{width}.{digits}f}"
 
 
-def analyse(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None) -> MarginsReport:
+def margins_report(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None) -> MarginsReport:
     """Margins of every segment, with the reflex settings of ``model.reflex``.
 
     Parameters
@@ -606,7 +606,7 @@ def report_responses(model: Model, report: MarginsReport) -> ReportResponses:
     model : Model
         The model of the report (geometry and the simulation settings of ``model.reflex``).
     report : MarginsReport
-        Output of :func:`analyse` for ``model``.
+        Output of :func:`margins_report` for ``model``.
 
     Returns
     -------

@@ -360,7 +360,7 @@ def chain_delay_margin(mass, stiffness, damping, kp, kd, lag=0.0) -> LoopDelayMa
     return from_crossings(w, phases, directions, stable)
 
 
-def delay_margin_of(chain: LinearChain, kp, kd, lag=0.0, u=()) -> LoopDelayMargin:
+def linear_chain_delay_margin(chain: LinearChain, kp, kd, lag=0.0, u=()) -> LoopDelayMargin:
     """:func:`chain_delay_margin` of any linearised chain at the controls ``u``: M, K(u), D(u).
 
     Parameters
@@ -398,7 +398,7 @@ def pade_margin(exact: LoopDelayMargin, order: int) -> float:
     Parameters
     ----------
     exact : LoopDelayMargin
-        The crossings of :func:`chain_delay_margin` (or :func:`spinectl.reflex.siso.delay_margin`).
+        The crossings of :func:`chain_delay_margin` (or :func:`spinectl.reflex.siso.loop_delay_margin`).
     order : int
         Order n of the approximant.
 

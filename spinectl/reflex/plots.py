@@ -25,6 +25,7 @@ from matplotlib.ticker import MultipleLocator
 
 from ..canvas import new_figure, save_figures, save_file
 from ..model.params import Model
+from .delay import delay_text
 from .loops import ignoring_underflow
 from .margins import MarginsReport, ReportResponses, report_responses
 from .simulate import Simulation
@@ -122,7 +123,7 @@ def _margin_label(name: str, seg) -> str:
     """The legend entry of a segment: its name and, if known, its delay, phase and upper gain margins."""
     if seg is None or np.isnan(seg.delay_margin):
         return name
-    parts = [f"tau_m {'unbounded' if np.isinf(seg.delay_margin) else f'{seg.delay_margin:.3g} s'}"]
+    parts = [f"tau_m {delay_text(seg.delay_margin, 3)}"]
     if np.isfinite(seg.phase_margin_deg):
         parts.append(f"PM {seg.phase_margin_deg:.0f} deg")
     if np.isfinite(seg.gain_margin):
@@ -223,7 +224,7 @@ def frequency_range(report: MarginsReport) -> tuple[float, float]:
     Parameters
     ----------
     report : MarginsReport
-        Output of :func:`spinectl.reflex.margins.analyse`.
+        Output of :func:`spinectl.reflex.margins.margins_report`.
 
     Returns
     -------
@@ -247,7 +248,7 @@ def report_figures(report: MarginsReport, responses: ReportResponses) -> dict[st
     Parameters
     ----------
     report : MarginsReport
-        Output of :func:`spinectl.reflex.margins.analyse` (titles, frequency range).
+        Output of :func:`spinectl.reflex.margins.margins_report` (titles, frequency range).
     responses : ReportResponses
         Its loops and simulations.
 
@@ -317,7 +318,7 @@ def write_plots(report: MarginsReport, folder: str | Path, model: Model) -> list
     Parameters
     ----------
     report : MarginsReport
-        Output of :func:`spinectl.reflex.margins.analyse` for ``model``.
+        Output of :func:`spinectl.reflex.margins.margins_report` for ``model``.
     folder : str or Path
         Folder for the PNG files (created if missing).
     model : Model

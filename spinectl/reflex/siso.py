@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ParameterError
-from .delay import DELAY_INDEPENDENT, FINITE, STATUS, UNDEFINED, UNSTABLE_WITHOUT_DELAY
+from .delay import DELAY_INDEPENDENT, FINITE, STATUS, UNDEFINED, UNSTABLE_WITHOUT_DELAY, delay_text
 
 MAX_SPAN = 1e100
 """Largest ratio of the loop's coefficients in magnitude (the largest nonzero over the smallest).
@@ -126,7 +126,7 @@ class LoopDelayMargin:
         str
             A few lines, no final newline.
         """
-        margin = {np.inf: "unbounded"}.get(self.margin, f"{self.margin:.6g} s")
+        margin = delay_text(self.margin, 6)
         where = f" at {self.frequency:.6g} rad/s" if np.isfinite(self.frequency) else ""
         lines = [f"delay margin {margin}{where} ({self.status})"]
         delays = self.critical_delays(bound)
@@ -235,7 +235,7 @@ def _positive_roots(f):
     return x[keep], np.where(tangent[keep], 0.0, np.sign(np.polyval(slope, x[keep])))
 
 
-def delay_margin(loop) -> LoopDelayMargin:
+def loop_delay_margin(loop) -> LoopDelayMargin:
     """Exact delay margin of a SISO loop L(s) in the loop L(s) exp(-s tau), unity negative feedback.
 
     Every gain crossover from F(x) = abs(D(jw))^2 - abs(N(jw))^2 = 0, the phase

@@ -13,7 +13,7 @@ from spinectl.model.config import load_preset, set_parameters
 from spinectl.model.stability import segment_stability
 from spinectl.optimise.reference import solve_point
 from spinectl.reflex.chain_verdict import chain_verdict, margins_with_chain
-from spinectl.reflex.margins import analyse, operating_point
+from spinectl.reflex.margins import margins_report, operating_point
 
 
 @pytest.fixture
@@ -36,12 +36,12 @@ def _library_model(base, state):
 
 
 def test_point_numbers_equal_the_library_at_the_same_point(state):
-    """Margins as `spinectl margins` computes them (reflex.margins.analyse); eigenvalues and CT as
+    """Margins as `spinectl margins` computes them (reflex.margins.margins_report); eigenvalues and CT as
     `spinectl stability` at PCSA = activation x the optimum (docs/reflex.md)."""
     base = load_preset("wagner2012")
     got = nb.point_numbers(base, state)
     model = _library_model(base, state)
-    report = analyse(model, state.eccentricity, state.lordosis)
+    report = margins_report(model, state.eccentricity, state.lordosis)
     np.testing.assert_array_equal(got.delay_margin, [s.delay_margin for s in report.segments])
     assert list(got.stable_at_delay) == [s.stable_at_delay for s in report.segments]
     pcsa = state.activation * solve_point(model, state.eccentricity, state.lordosis).pcsa
@@ -155,16 +155,18 @@ def answer():
 
 
 def test_design_meets_the_delay_checked_by_the_margins_report(answer):
-    """Joint by joint, second route: reflex.margins.analyse with reflex.activation = the answer gives every
+    """Joint by joint, second route: reflex.margins.margins_report with reflex.activation = the answer gives every
     segment an exact delay margin >= tau, and 1 % less activation leaves one below (the least); the chain's
     least static local stiffness is the chain verdict's (margins_with_chain at the same operating point)."""
     base, state, design = answer
     assert design.status == "ok"
     model = model_at(base, state)
-    at = analyse(set_parameters(model, {"reflex.activation": design.activation}), state.eccentricity, state.lordosis)
+    at = margins_report(
+        set_parameters(model, {"reflex.activation": design.activation}), state.eccentricity, state.lordosis
+    )
     assert min(s.delay_margin for s in at.segments) >= state.delay * (1 - 1e-9)
     below = set_parameters(model, {"reflex.activation": 0.99 * design.activation})
-    assert min(s.delay_margin for s in analyse(below, state.eccentricity, state.lordosis).segments) < state.delay
+    assert min(s.delay_margin for s in margins_report(below, state.eccentricity, state.lordosis).segments) < state.delay
     verdict = nb.point_numbers(base, state).chain
     np.testing.assert_allclose(design.chain.least_static, verdict.local_stiffness, rtol=1e-9)
     assert design.chain.delay_margin >= state.delay and design.chain.max_root_real < 0

@@ -136,7 +136,7 @@ def test_an_absurd_grid_is_refused_before_any_work(model):
 
 
 def test_delay_margins_in_the_sweep_equal_the_margins_report():
-    """Second path: the per-point ``margins.analyse`` (per-point optimum, python-control
+    """Second path: the per-point ``margins.margins_report`` (per-point optimum, python-control
     alongside) gives the same gains, delay margins and verdicts as the vectorised sweep."""
     from spinectl.reflex import margins
 
@@ -145,7 +145,7 @@ def test_delay_margins_in_the_sweep_equal_the_margins_report():
     ds = sweep.sweep(model, E, L, progress=False)
     for e in E:
         for lam in L:
-            report = margins.analyse(model, float(e), float(lam))
+            report = margins.margins_report(model, float(e), float(lam))
             point = ds.sel(E=e, Lambda=lam)
             for k, seg in enumerate(report.segments):
                 assert point.reflex_kp_Nm_per_rad.values[k] == pytest.approx(seg.kp, rel=1e-6)

@@ -10,7 +10,7 @@ import pytest
 from spinectl import optimise
 from spinectl.errors import ModelError
 from spinectl.model.stability import segment_stability
-from spinectl.optimise import reference, stabilising
+from spinectl.optimise import stabilising
 
 
 def _with(model, **settings):
@@ -63,15 +63,3 @@ def test_a_computed_optimum_beyond_any_muscle_is_an_answer_not_a_unit_slip():
     result = stabilising.stability_at(heavy, 0.03, 0.04)
     assert result.pcsa.max() > MAX_PLAUSIBLE_PCSA  # (zero margins: marginally stable by construction)
     assert result.min_pcsa == pytest.approx(scale * stabilising.stability_at(base, 0.03, 0.04).min_pcsa, rel=1e-6)
-
-
-@pytest.mark.parametrize("name", sorted(reference.MOVED))
-def test_the_old_names_in_the_reference_warn_and_are_the_new(name):
-    """The names that left optimise/reference (so that it imports nothing of the fast path) still
-    read there until the next release: the same object, with a DeprecationWarning naming the new module;
-    any other missing name is an AttributeError."""
-    with pytest.warns(DeprecationWarning, match=f"optimise.stabilising.{name}"):
-        old = getattr(reference, name)
-    assert old is getattr(stabilising, name)
-    with pytest.raises(AttributeError, match="no_such_name"):
-        reference.no_such_name  # noqa: B018

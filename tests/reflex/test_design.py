@@ -5,11 +5,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from spinectl.model import config
+from spinectl.model import chain, config
 from spinectl.model.checks import checked_coefficients
 from spinectl.reflex import design as dz
 from spinectl.reflex import margins
 from spinectl.reflex.chain_margins import stable_at
+from spinectl.reflex.delay import delay_text
+from spinectl.reflex.design import roots
 from spinectl.reflex.mimo import chain_delay_margin
 
 SUBJECT = {"body.mass": 35.0, "passive.stiffness": 10.0, "reflex.delay": 0.12}
@@ -21,16 +23,16 @@ def _subject(**extra):
 
 
 def test_the_least_activation_meets_the_delay_and_a_little_less_does_not():
-    """Joint by joint, checked through margins.analyse (the operating point re-solved, the rule's gains, the exact
-    margins): at the returned activation every segment's margin is >= 120 ms; 1e-4 below it L1L2's is not. About
+    """Joint by joint, checked through margins.margins_report (the operating point re-solved, the rule's gains, the
+    exact margins): at the returned activation every segment's margin is >= 120 ms; 1e-4 below it L1L2's is not. About
     31 % of the minimum PCSA, 13.7 cm^2 (19 %, 8.3 cm^2, under the former rule that cancelled the lag, as found by
     looping over ``margins --activation`` by hand)."""
     model = _subject()
     activation, segments, optimum, status, _, method = dz.joint_design(model, 0.03, 0.04)
     assert status == "ok" and method.startswith("bisection")
-    at = margins.analyse(config.set_parameters(model, {"reflex.activation": activation}), 0.03, 0.04)
+    at = margins.margins_report(config.set_parameters(model, {"reflex.activation": activation}), 0.03, 0.04)
     assert all(s.delay_margin >= 0.12 for s in at.segments) and at.all_stable_at_delay
-    below = margins.analyse(config.set_parameters(model, {"reflex.activation": activation - 1e-4}), 0.03, 0.04)
+    below = margins.margins_report(config.set_parameters(model, {"reflex.activation": activation - 1e-4}), 0.03, 0.04)
     assert min(s.delay_margin for s in below.segments) < 0.12
     assert activation == pytest.approx(max(s.activation for s in segments))  # monotone: the slowest segment's
     assert activation == pytest.approx(0.3145, abs=1e-3)
@@ -59,17 +61,15 @@ def test_a_segment_at_its_least_activation_has_the_closed_form_margin_equal_to_t
 
 
 @pytest.mark.parametrize("local_damping", [1.0, 0.0])
-def test_the_chain_design_has_its_certificate_and_a_little_less_fails(monkeypatch, local_damping):
+def test_the_chain_design_has_its_certificate_and_a_little_less_fails(local_damping):
     """The chain at activation 0.5: the returned local stiffness f k* gives an exact multivariable margin >= the
-    delay and a rightmost root in the left half-plane (recomputed here); one bisection step below it (the scan step
-    halved BISECTIONS times) the exact margin falls short of the delay, and just past that margin the rightmost
+    delay and a rightmost root in the left half-plane (recomputed here); one grid step below it (2^-BISECTIONS of
+    the search's range [0, 1]) the exact margin falls short of the delay, and just past that margin the rightmost
     root (a second method) lies on the right. With the local muscles' damping (local.damping = 1) the design is
     f = 0.734 and the loop loses stability at its first crossing, 12.2 rad/s. Stiffness only (0), f = 0.9997, and
     the loop one step below is stable at the delay itself but not on all of [0, delay]: delay systems switch
     stability, and a narrow crossing band at about 217 rad/s opens unstable windows well below the delay (near
     5-10 ms and 34-39 ms). The rule's reflex vanishes at f = 1, so f <= 1."""
-    monkeypatch.setattr(dz, "CHAIN_SCAN", 5)
-    monkeypatch.setattr(dz, "BISECTIONS", 12)
     model = _subject(**{"reflex.activation": 0.5, "local.damping": local_damping})
     optimum = margins.solve_point(model, 0.03, 0.04).pcsa
     result = dz.chain_design(model, 0.03, 0.04, 0.5 * optimum, 0.5)
@@ -84,7 +84,7 @@ def test_the_chain_design_has_its_certificate_and_a_little_less_fails(monkeypatc
     exact = chain_delay_margin(mass, k, d, kp, kd, 0.05)
     assert stable_at(exact, 0.12) and exact.margin >= 0.12
     assert dz.rightmost_root(mass, k, d, kp, kd, 0.12, 0.05, dz.SPECTRAL_NODES).real < 0
-    step = 1.0 / (dz.CHAIN_SCAN - 1) / 2**dz.BISECTIONS
+    step = 1.0 / 2**dz.BISECTIONS
     k, d, kp, kd = loop(result.fraction - step)
     less = chain_delay_margin(mass, k, d, kp, kd, 0.05)
     assert less.margin < 0.12
@@ -138,7 +138,7 @@ def test_a_fast_seed_does_not_overflow_the_rightmost_root(monkeypatch):
     with np.errstate(over="raise", invalid="raise", divide="raise"):
         s = dz.rightmost_root(m, k, d, kp, kd, 0.1)
         assert abs(1e-3 * s**2 + 10.0 * s + 1.0 + 0.5 * np.exp(-0.1 * s)) < 1e-9 and s.real < 0
-        monkeypatch.setattr(dz, "MAX_EXPONENT", np.inf)
+        monkeypatch.setattr(roots, "MAX_EXPONENT", np.inf)
         with pytest.raises(FloatingPointError):
             dz.rightmost_root(m, k, d, kp, kd, 0.1)
 
@@ -151,7 +151,7 @@ def test_a_delay_no_activation_meets_is_an_answer():
     assert status == "infeasible" and np.isnan(activation) and 0 < largest < 0.05
     scan = np.linspace(0, 1, dz.SCAN)
     at = [
-        margins.analyse(config.set_parameters(model, {"reflex.activation": a}), 0.0, 0.0, kp=300.0, kd=0.0)
+        margins.margins_report(config.set_parameters(model, {"reflex.activation": a}), 0.0, 0.0, kp=300.0, kd=0.0)
         for a in scan[::10]
     ]
     assert max(min(s.delay_margin for s in r.segments) for r in at) <= largest + 1e-12
@@ -161,8 +161,8 @@ def test_a_delay_prints_with_its_unit_or_unbounded_without_one():
     """The table's delays: 120 ms in ms, 329.8 s (the plain case's chain margin, stiffness only) in s, an infinite
     margin as 'unbounded (delay-independent)' with no unit (not 'unbounded ms'), NaN as 'none'; and so in the
     certificate of a Design's table."""
-    assert dz._delay(0.12) == "120 ms" and dz._delay(329.847) == "329.8 s" and dz._delay(np.nan) == "none"
-    assert dz._delay(np.inf) == "unbounded (delay-independent)"
+    assert delay_text(0.12) == "120 ms" and delay_text(329.847) == "329.8 s" and delay_text(np.nan) == "none"
+    assert delay_text(np.inf) == "unbounded (delay-independent)"
     n = 5
     chain = dz.ChainDesign(0.5, 0.9, np.ones(n), np.ones(n), np.inf, -1.0, np.inf, "test")
     seg = tuple(dz.SegmentDesign(f"S{i}", 0.1, 1e-4, 0.2, True) for i in range(n))
@@ -172,23 +172,26 @@ def test_a_delay_prints_with_its_unit_or_unbounded_without_one():
     assert "unbounded ms" not in d.table()
 
 
-def test_the_chains_largest_delay_met_is_the_largest_any_tried_design_meets(monkeypatch):
+def test_the_chains_largest_delay_met_is_the_largest_any_tried_design_meets():
     """chain.largest_delay_met_s means what the top-level (joint-by-joint) one means: the largest delay met by any
     design tried, not the margin of the least design. Under the rule's gains the scan reaches f = 1, which has no
     reflex and is stable at every delay, so it is unbounded (inf); the least design's own margin is finite. The
-    second method: each scanned fraction's exact margin recomputed (_chain_margin), whose largest is inf too."""
-    monkeypatch.setattr(dz, "CHAIN_SCAN", 5)
-    monkeypatch.setattr(dz, "BISECTIONS", 12)
+    second method: each scanned fraction's exact margin recomputed here (0 where unstable without delay), whose
+    largest is inf too."""
     model = config.set_parameters(config.load_preset("wagner2012"), {"reflex.delay": 0.12})
     optimum = margins.solve_point(model, 0.03, 0.04).pcsa
     result = dz.chain_design(model, 0.03, 0.04, 0.5 * optimum, 0.5)
     mass, stiffness, damping = dz.chain_matrices(model, 0.03, 0.04, 0.5 * optimum)
-    scanned = [
-        dz._chain_margin(
-            model, mass, stiffness, damping, result.least_static, f, None, None, model.reflex.activation_time_constant
-        )
-        for f in np.linspace(0.0, 1.0, dz.CHAIN_SCAN)
-    ]
+    lag = model.reflex.activation_time_constant
+
+    def margin(f):
+        k, d, kp, kd = dz.chain_loop_at(model, mass, stiffness, damping, result.least_static, f)
+        if not (np.any(kp) or np.any(kd)):  # no reflex: every delay, where the chain holds itself
+            return np.inf if chain.coupled_margin(k) > 0 else 0.0
+        exact = chain_delay_margin(mass, k, d, kp, kd, lag)
+        return float(exact.margin) if exact.stable_without_delay else 0.0
+
+    scanned = [margin(f) for f in np.linspace(0.0, 1.0, dz.CHAIN_SCAN)]
     assert np.isfinite(result.delay_margin) and result.delay_margin >= 0.12
     assert result.largest_delay == max(scanned) == np.inf
     assert result.to_dict()["largest_delay_met_s"] == np.inf

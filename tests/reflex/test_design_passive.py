@@ -1,4 +1,4 @@
-"""The chain's verdicts against the passive stiffness (spinectl.reflex.design.passive_curve, crisco_stiffness)."""
+"""The chain against the passive stiffness (spinectl.reflex.design.passive: passive_curve, crisco_stiffness)."""
 
 from __future__ import annotations
 
@@ -8,6 +8,7 @@ import pytest
 from spinectl.errors import ParameterError
 from spinectl.model import chain, config
 from spinectl.reflex import design as dz
+from spinectl.reflex.design import passive
 
 
 def _margin(model, e, lam, k, pcsa, local=0.0):
@@ -59,8 +60,8 @@ def test_global_muscles_alone_stabilise_the_chain_above_a_passive_stiffness(pres
     curve = dz.passive_curve(model, 0.0, 0.0, ks)
     assert low <= curve.threshold <= high
     assert np.isnan(curve.global_pcsa[0]) and curve.global_status[0].startswith("infeasible")
-    assert not np.isfinite(dz._global_alone(model, 0.0, 0.0, curve.threshold - 0.05).total_pcsa)
-    alone = dz._global_alone(model, 0.0, 0.0, ks[1])
+    assert not np.isfinite(passive._global_alone(model, 0.0, 0.0, curve.threshold - 0.05).total_pcsa)
+    alone = passive._global_alone(model, 0.0, 0.0, ks[1])
     mu = model.optimisation.stability_margin
     assert _margin(model, 0.0, 0.0, ks[1], alone.pcsa) >= mu * (1 - 1e-3)
     assert curve.global_pcsa[1] == pytest.approx(alone.total_pcsa)
@@ -72,7 +73,7 @@ def test_at_crisco_stiffness_wagner2012_is_stable_with_global_muscle_alone():
     stabilise the chain' fails there."""
     model = config.load_preset("wagner2012")
     curve = dz.passive_curve(model, 0.0, 0.0, [0.0])
-    alone = dz._global_alone(model, 0.0, 0.0, curve.crisco)
+    alone = passive._global_alone(model, 0.0, 0.0, curve.crisco)
     assert 1e4 * curve.crisco_global_pcsa == pytest.approx(27.6, abs=0.15)
     assert _margin(model, 0.0, 0.0, curve.crisco, alone.pcsa) >= model.optimisation.stability_margin * (1 - 1e-3)
 
@@ -119,8 +120,8 @@ def test_the_two_columns_are_at_different_distributions_and_the_note_says_so(nea
     model = config.load_preset("wagner2012")
     curve = near_crisco
     optimum = np.asarray(solve_point(model, 0.0, 0.0).pcsa, float)
-    alone = dz._global_alone(model, 0.0, 0.0, 40.0)
-    own = least_local_stiffness(dz._physical(model, 40.0), 0.0, 0.0, alone.pcsa, given=False).local_stiffness
+    alone = passive._global_alone(model, 0.0, 0.0, 40.0)
+    own = least_local_stiffness(passive._physical(model, 40.0), 0.0, 0.0, alone.pcsa, given=False).local_stiffness
     assert np.sum(own) < 1e-3 and curve.local_stiffness[1].sum() > 50.0
     assert alone.total_pcsa < curve.paper_pcsa
     np.testing.assert_allclose(curve.fixed_pcsa, optimum)

@@ -1,14 +1,17 @@
-"""The design curve's chain search (spinectl.reflex.design._chain_curve, _bracket_root): the least local stiffness
-per delay by a safeguarded inverse interpolation of the exact margins, against a plain bisection."""
+"""The chain's search (spinectl.reflex.design.chain: chain_curve, _bracket_root): the least local stiffness per
+delay by a safeguarded inverse interpolation of the exact margins on the bisection's grid, against a plain bisection
+(the test oracle)."""
 
 from __future__ import annotations
 
 import numpy as np
-import pytest
 
 from spinectl.model import config
+from spinectl.optimise.coupled import least_local_stiffness_stacked
 from spinectl.reflex import design as dz
 from spinectl.reflex.chain_margins import stable_at
+from spinectl.reflex.design import chain as dc
+from spinectl.reflex.mimo import chain_delay_margin
 from spinectl.reflex.siso import from_crossings
 
 SUBJECT = {"body.mass": 35.0, "passive.stiffness": 10.0}
@@ -32,16 +35,17 @@ def _bisect(meets, lo=0.0, hi=1.0):
 def test_the_chain_curve_equals_a_plain_bisection_and_is_certified():
     """A second method: at 40, 120 and 200 ms, a plain bisection of the local-stiffness fraction on [0, 1] written
     here (its own verdict: the exact multivariable margin at least the delay, no critical delay crossed below it,
-    the rightmost root in the left half-plane) gives the curve's fraction to the bisection's width 2^-20; and the
+    the rightmost root in the left half-plane) gives the curve's fraction exactly (both judge only fractions on the
+    grid of 2^-20, and the fractions that meet form an interval here, so both end at its least grid point); and the
     curve's fraction is certified by the same verdict: it meets the delay, 2^-20 less does not."""
     model = _subject()
     mass, stiffness, damping = dz.chain_matrices(model, 0.03, 0.04, model.reflex.activation * _optimum(model))
-    _, least = dz.least_local_stiffness_stacked(stiffness[None], model.optimisation.stability_margin)
+    _, least = least_local_stiffness_stacked(stiffness[None], model.optimisation.stability_margin)
     lag = model.reflex.activation_time_constant
 
     def meets(f, d):
         k, dl, p, dd = dz.chain_loop_at(model, mass, stiffness, damping, least[0], f)
-        exact = dz.chain_delay_margin(mass, k, dl, p, dd, lag)
+        exact = chain_delay_margin(mass, k, dl, p, dd, lag)
         if not (stable_at(exact, d) and exact.margin >= d):
             return False
         return dz.rightmost_root(mass, k, dl, p, dd, d, lag).real < 0
@@ -50,7 +54,7 @@ def test_the_chain_curve_equals_a_plain_bisection_and_is_certified():
     curve = dz.delay_curve(model, 0.03, 0.04, delays)
     for j, d in enumerate(delays):
         f = curve.local_fraction[0, j]
-        assert f == pytest.approx(_bisect(lambda x, d=d: meets(x, d)), abs=WIDTH)
+        assert f == _bisect(lambda x, d=d: meets(x, d))
         assert meets(f, d) and not meets(f - WIDTH, d)
 
 
@@ -60,8 +64,8 @@ def test_the_chain_curve_needs_less_than_half_the_exact_margins_of_a_bisection(m
     see the curve), which a bisection to 2^-20 of a bracket of at least 2^-8 finds in at least 12 exact margins:
     at least 96 for the 8. The interpolation must need at most half of that (it needs 45; the bisection 131)."""
     calls = []
-    margin = dz.chain_delay_margin
-    monkeypatch.setattr(dz, "chain_delay_margin", lambda *a: calls.append(1) or margin(*a))
+    margin = dc.chain_delay_margin
+    monkeypatch.setattr(dc, "chain_delay_margin", lambda *a: calls.append(1) or margin(*a))
     dz.delay_curve(_subject(), 0.03, 0.04, np.linspace(0.0, 0.2, 9))
     assert len(calls) <= 48
 
@@ -74,16 +78,17 @@ def _tau(f):
 def test_the_search_is_certified_where_the_margin_jumps_and_bends(monkeypatch):
     """The chain's margin replaced by _tau (monkeypatched: the loop carries the fraction, the margin is _tau's one
     destabilising crossing at 1 rad/s, the root's sign follows it): at 21 delays 0 to 200 ms, across the jump and
-    the kink, the curve's fraction meets the delay and 2^-20 less does not (read from _tau itself), and it equals a
-    plain bisection of _tau >= d to 2^-20."""
-    monkeypatch.setattr(dz, "chain_loop_at", lambda *a: (np.array([a[5]]), None, np.array([1.0 - a[5]]), np.ones(1)))
-    monkeypatch.setattr(dz, "chain_delay_margin", lambda m, k, *a: from_crossings([1.0], [_tau(k[0])], [1.0], True))
-    monkeypatch.setattr(dz, "rightmost_root", lambda m, k, dl, p, dd, d, lag: complex(1.0 - 2.0 * (_tau(k[0]) > d)))
+    the kink, the curve's fraction meets the delay and 2^-20 less does not (read from _tau itself: a margin equal to
+    the delay is a root on the axis, which does not meet it, as stable_at says), and it equals a plain bisection of
+    _tau > d exactly (both on the grid of 2^-20; at 30 ms the change falls on a grid point, f = 0.25)."""
+    monkeypatch.setattr(dc, "chain_loop_at", lambda *a: (np.array([a[5]]), None, np.array([1.0 - a[5]]), np.ones(1)))
+    monkeypatch.setattr(dc, "chain_delay_margin", lambda m, k, *a: from_crossings([1.0], [_tau(k[0])], [1.0], True))
+    monkeypatch.setattr(dc, "rightmost_root", lambda m, k, dl, p, dd, d, lag, *_: complex(1.0 - 2.0 * (_tau(k[0]) > d)))
     delays = np.linspace(0.0, 0.2, 21)
     curve = dz.delay_curve(_subject(), 0.03, 0.04, delays)
     for d, f in zip(delays[1:], curve.local_fraction[0, 1:], strict=True):
-        assert _tau(f) >= d and _tau(f - WIDTH) < d
-        assert f == pytest.approx(_bisect(lambda x, d=d: _tau(x) >= d), abs=WIDTH)
+        assert _tau(f) > d >= _tau(f - WIDTH)
+        assert f == _bisect(lambda x, d=d: _tau(x) > d)
 
 
 def test_a_stalling_estimate_falls_back_to_bisection():
@@ -102,12 +107,12 @@ def test_a_stalling_estimate_falls_back_to_bisection():
     def stalling():
         return max([x for x in judged if x < change]) + 1e-12
 
-    f = dz._bracket_root(meets, stalling, 0.0, 1.0, WIDTH)
+    f = dc._bracket_root(meets, stalling, 0.0, 1.0, WIDTH)
     assert f >= change > f - WIDTH
     assert len(judged) - 1 <= 4 * 21
     for estimate in (lambda: None, lambda: 2.0):
         judged[:] = [0.0]
-        assert dz._bracket_root(meets, estimate, 0.0, 1.0, WIDTH) == _bisect(lambda x: x >= change)
+        assert dc._bracket_root(meets, estimate, 0.0, 1.0, WIDTH) == _bisect(lambda x: x >= change)
         assert len(judged) - 1 == dz.BISECTIONS
 
 

@@ -73,12 +73,12 @@ def test_library_callers_under_their_own_guard_are_not_checked_again():
     ("gains", "field"),
     [({"kp": -3.0}, "reflex.kp"), ({"kd": -0.5}, "reflex.kd"), ({"kp": True}, "reflex.kp"), ({"kd": "2"}, "reflex.kd")],
 )
-def test_analyse_refuses_negative_or_non_numeric_gains_itself(gains, field):
-    """The library's ``analyse`` checks the gains it is given as the model's ``reflex.kp``/``kd`` are
+def test_margins_report_refuses_negative_or_non_numeric_gains_itself(gains, field):
+    """The library's ``margins_report`` checks the gains it is given as the model's ``reflex.kp``/``kd`` are
     checked (before: only the CLI did, through a discarded ``set_parameter``; the library gave margins)."""
     from spinectl.model.config import load_config
-    from spinectl.reflex.margins import analyse
+    from spinectl.reflex.margins import margins_report
 
     with pytest.raises(ParameterError) as info:
-        analyse(load_config(None, preset="wagner2012"), 0.0, 0.0, **gains)
+        margins_report(load_config(None, preset="wagner2012"), 0.0, 0.0, **gains)
     assert info.value.field == field

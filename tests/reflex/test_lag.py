@@ -40,7 +40,7 @@ def _pure_delay_outputs() -> dict:
     out["rhp"] = reflex.right_half_plane_roots(s, d, th, kp, kd, tau, 0.0)
     out["stable"] = reflex.stable_at_delay(s, d, th, kp, kd, tau, 0.0)
     out["cg_lo"], out["cg_hi"] = reflex.critical_gains(s[:40], d[:40], th[:40], kd[:40], tau[:40], lag=0.0)
-    out["rule_kp"], out["rule_kd"] = reflex.default_gains(s, d, th, 1.5, 1.0, 0.0)
+    out["rule_kp"], out["rule_kd"] = reflex.default_gains(s, d, th, 1.5, 1.0)
     grid = reflex.landscape(s, d, th, Reflex(activation_time_constant=0.0))
     for f in ("kp", "kd", "delay_margin", "delay_margin_status", "crossing_frequency", "delay_margin_pade"):
         out["land_" + f] = getattr(grid, f)
@@ -173,9 +173,10 @@ def test_the_rule_does_not_cancel_the_lag():
     kp T_a, and where the damping part was 0 the reflex kp (T_a s + 1) cancelled the lag exactly."""
     s, d, theta = 50.0, -20.0, 2.0  # 2 sqrt(theta (kp - S)) = 14.1 < |D|: the rule's damping part is 0
     kp0, kd0 = reflex.default_gains(s, d, theta, 1.5, 1.0)
-    for lag in (0.05, 0.1):
-        kp, kd = reflex.default_gains(s, d, theta, 1.5, 1.0, lag)
-        assert kp == kp0 == 75.0 and kd == kd0 == 0.0
+    assert kp0 == 75.0 and kd0 == 0.0
+    for lag in (0.05, 0.1):  # the landscape resolves the rule's gains beside the lag: the same gains
+        grid = reflex.landscape(s, d, theta, Reflex(activation_time_constant=lag))
+        assert grid.kp == kp0 and grid.kd == kd0
 
 
 def test_the_margins_at_the_default_operating_point_change_with_the_lag():
@@ -188,7 +189,7 @@ def test_the_margins_at_the_default_operating_point_change_with_the_lag():
     found = []
     for lag in (0.0, 0.05, 0.1):
         model = config.set_parameters(config.load_preset("wagner2012"), {"reflex.activation_time_constant": lag})
-        seg = margins.analyse(model, 0.0, 0.0).segments[0]
+        seg = margins.margins_report(model, 0.0, 0.0).segments[0]
         tau, _ = _crossing_by_bisection(seg.stiffness, seg.damping, seg.inertia, seg.kp, seg.kd, lag)
         assert seg.delay_margin == pytest.approx(tau, rel=1e-9)
         found.append(seg.delay_margin)
@@ -200,7 +201,7 @@ def test_landscape_with_the_lag_is_the_pointwise_answer(rng):
     s, d, theta = rng.uniform(-40, 120, shape), -rng.uniform(0, 30, shape), rng.uniform(1, 4, shape)
     settings = Reflex(activation_time_constant=0.08)
     grid = reflex.landscape(s, d, theta, settings)
-    kp, kd = reflex.default_gains(s, d, theta, 1.5, 1.0, 0.08)
+    kp, kd = reflex.default_gains(s, d, theta, 1.5, 1.0)
     exact = reflex.delay_margin(s, d, theta, kp, kd, 0.08)
     assert np.array_equal(grid.delay_margin, exact.margin) and np.array_equal(grid.kd, kd)
     assert np.array_equal(grid.stable_at_delay, reflex.stable_at_delay(s, d, theta, kp, kd, settings.delay, 0.08))

@@ -24,7 +24,7 @@ def _with_reflex(model, **changes):
 def test_activation_one_is_self_stable_and_needs_no_reflex(model):
     """At the minimum stabilising PCSA every segment has S <= -margin < 0: the rule gives kp = 0, and
     the muscles' own damping exceeds the rule's target, so kd = 0 too: any delay is tolerated."""
-    report = margins.analyse(_with_reflex(model, activation=1.0), E, LAMBDA)
+    report = margins.margins_report(_with_reflex(model, activation=1.0), E, LAMBDA)
     assert report.point.status == "optimal"
     for seg in report.segments:
         assert seg.self_stable and seg.kp == 0 and seg.kd == 0
@@ -35,7 +35,7 @@ def test_activation_one_is_self_stable_and_needs_no_reflex(model):
 def test_activation_zero_is_reflex_only(model):
     """No co-contraction: S = m g r_y (gravity alone) and D = 0 at every segment; the optimiser is skipped.
     At 50 ms (with the default 50 ms activation lag the reflex-only margins are 63-95 ms) every loop is stable."""
-    report = margins.analyse(_with_reflex(model, activation=0.0, delay=0.05), E, LAMBDA)
+    report = margins.margins_report(_with_reflex(model, activation=0.0, delay=0.05), E, LAMBDA)
     assert report.point.status == margins.SKIPPED and not report.point.pcsa.any()
     coeffs = segment_coefficients(model, E, LAMBDA)
     np.testing.assert_allclose([s.stiffness for s in report.segments], coeffs.gravity_stiffness)
@@ -48,19 +48,20 @@ def test_activation_zero_is_reflex_only(model):
 
 
 def test_explicit_gains_replace_the_rule(model):
-    report = margins.analyse(_with_reflex(model, activation=0.0), E, LAMBDA, kp=200.0)
+    report = margins.margins_report(_with_reflex(model, activation=0.0), E, LAMBDA, kp=200.0)
     assert all(s.kp == 200.0 for s in report.segments)
     s = report.segments[2]
-    lag = model.reflex.activation_time_constant
-    assert s.kd == pytest.approx(float(reflex.default_gains(s.stiffness, 0.0, s.inertia, 1.5, 1.0, lag)[1]))
-    configured = margins.analyse(_with_reflex(model, activation=0.0, gains="explicit", kp=150.0, kd=20.0), E, LAMBDA)
+    assert s.kd == pytest.approx(float(reflex.default_gains(s.stiffness, 0.0, s.inertia, 1.5, 1.0)[1]))
+    configured = margins.margins_report(
+        _with_reflex(model, activation=0.0, gains="explicit", kp=150.0, kd=20.0), E, LAMBDA
+    )
     assert all((s.kp, s.kd) == (150.0, 20.0) for s in configured.segments)
 
 
 def test_infeasible_optimum_is_an_answer_not_an_exception(model):
     """A PCSA bound far below what stability needs: solve_point is infeasible; every value is NaN."""
     tiny = model.replace(optimisation=Optimisation(pcsa_max=1e-8))
-    report = margins.analyse(_with_reflex(tiny, activation=0.5), E, LAMBDA)
+    report = margins.margins_report(_with_reflex(tiny, activation=0.5), E, LAMBDA)
     assert report.point.status == "infeasible" and not report.point.ok
     for seg in report.segments:
         assert np.isnan(seg.stiffness) and np.isnan(seg.delay_margin) and seg.delay_margin_status == "undefined"
@@ -71,7 +72,7 @@ def test_python_control_overflow_leaves_the_exact_margins(model):
     """Padé order 10 at a 1 us delay: python-control's polynomial margins overflow (coefficients
     ~ (1/tau)^10); its reading is dropped (None, NaN gain margins), the exact analysis stands."""
     model = _with_reflex(model, activation=0.0, delay=1e-6, pade_order=10, activation_time_constant=0.0)
-    report = margins.analyse(model, E, LAMBDA)
+    report = margins.margins_report(model, E, LAMBDA)
     for seg in report.segments:
         assert seg.python_control is None and np.isnan(seg.gain_margin)
         assert 0.1 < seg.delay_margin < 0.2 and seg.stable_at_delay
@@ -103,7 +104,7 @@ JSON_KEYS = (
 
 def test_to_dict_schema_and_values(model):
     """The document's numbers are the exact analysis of its own S, D, theta, kp, kd (reflex.delay_margin)."""
-    report = margins.analyse(_with_reflex(model, activation=0.0, delay=0.1, pade_order=3), E, LAMBDA)
+    report = margins.margins_report(_with_reflex(model, activation=0.0, delay=0.1, pade_order=3), E, LAMBDA)
     doc = report.to_dict()
     assert doc["E_m"] == E and doc["Lambda_m"] == LAMBDA and doc["activation"] == 0.0
     assert doc["delay_s"] == 0.1 and doc["pade_order"] == 3 and doc["optimum_status"] == "skipped"
@@ -133,33 +134,33 @@ def test_to_dict_schema_and_values(model):
 
 
 def test_to_dict_pcsa_in_cm2_by_muscle(model):
-    report = margins.analyse(_with_reflex(model, activation=0.5), E, LAMBDA)
+    report = margins.margins_report(_with_reflex(model, activation=0.5), E, LAMBDA)
     doc = report.to_dict()
     assert list(doc["pcsa_cm2"]) == list(model.muscle_names)
     np.testing.assert_allclose(list(doc["pcsa_cm2"].values()), report.point.pcsa * 1e4, rtol=1e-12)
 
 
 def test_self_stable_margins_are_infinite_in_the_dict(model):
-    doc = margins.analyse(_with_reflex(model, activation=1.0), E, LAMBDA).to_dict()
+    doc = margins.margins_report(_with_reflex(model, activation=1.0), E, LAMBDA).to_dict()
     assert all(
         s["delay_margin_s"] == float("inf") and s["delay_margin_status"] == "delay_independent" for s in doc["segments"]
     )
 
 
 def test_undefined_python_control_reading_is_none_in_the_dict(model):
-    report = margins.analyse(_with_reflex(model, activation=0.0, delay=1e-6, pade_order=10), E, LAMBDA)
+    report = margins.margins_report(_with_reflex(model, activation=0.0, delay=1e-6, pade_order=10), E, LAMBDA)
     assert all(s["python_control"] is None for s in report.to_dict()["segments"])
 
 
 def test_table_names_the_minimum_pcsa_status_only_where_it_was_not_solved(model):
     """A solved minimum PCSA goes without saying (was "(optimum: optimal)"); another status is named."""
-    report = margins.analyse(_with_reflex(model, activation=0.5), E, LAMBDA, kp=150.0, kd=20.0)
+    report = margins.margins_report(_with_reflex(model, activation=0.5), E, LAMBDA, kp=150.0, kd=20.0)
     assert report.point.status == "optimal"
     assert "activation 0.5 x minimum PCSA, delay" in report.table().splitlines()[1]
 
 
 def test_table(model):
-    report = margins.analyse(_with_reflex(model, activation=0.0), E, LAMBDA, kp=150.0, kd=20.0)
+    report = margins.margins_report(_with_reflex(model, activation=0.0), E, LAMBDA, kp=150.0, kd=20.0)
     lines = report.table().splitlines()
     assert lines[0] == source.header(model)  # the model's line first (docs/model.md, "The default model")
     assert lines[1].startswith("E = 3.00 cm, Lambda = 4.00 cm, activation 0 x minimum PCSA (minimum PCSA: skipped)")
@@ -174,7 +175,7 @@ def test_table(model):
 def test_table_writes_inf_and_nan_as_words(model):
     """Self-stable without reflex: delay margins and gain factors are "unbounded", the phase margin and
     crossover "none", and the slowest time constant is -1/max Re lambda of paper eq. (1); no optimum: "n/a"."""
-    report = margins.analyse(_with_reflex(model, activation=1.0), E, LAMBDA)
+    report = margins.margins_report(_with_reflex(model, activation=1.0), E, LAMBDA)
     table = report.table()
     assert " unbounded " in table and " none " in table and "inf" not in table and "nan" not in table
     seg = report.segments[0]
@@ -182,14 +183,14 @@ def test_table_writes_inf_and_nan_as_words(model):
     row = next(line for line in table.splitlines() if line.startswith(seg.name)).split()
     assert row[4] == "yes" and float(row[5]) == pytest.approx(slow, abs=1e-3)
     infeasible = model.replace(optimisation=Optimisation(pcsa_max=1e-8))
-    table = margins.analyse(_with_reflex(infeasible, activation=0.5), E, LAMBDA).table()
+    table = margins.margins_report(_with_reflex(infeasible, activation=0.5), E, LAMBDA).table()
     assert " n/a " in table and "nan" not in table
 
 
 def test_report_responses_of_a_reflex_only_report(model):
     """Activation 0: every segment has a loop (the Pade loop of its own gains) and a simulation."""
     model = _with_reflex(model, activation=0.0, sim_duration=0.3)
-    report = margins.analyse(model, E, LAMBDA)
+    report = margins.margins_report(model, E, LAMBDA)
     responses = margins.report_responses(model, report)
     names = [s.name for s in report.segments]
     assert list(responses.loops) == names and list(responses.simulations) == names
@@ -209,10 +210,10 @@ def test_report_responses_of_a_reflex_only_report(model):
 def test_report_responses_without_reflex_or_optimum(model):
     """Self-stable segments (kp = kd = 0) have no loop but a simulation; an infeasible optimum has neither."""
     stable = _with_reflex(model, activation=1.0, sim_duration=0.3)
-    responses = margins.report_responses(stable, margins.analyse(stable, E, LAMBDA))
+    responses = margins.report_responses(stable, margins.margins_report(stable, E, LAMBDA))
     assert responses.loops == {} and len(responses.simulations) == 5
     tiny = _with_reflex(model.replace(optimisation=Optimisation(pcsa_max=1e-8)), activation=0.5)
-    assert margins.report_responses(tiny, margins.analyse(tiny, E, LAMBDA)) == margins.ReportResponses({}, {})
+    assert margins.report_responses(tiny, margins.margins_report(tiny, E, LAMBDA)) == margins.ReportResponses({}, {})
 
 
 @pytest.mark.parametrize(
@@ -225,8 +226,8 @@ def test_report_responses_without_reflex_or_optimum(model):
     ],
 )
 def test_gains_say_how_they_were_chosen(model, kp, kd, label):
-    """Gains given to analyse are explicit in the report, also where the model's setting is 'rule'."""
-    report = margins.analyse(_with_reflex(model, activation=0.0), E, LAMBDA, kp=kp, kd=kd)
+    """Gains given to margins_report are explicit in the report, also where the model's setting is 'rule'."""
+    report = margins.margins_report(_with_reflex(model, activation=0.0), E, LAMBDA, kp=kp, kd=kd)
     assert report.gains == label and report.to_dict()["gains"] == label
 
 
@@ -239,7 +240,7 @@ def test_kp_range_without_delay_is_the_hurwitz_range_with_the_lag(model):
     lag = lagged.reflex.activation_time_constant
     assert lag > 0
     for kp in (None, 100.0):
-        for seg in margins.analyse(lagged, E, LAMBDA, kp=kp).segments:
+        for seg in margins.margins_report(lagged, E, LAMBDA, kp=kp).segments:
             s, d, theta, kd = seg.stiffness, seg.damping, seg.inertia, seg.kd
             high = s + (theta - lag * d) * (kd - d - lag * s) / (lag * theta)
             assert seg.kp_min == pytest.approx(s) and seg.kp_max == pytest.approx(high, rel=1e-12)

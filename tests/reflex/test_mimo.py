@@ -100,8 +100,8 @@ def test_simulation_with_the_true_delay_turns_unstable_at_the_margin():
 
 def test_chain_rule_is_the_segment_rule_on_a_diagonal_chain():
     """With k = max(S, 0), the segment's deficit, chain_gains gives default_gains of every segment."""
-    kp, kd = chain_gains(np.diag(THETA), np.diag(S), np.diag(D), np.maximum(S, 0.0), 1.5, 1.0, 0.05)
-    kp0, kd0 = default_gains(S, D, THETA, 1.5, 1.0, 0.05)
+    kp, kd = chain_gains(np.diag(THETA), np.diag(S), np.diag(D), np.maximum(S, 0.0), 1.5, 1.0)
+    kp0, kd0 = default_gains(S, D, THETA, 1.5, 1.0)
     np.testing.assert_allclose(kp, kp0, rtol=1e-15)
     np.testing.assert_allclose(kd, kd0, rtol=1e-15)
 
@@ -144,7 +144,7 @@ def test_the_delay_margin_of_a_chain_built_by_hand_is_that_of_its_modes():
     chain's margin is the smallest of the two modes' (u = (1, 2, 0.5), g = 3: lambda = 1 +- sqrt(6.5))."""
     from spinectl.model.linear_chain import LinearChain
     from spinectl.reflex.chain_system import linear_chain_system
-    from spinectl.reflex.mimo import delay_margin_of
+    from spinectl.reflex.mimo import linear_chain_delay_margin
 
     g, m, beta, kp, kd = 3.0, 2.0, 0.5, 10.0, 2.0
     e1, e2, one = np.diag([1.0, 0.0]), np.diag([0.0, 1.0]), np.ones((2, 2))
@@ -167,11 +167,11 @@ def test_the_delay_margin_of_a_chain_built_by_hand_is_that_of_its_modes():
         w = np.sqrt((-b + np.sqrt(b * b - 4 * m**2 * (lam**2 - kp**2))) / (2 * m**2))
         p, q = -m * w**2 + 1j * beta * w - lam, kp + 1j * kd * w
         taus.append(np.mod(-np.angle(-p / q), 2 * np.pi) / w)
-    exact = delay_margin_of(chain, np.full(2, kp), np.full(2, kd), 0.0, u)
+    exact = linear_chain_delay_margin(chain, np.full(2, kp), np.full(2, kd), 0.0, u)
     assert exact.status == "finite" and exact.stable_without_delay
     np.testing.assert_allclose(exact.margin, min(taus), rtol=1e-9)
     # the same on the chain fixed at u (no controls), and its state-space poles are eq. 1's of each mode
-    assert delay_margin_of(chain.at(u), np.full(2, kp), np.full(2, kd)).margin == exact.margin
+    assert linear_chain_delay_margin(chain.at(u), np.full(2, kp), np.full(2, kd)).margin == exact.margin
     poles = np.sort_complex(linear_chain_system(chain, u).poles())
     modes = np.sort_complex(
         np.concatenate([np.roots([m, beta, -lam]) for lam in np.linalg.eigvalsh(chain.stiffness(u))])
@@ -215,7 +215,7 @@ def test_the_narrow_band_of_a_lightly_reflexed_paper_chain_is_found():
     1 - 0.9999 (the case spinectl design's chain search meets): the crossings lie 0.035 % apart
     near 381 rad/s, and the former sweep called the loop delay-independent. A second method,
     the rightmost root by Newton from a Chebyshev discretisation of the delay equation
-    (reflex.design.rightmost_root, Breda et al. 2005), is left of the axis 2 % below the exact
+    (reflex.design.roots.rightmost_root, Breda et al. 2005), is left of the axis 2 % below the exact
     margin and right of it 2 % above and at 0.12 s."""
     from spinectl.model import chain, geometry
     from spinectl.model.config import set_parameters
@@ -230,7 +230,7 @@ def test_the_narrow_band_of_a_lightly_reflexed_paper_chain_is_found():
     mass = chain.mass_matrix(model, geometry.cor_positions(e, lam, model.geometry))
     stiffness, damping = coefficients.stiffness(pcsa), coefficients.damping(pcsa)
     least = least_local_stiffness_stacked(stiffness[None], model.optimisation.stability_margin)[1][0]
-    kp, kd = chain_gains(mass, stiffness, damping, least, r.gain_factor, r.damping_ratio, r.activation_time_constant)
+    kp, kd = chain_gains(mass, stiffness, damping, least, r.gain_factor, r.damping_ratio)
     k, kp, kd, lag = stiffness - f * np.diag(least), (1 - f) * kp, (1 - f) * kd, r.activation_time_constant
     exact = chain_delay_margin(mass, k, damping, kp, kd, lag)
     assert exact.status == "finite" and 380.0 < exact.frequency < 383.0

@@ -12,6 +12,7 @@ from matplotlib.figure import Figure
 
 from spinectl.model.params import Optimisation, Reflex
 from spinectl.reflex import loops, margins, plots, simulate
+from spinectl.reflex.delay import delay_text
 
 PNG = b"\x89PNG\r\n\x1a\n"
 
@@ -68,7 +69,7 @@ def test_save_figure_writes_pngs_and_leaves_no_temporaries(tmp_path, model):
 def test_write_plots_of_a_reflex_only_report(tmp_path, model):
     """Activation 0: every segment needs its reflex, so every plot has something to draw."""
     model = _reflex(model, activation=0.0, sim_duration=0.3)
-    report = margins.analyse(model, 0.03, 0.04)
+    report = margins.margins_report(model, 0.03, 0.04)
     written = plots.write_plots(report, tmp_path / "p", model)
     assert [p.name for p in written] == list(plots.PLOT_FILES)
     assert sorted(p.name for p in (tmp_path / "p").iterdir()) == sorted(plots.PLOT_FILES)
@@ -82,17 +83,19 @@ def test_write_plots_without_a_loop_writes_the_response_only(tmp_path, model):
     user's: the earlier Bode and Nyquist plots go (they showed another configuration),
     the user's file stays.
     """
-    plots.write_plots(margins.analyse(_reflex(model, activation=0.0, sim_duration=0.3), 0.03, 0.04), tmp_path, model)
+    plots.write_plots(
+        margins.margins_report(_reflex(model, activation=0.0, sim_duration=0.3), 0.03, 0.04), tmp_path, model
+    )
     (tmp_path / "notes.txt").write_text("mine")
     model = _reflex(model, activation=1.0, sim_duration=0.3)
-    written = plots.write_plots(margins.analyse(model, 0.03, 0.04), tmp_path, model)
+    written = plots.write_plots(margins.margins_report(model, 0.03, 0.04), tmp_path, model)
     assert [p.name for p in written] == ["response.png"]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["notes.txt", "response.png"]
 
 
 def test_report_figures_draw_the_responses_they_are_given(model):
     model = _reflex(model, activation=0.0, sim_duration=0.3)
-    report = margins.analyse(model, 0.03, 0.04)
+    report = margins.margins_report(model, 0.03, 0.04)
     figures = plots.report_figures(report, margins.ReportResponses(loops={}, simulations=_runs(model)))
     assert list(figures) == ["response.png"] and "E = 3 cm, Lambda = 4 cm" in figures["response.png"].get_suptitle()
 
@@ -100,14 +103,16 @@ def test_report_figures_draw_the_responses_they_are_given(model):
 def test_frequency_range_spans_the_loops_rates(model):
     """A decade around every crossover, the Pade corner order/tau and the lag's corner 1/T_a; (0.1, 10) rad/s
     when no rate is known (no segment, no delay, no lag)."""
-    report = margins.analyse(_reflex(model, activation=0.0), 0.03, 0.04)
+    report = margins.margins_report(_reflex(model, activation=0.0), 0.03, 0.04)
     low, high = plots.frequency_range(report)
     crossovers = [s.crossover_rad_s for s in report.segments]
     assert low <= min(crossovers) / 10 and high >= report.pade_order / report.delay * 10
     infeasible = model.replace(optimisation=Optimisation(pcsa_max=1e-8))
-    lagged = margins.analyse(_reflex(infeasible, activation=0.5, delay=0.0), 0.03, 0.04)
+    lagged = margins.margins_report(_reflex(infeasible, activation=0.5, delay=0.0), 0.03, 0.04)
     assert plots.frequency_range(lagged) == pytest.approx((2.0, 200.0))  # 1/T_a = 20 rad/s alone
-    nothing = margins.analyse(_reflex(infeasible, activation=0.5, delay=0.0, activation_time_constant=0.0), 0.03, 0.04)
+    nothing = margins.margins_report(
+        _reflex(infeasible, activation=0.5, delay=0.0, activation_time_constant=0.0), 0.03, 0.04
+    )
     assert plots.frequency_range(nothing) == pytest.approx((0.1, 10.0))
 
 
@@ -126,12 +131,14 @@ def test_bode_marks_the_margins_of_a_report(model):
     """Half activation: every loop gets a legend entry with its exact delay margin, a dot at (w_c, 1) and a phase
     bar of length PM at w_c, from the drawn phase at w_c to -180 deg (mod 360)."""
     model = _reflex(model, activation=0.5, sim_duration=0.3)
-    report = margins.analyse(model, 0.03, 0.04)
+    report = margins.margins_report(model, 0.03, 0.04)
     responses = margins.report_responses(model, report)
     fig = plots.report_figures(report, responses)["bode.png"]
     magnitude, phase = fig.axes[:2]
     labels = [text.get_text() for text in phase.get_legend().get_texts()][: len(report.segments)]  # then the keys
-    assert all(f"tau_m {s.delay_margin:.3g} s" in label for s, label in zip(report.segments, labels, strict=True))
+    assert all(
+        f"tau_m {delay_text(s.delay_margin, 3)}" in label for s, label in zip(report.segments, labels, strict=True)
+    )
     n = len(report.segments)
     bars = phase.get_lines()[n:]
     assert len(bars) == n
@@ -146,7 +153,7 @@ def test_responses_span_five_slowest_time_constants(model):
     """The simulated response of a segment lasts 5 / |Re p| of its slowest root (Padé closed loop or, without
     reflex, paper eq. 1), between 1 s and sim_duration: not a fixed length."""
     model = _reflex(model, activation=0.5)
-    report = margins.analyse(model, 0.03, 0.04)
+    report = margins.margins_report(model, 0.03, 0.04)
     seg = report.segments[2]
     poles = loops.closed_loop(
         seg.stiffness, seg.damping, seg.inertia, seg.kp, seg.kd, report.delay, report.pade_order, lag=0.05
@@ -168,7 +175,7 @@ def at_a():
     # 12 s: five slowest time constants of the lagged loops are 3.6-10 s for L1L2-L4L5 (the rule does not
     # compensate the lag), so a shorter cap would end every simulation at the same time
     model = _reflex(model, activation=0.5, sim_duration=12.0)
-    report = margins.analyse(model, 0.0, 0.0)
+    report = margins.margins_report(model, 0.0, 0.0)
     return report, plots.report_figures(report, margins.report_responses(model, report))
 
 

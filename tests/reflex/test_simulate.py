@@ -120,7 +120,7 @@ def test_bisection_on_the_lagged_simulation_finds_the_exact_lagged_margin(model)
     shortened it (the same gains without the lag tolerate more)."""
     s, d, theta = _linear(model, HALF, L3L4)
     lag = LAGGED.activation_time_constant
-    kp, kd = reflex.default_gains(s, d, theta, 1.5, 1.0, lag)
+    kp, kd = reflex.default_gains(s, d, theta, 1.5, 1.0)
     margin = float(reflex.delay_margin(s, d, theta, kp, kd, lag).margin)
     assert margin < float(reflex.delay_margin(s, d, theta, kp, kd).margin)
     plant = simulate.segment_plant(model, E, LAMBDA, L3L4, HALF)

@@ -3,7 +3,7 @@
 The layers and their order are those of CONTRIBUTING.md ("Architecture", "Layers"; a test
 checks that its table and :data:`LAYERS` agree, and that its tree names every module):
 
-    _version _aliases _threads errors units _validate _oscalls quoting atomic jsondoc canvas presets
+    _version _threads errors _optional units _validate _oscalls quoting atomic jsondoc canvas presets
     <  model  <  optimise  <  reflex  <  anatomy  <  landscape  <  paper  <  explore  <  cli
 
 A module may import modules of its own layer and of the layers before it, never
@@ -16,11 +16,10 @@ line's entry point and belongs to its layer.
 Every module is parsed with :mod:`ast`, nothing is imported: relative and
 absolute imports are resolved to modules of spinectl, those inside functions
 included for the layers. Imports by :func:`importlib.import_module` are not
-seen; the package has two, both by design: its deprecated aliases of 0.1's
-module names (``spinectl/__init__.py``, ``spinectl/_aliases.py``) and the CLI's
-sub-commands. The cycle check uses every import, those inside functions too: a
-cycle at import time means a module can be half-initialised when another reads
-it, and one closed inside a function (deferred to break the first kind) still
+seen; the package has two, both by design: its subpackages imported on first
+use (``spinectl/__init__.py``) and the CLI's sub-commands. The cycle check uses
+every import, those inside functions too: a cycle at import time means a module
+can be half-initialised when another reads it, and one closed inside a function (deferred to break the first kind) still
 means two modules that each need the other, so neither is the lower part.
 """
 
@@ -41,9 +40,9 @@ PACKAGE = ROOT / "spinectl"
 LAYERS = (
     (
         "_version",
-        "_aliases",
         "_threads",
         "errors",
+        "_optional",
         "units",
         "_validate",
         "_oscalls",

@@ -86,6 +86,30 @@ def margin_from_delays(first_delays, frequency, stable0, undefined) -> DelayMarg
     return DelayMargin(margin=margin, frequency=freq, status=status.astype(np.int8))
 
 
+def delay_text(seconds: float, digits: int = 4) -> str:
+    """A delay as text with its unit: ms below 1 s, s from 1 s; inf 'unbounded (delay-independent)', NaN 'none'.
+
+    The one way every report of the reflex prints a delay or a delay margin.
+
+    Parameters
+    ----------
+    seconds : float
+        The delay [s].
+    digits : int, optional
+        Significant digits.
+
+    Returns
+    -------
+    str
+        E.g. '120 ms', '329.8 s'.
+    """
+    if np.isnan(seconds):
+        return "none"
+    if np.isinf(seconds):
+        return "unbounded (delay-independent)"
+    return f"{seconds:.{digits}g} s" if seconds >= 1.0 else f"{seconds * 1000:.{digits}g} ms"
+
+
 def undefined_inputs(*values):
     """Where any input is NaN, broadcast: the points whose margin is undefined.
 

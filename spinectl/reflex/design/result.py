@@ -1,0 +1,378 @@
+"""The answers of the design question as data: one delay (:class:`Design`) and the curve (:class:`DesignCurve`).
+
+Each answer has its JSON document (``to_dict``) and its table (``table``); the computations are in
+:mod:`~spinectl.reflex.design.joint` (joint by joint), :mod:`~spinectl.reflex.design.chain` (the chain) and
+:mod:`~spinectl.reflex.design.curve` (both, at one delay or against the delay).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...model.stability import criterion
+from ...units import m2_to_cm2
+from ..delay import delay_text
+
+LOCAL_MAX = 2.0
+"""Largest local stiffness searched with explicit gains, as a multiple of the least for static stability k*
+(the rule's reflex vanishes at 1 k*, where the search ends)."""
+
+
+@dataclass(frozen=True)
+class SegmentDesign:
+    """One segment's least co-contraction, joint by joint.
+
+    Attributes
+    ----------
+    name : str
+    activation : float
+        The least fraction of the minimum stabilising PCSA [1]; NaN if none in [0, 1].
+    pcsa : float
+        The total PCSA at that activation [m^2].
+    delay_margin : float
+        The segment's exact delay margin there [s].
+    monotone : bool
+        The margin is non-decreasing in the activation on the scan.
+    """
+
+    name: str
+    activation: float
+    pcsa: float
+    delay_margin: float
+    monotone: bool
+
+    def to_dict(self) -> dict:
+        """``name``, ``activation``, ``pcsa_cm2``, ``delay_margin_s``, ``monotone``.
+
+        Returns
+        -------
+        dict
+        """
+        return {
+            "name": self.name,
+            "activation": self.activation,
+            "pcsa_cm2": float(m2_to_cm2(self.pcsa)),
+            "delay_margin_s": self.delay_margin,
+            "monotone": self.monotone,
+        }
+
+
+@dataclass(frozen=True)
+class ChainDesign:
+    """The chain's least local stiffness at a global activation.
+
+    Attributes
+    ----------
+    activation : float
+        The global activation [1] (``reflex.activation``).
+    fraction : float
+        f: the local stiffness as a multiple of k* [1]; NaN if none up to :data:`LOCAL_MAX`.
+    local_stiffness : numpy.ndarray, shape (n_cor,)
+        f k* per joint [N m/rad].
+    least_static : numpy.ndarray, shape (n_cor,)
+        k* per joint [N m/rad].
+    delay_margin : float
+        The exact multivariable delay margin at the design [s].
+    max_root_real : float
+        Re of the rightmost characteristic root at the delay [1/s]
+        (:func:`~spinectl.reflex.design.roots.rightmost_root`).
+    largest_delay : float
+        The largest delay met by any local stiffness the search tried [s]: the largest exact margin
+        there (with the design's own); inf (JSON null, "unbounded") when one is stable at every delay, e.g. the
+        rule's f = 1, which has no reflex. The same meaning as :attr:`Design.largest_delay` joint by joint.
+    method : str
+    """
+
+    activation: float
+    fraction: float
+    local_stiffness: np.ndarray
+    least_static: np.ndarray
+    delay_margin: float
+    max_root_real: float
+    largest_delay: float
+    method: str
+
+    def to_dict(self) -> dict:
+        """``criterion``, ``activation``, ``local_stiffness_fraction``, ``local_stiffness_Nm_per_rad``, ....
+
+        Returns
+        -------
+        dict
+            Also ``least_static_local_stiffness_Nm_per_rad``, ``delay_margin_s``,
+            ``max_root_real_per_s``, ``largest_delay_met_s`` and ``method``.
+        """
+        return {
+            "criterion": criterion("chain", len(self.local_stiffness)),
+            "activation": self.activation,
+            "local_stiffness_fraction": self.fraction,
+            "local_stiffness_Nm_per_rad": self.local_stiffness.tolist(),
+            "least_static_local_stiffness_Nm_per_rad": self.least_static.tolist(),
+            "delay_margin_s": self.delay_margin,
+            "max_root_real_per_s": self.max_root_real,
+            "largest_delay_met_s": self.largest_delay,
+            "method": self.method,
+        }
+
+
+@dataclass(frozen=True)
+class Design:
+    """Both answers to the design question at one (E, Lambda) and delay.
+
+    Attributes
+    ----------
+    eccentricity, lordosis : float
+        E and Lambda [m].
+    delay, activation_time_constant : float
+        tau [s] and T_a [s].
+    activation : float
+        The least activation for every segment at once [1]; NaN if infeasible.
+    pcsa : float
+        Total PCSA at it [m^2].
+    segments : tuple of SegmentDesign
+    chain : ChainDesign
+    status : str
+        'ok'; 'infeasible' (joint by joint: no activation in [0, 1] meets the delay); 'chain_infeasible'
+        (no local stiffness up to :data:`LOCAL_MAX` k*); or the optimum's status.
+    largest_delay : float
+        Joint by joint, the largest delay met by any activation on the scan of [0, 1] [s]: the largest over
+        the scan of the smallest segment margin; inf (JSON null, "unbounded") when every segment is stable at
+        every delay there. The chain's is :attr:`ChainDesign.largest_delay`.
+    method : str
+        How the activation was searched (see the module).
+    model : dict
+        The model's provenance and header line.
+    """
+
+    eccentricity: float
+    lordosis: float
+    delay: float
+    activation_time_constant: float
+    activation: float
+    pcsa: float
+    segments: tuple[SegmentDesign, ...]
+    chain: ChainDesign
+    status: str
+    largest_delay: float
+    method: str
+    model: dict
+
+    def to_dict(self) -> dict:
+        """The document of ``spinectl design --json``.
+
+        Returns
+        -------
+        dict
+            The model's provenance, ``E_m``, ``Lambda_m``, ``delay_s``, ``activation_time_constant_s``,
+            ``status``, ``criterion`` (joint by joint), ``activation``, ``pcsa_cm2``, ``method``,
+            ``largest_delay_met_s``, ``segments`` (:meth:`SegmentDesign.to_dict`) and ``chain``
+            (:meth:`ChainDesign.to_dict`).
+        """
+        model = {k: v for k, v in self.model.items() if k != "header"}
+        return model | {
+            "E_m": self.eccentricity,
+            "Lambda_m": self.lordosis,
+            "delay_s": self.delay,
+            "activation_time_constant_s": self.activation_time_constant,
+            "status": self.status,
+            "criterion": criterion("joint", len(self.segments)),
+            "activation": self.activation,
+            "pcsa_cm2": float(m2_to_cm2(self.pcsa)),
+            "method": self.method,
+            "largest_delay_met_s": self.largest_delay,
+            "segments": [s.to_dict() for s in self.segments],
+            "chain": self.chain.to_dict(),
+        }
+
+    def table(self) -> str:
+        """The design as readable text: both criteria, each with its answer and certificate.
+
+        Returns
+        -------
+        str
+            No final newline.
+        """
+        c = self.chain
+        lines = [
+            self.model.get("header", "preset unknown"),
+            f"E = {self.eccentricity * 100:.2f} cm, Lambda = {self.lordosis * 100:.2f} cm, delay "
+            f"{delay_text(self.delay)}, activation lag {self.activation_time_constant * 1000:.4g} ms; "
+            f"status {self.status}",
+            "",
+            f"{criterion('joint', len(self.segments))}: least co-contraction ({self.method})",
+            f"{'segment':8} {'activation':>10} {'PCSA[cm2]':>10} {'tau_m[s]':>10}",
+        ]
+        lines += [
+            f"{s.name:8} {_word(s.activation, 10, '.4f')} {_word(m2_to_cm2(s.pcsa), 10, '.2f')} "
+            f"{_word(s.delay_margin, 10, '.4f')}"
+            for s in self.segments
+        ]
+        lines += [
+            (
+                f"every segment at once: activation {self.activation:.4f} x minimum PCSA "
+                f"({m2_to_cm2(self.pcsa):.2f} cm^2)"
+                if np.isfinite(self.activation)
+                else f"no activation in [0, 1] meets the delay at every segment; the largest delay met: "
+                f"{delay_text(self.largest_delay)}"
+            ),
+            "",
+            f"{criterion('chain', len(c.local_stiffness))}: least local stiffness at activation "
+            f"{_word(c.activation, 0, '.4f')} ({c.method})",
+        ]
+        if np.isfinite(c.fraction):
+            lines += [
+                "local stiffness [N m/rad]: "
+                + ", ".join(f"{s.name} {k:.2f}" for s, k in zip(self.segments, c.local_stiffness, strict=True))
+                + f"  ({c.fraction:.4f} x the least for static stability, total {np.sum(c.local_stiffness):.1f})",
+                f"certificate: exact delay margin {delay_text(c.delay_margin)} >= {delay_text(self.delay)}; "
+                f"rightmost root at the delay Re s = {_word(c.max_root_real, 0, '.4g')} 1/s",
+            ]
+        else:
+            lines.append(f"no local stiffness meets the delay; the largest delay met: {delay_text(c.largest_delay)}")
+        return "\n".join(lines)
+
+    def __bool__(self):
+        raise TypeError(
+            "the truth value of a Design is ambiguous: use design.status == 'ok' (both criteria met), or "
+            "design.activation / design.chain.fraction (NaN where none meets the delay)"
+        )
+
+
+def _word(value: float, width: int, fmt: str) -> str:
+    """A number, or 'none' (NaN) / 'unbounded' (inf), right-aligned in ``width``."""
+    text = "none" if np.isnan(value) else ("unbounded" if np.isinf(value) else format(value, fmt))
+    return f"{text:>{width}}"
+
+
+REACTION_TIMES = (
+    (0.053, "healthy, agonists off (Radebold et al. 2000)"),
+    (0.070, "healthy, antagonists on; patients, agonists off"),
+)
+"""Trunk muscles' reaction times after a sudden load release [s], with labels: Radebold et al. (2000), 17 healthy
+subjects (shut-off of the agonists 53 ms, switch-on of the antagonists 70 ms) and 17 patients with chronic low back
+pain (shut-off 70 ms), averaged over trials and directions; doi:10.1097/00007632-200004150-00009."""
+
+
+@dataclass(frozen=True)
+class DesignCurve:
+    """The design question against the delay (and the lag), both criteria, at one (E, Lambda).
+
+    Leading dimensions (n_lags, n_delays); NaN where no design meets the delay.
+
+    Attributes
+    ----------
+    eccentricity, lordosis : float
+        E and Lambda [m].
+    delays : numpy.ndarray, shape (n_delays,)
+        tau, ascending [s].
+    lags : numpy.ndarray, shape (n_lags,)
+        T_a [s].
+    activation : numpy.ndarray
+        Joint by joint: the least activation for every segment at once [1].
+    segment_activation : numpy.ndarray, shape (n_lags, n_delays, n_cor)
+        Each segment's own least activation [1].
+    pcsa : numpy.ndarray
+        The total PCSA at ``activation`` [m^2].
+    chain_activation : float
+        The chain's global activation (``reflex.activation``) [1].
+    local_fraction : numpy.ndarray
+        The chain: the least local stiffness as a multiple f of k* [1].
+    local_stiffness : numpy.ndarray, shape (n_lags, n_delays, n_cor)
+        f k* per joint [N m/rad].
+    chain_margin : numpy.ndarray
+        The exact multivariable delay margin at the chain's design [s] (>= the delay: the certificate).
+    max_root_real : numpy.ndarray
+        Re of the rightmost characteristic root found at the delay from the poles' seeds [1/s]
+        (:func:`~spinectl.reflex.design.roots.rightmost_root` with ``nodes`` = 0).
+    names : tuple of str
+    model : dict
+    """
+
+    eccentricity: float
+    lordosis: float
+    delays: np.ndarray
+    lags: np.ndarray
+    activation: np.ndarray
+    segment_activation: np.ndarray
+    pcsa: np.ndarray
+    chain_activation: float
+    local_fraction: np.ndarray
+    local_stiffness: np.ndarray
+    chain_margin: np.ndarray
+    max_root_real: np.ndarray
+    names: tuple[str, ...]
+    model: dict
+
+    def to_dict(self) -> dict:
+        """The document of ``spinectl design --delays ... --json``.
+
+        Returns
+        -------
+        dict
+            Provenance, ``E_m``, ``Lambda_m``, ``delays_s``, ``reaction_times_s``, and ``curves``: one per lag
+            with ``activation_time_constant_s``, ``joint`` (``criterion``, ``activation``, ``pcsa_cm2``,
+            ``segments``: name and activation per delay) and ``chain`` (``criterion``, ``activation``,
+            ``local_stiffness_fraction``, ``local_stiffness_Nm_per_rad``, ``local_stiffness_total_Nm_per_rad``,
+            ``delay_margin_s``, ``max_root_real_per_s``).
+        """
+        model = {k: v for k, v in self.model.items() if k != "header"}
+        n = len(self.names)
+        curves = []
+        for i, lag in enumerate(self.lags):
+            joint = {
+                "criterion": criterion("joint", n),
+                "activation": self.activation[i].tolist(),
+                "pcsa_cm2": m2_to_cm2(self.pcsa[i]).tolist(),
+                "segments": [
+                    {"name": name, "activation": self.segment_activation[i, :, k].tolist()}
+                    for k, name in enumerate(self.names)
+                ],
+            }
+            chain_part = {
+                "criterion": criterion("chain", n),
+                "activation": self.chain_activation,
+                "local_stiffness_fraction": self.local_fraction[i].tolist(),
+                "local_stiffness_Nm_per_rad": self.local_stiffness[i].tolist(),
+                "local_stiffness_total_Nm_per_rad": self.local_stiffness[i].sum(axis=1).tolist(),
+                "delay_margin_s": self.chain_margin[i].tolist(),
+                "max_root_real_per_s": self.max_root_real[i].tolist(),
+            }
+            curves.append({"activation_time_constant_s": float(lag), "joint": joint, "chain": chain_part})
+        return model | {
+            "E_m": self.eccentricity,
+            "Lambda_m": self.lordosis,
+            "delays_s": self.delays.tolist(),
+            "reaction_times_s": [{"delay_s": t, "label": label} for t, label in REACTION_TIMES],
+            "curves": curves,
+        }
+
+    def table(self) -> str:
+        """The curves as rows per lag: both criteria's required design per delay.
+
+        Returns
+        -------
+        str
+            No final newline.
+        """
+        n = len(self.names)
+        lines = [
+            self.model.get("header", "preset unknown"),
+            f"E = {self.eccentricity * 100:.2f} cm, Lambda = {self.lordosis * 100:.2f} cm; joint by joint: "
+            f"{criterion('joint', n)}; chain: {criterion('chain', n)} at activation {self.chain_activation:.4g}",
+        ]
+        for i, lag in enumerate(self.lags):
+            lines += [
+                "",
+                f"activation lag T_a = {lag * 1000:.4g} ms",
+                f"{'delay[ms]':>9} {'joint: activation':>17} {'PCSA[cm2]':>10} {'chain: sum k[N m/rad]':>21} "
+                f"{'x k*':>7} {'tau_m[ms]':>10}",
+            ]
+            lines += [
+                f"{d * 1000:9.4g} {_word(self.activation[i, j], 17, '.4f')} "
+                f"{_word(m2_to_cm2(self.pcsa[i, j]), 10, '.2f')} "
+                f"{_word(float(np.sum(self.local_stiffness[i, j])), 21, '.1f')} "
+                f"{_word(self.local_fraction[i, j], 7, '.4f')} {_word(self.chain_margin[i, j] * 1000, 10, '.4g')}"
+                for j, d in enumerate(self.delays)
+            ]
+        return "\n".join(lines)
