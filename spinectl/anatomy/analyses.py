@@ -95,8 +95,19 @@ def state_matrix(chain: LinearChain, a) -> np.ndarray:
 
 
 def plane_text(plane: str) -> str:
-    """A mapping's plane as a table's first line names it: ``'sagittal plane'``, ``'coronal plane'``, and
-    ``'3d'`` (every chain joint of every plane at once) as ``'all three planes (3-D)'``."""
+    """A mapping's plane as a table's first line names it.
+
+    Parameters
+    ----------
+    plane : str
+        One of the mapping's planes (:data:`spinectl.anatomy.mapping.PLANES`).
+
+    Returns
+    -------
+    str
+        ``'sagittal plane'``, ``'coronal plane'``, and for ``'3d'`` (every chain joint of every plane at
+        once) ``'all three planes (3-D)'``.
+    """
     return "all three planes (3-D)" if plane == "3d" else f"{plane} plane"
 
 

@@ -540,7 +540,19 @@ def remedy(anatomy, optimise_at, opt: Optimum, classic: Optimum, joint_stiffness
 
 
 def remedy_text(value: float) -> str:
-    """The remedy as the table's hint ends: ``"; feasible from 39.9 N m/rad at each chain joint: ..."``."""
+    """The remedy as the table's hint ends it.
+
+    Parameters
+    ----------
+    value : float
+        :attr:`OptimisedResult.remedy` [N m/rad].
+
+    Returns
+    -------
+    str
+        ``"; feasible from 39.9 N m/rad at each chain joint: spinectl anatomy --optimise --joint-stiffness 40"``
+        (the value named rounded up to 3 digits, so still feasible); ``""`` for NaN.
+    """
     if np.isnan(value):
         return ""
     if np.isinf(value):

@@ -242,8 +242,14 @@ def main(argv: list[str] | None = None) -> int:
         sys.stdout = stdout
 
 
+NOTES: list[str] = []
+"""Notes for the user that :func:`main` prints on stderr after a command's answer (a failed run prints its
+one-line error alone; :func:`spinectl.cli._common.note_after`); emptied at the start of every command."""
+
+
 def _run(argv) -> int:
     """Parse, run the command, flush standard output: the exit code, or :class:`_StdoutError`."""
+    NOTES.clear()
     try:
         with warnings.catch_warnings():
             warnings.showwarning = _one_line_warning
@@ -258,6 +264,8 @@ def _run(argv) -> int:
         print("spinectl: interrupted", file=sys.stderr)
         return 130
     sys.stdout.flush()  # a full device shows here, not in the interpreter's exit (a traceback, exit 120)
+    for note in NOTES if code == 0 else ():  # after the answer: a failed run says its error alone
+        print(f"spinectl: warning: {printable(note)}", file=sys.stderr)
     return code
 
 

@@ -6,7 +6,6 @@ import argparse
 import math
 import os
 import sys
-import warnings
 
 import numpy as np
 
@@ -173,8 +172,8 @@ def lordosis_option(model: Model, angle: float | None, lordosis: float | None, o
     except ParameterError as exc:
         raise ParameterError(option, exc.message) from None
     slip = radian_slip(angle)
-    if slip:  # a valid angle, analysed as given: said, as the --pcsa slip is (the CLI prints it in one line)
-        warnings.warn(f"{option}: {slip}", stacklevel=2)
+    if slip:  # a valid angle, analysed as given: said after the answer, as the --pcsa slip is
+        note_after(f"{option}: {slip}")
     return float(lordosis) if np.ndim(lordosis) == 0 else lordosis
 
 
@@ -313,6 +312,20 @@ def pcsa_option(values: list[float] | None):
             f"must be at most {limit:g} cm^2 per muscle, beyond which the torques overflow (got {max(values):g})",
         )
     return cm2_to_m2(values)
+
+
+def note_after(text: str) -> None:
+    """Say ``text`` on stderr after the command's answer, as ``spinectl: warning: <text>``
+    (:data:`spinectl.cli.NOTES`; a failed run says its error alone).
+
+    Parameters
+    ----------
+    text : str
+        One line, e.g. ``"--lordosis-angle: 0.7 deg is a nearly straight spine ..."``.
+    """
+    from . import NOTES
+
+    NOTES.append(text)
 
 
 def note_pcsa_slip(values: list[float] | None) -> None:

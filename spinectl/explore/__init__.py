@@ -8,8 +8,27 @@ and the Panel app itself, whose Bokeh views show the same data (:mod:`~spinectl.
 imported only where Panel is installed: ``pip install 'spinectl[explore]'``).
 """
 
-from .numbers import PointNumbers, landscapes, point_numbers
-from .state import SLIDERS, ExploreState, initial_state, model_at, state_toml
+import importlib
+
+_HOMES = {
+    "PointNumbers": "numbers",
+    "landscapes": "numbers",
+    "point_numbers": "numbers",
+    "SLIDERS": "state",
+    "ExploreState": "state",
+    "initial_state": "state",
+    "model_at": "state",
+    "state_toml": "state",
+}
+"""Where each re-exported name lives: imported on first use (PEP 562), so that the command line's parser,
+which reads :mod:`~spinectl.explore.hosts` for ``--max-sessions``, does not import the numbers' solvers."""
+
+
+def __getattr__(name: str):
+    """A name of :data:`__all__`, from its module on first use."""
+    if name not in _HOMES:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    return getattr(importlib.import_module(f"{__name__}.{_HOMES[name]}"), name)
 
 __all__ = [
     "SLIDERS",

@@ -141,16 +141,41 @@ class Sessions:
         context.application.add(_SessionEnd(self))
 
     def live(self) -> set[str]:
-        """The ids of the sessions alive and of those being made."""
+        """The ids of the sessions alive and of those being made.
+
+        Returns
+        -------
+        set of str
+        """
         return {session.id for session in self.context.sessions} | self._making
 
     def admits(self, session_id: str) -> bool:
-        """Whether a request for ``session_id`` may go on: its session lives, or there is room for one more."""
+        """Whether a request for ``session_id`` may go on: its session lives, or there is room for one more.
+
+        Parameters
+        ----------
+        session_id : str
+            Bokeh's session id.
+
+        Returns
+        -------
+        bool
+        """
         live = self.live()
         return session_id in live or len(live) < self.limit
 
     def admits_websocket(self, request) -> bool:
-        """Whether a request may go on unless it is a websocket that would make one session too many."""
+        """Whether a request may go on unless it is a websocket that would make one session too many.
+
+        Parameters
+        ----------
+        request : tornado.httputil.HTTPServerRequest
+            The request, before its upgrade (its path and ``Sec-WebSocket-Protocol``).
+
+        Returns
+        -------
+        bool
+        """
         if request.path != WEBSOCKET_PATH:
             return True
         protocols = [p.strip() for p in request.headers.get("Sec-WebSocket-Protocol", "").split(",")]
@@ -161,7 +186,12 @@ class Sessions:
         return self.admits(session_id)
 
     def refusal(self) -> str:
-        """The one line that refuses a session: how many live, what to do."""
+        """The one line that refuses a session: how many live, what to do.
+
+        Returns
+        -------
+        str
+        """
         return (
             f"refused: {self.limit} sessions are open, the most the explorer serves at once (--max-sessions); "
             f"one ends {UNUSED_SESSION_S:g} s after its tab is closed"
@@ -182,7 +212,13 @@ class Sessions:
         return session
 
     def report(self, event: str) -> None:
-        """One line on standard output: a session ``event`` and how many are alive."""
+        """One line on standard output: a session ``event`` and how many are alive.
+
+        Parameters
+        ----------
+        event : str
+            ``"opened"`` or ``"ended"``.
+        """
         print(f"spinectl explore: session {event} ({len(self.live())} open, at most {self.limit})", flush=True)
 
 
