@@ -34,6 +34,7 @@ import re
 import signal
 import sys
 import tempfile
+import threading
 import time
 from collections.abc import Callable, Iterable, Iterator
 
@@ -408,6 +409,7 @@ def _local_cluster(n: int):
     import dask
     from distributed import Client, LocalCluster
 
+    held = _HeldInterrupt()
     previous = _block_interrupts()
     try:
         settings = {MALLOC_TRIM_SETTING: None, "distributed.worker.multiprocessing-method": START_METHOD}
@@ -426,15 +428,18 @@ def _local_cluster(n: int):
         try:
             client = Client(cluster, set_as_default=False)
             try:
-                _restore_interrupts(previous)  # a Ctrl-C of the start-up acts here
+                _restore_interrupts(previous)
+                held.release()  # a Ctrl-C of the start-up acts here
                 yield client
             finally:
                 _block_interrupts()
+                held.hold()
                 client.close()
         finally:
             cluster.close()
     finally:
         _restore_interrupts(previous)
+        held.release()
 
 
 @contextlib.contextmanager
@@ -455,6 +460,43 @@ def _workers_stderr():
         finally:
             os.dup2(saved, 2)
             os.close(saved)
+
+
+class _HeldInterrupt:
+    """Python's Ctrl-C handler, replaced by one that notes the interrupt while a cluster starts or closes.
+
+    The blocked SIGINT (:func:`_block_interrupts`) holds a Ctrl-C sent to this thread, and so to the
+    process group a terminal signals; but a SIGINT sent to the process alone (``kill -INT``, as job
+    managers send it) is delivered to any thread that does not block it, one of those the cluster
+    started before, and Python then raises KeyboardInterrupt in the main thread in the middle of the
+    start, whatever its mask: distributed asserted after about a minute. While held, the handler
+    notes it; :meth:`release` raises it then. Only Python's own handler is replaced: an ignored
+    SIGINT stays ignored, and outside the main thread nothing changes (no handler can be set there).
+    """
+
+    def __init__(self):
+        self.caught = False
+        self.previous = None
+        self.hold()
+
+    def hold(self) -> None:
+        """Note a Ctrl-C from now on, instead of raising it."""
+        if threading.current_thread() is threading.main_thread() and (
+            signal.getsignal(signal.SIGINT) is signal.default_int_handler
+        ):
+            self.previous = signal.signal(signal.SIGINT, self._note)
+
+    def _note(self, signum, frame) -> None:
+        self.caught = True
+
+    def release(self) -> None:
+        """Restore Python's handler, and raise KeyboardInterrupt if a Ctrl-C came while held."""
+        if self.previous is not None:
+            signal.signal(signal.SIGINT, self.previous)
+            self.previous = None
+        if self.caught:
+            self.caught = False
+            raise KeyboardInterrupt
 
 
 def _block_interrupts():
