@@ -72,7 +72,7 @@ def from_xml_comment(comment: str) -> str:
 
 
 def toml_comment(text: str) -> str:
-    """``text`` as one TOML comment line: ``# `` and the text with line breaks and control characters escaped.
+    """``text`` as one TOML comment line: ``"# "`` and the text with line breaks and control characters escaped.
 
     A line break would end the comment and make the rest of the text TOML; TOML allows no control
     character but the tab in a comment either (TOML 1.0, "Comment").

@@ -8,6 +8,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
+
 from .._validate import printable
 from ..atomic import check_distinct, check_writable
 from ..errors import ParameterError
@@ -157,3 +159,67 @@ def export_model(
     from .export_osim import export_osim
 
     return export_osim(model, eccentricity, lordosis, out, muscle=osim_muscle, **options)
+
+
+def export_verdicts(solution, out, fmt: str, osim_muscle: str = "millard") -> list[str]:
+    """What the exported chain's stability is, each line naming whose model says it.
+
+    spinectl's verdict is that of its own chain at the exported solution (:attr:`PaperSolution.eigenvalues`,
+    all CoRs free). An OpenSim file with Millard muscles carries Millard's curves, not the paper's, so its
+    dynamics differ (docs/interchange.md): its second line is OpenSim's own linearisation of the file
+    written (:func:`~spinectl.anatomy.export_osim.opensim_linearisation`), the referee of what OpenSim will do.
+
+    Parameters
+    ----------
+    solution : spinectl.anatomy.export_mjcf.PaperSolution
+        What :func:`export_model` wrote.
+    out : str or pathlib.Path
+        The file written.
+    fmt : {"mjcf", "osim"}
+        Its format.
+    osim_muscle : {"millard", "paper"}
+        The OpenSim file's muscle model.
+
+    Returns
+    -------
+    list of str
+        One line per verdict: ``"spinectl's chain (all CoRs free, the paper's muscle laws): stable, largest
+        real part -0.0327 1/s"``, then for a Millard file OpenSim's.
+    """
+    lines = [_verdict_line("spinectl's chain (all CoRs free, the paper's muscle laws)", solution.eigenvalues)]
+    if fmt == "osim" and osim_muscle == "millard":
+        eigenvalues = opensim_eigenvalues(out, solution.model.geometry.cor_names)
+        lines.append(
+            _verdict_line("OpenSim's own linearisation of the file (Millard's muscle curves)", eigenvalues)
+            + f", {int(np.sum(eigenvalues.real >= 0))} of {eigenvalues.size} eigenvalues with Re >= 0"
+        )
+    return lines
+
+
+def opensim_eigenvalues(path, names) -> np.ndarray:
+    """The eigenvalues of OpenSim's own linearisation of an exported file (the engine as referee).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        An ``.osim`` file written by :func:`export_model`.
+    names : sequence of str
+        Its chain's coordinates, top to bottom (the model's ``geometry.cor_names``).
+
+    Returns
+    -------
+    numpy.ndarray, shape (2 n,)
+        Of the state matrix [[0, I], [M^-1 K, M^-1 D]] of
+        :func:`~spinectl.anatomy.export_osim.opensim_linearisation` [1/s] (docs/chain.md's convention).
+    """
+    from ..model.chain import state_matrix
+    from .export_osim import opensim_linearisation
+
+    _, stiffness, damping, mass = opensim_linearisation(path, names)
+    return np.linalg.eigvals(state_matrix(mass, stiffness, damping))
+
+
+def _verdict_line(whose: str, eigenvalues) -> str:
+    """``whose: stable|unstable, largest real part x 1/s``, the criterion being every eigenvalue's Re < 0."""
+    growth = float(np.max(np.real(eigenvalues)))
+    return f"{whose}: {'stable' if growth < 0 else 'unstable'}, largest real part of its eigenvalues {growth:.6g} 1/s"

@@ -59,7 +59,7 @@ def run(args) -> int:
     int
         Exit code 0.
     """
-    from ..anatomy.interchange import check_output, export_model
+    from ..anatomy.interchange import check_output, export_model, export_verdicts
 
     fmt = check_output(args.out, args.format, {"--config": args.config})  # before the model and its solve
     model = load_model(args)
@@ -75,10 +75,7 @@ def run(args) -> int:
         inputs={"--config": args.config},
         osim_muscle=args.osim_muscle,
     )
-    growth = max(solution.eigenvalues.real)
-    verdict = "stable" if growth < 0 else "unstable"
-    print(
-        f"wrote {args.out} ({fmt}): E = {args.E:g} m, Lambda = {args.Lambda:g} m; the chain (all CoRs free) is "
-        f"{verdict}, largest real part of its eigenvalues {growth:.6g} 1/s"
-    )
+    print(f"wrote {args.out} ({fmt}): E = {args.E:g} m, Lambda = {args.Lambda:g} m")
+    for line in export_verdicts(solution, args.out, fmt, args.osim_muscle):
+        print(line)
     return 0

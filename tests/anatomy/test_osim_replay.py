@@ -274,12 +274,35 @@ def test_the_least_local_stiffness_of_opensims_own_k_makes_millards_chain_stable
     assert np.all(_modes(linearisation)[0].real < 0)
 
 
+def test_the_millard_exports_verdicts_are_spinectls_and_opensims(exported, tmp_path, capsys):
+    """``export --format osim --with-local-stiffness`` (Millard's curves): spinectl's chain is stable with its least
+    local stiffness while OpenSim's linearisation of the same file grows; each line names whose it is, and
+    OpenSim's growth is that of the module's own linearisation of the same export (the replay tests above)."""
+    model, files = exported
+    _, solution, linearisation = files["millard", True]
+    out = tmp_path / "m.osim"
+    argv = ["export", "--format", "osim", "--E", str(E), "--Lambda", str(LAMBDA), "--with-local-stiffness"]
+    assert main([*argv, "--out", str(out)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    growth = np.max(_modes(linearisation)[0].real)
+    assert lines[1] == (
+        "spinectl's chain (all CoRs free, the paper's muscle laws): stable, largest real part of its eigenvalues "
+        f"{np.max(solution.eigenvalues.real):.6g} 1/s"
+    )
+    assert lines[2].startswith(
+        "OpenSim's own linearisation of the file (Millard's muscle curves): unstable, largest real part of its "
+        f"eigenvalues {growth:.6g} 1/s"
+    )
+    assert growth > 0 > np.max(solution.eigenvalues.real)
+
+
 def test_cli_exports_the_papers_curves_and_the_import_names_what_it_reads(tmp_path, capsys):
     """``spinectl export --osim-muscle paper`` writes RigidTendonMuscles; ``spinectl anatomy`` of that file is one
     line naming the muscle class (the import reads Millard's muscle only), exit 2; --osim-muscle with MJCF is one
     line, exit 2, nothing written."""
     out = tmp_path / "paper.osim"
     assert main(["export", "--E", "0.03", "--Lambda", "0.04", "--osim-muscle", "paper", "--out", str(out)]) == 0
+    assert "OpenSim's own" not in capsys.readouterr().out  # the paper's curves: one model, one verdict
     assert osim.Model(str(out)).getMuscles().get(0).getConcreteClassName() == "RigidTendonMuscle"
     capsys.readouterr()
     assert main(["anatomy", str(out)]) == 2

@@ -14,7 +14,9 @@ a text changed, so that incremental builds stay incremental):
   ``notebooks.md`` (myst-nb executes them);
 - ``_generated/calibration-parameters.md``, ``_generated/landmark-verdicts.md`` and
   ``_generated/landmark-assumptions.md``: the tables of ``reproduction.md`` (free parameters,
-  verdict of every landmark, every landmark under each assumption, measured at the build).
+  verdict of every landmark, every landmark under each assumption, measured at the build);
+- ``_generated/export-eigenvalues.md``: the exports' eigenvalues in ``interchange.md``, spinectl's
+  and OpenSim's own linearisation of each file (measured at the build).
 
 ``_generated/`` is excluded from the sources (its files are included by
 ``parameters.md``, ``index.md``, ``notebooks.md`` and ``reproduction.md``);
@@ -32,7 +34,7 @@ from __future__ import annotations
 import importlib.util
 from pathlib import Path
 
-from . import fields, guide, notebooks, parameters, reexports, reproduction
+from . import fields, guide, interchange, notebooks, parameters, reexports, reproduction
 
 GENERATED = "_generated"
 
@@ -58,6 +60,7 @@ def generate(app) -> None:
     write_if_changed(out / "calibration-parameters.md", reproduction.parameter_table())
     write_if_changed(out / "landmark-verdicts.md", reproduction.landmark_table())
     write_if_changed(out / "landmark-assumptions.md", reproduction.assumption_table())
+    write_if_changed(out / "export-eigenvalues.md", interchange.export_table())
 
 
 def prune_api_pages(app) -> None:
