@@ -522,10 +522,15 @@ class ReportResponses:
     simulations : dict of str to Simulation
         Segment name -> two simulated runs, with the reflex (run 0) and without it (run 1)
         (:func:`spinectl.reflex.simulate.simulate`), for each segment with a finite stiffness.
+    chain : tuple of Simulation or None
+        The chain, every CoR free (:func:`spinectl.reflex.simulate.simulate_chain` of its nonlinear plant), with
+        the chain's reflex and without it, every joint perturbed alike; one run per joint each. None where the
+        report has no chain verdict or no segment was simulated.
     """
 
     loops: dict
     simulations: dict
+    chain: tuple | None = None
 
 
 RESPONSE_SPAN = 5.0
@@ -644,4 +649,20 @@ def report_responses(model: Model, report: MarginsReport) -> ReportResponses:
         )
         for k, s in usable
     }
-    return ReportResponses(loops=transfer, simulations=simulations)
+    return ReportResponses(loops=transfer, simulations=simulations, chain=_chain_responses(model, report, simulations))
+
+
+def _chain_responses(model: Model, report: MarginsReport, simulations: dict) -> tuple | None:
+    """The chain's response with its reflex and without, over the longest segment's span (see ReportResponses)."""
+    point, verdict = report.point, report.chain
+    if verdict is None or not simulations or not point.ok:
+        return None
+    plant = simulate.nonlinear_chain_plant(model, point.eccentricity, point.lordosis, point.pcsa)
+    span = max(float(sim.time[-1]) for sim in simulations.values())
+    settings = dataclasses.replace(model.reflex, sim_duration=max(span, 10 * model.reflex.sim_time_step))
+    kick, none = np.full(len(verdict.kp), model.reflex.sim_perturbation), np.zeros(len(verdict.kp))
+    runs = [
+        simulate.simulate_chain(plant, kp, kd, [report.delay], settings, kick)[0]
+        for kp, kd in ((verdict.kp, verdict.kd), (none, none))
+    ]
+    return tuple(runs)

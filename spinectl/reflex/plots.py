@@ -13,6 +13,7 @@ figure: nothing needs a display.
 
 from __future__ import annotations
 
+import textwrap
 from collections.abc import Mapping
 from pathlib import Path
 
@@ -25,6 +26,7 @@ from matplotlib.ticker import MultipleLocator
 
 from ..canvas import new_figure, save_figures, save_file
 from ..model.params import Model
+from ..model.stability import criterion
 from .delay import delay_text
 from .loops import ignoring_underflow
 from .margins import MarginsReport, ReportResponses, report_responses
@@ -175,7 +177,9 @@ def nyquist_figure(loops: Mapping[str, ct.TransferFunction], title: str = "") ->
     return fig
 
 
-def response_figure(responses: Mapping[str, Simulation], title: str = "") -> Figure:
+def response_figure(
+    responses: Mapping[str, Simulation], title: str = "", chain: tuple | None = None, chain_label: str = ""
+) -> Figure:
     """Angle after the perturbation, with the reflex (run 0) and without it (run 1), per segment.
 
     Each panel is scaled to the response with the reflex; a response without it that
@@ -190,15 +194,21 @@ def response_figure(responses: Mapping[str, Simulation], title: str = "") -> Fig
         Segment name -> a batch of two runs (:func:`spinectl.reflex.simulate.simulate`).
     title : str, optional
         Figure title.
+    chain : tuple of Simulation, optional
+        The chain with its reflex and without (:attr:`spinectl.reflex.margins.ReportResponses.chain`): a last
+        panel, every joint's angle, under its own criterion.
+    chain_label : str, optional
+        The chain's verdict at the delay, as its panel's title says it (the exact one, not the simulation's).
 
     Returns
     -------
     matplotlib.figure.Figure
-        One panel per segment; nothing is written.
+        One panel per segment, each simulated alone (joint by joint), and one for the chain; nothing is written.
     """
-    fig = new_figure(figsize=(7, 1.6 * len(responses) + 1))
-    axes = fig.subplots(len(responses), 1, squeeze=False)
-    for ax, (name, sim) in zip(axes[:, 0], responses.items(), strict=True):
+    rows = len(responses) + (chain is not None)
+    fig = new_figure(figsize=(7, 1.6 * rows + 1.2))
+    axes = fig.subplots(rows, 1, squeeze=False)
+    for ax, (name, sim) in zip(axes[:, 0], responses.items(), strict=False):
         scale = 1e3  # mrad
         verdict = ["stable" if s else "unstable" for s in sim.stable]
         ax.plot(sim.time, sim.alpha[0] * scale, label=f"reflex, tau = {sim.delay[0]:g} s ({verdict[0]})")
@@ -208,11 +218,39 @@ def response_figure(responses: Mapping[str, Simulation], title: str = "") -> Fig
         ax.set_ylabel(f"{name}\nalpha [mrad]")
         ax.set_xlim(sim.time[0], sim.time[-1])
         ax.legend(loc="best", fontsize="small")
+    if chain is not None:
+        _chain_panel(axes[-1, 0], chain, chain_label)
     axes[-1, 0].set_xlabel("time [s]")
-    default = "Response to a perturbation (nonlinear segment, true delay)"
-    fig.suptitle(f"{title or default}\n{RESPONSE_NOTE}" if len(responses) > 1 else title or default, fontsize="medium")
+    default = "Response to a perturbation (nonlinear, true delay)"
+    joint = f"segments: {criterion('joint')}"
+    notes = [joint] + ([RESPONSE_NOTE] if len(responses) > 1 else [])
+    fig.suptitle("\n".join([title or default, *notes]), fontsize="medium")
     fig.tight_layout()
     return fig
+
+
+def _chain_panel(ax, chain: tuple, label: str) -> None:
+    """The chain's joints with the reflex (solid) and without (dashed), scaled to the response with the reflex."""
+    scale = 1e3  # mrad
+    with_reflex, without = chain
+    for j, alpha in enumerate(with_reflex.alpha):
+        ax.plot(with_reflex.time, alpha * scale, color=f"C{j}", lw=1.0)
+        ax.plot(without.time, without.alpha[j] * scale, color=f"C{j}", lw=0.8, ls="--")
+    top = 1.3 * max(abs(with_reflex.alpha).max(), 1e-12) * scale
+    ax.set_ylim(-top, top)
+    ax.set_xlim(with_reflex.time[0], _shown_until(with_reflex))
+    ax.set_ylabel("chain\nalpha [mrad]")
+    ax.set_title(textwrap.fill(label, 90), fontsize="small")
+
+
+def _shown_until(sim: Simulation) -> float:
+    """The end of a response's time axis [s]: twice the time of divergence where it diverged (the angles are
+    frozen after it), else the whole simulation."""
+    if not sim.diverged.any():
+        return float(sim.time[-1])
+    moving = np.flatnonzero(np.any(np.diff(sim.alpha, axis=1) != 0, axis=0))
+    last = sim.time[moving[-1] + 1] if moving.size else sim.time[-1]
+    return float(min(2.0 * last, sim.time[-1]))
 
 
 def frequency_range(report: MarginsReport) -> tuple[float, float]:
@@ -269,8 +307,22 @@ def report_figures(report: MarginsReport, responses: ReportResponses) -> dict[st
         nyquist_title = f"Nyquist, tau = {report.delay:g} s; {where}{_left_out(report, responses)}"
         figures["nyquist.png"] = nyquist_figure(responses.loops, nyquist_title)
     if responses.simulations:
-        figures["response.png"] = response_figure(responses.simulations, f"Response to a perturbation; {where}")
+        figures["response.png"] = response_figure(
+            responses.simulations, f"Response to a perturbation; {where}", responses.chain, _chain_label(report)
+        )
     return figures
+
+
+def _chain_label(report: MarginsReport) -> str:
+    """The chain panel's title: its criterion and its exact verdict at the delay (solid: reflex, dashed: none)."""
+    chain = report.chain
+    if chain is None:
+        return ""
+    verdict = "stable" if chain.stable_at_delay else "NOT stable"
+    return (
+        f"{chain.criterion}, the same reflex at every joint: {verdict} at {delay_text(report.delay)} "
+        f"(exact delay margin {delay_text(chain.exact.margin)}); solid: reflex, dashed: none"
+    )
 
 
 def _left_out(report: MarginsReport, responses: ReportResponses) -> str:

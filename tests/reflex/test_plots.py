@@ -44,7 +44,8 @@ def test_figure_functions_return_figures_and_write_nothing(tmp_path, monkeypatch
     assert [f.get_suptitle() for f in figures] == [
         "Reflex loop L(jw)",
         "Nyquist plot of L(jw)",
-        "Response to a perturbation (nonlinear segment, true delay)",
+        "Response to a perturbation (nonlinear, true delay)\n"
+        "segments: joint by joint (each CoR alone, the others fixed; the paper's criterion)",
     ]
 
 
@@ -233,3 +234,30 @@ def test_the_response_title_lies_inside_the_figure(at_a):
     fig.canvas.draw()
     box = fig._suptitle.get_window_extent(fig.canvas.get_renderer())
     assert fig.bbox.x0 <= box.x0 and box.x1 <= fig.bbox.x1 and box.y1 <= fig.bbox.y1
+
+
+def test_the_response_names_each_criterion_and_draws_the_chain():
+    """``margins --plot`` at E = 3 cm, Lambda = 4 cm, activation 0.5, 100 ms (wagner2012): every segment alone is
+    stable at the delay while the chain is not (its exact margin, 0.157 ms, is far below 100 ms;
+    test_margins_cmd): the figure says the segments' criterion, and a last panel draws the chain, all CoRs free,
+    under the same reflex, titled with the chain's exact verdict; its simulation diverges, as that verdict says."""
+    from spinectl import load_preset
+    from spinectl.reflex.chain_verdict import margins_with_chain
+
+    model = _reflex(load_preset("wagner2012"), activation=0.5, delay=0.1)
+    report = margins_with_chain(model, 0.03, 0.04)
+    assert report.chain is not None and not report.chain.stable_at_delay  # the premise
+    responses = margins.report_responses(model, report)
+    fig = plots.report_figures(report, responses)["response.png"]
+    assert "segments: joint by joint" in fig.get_suptitle()
+    assert len(fig.axes) == len(report.segments) + 1
+    chain_ax = fig.axes[-1]
+    assert (
+        chain_ax.get_title()
+        .replace("\n", " ")
+        .startswith("chain (all 5 CoRs free), the same reflex at every joint: NOT stable at 100 ms")
+    )
+    with_reflex, without = responses.chain
+    assert with_reflex.alpha.shape[0] == without.alpha.shape[0] == 5  # one run per joint
+    assert with_reflex.diverged.any()  # the simulation agrees with the exact verdict
+    np.testing.assert_array_equal(with_reflex.kp, np.asarray(report.chain.kp))
