@@ -48,7 +48,7 @@ from .._validate import printable
 from ..errors import ModelError, ParameterError
 from .export_osim import require_opensim
 from .linearise import STEP, Linearisation, Rhythm, constrained_chain, free_chain
-from .mapping import Mapping, default_mapping, read_mapping
+from .mapping import Mapping, default_mapping, located, read_mapping
 from .model import Anatomy
 
 
@@ -320,12 +320,14 @@ def _check_mapping(engine: OsimEngine, mapping: Mapping) -> None:
     for group, names in mapping.bodies.items():
         missing = [n for n in names if n not in bodies]
         if missing:
-            raise ParameterError(f"mapping.bodies.{group}", f"names bodies that {engine.name} lacks: {missing}")
+            lacks = f"names bodies that {engine.name} lacks: {missing}"
+            raise ParameterError(located(mapping.path, f"bodies.{group}"), lacks)
     coords = engine.model.getCoordinateSet()
     for plane, names in mapping.planes.items():
         missing = [n for n in names if not coords.contains(n)]
         if missing:
-            raise ParameterError(f"mapping.planes.{plane}", f"names coordinates that {engine.name} lacks: {missing}")
+            lacks = f"names coordinates that {engine.name} lacks: {missing}"
+            raise ParameterError(located(mapping.path, f"planes.{plane}"), lacks)
     if engine.model.getMuscles().getSize() == 0:
         raise ParameterError("model", f"{engine.name} has no muscles")
 
