@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .. import _validate as v
-from .._validate import escaped
+from .._validate import SHOWN_CHARS, printable
 from ..errors import ConfigError, ParameterError
 from ..model import _toml
 from .engine import Engine, require_mujoco
@@ -86,9 +86,13 @@ def located(path, key: str) -> str:
     Returns
     -------
     str
-        E.g. ``"m.toml: joint_stiffness.Nm_per_rad"``.
+        E.g. ``"m.toml: joint_stiffness.Nm_per_rad"``; a path beyond
+        :data:`~spinectl._validate.SHOWN_CHARS` characters is shortened at its start.
     """
-    return f"{escaped(str(path))}: {key}"
+    text = printable(str(path))
+    if len(text) > SHOWN_CHARS:  # the end names the file: shortened at the start
+        text = "..." + text[3 - SHOWN_CHARS :]
+    return f"{text}: {key}"
 
 
 def read_mapping(path: str | Path) -> Mapping:
@@ -128,8 +132,9 @@ def read_mapping(path: str | Path) -> Mapping:
 def _mapping(doc: dict, path: str) -> Mapping:
     """The Mapping of a parsed file; errors name the key only (:func:`read_mapping` adds the file)."""
     _toml.check_keys(doc, KEYS)
-    for section, value in doc.items():
+    for section, value in doc.items():  # every section a table before any of their keys is read
         _toml.check_table(value, section)
+    for section, value in doc.items():
         _toml.check_keys(value, KEYS[section], section)
     bodies, planes, stiff = doc.get("bodies", {}), doc.get("planes", {}), doc.get("joint_stiffness", {})
     for group in GROUPS:
