@@ -115,11 +115,8 @@ def file_key(spec, text: bytes = b"") -> str | None:
         write it: a missing mesh, a zero mass) or an asset file cannot be read: the compiler then
         says why, as without the cache.
     """
-    from .engine import engine_output_to_stderr
-
     try:
-        with engine_output_to_stderr():
-            parts = [spec.to_xml(), text]
+        parts = [spec.to_xml(), text]
     except ValueError as exc:
         log.debug("no compiled-model cache: MuJoCo cannot write the model: %s", exc)
         return None
