@@ -10,12 +10,14 @@ from ._common import emit_json, finite_float
 
 MAX_DERIVATIVE_GAIN = 1e6
 """Largest reflex derivative gain kd [N m s/rad]: the chain's delay margin scales as 1/kd from 1e3 to 1e6
-(1.85e-5, 1.85e-8 s on MyoTorso at kp = 400, no lag), 1e5 times the chain's own damping."""
+(1.85e-5, 1.85e-8 s on MyoTorso at kp = 400, no lag), the arithmetic holding there."""
 
 MAX_CONTROL = 1e6
 """Largest control of a muscle other than MuJoCo's (whose activation is in [0, 1]), e.g. the PCSA [cm^2] of
-spinectl's export: 1000 times the plausible PCSA (1000 cm^2, :data:`spinectl.model.checks.MAX_PLAUSIBLE_PCSA`),
-its stiffness within the bound of :data:`~spinectl.anatomy.mapping.MAX_STIFFNESS`'s verified range."""
+spinectl's export: 1000 times the plausible PCSA (1000 cm^2, :data:`spinectl.model.checks.MAX_PLAUSIBLE_PCSA`).
+The export's chain stiffens by about 60 N m/rad per cm^2 (its largest eigenvalue of K 5.8e78 N m/rad at 1e77 cm^2),
+so 6e7 N m/rad at the bound, within the 1e8 N m/rad up to which :data:`~spinectl.anatomy.mapping.MAX_STIFFNESS`
+was measured to hold."""
 
 STIFFNESS_WHY = " N m/rad, the bound of the chain's arithmetic (spinectl.anatomy.mapping.MAX_STIFFNESS)"
 
