@@ -13,7 +13,7 @@ The key is a SHA-256 of what the compiled model depends on:
 - a built-in model: its name and myo-sim's package files, the sources (``.py``, ``.xml``,
   ``.json``, ``.toml``) by content and the other files (meshes, textures) by size and
   modification time, as Python's own bytecode cache checks a source;
-- an MJCF file: the model as MuJoCo parsed it (:meth:`mujoco.MjSpec.to_xml`, its includes
+- an MJCF file: its bytes, the model as MuJoCo parsed it (:meth:`mujoco.MjSpec.to_xml`, its includes
   merged) and the bytes of every mesh, texture, height field and skin file it names.
 
 The folder is ``$SPINECTL_CACHE_DIR``, else ``$XDG_CACHE_HOME/spinectl``, else
@@ -97,20 +97,29 @@ def builtin_key(name: str, package) -> str:
     return _key(*parts)
 
 
-def file_key(spec) -> str | None:
+def file_key(spec, text: bytes = b"") -> str | None:
     """The key of a model parsed from an MJCF file: its MJCF as MuJoCo writes it and its asset files' bytes.
 
     Parameters
     ----------
     spec : mujoco.MjSpec
         The spec parsed from the file (:meth:`mujoco.MjSpec.from_file`).
+    text : bytes
+        The file's own bytes: MuJoCo's writing of the spec drops what it reads as a default, a
+        ``stiffness="nan"`` included, so that file's key would be that of the file without it.
 
     Returns
     -------
     str or None
-        Hex SHA-256, or None (no cache) where an asset file cannot be read.
+        Hex SHA-256, or None (no cache) where MuJoCo cannot write the model (it compiles it to
+        write it: a missing mesh, a zero mass) or an asset file cannot be read: the compiler then
+        says why, as without the cache.
     """
-    parts = [spec.to_xml()]
+    try:
+        parts = [spec.to_xml(), text]
+    except ValueError as exc:
+        log.debug("no compiled-model cache: MuJoCo cannot write the model: %s", exc)
+        return None
     base = Path(spec.modelfiledir or ".")
     kinds = (
         (spec.meshes, spec.meshdir),

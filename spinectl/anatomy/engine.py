@@ -17,13 +17,19 @@ IROS 2012, 5026-5033. doi:10.1109/IROS.2012.6386109.
 
 from __future__ import annotations
 
+import contextlib
+import ctypes
 import hashlib
+import os
+import sys
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from .._optional import require_module
+from .._validate import printable, show
 from ..errors import ParameterError, SpinectlError
 
 BUILTIN = ("myotorso",)
@@ -47,7 +53,140 @@ def require_mujoco():
     module
         :mod:`mujoco`.
     """
-    return require_module("mujoco", AnatomyUnavailable, f"anatomical models need MuJoCo: {INSTALL_HINT}")
+    mujoco = require_module("mujoco", AnatomyUnavailable, f"anatomical models need MuJoCo: {INSTALL_HINT}")
+    if mujoco.get_mju_user_warning() is None:  # a handler of the caller's own stays
+        mujoco.set_mju_user_warning(_mujoco_warning)
+    return mujoco
+
+
+class EngineWarning(UserWarning):
+    """A warning of MuJoCo's about the model it loaded (e.g. a NaN in its XML)."""
+
+
+_heard: list | None = None
+"""MuJoCo's warnings while a model loads (:func:`_hearing`): said after the load, or dropped if it fails."""
+
+
+def _mujoco_warning(text) -> None:
+    """MuJoCo's warning handler, in place of its own (which prints to standard output, where spinectl's table
+    or JSON goes, and appends to ``MUJOCO_LOG.TXT`` in the working folder)."""
+    try:  # never raise: an exception in MuJoCo's C callback aborts the process
+        message = f"MuJoCo: {one_line(text)}"
+        if _heard is not None:
+            _heard.append(message)
+        else:
+            sys.stderr.write(f"spinectl: warning: {message}\n")
+    except BaseException:  # noqa: B036, S110 (the same reason)
+        pass
+
+
+@contextlib.contextmanager
+def _hearing():
+    """MuJoCo's warnings in the block, each a :class:`EngineWarning` after it; if the block raises a
+    :class:`ParameterError`, its message ends with them instead (``XML contains a 'NaN'`` beside the
+    compiler's complaint about the mass that was NaN)."""
+    global _heard
+    outer, _heard = _heard, []
+    try:
+        yield
+        heard = _heard
+    except ParameterError as exc:
+        if not _heard:
+            raise
+        said = "; ".join(dict.fromkeys(_heard))
+        raise type(exc)(exc.field, f"{exc.message} ({said})") from None
+    finally:
+        _heard = outer
+    for message in dict.fromkeys(heard):
+        warnings.warn(message, EngineWarning, stacklevel=4)
+
+
+def one_line(message: str) -> str:
+    """An engine's message on one line: its lines joined, so that the reason on a later line is kept.
+
+    MuJoCo puts the element and the line of an XML error on the line after the error
+    (``XML Error: invalid keyword: 'bogus'`` / ``Element 'joint', line 2``).
+
+    Parameters
+    ----------
+    message : str
+        The message, e.g. ``str(exc)`` of the engine's exception.
+
+    Returns
+    -------
+    str
+        Its non-blank lines, stripped and joined by "; ", control characters escaped.
+    """
+    return printable("; ".join(line.strip() for line in str(message).splitlines() if line.strip()))
+
+
+@contextlib.contextmanager
+def engine_output_to_stderr():
+    """Send what the engines' C/C++ code prints to standard output to standard error instead, inside the block.
+
+    OpenSim's logger writes its warnings (``[warning] Couldn't find file 'r_pelvis.vtp'.`` for every
+    mesh a downloaded model lacks) and MuJoCo its (``WARNING: XML contains a 'NaN'``) to the
+    process's standard output, where spinectl's table or JSON document goes. File descriptor 1 is
+    pointed at standard error for the block (after both Python's and C's buffers are flushed, so
+    nothing is moved across); where it cannot be (no descriptor 1 or 2), the block runs as it is.
+
+    Yields
+    ------
+    None
+    """
+    try:
+        sys.stdout.flush()
+        saved = os.dup(1)
+    except (OSError, ValueError):  # no standard output to protect
+        yield
+        return
+    try:
+        _flush_c_streams()
+        os.dup2(2, 1)
+    except OSError:
+        os.close(saved)
+        yield
+        return
+    try:
+        yield
+    finally:
+        _flush_c_streams()
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
+def _flush_c_streams() -> None:
+    """fflush(NULL): C's buffered standard output written out before its descriptor changes."""
+    try:
+        ctypes.CDLL(None).fflush(None)
+    except (OSError, AttributeError):  # no C library by that name (Windows): its streams flush at exit
+        pass
+
+
+def model_file(text: str, allowed: str) -> Path:
+    """The path of a model file, if it is a regular file; else one line naming ``model``.
+
+    Parameters
+    ----------
+    text : str
+        The path as given.
+    allowed : str
+        What the model may be, for the message, e.g. ``"an MJCF file"``.
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    path = Path(text)
+    try:
+        exists, regular = path.exists(), path.is_file()
+    except (OSError, ValueError) as exc:  # a name too long for the file system, a NUL byte
+        reason = getattr(exc, "strerror", None) or type(exc).__name__
+        raise ParameterError("model", f"cannot read {show(text)}: {reason}") from None
+    if not regular:
+        what = "not a regular file" if exists else "no such file"
+        raise ParameterError("model", f"must be {allowed} ({what}: {show(text)})")
+    return path
 
 
 @dataclass
@@ -205,15 +344,77 @@ class Engine:
         return d.qfrc_actuator + d.qfrc_passive - d.qfrc_bias
 
 
+ELEMENTS = {
+    "body": "body",
+    "jnt": "joint",
+    "dof": "joint",
+    "geom": "geom",
+    "site": "site",
+    "cam": "camera",
+    "light": "light",
+    "mesh": "mesh",
+    "tendon": "tendon",
+    "actuator": "actuator",
+    "eq": "equality",
+    "key": "key",
+}
+"""The MJCF element of a compiled field's prefix (``jnt_stiffness`` is a ``<joint>``'s ``stiffness``)."""
+
+
+def check_finite(model, source: str) -> None:
+    """Refuse a compiled model with a NaN or infinite number, naming the element and attribute it came from.
+
+    MuJoCo compiles ``stiffness="nan"`` with a warning only; every quantity spinectl reads
+    would then be NaN, and the error would name an internal field instead of the file.
+
+    Parameters
+    ----------
+    model : mujoco.MjModel
+        The compiled model.
+    source : str
+        The model's source, named in the message.
+
+    Raises
+    ------
+    ParameterError
+        Field ``model``: the source, the element (kind and name, where MuJoCo's field says)
+        and the attribute, e.g. ``joint 'L4L5': stiffness is nan (MuJoCo's jnt_stiffness)``.
+    """
+    mujoco = require_mujoco()
+    holders = [(name, getattr(model, name)) for name in dir(model) if not name.startswith("_")]
+    holders += [(f"opt_{name}", getattr(model.opt, name)) for name in dir(model.opt) if not name.startswith("_")]
+    for name, value in holders:
+        if not (isinstance(value, np.ndarray | float) and np.asarray(value).dtype.kind == "f"):
+            continue
+        bad = ~np.isfinite(np.asarray(value))
+        if bad.any():
+            row = int(np.argwhere(bad)[0][0]) if np.ndim(value) else 0
+            prefix, _, attribute = name.partition("_")
+            element = ELEMENTS.get(prefix, "option" if prefix == "opt" else None)
+            where = f"<{element}>" if element else "the model"
+            if element and element != "option":
+                if prefix == "dof":
+                    row = int(model.dof_jntid[row])
+                obj = getattr(mujoco.mjtObj, f"mjOBJ_{'JOINT' if prefix == 'dof' else element.upper()}", None)
+                label = mujoco.mj_id2name(model, obj, row) if obj is not None else None
+                where = f"<{element}> {label!r}" if label else f"<{element}> number {row}"
+            shown = np.asarray(value)[bad].flat[0]
+            raise ParameterError(
+                "model", f"{source}: {where}: {attribute} is {shown} (MuJoCo's {name}): every number must be finite"
+            )
+
+
 def _compile(spec, spec_factory, name: str, source: str, digest: str, key: str | None) -> Engine:
     """Compile ``spec`` (or read its compiled model from the cache under ``key``) into an Engine."""
     from . import cache
 
     mujoco = require_mujoco()
     try:
-        model = spec.compile()
+        with engine_output_to_stderr():
+            model = spec.compile()
     except ValueError as exc:
-        raise ParameterError("model", f"MuJoCo cannot compile {source}: {str(exc).splitlines()[0]}") from None
+        raise ParameterError("model", f"MuJoCo cannot compile {source}: {one_line(exc)}") from None
+    check_finite(model, source)
     if key is not None:
         cache.write(key, model, {"sha256": digest})
     return Engine(model, mujoco.MjData(model), name, source, digest, spec_factory)
@@ -234,11 +435,15 @@ def _cached(key: str | None, spec_factory, name: str, source: str, digest: str |
     digest = digest or meta.get("sha256")
     if not isinstance(digest, str):
         return None
+    check_finite(model, source)  # a file cached before this check was made
     return Engine(model, require_mujoco().MjData(model), name, source, digest, spec_factory)
 
 
 def load_engine(model: str | Path, cache: bool = True) -> Engine:
     """Compile a built-in model (``"myotorso"``) or an MJCF file with MuJoCo, or read it from the cache.
+
+    MuJoCo's warnings (e.g. ``XML contains a 'NaN'``) come as :class:`EngineWarning` after a model
+    that loads, never on standard output.
 
     Parameters
     ----------
@@ -252,6 +457,13 @@ def load_engine(model: str | Path, cache: bool = True) -> Engine:
     -------
     Engine
     """
+    require_mujoco()
+    with _hearing():
+        return _load_engine(model, cache)
+
+
+def _load_engine(model: str | Path, cache: bool) -> Engine:
+    """:func:`load_engine`'s work, MuJoCo's warnings heard by the caller."""
     from . import cache as compiled
 
     mujoco = require_mujoco()
@@ -272,19 +484,18 @@ def load_engine(model: str | Path, cache: bool = True) -> Engine:
         spec = builtin()
         # a composed model: the SHA-256 of the MJCF text MuJoCo writes of it
         return _compile(spec, builtin, text, source, hashlib.sha256(spec.to_xml().encode()).hexdigest(), key)
-    path = Path(text)
-    if not path.is_file():
-        what = "no such MJCF file" if path.suffix.lower() in (".xml", ".mjcf") else "not an MJCF file"
-        raise ParameterError("model", f"must be one of {BUILTIN} or an MJCF file ({what}: {text!r})")
+    path = model_file(text, f"one of {BUILTIN} or an MJCF file")
 
     def factory():
         try:
-            return mujoco.MjSpec.from_file(str(path))
+            with engine_output_to_stderr():
+                return mujoco.MjSpec.from_file(str(path))
         except ValueError as exc:
-            raise ParameterError("model", f"{text} is not a valid MJCF file: {str(exc).splitlines()[0]}") from None
+            raise ParameterError("model", f"{printable(text)} is not a valid MJCF file: {one_line(exc)}") from None
 
     spec = factory()
-    key = compiled.file_key(spec) if cache else None
+    data = path.read_bytes()
+    key = compiled.file_key(spec, data) if cache else None
     source = str(path.resolve())
-    digest = hashlib.sha256(path.read_bytes()).hexdigest()  # a file: the SHA-256 of its bytes
+    digest = hashlib.sha256(data).hexdigest()  # a file: the SHA-256 of its bytes
     return _cached(key, factory, path.stem, source, digest) or _compile(spec, factory, path.stem, source, digest, key)

@@ -17,11 +17,13 @@ so the thorax's head and arm attachments count as thorax.
 
 from __future__ import annotations
 
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
+from .. import _validate as v
+from .._validate import SHOWN_CHARS, printable
 from ..errors import ConfigError, ParameterError
+from ..model import _toml
 from .engine import Engine, require_mujoco
 
 MAPPINGS = Path(__file__).resolve().parent / "mappings"
@@ -56,8 +58,49 @@ class Mapping:
     path: str
 
 
+MAX_STIFFNESS = 1e6
+"""Largest stiffness [N m/rad] added at a joint, by a mapping or ``--joint-stiffness``, and the bound of the
+other stiffnesses of ``spinectl anatomy`` (``--margin``, ``--kp``): about 2000 times the stiffest lumbar
+motion segment (6-11 N m/deg, 340-630 N m/rad, Miller et al. 1986, the built-in mapping's source), and a
+hundred times below where the arithmetic stops holding. Measured on MyoTorso: the optimum with the
+stability criterion (a conic programme, relative tolerance about 1e-8 against muscle torques of
+1-100 N m) is exact with 1e8 N m/rad added at each joint (its cost that of the classic optimum, as it must
+be), ``optimal_inaccurate`` from 1e9 and a wrong optimum (cost 1.9e-39) at 1e77; the chain's delay margin
+scales as 1/kp up to kp = 1e8 (5e-5, 5e-7, 5e-9 s at 1e4, 1e6, 1e8) and is ``delay_independent`` at 1e12;
+at 1e308 the eigenvalues of -K were NaN."""
+
+KEYS = {"bodies": GROUPS, "planes": PLANES, "joint_stiffness": ("Nm_per_rad", "source")}
+"""The sections of a mapping file and the keys of each."""
+
+
+def located(path, key: str) -> str:
+    """The field of a mapping's key in a message: the file as given, then the key as written in it.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The mapping file.
+    key : str
+        A dotted key of the file, e.g. ``"joint_stiffness.Nm_per_rad"``.
+
+    Returns
+    -------
+    str
+        E.g. ``"m.toml: joint_stiffness.Nm_per_rad"``; a path beyond
+        :data:`~spinectl._validate.SHOWN_CHARS` characters is shortened at its start.
+    """
+    text = printable(str(path))
+    if len(text) > SHOWN_CHARS:  # the end names the file: shortened at the start
+        text = "..." + text[3 - SHOWN_CHARS :]
+    return f"{text}: {key}"
+
+
 def read_mapping(path: str | Path) -> Mapping:
     """Read and check a mapping file (its keys; the names are checked against a model by :func:`check_mapping`).
+
+    The file is read and parsed as every TOML file of the project (:mod:`spinectl.model._toml`): a
+    regular UTF-8 file, unknown sections and keys refused with a "did you mean", each value of its
+    type, every name once.
 
     Parameters
     ----------
@@ -67,28 +110,73 @@ def read_mapping(path: str | Path) -> Mapping:
     Returns
     -------
     Mapping
+
+    Raises
+    ------
+    ConfigError
+        The file cannot be read (field ``mapping``), is not TOML, or has an unknown key.
+    ParameterError
+        A value of the wrong type or range, a name given twice; the field names the file and the key.
     """
     path = Path(path)
     try:
-        doc = tomllib.loads(path.read_text(encoding="utf-8"))
-    except (OSError, tomllib.TOMLDecodeError) as exc:
-        raise ConfigError("mapping", f"cannot read {path}: {exc}") from None
+        doc = _toml.parse(_toml.read_text(path), str(path))
+    except ConfigError as exc:
+        raise ConfigError("mapping", exc.message) from None
+    try:
+        return _mapping(doc, str(path))
+    except ParameterError as exc:
+        raise type(exc)(located(path, exc.field), exc.message) from None
+
+
+def _mapping(doc: dict, path: str) -> Mapping:
+    """The Mapping of a parsed file; errors name the key only (:func:`read_mapping` adds the file)."""
+    _toml.check_keys(doc, KEYS)
+    for section, value in doc.items():  # every section a table before any of their keys is read
+        _toml.check_table(value, section)
+    for section, value in doc.items():
+        _toml.check_keys(value, KEYS[section], section)
     bodies, planes, stiff = doc.get("bodies", {}), doc.get("planes", {}), doc.get("joint_stiffness", {})
     for group in GROUPS:
-        if not (isinstance(bodies.get(group), list) and bodies[group]):
-            raise ConfigError(f"mapping.bodies.{group}", "must be a non-empty list of body names")
-    if not planes or not set(planes) <= set(PLANES):
-        raise ConfigError("mapping.planes", f"must give joint lists for some of {PLANES} (got {sorted(planes)})")
+        if group not in bodies:
+            raise ParameterError(f"bodies.{group}", "is required: a non-empty list of body names")
+    if not planes:
+        raise ParameterError("planes", f"must give the chain's joints in some of {', '.join(PLANES)}")
+    mapped = {g: _names(f"bodies.{g}", bodies[g]) for g in GROUPS}
+    _disjoint("bodies", mapped, "a body belongs to one group")
+    chains = {p: _names(f"planes.{p}", v) for p, v in planes.items()}
+    # a joint turns in one plane: 3d lists the planes' joints together, but sagittal and coronal share none
+    _disjoint("planes", {p: chains[p] for p in ("sagittal", "coronal") if p in chains}, "a joint turns in one plane")
     value = stiff.get("Nm_per_rad", 0.0)
-    if not isinstance(value, int | float) or value < 0:
-        raise ConfigError("mapping.joint_stiffness.Nm_per_rad", f"must be a number >= 0 (got {value!r})")
-    return Mapping(
-        bodies={g: tuple(bodies[g]) for g in GROUPS},
-        planes={p: tuple(v) for p, v in planes.items()},
-        joint_stiffness=float(value),
-        stiffness_source=str(stiff.get("source", "")),
-        path=str(path),
-    )
+    value = v.non_negative("joint_stiffness.Nm_per_rad", value)
+    if value > MAX_STIFFNESS:
+        raise ParameterError(
+            "joint_stiffness.Nm_per_rad",
+            f"must be at most {MAX_STIFFNESS:g} N m/rad, beyond which the chain's arithmetic fails (got {value:g})",
+        )
+    source = stiff.get("source", "")
+    if not isinstance(source, str):
+        raise ParameterError("joint_stiffness.source", f"must be a string (got {v.show(source)})")
+    return Mapping(bodies=mapped, planes=chains, joint_stiffness=value, stiffness_source=source, path=path)
+
+
+def _names(key: str, value) -> tuple:
+    """A non-empty list of distinct printable names (:func:`spinectl._validate.labels`)."""
+    if isinstance(value, list) and not value:
+        raise ParameterError(key, "must be a non-empty list of names (got [])")
+    return v.labels(key, value)
+
+
+def _disjoint(section: str, lists: dict, why: str) -> None:
+    """Refuse a name in two of the lists of ``section``."""
+    seen: dict = {}
+    for key, names in lists.items():
+        for name in names:
+            if name in seen:
+                raise ParameterError(
+                    f"{section}.{key}", f"lists {v.show(name)}, which {section}.{seen[name]} lists too: {why}"
+                )
+            seen[name] = key
 
 
 def default_mapping(name: str, *aliases: str) -> Mapping:
@@ -129,11 +217,13 @@ def check_mapping(engine: Engine, mapping: Mapping) -> None:
     for group, names in mapping.bodies.items():
         missing = [n for n in names if mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, n) < 0]
         if missing:
-            raise ParameterError(f"mapping.bodies.{group}", f"names bodies that {engine.name} lacks: {missing}")
+            lacks = f"names bodies that {engine.name} lacks: {missing}"
+            raise ParameterError(located(mapping.path, f"bodies.{group}"), lacks)
     for plane, names in mapping.planes.items():
         missing = [n for n in names if mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, n) < 0]
         if missing:
-            raise ParameterError(f"mapping.planes.{plane}", f"names joints that {engine.name} lacks: {missing}")
+            lacks = f"names joints that {engine.name} lacks: {missing}"
+            raise ParameterError(located(mapping.path, f"planes.{plane}"), lacks)
     if not engine.muscle_ids().size:
         raise ParameterError(
             "model", f"{engine.name} has no muscles (no tendon actuator with muscle or no activation dynamics)"

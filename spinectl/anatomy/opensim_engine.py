@@ -40,15 +40,15 @@ from __future__ import annotations
 import hashlib
 import re
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
 from .._validate import printable
 from ..errors import ModelError, ParameterError
+from .engine import engine_output_to_stderr, model_file, one_line
 from .export_osim import require_opensim
 from .linearise import STEP, Linearisation, Rhythm, constrained_chain, free_chain
-from .mapping import Mapping, default_mapping, read_mapping
+from .mapping import Mapping, default_mapping, located, read_mapping
 from .model import Anatomy
 
 
@@ -202,14 +202,13 @@ def load_engine(path) -> OsimEngine:
     OsimEngine
     """
     osim = require_opensim()
-    path = Path(path)
-    if not path.is_file():
-        raise ParameterError("model", f"no such .osim file: {printable(str(path))}")
+    path = model_file(str(path), "an .osim file")
     try:
-        model = osim.Model(str(path))
-        schema = _schema(osim, model, path)
-        couplers = _couplers(osim, model)
-        state = model.initSystem()
+        with engine_output_to_stderr():  # OpenSim's warnings (e.g. of each missing mesh) are not our output
+            model = osim.Model(str(path))
+            schema = _schema(osim, model, path)
+            couplers = _couplers(osim, model)
+            state = model.initSystem()
     except Exception as exc:  # OpenSim raises its own exception types, one line each
         if isinstance(exc, ParameterError):
             raise
@@ -222,8 +221,7 @@ def load_engine(path) -> OsimEngine:
 def _one_line(exc) -> str:
     """OpenSim's message on one line: its lines joined, the C++ wrapper's prefix dropped, so that the reason
     (e.g. Simbody's "The given Node was not an Element", on a later line) is kept."""
-    lines = [line.strip() for line in str(exc).splitlines() if line.strip()]
-    text = " ".join(lines) or type(exc).__name__
+    text = one_line(exc) or type(exc).__name__
     return re.sub(r"^std::exception in '[^']*': ", "", text)
 
 
@@ -320,12 +318,14 @@ def _check_mapping(engine: OsimEngine, mapping: Mapping) -> None:
     for group, names in mapping.bodies.items():
         missing = [n for n in names if n not in bodies]
         if missing:
-            raise ParameterError(f"mapping.bodies.{group}", f"names bodies that {engine.name} lacks: {missing}")
+            lacks = f"names bodies that {engine.name} lacks: {missing}"
+            raise ParameterError(located(mapping.path, f"bodies.{group}"), lacks)
     coords = engine.model.getCoordinateSet()
     for plane, names in mapping.planes.items():
         missing = [n for n in names if not coords.contains(n)]
         if missing:
-            raise ParameterError(f"mapping.planes.{plane}", f"names coordinates that {engine.name} lacks: {missing}")
+            lacks = f"names coordinates that {engine.name} lacks: {missing}"
+            raise ParameterError(located(mapping.path, f"planes.{plane}"), lacks)
     if engine.model.getMuscles().getSize() == 0:
         raise ParameterError("model", f"{engine.name} has no muscles")
 

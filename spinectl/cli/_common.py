@@ -403,13 +403,17 @@ def refuse_set_twice(assignments: list[str], options: dict) -> None:
             raise ParameterError(options[dotted], f"sets {dotted}, as does --set {dotted}: give one of them")
 
 
-def finite_float(name: str):
-    """An argparse ``type`` accepting finite floats only, naming the option on error.
+def finite_float(name: str, low: float | None = None, high: float | None = None, why: str = ""):
+    """An argparse ``type`` accepting finite floats only (in [low, high] where given), naming the option on error.
 
     Parameters
     ----------
     name : str
         The option, e.g. ``"--E"``, as named in the error message.
+    low, high : float, optional
+        The closed interval allowed, in the option's unit; None: no bound on that side.
+    why : str
+        The interval's unit and reason, said after it, e.g. ``" N m/rad, ..."``.
     """
 
     def convert(text: str) -> float:
@@ -419,6 +423,10 @@ def finite_float(name: str):
             raise argparse.ArgumentTypeError(f"{name} must be a number (got {text!r})") from None
         if not math.isfinite(value):
             raise argparse.ArgumentTypeError(f"{name} must be finite (got {text!r})")
+        if (low is not None and value < low) or (high is not None and value > high):
+            interval = f"in [{low:g}, {high:g}]" if None not in (low, high) else f"at most {high:g}"
+            interval = f"at least {low:g}" if high is None else interval
+            raise argparse.ArgumentTypeError(f"{name} must be {interval}{why} (got {text!r})")
         return value + 0.0  # -0 becomes 0
 
     convert.__name__ = name

@@ -2,7 +2,24 @@
 
 from __future__ import annotations
 
+import argparse
+
+from ..anatomy.mapping import MAX_STIFFNESS
+from ..model.params.bounds import MAX_ACTIVATION_TIME_CONSTANT
 from ._common import emit_json, finite_float
+
+MAX_DERIVATIVE_GAIN = 1e6
+"""Largest reflex derivative gain kd [N m s/rad]: the chain's delay margin scales as 1/kd from 1e3 to 1e6
+(1.85e-5, 1.85e-8 s on MyoTorso at kp = 400, no lag), the arithmetic holding there."""
+
+MAX_CONTROL = 1e6
+"""Largest control of a muscle other than MuJoCo's (whose activation is in [0, 1]), e.g. the PCSA [cm^2] of
+spinectl's export: 1000 times the plausible PCSA (1000 cm^2, :data:`spinectl.model.checks.MAX_PLAUSIBLE_PCSA`).
+The export's chain stiffens by about 60 N m/rad per cm^2 (its largest eigenvalue of K 5.8e78 N m/rad at 1e77 cm^2),
+so 6e7 N m/rad at the bound, within the 1e8 N m/rad up to which :data:`~spinectl.anatomy.mapping.MAX_STIFFNESS`
+was measured to hold."""
+
+STIFFNESS_WHY = " N m/rad, the bound of the chain's arithmetic (spinectl.anatomy.mapping.MAX_STIFFNESS)"
 
 
 def register(sub) -> None:
@@ -35,7 +52,7 @@ def register(sub) -> None:
     parser.add_argument("--plane", default="sagittal", help="sagittal, coronal or 3d (default: sagittal)")
     parser.add_argument(
         "--activation",
-        type=finite_float("--activation"),
+        type=finite_float("--activation", high=MAX_CONTROL, why=" (a control; MuJoCo's muscles: [0, 1])"),
         default=None,
         metavar="A",
         help="activation of every muscle, in [0, 1] (or its control, e.g. a PCSA in cm^2 in spinectl's "
@@ -44,6 +61,7 @@ def register(sub) -> None:
     )
     parser.add_argument(
         "--joint-stiffness",
+        type=_joint_stiffness,
         default="none",
         metavar="K",
         help="intervertebral stiffness added at each chain joint: none (the model's own, default), "
@@ -76,20 +94,25 @@ def register(sub) -> None:
     )
     parser.add_argument(
         "--margin",
-        type=finite_float("--margin"),
+        type=finite_float("--margin", 0.0, MAX_STIFFNESS, STIFFNESS_WHY),
         default=1.0,
         help="with --optimise: the static margin mu of the stability criterion [N m/rad] (default: 1)",
     )
     parser.add_argument(
         "--kp",
-        type=finite_float("--kp"),
+        type=finite_float("--kp", 0.0, MAX_STIFFNESS, STIFFNESS_WHY),
         help="also the free chain's exact delay margin under a delayed PD reflex with this proportional gain "
         "at every joint [N m/rad] (with --kd)",
     )
-    parser.add_argument("--kd", type=finite_float("--kd"), default=0.0, help="the reflex's derivative gain [N m s/rad]")
+    parser.add_argument(
+        "--kd",
+        type=finite_float("--kd", 0.0, MAX_DERIVATIVE_GAIN, " N m s/rad"),
+        default=0.0,
+        help="the reflex's derivative gain [N m s/rad]",
+    )
     parser.add_argument(
         "--activation-lag",
-        type=finite_float("--activation-lag"),
+        type=finite_float("--activation-lag", 0.0, MAX_ACTIVATION_TIME_CONSTANT, " s"),
         default=0.05,
         metavar="T_A",
         help="time constant of the reflex's force generation [s] (default: 0.05)",
@@ -132,6 +155,24 @@ def run(args) -> int:
     int
         Exit code 0 (an unstable chain and an infeasible optimum are answers).
     """
+    from ..anatomy.engine import engine_output_to_stderr
+
+    with engine_output_to_stderr():  # the engines' own prints (OpenSim's warnings) are not the table or JSON
+        result, curve = _answers(args)
+    if args.json:
+        doc = result.to_dict()
+        if curve is not None:
+            doc["lordosis_curve"] = curve
+        emit_json(doc)
+    else:
+        print(result.table())
+        if curve is not None:
+            print(_curve_table(curve))
+    return 0
+
+
+def _answers(args) -> tuple:
+    """The analysis (or the optimum) and the lordosis curve (None without --lordosis); figures written."""
     from ..anatomy import load
     from ..anatomy.analyses import analyse
 
@@ -180,16 +221,20 @@ def run(args) -> int:
 
         analysis = result.analysis if args.optimise else result
         save_anatomy_figures(anatomy, analysis, curve, args.plot)
-    if args.json:
-        doc = result.to_dict()
-        if curve is not None:
-            doc["lordosis_curve"] = curve
-        emit_json(doc)
-    else:
-        print(result.table())
-        if curve is not None:
-            print(_curve_table(curve))
-    return 0
+    return result, curve
+
+
+def _joint_stiffness(text: str):
+    """--joint-stiffness: ``none``, ``mapped`` or a stiffness in [0, MAX_STIFFNESS] N m/rad."""
+    if text in ("none", "mapped"):
+        return text
+    try:
+        float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"--joint-stiffness must be none, mapped or a number [N m/rad] (got {text!r})"
+        ) from None
+    return finite_float("--joint-stiffness", 0.0, MAX_STIFFNESS, STIFFNESS_WHY)(text)
 
 
 def _degrees(text: str):

@@ -204,3 +204,59 @@ def test_no_cache_on_the_command_line_writes_nothing(folder, tmp_path, capsys):
     assert main(["anatomy", str(path)]) == 2
     assert len(list(folder.glob("*.mjb"))) == 1
     assert capsys.readouterr().err.count("\n") == 2
+
+
+@pytest.mark.parametrize("cached", [True, False], ids=["cache", "no-cache"])
+@pytest.mark.parametrize(
+    ("fault", "said"),
+    [
+        ("missing mesh", "MuJoCo cannot compile"),  # before, with the cache: a ValueError traceback
+        ("nan mass", "Element name 'link', id 1"),  # MuJoCo's second line, and its NaN warning
+        ("nan stiffness", "<joint> 'hinge': stiffness is nan (MuJoCo's jnt_stiffness)"),  # before: LinearChain's
+        ("inf stiffness", "<joint> 'hinge': stiffness is inf"),
+        ("bad keyword", "invalid keyword: 'bogus'; Element 'joint', line 5"),  # before: cut at the first line
+    ],
+)
+def test_an_mjcf_that_mujoco_refuses_is_one_line_with_its_reason(
+    folder, tmp_path, capfd, monkeypatch, fault, said, cached
+):
+    """The tiny model with one fault, loaded with and without the compiled-model cache: `spinectl anatomy` says
+    MuJoCo's reason (all its lines joined) or names the element and attribute of a non-finite number, one line on
+    stderr, exit 2; nothing on stdout, no MUJOCO_LOG.TXT where it runs (MuJoCo's own warning handler writes both)."""
+    from spinectl.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    path = tiny(tmp_path / "model")
+    text = path.read_text()
+    if fault == "missing mesh":
+        (tmp_path / "model" / "box.obj").unlink()
+    elif fault == "nan mass":
+        text = text.replace(
+            '<joint name="hinge"', '<inertial pos="0 0 0" mass="nan" diaginertia="1 1 1"/><joint name="hinge"'
+        )
+    elif fault == "bad keyword":
+        text = text.replace('type="hinge"', 'type="bogus"')
+    else:
+        text = text.replace('stiffness="1.0"', f'stiffness="{fault.split()[0]}"')
+    path.write_text(text)
+    argv = ["anatomy", str(path)] + ([] if cached else ["--no-cache"])
+    assert main(argv) == 2
+    out, err = capfd.readouterr()
+    assert out == "" and err.count("\n") == 1 and err.startswith("spinectl: error: model: ") and said in err, err
+    if fault.startswith("nan"):
+        assert "XML contains a 'NaN'" in err
+    assert not (tmp_path / "MUJOCO_LOG.TXT").exists()
+
+
+def test_a_nan_is_not_the_cached_model_without_it(folder, tmp_path):
+    """MuJoCo writes the spec of `stiffness="nan"` as if the attribute were absent: the key reads the file's own
+    bytes too, so the NaN file is not given the clean file's compiled model from the cache (before: it was, and the
+    NaN went unnoticed)."""
+    from spinectl.anatomy.engine import load_engine
+    from spinectl.errors import ParameterError
+
+    clean = tiny(tmp_path / "a", stiffness=0.0)
+    assert load_engine(clean).model.jnt_stiffness[0] == 0.0  # now cached
+    faulty = tiny(tmp_path / "a", stiffness="nan")
+    with pytest.raises(ParameterError, match="stiffness is nan"):
+        load_engine(faulty)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import sys
 
 import pytest
@@ -64,14 +65,14 @@ def test_a_model_without_muscles_or_mapped_bodies_is_refused(tmp_path, torso):
 
     path = tmp_path / "bare.xml"
     path.write_text(
-        '<mujoco><worldbody><body name="sacrum"><joint name="j" type="hinge"/><geom size=".1"/>'
-        "</body></worldbody></mujoco>"
+        '<mujoco><worldbody><body name="sacrum"><body name="l1"><joint name="j" type="hinge"/><geom size=".1"/>'
+        '<body name="torso"><geom size=".1"/></body></body></body></worldbody></mujoco>'
     )
-    with pytest.raises(ParameterError, match="mapping.bodies.vertebrae: names bodies that bare lacks"):
+    with pytest.raises(ParameterError, match="myotorso.toml: bodies.vertebrae: names bodies that bare lacks"):
         anatomy.load(path, MAPPINGS / "myotorso.toml")
     mapping = tmp_path / "m.toml"
     mapping.write_text(
-        '[bodies]\npelvis = ["sacrum"]\nvertebrae = ["sacrum"]\nthorax = ["sacrum"]\n[planes]\nsagittal = ["j"]\n'
+        '[bodies]\npelvis = ["sacrum"]\nvertebrae = ["l1"]\nthorax = ["torso"]\n[planes]\nsagittal = ["j"]\n'
     )
     with pytest.raises(ParameterError, match="no muscles"):
         anatomy.load(path, mapping)
@@ -95,3 +96,113 @@ def test_without_mujoco_one_line_says_what_to_install(monkeypatch):
     monkeypatch.setitem(sys.modules, "mujoco", None)
     with pytest.raises(engine.AnatomyUnavailable, match=r"pip install 'spinectl\[anatomy\]'"):
         engine.load_engine("myotorso")
+
+
+# A mapping file is validated as every TOML file of the project (spinectl.model._toml): each case below is one
+# edit of the built-in myotorso.toml, and the line names the file and the key.
+EDITS = {
+    "misspelt section": (("[joint_stiffness]", "[joint_stiffnes]"), "joint_stiffnes: unknown key 'joint_stiffnes'"),
+    "misspelt key in a known section": (("Nm_per_rad =", "Nm_per_radian ="), "joint_stiffness.Nm_per_radian: unknown"),
+    "misspelt group": (("pelvis = [", "pelvs = ["), "bodies.pelvs: unknown key 'pelvs' (allowed: pelvis, thorax"),
+    "unknown plane": (("coronal = [", "frontal = ["), "planes.frontal: unknown key 'frontal'"),
+    "bool for a number": (("Nm_per_rad = 343.77", "Nm_per_rad = true"), "Nm_per_rad: must be a number (got True)"),
+    "string for a number": (("Nm_per_rad = 343.77", 'Nm_per_rad = "343"'), "Nm_per_rad: must be a number (got '343')"),
+    "nan": (("Nm_per_rad = 343.77", "Nm_per_rad = nan"), "joint_stiffness.Nm_per_rad: must be finite (got nan)"),
+    "inf": (("Nm_per_rad = 343.77", "Nm_per_rad = inf"), "joint_stiffness.Nm_per_rad: must be finite (got inf)"),
+    "beyond the bound": (("Nm_per_rad = 343.77", "Nm_per_rad = 1e7"), "Nm_per_rad: must be at most 1e+06 N m/rad"),
+    "negative": (("Nm_per_rad = 343.77", "Nm_per_rad = -1.0"), "Nm_per_rad: must be >= 0 (got -1)"),
+    "number for a source": (("source = ", "source = 3 #"), "joint_stiffness.source: must be a string (got 3)"),
+    "joint twice in a plane": (('"L4_L5_FE", "L3_L4_FE"', '"L4_L5_FE", "L4_L5_FE"'), "planes.sagittal: must be unique"),
+    "joint in two planes": (('"L4_L5_LB", "L3_L4_LB"', '"L4_L5_FE", "L3_L4_LB"'), "planes.coronal: lists 'L4_L5_FE'"),
+    "body twice in a group": (('"lumbar5", "lumbar4"', '"lumbar5", "lumbar5"'), "bodies.vertebrae: must be unique"),
+    "body in two groups": (('thorax = ["torso"]', 'thorax = ["lumbar1"]'), "bodies.thorax: lists 'lumbar1', which"),
+    "string for a list": (('thorax = ["torso"]', 'thorax = "torso"'), "bodies.thorax: must be a list of strings"),
+    "number in a list": (('thorax = ["torso"]', "thorax = [3]"), "bodies.thorax[0]: must be a non-empty printable"),
+    "empty list": (('thorax = ["torso"]', "thorax = []"), "bodies.thorax: must be a non-empty list of names"),
+    "section not a table": (("[joint_stiffness]", "[bodies.more]"), "bodies.more: unknown key 'more'"),
+    "value for a section": (
+        (("# MyoTorso", "joint_stiffness = 3\n# MyoTorso"), ("\n[joint_stiffness]", "\n[bodies.x]")),
+        "m.toml: joint_stiffness: must be a table (got 3)",
+    ),
+    "array of tables": (("[bodies]", "[[bodies]]"), "bodies: must be a table"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(EDITS))
+def test_a_mapping_file_is_validated_key_by_key(tmp_path, case):
+    """Unknown sections and keys ("did you mean"), types, finite numbers in bounds, each name once and a joint in
+    one plane (3d lists them all): one line naming the file and the key (before: unknown keys were ignored, so a
+    misspelt [joint_stiffness] added 0 with --joint-stiffness mapped; `true` was taken as 1; a joint listed twice
+    was analysed as a chain of two joints in one; a NaN was blamed on LinearChain.stiffness_offset)."""
+    from spinectl.anatomy.mapping import MAPPINGS, read_mapping
+
+    edits, message = EDITS[case]
+    text = (MAPPINGS / "myotorso.toml").read_text()
+    for old, new in (edits,) if isinstance(edits[0], str) else edits:
+        assert old in text
+        text = text.replace(old, new, 1)
+    path = tmp_path / "m.toml"
+    path.write_text(text)
+    with pytest.raises(ParameterError) as error:
+        read_mapping(path)
+    assert str(error.value).startswith("...") and "/m.toml: " in str(error.value), str(error.value)
+    assert message in str(error.value), str(error.value)
+    assert "\n" not in str(error.value)
+
+
+def test_the_built_in_mappings_pass_the_same_checks():
+    """Both built-in mappings read without complaint, myotorso's cited stiffness as written."""
+    from spinectl.anatomy.mapping import MAPPINGS, read_mapping
+
+    assert read_mapping(MAPPINGS / "myotorso.toml").joint_stiffness == 343.77
+    assert read_mapping(MAPPINGS / "wagner2012_chain.toml").planes["sagittal"]
+
+
+@pytest.mark.parametrize(
+    "kind", ["fifo", "folder", "device", "binary", "latin-1", "not toml", "300-character name", "5000-character path"]
+)
+def test_a_mapping_that_cannot_be_read_is_one_line(tmp_path, kind):
+    """What `--config` refuses, `--mapping` refuses by the same reader (spinectl.model._toml.read_text): a FIFO
+    and /dev/zero (before: read for ever, or until memory ran out), a folder, bytes that are not UTF-8, text
+    that is not TOML, names too long for the file system (before: an OSError traceback)."""
+    from spinectl.anatomy.mapping import read_mapping
+    from spinectl.errors import ConfigError
+
+    path = tmp_path / "m.toml"
+    if kind == "fifo":
+        os.mkfifo(path)
+    elif kind == "binary":
+        path.write_bytes(bytes(range(256)))
+    elif kind == "latin-1":
+        path.write_bytes('[bodies]\npelvis = ["sacr\u00fcm"]\n'.encode("latin-1"))
+    elif kind == "not toml":
+        path.write_text("[bodies\n")
+    path = {"folder": tmp_path, "device": "/dev/zero", "300-character name": tmp_path / ("m" * 300 + ".toml")}.get(
+        kind, "x" * 5000 if kind == "5000-character path" else path
+    )
+    expected = {
+        "fifo": "not a regular file",
+        "folder": "not a regular file",
+        "device": "not a regular file",
+        "binary": "is not UTF-8 text",
+        "latin-1": "is not UTF-8 text",
+        "not toml": "is not valid TOML",
+        "300-character name": "File name too long",
+        "5000-character path": "File name too long",
+    }[kind]
+    with pytest.raises(ConfigError) as error:
+        read_mapping(path)
+    assert str(error.value).startswith("mapping: ") and expected in str(error.value) and "\n" not in str(error.value)
+
+
+def test_a_misspelt_mapped_stiffness_is_refused_at_the_command_line(tmp_path, capsys):
+    """`anatomy --mapping m.toml --joint-stiffness mapped` with [joint_stiffnes]: one line, exit 2, nothing on
+    stdout (before: 0 N m/rad added, silently, instead of the file's 343.77)."""
+    from spinectl.anatomy.mapping import MAPPINGS
+    from spinectl.cli import main
+
+    path = tmp_path / "m.toml"
+    path.write_text((MAPPINGS / "myotorso.toml").read_text().replace("[joint_stiffness]", "[joint_stiffnes]"))
+    assert main(["anatomy", "--mapping", str(path), "--joint-stiffness", "mapped"]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == "" and captured.err.count("\n") == 1 and "did you mean 'joint_stiffness'?" in captured.err

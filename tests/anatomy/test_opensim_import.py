@@ -8,6 +8,9 @@ tests derive the difference from Millard's curve values (OpenSim's calcValue / c
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -351,3 +354,49 @@ def test_the_help_names_osim_files(capsys):
     assert main(["anatomy", "--help"]) == 0
     out = " ".join(capsys.readouterr().out.split())
     assert "'myotorso', an MJCF file or an OpenSim .osim file" in out
+
+
+def _run(*args):
+    """`python -m spinectl ARGS` in a subprocess: OpenSim's C++ logger writes to the process's file descriptor 1,
+    which capsys does not see."""
+    import subprocess
+    import sys
+
+    return subprocess.run([sys.executable, "-m", "spinectl", *args], capture_output=True, text=True, check=False)
+
+
+def test_opensims_warnings_of_missing_meshes_stay_off_the_json(imported, tmp_path):
+    """A body with a mesh file that is absent (as in a downloaded model without its Geometry folder, added with
+    OpenSim's API): OpenSim warns `Couldn't find file 'absent_mesh.vtp'` as it builds the model. `anatomy --json`
+    prints a JSON document alone on stdout, the warning on stderr (before: the warning was stdout's first line)."""
+    built = osim.Model(str(imported[4]))
+    built.getBodySet().get(0).attachGeometry(osim.Mesh("absent_mesh.vtp"))
+    built.finalizeConnections()
+    out = tmp_path / "meshed.osim"
+    built.printToXML(str(out))
+    result = _run("anatomy", str(out), "--json")
+    assert result.returncode == 0, result.stderr
+    assert json.loads(result.stdout)["plane"] == "sagittal"
+    assert "absent_mesh.vtp" in result.stderr and "absent_mesh.vtp" not in result.stdout
+
+
+SHARED = Path("/work/shared/models/pose2sim-beaucage-gauvreau/Model_Pose2Sim_muscles_flex.osim")
+
+
+@pytest.mark.skipif(not SHARED.is_file(), reason="the shared downloaded models (/work/shared/models) are absent")
+def test_a_downloaded_model_without_meshes_prints_nothing_but_spinectls_own(tmp_path):
+    """The Pose2Sim model as distributed, without its Geometry folder: OpenSim warns about about a hundred missing
+    meshes; stdout stays empty for whatever spinectl answers (its DeGroote muscles are refused: one line on stderr),
+    and the warnings are on stderr."""
+    mapping = tmp_path / "p2s.toml"
+    mapping.write_text(
+        '[bodies]\npelvis = ["sacrum", "pelvis"]\nvertebrae = ["lumbar5", "lumbar4", "lumbar3", "lumbar2", "lumbar1"]\n'
+        'thorax = ["torso"]\n[planes]\nsagittal = ["L5_S1_Flex_Ext", "L4_L5_Flex_Ext", "L3_L4_Flex_Ext", '
+        '"L2_L3_Flex_Ext", "L1_L2_Flex_Ext"]\n'
+    )
+    result = _run("anatomy", str(SHARED), "--mapping", str(mapping), "--json")
+    if result.returncode == 0:  # an import that reads its muscles: the document alone
+        json.loads(result.stdout)
+    else:
+        assert result.stdout == "" and result.stderr.strip().splitlines()[-1].startswith("spinectl: error: ")
+    assert "Couldn't find file" in result.stderr and "Couldn't find file" not in result.stdout

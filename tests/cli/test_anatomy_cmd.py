@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import json
+import os
 
+import numpy as np
 import pytest
 
 from spinectl import jsondoc
@@ -81,7 +83,7 @@ def test_the_3d_mapping_is_named_all_three_planes(cached, capsys):
     [
         (["--activation", "1.5"], "activation: must be in [0, 1]"),
         (["--plane", "axial"], "plane: must be one of"),
-        (["--joint-stiffness", "soft"], "joint_stiffness: must be"),
+        (["--joint-stiffness", "soft"], "--joint-stiffness must be none, mapped or a number"),
         (["no-such-model"], "model: must be one of"),
     ],
 )
@@ -171,3 +173,60 @@ def test_an_infeasible_optimum_keeps_the_json_keys(cached, capsys):
     for key in ("eigenvalues", "joint_self_stable", "chain_stable"):
         assert infeasible[key] is None and infeasible[f"{key}_reason"] == "not_computed"
     assert infeasible["muscles"] == solved["muscles"] and infeasible["joints"] == solved["joints"]
+
+
+BOUND = "must be in [0, 1e+06] N m/rad, the bound of the chain's arithmetic"
+"""spinectl.anatomy.mapping.MAX_STIFFNESS: 1e6 N m/rad (its docstring: measured exact to 1e8, wrong from 1e9-1e12)."""
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--joint-stiffness", "1e308"], f"--joint-stiffness {BOUND}"),  # before: NaN eigenvalues, exit 0
+        (["--joint-stiffness", "1.1e6"], f"--joint-stiffness {BOUND}"),
+        (["--joint-stiffness", "-0.5"], f"--joint-stiffness {BOUND}"),
+        (["--kp", "1e308"], f"--kp {BOUND}"),  # before: a LinAlgError traceback
+        (["--kp", "2e6"], f"--kp {BOUND}"),
+        (["--kp", "100", "--kd", "1e300"], "--kd must be in [0, 1e+06] N m s/rad"),
+        (
+            ["--kp", "100", "--activation-lag", "5"],
+            "--activation-lag must be in [0, 1] s",
+        ),  # MAX_ACTIVATION_TIME_CONSTANT
+        (["--activation", "1e308"], "--activation must be at most 1e+06"),
+        (["--optimise", "--margin", "1e308"], f"--margin {BOUND}"),  # before: 90 s, then solver_error
+    ],
+)
+def test_every_number_has_its_bound(capsys, argv, message):
+    """Each numeric option of `anatomy` refused beyond the bound where its arithmetic holds: one line, exit 2,
+    before any model is loaded (argparse's type)."""
+    assert main(["anatomy", *argv]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == "" and message in captured.err and captured.err.count("\n") == 1
+
+
+def test_the_bounds_themselves_are_answers(cached, capsys):
+    """At the bounds (1e6 N m/rad added, kp = 1e6, kd = 1e6, lag 1 s) the answer is finite: the chain's
+    eigenvalues of -K all about 1e6 (the added stiffness dominates MyoTorso's own, |K_0| < 400 N m/rad), the
+    delay margin finite and positive."""
+    argv = ["anatomy", "--joint-stiffness", "1e6", "--kp", "1e6", "--kd", "1e6", "--activation-lag", "1", "--json"]
+    assert main(argv) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert np.allclose(doc["eigenvalues"], 1e6, rtol=1e-3)
+    assert doc["reflex"]["delay_margin_status"] == "finite" and 0 < doc["reflex"]["delay_margin_s"] < 1
+
+
+@pytest.mark.parametrize("kind", ["5000-character path", "300-character name", "folder", "fifo"])
+def test_a_model_path_that_is_no_file_is_one_line(tmp_path, capsys, kind):
+    """A model path too long for the file system (the whole path, or one name over 255 bytes), a folder, a FIFO:
+    `model: ...`, one line, exit 2 (before: an OSError traceback for the long names)."""
+    path = {
+        "5000-character path": "a" * 5000 + ".xml",
+        "300-character name": str(tmp_path / ("b" * 300 + ".osim")),
+        "folder": str(tmp_path),
+        "fifo": str(tmp_path / "model.xml"),
+    }[kind]
+    if kind == "fifo":
+        os.mkfifo(path)
+    assert main(["anatomy", path]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == "" and captured.err.startswith("spinectl: error: model: ") and captured.err.count("\n") == 1
