@@ -12,7 +12,7 @@ from ..errors import ParameterError
 from ..model.linear_chain import LinearChain
 from .engine import CONTROL_UNIT, Engine, load_engine, require_mujoco
 from .linearise import Linearisation, constrained_chain, free_chain, linearise, rhythm
-from .mapping import Mapping, check_mapping, classify, default_mapping, read_mapping
+from .mapping import MAX_STIFFNESS, Mapping, check_mapping, classify, default_mapping, read_mapping
 
 
 @dataclass
@@ -167,9 +167,11 @@ class Anatomy:
                 value = float(joint_stiffness)
             except (TypeError, ValueError):
                 value = -1.0
-            if not (np.isfinite(value) and value >= 0):
+            if not (np.isfinite(value) and 0 <= value <= MAX_STIFFNESS):  # the command line's bound, for Python too
                 raise ParameterError(
-                    "joint_stiffness", f"must be 'none', 'mapped' or a number >= 0 [N m/rad] (got {joint_stiffness!r})"
+                    "joint_stiffness",
+                    f"must be 'none', 'mapped' or a number in [0, {MAX_STIFFNESS:g}] N m/rad, beyond which the "
+                    f"chain's arithmetic fails (got {joint_stiffness!r})",
                 )
         return np.full(n, value)
 

@@ -85,6 +85,9 @@ def test_bad_criterion_is_refused(torso):
         optimise(torso, stability="diagonal")
     with pytest.raises(ParameterError, match="margin"):
         optimise(torso, margin=-1)
+    # the command line's bound holds from Python too (before: NaN eigenvalues at 1e308, exit 0 from the CLI)
+    with pytest.raises(ParameterError, match=r"joint_stiffness: must be .* in \[0, 1e\+06\] N m/rad"):
+        optimise(torso, joint_stiffness=1e308)
 
 
 def test_the_lordosis_moves_the_chain_along_the_rhythm(torso):
