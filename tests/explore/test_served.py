@@ -272,4 +272,7 @@ def test_sessions_beyond_the_bound_get_503_until_one_ends():
         browser_harness.wait_for_line(log, "session ended (1 open, at most 2)")
         assert _get_with(url, {})[0] == 200
     opened = [line.strip() for line in log if "session opened" in line]
-    assert opened == [f"spinectl explore: session opened ({n} open, at most 2)" for n in (1, 2, 2)]
+    assert opened[:2] == [f"spinectl explore: session opened ({n} open, at most 2)" for n in (1, 2)]
+    # the third: 2 open, or 1 where the other unconnected session ended too before it (both expire 15 s after
+    # they were made, a few ms apart; a loaded machine can order the lines either way)
+    assert len(opened) == 3 and opened[2] in {f"spinectl explore: session opened ({n} open, at most 2)" for n in (1, 2)}
