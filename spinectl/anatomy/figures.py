@@ -153,7 +153,11 @@ def lordosis_figure(curve: dict, title: str = ""):
     bottom.axhline(0.0, color="tab:red", lw=0.8)
     top.set_ylabel(r"least cost $\sum_i w_i a_i^2$ [1]")
     bottom.set_ylabel("least eigenvalue of -K [N m/rad]\n(free chain; < 0 unstable)")
-    bottom.set_xlabel("lordosis: change of the chain's summed angle along the rhythm [deg] (+: +flex_extension)")
+    bottom.set_xlabel(
+        "lordosis: change of the chain's summed angle along the rhythm [deg] (+: +flex_extension)\n"
+        "the thorax tilts with it: not a lordosis at a fixed upright trunk",
+        fontsize=8,
+    )
     top.legend(fontsize=8, title="criterion (star: least cost)", title_fontsize=8)
     top.set_title(title or "the three optima over the lordosis", fontsize=10)
     return fig

@@ -710,6 +710,13 @@ def lordosis_direction(anatomy: Anatomy, rhy, n: int, degrees: float) -> np.ndar
     return direction * np.radians(degrees) / direction[:n].sum()
 
 
+CURVE_MEANING = (
+    "the lordosis moves the chain along the model's rhythm from its posture, so the thorax above it tilts too: "
+    "not a lordosis at a fixed upright trunk"
+)
+"""What the anatomy's lordosis axis is, said wherever its curve is shown (table and figure)."""
+
+
 def lordosis_curve(
     anatomy: Anatomy,
     degrees,

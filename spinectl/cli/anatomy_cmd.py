@@ -249,7 +249,9 @@ def _degrees(text: str):
 
 def _curve_table(curve: dict) -> str:
     """The lordosis curve as rows: each criterion's least cost (or its status) per posture."""
-    lines = ["", "lordosis [deg]  cost: classic  joint by joint  the chain (free)"]
+    from ..anatomy.optimum import CURVE_MEANING
+
+    lines = ["", f"lordosis curve ({CURVE_MEANING})", "lordosis [deg]  cost: classic  joint by joint  the chain (free)"]
     for i, deg in enumerate(curve["lordosis_deg"]):
         cells = []
         for criterion in ("none", "joints", "chain"):

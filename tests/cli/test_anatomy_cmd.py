@@ -118,6 +118,17 @@ def test_lordosis_curve_in_json_and_bad_range(cached, capsys):
     assert "--lordosis: must be START:STOP:N" in capsys.readouterr().err
 
 
+def test_the_lordosis_curve_says_the_thorax_tilts_with_it(cached, capsys):
+    """The anatomy's lordosis axis moves the chain along the rhythm, which tilts the thorax: the table says so
+    above the curve (a reader took it for a lordosis at an upright trunk)."""
+    from spinectl.anatomy.optimum import CURVE_MEANING
+
+    assert main(["anatomy", "--lordosis", "-10:10:3", "--joint-stiffness", "50"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    head = lines.index(next(line for line in lines if line.startswith("lordosis [deg]")))
+    assert lines[head - 1] == f"lordosis curve ({CURVE_MEANING})" and "thorax" in CURVE_MEANING
+
+
 def test_reflex_options_give_the_delay_margin(cached, capsys):
     assert main(["anatomy", "--optimise", "--stability", "none", "--kp", "120", "--kd", "5", "--json"]) == 0
     reflex = json.loads(capsys.readouterr().out)["reflex"]
