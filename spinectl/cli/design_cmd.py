@@ -82,6 +82,9 @@ PASSIVE_EXAMPLE = "in N m/rad, e.g. 0:80:41"
 DELAYS_EXAMPLE = "in seconds, e.g. 0:0.2:41"
 """The forms of ``--passive`` and ``--delays``, for a malformed one."""
 
+STATIC_ONLY = ("--delay", "--activation-lag", "--activation", "--kp", "--kd")
+"""The reflex's options, which ``--passive`` does not use: refused with it rather than ignored."""
+
 OVERRIDES = (
     ("delay", "reflex.delay"),
     ("activation_lag", "reflex.activation_time_constant"),
@@ -112,6 +115,13 @@ def run(args) -> int:
     aliases |= body_aliases(args)  # --K and --mass, as on stability and margins
     if args.passive is not None and args.K is not None:
         raise ParameterError("--K", "cannot go with --passive, which varies K")
+    for option in STATIC_ONLY if args.passive is not None else ():
+        if getattr(args, option.lstrip("-").replace("-", "_")) is not None:  # before: ignored without a word
+            raise ParameterError(
+                option,
+                "cannot go with --passive, whose answers are static (no reflex: the global PCSA alone and the "
+                "least local stiffness at the minimum PCSA); a reflex's design is --delay or --delays without --passive",
+            )
     model = load_model(args, aliases)
     check_position(model, args)
     kp = None if args.kp is None else non_negative("--kp", args.kp)

@@ -216,3 +216,11 @@ def test_a_long_curve_is_announced_on_stderr_first(capsys, monkeypatch, argv, co
     monkeypatch.setattr(budget, constant, 100.0)
     assert main(argv) == 0
     assert capsys.readouterr().err == f"{line} (estimated)\n"
+
+
+@pytest.mark.parametrize(("option", "value"), [("--delay", "0.1"), ("--kp", "50"), ("--activation", "0.8")])
+def test_passive_refuses_the_reflexs_options_it_would_ignore(option, value, capsys):
+    """--passive's answers are static (the global PCSA alone, the least local stiffness at the minimum PCSA): a
+    reflex option beside it was ignored without a word (before: --delay 0.1 ran and said nothing of it)."""
+    message = _refusal(["design", "--passive", "0:80:3", "--E", "0.03", option, value], capsys)
+    assert message.startswith("cannot go with --passive, whose answers are static")
