@@ -120,7 +120,8 @@ def run(args) -> int:
             raise ParameterError(
                 option,
                 "cannot go with --passive, whose answers are static (no reflex: the global PCSA alone and the "
-                "least local stiffness at the minimum PCSA); a reflex's design is --delay or --delays without --passive",
+                "least local stiffness at the minimum PCSA); a reflex's design is --delay or --delays without "
+                "--passive",
             )
     model = load_model(args, aliases)
     check_position(model, args)

@@ -166,6 +166,30 @@ def table_html(numbers: PointNumbers) -> str:
     return f'{status}<table class="spinectl-numbers">{caption}<tr>{head}</tr>{body}</table>{chain_html(numbers)}'
 
 
+def verdicts_html(numbers: PointNumbers) -> str:
+    """The two verdicts at the delay, on the first screen: joint by joint, then the chain (red where not stable).
+
+    Parameters
+    ----------
+    numbers : PointNumbers
+
+    Returns
+    -------
+    str
+        Two ``<p>`` lines (:meth:`PointNumbers.verdicts`), keyed ``data-verdict="joint"`` and ``"chain"``.
+    """
+    held = (bool(np.all(numbers.stable_at_delay)), bool(numbers.chain.stable_at_delay))
+    lines = []
+    for key, text, ok in zip(("joint", "chain"), numbers.verdicts(), held, strict=True):
+        colour = "inherit" if ok else UNSTABLE_COLOUR
+        lines.append(f'<p data-verdict="{key}" style="margin:2px 0;color:{colour}"><b>{html.escape(text)}</b></p>')
+    return "".join(lines)
+
+
+UNSTABLE_COLOUR = "#b00020"
+"""The colour of a verdict that does not hold at the delay."""
+
+
 def chain_html(numbers: PointNumbers) -> str:
     """The chain's verdict under the same reflex, every CoR free, as a one-row HTML table captioned with its criterion.
 
@@ -253,6 +277,7 @@ class Explorer:
         self.drawing = pn.pane.SVG(None, width=int(views.DRAWING_SIZE[0] * DPI), name="drawing")
         self.views = {"eigenvalues": _EigenvalueView(), **{name: _BarView(name) for name in BAR_VIEWS}}
         self.table = pn.pane.HTML("", name="numbers")
+        self.verdicts = pn.pane.HTML("", name="verdicts")
         self.status = pn.pane.Markdown("", name="status")
         self.progress = pn.indicators.Progress(active=False, visible=False, width=200)
         self.design_button = pn.widgets.Button(label=DESIGN_LABEL, width=260)
@@ -312,7 +337,7 @@ class Explorer:
         )
         point = pn.Row(self.drawing, self.views["eigenvalues"].pane, self.views["counter_torques"].pane)
         below = pn.Row(self.views["delay_margins"].pane, *(view.pane for view in self.maps.values()))
-        return pn.Row(controls, pn.Column(point, below, self.table, self.design))
+        return pn.Row(controls, pn.Column(self.verdicts, point, below, self.table, self.design))
 
     # --- events ---------------------------------------------------------------------------
 
@@ -413,6 +438,7 @@ class Explorer:
                 if changed or view.name == "delay_margins":
                     view.show(numbers)
             self.table.object = table_html(numbers)
+            self.verdicts.object = verdicts_html(numbers)
             self._show_design()
             for view in self.maps.values():
                 view.mark(self.state)

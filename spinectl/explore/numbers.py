@@ -27,6 +27,7 @@ from ..model.stability import criterion, segment_stability
 from ..paper import grid
 from ..reflex.chain_margins import stable_at
 from ..reflex.chain_verdict import ChainReflexVerdict, margins_with_chain
+from ..reflex.delay import delay_text
 from ..reflex.design import Design, design
 from ..reflex.margins import MarginsReport, margins_report
 from ..units import m2_to_cm2
@@ -119,6 +120,26 @@ class PointNumbers:
             "growth_times_s": " to ".join(extremes),
             "slowest_time_constant_s": shown(modes.slowest_time_constant),
         }
+
+    def verdicts(self) -> list[str]:
+        """The two verdicts at the delay, each with its criterion, as the explorer's first lines say them.
+
+        Returns
+        -------
+        list of str
+            Joint by joint (how many segments are stable alone at the delay), then the chain under the same
+            reflex, every CoR free (stable or not, with its exact delay margin [s]).
+        """
+        delay = delay_text(self.state.delay)
+        alone = int(np.sum(self.stable_at_delay))
+        segments = "every segment" if alone == self.stable_at_delay.size else f"{alone} of {self.stable_at_delay.size}"
+        row = self.chain_row()
+        chain = {"yes": "stable", "no": "NOT stable", "undefined": "undefined"}[row["stable_at_delay"]]
+        return [
+            f"{self.criterion}: {segments} stable at τ = {delay}",
+            f"{row['criterion']}, the same reflex at every joint: {chain} at τ = {delay} "
+            f"(exact delay margin {delay_text(self.chain.exact.margin)})",
+        ]
 
     def rows(self) -> list[dict[str, str]]:
         """One row per segment, every number as shown (:func:`shown`), for the explorer's table.

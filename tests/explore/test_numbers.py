@@ -202,3 +202,31 @@ def test_the_previous_points_chain_is_reused_only_where_the_delay_alone_moved(st
     assert got.chain_row()["stable_at_delay"] == ("yes" if fresh.stable_at_delay else "no")
     reused = got.chain.exact is previous.chain.exact
     assert reused == ("delay" in change)
+
+
+def test_the_first_lines_give_both_verdicts_each_with_its_criterion():
+    """wagner2012 at E = 3 cm, Lambda = 4 cm, activation 0.5, 100 ms (the explorer's opening point): every segment
+    alone is stable at the delay while the chain is not (margins_with_chain, called here directly); the two lines
+    that head the page say both, each with its criterion and the chain's exact margin (before: the chain's verdict
+    was below the fold, under five green bars)."""
+    from spinectl.explore.app import UNSTABLE_COLOUR, verdicts_html
+    from spinectl.reflex.delay import delay_text
+
+    base = load_preset("wagner2012")
+    state = ExploreState(0.03, 0.04, mass=base.body.mass, stiffness=0.0, delay=0.1, activation=0.5,
+                         activation_lag=0.05)  # fmt: skip
+    numbers = nb.point_numbers(base, state)
+    report = margins_with_chain(_library_model(base, state), 0.03, 0.04)
+    assert all(s.stable_at_delay for s in report.segments) and not report.chain.stable_at_delay  # the premise
+    joint, chain_line = numbers.verdicts()
+    assert (
+        joint
+        == "joint by joint (each CoR alone, the others fixed; the paper's criterion): every segment stable at τ = 100 ms"
+    )
+    assert chain_line == (
+        "chain (all 5 CoRs free), the same reflex at every joint: NOT stable at τ = 100 ms "
+        f"(exact delay margin {delay_text(report.chain.exact.margin)})"
+    )
+    page = verdicts_html(numbers)
+    assert page.index('data-verdict="joint"') < page.index('data-verdict="chain"')
+    assert page.count(UNSTABLE_COLOUR) == 1 and page.index(UNSTABLE_COLOUR) > page.index('data-verdict="chain"')
