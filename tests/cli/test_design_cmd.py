@@ -187,9 +187,9 @@ def test_too_many_designs_are_refused_before_any_work(capsys, monkeypatch, delay
     """Delays times lags is bounded (params.bounds.MAX_DESIGNS = 10,000, about 50 ms each): 1000 delays at 200 lags
     (the issue's 200,000 designs, some 3 hours) and 101 delays at 100 lags, one above the bound, are one line,
     before any design is solved (before: accepted, with no estimate)."""
-    import spinectl.reflex.design as design
+    from spinectl.reflex.design import curve
 
-    monkeypatch.setattr(design, "checked_coefficients", lambda *a: pytest.fail("solved before the refusal"))
+    monkeypatch.setattr(curve, "checked_coefficients", lambda *a: pytest.fail("solved before the refusal"))
     values = ",".join(f"{i / 1000:g}" for i in range(lags))
     message = _refusal(["design", "--delays", delays, "--lags", values], capsys)
     assert message == f"must give at most 10,000 designs, delays times lags, about 50 ms each (got {product})"
