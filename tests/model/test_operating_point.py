@@ -20,7 +20,7 @@ from spinectl.model import chain, geometry
 from spinectl.model.linear_chain import LinearChain
 from spinectl.model.operating_point import OperatingPoint, chain_at
 from spinectl.model.stability import chain_modes
-from spinectl.optimise.coupled import coupled_stability_at, least_local_stiffness_stacked
+from spinectl.optimise.coupled import coupled_stability_at, least_local_stiffness_stacked, point_at_activation
 from spinectl.optimise.stabilising import minimum_stabilising_pcsa
 from spinectl.reflex import design as dz
 from spinectl.reflex.chain_verdict import chain_verdict
@@ -171,3 +171,17 @@ def test_an_analysis_of_a_linear_chain_runs_on_the_points_chain(model):
     _, least = least_local_stiffness_stacked(bare.stiffness_offset[None], mu)
     held = chain_at(OperatingPoint(model, E, LAMBDA, pcsa, local_stiffness=least[0]))
     assert static_margin(held) == pytest.approx(mu, abs=1e-6)  # Clarabel's tolerance [N m/rad]
+
+
+def test_the_point_at_an_activation_is_that_fraction_of_the_optimum(model):
+    """point_at_activation: the PCSA activation x the minimum stabilising PCSA (its own call here), bit for bit,
+    of any size (computed); 1 is the optimum itself, what stability --coupled takes without --pcsa; a negative
+    activation is one ParameterError naming it."""
+    optimum = minimum_stabilising_pcsa(model, E, LAMBDA)
+    np.testing.assert_array_equal(point_at_activation(model, E, LAMBDA, 0.5).pcsa, 0.5 * optimum)
+    np.testing.assert_array_equal(point_at_activation(model, E, LAMBDA).pcsa, optimum)
+    np.testing.assert_array_equal(coupled_stability_at(model, E, LAMBDA).pcsa, optimum)
+    assert point_at_activation(model, E, LAMBDA, 1e4).pcsa.max() > 0.1  # beyond MAX_PLAUSIBLE_PCSA: computed
+    with pytest.raises(ParameterError) as err:
+        point_at_activation(model, E, LAMBDA, -0.5)
+    assert err.value.field == "activation"

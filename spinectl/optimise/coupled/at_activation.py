@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..._validate import non_negative
 from ...model import chain
 from ...model.checks import arithmetic_guard, expand_pcsa
 from ...model.linear_chain import LinearChain
@@ -223,6 +224,41 @@ class CoupledStability:
         return "\n".join(lines)
 
 
+def point_at_activation(
+    model: Model, eccentricity: float, lordosis: float, activation: float = 1.0, local_stiffness=0.0
+) -> OperatingPoint:
+    """The operating point at a fraction of the minimum stabilising PCSA: activation x A* (docs/chain.md).
+
+    The activation becomes the point's PCSA here, in the optimiser's layer: A* is
+    :func:`~spinectl.optimise.stabilising.minimum_stabilising_pcsa` (the fast path), computed, so of any size.
+
+    Parameters
+    ----------
+    model : Model
+    eccentricity, lordosis : float
+        E and Lambda [m].
+    activation : float
+        The fraction of A* [1], >= 0; 1 (the default): A* itself.
+    local_stiffness : float or array_like, shape (n_cor,)
+        k_j >= 0 added at each joint [N m/rad]; 0 (the default): none.
+
+    Returns
+    -------
+    OperatingPoint
+        PCSA activation x A* [m^2].
+
+    Raises
+    ------
+    ParameterError
+        ``activation`` negative or not a number; a field of the point out of range.
+    ModelError
+        No activation within the bounds stabilises every segment (no A*), or the model cannot be evaluated there.
+    """
+    activation = non_negative("activation", activation)
+    pcsa = minimum_stabilising_pcsa(model, eccentricity, lordosis)
+    return OperatingPoint(model, eccentricity, lordosis, activation * pcsa, local_stiffness, slip_check=False)
+
+
 def coupled_stability_at(
     model: Model, eccentricity: float, lordosis: float, pcsa=None, *, slip_check: bool = True
 ) -> CoupledStability:
@@ -266,9 +302,12 @@ def coupled_stability_at(
     """
     e, lam = float(eccentricity), float(lordosis)
     given = pcsa is not None and slip_check  # a computed optimum, or a checked unit: any size is an answer
-    pcsa = expand_pcsa(model, pcsa, given=given) if pcsa is not None else minimum_stabilising_pcsa(model, e, lam)
-    data = coupled_data(model, e, lam)
-    at_point = chain_at(OperatingPoint(model, e, lam, pcsa, slip_check=given))
+    point = (
+        point_at_activation(model, e, lam)
+        if pcsa is None  # the PCSA's errors before the position's, as ever:
+        else OperatingPoint(model, e, lam, expand_pcsa(model, pcsa, given=given), slip_check=given)
+    )
+    pcsa, at_point, data = point.pcsa, chain_at(point), coupled_data(model, e, lam)
     local = least_local_stiffness(model, e, lam, pcsa, given=given)  # the SDP, outside numpy's guard
     with arithmetic_guard(e, lam):
         mass, stiffness, damping = at_point.mass_matrix, at_point.stiffness_offset, at_point.damping_offset
