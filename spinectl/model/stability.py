@@ -16,15 +16,19 @@ References
 
 from __future__ import annotations
 
+import contextlib
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import ParameterError
 from ..units import m2_to_cm2
-from . import chain, geometry
+from . import chain
 from .checks import arithmetic_guard, checked_coefficients, expand_pcsa
+from .linear_chain import LinearChain
 from .mechanics import SegmentCoefficients
+from .operating_point import OperatingPoint, chain_at
 from .params import Model
 from .source import header, provenance
 
@@ -539,7 +543,11 @@ class ChainModes:
 
 
 def chain_modes(model: Model, eccentricity: float, lordosis: float, pcsa, local_stiffness=0.0) -> ChainModes:
-    """The chain's modes at a global PCSA: its matrices (milliseconds) and their eigenvalues.
+    """The chain's modes at a global PCSA: :func:`modes_of` the chain at that operating point (milliseconds).
+
+    The chain is :func:`~spinectl.model.operating_point.chain_at` the
+    :class:`~spinectl.model.operating_point.OperatingPoint` of these arguments (``pcsa`` as computed: no
+    unit-slip check).
 
     Parameters
     ----------
@@ -557,18 +565,45 @@ def chain_modes(model: Model, eccentricity: float, lordosis: float, pcsa, local_
     ChainModes
         The eigenvalues [1/s] of :func:`spinectl.model.chain.dynamic_eigenvalues`.
 
+    Raises
+    ------
+    ParameterError
+        A field of the operating point out of range (:class:`~spinectl.model.operating_point.OperatingPoint`).
+
     References
     ----------
     Bergmark A (1989). Stability of the lumbar spine. A study in mechanical engineering.
     Acta Orthop Scand Suppl 230:1-54. doi:10.3109/17453678909154177.
     """
-    e, lam = float(eccentricity), float(lordosis)
-    with arithmetic_guard(e, lam):
-        coefficients = chain.chain_coefficients(model, e, lam)
-        mass = chain.mass_matrix(model, geometry.cor_positions(e, lam, model.geometry))
-        stiffness = coefficients.stiffness(pcsa, local_stiffness)
-        eigs = chain.dynamic_eigenvalues(mass, stiffness, coefficients.damping(pcsa, local_stiffness))
-    return ChainModes(segment_names=model.geometry.cor_names, eigenvalues=eigs)
+    point = OperatingPoint(model, eccentricity, lordosis, pcsa, local_stiffness, slip_check=False)
+    return modes_of(chain_at(point), guard=arithmetic_guard(point.eccentricity, point.lordosis))
+
+
+def modes_of(linear: LinearChain, guard=None) -> ChainModes:
+    """The modes of a chain at its operating point: the eigenvalues of its M, K and D (an analysis of a chain).
+
+    Parameters
+    ----------
+    linear : LinearChain
+        Fixed at its operating point, without controls (:func:`spinectl.model.operating_point.chain_at`).
+    guard : context manager, optional
+        Around the arithmetic (:func:`~spinectl.model.checks.arithmetic_guard` of the point); default none.
+
+    Returns
+    -------
+    ChainModes
+        The eigenvalues [1/s] of :func:`spinectl.model.chain.dynamic_eigenvalues`; NaN where M is singular.
+
+    Raises
+    ------
+    ParameterError
+        A chain with free controls.
+    """
+    if linear.n_controls:
+        raise ParameterError("chain", f"must be fixed at its operating point (got {linear.n_controls} free controls)")
+    with guard if guard is not None else contextlib.nullcontext():
+        eigs = chain.dynamic_eigenvalues(linear.mass_matrix, linear.stiffness_offset, linear.damping_offset)
+    return ChainModes(segment_names=linear.joints, eigenvalues=eigs)
 
 
 def segment_stability(

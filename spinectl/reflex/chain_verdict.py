@@ -2,12 +2,13 @@
 
 ``spinectl margins`` judges each segment alone, the others fixed (the paper's criterion). The
 same operating point and the same reflex rule on the whole chain, every CoR free, can give the
-opposite answer; so the report carries both. The chain's matrices cost milliseconds
-(:func:`spinectl.model.stability.chain_modes`), its least local stiffness one small Clarabel
-problem (:func:`spinectl.optimise.coupled.least_local_stiffness_stacked`, the deficit the
-rule :func:`spinectl.reflex.gains.chain_gains` compensates) and its exact delay margin one
-delay-free eigenvalue problem (:func:`spinectl.reflex.mimo.chain_delay_margin`); ``--coupled`` keeps the
-full report (disk margins, Padé loop: :mod:`spinectl.reflex.chain_margins`).
+opposite answer; so the report carries both. The chain at the operating point costs milliseconds
+(:func:`spinectl.model.operating_point.chain_at`; its modes, :func:`spinectl.model.stability.modes_of`),
+its least local stiffness one small Clarabel problem
+(:func:`spinectl.optimise.coupled.least_local_stiffness_stacked`, the deficit the rule
+:func:`spinectl.reflex.gains.chain_gains` compensates) and its exact delay margin one delay-free eigenvalue
+problem (:func:`spinectl.reflex.mimo.chain_delay_margin`); ``--coupled`` keeps the full report (disk margins,
+Padé loop: :mod:`spinectl.reflex.chain_margins`).
 """
 
 from __future__ import annotations
@@ -17,15 +18,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..model import chain, geometry
 from ..model.checks import arithmetic_guard
+from ..model.operating_point import OperatingPoint, chain_at
 from ..model.params import Model
-from ..model.stability import CHAIN_DEPENDS_ON, ChainModes, chain_modes, criterion
+from ..model.stability import CHAIN_DEPENDS_ON, ChainModes, criterion, modes_of
 from ..optimise.coupled import least_local_stiffness_stacked
 from .chain_margins import stable_at
 from .delay import delay_text
 from .gains import resolve_chain_gains
-from .margins import MarginsReport, OperatingPoint, margins_report
+from .margins import ActivationPoint, MarginsReport, margins_report
 from .mimo import chain_delay_margin
 from .siso import LoopDelayMargin
 
@@ -119,7 +120,7 @@ class ChainReflexVerdict:
 
 
 def chain_verdict(
-    model: Model, point: OperatingPoint, delay: float, lag: float, kp=None, kd=None
+    model: Model, point: ActivationPoint, delay: float, lag: float, kp=None, kd=None
 ) -> ChainReflexVerdict:
     """The chain at ``point`` under the delayed reflex: the rule on the chain, or the explicit gains.
 
@@ -127,7 +128,7 @@ def chain_verdict(
     ----------
     model : Model
         ``model.reflex`` gives the rule's settings and its ``gains`` ('rule' or 'explicit').
-    point : OperatingPoint
+    point : ActivationPoint
         The operating point of :func:`spinectl.reflex.margins.operating_point`.
     delay, lag : float
         tau [s] and T_a [s].
@@ -142,11 +143,9 @@ def chain_verdict(
     e, lam = point.eccentricity, point.lordosis
     settings, n = model.reflex, len(model.geometry.cor_names)
     pcsa = point.pcsa if point.ok else np.zeros_like(point.pcsa)
-    modes = chain_modes(model, e, lam, pcsa)
-    with arithmetic_guard(e, lam):
-        coefficients = chain.chain_coefficients(model, e, lam)
-        stiffness, damping = coefficients.stiffness(pcsa), coefficients.damping(pcsa)
-        mass = chain.mass_matrix(model, geometry.cor_positions(e, lam, model.geometry))
+    linear = chain_at(OperatingPoint(model, e, lam, pcsa, slip_check=False))
+    modes = modes_of(linear, guard=arithmetic_guard(e, lam))
+    mass, stiffness, damping = linear.mass_matrix, linear.stiffness_offset, linear.damping_offset
     if not (point.ok and modes.defined):  # no optimum, or levels without mass: nothing to judge
         nan = np.full(n, np.nan)
         modes = dataclasses.replace(modes, eigenvalues=np.full(2 * n, complex(np.nan, np.nan)))  # no optimum: undefined

@@ -34,8 +34,12 @@ SKIPPED = "skipped"
 
 
 @dataclass(frozen=True)
-class OperatingPoint:
+class ActivationPoint:
     """PCSA and linearised segments at one (E, Lambda) and activation level.
+
+    The activation resolved into a PCSA by the optimiser, and each segment alone at it; the chain at the
+    same PCSA is :func:`~spinectl.model.operating_point.chain_at` its
+    :class:`~spinectl.model.operating_point.OperatingPoint` (:func:`spinectl.reflex.chain_verdict.chain_verdict`).
 
     Attributes
     ----------
@@ -70,7 +74,7 @@ class OperatingPoint:
         return bool(np.all(np.isfinite(self.pcsa)))
 
 
-def operating_point(model: Model, eccentricity: float, lordosis: float, activation: float) -> OperatingPoint:
+def operating_point(model: Model, eccentricity: float, lordosis: float, activation: float) -> ActivationPoint:
     """PCSA = activation x ``solve_point(model, E, Lambda).pcsa`` and the segments it gives.
 
     An infeasible optimum is reported in ``status`` with NaN values, never raised.
@@ -85,7 +89,7 @@ def operating_point(model: Model, eccentricity: float, lordosis: float, activati
 
     Returns
     -------
-    OperatingPoint
+    ActivationPoint
         The PCSA [m^2] and each segment's S [N m/rad], D [N m s/rad] and theta [kg m^2] there.
     """
     coeffs = checked_coefficients(model, float(eccentricity), float(lordosis))
@@ -94,7 +98,7 @@ def operating_point(model: Model, eccentricity: float, lordosis: float, activati
     else:
         optimum = solve_point(model, eccentricity, lordosis)
         status, pcsa = optimum.status, activation * optimum.pcsa
-    return OperatingPoint(
+    return ActivationPoint(
         eccentricity=float(eccentricity),
         lordosis=float(lordosis),
         activation=float(activation),
@@ -293,7 +297,7 @@ class MarginsReport:
 
     Attributes
     ----------
-    point : OperatingPoint
+    point : ActivationPoint
     delay : float
         Reflex delay tau [s].
     activation_time_constant : float
@@ -312,7 +316,7 @@ class MarginsReport:
         (:func:`spinectl.reflex.chain_verdict.margins_with_chain`); None: the segments' alone.
     """
 
-    point: OperatingPoint
+    point: ActivationPoint
     delay: float
     activation_time_constant: float
     pade_order: int

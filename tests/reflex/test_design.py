@@ -7,6 +7,7 @@ import pytest
 
 from spinectl.model import chain, config
 from spinectl.model.checks import checked_coefficients
+from spinectl.model.operating_point import OperatingPoint, chain_at
 from spinectl.reflex import design as dz
 from spinectl.reflex import margins
 from spinectl.reflex.chain_margins import stable_at
@@ -75,10 +76,11 @@ def test_the_chain_design_has_its_certificate_and_a_little_less_fails(local_damp
     result = dz.chain_design(model, 0.03, 0.04, 0.5 * optimum, 0.5)
     assert 0 < result.fraction <= 1 and result.delay_margin >= 0.12 and result.max_root_real < 0
     assert result.fraction < 0.75 if local_damping else result.fraction > 0.999  # the damping lets the reflex help
-    mass, stiffness, damping = dz.chain_matrices(model, 0.03, 0.04, 0.5 * optimum)
+    linear = chain_at(OperatingPoint(model, 0.03, 0.04, 0.5 * optimum, slip_check=False))
+    mass = linear.mass_matrix
 
     def loop(f):
-        return dz.chain_loop_at(model, mass, stiffness, damping, result.least_static, f)
+        return dz.chain_loop_at(model, linear, result.least_static, f)
 
     k, d, kp, kd = loop(result.fraction)
     exact = chain_delay_margin(mass, k, d, kp, kd, 0.05)
@@ -95,19 +97,20 @@ def test_the_chains_loop_carries_the_local_muscles_damping():
     """chain_loop_at at local stiffness f k*: the stiffness K - f diag(k*) and the damping D - c_loc f diag(k*),
     c_loc = (1 + a) / (q hill_b (vmax_slow + vmax_fast_gain FT) l_opt/l) by hand (docs/chain.md); the rule's
     gains do not depend on the local damping (they are set at f = 0). With local.damping = 0 the damping is the
-    global muscles' D bit for bit, the stiffness-only model."""
+    global muscles' D bit for bit, the stiffness-only model (c_loc is the chain's: the chain of each model)."""
     on = _subject(**{"reflex.activation": 0.5})
     off = _subject(**{"reflex.activation": 0.5, "local.damping": 0.0})
     optimum = margins.solve_point(on, 0.03, 0.04).pcsa
-    mass, stiffness, damping = dz.chain_matrices(on, 0.03, 0.04, 0.5 * optimum)
+    linear = chain_at(OperatingPoint(on, 0.03, 0.04, 0.5 * optimum, slip_check=False))
+    stiffness, damping = linear.stiffness_offset, linear.damping_offset
     least, f = np.array([60.0, 90.0, 95.0, 66.0, 19.0]), 0.7
     fibre = on.fibre
     b = fibre.hill_b * (fibre.vmax_slow + fibre.vmax_fast_gain * fibre.fast_twitch) * fibre.optimal_length_ratio
     c_loc = (1.0 + fibre.hill_a) / b / on.local.stiffness_gain
-    k, d, kp, kd = dz.chain_loop_at(on, mass, stiffness, damping, least, f)
+    k, d, kp, kd = dz.chain_loop_at(on, linear, least, f)
     np.testing.assert_array_equal(k, stiffness - f * np.diag(least))
     np.testing.assert_allclose(d, damping - c_loc * f * np.diag(least), rtol=1e-12, atol=1e-12)
-    k0, d0, kp0, kd0 = dz.chain_loop_at(off, mass, stiffness, damping, least, f)
+    k0, d0, kp0, kd0 = dz.chain_loop_at(off, chain_at(OperatingPoint(off, 0.03, 0.04, 0.5 * optimum)), least, f)
     np.testing.assert_array_equal(d0, damping)
     np.testing.assert_array_equal(k0, k)
     np.testing.assert_array_equal(kp0, kp)
@@ -181,11 +184,12 @@ def test_the_chains_largest_delay_met_is_the_largest_any_tried_design_meets():
     model = config.set_parameters(config.load_preset("wagner2012"), {"reflex.delay": 0.12})
     optimum = margins.solve_point(model, 0.03, 0.04).pcsa
     result = dz.chain_design(model, 0.03, 0.04, 0.5 * optimum, 0.5)
-    mass, stiffness, damping = dz.chain_matrices(model, 0.03, 0.04, 0.5 * optimum)
+    linear = chain_at(OperatingPoint(model, 0.03, 0.04, 0.5 * optimum, slip_check=False))
+    mass = linear.mass_matrix
     lag = model.reflex.activation_time_constant
 
     def margin(f):
-        k, d, kp, kd = dz.chain_loop_at(model, mass, stiffness, damping, result.least_static, f)
+        k, d, kp, kd = dz.chain_loop_at(model, linear, result.least_static, f)
         if not (np.any(kp) or np.any(kd)):  # no reflex: every delay, where the chain holds itself
             return np.inf if chain.coupled_margin(k) > 0 else 0.0
         exact = chain_delay_margin(mass, k, d, kp, kd, lag)

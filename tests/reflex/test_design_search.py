@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from spinectl.model import config
+from spinectl.model.operating_point import OperatingPoint, chain_at
 from spinectl.optimise.coupled import least_local_stiffness_stacked
 from spinectl.reflex import design as dz
 from spinectl.reflex.chain_margins import stable_at
@@ -39,12 +40,13 @@ def test_the_chain_curve_equals_a_plain_bisection_and_is_certified():
     grid of 2^-20, and the fractions that meet form an interval here, so both end at its least grid point); and the
     curve's fraction is certified by the same verdict: it meets the delay, 2^-20 less does not."""
     model = _subject()
-    mass, stiffness, damping = dz.chain_matrices(model, 0.03, 0.04, model.reflex.activation * _optimum(model))
-    _, least = least_local_stiffness_stacked(stiffness[None], model.optimisation.stability_margin)
+    linear = chain_at(OperatingPoint(model, 0.03, 0.04, model.reflex.activation * _optimum(model), slip_check=False))
+    mass = linear.mass_matrix
+    _, least = least_local_stiffness_stacked(linear.stiffness_offset[None], model.optimisation.stability_margin)
     lag = model.reflex.activation_time_constant
 
     def meets(f, d):
-        k, dl, p, dd = dz.chain_loop_at(model, mass, stiffness, damping, least[0], f)
+        k, dl, p, dd = dz.chain_loop_at(model, linear, least[0], f)
         exact = chain_delay_margin(mass, k, dl, p, dd, lag)
         if not (stable_at(exact, d) and exact.margin >= d):
             return False
@@ -81,7 +83,7 @@ def test_the_search_is_certified_where_the_margin_jumps_and_bends(monkeypatch):
     the kink, the curve's fraction meets the delay and 2^-20 less does not (read from _tau itself: a margin equal to
     the delay is a root on the axis, which does not meet it, as stable_at says), and it equals a plain bisection of
     _tau > d exactly (both on the grid of 2^-20; at 30 ms the change falls on a grid point, f = 0.25)."""
-    monkeypatch.setattr(dc, "chain_loop_at", lambda *a: (np.array([a[5]]), None, np.array([1.0 - a[5]]), np.ones(1)))
+    monkeypatch.setattr(dc, "chain_loop_at", lambda *a: (np.array([a[3]]), None, np.array([1.0 - a[3]]), np.ones(1)))
     monkeypatch.setattr(dc, "chain_delay_margin", lambda m, k, *a: from_crossings([1.0], [_tau(k[0])], [1.0], True))
     monkeypatch.setattr(dc, "rightmost_root", lambda m, k, dl, p, dd, d, lag, *_: complex(1.0 - 2.0 * (_tau(k[0]) > d)))
     delays = np.linspace(0.0, 0.2, 21)

@@ -41,7 +41,8 @@ One module per programme; the SDP cores are written on any
 - :mod:`~spinectl.optimise.coupled.global_pcsa`: (b);
 - :mod:`~spinectl.optimise.coupled.joint`: (c) and the Pareto front;
 - :mod:`~spinectl.optimise.coupled.stacked_sdp`: (a) and (c) for a chunk of points, one Clarabel problem;
-- :mod:`~spinectl.optimise.coupled.at_activation`: the chain at one activation (``spinectl stability --coupled``).
+- :mod:`~spinectl.optimise.coupled.at_activation`: the operating point at an activation, and the chain there
+  (``spinectl stability --coupled``).
 
 Every public name of these modules is also here: ``spinectl.optimise.coupled.joint_optimum``
 as before the split.
@@ -52,7 +53,7 @@ Bergmark A (1989). Stability of the lumbar spine. A study in mechanical engineer
 Acta Orthop Scand Suppl 230:1-54. doi:10.3109/17453678909154177.
 """
 
-from .at_activation import CoupledStability, coupled_stability_at
+from .at_activation import CoupledStability, coupled_stability_at, point_at_activation
 from .data import CoupledData, CoupledOptimum, coupled_data
 from .global_pcsa import min_global_pcsa, min_global_pcsa_sdp
 from .joint import (
@@ -99,6 +100,7 @@ __all__ = [
     "min_global_pcsa",
     "min_global_pcsa_sdp",
     "pareto_front",
+    "point_at_activation",
     "shifted",
     "svec",
 ]

@@ -11,9 +11,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..._validate import non_negative
 from ...model import chain
 from ...model.checks import arithmetic_guard, expand_pcsa
 from ...model.linear_chain import LinearChain
+from ...model.operating_point import OperatingPoint, chain_at
 from ...model.params import Model
 from ...model.source import header, provenance
 from ...model.stability import criterion, eigenvalue_text, self_stable
@@ -31,22 +33,17 @@ class CoupledStability:
     ----------
     eccentricity, lordosis : float
         E and Lambda [m].
-    segment_names : tuple of str
-        The joints, top to bottom.
     variable_names : tuple of str
         The decision variables: the pairs (paired activation) or the muscles (independent).
     pcsa : numpy.ndarray, shape (n_muscles,)
         Global PCSA of each muscle [m^2].
-    stiffness : numpy.ndarray, shape (n_cor, n_cor)
-        K: global muscles, gravity and passive stiffness [N m/rad].
+    chain : LinearChain
+        The chain at this operating point (:func:`spinectl.model.operating_point.chain_at`): its joints
+        (:attr:`segment_names`), K (:attr:`stiffness`), D (:attr:`damping`) and M (:attr:`mass`).
     gravity_stiffness : numpy.ndarray, shape (n_cor, n_cor)
         K_g [N m/rad].
     stiffness_per_variable : numpy.ndarray, shape (n_var, n_cor, n_cor)
         dK/dx of each decision variable [N m/rad per cm^2].
-    damping : numpy.ndarray, shape (n_cor, n_cor)
-        D [N m s/rad].
-    mass : numpy.ndarray, shape (n_cor, n_cor)
-        M [kg m^2] (:func:`spinectl.model.chain.mass_matrix`).
     local : CoupledOptimum
         The least local stiffness that makes the chain statically stable at this activation
         (:func:`least_local_stiffness`, problem (a)).
@@ -60,14 +57,11 @@ class CoupledStability:
 
     eccentricity: float
     lordosis: float
-    segment_names: tuple[str, ...]
     variable_names: tuple[str, ...]
     pcsa: np.ndarray
-    stiffness: np.ndarray
+    chain: LinearChain
     gravity_stiffness: np.ndarray
     stiffness_per_variable: np.ndarray
-    damping: np.ndarray
-    mass: np.ndarray
     local: CoupledOptimum
     margin: float
     eigenvalues: np.ndarray
@@ -75,24 +69,32 @@ class CoupledStability:
 
     @property
     def linear_chain(self) -> LinearChain:
-        """The chain at this activation as a :class:`~spinectl.model.linear_chain.LinearChain` without controls.
+        """The chain at this activation (:attr:`chain`): the linear system the reflex analyses take.
 
-        K_0 = K (global muscles, gravity, passive), D_0 = D and M: the linear system the reflex
-        analyses take (:func:`spinectl.reflex.chain_margins.chain_reflex_margins`).
+        :func:`spinectl.reflex.chain_margins.chain_reflex_margins`,
+        :func:`spinectl.reflex.gain_search.search_chain_gains`.
         """
-        n = len(self.segment_names)
-        return LinearChain(
-            joints=self.segment_names,
-            controls=(),
-            control_class=(),
-            stiffness_per_control=np.zeros((n, n, 0)),
-            damping_per_control=np.zeros((n, n, 0)),
-            stiffness_offset=self.stiffness,
-            damping_offset=self.damping,
-            mass_matrix=self.mass,
-            lower=np.zeros(0),
-            upper=np.zeros(0),
-        )
+        return self.chain
+
+    @property
+    def segment_names(self) -> tuple[str, ...]:
+        """The joints, top to bottom."""
+        return self.chain.joints
+
+    @property
+    def stiffness(self) -> np.ndarray:
+        """K: global muscles, gravity and passive stiffness [N m/rad], shape (n_cor, n_cor)."""
+        return self.chain.stiffness_offset
+
+    @property
+    def damping(self) -> np.ndarray:
+        """D [N m s/rad], shape (n_cor, n_cor)."""
+        return self.chain.damping_offset
+
+    @property
+    def mass(self) -> np.ndarray:
+        """M [kg m^2] (:func:`spinectl.model.chain.mass_matrix`), shape (n_cor, n_cor)."""
+        return self.chain.mass_matrix
 
     @property
     def self_stable(self) -> bool:
@@ -222,13 +224,47 @@ class CoupledStability:
         return "\n".join(lines)
 
 
+def point_at_activation(
+    model: Model, eccentricity: float, lordosis: float, activation: float = 1.0, local_stiffness=0.0
+) -> OperatingPoint:
+    """The operating point at a fraction of the minimum stabilising PCSA: activation x A* (docs/chain.md).
+
+    The activation becomes the point's PCSA here, in the optimiser's layer: A* is
+    :func:`~spinectl.optimise.stabilising.minimum_stabilising_pcsa` (the fast path), computed, so of any size.
+
+    Parameters
+    ----------
+    model : Model
+    eccentricity, lordosis : float
+        E and Lambda [m].
+    activation : float
+        The fraction of A* [1], >= 0; 1 (the default): A* itself.
+    local_stiffness : float or array_like, shape (n_cor,)
+        k_j >= 0 added at each joint [N m/rad]; 0 (the default): none.
+
+    Returns
+    -------
+    OperatingPoint
+        PCSA activation x A* [m^2].
+
+    Raises
+    ------
+    ParameterError
+        ``activation`` negative or not a number; a field of the point out of range.
+    ModelError
+        No activation within the bounds stabilises every segment (no A*), or the model cannot be evaluated there.
+    """
+    activation = non_negative("activation", activation)
+    pcsa = minimum_stabilising_pcsa(model, eccentricity, lordosis)
+    return OperatingPoint(model, eccentricity, lordosis, activation * pcsa, local_stiffness, slip_check=False)
+
+
 def coupled_stability_at(
     model: Model, eccentricity: float, lordosis: float, pcsa=None, *, slip_check: bool = True
 ) -> CoupledStability:
     """The coupled chain at a global activation, by default the per-segment optimum.
 
-    The matrices of :func:`spinectl.model.chain.chain_coefficients` and
-    :func:`spinectl.model.chain.mass_matrix` at that activation, the static margin
+    The chain at that operating point (:func:`spinectl.model.operating_point.chain_at`), the static margin
     (:func:`spinectl.model.chain.coupled_margin`), the dynamic eigenvalues
     (:func:`spinectl.model.chain.dynamic_eigenvalues`) and the least local stiffness
     (:func:`least_local_stiffness`); docs/chain.md.
@@ -266,28 +302,26 @@ def coupled_stability_at(
     """
     e, lam = float(eccentricity), float(lordosis)
     given = pcsa is not None and slip_check  # a computed optimum, or a checked unit: any size is an answer
-    pcsa = expand_pcsa(model, pcsa, given=given) if pcsa is not None else minimum_stabilising_pcsa(model, e, lam)
-    data = coupled_data(model, e, lam)
-    coefficients = data.coefficients
+    point = (
+        point_at_activation(model, e, lam)
+        if pcsa is None  # the PCSA's errors before the position's, as ever:
+        else OperatingPoint(model, e, lam, expand_pcsa(model, pcsa, given=given), slip_check=given)
+    )
+    pcsa, at_point, data = point.pcsa, chain_at(point), coupled_data(model, e, lam)
     local = least_local_stiffness(model, e, lam, pcsa, given=given)  # the SDP, outside numpy's guard
     with arithmetic_guard(e, lam):
-        stiffness = coefficients.stiffness(pcsa)
-        damping = coefficients.damping(pcsa)
-        mass = data.chain.mass_matrix
+        mass, stiffness, damping = at_point.mass_matrix, at_point.stiffness_offset, at_point.damping_offset
         eigenvalues = chain.dynamic_eigenvalues(mass, stiffness, damping)
-        k = local.local_stiffness  # its stiffness and the damping of its force-velocity slope
-        with_local = chain.dynamic_eigenvalues(mass, stiffness - np.diag(k), coefficients.damping(pcsa, k))
+        k = local.local_stiffness  # its stiffness and the damping of its force-velocity slope; NaN if (a) failed
+        with_local = chain.dynamic_eigenvalues(mass, at_point.stiffness((), k), at_point.damping((), k))
     return CoupledStability(
         eccentricity=e,
         lordosis=lam,
-        segment_names=data.chain.joints,
         variable_names=data.chain.controls,
         pcsa=pcsa,
-        stiffness=stiffness,
-        gravity_stiffness=coefficients.gravity_stiffness,
+        chain=at_point,
+        gravity_stiffness=data.coefficients.gravity_stiffness,
         stiffness_per_variable=np.moveaxis(data.chain.stiffness_per_control, -1, 0),
-        damping=damping,
-        mass=mass,
         local=local,
         margin=float(chain.coupled_margin(stiffness)),
         eigenvalues=eigenvalues,

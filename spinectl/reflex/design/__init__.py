@@ -10,7 +10,7 @@ reflex's activation, :mod:`~spinectl.reflex.design.chain` (with its independent 
 :mod:`~spinectl.reflex.design.passive`.
 """
 
-from .chain import CHAIN_SCAN, chain_curve, chain_design, chain_loop_at, chain_matrices
+from .chain import CHAIN_SCAN, chain_curve, chain_design, chain_loop_at
 from .curve import delay_curve, design
 from .joint import BISECTIONS, SCAN, joint_design, least_activations, scan_margins, segment_margins_at
 from .passive import (
@@ -44,7 +44,6 @@ __all__ = [
     "chain_curve",
     "chain_design",
     "chain_loop_at",
-    "chain_matrices",
     "crisco_stiffness",
     "delay_curve",
     "design",

@@ -27,8 +27,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...model import chain, geometry
+from ...model.chain import coupled_margin
 from ...model.checks import arithmetic_guard
+from ...model.linear_chain import LinearChain
+from ...model.operating_point import OperatingPoint, chain_at
 from ...model.params import Model
 from ...optimise.coupled import least_local_stiffness_stacked
 from .. import gains
@@ -44,41 +46,22 @@ CHAIN_SCAN = 11
 (:attr:`ChainDesign.largest_delay`) and whether the scan shows the set of designs met to be an interval."""
 
 
-def chain_matrices(model: Model, eccentricity: float, lordosis: float, pcsa):
-    """M, K and D of the chain at a global PCSA [kg m^2], [N m/rad], [N m s/rad] (docs/chain.md).
-
-    Parameters
-    ----------
-    model : Model
-    eccentricity, lordosis : float
-        E and Lambda [m].
-    pcsa : array_like, shape (n_muscles,)
-        Global PCSA [m^2].
-
-    Returns
-    -------
-    mass, stiffness, damping : numpy.ndarray, shape (n_cor, n_cor)
-    """
-    with arithmetic_guard(eccentricity, lordosis):
-        coefficients = chain.chain_coefficients(model, eccentricity, lordosis)
-        mass = chain.mass_matrix(model, geometry.cor_positions(eccentricity, lordosis, model.geometry))
-        return mass, coefficients.stiffness(pcsa), coefficients.damping(pcsa)
-
-
-def chain_loop_at(model: Model, mass, stiffness, damping, least_static, fraction, kp=None, kd=None):
+def chain_loop_at(model: Model, linear: LinearChain, least_static, fraction, kp=None, kd=None):
     """The chain with local stiffness f k* and its damping, and its reflex gains: (1 - f)+ times the rule's.
 
     The rule on the chain (:func:`spinectl.reflex.gains.chain_gains`) at f = 0 compensates the
     whole deficit k*; as the local muscles take over a fraction f of it, the reflex keeps the
     rest, (1 - f)+ times both gains, so that at f >= 1 the chain holds itself without reflex.
     The local muscles damp what they stiffen: c_loc f k* on the diagonal of D
-    (:func:`spinectl.model.chain.local_damping_per_stiffness`; docs/chain.md).
+    (:meth:`spinectl.model.linear_chain.LinearChain.damping`; docs/chain.md).
 
     Parameters
     ----------
     model : Model
-    mass, stiffness, damping : numpy.ndarray, shape (n, n)
-        M, K (global muscles, gravity, passive), D (global muscles).
+        ``reflex``: the rule's settings and gains.
+    linear : LinearChain
+        The chain at the operating point (:func:`spinectl.model.operating_point.chain_at`): M, K (global
+        muscles, gravity, passive), D (global muscles), c_loc.
     least_static : numpy.ndarray, shape (n,)
         k* [N m/rad].
     fraction : float
@@ -95,11 +78,11 @@ def chain_loop_at(model: Model, mass, stiffness, damping, least_static, fraction
     kp, kd : numpy.ndarray, shape (n,)
         [N m/rad], [N m s/rad].
     """
-    k = stiffness - fraction * np.diag(least_static)
-    d = damping - np.diag(chain.local_damping(fraction * np.asarray(least_static, float), model))
+    k = fraction * np.asarray(least_static, float)  # NaN where (a) was unsolved: NaN matrices, judged undefined
+    mass, stiffness, damping = linear.mass_matrix, linear.stiffness_offset, linear.damping_offset
     scale = max(1.0 - fraction, 0.0)  # the reflex hands over to the local muscles: (1 - f)+ times the rule's gains
     p, dd = gains.resolve_chain_gains(model.reflex, mass, stiffness, damping, least_static, kp, kd, scale)
-    return k, d, p, dd
+    return linear.stiffness((), k), linear.damping((), k), p, dd
 
 
 def _top(model: Model, kp, kd) -> float:
@@ -117,8 +100,9 @@ class _Search:
 
     def __init__(self, model: Model, e: float, lam: float, pcsa, kp=None, kd=None):
         self.model, self.e, self.lam, self.kp, self.kd = model, e, lam, kp, kd
-        self.mass, self.stiffness, self.damping = chain_matrices(model, e, lam, pcsa)
-        _, least = least_local_stiffness_stacked(self.stiffness[None], model.optimisation.stability_margin)
+        self.chain = chain_at(OperatingPoint(model, e, lam, pcsa, slip_check=False))
+        self.mass = self.chain.mass_matrix
+        _, least = least_local_stiffness_stacked(self.chain.stiffness_offset[None], model.optimisation.stability_margin)
         self.least, self.lag = least[0], model.reflex.activation_time_constant
         self.margins: dict[float, object] = {}
         self.fails_from: dict[float, float] = {}  # f -> a delay at which f is unstable: f fails every longer one
@@ -128,7 +112,7 @@ class _Search:
         self.width = self.top / 2**BISECTIONS
 
     def loop(self, f):
-        return chain_loop_at(self.model, self.mass, self.stiffness, self.damping, self.least, f, self.kp, self.kd)
+        return chain_loop_at(self.model, self.chain, self.least, f, self.kp, self.kd)
 
     def root(self, f, d, nodes: int = 0) -> complex:
         """The rightmost characteristic root at f and d, once per (f, d) (with ``nodes``, afresh)."""
@@ -146,7 +130,7 @@ class _Search:
         if f not in self.margins:
             k, dl, p, dd = self.loop(f)
             if not (np.any(p) or np.any(dd)):  # no reflex: stable at every delay or none (no crossing to find)
-                self.margins[f] = from_crossings(np.empty(0), np.empty(0), np.empty(0), chain.coupled_margin(k) > 0)
+                self.margins[f] = from_crossings(np.empty(0), np.empty(0), np.empty(0), coupled_margin(k) > 0)
             else:
                 with arithmetic_guard(self.e, self.lam):
                     self.margins[f] = chain_delay_margin(self.mass, k, dl, p, dd, self.lag)
