@@ -400,7 +400,7 @@ def verdicts(spec: AtlasSpec, outputs: dict) -> dict[str, np.ndarray]:
     out = {
         "stabilisable_joint_by_joint": feasible,
         "counter_torque_within_limit": feasible & (outputs["counter_torque_max_Nm"] <= spec.counter_torque_limit),
-        "stable_at_delay": outputs["spine_delay_margin_s"] > outputs["delay_s"],
+        "spine_stable_at_delay": outputs["spine_delay_margin_s"] > outputs["delay_s"],
     }
     if "cocontraction_local_stiffness_max_Nm_per_rad" in outputs:
         k, limit = outputs["cocontraction_local_stiffness_max_Nm_per_rad"], outputs["local_stiffness_limit_Nm_per_rad"]
