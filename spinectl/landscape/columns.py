@@ -301,7 +301,18 @@ def chain_stiffness(chain_coeffs: chain.ChainCoefficients, pcsa) -> np.ndarray:
 
 
 def coupled_margin_columns(stiffness) -> dict[str, np.ndarray]:
-    """The coupled chain's static margin at the chosen activation, the smallest eigenvalue of -K [N m/rad]."""
+    """The coupled chain's static margin at the chosen activation, the smallest eigenvalue of -K (docs/chain.md).
+
+    Parameters
+    ----------
+    stiffness : numpy.ndarray, shape (P, n, n)
+        The chain's K at the chosen activation, :func:`chain_stiffness` of the minimum PCSA [N m/rad].
+
+    Returns
+    -------
+    dict of str to numpy.ndarray
+        ``coupled_margin_Nm_per_rad``, shape (P,) [N m/rad]; > 0 stable, NaN where infeasible.
+    """
     margin = chain.coupled_margin(np.nan_to_num(stiffness))
     return {"coupled_margin_Nm_per_rad": np.where(np.isnan(stiffness[:, 0, 0]), np.nan, margin)}
 
