@@ -139,7 +139,7 @@ def main() -> None:
     _, t_without, cpu_without = timed(spec, some, "fast")
     stacked = (t_with - t_without) / m
     sdp, sdp_cpu, totals = per_point_chain(spec, values, min(args.sample, m))
-    found = with_chain["local_stiffness_total_Nm_per_rad"][: totals.size]
+    found = with_chain["cocontraction_local_stiffness_total_Nm_per_rad"][: totals.size]
     print(f"chain's least local stiffness on {m} draws: stacked SDP {stacked * 1e3:.2f} ms per draw ", end="")
     print(f"(CPU {(cpu_with - cpu_without) / m * 1e3:.2f} ms)")
     print(

@@ -3,9 +3,10 @@
 Draws of the priors (:mod:`spinectl.landscape.priors`) on a scrambled Sobol' sequence in
 Saltelli's design (SALib), and for each draw the joint-by-joint optimum (the fast path of
 :mod:`spinectl.optimise.active_set`, the paper's criterion: each CoR alone, the others fixed),
-the exact delay margin at the chosen activation (:mod:`spinectl.reflex.maps`) and, with
-``chain``, the chain's least local stiffness (all CoRs free; one stacked SDP per chunk,
-:func:`spinectl.optimise.coupled.least_local_stiffness_stacked`). Then the probability of each
+the exact delay margin at the draw's co-contraction (:mod:`spinectl.reflex.maps`) and, with
+``chain``, the chain's least local stiffness at that co-contraction (all CoRs free; one stacked SDP per
+chunk, :func:`spinectl.optimise.coupled.least_local_stiffness_stacked`), every output computed by the
+sweep's functions (:mod:`spinectl.landscape.columns`) on the draws' coefficients. Then the probability of each
 verdict with its Wilson interval and the first- and total-order Sobol' indices with SALib's
 bootstrap intervals (docs/atlas.md).
 
@@ -37,11 +38,9 @@ from ..model.params import Model
 from ..model.source import header, provenance
 from ..optimise import active_set
 from ..optimise.problem import OK_STATUSES, problem_data
-from ..reflex.inputs import guarded
-from ..reflex.maps import landscape
-from ..units import M2_PER_CM2, m2_to_cm2
-from . import atlas_chunks, budget
+from . import atlas_chunks, budget, columns
 from .priors import PAPER_OPTIMUM, VERDICTS, AtlasSpec
+from .schema import DRAW_VARIABLES
 
 INSTALL_HINT = "pip install 'spinectl[atlas]' (SALib)"
 
@@ -63,8 +62,14 @@ levels' weight in the chain), so four models (two masses, three heights) give it
 chosen PCSA and T_a enters the reflex loops, whose margins are computed per segment anyway, so
 both are arrays over the stack."""
 
-OUTPUTS = ("min_pcsa_cm2", "counter_torque_norm_Nm", "local_stiffness_total_Nm_per_rad", "spine_delay_margin_s")
-"""The outputs whose Sobol' indices the atlas reports, named as the sweep's variables."""
+OUTPUTS = (
+    "min_pcsa_cm2",
+    "counter_torque_norm_Nm",
+    "cocontraction_local_stiffness_total_Nm_per_rad",
+    "spine_delay_margin_s",
+)
+"""The outputs whose Sobol' indices the atlas reports, each named and defined once in :mod:`spinectl.landscape.schema`
+(:data:`~spinectl.landscape.schema.VARIABLES` or :data:`~spinectl.landscape.schema.DRAW_VARIABLES`)."""
 
 
 class AtlasUnavailable(SpinectlError, ImportError):
@@ -223,9 +228,11 @@ def evaluate(spec: AtlasSpec, values: dict, *, method: str = "auto", update=None
     Returns
     -------
     dict of str to numpy.ndarray
-        ``min_pcsa_cm2``, ``counter_torque_norm_Nm``, ``counter_torque_max_Nm``, ``status``,
-        ``spine_delay_margin_s``, ``local_stiffness_total_Nm_per_rad``, ``local_stiffness_max_Nm_per_rad``
-        and ``local_stiffness_limit_Nm_per_rad``, shape (n,); NaN where infeasible.
+        ``min_pcsa_cm2``, ``counter_torque_norm_Nm``, ``status``, ``spine_delay_margin_s`` (the sweep's variables,
+        :data:`SEGMENT_OUTPUTS`), ``counter_torque_max_Nm``, ``delay_s`` and with ``chain``
+        ``cocontraction_local_stiffness_total_Nm_per_rad``, ``cocontraction_local_stiffness_max_Nm_per_rad`` and
+        ``local_stiffness_limit_Nm_per_rad`` (:data:`spinectl.landscape.schema.DRAW_VARIABLES`), shape (n,); NaN
+        where infeasible. Each computed by :mod:`spinectl.landscape.columns`.
     """
     fields = [name for name in values if "." in name]
     if method == "auto":
@@ -322,12 +329,11 @@ def _fast_chunk(spec: AtlasSpec, part: dict) -> dict[str, np.ndarray]:
     coeffs = _mixed([checked_coefficients(b, e, lam) for b in bases], weights, k)
     result = active_set.solve_block(problem_data(model, coeffs), model.optimisation.ct_tolerance)
     delay, activation, lag = (_field(spec, part, f"reflex.{name}") for name in _REFLEX_TERMS)
-    out = _segment_outputs(model, coeffs, result, delay, activation, lag)
+    out = _segment_outputs(model, e, lam, coeffs, result, delay, activation, lag)
     if spec.chain:
         with arithmetic_guard(e, lam):
             found = [chain.chain_coefficients(b, e, lam) for b in bases]
-        active = activation[:, None] * result.pcsa
-        out |= _chain_outputs(spec, model, _mixed(found, weights, k), active)
+        out |= _chain_outputs(spec, model, e, lam, _mixed(found, weights, k), result.pcsa, activation)
     return out
 
 
@@ -340,54 +346,39 @@ def _per_draw_chunk(spec: AtlasSpec, part: dict) -> dict[str, np.ndarray]:
         e, lam = part["eccentricity_m"][i : i + 1], part["lordosis_m"][i : i + 1]
         coeffs = checked_coefficients(model, e, lam)
         result = active_set.solve_block(problem_data(model, coeffs), model.optimisation.ct_tolerance)
-        row = _segment_outputs(model, coeffs, result, np.array([model.reflex.delay]))
+        row = _segment_outputs(model, e, lam, coeffs, result, np.array([model.reflex.delay]))
         if spec.chain:
             with arithmetic_guard(e, lam):
-                active = model.reflex.activation * result.pcsa
-                row |= _chain_outputs(spec, model, chain.chain_coefficients(model, e, lam), active)
+                found = chain.chain_coefficients(model, e, lam)
+            row |= _chain_outputs(spec, model, e, lam, found, result.pcsa)
         rows.append(row)
     return {k: np.concatenate([r[k] for r in rows]) for k in rows[0]}
 
 
-def _segment_outputs(model, coeffs, result, delay, activation=None, lag=None) -> dict[str, np.ndarray]:
-    """The joint-by-joint outputs of a block: min PCSA, counter torques, the exact delay margin.
+SEGMENT_OUTPUTS = ("min_pcsa_cm2", "counter_torque_norm_Nm", "status", "spine_delay_margin_s")
+"""The landscape's variables (:data:`spinectl.landscape.schema.VARIABLES`) that each draw keeps."""
+
+
+def _segment_outputs(model, e, lam, coeffs, result, delay, activation=None, lag=None) -> dict[str, np.ndarray]:
+    """The joint-by-joint outputs of a block, as the sweep computes them (:mod:`spinectl.landscape.columns`).
 
     ``activation`` and ``lag`` (T_a [s]), one per row, in place of the model's reflex; None: the model's.
     """
-    activation = model.reflex.activation if activation is None else np.asarray(activation, float)[:, None]
-    lag = None if lag is None else np.asarray(lag, float)[:, None]
-    active = activation * result.pcsa
-    with arithmetic_guard(0.0, 0.0), guarded():
-        maps = landscape(coeffs.stiffness(active), coeffs.damping(active), coeffs.inertia, model.reflex, lag=lag)
-    margin = np.min(maps.delay_margin, axis=-1)
-    return {
-        "min_pcsa_cm2": m2_to_cm2(result.min_pcsa),
-        "counter_torque_norm_Nm": np.linalg.norm(result.counter_torque, axis=-1),
-        "counter_torque_max_Nm": np.max(np.abs(result.counter_torque), axis=-1),
-        "status": result.status.astype(str),
-        "spine_delay_margin_s": margin,
-        "delay_s": np.asarray(delay, float),
-    }
+    found = columns.segment_columns(model, e, lam, coeffs, result, activation, lag)
+    out = {name: found[name] for name in SEGMENT_OUTPUTS}
+    out["status"] = out["status"].astype(str)  # the chunk files hold no Python objects (np.load without pickle)
+    return out | columns.counter_torque_max_columns(result) | columns.delay_columns(delay)
 
 
-def _chain_outputs(spec: AtlasSpec, model, coefficients, pcsa) -> dict[str, np.ndarray]:
-    """The chain's least local stiffness with the global muscles at ``pcsa`` (problem (a), docs/chain.md); its limit.
+def _chain_outputs(spec: AtlasSpec, model, e, lam, coefficients, pcsa, activation=None) -> dict[str, np.ndarray]:
+    """The chain's least local stiffness at the draw's co-contraction (problem (a), docs/chain.md); its limit.
 
-    The callers pass the draw's chosen activation times its minimum PCSA: the co-contraction the draw holds, which
-    its delay margin also uses, so that the local muscles supply what that activation leaves.
+    With the global muscles at ``reflex.activation`` (``activation`` per row, else the model's) times the minimum
+    PCSA: the co-contraction the draw holds, which its delay margin also uses, so that the local muscles supply what
+    that activation leaves (:func:`spinectl.landscape.columns.cocontraction_local_stiffness_columns`).
     """
-    from ..optimise import coupled  # cvxpy only where the chain's SDP is asked for
-
-    stiffness = coefficients.stiffness(np.nan_to_num(pcsa))
-    stiffness = np.where(np.isnan(pcsa).any(axis=-1)[:, None, None], np.nan, stiffness)
-    opt = model.optimisation
-    _, k = coupled.least_local_stiffness_stacked(stiffness, opt.stability_margin, opt.solver_tolerance)
-    limit = chain.local_stiffness_per_pcsa(model) * spec.local_pcsa_limit * M2_PER_CM2
-    return {
-        "local_stiffness_total_Nm_per_rad": np.sum(k, axis=-1),
-        "local_stiffness_max_Nm_per_rad": np.max(k, axis=-1),
-        "local_stiffness_limit_Nm_per_rad": np.full(k.shape[0], limit),
-    }
+    out = columns.cocontraction_local_stiffness_columns(model, e, lam, coefficients, pcsa, activation)
+    return out | columns.local_stiffness_limit_columns(model, spec.local_pcsa_limit, pcsa.shape[0])
 
 
 def verdicts(spec: AtlasSpec, outputs: dict) -> dict[str, np.ndarray]:
@@ -409,10 +400,10 @@ def verdicts(spec: AtlasSpec, outputs: dict) -> dict[str, np.ndarray]:
     out = {
         "stabilisable_joint_by_joint": feasible,
         "counter_torque_within_limit": feasible & (outputs["counter_torque_max_Nm"] <= spec.counter_torque_limit),
-        "stable_at_delay": outputs["spine_delay_margin_s"] > outputs["delay_s"],
+        "spine_stable_at_delay": outputs["spine_delay_margin_s"] > outputs["delay_s"],
     }
-    if "local_stiffness_max_Nm_per_rad" in outputs:
-        k, limit = outputs["local_stiffness_max_Nm_per_rad"], outputs["local_stiffness_limit_Nm_per_rad"]
+    if "cocontraction_local_stiffness_max_Nm_per_rad" in outputs:
+        k, limit = outputs["cocontraction_local_stiffness_max_Nm_per_rad"], outputs["local_stiffness_limit_Nm_per_rad"]
         out["chain_stabilisable_locally"] = np.isfinite(k) & (k <= limit)
     return out
 
@@ -509,7 +500,7 @@ def probability_rows(spec: AtlasSpec, n_rows: int) -> np.ndarray:
     return np.sort(np.concatenate([starts, starts + step - 1]))
 
 
-def analyse(spec: AtlasSpec, values: dict, outputs: dict) -> AtlasResult:
+def summarise(spec: AtlasSpec, values: dict, outputs: dict) -> AtlasResult:
     """Probabilities and Sobol' indices from the outputs at Saltelli's design.
 
     Parameters
@@ -547,7 +538,9 @@ def fingerprint(spec: AtlasSpec) -> str:
     """
     from .. import __version__
 
-    return hashlib.sha256(repr((spec, __version__)).encode()).hexdigest()[:16]
+    # the output names too: chunks saved under an output's former name are another atlas's, solved again
+    named = (spec, __version__, SEGMENT_OUTPUTS, tuple(DRAW_VARIABLES))
+    return hashlib.sha256(repr(named).encode()).hexdigest()[:16]
 
 
 def atlas_file(
@@ -713,7 +706,7 @@ def run_atlas(
     values = draw(spec, saltelli_unit(spec))
     folder = Path(out) / "chunks" if out is not None else None
     outputs = _solve(spec, values, folder, progress, where, notify or (lambda line: None))
-    result = analyse(spec, values, outputs)
+    result = summarise(spec, values, outputs)
     if out is not None:
         _write(result, Path(out), spec)
         atlas_chunks.remove_others(Path(out) / "chunks", fingerprint(spec))  # the folder is this atlas's now
@@ -846,7 +839,6 @@ def base_landscape(spec: AtlasSpec, draws: dict, n: int = 41) -> dict[str, np.nd
     dict
         ``eccentricity_m`` (n,), ``lordosis_m`` (n,) [m] and ``min_pcsa_cm2`` (n, n) [cm^2].
     """
-    from .columns import point_columns
 
     def axis(values, point):
         low, high = min(values.min(), point), max(values.max(), point)
@@ -856,5 +848,5 @@ def base_landscape(spec: AtlasSpec, draws: dict, n: int = 41) -> dict[str, np.nd
     e = axis(draws["eccentricity_m"], PAPER_OPTIMUM[0])
     lam = axis(draws["lordosis_m"], PAPER_OPTIMUM[1])
     grid_e, grid_l = np.meshgrid(e, lam, indexing="ij")
-    columns, _ = point_columns(spec.model, grid_e.ravel(), grid_l.ravel())
-    return {"eccentricity_m": e, "lordosis_m": lam, "min_pcsa_cm2": columns["min_pcsa_cm2"].reshape(n, n)}
+    found, _ = columns.point_columns(spec.model, grid_e.ravel(), grid_l.ravel())
+    return {"eccentricity_m": e, "lordosis_m": lam, "min_pcsa_cm2": found["min_pcsa_cm2"].reshape(n, n)}

@@ -106,7 +106,7 @@ def criterion(verdict: str, spec: AtlasSpec) -> str:
     str
     """
     text = VERDICTS[verdict]
-    if verdict != "stable_at_delay":
+    if verdict != "spine_stable_at_delay":
         return text
     if "reflex.delay" in spec.names:
         return f"{text}, each draw's delay drawn from its prior"

@@ -4,6 +4,10 @@ The grid is solved in chunks of points (working memory stays flat however fine t
 each chunk by the fast path (:mod:`spinectl.optimise.active_set`) or the per-point reference
 (:mod:`spinectl.optimise.reference`); the reflex columns follow from the chosen activation
 (:mod:`spinectl.reflex.maps`).
+
+Every output of :mod:`spinectl.landscape.schema` is computed here, each by one function: the sweep,
+the study and the atlas (whose draws' coefficients are its own, :mod:`spinectl.landscape.atlas`) call
+the same functions, so that one name means one quantity wherever it is written.
 """
 
 from __future__ import annotations
@@ -188,25 +192,62 @@ def _chunk(model: Model, e, lam, coeffs, chain_coeffs, method: str, update, coup
         update(len(data.stability))
     else:
         result = stacked.solve_points(data, tol, progress=update)
-    with arithmetic_guard(e, lam), guarded():  # e.g. K = 1e154 overflows S^2 in the reflex
-        columns = _chunk_columns(result, coeffs, model)
-        stiffness = _chain_stiffness(chain_coeffs, result.pcsa)
-        margin = chain.coupled_margin(np.nan_to_num(stiffness))
-        columns["coupled_margin_Nm_per_rad"] = np.where(np.isnan(stiffness[:, 0, 0]), np.nan, margin)
+    columns = segment_columns(model, e, lam, coeffs, result)
+    with arithmetic_guard(e, lam), guarded():
+        stiffness = chain_stiffness(chain_coeffs, result.pcsa)
+        columns |= coupled_margin_columns(stiffness)
     if coupled:  # SDPs: outside numpy's guard
-        columns |= _local_stiffness(model, stiffness, method)
+        columns |= local_stiffness_columns(model, stiffness, method)
         columns |= _joint_optimum(model, e, lam, data, chain_coeffs, method)
     return columns, result.per_point
 
 
-def _chunk_columns(result: stacked.BlockOptimum, coeffs, model: Model) -> dict[str, np.ndarray]:
-    """The Dataset's variables for one chunk, in the units of their names."""
-    return _reflex_columns(model, coeffs, result.pcsa) | {
+def segment_columns(model: Model, e, lam, coeffs, result, activation=None, lag=None) -> dict[str, np.ndarray]:
+    """The joint-by-joint variables of a block of points: the optimum, its coefficients, its reflex.
+
+    The sweep, the study and the atlas take these from here (docs/optimisation.md, the table of variables).
+
+    Parameters
+    ----------
+    model : Model
+        The tolerances and the reflex.
+    e, lam : numpy.ndarray, shape (P,)
+        E and Lambda of the points [m], named by an overflow's error.
+    coeffs : SegmentCoefficients
+        The segments' coefficients at the points (checked).
+    result : BlockOptimum
+        The joint-by-joint optimum at the points (:func:`spinectl.optimise.active_set.solve_block`).
+    activation, lag : array_like, shape (P,), optional
+        ``reflex.activation`` [1] and ``reflex.activation_time_constant`` [s] per point (the atlas's draws);
+        None: the model's.
+
+    Returns
+    -------
+    dict of str to numpy.ndarray
+        :data:`~spinectl.landscape.schema.VARIABLES` but the coupled chain's, leading dimension P, in the
+        units of their names.
+    """
+    with arithmetic_guard(e, lam), guarded():  # e.g. K = 1e154 overflows S^2 in the reflex
+        columns = _reflex_columns(model, coeffs, result.pcsa, activation, lag) | _optimum_columns(result)
+        columns |= _coefficient_columns(coeffs)
+        columns["slowest_time_constant_s"] = _slowest_time_constant(coeffs, result.pcsa)
+    return columns
+
+
+def _optimum_columns(result: stacked.BlockOptimum) -> dict[str, np.ndarray]:
+    """The joint-by-joint optimum's variables [cm^2, N m]."""
+    return {
         "min_pcsa_cm2": m2_to_cm2(result.min_pcsa),
         "pcsa_cm2": m2_to_cm2(result.pcsa),
         "counter_torque_Nm": result.counter_torque,
         "counter_torque_norm_Nm": np.linalg.norm(result.counter_torque, axis=-1),
         "status": result.status.astype(object),
+    }
+
+
+def _coefficient_columns(coeffs) -> dict[str, np.ndarray]:
+    """The segments' coefficients, per cm^2 of PCSA where they scale with it."""
+    return {
         "stiffness_per_cm2": coeffs.stiffness_per_pcsa * M2_PER_CM2,
         "damping_per_cm2": coeffs.damping_per_pcsa * M2_PER_CM2,
         "torque_per_cm2": coeffs.torque_per_pcsa * M2_PER_CM2,
@@ -214,8 +255,23 @@ def _chunk_columns(result: stacked.BlockOptimum, coeffs, model: Model) -> dict[s
         "gravity_torque_Nm": coeffs.gravity_torque,
         "passive_stiffness_Nm_per_rad": coeffs.passive_stiffness,
         "inertia_kgm2": coeffs.inertia,
-        "slowest_time_constant_s": _slowest_time_constant(coeffs, result.pcsa),
     }
+
+
+def counter_torque_max_columns(result) -> dict[str, np.ndarray]:
+    """The largest |CT_k| over the segments at the chosen activation [N m] (the atlas's ±30 N m verdict).
+
+    Parameters
+    ----------
+    result : BlockOptimum
+        The joint-by-joint optimum at P points.
+
+    Returns
+    -------
+    dict of str to numpy.ndarray
+        ``counter_torque_max_Nm``, shape (P,).
+    """
+    return {"counter_torque_max_Nm": np.max(np.abs(result.counter_torque), axis=-1)}
 
 
 def _slowest_time_constant(coeffs, pcsa) -> np.ndarray:
@@ -225,28 +281,169 @@ def _slowest_time_constant(coeffs, pcsa) -> np.ndarray:
     return np.where(np.isnan(pcsa).any(axis=-1), np.nan, tau)
 
 
-def _chain_stiffness(chain_coeffs: chain.ChainCoefficients, pcsa) -> np.ndarray:
-    """The coupled chain's K at the chosen activation [N m/rad], NaN where infeasible (docs/chain.md)."""
+def chain_stiffness(chain_coeffs: chain.ChainCoefficients, pcsa) -> np.ndarray:
+    """The coupled chain's K with the global muscles at ``pcsa``, NaN where infeasible (docs/chain.md).
+
+    Parameters
+    ----------
+    chain_coeffs : ChainCoefficients
+        The chain's coefficients at P points.
+    pcsa : numpy.ndarray, shape (P, n_muscles)
+        The global muscles' PCSA [m^2]; NaN where the optimum is infeasible.
+
+    Returns
+    -------
+    numpy.ndarray, shape (P, n_cor, n_cor)
+        K [N m/rad].
+    """
     stiffness = chain_coeffs.stiffness(np.nan_to_num(pcsa))
     return np.where(np.isnan(pcsa).any(axis=-1)[:, None, None], np.nan, stiffness)
 
 
-def _local_stiffness(model: Model, stiffness, method: str) -> dict[str, np.ndarray]:
-    """The least local stiffness at the chosen activation, problem (a) of docs/chain.md, per joint and total.
+def coupled_margin_columns(stiffness) -> dict[str, np.ndarray]:
+    """The coupled chain's static margin at the chosen activation, the smallest eigenvalue of -K (docs/chain.md).
 
-    The fast path solves the chunk as one stacked SDP, the per-point method one cvxpy SDP per point.
+    Parameters
+    ----------
+    stiffness : numpy.ndarray, shape (P, n, n)
+        The chain's K at the chosen activation, :func:`chain_stiffness` of the minimum PCSA [N m/rad].
+
+    Returns
+    -------
+    dict of str to numpy.ndarray
+        ``coupled_margin_Nm_per_rad``, shape (P,) [N m/rad]; > 0 stable, NaN where infeasible.
+    """
+    margin = chain.coupled_margin(np.nan_to_num(stiffness))
+    return {"coupled_margin_Nm_per_rad": np.where(np.isnan(stiffness[:, 0, 0]), np.nan, margin)}
+
+
+def least_local_stiffness(model: Model, stiffness, method: str = "fast") -> np.ndarray:
+    """The least local stiffness k_j at every point, problem (a) of docs/chain.md, at the chain's K given.
+
+    The fast path solves the points as one stacked SDP, the per-point method one cvxpy SDP per point.
+
+    Parameters
+    ----------
+    model : Model
+        ``optimisation.stability_margin`` and ``solver_tolerance``.
+    stiffness : numpy.ndarray, shape (P, n, n)
+        The chain's K with the global muscles at the activation asked for [N m/rad]; NaN rows: infeasible.
+    method : {'fast', 'per-point'}
+
+    Returns
+    -------
+    numpy.ndarray, shape (P, n)
+        k_j [N m/rad]; NaN where infeasible or not solved.
     """
     from ..optimise import coupled  # cvxpy (a second of imports) only where the chain's SDPs are asked for
 
     opt = model.optimisation
     if method == "fast":
         _, k = coupled.least_local_stiffness_stacked(stiffness, opt.stability_margin, opt.solver_tolerance)
-    else:
-        k = np.full(stiffness.shape[:-1], np.nan)
-        for i in np.flatnonzero(np.isfinite(stiffness[:, 0, 0])):
-            _, found = coupled.least_local_stiffness_at(stiffness[i], opt.stability_margin, opt.solver_tolerance)
-            k[i] = np.nan if found is None else found
+        return k
+    k = np.full(stiffness.shape[:-1], np.nan)
+    for i in np.flatnonzero(np.isfinite(stiffness[:, 0, 0])):
+        _, found = coupled.least_local_stiffness_at(stiffness[i], opt.stability_margin, opt.solver_tolerance)
+        k[i] = np.nan if found is None else found
+    return k
+
+
+def local_stiffness_columns(model: Model, stiffness, method: str = "fast") -> dict[str, np.ndarray]:
+    """The least local stiffness with the global muscles at the whole chosen activation, per joint and total.
+
+    Parameters
+    ----------
+    model : Model
+    stiffness : numpy.ndarray, shape (P, n, n)
+        The chain's K at the chosen activation, :func:`chain_stiffness` of the minimum PCSA [N m/rad].
+    method : {'fast', 'per-point'}
+
+    Returns
+    -------
+    dict of str to numpy.ndarray
+        ``local_stiffness_Nm_per_rad`` (P, n) and ``local_stiffness_total_Nm_per_rad`` (P,).
+    """
+    k = least_local_stiffness(model, stiffness, method)
     return {"local_stiffness_Nm_per_rad": k, "local_stiffness_total_Nm_per_rad": np.sum(k, axis=-1)}
+
+
+def cocontraction_local_stiffness_columns(
+    model: Model, e, lam, chain_coeffs, pcsa, activation=None, method: str = "fast"
+) -> dict[str, np.ndarray]:
+    """The least local stiffness with the global muscles at ``reflex.activation`` x the chosen PCSA: total, largest.
+
+    The co-contraction that the delay margin also assumes (:func:`segment_columns`), so that the local
+    muscles supply what that activation leaves; at ``reflex.activation`` = 1 the total is
+    ``local_stiffness_total_Nm_per_rad`` (:func:`local_stiffness_columns`), bit for bit.
+
+    Parameters
+    ----------
+    model : Model
+    e, lam : numpy.ndarray, shape (P,)
+        E and Lambda of the points [m], named by an overflow's error.
+    chain_coeffs : ChainCoefficients
+        The chain's coefficients at the points.
+    pcsa : numpy.ndarray, shape (P, n_muscles)
+        The chosen activation [m^2]; NaN where infeasible.
+    activation : array_like, shape (P,), optional
+        ``reflex.activation`` per point [1]; None: the model's.
+    method : {'fast', 'per-point'}
+
+    Returns
+    -------
+    dict of str to numpy.ndarray
+        ``cocontraction_local_stiffness_total_Nm_per_rad`` and ``cocontraction_local_stiffness_max_Nm_per_rad``,
+        shape (P,) [N m/rad].
+    """
+    with arithmetic_guard(e, lam):
+        stiffness = chain_stiffness(chain_coeffs, _scaled(model, activation) * pcsa)
+    k = least_local_stiffness(model, stiffness, method)
+    return {
+        "cocontraction_local_stiffness_total_Nm_per_rad": np.sum(k, axis=-1),
+        "cocontraction_local_stiffness_max_Nm_per_rad": np.max(k, axis=-1),
+    }
+
+
+def local_stiffness_limit_columns(model: Model, local_pcsa_limit: float, points: int) -> dict[str, np.ndarray]:
+    """The local muscles' stiffness at a PCSA per joint [N m/rad]: kappa times the limit, at every point.
+
+    Parameters
+    ----------
+    model : Model
+        ``local``: kappa, the stiffness per unit PCSA.
+    local_pcsa_limit : float
+        The limit [cm^2] (the atlas's ``local_pcsa_limit_cm2``).
+    points : int
+        P.
+
+    Returns
+    -------
+    dict of str to numpy.ndarray
+        ``local_stiffness_limit_Nm_per_rad``, shape (P,).
+    """
+    limit = chain.local_stiffness_per_pcsa(model) * local_pcsa_limit * M2_PER_CM2
+    return {"local_stiffness_limit_Nm_per_rad": np.full(points, limit)}
+
+
+def delay_columns(delay) -> dict[str, np.ndarray]:
+    """The reflex delay at every point [s], beside its delay margin (the atlas's ``stable_at_delay``).
+
+    Parameters
+    ----------
+    delay : array_like, shape (P,)
+        ``reflex.delay`` per point [s].
+
+    Returns
+    -------
+    dict of str to numpy.ndarray
+        ``delay_s``, shape (P,).
+    """
+    return {"delay_s": np.asarray(delay, float)}
+
+
+def _scaled(model: Model, activation) -> np.ndarray | float:
+    """``reflex.activation``: the model's, or one per point as a column that scales a (P, n) PCSA."""
+    return model.reflex.activation if activation is None else np.asarray(activation, float)[:, None]
 
 
 def _joint_optimum(model: Model, eccentricity, lordosis, data, coefficients, method: str) -> dict[str, np.ndarray]:
@@ -255,7 +452,7 @@ def _joint_optimum(model: Model, eccentricity, lordosis, data, coefficients, met
     The fast path solves the chunk as one stacked SDP and falls back to one cvxpy SDP per point
     where the stack fails as a whole (e.g. one infeasible point); the per-point method always does.
     """
-    from ..optimise import coupled  # as in _local_stiffness
+    from ..optimise import coupled  # as in least_local_stiffness
 
     kappa = chain.local_stiffness_per_pcsa(model) * M2_PER_CM2  # N m/rad per cm^2
     status = "per-point"
@@ -277,17 +474,19 @@ def _joint_optimum(model: Model, eccentricity, lordosis, data, coefficients, met
     }
 
 
-def _reflex_columns(model: Model, coeffs, pcsa) -> dict[str, np.ndarray]:
+def _reflex_columns(model: Model, coeffs, pcsa, activation=None, lag=None) -> dict[str, np.ndarray]:
     """Delayed PD reflex at every point and segment (docs/reflex.md), vectorised.
 
     The global muscles are active at ``reflex.activation`` times the chosen
-    activation (1: self-stable, no reflex needed; 0: reflex only); the gains
-    follow ``reflex``. The delay margin does not depend on the delay, so
+    activation (1: self-stable, no reflex needed; 0: reflex only), or ``activation``
+    per point; the gains follow ``reflex``, the lag ``lag`` per point where given.
+    The delay margin does not depend on the delay, so
     ``delay_margin_s > tau`` answers "stable at delay tau" for any tau.
     Infeasible points (NaN PCSA) get NaN and status 'undefined'.
     """
-    active = model.reflex.activation * pcsa
-    maps = landscape(coeffs.stiffness(active), coeffs.damping(active), coeffs.inertia, model.reflex)
+    active = _scaled(model, activation) * pcsa
+    lag = None if lag is None else np.asarray(lag, float)[:, None]
+    maps = landscape(coeffs.stiffness(active), coeffs.damping(active), coeffs.inertia, model.reflex, lag=lag)
     return {
         "reflex_kp_Nm_per_rad": maps.kp,
         "reflex_kd_Nms_per_rad": maps.kd,

@@ -49,7 +49,7 @@ VERDICTS = {
     "self-stable (a feasible minimum PCSA; joint by joint)",
     "counter_torque_within_limit": "every counter torque CT_k within +-counter_torque_limit_Nm (joint by joint)",
     "chain_stabilisable_locally": "the chain (all CoRs free) stabilised by local muscle within local_pcsa_limit_cm2",
-    "stable_at_delay": "the reflex loop of every segment stable at the reflex delay (joint by joint)",
+    "spine_stable_at_delay": "the reflex loop of every segment stable at the reflex delay (joint by joint)",
 }
 """The verdicts and the criterion each names."""
 

@@ -1,7 +1,9 @@
 """The landscape Dataset: its variables with units and long names, dimensions, coordinates and attributes.
 
 The schema is listed in docs/optimisation.md; sweeps (:mod:`spinectl.landscape.sweep`) and studies
-(:mod:`spinectl.landscape.study`) write the same variables.
+(:mod:`spinectl.landscape.study`) write the same variables, and the atlas (:mod:`spinectl.landscape.atlas`)
+those of its draws. Every output name has one entry here (:data:`VARIABLES` or :data:`DRAW_VARIABLES`, never
+both) and one function that computes it, in :mod:`spinectl.landscape.columns`, whichever command asks for it.
 """
 
 from __future__ import annotations
@@ -52,13 +54,38 @@ VARIABLES = {
     ),
     "local_stiffness_Nm_per_rad": (
         "N m rad-1",
-        "least local-muscle stiffness k_j that makes the coupled chain stable at the chosen activation (SDP)",
+        "least local-muscle stiffness k_j that makes the coupled chain stable at the chosen activation, the whole "
+        "minimum PCSA (SDP, problem (a))",
     ),
     "local_stiffness_total_Nm_per_rad": ("N m rad-1", "sum over the joints of local_stiffness_Nm_per_rad"),
     "joint_global_pcsa_cm2": ("cm2", "joint optimum of global and local muscle (coupled chain): total global PCSA"),
     "joint_local_pcsa_cm2": ("cm2", "joint optimum of global and local muscle (coupled chain): total local PCSA"),
 }
-"""Every data variable: units (UDUNITS) and long name."""
+"""Every data variable of a landscape (sweep, study): units (UDUNITS) and long name."""
+
+DRAW_VARIABLES = {
+    "counter_torque_max_Nm": ("N m", "largest |CT_k| over the segments at the chosen activation"),
+    "cocontraction_local_stiffness_total_Nm_per_rad": (
+        "N m rad-1",
+        "least total local-muscle stiffness sum k_j that makes the coupled chain stable with the global muscles at "
+        "reflex.activation x chosen PCSA, the draw's co-contraction (SDP, problem (a)); at reflex.activation = 1 "
+        "local_stiffness_total_Nm_per_rad",
+    ),
+    "cocontraction_local_stiffness_max_Nm_per_rad": (
+        "N m rad-1",
+        "largest k_j of the joints in cocontraction_local_stiffness_total_Nm_per_rad's optimum",
+    ),
+    "local_stiffness_limit_Nm_per_rad": (
+        "N m rad-1",
+        "the local muscles' stiffness at the atlas's local_pcsa_limit_cm2 per joint (kappa x the limit)",
+    ),
+    "delay_s": ("s", "the reflex delay of the draw (reflex.delay): stable_at_delay compares the margin with it"),
+}
+"""The atlas's outputs at each draw beyond :data:`VARIABLES` (``draws.npz``): units and long name.
+
+Before 0.1.0 was released, the atlas called ``cocontraction_local_stiffness_total_Nm_per_rad``
+``local_stiffness_total_Nm_per_rad``, the name of the landscape's variable at the whole minimum PCSA; the two differ
+wherever ``reflex.activation`` < 1 (docs/atlas.md, "The answer")."""
 
 ON_REQUEST = (
     "local_stiffness_Nm_per_rad",

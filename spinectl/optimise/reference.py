@@ -342,7 +342,7 @@ def min_norm_activation(model: Model, eccentricity: float, lordosis: float) -> P
 
 
 @dataclass(frozen=True)
-class ParetoFront:
+class CounterTorqueFront:
     """Least ||CT||_2 against the budget of total PCSA at one configuration.
 
     Attributes
@@ -364,7 +364,7 @@ class ParetoFront:
     status: tuple[str, ...]
 
 
-def pareto_front(model: Model, eccentricity: float, lordosis: float, n_points: int = 21) -> ParetoFront:
+def counter_torque_front(model: Model, eccentricity: float, lordosis: float, n_points: int = 21) -> CounterTorqueFront:
     """The Pareto front between total PCSA and ||CT||_2 (docs/optimisation.md, "Formulation").
 
     Stage 2 with the budget as a cvxpy Parameter, for ``n_points`` budgets
@@ -381,14 +381,14 @@ def pareto_front(model: Model, eccentricity: float, lordosis: float, n_points: i
 
     Returns
     -------
-    ParetoFront
+    CounterTorqueFront
         Budgets on the total PCSA [m^2], shape (n_points,), the least ||CT||_2 within
         each [N m] and the status per budget.
     """
     data = point_data(model, eccentricity, lordosis)
     far = point_optimum(data, np.inf)
     if not far.ok:
-        return ParetoFront(float(eccentricity), float(lordosis), np.array([]), np.array([]), (far.status,))
+        return CounterTorqueFront(float(eccentricity), float(lordosis), np.array([]), np.array([]), (far.status,))
     lowest = far.min_pcsa / M2_PER_CM2
     budgets = np.linspace(lowest, max(far.total_pcsa / M2_PER_CM2, lowest), n_points)
     norms, statuses = [], []
@@ -407,4 +407,6 @@ def pareto_front(model: Model, eccentricity: float, lordosis: float, n_points: i
         if status in OK_STATUSES:
             norm = np.linalg.norm(data.counter_torque(polished(data, "counter_torque", x.value, value)[0]))
         norms.append(norm)
-    return ParetoFront(float(eccentricity), float(lordosis), budgets * M2_PER_CM2, np.asarray(norms), tuple(statuses))
+    return CounterTorqueFront(
+        float(eccentricity), float(lordosis), budgets * M2_PER_CM2, np.asarray(norms), tuple(statuses)
+    )

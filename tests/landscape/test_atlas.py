@@ -11,6 +11,7 @@ import pytest
 from scipy import stats
 
 from spinectl.landscape import atlas
+from spinectl.landscape.columns import point_columns
 from spinectl.landscape.priors import parse_atlas
 from spinectl.model import chain
 from spinectl.model.clinical import lordosis_from_angle
@@ -47,6 +48,10 @@ distribution = "uniform"
 bounds = [0.053, 0.1]
 source = "s"
 """
+
+
+LOCAL = "cocontraction_local_stiffness_total_Nm_per_rad"
+"""The chain's least local stiffness at each draw's co-contraction (landscape/schema.DRAW_VARIABLES)."""
 
 
 def _spec(samples=4, seed=0, chain="true", chunk=16):
@@ -119,7 +124,9 @@ def test_the_fast_path_is_one_model_per_draw(priors, assignments):
         np.testing.assert_allclose(fast[name], reference[name], rtol=1e-9, atol=1e-12)
     np.testing.assert_array_equal(fast["status"], reference["status"])
     np.testing.assert_allclose(  # the stacked SDP holds each point's optimum to its tolerance (stacked_sdp)
-        fast["local_stiffness_total_Nm_per_rad"], reference["local_stiffness_total_Nm_per_rad"], rtol=1e-4
+        fast["cocontraction_local_stiffness_total_Nm_per_rad"],
+        reference["cocontraction_local_stiffness_total_Nm_per_rad"],
+        rtol=1e-4,
     )
 
 
@@ -133,7 +140,7 @@ def test_the_chains_local_stiffness_is_at_the_drawn_activation():
     head = "[atlas]\nsamples = 2\nseed = 3\nchain = true\nchunk_size = 16\n"
     spec = parse_atlas(head + PRIORS + MORE_PRIORS)
     values = atlas.draw(spec, atlas.saltelli_unit(spec))
-    found = atlas.evaluate(spec, values, method="fast")["local_stiffness_total_Nm_per_rad"]
+    found = atlas.evaluate(spec, values, method="fast")[LOCAL]
     fields = [name for name in values if "." in name]
     for i in range(3):
         model = set_parameters(spec.model, {f: float(values[f][i]) for f in fields})
@@ -143,6 +150,51 @@ def test_the_chains_local_stiffness_is_at_the_drawn_activation():
         status, k = least_local_stiffness_at(stiffness, model.optimisation.stability_margin)
         assert status == "optimal"
         assert found[i] == pytest.approx(np.sum(k), rel=1e-4)  # the SDPs' tolerance (stacked_sdp)
+
+
+@pytest.mark.parametrize("activation", [1.0, 0.5])
+def test_a_draws_outputs_are_the_sweeps_at_its_model_and_point(activation):
+    """Issue 33: the atlas computes with landscape/columns.py. A draw of the per-draw path equals point_columns of
+    its own model at its own point, bit for bit (the same functions on the same coefficients and one-point block).
+
+    The chain's local stiffness at the draw's co-contraction, cocontraction_local_stiffness_total_Nm_per_rad,
+    is the sweep's local_stiffness_total_Nm_per_rad (the whole minimum PCSA) bit for bit at reflex.activation = 1
+    (1.0 x PCSA is PCSA), and more at 0.5 (less global muscle leaves more to the local muscles): two quantities,
+    which the atlas wrote under the one name before.
+    """
+    head = "[atlas]\nsamples = 2\nseed = 1\nchain = true\nchunk_size = 16\n"
+    spec = parse_atlas(head + PRIORS, assignments=(f"reflex.activation={activation}",))
+    values = atlas.draw(spec, atlas.saltelli_unit(spec))
+    found = atlas.evaluate(spec, values, method="per-draw")
+    fields = [name for name in values if "." in name]
+    for i in range(2):
+        model = set_parameters(spec.model, {f: float(values[f][i]) for f in fields})
+        point = ([values["eccentricity_m"][i]], [values["lordosis_m"][i]])
+        sweep, _ = point_columns(model, *point, coupled=True)
+        for name in ("min_pcsa_cm2", "counter_torque_norm_Nm", "spine_delay_margin_s"):
+            assert found[name][i : i + 1].tobytes() == sweep[name].tobytes(), name
+        assert found["status"][i] == sweep["status"][0]
+        assert found["counter_torque_max_Nm"][i] == np.max(np.abs(sweep["counter_torque_Nm"][0]))
+        local, whole = (
+            found["cocontraction_local_stiffness_total_Nm_per_rad"][i],
+            sweep["local_stiffness_total_Nm_per_rad"],
+        )
+        if activation == 1.0:
+            assert local.tobytes() == whole[0].tobytes()
+        else:
+            assert local > whole[0] + 1.0  # N m/rad: well beyond the SDP's tolerance
+
+
+def test_the_fingerprint_holds_the_output_names(monkeypatch):
+    """Chunks saved under an output's former name are another atlas's: renaming an output changes the fingerprint,
+    so a resumed run solves them again rather than read back outputs the verdicts no longer find (issue 33)."""
+    spec = _spec()
+    key = atlas.fingerprint(spec)
+    former = {name.replace("cocontraction_", ""): v for name, v in atlas.DRAW_VARIABLES.items()}
+    monkeypatch.setattr(atlas, "DRAW_VARIABLES", former)
+    assert atlas.fingerprint(spec) != key
+    monkeypatch.undo()
+    assert atlas.fingerprint(spec) == key
 
 
 def test_draws_convert_the_angle_with_the_spline():
@@ -498,6 +550,7 @@ import dataclasses, os, signal, sys
 sys.path.insert(0, {str(Path(__file__).parent)!r})
 from test_atlas import _spec
 from spinectl.landscape import atlas
+from spinectl.landscape.columns import point_columns
 write = atlas.atomic_write_text
 def killed(target, text):
     if str(target).endswith("report.md"):

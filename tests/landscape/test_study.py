@@ -305,6 +305,15 @@ def test_the_chains_sdps_are_outputs_on_request(tmp_path):
     assert "local_stiffness_total_Nm_per_rad" not in study.parse_study(f"[axes]\n{GRID}").outputs
 
 
+@pytest.mark.parametrize("name", ["cocontraction_local_stiffness_total_Nm_per_rad", "delay_s"])
+def test_an_atlas_output_is_no_study_output(name):
+    """The atlas's own outputs (schema.DRAW_VARIABLES) are refused by name, not met with "did you mean" a landscape
+    variable: the co-contraction's local stiffness would be pointed at local_stiffness_total_Nm_per_rad, another
+    quantity (issue 33)."""
+    with pytest.raises(ConfigError, match=rf"study.outputs\[1\]: .*'{name}' is an output of the atlas's draws"):
+        study.parse_study(f"[study]\noutputs = ['status', '{name}']\n[axes]\n{GRID}")
+
+
 def test_two_local_workers_on_loopback_give_the_same_bits(reference, tmp_path, monkeypatch):
     """A LocalCluster of two worker processes: same store as in-process; it listens on 127.0.0.1 only."""
     listening: list[str] = []

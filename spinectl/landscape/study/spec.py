@@ -388,6 +388,11 @@ class Study:
         if not names:
             raise ParameterError("study.outputs", "must name at least one variable")
         for i, name in enumerate(names):
+            if isinstance(name, str) and name in schema.DRAW_VARIABLES:  # not "did you mean" another quantity
+                raise ConfigError(
+                    f"study.outputs[{i}]",
+                    f"must be a landscape variable; {show(name)} is an output of the atlas's draws (spinectl atlas)",
+                )
             if not isinstance(name, str) or name not in schema.VARIABLES:
                 raise ConfigError(f"study.outputs[{i}]", unknown_message(str(name), schema.VARIABLES))
             if name in names[:i]:  # a typo for another output, most likely: not silently one array
