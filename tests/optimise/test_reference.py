@@ -113,13 +113,13 @@ def test_solver_errors_fall_back_then_report(model, monkeypatch):
     assert opt.status == optimise.SOLVER_ERROR and np.isnan(opt.min_pcsa)
 
 
-def test_minimum_norm_activation_and_pareto_front(model):
+def test_minimum_norm_activation_and_counter_torque_front(model):
     """The front runs from the chosen activation's end (budget = minimum PCSA) to the
     minimum-norm activation, non-increasing in between (a convex trade-off)."""
     E, L = 0.08, 0.0
     far = optimise.min_norm_activation(model, E, L)
     near = optimise.solve_point(model, E, L)
-    front = optimise.pareto_front(model, E, L, n_points=6)
+    front = optimise.counter_torque_front(model, E, L, n_points=6)
     assert far.ok and near.ok and all(s == "optimal" for s in front.status)
     assert far.counter_torque_norm <= near.counter_torque_norm
     assert far.total_pcsa >= near.min_pcsa
