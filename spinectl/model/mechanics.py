@@ -150,7 +150,7 @@ def fibre_torque(alpha, omega, upper, lower, cor, fibre_params, errata):
     l0 = np.linalg.norm(np.asarray(lower) - np.asarray(upper), axis=-1)
     l_opt = fibre_params.optimal_length_ratio * l0
     length, h = fibre_length_and_lever_arm(upper, lower, cor, alpha)
-    return h * laws.tension(laws.get_law(fibre_params.law), length, h * omega, l_opt, fibre_params, errata)
+    return laws.tension(laws.get_law(fibre_params.law), length, h * omega, l_opt, fibre_params, errata, lever_arm=h)
 
 
 def muscle_torque_per_pcsa(model: Model, cor, alpha, omega):

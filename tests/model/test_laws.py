@@ -61,9 +61,9 @@ def _before_the_seam(model: Model):
 
 @pytest.mark.parametrize("preset", ["default", "wagner2012"])
 def test_the_registered_law_gives_the_numbers_before_the_seam_bit_for_bit(preset):
-    """The default law is the paper's: _fibre_laws (what K, D and the torques of the model and the chain are made of),
-    the MJCF gains, c_loc and the chain's nonlinear torque equal, bit for bit, the paper's relations composed as the
-    code composed them before the seam."""
+    """The default law is the paper's: _fibre_laws (what K, D and the torques of the model and the chain are made
+    of), the MJCF gains, c_loc and the nonlinear torques of the chain and of one segment (fibre_torque) equal, bit
+    for bit, the paper's relations composed as the code composed them before the seam."""
     model = load_preset(preset)
     assert model.fibre.law == "wagner2012" and laws.get_law(model.fibre.law) is laws.LAWS["wagner2012"]
     before = _before_the_seam(model)
@@ -91,6 +91,11 @@ def test_the_registered_law_gives_the_numbers_before_the_seam_bit_for_bit(preset
     tension = muscle.force_length(length[..., 0, :], l_opt, model.fibre) * muscle.force_velocity(velocity, hill)
     expected = (h * tension[..., None, :]) @ to_muscle
     np.testing.assert_array_equal(chain.chain_muscle_torque_per_pcsa(model, cor, q, qdot), expected)
+    alpha, omega = rng.uniform(-0.2, 0.2, (7, 1, 1)), rng.uniform(-1.0, 1.0, (7, 1, 1))
+    length, h = mechanics.fibre_length_and_lever_arm(upper, lower, cor[:, None, :], alpha)
+    expected = h * muscle.force_length(length, l_opt, model.fibre) * muscle.force_velocity(h * omega, hill)
+    torque = mechanics.fibre_torque(alpha, omega, upper, lower, cor[:, None, :], model.fibre, model.errata)
+    np.testing.assert_array_equal(torque, expected)
 
 
 def test_the_registered_law_is_the_closed_forms_of_docs_model():

@@ -115,11 +115,12 @@ class FibreRest:
     relative_velocity_slope: np.ndarray
 
 
-def tension(law: MuscleLaw, length, velocity, optimal_length, fibre, errata):
-    """A fibre's tension per unit f_iso at a length and a shortening velocity [1].
+def tension(law: MuscleLaw, length, velocity, optimal_length, fibre, errata, lever_arm=1.0):
+    """A fibre's tension per unit f_iso at a length and a shortening velocity [1], or its torque h T [m].
 
     T = f_L(l / l_opt) f_V(v) + f_P(l / l_opt), the rigid tendon's (module docstring); the paper's
-    M_i = h_i f_li f_Hi is h T (docs/model.md, "The muscle fibre").
+    M_i = h_i f_li f_Hi is h T (docs/model.md, "The muscle fibre"), computed as (h f_L) f_V + h f_P
+    with ``lever_arm`` h: the rounding of :func:`spinectl.model.mechanics.fibre_torque` before the seam.
 
     Parameters
     ----------
@@ -132,16 +133,19 @@ def tension(law: MuscleLaw, length, velocity, optimal_length, fibre, errata):
         l_opt [m].
     fibre : Fibre
     errata : Errata
+    lever_arm : array_like
+        h [m]; 1 (the default) gives the tension itself.
 
     Returns
     -------
     numpy.ndarray
-        T / f_iso [1]; the broadcast shape of the arguments.
+        h T / f_iso [m], or T / f_iso [1] without ``lever_arm``; the broadcast shape of the arguments.
     """
     ratio = np.asarray(length) / optimal_length
-    out = law.active_force_length(ratio, fibre) * law.force_velocity(velocity, optimal_length, fibre, errata)
+    active = lever_arm * law.active_force_length(ratio, fibre)  # 1 * f_L is f_L to the bit
+    out = active * law.force_velocity(velocity, optimal_length, fibre, errata)
     if law.passive_force_length is not None:
-        out = out + law.passive_force_length(ratio, fibre)
+        out = out + lever_arm * law.passive_force_length(ratio, fibre)
     return out
 
 

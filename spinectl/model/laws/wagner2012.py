@@ -21,80 +21,28 @@ import numpy as np
 from .. import muscle
 from .law import MuscleLaw, OpenSimCurves
 
+# The law's relations in the MuscleLaw's signatures (its attributes say what each takes and gives):
+# muscle.py's with l_opt = 1 for the force-length (x / 1 and a slope over 1 keep every bit), and the
+# Hill constants of the fibre's l_opt for the force-velocity.
 
-def active_force_length(ratio, fibre):
-    """f_L(x) = exp(-((x^k1 - 1) / k2)^2) [1] at x = l / l_opt (:func:`spinectl.model.muscle.force_length`).
 
-    Parameters
-    ----------
-    ratio : array_like
-        x = l / l_opt [1].
-    fibre : Fibre
-        Supplies k1 and k2 [1].
-
-    Returns
-    -------
-    numpy.ndarray
-        f_L [1], the shape of ``ratio``.
-    """
+def _active_force_length(ratio, fibre):
+    """f_L(x) = exp(-((x^k1 - 1) / k2)^2) [1] at x = l / l_opt."""
     return muscle.force_length(ratio, 1.0, fibre)
 
 
-def active_force_length_slope(ratio, fibre):
-    """df_L/dx [1] at x = l / l_opt (:func:`spinectl.model.muscle.force_length_slope` with l_opt = 1).
-
-    Parameters
-    ----------
-    ratio : array_like
-        x = l / l_opt [1].
-    fibre : Fibre
-        Supplies k1 and k2 [1].
-
-    Returns
-    -------
-    numpy.ndarray
-        df_L/dx [1], the shape of ``ratio``.
-    """
+def _active_force_length_slope(ratio, fibre):
+    """df_L/dx [1] at x = l / l_opt."""
     return muscle.force_length_slope(ratio, 1.0, fibre)
 
 
-def force_velocity(velocity, optimal_length, fibre, errata):
-    """Hill's f_H / f_iso [1] with the paper's constants for fibres of optimal length ``optimal_length``.
-
-    Parameters
-    ----------
-    velocity : array_like
-        Shortening velocity v [m/s].
-    optimal_length : array_like
-        l_opt [m].
-    fibre : Fibre
-    errata : Errata
-
-    Returns
-    -------
-    numpy.ndarray
-        f_H / f_iso [1] (:func:`spinectl.model.muscle.force_velocity`).
-    """
+def _force_velocity(velocity, optimal_length, fibre, errata):
+    """Hill's f_H / f_iso [1] at the shortening velocity ``velocity`` [m/s] of fibres of optimal length [m]."""
     return muscle.force_velocity(velocity, muscle.hill_constants(optimal_length, fibre, errata))
 
 
-def force_velocity_slope(velocity, optimal_length, fibre, errata):
-    """d(f_H / f_iso)/dv [s/m] with the paper's constants (:func:`spinectl.model.muscle.force_velocity_slope`).
-
-    Parameters
-    ----------
-    velocity : array_like
-        Shortening velocity v [m/s].
-    optimal_length : array_like
-        l_opt [m].
-    fibre : Fibre
-    errata : Errata
-
-    Returns
-    -------
-    numpy.ndarray
-        d(f_H / f_iso)/dv [s/m].
-    """
+def _force_velocity_slope(velocity, optimal_length, fibre, errata):
+    """d(f_H / f_iso)/dv [s/m] at the shortening velocity ``velocity`` [m/s] of fibres of optimal length [m]."""
     return muscle.force_velocity_slope(velocity, muscle.hill_constants(optimal_length, fibre, errata))
 
 
@@ -140,10 +88,10 @@ def opensim_curves(fibre, errata) -> OpenSimCurves:
 
 LAW = MuscleLaw(
     name="wagner2012",
-    active_force_length=active_force_length,
-    active_force_length_slope=active_force_length_slope,
-    force_velocity=force_velocity,
-    force_velocity_slope=force_velocity_slope,
+    active_force_length=_active_force_length,
+    active_force_length_slope=_active_force_length_slope,
+    force_velocity=_force_velocity,
+    force_velocity_slope=_force_velocity_slope,
     opensim=opensim_curves,
     reference="Wagner et al. (2012), Theor Biol Med Model 9:13, doi:10.1186/1742-4682-9-13; Hill (1938)",
 )
