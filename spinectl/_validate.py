@@ -7,6 +7,7 @@ one line: offending values are shown by a shortened ``repr``.
 
 from __future__ import annotations
 
+import difflib
 import math
 import numbers
 from collections.abc import Sequence
@@ -136,7 +137,7 @@ def in_range(name: str, value, low: float, high: float) -> float:
     return value
 
 
-def choice(name: str, value, allowed: Sequence[str]) -> str:
+def choice(name: str, value, allowed: Sequence[str], *, suggest: bool = False) -> str:
     """One of the strings in ``allowed``.
 
     Parameters
@@ -147,9 +148,13 @@ def choice(name: str, value, allowed: Sequence[str]) -> str:
         The value to check.
     allowed : sequence of str
         The accepted values.
+    suggest : bool
+        Add the closest allowed value to the message (``"; did you mean 'x'?"``), if one is close.
     """
     if not isinstance(value, str) or value not in allowed:
-        raise ParameterError(name, f"must be one of {', '.join(map(repr, allowed))} (got {show(value)})")
+        close = difflib.get_close_matches(value, list(allowed), n=1) if suggest and isinstance(value, str) else []
+        hint = f"; did you mean {close[0]!r}?" if close else ""
+        raise ParameterError(name, f"must be one of {', '.join(map(repr, allowed))} (got {show(value)}){hint}")
     return value
 
 

@@ -35,7 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from ..atomic import atomic_write_text, check_distinct
-from ..model import chain, geometry, muscle
+from ..model import chain, geometry, laws
 from ..model.mechanics import gravity_sign, inertia, passive_stiffness
 from ..model.params import Model
 from ..model.source import header
@@ -176,8 +176,9 @@ class Fibres:
         Upright length l0 [m].
     force, length_slope, velocity_slope : numpy.ndarray, shape (F,)
         Per unit PCSA of the fibre's muscle: tension T0 = sigma s f_l(l0) [N/m^2], dT/dl =
-        sigma s f_l'(l0) [N/m^3] and dT/dv = sigma s f_l(l0) f_H'(0) [N s/m^3], s the fibre's
-        share of its muscle and v the shortening velocity.
+        sigma s f_l'(l0) [N/m^3] and dT/dv = sigma s f_l(l0) f_H'(0) [N s/m^3] with the paper's
+        law (:func:`spinectl.model.laws.at_rest` with another), s the fibre's share of its muscle
+        and v the shortening velocity.
     """
 
     names: tuple
@@ -193,9 +194,9 @@ class Fibres:
 def fibre_gains(model: Model) -> Fibres:
     """Each fibre's tension, and its slopes in length and velocity, at the upright posture.
 
-    The paper's tension T = f_iso f_l(l) f_H(v) (:mod:`spinectl.model.muscle`), with f_iso =
-    sigma s PCSA, to first order about (l0, v = 0): T ~ T0 + T_l (l - l0) + T_v v, which is what
-    the chain's K and D are made of (docs/chain.md).
+    The tension T = f_iso T_law(l, v) of the fibres' muscle law (``fibre.law``, the paper's f_l(l) f_H(v);
+    :func:`spinectl.model.laws.at_rest`), with f_iso = sigma s PCSA, to first order about (l0, v = 0):
+    T ~ T0 + T_l (l - l0) + T_v v, which is what the chain's K and D are made of (docs/chain.md).
 
     Parameters
     ----------
@@ -208,9 +209,8 @@ def fibre_gains(model: Model) -> Fibres:
     upper, lower, share = geometry.all_fibres(model)
     l0 = np.linalg.norm(lower - upper, axis=-1)
     l_opt = model.fibre.optimal_length_ratio * l0
-    hill = muscle.hill_constants(l_opt, model.fibre, model.errata)
+    rest = laws.at_rest(laws.get_law(model.fibre.law), l0, l_opt, model.fibre, model.errata)
     f_iso = model.fibre.specific_tension * share.sum(axis=1)  # per unit PCSA of the fibre's muscle
-    f_l = muscle.force_length(l0, l_opt, model.fibre)
     owner = np.argmax(share, axis=1)
     counts: dict = {}
     names = []
@@ -223,9 +223,9 @@ def fibre_gains(model: Model) -> Fibres:
         upper=upper,
         lower=lower,
         length=l0,
-        force=f_iso * f_l,
-        length_slope=f_iso * muscle.force_length_slope(l0, l_opt, model.fibre),
-        velocity_slope=f_iso * f_l * muscle.force_velocity_slope(np.zeros_like(l0), hill),
+        force=f_iso * rest.tension,
+        length_slope=f_iso * rest.length_slope,
+        velocity_slope=f_iso * rest.tension * rest.relative_velocity_slope,
     )
 
 

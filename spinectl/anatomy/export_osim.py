@@ -20,10 +20,11 @@ The fibres are OpenSim muscles of one of two kinds (``muscle``, :data:`MUSCLES`)
   the posture differ from spinectl's (docs/interchange.md, "What is lost"), and Millard floors the
   activation at 0.01;
 - ``"paper"``: ``RigidTendonMuscle`` s (no tendon length, no pennation, the activation is the
-  control, unclamped) whose force-length and force-velocity curves are the paper's own formulas
-  as OpenSim ``ExpressionBasedFunction`` s (:func:`paper_curves`), no passive curve: OpenSim's
-  tension is then spinectl's at every length and velocity, so OpenSim's linearisation of the file
-  is the chain's K and D.
+  control, unclamped) whose curves are those of the model's muscle law (``fibre.law``) as OpenSim
+  ``ExpressionBasedFunction`` s (:func:`spinectl.model.laws.opensim_curves`; the paper's law: its
+  own formulas, no passive curve): OpenSim's tension is then spinectl's at every length and
+  velocity, so OpenSim's linearisation of the file is the chain's K and D. A law without such
+  expressions is refused in one line.
 
 The geometry, the masses, gravity and the springs are the same either way.
 
@@ -50,9 +51,9 @@ from .._optional import require_module
 from .._validate import printable
 from ..atomic import atomic_path, check_distinct, full_disk_note
 from ..errors import OutputError, ParameterError
-from ..model import chain, geometry
+from ..model import chain, geometry, laws
 from ..model.mechanics import gravity_sign
-from ..model.muscle import hill_constants, max_velocity
+from ..model.muscle import max_velocity
 from ..units import M2_PER_CM2
 from .engine import SpinectlError
 from .export_mjcf import PaperSolution, body_names, fibre_gains, paper_solution
@@ -154,46 +155,6 @@ def check_names(model) -> None:
             )
 
 
-def paper_curves(model) -> tuple:
-    """The paper's force-length and force-velocity factors as OpenSim expressions of the normalised fibre state.
-
-    OpenSim's ``RigidTendonMuscle`` evaluates its active force-length curve at x = l / l_opt and its
-    force-velocity curve at w = V / (l_opt v_hat), V the lengthening velocity and v_hat its
-    ``max_contraction_velocity`` [l_opt/s]. With v_max = v_hat l_opt (:func:`~spinectl.model.muscle.max_velocity`)
-    and the shortening velocity v = -w v_max, the paper's factors (:mod:`spinectl.model.muscle`) are
-    f_l = exp(-((x^k1 - 1) / k2)^2), and f_H = c~ / (b~ - w) - a for w <= 0 (concentric, v >= 0),
-    A - C~ / (w + B~) for w > 0, with b~, c~, B~, C~ the Hill constants over v_max (the same for every
-    fibre, since b and B scale with l_opt). Numbers are written with ``repr``: the shortest decimal
-    that reads back to the same double.
-
-    Parameters
-    ----------
-    model : Model
-
-    Returns
-    -------
-    tuple of str
-        (force-length expression in x, force-velocity expression in w).
-
-    References
-    ----------
-    Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012). Spinal lordosis optimizes the
-    requirements for a stable erect posture. Theor Biol Med Model 9:13. doi:10.1186/1742-4682-9-13.
-    """
-    fibre = model.fibre
-    unit = float(max_velocity(1.0, fibre))  # v_max of a fibre with l_opt = 1 m: the Hill constants over v_max
-    hill = hill_constants(np.asarray(1.0), fibre, model.errata)
-    a, b, c = float(hill.a), float(hill.b) / unit, float(hill.c) / unit
-    big_a, big_b, big_c = float(hill.A), float(hill.B) / unit, float(hill.C) / unit
-    length = f"exp(-((x^{float(fibre.k1)!r} - 1) / {float(fibre.k2)!r})^2)"
-    # step(-w) is 1 at w = 0: the concentric branch there, as spinectl's; min/max keep each branch off its pole
-    velocity = (
-        f"step(-w) * ({c!r} / ({b!r} - min(w, 0)) - {a!r})"
-        f" + (1 - step(-w)) * ({big_a!r} - {big_c!r} / (max(w, 0) + {big_b!r}))"
-    )
-    return length, velocity
-
-
 def _millard_fibre(osim, name, f_max, l_opt, length, v_hat):
     """One fibre as a rigid-tendon ``Millard2012EquilibriumMuscle`` with Millard's curves."""
     out = osim.Millard2012EquilibriumMuscle(name, f_max, l_opt, TENDON_SLACK_RATIO * length, 0.0)
@@ -205,12 +166,15 @@ def _millard_fibre(osim, name, f_max, l_opt, length, v_hat):
 
 
 def _paper_fibre(osim, name, f_max, l_opt, curves, v_hat):
-    """One fibre as a ``RigidTendonMuscle`` with the paper's curves (:func:`paper_curves`) and no tendon length."""
+    """One fibre as a ``RigidTendonMuscle`` with its law's curves (:class:`~spinectl.model.laws.OpenSimCurves`)
+    and no tendon length."""
     out = osim.RigidTendonMuscle(name, f_max, l_opt, 0.0, 0.0)
     out.set_max_contraction_velocity(v_hat)
-    out.set_active_force_length_curve(osim.ExpressionBasedFunction(curves[0], "x"))
-    out.set_force_velocity_curve(osim.ExpressionBasedFunction(curves[1], "w"))
-    out.set_passive_force_length_curve(osim.Constant(0.0))  # the paper's fibres have no passive force
+    out.set_active_force_length_curve(osim.ExpressionBasedFunction(curves.active_force_length, "x"))
+    out.set_force_velocity_curve(osim.ExpressionBasedFunction(curves.force_velocity, "w"))
+    passive = curves.passive_force_length  # None: no passive force (the paper's fibres)
+    passive = osim.Constant(0.0) if passive is None else osim.ExpressionBasedFunction(passive, "x")
+    out.set_passive_force_length_curve(passive)
     return out
 
 
@@ -274,7 +238,7 @@ def paper_osim(solution: PaperSolution, counter_torque=None, muscle: str = "mill
     fibres = fibre_gains(model)
     l_opt = model.fibre.optimal_length_ratio * fibres.length
     reference = REFERENCE_PCSA_CM2 * M2_PER_CM2
-    curves = paper_curves(model)
+    curves = laws.opensim_curves(model.fibre, model.errata) if muscle == "paper" else None
     for f, name in enumerate(fibres.names):
         f_max = float(model.fibre.specific_tension * reference / np.sum(fibres.muscle == fibres.muscle[f]))
         v_hat = float(max_velocity(l_opt[f], model.fibre) / l_opt[f])

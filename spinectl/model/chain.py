@@ -36,7 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..units import M2_PER_CM2
-from . import geometry, muscle
+from . import geometry, laws
 from .linear_chain import LinearChain
 from .mechanics import (
     _fibre_laws,
@@ -320,18 +320,18 @@ def dynamic_eigenvalues(mass, stiffness, damping):
 
 
 def _fibre_constants(model: Model):
-    """Attachments, fibre-to-muscle matrix per unit PCSA, upright length, l_opt and Hill constants."""
+    """Attachments, fibre-to-muscle matrix per unit PCSA, upright length, l_opt and the fibres' muscle law."""
     upper, lower, share = geometry.all_fibres(model)
     l0 = np.linalg.norm(lower - upper, axis=-1)
     l_opt = model.fibre.optimal_length_ratio * l0
-    hill = muscle.hill_constants(l_opt, model.fibre, model.errata)
-    return upper, lower, model.fibre.specific_tension * share, l0, l_opt, hill
+    return upper, lower, model.fibre.specific_tension * share, l0, l_opt, laws.get_law(model.fibre.law)
 
 
 def chain_muscle_torque_per_pcsa(model: Model, cor, q, qdot):
     """Nonlinear generalised torques of every muscle on every joint per unit PCSA [N m / m^2].
 
-    tau_j = sum over fibres of h_j f_l(l) f_H(v) (paper, Methods: M_i = h_i f_li f_Hi), with
+    tau_j = sum over fibres of h_j T(l, v) (paper, Methods: M_i = h_i f_li f_Hi; T the tension of the
+    fibre's muscle law, :func:`spinectl.model.laws.tension`), with
     the fibre's length l(q), its lever arm about the moved CoR j, h_j = -dl/dq_j, and its
     shortening velocity v = sum_j h_j q'_j. With one joint free this is
     :func:`spinectl.model.mechanics.muscle_torque_per_pcsa`.
@@ -350,12 +350,12 @@ def chain_muscle_torque_per_pcsa(model: Model, cor, q, qdot):
     -------
     numpy.ndarray, shape (..., n_cor, n_muscles)
     """
-    upper, lower, to_muscle, _, l_opt, hill = _fibre_constants(model)
+    upper, lower, to_muscle, _, l_opt, law = _fibre_constants(model)
     moved, _ = chain_positions(q, cor)
     tops = carried_points(upper, q, cor)  # (..., F, 2)
     length, h = fibre_length_and_lever_arm(tops[..., None, :, :], lower, moved[..., :, None, :])  # (..., n, F)
     velocity = np.einsum("...jf,...j->...f", h, np.asarray(qdot, float))
-    tension = muscle.force_length(length[..., 0, :], l_opt, model.fibre) * muscle.force_velocity(velocity, hill)
+    tension = laws.tension(law, length[..., 0, :], velocity, l_opt, model.fibre, model.errata)
     return (h * tension[..., None, :]) @ to_muscle
 
 
@@ -729,24 +729,26 @@ def local_stiffness_per_pcsa(model: Model) -> float:
 
 
 def local_damping_per_stiffness(model: Model) -> float:
-    """c_loc [s]: the joint damping of a local muscle per unit of its joint stiffness, from its Hill slope.
+    """c_loc [s]: the joint damping of a local muscle per unit of its joint stiffness, from its force-velocity slope.
 
-    A local muscle at force F with the global fibres' Hill curve (:func:`spinectl.model.muscle.force_velocity`,
-    the force scaled by F/f_iso) has dF/dv = F f_H'(0) at rest, v its shortening velocity. At the lever
-    arm r, v = r omega, so the joint damping is r^2 F abs(f_H'(0)); its stiffness is k = q F r^2 / l
-    (:func:`local_stiffness_per_pcsa`). Both are proportional to F r^2, so
+    A local muscle at force F with the global fibres' muscle law (``fibre.law``, the force scaled by
+    F/f_iso) has dF/dv = F s at rest, v its shortening velocity and s = (dT/dv) / T of the law at rest
+    (:func:`spinectl.model.laws.at_rest`; the paper's Hill slope f_H'(0)). At the lever arm r, v = r omega,
+    so the joint damping is r^2 F abs(s); its stiffness is k = q F r^2 / l (:func:`local_stiffness_per_pcsa`).
+    Both are proportional to F r^2, so
 
-        d = c_loc k,   c_loc = ``local.damping`` * l abs(f_H'(0)) / q,
+        d = c_loc k,   c_loc = ``local.damping`` * l abs(s) / q,
 
-    whatever the PCSA, activation or lever arm: f_H'(0) = -(1 + a) / b is that of a fibre of optimal
-    length l_opt = ``fibre.optimal_length_ratio`` * l (the local muscle all fibre, on the ascending limb
-    like the global ones). docs/chain.md, "Local muscles as joint stiffness and damping".
+    whatever the PCSA, activation or lever arm: s (with the paper's law f_H'(0) = -(1 + a) / b) is that of
+    a fibre of length l and optimal length l_opt = ``fibre.optimal_length_ratio`` * l (the local muscle all
+    fibre, on the ascending limb like the global ones). docs/chain.md, "Local muscles as joint stiffness
+    and damping".
 
     Parameters
     ----------
     model : Model
-        Supplies ``local`` (q, l [m], the factor ``damping``), ``fibre`` (the Hill constants) and
-        ``errata`` (their eccentric constant, which does not change the slope at rest).
+        Supplies ``local`` (q, l [m], the factor ``damping``), ``fibre`` (the law and its constants) and
+        ``errata`` (with the paper's law the eccentric constant, which does not change the slope at rest).
 
     Returns
     -------
@@ -762,8 +764,9 @@ def local_damping_per_stiffness(model: Model) -> float:
     the requirements for a stable erect posture. Theor Biol Med Model 9:13. doi:10.1186/1742-4682-9-13.
     """
     local = model.local
-    hill = muscle.hill_constants(model.fibre.optimal_length_ratio * local.length, model.fibre, model.errata)
-    slope = float(muscle.force_velocity_slope(0.0, hill))  # d(f_H / f_iso)/dv [s/m], < 0
+    l_opt = model.fibre.optimal_length_ratio * local.length
+    rest = laws.at_rest(laws.get_law(model.fibre.law), local.length, l_opt, model.fibre, model.errata)
+    slope = float(rest.relative_velocity_slope)  # (dT/dv) / T [s/m], < 0
     return local.damping * local.length * -slope / local.stiffness_gain
 
 

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import geometry, muscle
+from . import geometry, laws
 from .params import Model
 
 
@@ -125,8 +125,9 @@ def lever_arm_slope(upper, lower, cor):
 def fibre_torque(alpha, omega, upper, lower, cor, fibre_params, errata):
     """Nonlinear torque of fibres per unit isometric force, M_i / f_iso [m].
 
-    M_i = h_i f_l(l_i) f_H(h_i omega) (paper, Methods: M_i = h_i f_li f_Hi),
-    with l_opt = optimal_length_ratio * l0 and l0 the upright length.
+    M_i = h_i T(l_i, h_i omega) (paper, Methods: M_i = h_i f_li f_Hi), T the tension of the
+    fibre's muscle law (``fibre_params.law``, :func:`spinectl.model.laws.tension`), with
+    l_opt = optimal_length_ratio * l0 and l0 the upright length.
 
     Parameters
     ----------
@@ -137,6 +138,7 @@ def fibre_torque(alpha, omega, upper, lower, cor, fibre_params, errata):
     upper, lower, cor : array_like, shape (..., 2)
         Upright attachment points and CoR [m].
     fibre_params : Fibre
+        The fibres' constants and ``law``.
     errata : Errata
 
     Returns
@@ -147,11 +149,8 @@ def fibre_torque(alpha, omega, upper, lower, cor, fibre_params, errata):
     """
     l0 = np.linalg.norm(np.asarray(lower) - np.asarray(upper), axis=-1)
     l_opt = fibre_params.optimal_length_ratio * l0
-    hill = muscle.hill_constants(l_opt, fibre_params, errata)
     length, h = fibre_length_and_lever_arm(upper, lower, cor, alpha)
-    f_l = muscle.force_length(length, l_opt, fibre_params)
-    f_h = muscle.force_velocity(h * omega, hill)
-    return h * f_l * f_h
+    return laws.tension(laws.get_law(fibre_params.law), length, h * omega, l_opt, fibre_params, errata, lever_arm=h)
 
 
 def muscle_torque_per_pcsa(model: Model, cor, alpha, omega):
@@ -366,14 +365,14 @@ class SegmentCoefficients:
 
 def _fibre_laws(model: Model):
     """Every fibre's attachments, its share of the muscles' PCSA times the specific tension (f_iso per PCSA),
-    upright length l0 and, there, f_l, df_l/dl and df_H/dv at v = 0 (per unit f_iso)."""
+    upright length l0 and, there, by its muscle law (:func:`spinectl.model.laws.at_rest`), the tension T, dT/dl
+    and (dT/dv) / T (per unit f_iso; the paper's T = f_l, dT/dl = f_l' and (dT/dv) / T = f_H'(0))."""
     upper, lower, share = geometry.all_fibres(model)  # (F, 2), (F, 2), (F, M)
     l0 = np.linalg.norm(lower - upper, axis=-1)
     l_opt = model.fibre.optimal_length_ratio * l0
-    f_l = muscle.force_length(l0, l_opt, model.fibre)
-    f_l_slope = muscle.force_length_slope(l0, l_opt, model.fibre)
-    f_h_slope = muscle.force_velocity_slope(np.zeros_like(l0), muscle.hill_constants(l_opt, model.fibre, model.errata))
-    return upper, lower, model.fibre.specific_tension * share, l0, f_l, f_l_slope, f_h_slope
+    rest = laws.at_rest(laws.get_law(model.fibre.law), l0, l_opt, model.fibre, model.errata)
+    to_muscle = model.fibre.specific_tension * share
+    return upper, lower, to_muscle, l0, rest.tension, rest.length_slope, rest.relative_velocity_slope
 
 
 def _monomial_coefficients(model: Model):

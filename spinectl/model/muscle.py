@@ -1,6 +1,11 @@
-"""Muscle fibre mechanics: force-length and Hill force-velocity relations.
+"""Muscle fibre mechanics: the paper's force-length and Hill force-velocity relations.
 
-Pure array functions. Forces are returned per unit isometric force (divide by
+These are the formulas of the ``wagner2012`` muscle law (:mod:`spinectl.model.laws.wagner2012`):
+the model, the chain and the exports reach them through the muscle-law seam
+(:mod:`spinectl.model.laws`, docs/model.md, "The muscle-law seam"), never directly.
+Pure array functions; ``fibre`` is a :class:`~spinectl.model.params.Fibre` and ``errata`` an
+:class:`~spinectl.model.params.Errata`, read by attribute (so that the laws, which the parameters
+validate their ``law`` against, import no parameters). Forces are returned per unit isometric force (divide by
 f_iso = specific_tension * PCSA), so every quantity is linear in PCSA
 (docs/model.md, "Force-velocity"). Velocities are *shortening* velocities:
 v >= 0 concentric. The relations are the paper's [1]_ (Methods), with the eccentric
@@ -22,10 +27,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .params import Errata, Fibre
 
-
-def force_length(length, optimal_length, fibre: Fibre):
+def force_length(length, optimal_length, fibre):
     """Force-length factor f_l [1] (paper, Methods; its refs 17, 18).
 
     f_l = exp(-(((l / l_opt)^k1 - 1) / k2)^2), the paper's force-length relation [1]_
@@ -56,7 +59,7 @@ def force_length(length, optimal_length, fibre: Fibre):
     return np.exp(-(u**2))
 
 
-def force_length_slope(length, optimal_length, fibre: Fibre):
+def force_length_slope(length, optimal_length, fibre):
     """Derivative df_l/dl of :func:`force_length` [1/m], analytic.
 
     df_l/dl = f_l * (-2 u / k2) * k1 (l/l_opt)^(k1 - 1) / l_opt, u = ((l/l_opt)^k1 - 1)/k2.
@@ -113,7 +116,7 @@ class HillConstants:
     C: np.ndarray
 
 
-def max_velocity(optimal_length, fibre: Fibre):
+def max_velocity(optimal_length, fibre):
     """v_max = (vmax_slow + vmax_fast_gain FT) l_opt [m/s] (paper: (6 + 10 FT) l_opt).
 
     Parameters
@@ -131,7 +134,7 @@ def max_velocity(optimal_length, fibre: Fibre):
     return (fibre.vmax_slow + fibre.vmax_fast_gain * fibre.fast_twitch) * np.asarray(optimal_length)
 
 
-def hill_constants(optimal_length, fibre: Fibre, errata: Errata) -> HillConstants:
+def hill_constants(optimal_length, fibre, errata) -> HillConstants:
     """Hill constants per unit f_iso for fibres of optimal length ``optimal_length`` [m].
 
     The paper's constants [1]_ (Methods; docs/model.md, "Force-velocity") of the

@@ -217,3 +217,25 @@ def test_a_full_disk_is_one_line_and_leaves_nothing(tmp_path, monkeypatch, capsy
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and expected in err and "No space left on device" in err, err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["chain.osim"] and out.read_text(encoding="utf-8") == "old"
+
+
+def test_a_muscle_law_without_opensim_expressions_is_refused_and_nothing_written(tmp_path):
+    """A law registered with ``opensim=None`` (docs/model.md, "The muscle-law seam"): the ``paper`` muscles, which
+    carry the law's own curves, are one ParameterError naming fibre.law and leave no file; Millard's muscles, whose
+    curves are Millard's whatever the law, are written."""
+    import dataclasses
+
+    from spinectl.errors import ParameterError
+    from spinectl.model import laws
+
+    law = laws.register_law(dataclasses.replace(laws.LAWS["wagner2012"], name="without_opensim", opensim=None))
+    try:
+        paper = load_preset("wagner2012")
+        model = dataclasses.replace(paper, fibre=dataclasses.replace(paper.fibre, law=law.name))
+        with pytest.raises(ParameterError, match="^fibre.law: the muscle law 'without_opensim' has no OpenSim"):
+            export_osim(model, E, LAMBDA, tmp_path / "paper.osim", muscle="paper")
+        assert list(tmp_path.iterdir()) == []
+        export_osim(model, E, LAMBDA, tmp_path / "millard.osim", muscle="millard")
+        assert (tmp_path / "millard.osim").is_file()
+    finally:
+        del laws.LAWS[law.name]

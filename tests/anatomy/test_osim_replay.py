@@ -27,10 +27,9 @@ from spinectl.anatomy.export_osim import (  # noqa: E402
     export_osim,
     opensim_counter_torque,
     opensim_linearisation,
-    paper_curves,
 )
 from spinectl.cli import main  # noqa: E402
-from spinectl.model import chain, geometry  # noqa: E402
+from spinectl.model import chain, geometry, laws  # noqa: E402
 from spinectl.model import muscle as fibre_law  # noqa: E402
 from spinectl.model.config import load_preset  # noqa: E402
 
@@ -104,9 +103,9 @@ def test_the_papers_curves_in_the_file_are_spinectls_formulas(exported):
         if errata == model.errata.eccentric_constant:  # the file's own curves
             length, velocity = fibre.get_active_force_length_curve(), fibre.get_force_velocity_curve()
         else:
-            expressions = paper_curves(variant)
-            length = osim.ExpressionBasedFunction(expressions[0], "x")
-            velocity = osim.ExpressionBasedFunction(expressions[1], "w")
+            expressions = laws.opensim_curves(variant.fibre, variant.errata)
+            length = osim.ExpressionBasedFunction(expressions.active_force_length, "x")
+            velocity = osim.ExpressionBasedFunction(expressions.force_velocity, "w")
         hill = fibre_law.hill_constants(np.asarray(l_opt), variant.fibre, variant.errata)
         v_max = fibre_law.max_velocity(l_opt, variant.fibre)
         np.testing.assert_allclose(

@@ -60,6 +60,8 @@ def test_config_show_is_loadable_toml(capsys, tmp_path):
         (["stability", "--pcsa", "1,1,1", "--config", "/no/such.toml"], "file not found"),
         (["stability", "--pcsa", "1,1,1", "--preset", "nope"], "preset: must be one of"),
         (["stability", "--pcsa", "1,1,1", "--K", "-1"], "passive.stiffness: must be >= 0"),
+        (["stability", "--pcsa", "1,1,1", "--set", "fibre.law=hil"], "fibre.law: must be one of 'wagner2012'"),
+        (["export", "--set", "fibre.law=wagner2021", "--out", "x.xml"], "; did you mean 'wagner2012'?"),
         (["frobnicate"], "invalid choice"),
     ],
 )

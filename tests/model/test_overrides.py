@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from spinectl.errors import ConfigError, ParameterError
-from spinectl.model import config, source
+from spinectl.model import config, laws, source
 from spinectl.model._toml import to_dict
 from spinectl.model.params import Model
 from spinectl.model.stability import segment_stability
@@ -31,6 +31,15 @@ ALTERNATIVES = {
     "rule": "explicit",
 }
 """A second allowed value of each text parameter (their allowed values: docs/parameters.md)."""
+
+
+@pytest.fixture(autouse=True)
+def _second_law():
+    """The paper's law registered again as ``wagner2012_b``: the second allowed value of ``fibre.law`` (only the
+    paper's is built in), which :func:`_changed` gives it."""
+    law = laws.register_law(dataclasses.replace(laws.LAWS["wagner2012"], name="wagner2012_b"))
+    yield
+    del laws.LAWS[law.name]
 
 
 def _leaves(data, prefix=""):

@@ -104,7 +104,8 @@ KINDS = {
     "geometry.spline_bc": CHOICE,
     "geometry.eccentricity_range": PAIR,
     "geometry.lordosis_range": PAIR,
-    **{f"fibre.{f.name}": REAL for f in dataclasses.fields(Model().fibre)},
+    **{f"fibre.{f.name}": REAL for f in dataclasses.fields(Model().fibre) if f.name != "law"},
+    "fibre.law": CHOICE,
     "muscles.name": LABEL,
     "muscles.upper": PAIR,
     "muscles.lower": PAIR,
@@ -227,7 +228,7 @@ def invalid_values(dotted: str):
     }[kind]
     if kind == CHOICE:
         allowed = {"natural", "clamped", "not-a-knot", "physical", "paper", "destabilising", "printed"}
-        allowed |= {"corrected", "paired", "independent", "rule", "explicit"}
+        allowed |= {"corrected", "paired", "independent", "rule", "explicit", "wagner2012"}
         by_kind = by_kind.filter(lambda x: not (isinstance(x, str) and x in allowed))
     return st.one_of(by_kind, st.sampled_from(OUT_OF_RANGE[dotted])) if dotted in OUT_OF_RANGE else by_kind
 

@@ -7,12 +7,13 @@ from dataclasses import dataclass
 
 from ... import _validate as v
 from ...errors import ParameterError
+from ..laws import DEFAULT_LAW, LAWS
 from .bounds import MAX_FIBRES, _length, _specific_tension, _store, param
 
 
 @dataclass(frozen=True)
 class Fibre:
-    """Force-length and Hill force-velocity properties of every global muscle fibre."""
+    """Force-length and Hill force-velocity properties of every global muscle fibre, and its muscle law."""
 
     specific_tension: float = param(
         25.0e4, "N/m^2", "Isometric force per PCSA, f_iso / PCSA (paper: 25 N/cm^2 = 2.5e5 N/m^2)."
@@ -29,6 +30,13 @@ class Fibre:
     hill_b: float = param(0.25, "1", "b / v_max of the Hill curve (paper: b = v_max / 4).")
     eccentric_enhancement: float = param(
         1.5, "1", "f_ecc: the eccentric force tends to A = f_ecc f_iso (paper, its ref. 24: 1.5)."
+    )
+    law: str = param(
+        DEFAULT_LAW,
+        "",
+        "The muscle law: a registered name (spinectl.model.laws). 'wagner2012': the paper's force-length and "
+        "Hill force-velocity relations with the constants above, no passive force, a rigid tendon "
+        "(docs/model.md, The muscle-law seam).",
     )
 
     def __post_init__(self):
@@ -52,6 +60,7 @@ class Fibre:
             hill_a=v.positive("hill_a", self.hill_a),
             hill_b=v.positive("hill_b", self.hill_b),
             eccentric_enhancement=ecc,
+            law=v.choice("law", self.law, tuple(LAWS), suggest=True),
         )
 
 
