@@ -219,9 +219,8 @@ def test_the_first_lines_give_both_verdicts_each_with_its_criterion():
     report = margins_with_chain(_library_model(base, state), 0.03, 0.04)
     assert all(s.stable_at_delay for s in report.segments) and not report.chain.stable_at_delay  # the premise
     joint, chain_line = numbers.verdicts()
-    assert (
-        joint
-        == "joint by joint (each CoR alone, the others fixed; the paper's criterion): every segment stable at τ = 100 ms"
+    assert joint == (
+        "joint by joint (each CoR alone, the others fixed; the paper's criterion): every segment stable at τ = 100 ms"
     )
     assert chain_line == (
         "chain (all 5 CoRs free), the same reflex at every joint: NOT stable at τ = 100 ms "
