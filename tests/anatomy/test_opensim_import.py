@@ -231,7 +231,7 @@ def test_optimum_on_opensims_chain_is_the_least_effort_and_stable(lowest_joint):
     classic one."""
     from scipy.optimize import minimize
 
-    from spinectl.anatomy.opensim_engine import optimised, volume_weights
+    from spinectl.anatomy.optimum import optimised, volume_weights
 
     result = optimised(lowest_joint, equilibrium="free", margin=1.0)
     _, _, lin = lowest_joint.chains()
