@@ -31,8 +31,8 @@ from ..model.chain import dynamic_eigenvalues
 from ..model.chain import state_matrix as chain_state_matrix
 from ..model.linear_chain import LinearChain
 from ..model.stability import MARGINAL_TIME_CONSTANT, slowest_time_constant
-from .engine import require_mujoco
 from .contract import AnatomyEngine
+from .engine import require_mujoco
 from .model import Anatomy
 
 RANK_TOLERANCE = 1e-9

@@ -96,6 +96,16 @@ class AnatomyEngine(Protocol):
     def require_referee(self) -> None:
         """Return if MuJoCo's referee (``check``) can compare this model; else raise one line."""
 
+    def sagittal_axes(self, joints, posture=None) -> tuple:
+        """The sagittal plane's (horizontal, up) unit axes in the world, each shape (3,) (the figures)."""
+
+    def spine(self, joints, basis, posture=None, moved=None) -> tuple:
+        """The joints' centres of rotation (n, 2) and the thorax's centre of mass (2,), projected on ``basis``
+        [m], the joints' angles changed by ``moved`` [rad] if given."""
+
+    def muscle_paths(self, basis, posture=None) -> tuple:
+        """Per muscle, its path projected on ``basis``: a tuple of branches of shape (p_k, 2) [m]."""
+
 
 @dataclass
 class MappedModel:
@@ -287,6 +297,27 @@ class MappedModel:
         """
         raise ParameterError("check", f"MuJoCo is the referee, for MJCF models only; {self.name} is not one")
 
+    def sagittal_axes(self, joints, posture=None) -> tuple:
+        """An engine that gives no geometry draws no figure: one line (see :meth:`spine`)."""
+        raise self._no_geometry()
+
+    def spine(self, joints, basis, posture=None, moved=None) -> tuple:
+        """The figures' points (:class:`AnatomyEngine`); an engine without geometry refuses, one line.
+
+        Raises
+        ------
+        ParameterError
+            Field ``plot``.
+        """
+        raise self._no_geometry()
+
+    def muscle_paths(self, basis, posture=None) -> tuple:
+        """An engine that gives no geometry draws no figure: one line (see :meth:`spine`)."""
+        raise self._no_geometry()
+
+    def _no_geometry(self) -> ParameterError:
+        return ParameterError("plot", f"{self.name}'s engine gives no geometry to draw; analyse it without --plot")
+
 
 def lordosis_direction(anatomy, rhy, n: int, degrees: float) -> np.ndarray:
     """The change of the involved joints' angles [rad] that moves the chain by ``degrees`` along the rhythm.
@@ -374,9 +405,7 @@ def loader_of(model):
     if loader is None:
         names = sorted(k for k in ENGINES if not k.startswith("."))
         suffixes = ", ".join(sorted(k for k in ENGINES if k.startswith(".")))
-        raise ParameterError(
-            "model", f"must be one of {names} or a file ending in {suffixes} (got {show(text)})"
-        )
+        raise ParameterError("model", f"must be one of {names} or a file ending in {suffixes} (got {show(text)})")
     if isinstance(loader, str):
         module, _, function = loader.partition(":")
         loader = getattr(importlib.import_module(module), function)

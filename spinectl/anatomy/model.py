@@ -16,7 +16,7 @@ from .mapping import Mapping, check_mapping, classify, default_mapping, read_map
 
 @dataclass
 class Anatomy(MappedModel):
-    """A MuJoCo musculoskeletal model, mapped onto the chain: MuJoCo's :class:`~spinectl.anatomy.contract.AnatomyEngine`.
+    """A MuJoCo musculoskeletal model mapped onto the chain: MuJoCo's :class:`~spinectl.anatomy.contract.AnatomyEngine`.
 
     Attributes
     ----------
@@ -238,6 +238,97 @@ class Anatomy(MappedModel):
 
     def require_referee(self) -> None:
         """MuJoCo's own model is the referee of its chain (``check``): nothing to refuse."""
+
+    def _kinematics(self, qpos):
+        """MuJoCo's positions (bodies, anchors, tendon paths) at qpos; the engine's scratch data."""
+        mujoco = require_mujoco()
+        engine = self.engine
+        engine.data.qpos[:] = qpos
+        mujoco.mj_kinematics(engine.model, engine.data)
+        mujoco.mj_comPos(engine.model, engine.data)
+        mujoco.mj_tendon(engine.model, engine.data)
+        return engine.data
+
+    def sagittal_axes(self, joints, posture=None) -> tuple:
+        """The sagittal plane's (horizontal, vertical) unit axes in the world: up x the first joint's axis.
+
+        Parameters
+        ----------
+        joints : sequence of str
+            The sagittal chain's joints.
+        posture : array_like, optional
+            Full qpos; default the model's reference posture.
+
+        Returns
+        -------
+        tuple
+            (horizontal, up), numpy.ndarray of shape (3,) each.
+        """
+        data = self._kinematics(self.posture(posture))
+        gravity = np.asarray(self.engine.model.opt.gravity, float)
+        up = -gravity / np.linalg.norm(gravity) if np.linalg.norm(gravity) > 0 else np.array([0.0, 0.0, 1.0])
+        normal = np.asarray(data.xaxis[self.joint_ids(joints[:1])[0]], float)
+        horizontal = np.cross(up, normal)
+        return horizontal / np.linalg.norm(horizontal), up
+
+    def spine(self, joints, basis, posture=None, moved=None) -> tuple:
+        """The chain's centres of rotation (MuJoCo's joint anchors) and the thorax's centre of mass, projected.
+
+        Parameters
+        ----------
+        joints : sequence of str
+            The chain's joints.
+        basis : numpy.ndarray, shape (2, 3)
+            The plane's axes (:meth:`sagittal_axes`).
+        posture : array_like, optional
+            Full qpos; default the model's reference posture.
+        moved : array_like, shape (len(joints),), optional
+            Added to the joints' angles [rad] (the other joints held, equalities ignored).
+
+        Returns
+        -------
+        tuple
+            (numpy.ndarray of shape (n, 2), numpy.ndarray of shape (2,)) [m].
+        """
+        mujoco = require_mujoco()
+        model = self.engine.model
+        ids = self.joint_ids(joints)
+        q = self.posture(posture)
+        if moved is not None:
+            q = q.copy()
+            q[np.array([model.jnt_qposadr[j] for j in ids])] += moved
+        data = self._kinematics(q)
+        thorax = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, self.mapping.bodies["thorax"][0])
+        return data.xanchor[ids] @ basis.T, data.xipos[thorax] @ basis.T
+
+    def muscle_paths(self, basis, posture=None) -> tuple:
+        """Every muscle's path (MuJoCo's sites and wrapping points in order), projected, split at its pulleys.
+
+        Parameters
+        ----------
+        basis : numpy.ndarray, shape (2, 3)
+            The plane's axes (:meth:`sagittal_axes`).
+        posture : array_like, optional
+            Full qpos; default the model's reference posture.
+
+        Returns
+        -------
+        tuple
+            Per muscle, a tuple of branches, arrays of shape (p_k, 2) [m].
+        """
+        data = self._kinematics(self.posture(posture))
+        model = self.engine.model
+        points = data.wrap_xpos.reshape(-1, 3) @ basis.T
+        objects = data.wrap_obj.reshape(-1)
+        segments = []
+        for i in self.engine.muscle_ids():
+            tendon = int(model.actuator_trnid[i, 0])
+            start, count = int(data.ten_wrapadr[tendon]), int(data.ten_wrapnum[tendon])
+            pts, obj = points[start : start + count], objects[start : start + count]
+            pieces = np.split(pts, np.flatnonzero(obj == -2))  # a pulley (-2) starts the next branch
+            branches = [pieces[0]] + [piece[1:] for piece in pieces[1:]]
+            segments.append(tuple(b for b in branches if len(b) > 1))
+        return tuple(segments)
 
 
 def load(model: str | Path = "myotorso", mapping: str | Path | Mapping | None = None, cache: bool = True) -> Anatomy:

@@ -45,11 +45,11 @@ import numpy as np
 
 from .._validate import printable
 from ..errors import ModelError, ParameterError
+from .contract import MappedModel, lordosis_direction
 from .engine import engine_output_to_stderr, model_file, one_line
 from .export_osim import require_opensim
 from .linearise import STEP, Linearisation, Rhythm
 from .mapping import Mapping, default_mapping, located, read_mapping
-from .contract import MappedModel, lordosis_direction
 
 
 @dataclass(frozen=True)
@@ -756,6 +756,120 @@ class OsimAnatomy(MappedModel):
     def require_referee(self) -> None:
         """Refused: MuJoCo is the referee, for MJCF only (:meth:`OsimEngine.spec_factory`)."""
         self.engine.spec_factory()
+
+    def sagittal_axes(self, joints, posture=None) -> tuple:
+        """The sagittal plane's (horizontal, vertical) unit axes in ground: up x the first joint's axis.
+
+        Up is against OpenSim's gravity (``Model.getGravity``); the axis is the one about which the
+        first coordinate turns its joint's child frame (:func:`_turning_axis`).
+
+        Parameters
+        ----------
+        joints : sequence of str
+            The sagittal chain's coordinates.
+        posture : dict, optional
+            Coordinate name -> value [rad].
+
+        Returns
+        -------
+        tuple
+            (horizontal, up), numpy.ndarray of shape (3,) each.
+        """
+        values = self.posture(posture)
+        gravity = _vec3(self.engine.model.getGravity())
+        up = -gravity / np.linalg.norm(gravity) if np.linalg.norm(gravity) > 0 else np.array([0.0, 1.0, 0.0])
+        horizontal = np.cross(up, _turning_axis(self.engine, joints[0], values))
+        self.engine.set_posture(values)
+        return horizontal / np.linalg.norm(horizontal), up
+
+    def spine(self, joints, basis, posture=None, moved=None) -> tuple:
+        """The chain's joint centres (each coordinate's joint's child frame) and the thorax's mass centre, projected.
+
+        Parameters
+        ----------
+        joints : sequence of str
+            The chain's coordinates.
+        basis : numpy.ndarray, shape (2, 3)
+            The plane's axes (:meth:`sagittal_axes`).
+        posture : dict, optional
+            Coordinate name -> value [rad].
+        moved : array_like, shape (len(joints),), optional
+            Added to the coordinates' values [rad] (the others held, the couplers off).
+
+        Returns
+        -------
+        tuple
+            (numpy.ndarray of shape (n, 2), numpy.ndarray of shape (2,)) [m].
+        """
+        engine = self.engine
+        values = self.posture(posture)
+        shifted = dict(values)
+        for name, change in zip(joints, np.zeros(len(joints)) if moved is None else moved, strict=True):
+            shifted[name] = values.get(name, engine.coordinate(name).getDefaultValue()) + float(change)
+        engine.set_posture(shifted)
+        state = engine.state
+        cors = np.array(
+            [_vec3(engine.coordinate(n).getJoint().getChildFrame().getPositionInGround(state)) for n in joints]
+        )
+        name = self.mapping.bodies["thorax"][0]
+        if name == engine.model.getGround().getName():
+            thorax = np.zeros(3)
+        else:
+            body = engine.model.getBodySet().get(name)
+            thorax = _vec3(body.findStationLocationInGround(state, body.getMassCenter()))
+        engine.set_posture(values)
+        return cors @ basis.T, thorax @ basis.T
+
+    def muscle_paths(self, basis, posture=None) -> tuple:
+        """Every muscle's current path (OpenSim's path points, wrapping included, in ground), projected.
+
+        Parameters
+        ----------
+        basis : numpy.ndarray, shape (2, 3)
+            The plane's axes (:meth:`sagittal_axes`).
+        posture : dict, optional
+            Coordinate name -> value [rad].
+
+        Returns
+        -------
+        tuple
+            Per muscle, a tuple of one branch of shape (p, 2) [m] (none if its path has one point).
+        """
+        engine = self.engine
+        engine.set_posture(self.posture(posture))
+        muscles = engine.model.getMuscles()
+        out = []
+        for i in range(muscles.getSize()):
+            path = muscles.get(i).getGeometryPath().getCurrentPath(engine.state)
+            points = np.array([_vec3(path.get(k).getLocationInGround(engine.state)) for k in range(path.getSize())])
+            out.append((points.reshape(-1, 3) @ basis.T,) if len(points) > 1 else ())
+        return tuple(out)
+
+
+def _vec3(vector) -> np.ndarray:
+    """A SimTK Vec3 as a numpy array."""
+    return np.array([vector.get(k) for k in range(3)])
+
+
+def _turning_axis(engine: OsimEngine, name: str, values: dict) -> np.ndarray:
+    """The unit axis in ground about which coordinate ``name`` turns its joint's child frame at a posture.
+
+    Read off OpenSim's frames (the child frame's axes in ground, ``expressVectorInGround``) at the
+    posture and :data:`~spinectl.anatomy.linearise.STEP` on: the rotation between them is about that axis.
+    """
+    osim = require_opensim()
+    frame = engine.coordinate(name).getJoint().getChildFrame()
+
+    def axes(vals) -> np.ndarray:
+        engine.set_posture(vals)
+        return np.array([_vec3(frame.expressVectorInGround(engine.state, osim.Vec3(*e))) for e in np.eye(3)]).T
+
+    start = values.get(name, engine.coordinate(name).getDefaultValue())
+    turn = axes({**values, name: start + STEP}) @ axes(values).T
+    axis = np.array([turn[2, 1] - turn[1, 2], turn[0, 2] - turn[2, 0], turn[1, 0] - turn[0, 1]])
+    if not np.linalg.norm(axis) > 0:
+        raise ModelError(f"{engine.name}: coordinate {name} turns no frame (a translation?): no sagittal plane to draw")
+    return axis / np.linalg.norm(axis)
 
 
 def load_osim(path, mapping=None, cache: bool = True) -> OsimAnatomy:

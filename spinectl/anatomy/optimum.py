@@ -49,7 +49,7 @@ MARGIN = 1.0
 """Default static margin mu [N m/rad] of the stability constraints."""
 
 
-def volume_weights(anatomy: AnatomyEngineEngine) -> np.ndarray:
+def volume_weights(anatomy: AnatomyEngine) -> np.ndarray:
     """The optimum's volume weights, w_i proportional to each muscle's volume, normalised to mean 1.
 
     Each engine reads its own muscle parameters (MuJoCo's F0 and L0, OpenSim's maximal isometric
@@ -635,7 +635,7 @@ def skeleton(anatomy: AnatomyEngine, opt: Optimum, plane: str, joint_stiffness, 
     return analyse(anatomy, plane, lower, joint_stiffness=joint_stiffness, reflex=reflex)
 
 
-def lordosis_posture(anatomy: AnatomyEngineEngine, degrees: float, plane: str = "sagittal"):
+def lordosis_posture(anatomy: AnatomyEngine, degrees: float, plane: str = "sagittal"):
     """The reference posture with the plane's chain moved along the model's rhythm by ``degrees`` in total.
 
     The chain's joints (and those the rhythm slaves: MyoTorso's abdomen, the coordinates an

@@ -169,3 +169,13 @@ def test_a_model_no_engine_reads_is_refused_in_one_line(model, capsys):
     assert all(allowed in err for allowed in ("'myotorso'", ".xml", ".mjcf", ".osim"))
     with pytest.raises(ParameterError, match="must be one of"):
         anatomy.load(model)
+
+
+def test_an_engine_without_geometry_refuses_plot_in_one_line(fake_engine, tmp_path, capsys):
+    """`spinectl anatomy model.fake --plot DIR` on an engine that gives no points to draw (MappedModel's
+    default): one line naming `plot`, exit 2, nothing on stdout, no figure written."""
+    out_dir = tmp_path / "figs"
+    assert main(["anatomy", fake_engine, "--plot", str(out_dir)]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err.count("\n") == 1 and err.startswith("spinectl: error: plot: ")
+    assert not out_dir.exists() or not any(out_dir.iterdir())
