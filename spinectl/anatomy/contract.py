@@ -350,6 +350,30 @@ def lordosis_direction(anatomy, rhy, n: int, degrees: float) -> np.ndarray:
     return direction * np.radians(degrees) / direction[:n].sum()
 
 
+def plane_axes(gravity, normal, default_up) -> tuple:
+    """A plane's (horizontal, vertical) unit axes: vertical against gravity, horizontal up x the plane's normal.
+
+    Parameters
+    ----------
+    gravity : array_like, shape (3,)
+        The engine's gravity in its world [m/s^2].
+    normal : array_like, shape (3,)
+        The plane's normal (the first chain joint's axis), in the same world.
+    default_up : array_like, shape (3,)
+        The world's up where there is no gravity (MuJoCo's +z, OpenSim's +y).
+
+    Returns
+    -------
+    tuple
+        (horizontal, up), numpy.ndarray of shape (3,) each.
+    """
+    gravity = np.asarray(gravity, float)
+    size = np.linalg.norm(gravity)
+    up = -gravity / size if size > 0 else np.asarray(default_up, float)
+    horizontal = np.cross(up, np.asarray(normal, float))
+    return horizontal / np.linalg.norm(horizontal), up
+
+
 MUJOCO = "spinectl.anatomy.model:load"
 OPENSIM = "spinectl.anatomy.opensim_engine:load_osim"
 

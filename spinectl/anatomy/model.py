@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ModelError, ParameterError
-from .contract import MappedModel, lordosis_direction
+from .contract import MappedModel, lordosis_direction, plane_axes
 from .engine import CONTROL_UNIT, Engine, load_engine, require_mujoco
 from .linearise import Linearisation, linearise, rhythm
 from .mapping import Mapping, check_mapping, classify, default_mapping, read_mapping
@@ -18,16 +18,8 @@ from .mapping import Mapping, check_mapping, classify, default_mapping, read_map
 class Anatomy(MappedModel):
     """A MuJoCo musculoskeletal model mapped onto the chain: MuJoCo's :class:`~spinectl.anatomy.contract.AnatomyEngine`.
 
-    Attributes
-    ----------
-    engine : Engine
-        The compiled model.
-    mapping : Mapping
-        Its chain joints, body groups and added stiffness.
-    muscles : tuple of str
-        The actuators' names.
-    classes : tuple of str
-        Each muscle's class (:func:`spinectl.anatomy.mapping.classify`).
+    Its fields are :class:`~spinectl.anatomy.contract.MappedModel`'s, the engine a compiled MuJoCo
+    :class:`~spinectl.anatomy.engine.Engine`; its rhythm is the model's joint equalities.
     """
 
     engine: Engine
@@ -265,11 +257,8 @@ class Anatomy(MappedModel):
             (horizontal, up), numpy.ndarray of shape (3,) each.
         """
         data = self._kinematics(self.posture(posture))
-        gravity = np.asarray(self.engine.model.opt.gravity, float)
-        up = -gravity / np.linalg.norm(gravity) if np.linalg.norm(gravity) > 0 else np.array([0.0, 0.0, 1.0])
-        normal = np.asarray(data.xaxis[self.joint_ids(joints[:1])[0]], float)
-        horizontal = np.cross(up, normal)
-        return horizontal / np.linalg.norm(horizontal), up
+        normal = data.xaxis[self.joint_ids(joints[:1])[0]]
+        return plane_axes(self.engine.model.opt.gravity, normal, (0.0, 0.0, 1.0))
 
     def spine(self, joints, basis, posture=None, moved=None) -> tuple:
         """The chain's centres of rotation (MuJoCo's joint anchors) and the thorax's centre of mass, projected.

@@ -45,7 +45,7 @@ import numpy as np
 
 from .._validate import printable
 from ..errors import ModelError, ParameterError
-from .contract import MappedModel, lordosis_direction
+from .contract import MappedModel, lordosis_direction, plane_axes
 from .engine import engine_output_to_stderr, model_file, one_line
 from .export_osim import require_opensim
 from .linearise import STEP, Linearisation, Rhythm
@@ -776,11 +776,9 @@ class OsimAnatomy(MappedModel):
             (horizontal, up), numpy.ndarray of shape (3,) each.
         """
         values = self.posture(posture)
-        gravity = _vec3(self.engine.model.getGravity())
-        up = -gravity / np.linalg.norm(gravity) if np.linalg.norm(gravity) > 0 else np.array([0.0, 1.0, 0.0])
-        horizontal = np.cross(up, _turning_axis(self.engine, joints[0], values))
+        normal = _turning_axis(self.engine, joints[0], values)
         self.engine.set_posture(values)
-        return horizontal / np.linalg.norm(horizontal), up
+        return plane_axes(_vec3(self.engine.model.getGravity()), normal, (0.0, 1.0, 0.0))
 
     def spine(self, joints, basis, posture=None, moved=None) -> tuple:
         """The chain's joint centres (each coordinate's joint's child frame) and the thorax's mass centre, projected.

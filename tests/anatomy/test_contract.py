@@ -179,3 +179,11 @@ def test_an_engine_without_geometry_refuses_plot_in_one_line(fake_engine, tmp_pa
     out, err = capsys.readouterr()
     assert out == "" and err.count("\n") == 1 and err.startswith("spinectl: error: plot: ")
     assert not out_dir.exists() or not any(out_dir.iterdir())
+
+
+def test_every_exported_suffix_names_an_engine():
+    """Every suffix `spinectl export` writes (interchange.FORMATS: .xml, .mjcf, .osim) is one ENGINES reads, so
+    each exported file loads back (before the registry, `.mjcf` reached MuJoCo only by default)."""
+    from spinectl.anatomy.interchange import FORMATS
+
+    assert {suffix for suffixes in FORMATS.values() for suffix in suffixes} <= set(ENGINES)
