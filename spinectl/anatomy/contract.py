@@ -55,56 +55,236 @@ class AnatomyEngine(Protocol):
     control_unit: str
 
     def plane_joints(self, plane: str) -> tuple:
-        """The chain's joint names in ``plane``."""
+        """The chain's joint names in ``plane``.
+
+        Parameters
+        ----------
+        plane : str
+            One of the mapping's planes.
+
+        Returns
+        -------
+        tuple of str
+        """
 
     def control_bounds(self) -> tuple:
-        """(lower, upper) of each muscle's control [control unit]."""
+        """Each muscle's control bounds.
+
+        Returns
+        -------
+        tuple
+            (lower, upper), numpy.ndarray of shape (m,) [:attr:`control_unit`].
+        """
 
     def default_controls(self) -> np.ndarray:
-        """The controls analysed when none are given."""
+        """The controls analysed when none are given (the model's own, else 0).
+
+        Returns
+        -------
+        numpy.ndarray, shape (m,)
+        """
 
     def default_controls_source(self) -> str:
-        """Where :meth:`default_controls` come from, as one phrase."""
+        """Where :meth:`default_controls` come from, as one phrase.
+
+        Returns
+        -------
+        str
+        """
 
     def posture(self, posture=None):
-        """The operating point in the engine's own form: the reference posture, or ``posture`` checked."""
+        """The operating point in the engine's own form: the reference posture, or ``posture`` checked.
+
+        Parameters
+        ----------
+        posture : optional
+            The engine's posture (MuJoCo: the full qpos; OpenSim: coordinate name -> value [rad]).
+
+        Returns
+        -------
+        object
+        """
 
     def added_stiffness(self, joint_stiffness, n: int) -> np.ndarray:
-        """The stiffness added at each of n chain joints [N m/rad]."""
+        """The stiffness added at each of n chain joints.
+
+        Parameters
+        ----------
+        joint_stiffness : {"none", "mapped"} or float
+            None added, the mapping's cited value, or a value [N m/rad].
+        n : int
+            The number of chain joints.
+
+        Returns
+        -------
+        numpy.ndarray, shape (n,)
+            [N m/rad].
+        """
 
     def rhythm(self, plane: str = "sagittal", posture=None) -> tuple:
-        """(Rhythm, names of the coordinates it involves, the chain's first) at the posture."""
+        """The model's rhythm over the plane's chain at a posture.
+
+        Parameters
+        ----------
+        plane : str
+            One of the mapping's planes.
+        posture : optional
+            The operating point (:meth:`posture`).
+
+        Returns
+        -------
+        tuple
+            (:class:`~spinectl.anatomy.linearise.Rhythm`, names of the coordinates it involves, the chain's first).
+        """
 
     def linearise(self, plane: str = "sagittal", posture=None) -> tuple:
-        """(Linearisation, Rhythm, names of the involved coordinates) at the posture."""
+        """The linearisation over the plane's chain and the coordinates its rhythm ties, at a posture.
+
+        Parameters
+        ----------
+        plane : str
+            One of the mapping's planes.
+        posture : optional
+            The operating point (:meth:`posture`).
+
+        Returns
+        -------
+        tuple
+            (:class:`~spinectl.anatomy.linearise.Linearisation`, its Rhythm, names of the involved coordinates).
+        """
 
     def chains(self, plane: str = "sagittal", posture=None, joint_stiffness="none") -> tuple:
-        """(free LinearChain, LinearChain constrained by the rhythm, Linearisation)."""
+        """The free chain and the chain constrained by the rhythm.
+
+        Parameters
+        ----------
+        plane : str
+            One of the mapping's planes.
+        posture : optional
+            The operating point (:meth:`posture`).
+        joint_stiffness : {"none", "mapped"} or float
+            Added at each chain joint (:meth:`added_stiffness`).
+
+        Returns
+        -------
+        tuple
+            (free LinearChain, constrained LinearChain, Linearisation).
+        """
 
     def rhythm_size(self, plane: str = "sagittal", posture=None) -> int:
-        """How many coordinates the rhythm ties to the chain (0 without one)."""
+        """How many coordinates the rhythm ties to the chain.
+
+        Parameters
+        ----------
+        plane : str
+            One of the mapping's planes.
+        posture : optional
+            The operating point (:meth:`posture`).
+
+        Returns
+        -------
+        int
+            0 without a rhythm.
+        """
 
     def equilibrium_rows(self, lin, plane: str, posture, equilibrium: str) -> tuple:
-        """(lumbar rows of ``lin``, torque per control on the equilibrium's rows [N m], the rest [N m])."""
+        """The optimum's equilibrium on the linearisation.
+
+        Parameters
+        ----------
+        lin : Linearisation
+            At the posture (:meth:`chains`).
+        plane : str
+            The chain.
+        posture : object or None
+            The operating point (:meth:`posture`).
+        equilibrium : str
+            ``"rhythm"`` (the rhythm's independent coordinates) or ``"free"`` (every lumbar joint).
+
+        Returns
+        -------
+        tuple
+            (the lumbar rows of ``lin``, torque per control on the equilibrium's rows [N m], the rest [N m]).
+        """
 
     def volume_weights(self) -> np.ndarray:
-        """The optimum's cost weights, each muscle's volume normalised to mean 1."""
+        """The optimum's cost weights, each muscle's volume normalised to mean 1.
+
+        Returns
+        -------
+        numpy.ndarray, shape (m,)
+        """
 
     def lordosis_posture(self, degrees: float, plane: str = "sagittal"):
-        """The reference posture with the chain moved along the rhythm by ``degrees`` in total [deg]."""
+        """The reference posture with the chain moved along the rhythm by ``degrees`` in total.
+
+        Parameters
+        ----------
+        degrees : float
+            The change of the chain's summed angle [deg].
+        plane : str
+            The chain.
+
+        Returns
+        -------
+        object
+            The posture in the engine's form (:meth:`posture`).
+        """
 
     def require_referee(self) -> None:
         """Return if MuJoCo's referee (``check``) can compare this model; else raise one line."""
 
     def sagittal_axes(self, joints, posture=None) -> tuple:
-        """The sagittal plane's (horizontal, up) unit axes in the world, each shape (3,) (the figures)."""
+        """The sagittal plane's unit axes in the engine's world (the figures).
+
+        Parameters
+        ----------
+        joints : sequence of str
+            The sagittal chain's joints.
+        posture : optional
+            The operating point (:meth:`posture`).
+
+        Returns
+        -------
+        tuple
+            (horizontal, up), numpy.ndarray of shape (3,) each.
+        """
 
     def spine(self, joints, basis, posture=None, moved=None) -> tuple:
-        """The joints' centres of rotation (n, 2) and the thorax's centre of mass (2,), projected on ``basis``
-        [m], the joints' angles changed by ``moved`` [rad] if given."""
+        """The joints' centres of rotation and the thorax's centre of mass, projected.
+
+        Parameters
+        ----------
+        joints : sequence of str
+            The chain's joints.
+        basis : numpy.ndarray, shape (2, 3)
+            The plane's axes (:meth:`sagittal_axes`).
+        posture : optional
+            The operating point (:meth:`posture`).
+        moved : array_like, shape (len(joints),), optional
+            Added to the joints' angles [rad].
+
+        Returns
+        -------
+        tuple
+            (numpy.ndarray of shape (n, 2), numpy.ndarray of shape (2,)) [m].
+        """
 
     def muscle_paths(self, basis, posture=None) -> tuple:
-        """Per muscle, its path projected on ``basis``: a tuple of branches of shape (p_k, 2) [m]."""
+        """Every muscle's path, projected.
+
+        Parameters
+        ----------
+        basis : numpy.ndarray, shape (2, 3)
+            The plane's axes (:meth:`sagittal_axes`).
+        posture : optional
+            The operating point (:meth:`posture`).
+
+        Returns
+        -------
+        tuple
+            Per muscle, a tuple of branches of shape (p_k, 2) [m].
+        """
 
 
 @dataclass
@@ -220,6 +400,7 @@ class MappedModel:
         Parameters
         ----------
         plane : str
+            The chain's plane.
         posture : optional
             The operating point.
 
@@ -298,11 +479,40 @@ class MappedModel:
         raise ParameterError("check", f"MuJoCo is the referee, for MJCF models only; {self.name} is not one")
 
     def sagittal_axes(self, joints, posture=None) -> tuple:
-        """An engine that gives no geometry draws no figure: one line (see :meth:`spine`)."""
+        """An engine that gives no geometry draws no figure: one line (see :meth:`spine`).
+
+        Parameters
+        ----------
+        joints : sequence of str
+            The sagittal chain's joints.
+        posture : optional
+            The operating point.
+
+        Returns
+        -------
+        tuple
+            Never: raises :class:`~spinectl.errors.ParameterError` (field ``plot``).
+        """
         raise self._no_geometry()
 
     def spine(self, joints, basis, posture=None, moved=None) -> tuple:
         """The figures' points (:class:`AnatomyEngine`); an engine without geometry refuses, one line.
+
+        Parameters
+        ----------
+        joints : sequence of str
+            The chain's joints.
+        basis : numpy.ndarray, shape (2, 3)
+            The plane's axes.
+        posture : optional
+            The operating point.
+        moved : array_like, optional
+            Added to the joints' angles [rad].
+
+        Returns
+        -------
+        tuple
+            Never: raises.
 
         Raises
         ------
@@ -312,7 +522,20 @@ class MappedModel:
         raise self._no_geometry()
 
     def muscle_paths(self, basis, posture=None) -> tuple:
-        """An engine that gives no geometry draws no figure: one line (see :meth:`spine`)."""
+        """An engine that gives no geometry draws no figure: one line (see :meth:`spine`).
+
+        Parameters
+        ----------
+        basis : numpy.ndarray, shape (2, 3)
+            The plane's axes.
+        posture : optional
+            The operating point.
+
+        Returns
+        -------
+        tuple
+            Never: raises :class:`~spinectl.errors.ParameterError` (field ``plot``).
+        """
         raise self._no_geometry()
 
     def _no_geometry(self) -> ParameterError:

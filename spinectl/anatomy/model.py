@@ -18,8 +18,16 @@ from .mapping import Mapping, check_mapping, classify, default_mapping, read_map
 class Anatomy(MappedModel):
     """A MuJoCo musculoskeletal model mapped onto the chain: MuJoCo's :class:`~spinectl.anatomy.contract.AnatomyEngine`.
 
-    Its fields are :class:`~spinectl.anatomy.contract.MappedModel`'s, the engine a compiled MuJoCo
-    :class:`~spinectl.anatomy.engine.Engine`; its rhythm is the model's joint equalities.
+    Its rhythm is the model's joint equalities.
+
+    Parameters
+    ----------
+    engine : Engine
+        The compiled MuJoCo model (:class:`~spinectl.anatomy.engine.Engine`).
+    mapping : Mapping
+        Its chain joints, body groups and added stiffness.
+    muscles, classes : tuple of str
+        The actuators' names and their classes (:func:`spinectl.anatomy.mapping.classify`).
     """
 
     engine: Engine
