@@ -1,26 +1,28 @@
-"""Anatomical models (MuJoCo musculoskeletal models such as MyoTorso) as chains (docs/anatomy.md).
+"""Anatomical models (MuJoCo musculoskeletal models such as MyoTorso, OpenSim models) as chains (docs/anatomy.md).
 
 ``load("myotorso")`` compiles the model with MuJoCo, maps its lumbar joints onto the chain
 and classifies its muscles; :meth:`Anatomy.chain` gives the chain linearised at a posture
 as a :class:`~spinectl.model.linear_chain.LinearChain`, and :func:`analyse` the joint-by-joint
 and chain verdicts at an activation. Needs the extra ``spinectl[anatomy]`` (mujoco, myo-sim);
 an ``.osim`` file loads with OpenSim instead (``spinectl[opensim]``, docs/interchange.md).
+Every engine's model is an :class:`~spinectl.anatomy.contract.AnatomyEngine`; the engine is chosen
+by the model's name or suffix in :data:`~spinectl.anatomy.contract.ENGINES`
+(:func:`~spinectl.anatomy.contract.register_engine` adds one).
 """
 
-from pathlib import Path
-
-from . import model as _model
+from .contract import ENGINES, AnatomyEngine, register_engine
 from .model import Anatomy
 
 
-def load(model="myotorso", mapping=None, cache: bool = True) -> Anatomy:
-    """Load an anatomical model and map it onto the chain: MuJoCo's, or OpenSim's for an ``.osim`` file.
+def load(model="myotorso", mapping=None, cache: bool = True) -> AnatomyEngine:
+    """Load an anatomical model with its engine and map it onto the chain: MuJoCo's, or OpenSim's for ``.osim``.
 
     Parameters
     ----------
     model : str or pathlib.Path
-        ``"myotorso"``, an MJCF file (:func:`spinectl.anatomy.model.load`) or an ``.osim`` file
-        (:func:`spinectl.anatomy.opensim_engine.load_osim`).
+        ``"myotorso"``, an MJCF file (:func:`spinectl.anatomy.model.load`), an ``.osim`` file
+        (:func:`spinectl.anatomy.opensim_engine.load_osim`) or a model of a registered engine
+        (:data:`~spinectl.anatomy.contract.ENGINES`); any other name or suffix is refused in one line.
     mapping : str, pathlib.Path or Mapping, optional
         A mapping TOML file; default the built-in one of the model's name.
     cache : bool
@@ -29,13 +31,11 @@ def load(model="myotorso", mapping=None, cache: bool = True) -> Anatomy:
 
     Returns
     -------
-    Anatomy
+    AnatomyEngine
     """
-    if Path(str(model)).suffix.lower() == ".osim":
-        from .opensim_engine import load_osim
+    from .contract import load as load_model
 
-        return load_osim(model, mapping)
-    return _model.load(model, mapping, cache=cache)
+    return load_model(model, mapping, cache=cache)
 
 
-__all__ = ["Anatomy", "load"]
+__all__ = ["ENGINES", "Anatomy", "AnatomyEngine", "load", "register_engine"]

@@ -31,6 +31,7 @@ from ..model.chain import dynamic_eigenvalues
 from ..model.chain import state_matrix as chain_state_matrix
 from ..model.linear_chain import LinearChain
 from ..model.stability import MARGINAL_TIME_CONSTANT, slowest_time_constant
+from .contract import AnatomyEngine
 from .engine import require_mujoco
 from .model import Anatomy
 
@@ -38,17 +39,17 @@ RANK_TOLERANCE = 1e-9
 """A singular value below this times the largest counts as zero (the global muscles' rank)."""
 
 
-def activations(anatomy: Anatomy, activation) -> np.ndarray:
+def activations(anatomy: AnatomyEngine, activation) -> np.ndarray:
     """The activation vector: one value for every muscle, a vector, or a dict by muscle name (others 0).
 
     Parameters
     ----------
-    anatomy : Anatomy
+    anatomy : AnatomyEngine
         The model.
     activation : float, array_like, dict or None
         Activations in [0, 1] (MuJoCo's muscles; other muscles' controls within
-        :meth:`~spinectl.anatomy.model.Anatomy.control_bounds`, e.g. a PCSA [cm^2] of spinectl's
-        export); None: the model's keyframe 0 (:meth:`~spinectl.anatomy.model.Anatomy.default_controls`).
+        :meth:`~spinectl.anatomy.contract.AnatomyEngine.control_bounds`, e.g. a PCSA [cm^2] of spinectl's
+        export); None: the model's keyframe 0 (:meth:`~spinectl.anatomy.contract.AnatomyEngine.default_controls`).
 
     Returns
     -------
@@ -225,12 +226,12 @@ class GlobalCertificate:
     global_null_space_stiffness: np.ndarray
 
 
-def global_certificate(anatomy: Anatomy, chain: LinearChain, arms, a) -> GlobalCertificate:
+def global_certificate(anatomy: AnatomyEngine, chain: LinearChain, arms, a) -> GlobalCertificate:
     """The global muscles' null-space certificate on a chain.
 
     Parameters
     ----------
-    anatomy : Anatomy
+    anatomy : AnatomyEngine
         The model (its muscle classes).
     chain : LinearChain
         The (free) chain.
@@ -644,7 +645,7 @@ def reflex_margin(chain: LinearChain, a, kp: float, kd: float, lag: float) -> di
 
 
 def analyse(
-    anatomy: Anatomy,
+    anatomy: AnatomyEngine,
     plane: str = "sagittal",
     activation=0.0,
     posture=None,
@@ -656,7 +657,7 @@ def analyse(
 
     Parameters
     ----------
-    anatomy : Anatomy
+    anatomy : AnatomyEngine
         From :func:`spinectl.anatomy.load`.
     plane : str
         One of the mapping's planes.
@@ -682,6 +683,7 @@ def analyse(
     arms = lin.moment_arms[:, list(lin.dofs[: lin.n])]
     referee, rate = None, float("nan")
     if check:
+        anatomy.require_referee()
         if posture is not None and not np.allclose(anatomy.posture(posture), anatomy.engine.model.qpos0):
             raise ParameterError("check", "compares at the model's reference posture only")
         referee = mujoco_eigenvalues(anatomy, free, a, added)
@@ -691,7 +693,7 @@ def analyse(
             rate = mujoco_growth_rate(anatomy, free, a, added, values[lead].real, vectors[: free.n_joints, lead].real)
     classes = anatomy.classes
     return AnatomyResult(
-        model={"name": anatomy.name, "source": anatomy.engine.source, "sha256": anatomy.engine.sha256},
+        model={"name": anatomy.name, "source": anatomy.source, "sha256": anatomy.sha256},
         plane=plane,
         muscles={
             c: tuple(m for m, k in zip(anatomy.muscles, classes, strict=True) if k == c)
@@ -712,6 +714,6 @@ def analyse(
     )
 
 
-def _activation_source(anatomy: Anatomy, activation) -> str:
+def _activation_source(anatomy: AnatomyEngine, activation) -> str:
     """Where the analysed activations come from: given, or the model's own default controls."""
     return "given" if activation is not None else anatomy.default_controls_source()

@@ -7,55 +7,30 @@ from pathlib import Path
 
 import numpy as np
 
-from .._validate import printable
-from ..errors import ParameterError
-from ..model.linear_chain import LinearChain
+from ..errors import ModelError, ParameterError
+from .contract import MappedModel, lordosis_direction, plane_axes
 from .engine import CONTROL_UNIT, Engine, load_engine, require_mujoco
-from .linearise import Linearisation, constrained_chain, free_chain, linearise, rhythm
-from .mapping import MAX_STIFFNESS, Mapping, check_mapping, classify, default_mapping, read_mapping
+from .linearise import Linearisation, linearise, rhythm
+from .mapping import Mapping, check_mapping, classify, default_mapping, read_mapping
 
 
 @dataclass
-class Anatomy:
-    """A MuJoCo musculoskeletal model, mapped onto the chain.
+class Anatomy(MappedModel):
+    """A MuJoCo musculoskeletal model mapped onto the chain: MuJoCo's :class:`~spinectl.anatomy.contract.AnatomyEngine`.
 
-    Attributes
+    Its rhythm is the model's joint equalities.
+
+    Parameters
     ----------
     engine : Engine
-        The compiled model.
+        The compiled MuJoCo model (:class:`~spinectl.anatomy.engine.Engine`).
     mapping : Mapping
         Its chain joints, body groups and added stiffness.
-    muscles : tuple of str
-        The actuators' names.
-    classes : tuple of str
-        Each muscle's class (:func:`spinectl.anatomy.mapping.classify`).
+    muscles, classes : tuple of str
+        The actuators' names and their classes (:func:`spinectl.anatomy.mapping.classify`).
     """
 
     engine: Engine
-    mapping: Mapping
-    muscles: tuple
-    classes: tuple
-
-    @property
-    def name(self) -> str:
-        """The model's name."""
-        return self.engine.name
-
-    def plane_joints(self, plane: str) -> tuple:
-        """The chain's joint names in ``plane``.
-
-        Parameters
-        ----------
-        plane : str
-            One of the mapping's planes.
-
-        Returns
-        -------
-        tuple of str
-        """
-        if plane not in self.mapping.planes:
-            raise ParameterError("plane", f"must be one of {sorted(self.mapping.planes)} (got {printable(plane)})")
-        return self.mapping.planes[plane]
 
     def joint_ids(self, names) -> list:
         """MuJoCo joint ids of joint names.
@@ -144,36 +119,25 @@ class Anatomy:
             raise ParameterError("posture", f"must be {q0.size} finite generalised positions")
         return q
 
-    def added_stiffness(self, joint_stiffness, n: int) -> np.ndarray:
-        """The stiffness added at each of n chain joints [N m/rad].
+    def rhythm(self, plane: str = "sagittal", posture=None) -> tuple:
+        """The model's joint equalities that tie the plane's chain, at a posture.
 
         Parameters
         ----------
-        joint_stiffness : {"none", "mapped"} or float
-            None added, the mapping's cited value, or a value [N m/rad] >= 0.
-        n : int
-            The number of chain joints.
+        plane : str
+            One of the mapping's planes.
+        posture : array_like, optional
+            Full qpos; default the model's reference posture.
 
         Returns
         -------
-        numpy.ndarray, shape (n,)
+        tuple
+            (:class:`~spinectl.anatomy.linearise.Rhythm`, names of the involved joints, the chain's first).
         """
-        if joint_stiffness == "none":
-            value = 0.0
-        elif joint_stiffness == "mapped":
-            value = self.mapping.joint_stiffness
-        else:
-            try:
-                value = float(joint_stiffness)
-            except (TypeError, ValueError):
-                value = -1.0
-            if not (np.isfinite(value) and 0 <= value <= MAX_STIFFNESS):  # the command line's bound, for Python too
-                raise ParameterError(
-                    "joint_stiffness",
-                    f"must be 'none', 'mapped' or a number in [0, {MAX_STIFFNESS:g}] N m/rad, beyond which the "
-                    f"chain's arithmetic fails (got {joint_stiffness!r})",
-                )
-        return np.full(n, value)
+        self.engine.set_state(self.posture(posture))
+        rhy = rhythm(self.engine, self.joint_ids(self.plane_joints(plane)))
+        model = self.engine.model
+        return rhy, self.engine.names("joint", [model.dof_jntid[d] for d in rhy.dofs])
 
     def linearise(self, plane: str = "sagittal", posture=None) -> tuple:
         """Linearise at a posture over the plane's chain and the joints its rhythm slaves.
@@ -191,91 +155,177 @@ class Anatomy:
             (:class:`~spinectl.anatomy.linearise.Linearisation`,
             :class:`~spinectl.anatomy.linearise.Rhythm`, names of the involved joints).
         """
-        names = self.plane_joints(plane)
         q = self.posture(posture)
-        self.engine.set_state(q)
-        rhy = rhythm(self.engine, self.joint_ids(names))
-        lin = linearise(self.engine, q, rhy.dofs, len(names))
-        model = self.engine.model
-        involved = self.engine.names("joint", [model.dof_jntid[d] for d in rhy.dofs])
-        return lin, rhy, involved
+        rhy, involved = self.rhythm(plane, q)
+        return linearise(self.engine, q, rhy.dofs, len(self.plane_joints(plane))), rhy, involved
 
-    def rhythm_size(self, plane: str = "sagittal", posture=None) -> int:
-        """How many coordinates the model's rhythm (its joint equalities) ties to the chain: 0 without one.
+    def equilibrium_rows(self, lin, plane: str, posture, equilibrium: str) -> tuple:
+        """The optimum's equilibrium: every lumbar joint (``"free"``) or the rhythm's independent coordinates.
 
-        Parameters
-        ----------
-        plane : str
-            One of the mapping's planes.
-        posture : array_like, optional
-            Full qpos; default the model's reference posture.
-
-        Returns
-        -------
-        int
-            The dependent coordinates involved (the constrained chain's dofs minus its independent ones).
-        """
-        self.engine.set_state(self.posture(posture))
-        rhy = rhythm(self.engine, self.joint_ids(self.plane_joints(plane)))
-        return len(rhy.dofs) - len(rhy.independent)
-
-    def chains(self, plane: str = "sagittal", posture=None, joint_stiffness="none") -> tuple:
-        """The free chain and the chain constrained by the model's rhythm, as LinearChain objects.
+        The lumbar joints are the mapping's ``3d`` plane (this plane's joints if it has none); with
+        ``"rhythm"`` the model's joint equalities over them carry the rest (T^T tau = 0).
 
         Parameters
         ----------
+        lin : Linearisation
+            At the posture, over every dof.
         plane : str
-            One of the mapping's planes.
-        posture : array_like, optional
+            The chain.
+        posture : array_like or None
             Full qpos; default the model's reference posture.
-        joint_stiffness : {"none", "mapped"} or float
-            Intervertebral stiffness added at each chain joint (:meth:`added_stiffness`).
+        equilibrium : str
+            ``"rhythm"`` or ``"free"``.
 
         Returns
         -------
         tuple
-            (free :class:`~spinectl.model.linear_chain.LinearChain`, constrained one,
-            the :class:`~spinectl.anatomy.linearise.Linearisation`).
+            (the lumbar dofs, torque per control on the equilibrium's rows [N m], the rest [N m]).
         """
-        lin, rhy, involved = self.linearise(plane, posture)
-        n = lin.n
-        added = self.added_stiffness(joint_stiffness, n)
-        source = f"{self.engine.source}, {plane}"
-        controls = {"bounds": self.control_bounds(), "unit": self.control_unit}
-        free = free_chain(lin, involved[:n], self.muscles, self.classes, added, source, **controls)
-        full_added = np.concatenate([added, np.zeros(len(involved) - n)])
-        constrained = constrained_chain(
-            lin,
-            rhy,
-            involved,
-            self.muscles,
-            self.classes,
-            full_added,
-            source + ", constrained by the rhythm",
-            **controls,
-        )
-        return free, constrained, lin
+        lumbar = self.mapping.planes.get("3d", self.plane_joints(plane))
+        model = self.engine.model
+        rows = [int(model.jnt_dofadr[j]) for j in self.joint_ids(lumbar)]
+        if equilibrium == "free":
+            return rows, lin.torque_per_muscle[rows], lin.torque_offset[rows]
+        self.engine.set_state(self.posture(posture))
+        rhy = rhythm(self.engine, self.joint_ids(lumbar))
+        dofs = list(rhy.dofs)
+        return rows, rhy.transform.T @ lin.torque_per_muscle[dofs], rhy.transform.T @ lin.torque_offset[dofs]
 
-    def chain(self, plane: str = "sagittal", posture=None, joint_stiffness="none", constrained=False) -> LinearChain:
-        """One chain as a LinearChain (free by default).
-
-        Parameters
-        ----------
-        plane : str
-            One of the mapping's planes.
-        posture : array_like, optional
-            Full qpos; default the model's reference posture.
-        joint_stiffness : {"none", "mapped"} or float
-            Added at each chain joint.
-        constrained : bool
-            The chain constrained by the model's rhythm instead of the free chain.
+    def volume_weights(self) -> np.ndarray:
+        """w_i proportional to F0_i L0_i (MuJoCo's muscle parameters), normalised to mean 1.
 
         Returns
         -------
-        LinearChain
+        numpy.ndarray, shape (m,)
         """
-        free, con, _ = self.chains(plane, posture, joint_stiffness)
-        return con if constrained else free
+        mujoco = require_mujoco()
+        model, ids = self.engine.model, self.engine.muscle_ids()
+        if np.any(model.actuator_dyntype[ids] != mujoco.mjtDyn.mjDYN_MUSCLE):
+            raise ModelError(
+                f"{self.name}: the optimum's volume weights need MuJoCo muscles (their F0 and L0); its muscles "
+                "are general actuators (spinectl's export: analyse it without --optimise and --lordosis)"
+            )
+        gain = model.actuator_gainprm[ids]
+        lr = model.actuator_lengthrange[ids]
+        # MuJoCo's muscle: L0 = (lengthrange span) / (operating range span); F0 = force, or scale / acc0 if force < 0
+        length0 = (lr[:, 1] - lr[:, 0]) / (gain[:, 1] - gain[:, 0])
+        force0 = np.where(gain[:, 2] > 0, gain[:, 2], gain[:, 3] / model.actuator_acc0[ids])
+        volume = force0 * length0
+        return volume / volume.mean()
+
+    def lordosis_posture(self, degrees: float, plane: str = "sagittal") -> np.ndarray:
+        """The reference posture with the plane's chain moved along the model's rhythm by ``degrees`` in total.
+
+        The chain's joints (and those the rhythm slaves, e.g. MyoTorso's abdomen) move as the
+        rhythm's coefficients distribute them (:func:`~spinectl.anatomy.contract.lordosis_direction`);
+        the thorax is not held upright (it turns with the chain).
+
+        Parameters
+        ----------
+        degrees : float
+            The change of the chain's summed angle [deg].
+        plane : str
+            The chain.
+
+        Returns
+        -------
+        numpy.ndarray, shape (nq,)
+        """
+        rhy, _ = self.rhythm(plane)
+        q = self.posture()
+        q[list(rhy.dofs)] += lordosis_direction(self, rhy, len(self.plane_joints(plane)), degrees)
+        return q
+
+    def require_referee(self) -> None:
+        """MuJoCo's own model is the referee of its chain (``check``): nothing to refuse."""
+
+    def _kinematics(self, qpos):
+        """MuJoCo's positions (bodies, anchors, tendon paths) at qpos; the engine's scratch data."""
+        mujoco = require_mujoco()
+        engine = self.engine
+        engine.data.qpos[:] = qpos
+        mujoco.mj_kinematics(engine.model, engine.data)
+        mujoco.mj_comPos(engine.model, engine.data)
+        mujoco.mj_tendon(engine.model, engine.data)
+        return engine.data
+
+    def sagittal_axes(self, joints, posture=None) -> tuple:
+        """The sagittal plane's (horizontal, vertical) unit axes in the world: up x the first joint's axis.
+
+        Parameters
+        ----------
+        joints : sequence of str
+            The sagittal chain's joints.
+        posture : array_like, optional
+            Full qpos; default the model's reference posture.
+
+        Returns
+        -------
+        tuple
+            (horizontal, up), numpy.ndarray of shape (3,) each.
+        """
+        data = self._kinematics(self.posture(posture))
+        normal = data.xaxis[self.joint_ids(joints[:1])[0]]
+        return plane_axes(self.engine.model.opt.gravity, normal, (0.0, 0.0, 1.0))
+
+    def spine(self, joints, basis, posture=None, moved=None) -> tuple:
+        """The chain's centres of rotation (MuJoCo's joint anchors) and the thorax's centre of mass, projected.
+
+        Parameters
+        ----------
+        joints : sequence of str
+            The chain's joints.
+        basis : numpy.ndarray, shape (2, 3)
+            The plane's axes (:meth:`sagittal_axes`).
+        posture : array_like, optional
+            Full qpos; default the model's reference posture.
+        moved : array_like, shape (len(joints),), optional
+            Added to the joints' angles [rad] (the other joints held, equalities ignored).
+
+        Returns
+        -------
+        tuple
+            (numpy.ndarray of shape (n, 2), numpy.ndarray of shape (2,)) [m].
+        """
+        mujoco = require_mujoco()
+        model = self.engine.model
+        ids = self.joint_ids(joints)
+        q = self.posture(posture)
+        if moved is not None:
+            q = q.copy()
+            q[np.array([model.jnt_qposadr[j] for j in ids])] += moved
+        data = self._kinematics(q)
+        thorax = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, self.mapping.bodies["thorax"][0])
+        return data.xanchor[ids] @ basis.T, data.xipos[thorax] @ basis.T
+
+    def muscle_paths(self, basis, posture=None) -> tuple:
+        """Every muscle's path (MuJoCo's sites and wrapping points in order), projected, split at its pulleys.
+
+        Parameters
+        ----------
+        basis : numpy.ndarray, shape (2, 3)
+            The plane's axes (:meth:`sagittal_axes`).
+        posture : array_like, optional
+            Full qpos; default the model's reference posture.
+
+        Returns
+        -------
+        tuple
+            Per muscle, a tuple of branches, arrays of shape (p_k, 2) [m].
+        """
+        data = self._kinematics(self.posture(posture))
+        model = self.engine.model
+        points = data.wrap_xpos.reshape(-1, 3) @ basis.T
+        objects = data.wrap_obj.reshape(-1)
+        segments = []
+        for i in self.engine.muscle_ids():
+            tendon = int(model.actuator_trnid[i, 0])
+            start, count = int(data.ten_wrapadr[tendon]), int(data.ten_wrapnum[tendon])
+            pts, obj = points[start : start + count], objects[start : start + count]
+            pieces = np.split(pts, np.flatnonzero(obj == -2))  # a pulley (-2) starts the next branch
+            branches = [pieces[0]] + [piece[1:] for piece in pieces[1:]]
+            segments.append(tuple(b for b in branches if len(b) > 1))
+        return tuple(segments)
 
 
 def load(model: str | Path = "myotorso", mapping: str | Path | Mapping | None = None, cache: bool = True) -> Anatomy:

@@ -45,11 +45,11 @@ import numpy as np
 
 from .._validate import printable
 from ..errors import ModelError, ParameterError
+from .contract import MappedModel, lordosis_direction, plane_axes
 from .engine import engine_output_to_stderr, model_file, one_line
 from .export_osim import require_opensim
-from .linearise import STEP, Linearisation, Rhythm, constrained_chain, free_chain
+from .linearise import STEP, Linearisation, Rhythm
 from .mapping import Mapping, default_mapping, located, read_mapping
-from .model import Anatomy
 
 
 @dataclass(frozen=True)
@@ -524,8 +524,8 @@ def _same_contacts(engine: OsimEngine, wrapped: dict, before: dict, after: dict,
 
 
 @dataclass
-class OsimAnatomy(Anatomy):
-    """An OpenSim model mapped onto the chain: :class:`~spinectl.anatomy.model.Anatomy` with OpenSim as the engine.
+class OsimAnatomy(MappedModel):
+    """An OpenSim model mapped onto the chain: OpenSim's :class:`~spinectl.anatomy.contract.AnatomyEngine`.
 
     The free chain has the coordinate couplers off; the constrained chain applies their
     linearised relations (module docstring). MuJoCo's referee (``--check``) needs MJCF.
@@ -539,6 +539,8 @@ class OsimAnatomy(Anatomy):
     classes : tuple of str
         Each muscle's class.
     """
+
+    rhythm_name = "couplers"
 
     def control_bounds(self) -> tuple:
         """Each muscle's control bounds: [0, 1] (OpenSim's activations).
@@ -611,6 +613,24 @@ class OsimAnatomy(Anatomy):
             raise ParameterError("posture", "of an OpenSim model: a dict of coordinate name -> value [rad]")
         return dict(posture)
 
+    def rhythm(self, plane: str = "sagittal", posture=None) -> tuple:
+        """The couplers that tie the plane's chain as a Rhythm, at a posture (:func:`coupler_rhythm`).
+
+        Parameters
+        ----------
+        plane : str
+            One of the mapping's planes.
+        posture : dict, optional
+            Coordinate name -> value [rad].
+
+        Returns
+        -------
+        tuple
+            (Rhythm, the involved coordinates' names, the chain's first).
+        """
+        rhy, involved, _ = coupler_rhythm(self.engine, self.plane_joints(plane), self.posture(posture))
+        return rhy, involved
+
     def linearise(self, plane: str = "sagittal", posture=None) -> tuple:
         """The linearisation over the plane's coordinates and those its couplers tie.
 
@@ -626,27 +646,9 @@ class OsimAnatomy(Anatomy):
         tuple
             (Linearisation, Rhythm of the couplers (:func:`coupler_rhythm`), the involved coordinates' names).
         """
-        names = self.plane_joints(plane)
         values = self.posture(posture)
-        rhy, involved, _ = coupler_rhythm(self.engine, names, values)
-        return linearise(self.engine, involved, values, len(names)), rhy, involved
-
-    def rhythm_size(self, plane: str = "sagittal", posture=None) -> int:
-        """How many coordinates the model's couplers tie to the chain: 0 without one.
-
-        Parameters
-        ----------
-        plane : str
-            One of the mapping's planes.
-        posture : dict, optional
-            Coordinate name -> value [rad].
-
-        Returns
-        -------
-        int
-        """
-        rhy, _, _ = coupler_rhythm(self.engine, self.plane_joints(plane), self.posture(posture))
-        return len(rhy.dofs) - len(rhy.independent)
+        rhy, involved = self.rhythm(plane, values)
+        return linearise(self.engine, involved, values, len(self.plane_joints(plane))), rhy, involved
 
     def couplers(self, plane: str = "sagittal", posture=None) -> list:
         """The couplers that tie the plane's chain, each as one phrase with its slopes at the posture.
@@ -666,38 +668,209 @@ class OsimAnatomy(Anatomy):
         _, _, used = coupler_rhythm(self.engine, self.plane_joints(plane), values)
         return [c.describe(values, self.engine) for c in used]
 
-    def chains(self, plane: str = "sagittal", posture=None, joint_stiffness="none") -> tuple:
-        """The free chain (couplers off) and the chain constrained by the couplers, and the linearisation.
+    def chain_source(self, plane: str, posture=None) -> str:
+        """The chains' source line; away from the default posture, with the couplers' slopes there.
 
         Parameters
         ----------
         plane : str
-            One of the mapping's planes.
         posture : dict, optional
             Coordinate name -> value [rad].
-        joint_stiffness : {"none", "mapped"} or float
-            Added at each chain joint [N m/rad].
+
+        Returns
+        -------
+        str
+        """
+        source = f"{self.source}, {plane}"
+        if posture and self.engine.couplers:  # the engine's source gives the slopes at the default posture
+            source += f"; the couplers at this posture: {'; '.join(self.couplers(plane, posture)) or 'none'}"
+        return source
+
+    def equilibrium_rows(self, lin, plane: str, posture, equilibrium: str) -> tuple:
+        """The optimum's equilibrium: the chain's coordinates (``"free"``) or the couplers' independent ones.
+
+        With ``"rhythm"`` the couplers carry the rest (T^T tau = 0 over the involved coordinates).
+
+        Parameters
+        ----------
+        lin : Linearisation
+            At the posture, over the involved coordinates (the chain's first).
+        plane : str
+            The chain.
+        posture : dict or None
+            Coordinate name -> value [rad].
+        equilibrium : str
+            ``"rhythm"`` or ``"free"``.
 
         Returns
         -------
         tuple
-            (free LinearChain, constrained LinearChain, Linearisation).
+            (the chain's rows, torque per control on the equilibrium's rows [N m], the rest [N m]).
         """
-        lin, rhy, involved = self.linearise(plane, posture)
-        n = lin.n
-        added = self.added_stiffness(joint_stiffness, n)
-        source = f"{self.engine.source}, {plane}"
-        if posture and self.engine.couplers:  # the engine's source gives the slopes at the default posture
-            source += f"; the couplers at this posture: {'; '.join(self.couplers(plane, posture)) or 'none'}"
-        free = free_chain(lin, tuple(involved[:n]), self.muscles, self.classes, added, source)
-        full_added = np.concatenate([added, np.zeros(len(involved) - n)])
-        constrained = constrained_chain(
-            lin, rhy, involved, self.muscles, self.classes, full_added, source + ", constrained by the couplers"
+        rows = list(range(lin.n))
+        if equilibrium == "free":
+            return rows, lin.torque_per_muscle[rows], lin.torque_offset[rows]
+        rhy, _ = self.rhythm(plane, posture)
+        return rows, rhy.transform.T @ lin.torque_per_muscle, rhy.transform.T @ lin.torque_offset
+
+    def volume_weights(self) -> np.ndarray:
+        """w_i proportional to F_max,i l_opt,i (the Millard muscle's volume), normalised to mean 1.
+
+        Returns
+        -------
+        numpy.ndarray, shape (m,)
+        """
+        muscles = self.engine.model.getMuscles()
+        volume = np.array(
+            [
+                muscles.get(i).getMaxIsometricForce() * muscles.get(i).getOptimalFiberLength()
+                for i in range(muscles.getSize())
+            ]
         )
-        return free, constrained, lin
+        return volume / volume.mean()
+
+    def lordosis_posture(self, degrees: float, plane: str = "sagittal") -> dict:
+        """The default posture with the chain moved along the model's couplers by ``degrees`` in total.
+
+        The couplers' first independent coordinate and the coordinates they slave to it move as the
+        couplers' slopes at the default posture distribute them (:func:`coupler_rhythm`), the chain's
+        angles summing to ``degrees``; the engine sets them through OpenSim's coordinates
+        (:meth:`OsimEngine.set_posture`).
+
+        Parameters
+        ----------
+        degrees : float
+            The change of the chain's summed angle [deg].
+        plane : str
+
+        Returns
+        -------
+        dict
+            Coordinate name -> value [rad].
+        """
+        rhy, involved = self.rhythm(plane)
+        step = lordosis_direction(self, rhy, len(self.plane_joints(plane)), degrees)
+        engine = self.engine
+        return {n: engine.coordinate(n).getDefaultValue() + float(v) for n, v in zip(involved, step, strict=True)}
+
+    def require_referee(self) -> None:
+        """Refused: MuJoCo is the referee, for MJCF only (:meth:`OsimEngine.spec_factory`)."""
+        self.engine.spec_factory()
+
+    def sagittal_axes(self, joints, posture=None) -> tuple:
+        """The sagittal plane's (horizontal, vertical) unit axes in ground: up x the first joint's axis.
+
+        Up is against OpenSim's gravity (``Model.getGravity``); the axis is the one about which the
+        first coordinate turns its joint's child frame (:func:`_turning_axis`).
+
+        Parameters
+        ----------
+        joints : sequence of str
+            The sagittal chain's coordinates.
+        posture : dict, optional
+            Coordinate name -> value [rad].
+
+        Returns
+        -------
+        tuple
+            (horizontal, up), numpy.ndarray of shape (3,) each.
+        """
+        values = self.posture(posture)
+        normal = _turning_axis(self.engine, joints[0], values)
+        self.engine.set_posture(values)
+        return plane_axes(_vec3(self.engine.model.getGravity()), normal, (0.0, 1.0, 0.0))
+
+    def spine(self, joints, basis, posture=None, moved=None) -> tuple:
+        """The chain's joint centres (each coordinate's joint's child frame) and the thorax's mass centre, projected.
+
+        Parameters
+        ----------
+        joints : sequence of str
+            The chain's coordinates.
+        basis : numpy.ndarray, shape (2, 3)
+            The plane's axes (:meth:`sagittal_axes`).
+        posture : dict, optional
+            Coordinate name -> value [rad].
+        moved : array_like, shape (len(joints),), optional
+            Added to the coordinates' values [rad] (the others held, the couplers off).
+
+        Returns
+        -------
+        tuple
+            (numpy.ndarray of shape (n, 2), numpy.ndarray of shape (2,)) [m].
+        """
+        engine = self.engine
+        values = self.posture(posture)
+        shifted = dict(values)
+        for name, change in zip(joints, np.zeros(len(joints)) if moved is None else moved, strict=True):
+            shifted[name] = values.get(name, engine.coordinate(name).getDefaultValue()) + float(change)
+        engine.set_posture(shifted)
+        state = engine.state
+        cors = np.array(
+            [_vec3(engine.coordinate(n).getJoint().getChildFrame().getPositionInGround(state)) for n in joints]
+        )
+        name = self.mapping.bodies["thorax"][0]
+        if name == engine.model.getGround().getName():
+            thorax = np.zeros(3)
+        else:
+            body = engine.model.getBodySet().get(name)
+            thorax = _vec3(body.findStationLocationInGround(state, body.getMassCenter()))
+        engine.set_posture(values)
+        return cors @ basis.T, thorax @ basis.T
+
+    def muscle_paths(self, basis, posture=None) -> tuple:
+        """Every muscle's current path (OpenSim's path points, wrapping included, in ground), projected.
+
+        Parameters
+        ----------
+        basis : numpy.ndarray, shape (2, 3)
+            The plane's axes (:meth:`sagittal_axes`).
+        posture : dict, optional
+            Coordinate name -> value [rad].
+
+        Returns
+        -------
+        tuple
+            Per muscle, a tuple of one branch of shape (p, 2) [m] (none if its path has one point).
+        """
+        engine = self.engine
+        engine.set_posture(self.posture(posture))
+        muscles = engine.model.getMuscles()
+        out = []
+        for i in range(muscles.getSize()):
+            path = muscles.get(i).getGeometryPath().getCurrentPath(engine.state)
+            points = np.array([_vec3(path.get(k).getLocationInGround(engine.state)) for k in range(path.getSize())])
+            out.append((points.reshape(-1, 3) @ basis.T,) if len(points) > 1 else ())
+        return tuple(out)
 
 
-def load_osim(path, mapping=None) -> OsimAnatomy:
+def _vec3(vector) -> np.ndarray:
+    """A SimTK Vec3 as a numpy array."""
+    return np.array([vector.get(k) for k in range(3)])
+
+
+def _turning_axis(engine: OsimEngine, name: str, values: dict) -> np.ndarray:
+    """The unit axis in ground about which coordinate ``name`` turns its joint's child frame at a posture.
+
+    Read off OpenSim's frames (the child frame's axes in ground, ``expressVectorInGround``) at the
+    posture and :data:`~spinectl.anatomy.linearise.STEP` on: the rotation between them is about that axis.
+    """
+    osim = require_opensim()
+    frame = engine.coordinate(name).getJoint().getChildFrame()
+
+    def axes(vals) -> np.ndarray:
+        engine.set_posture(vals)
+        return np.array([_vec3(frame.expressVectorInGround(engine.state, osim.Vec3(*e))) for e in np.eye(3)]).T
+
+    start = values.get(name, engine.coordinate(name).getDefaultValue())
+    turn = axes({**values, name: start + STEP}) @ axes(values).T
+    axis = np.array([turn[2, 1] - turn[1, 2], turn[0, 2] - turn[2, 0], turn[1, 0] - turn[0, 1]])
+    if not np.linalg.norm(axis) > 0:
+        raise ModelError(f"{engine.name}: coordinate {name} turns no frame (a translation?): no sagittal plane to draw")
+    return axis / np.linalg.norm(axis)
+
+
+def load_osim(path, mapping=None, cache: bool = True) -> OsimAnatomy:
     """Load an ``.osim`` model with OpenSim and map it onto the chain.
 
     Parameters
@@ -707,6 +880,9 @@ def load_osim(path, mapping=None) -> OsimAnatomy:
     mapping : str, pathlib.Path or Mapping, optional
         A mapping TOML (names of OpenSim bodies and coordinates); default the built-in one of the
         model's name (``wagner2012_chain`` for spinectl's own export).
+    cache : bool
+        Unused: an ``.osim`` file is built anew each time (the loaders' common signature,
+        :data:`spinectl.anatomy.contract.ENGINES`).
 
     Returns
     -------
@@ -726,165 +902,3 @@ def load_osim(path, mapping=None) -> OsimAnatomy:
         described = "; ".join(c.describe({}, engine) for c in engine.couplers)
         engine.source += f"; coupler constraints (off in the free chain, linearised in the constrained): {described}"
     return OsimAnatomy(engine, mapping, names, _classify(engine, mapping))
-
-
-def volume_weights(anatomy: OsimAnatomy) -> np.ndarray:
-    """w_i proportional to F_max,i l_opt,i (the Millard muscle's volume), normalised to mean 1.
-
-    Parameters
-    ----------
-    anatomy : OsimAnatomy
-
-    Returns
-    -------
-    numpy.ndarray, shape (m,)
-    """
-    muscles = anatomy.engine.model.getMuscles()
-    volume = np.array(
-        [
-            muscles.get(i).getMaxIsometricForce() * muscles.get(i).getOptimalFiberLength()
-            for i in range(muscles.getSize())
-        ]
-    )
-    return volume / volume.mean()
-
-
-def optimise(
-    anatomy: OsimAnatomy,
-    plane="sagittal",
-    stability="chain",
-    margin=1.0,
-    joint_stiffness="none",
-    equilibrium="rhythm",
-    posture=None,
-):
-    """The least-effort activations on OpenSim's chain (:func:`spinectl.anatomy.optimum.optimise`'s problem).
-
-    Equilibrium holds on the chain's coordinates (``"free"``) or on the couplers' independent
-    ones, the couplers carrying the rest (``"rhythm"``); stability ``"rhythm"`` is imposed on the
-    chain constrained by the couplers. The problem is solved on the LinearChain by
-    :func:`spinectl.anatomy.optimum.solve_on_chain`, as for MJCF.
-
-    Parameters
-    ----------
-    anatomy : OsimAnatomy
-    plane : str
-    stability : str
-        One of :data:`spinectl.anatomy.optimum.STABILITY`.
-    margin : float
-        mu [N m/rad], >= 0.
-    joint_stiffness : {"none", "mapped"} or float
-    equilibrium : str
-        One of :data:`spinectl.anatomy.optimum.EQUILIBRIUM`.
-    posture : dict, optional
-        Coordinate name -> value [rad] (e.g. :func:`lordosis_posture`); default the coordinates' defaults.
-
-    Returns
-    -------
-    spinectl.anatomy.optimum.Optimum
-    """
-    from .optimum import check_choices, optimum_on_chains
-
-    check_choices(stability, equilibrium, margin)
-    free, constrained, lin = anatomy.chains(plane, posture, joint_stiffness)
-    rhy, _, _ = coupler_rhythm(anatomy.engine, anatomy.plane_joints(plane), anatomy.posture(posture))
-    rows = list(range(lin.n))
-    if equilibrium == "free":
-        tau_per, tau_0 = lin.torque_per_muscle[rows], lin.torque_offset[rows]
-    else:
-        tau_per, tau_0 = rhy.transform.T @ lin.torque_per_muscle, rhy.transform.T @ lin.torque_offset
-    w = volume_weights(anatomy)
-    return optimum_on_chains(free, constrained, lin, rows, tau_per, tau_0, w, stability, equilibrium, margin)
-
-
-def lordosis_posture(anatomy: OsimAnatomy, degrees: float, plane: str = "sagittal") -> dict:
-    """The default posture with the chain moved along the model's couplers by ``degrees`` in total.
-
-    :func:`spinectl.anatomy.optimum.lordosis_posture` on OpenSim's model: the couplers' first
-    independent coordinate and the coordinates they slave to it move as the couplers' slopes at
-    the default posture distribute them (:func:`coupler_rhythm`), the chain's angles summing to
-    ``degrees``; the engine sets them through OpenSim's coordinates (:meth:`OsimEngine.set_posture`).
-
-    Parameters
-    ----------
-    anatomy : OsimAnatomy
-    degrees : float
-        The change of the chain's summed angle [deg].
-    plane : str
-
-    Returns
-    -------
-    dict
-        Coordinate name -> value [rad].
-    """
-    from .optimum import lordosis_direction
-
-    names = anatomy.plane_joints(plane)
-    rhy, involved, _ = coupler_rhythm(anatomy.engine, names, {})
-    step = lordosis_direction(anatomy, rhy, len(names), degrees)
-    return {n: anatomy.engine.coordinate(n).getDefaultValue() + float(v) for n, v in zip(involved, step, strict=True)}
-
-
-def lordosis_curve(anatomy: OsimAnatomy, degrees, **options) -> dict:
-    """The three optima over the lordosis on OpenSim's chain (:func:`spinectl.anatomy.optimum.lordosis_curve`).
-
-    The postures are :func:`lordosis_posture`'s (the couplers as the rhythm), the optima :func:`optimise`'s.
-
-    Parameters
-    ----------
-    anatomy : OsimAnatomy
-    degrees : array_like
-        Changes of the chain's summed angle [deg].
-    **options
-        ``plane``, ``margin``, ``joint_stiffness``, ``equilibrium``.
-
-    Returns
-    -------
-    dict
-        As :func:`spinectl.anatomy.optimum.lordosis_curve`.
-    """
-    from .optimum import lordosis_curve as curve
-
-    return curve(anatomy, degrees, posture_at=lordosis_posture, optimise_at=optimise, **options)
-
-
-def optimised(
-    anatomy: OsimAnatomy,
-    plane="sagittal",
-    stability="chain",
-    margin=1.0,
-    joint_stiffness="none",
-    equilibrium="rhythm",
-    check=False,
-    reflex=None,
-):
-    """The optimum with a criterion and without on OpenSim's chain, and the analysis at it.
-
-    Parameters
-    ----------
-    anatomy : OsimAnatomy
-    plane, stability, margin, joint_stiffness, equilibrium
-        As :func:`optimise`.
-    check : bool
-        Refused: MuJoCo is the referee, for MJCF only (:meth:`OsimEngine.spec_factory`).
-    reflex : tuple, optional
-        ``(kp, kd, lag)`` (:func:`spinectl.anatomy.analyses.reflex_margin`).
-
-    Returns
-    -------
-    spinectl.anatomy.optimum.OptimisedResult
-    """
-    from .analyses import analyse
-    from .optimum import OptimisedResult, remedy, skeleton
-
-    if check:
-        anatomy.engine.spec_factory()
-    kwargs = {"plane": plane, "margin": margin, "joint_stiffness": joint_stiffness, "equilibrium": equilibrium}
-    opt = optimise(anatomy, stability=stability, **kwargs)
-    classic = opt if stability == "none" else optimise(anatomy, stability="none", **kwargs)
-    analysis = None
-    if opt.ok:
-        analysis = analyse(anatomy, plane, opt.activations, joint_stiffness=joint_stiffness, reflex=reflex)
-    empty = skeleton(anatomy, opt, reflex=reflex, **kwargs)
-    fix = remedy(anatomy, optimise, opt, classic, joint_stiffness, kwargs)
-    return OptimisedResult(anatomy, opt, classic, float(margin), plane, analysis, empty, fix)

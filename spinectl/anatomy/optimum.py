@@ -38,11 +38,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ModelError, ParameterError
+from ..errors import ParameterError
 from ..model.linear_chain import LinearChain
-from .engine import require_mujoco
-from .linearise import rhythm
-from .model import Anatomy
+from .contract import AnatomyEngine
 
 STABILITY = ("chain", "joints", "rhythm", "none")
 EQUILIBRIUM = ("rhythm", "free")
@@ -51,32 +49,22 @@ MARGIN = 1.0
 """Default static margin mu [N m/rad] of the stability constraints."""
 
 
-def volume_weights(anatomy: Anatomy) -> np.ndarray:
-    """w_i proportional to F0_i L0_i (MuJoCo's muscle parameters), normalised to mean 1.
+def volume_weights(anatomy: AnatomyEngine) -> np.ndarray:
+    """The optimum's volume weights, w_i proportional to each muscle's volume, normalised to mean 1.
+
+    Each engine reads its own muscle parameters (MuJoCo's F0 and L0, OpenSim's maximal isometric
+    force and optimal fibre length): :meth:`~spinectl.anatomy.contract.AnatomyEngine.volume_weights`.
 
     Parameters
     ----------
-    anatomy : Anatomy
+    anatomy : AnatomyEngine
         The model.
 
     Returns
     -------
     numpy.ndarray, shape (m,)
     """
-    mujoco = require_mujoco()
-    model, ids = anatomy.engine.model, anatomy.engine.muscle_ids()
-    if np.any(model.actuator_dyntype[ids] != mujoco.mjtDyn.mjDYN_MUSCLE):
-        raise ModelError(
-            f"{anatomy.name}: the optimum's volume weights need MuJoCo muscles (their F0 and L0); its muscles "
-            "are general actuators (spinectl's export: analyse it without --optimise and --lordosis)"
-        )
-    gain = model.actuator_gainprm[ids]
-    lr = model.actuator_lengthrange[ids]
-    # MuJoCo's muscle: L0 = (lengthrange span) / (operating range span); F0 = force, or scale / acc0 if force < 0
-    length0 = (lr[:, 1] - lr[:, 0]) / (gain[:, 1] - gain[:, 0])
-    force0 = np.where(gain[:, 2] > 0, gain[:, 2], gain[:, 3] / model.actuator_acc0[ids])
-    volume = force0 * length0
-    return volume / volume.mean()
+    return anatomy.volume_weights()
 
 
 def solve_on_chain(chain: LinearChain, tau_per, tau_0, weights, stability: str, margin: float):
@@ -160,7 +148,7 @@ class Optimum:
 
 
 def optimise(
-    anatomy: Anatomy,
+    anatomy: AnatomyEngine,
     plane: str = "sagittal",
     stability: str = "chain",
     margin: float = MARGIN,
@@ -173,7 +161,7 @@ def optimise(
 
     Parameters
     ----------
-    anatomy : Anatomy
+    anatomy : AnatomyEngine
         The model.
     plane : str
         The chain whose stability is imposed (equilibrium holds on every lumbar joint: the
@@ -182,8 +170,9 @@ def optimise(
         ``"chain"``, ``"joints"`` or ``"none"`` (module docstring).
     margin : float
         mu [N m/rad], >= 0.
-    posture : array_like, optional
-        Full qpos; default the model's reference posture.
+    posture : optional
+        The operating point in the engine's form (MuJoCo: the full qpos; OpenSim: coordinate name ->
+        value [rad]); default the model's reference posture.
     joint_stiffness : {"none", "mapped"} or float
         Added at each chain joint [N m/rad].
     weights : str
@@ -197,17 +186,8 @@ def optimise(
     """
     check_choices(stability, equilibrium, margin, weights)
     free, constrained, lin = anatomy.chains(plane, posture, joint_stiffness)
-    lumbar = anatomy.mapping.planes.get("3d", anatomy.plane_joints(plane))
-    model = anatomy.engine.model
-    rows = [int(model.jnt_dofadr[j]) for j in anatomy.joint_ids(lumbar)]
-    if equilibrium == "free":
-        tau_per, tau_0 = lin.torque_per_muscle[rows], lin.torque_offset[rows]
-    else:
-        anatomy.engine.set_state(anatomy.posture(posture))
-        rhy = rhythm(anatomy.engine, anatomy.joint_ids(lumbar))
-        dofs = list(rhy.dofs)
-        tau_per, tau_0 = rhy.transform.T @ lin.torque_per_muscle[dofs], rhy.transform.T @ lin.torque_offset[dofs]
-    w = volume_weights(anatomy) if weights == "volume" else np.ones(free.n_controls)
+    rows, tau_per, tau_0 = anatomy.equilibrium_rows(lin, plane, posture, equilibrium)
+    w = anatomy.volume_weights() if weights == "volume" else np.ones(free.n_controls)
     return optimum_on_chains(free, constrained, lin, rows, tau_per, tau_0, w, stability, equilibrium, margin)
 
 
@@ -293,7 +273,7 @@ def _residual(chain, tau_per, tau_0) -> float:
     return float(np.linalg.norm(lsq_linear(tau_per, -tau_0, bounds=(chain.lower, chain.upper)).fun))
 
 
-def _optimum_dict(anatomy: Anatomy, opt: Optimum) -> dict:
+def _optimum_dict(anatomy: AnatomyEngine, opt: Optimum) -> dict:
     return {
         "stability": opt.stability,
         "equilibrium": opt.equilibrium,
@@ -352,7 +332,7 @@ class OptimisedResult:
 
     Attributes
     ----------
-    anatomy : Anatomy
+    anatomy : AnatomyEngine
         The model.
     optimum : Optimum
         With the criterion asked for.
@@ -374,7 +354,7 @@ class OptimisedResult:
         equilibrium fails).
     """
 
-    anatomy: Anatomy
+    anatomy: AnatomyEngine
     optimum: Optimum
     classic: Optimum
     margin: float
@@ -426,9 +406,9 @@ class OptimisedResult:
 
     def _header(self) -> dict:
         """The model and the chain, where there is no analysis (an infeasible optimum)."""
-        engine = self.anatomy.engine
+        anatomy = self.anatomy
         return {
-            "model": {"name": engine.name, "source": engine.source, "sha256": engine.sha256},
+            "model": {"name": anatomy.name, "source": anatomy.source, "sha256": anatomy.sha256},
             "plane": self.plane,
             "joints": list(self.anatomy.plane_joints(self.plane)),
         }
@@ -513,7 +493,7 @@ def remedy(anatomy, optimise_at, opt: Optimum, classic: Optimum, joint_stiffness
 
     Parameters
     ----------
-    anatomy : Anatomy or OsimAnatomy
+    anatomy : AnatomyEngine
         The model (its :meth:`added_stiffness` reads ``joint_stiffness``).
     optimise_at : callable
         The engine's ``optimise(anatomy, stability=..., **kwargs)``.
@@ -577,7 +557,7 @@ EQUILIBRIUM_HINT = (
 
 
 def optimised(
-    anatomy: Anatomy,
+    anatomy: AnatomyEngine,
     plane: str = "sagittal",
     stability: str = "chain",
     margin: float = MARGIN,
@@ -590,7 +570,7 @@ def optimised(
 
     Parameters
     ----------
-    anatomy : Anatomy
+    anatomy : AnatomyEngine
         The model.
     plane : str
         The chain.
@@ -614,6 +594,8 @@ def optimised(
     """
     from .analyses import analyse
 
+    if check:  # refused before any optimum is solved, on an engine MuJoCo cannot referee
+        anatomy.require_referee()
     kwargs = {"plane": plane, "margin": margin, "joint_stiffness": joint_stiffness, "equilibrium": equilibrium}
     opt = optimise(anatomy, stability=stability, **kwargs)
     classic = opt if stability == "none" else optimise(anatomy, stability="none", **kwargs)
@@ -625,12 +607,12 @@ def optimised(
     return OptimisedResult(anatomy, opt, classic, float(margin), plane, analysis, empty, fix)
 
 
-def skeleton(anatomy: Anatomy, opt: Optimum, plane: str, joint_stiffness, reflex=None, **_):
+def skeleton(anatomy: AnatomyEngine, opt: Optimum, plane: str, joint_stiffness, reflex=None, **_):
     """Where the optimum is infeasible, the analysis at the lower control bounds (its JSON's keys); else None.
 
     Parameters
     ----------
-    anatomy : Anatomy
+    anatomy : AnatomyEngine
         The model.
     opt : Optimum
         The optimum.
@@ -653,16 +635,17 @@ def skeleton(anatomy: Anatomy, opt: Optimum, plane: str, joint_stiffness, reflex
     return analyse(anatomy, plane, lower, joint_stiffness=joint_stiffness, reflex=reflex)
 
 
-def lordosis_posture(anatomy: Anatomy, degrees: float, plane: str = "sagittal") -> np.ndarray:
+def lordosis_posture(anatomy: AnatomyEngine, degrees: float, plane: str = "sagittal"):
     """The reference posture with the plane's chain moved along the model's rhythm by ``degrees`` in total.
 
-    The chain's joints (and those the rhythm slaves, e.g. MyoTorso's abdomen) move as the
-    rhythm's coefficients distribute them, their angles summing to ``degrees`` over the chain;
-    the thorax is not held upright (it turns with the chain).
+    The chain's joints (and those the rhythm slaves: MyoTorso's abdomen, the coordinates an
+    ``.osim``'s couplers tie) move as the rhythm distributes them, their angles summing to
+    ``degrees`` over the chain (:func:`~spinectl.anatomy.contract.lordosis_direction`); the thorax
+    is not held upright (it turns with the chain).
 
     Parameters
     ----------
-    anatomy : Anatomy
+    anatomy : AnatomyEngine
         The model.
     degrees : float
         The change of the chain's summed angle [deg].
@@ -671,43 +654,10 @@ def lordosis_posture(anatomy: Anatomy, degrees: float, plane: str = "sagittal") 
 
     Returns
     -------
-    numpy.ndarray, shape (nq,)
+    object
+        The posture in the engine's form (MuJoCo: the full qpos; OpenSim: coordinate name -> value [rad]).
     """
-    lin, rhy, _ = anatomy.linearise(plane)
-    q = anatomy.posture()
-    q[list(rhy.dofs)] += lordosis_direction(anatomy, rhy, lin.n, degrees)
-    return q
-
-
-def lordosis_direction(anatomy: Anatomy, rhy, n: int, degrees: float) -> np.ndarray:
-    """The change of the involved joints' angles [rad] that moves the chain by ``degrees`` along the rhythm.
-
-    The rhythm's first independent coordinate and the joints it slaves move as its column of T;
-    a chain whose first joint no rhythm ties to another has no lordosis to move along (one line).
-
-    Parameters
-    ----------
-    anatomy : Anatomy
-        The model (for its name).
-    rhy : spinectl.anatomy.linearise.Rhythm
-        The rhythm over the involved joints, the chain's n first.
-    n : int
-        The number of chain joints.
-    degrees : float
-        The change of the chain's summed angle [deg].
-
-    Returns
-    -------
-    numpy.ndarray, shape (len(rhy.dofs),)
-    """
-    direction = rhy.transform[:, 0]
-    if n > 1 and np.count_nonzero(direction[:n]) < 2:
-        raise ModelError(
-            f"lordosis: {anatomy.name} has no rhythm (joint equality or coordinate coupler) that ties its chain's "
-            "first joint to the others, so the chain has no lordosis to move along; give the model one "
-            "(spinectl's export: export it at another Lambda)"
-        )
-    return direction * np.radians(degrees) / direction[:n].sum()
+    return anatomy.lordosis_posture(degrees, plane)
 
 
 CURVE_MEANING = (
@@ -718,29 +668,23 @@ CURVE_MEANING = (
 
 
 def lordosis_curve(
-    anatomy: Anatomy,
+    anatomy: AnatomyEngine,
     degrees,
     plane: str = "sagittal",
     margin: float = MARGIN,
     joint_stiffness="none",
     equilibrium: str = "rhythm",
-    posture_at=None,
-    optimise_at=None,
 ) -> dict:
     """The three optima (classic, joint by joint, the chain) over the lordosis.
 
     Parameters
     ----------
-    anatomy : Anatomy
+    anatomy : AnatomyEngine
         The model.
     degrees : array_like
         Changes of the chain's summed angle about the reference posture [deg].
     plane, margin, joint_stiffness, equilibrium
         As in :func:`optimise`.
-    posture_at, optimise_at : callable, optional
-        The engine's posture at a lordosis and its optimum there; default MuJoCo's,
-        :func:`lordosis_posture` and :func:`optimise` (OpenSim's:
-        :func:`spinectl.anatomy.opensim_engine.lordosis_curve`).
 
     Returns
     -------
@@ -749,13 +693,11 @@ def lordosis_curve(
         ``status`` and ``margin_Nm_per_rad`` (the least eigenvalue of -K) lists.
     """
     degrees = np.asarray(degrees, float)
-    posture_at = lordosis_posture if posture_at is None else posture_at
-    optimise_at = optimise if optimise_at is None else optimise_at
-    postures = [posture_at(anatomy, d, plane) for d in degrees]
+    postures = [anatomy.lordosis_posture(d, plane) for d in degrees]
     out = {"lordosis_deg": degrees.tolist()}
     for criterion in ("none", "joints", "chain"):
         rows = [
-            optimise_at(
+            optimise(
                 anatomy,
                 plane=plane,
                 stability=criterion,

@@ -181,8 +181,6 @@ def _answers(args) -> tuple:
     if args.optimise:
         from ..anatomy.optimum import optimised
 
-        if str(args.model).lower().endswith(".osim"):
-            from ..anatomy.opensim_engine import optimised  # the same problem on OpenSim's chain
         result = optimised(
             anatomy,
             plane=args.plane,
@@ -206,8 +204,6 @@ def _answers(args) -> tuple:
     if args.lordosis:
         from ..anatomy.optimum import lordosis_curve
 
-        if str(args.model).lower().endswith(".osim"):
-            from ..anatomy.opensim_engine import lordosis_curve  # along the model's couplers
         curve = lordosis_curve(
             anatomy,
             _degrees(args.lordosis),

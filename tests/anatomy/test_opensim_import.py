@@ -231,7 +231,7 @@ def test_optimum_on_opensims_chain_is_the_least_effort_and_stable(lowest_joint):
     classic one."""
     from scipy.optimize import minimize
 
-    from spinectl.anatomy.opensim_engine import optimised, volume_weights
+    from spinectl.anatomy.optimum import optimised, volume_weights
 
     result = optimised(lowest_joint, equilibrium="free", margin=1.0)
     _, _, lin = lowest_joint.chains()
@@ -400,3 +400,37 @@ def test_a_downloaded_model_without_meshes_prints_nothing_but_spinectls_own(tmp_
     else:
         assert result.stdout == "" and result.stderr.strip().splitlines()[-1].startswith("spinectl: error: ")
     assert "Couldn't find file" in result.stderr and "Couldn't find file" not in result.stdout
+
+
+def test_opensims_model_meets_the_engine_contract(imported):
+    """OsimAnatomy is an AnatomyEngine (runtime_checkable: every member of the contract present), and no
+    longer a MuJoCo Anatomy (whose MuJoCo-only methods it inherited before the contract)."""
+    from spinectl.anatomy.contract import AnatomyEngine
+    from spinectl.anatomy.model import Anatomy
+
+    assert isinstance(imported[1], AnatomyEngine) and not isinstance(imported[1], Anatomy)
+
+
+def test_the_osim_is_drawn_as_mujoco_draws_the_same_export(imported, tmp_path):
+    """The figures' points of the .osim export (OpenSim's joint centres, thorax mass centre, muscles' current
+    paths, its plane from gravity and the first joint's turning axis) equal those MuJoCo computes on the MJCF
+    export of the same model, to 1e-12 m: at the posture and bent along each mode of the MJCF's free chain
+    (before: `anatomy chain.osim --plot` raised a TypeError from MuJoCo's kinematics given OpenSim's model)."""
+    from spinectl.anatomy.analyses import verdict
+    from spinectl.anatomy.drawing import mode_shapes, sagittal_projection
+    from spinectl.anatomy.export_mjcf import export_mjcf
+
+    pytest.importorskip("mujoco", reason="MuJoCo is the referee: pip install 'spinectl[anatomy]'")
+    model, loaded, *_ = imported
+    export_mjcf(model, E, LAMBDA, tmp_path / "chain.xml")
+    referee = anatomy.load(tmp_path / "chain.xml", cache=False)
+    ours, theirs = sagittal_projection(loaded), sagittal_projection(referee)
+    assert ours.muscles == theirs.muscles and ours.joints == theirs.joints
+    for name in ("cors", "thorax"):  # projected: the two worlds' axes differ (OpenSim's y up, MuJoCo's z up)
+        assert np.allclose(getattr(ours, name), getattr(theirs, name), rtol=0, atol=1e-12), name
+    for mine, other in zip(ours.segments, theirs.segments, strict=True):
+        assert len(mine) == len(other) == 1 and np.allclose(mine[0], other[0], rtol=0, atol=1e-12)
+    at = verdict(referee.chain("sagittal"), np.full(len(referee.muscles), 0.05))
+    bent, expected = mode_shapes(loaded, at), mode_shapes(referee, at)
+    assert np.allclose(bent.rest, expected.rest, rtol=0, atol=1e-12)
+    assert np.allclose(bent.bent, expected.bent, rtol=0, atol=1e-12)

@@ -107,7 +107,7 @@ def test_the_lordosis_posture_follows_opensims_couplers(exported):
     slopes, their angles summing to the lordosis. OpenSim is the referee: with the couplers enforced, its own
     constraint errors (State.getQErr after realizePosition) vanish at that posture (1e-12 rad), and not at the
     same lordosis put at L5S1 alone (the check can fail)."""
-    from spinectl.anatomy.opensim_engine import lordosis_posture
+    from spinectl.anatomy.optimum import lordosis_posture
 
     *_, coupled = exported
     loaded = anatomy.load(coupled)
@@ -134,7 +134,7 @@ def test_cli_lordosis_on_an_osim_is_the_optimum_at_each_posture(exported, capsys
     0 <= a <= 1) on OpenSim's linearisation at that posture, to 1e-4; the postures differ (so do the costs)."""
     from scipy.optimize import minimize
 
-    from spinectl.anatomy.opensim_engine import lordosis_posture, volume_weights
+    from spinectl.anatomy.optimum import lordosis_posture, volume_weights
 
     *_, coupled = exported
     assert main(["anatomy", str(coupled), "--lordosis", "-4:4:3", "--json"]) == 0
