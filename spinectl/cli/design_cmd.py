@@ -123,6 +123,8 @@ def run(args) -> int:
     int
         Exit code 0 (also for a delay no design meets: status 'infeasible').
     """
+    from math import inf
+
     from .._validate import in_range, non_negative
     from ..errors import ParameterError
     from ..model import clinical
@@ -158,7 +160,8 @@ def run(args) -> int:
         return _passive(model, args)
     if args.delays is not None:
         return _delays(model, args, kp, kd)
-    ratio = 1.0 if args.margin is None else in_range("--margin", args.margin, 1.0, MAX_DELAY / model.reflex.delay)
+    delay = model.reflex.delay
+    ratio = 1.0 if args.margin is None else in_range("--margin", args.margin, 1.0, MAX_DELAY / delay if delay else inf)
     result = answer(model, args.E, args.Lambda, kp=kp, kd=kd, search=args.gains == "search", ratio=ratio)
     if args.json:
         emit_json(clinical.with_lordosis_angle(result.to_dict(), model))

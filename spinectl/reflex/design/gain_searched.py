@@ -5,9 +5,9 @@ gains handed over to the local muscles, (1 - f)+ times :func:`spinectl.reflex.ga
 diagonal gains can need less local stiffness (docs/reflex.md, "The design question, over every diagonal
 reflex"). :func:`gain_searched_design` answers over all of them: a bisection on f in [0, f_rule] (f_rule the
 rule's answer, whose gains are a candidate, so the answer is never above it), each fraction judged with the
-gains in hand first and, if they fail, with the seeded gain search of
-:func:`spinectl.reflex.gain_search.search_chain_gains` (it maximises the exact margin; started from the
-best of the gains in hand and the rule's full gains). A fraction is accepted only with a certificate: the
+gains in hand first, then with the best of the rule's shape at other strengths (:data:`SHAPE_FACTORS`) and,
+if that fails, with the seeded gain search of :func:`spinectl.reflex.gain_search.search_chain_gains` (it
+maximises the exact margin) started from it. A fraction is accepted only with a certificate: the
 exact margin of its gains (:func:`spinectl.reflex.mimo.chain_delay_margin`) meets the delay with no
 critical delay crossed below it, and the rightmost root at the delay
 (:func:`~spinectl.reflex.design.roots.rightmost_root`, with the Chebyshev seeds) has Re s < 0.
@@ -46,6 +46,10 @@ SEARCH_BUDGET = {"population": 1, "generations": 3, "restarts": 2, "restart_eval
 """The budget of each gain search (:func:`spinectl.reflex.gain_search.search_chain_gains`): 10 members over
 4 generations, then at most two Nelder-Mead runs of 100 exact margins: about 250 exact margins, 5-20 s."""
 
+SHAPE_FACTORS = (0.2, 0.3, 0.4, 0.6, 1.0)
+"""Multiples of the rule's full gains (before the hand-over), k_p and k_d apart, tried as the search's start:
+the rule's shape at other strengths (the issue's examples, 0.40 k_p with 0.30 k_d, lie on it)."""
+
 SEARCH_SEED = 0
 """The seed of every gain search: the same model gives the same answer."""
 
@@ -75,9 +79,9 @@ class GainSearchedDesign:
     max_root_real : float
         Re of the rightmost root at the delay [1/s] (< 0).
     searches : int
-        Gain searches run.
+        Gain searches run (a fraction held by the gains in hand or a shape needs none).
     evaluations : int
-        Exact margins the searches computed.
+        Exact margins (or delay-free root checks) computed.
     method : str
     """
 
@@ -129,7 +133,7 @@ class GainSearchedDesign:
             "  gains: " + _gains_text(names, self.kp, self.kd),
             f"  certificate: exact delay margin {delay_text(self.delay_margin)}; rightmost root at the delay "
             f"Re s = {self.max_root_real:.4g} 1/s",
-            f"  search: {self.method}; {self.searches} seeded gain searches, {self.evaluations} exact margins "
+            f"  search: {self.method}; {self.searches} seeded gain searches, {self.evaluations} margin evaluations "
             f"(budget: {SEARCH_STEPS} bisections, each search {_budget_text()}, seed {SEARCH_SEED})",
         ]
 
@@ -203,7 +207,7 @@ class _Chain:
         self.model, self.least = model, np.asarray(least_static, float)
         self.mass, self.stiffness, self.damping = chain_matrices(model, e, lam, pcsa)
         self.delay, self.lag = model.reflex.delay, model.reflex.activation_time_constant
-        self.evaluations = 0
+        self.evaluations = self.searches = 0
 
     def loop(self, f, kp=None, kd=None):
         return chain_loop_at(self.model, self.mass, self.stiffness, self.damping, self.least, f, kp, kd)
@@ -225,9 +229,12 @@ class _Chain:
         return (margin, float(root.real)) if root.real < 0 else None
 
     def search(self, f, starts):
-        """The best gains the seeded search finds at f, from the best of ``starts``: (kp, kd, evaluations)."""
+        """Gains for f: the best of ``starts`` if it holds f, else the seeded search's best from it (kp, kd)."""
         k, d, _, _ = self.loop(f)
         kp, kd = max(starts, key=lambda g: self.margin(f, *g))
+        if self.certify(f, kp, kd) is not None:
+            return kp, kd
+        self.searches += 1
         found = search_chain_gains(
             fixed_chain(self.model.geometry.cor_names, self.mass, k, d), kp, kd, self.lag, seed=SEARCH_SEED,
             **SEARCH_BUDGET,
@@ -261,16 +268,16 @@ def gain_searched_design(model: Model, eccentricity: float, lordosis: float, pcs
         nan = np.full(n, np.nan)
         return GainSearchedDesign(np.nan, nan, nan, nan, np.nan, np.nan, 0, 0, "none: the rule has no design")
     chain = _Chain(model, float(eccentricity), float(lordosis), pcsa, rule.least_static)
-    full = chain.loop(0.0)[2:]  # the rule's gains before the hand-over: a start at every fraction
+    kp0, kd0 = chain.loop(0.0)[2:]  # the rule's gains before the hand-over: its shape, at other strengths
+    shapes = [(a * kp0, b * kd0) for a in SHAPE_FACTORS for b in SHAPE_FACTORS]
     best = (rule.fraction, rule.kp, rule.kd, rule.delay_margin, rule.max_root_real)
-    lo, hi, searches = 0.0, rule.fraction, 0
+    lo, hi = 0.0, rule.fraction
     for _ in range(SEARCH_STEPS):
         f = 0.5 * (lo + hi)
         held = chain.certify(f, best[1], best[2])  # the gains in hand first: no search if they hold f
         gains = (best[1], best[2])
         if held is None:
-            gains = chain.search(f, [gains, full])
-            searches += 1
+            gains = chain.search(f, [gains, *shapes])
             held = chain.certify(f, *gains)
         if held is None:
             lo = f
@@ -283,7 +290,7 @@ def gain_searched_design(model: Model, eccentricity: float, lordosis: float, pcs
     )
     return GainSearchedDesign(
         float(f), f * rule.least_static, np.asarray(kp, float), np.asarray(kd, float), float(margin),
-        float(root), searches, chain.evaluations, method,
+        float(root), chain.searches, chain.evaluations, method,
     )  # fmt: skip
 
 

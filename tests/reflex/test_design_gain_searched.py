@@ -1,0 +1,124 @@
+"""The design over every diagonal PD reflex (spinectl.reflex.design.gain_searched), its labels and its margin."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from spinectl.model import config
+from spinectl.optimise.reference import solve_point
+from spinectl.reflex import design as dz
+from spinectl.reflex.chain_margins import stable_at
+from spinectl.reflex.design.chain import chain_loop_at, chain_matrices
+from spinectl.reflex.design.roots import SPECTRAL_NODES, rightmost_root
+from spinectl.reflex.mimo import chain_delay_margin
+
+AT = (0.03, 0.04)
+"""E = 3 cm, Lambda = 4 cm: the issue's position (``wagner2012``, T_a = 50 ms)."""
+
+
+def _model(delay, **extra):
+    return config.set_parameters(config.load_preset("wagner2012"), {"reflex.delay": delay} | extra)
+
+
+def _chain_at(model, fraction):
+    """M, K - f diag(k*), D less the local damping, and the rule's gains before the hand-over, by the library."""
+    optimum = np.asarray(solve_point(model, *AT).pcsa, float)
+    mass, k, d = chain_matrices(model, *AT, model.reflex.activation * optimum)
+    least = dz.design(model, *AT).chain.least_static
+    stiffness, damping, _, _ = chain_loop_at(model, mass, k, d, least, fraction)
+    _, _, kp0, kd0 = chain_loop_at(model, mass, k, d, least, 0.0)
+    return mass, stiffness, damping, kp0, kd0
+
+
+@pytest.fixture(scope="module")
+def searched_40ms():
+    """The issue's case: 40 ms, ``wagner2012`` at (3, 4) cm, the gain search on (one run, about a minute)."""
+    return dz.answer(_model(0.04), *AT, search=True)
+
+
+def test_the_issues_40ms_gains_hold_less_stiffness_than_the_rule():
+    """The issue's claim, recomputed with the library's exact margin: at 0.9 of the rule's f (0.5617 x k*) the chain
+    with 0.40 k_p and 0.30 k_d of the rule's gains (before the hand-over) is stable at 40 ms: margin 47.5 ms here
+    (the issue says 42.3 ms), rightmost root -0.15 1/s. So the rule's f is not the least over diagonal gains; with
+    the rule's own hand-over gains, (1 - 0.9 f)+ of them, the same stiffness holds 27.6 ms only."""
+    model = _model(0.04)
+    rule = dz.design(model, *AT).chain.fraction
+    mass, k, d, kp0, kd0 = _chain_at(model, 0.9 * rule)
+    exact = chain_delay_margin(mass, k, d, 0.40 * kp0, 0.30 * kd0, model.reflex.activation_time_constant)
+    assert stable_at(exact, 0.04) and exact.margin == pytest.approx(0.04747, abs=2e-4)
+    root = rightmost_root(mass, k, d, 0.40 * kp0, 0.30 * kd0, 0.04, model.reflex.activation_time_constant, 24)
+    assert root.real < 0
+    scaled = 1 - 0.9 * rule
+    assert chain_delay_margin(mass, k, d, scaled * kp0, scaled * kd0, 0.05).margin == pytest.approx(0.0276, abs=2e-4)
+
+
+def test_the_searched_answer_is_certified_and_below_the_rules(searched_40ms):
+    """At its reported f and gains the library's exact margin meets 40 ms with no crossing below, and the rightmost
+    root (Chebyshev seeds) lies on the left; f is strictly below the rule's (the 0.9 f of the issue holds, so the
+    bisection's fourth step, 0.9 x 0.5617 = 0.5055 or lower, is certified)."""
+    s, rule = searched_40ms.searched, searched_40ms.chain
+    assert s.fraction < rule.fraction and s.fraction <= 0.9 * rule.fraction + 1e-12
+    mass, k, d, _, _ = _chain_at(_model(0.04), s.fraction)
+    np.testing.assert_allclose(s.local_stiffness, s.fraction * rule.least_static)
+    exact = chain_delay_margin(mass, k, d, s.kp, s.kd, 0.05)
+    assert stable_at(exact, 0.04) and exact.margin >= 0.04 and exact.margin == pytest.approx(s.delay_margin)
+    root = rightmost_root(mass, k, d, s.kp, s.kd, 0.04, 0.05, SPECTRAL_NODES)
+    assert root.real < 0 and root.real == pytest.approx(s.max_root_real, rel=1e-6, abs=1e-9)
+    assert {"reflex", "kp_Nm_per_rad", "budget"} <= set(searched_40ms.to_dict()["chain_gain_searched"])
+    table = searched_40ms.table()
+    assert "any diagonal PD gains, searched" in table and "the reflex rule, (1 - f)+" in table
+
+
+def test_the_rules_answer_is_the_searched_answer_when_no_smaller_fraction_is_certified(monkeypatch):
+    """The rule's design is the first candidate: where no gains certify any smaller fraction (every certificate
+    refused), every halving fails and the answer is the rule's own f, gains, margin and root, never above them."""
+    from spinectl.reflex.design import gain_searched
+
+    monkeypatch.setattr(gain_searched._Chain, "certify", lambda self, f, kp, kd: None)
+    monkeypatch.setattr(gain_searched._Chain, "search", lambda self, f, starts: starts[0])
+    model = _model(0.12, **{"body.mass": 35.0, "passive.stiffness": 10.0})  # a variant: the subject at 120 ms
+    result = dz.answer(model, *AT, search=True)
+    s, rule = result.searched, result.chain
+    assert s.fraction == rule.fraction and s.delay_margin == rule.delay_margin >= 0.12
+    np.testing.assert_array_equal(s.kp, rule.kp)
+    np.testing.assert_array_equal(s.kd, rule.kd)
+    assert "0 % less" in result.table()
+
+
+@pytest.mark.parametrize(("delay", "ratio"), [(0.1, 1.2), (0.04, 1.5)])
+def test_a_margin_ratio_is_the_design_at_ratio_times_the_delay(delay, ratio):
+    """--margin R is the rule's design at R x the delay (it then holds every delay up to R tau: its exact margin is
+    the first critical delay): the chain's fraction and the joint-by-joint activation equal design() there."""
+    result = dz.answer(_model(delay), *AT, ratio=ratio)
+    direct = dz.design(_model(ratio * delay), *AT)
+    assert result.chain.fraction == direct.chain.fraction and result.activation == direct.activation
+    assert result.delay == pytest.approx(ratio * delay) and result.nominal_delay == delay
+    assert result.margin_cost is None and "holds every delay up to" in result.table()
+
+
+def test_the_default_shows_the_cost_of_a_margin_of_1_1():
+    """Without --margin the table says the least value is a stability boundary and what 1.1 x the delay costs: the
+    rule's design at 1.1 tau (from design() itself), more local stiffness than at tau."""
+    result = dz.answer(_model(0.1), *AT)
+    longer = dz.design(_model(0.11), *AT).chain
+    assert result.margin_cost.ratio == dz.COST_RATIO == 1.1
+    assert result.margin_cost.fraction == longer.fraction > result.chain.fraction
+    table = result.table()
+    assert "sits on its stability boundary (margin = the delay)" in table
+    assert f"{np.sum(longer.local_stiffness):.1f} N m/rad" in table
+
+
+@pytest.mark.parametrize("K", [0.0, 40.0])
+def test_the_printed_global_pcsa_is_the_activation_times_the_minimum_pcsa_at_K(K):
+    """The chain's global PCSA is reflex.activation x the minimum stabilising PCSA of optimise.solve_point at this
+    K (which shrinks as K grows: K = 40 a variant); the gains are the rule's at the design, (1 - f)+ of the full."""
+    model = _model(0.04, **{"passive.stiffness": K})
+    result = dz.answer(model, *AT)
+    optimum = np.sum(solve_point(model, *AT).pcsa)
+    assert result.chain.pcsa == pytest.approx(model.reflex.activation * optimum, rel=1e-12)
+    assert result.to_dict()["chain"]["global_pcsa_cm2"] == pytest.approx(1e4 * 0.5 * optimum, rel=1e-12)
+    assert f"global PCSA {1e4 * 0.5 * optimum:.2f} cm^2" in result.table()
+    mass, _, _, kp0, kd0 = _chain_at(model, result.chain.fraction)
+    np.testing.assert_allclose(result.chain.kp, (1 - result.chain.fraction) * kp0, rtol=1e-12)
+    np.testing.assert_allclose(result.chain.kd, (1 - result.chain.fraction) * kd0, rtol=1e-12)
