@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -15,6 +17,8 @@ from spinectl.reflex.mimo import chain_delay_margin
 
 AT = (0.03, 0.04)
 """E = 3 cm, Lambda = 4 cm: the issue's position (``wagner2012``, T_a = 50 ms)."""
+
+DOCS = Path(__file__).resolve().parents[2] / "docs" / "reflex.md"
 
 
 def _model(delay, **extra):
@@ -68,6 +72,8 @@ def test_the_searched_answer_is_certified_and_below_the_rules(searched_40ms):
     assert {"reflex", "kp_Nm_per_rad", "budget"} <= set(searched_40ms.to_dict()["chain_gain_searched"])
     table = searched_40ms.table()
     assert "any diagonal PD gains, searched" in table and "the reflex rule, (1 - f)+" in table
+    quoted = [line for line in table.splitlines() if line.startswith("over any diagonal PD gains")]
+    assert quoted[0] in DOCS.read_text(encoding="utf-8")  # docs/reflex.md quotes the table, not a typed number
 
 
 def test_the_rules_answer_is_the_searched_answer_when_no_smaller_fraction_is_certified(monkeypatch):
