@@ -242,8 +242,14 @@ def test_passive_refuses_the_reflexs_options_it_would_ignore(option, value, caps
 def test_a_margin_or_a_gain_search_where_it_does_not_apply_is_one_line_exit_2(argv, needle, capsys):
     """--margin R below 1 (a design for shorter delays than asked), or R x the delay beyond 10 s, and --gains or
     --margin beside --delays or --passive (which would ignore them) are refused: one line, exit 2, no output."""
-    assert main(["design", "--preset", "wagner2012", "--delay", "0.1", *argv] if "--passive" not in argv
-                else ["design", "--preset", "wagner2012", *argv]) == 2
+    assert (
+        main(
+            ["design", "--preset", "wagner2012", "--delay", "0.1", *argv]
+            if "--passive" not in argv
+            else ["design", "--preset", "wagner2012", *argv]
+        )
+        == 2
+    )
     out, err = capsys.readouterr()
     assert out == "" and err.count("\n") == 1 and needle in err
 

@@ -7,11 +7,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from spinectl.model import config
+from spinectl.model import chain, config
 from spinectl.optimise.reference import solve_point
 from spinectl.reflex import design as dz
+from spinectl.reflex import gains
 from spinectl.reflex.chain_margins import stable_at
-from spinectl.reflex.design.chain import chain_loop_at, chain_matrices
 from spinectl.reflex.design.roots import SPECTRAL_NODES, rightmost_root
 from spinectl.reflex.mimo import chain_delay_margin
 
@@ -26,13 +26,19 @@ def _model(delay, **extra):
 
 
 def _chain_at(model, fraction):
-    """M, K - f diag(k*), D less the local damping, and the rule's gains before the hand-over, by the library."""
+    """M, K - f diag(k*), D - c_loc f diag(k*) and the rule's full gains (before the hand-over), recomputed from the
+    model's chain (spinectl.model.chain) and the rule (gains.chain_gains), not from the module under test."""
     optimum = np.asarray(solve_point(model, *AT).pcsa, float)
-    mass, k, d = chain_matrices(model, *AT, model.reflex.activation * optimum)
+    pcsa = model.reflex.activation * optimum
+    coefficients = chain.chain_coefficients(model, *AT)
+    mass = chain.linear_chain(model, *AT, coefficients).mass_matrix
+    k, d = coefficients.stiffness(pcsa), coefficients.damping(pcsa)
     least = dz.design(model, *AT).chain.least_static
-    stiffness, damping, _, _ = chain_loop_at(model, mass, k, d, least, fraction)
-    _, _, kp0, kd0 = chain_loop_at(model, mass, k, d, least, 0.0)
-    return mass, stiffness, damping, kp0, kd0
+    r = model.reflex
+    kp0, kd0 = gains.chain_gains(mass, k, d, least, r.gain_factor, r.damping_ratio)
+    local = fraction * least
+    c_loc = chain.linear_chain(model, *AT, coefficients).local_damping_per_stiffness
+    return mass, k - np.diag(local), d - np.diag(c_loc * local), kp0, kd0
 
 
 @pytest.fixture(scope="module")

@@ -30,13 +30,17 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from ...model.chain import chain_coefficients, linear_chain
+from ...model.checks import arithmetic_guard
 from ...model.linear_chain import LinearChain
 from ...model.params import Model
+from .. import gains
 from ..chain_margins import stable_at
 from ..delay import delay_text
 from ..gain_search import search_chain_gains
 from ..mimo import chain_delay_margin
-from .chain import chain_design, chain_loop_at, chain_matrices
+from .chain import chain_design
+from .result import gains_text
 from .roots import SPECTRAL_NODES, rightmost_root
 
 SEARCH_STEPS = 5
@@ -130,7 +134,7 @@ class GainSearchedDesign:
         return [
             f"over {SEARCHED_REFLEX}: local stiffness {total:.1f} N m/rad ({self.fraction:.4f} x k*; the rule's "
             f"{rule_total:.1f}, {100 * (1 - total / rule_total) if rule_total > 0 else 0.0:.0f} % less)",
-            "  gains: " + _gains_text(names, self.kp, self.kd),
+            "  gains: " + gains_text(names, self.kp, self.kd),
             f"  certificate: exact delay margin {delay_text(self.delay_margin)}; rightmost root at the delay "
             f"Re s = {self.max_root_real:.4g} 1/s",
             f"  search: {self.method}; {self.searches} seeded gain searches, {self.evaluations} margin evaluations "
@@ -170,34 +174,38 @@ class MarginCost:
         }
 
 
-def _gains_text(names, kp, kd) -> str:
-    return ", ".join(f"{n} kp {p:.1f} kd {d:.2f}" for n, p, d in zip(names, kp, kd, strict=True))
-
-
 def _budget_text() -> str:
     return ", ".join(f"{k} {v}" for k, v in SEARCH_BUDGET.items())
 
 
-def fixed_chain(names, mass, stiffness, damping) -> LinearChain:
-    """The chain at fixed matrices as a :class:`~spinectl.model.linear_chain.LinearChain` without controls.
+def chain_at_pcsa(model: Model, eccentricity: float, lordosis: float, pcsa) -> LinearChain:
+    """The chain with its global muscles fixed at a PCSA, as a :class:`~spinectl.model.linear_chain.LinearChain`.
+
+    :func:`spinectl.model.chain.linear_chain` (its joints, M and the local muscles' c_loc) with K_0 and D_0 the
+    muscles' sums per m^2 of each (:meth:`spinectl.model.chain.ChainCoefficients.stiffness`), as the chain's
+    design computes them; local stiffness k is added by ``.at((), k)``, with its damping c_loc k.
 
     Parameters
     ----------
-    names : sequence of str
-    mass, stiffness, damping : numpy.ndarray, shape (n, n)
-        M [kg m^2], K [N m/rad], D [N m s/rad].
+    model : Model
+    eccentricity, lordosis : float
+        E and Lambda [m].
+    pcsa : numpy.ndarray, shape (n_muscles,)
+        Global PCSA [m^2].
 
     Returns
     -------
     LinearChain
+        Without controls.
     """
-    n = len(names)
-    none = np.zeros((n, n, 0))
-    return LinearChain(
-        joints=tuple(names), controls=(), control_class=(), stiffness_per_control=none, damping_per_control=none,
-        stiffness_offset=np.asarray(stiffness, float), damping_offset=np.asarray(damping, float),
-        mass_matrix=np.asarray(mass, float), lower=np.zeros(0), upper=np.zeros(0),
-    )  # fmt: skip
+    with arithmetic_guard(eccentricity, lordosis):
+        coefficients = chain_coefficients(model, eccentricity, lordosis)
+        free = linear_chain(model, eccentricity, lordosis, coefficients)
+        return replace(
+            free.at(np.zeros(free.n_controls)),
+            stiffness_offset=coefficients.stiffness(pcsa),
+            damping_offset=coefficients.damping(pcsa),
+        )
 
 
 class _Chain:
@@ -205,16 +213,28 @@ class _Chain:
 
     def __init__(self, model: Model, e: float, lam: float, pcsa, least_static):
         self.model, self.least = model, np.asarray(least_static, float)
-        self.mass, self.stiffness, self.damping = chain_matrices(model, e, lam, pcsa)
+        self.linear = chain_at_pcsa(model, e, lam, pcsa)
+        self.mass = self.linear.mass_matrix
         self.delay, self.lag = model.reflex.delay, model.reflex.activation_time_constant
         self.evaluations = self.searches = 0
 
-    def loop(self, f, kp=None, kd=None):
-        return chain_loop_at(self.model, self.mass, self.stiffness, self.damping, self.least, f, kp, kd)
+    def at(self, f) -> LinearChain:
+        """The chain with local stiffness f k* and its damping."""
+        return self.linear.at((), f * self.least)
+
+    def gains(self, f, kp=None, kd=None):
+        """The rule's gains handed over at f, (1 - f)+ times its full gains (or the given gains)."""
+        k, d = self.linear.stiffness_offset, self.linear.damping_offset
+        scale = max(1.0 - f, 0.0)  # as the rule's design hands over to the local muscles
+        return gains.resolve_chain_gains(self.model.reflex, self.mass, k, d, self.least, kp, kd, scale)
+
+    def loop(self, f):
+        chain = self.at(f)
+        return chain.stiffness_offset, chain.damping_offset
 
     def margin(self, f, kp, kd) -> float:
         """The exact margin of gains at f [s]; 0 if unstable without delay or a critical delay crossed below."""
-        k, d, _, _ = self.loop(f)
+        k, d = self.loop(f)
         exact = chain_delay_margin(self.mass, k, d, kp, kd, self.lag)
         self.evaluations += 1
         return float(exact.margin) if stable_at(exact, self.delay) and exact.stable_without_delay else 0.0
@@ -224,20 +244,18 @@ class _Chain:
         margin = self.margin(f, kp, kd)
         if not margin >= self.delay:
             return None
-        k, d, _, _ = self.loop(f)
+        k, d = self.loop(f)
         root = rightmost_root(self.mass, k, d, kp, kd, self.delay, self.lag, SPECTRAL_NODES)
         return (margin, float(root.real)) if root.real < 0 else None
 
     def search(self, f, starts):
         """Gains for f: the best of ``starts`` if it holds f, else the seeded search's best from it (kp, kd)."""
-        k, d, _, _ = self.loop(f)
         kp, kd = max(starts, key=lambda g: self.margin(f, *g))
         if self.certify(f, kp, kd) is not None:
             return kp, kd
         self.searches += 1
         found = search_chain_gains(
-            fixed_chain(self.model.geometry.cor_names, self.mass, k, d), kp, kd, self.lag, seed=SEARCH_SEED,
-            **SEARCH_BUDGET,
+            self.at(f), kp, kd, self.lag, seed=SEARCH_SEED, **SEARCH_BUDGET
         )  # fmt: skip
         self.evaluations += found.evaluations
         return found.kp, found.kd
@@ -268,7 +286,7 @@ def gain_searched_design(model: Model, eccentricity: float, lordosis: float, pcs
         nan = np.full(n, np.nan)
         return GainSearchedDesign(np.nan, nan, nan, nan, np.nan, np.nan, 0, 0, "none: the rule has no design")
     chain = _Chain(model, float(eccentricity), float(lordosis), pcsa, rule.least_static)
-    kp0, kd0 = chain.loop(0.0)[2:]  # the rule's gains before the hand-over: its shape, at other strengths
+    kp0, kd0 = chain.gains(0.0)  # the rule's gains before the hand-over: its shape, at other strengths
     shapes = [(a * kp0, b * kd0) for a in SHAPE_FACTORS for b in SHAPE_FACTORS]
     best = (rule.fraction, rule.kp, rule.kd, rule.delay_margin, rule.max_root_real)
     lo, hi = 0.0, rule.fraction
@@ -331,11 +349,14 @@ def answer(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None,
     optimum = np.asarray(solve_point(at, e, lam).pcsa, float)
     pcsa = at.reflex.activation * optimum
     rule = result.chain
-    gains = _Chain(at, e, lam, pcsa, rule.least_static).loop(rule.fraction, kp, kd)[2:] if np.isfinite(
-        rule.fraction
-    ) else (np.full(len(rule.least_static), np.nan),) * 2
+    n = len(rule.least_static)
+    kp_used, kd_used = (
+        _Chain(at, e, lam, pcsa, rule.least_static).gains(rule.fraction, kp, kd)
+        if np.isfinite(rule.fraction)
+        else (np.full(n, np.nan), np.full(n, np.nan))
+    )
     label = RULE_REFLEX if at.reflex.gains == "rule" and kp is None and kd is None else GIVEN_REFLEX
-    rule = replace(rule, pcsa=float(np.sum(pcsa)), kp=np.asarray(gains[0]), kd=np.asarray(gains[1]), reflex=label)
+    rule = replace(rule, pcsa=float(np.sum(pcsa)), kp=np.asarray(kp_used), kd=np.asarray(kd_used), reflex=label)
     cost = None
     if ratio == 1.0 and np.all(np.isfinite(pcsa)) and COST_RATIO * nominal <= _max_delay():
         longer = config.set_parameters(model, {"reflex.delay": COST_RATIO * nominal})

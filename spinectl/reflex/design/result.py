@@ -196,20 +196,24 @@ class Design:
             (:meth:`ChainDesign.to_dict`).
         """
         model = {k: v for k, v in self.model.items() if k != "header"}
-        return model | {
-            "E_m": self.eccentricity,
-            "Lambda_m": self.lordosis,
-            "delay_s": self.delay,
-            "activation_time_constant_s": self.activation_time_constant,
-            "status": self.status,
-            "criterion": criterion("joint", len(self.segments)),
-            "activation": self.activation,
-            "pcsa_cm2": float(m2_to_cm2(self.pcsa)),
-            "method": self.method,
-            "largest_delay_met_s": self.largest_delay,
-            "segments": [s.to_dict() for s in self.segments],
-            "chain": self.chain.to_dict(),
-        } | self._robustness()
+        return (
+            model
+            | {
+                "E_m": self.eccentricity,
+                "Lambda_m": self.lordosis,
+                "delay_s": self.delay,
+                "activation_time_constant_s": self.activation_time_constant,
+                "status": self.status,
+                "criterion": criterion("joint", len(self.segments)),
+                "activation": self.activation,
+                "pcsa_cm2": float(m2_to_cm2(self.pcsa)),
+                "method": self.method,
+                "largest_delay_met_s": self.largest_delay,
+                "segments": [s.to_dict() for s in self.segments],
+                "chain": self.chain.to_dict(),
+            }
+            | self._robustness()
+        )
 
     def _robustness(self) -> dict:
         """The margin ratio, the cost of the default one and the searched answer, where computed."""
@@ -274,11 +278,12 @@ class Design:
         c, names = self.chain, [s.name for s in self.segments]
         if not c.reflex:
             return []
-        lines = [f"  reflex assumed: {c.reflex}; global PCSA {m2_to_cm2(c.pcsa):.2f} cm^2 "
-                 f"(activation {c.activation:.4g} x the minimum stabilising PCSA at this K, which shrinks as K grows)"]
+        lines = [
+            f"  reflex assumed: {c.reflex}; global PCSA {m2_to_cm2(c.pcsa):.2f} cm^2 "
+            f"(activation {c.activation:.4g} x the minimum stabilising PCSA at this K, which shrinks as K grows)"
+        ]
         if c.kp is not None and np.all(np.isfinite(c.kp)):
-            lines.append("  gains: " + ", ".join(
-                f"{n} kp {p:.1f} kd {d:.2f}" for n, p, d in zip(names, c.kp, c.kd, strict=True)))
+            lines.append("  gains: " + gains_text(names, c.kp, c.kd))
         if np.isfinite(c.fraction):
             lines.append(self._boundary_line())
         if self.searched is not None:
@@ -289,14 +294,18 @@ class Design:
         """The least value is a stability boundary; what a margin costs."""
         c = self.chain
         if self.margin_ratio != 1.0:
-            return (f"  robust: designed at {self.margin_ratio:g} x the delay {delay_text(self.nominal_delay)}, so "
-                    f"it holds every delay up to {delay_text(self.delay)} (--margin {self.margin_ratio:g})")
+            return (
+                f"  robust: designed at {self.margin_ratio:g} x the delay {delay_text(self.nominal_delay)}, so "
+                f"it holds every delay up to {delay_text(self.delay)} (--margin {self.margin_ratio:g})"
+            )
         text = "  boundary: the least value sits on its stability boundary (margin = the delay)"
         cost = self.margin_cost
         if cost is not None and np.isfinite(cost.fraction):
             more = np.sum(cost.local_stiffness) - np.sum(c.local_stiffness)
-            text += (f"; a margin of {cost.ratio:g} x the delay needs {np.sum(cost.local_stiffness):.1f} N m/rad "
-                     f"({cost.fraction:.4f} x k*, {more:+.1f}; --margin R)")
+            text += (
+                f"; a margin of {cost.ratio:g} x the delay needs {np.sum(cost.local_stiffness):.1f} N m/rad "
+                f"({cost.fraction:.4f} x k*, {more:+.1f}; --margin R)"
+            )
         elif cost is not None:
             text += f"; no local stiffness holds {cost.ratio:g} x the delay"
         return text
@@ -306,6 +315,11 @@ class Design:
             "the truth value of a Design is ambiguous: use design.status == 'ok' (both criteria met), or "
             "design.activation / design.chain.fraction (NaN where none meets the delay)"
         )
+
+
+def gains_text(names, kp, kd) -> str:
+    """Each joint's diagonal gains as text: ``L1L2 kp 30.0 kd 2.16, ...`` ([N m/rad], [N m s/rad])."""
+    return ", ".join(f"{n} kp {p:.1f} kd {d:.2f}" for n, p, d in zip(names, kp, kd, strict=True))
 
 
 def _word(value: float, width: int, fmt: str) -> str:
