@@ -8,10 +8,12 @@ import numpy as np
 import pytest
 
 from spinectl.model import chain, config
+from spinectl.model.checks import checked_coefficients
 from spinectl.optimise.reference import solve_point
 from spinectl.reflex import design as dz
 from spinectl.reflex import gains
 from spinectl.reflex.chain_margins import stable_at
+from spinectl.reflex.delay import delay_margin
 from spinectl.reflex.design.roots import SPECTRAL_NODES, rightmost_root
 from spinectl.reflex.mimo import chain_delay_margin
 
@@ -134,3 +136,40 @@ def test_the_printed_global_pcsa_is_the_activation_times_the_minimum_pcsa_at_K(K
     mass, _, _, kp0, kd0 = _chain_at(model, result.chain.fraction)
     np.testing.assert_allclose(result.chain.kp, (1 - result.chain.fraction) * kp0, rtol=1e-12)
     np.testing.assert_allclose(result.chain.kd, (1 - result.chain.fraction) * kd0, rtol=1e-12)
+
+
+def test_the_issues_l1l2_claim_with_the_segments_exact_margin():
+    """The issue's joint-by-joint claim, recomputed: at 120 ms (``wagner2012``, (3, 4) cm) L1L2 at 0.6 of its rule
+    co-contraction, with the rule's k_p and k_d = 8 instead of the rule's 3.9 N m s/rad, has the exact margin 128.0 ms
+    (spinectl.reflex.delay.delay_margin with the lag) where the rule's gains hold 92.3 ms."""
+    model = _model(0.12)
+    result = dz.design(model, *AT)
+    coefficients = checked_coefficients(model, *AT)
+    pcsa = 0.6 * result.segments[0].activation * np.asarray(solve_point(model, *AT).pcsa, float)
+    s, d, theta = coefficients.stiffness(pcsa)[0], coefficients.damping(pcsa)[0], coefficients.inertia[0]
+    kp, kd = (float(x[0]) for x in gains.resolve_gains([s], [d], [theta], model.reflex))
+    assert kd == pytest.approx(3.91, abs=0.01)
+    margins = delay_margin([s, s], [d, d], [theta, theta], [kp, kp], [kd, 8.0], 0.05).margin
+    np.testing.assert_allclose(margins, [0.0923, 0.1280], atol=2e-4)
+
+
+@pytest.mark.parametrize(("delay", "extra"), [(0.12, {}), (0.07, {"body.mass": 35.0, "passive.stiffness": 10.0})])
+def test_joint_by_joint_over_every_gain_is_certified_and_below_the_rule(delay, extra):
+    """Each segment at the common activation the grid certified, with its reported gains: the exact margin (recomputed
+    by delay_margin) meets the delay and the rightmost root of theta s^2 - D s - S + (kp + kd s) e^{-s tau} / (T_a s
+    + 1) at the delay lies on the left; the activation is at most the rule's, and strictly below it at 120 ms
+    (the issue's case: 0.0288 against 0.3783) and for the subject at 70 ms (a variant)."""
+    model = _model(delay, **extra)
+    result = dz.answer(model, *AT)
+    j = result.joint_searched
+    assert j.activation < result.activation and np.all(j.segment_activation <= j.activation + 1e-12)
+    coefficients = checked_coefficients(model, *AT)
+    pcsa = j.activation * np.asarray(solve_point(model, *AT).pcsa, float)
+    s, d, theta = coefficients.stiffness(pcsa), coefficients.damping(pcsa), coefficients.inertia
+    margins = np.asarray(delay_margin(s, d, theta, j.kp, j.kd, 0.05).margin)
+    assert np.all(margins >= delay) and margins == pytest.approx(j.delay_margin)
+    for k in range(len(s)):
+        root = rightmost_root([[theta[k]]], [[s[k]]], [[d[k]]], [j.kp[k]], [j.kd[k]], delay, 0.05, SPECTRAL_NODES)
+        assert root.real < 0
+    assert "any PD gains per segment, searched on a grid" in result.table()
+    assert result.to_dict()["joint_gain_searched"]["activation"] == j.activation

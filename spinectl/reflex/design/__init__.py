@@ -24,6 +24,7 @@ from .gain_searched import (
     gain_searched_design,
 )
 from .joint import BISECTIONS, SCAN, joint_design, least_activations, scan_margins, segment_margins_at
+from .joint_searched import JointSearchedDesign, joint_searched_design
 from .passive import (
     CRISCO_LOAD,
     PAPER_PASSIVE,
@@ -55,6 +56,7 @@ __all__ = [
     "Design",
     "DesignCurve",
     "GainSearchedDesign",
+    "JointSearchedDesign",
     "MarginCost",
     "PassiveCurve",
     "SegmentDesign",
@@ -68,6 +70,7 @@ __all__ = [
     "design",
     "gain_searched_design",
     "joint_design",
+    "joint_searched_design",
     "least_activations",
     "passive_chain_model",
     "passive_curve",

@@ -21,7 +21,8 @@ with :data:`SEARCH_BUDGET`, seeded (:data:`SEARCH_SEED`), so the answer is repro
 :func:`answer` is ``spinectl design``: the rule's design (:func:`~spinectl.reflex.design.curve.design`) at
 the delay times a margin ratio R (a design at R tau holds for every delay up to R tau: its exact margin is
 the first critical delay), with the global PCSA and the gains it used, the cost of the modest ratio
-:data:`COST_RATIO` beside it, and the searched answer on request.
+:data:`COST_RATIO` beside it, joint by joint the answer over every segment's gains
+(:mod:`~spinectl.reflex.design.joint_searched`, milliseconds) and the chain's searched answer on request.
 """
 
 from __future__ import annotations
@@ -40,6 +41,7 @@ from ..delay import delay_text
 from ..gain_search import search_chain_gains
 from ..mimo import chain_delay_margin
 from .chain import chain_design
+from .joint_searched import joint_searched_design
 from .result import gains_text
 from .roots import SPECTRAL_NODES, rightmost_root
 
@@ -332,7 +334,7 @@ def answer(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None,
     -------
     Design
         With ``margin_ratio``, ``nominal_delay``, ``margin_cost`` (at :data:`COST_RATIO` where R = 1),
-        ``searched`` and the chain's ``pcsa``, ``kp``, ``kd`` and ``reflex``.
+        ``searched``, ``joint_searched`` and the chain's ``pcsa``, ``kp``, ``kd`` and ``reflex``.
 
     Raises
     ------
@@ -363,9 +365,11 @@ def answer(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None,
         c = chain_design(longer, e, lam, pcsa, at.reflex.activation, kp, kd)
         cost = MarginCost(COST_RATIO, c.fraction, c.local_stiffness)
     searched = gain_searched_design(at, e, lam, pcsa, rule) if search and np.all(np.isfinite(pcsa)) else None
+    joint = joint_searched_design(at, e, lam, result, kp, kd)  # milliseconds: always beside the rule's
     return replace(
-        result, chain=rule, margin_ratio=float(ratio), nominal_delay=nominal, margin_cost=cost, searched=searched
-    )
+        result, chain=rule, margin_ratio=float(ratio), nominal_delay=nominal, margin_cost=cost, searched=searched,
+        joint_searched=joint,
+    )  # fmt: skip
 
 
 def _max_delay() -> float:

@@ -183,6 +183,7 @@ class Design:
     nominal_delay: float = float("nan")
     margin_cost: object = None
     searched: object = None
+    joint_searched: object = None
 
     def to_dict(self) -> dict:
         """The document of ``spinectl design --json``.
@@ -224,6 +225,8 @@ class Design:
             out["margin_cost"] = self.margin_cost.to_dict()
         if self.searched is not None:
             out["chain_gain_searched"] = self.searched.to_dict()
+        if self.joint_searched is not None:
+            out["joint_gain_searched"] = self.joint_searched.to_dict()
         return out
 
     def table(self) -> str:
@@ -257,6 +260,7 @@ class Design:
                 else f"no activation in [0, 1] meets the delay at every segment; the largest delay met: "
                 f"{delay_text(self.largest_delay)}"
             ),
+            *self._joint_lines(),
             "",
             f"{criterion('chain', len(c.local_stiffness))}: least local stiffness at activation "
             f"{_word(c.activation, 0, '.4f')} ({c.method})",
@@ -272,6 +276,12 @@ class Design:
         else:
             lines.append(f"no local stiffness meets the delay; the largest delay met: {delay_text(c.largest_delay)}")
         return "\n".join(lines + self._chain_lines())
+
+    def _joint_lines(self) -> list[str]:
+        """Joint by joint: the reflex the answer assumes, and the answer over every segment's gains."""
+        if self.joint_searched is None:
+            return []
+        return ["  reflex assumed: the reflex rule at each activation", *self.joint_searched.lines(self.activation)]
 
     def _chain_lines(self) -> list[str]:
         """The reflex the chain's answer assumes, its PCSA and gains, the margin it has and the searched answer."""
