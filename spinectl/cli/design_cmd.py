@@ -52,6 +52,20 @@ def register(sub) -> None:
     parser.add_argument("--kp", type=finite_float("--kp"), help="proportional gain [N m/rad] (default: the rule)")
     parser.add_argument("--kd", type=finite_float("--kd"), help="derivative gain [N m s/rad] (default: the rule)")
     parser.add_argument(
+        "--gains",
+        choices=("rule", "search"),
+        help="the chain's reflex: rule (default) answers for the rule's gains handed over to the local muscles; "
+        "search also answers over every diagonal PD reflex, a seeded gain search certified by the exact margin "
+        "and the rightmost root (tens of seconds)",
+    )
+    parser.add_argument(
+        "--margin",
+        type=finite_float("--margin"),
+        metavar="R",
+        help="a delay-margin ratio R >= 1: the design holds every delay up to R x the delay (the design at R x "
+        "the delay); default 1, with the cost of 1.1 shown",
+    )
+    parser.add_argument(
         "--passive",
         metavar="START:STOP:NUM",
         help="instead: the chain's least global PCSA alone and least local stiffness against the passive "
@@ -82,8 +96,11 @@ PASSIVE_EXAMPLE = "in N m/rad, e.g. 0:80:41"
 DELAYS_EXAMPLE = "in seconds, e.g. 0:0.2:41"
 """The forms of ``--passive`` and ``--delays``, for a malformed one."""
 
-STATIC_ONLY = ("--delay", "--activation-lag", "--activation", "--kp", "--kd")
+STATIC_ONLY = ("--delay", "--activation-lag", "--activation", "--kp", "--kd", "--gains", "--margin")
 """The reflex's options, which ``--passive`` does not use: refused with it rather than ignored."""
+
+ONE_DELAY_ONLY = ("--gains", "--margin")
+"""Options of the one-delay design, refused with ``--delays`` rather than ignored."""
 
 OVERRIDES = (
     ("delay", "reflex.delay"),
@@ -106,10 +123,13 @@ def run(args) -> int:
     int
         Exit code 0 (also for a delay no design meets: status 'infeasible').
     """
-    from .._validate import non_negative
+    from math import inf
+
+    from .._validate import in_range, non_negative
     from ..errors import ParameterError
     from ..model import clinical
-    from ..reflex.design import design
+    from ..model.params import MAX_DELAY
+    from ..reflex.design import answer
 
     aliases = {dotted: ("--" + option.replace("_", "-"), getattr(args, option)) for option, dotted in OVERRIDES}
     aliases |= body_aliases(args)  # --K and --mass, as on stability and margins
@@ -133,11 +153,16 @@ def run(args) -> int:
         raise ParameterError("--lags", "needs --delays")
     if args.passive is not None and args.delays is not None:
         raise ParameterError("--passive", "cannot go with --delays (one curve at a time)")
+    for option in ONE_DELAY_ONLY if args.delays is not None else ():
+        if getattr(args, option.lstrip("-")) is not None:
+            raise ParameterError(option, "needs the one-delay design (--delay), not --delays")
     if args.passive is not None:
         return _passive(model, args)
     if args.delays is not None:
         return _delays(model, args, kp, kd)
-    result = design(model, args.E, args.Lambda, kp=kp, kd=kd)
+    delay = model.reflex.delay
+    ratio = 1.0 if args.margin is None else in_range("--margin", args.margin, 1.0, MAX_DELAY / delay if delay else inf)
+    result = answer(model, args.E, args.Lambda, kp=kp, kd=kd, search=args.gains == "search", ratio=ratio)
     if args.json:
         emit_json(clinical.with_lordosis_angle(result.to_dict(), model))
     else:

@@ -10,7 +10,7 @@ from spinectl import jsondoc
 from spinectl.cli import main
 from spinectl.model import config
 from spinectl.model.clinical import with_lordosis_angle
-from spinectl.reflex.design import design
+from spinectl.reflex.design import answer, design
 
 KEYS = ("activation", "segments", "chain", "delay_s", "activation_time_constant_s", "status")
 
@@ -23,11 +23,13 @@ def test_json_is_the_designs_dict_with_the_keys_for_scripts(capsys):
     assert main(argv) == 0
     out = capsys.readouterr().out
     model = config.set_parameters(config.load_preset("wagner2012"), {"reflex.delay": 0.04})
-    assert out == jsondoc.dumps(with_lordosis_angle(design(model, 0.03, 0.04).to_dict(), model))
+    assert out == jsondoc.dumps(with_lordosis_angle(answer(model, 0.03, 0.04).to_dict(), model))
     doc = json.loads(out, parse_constant=lambda word: pytest.fail(f"{word} in strict JSON"))
     assert all(key in doc for key in KEYS) and doc["delay_s"] == 0.04
     assert all({"name", "activation", "pcsa_cm2", "delay_margin_s"} <= set(s) for s in doc["segments"])
     assert {"local_stiffness_Nm_per_rad", "activation", "delay_margin_s", "max_root_real_per_s"} <= set(doc["chain"])
+    assert {"reflex", "global_pcsa_cm2", "kp_Nm_per_rad", "kd_Nms_per_rad"} <= set(doc["chain"])
+    assert doc["margin_ratio"] == 1.0 and doc["margin_cost"]["margin_ratio"] == 1.1
     assert doc["criterion"].startswith("joint by joint") and doc["chain"]["criterion"].startswith("chain")
 
 
@@ -224,3 +226,43 @@ def test_passive_refuses_the_reflexs_options_it_would_ignore(option, value, caps
     reflex option beside it was ignored without a word (before: --delay 0.1 ran and said nothing of it)."""
     message = _refusal(["design", "--passive", "0:80:3", "--E", "0.03", option, value], capsys)
     assert message.startswith("cannot go with --passive, whose answers are static")
+
+
+@pytest.mark.parametrize(
+    ("argv", "needle"),
+    [
+        (["--margin", "0.9"], "--margin: must be in [1, "),
+        (["--margin", "200"], "--margin: must be in [1, 100]"),  # 200 x 0.1 s is beyond the delay's 10 s
+        (["--delays", "0:0.1:3", "--margin", "1.1"], "--margin: needs the one-delay design (--delay), not --delays"),
+        (["--delays", "0:0.1:3", "--gains", "search"], "--gains: needs the one-delay design"),
+        (["--passive", "0:80:3", "--gains", "search"], "--gains: cannot go with --passive"),
+        (["--passive", "0:80:3", "--margin", "1.2"], "--margin: cannot go with --passive"),
+    ],
+)
+def test_a_margin_or_a_gain_search_where_it_does_not_apply_is_one_line_exit_2(argv, needle, capsys):
+    """--margin R below 1 (a design for shorter delays than asked), or R x the delay beyond 10 s, and --gains or
+    --margin beside --delays or --passive (which would ignore them) are refused: one line, exit 2, no output."""
+    assert (
+        main(
+            ["design", "--preset", "wagner2012", "--delay", "0.1", *argv]
+            if "--passive" not in argv
+            else ["design", "--preset", "wagner2012", *argv]
+        )
+        == 2
+    )
+    out, err = capsys.readouterr()
+    assert out == "" and err.count("\n") == 1 and needle in err
+
+
+def test_margin_prints_the_design_at_r_times_the_delay(capsys):
+    """``--delay 0.1 --margin 1.2`` prints the design of ``--delay 0.12`` (the same local stiffness), saying it holds
+    every delay up to 120 ms."""
+    point = ["design", "--preset", "wagner2012", "--E", "0.03", "--Lambda", "0.04"]
+    assert main([*point, "--delay", "0.1", "--margin", "1.2", "--json"]) == 0
+    robust = json.loads(capsys.readouterr().out)
+    assert main([*point, "--delay", "0.12", "--json"]) == 0
+    direct = json.loads(capsys.readouterr().out)
+    assert robust["chain"]["local_stiffness_Nm_per_rad"] == direct["chain"]["local_stiffness_Nm_per_rad"]
+    assert robust["margin_ratio"] == 1.2 and robust["nominal_delay_s"] == 0.1
+    assert main([*point, "--delay", "0.1", "--margin", "1.2"]) == 0
+    assert "holds every delay up to 120 ms" in capsys.readouterr().out

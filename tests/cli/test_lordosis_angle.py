@@ -85,7 +85,7 @@ def _recorder(seen: dict, stop: bool):
     [
         (["margins"], "spinectl.reflex.chain_verdict", "margins_with_chain"),
         (["margins", "--coupled"], "spinectl.reflex.chain_margins", "coupled_margins"),
-        (["design"], "spinectl.reflex.design", "design"),
+        (["design"], "spinectl.reflex.design", "answer"),
     ],
 )
 def test_reflex_commands_pass_the_angle_as_its_lambda(command, module, name, monkeypatch, capsys):

@@ -83,6 +83,13 @@ class ChainDesign:
         there (with the design's own); inf (JSON null, "unbounded") when one is stable at every delay, e.g. the
         rule's f = 1, which has no reflex. The same meaning as :attr:`Design.largest_delay` joint by joint.
     method : str
+    pcsa : float
+        The global PCSA the chain used [m^2]: ``activation`` times the minimum stabilising PCSA at this
+        (E, Lambda, K); NaN if not recorded.
+    kp, kd : numpy.ndarray or None, shape (n_cor,)
+        The reflex gains at the design [N m/rad], [N m s/rad]; None if not recorded.
+    reflex : str
+        The reflex the answer assumes (:data:`~spinectl.reflex.design.gain_searched.RULE_REFLEX`); '' if not recorded.
     """
 
     activation: float
@@ -93,6 +100,10 @@ class ChainDesign:
     max_root_real: float
     largest_delay: float
     method: str
+    pcsa: float = float("nan")
+    kp: np.ndarray | None = None
+    kd: np.ndarray | None = None
+    reflex: str = ""
 
     def to_dict(self) -> dict:
         """``criterion``, ``activation``, ``local_stiffness_fraction``, ``local_stiffness_Nm_per_rad``, ....
@@ -113,6 +124,17 @@ class ChainDesign:
             "max_root_real_per_s": self.max_root_real,
             "largest_delay_met_s": self.largest_delay,
             "method": self.method,
+        } | self._used()
+
+    def _used(self) -> dict:
+        """The reflex assumed, the global PCSA and the gains, where recorded."""
+        if not self.reflex:
+            return {}
+        return {
+            "reflex": self.reflex,
+            "global_pcsa_cm2": float(m2_to_cm2(self.pcsa)),
+            "kp_Nm_per_rad": None if self.kp is None else self.kp.tolist(),
+            "kd_Nms_per_rad": None if self.kd is None else self.kd.tolist(),
         }
 
 
@@ -157,6 +179,11 @@ class Design:
     largest_delay: float
     method: str
     model: dict
+    margin_ratio: float = 1.0
+    nominal_delay: float = float("nan")
+    margin_cost: object = None
+    searched: object = None
+    joint_searched: object = None
 
     def to_dict(self) -> dict:
         """The document of ``spinectl design --json``.
@@ -170,20 +197,37 @@ class Design:
             (:meth:`ChainDesign.to_dict`).
         """
         model = {k: v for k, v in self.model.items() if k != "header"}
-        return model | {
-            "E_m": self.eccentricity,
-            "Lambda_m": self.lordosis,
-            "delay_s": self.delay,
-            "activation_time_constant_s": self.activation_time_constant,
-            "status": self.status,
-            "criterion": criterion("joint", len(self.segments)),
-            "activation": self.activation,
-            "pcsa_cm2": float(m2_to_cm2(self.pcsa)),
-            "method": self.method,
-            "largest_delay_met_s": self.largest_delay,
-            "segments": [s.to_dict() for s in self.segments],
-            "chain": self.chain.to_dict(),
-        }
+        return (
+            model
+            | {
+                "E_m": self.eccentricity,
+                "Lambda_m": self.lordosis,
+                "delay_s": self.delay,
+                "activation_time_constant_s": self.activation_time_constant,
+                "status": self.status,
+                "criterion": criterion("joint", len(self.segments)),
+                "activation": self.activation,
+                "pcsa_cm2": float(m2_to_cm2(self.pcsa)),
+                "method": self.method,
+                "largest_delay_met_s": self.largest_delay,
+                "segments": [s.to_dict() for s in self.segments],
+                "chain": self.chain.to_dict(),
+            }
+            | self._robustness()
+        )
+
+    def _robustness(self) -> dict:
+        """The margin ratio, the cost of the default one and the searched answer, where computed."""
+        out = {}
+        if np.isfinite(self.nominal_delay):
+            out |= {"margin_ratio": self.margin_ratio, "nominal_delay_s": self.nominal_delay}
+        if self.margin_cost is not None:
+            out["margin_cost"] = self.margin_cost.to_dict()
+        if self.searched is not None:
+            out["chain_gain_searched"] = self.searched.to_dict()
+        if self.joint_searched is not None:
+            out["joint_gain_searched"] = self.joint_searched.to_dict()
+        return out
 
     def table(self) -> str:
         """The design as readable text: both criteria, each with its answer and certificate.
@@ -216,6 +260,7 @@ class Design:
                 else f"no activation in [0, 1] meets the delay at every segment; the largest delay met: "
                 f"{delay_text(self.largest_delay)}"
             ),
+            *self._joint_lines(),
             "",
             f"{criterion('chain', len(c.local_stiffness))}: least local stiffness at activation "
             f"{_word(c.activation, 0, '.4f')} ({c.method})",
@@ -230,13 +275,61 @@ class Design:
             ]
         else:
             lines.append(f"no local stiffness meets the delay; the largest delay met: {delay_text(c.largest_delay)}")
-        return "\n".join(lines)
+        return "\n".join(lines + self._chain_lines())
+
+    def _joint_lines(self) -> list[str]:
+        """Joint by joint: the reflex the answer assumes, and the answer over every segment's gains."""
+        if self.joint_searched is None:
+            return []
+        return ["  reflex assumed: the reflex rule at each activation", *self.joint_searched.lines(self.activation)]
+
+    def _chain_lines(self) -> list[str]:
+        """The reflex the chain's answer assumes, its PCSA and gains, the margin it has and the searched answer."""
+        c, names = self.chain, [s.name for s in self.segments]
+        if not c.reflex:
+            return []
+        lines = [
+            f"  reflex assumed: {c.reflex}; global PCSA {m2_to_cm2(c.pcsa):.2f} cm^2 "
+            f"(activation {c.activation:.4g} x the minimum stabilising PCSA at this K, which shrinks as K grows)"
+        ]
+        if c.kp is not None and np.all(np.isfinite(c.kp)):
+            lines.append("  gains: " + gains_text(names, c.kp, c.kd))
+        if np.isfinite(c.fraction):
+            lines.append(self._boundary_line())
+        if self.searched is not None:
+            lines += self.searched.lines(names, c.fraction, c.least_static)
+        return lines
+
+    def _boundary_line(self) -> str:
+        """The least value is a stability boundary; what a margin costs."""
+        c = self.chain
+        if self.margin_ratio != 1.0:
+            return (
+                f"  robust: designed at {self.margin_ratio:g} x the delay {delay_text(self.nominal_delay)}, so "
+                f"it holds every delay up to {delay_text(self.delay)} (--margin {self.margin_ratio:g})"
+            )
+        text = "  boundary: the least value sits on its stability boundary (margin = the delay)"
+        cost = self.margin_cost
+        if cost is not None and np.isfinite(cost.fraction):
+            more = np.sum(cost.local_stiffness) - np.sum(c.local_stiffness)
+            text += (
+                f"; a margin of {cost.ratio:g} x the delay needs {np.sum(cost.local_stiffness):.1f} N m/rad "
+                f"({cost.fraction:.4f} x k*, {more:+.1f}; --margin R)"
+            )
+        elif cost is not None:
+            text += f"; no local stiffness holds {cost.ratio:g} x the delay"
+        return text
 
     def __bool__(self):
         raise TypeError(
             "the truth value of a Design is ambiguous: use design.status == 'ok' (both criteria met), or "
             "design.activation / design.chain.fraction (NaN where none meets the delay)"
         )
+
+
+def gains_text(names, kp, kd) -> str:
+    """Each joint's diagonal gains as text: ``L1L2 kp 30.0 kd 2.16, ...`` ([N m/rad], [N m s/rad])."""
+    return ", ".join(f"{n} kp {p:.1f} kd {d:.2f}" for n, p, d in zip(names, kp, kd, strict=True))
 
 
 def _word(value: float, width: int, fmt: str) -> str:

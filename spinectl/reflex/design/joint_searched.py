@@ -1,0 +1,213 @@
+"""Joint by joint over every PD reflex: each segment's least co-contraction when its (k_p, k_d) are free.
+
+The joint-by-joint design (:mod:`~spinectl.reflex.design.joint`) answers for the reflex rule at each
+activation. Here each segment's gains are searched instead: at an activation a, the segment's exact delay
+margin with the lag (:func:`spinectl.reflex.delay.delay_margin`, vectorised) over a log grid of
+:data:`GRID` x :data:`GRID` gains, :data:`DECADES` decades each side of the rule's (or of the segment's own
+scale where the rule gives none), with the rule's gains and none at all; the best is accepted only with the
+certificate of the chain's design, its margin at least the delay and the rightmost root of the segment's
+characteristic equation at the delay (:func:`~spinectl.reflex.design.roots.rightmost_root` on the 1 x 1
+chain, Chebyshev seeds) on the left. Each segment's activation is bisected in [0, a_rule] (its rule's
+answer, a candidate with the rule's gains, so never above it) in :data:`HALVINGS` halvings; the common
+activation is the largest of them, certified again at every segment. As for the chain, whether the least
+activation is monotone for some gains is not known, so the answer is the least certified, not a proof.
+A grid of the segment's two gains costs milliseconds, so the whole answer does too.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...model.checks import arithmetic_guard, checked_coefficients
+from ...model.params import Model
+from ...optimise.reference import solve_point
+from .. import gains
+from ..delay import delay_margin
+from .result import gains_text
+from .roots import SPECTRAL_NODES, rightmost_root
+
+GRID = 61
+"""Gains per axis of each segment's grid (k_p and k_d): 3,721 exact margins in one vectorised call."""
+
+DECADES = 1.5
+"""Half-width of the grid in decades of each gain around its centre."""
+
+HALVINGS = 20
+"""Halvings of [0, a_rule] per segment: the answer to 1e-6 of a_rule above the least certified."""
+
+SEARCHED_JOINT_REFLEX = "any PD gains per segment, searched on a grid"
+"""The reflex the joint-by-joint searched answer assumes."""
+
+
+@dataclass(frozen=True)
+class JointSearchedDesign:
+    """Joint by joint, the least co-contraction the gain grid certified, every segment's gains free.
+
+    Attributes
+    ----------
+    activation : float
+        The least common activation certified [1] (at most the rule's); NaN if the rule has none.
+    pcsa : float
+        The total PCSA there [m^2].
+    names : tuple of str
+    segment_activation : numpy.ndarray, shape (n_cor,)
+        Each segment's own least activation certified [1].
+    kp, kd : numpy.ndarray, shape (n_cor,)
+        Each segment's certified gains at the common activation [N m/rad], [N m s/rad].
+    delay_margin : numpy.ndarray, shape (n_cor,)
+        Their exact margins there [s].
+    max_root_real : numpy.ndarray, shape (n_cor,)
+        Re of each segment's rightmost root at the delay [1/s].
+    """
+
+    activation: float
+    pcsa: float
+    names: tuple
+    segment_activation: np.ndarray
+    kp: np.ndarray
+    kd: np.ndarray
+    delay_margin: np.ndarray
+    max_root_real: np.ndarray
+
+    def to_dict(self) -> dict:
+        """``reflex``, ``activation``, ``pcsa_cm2``, ``segments`` (name, activation, gains, margin, root), ``grid``.
+
+        Returns
+        -------
+        dict
+        """
+        segments = [
+            {
+                "name": n,
+                "activation": float(self.segment_activation[k]),
+                "kp_Nm_per_rad": float(self.kp[k]),
+                "kd_Nms_per_rad": float(self.kd[k]),
+                "delay_margin_s": float(self.delay_margin[k]),
+                "max_root_real_per_s": float(self.max_root_real[k]),
+            }
+            for k, n in enumerate(self.names)
+        ]
+        return {
+            "reflex": SEARCHED_JOINT_REFLEX,
+            "activation": self.activation,
+            "pcsa_cm2": 1e4 * self.pcsa,
+            "segments": segments,
+            "grid": {"gains_per_axis": GRID, "decades_each_side": DECADES, "halvings": HALVINGS},
+        }
+
+    def lines(self, rule_activation: float) -> list[str]:
+        """The table's lines, beside the rule's common activation.
+
+        Returns
+        -------
+        list of str
+        """
+        if not np.isfinite(self.activation):
+            return [f"over {SEARCHED_JOINT_REFLEX}: none (the rule has no design to start from)"]
+        less = 100 * (1 - self.activation / rule_activation) if rule_activation > 0 else 0.0
+        return [
+            f"over {SEARCHED_JOINT_REFLEX}: activation {self.activation:.4f} x minimum PCSA "
+            f"({1e4 * self.pcsa:.2f} cm^2; the rule's {rule_activation:.4f}, {less:.0f} % less)",
+            "  each segment's own: "
+            + ", ".join(f"{n} {a:.4f}" for n, a in zip(self.names, self.segment_activation, strict=True)),
+            "  gains there: " + gains_text(self.names, self.kp, self.kd),
+            "  certificate: exact margins "
+            + ", ".join(f"{1000 * m:.1f}" for m in self.delay_margin)
+            + f" ms; rightmost roots Re s <= {np.max(self.max_root_real):.4g} 1/s "
+            f"(grid {GRID} x {GRID} gains, {DECADES:g} decades each side, {HALVINGS} halvings)",
+        ]
+
+
+class _Segments:
+    """The segments at the position: each one's loop at an activation, its best gains and their certificate."""
+
+    def __init__(self, model: Model, e: float, lam: float, kp=None, kd=None):
+        self.model, self.kp, self.kd = model, kp, kd
+        self.coefficients = checked_coefficients(model, e, lam)
+        self.optimum = np.asarray(solve_point(model, e, lam).pcsa, float)
+        self.delay, self.lag = model.reflex.delay, model.reflex.activation_time_constant
+        steps = 10.0 ** np.linspace(-DECADES, DECADES, GRID)
+        self.p_steps, self.d_steps = (x.ravel() for x in np.meshgrid(steps, steps))
+
+    def plant(self, k: int, a: float):
+        """(S, D, theta) of segment k at activation a."""
+        p = a * self.optimum
+        return self.coefficients.stiffness(p)[k], self.coefficients.damping(p)[k], self.coefficients.inertia[k]
+
+    def best(self, k: int, a: float):
+        """(kp, kd, margin) of the best gains on the grid around the rule's, the rule's and none, at a."""
+        s, d, theta = self.plant(k, a)
+        rule_p, rule_d = (
+            float(x[0]) for x in gains.resolve_gains([s], [d], [theta], self.model.reflex, self.kp, self.kd)
+        )
+        centre_p = max(rule_p, abs(s), 1.0)  # the rule gives no k_p to a self-stable segment: its own scale
+        centre_d = max(rule_d, np.sqrt(theta * centre_p))
+        kps = np.concatenate([centre_p * self.p_steps, [rule_p, 0.0]])
+        kds = np.concatenate([centre_d * self.d_steps, [rule_d, 0.0]])
+        with np.errstate(all="ignore"):
+            margins = np.asarray(delay_margin(s, d, theta, kps, kds, self.lag).margin, float)
+        i = int(np.nanargmax(np.where(np.isnan(margins), -np.inf, margins)))
+        return kps[i], kds[i], float(margins[i])
+
+    def certify(self, k: int, a: float):
+        """(kp, kd, margin, root's Re) if the best gains hold segment k at a at the delay, else None."""
+        kp, kd, margin = self.best(k, a)
+        if not margin >= self.delay:
+            return None
+        s, d, theta = self.plant(k, a)
+        root = rightmost_root([[theta]], [[s]], [[d]], [kp], [kd], self.delay, self.lag, SPECTRAL_NODES)
+        return (kp, kd, margin, float(root.real)) if root.real < 0 else None
+
+    def least(self, k: int, rule: float) -> float:
+        """Segment k's least activation certified in [0, rule] (the rule's answer, itself certified by the rule)."""
+        if self.certify(k, 0.0) is not None:
+            return 0.0
+        lo, hi = 0.0, rule
+        for _ in range(HALVINGS):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (lo, mid) if self.certify(k, mid) is not None else (mid, hi)
+        return hi
+
+
+def joint_searched_design(model: Model, eccentricity: float, lordosis: float, design, kp=None, kd=None):
+    """Joint by joint over every PD reflex per segment: the least co-contraction certified (see the module).
+
+    Parameters
+    ----------
+    model : Model
+        ``model.reflex``: the delay, lag and the rule (or explicit gains) the grid centres on.
+    eccentricity, lordosis : float
+        E and Lambda [m].
+    design : Design
+        The rule's answer at the same delay (:func:`~spinectl.reflex.design.curve.design`): each segment's
+        activation bounds its search.
+    kp, kd : float, optional
+        Explicit gains the grid centres on.
+
+    Returns
+    -------
+    JointSearchedDesign
+    """
+    e, lam = float(eccentricity), float(lordosis)
+    names = tuple(s.name for s in design.segments)
+    rule = np.array([s.activation for s in design.segments], float)
+    n = len(names)
+    if not np.isfinite(design.activation):
+        nan = np.full(n, np.nan)
+        return JointSearchedDesign(np.nan, np.nan, names, nan, nan, nan, nan, nan)
+    segments = _Segments(model, e, lam, kp, kd)
+    with arithmetic_guard(e, lam):
+        own = np.array([segments.least(k, rule[k]) for k in range(n)])
+        common = float(np.max(own))
+        held = [segments.certify(k, common) for k in range(n)]
+        if any(h is None for h in held):  # a segment the grid holds below but not at the common activation
+            common = design.activation
+            held = [segments.certify(k, common) for k in range(n)]
+    if any(h is None for h in held):  # the rule's own gains at its answer are the certificate there
+        nan = np.full(n, np.nan)
+        return JointSearchedDesign(design.activation, design.pcsa, names, rule, nan, nan, nan, nan)
+    kps, kds, margins, roots = (np.array(x, float) for x in zip(*held, strict=True))
+    pcsa = common * float(np.sum(segments.optimum))
+    return JointSearchedDesign(common, pcsa, names, own, kps, kds, margins, roots)

@@ -1,0 +1,176 @@
+"""The design over every diagonal PD reflex (spinectl.reflex.design.gain_searched), its labels and its margin."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from spinectl.model import chain, config
+from spinectl.model.checks import checked_coefficients
+from spinectl.optimise.reference import solve_point
+from spinectl.reflex import design as dz
+from spinectl.reflex import gains
+from spinectl.reflex.chain_margins import stable_at
+from spinectl.reflex.delay import delay_margin
+from spinectl.reflex.design.roots import SPECTRAL_NODES, rightmost_root
+from spinectl.reflex.mimo import chain_delay_margin
+
+AT = (0.03, 0.04)
+"""E = 3 cm, Lambda = 4 cm: the issue's position (``wagner2012``, T_a = 50 ms)."""
+
+DOCS = Path(__file__).resolve().parents[2] / "docs" / "reflex.md"
+
+
+def _model(delay, **extra):
+    return config.set_parameters(config.load_preset("wagner2012"), {"reflex.delay": delay} | extra)
+
+
+def _chain_at(model, fraction):
+    """M, K - f diag(k*), D - c_loc f diag(k*) and the rule's full gains (before the hand-over), recomputed from the
+    model's chain (spinectl.model.chain) and the rule (gains.chain_gains), not from the module under test."""
+    optimum = np.asarray(solve_point(model, *AT).pcsa, float)
+    pcsa = model.reflex.activation * optimum
+    coefficients = chain.chain_coefficients(model, *AT)
+    mass = chain.linear_chain(model, *AT, coefficients).mass_matrix
+    k, d = coefficients.stiffness(pcsa), coefficients.damping(pcsa)
+    least = dz.design(model, *AT).chain.least_static
+    r = model.reflex
+    kp0, kd0 = gains.chain_gains(mass, k, d, least, r.gain_factor, r.damping_ratio)
+    local = fraction * least
+    c_loc = chain.linear_chain(model, *AT, coefficients).local_damping_per_stiffness
+    return mass, k - np.diag(local), d - np.diag(c_loc * local), kp0, kd0
+
+
+@pytest.fixture(scope="module")
+def searched_40ms():
+    """The issue's case: 40 ms, ``wagner2012`` at (3, 4) cm, the gain search on (one run, about a minute)."""
+    return dz.answer(_model(0.04), *AT, search=True)
+
+
+def test_the_issues_40ms_gains_hold_less_stiffness_than_the_rule():
+    """The issue's claim, recomputed with the library's exact margin: at 0.9 of the rule's f (0.5617 x k*) the chain
+    with 0.40 k_p and 0.30 k_d of the rule's gains (before the hand-over) is stable at 40 ms: margin 47.5 ms here
+    (the issue says 42.3 ms), rightmost root -0.15 1/s. So the rule's f is not the least over diagonal gains; with
+    the rule's own hand-over gains, (1 - 0.9 f)+ of them, the same stiffness holds 27.6 ms only."""
+    model = _model(0.04)
+    rule = dz.design(model, *AT).chain.fraction
+    mass, k, d, kp0, kd0 = _chain_at(model, 0.9 * rule)
+    exact = chain_delay_margin(mass, k, d, 0.40 * kp0, 0.30 * kd0, model.reflex.activation_time_constant)
+    assert stable_at(exact, 0.04) and exact.margin == pytest.approx(0.04747, abs=2e-4)
+    root = rightmost_root(mass, k, d, 0.40 * kp0, 0.30 * kd0, 0.04, model.reflex.activation_time_constant, 24)
+    assert root.real < 0
+    scaled = 1 - 0.9 * rule
+    assert chain_delay_margin(mass, k, d, scaled * kp0, scaled * kd0, 0.05).margin == pytest.approx(0.0276, abs=2e-4)
+
+
+def test_the_searched_answer_is_certified_and_below_the_rules(searched_40ms):
+    """At its reported f and gains the library's exact margin meets 40 ms with no crossing below, and the rightmost
+    root (Chebyshev seeds) lies on the left; f is strictly below the rule's (the 0.9 f of the issue holds, so the
+    bisection's fourth step, 0.9 x 0.5617 = 0.5055 or lower, is certified)."""
+    s, rule = searched_40ms.searched, searched_40ms.chain
+    assert s.fraction < rule.fraction and s.fraction <= 0.9 * rule.fraction + 1e-12
+    mass, k, d, _, _ = _chain_at(_model(0.04), s.fraction)
+    np.testing.assert_allclose(s.local_stiffness, s.fraction * rule.least_static)
+    exact = chain_delay_margin(mass, k, d, s.kp, s.kd, 0.05)
+    assert stable_at(exact, 0.04) and exact.margin >= 0.04 and exact.margin == pytest.approx(s.delay_margin)
+    root = rightmost_root(mass, k, d, s.kp, s.kd, 0.04, 0.05, SPECTRAL_NODES)
+    assert root.real < 0 and root.real == pytest.approx(s.max_root_real, rel=1e-6, abs=1e-9)
+    assert {"reflex", "kp_Nm_per_rad", "budget"} <= set(searched_40ms.to_dict()["chain_gain_searched"])
+    table = searched_40ms.table()
+    assert "any diagonal PD gains, searched" in table and "the reflex rule, (1 - f)+" in table
+    quoted = [line for line in table.splitlines() if line.startswith("over any diagonal PD gains")]
+    assert quoted[0] in DOCS.read_text(encoding="utf-8")  # docs/reflex.md quotes the table, not a typed number
+
+
+def test_the_rules_answer_is_the_searched_answer_when_no_smaller_fraction_is_certified(monkeypatch):
+    """The rule's design is the first candidate: where no gains certify any smaller fraction (every certificate
+    refused), every halving fails and the answer is the rule's own f, gains, margin and root, never above them."""
+    from spinectl.reflex.design import gain_searched
+
+    monkeypatch.setattr(gain_searched._Chain, "certify", lambda self, f, kp, kd: None)
+    monkeypatch.setattr(gain_searched._Chain, "search", lambda self, f, starts: starts[0])
+    model = _model(0.12, **{"body.mass": 35.0, "passive.stiffness": 10.0})  # a variant: the subject at 120 ms
+    result = dz.answer(model, *AT, search=True)
+    s, rule = result.searched, result.chain
+    assert s.fraction == rule.fraction and s.delay_margin == rule.delay_margin >= 0.12
+    np.testing.assert_array_equal(s.kp, rule.kp)
+    np.testing.assert_array_equal(s.kd, rule.kd)
+    assert "0 % less" in result.table()
+
+
+@pytest.mark.parametrize(("delay", "ratio"), [(0.1, 1.2), (0.04, 1.5)])
+def test_a_margin_ratio_is_the_design_at_ratio_times_the_delay(delay, ratio):
+    """--margin R is the rule's design at R x the delay (it then holds every delay up to R tau: its exact margin is
+    the first critical delay): the chain's fraction and the joint-by-joint activation equal design() there."""
+    result = dz.answer(_model(delay), *AT, ratio=ratio)
+    direct = dz.design(_model(ratio * delay), *AT)
+    assert result.chain.fraction == direct.chain.fraction and result.activation == direct.activation
+    assert result.delay == pytest.approx(ratio * delay) and result.nominal_delay == delay
+    assert result.margin_cost is None and "holds every delay up to" in result.table()
+
+
+def test_the_default_shows_the_cost_of_a_margin_of_1_1():
+    """Without --margin the table says the least value is a stability boundary and what 1.1 x the delay costs: the
+    rule's design at 1.1 tau (from design() itself), more local stiffness than at tau."""
+    result = dz.answer(_model(0.1), *AT)
+    longer = dz.design(_model(0.11), *AT).chain
+    assert result.margin_cost.ratio == dz.COST_RATIO == 1.1
+    assert result.margin_cost.fraction == longer.fraction > result.chain.fraction
+    table = result.table()
+    assert "sits on its stability boundary (margin = the delay)" in table
+    assert f"{np.sum(longer.local_stiffness):.1f} N m/rad" in table
+
+
+@pytest.mark.parametrize("K", [0.0, 40.0])
+def test_the_printed_global_pcsa_is_the_activation_times_the_minimum_pcsa_at_K(K):
+    """The chain's global PCSA is reflex.activation x the minimum stabilising PCSA of optimise.solve_point at this
+    K (which shrinks as K grows: K = 40 a variant); the gains are the rule's at the design, (1 - f)+ of the full."""
+    model = _model(0.04, **{"passive.stiffness": K})
+    result = dz.answer(model, *AT)
+    optimum = np.sum(solve_point(model, *AT).pcsa)
+    assert result.chain.pcsa == pytest.approx(model.reflex.activation * optimum, rel=1e-12)
+    assert result.to_dict()["chain"]["global_pcsa_cm2"] == pytest.approx(1e4 * 0.5 * optimum, rel=1e-12)
+    assert f"global PCSA {1e4 * 0.5 * optimum:.2f} cm^2" in result.table()
+    mass, _, _, kp0, kd0 = _chain_at(model, result.chain.fraction)
+    np.testing.assert_allclose(result.chain.kp, (1 - result.chain.fraction) * kp0, rtol=1e-12)
+    np.testing.assert_allclose(result.chain.kd, (1 - result.chain.fraction) * kd0, rtol=1e-12)
+
+
+def test_the_issues_l1l2_claim_with_the_segments_exact_margin():
+    """The issue's joint-by-joint claim, recomputed: at 120 ms (``wagner2012``, (3, 4) cm) L1L2 at 0.6 of its rule
+    co-contraction, with the rule's k_p and k_d = 8 instead of the rule's 3.9 N m s/rad, has the exact margin 128.0 ms
+    (spinectl.reflex.delay.delay_margin with the lag) where the rule's gains hold 92.3 ms."""
+    model = _model(0.12)
+    result = dz.design(model, *AT)
+    coefficients = checked_coefficients(model, *AT)
+    pcsa = 0.6 * result.segments[0].activation * np.asarray(solve_point(model, *AT).pcsa, float)
+    s, d, theta = coefficients.stiffness(pcsa)[0], coefficients.damping(pcsa)[0], coefficients.inertia[0]
+    kp, kd = (float(x[0]) for x in gains.resolve_gains([s], [d], [theta], model.reflex))
+    assert kd == pytest.approx(3.91, abs=0.01)
+    margins = delay_margin([s, s], [d, d], [theta, theta], [kp, kp], [kd, 8.0], 0.05).margin
+    np.testing.assert_allclose(margins, [0.0923, 0.1280], atol=2e-4)
+
+
+@pytest.mark.parametrize(("delay", "extra"), [(0.12, {}), (0.07, {"body.mass": 35.0, "passive.stiffness": 10.0})])
+def test_joint_by_joint_over_every_gain_is_certified_and_below_the_rule(delay, extra):
+    """Each segment at the common activation the grid certified, with its reported gains: the exact margin (recomputed
+    by delay_margin) meets the delay and the rightmost root of theta s^2 - D s - S + (kp + kd s) e^{-s tau} / (T_a s
+    + 1) at the delay lies on the left; the activation is at most the rule's, and strictly below it at 120 ms
+    (the issue's case: 0.0288 against 0.3783) and for the subject at 70 ms (a variant)."""
+    model = _model(delay, **extra)
+    result = dz.answer(model, *AT)
+    j = result.joint_searched
+    assert j.activation < result.activation and np.all(j.segment_activation <= j.activation + 1e-12)
+    coefficients = checked_coefficients(model, *AT)
+    pcsa = j.activation * np.asarray(solve_point(model, *AT).pcsa, float)
+    s, d, theta = coefficients.stiffness(pcsa), coefficients.damping(pcsa), coefficients.inertia
+    margins = np.asarray(delay_margin(s, d, theta, j.kp, j.kd, 0.05).margin)
+    assert np.all(margins >= delay) and margins == pytest.approx(j.delay_margin)
+    for k in range(len(s)):
+        root = rightmost_root([[theta[k]]], [[s[k]]], [[d[k]]], [j.kp[k]], [j.kd[k]], delay, 0.05, SPECTRAL_NODES)
+        assert root.real < 0
+    lines = [line for line in result.table().splitlines() if line.startswith("over any PD gains per segment")]
+    assert lines and (extra or lines[0] in DOCS.read_text(encoding="utf-8"))  # docs/reflex.md quotes the 120 ms one
+    assert result.to_dict()["joint_gain_searched"]["activation"] == j.activation
