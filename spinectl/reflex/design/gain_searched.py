@@ -31,9 +31,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ...model.chain import chain_coefficients, linear_chain
-from ...model.checks import arithmetic_guard
 from ...model.linear_chain import LinearChain
+from ...model.operating_point import OperatingPoint, chain_at
 from ...model.params import Model
 from .. import gains
 from ..chain_margins import stable_at
@@ -180,42 +179,12 @@ def _budget_text() -> str:
     return ", ".join(f"{k} {v}" for k, v in SEARCH_BUDGET.items())
 
 
-def chain_at_pcsa(model: Model, eccentricity: float, lordosis: float, pcsa) -> LinearChain:
-    """The chain with its global muscles fixed at a PCSA, as a :class:`~spinectl.model.linear_chain.LinearChain`.
-
-    :func:`spinectl.model.chain.linear_chain` (its joints, M and the local muscles' c_loc) with K_0 and D_0 the
-    muscles' sums per m^2 of each (:meth:`spinectl.model.chain.ChainCoefficients.stiffness`), as the chain's
-    design computes them; local stiffness k is added by ``.at((), k)``, with its damping c_loc k.
-
-    Parameters
-    ----------
-    model : Model
-    eccentricity, lordosis : float
-        E and Lambda [m].
-    pcsa : numpy.ndarray, shape (n_muscles,)
-        Global PCSA [m^2].
-
-    Returns
-    -------
-    LinearChain
-        Without controls.
-    """
-    with arithmetic_guard(eccentricity, lordosis):
-        coefficients = chain_coefficients(model, eccentricity, lordosis)
-        free = linear_chain(model, eccentricity, lordosis, coefficients)
-        return replace(
-            free.at(np.zeros(free.n_controls)),
-            stiffness_offset=coefficients.stiffness(pcsa),
-            damping_offset=coefficients.damping(pcsa),
-        )
-
-
 class _Chain:
     """The chain at its operating point: the loop at each fraction, and the certificate of gains there."""
 
     def __init__(self, model: Model, e: float, lam: float, pcsa, least_static):
         self.model, self.least = model, np.asarray(least_static, float)
-        self.linear = chain_at_pcsa(model, e, lam, pcsa)
+        self.linear = chain_at(OperatingPoint(model, e, lam, pcsa, slip_check=False))  # local stiffness: .at((), k)
         self.mass = self.linear.mass_matrix
         self.delay, self.lag = model.reflex.delay, model.reflex.activation_time_constant
         self.evaluations = self.searches = 0
