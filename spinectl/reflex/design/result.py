@@ -20,6 +20,11 @@ LOCAL_MAX = 2.0
 (the rule's reflex vanishes at 1 k*, where the search ends)."""
 
 
+BOUNDARY_RTOL = 1e-3
+"""A chain design's margin more than this above the delay (relative) did not stop on the delay: the least
+stiffness is where the margin jumps past it (at K = 40 N m/rad, 376 ms against 120 ms), not a boundary at it."""
+
+
 @dataclass(frozen=True)
 class SegmentDesign:
     """One segment's least co-contraction, joint by joint.
@@ -307,6 +312,13 @@ class Design:
             return (
                 f"  robust: designed at {self.margin_ratio:g} x the delay {delay_text(self.nominal_delay)}, so "
                 f"it holds every delay up to {delay_text(self.delay)} (--margin {self.margin_ratio:g})"
+            )
+        ratio = c.delay_margin / self.delay if self.delay > 0 else np.inf
+        if ratio > 1.0 + BOUNDARY_RTOL:  # the margin jumped past the delay at the least value: no delay sets it
+            return (
+                f"  boundary: the least value is where the margin jumps past the delay, from below it to "
+                f"{delay_text(c.delay_margin)} ({ratio:.3g} x the delay), not where it equals the delay: less "
+                f"stiffness is unstable at this delay, and any margin up to {ratio:.3g} x costs nothing more"
             )
         text = "  boundary: the least value sits on its stability boundary (margin = the delay)"
         cost = self.margin_cost
