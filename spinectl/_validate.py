@@ -339,3 +339,39 @@ def range_spec(name: str, spec: str, limit: int, example: str, bounds=None, unit
             name, f"must be in [{low:g}, {high:g}] {unit} (got {spec!r}: {start:g} to {stop:g} {unit})"
         )
     return axis
+
+
+def file_fault(path, limit: int) -> str:
+    """Why a file cannot be read as a small regular file, or ``""``: not one (a FIFO, a device such as /dev/zero,
+    a folder, also behind a symbolic link), or larger than ``limit`` bytes.
+
+    A reader that opens such a file blocks for ever (a FIFO) or reads until memory runs out (/dev/zero, a
+    huge file): check before opening.
+
+    Parameters
+    ----------
+    path : os.PathLike
+        The file.
+    limit : int
+        The most bytes it may hold [B].
+
+    Returns
+    -------
+    str
+        E.g. ``"is not a regular file"``, ``"is larger than 16 MiB"``; ``""`` for a regular file within the
+        limit, or one that does not exist (the reader says that).
+    """
+    import os
+    import stat
+
+    try:
+        status = os.stat(path)  # follows links: a link to /dev/zero is /dev/zero
+    except FileNotFoundError:
+        return ""
+    except OSError as exc:
+        return f"cannot be read ({exc.strerror or exc.__class__.__name__})"
+    if not stat.S_ISREG(status.st_mode):
+        return "is not a regular file"
+    if status.st_size > limit:
+        return f"is larger than {limit / 2**20:g} MiB"
+    return ""

@@ -208,7 +208,7 @@ def load_atlas(path: str | Path, model: Model | None = None, assignments=()) -> 
         Unreadable, not TOML, or any field invalid: one line naming the field.
     """
     path = Path(path)
-    text = _toml.read_text(path)
+    text = _toml.read_text(path, "atlas")
     return parse_atlas(text, source=str(path), base_dir=path.parent, model=model, assignments=assignments)
 
 

@@ -20,14 +20,21 @@ from .._validate import escaped, show
 from ..errors import ConfigError, ParameterError
 from ..quoting import toml_comment, toml_string
 
+MAX_TEXT_BYTES = 16 * 1024 * 1024
+"""The largest parameter, study, atlas or mapping file read [B]: such files are kilobytes (a model with every
+field, 20 pairs and 24 CoRs is under 20 kB); an 8 GB file was read whole (17 GB of memory, a minute) before
+its TOML was found invalid."""
 
-def read_text(path: Path) -> str:
+
+def read_text(path: Path, field: str = "config") -> str:
     """The text of a configuration file, or a :class:`ConfigError` saying why not.
 
     Parameters
     ----------
     path : Path
         A TOML file (UTF-8).
+    field : str, optional
+        What the error names: the option or kind of file (``config``, ``mapping``, ``atlas``, ``study``).
 
     Returns
     -------
@@ -37,23 +44,27 @@ def read_text(path: Path) -> str:
     Raises
     ------
     ConfigError
-        Missing, not a regular file, unreadable or not UTF-8 (field ``config``).
+        Missing, not a regular file, larger than :data:`MAX_TEXT_BYTES`, unreadable or not UTF-8.
     """
     shown = show(str(path))
     try:
         if not path.exists():
-            raise ConfigError("config", f"file not found: {shown}")
+            raise ConfigError(field, f"file not found: {shown}")
         if not path.is_file():  # a folder, or a device such as /dev/zero that never ends
-            raise ConfigError("config", f"not a regular file: {shown}")
+            raise ConfigError(field, f"not a regular file: {shown}")
+        with path.open("rb") as stream:  # at most the bound: a file that grows meanwhile is still refused
+            data = stream.read(MAX_TEXT_BYTES + 1)
+        if len(data) > MAX_TEXT_BYTES:
+            raise ConfigError(field, f"{shown} is larger than {MAX_TEXT_BYTES // 2**20} MiB: not a spinectl TOML file")
         # TOML is UTF-8 whatever the locale; a byte-order mark (as some Windows editors write) is not content
-        return path.read_text(encoding="utf-8-sig")
+        return data.decode("utf-8-sig")
     except ConfigError:
         raise
     except UnicodeDecodeError:
-        raise ConfigError("config", f"{shown} is not UTF-8 text") from None
+        raise ConfigError(field, f"{shown} is not UTF-8 text") from None
     except (OSError, ValueError) as exc:  # permissions, name too long, a NUL byte in the name
         reason = getattr(exc, "strerror", None) or exc.__class__.__name__
-        raise ConfigError("config", f"cannot read {shown}: {reason}") from None
+        raise ConfigError(field, f"cannot read {shown}: {reason}") from None
 
 
 def parse(text: str, source: str) -> dict:

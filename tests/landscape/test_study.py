@@ -1070,6 +1070,56 @@ def test_a_damaged_zmetadata_is_named_with_its_remedy(tmp_path, capsys, damage, 
     assert json.loads(file.read_text()) == json.loads(written)
 
 
+@pytest.mark.parametrize(
+    ("name", "make"),
+    [
+        (".zmetadata", lambda file: file.symlink_to("/dev/zero")),  # read until the memory ran out (24 GB, OOM)
+        (".zmetadata", os.mkfifo),  # read for ever
+        ("status/.zarray", os.mkfifo),  # an array's own metadata: --resume hung, its lock left behind
+        (".zattrs", lambda file: file.mkdir()),
+    ],
+)
+def test_a_metadata_file_that_is_no_regular_file_is_named_not_read(tmp_path, capsys, name, make):
+    """A store's metadata file replaced by a FIFO, a link to /dev/zero or a folder: --resume and load refuse it in
+    one line naming the file, before zarr opens it (before: a hang, or the kernel's OOM killer), and no lock is
+    left behind."""
+    text = STUDY.replace('"body.mass" = [35.0, 45.0]\n', "")
+    path, out = write(tmp_path, text), tmp_path / "s.zarr"
+    arguments = ["study", str(path), "--out", str(out), "--scheduler", "synchronous"]
+    assert main(arguments) == 0
+    file = out / name
+    file.unlink()
+    make(file)
+    capsys.readouterr()
+    assert main([*arguments, "--resume"]) == 2
+    err = capsys.readouterr().err
+    assert len(err.splitlines()) == 1 and f"its metadata file {str(file)!r} is not a regular file" in err
+    assert not Path(f"{out}.lock").exists()
+    with pytest.raises(ParameterError, match="is not a regular file"):
+        study.load(out)
+
+
+def test_a_text_file_beyond_the_bound_is_refused_unread(tmp_path, capsys, monkeypatch):
+    """Every TOML reader (config, study, atlas, mapping) refuses a file over 16 MiB before reading it (before: an
+    8 GB file read whole, 17 GB of memory, then "not valid TOML"); a sparse file costs no disk here."""
+    from spinectl.model._toml import MAX_TEXT_BYTES
+
+    monkeypatch.chdir(tmp_path)  # a short name in the messages
+    big = Path("big.toml")
+    with big.open("wb") as stream:
+        stream.truncate(MAX_TEXT_BYTES + 1)
+    for argv, field in (
+        (["config", "show", "--config", str(big)], "config"),
+        (["study", str(big), "--out", "s.zarr"], "study"),
+        (["atlas", str(big), "--out", "a"], "atlas"),
+    ):
+        assert main(argv) == 2
+        err = capsys.readouterr().err
+        assert err == f"spinectl: error: {field}: 'big.toml' is larger than 16 MiB: not a spinectl TOML file\n"
+    big.write_text("# a comment\n" * 10)  # a small file of the same name reads
+    assert main(["config", "show", "--config", str(big)]) == 0
+
+
 def test_a_ctrl_c_sent_to_the_process_while_the_cluster_starts_waits_for_the_start():
     """A SIGINT sent to the process (kill -INT pid, as job managers send it) while the main thread blocks SIGINT
     is delivered to another thread, and Python raised KeyboardInterrupt in the main thread at once, in the

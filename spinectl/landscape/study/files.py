@@ -65,10 +65,7 @@ def load_study(path: str | Path, overrides=()) -> Study:
         A value is invalid; the field is named as in the file, e.g. ``axes."body.mass"[2]``.
     """
     path = Path(path)
-    try:
-        text = read_text(path)
-    except ConfigError as exc:
-        raise ConfigError("study", exc.message) from None
+    text = read_text(path, "study")
     return parse_study(text, base_dir=path.parent, source=str(path), overrides=overrides)
 
 

@@ -46,6 +46,7 @@ from ...errors import OutputError, ParameterError
 from ...model import config, source
 from ...model._toml import field_metadata
 from .. import schema
+from .metadata import check_consolidated, check_metadata_files
 from .spec import SAMPLE, STORE_FORMAT, Chunk, Study
 
 DONE = "chunk_done"
@@ -311,6 +312,7 @@ def create(study: Study, path: str | Path, probe: dict) -> np.ndarray:
 
 
 def _done_counts(study: Study, path: Path) -> np.ndarray:
+    check_metadata_files(path)
     try:  # the root's own attributes: a damaged .zmetadata is reported as such below, not as a foreign folder
         root = zarr.open_group(path, mode="r", zarr_format=ZARR_FORMAT, use_consolidated=False)
         digest = root.attrs.get("study_digest")
@@ -325,7 +327,7 @@ def _done_counts(study: Study, path: Path) -> np.ndarray:
             "with the study file that made it, or write to another store",
         )
     group = _checked_group(path)  # a study store, but its layout may be damaged: say what is lost
-    _check_consolidated(path)
+    check_consolidated(path)
     try:
         return group[DONE][:].astype(int)
     except OPEN_ERRORS as exc:  # a store made before the layout was recorded
@@ -428,6 +430,7 @@ def open_store(path: str | Path) -> xr.Dataset:
         lost or changed), or a chunk counted done has lost its data or has other bytes than
         those written (field ``store``).
     """
+    check_metadata_files(path)
     try:
         with warnings.catch_warnings():  # zarr warns of a folder whose metadata is lost: checked below
             warnings.simplefilter("ignore", zarr.errors.ZarrUserWarning)
@@ -450,45 +453,8 @@ def open_store(path: str | Path) -> xr.Dataset:
         if blocked is not None:  # a resume alone cannot replace a folder there
             advice = f"remove {str(blocked)!r}, which is not a file, then {advice}"
         raise ParameterError("store", f"{_missing_text(path, missing)}: {advice}")
-    _check_consolidated(path)
+    check_consolidated(path)
     return dataset
-
-
-def _check_consolidated(path) -> None:
-    """A finished store's ``.zmetadata``, if any, must be what its files say: a copy for ``xarray.open_zarr``,
-    which the resume of a finished store writes again (the remedy the error gives)."""
-    file = Path(path) / ".zmetadata"
-    if not (file.exists() or file.is_symlink()):
-        return
-    try:
-        fault = _consolidated_fault(Path(path), json.loads(file.read_text(encoding="utf-8"), parse_constant=str))
-    except (OSError, UnicodeDecodeError, ValueError) as exc:
-        fault = f"cannot be read as JSON ({exc.strerror if isinstance(exc, OSError) else exc})"
-    if fault:
-        raise ParameterError(
-            "store",
-            f"{str(path)!r} is damaged: its consolidated metadata {str(file)!r} {fault}: remove that file and run "
-            "the study again with --resume, which writes it anew from the arrays' own metadata",
-        )
-
-
-def _consolidated_fault(path: Path, document) -> str:
-    """What is wrong with a consolidated metadata document, or ``""``: its form, then each entry against its file."""
-    entries = document.get("metadata") if isinstance(document, dict) else None
-    if not isinstance(entries, dict) or document.get("zarr_consolidated_format") != 1:
-        return "is not Zarr's consolidated metadata (a table of 'metadata' with 'zarr_consolidated_format' = 1)"
-    folders = ["", *(f"{d.name}/" for d in path.iterdir() if d.is_dir())]  # the root and its arrays: no subgroups
-    files = {f"{f}{name}" for f in folders for name in (".zgroup", ".zattrs", ".zarray") if (path / f / name).is_file()}
-    if set(entries) != files:
-        return f"does not list the store's metadata files (lists {len(entries)}, the store has {len(files)})"
-    for name, entry in sorted(entries.items()):
-        try:
-            same = json.loads((path / name).read_text(encoding="utf-8"), parse_constant=str) == entry
-        except (OSError, UnicodeDecodeError, ValueError):
-            same = False
-        if not same:
-            return f"does not hold what {name!r} of the store holds"
-    return ""
 
 
 def load(path: str | Path) -> xr.Dataset:

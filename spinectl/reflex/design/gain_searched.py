@@ -126,6 +126,15 @@ class GainSearchedDesign:
     def lines(self, names, rule_fraction: float, least_static) -> list[str]:
         """The table's lines for this answer, beside the rule's f.
 
+        Parameters
+        ----------
+        names : sequence of str
+            The joints.
+        rule_fraction : float
+            The rule's answer f, of k*.
+        least_static : array_like, shape (n,)
+            k*, the least local stiffness for static stability [N m/rad].
+
         Returns
         -------
         list of str

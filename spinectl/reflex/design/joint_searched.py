@@ -100,6 +100,11 @@ class JointSearchedDesign:
     def lines(self, rule_activation: float) -> list[str]:
         """The table's lines, beside the rule's common activation.
 
+        Parameters
+        ----------
+        rule_activation : float
+            The rule's answer, one activation for every segment [x minimum PCSA].
+
         Returns
         -------
         list of str

@@ -170,6 +170,18 @@ class Design:
         How the activation was searched (see the module).
     model : dict
         The model's provenance and header line.
+    margin_ratio : float
+        R of ``--margin R``: the design holds every delay up to R x :attr:`nominal_delay` (1: at the delay).
+    nominal_delay : float
+        The delay asked for [s]; :attr:`delay` is R times it.
+    margin_cost : object or None
+        The chain's design at 1.1 x the delay, what a modest margin costs (None where not computed).
+    searched : object or None
+        The chain's design over every diagonal PD reflex (``--gains search``,
+        :class:`~spinectl.reflex.design.gain_searched.GainSearchedDesign`), or None.
+    joint_searched : object or None
+        Joint by joint over every segment's PD gains
+        (:class:`~spinectl.reflex.design.joint_searched.JointSearchedDesign`), or None.
     """
 
     eccentricity: float
@@ -340,7 +352,20 @@ class Design:
 
 
 def gains_text(names, kp, kd) -> str:
-    """Each joint's diagonal gains as text: ``L1L2 kp 30.0 kd 2.16, ...`` ([N m/rad], [N m s/rad])."""
+    """Each joint's diagonal gains as text.
+
+    Parameters
+    ----------
+    names : sequence of str
+        The joints.
+    kp, kd : array_like, shape (n,)
+        Gains [N m/rad], [N m s/rad].
+
+    Returns
+    -------
+    str
+        ``L1L2 kp 30.0 kd 2.16, ...``.
+    """
     return ", ".join(f"{n} kp {p:.1f} kd {d:.2f}" for n, p, d in zip(names, kp, kd, strict=True))
 
 
