@@ -33,6 +33,23 @@ def show(value) -> str:
     return _shorten(text)
 
 
+def show_path(path) -> str:
+    """A path quoted as :func:`show` quotes it, shortened at the start so that the file's own name stays.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The path.
+
+    Returns
+    -------
+    str
+        E.g. ``"'.../run-3/model.xml'"``.
+    """
+    text = repr(str(path))
+    return text if len(text) <= SHOWN_CHARS else "'..." + text[-(SHOWN_CHARS - 4) :]
+
+
 def escaped(text: str) -> str:
     """``text`` without quotes but with line breaks and control characters escaped, shortened like :func:`show`.
 

@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from .._optional import require_module
-from .._validate import printable, show
+from .._validate import file_fault, printable, show, show_path
 from ..errors import ParameterError, SpinectlError
 
 BUILTIN = ("myotorso",)
@@ -187,6 +187,54 @@ def model_file(text: str, allowed: str) -> Path:
         what = "not a regular file" if exists else "no such file"
         raise ParameterError("model", f"must be {allowed} ({what}: {show(text)})")
     return path
+
+
+MAX_MODEL_FILE_BYTES = 1 << 30
+"""The largest file an MJCF model names that is read (a mesh of a published model is megabytes) [B]."""
+
+
+def check_files_named(path: Path, seen: frozenset = frozenset()) -> None:
+    """Every file an MJCF file names (``<include file>``, a mesh's, a texture's) a regular file, before MuJoCo
+    reads them: a FIFO there hung MuJoCo's reader for ever.
+
+    The XML is read with the standard library only to find the ``file`` attributes; MuJoCo parses the model.
+    A name is resolved as MuJoCo resolves it, against the file's folder and the compiler's ``meshdir``,
+    ``texturedir`` and ``assetdir``; a file that does not exist is MuJoCo's to report. Included files are
+    checked in turn.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        An MJCF file.
+    seen : frozenset, optional
+        The files on the way here (an include cycle is MuJoCo's to report).
+
+    Raises
+    ------
+    ParameterError
+        Naming the file and what it is (field ``model``).
+    """
+    import xml.etree.ElementTree as ElementTree
+
+    try:
+        root = ElementTree.parse(path).getroot()
+    except (ElementTree.ParseError, OSError):
+        return  # MuJoCo says why, in its words
+    folders = [path.parent] + [
+        path.parent / value
+        for compiler in root.iter("compiler")
+        for key in ("assetdir", "meshdir", "texturedir")
+        if (value := compiler.get(key))
+    ]
+    for element in root.iter():
+        name = element.get("file")
+        if not name:
+            continue
+        for candidate in (folder / name for folder in folders):
+            if fault := file_fault(candidate, MAX_MODEL_FILE_BYTES):
+                raise ParameterError("model", f"{show_path(path)} names {show_path(name)}, which {fault}")
+            if element.tag == "include" and candidate.is_file() and candidate not in seen:
+                check_files_named(candidate, seen | {path})
 
 
 @dataclass
@@ -485,6 +533,7 @@ def _load_engine(model: str | Path, cache: bool) -> Engine:
         # a composed model: the SHA-256 of the MJCF text MuJoCo writes of it
         return _compile(spec, builtin, text, source, hashlib.sha256(spec.to_xml().encode()).hexdigest(), key)
     path = model_file(text, f"one of {BUILTIN} or an MJCF file")
+    check_files_named(path)
 
     def factory():
         try:

@@ -9,6 +9,8 @@ its moment arms and their Hessians, the fibres' force and slopes from MuJoCo's o
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -174,3 +176,29 @@ def test_a_mapping_naming_joints_the_export_lacks_is_one_line(imported, tmp_path
     assert main(["anatomy", str(path), "--mapping", str(mapping), "--no-cache"]) == 2
     captured = capsys.readouterr()
     assert captured.out == "" and captured.err.count("\n") == 1 and "L9L10" in captured.err
+
+
+@pytest.mark.parametrize("target", ["fifo", "/dev/zero", "folder"])
+def test_a_file_the_mjcf_names_that_is_no_regular_file_is_refused_before_mujoco_reads_it(tmp_path, target):
+    """An ``<include file>`` (or a mesh's file) that is a FIFO hung MuJoCo's reader for ever: it is refused in one
+    line naming the file, by a check that only looks at the files (so this test cannot hang), before MuJoCo
+    opens them; a nested include is followed; a regular included file passes."""
+    import os
+
+    from spinectl.anatomy.engine import check_files_named
+    from spinectl.errors import ParameterError
+
+    named = {"fifo": tmp_path / "x.fifo", "/dev/zero": Path("/dev/zero"), "folder": tmp_path / "d"}[target]
+    if target == "fifo":
+        os.mkfifo(named)
+    elif target == "folder":
+        named.mkdir()
+    inner = tmp_path / "inner.xml"
+    inner.write_text(f'<mujocoinclude><include file="{named}"/></mujocoinclude>')
+    outer = tmp_path / "outer.xml"
+    outer.write_text('<mujoco><include file="inner.xml"/><worldbody/></mujoco>')
+    with pytest.raises(ParameterError, match=f"{named.name}', which is not a regular file") as info:
+        check_files_named(outer)
+    assert info.value.field == "model" and "inner.xml' names" in info.value.message
+    inner.write_text("<mujocoinclude/>")
+    check_files_named(outer)  # nothing raised
