@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from ..anatomy.mapping import MAX_STIFFNESS
+from ..errors import ParameterError
 from ..model.params.bounds import MAX_ACTIVATION_TIME_CONSTANT
 from ._common import emit_json, finite_float
 
@@ -178,6 +179,8 @@ def _answers(args) -> tuple:
 
     anatomy = load(args.model, args.mapping, cache=not args.no_cache)
     reflex = None if args.kp is None else (args.kp, args.kd, args.activation_lag)
+    if args.optimise and args.activation is not None:  # before: ignored without a word
+        raise ParameterError("--activation", "cannot go with --optimise, which finds the activations itself")
     if args.optimise:
         from ..anatomy.optimum import optimised
 

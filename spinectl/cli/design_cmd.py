@@ -99,7 +99,7 @@ DELAYS_EXAMPLE = "in seconds, e.g. 0:0.2:41"
 STATIC_ONLY = ("--delay", "--activation-lag", "--activation", "--kp", "--kd", "--gains", "--margin")
 """The reflex's options, which ``--passive`` does not use: refused with it rather than ignored."""
 
-ONE_DELAY_ONLY = ("--gains", "--margin")
+ONE_DELAY_ONLY = ("--delay", "--gains", "--margin")
 """Options of the one-delay design, refused with ``--delays`` rather than ignored."""
 
 OVERRIDES = (
@@ -154,8 +154,9 @@ def run(args) -> int:
     if args.passive is not None and args.delays is not None:
         raise ParameterError("--passive", "cannot go with --delays (one curve at a time)")
     for option in ONE_DELAY_ONLY if args.delays is not None else ():
-        if getattr(args, option.lstrip("-")) is not None:
-            raise ParameterError(option, "needs the one-delay design (--delay), not --delays")
+        if getattr(args, option.lstrip("-")) is not None:  # --delay was ignored without a word
+            why = "whose delays are the curve's axis" if option == "--delay" else "which it does not take"
+            raise ParameterError(option, f"cannot go with --delays, {why}: the one-delay design is --delay")
     if args.passive is not None:
         return _passive(model, args)
     if args.delays is not None:

@@ -241,3 +241,11 @@ def test_a_model_path_that_is_no_file_is_one_line(tmp_path, capsys, kind):
     assert main(["anatomy", path]) == 2
     captured = capsys.readouterr()
     assert captured.out == "" and captured.err.startswith("spinectl: error: model: ") and captured.err.count("\n") == 1
+
+
+def test_the_optimum_refuses_an_activation_it_would_ignore(cached, capsys):
+    """--optimise finds the activations itself: a given --activation was ignored without a word (exit 0)."""
+    assert main(["anatomy", "--optimise", "--activation", "0.5"]) == 2
+    assert capsys.readouterr().err == (
+        "spinectl: error: --activation: cannot go with --optimise, which finds the activations itself\n"
+    )

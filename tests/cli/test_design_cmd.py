@@ -233,8 +233,9 @@ def test_passive_refuses_the_reflexs_options_it_would_ignore(option, value, caps
     [
         (["--margin", "0.9"], "--margin: must be in [1, "),
         (["--margin", "200"], "--margin: must be in [1, 100]"),  # 200 x 0.1 s is beyond the delay's 10 s
-        (["--delays", "0:0.1:3", "--margin", "1.1"], "--margin: needs the one-delay design (--delay), not --delays"),
-        (["--delays", "0:0.1:3", "--gains", "search"], "--gains: needs the one-delay design"),
+        (["--delays", "0:0.1:3", "--margin", "1.1"], "--margin: cannot go with --delays, which it does not take"),
+        (["--delays", "0:0.1:3", "--gains", "search"], "--gains: cannot go with --delays"),
+        (["--delays", "0:0.1:3", "--delay", "0.15"], "--delay: cannot go with --delays, whose delays are the curve's"),
         (["--passive", "0:80:3", "--gains", "search"], "--gains: cannot go with --passive"),
         (["--passive", "0:80:3", "--margin", "1.2"], "--margin: cannot go with --passive"),
     ],
@@ -245,7 +246,7 @@ def test_a_margin_or_a_gain_search_where_it_does_not_apply_is_one_line_exit_2(ar
     assert (
         main(
             ["design", "--preset", "wagner2012", "--delay", "0.1", *argv]
-            if "--passive" not in argv
+            if "--passive" not in argv and "--delays" not in argv
             else ["design", "--preset", "wagner2012", *argv]
         )
         == 2
