@@ -102,7 +102,8 @@ class Prior:
             F(high) - F(low).
         """
         dist = self._frozen()
-        return float(dist.cdf(self.bounds[1]) - dist.cdf(self.bounds[0]))
+        with np.errstate(all="ignore"):  # a spread near the smallest double: the answer is checked, not warned of
+            return float(dist.cdf(self.bounds[1]) - dist.cdf(self.bounds[0]))
 
     def ppf(self, u) -> np.ndarray:
         """The truncated distribution's quantiles: F^-1(F(low) + u (F(high) - F(low))).
@@ -118,8 +119,9 @@ class Prior:
             Values of the parameter in its unit, the shape of ``u``, within the bounds.
         """
         dist = self._frozen()
-        low, high = dist.cdf(self.bounds[0]), dist.cdf(self.bounds[1])
-        return np.clip(dist.ppf(low + np.asarray(u, float) * (high - low)), *self.bounds)
+        with np.errstate(all="ignore"):  # numpy's overflow warnings at sd ~ 1e-320: the quantiles are checked
+            low, high = dist.cdf(self.bounds[0]), dist.cdf(self.bounds[1])
+            return np.clip(dist.ppf(low + np.asarray(u, float) * (high - low)), *self.bounds)
 
 
 def _log_variance(mean: float, sd: float) -> float:

@@ -141,6 +141,19 @@ def test_a_lognormal_of_tiny_sd_draws_its_mean(sd):
     np.testing.assert_allclose(prior.ppf([1e-9, 0.5, 1 - 1e-9]), 40.0, rtol=1e-9)
 
 
+@pytest.mark.parametrize("sd", [1e-320, 1e-310])
+def test_a_truncated_normal_of_a_subnormal_sd_is_quiet_and_draws_its_mean(sd):
+    """sd in the subnormal range: numpy's overflow warning leaked onto stderr twice ("overflow encountered in
+    divide", exit 0); the draws are the mean, and nothing is warned (warnings are errors here)."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        text = HEAD + _prior(distribution="truncated normal", mean=40.0, sd=sd, bounds=[30.0, 50.0])
+        prior = parse_atlas(text).priors[0]
+        np.testing.assert_allclose(prior.ppf([1e-9, 0.5, 1 - 1e-9]), 40.0, rtol=1e-12)
+
+
 @pytest.mark.parametrize("parameter", ["reflex.pade_order", "muscles.1.fibres"])
 def test_a_prior_on_an_integer_field_says_it_is_a_count(parameter):
     """An integer field (a count): the reason is that priors draw real numbers (it was 'must be an integer
