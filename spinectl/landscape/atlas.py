@@ -35,11 +35,11 @@ from ..model.checks import arithmetic_guard, checked_coefficients
 from ..model.clinical import lordosis_angle, lordosis_from_angle
 from ..model.config import set_parameters
 from ..model.params import Model
-from ..model.source import header, provenance
+from ..model.source import provenance
 from ..optimise import active_set
 from ..optimise.problem import OK_STATUSES, problem_data
 from . import atlas_chunks, budget, columns
-from .priors import PAPER_OPTIMUM, VERDICTS, AtlasSpec
+from .priors import PAPER_OPTIMUM, VERDICTS, AtlasSpec, model_line
 from .schema import DRAW_VARIABLES
 
 INSTALL_HINT = "pip install 'spinectl[atlas]' (SALib)"
@@ -125,9 +125,9 @@ class AtlasResult:
         Returns
         -------
         str
-            The base model's :func:`~spinectl.model.source.header` line, then one line per verdict and per output.
+            The base model (:func:`~spinectl.landscape.priors.model_line`), then a line per verdict and per output.
         """
-        lines = [header(self.model)] if self.model is not None else []
+        lines = [model_line(self.model, self.draws)] if self.model is not None else []
         lines.append(f"{self.n_evaluations} evaluations")
         for name, v in self.probabilities.items():
             lines.append(f"P({name}) = {v['p']:.3f}  [{v['low']:.3f}, {v['high']:.3f}]  ({VERDICTS[name]})")

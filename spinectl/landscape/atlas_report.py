@@ -5,9 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..canvas import new_figure
-from ..model.source import header
 from ..quoting import markdown_cell_code, markdown_text
-from .priors import VERDICTS, AtlasSpec
+from .priors import VERDICTS, AtlasSpec, model_line
 
 
 def report_text(result, spec: AtlasSpec) -> str:
@@ -26,7 +25,7 @@ def report_text(result, spec: AtlasSpec) -> str:
     lines = [
         "# Population stability atlas",
         "",
-        f"Model: {markdown_text(model_line(spec))} (the parameters no prior varies).",
+        f"Model: {markdown_text(model_line(spec.model, spec.names))} (the parameters no prior varies).",
         "",
         f"{result.n_evaluations} model evaluations: Saltelli's design on a scrambled Sobol' sequence "
         f"(N = {spec.samples}, seed {spec.seed}); probabilities over the 2 N = {2 * spec.samples} draws of "
@@ -72,24 +71,6 @@ def report_text(result, spec: AtlasSpec) -> str:
             lines.append(f"| {markdown_cell_code(name)} | {first} | {total} |")
         lines.append("")
     return "\n".join(lines) + "\n"
-
-
-def model_line(spec: AtlasSpec) -> str:
-    """The base model as the report names it: its origin, and K only where no prior draws it.
-
-    Parameters
-    ----------
-    spec : AtlasSpec
-
-    Returns
-    -------
-    str
-        :func:`~spinectl.model.source.header` of the base model, with "K drawn from its prior" in place
-        of its K where ``passive.stiffness`` has a prior (the base model's K is no draw's).
-    """
-    if "passive.stiffness" not in spec.names:
-        return header(spec.model)
-    return header(spec.model, stiffness=f"K drawn from its prior, convention {spec.model.passive.convention}")
 
 
 def criterion(verdict: str, spec: AtlasSpec) -> str:

@@ -19,6 +19,7 @@ from ..errors import ConfigError, ParameterError
 from ..model import _toml
 from ..model.config import DEFAULT_PRESET, apply_overrides, load_model_spec, load_preset
 from ..model.params import Model
+from ..model.source import header
 
 FAMILIES = ("normal", "lognormal", "uniform", "truncated normal")
 """Distribution families of a prior; every draw is truncated to the prior's bounds."""
@@ -52,6 +53,28 @@ VERDICTS = {
     "spine_stable_at_delay": "the reflex loop of every segment stable at the reflex delay (joint by joint)",
 }
 """The verdicts and the criterion each names."""
+
+
+def model_line(model: Model, varied) -> str:
+    """The atlas's base model as its outputs name it: its header, K only where no prior draws it.
+
+    Parameters
+    ----------
+    model : Model
+        The base model (the parameters no prior varies).
+    varied : iterable of str
+        The parameters the priors vary (:attr:`AtlasSpec.names`).
+
+    Returns
+    -------
+    str
+        :func:`~spinectl.model.source.header` of the base model, with "K drawn from its prior" in place of its K
+        where ``passive.stiffness`` has a prior (the base model's K is no draw's: it printed K = 0).
+    """
+    if "passive.stiffness" not in set(varied):
+        return header(model)
+    return header(model, stiffness=f"K drawn from its prior, convention {model.passive.convention}")
+
 
 LEAST_MASS = 1e-9
 """Smallest share of a distribution's mass that its bounds may hold: less is 'no mass' (a typo)."""

@@ -172,7 +172,12 @@ def answer(measurements: Sequence[Measurement]) -> str:
     else:
         failed = " and ".join(f"`{m.landmark.name}`" for m in (lordosis, torque) if not m.agrees)
         verdict = f"**The paper's main claim is not reproduced with these parameters** ({failed} disagree): {found}."
-    return f"{QUESTION}\n\n{verdict}"
+    criterion = (
+        "The criterion is the paper's, joint by joint (each CoR alone, the others fixed; minimum PCSA for "
+        "self-stability and counter torques as in Figures 3 and 4); with every CoR free at once the chain is "
+        "another question (`spinectl stability --coupled`, docs/chain.md)."
+    )
+    return f"{QUESTION}\n\n{verdict} {criterion}"
 
 
 def _k_unit(convention: str) -> str:

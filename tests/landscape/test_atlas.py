@@ -622,3 +622,15 @@ def test_the_report_says_what_each_verdict_and_interval_rests_on():
     delay_ms = f"{fixed.model.reflex.delay * 1e3:g} ms"
     assert f"the model's {delay_ms} at every draw (no prior draws it)" in text
     assert f"K = {fixed.model.passive.stiffness:g} N m/rad" in text and "K drawn" not in text
+
+
+def test_the_console_table_says_k_is_drawn_where_a_prior_draws_it():
+    """The atlas's table (its stdout) named the base model's 'K = 0 N m/rad' while K was drawn from 0 to 30 N m/rad
+    (the report said "K drawn from its prior"): both now say it, from one function (priors.model_line)."""
+    spec = _spec(chain="false")
+    assert "passive.stiffness" in spec.names  # the premise
+    result = atlas.AtlasResult(1, {}, {}, {}, {}, {"passive.stiffness": np.array([5.0])}, spec.model)
+    first = result.table().splitlines()[0]
+    assert "K drawn from its prior" in first and "K = " not in first
+    fixed = atlas.AtlasResult(1, {}, {}, {}, {}, {"body.mass": np.array([40.0])}, spec.model)
+    assert f"K = {spec.model.passive.stiffness:g} N m/rad" in fixed.table().splitlines()[0]
