@@ -14,6 +14,7 @@ from .._validate import printable
 from ..atomic import check_distinct, check_writable
 from ..errors import ParameterError
 from ..model.params import Model
+from ..units import m2_to_cm2
 
 FORMATS = {"mjcf": (".xml", ".mjcf"), "osim": (".osim",)}
 """The export formats and the file suffixes that name them."""
@@ -183,15 +184,26 @@ def export_verdicts(solution, out, fmt: str, osim_muscle: str = "millard") -> li
     Returns
     -------
     list of str
-        One line per verdict: ``"spinectl's chain (all CoRs free, the paper's muscle laws): stable, largest
-        real part -0.0327 1/s"``, then for a Millard file OpenSim's.
+        What was exported (the global PCSA, the local stiffness as springs), then one line per verdict:
+        ``"spinectl's chain with them (all CoRs free, the paper's muscle laws): stable, largest real part
+        -0.0327 1/s"``, then for a Millard file OpenSim's, with the remedy where it grows.
     """
-    lines = [_verdict_line("spinectl's chain (all CoRs free, the paper's muscle laws)", solution.eigenvalues)]
+    springs = float(np.sum(solution.local_stiffness))
+    what = (
+        f"global PCSA {m2_to_cm2(np.sum(solution.pcsa)):.2f} cm^2 (the per-segment optimum unless given), "
+        + (f"local stiffness {springs:.1f} N m/rad in all as joint springs" if springs else "no local stiffness")
+    )
+    lines = [
+        f"exported: {what}",
+        _verdict_line("spinectl's chain with them (all CoRs free, the paper's muscle laws)", solution.eigenvalues),
+    ]
     if fmt == "osim" and osim_muscle == "millard":
         eigenvalues = opensim_eigenvalues(out, solution.model.geometry.cor_names)
+        growing = int(np.sum(eigenvalues.real >= 0))
         lines.append(
             _verdict_line("OpenSim's own linearisation of the file (Millard's muscle curves)", eigenvalues)
-            + f", {int(np.sum(eigenvalues.real >= 0))} of {eigenvalues.size} eigenvalues with Re >= 0"
+            + f", {growing} of {eigenvalues.size} eigenvalues with Re >= 0"
+            + ("; for a file whose dynamics are spinectl's chain: --osim-muscle paper" if growing else "")
         )
     return lines
 

@@ -75,7 +75,12 @@ def run(args) -> int:
         inputs={"--config": args.config},
         osim_muscle=args.osim_muscle,
     )
-    print(f"wrote {args.out} ({fmt}): E = {args.E:g} m, Lambda = {args.Lambda:g} m")
+    written = args.out
+    if fmt == "osim":
+        from ..anatomy.export_osim import controls_path
+
+        written = f"{args.out} and {controls_path(args.out)}"
+    print(f"wrote {written} ({fmt}): E = {args.E:g} m, Lambda = {args.Lambda:g} m")
     for line in export_verdicts(solution, args.out, fmt, args.osim_muscle):
         print(line)
     return 0

@@ -217,7 +217,8 @@ def test_cli_writes_the_file_and_refuses_to_overwrite_its_input(tmp_path, capsys
     out = tmp_path / "chain.xml"
     assert main(["export", "--E", "0.03", "--Lambda", "0.04", "--out", str(out)]) == 0
     printed = capsys.readouterr().out
-    assert "spinectl's chain (all CoRs free, the paper's muscle laws): unstable" in printed
+    assert "spinectl's chain with them (all CoRs free, the paper's muscle laws): unstable" in printed
+    assert "exported: global PCSA 35.80 cm^2 (the per-segment optimum unless given), no local stiffness" in printed
     assert mujoco.MjModel.from_xml_path(str(out)).nu == 35
     config = tmp_path / "model.toml"
     config.write_text("")

@@ -195,7 +195,11 @@ class CoupledStability:
             + f"  (total {pcsa.sum():.2f})",
         ]
         for title, matrix, fmt in (
-            ("stiffness K [N m/rad] (global muscles, gravity, passive)", self.stiffness, "10.3f"),
+            (
+                "stiffness K [N m/rad] (global muscles, gravity, passive; eq. 1's sign: -K > 0 restores)",
+                self.stiffness,
+                "10.3f",
+            ),
             ("damping D [N m s/rad]", self.damping, "10.4f"),
             ("mass M [kg m^2]", self.mass, "10.4f"),
         ):
@@ -208,7 +212,7 @@ class CoupledStability:
             f"{name}: static margin (smallest eigenvalue of -K) = {self.margin:.3f} N m/rad "
             f"({'stable' if self.margin > 0 else 'UNSTABLE'})",
             "eigenvalues [1/s]: " + ", ".join(eigenvalue_text(z) for z in self.eigenvalues),
-            f"{name}: global muscles alone: "
+            f"{name}: global muscles alone, no reflex: "
             + (
                 "eigenvalues undefined, the mass matrix is singular (levels.mass = 0)"
                 if np.isnan(self.eigenvalues).any()
