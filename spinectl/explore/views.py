@@ -92,7 +92,7 @@ def eigenvalue_data(numbers: PointNumbers) -> ViewData:
         "re": eigs.real.ravel().tolist(),
         "im": eigs.imag.ravel().tolist(),
     }
-    return ViewData(columns, (-reach, reach), "eigenvalues, joint by joint (shaded: unstable)")
+    return ViewData(columns, (-reach, reach), "eigenvalues, no reflex, joint by joint (shaded: unstable)")
 
 
 def _bar_columns(names, values, colours) -> dict:
@@ -122,7 +122,7 @@ def counter_torque_data(numbers: PointNumbers) -> ViewData:
     names = numbers.segment_names
     finite = numbers.counter_torque[np.isfinite(numbers.counter_torque)]
     reach = 1.15 * max(CT_LIMIT, float(np.max(np.abs(finite), initial=0.0)))
-    title = f"counter torques, ‖CT‖ = {np.linalg.norm(numbers.counter_torque):.3g} N m"
+    title = f"CT at activation {numbers.state.activation:g}, ‖CT‖ = {np.linalg.norm(numbers.counter_torque):.3g} N m"
     return ViewData(_bar_columns(names, numbers.counter_torque, _colours(len(names))), (-reach, reach), title)
 
 
