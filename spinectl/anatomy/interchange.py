@@ -189,9 +189,8 @@ def export_verdicts(solution, out, fmt: str, osim_muscle: str = "millard") -> li
         -0.0327 1/s"``, then for a Millard file OpenSim's, with the remedy where it grows.
     """
     springs = float(np.sum(solution.local_stiffness))
-    what = (
-        f"global PCSA {m2_to_cm2(np.sum(solution.pcsa)):.2f} cm^2 (the per-segment optimum unless given), "
-        + (f"local stiffness {springs:.1f} N m/rad in all as joint springs" if springs else "no local stiffness")
+    what = f"global PCSA {m2_to_cm2(np.sum(solution.pcsa)):.2f} cm^2 (the per-segment optimum unless given), " + (
+        f"local stiffness {springs:.1f} N m/rad in all as joint springs" if springs else "no local stiffness"
     )
     lines = [
         f"exported: {what}",
