@@ -258,7 +258,7 @@ class Design:
         lines = [
             self.model.get("header", "preset unknown"),
             f"E = {self.eccentricity * 100:.2f} cm, Lambda = {self.lordosis * 100:.2f} cm, delay "
-            f"{delay_text(self.delay)}, activation lag {self.activation_time_constant * 1000:.4g} ms; "
+            f"{self._delay_words()}, activation lag {self.activation_time_constant * 1000:.4g} ms; "
             f"status {self.status}",
             "",
             f"{criterion('joint', len(self.segments))}: least co-contraction ({self.method})",
@@ -271,8 +271,8 @@ class Design:
         ]
         lines += [
             (
-                f"every segment at once: activation {self.activation:.4f} x minimum PCSA "
-                f"({m2_to_cm2(self.pcsa):.2f} cm^2)"
+                f"one activation for every segment (the largest above): {self.activation:.4f} x minimum PCSA "
+                f"({m2_to_cm2(self.pcsa):.2f} cm^2); tau_m: each segment's exact delay margin at its activation"
                 if np.isfinite(self.activation)
                 else f"no activation in [0, 1] meets the delay at every segment; the largest delay met: "
                 f"{delay_text(self.largest_delay)}"
@@ -310,12 +310,20 @@ class Design:
             f"(activation {c.activation:.4g} x the minimum stabilising PCSA at this K, which shrinks as K grows)"
         ]
         if c.kp is not None and np.all(np.isfinite(c.kp)):
-            lines.append("  gains: " + gains_text(names, c.kp, c.kd))
+            lines.append("  gains (kp [N m/rad], kd [N m s/rad]): " + gains_text(names, c.kp, c.kd))
         if np.isfinite(c.fraction):
             lines.append(self._boundary_line())
         if self.searched is not None:
             lines += self.searched.lines(names, c.fraction, c.least_static)
         return lines
+
+    def _delay_words(self) -> str:
+        """The delay designed for, and the one asked for where ``--margin R`` made them differ."""
+        if self.margin_ratio == 1.0:
+            return delay_text(self.delay)
+        return (
+            f"{delay_text(self.nominal_delay)} (designed at {delay_text(self.delay)}: --margin {self.margin_ratio:g})"
+        )
 
     def _boundary_line(self) -> str:
         """The least value is a stability boundary; what a margin costs."""
