@@ -89,8 +89,12 @@ def atomic_path(target: str | Path, *, directory: bool = False) -> Iterator[Path
     """
     target = _named(target)
     with output_errors(target):
-        target.parent.mkdir(parents=True, exist_ok=True)
-        tmp = _temporary(target, directory)
+        made = _make_folder(target.parent)
+        try:
+            tmp = _temporary(target, directory)
+        except BaseException:
+            _remove_made(made)
+            raise
     try:
         with output_errors(target, errnos=DEVICE_ERRORS):  # the writer meets a full disk
             yield tmp
@@ -106,6 +110,7 @@ def atomic_path(target: str | Path, *, directory: bool = False) -> Iterator[Path
             shutil.rmtree(tmp, ignore_errors=True)
         else:
             tmp.unlink(missing_ok=True)
+        _remove_made(made)  # nothing written: not even the folders made for it
         raise
     if old is not None:  # the old folder, now at the temporary's name: only what was read goes
         _settle(old, target, seen, written)
@@ -191,6 +196,36 @@ def output_errors(target: str | Path, errnos=None) -> Iterator[None]:
             raise
         reason = exc.strerror or exc.__class__.__name__
         raise OutputError(f"cannot write {str(target)!r}: {reason}") from None
+
+
+def _make_folder(folder: Path) -> list[Path]:
+    """Make ``folder`` and its missing parents; return those made, deepest first (for :func:`_remove_made`)."""
+    made, missing = [], folder
+    while not missing.exists() and missing != missing.parent:
+        made.append(missing)
+        missing = missing.parent
+    folder.mkdir(parents=True, exist_ok=True)
+    return made
+
+
+def _remove_made(made: list[Path]) -> None:
+    """Remove the folders :func:`_make_folder` made, deepest first, while they are empty."""
+    for folder in made:
+        try:
+            folder.rmdir()
+        except OSError:  # another writer's file in it meanwhile: it stays
+            return
+
+
+def _in_nearest_folder(target: Path) -> Path:
+    """``target``'s name in the nearest folder that exists on its way: where a check can probe writing without
+    making the folders a write would make (an export refused after its check left an empty folder)."""
+    folder = target.parent
+    while not folder.exists() and folder != folder.parent:
+        folder = folder.parent
+    if not folder.is_dir():
+        raise NotADirectoryError(errno.ENOTDIR, f"{str(folder)!r} is not a folder")
+    return folder / target.name
 
 
 def _temporary(target: Path, directory: bool) -> Path:
@@ -398,8 +433,7 @@ def check_writable(target: str | Path) -> Path:
     with output_errors(target):
         if target.is_dir():
             raise IsADirectoryError(errno.EISDIR, "Is a directory")
-        target.parent.mkdir(parents=True, exist_ok=True)
-        _temporary(target, directory=False).unlink()
+        _temporary(_in_nearest_folder(target), directory=False).unlink()  # makes no folder: a check writes nothing
     return target
 
 
@@ -506,8 +540,7 @@ def check_folder(target: str | Path, names=()) -> Path:
                 "for a new one when the run ends (its other files are kept), which would pull it from under the "
                 "shell: run from another folder or name another for the output"
             )
-        target.parent.mkdir(parents=True, exist_ok=True)
-        _temporary(target, directory=True).rmdir()
+        _temporary(_in_nearest_folder(target), directory=True).rmdir()
         if target.is_dir():
             _inventory(target)  # a mount point or a pinned file inside: refused before the work
     for name in names:
@@ -561,7 +594,12 @@ def staged_directory(target: str | Path, names=(), replaces=()) -> Iterator[Path
             yield stage
         return
     with output_errors(target):
-        stage = _temporary(target, directory=True)
+        made = _make_folder(target.parent)
+        try:
+            stage = _temporary(target, directory=True)
+        except BaseException:
+            _remove_made(made)
+            raise
     old = None
     try:
         yield stage
@@ -574,6 +612,7 @@ def staged_directory(target: str | Path, names=(), replaces=()) -> Iterator[Path
     finally:
         if old is None:  # not swapped: the staging folder holds this run's files and links only
             shutil.rmtree(stage, ignore_errors=True)
+            _remove_made(made)
     if old is not None:
         _settle(old, target, seen, written)
     with output_errors(target):

@@ -52,7 +52,7 @@ def read_text(path: Path, field: str = "config") -> str:
             raise ConfigError(field, f"file not found: {shown}")
         if not path.is_file():  # a folder, or a device such as /dev/zero that never ends
             raise ConfigError(field, f"not a regular file: {shown}")
-        with path.open("rb") as stream:  # at most the bound: a file that grows meanwhile is still refused
+        with path.open(mode="rb") as stream:  # at most the bound: a file that grows meanwhile is still refused
             data = stream.read(MAX_TEXT_BYTES + 1)
         if len(data) > MAX_TEXT_BYTES:
             raise ConfigError(field, f"{shown} is larger than {MAX_TEXT_BYTES // 2**20} MiB: not a spinectl TOML file")

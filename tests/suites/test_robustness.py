@@ -616,7 +616,27 @@ def test_check_writable_fails_where_the_write_would_and_leaves_nothing(tmp_path)
     assert check_writable(tmp_path / "new" / "out.nc") == tmp_path / "new" / "out.nc"
     assert check_writable(tmp_path / "a_file") == tmp_path / "a_file"
     assert (tmp_path / "a_file").read_text() == "keep"
-    assert sorted(p.name for p in tmp_path.rglob("*")) == ["a_file", "new", "taken"]  # no file made
+    assert sorted(p.name for p in tmp_path.rglob("*")) == ["a_file", "taken"]  # no file, and no folder, made
+
+
+def test_a_failed_write_removes_the_folders_it_made(tmp_path):
+    """A write into folders that do not exist yet makes them; if the writer fails (a full disk, Ctrl-C), they go
+    too: nothing is left (before: ``export --out full/sub/d.xml`` onto a full disk left an empty ``sub``); a
+    folder that held something before stays."""
+    from spinectl.atomic import atomic_path, staged_directory
+
+    (tmp_path / "kept").mkdir()
+    for target in (tmp_path / "new" / "deeper" / "out.txt", tmp_path / "kept" / "new" / "out.txt"):
+        with pytest.raises(OSError, match="No space"), atomic_path(target) as tmp:
+            tmp.write_text("half")
+            raise OSError(28, "No space left on device")
+    with pytest.raises(KeyboardInterrupt), staged_directory(tmp_path / "made" / "figures") as stage:
+        (stage / "a.png").write_bytes(b"x")
+        raise KeyboardInterrupt
+    assert sorted(p.relative_to(tmp_path).as_posix() for p in tmp_path.rglob("*")) == ["kept"]
+    with atomic_path(tmp_path / "new" / "out.txt") as tmp:  # a write that succeeds keeps its folder
+        tmp.write_text("whole")
+    assert (tmp_path / "new" / "out.txt").read_text() == "whole"
 
 
 def _links(folder) -> None:
