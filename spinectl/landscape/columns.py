@@ -259,7 +259,7 @@ def _coefficient_columns(coeffs) -> dict[str, np.ndarray]:
 
 
 def counter_torque_max_columns(result) -> dict[str, np.ndarray]:
-    """The largest |CT_k| over the segments at the chosen activation [N m] (the atlas's ±30 N m verdict).
+    """The largest abs(CT_k) over the segments at the chosen activation [N m] (the atlas's ±30 N m verdict).
 
     Parameters
     ----------
