@@ -154,7 +154,7 @@ def test_the_chains_local_stiffness_is_at_the_drawn_activation():
 
 @pytest.mark.parametrize("activation", [1.0, 0.5])
 def test_a_draws_outputs_are_the_sweeps_at_its_model_and_point(activation):
-    """Issue 33: the atlas computes with landscape/columns.py. A draw of the per-draw path equals point_columns of
+    """The atlas computes with landscape/columns.py (before, with functions of its own). A draw of the per-draw path equals point_columns of
     its own model at its own point, bit for bit (the same functions on the same coefficients and one-point block).
 
     The chain's local stiffness at the draw's co-contraction, cocontraction_local_stiffness_total_Nm_per_rad,
@@ -187,7 +187,7 @@ def test_a_draws_outputs_are_the_sweeps_at_its_model_and_point(activation):
 
 def test_the_fingerprint_holds_the_output_names(monkeypatch):
     """Chunks saved under an output's former name are another atlas's: renaming an output changes the fingerprint,
-    so a resumed run solves them again rather than read back outputs the verdicts no longer find (issue 33)."""
+    so a resumed run solves them again rather than read back outputs the verdicts no longer find."""
     spec = _spec()
     key = atlas.fingerprint(spec)
     former = {name.replace("cocontraction_", ""): v for name, v in atlas.DRAW_VARIABLES.items()}

@@ -1,6 +1,6 @@
 """The schema: every output name with one entry (units, description) and one function that computes it.
 
-Issue 33: the atlas computed its outputs with its own functions, and ``local_stiffness_total_Nm_per_rad`` meant
+Before, the atlas computed its outputs with its own functions, and ``local_stiffness_total_Nm_per_rad`` meant
 the whole minimum PCSA's local stiffness in the sweep and ``reflex.activation`` times it in the atlas. These
 tests walk the schema: each name is defined once, computed once (in landscape/columns.py) and written by the
 sweep, the study and the atlas only as defined.

@@ -309,7 +309,7 @@ def test_the_chains_sdps_are_outputs_on_request(tmp_path):
 def test_an_atlas_output_is_no_study_output(name):
     """The atlas's own outputs (schema.DRAW_VARIABLES) are refused by name, not met with "did you mean" a landscape
     variable: the co-contraction's local stiffness would be pointed at local_stiffness_total_Nm_per_rad, another
-    quantity (issue 33)."""
+    quantity."""
     with pytest.raises(ConfigError, match=rf"study.outputs\[1\]: .*'{name}' is an output of the atlas's draws"):
         study.parse_study(f"[study]\noutputs = ['status', '{name}']\n[axes]\n{GRID}")
 
