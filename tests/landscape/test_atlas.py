@@ -155,7 +155,8 @@ def test_the_chains_local_stiffness_is_at_the_drawn_activation():
 @pytest.mark.parametrize("activation", [1.0, 0.5])
 def test_a_draws_outputs_are_the_sweeps_at_its_model_and_point(activation):
     """The atlas computes with landscape/columns.py (before, with functions of its own). A draw of the per-draw
-    path equals point_columns of its own model at its own point, bit for bit (the same functions on the same coefficients and one-point block).
+    path equals point_columns of its own model at its own point, bit for bit (the same functions on the same
+    coefficients and one-point block).
 
     The chain's local stiffness at the draw's co-contraction, cocontraction_local_stiffness_total_Nm_per_rad,
     is the sweep's local_stiffness_total_Nm_per_rad (the whole minimum PCSA) bit for bit at reflex.activation = 1
