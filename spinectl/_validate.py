@@ -10,6 +10,8 @@ from __future__ import annotations
 import difflib
 import math
 import numbers
+import os
+import stat
 from collections.abc import Sequence
 
 from .errors import ParameterError
@@ -378,9 +380,6 @@ def file_fault(path, limit: int) -> str:
         E.g. ``"is not a regular file"``, ``"is larger than 16 MiB"``; ``""`` for a regular file within the
         limit, or one that does not exist (the reader says that).
     """
-    import os
-    import stat
-
     try:
         status = os.stat(path)  # follows links: a link to /dev/zero is /dev/zero
     except FileNotFoundError:

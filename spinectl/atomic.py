@@ -198,12 +198,19 @@ def output_errors(target: str | Path, errnos=None) -> Iterator[None]:
         raise OutputError(f"cannot write {str(target)!r}: {reason}") from None
 
 
+def _missing_folders(folder: Path) -> list[Path]:
+    """``folder`` and its parents that do not exist yet, deepest first (the nearest that exists is the last's
+    parent)."""
+    missing = []
+    while not folder.exists() and folder != folder.parent:
+        missing.append(folder)
+        folder = folder.parent
+    return missing
+
+
 def _make_folder(folder: Path) -> list[Path]:
     """Make ``folder`` and its missing parents; return those made, deepest first (for :func:`_remove_made`)."""
-    made, missing = [], folder
-    while not missing.exists() and missing != missing.parent:
-        made.append(missing)
-        missing = missing.parent
+    made = _missing_folders(folder)
     folder.mkdir(parents=True, exist_ok=True)
     return made
 
@@ -220,9 +227,8 @@ def _remove_made(made: list[Path]) -> None:
 def _in_nearest_folder(target: Path) -> Path:
     """``target``'s name in the nearest folder that exists on its way: where a check can probe writing without
     making the folders a write would make (an export refused after its check left an empty folder)."""
-    folder = target.parent
-    while not folder.exists() and folder != folder.parent:
-        folder = folder.parent
+    missing = _missing_folders(target.parent)
+    folder = missing[-1].parent if missing else target.parent
     if not folder.is_dir():
         raise NotADirectoryError(errno.ENOTDIR, f"{str(folder)!r} is not a folder")
     return folder / target.name

@@ -10,7 +10,7 @@ import sys
 import numpy as np
 
 from .. import jsondoc
-from .._validate import printable, show
+from .._validate import show
 from ..atomic import atomic_write_text
 from ..errors import ParameterError
 from ..model.config import DEFAULT_PRESET, PRESET_GUIDANCE, apply_overrides, load_config, set_parameters
@@ -349,7 +349,7 @@ def note_pcsa_slip(values: list[float] | None) -> None:
     if max(values, default=0.0) > limit:
         notes.append(f"{max(values):g} cm^2 is more than any muscle's PCSA (above {limit:g} cm^2); analysed as given")
     if any(notes):
-        print(f"spinectl: warning: --pcsa: {printable('; '.join(n for n in notes if n))}", file=sys.stderr)
+        note_after(f"--pcsa: {'; '.join(n for n in notes if n)}")
 
 
 def load_model(args: argparse.Namespace, aliases: dict | None = None) -> Model:
