@@ -460,6 +460,11 @@ class AnatomyResult:
     rhythm_size: int = 1
     joint_slopes: np.ndarray | None = None
 
+    @property
+    def activation_mean(self) -> float:
+        """The mean of :attr:`activations`; NaN for a model without muscles (its passive chain)."""
+        return float(self.activations.mean()) if self.activations.size else float("nan")
+
     def referee_error(self) -> float:
         """Largest relative difference between spinectl's and MuJoCo's eigenvalues, matched one to one.
 
@@ -498,7 +503,7 @@ class AnatomyResult:
             "global_singular_values_m_per_rad": cert.singular_values.tolist(),
             "global_null_space": cert.null_space.T.tolist(),
             "null_space_stiffness_Nm_per_rad": cert.null_space_stiffness.tolist(),
-            "activation_mean": float(self.activations.mean()),
+            "activation_mean": self.activation_mean,
             "control_unit": self.control_unit,
             "activation_source": self.activation_source,
             "stiffness_matrix_Nm_per_rad": free.stiffness.tolist(),
@@ -566,9 +571,9 @@ class AnatomyResult:
         lines = [
             f"{self.model['name']} ({self.model['source']}), {plane_text(self.plane)}, "
             + (
-                f"mean activation {self.activations.mean():.3g}"
+                f"mean activation {self.activation_mean:.3g}"
                 if self.control_unit == "1"
-                else f"mean control {self.activations.mean():.4g} {self.control_unit}"
+                else f"mean control {self.activation_mean:.4g} {self.control_unit}"
             )
             + f" ({self.activation_source})",
             f"muscles: {counts}; global muscles' moment-arm rank {cert.rank} of {len(free.joints)} "
