@@ -61,7 +61,7 @@ def _custom(name, parent, child, coordinate, function, height):
     )
 
 
-def build(path: Path, springs=SPRINGS, functions=None, muscle=False) -> Path:
+def build(path: Path, springs=SPRINGS, functions=None, muscle=False, slider=False) -> Path:
     """The three-joint model of the module docstring, written to ``path`` with OpenSim's API."""
     functions = functions or [osim.LinearFunction(s, 0.0) for s in SLOPES]
     model = osim.Model()
@@ -83,6 +83,10 @@ def build(path: Path, springs=SPRINGS, functions=None, muscle=False) -> Path:
         spring.setName(f"spring{k + 1}")
         spring.setStiffness(float(stiffness))
         model.addForce(spring)
+    if slider:  # a body on the top one that slides: its coordinate s4_coord_0 turns no joint
+        body = osim.Body("b4", 1.0, osim.Vec3(0), osim.Inertia(0.01, 0.01, 0.01))
+        model.addBody(body)
+        model.addJoint(osim.SliderJoint("s4", model.getBodySet().get("b3"), body))
     if muscle:  # a rigid-tendon Millard muscle from ground to the top body, in front of the joints
         fibre = osim.Millard2012EquilibriumMuscle("front", 500.0, 0.15, 0.1, 0.0)
         fibre.set_ignore_tendon_compliance(True)
@@ -262,6 +266,19 @@ def test_a_model_without_muscles_answers_its_passive_chain_with_the_slopes_shown
     assert doc["joint_stiffness_Nm_per_rad"] == [20.0] * 3
     assert main(["anatomy", str(path), "--mapping", str(mapping)]) == 0
     assert "the joints turn q1 0.5, q2 1, q3 0.25 rad per coordinate rad" in capsys.readouterr().out
+
+
+def test_a_chain_coordinate_that_turns_no_joint_is_refused_in_one_line(tmp_path, capsys):
+    """A mapping that puts a translation (a SliderJoint's coordinate) in the chain has no joint angle there:
+    one line naming the coordinate, exit 2, nothing on stdout."""
+    path = build(tmp_path / "slid.osim", slider=True)
+    mapping = tmp_path / "slid.toml"
+    mapping.write_text(MAPPING.replace('"q3"]', '"s4_coord_0"]'))
+    assert main(["anatomy", str(path), "--mapping", str(mapping)]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    assert "spinectl: error: tiny: chain coordinate(s) ['s4_coord_0'] turn no joint" in captured.err
+    assert len(captured.err.strip().splitlines()) == 1
 
 
 def test_myotorsos_coordinates_are_its_joint_angles(torso):
