@@ -200,10 +200,9 @@ def rhythm_in_angles(rhy: Rhythm, slopes: JointSlopes, name: str = "model") -> R
     sigma = np.diag(jac)
     own = sigma[ind]  # each independent coordinate's own slope
     qpp = -second[ind] / own**3
-    curvature = (
-        second[:, None] * (rhy.transform / own) ** 2
-        + sigma[:, None] * (rhy.curvature / own**2 + rhy.transform * qpp)
-        if np.allclose(jac, np.diag(sigma), rtol=0, atol=UNIT_TOLERANCE)
-        else jac @ rhy.curvature  # linear and uncurved (_require_supported): zero
-    )
+    if np.allclose(jac, np.diag(sigma), rtol=0, atol=UNIT_TOLERANCE):
+        curved = second[:, None] * (rhy.transform / own) ** 2
+        curvature = curved + sigma[:, None] * (rhy.curvature / own**2 + rhy.transform * qpp)
+    else:  # a full S is linear and the rhythm uncurved (_require_supported): no curvature
+        curvature = np.zeros_like(rhy.curvature)
     return replace(rhy, transform=transform, curvature=curvature)

@@ -61,7 +61,9 @@ def joint_slopes(engine, names, values: dict) -> JointSlopes:
     sizes = np.linalg.norm(own, axis=1)
     if not np.all(sizes > 0):
         still = [n for n, size in zip(names, sizes, strict=True) if not size > 0]
-        raise ModelError(f"{engine.name}: chain coordinate(s) {still} turn no joint here (a translation?): no joint angle")
+        raise ModelError(
+            f"{engine.name}: chain coordinate(s) {still} turn no joint here (a translation?): no joint angle"
+        )
     axes = own / sizes[:, None]
     axes *= np.where(axes @ axes[0] < 0, -1.0, 1.0)[:, None]
     jacobian = np.einsum("jkx,jx->jk", spins, axes)

@@ -50,8 +50,8 @@ from .engine import engine_output_to_stderr, model_file, one_line
 from .export_osim import require_opensim
 from .joint_angles import JointSlopes
 from .linearise import STEP, Linearisation, Rhythm
-from .opensim_angles import joint_slopes
 from .mapping import Mapping, default_mapping, located, read_mapping
+from .opensim_angles import joint_slopes
 
 
 @dataclass(frozen=True)
@@ -669,7 +669,7 @@ class OsimAnatomy(MappedModel):
         return [c.describe(values, self.engine) for c in used]
 
     def joint_slopes(self, plane: str = "sagittal", posture=None) -> JointSlopes:
-        """How the plane's chain joints turn per unit of its coordinates, by OpenSim's kinematics (:func:`joint_slopes`).
+        """How the plane's chain joints turn per unit of its coordinates, by OpenSim's frames (:func:`joint_slopes`).
 
         A CustomJoint's SpatialTransform may scale its coordinate (Christophy's ``flex_extension``
         turns L5/S1 0.125 rad per radian); the chains are per radian of each joint's rotation.

@@ -163,7 +163,8 @@ def test_added_joint_stiffness_is_k_per_joint_radian_and_s_k_s_on_the_coordinate
     np.testing.assert_allclose(
         con.stiffness_offset - con0.stiffness_offset, -k * np.diag([1 + (0.25 * COUPLING / 0.5) ** 2, 1.0]), atol=1e-9
     )
-    sprung = anatomy.load(build(tmp_path / "sprung.osim", [s + k * g**2 for s, g in zip(SPRINGS, SLOPES)]), mapping)
+    springs = [s + k * g**2 for s, g in zip(SPRINGS, SLOPES, strict=True)]
+    sprung = anatomy.load(build(tmp_path / "sprung.osim", springs), mapping)
     np.testing.assert_allclose(sprung.chain("sagittal").stiffness_offset, free.stiffness_offset, rtol=1e-7)
 
 
@@ -318,3 +319,61 @@ def test_christophys_skeleton_turns_l5s1_by_its_transforms_slope_and_answers_its
     result = analyse(loaded, joint_stiffness=50.0)
     assert result.to_dict()["joint_rad_per_coordinate_rad"] == pytest.approx(list(transforms))
     np.testing.assert_allclose(result.free.stiffness - free0.stiffness_offset, -50.0 * np.eye(5), atol=1e-9)
+
+
+def _composite(q0_posture: float):
+    """A rhythm over three coordinates (q1 = 0.3 q0 + 0.2 q0^2 on the chain, q2 = 0.5 q0 off it) and a chain of two
+    joints that turn nonlinearly (theta0 = q0 + 0.4 q0^2, theta1 = 0.7 q1 + 0.1 q1^2): the Rhythm and JointSlopes
+    at q0, and theta(theta0) in closed form, the reference."""
+    from spinectl.anatomy.joint_angles import JointSlopes
+    from spinectl.anatomy.linearise import Rhythm
+
+    q0 = q0_posture
+    q1 = 0.3 * q0 + 0.2 * q0**2
+    rhy = Rhythm((0,), (0, 1, 2), np.array([[1.0], [0.3 + 0.4 * q0], [0.5]]), np.array([[0.0], [0.4], [0.0]]))
+    slopes = JointSlopes(np.diag([1 + 0.8 * q0, 0.7 + 0.2 * q1]), np.array([0.8, 0.2]))
+
+    def angles(theta0):
+        q = (-1 + np.sqrt(1 + 1.6 * theta0)) / 0.8  # q0 of theta0
+        dep = 0.3 * q + 0.2 * q**2
+        return np.array([theta0, 0.7 * dep + 0.1 * dep**2, 0.5 * q])
+
+    return rhy, slopes, angles, q0 + 0.4 * q0**2
+
+
+def test_the_rhythm_in_joint_angles_is_the_composite_maps_derivatives():
+    """T_theta and its curvature are the first and second derivatives of theta(theta_ind), the rhythm composed with
+    the joints' curved transforms, by central differences of the closed form (the off-chain coordinate as it is)."""
+    from spinectl.anatomy.joint_angles import rhythm_in_angles
+
+    rhy, slopes, angles, theta0 = _composite(0.1)
+    ours = rhythm_in_angles(rhy, slopes)
+    h = 1e-4
+    first = (angles(theta0 + h) - angles(theta0 - h)) / (2 * h)
+    second = (angles(theta0 + h) - 2 * angles(theta0) + angles(theta0 - h)) / h**2
+    np.testing.assert_allclose(ours.transform[:, 0], first, rtol=1e-7)
+    np.testing.assert_allclose(ours.curvature[:, 0], second, rtol=1e-5, atol=1e-6)
+
+
+def test_a_joint_turned_by_several_coordinates_is_linear_or_refused():
+    """A full Jacobian S (joint 0 turned by q0 and q1) is a linear change of variables, K_theta = W^T K W with
+    W = S^-1 exactly; with a curved transform as well it is refused in one line (the curvature of a joint turned by
+    several coordinates is not taken)."""
+    from spinectl.anatomy.joint_angles import JointSlopes, linearisation_in_angles
+    from spinectl.anatomy.linearise import Linearisation
+    from spinectl.errors import ModelError
+
+    rng = np.random.default_rng(3)
+    k = rng.normal(size=(2, 2))
+    k = k + k.T
+    lin = Linearisation(
+        (0, 1), 2, np.zeros((2, 2, 0)), k, np.zeros((2, 2, 0)), np.zeros((2, 2)), np.eye(2),
+        np.zeros((2, 0)), np.array([1.0, -2.0]), np.zeros((0, 2)),
+    )  # fmt: skip
+    jacobian = np.array([[0.5, 0.2], [0.0, 1.0]])
+    w = np.linalg.inv(jacobian)
+    ours = linearisation_in_angles(lin, JointSlopes(jacobian, np.zeros(2)))
+    np.testing.assert_allclose(ours.stiffness_offset, w.T @ k @ w, rtol=1e-14)
+    np.testing.assert_allclose(ours.torque_offset, w.T @ np.array([1.0, -2.0]), rtol=1e-14)
+    with pytest.raises(ModelError, match="several chain coordinates and not linearly"):
+        linearisation_in_angles(lin, JointSlopes(jacobian, np.array([0.1, 0.0])))
