@@ -244,7 +244,7 @@ def global_certificate(anatomy: AnatomyEngine, chain: LinearChain, arms, a) -> G
     -------
     GlobalCertificate
     """
-    is_global = np.array([c == "global" for c in chain.control_class])
+    is_global = np.array([c == "global" for c in chain.control_class], bool)  # bool also without muscles
     _, sv, vt = np.linalg.svd(arms[is_global], full_matrices=True)
     sv = np.concatenate([sv, np.zeros(chain.n_joints - sv.size)])
     rank = int(np.sum(sv > RANK_TOLERANCE * sv.max())) if sv.size and sv.max() > 0 else 0
@@ -437,6 +437,10 @@ class AnatomyResult:
     rhythm_size : int
         How many coordinates the model's rhythm ties to the chain; 0: no rhythm (no joint
         equality or coupler), the constrained chain is the free one.
+    joint_slopes : numpy.ndarray or None
+        Where the chain's coordinates are not its joints' angles: each joint's rotation per unit of
+        its own coordinate [rad per coordinate rad] (the stiffnesses are per joint radian,
+        :mod:`spinectl.anatomy.joint_angles`); None where they are (a MuJoCo hinge).
     """
 
     model: dict
@@ -454,6 +458,12 @@ class AnatomyResult:
     control_unit: str = "1"
     activation_source: str = "given"
     rhythm_size: int = 1
+    joint_slopes: np.ndarray | None = None
+
+    @property
+    def activation_mean(self) -> float:
+        """The mean of :attr:`activations`; NaN for a model without muscles (its passive chain)."""
+        return float(self.activations.mean()) if self.activations.size else float("nan")
 
     def referee_error(self) -> float:
         """Largest relative difference between spinectl's and MuJoCo's eigenvalues, matched one to one.
@@ -493,7 +503,7 @@ class AnatomyResult:
             "global_singular_values_m_per_rad": cert.singular_values.tolist(),
             "global_null_space": cert.null_space.T.tolist(),
             "null_space_stiffness_Nm_per_rad": cert.null_space_stiffness.tolist(),
-            "activation_mean": float(self.activations.mean()),
+            "activation_mean": self.activation_mean,
             "control_unit": self.control_unit,
             "activation_source": self.activation_source,
             "stiffness_matrix_Nm_per_rad": free.stiffness.tolist(),
@@ -527,6 +537,8 @@ class AnatomyResult:
                 "modes_removed": free.stiffness.shape[0] - con.stiffness.shape[0],
             },
         }
+        if self.joint_slopes is not None:  # only where the units differ: a hinge's output stays as it was
+            out["joint_rad_per_coordinate_rad"] = self.joint_slopes.tolist()
         if self.mujoco_eigenvalues is not None:
             out["mujoco_eigenvalues"] = cplx(self.mujoco_eigenvalues)
             out["mujoco_relative_difference"] = self.referee_error()
@@ -535,6 +547,16 @@ class AnatomyResult:
         if self.reflex is not None:
             out["reflex"] = self.reflex
         return out
+
+    def _angle_note(self) -> list:
+        """One line where the coordinates are not the joints' angles: the slopes, and what the table is per."""
+        if self.joint_slopes is None:
+            return []
+        turns = ", ".join(f"{j} {s:.4g}" for j, s in zip(self.free.joints, self.joint_slopes, strict=True))
+        return [
+            f"per radian of each joint's rotation, not of its coordinate (stiffness, added stiffness, "
+            f"eigenvalues of -K): the joints turn {turns} rad per coordinate rad"
+        ]
 
     def table(self) -> str:
         """A plain-text table; every verdict names its criterion.
@@ -549,14 +571,15 @@ class AnatomyResult:
         lines = [
             f"{self.model['name']} ({self.model['source']}), {plane_text(self.plane)}, "
             + (
-                f"mean activation {self.activations.mean():.3g}"
+                f"mean activation {self.activation_mean:.3g}"
                 if self.control_unit == "1"
-                else f"mean control {self.activations.mean():.4g} {self.control_unit}"
+                else f"mean control {self.activation_mean:.4g} {self.control_unit}"
             )
             + f" ({self.activation_source})",
             f"muscles: {counts}; global muscles' moment-arm rank {cert.rank} of {len(free.joints)} "
             f"(singular values {', '.join(f'{s:.3g}' for s in cert.singular_values)} m/rad)",
             f"joint stiffness added: {self.joint_stiffness_added[0]:.4g} N m/rad per joint",
+            *self._angle_note(),
             "",
             f"{'joint':<16}{'-K_jj [N m/rad]':>16}  joint by joint (others fixed)",
             f"{'':<16}{'(> 0 restores)':>16}",
@@ -711,7 +734,14 @@ def analyse(
         control_unit=anatomy.control_unit,
         activation_source=_activation_source(anatomy, activation),
         rhythm_size=anatomy.rhythm_size(plane, posture),
+        joint_slopes=_slopes_shown(anatomy, plane, posture),
     )
+
+
+def _slopes_shown(anatomy: AnatomyEngine, plane: str, posture) -> np.ndarray | None:
+    """The chain joints' rotation per unit of their own coordinates, where that is not 1 (else None)."""
+    slopes = anatomy.joint_slopes(plane, posture)
+    return None if slopes.is_identity() else slopes.slopes
 
 
 def _activation_source(anatomy: AnatomyEngine, activation) -> str:

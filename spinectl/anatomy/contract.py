@@ -26,6 +26,7 @@ import numpy as np
 from .._validate import printable, show
 from ..errors import ModelError, ParameterError
 from ..model.linear_chain import LinearChain
+from .joint_angles import JointSlopes, linearisation_in_angles, rhythm_in_angles
 from .linearise import constrained_chain, free_chain
 from .mapping import MAX_STIFFNESS, Mapping
 
@@ -119,6 +120,21 @@ class AnatomyEngine(Protocol):
         -------
         numpy.ndarray, shape (n,)
             [N m/rad].
+        """
+
+    def joint_slopes(self, plane: str = "sagittal", posture=None) -> JointSlopes:
+        """How the plane's chain joints turn per unit of its coordinates at a posture (identity: a hinge).
+
+        Parameters
+        ----------
+        plane : str
+            One of the mapping's planes.
+        posture : optional
+            The operating point (:meth:`posture`).
+
+        Returns
+        -------
+        JointSlopes
         """
 
     def rhythm(self, plane: str = "sagittal", posture=None) -> tuple:
@@ -410,8 +426,49 @@ class MappedModel:
         """
         return f"{self.source}, {plane}"
 
+    def joint_slopes(self, plane: str = "sagittal", posture=None) -> JointSlopes:
+        """How the plane's chain joints turn per unit of its coordinates: the identity (a hinge's coordinate).
+
+        An engine whose coordinates are not its joints' angles (OpenSim's CustomJoint) measures them.
+
+        Parameters
+        ----------
+        plane : str
+            One of the mapping's planes.
+        posture : optional
+            The operating point (:meth:`posture`).
+
+        Returns
+        -------
+        JointSlopes
+        """
+        return JointSlopes.identity(len(self.plane_joints(plane)))
+
+    def joint_rhythm(self, plane: str = "sagittal", posture=None) -> tuple:
+        """The rhythm over the joints' angles (:func:`~spinectl.anatomy.joint_angles.rhythm_in_angles`).
+
+        The variables of the chains (:meth:`chains`) and their Linearisation: what their torques pair with.
+
+        Parameters
+        ----------
+        plane : str
+            One of the mapping's planes.
+        posture : optional
+            The operating point (:meth:`posture`).
+
+        Returns
+        -------
+        tuple
+            (Rhythm in joint angles, names of the coordinates it involves, the chain's first).
+        """
+        rhy, involved = self.rhythm(plane, posture)
+        return rhythm_in_angles(rhy, self.joint_slopes(plane, posture), self.name), involved
+
     def chains(self, plane: str = "sagittal", posture=None, joint_stiffness="none") -> tuple:
         """The free chain and the chain constrained by the model's rhythm, as LinearChain objects.
+
+        Both per radian of each joint's rotation, the engine's coordinates changed to the joints' angles
+        (:mod:`spinectl.anatomy.joint_angles`, :meth:`joint_slopes`), and so is the stiffness added.
 
         Parameters
         ----------
@@ -426,9 +483,11 @@ class MappedModel:
         -------
         tuple
             (free :class:`~spinectl.model.linear_chain.LinearChain`, constrained one,
-            the :class:`~spinectl.anatomy.linearise.Linearisation`).
+            the :class:`~spinectl.anatomy.linearise.Linearisation` in the joints' angles).
         """
         lin, rhy, involved = self.linearise(plane, posture)
+        slopes = self.joint_slopes(plane, posture)
+        lin, rhy = linearisation_in_angles(lin, slopes, self.name), rhythm_in_angles(rhy, slopes, self.name)
         n = lin.n
         added = self.added_stiffness(joint_stiffness, n)
         source = self.chain_source(plane, posture)
@@ -542,11 +601,12 @@ class MappedModel:
         return ParameterError("plot", f"{self.name}'s engine gives no geometry to draw; analyse it without --plot")
 
 
-def lordosis_direction(anatomy, rhy, n: int, degrees: float) -> np.ndarray:
-    """The change of the involved joints' angles [rad] that moves the chain by ``degrees`` along the rhythm.
+def lordosis_direction(anatomy, rhy, n: int, degrees: float, slopes=None) -> np.ndarray:
+    """The change of the involved coordinates [rad] that moves the chain's joint angles by ``degrees`` in sum.
 
     The rhythm's first independent coordinate and the joints it slaves move as its column of T;
     a chain whose first joint no rhythm ties to another has no lordosis to move along (one line).
+    The sum is of the joints' rotations (S T's column over the chain), not of their coordinates.
 
     Parameters
     ----------
@@ -557,20 +617,24 @@ def lordosis_direction(anatomy, rhy, n: int, degrees: float) -> np.ndarray:
     n : int
         The number of chain joints.
     degrees : float
-        The change of the chain's summed angle [deg].
+        The change of the chain's summed joint angle [deg].
+    slopes : JointSlopes, optional
+        The chain's joint rotation per coordinate (:meth:`MappedModel.joint_slopes`); default the identity.
 
     Returns
     -------
     numpy.ndarray, shape (len(rhy.dofs),)
+        In the rhythm's coordinates.
     """
     direction = rhy.transform[:, 0]
+    turned = direction[:n] if slopes is None or slopes.is_identity() else slopes.jacobian @ direction[:n]
     if n > 1 and np.count_nonzero(direction[:n]) < 2:
         raise ModelError(
             f"lordosis: {anatomy.name} has no rhythm (joint equality or coordinate coupler) that ties its chain's "
             "first joint to the others, so the chain has no lordosis to move along; give the model one "
             "(spinectl's export: export it at another Lambda)"
         )
-    return direction * np.radians(degrees) / direction[:n].sum()
+    return direction * np.radians(degrees) / turned.sum()
 
 
 def plane_axes(gravity, normal, default_up) -> tuple:

@@ -203,7 +203,7 @@ def default_mapping(name: str, *aliases: str) -> Mapping:
 
 
 def check_mapping(engine: Engine, mapping: Mapping) -> None:
-    """Check that every body and joint the mapping names exists, and that the model has muscles.
+    """Check that every body and joint the mapping names exists (a model without muscles is its passive chain).
 
     Parameters
     ----------
@@ -224,10 +224,6 @@ def check_mapping(engine: Engine, mapping: Mapping) -> None:
         if missing:
             lacks = f"names joints that {engine.name} lacks: {missing}"
             raise ParameterError(located(mapping.path, f"planes.{plane}"), lacks)
-    if not engine.muscle_ids().size:
-        raise ParameterError(
-            "model", f"{engine.name} has no muscles (no tendon actuator with muscle or no activation dynamics)"
-        )
 
 
 def body_groups(engine: Engine, mapping: Mapping) -> dict:

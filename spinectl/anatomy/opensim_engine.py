@@ -48,8 +48,10 @@ from ..errors import ModelError, ParameterError
 from .contract import MappedModel, lordosis_direction, plane_axes
 from .engine import engine_output_to_stderr, model_file, one_line
 from .export_osim import require_opensim
+from .joint_angles import JointSlopes
 from .linearise import STEP, Linearisation, Rhythm
 from .mapping import Mapping, default_mapping, located, read_mapping
+from .opensim_angles import joint_slopes
 
 
 @dataclass(frozen=True)
@@ -311,7 +313,7 @@ def _base_body(frame) -> str:
 
 
 def _check_mapping(engine: OsimEngine, mapping: Mapping) -> None:
-    """Every mapped body and coordinate exists, and the model has muscles: else one line."""
+    """Every mapped body and coordinate exists: else one line (a model without muscles is its passive chain)."""
     bodies = {engine.model.getGround().getName()} | {
         engine.model.getBodySet().get(i).getName() for i in range(engine.model.getBodySet().getSize())
     }
@@ -326,8 +328,6 @@ def _check_mapping(engine: OsimEngine, mapping: Mapping) -> None:
         if missing:
             lacks = f"names coordinates that {engine.name} lacks: {missing}"
             raise ParameterError(located(mapping.path, f"planes.{plane}"), lacks)
-    if engine.model.getMuscles().getSize() == 0:
-        raise ParameterError("model", f"{engine.name} has no muscles")
 
 
 def _classify(engine: OsimEngine, mapping: Mapping) -> tuple:
@@ -399,7 +399,7 @@ def _arms_and_passive(engine: OsimEngine, names, values: dict):
             [-muscles.get(i).computeMomentArm(state, engine.coordinate(c)) for c in names]
             for i in range(muscles.getSize())
         ]
-    )
+    ).reshape(muscles.getSize(), len(names))  # (0, s) without muscles: the passive chain
     forces = model.getForceSet()
     for i in range(forces.getSize()):  # gravity and the passive forces only: muscles and actuators off
         force = forces.get(i)
@@ -668,6 +668,25 @@ class OsimAnatomy(MappedModel):
         _, _, used = coupler_rhythm(self.engine, self.plane_joints(plane), values)
         return [c.describe(values, self.engine) for c in used]
 
+    def joint_slopes(self, plane: str = "sagittal", posture=None) -> JointSlopes:
+        """How the plane's chain joints turn per unit of its coordinates, by OpenSim's frames (:func:`joint_slopes`).
+
+        A CustomJoint's SpatialTransform may scale its coordinate (Christophy's ``flex_extension``
+        turns L5/S1 0.125 rad per radian); the chains are per radian of each joint's rotation.
+
+        Parameters
+        ----------
+        plane : str
+            One of the mapping's planes.
+        posture : dict, optional
+            Coordinate name -> value [rad].
+
+        Returns
+        -------
+        JointSlopes
+        """
+        return joint_slopes(self.engine, self.plane_joints(plane), self.posture(posture))
+
     def chain_source(self, plane: str, posture=None) -> str:
         """The chains' source line; away from the default posture, with the couplers' slopes there.
 
@@ -710,7 +729,7 @@ class OsimAnatomy(MappedModel):
         rows = list(range(lin.n))
         if equilibrium == "free":
             return rows, lin.torque_per_muscle[rows], lin.torque_offset[rows]
-        rhy, _ = self.rhythm(plane, posture)
+        rhy, _ = self.joint_rhythm(plane, posture)  # lin is in the joints' angles (MappedModel.chains)
         return rows, rhy.transform.T @ lin.torque_per_muscle, rhy.transform.T @ lin.torque_offset
 
     def volume_weights(self) -> np.ndarray:
@@ -734,7 +753,8 @@ class OsimAnatomy(MappedModel):
 
         The couplers' first independent coordinate and the coordinates they slave to it move as the
         couplers' slopes at the default posture distribute them (:func:`coupler_rhythm`), the chain's
-        angles summing to ``degrees``; the engine sets them through OpenSim's coordinates
+        joint angles (not its coordinates, :meth:`joint_slopes`) summing to ``degrees``; the engine sets
+        them through OpenSim's coordinates
         (:meth:`OsimEngine.set_posture`).
 
         Parameters
@@ -749,7 +769,8 @@ class OsimAnatomy(MappedModel):
             Coordinate name -> value [rad].
         """
         rhy, involved = self.rhythm(plane)
-        step = lordosis_direction(self, rhy, len(self.plane_joints(plane)), degrees)
+        n = len(self.plane_joints(plane))
+        step = lordosis_direction(self, rhy, n, degrees, self.joint_slopes(plane))
         engine = self.engine
         return {n: engine.coordinate(n).getDefaultValue() + float(v) for n, v in zip(involved, step, strict=True)}
 
@@ -792,7 +813,8 @@ class OsimAnatomy(MappedModel):
         posture : dict, optional
             Coordinate name -> value [rad].
         moved : array_like, shape (len(joints),), optional
-            Added to the coordinates' values [rad] (the others held, the couplers off).
+            Added to the joints' angles [rad] (the chains' variables, :meth:`joint_slopes`), the others
+            held, the couplers off.
 
         Returns
         -------
@@ -802,6 +824,9 @@ class OsimAnatomy(MappedModel):
         engine = self.engine
         values = self.posture(posture)
         shifted = dict(values)
+        if moved is not None:  # the coordinates' change that turns the joints by ``moved``
+            slopes = joint_slopes(engine, joints, values)
+            moved = moved if slopes.is_identity() else np.linalg.solve(slopes.jacobian, np.asarray(moved, float))
         for name, change in zip(joints, np.zeros(len(joints)) if moved is None else moved, strict=True):
             shifted[name] = values.get(name, engine.coordinate(name).getDefaultValue()) + float(change)
         engine.set_posture(shifted)

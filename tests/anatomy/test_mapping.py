@@ -58,8 +58,9 @@ def test_unknown_model_is_one_line():
         anatomy.load("no-such-model")
 
 
-def test_a_model_without_muscles_or_mapped_bodies_is_refused(tmp_path, torso):
-    """An MJCF without the mapped bodies, and one without muscles, each give one line naming the problem."""
+def test_a_model_without_mapped_bodies_is_refused_and_one_without_muscles_is_its_passive_chain(tmp_path, torso):
+    """An MJCF without the mapped bodies gives one line naming the problem; one without muscles loads as its
+    passive chain (no controls; test_passive_chain.py checks its numbers)."""
     from spinectl import anatomy
     from spinectl.anatomy.mapping import MAPPINGS
 
@@ -74,8 +75,8 @@ def test_a_model_without_muscles_or_mapped_bodies_is_refused(tmp_path, torso):
     mapping.write_text(
         '[bodies]\npelvis = ["sacrum"]\nvertebrae = ["l1"]\nthorax = ["torso"]\n[planes]\nsagittal = ["j"]\n'
     )
-    with pytest.raises(ParameterError, match="no muscles"):
-        anatomy.load(path, mapping)
+    passive = anatomy.load(path, mapping, cache=False).chain("sagittal")
+    assert passive.joints == ("j",) and passive.n_controls == 0
 
 
 def test_bad_activation_and_plane_are_refused(torso):
