@@ -32,12 +32,24 @@ class OutputWarning(UserWarning):
 def inventory(root: Path, files: bool = True) -> dict[str, tuple]:
     """Every entry below ``root`` (path relative to it) -> its :func:`_identity`, read now.
 
-    Raises :class:`OutputError` for what a swap of ``root`` cannot move or remove: a
-    mount point inside (an entry on another device, or a mount point of
-    system's table of mounts, e.g. a bind mount on the same device), an immutable or
-    append-only entry, or a folder (``root`` too) whose entries this user cannot remove.
-    With ``files=False`` the attributes of regular files are not read (one ``open`` each):
-    for a caller that links every file, which Linux refuses for such a file.
+    Parameters
+    ----------
+    root : Path
+        The folder a swap will replace.
+    files : bool
+        False: the attributes of regular files are not read (one ``open`` each), for a caller that
+        links every file (Linux refuses to link an immutable or append-only one).
+
+    Returns
+    -------
+    dict of str to tuple
+
+    Raises
+    ------
+    OutputError
+        What a swap of ``root`` cannot move or remove: a mount point inside (another device, or in the
+        system's table of mounts), an immutable or append-only entry, a folder whose entries this user
+        cannot remove.
     """
     top = os.lstat(root)
     mounted = _mount_points_below(root)
@@ -68,7 +80,16 @@ def _identity(info: os.stat_result) -> tuple:
 
 
 def check_removable(path: Path, info: os.stat_result, root: Path | None = None) -> None:
-    """:class:`OutputError` if the entry ``path`` is pinned, or is a folder whose entries cannot be removed."""
+    """:class:`OutputError` if the entry ``path`` is pinned, or is a folder whose entries cannot be removed.
+
+    Parameters
+    ----------
+    path : Path
+    info : os.stat_result
+        Its ``lstat``.
+    root : Path, optional
+        The folder the message names (default: ``path``'s parent).
+    """
     pinned = _pinned(path, info)
     if pinned:
         raise _refused(root or path.parent, path, f"is {pinned}")
@@ -93,6 +114,15 @@ def settle(old: Path, new: Path, seen: dict[str, tuple], written: frozenset) -> 
     holds only a kept copy; where the run wrote that name too (``written``, top-level
     names), the old folder is kept, renamed to a visible ``<name>.kept-…`` beside, with
     an :class:`OutputWarning`.
+
+    Parameters
+    ----------
+    old, new : Path
+        The old folder (swapped aside) and the new one (at the target).
+    seen : dict of str to tuple
+        :func:`inventory` of the old folder, read before the swap.
+    written : frozenset of str
+        The top-level names this run wrote.
     """
     device = os.lstat(old).st_dev
     for _ in range(3):  # an entry that came while the folder was emptied: look again

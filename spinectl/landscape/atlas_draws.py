@@ -88,6 +88,17 @@ def saltelli_unit(spec: AtlasSpec) -> np.ndarray:
 
 
 def unit_problem(n: int) -> dict:
+    """SALib's problem of ``n`` variables on the unit cube (the priors' quantiles map them).
+
+    Parameters
+    ----------
+    n : int
+        D, the number of priors.
+
+    Returns
+    -------
+    dict
+    """
     return {"num_vars": n, "names": [f"x{i}" for i in range(n)], "bounds": [[0.0, 1.0]] * n}
 
 

@@ -621,6 +621,14 @@ def linear_chain(model: Model, eccentricity: float, lordosis: float, coefficient
     Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012). Spinal lordosis
     optimizes the requirements for a stable erect posture. Theor Biol Med Model 9:13.
     doi:10.1186/1742-4682-9-13.
+
+    Examples
+    --------
+    >>> from spinectl import load_preset
+    >>> from spinectl.model.chain import linear_chain
+    >>> chain = linear_chain(load_preset("wagner2012"), 0.03, 0.04)
+    >>> chain.controls, chain.control_unit, chain.mass_matrix.shape
+    (('straight', 'oblique_outer', 'oblique_inner'), 'cm^2', (5, 5))
     """
     e, lam = float(eccentricity), float(lordosis)
     coeffs = chain_coefficients(model, e, lam) if coefficients is None else coefficients

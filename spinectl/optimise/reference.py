@@ -314,6 +314,14 @@ def solve_point(model: Model, eccentricity: float, lordosis: float) -> PointOpti
     .. [1] Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012). Spinal
        lordosis optimizes the requirements for a stable erect posture. Theor Biol Med
        Model 9:13. doi:10.1186/1742-4682-9-13
+
+    Examples
+    --------
+    >>> from spinectl import load_preset
+    >>> from spinectl.optimise import solve_point
+    >>> optimum = solve_point(load_preset("wagner2012"), 0.03, 0.04)
+    >>> optimum.status, round(optimum.min_pcsa * 1e4, 1)  # [cm^2]
+    ('optimal', 35.8)
     """
     data = point_data(model, eccentricity, lordosis)
     return point_optimum(data, model.optimisation.ct_tolerance, eccentricity, lordosis)
