@@ -176,6 +176,7 @@ def wilson(successes: int, n: int, confidence: float) -> dict[str, float]:
     """
     from scipy.stats import binomtest
 
+    # Wilson's interval, not the normal one: it stays inside [0, 1] and keeps its level for a rare verdict
     ci = binomtest(int(successes), int(n)).proportion_ci(confidence_level=confidence, method="wilson")
     return {"p": successes / n, "low": float(ci.low), "high": float(ci.high)}
 
@@ -260,7 +261,7 @@ def summarise(spec: AtlasSpec, values: dict, outputs: dict) -> AtlasResult:
     AtlasResult
     """
     n = outputs["status"].size
-    rows = probability_rows(spec, n)
+    rows = probability_rows(spec, n)  # A's and B's rows only: the others mix two draws' columns, no cohort's member
     found = verdicts(spec, outputs)
     probabilities = {name: wilson(int(v[rows].sum()), rows.size, spec.confidence) for name, v in found.items()}
     names = [o for o in OUTPUTS if o in outputs]

@@ -83,6 +83,7 @@ def chain_positions(q, cor):
     n = cor.shape[-2]
     moved = np.array(np.broadcast_to(cor, np.broadcast_shapes(q.shape + (2,), cor.shape)))
     angle = np.zeros(moved.shape[:-2])
+    # from the pelvis up: CoR j turns about CoR j + 1 by every joint angle below it (the pelvis is fixed)
     for j in range(n - 2, -1, -1):
         angle = angle + q[..., j + 1]
         moved[..., j, :] = moved[..., j + 1, :] + rotate(cor[..., j, :] - cor[..., j + 1, :], angle)
@@ -288,6 +289,7 @@ def state_matrix(mass, stiffness, damping):
     """
     mass, stiffness, damping = np.broadcast_arrays(*(np.asarray(x, float) for x in (mass, stiffness, damping)))
     n = mass.shape[-1]
+    # a massless level makes M singular: no state form exists, so NaN rather than a solve's noise
     singular = np.linalg.cond(mass) > 1.0 / np.finfo(float).eps
     regular = np.where(singular[..., None, None], np.eye(n), mass)
     lower = np.linalg.solve(regular, np.concatenate([stiffness, damping], axis=-1))  # (..., n, 2 n)
@@ -321,6 +323,7 @@ def dynamic_eigenvalues(mass, stiffness, damping):
     a = state_matrix(mass, stiffness, damping)
     finite = np.all(np.isfinite(a), axis=(-2, -1))
     eigs = np.linalg.eigvals(np.where(finite[..., None, None], a, 0.0)).astype(complex)
+    # rightmost first: the first eigenvalue decides stability (stable sort: conjugates keep their order)
     eigs = np.take_along_axis(eigs, np.argsort(-eigs.real, axis=-1, kind="stable"), axis=-1)
     return np.where(finite[..., None], eigs, complex(np.nan, np.nan))
 
@@ -446,6 +449,7 @@ class ChainCoefficients:
             Symmetric [N m/rad]; its diagonal is S_k - k_k.
         """
         muscular = np.einsum("...jkm,...m->...jk", self.stiffness_per_pcsa, np.asarray(pcsa, float))
+        # the passive stiffness and the local muscles span one joint each: they enter the diagonal only
         diagonal = self.passive_stiffness + np.asarray(local_stiffness, float)
         return muscular + self.gravity_stiffness - diagonal[..., None] * np.eye(diagonal.shape[-1])
 
@@ -493,6 +497,9 @@ def _monomial_coefficients(model: Model):
     """
     upper, lower, to_muscle, l0, f_l, f_l_slope, f_h_slope = _fibre_laws(model)
     e = lower - upper
+    # the lever arm is affine in the CoR c = (x, y): h = a + b x + d y, since the fibre's line does not move
+    # with c. So h_j h_k and the Hessian are quadratic in the CoRs' coordinates: per fibre, eight numbers
+    # (one per monomial), and every grid point's matrices are one matrix product, no loop over fibres.
     a, b, d = cross2(upper, e) / l0, -e[:, 1] / l0, e[:, 0] / l0
     zero, one = np.zeros_like(a), np.ones_like(a)
     hh = np.stack([a * a, a * b, a * d, b * b, b * d, d * d, zero, zero])  # h_j h_k
@@ -538,7 +545,9 @@ def _gravity_stiffness(model: Model, y):
     w (sum_{b < hi} Y_b - hi y_hi).
     """
     n = y.shape[-1]
-    higher = np.minimum.outer(np.arange(n), np.arange(n))  # CoRs are ordered top to bottom
+    # dtau_j/dq_k moves what both joints carry, the weight above the higher of CoRs j and k, so the
+    # entry depends on that CoR alone (CoRs are ordered top to bottom: the higher has the lower index)
+    higher = np.minimum.outer(np.arange(n), np.arange(n))
     y_hi = y[..., higher]
     below = np.concatenate([np.zeros(y.shape[:-1] + (1,)), np.cumsum((y[..., :-1] + y[..., 1:]) / 2, axis=-1)], -1)
     levels = level_weight(model) * (below[..., higher] - higher * y_hi)

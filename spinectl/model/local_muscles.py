@@ -85,7 +85,8 @@ def local_damping_per_stiffness(model: Model) -> float:
     local = model.local
     l_opt = model.fibre.optimal_length_ratio * local.length
     rest = laws.at_rest(laws.get_law(model.fibre.law), local.length, l_opt, model.fibre, model.errata)
-    slope = float(rest.relative_velocity_slope)  # (dT/dv) / T [s/m], < 0
+    slope = float(rest.relative_velocity_slope)  # (dT/dv) / T [s/m], < 0: the force falls as the muscle shortens
+    # d / k = (r^2 F abs(s)) / (q F r^2 / l): F and r cancel, so c_loc holds at every activation and lever arm
     return local.damping * local.length * -slope / local.stiffness_gain
 
 
