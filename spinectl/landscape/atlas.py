@@ -1,19 +1,10 @@
-"""The population stability atlas: cohort priors drawn, every draw solved, verdicts and Sobol' indices.
+"""The population stability atlas: verdicts' probabilities and Sobol' indices of the draws, run chunk by chunk.
 
-Draws of the priors (:mod:`spinectl.landscape.priors`) on a scrambled Sobol' sequence in
-Saltelli's design (SALib), and for each draw the joint-by-joint optimum (the fast path of
-:mod:`spinectl.optimise.active_set`, the paper's criterion: each CoR alone, the others fixed),
-the exact delay margin at the draw's co-contraction (:mod:`spinectl.reflex.maps`) and, with
-``chain``, the chain's least local stiffness at that co-contraction (all CoRs free; one stacked SDP per
-chunk, :func:`spinectl.optimise.coupled.least_local_stiffness_stacked`), every output computed by the
-sweep's functions (:mod:`spinectl.landscape.columns`) on the draws' coefficients. Then the probability of each
-verdict with its Wilson interval and the first- and total-order Sobol' indices with SALib's
-bootstrap intervals (docs/atlas.md).
-
-The draws are solved chunk by chunk on the study engine's executor
-(:func:`spinectl.landscape.study.executor.executor`: in-process, a local Dask cluster or an
-existing one, as ``spinectl study`` chooses), each chunk saved in ``DIR/chunks`` as it
-finishes, so that an interrupted atlas resumes where it stopped.
+The draws and their outputs are :mod:`spinectl.landscape.atlas_draws`. Here: the probability of each
+verdict with its Wilson interval and the first- and total-order Sobol' indices with SALib's bootstrap
+intervals (docs/atlas.md); the draws solved chunk by chunk on the study engine's executor
+(:func:`spinectl.landscape.study.executor.executor`), each chunk saved in ``DIR/chunks`` as it finishes
+so that an interrupted atlas resumes where it stopped; the output files.
 """
 
 from __future__ import annotations
