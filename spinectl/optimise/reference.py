@@ -24,12 +24,9 @@ self-stable activations), then the least total PCSA with that CT; the Pareto
 front is stage 2 for budgets from t* up to the total PCSA of the minimum-norm
 activation.
 
-Results are returned in SI (m^2). Infeasible points are answers, not
-exceptions: NaN values and a ``status``. cvxpy is imported only where a problem is built here
-(about 2 s). :mod:`spinectl.optimise.stacked` and :mod:`spinectl.optimise.active_set` solve the
-same problems for a block of points at once, fall back on this module and are checked against
-it; this module imports neither. The stability at one point with its minimum stabilising PCSA,
-solved by the fast path, is :mod:`spinectl.optimise.stabilising`.
+Results are returned in SI (m^2). Infeasible points are answers, not exceptions: NaN values and a
+``status``. cvxpy is imported only where a problem is built here (about 2 s); this module imports
+neither fast path, which fall back on it and are checked against it.
 """
 
 from __future__ import annotations
