@@ -250,6 +250,23 @@ def summarise(spec: AtlasSpec, values: dict, outputs: dict) -> AtlasResult:
     Returns
     -------
     AtlasResult
+
+    Examples
+    --------
+    A cohort whose upper-body mass alone varies, 30 to 50 kg, at the preset's posture (needs SALib):
+
+    >>> from spinectl.landscape import atlas
+    >>> from spinectl.landscape.priors import parse_atlas
+    >>> spec = parse_atlas(
+    ...     "[atlas]\\nsamples = 16\\nchain = false\\n[[prior]]\\nparameter = 'body.mass'\\n"
+    ...     "distribution = 'uniform'\\nbounds = [30.0, 50.0]\\nsource = 'an example'\\n"
+    ... )
+    >>> values = atlas.draw(spec, atlas.saltelli_unit(spec))
+    >>> result = atlas.summarise(spec, values, atlas.evaluate(spec, values))
+    >>> result.n_evaluations  # N (D + 2) = 16 x 3
+    48
+    >>> {name: round(v["p"], 2) for name, v in result.probabilities.items()}
+    {'stabilisable_joint_by_joint': 1.0, 'counter_torque_within_limit': 0.0, 'spine_stable_at_delay': 1.0}
     """
     n = outputs["status"].size
     rows = probability_rows(spec, n)  # A's and B's rows only: the others mix two draws' columns, no cohort's member

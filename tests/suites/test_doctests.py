@@ -14,6 +14,7 @@ import importlib
 import pytest
 
 MODULES = {
+    "spinectl.landscape.atlas": ("SALib",),
     "spinectl.model.config": (),
     "spinectl.model.chain": (),
     "spinectl.model.operating_point": (),
