@@ -191,11 +191,13 @@ def _body_bases(spec: AtlasSpec, mass: np.ndarray, height: np.ndarray):
     t = mass / spec.model.body.mass
     weights = []
     for j, node in enumerate(heights):
+        # L_j(y): 1 at height j, 0 at the others; a quadratic q(y) is sum_j L_j(y) q(y_j) exactly (3 nodes)
         lagrange = np.ones_like(height)
         for i, other in enumerate(heights):
             if i != j:
                 lagrange = lagrange * (height - other) / (node - other)
         weights.append(t * lagrange)
+    # the mass-free part A, (1 - t) of it: A = 2 f(m0 / 2, y_0) - f(m0, y_0), on the last base and the first
     weights[0] = weights[0] - (1.0 - t)
     weights.append(2.0 * (1.0 - t))
     return _bases(spec.model, heights), np.stack(weights, axis=-1)
@@ -222,6 +224,7 @@ def _mixed(found: list, weights: np.ndarray, k: np.ndarray):
 
     def mix(name):
         arrays = [getattr(c, name) for c in found]
+        # every term is affine in the bases' values (A + m q(y)), so the draw's term is their weighted sum
         w = weights.reshape(weights.shape[:1] + (1,) * (arrays[0].ndim - 1) + weights.shape[1:])
         return sum(w[..., j] * a for j, a in enumerate(arrays))
 
