@@ -8,13 +8,13 @@ folder replaces a folder in one step where the OS can (Linux's ``renameat2`` wit
 that a set of files changes as a whole.
 
 The folder swap moves only what it can move back and remove. Before it, the old
-folder is read whole (:func:`_inventory`): a mount point inside it (another
+folder is read whole (:func:`~spinectl._folder_swap.inventory`): a mount point inside it (another
 device, or one of the system's table of mounts: a rename would carry the
 mounted file system into the hidden old folder, whose removal would empty it), an
 immutable or append-only entry (``chattr +i``: it could be swapped away but never
 removed) or a folder whose entries this user cannot remove is refused with one line,
 before anything moves. After the swap the old folder is removed entry by entry
-(:func:`_settle`), never as a tree: an entry goes only if it was there when the run
+(:func:`~spinectl._folder_swap.settle`), never as a tree: an entry goes only if it was there when the run
 read the folder (it was kept in the new folder, or replaced by this run's file) or
 is a hard link to the entry of the new folder; an entry that another process wrote
 during the swap is moved back into the new folder, and one that cannot be (the
@@ -41,18 +41,15 @@ import os
 import re
 import shutil
 import socket
-import stat
 import tempfile
-import warnings
 import zlib
 from collections.abc import Iterator
 from pathlib import Path
 
+from ._folder_swap import OutputWarning, check_removable, inventory, settle  # noqa: F401 (OutputWarning public here)
 from ._oscalls import FS_IOC_GETFLAGS, PINNED_FLAGS, RENAME_EXCHANGE, RENAME_NOREPLACE  # noqa: F401 (public here)
 from ._oscalls import check_way as _check_way
 from ._oscalls import exchange as _exchange
-from ._oscalls import mount_points_below as _mount_points_below
-from ._oscalls import pinned as _pinned
 from ._oscalls import start_time as _start_time
 from ._oscalls import synced as _synced
 from ._validate import show
@@ -101,7 +98,7 @@ def atomic_path(target: str | Path, *, directory: bool = False) -> Iterator[Path
         with output_errors(target):
             _set_mode(tmp, target, directory)
             # an old folder: refused if a swap could not move or remove it all, before anything moves
-            seen = _inventory(target) if directory and target.is_dir() else {}
+            seen = inventory(target) if directory and target.is_dir() else {}
             written = frozenset(os.listdir(tmp)) if directory else frozenset()
             _synced(tmp)
             old = _swap(tmp, target, directory)
@@ -113,7 +110,7 @@ def atomic_path(target: str | Path, *, directory: bool = False) -> Iterator[Path
         _remove_made(made)  # nothing written: not even the folders made for it
         raise
     if old is not None:  # the old folder, now at the temporary's name: only what was read goes
-        _settle(old, target, seen, written)
+        settle(old, target, seen, written)
     with output_errors(target):
         _synced(target.parent, tree=False)  # the rename itself (after the swap: a failure must not undo it)
 
@@ -347,7 +344,7 @@ def remove_stale(folder: str | Path) -> list[Path]:
 
     Only names of :func:`_temporary` count, and only those whose owner is gone
     (:meth:`Owner.gone`); a folder goes only if nothing in it lies on another file
-    system or is pinned (:func:`_inventory`). Best effort: what cannot be removed stays.
+    system or is pinned (:func:`~spinectl._folder_swap.inventory`). Best effort: what cannot be removed stays.
 
     Parameters
     ----------
@@ -370,7 +367,7 @@ def remove_stale(folder: str | Path) -> list[Path]:
             continue
         with contextlib.suppress(OSError, OutputError):
             if entry.is_dir(follow_symlinks=False):
-                _inventory(Path(entry.path))  # nothing mounted or pinned inside
+                inventory(Path(entry.path))  # nothing mounted or pinned inside
                 shutil.rmtree(entry.path)
             else:
                 os.unlink(entry.path)
@@ -392,7 +389,7 @@ def _set_mode(tmp: Path, target: Path, directory: bool) -> None:
 def _swap(tmp: Path, target: Path, directory: bool) -> Path | None:
     """Put ``tmp`` in the place of ``target``; return where the old folder went (None: no old folder).
 
-    The old folder is not removed here: :func:`_settle` removes what the run read of it.
+    The old folder is not removed here: :func:`~spinectl._folder_swap.settle` removes what the run read of it.
     """
     if not (directory and target.exists()):
         os.replace(tmp, target)
@@ -548,7 +545,7 @@ def check_folder(target: str | Path, names=()) -> Path:
             )
         _temporary(_in_nearest_folder(target), directory=True).rmdir()
         if target.is_dir():
-            _inventory(target)  # a mount point or a pinned file inside: refused before the work
+            inventory(target)  # a mount point or a pinned file inside: refused before the work
     for name in names:
         with output_errors(target / name):
             if (target / name).is_dir():
@@ -620,7 +617,7 @@ def staged_directory(target: str | Path, names=(), replaces=()) -> Iterator[Path
             shutil.rmtree(stage, ignore_errors=True)
             _remove_made(made)
     if old is not None:
-        _settle(old, target, seen, written)
+        settle(old, target, seen, written)
     with output_errors(target):
         _synced(target.parent, tree=False)  # the rename itself
 
@@ -628,9 +625,9 @@ def staged_directory(target: str | Path, names=(), replaces=()) -> Iterator[Path
 def _keep_the_others(target: Path, stage: Path, replaced: set[str]) -> dict[str, tuple]:
     """Hard-link (or copy) into ``stage`` every entry of ``target`` that the run did not write, but ``replaced``.
 
-    Returns the :func:`_inventory` of ``target`` read before (what the swap may remove afterwards).
+    Returns the :func:`~spinectl._folder_swap.inventory` of ``target`` read before (what the swap may remove).
     """
-    seen = _inventory(target, files=False)  # the files kept are checked by their link (below)
+    seen = inventory(target, files=False)  # the files kept are checked by their link (below)
     link = functools.partial(_link_or_copy, root=target)
     for item in target.iterdir():
         new = stage / item.name
@@ -639,9 +636,9 @@ def _keep_the_others(target: Path, stage: Path, replaced: set[str]) -> dict[str,
                 kind = "a folder" if item.is_dir() else "a file"
                 raise OutputError(f"cannot write {str(item)!r}: {kind} of that name is in the way")
             if item.is_dir() and not item.is_symlink():
-                _inventory(item)  # not linked: its files are checked here
+                inventory(item)  # not linked: its files are checked here
             else:
-                _check_removable(item, os.lstat(item), target)
+                check_removable(item, os.lstat(item), target)
             continue
         if item.is_dir() and not item.is_symlink():
             shutil.copytree(item, new, symlinks=True, copy_function=link)
@@ -654,7 +651,7 @@ def _link_or_copy(source, destination, root: Path | None = None) -> None:
     """Hard-link ``source`` as ``destination`` (a symbolic link as itself), or copy it where links fail.
 
     Linux refuses to link an immutable or append-only file (EPERM): that is an
-    :class:`OutputError` (via :func:`_check_removable`), since the swap could not remove it.
+    :class:`OutputError` (via :func:`check_removable`), since the swap could not remove it.
     """
     if os.path.islink(source):
         os.symlink(os.readlink(source), destination)
@@ -663,7 +660,7 @@ def _link_or_copy(source, destination, root: Path | None = None) -> None:
         os.link(source, destination)
     except OSError as exc:  # no hard links on this file system, or a file that may not be linked
         if exc.errno == errno.EPERM and root is not None:
-            _check_removable(Path(source), os.lstat(source), root)
+            check_removable(Path(source), os.lstat(source), root)
         shutil.copy2(source, destination)
 
 
@@ -711,148 +708,3 @@ def _filled_in_place(target: Path, replaced: set[str]) -> Iterator[Path]:
                     (target / name).unlink()
     finally:
         shutil.rmtree(stage, ignore_errors=True)
-
-
-# --- what a folder swap may move and remove ----------------------------------------------
-
-
-class OutputWarning(UserWarning):
-    """Files that another process wrote into an output folder while it was replaced were kept aside."""
-
-
-def _inventory(root: Path, files: bool = True) -> dict[str, tuple]:
-    """Every entry below ``root`` (path relative to it) -> its :func:`_identity`, read now.
-
-    Raises :class:`OutputError` for what a swap of ``root`` cannot move or remove: a
-    mount point inside (an entry on another device, or a mount point of
-    system's table of mounts, e.g. a bind mount on the same device), an immutable or
-    append-only entry, or a folder (``root`` too) whose entries this user cannot remove.
-    With ``files=False`` the attributes of regular files are not read (one ``open`` each):
-    for a caller that links every file, which Linux refuses for such a file.
-    """
-    top = os.lstat(root)
-    mounted = _mount_points_below(root)
-    if mounted:
-        raise _refused(root, mounted[0], "is a mount point")
-    _check_removable(root, top)
-    seen: dict[str, tuple] = {}
-    folders = [(str(root), "")]
-    while folders:
-        folder, rel = folders.pop()
-        with os.scandir(folder) as entries:
-            for entry in entries:
-                info = entry.stat(follow_symlinks=False)
-                name = f"{rel}/{entry.name}" if rel else entry.name
-                if info.st_dev != top.st_dev:
-                    raise _refused(root, entry.path, "is on another file system (a mount point)")
-                if files or not stat.S_ISREG(info.st_mode):
-                    _check_removable(Path(entry.path), info, root)
-                seen[name] = _identity(info)
-                if stat.S_ISDIR(info.st_mode):
-                    folders.append((entry.path, name))
-    return seen
-
-
-def _identity(info: os.stat_result) -> tuple:
-    """(device, inode, type, size, modification time): an entry unchanged since it was read has the same."""
-    return (info.st_dev, info.st_ino, stat.S_IFMT(info.st_mode), info.st_size, info.st_mtime_ns)
-
-
-def _check_removable(path: Path, info: os.stat_result, root: Path | None = None) -> None:
-    """:class:`OutputError` if the entry ``path`` is pinned, or is a folder whose entries cannot be removed."""
-    pinned = _pinned(path, info)
-    if pinned:
-        raise _refused(root or path.parent, path, f"is {pinned}")
-    if stat.S_ISDIR(info.st_mode) and not os.access(path, os.W_OK | os.X_OK):
-        raise _refused(root or path.parent, path, "is a folder whose entries this user cannot remove")
-
-
-def _refused(root: Path, entry, why: str) -> OutputError:
-    return OutputError(
-        f"cannot write {str(root)!r}: {show(os.path.relpath(entry, root))} in it {why}; the folder is "
-        "replaced as a whole when the "
-        "run ends, and that entry could not go with it safely: move it out, or write to another folder"
-    )
-
-
-def _settle(old: Path, new: Path, seen: dict[str, tuple], written: frozenset) -> None:
-    """Remove the old folder after a swap, entry by entry; move back what another process wrote meanwhile.
-
-    An entry goes if it is a hard link to the entry of ``new`` of its name, or is as it
-    was read (``seen``: kept in ``new``, or replaced by this run's file). Anything else
-    appeared or changed during the swap: it moves into ``new`` where that name is free or
-    holds only a kept copy; where the run wrote that name too (``written``, top-level
-    names), the old folder is kept, renamed to a visible ``<name>.kept-…`` beside, with
-    an :class:`OutputWarning`.
-    """
-    device = os.lstat(old).st_dev
-    for _ in range(3):  # an entry that came while the folder was emptied: look again
-        _settle_folder(old, new, "", seen, written, device)
-        try:
-            old.rmdir()
-            return
-        except FileNotFoundError:
-            return
-        except OSError:
-            continue
-    _keep_aside(old, new)
-
-
-def _settle_folder(folder: Path, new: Path, rel: str, seen: dict, written: frozenset, device: int) -> None:
-    try:
-        entries = list(os.scandir(folder))
-    except OSError:
-        return
-    for entry in entries:
-        name = f"{rel}/{entry.name}" if rel else entry.name
-        here, there = Path(entry.path), new / entry.name
-        with contextlib.suppress(OSError):
-            info = entry.stat(follow_symlinks=False)
-            now, then = _identity(info), seen.get(name)
-            if stat.S_ISDIR(info.st_mode) and info.st_dev == device and then is not None and then[:3] == now[:3]:
-                _settle_folder(here, there, name, seen, written, device)
-                here.rmdir()
-            elif _linked(here, there) or (now == then and not stat.S_ISDIR(info.st_mode)):
-                here.unlink()
-            elif not os.path.lexists(there):
-                _move_back(here, there)
-            elif name.split("/")[0] not in written and not here.is_dir() and not there.is_dir():
-                os.replace(here, there)  # a newer version of a file kept: it takes the kept copy's place
-
-
-def _linked(a: Path, b: Path) -> bool:
-    try:
-        one, two = os.lstat(a), os.lstat(b)
-    except OSError:
-        return False
-    return (one.st_dev, one.st_ino) == (two.st_dev, two.st_ino)
-
-
-def _move_back(here: Path, there: Path) -> None:
-    """Rename ``here`` to ``there`` unless ``there`` exists by then (``FileExistsError``)."""
-    if _exchange(here, there, RENAME_NOREPLACE):
-        return
-    if here.is_dir() and not here.is_symlink():
-        if os.path.lexists(there):
-            raise FileExistsError(errno.EEXIST, "File exists", str(there))
-        os.rename(here, there)
-    else:
-        os.link(here, there, follow_symlinks=False)  # fails if there exists
-        here.unlink()
-
-
-def _keep_aside(old: Path, new: Path) -> None:
-    """Rename what is left of the old folder to a visible name beside ``new`` and say so."""
-    kept = old
-    with contextlib.suppress(OSError):
-        aside = Path(tempfile.mkdtemp(prefix=f"{new.name}.kept-", dir=new.parent))
-        os.replace(old, aside)  # onto the empty folder just made
-        kept = aside
-    left = sorted(str(path.relative_to(kept)) for path in kept.rglob("*") if not path.is_dir())
-    warnings.warn(
-        OutputWarning(
-            f"{len(left)} file(s) written into {str(new)!r} by another process while it was replaced could not "
-            f"be put back (this run wrote the same names): they are kept in {str(kept)!r}"
-        ),
-        stacklevel=2,
-    )

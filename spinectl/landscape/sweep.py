@@ -1,11 +1,8 @@
 """Sweeps over the (E, Lambda) grid: the paper's landscapes as an xarray Dataset.
 
-The grid is solved in chunks of points (working memory stays flat however
-fine the grid), each chunk by the fast path (:mod:`spinectl.optimise.active_set`) or the
-per-point reference (:mod:`spinectl.optimise`). The Dataset carries the
-answers, the per-segment coefficients that define every problem (so that
-later analyses, e.g. delay margins, need not recompute them) and the
-resolved configuration; docs/optimisation.md lists the schema with units.
+The points are solved by :mod:`spinectl.landscape.columns`. The Dataset carries the answers, the
+per-segment coefficients that define every problem (so that later analyses, e.g. delay margins, need
+not recompute them) and the resolved configuration; docs/optimisation.md lists the schema with units.
 """
 
 from __future__ import annotations

@@ -1,15 +1,7 @@
-"""The model: parameters, TOML configuration, the physics of eq. 1 and its guarded evaluation.
+"""The model: parameters, TOML configuration, the physics of eq. 1 [1]_ and its guarded evaluation.
 
-docs/model.md. Parameters are frozen dataclasses (:mod:`~spinectl.model.params`) read
-from TOML with presets (:mod:`~spinectl.model.config`, on the schema engine
-:mod:`~spinectl.model._toml`); the physics are pure array functions in SI units:
-the spine's geometry (:mod:`~spinectl.model.geometry`), the muscle laws by name
-(:mod:`~spinectl.model.laws`; the paper's Hill-type relations in :mod:`~spinectl.model.muscle`),
-the torques and their derivatives per unit PCSA (:mod:`~spinectl.model.mechanics`);
-:mod:`~spinectl.model.checks` guards their evaluation and :mod:`~spinectl.model.stability`
-applies the paper's eq. 1 [1]_.
-
-Symbols and units: docs/glossary.md.
+docs/model.md; the modules: CONTRIBUTING.md's map; symbols and units: docs/glossary.md. The
+physics are pure array functions in SI units.
 
 References
 ----------

@@ -38,6 +38,12 @@ import numpy as np
 from ..units import M2_PER_CM2
 from . import geometry, laws
 from .linear_chain import LinearChain
+from .local_muscles import (  # noqa: F401 (the chain's callers name them here too: the MJCF export among them)
+    local_damping,
+    local_damping_per_stiffness,
+    local_pcsa,
+    local_stiffness_per_pcsa,
+)
 from .mechanics import (
     _fibre_laws,
     cross2,
@@ -77,6 +83,7 @@ def chain_positions(q, cor):
     n = cor.shape[-2]
     moved = np.array(np.broadcast_to(cor, np.broadcast_shapes(q.shape + (2,), cor.shape)))
     angle = np.zeros(moved.shape[:-2])
+    # from the pelvis up: CoR j turns about CoR j + 1 by every joint angle below it (the pelvis is fixed)
     for j in range(n - 2, -1, -1):
         angle = angle + q[..., j + 1]
         moved[..., j, :] = moved[..., j + 1, :] + rotate(cor[..., j, :] - cor[..., j + 1, :], angle)
@@ -282,6 +289,7 @@ def state_matrix(mass, stiffness, damping):
     """
     mass, stiffness, damping = np.broadcast_arrays(*(np.asarray(x, float) for x in (mass, stiffness, damping)))
     n = mass.shape[-1]
+    # a massless level makes M singular: no state form exists, so NaN rather than a solve's noise
     singular = np.linalg.cond(mass) > 1.0 / np.finfo(float).eps
     regular = np.where(singular[..., None, None], np.eye(n), mass)
     lower = np.linalg.solve(regular, np.concatenate([stiffness, damping], axis=-1))  # (..., n, 2 n)
@@ -315,6 +323,7 @@ def dynamic_eigenvalues(mass, stiffness, damping):
     a = state_matrix(mass, stiffness, damping)
     finite = np.all(np.isfinite(a), axis=(-2, -1))
     eigs = np.linalg.eigvals(np.where(finite[..., None, None], a, 0.0)).astype(complex)
+    # rightmost first: the first eigenvalue decides stability (stable sort: conjugates keep their order)
     eigs = np.take_along_axis(eigs, np.argsort(-eigs.real, axis=-1, kind="stable"), axis=-1)
     return np.where(finite[..., None], eigs, complex(np.nan, np.nan))
 
@@ -440,6 +449,7 @@ class ChainCoefficients:
             Symmetric [N m/rad]; its diagonal is S_k - k_k.
         """
         muscular = np.einsum("...jkm,...m->...jk", self.stiffness_per_pcsa, np.asarray(pcsa, float))
+        # the passive stiffness and the local muscles span one joint each: they enter the diagonal only
         diagonal = self.passive_stiffness + np.asarray(local_stiffness, float)
         return muscular + self.gravity_stiffness - diagonal[..., None] * np.eye(diagonal.shape[-1])
 
@@ -487,6 +497,9 @@ def _monomial_coefficients(model: Model):
     """
     upper, lower, to_muscle, l0, f_l, f_l_slope, f_h_slope = _fibre_laws(model)
     e = lower - upper
+    # the lever arm is affine in the CoR c = (x, y): h = a + b x + d y, since the fibre's line does not move
+    # with c. So h_j h_k and the Hessian are quadratic in the CoRs' coordinates: per fibre, eight numbers
+    # (one per monomial), and every grid point's matrices are one matrix product, no loop over fibres.
     a, b, d = cross2(upper, e) / l0, -e[:, 1] / l0, e[:, 0] / l0
     zero, one = np.zeros_like(a), np.ones_like(a)
     hh = np.stack([a * a, a * b, a * d, b * b, b * d, d * d, zero, zero])  # h_j h_k
@@ -532,7 +545,9 @@ def _gravity_stiffness(model: Model, y):
     w (sum_{b < hi} Y_b - hi y_hi).
     """
     n = y.shape[-1]
-    higher = np.minimum.outer(np.arange(n), np.arange(n))  # CoRs are ordered top to bottom
+    # dtau_j/dq_k moves what both joints carry, the weight above the higher of CoRs j and k, so the
+    # entry depends on that CoR alone (CoRs are ordered top to bottom: the higher has the lower index)
+    higher = np.minimum.outer(np.arange(n), np.arange(n))
     y_hi = y[..., higher]
     below = np.concatenate([np.zeros(y.shape[:-1] + (1,)), np.cumsum((y[..., :-1] + y[..., 1:]) / 2, axis=-1)], -1)
     levels = level_weight(model) * (below[..., higher] - higher * y_hi)
@@ -615,6 +630,14 @@ def linear_chain(model: Model, eccentricity: float, lordosis: float, coefficient
     Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012). Spinal lordosis
     optimizes the requirements for a stable erect posture. Theor Biol Med Model 9:13.
     doi:10.1186/1742-4682-9-13.
+
+    Examples
+    --------
+    >>> from spinectl import load_preset
+    >>> from spinectl.model.chain import linear_chain
+    >>> chain = linear_chain(load_preset("wagner2012"), 0.03, 0.04)
+    >>> chain.controls, chain.control_unit, chain.mass_matrix.shape
+    (('straight', 'oblique_outer', 'oblique_inner'), 'cm^2', (5, 5))
     """
     e, lam = float(eccentricity), float(lordosis)
     coeffs = chain_coefficients(model, e, lam) if coefficients is None else coefficients
@@ -699,111 +722,3 @@ def coupled_margin(stiffness):
     Acta Orthop Scand Suppl 230:1-54. doi:10.3109/17453678909154177.
     """
     return np.linalg.eigvalsh(-np.asarray(stiffness, float))[..., 0]
-
-
-def local_stiffness_per_pcsa(model: Model) -> float:
-    """Joint stiffness of a local muscle per unit PCSA at full activation [N m/rad / m^2].
-
-    kappa = q sigma r^2 / l: the muscle's short-range stiffness q F / l (Bergmark 1989;
-    Cholewicki & McGill 1996) with F = sigma A, acting at the lever arm r of its joint
-    (``local``; docs/chain.md). The geometric stiffness of its tension is neglected.
-
-    Parameters
-    ----------
-    model : Model
-        Supplies ``local`` (q, r [m], l [m]) and ``fibre.specific_tension`` sigma [N/m^2].
-
-    Returns
-    -------
-    float
-        kappa [N m/rad / m^2].
-
-    References
-    ----------
-    Cholewicki J, McGill SM (1996). Mechanical stability of the in vivo lumbar spine:
-    implications for injury and chronic low back pain. Clin Biomech 11(1):1-15.
-    doi:10.1016/0268-0033(95)00035-6.
-    """
-    local = model.local
-    return local.stiffness_gain * model.fibre.specific_tension * local.lever_arm**2 / local.length
-
-
-def local_damping_per_stiffness(model: Model) -> float:
-    """c_loc [s]: the joint damping of a local muscle per unit of its joint stiffness, from its force-velocity slope.
-
-    A local muscle at force F with the global fibres' muscle law (``fibre.law``, the force scaled by
-    F/f_iso) has dF/dv = F s at rest, v its shortening velocity and s = (dT/dv) / T of the law at rest
-    (:func:`spinectl.model.laws.at_rest`; the paper's Hill slope f_H'(0)). At the lever arm r, v = r omega,
-    so the joint damping is r^2 F abs(s); its stiffness is k = q F r^2 / l (:func:`local_stiffness_per_pcsa`).
-    Both are proportional to F r^2, so
-
-        d = c_loc k,   c_loc = ``local.damping`` * l abs(s) / q,
-
-    whatever the PCSA, activation or lever arm: s (with the paper's law f_H'(0) = -(1 + a) / b) is that of
-    a fibre of length l and optimal length l_opt = ``fibre.optimal_length_ratio`` * l (the local muscle all
-    fibre, on the ascending limb like the global ones). docs/chain.md, "Local muscles as joint stiffness
-    and damping".
-
-    Parameters
-    ----------
-    model : Model
-        Supplies ``local`` (q, l [m], the factor ``damping``), ``fibre`` (the law and its constants) and
-        ``errata`` (with the paper's law the eccentric constant, which does not change the slope at rest).
-
-    Returns
-    -------
-    float
-        c_loc [s]; 0 with ``local.damping`` = 0 (the stiffness-only model).
-
-    References
-    ----------
-    Hill AV (1938). The heat of shortening and the dynamic constants of muscle. Proc R Soc Lond B
-    126:136-195. doi:10.1098/rspb.1938.0050.
-
-    Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012). Spinal lordosis optimizes
-    the requirements for a stable erect posture. Theor Biol Med Model 9:13. doi:10.1186/1742-4682-9-13.
-    """
-    local = model.local
-    l_opt = model.fibre.optimal_length_ratio * local.length
-    rest = laws.at_rest(laws.get_law(model.fibre.law), local.length, l_opt, model.fibre, model.errata)
-    slope = float(rest.relative_velocity_slope)  # (dT/dv) / T [s/m], < 0
-    return local.damping * local.length * -slope / local.stiffness_gain
-
-
-def local_damping(local_stiffness, model: Model):
-    """The joint damping of local muscles of stiffness ``local_stiffness``: c_loc k [N m s/rad].
-
-    Positive (it enters D as -c_loc diag(k)); :func:`local_damping_per_stiffness`.
-
-    Parameters
-    ----------
-    local_stiffness : array_like
-        k [N m/rad].
-    model : Model
-
-    Returns
-    -------
-    numpy.ndarray
-        c_loc k [N m s/rad], the shape of ``local_stiffness``.
-    """
-    return local_damping_per_stiffness(model) * np.asarray(local_stiffness, float)
-
-
-def local_pcsa(local_stiffness, model: Model):
-    """The least local-muscle PCSA that gives a joint the stiffness ``local_stiffness`` [m^2].
-
-    A = k / kappa (:func:`local_stiffness_per_pcsa`), at full activation; compare with the
-    paper's 17 cm^2 (30 N m at 7 cm).
-
-    Parameters
-    ----------
-    local_stiffness : array_like
-        k [N m/rad].
-    model : Model
-
-    Returns
-    -------
-    numpy.ndarray
-        A [m^2], the shape of ``local_stiffness``.
-    """
-    return np.asarray(local_stiffness, float) / local_stiffness_per_pcsa(model)

@@ -76,6 +76,15 @@ def load_preset(name: str = DEFAULT_PRESET) -> Model:
     ------
     ConfigError
         ``name`` is not a built-in preset.
+
+    Examples
+    --------
+    >>> from spinectl import load_preset
+    >>> model = load_preset("wagner2012")
+    >>> model.geometry.cor_names
+    ('L1L2', 'L2L3', 'L3L4', 'L4L5', 'L5S1')
+    >>> model.reflex.delay  # tau [s]
+    0.1
     """
     presets = list_presets()
     if not isinstance(name, str) or name not in presets:

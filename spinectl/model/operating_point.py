@@ -122,6 +122,25 @@ def chain_at(point: OperatingPoint) -> LinearChain:
     Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012). Spinal lordosis
     optimizes the requirements for a stable erect posture. Theor Biol Med Model 9:13.
     doi:10.1186/1742-4682-9-13.
+
+    Examples
+    --------
+    At the paper's optimum every segment is stable alone, the chain with every CoR free is not
+    (-sym(K) has a negative eigenvalue); 100 N m/rad of local stiffness at each joint makes it so:
+
+    >>> import numpy as np
+    >>> from spinectl import load_preset
+    >>> from spinectl.model.operating_point import OperatingPoint, chain_at
+    >>> from spinectl.optimise.active_set import solve_point
+    >>> model = load_preset("wagner2012")
+    >>> pcsa = solve_point(model, 0.03, 0.04).pcsa
+    >>> def static_margin(chain):  # [N m/rad]
+    ...     k = chain.stiffness_offset
+    ...     return round(float(np.linalg.eigvalsh(-(k + k.T) / 2)[0]), 1)
+    >>> static_margin(chain_at(OperatingPoint(model, 0.03, 0.04, pcsa, slip_check=False)))
+    -56.2
+    >>> static_margin(chain_at(OperatingPoint(model, 0.03, 0.04, pcsa, local_stiffness=100.0, slip_check=False)))
+    43.8
     """
     model, e, lam = point.model, point.eccentricity, point.lordosis
     with arithmetic_guard(e, lam):

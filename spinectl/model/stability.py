@@ -645,6 +645,20 @@ def segment_stability(
     .. [1] Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012). Spinal
        lordosis optimizes the requirements for a stable erect posture. Theor Biol Med
        Model 9:13. doi:10.1186/1742-4682-9-13
+
+    Examples
+    --------
+    The paper's verdict at its optimum (E = 3 cm, Lambda = 4 cm) and the minimum PCSA there:
+
+    >>> from spinectl import load_preset, segment_stability
+    >>> from spinectl.optimise.active_set import solve_point
+    >>> model = load_preset("wagner2012")
+    >>> optimum = solve_point(model, 0.03, 0.04)
+    >>> round(optimum.min_pcsa * 1e4, 1)  # [cm^2]
+    35.8
+    >>> result = segment_stability(model, 0.03, 0.04, optimum.pcsa, given=False)
+    >>> result.self_stable.tolist()
+    [True, True, True, True, True]
     """
     coeffs = checked_coefficients(model, float(eccentricity), float(lordosis))
     pcsa = expand_pcsa(model, pcsa, given=given)

@@ -1,20 +1,11 @@
 """The optimisation at every grid point: minimum PCSA, least counter torque, least-norm activation.
 
 docs/model.md, "The optimisation", and docs/optimisation.md. One formulation
-(:mod:`~spinectl.optimise.problem`) is solved three ways: per point with cvxpy, the
-readable reference (:mod:`~spinectl.optimise.reference`); for blocks of points by
-guessed and verified active sets in batched numpy, the fast path
-(:mod:`~spinectl.optimise.active_set`); and for blocks of points as one stacked
-Clarabel problem, the fast path's fallback (:mod:`~spinectl.optimise.stacked`). The
-solvers' answers are polished to the exact optimum (:mod:`~spinectl.optimise.polish`);
-the fast path's are exact KKT points already. The reference imports neither fast path; the
-stability of one point at its minimum stabilising PCSA, solved by the fast path, sits above both
-(:mod:`~spinectl.optimise.stabilising`). The coupled chain's semidefinite programmes, on any
-:class:`~spinectl.model.linear_chain.LinearChain`, are :mod:`~spinectl.optimise.coupled`.
-
+(:mod:`~spinectl.optimise.problem`) solved three ways: per point with cvxpy, the readable reference
+(:mod:`~spinectl.optimise.reference`); for blocks of points by verified active sets, the fast path
+(:mod:`~spinectl.optimise.active_set`); as one stacked Clarabel problem, its fallback
+(:mod:`~spinectl.optimise.stacked`). The coupled chain's programmes are :mod:`~spinectl.optimise.coupled`.
 The per-point API is re-exported here: ``optimise.solve_point(model, E, Lambda)``.
-
-Symbols and units: docs/glossary.md.
 """
 
 from .problem import (

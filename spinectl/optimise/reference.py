@@ -24,12 +24,9 @@ self-stable activations), then the least total PCSA with that CT; the Pareto
 front is stage 2 for budgets from t* up to the total PCSA of the minimum-norm
 activation.
 
-Results are returned in SI (m^2). Infeasible points are answers, not
-exceptions: NaN values and a ``status``. cvxpy is imported only where a problem is built here
-(about 2 s). :mod:`spinectl.optimise.stacked` and :mod:`spinectl.optimise.active_set` solve the
-same problems for a block of points at once, fall back on this module and are checked against
-it; this module imports neither. The stability at one point with its minimum stabilising PCSA,
-solved by the fast path, is :mod:`spinectl.optimise.stabilising`.
+Results are returned in SI (m^2). Infeasible points are answers, not exceptions: NaN values and a
+``status``. cvxpy is imported only where a problem is built here (about 2 s); this module imports
+neither fast path, which fall back on it and are checked against it.
 """
 
 from __future__ import annotations
@@ -314,6 +311,14 @@ def solve_point(model: Model, eccentricity: float, lordosis: float) -> PointOpti
     .. [1] Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012). Spinal
        lordosis optimizes the requirements for a stable erect posture. Theor Biol Med
        Model 9:13. doi:10.1186/1742-4682-9-13
+
+    Examples
+    --------
+    >>> from spinectl import load_preset
+    >>> from spinectl.optimise import solve_point
+    >>> optimum = solve_point(load_preset("wagner2012"), 0.03, 0.04)
+    >>> optimum.status, round(optimum.min_pcsa * 1e4, 1)  # [cm^2]
+    ('optimal', 35.8)
     """
     data = point_data(model, eccentricity, lordosis)
     return point_optimum(data, model.optimisation.ct_tolerance, eccentricity, lordosis)

@@ -94,6 +94,14 @@ def stability_at(
         ``pcsa`` not given and no activation stabilises every segment.
     ParameterError
         E, Lambda or ``pcsa`` out of range.
+
+    Examples
+    --------
+    >>> from spinectl import load_preset
+    >>> from spinectl.optimise.stabilising import stability_at
+    >>> result = stability_at(load_preset("wagner2012"), 0.03, 0.04)
+    >>> round(float(result.min_pcsa) * 1e4, 1), bool(result.self_stable.all())  # [cm^2]
+    (35.8, True)
     """
     if pcsa is not None:
         return segment_stability(model, eccentricity, lordosis, pcsa, given=slip_check)

@@ -1,16 +1,11 @@
 """Reflex margins of the whole chain at one configuration: ``spinectl margins --coupled`` (docs/chain.md).
 
-The margins of any linearised chain under the diagonal delayed reflex are
-:func:`chain_reflex_margins` (on a :class:`~spinectl.model.linear_chain.LinearChain`); the paper's
-chain at its operating point is :func:`coupled_margins`.
-
-The operating point is that of ``spinectl margins`` (``reflex.activation`` times the per-segment
-optimum, :func:`spinectl.reflex.margins.operating_point`); the chain's matrices there come from
-:func:`spinectl.optimise.coupled.at_activation.coupled_stability_at`; the diagonal gains from the rule
-:func:`spinectl.reflex.gains.chain_gains` (or ``reflex.kp``, ``reflex.kd``, or the options); the
-exact delay margin from :func:`spinectl.reflex.mimo.chain_delay_margin`, its Padé estimate from
-:func:`~spinectl.reflex.mimo.pade_margin`, the disk margins of the Padé loop from
-:func:`spinectl.reflex.chain_system.chain_disk_margins`.
+The margins of any linearised chain under the diagonal delayed reflex are :func:`chain_reflex_margins`
+(on a :class:`~spinectl.model.linear_chain.LinearChain`); the paper's chain at the operating point of
+``spinectl margins`` (``reflex.activation`` times the per-segment optimum) is :func:`coupled_margins`:
+the rule's diagonal gains (:func:`spinectl.reflex.gains.chain_gains`, or the configured or given ones),
+the exact delay margin (:func:`spinectl.reflex.mimo.chain_delay_margin`), its Padé estimate and the
+disk margins of the Padé loop.
 """
 
 from __future__ import annotations

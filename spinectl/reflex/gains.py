@@ -17,22 +17,12 @@ from .inputs import validated
 def default_gains(stiffness, damping, inertia, gain_factor, damping_ratio):
     """The default reflex rule (docs/reflex.md, "The default reflex, and the activation level").
 
-    kp = gain_factor * max(S, 0): the stiffness deficit below self-stability
-    times a factor > 1, so that the reflexive stiffness kp - S = (gain_factor - 1) S
-    replaces the missing one; a self-stable segment (S < 0) gets no proportional
-    reflex. kd = max(0, 2 zeta sqrt(theta (kp - S)) + D): the delay-free closed loop
-    theta s^2 + (kd - D) s + (kp - S) gets the damping ratio zeta, counting the
-    muscles' own damping -D >= 0 first (kd = 0 when they already damp enough).
-    The rule is the lag-free segment's and takes no T_a: the activation lag 1/(T_a s + 1) acts on the
-    reflex's torque after it, as the muscles' force generation does, and the gains do not undo it. (Before, the
-    rule added kp T_a to kd; where the damping part is 0, at the default operating point,
-    that made the reflex kp (T_a s + 1), which cancels the lag exactly, so that the margins did
-    not depend on T_a.) Trunk reflexes are identified so: delayed gains on the trunk's angle and
-    angular velocity, in series with the muscles' activation dynamics (Moorhouse and Granata
-    2007 [3]_; docs/reflex.md, "The default reflex, and the activation level").
-    The factor 1.5 and zeta = 1 were chosen against Stépán's bound sqrt(2 theta / S),
-    the longest delay any delayed PD can balance the reflex-only segment with [1]_ [2]_
-    (docs/reflex.md).
+    kp = gain_factor * max(S, 0): the stiffness deficit times a factor > 1, so that the reflexive
+    stiffness (gain_factor - 1) S replaces the missing one. kd = max(0, 2 zeta sqrt(theta (kp - S)) + D):
+    the delay-free closed loop gets the damping ratio zeta, the muscles' own damping -D >= 0 counted
+    first. The rule takes no T_a: the activation lag acts on the reflex's torque after it, as in trunk
+    reflexes identified so [3]_. Why 1.5 and zeta = 1 (against Stépán's bound sqrt(2 theta / S) [1]_ [2]_):
+    docs/reflex.md, "The default reflex, and the activation level".
 
     Parameters
     ----------
@@ -65,6 +55,8 @@ def default_gains(stiffness, damping, inertia, gain_factor, damping_ratio):
 
 def _derivative_gain(kp, stiffness, damping, inertia, damping_ratio):
     """kd = max(0, 2 zeta sqrt(theta (kp - S)) + D): the rule's damping (see :func:`default_gains`)."""
+    # theta s^2 + (kd - D) s + (kp - S) has the damping ratio zeta when kd - D = 2 zeta sqrt(theta (kp - S));
+    # D < 0 is the muscles' own damping, counted first, so kd may be 0 where they damp enough
     net = np.maximum(kp - stiffness, 0.0)
     return np.maximum(2.0 * damping_ratio * np.sqrt(inertia * net) + damping, 0.0)
 
@@ -97,6 +89,8 @@ def chain_gains(mass, stiffness, damping, local_stiffness, gain_factor, damping_
     """
     diagonal = (np.diagonal(np.asarray(x, float)) for x in (mass, stiffness, damping))
     theta, s, d = diagonal
+    # the chain's deficit at joint j is k_j (what the whole chain lacks there), not max(S_j, 0): the segment
+    # alone can be stable where the chain is not; the damping per joint from the diagonal, as for a segment
     kp = gain_factor * np.maximum(np.asarray(local_stiffness, float), 0.0)
     return kp, _derivative_gain(kp, s, d, theta, damping_ratio)
 

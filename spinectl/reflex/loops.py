@@ -1,17 +1,10 @@
 """Segments and reflex loops as python-control systems (docs/reflex.md, "The loop").
 
-One python-control object per segment, for the command line, plots and checks;
-sweeps use the vectorised :mod:`spinectl.reflex` instead.
-
-- :func:`segment_system`: the linearised segment as a ``StateSpace``, states
-  (alpha, omega), input a torque [N m], output alpha [rad];
-- :func:`pade_delay`: exp(-s tau) as python-control's Padé approximant;
-- :func:`activation_lag`: the force generation 1/(T_a s + 1) after the delay;
-- :func:`reflex_controller`, :func:`loop_transfer`: C(s) = kp + kd s and
-  L(s) = C(s) e^{-s tau} A(s) G(s), A(s) = 1/(T_a s + 1), G(s) = 1 / (theta s^2 - D s - S);
-- :func:`closed_loop`: the segment under the delayed reflex, from a disturbing torque to alpha;
-- :func:`loop_margins`: python-control's margins of L, read for an open-loop unstable plant;
-- :func:`ignoring_underflow`: python-control's frequency responses without underflow warnings.
+One python-control object per segment, for the command line, plots and checks (sweeps use the
+vectorised :mod:`spinectl.reflex` instead): the segment G(s) = 1 / (theta s^2 - D s - S), the Padé
+delay, the activation lag A(s) = 1/(T_a s + 1), the reflex C(s) = kp + kd s, the loop
+L(s) = C(s) e^{-s tau} A(s) G(s), the closed loop and python-control's margins of L, read for an
+open-loop unstable plant.
 """
 
 from __future__ import annotations

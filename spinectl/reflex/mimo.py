@@ -384,6 +384,25 @@ def linear_chain_delay_margin(chain: LinearChain, kp, kd, lag=0.0, u=()) -> Loop
     ----------
     .. [1] Michiels W, Niculescu S-I (2014). Stability, Control, and Computation for Time-Delay
        Systems. An Eigenvalue-Based Approach. 2nd ed., SIAM. doi:10.1137/1.9781611973631.
+
+    Examples
+    --------
+    The chain of :func:`spinectl.model.operating_point.chain_at`'s example, statically stable with local
+    stiffness: without a reflex no delay destabilises it, a PD reflex on every joint does within 2 ms:
+
+    >>> import numpy as np
+    >>> from spinectl import load_preset
+    >>> from spinectl.model.operating_point import OperatingPoint, chain_at
+    >>> from spinectl.optimise.active_set import solve_point
+    >>> from spinectl.reflex.mimo import linear_chain_delay_margin
+    >>> model = load_preset("wagner2012")
+    >>> point = OperatingPoint(model, 0.03, 0.04, solve_point(model, 0.03, 0.04).pcsa, 100.0, slip_check=False)
+    >>> chain = chain_at(point)
+    >>> linear_chain_delay_margin(chain, np.zeros(5), np.zeros(5)).status
+    'delay_independent'
+    >>> found = linear_chain_delay_margin(chain, np.full(5, 50.0), np.full(5, 5.0))
+    >>> found.status, round(found.margin * 1e3, 1)  # [ms]
+    ('finite', 1.4)
     """
     return chain_delay_margin(chain.mass_matrix, chain.stiffness(u), chain.damping(u), kp, kd, lag)
 

@@ -267,6 +267,16 @@ def loop_delay_margin(loop) -> LoopDelayMargin:
     ----------
     .. [1] Cooke KL, van den Driessche P (1986). On zeroes of some transcendental
        equations. Funkcialaj Ekvacioj 29:77-90.
+
+    Examples
+    --------
+    The segment of :func:`spinectl.reflex.delay_margin`'s example as a loop, L(s) = (kd s + kp) / (theta s^2 - D s - S):
+
+    >>> import control
+    >>> from spinectl import loop_delay_margin
+    >>> found = loop_delay_margin(control.tf([20.0, 150.0], [1.0, 5.0, -100.0]))
+    >>> found.status, round(found.margin * 1e3, 1)  # [ms]
+    ('finite', 88.3)
     """
     num, den = _coefficients(loop)
     empty = np.empty(0)

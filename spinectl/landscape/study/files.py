@@ -1,12 +1,8 @@
 """The study file: TOML read, checked against its schema and turned into a :class:`~.spec.Study`.
 
-The format is that of ``docs/studies.md``: the sections ``[study]`` (base
-model, outputs, chunking), ``[model]`` (parameters over the base model),
-``[axes]`` (the grid and the parameter axes: a list, one value or
-``{ start, stop, num }``) and ``[samples]`` (Monte-Carlo draws). Keys are
-checked by the engine of the model files (:mod:`spinectl.model._toml`), so a
-study file and a model file report the same mistakes in the same words; the
-values are validated by the dataclasses of :mod:`spinectl.landscape.study.spec`.
+The format is that of ``docs/studies.md``. Keys are checked by the engine of the model files
+(:mod:`spinectl.model._toml`), so a study file and a model file report the same mistakes in the same
+words; the values are validated by the dataclasses of :mod:`spinectl.landscape.study.spec`.
 """
 
 from __future__ import annotations

@@ -1,24 +1,9 @@
-"""Running a study: chunks solved in-process or on a ``dask.distributed`` cluster, written as they finish.
+"""Running a study: its chunks on the executor (:mod:`spinectl.landscape.study.executor`), written as they finish.
 
-Where the chunks run (:func:`run_study`; :func:`spinectl.landscape.study.executor.executor`):
-
-- ``scheduler=None``: a local cluster started for the run, one single-threaded
-  process per worker (cvxpy model building is pure Python and not
-  thread-safe), listening on 127.0.0.1 only, no dashboard; closed at the end
-  whatever happens. A study with at most one chunk left runs in-process.
-- ``scheduler="synchronous"``: in-process, one chunk after another.
-- ``scheduler="tcp://host:port"``: an existing cluster; its workers need the same spinectl.
-  The connection and the handshake give up after ``connect_timeout`` (anything that
-  listens there but is no Dask scheduler included), and the run waits at most
-  ``worker_timeout`` for a first worker, before the store is made.
-
-The store is locked for the run (:func:`spinectl.landscape.study.store.locked`): a
-second run on the same store stops at once with a line naming the first.
-
-The client writes every finished chunk (:class:`spinectl.landscape.study.store.Writer`) and
-keeps at most two chunks per worker thread submitted, so neither the
-scheduler nor the client holds more than a few chunks, however large the
-study; an interrupted run loses at most those.
+The store is locked for the run (:func:`spinectl.landscape.study.store.locked`): a second run on the
+same store stops at once with a line naming the first. The client writes every finished chunk
+(:class:`spinectl.landscape.study.store.Writer`); the executor keeps few in flight, so an interrupted
+run loses at most those.
 """
 
 from __future__ import annotations

@@ -1,17 +1,9 @@
-"""The study: a validated :class:`Study` and its plan of chunks.
+"""The study: a validated :class:`Study` and its plan of chunks (docs/studies.md).
 
-A study names a base model, the E x Lambda grid, any number of parameter axes
-(any dotted parameter, e.g. ``body.mass``, ``passive.stiffness``,
-``reflex.delay``) and Monte-Carlo draws of parameters (one ``sample``
-dimension). A :class:`Study` is a frozen dataclass that validates every value
-through :func:`spinectl.model.config.set_parameters` before any work starts;
-:mod:`spinectl.landscape.study.files` reads it from a study file (TOML, format
-in ``docs/studies.md``), and errors name the fields as that file writes them.
-
-The work is cut into chunks: one combination of the parameter axes (and
-sample) times a tile of the grid, each solved as one stacked problem by the
-fast path (:func:`spinectl.landscape.columns.point_columns`). The chunks are fixed by the
-study alone, never by the workers, so every worker count gives the same bits.
+The work is cut into chunks: one combination of the parameter axes (and sample) times a tile of the
+grid, each solved as one stacked problem by the fast path
+(:func:`spinectl.landscape.columns.point_columns`). The chunks are fixed by the study alone, never by
+the workers, so every worker count gives the same bits.
 """
 
 from __future__ import annotations

@@ -1,34 +1,16 @@
-"""Model parameters as frozen dataclasses.
+"""Model parameters as frozen dataclasses, one module per section (CONTRIBUTING.md's map), re-exported here.
 
-Every number the model uses lives here, with its unit and source in the field
-metadata (``unit``, ``doc``); there are no magic numbers in the physics
-modules. All values are SI (m, kg, N, s, rad) except where the field says
-otherwise. Instances validate themselves on construction and raise
-:class:`~spinectl.errors.ParameterError` naming the field.
-
-Reading and writing TOML lives in :mod:`spinectl.model.config`; this module does no
-I/O. docs/model.md sets out the reading of the paper [1]_ ("the paper") that
-these defaults encode; docs/parameters.md lists every field with its unit,
-default and source, and docs/glossary.md the symbols.
+Every number the model uses lives here, with its unit and source in the field metadata (``unit``,
+``doc``); SI unless the field says otherwise. Instances validate themselves on construction and
+raise :class:`~spinectl.errors.ParameterError` naming the field. No I/O (TOML:
+:mod:`spinectl.model.config`). docs/model.md sets out the reading of the paper [1]_ that the
+defaults encode, docs/parameters.md lists every field.
 
 References
 ----------
 .. [1] Wagner H, Liebetrau A, Schinowski D, Wulf T, de Lussanet MHE (2012). Spinal
    lordosis optimizes the requirements for a stable erect posture. Theor Biol Med
    Model 9:13. doi:10.1186/1742-4682-9-13
-
-One module per parameter section, on the bounds below them:
-
-- :mod:`~spinectl.model.params.bounds`: the bounds of the parameters and the validation helpers;
-- :mod:`~spinectl.model.params.body`: the upper body and the spine's geometry;
-- :mod:`~spinectl.model.params.muscles`: the global muscles' fibres and antagonistic pairs;
-- :mod:`~spinectl.model.params.segments`: the passive stiffness, the local muscles, the levels' inertia;
-- :mod:`~spinectl.model.params.solving`: the errata chosen and the optimisation settings;
-- :mod:`~spinectl.model.params.reflex`: the delayed PD reflex and its simulation;
-- :mod:`~spinectl.model.params.model`: the whole parameter set, :class:`Model`.
-
-Every public name of these modules is also here: ``spinectl.model.params.Model``
-as before the split.
 """
 
 from __future__ import annotations

@@ -1,20 +1,9 @@
 """Calibration of the parameters the paper does not state, against the paper's landmarks.
 
-The paper (Wagner et al. 2012) gives neither the upper-body mass, nor the
-muscle attachment coordinates, nor the fibre spread. This package fits them,
-within anatomically plausible bounds, to the landmarks of
-:mod:`spinectl.paper.landmarks` (what the paper's Results and Discussion report), and
-reports the residual of every landmark (docs/reproduction.md, "The calibration"):
-
-- :mod:`~spinectl.paper.calibration.parameters`: the free parameters, their bounds
-  with sources, and the map between a parameter vector and a model;
-- :mod:`~spinectl.paper.calibration.targets`: the landmarks as targets, and the loss;
-- :mod:`~spinectl.paper.calibration.landscapes`: coarse landscapes for fitting, the
-  paper's 81 x 81 grid for verifying;
-- :mod:`~spinectl.paper.calibration.fit`: :func:`calibrate`, differential evolution
-  then Nelder-Mead, with both passive-stiffness conventions;
-- :mod:`~spinectl.paper.calibration.sensitivity`: what the landmarks identify;
-- :mod:`~spinectl.paper.calibration.output`: the summary, the preset TOML, the loss history.
+The paper (Wagner et al. 2012) gives neither the upper-body mass, nor the muscle attachment
+coordinates, nor the fibre spread. This package fits them, within anatomically plausible bounds,
+to the landmarks of :mod:`spinectl.paper.landmarks`, and reports the residual of every landmark
+(docs/reproduction.md, "The calibration"; the modules: CONTRIBUTING.md's map).
 """
 
 from .fit import (

@@ -1,34 +1,11 @@
 """The paper's figures from a sweep Dataset: Figures 3, 4 and S1, the ratio S1 / 3 and coupled / per segment.
 
-Filled contours over E (abscissa) and Lambda (ordinate), both in cm, on any
-grid: labelled contour lines, positions A-D (:data:`spinectl.paper.grid.POSITIONS`)
-where they lie inside the grid and the grid's other corners by their
-coordinates, the paper's ridge Lambda = 1.7 E and its optimum (E ~ 3, Lambda ~ 4 cm,
-which its Discussion calls position C, beside the corner C). Figure 4 adds the
-+-30 N m limit of the local muscles as a contour; Figure 3 optionally the model
-drawn at the grid's corners (:mod:`spinectl.paper.drawing`), as the paper's corner panels.
-Each figure function draws on a new figure with the Agg
-canvas (:func:`spinectl.canvas.new_figure`: no global backend state, no display
-needed) and returns it, writing nothing; :func:`~spinectl.paper.figures.files.save_figure`
-writes one atomically as PNG, PDF or SVG, :func:`~spinectl.paper.figures.sets.figure_set`
-draws the set (:class:`~spinectl.paper.figures.sets.FigureOptions`: format, colour range,
-shared scale, ratio map, insets) and :func:`~spinectl.paper.figures.sets.draw_figures` saves
-it as a whole.
-
-One module per figure family, on the shared parts below them:
-
-- :mod:`~spinectl.paper.figures.style`: what every landscape shares (size, levels, colour bar, titles);
-- :mod:`~spinectl.paper.figures.labels`: labels placed clear of each other on the laid-out canvas;
-- :mod:`~spinectl.paper.figures.landscape`: any variable over E x Lambda, A-D, the ridge and the optimum marked;
-- :mod:`~spinectl.paper.figures.min_pcsa`: Figures 3 and S1, with the corner insets;
-- :mod:`~spinectl.paper.figures.counter_torque`: Figure 4 and the ±30 N m limit;
-- :mod:`~spinectl.paper.figures.ratios`: the ratio maps, S1 / 3 and coupled / per segment;
-- :mod:`~spinectl.paper.figures.pareto`: the coupled chain's Pareto front;
-- :mod:`~spinectl.paper.figures.files`: the save step (PNG, PDF, SVG), resolutions and file names;
-- :mod:`~spinectl.paper.figures.sets`: the figures of a landscape as a set, drawn and saved all or none.
-
-Every public name of these modules is also here: ``spinectl.paper.figures.draw_figures``
-as before the split.
+Filled contours over E and Lambda [cm] on any grid, positions A-D, the ridge Lambda = 1.7 E and the
+optimum marked (docs/figures.md). Each figure function draws on a new Agg figure
+(:func:`spinectl.canvas.new_figure`) and returns it, writing nothing;
+:func:`~spinectl.paper.figures.files.save_figure` writes one atomically,
+:func:`~spinectl.paper.figures.sets.draw_figures` a set as a whole. One module per figure family
+(CONTRIBUTING.md's map), every public name re-exported here.
 """
 
 from __future__ import annotations

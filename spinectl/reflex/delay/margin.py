@@ -186,6 +186,15 @@ def delay_margin(stiffness, damping, inertia, kp, kd, lag=0.0) -> DelayMargin:
        switches. J Math Anal Appl 86:592-627.
     .. [2] Cooke KL, van den Driessche P (1986). On zeroes of some transcendental
        equations. Funkcialaj Ekvacioj 29:77-90.
+
+    Examples
+    --------
+    A segment 100 N m/rad short of self-stability under kp = 150 N m/rad, kd = 20 N m s/rad:
+
+    >>> from spinectl.reflex import delay_margin
+    >>> found = delay_margin(stiffness=100.0, damping=-5.0, inertia=1.0, kp=150.0, kd=20.0)
+    >>> round(float(found.margin) * 1e3, 1)  # [ms]
+    88.3
     """
     check_retarded(inertia, damping, kd, lag)
     s, d, theta, kp, kd, lag = as_arrays(stiffness, damping, inertia, kp, kd, lag)

@@ -41,6 +41,16 @@ def design(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None)
     ------
     ParameterError
         E or Lambda out of range.
+
+    Examples
+    --------
+    >>> from spinectl import load_preset
+    >>> from spinectl.reflex.design import design
+    >>> answer = design(load_preset("wagner2012"), 0.03, 0.04)  # at the preset's 100 ms delay
+    >>> answer.status, round(answer.activation, 3)  # joint by joint: the least co-contraction
+    ('ok', 0.271)
+    >>> round(float(answer.chain.local_stiffness.sum()), 1)  # the chain: local stiffness [N m/rad]
+    135.8
     """
     from ...model.source import header, provenance
 
