@@ -50,6 +50,7 @@ from .engine import engine_output_to_stderr, model_file, one_line
 from .export_osim import require_opensim
 from .linearise import STEP, Linearisation, Rhythm
 from .mapping import Mapping, default_mapping, located, read_mapping
+from .osim_geometry import geometry
 
 
 @dataclass(frozen=True)
@@ -136,6 +137,8 @@ class OsimEngine:
         The model's name, the file's path and the SHA-256 of its bytes.
     couplers : tuple of Coupler
         The model's ``CoordinateCouplerConstraint`` s, switched off in ``model`` (the free chain).
+    mobilities : dict
+        Coordinate name -> its mobility index, read once (:func:`_mobility_order`).
     """
 
     model: object
@@ -144,6 +147,7 @@ class OsimEngine:
     source: str
     sha256: str
     couplers: tuple = field(default=())
+    mobilities: dict = field(default_factory=dict, repr=False)
 
     def coordinate(self, name: str):
         """The coordinate of that name.
@@ -388,47 +392,22 @@ def _curves(engine: OsimEngine, lengths, velocities) -> np.ndarray:
     return out
 
 
-def _arms_and_passive(engine: OsimEngine, names, values: dict):
-    """dl/dq of every muscle over the chain's coordinates (-computeMomentArm) and the passive torques [N m]."""
-    osim = require_opensim()
-    engine.set_posture(values)
-    model, state = engine.model, engine.state
-    muscles = model.getMuscles()
-    arms = np.array(
-        [
-            [-muscles.get(i).computeMomentArm(state, engine.coordinate(c)) for c in names]
-            for i in range(muscles.getSize())
-        ]
-    )
-    forces = model.getForceSet()
-    for i in range(forces.getSize()):  # gravity and the passive forces only: muscles and actuators off
-        force = forces.get(i)
-        force.setAppliesForce(state, osim.Actuator.safeDownCast(force) is None)
-    model.realizeDynamics(state)
-    needed = osim.InverseDynamicsSolver(model).solve(state, osim.Vector(state.getNU(), 0.0))
-    order = _mobility_order(engine)
-    passive = -np.array([needed.get(order[c]) for c in names])
-    for i in range(forces.getSize()):
-        forces.get(i).setAppliesForce(state, True)
-    return arms, passive
-
-
 def _mobility_order(engine: OsimEngine) -> dict:
     """Coordinate name -> its index among the system's mobilities (the order of calcM and the inverse dynamics).
 
-    Read off the state (OpenSim's Python bindings do not wrap the tree order): the entry of U
-    that each coordinate's speed sets. One speed per coordinate (no ball or free joints).
+    Read off the state once per engine (OpenSim's Python bindings do not wrap the tree order):
+    the entry of U that each coordinate's speed sets. One speed per coordinate (no ball or free joints).
     """
+    if engine.mobilities:
+        return engine.mobilities
     coords, state = engine.model.getCoordinateSet(), engine.state
-    order = {}
-    for i in range(coords.getSize()):  # the one speed that a coordinate's speed sets
-        for j in range(coords.getSize()):
-            coords.get(j).setSpeedValue(state, float(i == j))
-        u = state.getU()
-        order[coords.get(i).getName()] = int(np.argmax([abs(u.get(k)) for k in range(u.size())]))
     for j in range(coords.getSize()):
         coords.get(j).setSpeedValue(state, 0.0)
-    return order
+    for i in range(coords.getSize()):  # the one speed that a coordinate's speed sets
+        coords.get(i).setSpeedValue(state, 1.0)
+        engine.mobilities[coords.get(i).getName()] = int(np.argmax(np.abs(state.getU().to_numpy())))
+        coords.get(i).setSpeedValue(state, 0.0)
+    return engine.mobilities
 
 
 def linearise(engine: OsimEngine, names, values: dict, n=None) -> Linearisation:
@@ -449,35 +428,12 @@ def linearise(engine: OsimEngine, names, values: dict, n=None) -> Linearisation:
     Linearisation
         Over ``names`` (``dofs`` = 0 ... len(names) - 1), the other coordinates held.
     """
-    osim = require_opensim()
     names = list(names)
     s = len(names)
     n = s if n is None else int(n)
-    arms, passive = _arms_and_passive(engine, names, values)
-    muscles = engine.model.getMuscles()
-    engine.set_posture(values)
-    lengths = np.array([muscles.get(i).getLength(engine.state) for i in range(muscles.getSize())])
+    geo = geometry(engine, names, values, _mobility_order(engine))
+    arms, passive, dpassive, hessian, lengths = geo.arms, geo.passive, geo.dpassive, geo.hessian, geo.lengths
     gain, dgain_dl, dgain_dv, bias, dbias_dl, dbias_dv = _curves(engine, lengths, np.zeros_like(lengths))
-    mass = osim.Matrix()
-    engine.model.getMatterSubsystem().calcM(engine.state, mass)
-    order = _mobility_order(engine)
-    index = [order[c] for c in names]
-    full = np.array([[mass.get(i, j) for j in range(mass.ncol())] for i in range(mass.nrow())])
-    hessian = np.zeros((len(lengths), s, s))
-    dpassive = np.zeros((s, s))
-    wrapped = _wrapped(engine)
-    touching = _contacts(engine, wrapped)
-    for k, name in enumerate(names):
-        sides = []
-        for sign in (1.0, -1.0):
-            moved = dict(values)
-            moved[name] = values.get(name, engine.coordinate(name).getDefaultValue()) + sign * STEP
-            sides.append(_arms_and_passive(engine, names, moved))
-            _same_contacts(engine, wrapped, touching, _contacts(engine, wrapped), name)
-        hessian[:, :, k] = (sides[0][0] - sides[1][0]) / (2 * STEP)
-        dpassive[:, k] = (sides[0][1] - sides[1][1]) / (2 * STEP)
-    engine.set_posture(values)
-    hessian = 0.5 * (hessian + hessian.transpose(0, 2, 1))
     rr = np.einsum("ij,ik->jki", arms, arms)
     return Linearisation(
         dofs=tuple(range(s)),
@@ -486,41 +442,11 @@ def linearise(engine: OsimEngine, names, values: dict, n=None) -> Linearisation:
         stiffness_offset=0.5 * (dpassive + dpassive.T) + np.einsum("ijk,i->jk", hessian, bias) + rr @ dbias_dl,
         damping_per_muscle=rr * dgain_dv,
         damping_offset=rr @ dbias_dv,  # the fibres' damping (Millard's fiber_damping)
-        mass=full[np.ix_(index, index)],
+        mass=geo.mass,
         torque_per_muscle=arms.T * gain,
         torque_offset=passive + arms.T @ bias,
         moment_arms=arms,
     )
-
-
-def _wrapped(engine: OsimEngine) -> dict:
-    """Muscle index -> the names of the wrap objects on its path, for the muscles that have any."""
-    muscles = engine.model.getMuscles()
-    out = {}
-    for i in range(muscles.getSize()):
-        wraps = muscles.get(i).getGeometryPath().getWrapSet()
-        if wraps.getSize():
-            out[i] = [wraps.get(k).getWrapObject().getName() for k in range(wraps.getSize())]
-    return out
-
-
-def _contacts(engine: OsimEngine, wrapped: dict) -> dict:
-    """Muscle index -> how many points its current path has (2 more per wrap it touches), at the set posture."""
-    muscles = engine.model.getMuscles()
-    engine.model.realizePosition(engine.state)
-    return {i: muscles.get(i).getGeometryPath().getCurrentPath(engine.state).getSize() for i in wrapped}
-
-
-def _same_contacts(engine: OsimEngine, wrapped: dict, before: dict, after: dict, coordinate: str) -> None:
-    """A muscle that touches a wrap on one side of the posture only has a kinked moment arm there: one line."""
-    for i, count in before.items():
-        if after[i] != count:
-            muscle = engine.model.getMuscles().get(i).getName()
-            raise ModelError(
-                f"{engine.name}: muscle {muscle} starts or stops wrapping over {', '.join(wrapped[i])} within "
-                f"{STEP:g} rad of the posture ({coordinate}): its moment arm has a kink there, which the "
-                "linearisation cannot differentiate; nothing was linearised (move the posture off the contact)"
-            )
 
 
 @dataclass
