@@ -39,7 +39,7 @@ from __future__ import annotations
 
 import hashlib
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 
@@ -50,6 +50,7 @@ from .engine import engine_output_to_stderr, model_file, one_line
 from .export_osim import require_opensim
 from .linearise import STEP, Linearisation, Rhythm
 from .mapping import Mapping, default_mapping, located, read_mapping
+from . import osim_cache
 from .osim_geometry import geometry
 
 
@@ -139,6 +140,10 @@ class OsimEngine:
         The model's ``CoordinateCouplerConstraint`` s, switched off in ``model`` (the free chain).
     mobilities : dict
         Coordinate name -> its mobility index, read once (:func:`_mobility_order`).
+    cache : bool
+        Whether :func:`linearise` reads and writes the cache of linearisations (:mod:`spinectl.anatomy.osim_cache`).
+    linearisations : dict
+        The linearisations made in this process, by their cache key (kept with or without ``cache``).
     """
 
     model: object
@@ -148,6 +153,8 @@ class OsimEngine:
     sha256: str
     couplers: tuple = field(default=())
     mobilities: dict = field(default_factory=dict, repr=False)
+    cache: bool = True
+    linearisations: dict = field(default_factory=dict, repr=False)
 
     def coordinate(self, name: str):
         """The coordinate of that name.
@@ -194,12 +201,14 @@ class OsimEngine:
         self.model.realizePosition(self.state)
 
 
-def load_engine(path) -> OsimEngine:
+def load_engine(path, cache: bool = True) -> OsimEngine:
     """Build an ``.osim`` file with OpenSim.
 
     Parameters
     ----------
     path : str or pathlib.Path
+    cache : bool
+        Whether its linearisations are read from and written to the cache (:mod:`spinectl.anatomy.osim_cache`).
 
     Returns
     -------
@@ -219,7 +228,7 @@ def load_engine(path) -> OsimEngine:
         raise ParameterError("model", f"OpenSim cannot build {path}: {_one_line(exc)}") from None
     digest = hashlib.sha256(path.read_bytes()).hexdigest()
     source = str(path.resolve()) + schema
-    return OsimEngine(model, state, model.getName() or path.stem, source, digest, couplers)
+    return OsimEngine(model, state, model.getName() or path.stem, source, digest, couplers, cache=cache)
 
 
 def _one_line(exc) -> str:
@@ -411,7 +420,41 @@ def _mobility_order(engine: OsimEngine) -> dict:
 
 
 def linearise(engine: OsimEngine, names, values: dict, n=None) -> Linearisation:
-    """K_i, K_0, D_i, D_0, M over the given coordinates at a posture (module docstring).
+    """K_i, K_0, D_i, D_0, M over the given coordinates at a posture, made once (module docstring).
+
+    Made once per process and engine (:attr:`OsimEngine.linearisations`) and, with
+    :attr:`OsimEngine.cache`, read from or written to the cache of linearisations
+    (:mod:`spinectl.anatomy.osim_cache`): bit for bit what :func:`_linearise` returns.
+
+    Parameters
+    ----------
+    engine : OsimEngine
+    names : sequence of str
+        The coordinates involved, the chain's first.
+    values : dict
+        Coordinate name -> value [rad] of the posture (others at their defaults).
+    n : int, optional
+        How many of ``names`` are the chain's (default all).
+
+    Returns
+    -------
+    Linearisation
+        Over ``names`` (``dofs`` = 0 ... len(names) - 1), the other coordinates held; a copy.
+    """
+    names = [str(c) for c in names]
+    n = len(names) if n is None else int(n)
+    key = osim_cache.key(engine.sha256, names, n, values)
+    lin = engine.linearisations.get(key) or (osim_cache.read(key) if engine.cache else None)
+    if lin is None:
+        lin = _linearise(engine, names, values, n)
+        if engine.cache:
+            osim_cache.write(key, lin)
+    engine.linearisations[key] = lin
+    return replace(lin, **{f.name: np.copy(v) for f in fields(lin) if isinstance(v := getattr(lin, f.name), np.ndarray)})
+
+
+def _linearise(engine: OsimEngine, names, values: dict, n=None) -> Linearisation:
+    """K_i, K_0, D_i, D_0, M over the given coordinates at a posture, computed (module docstring).
 
     Parameters
     ----------
@@ -807,14 +850,15 @@ def load_osim(path, mapping=None, cache: bool = True) -> OsimAnatomy:
         A mapping TOML (names of OpenSim bodies and coordinates); default the built-in one of the
         model's name (``wagner2012_chain`` for spinectl's own export).
     cache : bool
-        Unused: an ``.osim`` file is built anew each time (the loaders' common signature,
-        :data:`spinectl.anatomy.contract.ENGINES`).
+        Read the model's linearisations from the cache of linearisations and write them there
+        (:mod:`spinectl.anatomy.osim_cache`); False linearises anew and leaves the cache alone.
+        The model itself is built anew each time (OpenSim has no compiled form to keep).
 
     Returns
     -------
     OsimAnatomy
     """
-    engine = load_engine(path)
+    engine = load_engine(path, cache=cache)
     if mapping is None:
         mapping = default_mapping(engine.name)
     elif not isinstance(mapping, Mapping):
