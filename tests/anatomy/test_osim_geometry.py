@@ -232,3 +232,52 @@ def test_an_unwritable_cache_folder_is_no_cache(wrapped, tmp_path, monkeypatch):
     monkeypatch.setenv("SPINECTL_CACHE_DIR", str(blocker / "cache"))
     fresh = opensim_engine.load_osim(path, cache=False).linearise("sagittal")[0]
     assert _identical(opensim_engine.load_osim(path).linearise("sagittal")[0], fresh)
+
+
+SHARED = Path("/work/shared/models/pose2sim-beaucage-gauvreau/Model_Pose2Sim_muscles_flex.osim")
+POSE2SIM_CHAIN = ["L5_S1_Flex_Ext", "L4_L5_Flex_Ext", "L3_L4_Flex_Ext", "L2_L3_Flex_Ext", "L1_L2_Flex_Ext", "L1_T12_Flex_Ext"]
+
+
+def _as_rigid_millard(source: Path, target: Path) -> None:
+    """A copy of ``source`` with every muscle a rigid-tendon Millard muscle on the same path (OpenSim's API)."""
+    model = osim.Model(str(source))
+    forces = model.updForceSet()
+    for name in [model.getMuscles().get(i).getName() for i in range(model.getMuscles().getSize())]:
+        old = osim.Muscle.safeDownCast(forces.get(name))
+        new = osim.Millard2012EquilibriumMuscle()
+        new.setName(name)
+        new.setMaxIsometricForce(old.getMaxIsometricForce())
+        new.setOptimalFiberLength(old.getOptimalFiberLength())
+        new.setTendonSlackLength(old.getTendonSlackLength())
+        new.setPennationAngleAtOptimalFiberLength(0.0)
+        new.set_ignore_tendon_compliance(True)
+        new.set_path(old.get_path())
+        forces.remove(forces.getIndex(name))
+        forces.append(new)
+    model.finalizeConnections()
+    model.printToXML(str(target))
+
+
+@pytest.mark.skipif(not SHARED.is_file(), reason="the shared downloaded models (/work/shared/models) are absent")
+def test_the_geometry_is_the_present_paths_on_a_published_model(tmp_path):
+    """The Pose2Sim model (318 muscles, 41 wrap cylinders and 3 ellipsoids: latissimus dorsi over the torso), its
+    muscles made rigid-tendon Millard in a temporary copy: arms, Hessians and passive torques over its lumbar
+    flexion coordinates equal the present path's to the tolerances of test_the_geometry_is_the_present_paths.
+    Why the arms are not differences of getLength: over the ellipsoid, LD_L2_r's length changes with L1_T12 at
+    1.99 times the rate of its arm (central differences, step 1e-6 rad; the arm is what OpenSim's forces follow)."""
+    copy = tmp_path / "pose2sim_millard.osim"
+    _as_rigid_millard(SHARED, copy)
+    engine = opensim_engine.load_engine(copy, cache=False)
+    geo = geometry(engine, POSE2SIM_CHAIN, {}, opensim_engine._mobility_order(engine))
+    arms, hessian, passive, dpassive = _reference(engine, POSE2SIM_CHAIN, {})
+    assert np.max(np.abs(geo.arms - arms)) <= 1e-12 * np.max(np.abs(arms))
+    assert np.max(np.abs(geo.hessian - hessian)) <= 1e-6 * np.max(np.abs(hessian))
+    assert np.max(np.abs(geo.passive - passive)) <= 1e-12 * np.max(np.abs(passive))
+    assert np.max(np.abs(geo.dpassive - dpassive)) <= 1e-8 * np.max(np.abs(dpassive))
+    muscles = engine.model.getMuscles()
+    index = next(i for i in range(muscles.getSize()) if muscles.get(i).getName() == "LD_L2_r")
+    sides = []
+    for sign in (1.0, -1.0):
+        engine.set_posture({"L1_T12_Flex_Ext": sign * 1e-6})
+        sides.append(muscles.get(index).getLength(engine.state))
+    assert abs((sides[0] - sides[1]) / 2e-6 / geo.arms[index, -1] - 1.99) <= 0.01
