@@ -2,7 +2,9 @@
 
 Everything is OpenSim's: the model is read and built by :class:`opensim.Model` (spinectl
 parses no ``.osim`` of its own), the muscles' path lengths and moment arms
-(``Muscle.getLength``, ``computeMomentArm``, wrapping and conditional points included), the
+(``Muscle.getLength``, and ``getLengtheningSpeed`` at unit coordinate speeds: what
+``computeMomentArm`` returns, every muscle at once, :mod:`~spinectl.anatomy.osim_geometry`;
+wrapping and conditional points included), the
 muscle curves (Millard 2012's active and passive force-length and force-velocity curves,
 ``calcValue``/``calcDerivative``), the generalised gravity and every passive force (minus the
 inverse dynamics at rest with the muscles and actuators off) and the mass matrix
