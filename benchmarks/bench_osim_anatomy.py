@@ -67,9 +67,9 @@ def present_geometry(engine, names, values):
     def arms_and_passive(vals):
         engine.set_posture(vals)
         muscles, state = engine.model.getMuscles(), engine.state
-        arms = np.array(
-            [[-muscles.get(i).computeMomentArm(state, engine.coordinate(c)) for c in names] for i in range(muscles.getSize())]
-        )
+        coordinates = [engine.coordinate(c) for c in names]
+        each = [muscles.get(i) for i in range(muscles.getSize())]
+        arms = np.array([[-muscle.computeMomentArm(state, c) for c in coordinates] for muscle in each])
         forces = engine.model.getForceSet()
         for i in range(forces.getSize()):
             forces.get(i).setAppliesForce(state, osim.Actuator.safeDownCast(forces.get(i)) is None)

@@ -47,12 +47,12 @@ import numpy as np
 
 from .._validate import printable
 from ..errors import ModelError, ParameterError
+from . import osim_cache
 from .contract import MappedModel, lordosis_direction, plane_axes
 from .engine import engine_output_to_stderr, model_file, one_line
 from .export_osim import require_opensim
 from .linearise import STEP, Linearisation, Rhythm
 from .mapping import Mapping, default_mapping, located, read_mapping
-from . import osim_cache
 from .osim_geometry import geometry
 
 
@@ -452,7 +452,8 @@ def linearise(engine: OsimEngine, names, values: dict, n=None) -> Linearisation:
         if engine.cache:
             osim_cache.write(key, lin)
     engine.linearisations[key] = lin
-    return replace(lin, **{f.name: np.copy(v) for f in fields(lin) if isinstance(v := getattr(lin, f.name), np.ndarray)})
+    arrays = {f.name: getattr(lin, f.name) for f in fields(lin)}
+    return replace(lin, **{name: np.copy(v) for name, v in arrays.items() if isinstance(v, np.ndarray)})
 
 
 def _linearise(engine: OsimEngine, names, values: dict, n=None) -> Linearisation:

@@ -64,9 +64,9 @@ def _reference(engine, names, values):
     def arms_and_passive(vals):
         engine.set_posture(vals)
         muscles, state = engine.model.getMuscles(), engine.state
-        arms = np.array(
-            [[-muscles.get(i).computeMomentArm(state, engine.coordinate(c)) for c in names] for i in range(muscles.getSize())]
-        )
+        coordinates = [engine.coordinate(c) for c in names]
+        each = [muscles.get(i) for i in range(muscles.getSize())]
+        arms = np.array([[-muscle.computeMomentArm(state, c) for c in coordinates] for muscle in each])
         forces = engine.model.getForceSet()
         for i in range(forces.getSize()):
             forces.get(i).setAppliesForce(state, osim.Actuator.safeDownCast(forces.get(i)) is None)
@@ -113,7 +113,7 @@ def test_the_arms_are_the_differences_of_opensims_lengths_over_a_cylinder(wrappe
     geo = geometry(engine, CHAIN, {}, opensim_engine._mobility_order(engine))
     muscle, h = engine.model.getMuscles().get(WRAPPED), 1e-6
     lengths = []
-    for k, name in enumerate(CHAIN):
+    for name in CHAIN:
         sides = []
         for sign in (1.0, -1.0):
             engine.set_posture({name: sign * h})
@@ -235,7 +235,7 @@ def test_an_unwritable_cache_folder_is_no_cache(wrapped, tmp_path, monkeypatch):
 
 
 SHARED = Path("/work/shared/models/pose2sim-beaucage-gauvreau/Model_Pose2Sim_muscles_flex.osim")
-POSE2SIM_CHAIN = ["L5_S1_Flex_Ext", "L4_L5_Flex_Ext", "L3_L4_Flex_Ext", "L2_L3_Flex_Ext", "L1_L2_Flex_Ext", "L1_T12_Flex_Ext"]
+POSE2SIM_CHAIN = [f"{joint}_Flex_Ext" for joint in ("L5_S1", "L4_L5", "L3_L4", "L2_L3", "L1_L2", "L1_T12")]
 
 
 def _as_rigid_millard(source: Path, target: Path) -> None:
