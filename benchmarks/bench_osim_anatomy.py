@@ -5,15 +5,16 @@
 
 The present path is the one spinectl took before (docs/anatomy.md, "Speed"): every muscle's
 ``computeMomentArm`` about every coordinate at the posture and at q +- STEP e_k for the
-Hessians, the inverse dynamics each time, no cache. It is written out here
-(:func:`present_geometry`) and timed against :func:`spinectl.anatomy.osim_geometry.geometry` on
-the same coordinates, with the largest difference. Then, each in a fresh process with a cache
-folder of its own, ``spinectl anatomy MODEL --mapping MAP`` (one table; target <= 5 s of wall time
-after the first load, i.e. with the linearisation cached) and ``--lordosis -20:20:41`` (41
+Hessians, the inverse dynamics each time, no cache. It is written out in
+tests/anatomy/osim_reference.py (``present_geometry``, shared with the tests) and timed
+against :func:`spinectl.anatomy.osim_geometry.geometry` on the same coordinates, with the
+largest difference. Then, each in a fresh process with a cache folder of its own,
+``spinectl anatomy MODEL --mapping MAP`` (one table; target <= 5 s of wall time after the
+first load, i.e. with the linearisation cached) and ``--lordosis -20:20:41`` (41
 postures, three optima each; target <= 60 s), cold (the cache empty: the first load) and warm.
 The present path's wall times are estimated from the same runs: the present path linearised
 once per table and three times per posture (once per optimum), each at the measured cost of
-:func:`present_geometry` instead of the new one.
+``present_geometry`` instead of the new one.
 
 Models, each built in a temporary folder through OpenSim's API:
 
@@ -42,6 +43,7 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "tests" / "anatomy"))  # osim_reference: the previous path, shared with the tests
 
 SHARED = Path("/work/shared/models/pose2sim-beaucage-gauvreau/Model_Pose2Sim_muscles_flex.osim")
 POSE2SIM_MAPPING = """[bodies]
@@ -53,41 +55,6 @@ sagittal = ["L5_S1_Flex_Ext", "L4_L5_Flex_Ext", "L3_L4_Flex_Ext", "L2_L3_Flex_Ex
 """
 CHAIN_BODIES = ["ground", "vertebra_above_L5S1", "vertebra_above_L4L5", "vertebra_above_L3L4"]
 CHAIN_BODIES += ["vertebra_above_L2L3", "thorax"]
-
-
-def present_geometry(engine, names, values):
-    """The present path: -computeMomentArm per muscle and coordinate, central differences of them, inverse dynamics."""
-    import opensim as osim
-
-    from spinectl.anatomy.linearise import STEP
-    from spinectl.anatomy.opensim_engine import _mobility_order
-
-    order = _mobility_order(engine)
-
-    def arms_and_passive(vals):
-        engine.set_posture(vals)
-        muscles, state = engine.model.getMuscles(), engine.state
-        coordinates = [engine.coordinate(c) for c in names]
-        each = [muscles.get(i) for i in range(muscles.getSize())]
-        arms = np.array([[-muscle.computeMomentArm(state, c) for c in coordinates] for muscle in each])
-        forces = engine.model.getForceSet()
-        for i in range(forces.getSize()):
-            forces.get(i).setAppliesForce(state, osim.Actuator.safeDownCast(forces.get(i)) is None)
-        engine.model.realizeDynamics(state)
-        needed = osim.InverseDynamicsSolver(engine.model).solve(state, osim.Vector(state.getNU(), 0.0))
-        for i in range(forces.getSize()):
-            forces.get(i).setAppliesForce(state, True)
-        return arms, -np.array([needed.get(order[c]) for c in names])
-
-    arms, _ = arms_and_passive(values)
-    hessian = np.zeros((arms.shape[0], len(names), len(names)))
-    for k, name in enumerate(names):
-        start = values.get(name, engine.coordinate(name).getDefaultValue())
-        up = arms_and_passive({**values, name: start + STEP})[0]
-        down = arms_and_passive({**values, name: start - STEP})[0]
-        hessian[:, :, k] = (up - down) / (2 * STEP)
-    engine.set_posture(values)
-    return arms, 0.5 * (hessian + hessian.transpose(0, 2, 1))
 
 
 def built_model(folder: Path, muscles: int, seed: int = 0) -> tuple:
@@ -135,30 +102,17 @@ def built_model(folder: Path, muscles: int, seed: int = 0) -> tuple:
 
 def pose2sim_model(folder: Path) -> tuple:
     """The Pose2Sim model with rigid-tendon Millard muscles on the same paths, and its mapping: (path, mapping)."""
-    import opensim as osim
+    from osim_reference import rigid_millard_copy
 
-    model = osim.Model(str(SHARED))
-    forces = model.updForceSet()
-    for name in [model.getMuscles().get(i).getName() for i in range(model.getMuscles().getSize())]:
-        old = osim.Muscle.safeDownCast(forces.get(name))
-        new = osim.Millard2012EquilibriumMuscle()
-        new.setName(name)
-        new.setMaxIsometricForce(old.getMaxIsometricForce())
-        new.setOptimalFiberLength(old.getOptimalFiberLength())
-        new.setTendonSlackLength(old.getTendonSlackLength())
-        new.setPennationAngleAtOptimalFiberLength(0.0)
-        new.set_ignore_tendon_compliance(True)
-        new.set_path(old.get_path())
-        forces.remove(forces.getIndex(name))
-        forces.append(new)
-    model.finalizeConnections()
-    model.printToXML(str(folder / "pose2sim_millard.osim"))
+    rigid_millard_copy(SHARED, folder / "pose2sim_millard.osim")
     (folder / "pose2sim.toml").write_text(POSE2SIM_MAPPING)
     return folder / "pose2sim_millard.osim", folder / "pose2sim.toml"
 
 
 def geometry_times(path: Path, mapping) -> dict:
     """The present path's and the new geometry's times at the reference posture [s] and their difference."""
+    from osim_reference import present_geometry
+
     from spinectl.anatomy.opensim_engine import _mobility_order, load_osim
     from spinectl.anatomy.osim_geometry import geometry
 
@@ -169,7 +123,7 @@ def geometry_times(path: Path, mapping) -> dict:
     geo = geometry(engine, involved, {}, _mobility_order(engine))
     new = time.perf_counter() - start
     start = time.perf_counter()
-    arms, hessian = present_geometry(engine, involved, {})
+    arms, hessian, _, _ = present_geometry(engine, involved, {})
     present = time.perf_counter() - start
     return {
         "muscles": len(anatomy.muscles),

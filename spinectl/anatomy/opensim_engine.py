@@ -55,6 +55,9 @@ from .linearise import STEP, Linearisation, Rhythm
 from .mapping import Mapping, default_mapping, located, read_mapping
 from .osim_geometry import geometry
 
+KEPT = 256
+"""How many linearisations an engine keeps in memory (:attr:`OsimEngine.linearisations`), the latest."""
+
 
 @dataclass(frozen=True)
 class Coupler:
@@ -145,7 +148,7 @@ class OsimEngine:
     cache : bool
         Whether :func:`linearise` reads and writes the cache of linearisations (:mod:`spinectl.anatomy.osim_cache`).
     linearisations : dict
-        The linearisations made in this process, by their cache key (kept with or without ``cache``).
+        The latest :data:`KEPT` linearisations made in this process, by their cache key (with or without ``cache``).
     """
 
     model: object
@@ -452,28 +455,14 @@ def linearise(engine: OsimEngine, names, values: dict, n=None) -> Linearisation:
         if engine.cache:
             osim_cache.write(key, lin)
     engine.linearisations[key] = lin
+    if len(engine.linearisations) > KEPT:  # the oldest goes: a sweep over postures holds KEPT at most
+        engine.linearisations.pop(next(iter(engine.linearisations)))
     arrays = {f.name: getattr(lin, f.name) for f in fields(lin)}
     return replace(lin, **{name: np.copy(v) for name, v in arrays.items() if isinstance(v, np.ndarray)})
 
 
 def _linearise(engine: OsimEngine, names, values: dict, n=None) -> Linearisation:
-    """K_i, K_0, D_i, D_0, M over the given coordinates at a posture, computed (module docstring).
-
-    Parameters
-    ----------
-    engine : OsimEngine
-    names : sequence of str
-        The coordinates involved, the chain's first.
-    values : dict
-        Coordinate name -> value [rad] of the posture (others at their defaults).
-    n : int, optional
-        How many of ``names`` are the chain's (default all).
-
-    Returns
-    -------
-    Linearisation
-        Over ``names`` (``dofs`` = 0 ... len(names) - 1), the other coordinates held.
-    """
+    """:func:`linearise` computed, neither kept nor cached (the same parameters and result)."""
     names = list(names)
     s = len(names)
     n = s if n is None else int(n)

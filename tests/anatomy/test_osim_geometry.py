@@ -1,9 +1,9 @@
 """OpenSim's geometry at a posture (spinectl.anatomy.osim_geometry) and the cache of linearisations (osim_cache).
 
-The reference is the path spinectl took before: every muscle's ``computeMomentArm`` about every
-coordinate (OpenSim's MomentArmSolver), their central differences over q with
-spinectl.anatomy.linearise.STEP for the Hessians, and OpenSim's inverse dynamics with the
-actuators off for the passive torques, written out here. The model is spinectl's export of the
+The reference is the path spinectl took before (tests/anatomy/osim_reference.py): every muscle's
+``computeMomentArm`` about every coordinate (OpenSim's MomentArmSolver), their central
+differences over q with spinectl.anatomy.linearise.STEP for the Hessians, and OpenSim's
+inverse dynamics with the actuators off for the passive torques. The model is spinectl's export of the
 paper's chain (30 Millard muscles) with a WrapCylinder that one muscle wraps over, built through
 OpenSim's API in the test.
 """
@@ -17,9 +17,10 @@ import pytest
 
 osim = pytest.importorskip("opensim", reason="needs the opensim extra: pip install 'spinectl[opensim]'")
 
+from osim_reference import present_geometry, rigid_millard_copy  # noqa: E402 (tests/anatomy/osim_reference.py)
+
 from spinectl.anatomy import opensim_engine, osim_cache  # noqa: E402
 from spinectl.anatomy.export_osim import export_osim  # noqa: E402
-from spinectl.anatomy.linearise import STEP  # noqa: E402
 from spinectl.anatomy.osim_geometry import geometry  # noqa: E402
 from spinectl.model.config import load_preset  # noqa: E402
 
@@ -57,47 +58,17 @@ def wrapped(tmp_path_factory):
     return folder / "wrapped.osim", opensim_engine.load_engine(folder / "wrapped.osim", cache=False)
 
 
-def _reference(engine, names, values):
-    """The present path's arms (-computeMomentArm), Hessians (their central differences) and passive torques."""
-    order = opensim_engine._mobility_order(engine)
-
-    def arms_and_passive(vals):
-        engine.set_posture(vals)
-        muscles, state = engine.model.getMuscles(), engine.state
-        coordinates = [engine.coordinate(c) for c in names]
-        each = [muscles.get(i) for i in range(muscles.getSize())]
-        arms = np.array([[-muscle.computeMomentArm(state, c) for c in coordinates] for muscle in each])
-        forces = engine.model.getForceSet()
-        for i in range(forces.getSize()):
-            forces.get(i).setAppliesForce(state, osim.Actuator.safeDownCast(forces.get(i)) is None)
-        engine.model.realizeDynamics(state)
-        needed = osim.InverseDynamicsSolver(engine.model).solve(state, osim.Vector(state.getNU(), 0.0))
-        for i in range(forces.getSize()):
-            forces.get(i).setAppliesForce(state, True)
-        return arms, -np.array([needed.get(order[c]) for c in names])
-
-    arms, passive = arms_and_passive(values)
-    hessian, dpassive = np.zeros((arms.shape[0], len(names), len(names))), np.zeros((len(names), len(names)))
-    for k, name in enumerate(names):
-        up = arms_and_passive({**values, name: values.get(name, 0.0) + STEP})
-        down = arms_and_passive({**values, name: values.get(name, 0.0) - STEP})
-        hessian[:, :, k] = (up[0] - down[0]) / (2 * STEP)
-        dpassive[:, k] = (up[1] - down[1]) / (2 * STEP)
-    engine.set_posture(values)
-    return arms, 0.5 * (hessian + hessian.transpose(0, 2, 1)), passive, dpassive
-
-
 @pytest.mark.parametrize("values", [{}, {"L4L5": 0.05, "L2L3": -0.03}], ids=["upright", "bent"])
 def test_the_geometry_is_the_present_paths(wrapped, values):
-    """Arms, Hessians, passive torques and their derivatives equal the present path's (_reference): the arms to
-    1e-12 of the largest (both are OpenSim's lengthening speed per coordinate speed, to rounding), the Hessians
+    """Arms, Hessians, passive torques and their derivatives equal the present path's (present_geometry): the arms
+    to 1e-12 of the largest (both are OpenSim's lengthening speed per coordinate speed, to rounding), the Hessians
     to 1e-6 of the largest entry (the same central differences of the same arms), the passive torques to 1e-12
     and their derivatives to 1e-8 of the largest. The wrapped muscle's path touches the cylinder (4 points)."""
     _, engine = wrapped
     engine.set_posture(values)
     assert engine.model.getMuscles().get(WRAPPED).getGeometryPath().getCurrentPath(engine.state).getSize() == 4
     geo = geometry(engine, CHAIN, values, opensim_engine._mobility_order(engine))
-    arms, hessian, passive, dpassive = _reference(engine, CHAIN, values)
+    arms, hessian, passive, dpassive = present_geometry(engine, CHAIN, values)
     assert np.max(np.abs(geo.arms - arms)) <= 1e-12 * np.max(np.abs(arms))
     assert np.max(np.abs(geo.hessian - hessian)) <= 1e-6 * np.max(np.abs(hessian))
     assert np.max(np.abs(geo.hessian[WRAPPED] - hessian[WRAPPED])) <= 1e-6 * np.max(np.abs(hessian[WRAPPED]))
@@ -238,26 +209,6 @@ SHARED = Path("/work/shared/models/pose2sim-beaucage-gauvreau/Model_Pose2Sim_mus
 POSE2SIM_CHAIN = [f"{joint}_Flex_Ext" for joint in ("L5_S1", "L4_L5", "L3_L4", "L2_L3", "L1_L2", "L1_T12")]
 
 
-def _as_rigid_millard(source: Path, target: Path) -> None:
-    """A copy of ``source`` with every muscle a rigid-tendon Millard muscle on the same path (OpenSim's API)."""
-    model = osim.Model(str(source))
-    forces = model.updForceSet()
-    for name in [model.getMuscles().get(i).getName() for i in range(model.getMuscles().getSize())]:
-        old = osim.Muscle.safeDownCast(forces.get(name))
-        new = osim.Millard2012EquilibriumMuscle()
-        new.setName(name)
-        new.setMaxIsometricForce(old.getMaxIsometricForce())
-        new.setOptimalFiberLength(old.getOptimalFiberLength())
-        new.setTendonSlackLength(old.getTendonSlackLength())
-        new.setPennationAngleAtOptimalFiberLength(0.0)
-        new.set_ignore_tendon_compliance(True)
-        new.set_path(old.get_path())
-        forces.remove(forces.getIndex(name))
-        forces.append(new)
-    model.finalizeConnections()
-    model.printToXML(str(target))
-
-
 @pytest.mark.skipif(not SHARED.is_file(), reason="the shared downloaded models (/work/shared/models) are absent")
 def test_the_geometry_is_the_present_paths_on_a_published_model(tmp_path):
     """The Pose2Sim model (318 muscles, 41 wrap cylinders and 3 ellipsoids: latissimus dorsi over the torso), its
@@ -266,10 +217,10 @@ def test_the_geometry_is_the_present_paths_on_a_published_model(tmp_path):
     Why the arms are not differences of getLength: over the ellipsoid, LD_L2_r's length changes with L1_T12 at
     1.99 times the rate of its arm (central differences, step 1e-6 rad; the arm is what OpenSim's forces follow)."""
     copy = tmp_path / "pose2sim_millard.osim"
-    _as_rigid_millard(SHARED, copy)
+    rigid_millard_copy(SHARED, copy)
     engine = opensim_engine.load_engine(copy, cache=False)
     geo = geometry(engine, POSE2SIM_CHAIN, {}, opensim_engine._mobility_order(engine))
-    arms, hessian, passive, dpassive = _reference(engine, POSE2SIM_CHAIN, {})
+    arms, hessian, passive, dpassive = present_geometry(engine, POSE2SIM_CHAIN, {})
     assert np.max(np.abs(geo.arms - arms)) <= 1e-12 * np.max(np.abs(arms))
     assert np.max(np.abs(geo.hessian - hessian)) <= 1e-6 * np.max(np.abs(hessian))
     assert np.max(np.abs(geo.passive - passive)) <= 1e-12 * np.max(np.abs(passive))
@@ -281,3 +232,17 @@ def test_the_geometry_is_the_present_paths_on_a_published_model(tmp_path):
         engine.set_posture({"L1_T12_Flex_Ext": sign * 1e-6})
         sides.append(muscles.get(index).getLength(engine.state))
     assert abs((sides[0] - sides[1]) / 2e-6 / geo.arms[index, -1] - 1.99) <= 0.01
+
+
+def test_an_engine_keeps_its_latest_linearisations_only(wrapped, cache, monkeypatch):
+    """With KEPT = 2, three postures leave the last two in the engine's memory (a sweep does not grow it without
+    bound); the first is read back from the cache, identical."""
+    path, _ = wrapped
+    monkeypatch.setattr(opensim_engine, "KEPT", 2)
+    anatomy = opensim_engine.load_osim(path)
+    first = anatomy.linearise("sagittal", {"L4L5": 0.01})[0]
+    for angle in (0.02, 0.03):
+        anatomy.linearise("sagittal", {"L4L5": angle})
+    assert len(anatomy.engine.linearisations) == 2
+    _refuse_to_compute(monkeypatch)
+    assert _identical(anatomy.linearise("sagittal", {"L4L5": 0.01})[0], first)
