@@ -3,13 +3,14 @@
 The moment arms are OpenSim's own: with the posture realised once and every speed zero but
 coordinate k's at 1 rad/s (``Model.realizeVelocity``), every muscle's lengthening speed
 (``Muscle.getLengtheningSpeed``, OpenSim's path: via, conditional and moving points, wrapping)
-is its dL/dq_k, the arm of the forces OpenSim applies along the path. That is what
+is its rate of lengthening per unit of q_k, the arm of the forces OpenSim applies along the
+path (dL/dq_k wherever OpenSim's path length is smooth and consistent with it). That is what
 ``computeMomentArm`` returns with no enforced constraint coupling the coordinate to another
 (spinectl switches the couplers off), but it realises the whole model again for each muscle and
 coordinate: s velocity realisations per posture replace m s position realisations.
 The Hessians are central differences of these arms over q with step
-:data:`~spinectl.anatomy.linearise.STEP` (truncation STEP^2/6 |d^3 r/dq^3|, rounding
-eps |r| / STEP: both about 1e-12 m/rad^2 for arms of 0.1 m), at the 2s postures q +- STEP e_k,
+:data:`~spinectl.anatomy.linearise.STEP` (truncation STEP^2/6 abs(d^3 r/dq^3), rounding
+eps abs(r) / STEP: both about 1e-12 m/rad^2 for arms of 0.1 m), at the 2s postures q +- STEP e_k,
 as before; so are the passive torques' (OpenSim's inverse dynamics with the muscles and
 actuators off: gravity and every passive force). Every wrapped muscle's contacts are checked
 at each of these postures: a muscle that starts or stops wrapping within STEP has a kinked arm
