@@ -27,7 +27,8 @@ def load(model="myotorso", mapping=None, cache: bool = True) -> AnatomyEngine:
         A mapping TOML file; default the built-in one of the model's name.
     cache : bool
         For MuJoCo's models: read the compiled model from the cache of compiled models, and write
-        it there (:mod:`spinectl.anatomy.cache`); False compiles it anew. An ``.osim`` file is not cached.
+        it there (:mod:`spinectl.anatomy.cache`); for an ``.osim`` file, its linearisations
+        (:mod:`spinectl.anatomy.osim_cache`). False compiles and linearises anew.
 
     Returns
     -------

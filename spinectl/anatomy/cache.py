@@ -56,16 +56,31 @@ def cache_dir() -> Path:
     return Path.home() / ".cache" / "spinectl"
 
 
+def digest(*parts) -> str:
+    """SHA-256 of ``parts`` (each bytes or str, length-prefixed so that no two lists collide).
+
+    Parameters
+    ----------
+    *parts : bytes or str
+
+    Returns
+    -------
+    str
+        Hex SHA-256.
+    """
+    out = hashlib.sha256()
+    for part in parts:
+        data = part.encode() if isinstance(part, str) else bytes(part)
+        out.update(len(data).to_bytes(8, "little"))
+        out.update(data)
+    return out.hexdigest()
+
+
 def _key(*parts) -> str:
-    """SHA-256 of the versions and ``parts`` (each bytes or str, length-prefixed so that no two lists collide)."""
+    """SHA-256 of the versions and ``parts`` (:func:`digest`)."""
     import mujoco
 
-    digest = hashlib.sha256()
-    for part in (f"format {FORMAT}", f"mujoco {mujoco.__version__}", *parts):
-        data = part.encode() if isinstance(part, str) else bytes(part)
-        digest.update(len(data).to_bytes(8, "little"))
-        digest.update(data)
-    return digest.hexdigest()
+    return digest(f"format {FORMAT}", f"mujoco {mujoco.__version__}", *parts)
 
 
 def builtin_key(name: str, package) -> str:

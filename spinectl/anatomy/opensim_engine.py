@@ -2,7 +2,9 @@
 
 Everything is OpenSim's: the model is read and built by :class:`opensim.Model` (spinectl
 parses no ``.osim`` of its own), the muscles' path lengths and moment arms
-(``Muscle.getLength``, ``computeMomentArm``, wrapping and conditional points included), the
+(``Muscle.getLength``, and ``getLengtheningSpeed`` at unit coordinate speeds: what
+``computeMomentArm`` returns, every muscle at once, :mod:`~spinectl.anatomy.osim_geometry`;
+wrapping and conditional points included), the
 muscle curves (Millard 2012's active and passive force-length and force-velocity curves,
 ``calcValue``/``calcDerivative``), the generalised gravity and every passive force (minus the
 inverse dynamics at rest with the muscles and actuators off) and the mass matrix
@@ -39,12 +41,13 @@ from __future__ import annotations
 
 import hashlib
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 
 from .._validate import printable
 from ..errors import ModelError, ParameterError
+from . import osim_cache
 from .contract import MappedModel, lordosis_direction, plane_axes
 from .engine import engine_output_to_stderr, model_file, one_line
 from .export_osim import require_opensim
@@ -52,6 +55,10 @@ from .joint_angles import JointSlopes
 from .linearise import STEP, Linearisation, Rhythm
 from .mapping import Mapping, default_mapping, located, read_mapping
 from .opensim_angles import joint_slopes
+from .osim_geometry import geometry
+
+KEPT = 256
+"""How many linearisations an engine keeps in memory (:attr:`OsimEngine.linearisations`), the latest."""
 
 
 @dataclass(frozen=True)
@@ -138,6 +145,12 @@ class OsimEngine:
         The model's name, the file's path and the SHA-256 of its bytes.
     couplers : tuple of Coupler
         The model's ``CoordinateCouplerConstraint`` s, switched off in ``model`` (the free chain).
+    mobilities : dict
+        Coordinate name -> its mobility index, read once (:func:`_mobility_order`).
+    cache : bool
+        Whether :func:`linearise` reads and writes the cache of linearisations (:mod:`spinectl.anatomy.osim_cache`).
+    linearisations : dict
+        The latest :data:`KEPT` linearisations made in this process, by their cache key (with or without ``cache``).
     """
 
     model: object
@@ -146,6 +159,9 @@ class OsimEngine:
     source: str
     sha256: str
     couplers: tuple = field(default=())
+    mobilities: dict = field(default_factory=dict, repr=False)
+    cache: bool = True
+    linearisations: dict = field(default_factory=dict, repr=False)
 
     def coordinate(self, name: str):
         """The coordinate of that name.
@@ -192,12 +208,14 @@ class OsimEngine:
         self.model.realizePosition(self.state)
 
 
-def load_engine(path) -> OsimEngine:
+def load_engine(path, cache: bool = True) -> OsimEngine:
     """Build an ``.osim`` file with OpenSim.
 
     Parameters
     ----------
     path : str or pathlib.Path
+    cache : bool
+        Whether its linearisations are read from and written to the cache (:mod:`spinectl.anatomy.osim_cache`).
 
     Returns
     -------
@@ -217,7 +235,7 @@ def load_engine(path) -> OsimEngine:
         raise ParameterError("model", f"OpenSim cannot build {path}: {_one_line(exc)}") from None
     digest = hashlib.sha256(path.read_bytes()).hexdigest()
     source = str(path.resolve()) + schema
-    return OsimEngine(model, state, model.getName() or path.stem, source, digest, couplers)
+    return OsimEngine(model, state, model.getName() or path.stem, source, digest, couplers, cache=cache)
 
 
 def _one_line(exc) -> str:
@@ -388,51 +406,30 @@ def _curves(engine: OsimEngine, lengths, velocities) -> np.ndarray:
     return out
 
 
-def _arms_and_passive(engine: OsimEngine, names, values: dict):
-    """dl/dq of every muscle over the chain's coordinates (-computeMomentArm) and the passive torques [N m]."""
-    osim = require_opensim()
-    engine.set_posture(values)
-    model, state = engine.model, engine.state
-    muscles = model.getMuscles()
-    arms = np.array(
-        [
-            [-muscles.get(i).computeMomentArm(state, engine.coordinate(c)) for c in names]
-            for i in range(muscles.getSize())
-        ]
-    ).reshape(muscles.getSize(), len(names))  # (0, s) without muscles: the passive chain
-    forces = model.getForceSet()
-    for i in range(forces.getSize()):  # gravity and the passive forces only: muscles and actuators off
-        force = forces.get(i)
-        force.setAppliesForce(state, osim.Actuator.safeDownCast(force) is None)
-    model.realizeDynamics(state)
-    needed = osim.InverseDynamicsSolver(model).solve(state, osim.Vector(state.getNU(), 0.0))
-    order = _mobility_order(engine)
-    passive = -np.array([needed.get(order[c]) for c in names])
-    for i in range(forces.getSize()):
-        forces.get(i).setAppliesForce(state, True)
-    return arms, passive
-
-
 def _mobility_order(engine: OsimEngine) -> dict:
     """Coordinate name -> its index among the system's mobilities (the order of calcM and the inverse dynamics).
 
-    Read off the state (OpenSim's Python bindings do not wrap the tree order): the entry of U
-    that each coordinate's speed sets. One speed per coordinate (no ball or free joints).
+    Read off the state once per engine (OpenSim's Python bindings do not wrap the tree order):
+    the entry of U that each coordinate's speed sets. One speed per coordinate (no ball or free joints).
     """
+    if engine.mobilities:
+        return engine.mobilities
     coords, state = engine.model.getCoordinateSet(), engine.state
-    order = {}
-    for i in range(coords.getSize()):  # the one speed that a coordinate's speed sets
-        for j in range(coords.getSize()):
-            coords.get(j).setSpeedValue(state, float(i == j))
-        u = state.getU()
-        order[coords.get(i).getName()] = int(np.argmax([abs(u.get(k)) for k in range(u.size())]))
     for j in range(coords.getSize()):
         coords.get(j).setSpeedValue(state, 0.0)
-    return order
+    for i in range(coords.getSize()):  # the one speed that a coordinate's speed sets
+        coords.get(i).setSpeedValue(state, 1.0)
+        engine.mobilities[coords.get(i).getName()] = int(np.argmax(np.abs(state.getU().to_numpy())))
+        coords.get(i).setSpeedValue(state, 0.0)
+    return engine.mobilities
 
 
 def linearise(engine: OsimEngine, names, values: dict, n=None) -> Linearisation:
-    """K_i, K_0, D_i, D_0, M over the given coordinates at a posture (module docstring).
+    """K_i, K_0, D_i, D_0, M over the given coordinates at a posture, made once (module docstring).
+
+    Made once per process and engine (:attr:`OsimEngine.linearisations`) and, with
+    :attr:`OsimEngine.cache`, read from or written to the cache of linearisations
+    (:mod:`spinectl.anatomy.osim_cache`): bit for bit what :func:`_linearise` returns.
 
     Parameters
     ----------
@@ -447,37 +444,31 @@ def linearise(engine: OsimEngine, names, values: dict, n=None) -> Linearisation:
     Returns
     -------
     Linearisation
-        Over ``names`` (``dofs`` = 0 ... len(names) - 1), the other coordinates held.
+        Over ``names`` (``dofs`` = 0 ... len(names) - 1), the other coordinates held; a copy.
     """
-    osim = require_opensim()
+    names = [str(c) for c in names]
+    n = len(names) if n is None else int(n)
+    key = osim_cache.key(engine.sha256, names, n, values)
+    lin = engine.linearisations.get(key) or (osim_cache.read(key) if engine.cache else None)
+    if lin is None:
+        lin = _linearise(engine, names, values, n)
+        if engine.cache:
+            osim_cache.write(key, lin)
+    engine.linearisations[key] = lin
+    if len(engine.linearisations) > KEPT:  # the oldest goes: a sweep over postures holds KEPT at most
+        engine.linearisations.pop(next(iter(engine.linearisations)))
+    arrays = {f.name: getattr(lin, f.name) for f in fields(lin)}
+    return replace(lin, **{name: np.copy(v) for name, v in arrays.items() if isinstance(v, np.ndarray)})
+
+
+def _linearise(engine: OsimEngine, names, values: dict, n=None) -> Linearisation:
+    """:func:`linearise` computed, neither kept nor cached (the same parameters and result)."""
     names = list(names)
     s = len(names)
     n = s if n is None else int(n)
-    arms, passive = _arms_and_passive(engine, names, values)
-    muscles = engine.model.getMuscles()
-    engine.set_posture(values)
-    lengths = np.array([muscles.get(i).getLength(engine.state) for i in range(muscles.getSize())])
+    geo = geometry(engine, names, values, _mobility_order(engine))
+    arms, passive, dpassive, hessian, lengths = geo.arms, geo.passive, geo.dpassive, geo.hessian, geo.lengths
     gain, dgain_dl, dgain_dv, bias, dbias_dl, dbias_dv = _curves(engine, lengths, np.zeros_like(lengths))
-    mass = osim.Matrix()
-    engine.model.getMatterSubsystem().calcM(engine.state, mass)
-    order = _mobility_order(engine)
-    index = [order[c] for c in names]
-    full = np.array([[mass.get(i, j) for j in range(mass.ncol())] for i in range(mass.nrow())])
-    hessian = np.zeros((len(lengths), s, s))
-    dpassive = np.zeros((s, s))
-    wrapped = _wrapped(engine)
-    touching = _contacts(engine, wrapped)
-    for k, name in enumerate(names):
-        sides = []
-        for sign in (1.0, -1.0):
-            moved = dict(values)
-            moved[name] = values.get(name, engine.coordinate(name).getDefaultValue()) + sign * STEP
-            sides.append(_arms_and_passive(engine, names, moved))
-            _same_contacts(engine, wrapped, touching, _contacts(engine, wrapped), name)
-        hessian[:, :, k] = (sides[0][0] - sides[1][0]) / (2 * STEP)
-        dpassive[:, k] = (sides[0][1] - sides[1][1]) / (2 * STEP)
-    engine.set_posture(values)
-    hessian = 0.5 * (hessian + hessian.transpose(0, 2, 1))
     rr = np.einsum("ij,ik->jki", arms, arms)
     return Linearisation(
         dofs=tuple(range(s)),
@@ -486,41 +477,11 @@ def linearise(engine: OsimEngine, names, values: dict, n=None) -> Linearisation:
         stiffness_offset=0.5 * (dpassive + dpassive.T) + np.einsum("ijk,i->jk", hessian, bias) + rr @ dbias_dl,
         damping_per_muscle=rr * dgain_dv,
         damping_offset=rr @ dbias_dv,  # the fibres' damping (Millard's fiber_damping)
-        mass=full[np.ix_(index, index)],
+        mass=geo.mass,
         torque_per_muscle=arms.T * gain,
         torque_offset=passive + arms.T @ bias,
         moment_arms=arms,
     )
-
-
-def _wrapped(engine: OsimEngine) -> dict:
-    """Muscle index -> the names of the wrap objects on its path, for the muscles that have any."""
-    muscles = engine.model.getMuscles()
-    out = {}
-    for i in range(muscles.getSize()):
-        wraps = muscles.get(i).getGeometryPath().getWrapSet()
-        if wraps.getSize():
-            out[i] = [wraps.get(k).getWrapObject().getName() for k in range(wraps.getSize())]
-    return out
-
-
-def _contacts(engine: OsimEngine, wrapped: dict) -> dict:
-    """Muscle index -> how many points its current path has (2 more per wrap it touches), at the set posture."""
-    muscles = engine.model.getMuscles()
-    engine.model.realizePosition(engine.state)
-    return {i: muscles.get(i).getGeometryPath().getCurrentPath(engine.state).getSize() for i in wrapped}
-
-
-def _same_contacts(engine: OsimEngine, wrapped: dict, before: dict, after: dict, coordinate: str) -> None:
-    """A muscle that touches a wrap on one side of the posture only has a kinked moment arm there: one line."""
-    for i, count in before.items():
-        if after[i] != count:
-            muscle = engine.model.getMuscles().get(i).getName()
-            raise ModelError(
-                f"{engine.name}: muscle {muscle} starts or stops wrapping over {', '.join(wrapped[i])} within "
-                f"{STEP:g} rad of the posture ({coordinate}): its moment arm has a kink there, which the "
-                "linearisation cannot differentiate; nothing was linearised (move the posture off the contact)"
-            )
 
 
 @dataclass
@@ -906,14 +867,15 @@ def load_osim(path, mapping=None, cache: bool = True) -> OsimAnatomy:
         A mapping TOML (names of OpenSim bodies and coordinates); default the built-in one of the
         model's name (``wagner2012_chain`` for spinectl's own export).
     cache : bool
-        Unused: an ``.osim`` file is built anew each time (the loaders' common signature,
-        :data:`spinectl.anatomy.contract.ENGINES`).
+        Read the model's linearisations from the cache of linearisations and write them there
+        (:mod:`spinectl.anatomy.osim_cache`); False linearises anew and leaves the cache alone.
+        The model itself is built anew each time (OpenSim has no compiled form to keep).
 
     Returns
     -------
     OsimAnatomy
     """
-    engine = load_engine(path)
+    engine = load_engine(path, cache=cache)
     if mapping is None:
         mapping = default_mapping(engine.name)
     elif not isinstance(mapping, Mapping):

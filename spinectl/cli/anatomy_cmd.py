@@ -135,7 +135,8 @@ def register(sub) -> None:
         "--no-cache",
         action="store_true",
         help="compile the model anew, neither reading nor writing the cache of compiled models "
-        "($SPINECTL_CACHE_DIR, else $XDG_CACHE_HOME/spinectl, else ~/.cache/spinectl)",
+        "(an .osim file's: its linearisations) ($SPINECTL_CACHE_DIR, else $XDG_CACHE_HOME/spinectl, "
+        "else ~/.cache/spinectl)",
     )
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     parser.set_defaults(func=run)
