@@ -193,9 +193,12 @@ def _evaluate(engine, values: dict, acts, floors, arms, names, rigid) -> np.ndar
     damping = _path_damping(engine, acts, arms, names, np.flatnonzero(rigid))
     springs = np.flatnonzero(~rigid)
     if springs.size:
-        k_t, k_f = _read(engine, "getTendonStiffness"), _read(engine, "getFiberStiffnessAlongTendon")
-        c_f = _fibre_damping(engine, np.asarray(acts, float), floors, springs)
-        damping[springs] = c_f[springs] * (k_t[springs] / (k_t[springs] + k_f[springs])) ** 2
+        k_t, k_f = _read(engine, "getTendonStiffness")[springs], _read(engine, "getFiberStiffnessAlongTendon")[springs]
+        c_f = _fibre_damping(engine, np.asarray(acts, float), floors, springs)[springs]
+        # a slack tendon (k_T = 0) passes no damping: the share k_T / (k_T + k_F) is 0; a tendon that OpenSim
+        # reports infinitely stiff (a Thelen tendon below its slack strain's toe, say) passes it all: 1
+        share = np.divide(k_t, k_t + k_f, out=np.where(np.isinf(k_t), 1.0, 0.0), where=np.isfinite(k_t) & (k_t > 0))
+        damping[springs] = c_f * share**2
     return np.array([force, stiffness, damping])
 
 

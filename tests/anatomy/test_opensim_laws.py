@@ -11,6 +11,8 @@ at each perturbed posture), differenced centrally in the coordinates (K) and in 
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -83,11 +85,11 @@ def build(path, law: str, compliant: bool = False, pennation: float = 0.0, wrap=
     return str(path)
 
 
-def _mobilities(model, state) -> list:
-    """The index in the system's speeds of each of NAMES."""
+def _mobilities(model, state, names) -> list:
+    """The index in the system's speeds of each coordinate of ``names`` (the others' speeds 0)."""
     coords, out = model.getCoordinateSet(), []
-    for name in NAMES:
-        for other in NAMES:
+    for name in names:
+        for other in names:
             coords.get(other).setSpeedValue(state, float(other == name))
         u = state.getU()
         out.append(int(np.argmax([abs(u.get(k)) for k in range(u.size())])))
@@ -95,10 +97,11 @@ def _mobilities(model, state) -> list:
 
 
 def opensim_torque(model, state, q: dict, u: dict, a) -> np.ndarray:
-    """OpenSim's net generalised force on NAMES at (q, u) with every muscle at activation ``a`` [N m]."""
-    order = _mobilities(model, state)
+    """OpenSim's net generalised force on the coordinates of ``q`` at (q, u), every muscle at ``a`` [N m]."""
+    names = list(q)
+    order = _mobilities(model, state, names)
     coords = model.getCoordinateSet()
-    for name in NAMES:
+    for name in names:
         coords.get(name).setValue(state, q[name], False)
         coords.get(name).setSpeedValue(state, u[name])
     model.realizeVelocity(state)
@@ -111,18 +114,24 @@ def opensim_torque(model, state, q: dict, u: dict, a) -> np.ndarray:
     return -np.array([needed.get(k) for k in order])
 
 
-def referee(path, a, step=1e-5) -> tuple:
-    """(tau, K = dtau/dq, D = dtau/du) by OpenSim alone, central differences of step ``step`` [rad, rad/s]."""
-    model = osim.Model(path)
-    state = model.initSystem()
-    still = dict.fromkeys(NAMES, 0.0)
-    tau = opensim_torque(model, state, POSTURE, still, a)
-    K, D = np.zeros((2, 2)), np.zeros((2, 2))
-    for k, name in enumerate(NAMES):
-        moved = [opensim_torque(model, state, {**POSTURE, name: POSTURE[name] + s * step}, still, a) for s in (1, -1)]
+def referee(path_or_model, a, step=1e-5, posture=None, state=None) -> tuple:
+    """(tau, K = dtau/dq, D = dtau/du) by OpenSim alone over the posture's coordinates, central differences of step
+    ``step`` [rad, rad/s]; ``path_or_model`` a file (built anew) or a model with its ``state``."""
+    posture = POSTURE if posture is None else posture
+    if state is None:
+        model = osim.Model(path_or_model)
+        state = model.initSystem()
+    else:
+        model = path_or_model
+    names, still = list(posture), dict.fromkeys(posture, 0.0)
+    tau = opensim_torque(model, state, posture, still, a)
+    K, D = np.zeros((len(names), len(names))), np.zeros((len(names), len(names)))
+    for k, name in enumerate(names):
+        moved = [opensim_torque(model, state, {**posture, name: posture[name] + s * step}, still, a) for s in (1, -1)]
         K[:, k] = (moved[0] - moved[1]) / (2 * step)
-        sped = [opensim_torque(model, state, POSTURE, {**still, name: s * step}, a) for s in (1, -1)]
+        sped = [opensim_torque(model, state, posture, {**still, name: s * step}, a) for s in (1, -1)]
         D[:, k] = (sped[0] - sped[1]) / (2 * step)
+    opensim_torque(model, state, posture, still, a)
     return tau, K, D
 
 
@@ -261,3 +270,51 @@ def test_an_unsupported_muscle_class_is_one_line(tmp_path):
     message = str(caught.value)
     assert "\n" not in message and "odd (RigidTendonMuscle)" in message
     assert "Millard2012EquilibriumMuscle, Thelen2003Muscle, DeGrooteFregly2016Muscle" in message
+
+
+SHARED = Path("/work/shared/models")
+POSE2SIM = SHARED / "pose2sim-beaucage-gauvreau" / "Model_Pose2Sim_muscles_flex.osim"
+CYCLIST = SHARED / "allaire-cyclist" / "s01modelScaled.osim"
+
+
+def _shared_check(path, names, levels, step):
+    """spinectl's and OpenSim's (tau, K, D) over ``names`` at the default posture (couplers off), per activation."""
+    engine = load_engine(path)
+    m = engine.model.getMuscles().getSize()
+    posture = {n: engine.coordinate(n).getDefaultValue() for n in names}
+    out = []
+    for level in levels:
+        a = np.full(m, level)
+        lin = linearise(engine, names, {}, activations=a)
+        out.append((lin, spinectl_at(lin, a), referee(engine.model, a, step=step, posture=posture, state=engine.state)))
+    return out
+
+
+@pytest.mark.skipif(not POSE2SIM.is_file(), reason="the shared downloaded models (/work/shared/models) are absent")
+def test_the_pose2sim_models_de_groote_muscles_are_opensims():
+    """The Pose2Sim model as downloaded (318 rigid-tendon De Groote muscles, 212 pennate; before: refused) over
+    L5/S1 ... L3/L4 flexion at a = 0.05 and 0.5: tau and D equal OpenSim's central differences to 1e-6 of their
+    largest entry, K to 2e-4 of it against the symmetric part of OpenSim's. OpenSim's own K there is not symmetric
+    (its antisymmetric part is 8e-5 at 0.05 and 4.5e-4 at 0.5 of the largest entry, measured; a gradient's is 0):
+    the muscles' generalised forces in this model are not exactly the gradient of their path lengths, which the
+    geometry's linearisation (sum r f, a symmetric Hessian) cannot follow; each muscle's stiffness dF/dL is
+    OpenSim's to 2e-9 (measured against central differences of getTendonForce)."""
+    names = ["L5_S1_Flex_Ext", "L4_L5_Flex_Ext", "L3_L4_Flex_Ext"]
+    for lin, (tau, K, D), (ref_tau, ref_K, ref_D) in _shared_check(POSE2SIM, names, (0.05, 0.5), 1e-5):
+        assert lin.notes == ()
+        _close(tau, ref_tau, 1e-6)
+        _close(D, ref_D, 1e-6)
+        _close(K, 0.5 * (ref_K + ref_K.T), 2e-4)
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not CYCLIST.is_file(), reason="the shared downloaded models (/work/shared/models) are absent")
+def test_the_cyclist_models_thelen_and_compliant_millard_muscles_are_opensims():
+    """The Allaire/Bruno cyclist model as downloaded (Thelen and compliant Millard muscles; before: refused) over
+    L5/S1 and L4/L5 flexion at a = 0.5: tau and K equal OpenSim's central differences (fibres in equilibrium at each
+    posture) to 1e-4 of their largest entry, and the linearisation says it is the tangent at that activation."""
+    names = ["L5_S1_FE", "L4_L5_FE"]
+    ((lin, (tau, K, _), (ref_tau, ref_K, _)),) = _shared_check(CYCLIST, names, (0.5,), 1e-4)
+    assert "compliant-tendon muscle(s)" in lin.notes[0]
+    _close(tau, ref_tau)
+    _close(K, ref_K)
