@@ -139,8 +139,7 @@ def _read(engine, getter: str) -> np.ndarray:
 def _fibre_damping(engine, acts, floors, rows) -> np.ndarray:
     """c_F of the compliant muscles ``rows`` at the realised equilibrium (module docstring), 0 elsewhere [N s/m]."""
     osim = require_opensim()
-    model, state = engine.model, engine.state
-    muscles = model.getMuscles()
+    state = engine.state
     active = _read(engine, "getActiveFiberForceAlongTendon")
     out = np.zeros(len(acts))
     steps = [np.minimum(acts + ACTIVATION_STEP, 1.0), np.maximum(acts - ACTIVATION_STEP, floors)]

@@ -548,8 +548,8 @@ def remedy_text(value: float) -> str:
 feasible."""
 
 EQUILIBRIUM_HINT = (
-    "the equilibrium fails, not the stability criterion: no activations within their bounds hold the posture even without "
-    "a criterion (the classic optimum is infeasible too); the bounded least-squares residual of the net torque "
+    "the equilibrium fails, not the stability criterion: no activations within their bounds hold the posture even "
+    "without a criterion (the classic optimum is infeasible too); the bounded least-squares residual of the net torque "
     "is {residual:.3g} N m over the {rows} equilibrium rows: the posture needs torques besides the muscles' "
     "(spinectl's export: its counter torques, actuators that the optimum does not hold)"
 )
