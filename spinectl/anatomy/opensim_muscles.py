@@ -103,7 +103,16 @@ def activation_floor(muscle) -> float:
 
 
 def compliant(muscle) -> bool:
-    """Whether the muscle's tendon is compliant (Thelen's always is)."""
+    """Whether the muscle's tendon is compliant (Thelen's always is).
+
+    Parameters
+    ----------
+    muscle : opensim.Muscle
+
+    Returns
+    -------
+    bool
+    """
     return muscle.getConcreteClassName() == "Thelen2003Muscle" or not muscle.get_ignore_tendon_compliance()
 
 
