@@ -153,7 +153,7 @@ class AnatomyEngine(Protocol):
             (:class:`~spinectl.anatomy.linearise.Linearisation`, its Rhythm, names of the involved coordinates).
         """
 
-    def chains(self, plane: str = "sagittal", posture=None, joint_stiffness="none") -> tuple:
+    def chains(self, plane: str = "sagittal", posture=None, joint_stiffness="none", activations=None) -> tuple:
         """The free chain and the chain constrained by the rhythm.
 
         Parameters
@@ -164,6 +164,9 @@ class AnatomyEngine(Protocol):
             The operating point (:meth:`posture`).
         joint_stiffness : {"none", "mapped"} or float
             Added at each chain joint (:meth:`added_stiffness`).
+        activations : array_like, optional
+            The operating activations, where an engine whose muscle forces are not affine in them
+            linearises (OpenSim's compliant tendons); the others ignore them.
 
         Returns
         -------
@@ -314,6 +317,10 @@ class MappedModel:
     rhythm_name = "rhythm"
     """What the constrained chain's source says constrains it (OpenSim: its couplers)."""
 
+    linearised_at_activations = False
+    """Whether ``linearise`` takes the operating activations (``activations=``): True for an engine whose
+    muscle forces are not affine in them (OpenSim's compliant tendons), linearised there."""
+
     @property
     def name(self) -> str:
         """The model's name."""
@@ -410,7 +417,7 @@ class MappedModel:
         """
         return f"{self.source}, {plane}"
 
-    def chains(self, plane: str = "sagittal", posture=None, joint_stiffness="none") -> tuple:
+    def chains(self, plane: str = "sagittal", posture=None, joint_stiffness="none", activations=None) -> tuple:
         """The free chain and the chain constrained by the model's rhythm, as LinearChain objects.
 
         Parameters
@@ -421,6 +428,9 @@ class MappedModel:
             The operating point (:meth:`posture`); default the reference posture.
         joint_stiffness : {"none", "mapped"} or float
             Intervertebral stiffness added at each chain joint (:meth:`added_stiffness`).
+        activations : array_like, shape (m,), optional
+            The operating activations, for an engine that linearises there
+            (:attr:`linearised_at_activations`); ignored by the others (exact at every activation).
 
         Returns
         -------
@@ -428,7 +438,8 @@ class MappedModel:
             (free :class:`~spinectl.model.linear_chain.LinearChain`, constrained one,
             the :class:`~spinectl.anatomy.linearise.Linearisation`).
         """
-        lin, rhy, involved = self.linearise(plane, posture)
+        at = {"activations": activations} if activations is not None and self.linearised_at_activations else {}
+        lin, rhy, involved = self.linearise(plane, posture, **at)
         n = lin.n
         added = self.added_stiffness(joint_stiffness, n)
         source = self.chain_source(plane, posture)

@@ -510,6 +510,7 @@ class OsimAnatomy(MappedModel):
     """
 
     rhythm_name = "couplers"
+    linearised_at_activations = True  # compliant tendons: the tangent at the operating activations
 
     def control_bounds(self) -> tuple:
         """Each muscle's activation range: [its law's floor, 1] (Millard's and Thelen's ``minimum_activation``).

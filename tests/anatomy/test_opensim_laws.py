@@ -253,6 +253,37 @@ def test_millards_activation_floor_is_the_control_bound(tmp_path):
     np.testing.assert_array_equal(other.control_bounds()[0], 0.0)
 
 
+def test_the_analysis_linearises_compliant_muscles_at_the_given_activations(tmp_path):
+    """``analyse(model, activation=0.5)`` on compliant Millard muscles: its free chain's K at 0.5 is the
+    linearisation at 0.5 (to rounding), not the tangent at the default activations (the floor), which is off by more
+    than 1 % there (the tangent's error away from its point)."""
+    from spinectl.anatomy.analyses import analyse
+
+    path = build(tmp_path / "chain.osim", "millard", compliant=True, pennation=PENNATION)
+    loaded = load_osim(path, mapping=_mapping(tmp_path))
+    a = np.full(4, 0.5)
+    result = analyse(loaded, activation=0.5)
+    at_half = spinectl_at(linearise(loaded.engine, NAMES, {}, activations=a), a)[1]
+    at_floor = spinectl_at(linearise(loaded.engine, NAMES, {}), a)[1]
+    _close(result.free.stiffness, at_half, 1e-9)  # K(a) of the free chain (no stiffness added)
+    assert np.max(np.abs(at_floor - at_half)) > 0.01 * np.max(np.abs(at_half))
+
+
+def test_an_activation_below_the_floor_is_refused_naming_the_floor(tmp_path):
+    """``activation=0`` on Millard muscles (floor 0.01, OpenSim's default) is one line naming the floor, not
+    "[0, 1]"; 0.01 is analysed; on De Groote muscles (no floor) 0 is analysed."""
+    from spinectl.anatomy.analyses import analyse
+    from spinectl.errors import ParameterError
+
+    millard = load_osim(build(tmp_path / "millard.osim", "millard"), mapping=_mapping(tmp_path))
+    with pytest.raises(ParameterError) as caught:
+        analyse(millard, activation=0.0)
+    assert "minimum activation (0.01 ... 0.01)" in str(caught.value) and "got 0 ... 0" in str(caught.value)
+    assert analyse(millard, activation=0.01).activations.min() == 0.01
+    degroote = load_osim(build(tmp_path / "degroote.osim", "degroote"), mapping=_mapping(tmp_path))
+    assert analyse(degroote, activation=0.0).activations.max() == 0.0
+
+
 def test_an_unsupported_muscle_class_is_one_line(tmp_path):
     """A muscle of a class OpenSim evaluates but the import does not read (McKibben here, a RigidTendonMuscle in
     tests/anatomy/test_osim_replay.py) is refused naming the muscle, its class and the supported classes."""
