@@ -327,8 +327,8 @@ def test_the_pose2sim_models_de_groote_muscles_are_opensims():
     L5/S1 ... L3/L4 flexion at a = 0.05 and 0.5: tau and D equal OpenSim's central differences to 1e-6 of their
     largest entry, K to 2e-4 of it against the symmetric part of OpenSim's. OpenSim's own K there is not symmetric
     (its antisymmetric part is 8e-5 at 0.05 and 4.5e-4 at 0.5 of the largest entry, measured; a gradient's is 0):
-    the muscles' generalised forces in this model are not exactly the gradient of their path lengths, which the
-    geometry's linearisation (sum r f, a symmetric Hessian) cannot follow; each muscle's stiffness dF/dL is
+    the wrapping muscles' moment arms (latissimus dorsi) differ from -dL/dq by up to 3 % of the largest arm, which
+    the geometry's linearisation (sum r f, a symmetric Hessian) cannot follow; each muscle's stiffness dF/dL is
     OpenSim's to 2e-9 (measured against central differences of getTendonForce)."""
     names = ["L5_S1_Flex_Ext", "L4_L5_Flex_Ext", "L3_L4_Flex_Ext"]
     for lin, (tau, K, D), (ref_tau, ref_K, ref_D) in _shared_check(POSE2SIM, names, (0.05, 0.5), 1e-5):
