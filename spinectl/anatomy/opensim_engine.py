@@ -53,7 +53,7 @@ from .engine import engine_output_to_stderr, model_file, one_line
 from .export_osim import require_opensim
 from .linearise import STEP, Linearisation, Rhythm
 from .mapping import Mapping, default_mapping, located, read_mapping
-from .opensim_muscles import activation_floor, check_muscle, tension_terms
+from .opensim_muscles import activation_floor, check_muscle, compliant, tension_terms
 
 
 @dataclass(frozen=True)
@@ -879,6 +879,9 @@ def load_osim(path, mapping=None, cache: bool = True) -> OsimAnatomy:
     for i in range(muscles.getSize()):
         check_muscle(engine.name, muscles.get(i))
     names = tuple(muscles.get(i).getName() for i in range(muscles.getSize()))
+    springs = sum(compliant(muscles.get(i)) for i in range(muscles.getSize()))
+    if springs:  # in the source line too: the chains are exact at the analysed activations only
+        engine.source += f"; {springs} compliant-tendon muscles linearised at the analysed activations"
     if engine.couplers:  # in the model's source line, which every table and JSON prints
         described = "; ".join(c.describe({}, engine) for c in engine.couplers)
         engine.source += f"; coupler constraints (off in the free chain, linearised in the constrained): {described}"
