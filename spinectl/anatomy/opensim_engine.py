@@ -563,7 +563,7 @@ class OsimAnatomy(MappedModel):
         """
         names = self._controllers()
         if not names:
-            return "each muscle's floor (0, or Millard's and Thelen's minimum_activation): the model has no controller"
+            return "each muscle's activation floor: the model has no controller"
         return f"the model's controls at t = 0 ({', '.join(names)})"
 
     def _controllers(self) -> list:
