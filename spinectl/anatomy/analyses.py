@@ -59,6 +59,8 @@ def activations(anatomy: AnatomyEngine, activation) -> np.ndarray:
     lower, upper = anatomy.control_bounds()
     unit = anatomy.control_unit
     allowed = "[0, 1]" if unit == "1" else f"[{lower.min():g}, {upper.max():g}] {unit}"
+    if unit == "1" and np.any(lower > 0):  # a law's activation floor (OpenSim's Millard and Thelen muscles)
+        allowed = f"[floor, 1], each muscle's floor its law's minimum activation ({lower.min():g} ... {lower.max():g})"
     if activation is None:
         a = anatomy.default_controls()
     elif isinstance(activation, dict):
@@ -701,7 +703,7 @@ def analyse(
     AnatomyResult
     """
     a = activations(anatomy, activation)
-    free, con, lin = anatomy.chains(plane, posture, joint_stiffness)
+    free, con, lin = anatomy.chains(plane, posture, joint_stiffness, activations=a)
     added = anatomy.added_stiffness(joint_stiffness, free.n_joints)
     arms = lin.moment_arms[:, list(lin.dofs[: lin.n])]
     referee, rate = None, float("nan")

@@ -169,7 +169,7 @@ class AnatomyEngine(Protocol):
             (:class:`~spinectl.anatomy.linearise.Linearisation`, its Rhythm, names of the involved coordinates).
         """
 
-    def chains(self, plane: str = "sagittal", posture=None, joint_stiffness="none") -> tuple:
+    def chains(self, plane: str = "sagittal", posture=None, joint_stiffness="none", activations=None) -> tuple:
         """The free chain and the chain constrained by the rhythm.
 
         Parameters
@@ -180,6 +180,9 @@ class AnatomyEngine(Protocol):
             The operating point (:meth:`posture`).
         joint_stiffness : {"none", "mapped"} or float
             Added at each chain joint (:meth:`added_stiffness`).
+        activations : array_like, optional
+            The operating activations, where an engine whose muscle forces are not affine in them
+            linearises (OpenSim's compliant tendons); the others ignore them.
 
         Returns
         -------
@@ -330,6 +333,10 @@ class MappedModel:
     rhythm_name = "rhythm"
     """What the constrained chain's source says constrains it (OpenSim: its couplers)."""
 
+    linearised_at_activations = False
+    """Whether ``linearise`` takes the operating activations (``activations=``): True for an engine whose
+    muscle forces are not affine in them (OpenSim's compliant tendons), linearised there."""
+
     @property
     def name(self) -> str:
         """The model's name."""
@@ -464,7 +471,7 @@ class MappedModel:
         rhy, involved = self.rhythm(plane, posture)
         return rhythm_in_angles(rhy, self.joint_slopes(plane, posture), self.name), involved
 
-    def chains(self, plane: str = "sagittal", posture=None, joint_stiffness="none") -> tuple:
+    def chains(self, plane: str = "sagittal", posture=None, joint_stiffness="none", activations=None) -> tuple:
         """The free chain and the chain constrained by the model's rhythm, as LinearChain objects.
 
         Both per radian of each joint's rotation, the engine's coordinates changed to the joints' angles
@@ -478,6 +485,9 @@ class MappedModel:
             The operating point (:meth:`posture`); default the reference posture.
         joint_stiffness : {"none", "mapped"} or float
             Intervertebral stiffness added at each chain joint (:meth:`added_stiffness`).
+        activations : array_like, shape (m,), optional
+            The operating activations, for an engine that linearises there
+            (:attr:`linearised_at_activations`); ignored by the others (exact at every activation).
 
         Returns
         -------
@@ -485,7 +495,8 @@ class MappedModel:
             (free :class:`~spinectl.model.linear_chain.LinearChain`, constrained one,
             the :class:`~spinectl.anatomy.linearise.Linearisation` in the joints' angles).
         """
-        lin, rhy, involved = self.linearise(plane, posture)
+        at = {"activations": activations} if activations is not None and self.linearised_at_activations else {}
+        lin, rhy, involved = self.linearise(plane, posture, **at)
         slopes = self.joint_slopes(plane, posture)
         lin, rhy = linearisation_in_angles(lin, slopes, self.name), rhythm_in_angles(rhy, slopes, self.name)
         n = lin.n

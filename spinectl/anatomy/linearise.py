@@ -135,6 +135,9 @@ class Linearisation:
         Passive muscle forces less gravity on every dof at the posture [N m].
     moment_arms : numpy.ndarray, shape (m, nv)
         r_i [m/rad].
+    notes : tuple of str
+        How the muscles' forces were linearised where it is not exact (e.g. OpenSim's compliant
+        tendons, at the operating activations); empty when exact.
     """
 
     dofs: tuple
@@ -147,6 +150,7 @@ class Linearisation:
     torque_per_muscle: np.ndarray
     torque_offset: np.ndarray
     moment_arms: np.ndarray
+    notes: tuple = ()
 
 
 def _curves(engine: Engine):

@@ -5,16 +5,19 @@ parses no ``.osim`` of its own), the muscles' path lengths and moment arms
 (``Muscle.getLength``, and ``getLengtheningSpeed`` at unit coordinate speeds: what
 ``computeMomentArm`` returns, every muscle at once, :mod:`~spinectl.anatomy.osim_geometry`;
 wrapping and conditional points included), the
-muscle curves (Millard 2012's active and passive force-length and force-velocity curves,
-``calcValue``/``calcDerivative``), the generalised gravity and every passive force (minus the
+muscles' forces along their paths with their stiffness and damping (whatever their law,
+:mod:`spinectl.anatomy.opensim_muscles`), the generalised gravity and every passive force (minus the
 inverse dynamics at rest with the muscles and actuators off) and the mass matrix
 (``SimbodyMatterSubsystem.calcM``). The linearisation is that of
 :mod:`spinectl.anatomy.linearise`: K_i = H_i gain_i + gain_i' r_i r_i^T, with the Hessians H_i
 by central differences of OpenSim's moment arms, K_0 by central differences of the passive
 torques, so the chain is a :class:`~spinectl.model.linear_chain.LinearChain` like MuJoCo's.
 
-Supported muscles: ``Millard2012EquilibriumMuscle`` with a rigid tendon (fibre length = path
-length - tendon slack length, no pennation), its activation the control.
+Supported muscles: ``Millard2012EquilibriumMuscle``, ``Thelen2003Muscle`` and
+``DeGrooteFregly2016Muscle``, rigid or compliant tendon, pennate or not, their activation the
+control within [the law's minimum activation, 1]; a rigid tendon's force is affine in the
+activation (exact), a compliant one's is linearised at the operating activations
+(:mod:`spinectl.anatomy.opensim_muscles`).
 
 Coordinate coupler constraints (``CoordinateCouplerConstraint``, e.g. the lumbar rhythm of
 Christophy et al. 2012) are switched off in the engine, so the **free** chain is the chain with
@@ -55,6 +58,7 @@ from .joint_angles import JointSlopes
 from .linearise import STEP, Linearisation, Rhythm
 from .mapping import Mapping, default_mapping, located, read_mapping
 from .opensim_angles import joint_slopes
+from .opensim_muscles import activation_floor, check_muscle, compliant, tension_terms
 from .osim_geometry import geometry
 
 KEPT = 256
@@ -151,6 +155,9 @@ class OsimEngine:
         Whether :func:`linearise` reads and writes the cache of linearisations (:mod:`spinectl.anatomy.osim_cache`).
     linearisations : dict
         The latest :data:`KEPT` linearisations made in this process, by their cache key (with or without ``cache``).
+    springs : int
+        How many muscles have a compliant tendon (linearised at the operating activations, which then
+        belong to a linearisation's key).
     """
 
     model: object
@@ -162,6 +169,7 @@ class OsimEngine:
     mobilities: dict = field(default_factory=dict, repr=False)
     cache: bool = True
     linearisations: dict = field(default_factory=dict, repr=False)
+    springs: int = 0
 
     def coordinate(self, name: str):
         """The coordinate of that name.
@@ -365,45 +373,6 @@ def _classify(engine: OsimEngine, mapping: Mapping) -> tuple:
     return tuple(classes)
 
 
-def _millard(engine: OsimEngine, muscle):
-    """The Millard muscle behind ``muscle``, rigid tendon, or one line saying what is not supported."""
-    osim = require_opensim()
-    millard = osim.Millard2012EquilibriumMuscle.safeDownCast(muscle)
-    if millard is None or not millard.get_ignore_tendon_compliance():
-        raise ModelError(
-            f"{engine.name}: muscle {muscle.getName()} ({muscle.getConcreteClassName()}) is not supported: "
-            "the OpenSim import reads Millard2012EquilibriumMuscle with a rigid tendon"
-        )
-    return millard
-
-
-def _curves(engine: OsimEngine, lengths, velocities) -> np.ndarray:
-    """gain, dgain/dl, dgain/dv, bias, dbias/dl, dbias/dv of every muscle (force along its length, negative pulls).
-
-    Millard, rigid tendon, no pennation: with l~ = (L - L_s) / l_opt and v~ = V / (l_opt v_max),
-    the tension is F_max (a f_AL(l~) f_V(v~) + f_PE(l~) + beta v~), beta the fibre damping.
-    """
-    muscles = engine.model.getMuscles()
-    out = np.zeros((6, muscles.getSize()))
-    for i in range(muscles.getSize()):
-        m = _millard(engine, muscles.get(i))
-        f_max, l_opt = m.getMaxIsometricForce(), m.getOptimalFiberLength()
-        v_unit = l_opt * m.getMaxContractionVelocity()
-        lt = (lengths[i] - m.getTendonSlackLength()) / l_opt
-        vt = velocities[i] / v_unit
-        active, fv, passive = m.getActiveForceLengthCurve(), m.getForceVelocityCurve(), m.getFiberForceLengthCurve()
-        beta = m.get_fiber_damping()
-        out[:, i] = -f_max * np.array(
-            [
-                active.calcValue(lt) * fv.calcValue(vt),
-                active.calcDerivative(lt, 1) * fv.calcValue(vt) / l_opt,
-                active.calcValue(lt) * fv.calcDerivative(vt, 1) / v_unit,
-                passive.calcValue(lt) + beta * vt,
-                passive.calcDerivative(lt, 1) / l_opt,
-                beta / v_unit,
-            ]
-        )
-    return out
 
 
 def _mobility_order(engine: OsimEngine) -> dict:
@@ -424,8 +393,9 @@ def _mobility_order(engine: OsimEngine) -> dict:
     return engine.mobilities
 
 
-def linearise(engine: OsimEngine, names, values: dict, n=None) -> Linearisation:
+def linearise(engine: OsimEngine, names, values: dict, n=None, activations=None) -> Linearisation:
     """K_i, K_0, D_i, D_0, M over the given coordinates at a posture, made once (module docstring).
+
 
     Made once per process and engine (:attr:`OsimEngine.linearisations`) and, with
     :attr:`OsimEngine.cache`, read from or written to the cache of linearisations
@@ -440,6 +410,9 @@ def linearise(engine: OsimEngine, names, values: dict, n=None) -> Linearisation:
         Coordinate name -> value [rad] of the posture (others at their defaults).
     n : int, optional
         How many of ``names`` are the chain's (default all).
+    activations : array_like, shape (m,), optional
+        The operating activations, where compliant-tendon muscles are linearised
+        (:func:`spinectl.anatomy.opensim_muscles.tension_terms`); default each muscle's floor.
 
     Returns
     -------
@@ -448,10 +421,12 @@ def linearise(engine: OsimEngine, names, values: dict, n=None) -> Linearisation:
     """
     names = [str(c) for c in names]
     n = len(names) if n is None else int(n)
-    key = osim_cache.key(engine.sha256, names, n, values)
+    # a rigid tendon's terms are exact at every activation, a compliant one's the tangent at these
+    operating = None if activations is None else np.asarray(activations, dtype=float)
+    key = osim_cache.key(engine.sha256, names, n, values, operating if engine.springs else None)
     lin = engine.linearisations.get(key) or (osim_cache.read(key) if engine.cache else None)
     if lin is None:
-        lin = _linearise(engine, names, values, n)
+        lin = _linearise(engine, names, values, n, operating)
         if engine.cache:
             osim_cache.write(key, lin)
     engine.linearisations[key] = lin
@@ -461,14 +436,16 @@ def linearise(engine: OsimEngine, names, values: dict, n=None) -> Linearisation:
     return replace(lin, **{name: np.copy(v) for name, v in arrays.items() if isinstance(v, np.ndarray)})
 
 
-def _linearise(engine: OsimEngine, names, values: dict, n=None) -> Linearisation:
+def _linearise(engine: OsimEngine, names, values: dict, n=None, activations=None) -> Linearisation:
     """:func:`linearise` computed, neither kept nor cached (the same parameters and result)."""
     names = list(names)
     s = len(names)
     n = s if n is None else int(n)
     geo = geometry(engine, names, values, _mobility_order(engine))
     arms, passive, dpassive, hessian, lengths = geo.arms, geo.passive, geo.dpassive, geo.hessian, geo.lengths
-    gain, dgain_dl, dgain_dv, bias, dbias_dl, dbias_dv = _curves(engine, lengths, np.zeros_like(lengths))
+    operating = np.zeros(len(lengths)) if activations is None else activations
+    terms, notes = tension_terms(engine, values, operating, arms, names)
+    gain, dgain_dl, dgain_dv, bias, dbias_dl, dbias_dv = terms
     rr = np.einsum("ij,ik->jki", arms, arms)
     return Linearisation(
         dofs=tuple(range(s)),
@@ -476,11 +453,12 @@ def _linearise(engine: OsimEngine, names, values: dict, n=None) -> Linearisation
         stiffness_per_muscle=hessian.transpose(1, 2, 0) * gain + rr * dgain_dl,
         stiffness_offset=0.5 * (dpassive + dpassive.T) + np.einsum("ijk,i->jk", hessian, bias) + rr @ dbias_dl,
         damping_per_muscle=rr * dgain_dv,
-        damping_offset=rr @ dbias_dv,  # the fibres' damping (Millard's fiber_damping)
+        damping_offset=rr @ dbias_dv,  # the fibres' own damping (e.g. Millard's fiber_damping)
         mass=geo.mass,
         torque_per_muscle=arms.T * gain,
         torque_offset=passive + arms.T @ bias,
         moment_arms=arms,
+        notes=notes,
     )
 
 
@@ -502,16 +480,22 @@ class OsimAnatomy(MappedModel):
     """
 
     rhythm_name = "couplers"
+    linearised_at_activations = True  # compliant tendons: the tangent at the operating activations
 
     def control_bounds(self) -> tuple:
-        """Each muscle's control bounds: [0, 1] (OpenSim's activations).
+        """Each muscle's activation range: [its law's floor, 1] (Millard's and Thelen's ``minimum_activation``).
+
+        OpenSim holds a Millard or Thelen muscle's activation at its floor or above, so an
+        activation below it is not the muscle's (:func:`~spinectl.anatomy.opensim_muscles.activation_floor`).
 
         Returns
         -------
         tuple
             (lower, upper), numpy.ndarray of shape (m,).
         """
-        return np.zeros(len(self.muscles)), np.ones(len(self.muscles))
+        muscles = self.engine.model.getMuscles()
+        lower = np.array([activation_floor(muscles.get(i)) for i in range(muscles.getSize())])
+        return lower, np.ones(len(self.muscles))
 
     @property
     def control_unit(self) -> str:
@@ -519,24 +503,26 @@ class OsimAnatomy(MappedModel):
         return "1"
 
     def default_controls(self) -> np.ndarray:
-        """The activations analysed when none are given: the model's own controls at t = 0, else 0.
+        """The activations analysed when none are given: the model's own controls at t = 0, else the floor.
 
         The model's controllers (spinectl's export: the ``PrescribedController`` of the solution)
         evaluated by OpenSim at the posture's time t = 0 (``Model.realizeVelocity``, then each
         muscle's ``getControl``), as MuJoCo's import takes keyframe 0's; 0 without a controller.
-        Clipped to [0, 1], the muscles' control bounds (round-off of the export's near-zero controls).
+        Clipped to the muscles' control bounds (:meth:`control_bounds`: round-off of the export's
+        near-zero controls, and OpenSim's own floor of Millard's and Thelen's activations).
 
         Returns
         -------
         numpy.ndarray, shape (m,)
         """
+        lower, upper = self.control_bounds()
         if not self._controllers():
-            return np.zeros(len(self.muscles))
+            return lower
         model, state = self.engine.model, self.engine.state
         state.setTime(0.0)
         model.realizeVelocity(state)
         muscles = model.getMuscles()
-        return np.clip([muscles.get(i).getControl(state) for i in range(muscles.getSize())], 0.0, 1.0)
+        return np.clip([muscles.get(i).getControl(state) for i in range(muscles.getSize())], lower, upper)
 
     def default_controls_source(self) -> str:
         """Where :meth:`default_controls` come from, as one phrase.
@@ -547,7 +533,7 @@ class OsimAnatomy(MappedModel):
         """
         names = self._controllers()
         if not names:
-            return "0: the model has no controller"
+            return "each muscle's activation floor: the model has no controller"
         return f"the model's controls at t = 0 ({', '.join(names)})"
 
     def _controllers(self) -> list:
@@ -592,7 +578,7 @@ class OsimAnatomy(MappedModel):
         rhy, involved, _ = coupler_rhythm(self.engine, self.plane_joints(plane), self.posture(posture))
         return rhy, involved
 
-    def linearise(self, plane: str = "sagittal", posture=None) -> tuple:
+    def linearise(self, plane: str = "sagittal", posture=None, activations=None) -> tuple:
         """The linearisation over the plane's coordinates and those its couplers tie.
 
         Parameters
@@ -601,6 +587,9 @@ class OsimAnatomy(MappedModel):
             One of the mapping's planes.
         posture : dict, optional
             Coordinate name -> value [rad].
+        activations : array_like, shape (m,), optional
+            Where compliant-tendon muscles are linearised (their forces are not affine in the
+            activation); default :meth:`default_controls`. Rigid-tendon muscles are exact at any.
 
         Returns
         -------
@@ -609,7 +598,8 @@ class OsimAnatomy(MappedModel):
         """
         values = self.posture(posture)
         rhy, involved = self.rhythm(plane, values)
-        return linearise(self.engine, involved, values, len(self.plane_joints(plane))), rhy, involved
+        operating = self.default_controls() if activations is None else np.asarray(activations, float)
+        return linearise(self.engine, involved, values, len(self.plane_joints(plane)), operating), rhy, involved
 
     def couplers(self, plane: str = "sagittal", posture=None) -> list:
         """The couplers that tie the plane's chain, each as one phrase with its slopes at the posture.
@@ -883,8 +873,12 @@ def load_osim(path, mapping=None, cache: bool = True) -> OsimAnatomy:
     _check_mapping(engine, mapping)
     muscles = engine.model.getMuscles()
     for i in range(muscles.getSize()):
-        _millard(engine, muscles.get(i))
+        check_muscle(engine.name, muscles.get(i))
     names = tuple(muscles.get(i).getName() for i in range(muscles.getSize()))
+    springs = sum(compliant(muscles.get(i)) for i in range(muscles.getSize()))
+    engine.springs = springs
+    if springs:  # in the source line too: the chains are exact at the analysed activations only
+        engine.source += f"; {springs} compliant-tendon muscles linearised at the analysed activations"
     if engine.couplers:  # in the model's source line, which every table and JSON prints
         described = "; ".join(c.describe({}, engine) for c in engine.couplers)
         engine.source += f"; coupler constraints (off in the free chain, linearised in the constrained): {described}"

@@ -445,7 +445,7 @@ class OptimisedResult:
 
 
 INFEASIBLE_HINT = (
-    "no activations in [0, 1] meet the criterion: the model's joints have no stiffness of their own; "
+    "no activations within their bounds meet the criterion: the model's joints have no stiffness of their own; "
     "--joint-stiffness mapped or a value in N m/rad adds it (docs/anatomy.md, 'The optimum')"
 )
 MAX_REMEDY = 1e5
@@ -548,8 +548,8 @@ def remedy_text(value: float) -> str:
 feasible."""
 
 EQUILIBRIUM_HINT = (
-    "the equilibrium fails, not the stability criterion: no activations in [0, 1] hold the posture even without "
-    "a criterion (the classic optimum is infeasible too); the bounded least-squares residual of the net torque "
+    "the equilibrium fails, not the stability criterion: no activations within their bounds hold the posture even "
+    "without a criterion (the classic optimum is infeasible too); the bounded least-squares residual of the net torque "
     "is {residual:.3g} N m over the {rows} equilibrium rows: the posture needs torques besides the muscles' "
     "(spinectl's export: its counter torques, actuators that the optimum does not hold)"
 )

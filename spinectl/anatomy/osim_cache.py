@@ -50,7 +50,7 @@ def _code() -> str:
     return digest(*parts)
 
 
-def key(sha256: str, names, n: int, values: dict) -> str:
+def key(sha256: str, names, n: int, values: dict, activations=None) -> str:
     """The key of a linearisation of an ``.osim`` file at a posture.
 
     Parameters
@@ -63,6 +63,8 @@ def key(sha256: str, names, n: int, values: dict) -> str:
         How many of ``names`` are the chain's.
     values : dict
         Coordinate name -> value [rad] of the posture (the others at the file's defaults).
+    activations : numpy.ndarray, shape (m,), optional
+        The operating activations [1], where the linearisation depends on them (compliant tendons).
 
     Returns
     -------
@@ -82,6 +84,7 @@ def key(sha256: str, names, n: int, values: dict) -> str:
         "\n".join(names),
         str(int(n)),
         "\n".join(posture),
+        "" if activations is None else " ".join(float(a).hex() for a in activations),
     )
 
 
@@ -114,6 +117,7 @@ def read(key_: str) -> Linearisation | None:
         return None
     arrays["dofs"] = tuple(int(d) for d in arrays["dofs"])
     arrays["n"] = int(arrays["n"])
+    arrays["notes"] = tuple(str(note) for note in arrays["notes"])
     return Linearisation(**arrays)
 
 

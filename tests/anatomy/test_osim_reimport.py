@@ -131,7 +131,8 @@ def test_the_lordosis_posture_follows_opensims_couplers(exported):
 def test_cli_lordosis_on_an_osim_is_the_optimum_at_each_posture(exported, capsys):
     """`spinectl anatomy rhythm.osim --lordosis -4:4:3 --json`: the curve's classic cost at each posture equals
     SciPy's SLSQP on the same problem (min sum w a^2, the couplers' independent torque T^T (tau_per a + tau_0) = 0,
-    0 <= a <= 1) on OpenSim's linearisation at that posture, to 1e-4; the postures differ (so do the costs)."""
+    Millard's floor 0.01 <= a <= 1) on OpenSim's linearisation at that posture, to 1e-4; the postures differ (so do
+    the costs)."""
     from scipy.optimize import minimize
 
     from spinectl.anatomy.optimum import lordosis_posture, volume_weights
@@ -152,7 +153,7 @@ def test_cli_lordosis_on_an_osim_is_the_optimum_at_each_posture(exported, capsys
             np.full(w.size, 0.01),
             jac=lambda a: 2 * w * a,
             method="SLSQP",
-            bounds=[(0, 1)] * w.size,
+            bounds=[(0.01, 1)] * w.size,  # Millard's minimum_activation, OpenSim's default
             constraints={"type": "eq", "fun": lambda a, p=tau_per, c=tau_0: p @ a + c, "jac": lambda a, p=tau_per: p},
             options={"ftol": 1e-14, "maxiter": 500},
         )
@@ -185,19 +186,19 @@ def test_an_export_whose_controls_would_overwrite_its_config_is_refused(tmp_path
 def test_the_default_activations_of_an_export_are_its_prescribed_controls(exported, capsys):
     """`spinectl anatomy chain.osim` analyses the model at its own PrescribedController's controls at t = 0: the
     same -K as the exported activations given explicitly (each fibre's muscle PCSA / 100 cm^2, as the export
-    writes them) to 1e-12, not activation 0; its -K_jj are docs/interchange.md's "chain at the solution"
-    (L1L2 ... L5S1: -51.3, -57.3, -54.5, -43.0, -25.6 N m/rad, to 0.05), and the header and JSON say where the
-    activations come from."""
+    writes them, held at Millard's floor 0.01 as OpenSim holds them) to 1e-12, not activation 0; its -K_jj are
+    docs/interchange.md's "chain at the solution" (L1L2 ... L5S1: -54.0, -59.2, -54.8, -40.6, -19.9 N m/rad, to
+    0.05), and the header and JSON say where the activations come from."""
     from spinectl.anatomy.analyses import analyse
 
     model, solution, path, _ = exported
     loaded = anatomy.load(path)
     fibres = fibre_gains(model)
-    given = solution.pcsa[fibres.muscle] / (REFERENCE_PCSA_CM2 * M2_PER_CM2)
+    given = np.maximum(solution.pcsa[fibres.muscle] / (REFERENCE_PCSA_CM2 * M2_PER_CM2), 0.01)
     default, explicit = analyse(loaded, activation=None), analyse(loaded, activation=given)
     assert np.max(np.abs(default.activations - given)) <= 1e-12
     assert np.allclose(default.free.stiffness, explicit.free.stiffness, rtol=0, atol=1e-9)
-    documented = [-51.3, -57.3, -54.5, -43.0, -25.6]  # L1L2 ... L5S1
+    documented = [-54.0, -59.2, -54.8, -40.6, -19.9]  # L1L2 ... L5S1
     assert np.allclose(default.free.joint_stiffness[REVERSED], documented, rtol=0, atol=0.05)
     assert "PrescribedController solution" in default.table().splitlines()[0]
     assert main(["anatomy", str(path), "--json"]) == 0

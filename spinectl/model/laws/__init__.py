@@ -6,6 +6,10 @@ A new law is one module that builds a :class:`MuscleLaw` and one :func:`register
 (CONTRIBUTING.md, "Extension points"); the model (:mod:`spinectl.model.mechanics`), the chain
 (:mod:`spinectl.model.chain`) and the exports (:mod:`spinectl.anatomy.export_mjcf`,
 :mod:`spinectl.anatomy.export_osim`) then use it through :func:`tension` and :func:`at_rest`.
+
+An ``.osim`` model's muscles bring their own law (Millard 2012, Thelen 2003, De Groote-Fregly
+2016), which OpenSim evaluates: the OpenSim engine's law is that evaluation,
+``spinectl.anatomy.opensim_muscles``, not an entry of this registry (docs/model.md).
 """
 
 from __future__ import annotations
