@@ -243,7 +243,9 @@ def load_engine(path, cache: bool = True) -> OsimEngine:
         raise ParameterError("model", f"OpenSim cannot build {path}: {_one_line(exc)}") from None
     digest = hashlib.sha256(path.read_bytes()).hexdigest()
     source = str(path.resolve()) + schema
-    return OsimEngine(model, state, model.getName() or path.stem, source, digest, couplers, cache=cache)
+    muscles = model.getMuscles()
+    springs = sum(compliant(muscles.get(i)) for i in range(muscles.getSize()))
+    return OsimEngine(model, state, model.getName() or path.stem, source, digest, couplers, cache=cache, springs=springs)
 
 
 def _one_line(exc) -> str:
@@ -875,10 +877,8 @@ def load_osim(path, mapping=None, cache: bool = True) -> OsimAnatomy:
     for i in range(muscles.getSize()):
         check_muscle(engine.name, muscles.get(i))
     names = tuple(muscles.get(i).getName() for i in range(muscles.getSize()))
-    springs = sum(compliant(muscles.get(i)) for i in range(muscles.getSize()))
-    engine.springs = springs
-    if springs:  # in the source line too: the chains are exact at the analysed activations only
-        engine.source += f"; {springs} compliant-tendon muscles linearised at the analysed activations"
+    if engine.springs:  # in the source line too: the chains are exact at the analysed activations only
+        engine.source += f"; {engine.springs} compliant-tendon muscles linearised at the analysed activations"
     if engine.couplers:  # in the model's source line, which every table and JSON prints
         described = "; ".join(c.describe({}, engine) for c in engine.couplers)
         engine.source += f"; coupler constraints (off in the free chain, linearised in the constrained): {described}"

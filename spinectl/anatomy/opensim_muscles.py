@@ -234,7 +234,7 @@ def tension_terms(engine, values: dict, operating, arms, names) -> tuple:
     muscles = engine.model.getMuscles()
     items = [muscles.get(i) for i in range(muscles.getSize())]
     floors = np.array([activation_floor(m) for m in items])
-    rigid = np.array([not compliant(m) for m in items])
+    rigid = np.array([not compliant(m) for m in items], dtype=bool)  # bool also without muscles
     a0 = np.clip(np.asarray(operating, float), floors, 1.0)
     # rigid: two activations across the range (F affine in a there); compliant: the tangent at a0
     low = np.where(rigid, floors + 0.25 * (1.0 - floors), np.maximum(a0 - ACTIVATION_STEP, floors))
