@@ -29,7 +29,7 @@ import numpy as np
 from ..errors import ParameterError
 from ..model.chain import dynamic_eigenvalues
 from ..model.chain import state_matrix as chain_state_matrix
-from ..model.linear_chain import LinearChain
+from ..model.linear_chain import CONTROL_CLASSES, LinearChain
 from ..model.stability import MARGINAL_TIME_CONSTANT, slowest_time_constant
 from .contract import AnatomyEngine
 from .engine import require_mujoco
@@ -410,7 +410,7 @@ class AnatomyResult:
     plane : str
         The plane.
     muscles : dict
-        ``global``, ``local``, ``between``: muscle names by class.
+        ``global``, ``local``, ``between``, ``non-lumbar``: muscle names by class (docs/anatomy.md).
     activations : numpy.ndarray, shape (m,)
         [1].
     joint_stiffness_added : numpy.ndarray, shape (n,)
@@ -697,7 +697,7 @@ def analyse(
         plane=plane,
         muscles={
             c: tuple(m for m, k in zip(anatomy.muscles, classes, strict=True) if k == c)
-            for c in ("global", "local", "between")
+            for c in CONTROL_CLASSES
         },
         activations=a,
         joint_stiffness_added=added,

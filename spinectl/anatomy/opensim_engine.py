@@ -48,6 +48,7 @@ from ..errors import ModelError, ParameterError
 from .contract import MappedModel, lordosis_direction, plane_axes
 from .engine import engine_output_to_stderr, model_file, one_line
 from .export_osim import require_opensim
+from .classes import Skeleton, classify_muscles
 from .linearise import STEP, Linearisation, Rhythm
 from .mapping import Mapping, default_mapping, located, read_mapping
 
@@ -331,20 +332,42 @@ def _check_mapping(engine: OsimEngine, mapping: Mapping) -> None:
 
 
 def _classify(engine: OsimEngine, mapping: Mapping) -> tuple:
-    """Each muscle's class by the bodies its path points are fixed to (spinectl.anatomy.mapping's rule)."""
-    group_of = {body: group for group, names in mapping.bodies.items() for body in names}
+    """Each muscle's class by the bodies its path points are fixed to (:mod:`spinectl.anatomy.classes`' rule)."""
+    tree = _skeleton(engine, mapping)
+    index = {name: b for b, name in enumerate(tree.names)}
     muscles = engine.model.getMuscles()
-    classes = []
+    attachments = []
     for i in range(muscles.getSize()):
         points = muscles.get(i).getGeometryPath().getPathPointSet()
-        groups = {group_of.get(_base_body(points.get(k).getParentFrame()), "other") for k in range(points.getSize())}
-        if "vertebrae" in groups:
-            classes.append("local")
-        elif groups <= {"pelvis", "thorax"}:
-            classes.append("global")
-        else:
-            classes.append("between")
-    return tuple(classes)
+        attachments.append({index[_base_body(points.get(k).getParentFrame())] for k in range(points.getSize())})
+    return classify_muscles(tree, mapping.bodies, attachments)
+
+
+def _skeleton(engine: OsimEngine, mapping: Mapping) -> Skeleton:
+    """OpenSim's joint tree as a :class:`~spinectl.anatomy.classes.Skeleton`, ground first, parents first.
+
+    A body is rigid on its parent where its joint has no coordinate (a ``WeldJoint``) or every
+    one is locked (``Coordinate.getDefaultLocked``); a chain body where a mapped coordinate moves it.
+    """
+    model = engine.model
+    mapped = {n for names in mapping.planes.values() for n in names}
+    joints = model.getJointSet()
+    below: dict = {}
+    for i in range(joints.getSize()):
+        joint = joints.get(i)
+        coords = [joint.get_coordinates(k) for k in range(joint.numCoordinates())]
+        rigid = all(c.getDefaultLocked() for c in coords)  # True without coordinates: a weld
+        chain = any(c.getName() in mapped for c in coords)
+        child = _base_body(joint.getChildFrame())
+        below.setdefault(_base_body(joint.getParentFrame()), []).append((child, rigid, chain))
+    names, parent, rigid, chain = [model.getGround().getName()], [-1], [False], [False]
+    for b, name in enumerate(names):  # breadth first: the list grows as it is read
+        for child, fixed, moved in below.get(name, ()):
+            names.append(child)
+            parent.append(b)
+            rigid.append(fixed)
+            chain.append(moved)
+    return Skeleton(tuple(names), tuple(parent), tuple(rigid), tuple(chain))
 
 
 def _millard(engine: OsimEngine, muscle):
