@@ -437,6 +437,12 @@ class AnatomyResult:
     rhythm_size : int
         How many coordinates the model's rhythm ties to the chain; 0: no rhythm (no joint
         equality or coupler), the constrained chain is the free one.
+    rhythm_left_out : tuple of str
+        The model's couplings of a chain coordinate to one off the chain (a routing body's), named:
+        not in the rhythm (:attr:`~spinectl.anatomy.linearise.Rhythm.left_out`).
+    devices : tuple of str
+        What the model holds besides muscles and how it enters the chain (welds, a free root fixed,
+        passive tendons), one phrase each (:attr:`~spinectl.anatomy.engine.Engine.devices`).
     """
 
     model: dict
@@ -454,6 +460,8 @@ class AnatomyResult:
     control_unit: str = "1"
     activation_source: str = "given"
     rhythm_size: int = 1
+    rhythm_left_out: tuple = ()
+    devices: tuple = ()
 
     def referee_error(self) -> float:
         """Largest relative difference between spinectl's and MuJoCo's eigenvalues, matched one to one.
@@ -525,7 +533,9 @@ class AnatomyResult:
                 ),
                 "rhythm": bool(self.rhythm_size),
                 "modes_removed": free.stiffness.shape[0] - con.stiffness.shape[0],
+                "rhythm_left_out": list(self.rhythm_left_out),
             },
+            "devices": list(self.devices),
         }
         if self.mujoco_eigenvalues is not None:
             out["mujoco_eigenvalues"] = cplx(self.mujoco_eigenvalues)
@@ -557,6 +567,7 @@ class AnatomyResult:
             f"muscles: {counts}; global muscles' moment-arm rank {cert.rank} of {len(free.joints)} "
             f"(singular values {', '.join(f'{s:.3g}' for s in cert.singular_values)} m/rad)",
             f"joint stiffness added: {self.joint_stiffness_added[0]:.4g} N m/rad per joint",
+            *(["devices: " + "; ".join(self.devices)] if self.devices else []),
             "",
             f"{'joint':<16}{'-K_jj [N m/rad]':>16}  joint by joint (others fixed)",
             f"{'':<16}{'(> 0 restores)':>16}",
@@ -583,6 +594,11 @@ class AnatomyResult:
                 f"{', '.join(con.joints)}): "
                 f"eigenvalues of -K {', '.join(f'{v:.4g}' for v in con.eigenvalues)} N m/rad: "
                 f"{word[con.chain_stable]}; the rhythm removes {len(free.joints) - len(con.joints)} modes"
+            )
+        if self.rhythm_left_out:
+            lines.append(
+                "left out of the rhythm (they tie a coordinate off the chain, e.g. a routing body, to the chain): "
+                + "; ".join(self.rhythm_left_out)
             )
         if cert.null_space.size:
             lines.append(
@@ -711,6 +727,8 @@ def analyse(
         control_unit=anatomy.control_unit,
         activation_source=_activation_source(anatomy, activation),
         rhythm_size=anatomy.rhythm_size(plane, posture),
+        rhythm_left_out=anatomy.rhythm(plane, posture)[0].left_out,
+        devices=tuple(getattr(anatomy.engine, "devices", ())),
     )
 
 

@@ -260,12 +260,14 @@ def _couplers(osim, model) -> tuple:
 
 
 def coupler_rhythm(engine: OsimEngine, chain, values: dict) -> tuple:
-    """The couplers as a :class:`~spinectl.anatomy.linearise.Rhythm` over the chain and the coordinates they tie.
+    """The couplers among the chain's own coordinates as a :class:`~spinectl.anatomy.linearise.Rhythm`.
 
-    A chain coordinate that a coupler slaves is replaced by the coupler's independent
-    coordinates (added if off the chain); a coordinate off the chain slaved to the chain's
-    independent ones is added as a dependent one. Only couplers whose dependent coordinate is
-    itself independent of the others are supported.
+    A coupler is the rhythm where its dependent coordinate and every independent one are the
+    chain's; one that ties a coordinate off the chain to the chain (the Pose2Sim model's
+    ``Abs_r3_con``: its ``Abdomen`` routing body on ``L5_S1_Flex_Ext``; a chain coordinate that
+    follows one off it) is named in :attr:`~spinectl.anatomy.linearise.Rhythm.left_out` instead, as
+    MuJoCo's joint equalities are (:func:`spinectl.anatomy.linearise.rhythm`). Only couplers whose
+    independent coordinates no other coupler slaves are supported.
 
     Parameters
     ----------
@@ -278,32 +280,31 @@ def coupler_rhythm(engine: OsimEngine, chain, values: dict) -> tuple:
     Returns
     -------
     tuple
-        (Rhythm, the involved coordinates' names, the couplers involved).
+        (Rhythm, the involved coordinates' names (the chain's), the couplers of the rhythm).
     """
-    slaved = {c.dependent: c for c in engine.couplers}
-    if any(name in slaved for c in engine.couplers for name in c.independent):
-        raise ModelError(f"{engine.name}: a coupler on a coordinate that another coupler slaves is not supported")
     chain = list(chain)
-    involved = list(chain)
-    for name in chain:
-        if name in slaved:
-            involved += [n for n in slaved[name].independent if n not in involved]
-    independent = [n for n in involved if n not in slaved]
-    involved += [
-        c.dependent for c in engine.couplers if c.dependent not in involved and set(c.independent) <= set(independent)
+    on_chain = [c for c in engine.couplers if c.dependent in chain and set(c.independent) <= set(chain)]
+    left_out = [
+        c.describe(values, engine)
+        for c in engine.couplers
+        if c not in on_chain and (c.dependent in chain or set(c.independent) & set(chain))
     ]
-    used = [slaved[n] for n in involved if n in slaved]
-    T = np.zeros((len(involved), len(independent)))
+    slaved = {c.dependent: c for c in on_chain}
+    if any(name in slaved for c in on_chain for name in c.independent):
+        raise ModelError(f"{engine.name}: a coupler on a coordinate that another coupler slaves is not supported")
+    independent = [n for n in chain if n not in slaved]
+    used = [slaved[n] for n in chain if n in slaved]
+    T = np.zeros((len(chain), len(independent)))
     C = np.zeros_like(T)
-    for row, name in enumerate(involved):
+    for row, name in enumerate(chain):
         if name in slaved:
             slopes, curvatures = slaved[name].derivatives(values, engine)
             cols = [independent.index(n) for n in slaved[name].independent]
             T[row, cols], C[row, cols] = slopes, curvatures
         else:
             T[row, independent.index(name)] = 1.0
-    rhy = Rhythm(tuple(involved.index(n) for n in independent), tuple(range(len(involved))), T, C)
-    return rhy, involved, tuple(used)
+    rhy = Rhythm(tuple(chain.index(n) for n in independent), tuple(range(len(chain))), T, C, tuple(left_out))
+    return rhy, chain, tuple(used)
 
 
 def _base_body(frame) -> str:
@@ -757,8 +758,9 @@ class OsimAnatomy(MappedModel):
 
         The couplers' first independent coordinate and the coordinates they slave to it move as the
         couplers' slopes at the default posture distribute them (:func:`coupler_rhythm`), the chain's
-        angles summing to ``degrees``; the engine sets them through OpenSim's coordinates
-        (:meth:`OsimEngine.set_posture`).
+        angles summing to ``degrees``; a coordinate off the chain that a coupler slaves to the chain (a
+        routing body's, left out of the rhythm) follows its coupler, so the posture is the model's. The
+        engine sets them through OpenSim's coordinates (:meth:`OsimEngine.set_posture`).
 
         Parameters
         ----------
@@ -774,7 +776,8 @@ class OsimAnatomy(MappedModel):
         rhy, involved = self.rhythm(plane)
         step = lordosis_direction(self, rhy, len(self.plane_joints(plane)), degrees)
         engine = self.engine
-        return {n: engine.coordinate(n).getDefaultValue() + float(v) for n, v in zip(involved, step, strict=True)}
+        values = {n: engine.coordinate(n).getDefaultValue() + float(v) for n, v in zip(involved, step, strict=True)}
+        return _followed(engine, values)
 
     def require_referee(self) -> None:
         """Refused: MuJoCo is the referee, for MJCF only (:meth:`OsimEngine.spec_factory`)."""
@@ -867,6 +870,19 @@ class OsimAnatomy(MappedModel):
         return tuple(out)
 
 
+def _followed(engine: OsimEngine, values: dict) -> dict:
+    """``values`` with the dependent coordinate of every coupler whose independent ones it gives set by the coupler."""
+    osim = require_opensim()
+    out = dict(values)
+    for c in engine.couplers:
+        if c.dependent not in values and set(c.independent) <= set(values):
+            x = osim.Vector(len(c.independent), 0.0)
+            for k, name in enumerate(c.independent):
+                x.set(k, float(values[name]))
+            out[c.dependent] = float(c.function.calcValue(x))
+    return out
+
+
 def _vec3(vector) -> np.ndarray:
     """A SimTK Vec3 as a numpy array."""
     return np.array([vector.get(k) for k in range(3)])
@@ -923,5 +939,8 @@ def load_osim(path, mapping=None, cache: bool = True) -> OsimAnatomy:
     names = tuple(muscles.get(i).getName() for i in range(muscles.getSize()))
     if engine.couplers:  # in the model's source line, which every table and JSON prints
         described = "; ".join(c.describe({}, engine) for c in engine.couplers)
-        engine.source += f"; coupler constraints (off in the free chain, linearised in the constrained): {described}"
+        engine.source += (
+            "; coupler constraints (off in the free chain; those among the chain's coordinates linearised in the "
+            f"constrained): {described}"
+        )
     return OsimAnatomy(engine, mapping, names, _classify(engine, mapping))
