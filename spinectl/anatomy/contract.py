@@ -600,7 +600,7 @@ def plane_axes(gravity, normal, default_up) -> tuple:
 MUJOCO = "spinectl.anatomy.model:load"
 OPENSIM = "spinectl.anatomy.opensim_engine:load_osim"
 
-ENGINES = {"myotorso": MUJOCO, ".xml": MUJOCO, ".mjcf": MUJOCO, ".osim": OPENSIM}
+ENGINES = {"myotorso": MUJOCO, "myofullbody": MUJOCO, ".xml": MUJOCO, ".mjcf": MUJOCO, ".osim": OPENSIM}
 """The engine of each built-in model name and each file suffix: its loader, ``"module:function"`` (imported
 when used, so an engine's package is needed only for its models) or a callable,
 ``loader(model, mapping=None, cache=True) -> AnatomyEngine``. The suffixes are those of

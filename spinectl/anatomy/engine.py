@@ -33,8 +33,9 @@ from .._validate import file_fault, printable, show, show_path
 from ..errors import ParameterError, SpinectlError
 from .devices import as_published
 
-BUILTIN = ("myotorso",)
-"""Model names that load from an installed package (MyoTorso from myo-sim)."""
+BUILTIN = ("myotorso", "myofullbody")
+"""Model names that load from an installed package (MyoTorso and MyoSuite's full body, its free root fixed
+(:mod:`spinectl.anatomy.devices`), from myo-sim)."""
 
 INSTALL_HINT = "pip install 'spinectl[anatomy]'"
 

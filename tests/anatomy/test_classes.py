@@ -336,3 +336,23 @@ def test_pose2sims_abdomen_coupler_is_left_out_of_the_rhythm():
     rhy, involved, used = coupler_rhythm(engine, chain, {})
     assert involved == chain and [c.dependent for c in used] == chain[1:]
     assert [text.split(" ")[0] for text in rhy.left_out] == ["Abs_r3_con", "L1_T12_Flex_Ext_con"]
+
+
+def test_myosuites_full_body_loads_with_its_root_fixed_and_limbs_non_lumbar():
+    """myo-sim's ``myofullbody`` (MyoTorso with legs, arms and head on a free root) loads as published: its free
+    root fixed and said; its muscles with no moment arm on any of the fifteen lumbar joints (MuJoCo's, at the
+    reference posture) are exactly the non-lumbar ones, and its trunk muscles keep MyoTorso's 42 global."""
+    pytest.importorskip("mujoco", reason="needs the anatomy extra: pip install 'spinectl[anatomy]'")
+    myo_sim = pytest.importorskip("myo_sim", reason="needs the anatomy extra: pip install 'spinectl[anatomy]'")
+    from spinectl import anatomy
+
+    if "myofullbody" not in getattr(myo_sim, "_composed_models", lambda: {"myofullbody"})():
+        pytest.skip(f"myo-sim {myo_sim.__version__} has no myofullbody")
+    body = anatomy.load("myofullbody")
+    assert body.engine.devices == ("free root joint of 'Full Body' fixed at its reference pose (qpos0)",)
+    engine = body.engine
+    engine.set_state(engine.model.qpos0)
+    dofs = [int(engine.model.jnt_dofadr[j]) for j in body.joint_ids(body.mapping.planes["3d"])]
+    idle = np.all(np.abs(engine.moment_arms()[engine.muscle_ids()][:, dofs]) <= 1e-12, axis=1)
+    assert [c == "non-lumbar" for c in body.classes] == list(idle)
+    assert body.classes.count("global") == 42 and body.classes.count("non-lumbar") > 200
