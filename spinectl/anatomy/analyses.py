@@ -711,10 +711,7 @@ def analyse(
     return AnatomyResult(
         model={"name": anatomy.name, "source": anatomy.source, "sha256": anatomy.sha256},
         plane=plane,
-        muscles={
-            c: tuple(m for m, k in zip(anatomy.muscles, classes, strict=True) if k == c)
-            for c in CONTROL_CLASSES
-        },
+        muscles={c: tuple(m for m, k in zip(anatomy.muscles, classes, strict=True) if k == c) for c in CONTROL_CLASSES},
         activations=a,
         joint_stiffness_added=added,
         stiffness_source=anatomy.mapping.stiffness_source if np.any(added > 0) else "",

@@ -23,10 +23,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..model.linear_chain import CONTROL_CLASSES as CLASSES
+from ..model.linear_chain import CONTROL_CLASSES
+
+CLASSES = CONTROL_CLASSES
+"""The classes (:data:`spinectl.model.linear_chain.CONTROL_CLASSES`, where the chain checks its controls')."""
 
 ORDER = ("thorax", "pelvis", "vertebrae")
 """The group of a rigid piece holding bodies of several groups: the first of these it holds."""
+
 
 @dataclass(frozen=True)
 class Skeleton:
@@ -139,19 +143,3 @@ def classify_muscles(skeleton: Skeleton, mapping_bodies: dict, attachments) -> t
         else:
             out.append("between")
     return tuple(out)
-
-
-def count_text(muscles: dict) -> str:
-    """The muscles' counts by class, as the table says them (every class, zero ones included).
-
-    Parameters
-    ----------
-    muscles : dict
-        Class -> muscle names.
-
-    Returns
-    -------
-    str
-        E.g. ``"44 global, 152 local, 14 between, 0 non-lumbar"``.
-    """
-    return ", ".join(f"{len(muscles.get(c, ()))} {c}" for c in CLASSES)

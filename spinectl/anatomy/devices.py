@@ -6,9 +6,10 @@ model's devices enter through its tree. :func:`as_published` edits the spec (MuJ
 
 - a **weld** equality between two bodies makes them one rigid piece: the device is the body whose
   own joints alone join it to their common ancestor (an exosuit strap with its free joint, not the
-  torso, which the lumbar chain's joints carry), else the one with fewer degrees of freedom to it. It loses its own joints and hangs on the other body
-  at their relative pose in the reference posture (``qpos0``), its subtree, sites and the tendons
-  routed over it with it; the weld is then met by construction and removed. A weld to the world
+  torso, which the lumbar chain's joints carry), else the one with fewer degrees of freedom to it.
+  It loses its own joints and hangs on the other body at their relative pose in the reference
+  posture (``qpos0``), its subtree, sites and the tendons routed over it with it (its bodies and
+  sites named ``device/...``); the weld is then met by construction and removed. A weld to the world
   (a body fixed in space) is the same with the world as the other body.
 - a **free root** joint (a full-body model's pelvis floating in the world) is removed, its body
   fixed at its reference pose, the analysis's operating point anyway; said in one line.
@@ -57,9 +58,10 @@ def as_published(spec) -> tuple:
 
 
 def _mujoco():
-    from .engine import require_mujoco
+    """:mod:`mujoco`: the engine (:func:`spinectl.anatomy.engine.require_mujoco`) has imported it before it calls."""
+    import mujoco
 
-    return require_mujoco()
+    return mujoco
 
 
 def _bodies_of(model, weld: int) -> tuple:

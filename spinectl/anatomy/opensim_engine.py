@@ -45,10 +45,10 @@ import numpy as np
 
 from .._validate import printable
 from ..errors import ModelError, ParameterError
+from .classes import Skeleton, classify_muscles
 from .contract import MappedModel, lordosis_direction, plane_axes
 from .engine import engine_output_to_stderr, model_file, one_line
 from .export_osim import require_opensim
-from .classes import Skeleton, classify_muscles
 from .linearise import STEP, Linearisation, Rhythm
 from .mapping import Mapping, default_mapping, located, read_mapping
 

@@ -317,6 +317,8 @@ KEPT_WHERE_INFEASIBLE = (
     "global_null_space",
     "modes_removed",
     "rhythm",
+    "devices",
+    "rhythm_left_out",
     "kp_Nm_per_rad",
     "kd_Nms_per_rad",
     "activation_lag_s",

@@ -16,6 +16,11 @@ import pytest
 
 from spinectl.anatomy.classes import Skeleton, classify_muscles
 
+try:  # imported first, as test_opensim_import.py does: imported after the CLI tests' modules, OpenSim's
+    import opensim  # noqa: F401  Function.calcDerivative refused its own StdVectorInt (a SWIG type clash)
+except ImportError:  # the OpenSim tests skip, one by one
+    pass
+
 MAPPING = """
 [bodies]
 pelvis = ["pelvis"]
@@ -105,7 +110,9 @@ def _mjcf_spec(weld=False, free_root=False, strap=False, rigid_strap=False, equa
         belt = holder.add_body(name="belt", pos=pos)
         if weld:
             belt.add_freejoint(name="belt_free")
-            spec.add_equality(type=mujoco.mjtEq.mjEQ_WELD, name1="belt", name2="chest", objtype=mujoco.mjtObj.mjOBJ_BODY)
+            spec.add_equality(
+                type=mujoco.mjtEq.mjEQ_WELD, name1="belt", name2="chest", objtype=mujoco.mjtObj.mjOBJ_BODY
+            )
         belt.add_geom(size=[0.02, 0, 0], mass=0.5)
         belt.add_site(name="belt_site")
         if strap:
