@@ -23,6 +23,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import ParameterError
+
 PREFIX = "device/"
 """The names of a moved device's bodies, sites and geoms (copies: MuJoCo's attach); its tendons and actuators keep
 their own."""
@@ -106,7 +108,13 @@ def _attach(spec, model, weld) -> str:
     up1, up2 = _ancestors(model, b1), _ancestors(model, b2)
     common = next(b for b in up1 if b in up2)
     device, other = (b1, b2) if _device_rank(model, b1, common) <= _device_rank(model, b2, common) else (b2, b1)
-    names = [mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, b) for b in (device, other)]
+    names = [mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, b) or "the world" for b in (device, other)]
+    if _path_dofs(model, device, common) > int(model.body_dofnum[device]):
+        raise ParameterError(
+            "model",
+            f"{spec.modelname or 'the model'}: weld {weld.name or e} ties {names[0]!r} to {names[1]!r} across joints of other bodies: a weld that "
+            "locks the model's joints is not supported (a device's weld ties a body that only its own joints move)"
+        )
     data = mujoco.MjData(model)
     mujoco.mj_kinematics(model, data)
     pos, quat = _relative_pose(data, other, device)
@@ -126,7 +134,7 @@ def _attach(spec, model, weld) -> str:
     for key in list(spec.keys)[keys:]:  # the copy's keyframes come along: the model's own stay
         spec.delete(key)
     _restore_names(spec)
-    return f"weld {weld.name or e}: {names[0]!r} rigid on {names[1] or 'the world'!r} at the reference pose (a device)"
+    return f"weld {weld.name or e}: {names[0]!r} rigid on {names[1]!r} at the reference pose (a device)"
 
 
 def _index(spec, weld) -> int:

@@ -479,6 +479,8 @@ def _compile(spec, spec_factory, name: str, source: str, digest: str, key: str |
         with engine_output_to_stderr():
             spec, notes = as_published(spec)
             model = spec.compile()
+    except SpinectlError:  # a weld as_published refuses, in its words
+        raise
     except ValueError as exc:
         raise ParameterError("model", f"MuJoCo cannot compile {source}: {one_line(exc)}") from None
     check_finite(model, source)

@@ -363,3 +363,20 @@ def test_myosuites_full_body_loads_with_its_root_fixed_and_limbs_non_lumbar():
     idle = np.all(np.abs(engine.moment_arms()[engine.muscle_ids()][:, dofs]) <= 1e-12, axis=1)
     assert [c == "non-lumbar" for c in body.classes] == list(idle)
     assert body.classes.count("global") == 42 and body.classes.count("non-lumbar") > 200
+
+
+def test_a_weld_that_locks_the_chain_is_one_line(tmp_path, capsys):
+    """A weld of the chest to the world ties a body that the chain's joints move, not its own: it would lock the
+    chain, which no device does; refused in one line naming the weld and the bodies, exit 2, nothing on stdout."""
+    mujoco = pytest.importorskip("mujoco", reason="needs the anatomy extra: pip install 'spinectl[anatomy]'")
+    from spinectl.cli import main
+
+    spec = _mjcf_spec()
+    spec.add_equality(type=mujoco.mjtEq.mjEQ_WELD, name="lock", name1="chest", objtype=mujoco.mjtObj.mjOBJ_BODY)
+    path = tmp_path / "locked.xml"
+    path.write_text(spec.to_xml())
+    (tmp_path / "mapping.toml").write_text(MAPPING)
+    assert main(["anatomy", str(path), "--mapping", str(tmp_path / "mapping.toml")]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err.count("\n") == 1
+    assert "model: mini: weld lock ties 'chest' to 'world' across joints of other bodies" in err
