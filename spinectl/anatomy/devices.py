@@ -112,8 +112,9 @@ def _attach(spec, model, weld) -> str:
     if _path_dofs(model, device, common) > int(model.body_dofnum[device]):
         raise ParameterError(
             "model",
-            f"{spec.modelname or 'the model'}: weld {weld.name or e} ties {names[0]!r} to {names[1]!r} across joints of other bodies: a weld that "
-            "locks the model's joints is not supported (a device's weld ties a body that only its own joints move)"
+            f"{spec.modelname or 'the model'}: weld {weld.name or e} ties {names[0]!r} to {names[1]!r} across joints "
+            "of other bodies: a weld that locks the model's joints is not supported (a device's weld ties a body "
+            "that only its own joints move)",
         )
     data = mujoco.MjData(model)
     mujoco.mj_kinematics(model, data)
