@@ -380,3 +380,27 @@ def test_a_weld_that_locks_the_chain_is_one_line(tmp_path, capsys):
     out, err = capsys.readouterr()
     assert out == "" and err.count("\n") == 1
     assert "model: mini: weld lock ties 'chest' to 'world' across joints of other bodies" in err
+
+
+def test_a_free_roots_keyframe_keeps_its_joints_and_controls(tmp_path):
+    """A keyframe of the floating model (root 7 numbers, then the hinges) is carried over by joint and actuator name
+    when the root is fixed: each hinge keeps its value, each muscle its control (the keyframe as written here)."""
+    mujoco = pytest.importorskip("mujoco", reason="needs the anatomy extra: pip install 'spinectl[anatomy]'")
+    spec = _mjcf_spec(free_root=True)
+    model = spec.compile()
+    qpos = model.qpos0.copy()
+    hinges = {"j1": 0.1, "j2": 0.2, "j3": 0.3, "hip": 0.4, "abd_r": 0.5}
+    for name, value in hinges.items():
+        qpos[model.joint(name).qposadr[0]] = value
+    spec.add_key(name="pose", qpos=qpos.tolist(), ctrl=[0.05 * (k + 1) for k in range(model.nu)])
+    folder = _folder(tmp_path, "k")
+    (folder / "mini.xml").write_text(spec.to_xml())
+    (folder / "mapping.toml").write_text(MAPPING)
+    from spinectl import anatomy
+
+    loaded = anatomy.load(folder / "mini.xml", folder / "mapping.toml", cache=False)
+    fixed = loaded.engine.model
+    assert fixed.nq == model.nq - 7 and fixed.nkey == 1
+    assert {n: fixed.key_qpos[0][fixed.joint(n).qposadr[0]] for n in hinges} == pytest.approx(hinges)
+    np.testing.assert_allclose(loaded.default_controls(), [0.05 * (k + 1) for k in range(model.nu)])
+    assert mujoco.mj_name2id(fixed, mujoco.mjtObj.mjOBJ_JOINT, "root") < 0
