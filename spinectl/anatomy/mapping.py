@@ -244,8 +244,7 @@ def skeleton(engine: Engine, mapping: Mapping) -> Skeleton:
     Skeleton
     """
     model = engine.model
-    joints = set(engine.names("joint"))
-    mapped = {n for names in mapping.planes.values() for n in names} & joints
+    mapped = {n for names in mapping.planes.values() for n in names}
     moved = {int(model.jnt_bodyid[j]) for j, name in enumerate(engine.names("joint")) if name in mapped}
     return Skeleton(
         names=tuple(engine.names("body")),
