@@ -44,12 +44,13 @@ def as_published(spec) -> tuple:
         (the spec, tuple of str: one phrase per weld and free root).
     """
     mujoco = _mujoco()
-    welds = [e for e in spec.equalities if e.type == mujoco.mjtEq.mjEQ_WELD and e.active]
+    # each weld with its index in the compiled model (MuJoCo compiles the equalities in the spec's order)
+    welds = [(k, e) for k, e in enumerate(spec.equalities) if e.type == mujoco.mjtEq.mjEQ_WELD and e.active]
     roots = [j for j in spec.joints if j.type == mujoco.mjtJoint.mjJNT_FREE]
     if not welds and not roots:
         return spec, ()
     before = spec.compile()  # the reference posture's poses, the keyframes' values by name
-    notes = [_attach(spec, before, weld) for weld in welds]
+    notes = [_attach(spec, before, k, weld) for k, weld in welds]
     for joint in [j for j in spec.joints if j.type == mujoco.mjtJoint.mjJNT_FREE]:
         body = joint.parent
         if body.parent.name == spec.worldbody.name:
@@ -100,10 +101,10 @@ def _ancestors(model, body: int) -> list:
     return out
 
 
-def _attach(spec, model, weld) -> str:
-    """Hang the weld's device body on the other body at their reference pose; the phrase that says so."""
+def _attach(spec, model, e: int, weld) -> str:
+    """Hang weld ``e``'s device body on the other body at their reference pose; the phrase that says so."""
     mujoco = _mujoco()
-    e = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_EQUALITY, weld.name) if weld.name else _index(spec, weld)
+    label = weld.name or str(e)
     b1, b2 = _bodies_of(model, e)
     up1, up2 = _ancestors(model, b1), _ancestors(model, b2)
     common = next(b for b in up1 if b in up2)
@@ -112,19 +113,22 @@ def _attach(spec, model, weld) -> str:
     if _path_dofs(model, device, common) > int(model.body_dofnum[device]):
         raise ParameterError(
             "model",
-            f"{spec.modelname or 'the model'}: weld {weld.name or e} ties {names[0]!r} to {names[1]!r} across joints "
+            f"{spec.modelname or 'the model'}: weld {label} ties {names[0]!r} to {names[1]!r} across joints "
             "of other bodies: a weld that locks the model's joints is not supported (a device's weld ties a body "
             "that only its own joints move)",
         )
     data = mujoco.MjData(model)
     mujoco.mj_kinematics(model, data)
     pos, quat = _relative_pose(data, other, device)
+    if model.eq_objtype[e] == mujoco.mjtObj.mjOBJ_SITE:  # MuJoCo welds the two sites' frames onto each other
+        sites = dict(zip((b1, b2), (int(model.eq_obj1id[e]), int(model.eq_obj2id[e])), strict=True))
+        pos, quat = _site_on_site(model, sites[other], sites[device])
     spec.delete(weld)
     moved = spec.body(names[0])
     for joint in list(moved.joints):
         spec.delete(joint)
     moved.pos, moved.quat = [0.0, 0.0, 0.0], [1.0, 0.0, 0.0, 0.0]  # its pose is the frame's
-    moved.alt.type = _mujoco().mjtOrientation.mjORIENTATION_QUAT
+    moved.alt.type = mujoco.mjtOrientation.mjORIENTATION_QUAT
     # the subtree, with the tendons and actuators routed over it, copied from a copy of the spec once the
     # original is gone (MuJoCo's attach copies what refers to the subtree, under a prefix)
     source = spec.copy()
@@ -135,11 +139,7 @@ def _attach(spec, model, weld) -> str:
     for key in list(spec.keys)[keys:]:  # the copy's keyframes come along: the model's own stay
         spec.delete(key)
     _restore_names(spec)
-    return f"weld {weld.name or e}: {names[0]!r} rigid on {names[1]!r} at the reference pose (a device)"
-
-
-def _index(spec, weld) -> int:
-    return next(k for k, e in enumerate(spec.equalities) if e is weld)
+    return f"weld {label}: {names[0]!r} rigid on {names[1]!r} at the reference pose (a device)"
 
 
 def _relative_pose(data, parent: int, child: int) -> tuple:
@@ -150,6 +150,16 @@ def _relative_pose(data, parent: int, child: int) -> tuple:
     inverse, quat = np.zeros(4), np.zeros(4)
     mujoco.mju_negQuat(inverse, data.xquat[parent])
     mujoco.mju_mulQuat(quat, inverse, data.xquat[child])
+    return pos, quat
+
+
+def _site_on_site(model, fixed: int, moved: int) -> tuple:
+    """The pose in the fixed site's body that puts the moved site's body with the two sites' frames one [m, 1]."""
+    mujoco = _mujoco()
+    inverse_pos, inverse_quat = np.zeros(3), np.zeros(4)
+    mujoco.mju_negPose(inverse_pos, inverse_quat, model.site_pos[moved], model.site_quat[moved])
+    pos, quat = np.zeros(3), np.zeros(4)
+    mujoco.mju_mulPose(pos, quat, model.site_pos[fixed], model.site_quat[fixed], inverse_pos, inverse_quat)
     return pos, quat
 
 

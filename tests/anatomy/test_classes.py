@@ -71,7 +71,7 @@ def test_the_rule_on_a_bare_tree():
     assert got == ("global", "local", "non-lumbar", "non-lumbar", "local")
 
 
-def _mjcf_spec(weld=False, free_root=False, strap=False, rigid_strap=False, equalities=False):
+def _mjcf_spec(weld=False, free_root=False, strap=False, rigid_strap=False, equalities=False, site_weld=False):
     """The test model through MuJoCo's MjSpec API (module docstring); options add the devices of MJCF as published."""
     mujoco = pytest.importorskip("mujoco", reason="needs the anatomy extra: pip install 'spinectl[anatomy]'")
     spec = mujoco.MjSpec()
@@ -104,14 +104,24 @@ def _mjcf_spec(weld=False, free_root=False, strap=False, rigid_strap=False, equa
     if equalities:
         for joint, coef in (("j2", RHYTHM[0]), ("j3", RHYTHM[1]), ("abd_r", 2.0)):
             spec.add_equality(type=mujoco.mjtEq.mjEQ_JOINT, name1=joint, name2="j1", data=[0, coef] + [0] * 10)
-    if weld or rigid_strap or strap:
+    if weld or rigid_strap or strap or site_weld:
         holder = bodies["chest"] if rigid_strap else spec.worldbody
         pos = [0.1, 0, 0.1] if rigid_strap else [0.1, 0, 1.5]  # the chest is at z = 1.4 in the world
+        pos = [0.3, 0.2, 1.7] if site_weld else pos  # away from the chest's site: MuJoCo pulls the sites together
         belt = holder.add_body(name="belt", pos=pos)
         if weld:
             belt.add_freejoint(name="belt_free")
             spec.add_equality(
                 type=mujoco.mjtEq.mjEQ_WELD, name1="belt", name2="chest", objtype=mujoco.mjtObj.mjOBJ_BODY
+            )
+        if site_weld:  # on a slide and a hinge of its own, its site welded onto one on the chest's
+            belt.add_joint(name="belt_slide", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[1, 0, 0])
+            belt.add_joint(name="belt_turn", axis=[0, 0, 1])
+            belt.add_site(name="belt_buckle", pos=[0.02, 0, -0.05])
+            bodies["chest"].add_site(name="chest_buckle", pos=[0.12, 0, 0.05])
+            site = mujoco.mjtObj.mjOBJ_SITE
+            spec.add_equality(
+                type=mujoco.mjtEq.mjEQ_WELD, name="buckle", name1="belt_buckle", name2="chest_buckle", objtype=site
             )
         belt.add_geom(size=[0.02, 0, 0], mass=0.5)
         belt.add_site(name="belt_site")
@@ -200,6 +210,20 @@ def test_a_weld_device_is_taken_into_the_chain(tmp_path):
     doc = analyse(welded, activation=0.2).to_dict()
     assert doc["devices"][0] == "weld 0: 'belt' rigid on 'chest' at the reference pose (a device)"
     assert welded.muscles == tuple(MUSCLES)  # the band is no muscle
+
+
+def test_a_site_weld_on_a_belts_own_joints_is_a_device_too(tmp_path):
+    """A variant: the belt on a slide and a hinge of its own (no free joint) in the world, welded by a named weld of
+    two sites (MuJoCo makes their frames one): the belt hangs on the chest with the sites together, which puts it
+    where the rigid belt is built (chest site at (0.12, 0, 0.05) less belt site at (0.02, 0, -0.05) = (0.1, 0,
+    0.1)); K and M as that model's."""
+    welded = _load_mjcf(_folder(tmp_path, "w"), site_weld=True)
+    rigid = _load_mjcf(_folder(tmp_path, "r"), rigid_strap=True)
+    ours, theirs = welded.chain("sagittal"), rigid.chain("sagittal")
+    a = np.full(ours.n_controls, 0.2)
+    np.testing.assert_allclose(ours.stiffness(a), theirs.stiffness(a), rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(ours.mass_matrix, theirs.mass_matrix, rtol=1e-12, atol=1e-12)
+    assert welded.engine.devices == ("weld buckle: 'belt' rigid on 'chest' at the reference pose (a device)",)
 
 
 def test_a_strap_tendon_is_a_device_with_its_spring_in_k0(tmp_path):
