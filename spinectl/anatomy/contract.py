@@ -41,7 +41,7 @@ class AnatomyEngine(Protocol):
     mapping : Mapping
         Its chain joints, body groups and added stiffness.
     muscles, classes : tuple of str
-        The muscles' names and classes (``global``, ``local``, ``between``).
+        The muscles' names and classes (``global``, ``local``, ``between``, ``non-lumbar``).
     control_unit : str
         The muscles' control unit (``"1"``: activations).
     """
