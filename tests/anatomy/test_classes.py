@@ -267,10 +267,11 @@ def test_a_free_root_is_fixed_at_its_reference_and_said(tmp_path, capsys):
     assert out.count("free root joint of 'pelvis' fixed at its reference pose") == 1
 
 
-def _osim_model(tmp_path):
+def _osim_model(tmp_path, locked=False):
     """The same tree through OpenSim's API: pelvis welded to ground, j1-j3 pin joints, chest welded on top, a
     femur on a hip pin joint, the routing body abd on v1; couplers j2 = 0.5 j1, j3 = 0.25 j1 and abd_r = 2 j1;
-    rigid-tendon Millard muscles along MUSCLES."""
+    rigid-tendon Millard muscles along MUSCLES. ``locked``: the chest on a pin joint whose coordinate is locked
+    instead of a weld."""
     osim = pytest.importorskip("opensim", reason="needs the opensim extra: pip install 'spinectl[opensim]'")
     model = osim.Model()
     model.setName("mini")
@@ -289,7 +290,12 @@ def _osim_model(tmp_path):
         model.addBody(body)
         bodies[name] = body
         args = (f"{name}_joint", bodies[parent], osim.Vec3(*offset), osim.Vec3(0), body, osim.Vec3(0), osim.Vec3(0))
-        if coordinate is None:
+        if coordinate is None and locked and name == "chest":
+            joint = osim.PinJoint(*args)
+            joint.updCoordinate().setName("chest_tilt")
+            joint.updCoordinate().setDefaultLocked(True)
+            model.addJoint(joint)
+        elif coordinate is None:
             model.addJoint(osim.WeldJoint(*args))
         else:
             joint = osim.PinJoint(*args)
@@ -319,11 +325,13 @@ def _osim_model(tmp_path):
     return path, mapping
 
 
-def test_opensim_classes_are_the_same_rule(tmp_path):
-    """OpenSim's model of the same tree (WeldJoints where MuJoCo has no joint): the classes are EXPECTED's."""
+@pytest.mark.parametrize("locked", [False, True], ids=["weld", "locked"])
+def test_opensim_classes_are_the_same_rule(tmp_path, locked):
+    """OpenSim's model of the same tree (WeldJoints where MuJoCo has no joint; or the chest on a pin joint whose
+    coordinate is locked, no free coordinate either): the classes are EXPECTED's."""
     from spinectl import anatomy
 
-    path, mapping = _osim_model(tmp_path)
+    path, mapping = _osim_model(tmp_path, locked)
     loaded = anatomy.load(path, mapping)
     assert dict(zip(loaded.muscles, loaded.classes, strict=True)) == EXPECTED
 
