@@ -29,7 +29,7 @@ import numpy as np
 from ..errors import ParameterError
 from ..model.chain import dynamic_eigenvalues
 from ..model.chain import state_matrix as chain_state_matrix
-from ..model.linear_chain import LinearChain
+from ..model.linear_chain import CONTROL_CLASSES, LinearChain
 from ..model.stability import MARGINAL_TIME_CONSTANT, slowest_time_constant
 from .contract import AnatomyEngine
 from .engine import require_mujoco
@@ -412,7 +412,7 @@ class AnatomyResult:
     plane : str
         The plane.
     muscles : dict
-        ``global``, ``local``, ``between``: muscle names by class.
+        ``global``, ``local``, ``between``, ``non-lumbar``: muscle names by class (docs/anatomy.md).
     activations : numpy.ndarray, shape (m,)
         [1].
     joint_stiffness_added : numpy.ndarray, shape (n,)
@@ -443,6 +443,12 @@ class AnatomyResult:
         Where the chain's coordinates are not its joints' angles: each joint's rotation per unit of
         its own coordinate [rad per coordinate rad] (the stiffnesses are per joint radian,
         :mod:`spinectl.anatomy.joint_angles`); None where they are (a MuJoCo hinge).
+    rhythm_left_out : tuple of str
+        The model's couplings of a chain coordinate to one off the chain (a routing body's), named:
+        not in the rhythm (:attr:`~spinectl.anatomy.linearise.Rhythm.left_out`).
+    devices : tuple of str
+        What the model holds besides muscles and how it enters the chain (welds, a free root fixed,
+        passive tendons), one phrase each (:attr:`~spinectl.anatomy.engine.Engine.devices`).
     """
 
     model: dict
@@ -461,6 +467,8 @@ class AnatomyResult:
     activation_source: str = "given"
     rhythm_size: int = 1
     joint_slopes: np.ndarray | None = None
+    rhythm_left_out: tuple = ()
+    devices: tuple = ()
 
     @property
     def activation_mean(self) -> float:
@@ -537,7 +545,9 @@ class AnatomyResult:
                 ),
                 "rhythm": bool(self.rhythm_size),
                 "modes_removed": free.stiffness.shape[0] - con.stiffness.shape[0],
+                "rhythm_left_out": list(self.rhythm_left_out),
             },
+            "devices": list(self.devices),
         }
         if self.joint_slopes is not None:  # only where the units differ: a hinge's output stays as it was
             out["joint_rad_per_coordinate_rad"] = self.joint_slopes.tolist()
@@ -582,6 +592,7 @@ class AnatomyResult:
             f"(singular values {', '.join(f'{s:.3g}' for s in cert.singular_values)} m/rad)",
             f"joint stiffness added: {self.joint_stiffness_added[0]:.4g} N m/rad per joint",
             *self._angle_note(),
+            *(["devices: " + "; ".join(self.devices)] if self.devices else []),
             "",
             f"{'joint':<16}{'-K_jj [N m/rad]':>16}  joint by joint (others fixed)",
             f"{'':<16}{'(> 0 restores)':>16}",
@@ -608,6 +619,11 @@ class AnatomyResult:
                 f"{', '.join(con.joints)}): "
                 f"eigenvalues of -K {', '.join(f'{v:.4g}' for v in con.eigenvalues)} N m/rad: "
                 f"{word[con.chain_stable]}; the rhythm removes {len(free.joints) - len(con.joints)} modes"
+            )
+        if self.rhythm_left_out:
+            lines.append(
+                "left out of the rhythm (they tie a coordinate off the chain, e.g. a routing body, to the chain): "
+                + "; ".join(self.rhythm_left_out)
             )
         if cert.null_space.size:
             lines.append(
@@ -720,10 +736,7 @@ def analyse(
     return AnatomyResult(
         model={"name": anatomy.name, "source": anatomy.source, "sha256": anatomy.sha256},
         plane=plane,
-        muscles={
-            c: tuple(m for m, k in zip(anatomy.muscles, classes, strict=True) if k == c)
-            for c in ("global", "local", "between")
-        },
+        muscles={c: tuple(m for m, k in zip(anatomy.muscles, classes, strict=True) if k == c) for c in CONTROL_CLASSES},
         activations=a,
         joint_stiffness_added=added,
         stiffness_source=anatomy.mapping.stiffness_source if np.any(added > 0) else "",
@@ -737,6 +750,8 @@ def analyse(
         activation_source=_activation_source(anatomy, activation),
         rhythm_size=anatomy.rhythm_size(plane, posture),
         joint_slopes=_slopes_shown(anatomy, plane, posture),
+        rhythm_left_out=anatomy.rhythm(plane, posture)[0].left_out,
+        devices=tuple(getattr(anatomy.engine, "devices", ())),
     )
 
 

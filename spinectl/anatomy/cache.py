@@ -33,8 +33,9 @@ from pathlib import Path
 
 from ..atomic import atomic_path
 
-FORMAT = 1
-"""The cache file's layout; a new number invalidates every older file."""
+FORMAT = 2
+"""The cache file's layout; a new number invalidates every older file (2: the model as published, its welds
+and free root taken into the tree, :mod:`spinectl.anatomy.devices`)."""
 
 SOURCE_SUFFIXES = frozenset({".py", ".xml", ".json", ".toml"})
 """A package's files hashed by content; the others (large binary assets) by size and modification time."""

@@ -42,7 +42,7 @@ class AnatomyEngine(Protocol):
     mapping : Mapping
         Its chain joints, body groups and added stiffness.
     muscles, classes : tuple of str
-        The muscles' names and classes (``global``, ``local``, ``between``).
+        The muscles' names and classes (``global``, ``local``, ``between``, ``non-lumbar``).
     control_unit : str
         The muscles' control unit (``"1"``: activations).
     """
@@ -675,7 +675,7 @@ def plane_axes(gravity, normal, default_up) -> tuple:
 MUJOCO = "spinectl.anatomy.model:load"
 OPENSIM = "spinectl.anatomy.opensim_engine:load_osim"
 
-ENGINES = {"myotorso": MUJOCO, ".xml": MUJOCO, ".mjcf": MUJOCO, ".osim": OPENSIM}
+ENGINES = {"myotorso": MUJOCO, "myofullbody": MUJOCO, ".xml": MUJOCO, ".mjcf": MUJOCO, ".osim": OPENSIM}
 """The engine of each built-in model name and each file suffix: its loader, ``"module:function"`` (imported
 when used, so an engine's package is needed only for its models) or a callable,
 ``loader(model, mapping=None, cache=True) -> AnatomyEngine``. The suffixes are those of

@@ -31,9 +31,11 @@ import numpy as np
 from .._optional import require_module
 from .._validate import file_fault, printable, show, show_path
 from ..errors import ParameterError, SpinectlError
+from .devices import as_published
 
-BUILTIN = ("myotorso",)
-"""Model names that load from an installed package (MyoTorso from myo-sim)."""
+BUILTIN = ("myotorso", "myofullbody")
+"""Model names that load from an installed package (MyoTorso and MyoSuite's full body, its free root fixed
+(:mod:`spinectl.anatomy.devices`), from myo-sim)."""
 
 INSTALL_HINT = "pip install 'spinectl[anatomy]'"
 
@@ -255,6 +257,8 @@ class Engine:
         SHA-256 of the MJCF text the model was compiled from.
     spec_factory : callable
         Returns a fresh, editable ``mujoco.MjSpec`` of the same model (for the referee's copy).
+    notes : tuple of str
+        What :func:`spinectl.anatomy.devices.as_published` did to the published model (welds, a free root).
     """
 
     model: object
@@ -263,6 +267,19 @@ class Engine:
     source: str
     sha256: str
     spec_factory: object = field(repr=False)
+    notes: tuple = ()
+
+    @property
+    def devices(self) -> tuple:
+        """The model's devices and how they enter the chain, one phrase each: :attr:`notes` and every passive tendon.
+
+        Returns
+        -------
+        tuple of str
+        """
+        from .devices import passive_tendons
+
+        return tuple(self.notes) + passive_tendons(self.model)
 
     def names(self, kind: str, ids=None) -> list:
         """Names of MuJoCo objects of one kind (``"joint"``, ``"body"``, ``"actuator"``, ...).
@@ -453,19 +470,32 @@ def check_finite(model, source: str) -> None:
 
 
 def _compile(spec, spec_factory, name: str, source: str, digest: str, key: str | None) -> Engine:
-    """Compile ``spec`` (or read its compiled model from the cache under ``key``) into an Engine."""
+    """Compile ``spec`` as published (:func:`~spinectl.anatomy.devices.as_published`) into an Engine, and cache it
+    under ``key``."""
     from . import cache
 
     mujoco = require_mujoco()
     try:
         with engine_output_to_stderr():
+            spec, notes = as_published(spec)
             model = spec.compile()
+    except SpinectlError:  # a weld as_published refuses, in its words
+        raise
     except ValueError as exc:
         raise ParameterError("model", f"MuJoCo cannot compile {source}: {one_line(exc)}") from None
     check_finite(model, source)
     if key is not None:
-        cache.write(key, model, {"sha256": digest})
-    return Engine(model, mujoco.MjData(model), name, source, digest, spec_factory)
+        cache.write(key, model, {"sha256": digest, "notes": list(notes)})
+    return Engine(model, mujoco.MjData(model), name, source, digest, _published(spec_factory), notes)
+
+
+def _published(spec_factory):
+    """A factory of the spec as :func:`_compile` compiles it (the referee's copy is the model analysed)."""
+
+    def factory():
+        return as_published(spec_factory())[0]
+
+    return factory
 
 
 def _cached(key: str | None, spec_factory, name: str, source: str, digest: str | None = None) -> Engine | None:
@@ -484,7 +514,9 @@ def _cached(key: str | None, spec_factory, name: str, source: str, digest: str |
     if not isinstance(digest, str):
         return None
     check_finite(model, source)  # a file cached before this check was made
-    return Engine(model, require_mujoco().MjData(model), name, source, digest, spec_factory)
+    notes = meta.get("notes", [])
+    notes = tuple(notes) if isinstance(notes, list) and all(isinstance(n, str) for n in notes) else ()
+    return Engine(model, require_mujoco().MjData(model), name, source, digest, _published(spec_factory), notes)
 
 
 def load_engine(model: str | Path, cache: bool = True) -> Engine:

@@ -12,7 +12,7 @@ import numpy as np
 from ..canvas import new_figure, save_figures
 from .drawing import ModeShapes, SagittalProjection
 
-CLASS_COLOURS = {"global": "tab:blue", "local": "tab:red", "between": "tab:green"}
+CLASS_COLOURS = {"global": "tab:blue", "local": "tab:red", "between": "tab:green", "non-lumbar": "tab:gray"}
 """Muscle class -> colour (:data:`spinectl.model.linear_chain.CONTROL_CLASSES`)."""
 
 PLOT_FILES = ("sagittal.png", "modes.png", "lordosis.png")
@@ -46,7 +46,7 @@ def sagittal_figure(projection: SagittalProjection, title: str = ""):
     fig = new_figure(figsize=(5.6, 7.2), layout="constrained")
     ax = fig.add_subplot()
     counts = {c: projection.classes.count(c) for c in CLASS_COLOURS}
-    for cls in ("local", "between", "global"):  # global on top: the fewest
+    for cls in ("non-lumbar", "local", "between", "global"):  # global on top: the fewest
         for segments, c in zip(projection.segments, projection.classes, strict=True):
             if c != cls:
                 continue

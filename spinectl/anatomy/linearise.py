@@ -60,12 +60,16 @@ class Rhythm:
         T = dq/dq_ind at the posture.
     curvature : numpy.ndarray, shape (len(dofs), len(independent))
         d^2 q/dq_ind^2 of each dof on its own independent coordinate (0 for a linear rhythm).
+    left_out : tuple of str
+        The model's other couplings of a chain coordinate (one side off the chain, e.g. a routing body
+        such as an ``Abdomen`` moved by the chain), each as one phrase: named, not in the rhythm.
     """
 
     independent: tuple
     dofs: tuple
     transform: np.ndarray
     curvature: np.ndarray
+    left_out: tuple = ()
 
 
 def _joint_dof(model, joint: int) -> int:
@@ -73,7 +77,12 @@ def _joint_dof(model, joint: int) -> int:
 
 
 def rhythm(engine: Engine, chain_joints) -> Rhythm:
-    """The active joint equalities of the model, as a map from the chain's independent coordinates.
+    """The active joint equalities among the chain's own joints, as a map from its independent coordinates.
+
+    Only an equality whose two joints are both the chain's (or that locks a chain joint) is the rhythm;
+    one that ties a joint off the chain to a chain joint (MyoTorso's ``Abs_r3``, its ``Abdomen``
+    routing body, on ``flex_extension``) is named in :attr:`Rhythm.left_out` instead: a routing body
+    does not decide the constrained chain's verdict (docs/anatomy.md, "The rhythm").
 
     Parameters
     ----------
@@ -88,21 +97,24 @@ def rhythm(engine: Engine, chain_joints) -> Rhythm:
     """
     mujoco = require_mujoco()
     model, qpos = engine.model, engine.data.qpos
-    slaved = {}  # dependent joint -> (independent joint or -1, polynomial coefficients)
+    chain = list(chain_joints)
+    slaved, left_out = {}, []  # dependent chain joint -> (independent chain joint or -1, polynomial coefficients)
     for e in range(model.neq):
         if not model.eq_active0[e]:
             continue
         if model.eq_type[e] != mujoco.mjtEq.mjEQ_JOINT:
             raise ModelError(f"{engine.name}: the constrained chain supports joint equalities only (equality {e})")
-        slaved[int(model.eq_obj1id[e])] = (int(model.eq_obj2id[e]), np.array(model.eq_data[e][:5]))
+        j1, j2 = int(model.eq_obj1id[e]), int(model.eq_obj2id[e])
+        if j1 in chain and (j2 < 0 or j2 in chain):
+            slaved[j1] = (j2, np.array(model.eq_data[e][:5]))
+        elif j1 in chain or j2 in chain:
+            left_out.append(_equality_text(engine, e, j1, j2))
     if any(j2 in slaved for j2, _ in slaved.values() if j2 >= 0):
         raise ModelError(f"{engine.name}: a joint equality on a joint that is itself slaved is not supported")
-    chain = list(chain_joints)
     independent = [j for j in chain if j not in slaved]
-    involved = chain + [j for j, (j2, _) in slaved.items() if j2 in independent and j not in chain]
-    T = np.zeros((len(involved), len(independent)))
+    T = np.zeros((len(chain), len(independent)))
     C = np.zeros_like(T)
-    for row, j in enumerate(involved):
+    for row, j in enumerate(chain):
         if j in independent:
             T[row, independent.index(j)] = 1.0
             continue
@@ -113,8 +125,16 @@ def rhythm(engine: Engine, chain_joints) -> Rhythm:
         powers = np.arange(5)
         T[row, independent.index(j2)] = np.sum(powers[1:] * c[1:] * x ** (powers[1:] - 1))
         C[row, independent.index(j2)] = np.sum(powers[2:] * (powers[2:] - 1) * c[2:] * x ** (powers[2:] - 2))
-    dofs = tuple(_joint_dof(model, j) for j in involved)
-    return Rhythm(tuple(involved.index(j) for j in independent), dofs, T, C)
+    dofs = tuple(_joint_dof(model, j) for j in chain)
+    return Rhythm(tuple(chain.index(j) for j in independent), dofs, T, C, tuple(left_out))
+
+
+def _equality_text(engine: Engine, e: int, j1: int, j2: int) -> str:
+    """One joint equality as a phrase: its name (or number), the dependent joint and what it follows."""
+    mujoco = require_mujoco()
+    name = mujoco.mj_id2name(engine.model, mujoco.mjtObj.mjOBJ_EQUALITY, e) or f"equality {e}"
+    first = engine.names("joint", [j1])[0]
+    return f"{name} ({first} locked)" if j2 < 0 else f"{name} ({first} on {engine.names('joint', [j2])[0]})"
 
 
 @dataclass(frozen=True)

@@ -3,16 +3,11 @@
 A small TOML file says which joints form the chain in each plane, which bodies are the
 pelvis, the vertebrae and the thorax, and the intervertebral stiffness that may be added;
 ``mappings/myotorso.toml`` is MyoTorso's. Muscles are classified by the bodies their
-tendon's path points (MuJoCo sites) are fixed to:
-
-- **global**: thorax and pelvis only (the paper's muscles, spanning the whole chain);
-- **local**: any vertebra of the chain;
-- **between**: any other body, e.g. MyoTorso's ``Abdomen``, a body of its own hanging on
-  lumbar5 and moved by the lumbar rhythm.
-
-Wrapping surfaces do not count: a tendon slides over them. A body that is not listed
-belongs to the group of the listed ancestor it is rigidly fixed to (no joint between),
-so the thorax's head and arm attachments count as thorax.
+tendon's path points (MuJoCo sites) are fixed to and the chain joints between them, by the
+rule of :mod:`spinectl.anatomy.classes` (the same for OpenSim): global, local, between or
+non-lumbar. A body with no joint to its parent is one rigid piece with it, and the piece
+counts as its mapped group (thorax first): MyoTorso's ``lumbar1`` has no joint to ``torso``,
+so a muscle from the sacrum to ``lumbar1`` is global.
 """
 
 from __future__ import annotations
@@ -24,6 +19,7 @@ from .. import _validate as v
 from .._validate import SHOWN_CHARS, printable
 from ..errors import ConfigError, ParameterError
 from ..model import _toml
+from .classes import Skeleton, classify_muscles, piece_groups
 from .engine import Engine, require_mujoco
 
 MAPPINGS = Path(__file__).resolve().parent / "mappings"
@@ -226,11 +222,40 @@ def check_mapping(engine: Engine, mapping: Mapping) -> None:
             raise ParameterError(located(mapping.path, f"planes.{plane}"), lacks)
 
 
+def skeleton(engine: Engine, mapping: Mapping) -> Skeleton:
+    """MuJoCo's body tree as the classes' :class:`~spinectl.anatomy.classes.Skeleton`.
+
+    A body with no joint is rigid on its parent; a body that one of the mapping's joints (any
+    plane) moves is a chain body.
+
+    Parameters
+    ----------
+    engine : Engine
+        The compiled model.
+    mapping : Mapping
+        Its mapping.
+
+    Returns
+    -------
+    Skeleton
+    """
+    model = engine.model
+    mapped = {n for names in mapping.planes.values() for n in names}
+    moved = {int(model.jnt_bodyid[j]) for j, name in enumerate(engine.names("joint")) if name in mapped}
+    return Skeleton(
+        names=tuple(engine.names("body")),
+        parent=tuple(int(p) if b else -1 for b, p in enumerate(model.body_parentid)),
+        rigid=tuple(bool(b and model.body_jntnum[b] == 0) for b in range(model.nbody)),
+        chain=tuple(b in moved for b in range(model.nbody)),
+    )
+
+
 def body_groups(engine: Engine, mapping: Mapping) -> dict:
     """Each body's group: ``"pelvis"``, ``"vertebrae"``, ``"thorax"`` or ``"between"``.
 
-    A listed body has its group; an unlisted one that is rigidly fixed to its parent (no
-    joint) takes its parent's group; any other body is ``"between"``.
+    A body has the group of its rigid piece (:func:`spinectl.anatomy.classes.piece_groups`:
+    the bodies joined to it with no joint between, thorax before pelvis before vertebrae);
+    a body of no mapped piece is ``"between"``.
 
     Parameters
     ----------
@@ -244,18 +269,8 @@ def body_groups(engine: Engine, mapping: Mapping) -> dict:
     dict
         Body id -> group.
     """
-    model = engine.model
-    listed = {name: group for group, names in mapping.bodies.items() for name in names}
-    names = engine.names("body")
-    groups = {}
-    for b in range(model.nbody):  # parents come before children in MuJoCo's body order
-        if names[b] in listed:
-            groups[b] = listed[names[b]]
-        elif b > 0 and model.body_jntnum[b] == 0 and groups.get(int(model.body_parentid[b])) in GROUPS:
-            groups[b] = groups[int(model.body_parentid[b])]
-        else:
-            groups[b] = "between"
-    return groups
+    groups = piece_groups(skeleton(engine, mapping), mapping.bodies)
+    return {b: group or "between" for b, group in enumerate(groups)}
 
 
 def muscle_bodies(engine: Engine) -> list:
@@ -284,10 +299,10 @@ def muscle_bodies(engine: Engine) -> list:
 
 
 def classify(engine: Engine, mapping: Mapping) -> tuple:
-    """Each muscle's class by the bodies it attaches to: ``"local"``, ``"global"`` or ``"between"``.
+    """Each muscle's class by its attachments: ``"global"``, ``"local"``, ``"between"`` or ``"non-lumbar"``.
 
-    Local if any attachment is on a vertebra; else global if all are on the pelvis or the
-    thorax; else between (module docstring).
+    :func:`spinectl.anatomy.classes.classify_muscles` on MuJoCo's body tree (:func:`skeleton`)
+    and the bodies of each muscle's sites (:func:`muscle_bodies`).
 
     Parameters
     ----------
@@ -301,14 +316,4 @@ def classify(engine: Engine, mapping: Mapping) -> tuple:
     tuple of str
         One class per muscle (:meth:`~spinectl.anatomy.engine.Engine.muscle_ids`).
     """
-    groups = body_groups(engine, mapping)
-    out = []
-    for bodies in muscle_bodies(engine):
-        attached = {groups[b] for b in bodies}
-        if "vertebrae" in attached:
-            out.append("local")
-        elif attached and attached <= {"pelvis", "thorax"}:
-            out.append("global")
-        else:
-            out.append("between")
-    return tuple(out)
+    return classify_muscles(skeleton(engine, mapping), mapping.bodies, muscle_bodies(engine))

@@ -216,9 +216,10 @@ class Anatomy(MappedModel):
     def lordosis_posture(self, degrees: float, plane: str = "sagittal") -> np.ndarray:
         """The reference posture with the plane's chain moved along the model's rhythm by ``degrees`` in total.
 
-        The chain's joints (and those the rhythm slaves, e.g. MyoTorso's abdomen) move as the
-        rhythm's coefficients distribute them (:func:`~spinectl.anatomy.contract.lordosis_direction`);
-        the thorax is not held upright (it turns with the chain).
+        The chain's joints move as the rhythm's coefficients distribute them
+        (:func:`~spinectl.anatomy.contract.lordosis_direction`), and a joint off the chain that a joint
+        equality slaves to them (MyoTorso's abdomen, left out of the rhythm) follows its equality: the
+        posture is the model's. The thorax is not held upright (it turns with the chain).
 
         Parameters
         ----------
@@ -234,7 +235,7 @@ class Anatomy(MappedModel):
         rhy, _ = self.rhythm(plane)
         q = self.posture()
         q[list(rhy.dofs)] += lordosis_direction(self, rhy, len(self.plane_joints(plane)), degrees)
-        return q
+        return _followed(self.engine.model, q)
 
     def require_referee(self) -> None:
         """MuJoCo's own model is the referee of its chain (``check``): nothing to refuse."""
@@ -326,6 +327,24 @@ class Anatomy(MappedModel):
             branches = [pieces[0]] + [piece[1:] for piece in pieces[1:]]
             segments.append(tuple(b for b in branches if len(b) > 1))
         return tuple(segments)
+
+
+def _followed(model, q) -> np.ndarray:
+    """q with every joint that an active joint equality slaves set by its polynomial of its master's angle.
+
+    MuJoCo's joint equality: q1 - q1_0 = sum_k c_k (q2 - q2_0)^k, k = 0..4 (``eq_data``); a lock (no
+    master) holds q1 at q1_0. The masters are taken as given (a slaved master is refused by the rhythm).
+    """
+    mujoco = require_mujoco()
+    q = np.array(q, float)
+    for e in range(model.neq):
+        if not model.eq_active0[e] or model.eq_type[e] != mujoco.mjtEq.mjEQ_JOINT:
+            continue
+        j1, j2 = int(model.eq_obj1id[e]), int(model.eq_obj2id[e])
+        a1 = model.jnt_qposadr[j1]
+        x = 0.0 if j2 < 0 else q[model.jnt_qposadr[j2]] - model.qpos0[model.jnt_qposadr[j2]]
+        q[a1] = model.qpos0[a1] + np.polyval(model.eq_data[e][4::-1], x)
+    return q
 
 
 def load(model: str | Path = "myotorso", mapping: str | Path | Mapping | None = None, cache: bool = True) -> Anatomy:

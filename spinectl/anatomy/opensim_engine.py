@@ -51,6 +51,7 @@ import numpy as np
 from .._validate import printable
 from ..errors import ModelError, ParameterError
 from . import osim_cache
+from .classes import Skeleton, classify_muscles
 from .contract import MappedModel, lordosis_direction, plane_axes
 from .engine import engine_output_to_stderr, model_file, one_line
 from .export_osim import require_opensim
@@ -289,12 +290,14 @@ def _couplers(osim, model) -> tuple:
 
 
 def coupler_rhythm(engine: OsimEngine, chain, values: dict) -> tuple:
-    """The couplers as a :class:`~spinectl.anatomy.linearise.Rhythm` over the chain and the coordinates they tie.
+    """The couplers among the chain's own coordinates as a :class:`~spinectl.anatomy.linearise.Rhythm`.
 
-    A chain coordinate that a coupler slaves is replaced by the coupler's independent
-    coordinates (added if off the chain); a coordinate off the chain slaved to the chain's
-    independent ones is added as a dependent one. Only couplers whose dependent coordinate is
-    itself independent of the others are supported.
+    A coupler is the rhythm where its dependent coordinate and every independent one are the
+    chain's; one that ties a coordinate off the chain to the chain (the Pose2Sim model's
+    ``Abs_r3_con``: its ``Abdomen`` routing body on ``L5_S1_Flex_Ext``; a chain coordinate that
+    follows one off it) is named in :attr:`~spinectl.anatomy.linearise.Rhythm.left_out` instead, as
+    MuJoCo's joint equalities are (:func:`spinectl.anatomy.linearise.rhythm`). Only couplers whose
+    independent coordinates no other coupler slaves are supported.
 
     Parameters
     ----------
@@ -307,32 +310,31 @@ def coupler_rhythm(engine: OsimEngine, chain, values: dict) -> tuple:
     Returns
     -------
     tuple
-        (Rhythm, the involved coordinates' names, the couplers involved).
+        (Rhythm, the involved coordinates' names (the chain's), the couplers of the rhythm).
     """
-    slaved = {c.dependent: c for c in engine.couplers}
-    if any(name in slaved for c in engine.couplers for name in c.independent):
-        raise ModelError(f"{engine.name}: a coupler on a coordinate that another coupler slaves is not supported")
     chain = list(chain)
-    involved = list(chain)
-    for name in chain:
-        if name in slaved:
-            involved += [n for n in slaved[name].independent if n not in involved]
-    independent = [n for n in involved if n not in slaved]
-    involved += [
-        c.dependent for c in engine.couplers if c.dependent not in involved and set(c.independent) <= set(independent)
+    on_chain = [c for c in engine.couplers if c.dependent in chain and set(c.independent) <= set(chain)]
+    left_out = [
+        c.describe(values, engine)
+        for c in engine.couplers
+        if c not in on_chain and (c.dependent in chain or set(c.independent) & set(chain))
     ]
-    used = [slaved[n] for n in involved if n in slaved]
-    T = np.zeros((len(involved), len(independent)))
+    slaved = {c.dependent: c for c in on_chain}
+    if any(name in slaved for c in on_chain for name in c.independent):
+        raise ModelError(f"{engine.name}: a coupler on a coordinate that another coupler slaves is not supported")
+    independent = [n for n in chain if n not in slaved]
+    used = [slaved[n] for n in chain if n in slaved]
+    T = np.zeros((len(chain), len(independent)))
     C = np.zeros_like(T)
-    for row, name in enumerate(involved):
+    for row, name in enumerate(chain):
         if name in slaved:
             slopes, curvatures = slaved[name].derivatives(values, engine)
             cols = [independent.index(n) for n in slaved[name].independent]
             T[row, cols], C[row, cols] = slopes, curvatures
         else:
             T[row, independent.index(name)] = 1.0
-    rhy = Rhythm(tuple(involved.index(n) for n in independent), tuple(range(len(involved))), T, C)
-    return rhy, involved, tuple(used)
+    rhy = Rhythm(tuple(chain.index(n) for n in independent), tuple(range(len(chain))), T, C, tuple(left_out))
+    return rhy, chain, tuple(used)
 
 
 def _base_body(frame) -> str:
@@ -359,20 +361,42 @@ def _check_mapping(engine: OsimEngine, mapping: Mapping) -> None:
 
 
 def _classify(engine: OsimEngine, mapping: Mapping) -> tuple:
-    """Each muscle's class by the bodies its path points are fixed to (spinectl.anatomy.mapping's rule)."""
-    group_of = {body: group for group, names in mapping.bodies.items() for body in names}
+    """Each muscle's class by the bodies its path points are fixed to (:mod:`spinectl.anatomy.classes`' rule)."""
+    tree = _skeleton(engine, mapping)
+    index = {name: b for b, name in enumerate(tree.names)}
     muscles = engine.model.getMuscles()
-    classes = []
+    attachments = []
     for i in range(muscles.getSize()):
         points = muscles.get(i).getGeometryPath().getPathPointSet()
-        groups = {group_of.get(_base_body(points.get(k).getParentFrame()), "other") for k in range(points.getSize())}
-        if "vertebrae" in groups:
-            classes.append("local")
-        elif groups <= {"pelvis", "thorax"}:
-            classes.append("global")
-        else:
-            classes.append("between")
-    return tuple(classes)
+        attachments.append({index[_base_body(points.get(k).getParentFrame())] for k in range(points.getSize())})
+    return classify_muscles(tree, mapping.bodies, attachments)
+
+
+def _skeleton(engine: OsimEngine, mapping: Mapping) -> Skeleton:
+    """OpenSim's joint tree as a :class:`~spinectl.anatomy.classes.Skeleton`, ground first, parents first.
+
+    A body is rigid on its parent where its joint has no coordinate (a ``WeldJoint``) or every
+    one is locked (``Coordinate.getDefaultLocked``); a chain body where a mapped coordinate moves it.
+    """
+    model = engine.model
+    mapped = {n for names in mapping.planes.values() for n in names}
+    joints = model.getJointSet()
+    below: dict = {}
+    for i in range(joints.getSize()):
+        joint = joints.get(i)
+        coords = [joint.get_coordinates(k) for k in range(joint.numCoordinates())]
+        rigid = all(c.getDefaultLocked() for c in coords)  # True without coordinates: a weld
+        chain = any(c.getName() in mapped for c in coords)
+        child = _base_body(joint.getChildFrame())
+        below.setdefault(_base_body(joint.getParentFrame()), []).append((child, rigid, chain))
+    names, parent, rigid, chain = [model.getGround().getName()], [-1], [False], [False]
+    for b, name in enumerate(names):  # breadth first: the list grows as it is read
+        for child, fixed, moved in below.get(name, ()):
+            names.append(child)
+            parent.append(b)
+            rigid.append(fixed)
+            chain.append(moved)
+    return Skeleton(tuple(names), tuple(parent), tuple(rigid), tuple(chain))
 
 
 
@@ -706,8 +730,9 @@ class OsimAnatomy(MappedModel):
 
         The couplers' first independent coordinate and the coordinates they slave to it move as the
         couplers' slopes at the default posture distribute them (:func:`coupler_rhythm`), the chain's
-        joint angles (not its coordinates, :meth:`joint_slopes`) summing to ``degrees``; the engine sets
-        them through OpenSim's coordinates
+        joint angles (not its coordinates, :meth:`joint_slopes`) summing to ``degrees``; a coordinate off
+        the chain that a coupler slaves to the chain (a routing body's, left out of the rhythm) follows
+        its coupler, so the posture is the model's. The engine sets them through OpenSim's coordinates
         (:meth:`OsimEngine.set_posture`).
 
         Parameters
@@ -725,7 +750,8 @@ class OsimAnatomy(MappedModel):
         n = len(self.plane_joints(plane))
         step = lordosis_direction(self, rhy, n, degrees, self.joint_slopes(plane))
         engine = self.engine
-        return {n: engine.coordinate(n).getDefaultValue() + float(v) for n, v in zip(involved, step, strict=True)}
+        values = {n: engine.coordinate(n).getDefaultValue() + float(v) for n, v in zip(involved, step, strict=True)}
+        return _followed(engine, values)
 
     def require_referee(self) -> None:
         """Refused: MuJoCo is the referee, for MJCF only (:meth:`OsimEngine.spec_factory`)."""
@@ -822,6 +848,19 @@ class OsimAnatomy(MappedModel):
         return tuple(out)
 
 
+def _followed(engine: OsimEngine, values: dict) -> dict:
+    """``values`` with the dependent coordinate of every coupler whose independent ones it gives set by the coupler."""
+    osim = require_opensim()
+    out = dict(values)
+    for c in engine.couplers:
+        if c.dependent not in values and set(c.independent) <= set(values):
+            x = osim.Vector(len(c.independent), 0.0)
+            for k, name in enumerate(c.independent):
+                x.set(k, float(values[name]))
+            out[c.dependent] = float(c.function.calcValue(x))
+    return out
+
+
 def _vec3(vector) -> np.ndarray:
     """A SimTK Vec3 as a numpy array."""
     return np.array([vector.get(k) for k in range(3)])
@@ -881,5 +920,8 @@ def load_osim(path, mapping=None, cache: bool = True) -> OsimAnatomy:
         engine.source += f"; {engine.springs} compliant-tendon muscles linearised at the analysed activations"
     if engine.couplers:  # in the model's source line, which every table and JSON prints
         described = "; ".join(c.describe({}, engine) for c in engine.couplers)
-        engine.source += f"; coupler constraints (off in the free chain, linearised in the constrained): {described}"
+        engine.source += (
+            "; coupler constraints (off in the free chain; those among the chain's coordinates linearised in the "
+            f"constrained): {described}"
+        )
     return OsimAnatomy(engine, mapping, names, _classify(engine, mapping))

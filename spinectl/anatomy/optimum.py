@@ -34,6 +34,7 @@ quadratic objectives. arXiv:2405.12762.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -248,6 +249,7 @@ def optimum_on_chains(free, constrained, lin, rows, tau_per, tau_0, w, stability
     -------
     Optimum
     """
+    free, constrained = _lumbar_only(free), _lumbar_only(constrained)
     chain, criterion = (constrained, "chain") if stability == "rhythm" else (free, stability)
     status, a = solve_on_chain(chain, tau_per, tau_0, w, criterion, margin)
     k = free.stiffness(a) if np.all(np.isfinite(a)) else np.full((free.n_joints,) * 2, np.nan)
@@ -266,11 +268,24 @@ def optimum_on_chains(free, constrained, lin, rows, tau_per, tau_0, w, stability
     )
 
 
+def _lumbar_only(chain: LinearChain) -> LinearChain:
+    """The chain with its non-lumbar controls held at their lower bound: a muscle that crosses no chain joint adds
+    no torque to the lumbar equilibrium and no stiffness, so it has no part in the lumbar optimum (left free, it
+    would take an activation of the solver's tolerance, 1e-3 on MyoTorso, where its volume weight is small)."""
+    idle = np.array([c == "non-lumbar" for c in chain.control_class], bool)
+    if not idle.any():
+        return chain
+    return dataclasses.replace(chain, upper=np.where(idle, chain.lower, chain.upper))
+
+
 def _residual(chain, tau_per, tau_0) -> float:
     """min ||tau_per a + tau_0|| over the chain's bounds [N m]: how far the equilibrium is from holding."""
     from scipy.optimize import lsq_linear
 
-    return float(np.linalg.norm(lsq_linear(tau_per, -tau_0, bounds=(chain.lower, chain.upper)).fun))
+    free = chain.upper > chain.lower  # the controls held at a bound (non-lumbar: _lumbar_only) are constants
+    rest = tau_0 + tau_per[:, ~free] @ chain.lower[~free]
+    bounds = (chain.lower[free], chain.upper[free])
+    return float(np.linalg.norm(lsq_linear(tau_per[:, free], -rest, bounds=bounds).fun))
 
 
 def _optimum_dict(anatomy: AnatomyEngine, opt: Optimum) -> dict:
@@ -302,6 +317,8 @@ KEPT_WHERE_INFEASIBLE = (
     "global_null_space",
     "modes_removed",
     "rhythm",
+    "devices",
+    "rhythm_left_out",
     "kp_Nm_per_rad",
     "kd_Nms_per_rad",
     "activation_lag_s",

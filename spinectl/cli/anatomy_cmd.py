@@ -47,7 +47,8 @@ def register(sub) -> None:
         "model",
         nargs="?",
         default="myotorso",
-        help="'myotorso', an MJCF file or an OpenSim .osim file (default: myotorso)",
+        help="'myotorso', an MJCF file or an OpenSim .osim file (default: myotorso; also 'myofullbody', "
+        "myo-sim's full body)",
     )
     parser.add_argument("--mapping", metavar="FILE", help="mapping TOML (default: the built-in one of the model)")
     parser.add_argument("--plane", default="sagittal", help="sagittal, coronal or 3d (default: sagittal)")

@@ -28,9 +28,10 @@ import numpy as np
 
 from ..errors import ParameterError
 
-CONTROL_CLASSES = ("global", "local", "between")
+CONTROL_CLASSES = ("global", "local", "between", "non-lumbar")
 """Muscle classes by the bodies a muscle attaches to (docs/chain.md): thorax and pelvis only;
-any vertebra of the chain; a body in between that is neither (e.g. MyoTorso's abdomen)."""
+any vertebra of the chain; a body in between that is neither (e.g. MyoTorso's abdomen); and a
+muscle that crosses no chain joint (a leg or arm muscle: no moment arm on the chain)."""
 
 
 @dataclass(frozen=True)

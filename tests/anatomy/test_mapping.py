@@ -25,11 +25,57 @@ GLOBAL_PREFIXES = (
 """The thorax-pelvis muscles by their anatomy (rectus abdominis, the iliocostalis slip to rib 12, quadratus
 lumborum's iliac-to-rib-12 fascicles, external obliques 5-6, internal obliques 4-6), named as in MyoTorso."""
 
+PELVIS_TO_L1 = (
+    "Ps_L1_",
+    "IL_L1_",
+    "LTpL_L1_",
+    "QL_post_I.3-L1_",
+    "MF_m1t.2_",
+    "MF_m1t.3_",
+)
+"""The pelvis-to-L1 fascicles by their anatomy (psoas from L1's body, transverse process and disc; iliocostalis and
+longissimus lumborum to L1; quadratus lumborum's posterior L1 fascicle; multifidus m1 to the sacrum): 16 muscles,
+8 a side. MyoTorso has no joint between ``lumbar1`` and ``torso`` (its chain ends at L1_L2), so L1 is the thorax's
+rigid piece and these span the whole chain exactly as a thorax-pelvis muscle does."""
+
 
 def test_global_muscles_are_the_thorax_pelvis_ones(torso):
-    """The global class is exactly the muscles that run from the rib cage to the pelvis by their anatomy."""
+    """The global class is the rib-cage-to-pelvis muscles by their anatomy and the 16 pelvis-to-L1 fascicles.
+
+    The 16 counted "local" before: ``lumbar1`` was taken as a vertebra though no joint separates it from the
+    thorax. Checked independently by MuJoCo's moment arms: each global muscle has one at every lumbar level (any
+    of the level's three joints), as a muscle spanning the whole chain must.
+    """
+    import numpy as np
+
     by_name = {m for m, c in zip(torso.muscles, torso.classes, strict=True) if c == "global"}
-    assert by_name == {m for m in torso.muscles if m.startswith(GLOBAL_PREFIXES)}
+    assert by_name == {m for m in torso.muscles if m.startswith(GLOBAL_PREFIXES + PELVIS_TO_L1)}
+    assert len(by_name - {m for m in torso.muscles if m.startswith(GLOBAL_PREFIXES)}) == 16
+    levels = _level_arms(torso)
+    assert all(np.all(row > 1e-9) for row, c in zip(levels, torso.classes, strict=True) if c == "global")
+
+
+def _level_arms(torso):
+    """Each muscle's largest moment arm at each of the five lumbar levels (over its three joints) [m/rad]."""
+    import numpy as np
+
+    engine = torso.engine
+    engine.set_state(engine.model.qpos0)
+    dofs = [int(engine.model.jnt_dofadr[j]) for j in torso.joint_ids(torso.mapping.planes["3d"])]
+    arms = engine.moment_arms()[engine.muscle_ids()][:, dofs]
+    return np.abs(arms).reshape(len(torso.muscles), 3, 5).max(axis=1)
+
+
+def test_muscles_within_the_thorax_are_non_lumbar(torso):
+    """MyoTorso's two longissimus thoracis slips from L1 to T1 (``LTpT_T1``) lie within the thorax's rigid piece
+    (lumbar1 and torso, no joint between): they cross no chain joint, so "non-lumbar"; MuJoCo gives them no moment
+    arm at any lumbar level, and every other muscle has one at some level."""
+    import numpy as np
+
+    levels = _level_arms(torso)
+    non = {m for m, c in zip(torso.muscles, torso.classes, strict=True) if c == "non-lumbar"}
+    assert non == {"LTpT_T1_r", "LTpT_T1_l"}
+    assert {m for m, row in zip(torso.muscles, levels, strict=True) if np.all(row <= 1e-12)} == non
 
 
 def test_between_muscles_hang_on_the_abdomen(torso):

@@ -178,3 +178,13 @@ def test_the_remedy_search_brackets_a_known_threshold():
     assert (
         least_joint_stiffness(lambda c: False) == np.inf and least_joint_stiffness(lambda c: c > MAX_REMEDY) == np.inf
     )
+
+
+def test_non_lumbar_muscles_take_no_effort_at_the_optimum(torso, optima):
+    """MyoTorso's two non-lumbar muscles (LTpT_T1, L1 to T1 on the thorax's rigid piece) have no moment arm on the
+    lumbar joints (MuJoCo's, at the reference posture), so no torque on the equilibrium's rows and no K_i: the optimum
+    holds them at 0 (left free, the solver gave them 6e-4 to 1e-3, its tolerance on their small volume weights)."""
+    non = [i for i, c in enumerate(torso.classes) if c == "non-lumbar"]
+    assert [torso.muscles[i] for i in non] == ["LTpT_T1_r", "LTpT_T1_l"]
+    for opt in optima.values():
+        assert np.abs(opt.activations[non]).max() <= 1e-9
