@@ -263,7 +263,7 @@ def test_a_model_without_muscles_answers_its_passive_chain_with_the_slopes_shown
     assert main(["anatomy", str(path), "--mapping", str(mapping), "--joint-stiffness", "20", "--json"]) == 0
     doc = json.loads(capsys.readouterr().out)
     assert doc["joint_rad_per_coordinate_rad"] == pytest.approx(list(SLOPES), rel=1e-12)
-    assert doc["muscles"] == {"global": [], "local": [], "between": []} and doc["chain_stable"] is True
+    assert doc["muscles"] == {"global": [], "local": [], "between": [], "non-lumbar": []} and doc["chain_stable"] is True
     assert doc["joint_stiffness_Nm_per_rad"] == [20.0] * 3
     assert main(["anatomy", str(path), "--mapping", str(mapping)]) == 0
     assert "the joints turn q1 0.5, q2 1, q3 0.25 rad per coordinate rad" in capsys.readouterr().out
