@@ -238,6 +238,12 @@ def test_passive_refuses_the_reflexs_options_it_would_ignore(option, value, caps
         (["--delays", "0:0.1:3", "--delay", "0.15"], "--delay: cannot go with --delays, whose delays are the curve's"),
         (["--passive", "0:80:3", "--gains", "search"], "--gains: cannot go with --passive"),
         (["--passive", "0:80:3", "--margin", "1.2"], "--margin: cannot go with --passive"),
+        (["--decay-rate", "25"], "--decay-rate: must be a decay rate in [0, 20) 1/s, below 1/T_a"),
+        (["--decay-rate", "-0.5"], "--decay-rate: must be"),
+        (["--decay-rate", "0.1", "--margin", "1.2"], "--decay-rate: cannot go with --margin"),
+        (["--decay-rate", "0.1", "--gains", "search"], "--decay-rate: cannot go with --gains search"),
+        (["--delays", "0:0.1:3", "--decay-rate", "0.1"], "--decay-rate: cannot go with --delays"),
+        (["--passive", "0:80:3", "--decay-rate", "0.1"], "--decay-rate: cannot go with --passive"),
     ],
 )
 def test_a_margin_or_a_gain_search_where_it_does_not_apply_is_one_line_exit_2(argv, needle, capsys):
@@ -267,3 +273,20 @@ def test_margin_prints_the_design_at_r_times_the_delay(capsys):
     assert robust["margin_ratio"] == 1.2 and robust["nominal_delay_s"] == 0.1
     assert main([*point, "--delay", "0.1", "--margin", "1.2"]) == 0
     assert "holds every delay up to 120 ms" in capsys.readouterr().out
+
+
+def test_decay_rate_prints_the_design_whose_roots_lie_beyond_minus_sigma(capsys):
+    """``--decay-rate 0.1`` answers the chain's least local stiffness with every root at the delay at Re s < -0.1
+    1/s (its rightmost root, the chain's own, in the JSON and the table), above the plain design's, and says what
+    it is; joint by joint is the plain design's (the decay rate is the chain's requirement)."""
+    point = ["design", "--preset", "wagner2012", "--E", "0.03", "--Lambda", "0.04", "--delay", "0.1"]
+    assert main([*point, "--decay-rate", "0.1", "--json"]) == 0
+    robust = json.loads(capsys.readouterr().out)
+    assert main([*point, "--json"]) == 0
+    plain = json.loads(capsys.readouterr().out)
+    assert robust["decay_rate_per_s"] == 0.1 and "margin_cost" not in robust
+    assert robust["chain"]["max_root_real_per_s"] <= -0.1 + 1e-9
+    assert robust["chain"]["local_stiffness_fraction"] > plain["chain"]["local_stiffness_fraction"]
+    assert robust["activation"] == plain["activation"]
+    assert main([*point, "--decay-rate", "0.1"]) == 0
+    assert "designed for a least decay rate 0.1 1/s (--decay-rate)" in capsys.readouterr().out
