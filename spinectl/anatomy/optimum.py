@@ -420,9 +420,8 @@ class OptimisedResult:
         -------
         str
         """
-        lines = [
-            _optimum_line(label, opt, self.margin) for label, opt in (("optimum", self.optimum), ("classic", self.classic))
-        ]
+        rows = (("optimum", self.optimum), ("classic", self.classic))
+        lines = [_optimum_line(label, opt, self.margin) for label, opt in rows]
         lines.append(self._price_line())
         if self.infeasible_constraint == "equilibrium":
             lines.append(EQUILIBRIUM_HINT.format(residual=self.classic.residual, rows=self.classic.net_torque.size))
