@@ -431,7 +431,6 @@ class OptimisedResult:
             lines += ["", "at the optimum's activations:", self.analysis.table()]
         return "\n".join(lines)
 
-
     def _price_line(self) -> str:
         """The price of stability, or why there is none (an infeasible optimum has no cost to compare)."""
         if self.optimum.ok and self.classic.ok:
