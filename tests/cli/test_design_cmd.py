@@ -290,3 +290,22 @@ def test_decay_rate_prints_the_design_whose_roots_lie_beyond_minus_sigma(capsys)
     assert robust["activation"] == plain["activation"]
     assert main([*point, "--decay-rate", "0.1"]) == 0
     assert "designed for a least decay rate 0.1 1/s (--decay-rate)" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(("extra", "fixed_at"), [([], "K = 0 N m/rad"), (["--set", "passive.stiffness=10"], "K = 10")])
+def test_passive_says_which_minimum_its_fixed_global_pcsa_is(extra, fixed_at, capsys):
+    """``design --passive`` holds one global PCSA while K varies: the table says what it is, the least total PCSA
+    for every segment self-stable joint by joint (the paper's criterion), solved at the model's own K (the preset's
+    0, or 10 N m/rad set), and held at every K of the sweep (it said "the paper's minimum" without what over or
+    where); its value is solve_point's total at that K."""
+    from spinectl.optimise.reference import solve_point
+    from spinectl.units import m2_to_cm2
+
+    argv = ["design", "--preset", "wagner2012", "--passive", "0:80:3", "--E", "0.03", "--Lambda", "0.04", *extra]
+    assert main(argv) == 0
+    line = next(x for x in capsys.readouterr().out.splitlines() if x.startswith("least local stiffness at a fixed"))
+    assert "self-stable joint by joint (each CoR alone, the others fixed" in line
+    assert f"solved once at the model's own {fixed_at}" in line and "held, muscle by muscle, at every K" in line
+    stiffness = 10.0 if extra else 0.0
+    model = config.set_parameters(config.load_preset("wagner2012"), {"passive.stiffness": stiffness})
+    assert f"{m2_to_cm2(solve_point(model, 0.03, 0.04).pcsa.sum()):.2f} cm^2" in line
