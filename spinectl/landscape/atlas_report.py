@@ -113,7 +113,40 @@ def _shown(value: float) -> str:
     return "–" if np.isnan(value) else f"{value:g}"
 
 
-def density_figure(landscape: dict, draws: dict, optimum: tuple[float, float]):
+DENSITY_LEVELS = (0.1, 0.3, 0.5, 0.7, 0.9)
+"""The density figure's contours, as fractions of the cohort density's peak."""
+
+
+def base_text(spec: AtlasSpec) -> str:
+    """What the density figure's background is computed at: the base model, its mass and K with units, and the
+    drawn parameters it does not follow (each draw's own mass or K is not the background's).
+
+    Parameters
+    ----------
+    spec : AtlasSpec
+
+    Returns
+    -------
+    str
+        E.g. ``"the base model (preset default): body.mass 40 kg, passive.stiffness K = 0 N m/rad; each draw's
+        own body.mass, passive.stiffness varies, the background does not"``.
+    """
+    from ..model.source import origin
+
+    model = spec.model
+    text = (
+        f"the base model ({origin(model)}): body.mass {model.body.mass:g} kg, passive.stiffness K = "
+        f"{model.passive.stiffness:g} N m/rad"
+    )
+    others = [p.parameter for p in spec.priors if p.parameter not in PLANE_PARAMETERS]
+    return text + (f"; each draw's own {', '.join(others)} varies, the background does not" if others else "")
+
+
+PLANE_PARAMETERS = ("eccentricity_m", "lordosis_m", "lordosis_angle_deg")
+"""The priors that place a draw on the figure's (E, Lambda) plane; the others vary what the background omits."""
+
+
+def density_figure(landscape: dict, draws: dict, optimum: tuple[float, float], base: str = ""):
     """The cohort's density of (E, Lambda) drawn over the landscape of min PCSA, with the paper's optimum.
 
     Parameters
@@ -124,27 +157,41 @@ def density_figure(landscape: dict, draws: dict, optimum: tuple[float, float]):
         ``eccentricity_m`` and ``lordosis_m`` of every draw [m].
     optimum : tuple of float
         (E, Lambda) to mark [m].
+    base : str
+        What the background is computed at (:func:`base_text`), in the colour bar's label.
 
     Returns
     -------
     matplotlib.figure.Figure
         Drawn on :func:`spinectl.canvas.new_figure`; axes in cm.
     """
-    fig = new_figure(figsize=(6.0, 4.8), layout="constrained")
+    import textwrap
+
+    from matplotlib.lines import Line2D
+
+    fig = new_figure(figsize=(6.4, 5.6), layout="constrained")
     ax = fig.add_subplot()
     e, lam = 100 * np.asarray(landscape["eccentricity_m"]), 100 * np.asarray(landscape["lordosis_m"])
     mesh = ax.pcolormesh(e, lam, np.asarray(landscape["min_pcsa_cm2"]).T, shading="nearest", cmap="viridis")
-    fig.colorbar(mesh, ax=ax, label="min PCSA [cm²] (joint by joint)")
+    fig.colorbar(mesh, ax=ax, label="background: min PCSA [cm²], joint by joint")
     points = 100 * np.stack([draws["eccentricity_m"], draws["lordosis_m"]])
+    handles = []
     if np.all(np.ptp(points, axis=1) > 0):  # a kernel density needs spread in both
         from scipy.stats import gaussian_kde
 
         x, y = np.meshgrid(e, lam, indexing="ij")
         density = gaussian_kde(points)(np.stack([x.ravel(), y.ravel()])).reshape(x.shape)
-        ax.contour(e, lam, density.T / density.max(), levels=(0.1, 0.3, 0.5, 0.7, 0.9), colors="white")
-    ax.plot(100 * optimum[0], 100 * optimum[1], "r*", markersize=14, label="the paper's optimum C")
+        ax.contour(e, lam, density.T / density.max(), levels=DENSITY_LEVELS, colors="white")
+        levels = ", ".join(f"{100 * v:g}" for v in DENSITY_LEVELS)
+        handles.append(Line2D([], [], color="white", label=f"cohort density: {levels} % of its peak"))
+    (star,) = ax.plot(100 * optimum[0], 100 * optimum[1], "r*", markersize=14, label="the paper's optimum C")
     ax.set_xlabel("eccentricity E [cm]")
     ax.set_ylabel("lordosis Λ [cm]")
-    ax.set_title("cohort density (white: 10 % to 90 % of its peak)")
-    ax.legend(loc="lower right")
+    ax.set_title(
+        f"where the cohort's {points.shape[1]} draws lie in (E, Λ), over the base model's min PCSA", fontsize=10
+    )
+    if base:
+        fig.supxlabel(textwrap.fill(f"background: {base}", 90), fontsize=8)
+    legend = ax.legend(handles=[*handles, star], loc="lower right", fontsize=8, facecolor="0.4", labelcolor="white")
+    legend.get_frame().set_alpha(0.8)
     return fig
