@@ -58,7 +58,7 @@ def report_text(result, spec: AtlasSpec) -> str:
     ]
     for name, v in result.probabilities.items():
         lines.append(f"| {name} | {criterion(name, spec)} | {v['p']:.3f} | [{v['low']:.3f}, {v['high']:.3f}] |")
-    lines += ["", "## Sobol' indices (first order S1, total ST, with bootstrap intervals)", ""]
+    lines += ["", "## Sobol' indices (first order S1, total ST, with bootstrap intervals)", "", SOBOL_NOTE, ""]
     tables = result.sobol | {f"{name} (indicator)": t for name, t in result.sobol_verdicts.items()}
     for output, table in tables.items():
         lines += [f"### `{output}`", ""]
@@ -67,10 +67,32 @@ def report_text(result, spec: AtlasSpec) -> str:
             continue
         lines += ["| parameter | S1 | ST |", "|---|---|---|"]
         for name, s in table.items():
-            first, total = f"{s['S1']:.3f} ± {s['S1_conf']:.3f}", f"{s['ST']:.3f} ± {s['ST_conf']:.3f}"
+            first = f"{s['S1']:.3f} ± {s['S1_conf']:.3f}{_outside(s['S1'], s['S1_conf'])}"
+            total = f"{s['ST']:.3f} ± {s['ST_conf']:.3f}{_outside(s['ST'], s['ST_conf'])}"
             lines.append(f"| {markdown_cell_code(name)} | {first} | {total} |")
         lines.append("")
     return "\n".join(lines) + "\n"
+
+
+SOBOL_NOTE = (
+    "S1 is the share of an output's variance that a parameter causes alone, ST the share it takes part in "
+    "(with the others); both lie in [0, 1], and S1 <= ST. The numbers here are estimates from the draws: "
+    "sampling error can put one below 0 or above 1 (marked with how to read it) or S1 above "
+    "ST. Read such an estimate by its interval: -0.05 ± 0.2 is 'no effect detected', not a negative share; "
+    "more samples narrow the intervals."
+)
+"""The report's words on what S1 and ST are and how an estimate outside [0, 1] reads."""
+
+
+def _outside(value: float, interval: float) -> str:
+    """How to read an estimate outside [0, 1]: as the nearest possible value where its interval reaches it, else
+    a sign of too few samples; '' inside [0, 1]."""
+    if not np.isfinite(value) or 0.0 <= value <= 1.0:
+        return ""
+    nearest = 0 if value < 0 else 1
+    if abs(value - nearest) <= interval:
+        return f" (read as {nearest}: within its interval)"
+    return " (outside [0, 1] beyond its interval: too few samples)"
 
 
 def criterion(verdict: str, spec: AtlasSpec) -> str:

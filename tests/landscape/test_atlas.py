@@ -664,3 +664,23 @@ def test_the_density_figure_says_what_it_draws_and_at_which_mass_and_k():
     assert "each draw's own body.mass, passive.stiffness, reflex.delay varies" in footer
     stiff = dataclasses.replace(spec, model=set_parameters(spec.model, {"passive.stiffness": 12.0}))
     assert "passive.stiffness K = 12 N m/rad" in base_text(stiff)
+
+
+def test_a_sobol_estimate_outside_zero_one_says_how_to_read_it():
+    """S1 and ST are variance shares in [0, 1]; their estimates are not (the report showed S1 = -0.158 ± 0.511 with
+    no word): the report says what they are and marks each estimate outside [0, 1], read as the nearest possible
+    value where its interval reaches it, else as too few samples; estimates inside are unmarked."""
+    from types import SimpleNamespace
+
+    from spinectl.landscape.atlas_report import SOBOL_NOTE, report_text
+
+    row = {"S1": -0.158, "S1_conf": 0.511, "ST": 0.222, "ST_conf": 0.419}
+    far = {"S1": 1.4, "S1_conf": 0.1, "ST": 0.5, "ST_conf": 0.1}
+    result = SimpleNamespace(
+        n_evaluations=4, probabilities={}, sobol={"min_pcsa_cm2": {"body.mass": row, "eccentricity_m": far}},
+        sobol_verdicts={}, draws={},
+    )  # fmt: skip
+    text = report_text(result, _spec(chain="false"))
+    assert SOBOL_NOTE in text and "not a negative share" in SOBOL_NOTE
+    assert "| `body.mass` | -0.158 ± 0.511 (read as 0: within its interval) | 0.222 ± 0.419 |" in text
+    assert "| `eccentricity_m` | 1.400 ± 0.100 (outside [0, 1] beyond its interval: too few samples) | 0.500" in text
