@@ -26,7 +26,17 @@ PLANES_3D = 3
 
 
 def level(k: int) -> str:
-    """The k-th intervertebral level from L5S1 up (0: ``L5S1``), or ``level k+1`` beyond C2C3."""
+    """The k-th intervertebral level from L5S1 up (0: ``L5S1``), or ``level k+1`` beyond C2C3.
+
+    Parameters
+    ----------
+    k : int
+        The joint's position in its chain, from L5S1 up.
+
+    Returns
+    -------
+    str
+    """
     return f"{VERTEBRAE[k + 1]}{VERTEBRAE[k]}" if k + 1 < len(VERTEBRAE) else f"level {k + 1}"
 
 
