@@ -69,10 +69,10 @@ def register(sub) -> None:
         "--decay-rate",
         type=finite_float("--decay-rate"),
         metavar="SIGMA",
-        help="instead of --margin, a least decay rate sigma [1/s]: the chain's least local stiffness for which "
-        "every characteristic root at the delay has Re s <= -sigma (disturbances die out at least as "
-        "exp(-sigma t)), certified as the delay is, on the loop shifted by sigma; below 1/T_a (joint by joint "
-        "unchanged)",
+        help="instead of --margin, a least decay rate sigma [1/s]: both answers (the least co-contraction joint "
+        "by joint, the chain's least local stiffness) with every characteristic root at the delay at "
+        "Re s <= -sigma (disturbances die out at least as exp(-sigma t)), certified as the delay is, on the "
+        "loops shifted by sigma; below 1/T_a",
     )
     parser.add_argument(
         "--passive",

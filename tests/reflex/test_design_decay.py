@@ -66,3 +66,33 @@ def test_a_decay_rate_at_or_beyond_its_bound_is_refused_naming_it(sigma, lag, ne
     with pytest.raises(Exception, match="--decay-rate") as caught:
         checked_decay_rate("--decay-rate", sigma, 0.1, lag)
     assert needle in str(caught.value)
+
+
+def test_joint_by_joint_each_segment_at_the_decay_rates_activation_has_its_roots_beyond_minus_sigma():
+    """Joint by joint at 0.1 1/s (wagner2012 at E = 3 cm, Lambda = 4 cm, 100 ms): at the common least activation
+    every segment's loop under the rule (theta s^2 - D s - S with the lag and the delayed PD, one joint), solved
+    here by Newton from 96 Chebyshev nodes (a second method), has its rightmost root at Re s <= -0.1; 1e-3 below it,
+    the binding segment's is right of -0.1; it needs more than stability alone. The margins reported are the
+    segments' own (>= the delay), and there is no 'largest delay met' (the shifted loops hold one delay)."""
+    from spinectl.model.checks import checked_coefficients
+    from spinectl.reflex import gains
+
+    model = config.load_preset("wagner2012")
+    plain = dz.joint_design(model, 0.03, 0.04)[0]
+    activation, segments, optimum, status, largest, _ = dz.joint_design(model, 0.03, 0.04, decay=0.1)
+    assert status == "ok" and activation > plain and np.isnan(largest)
+    assert all(s.delay_margin >= 0.1 for s in segments)
+    coefficients = checked_coefficients(model, 0.03, 0.04)
+
+    def rightmost(a):
+        pcsa = a * np.asarray(optimum)
+        s, d = coefficients.stiffness(pcsa), coefficients.damping(pcsa)
+        theta = np.broadcast_to(coefficients.inertia, s.shape)
+        kp, kd = gains.resolve_gains(s, d, theta, model.reflex)
+        return [
+            dz.rightmost_root([[theta[k]]], [[s[k]]], [[d[k]]], [kp[k]], [kd[k]], 0.1, 0.05, 96).real
+            for k in range(s.size)
+        ]
+
+    assert max(rightmost(activation)) <= -0.1 + 1e-6
+    assert max(rightmost(activation - 1e-3)) > -0.1

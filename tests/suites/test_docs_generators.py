@@ -198,9 +198,10 @@ def test_reproduction_tables_list_every_landmark_and_free_parameter():
 
 
 def test_the_decay_rate_table_is_what_design_answers():
-    """docs/reflex.md's --decay-rate table is generated: each row's total local stiffness and rightmost root are
-    those of spinectl.reflex.design.answer at that decay rate (the command's own numbers, never typed), the
-    rightmost root at or left of -sigma, and the stiffness grows with sigma; a rate the rule cannot reach says so."""
+    """docs/reflex.md's --decay-rate table is generated: each row's co-contraction, total local stiffness and
+    rightmost root are those of spinectl.reflex.design.answer at that decay rate (the command's own numbers,
+    never typed), the rightmost root at or left of -sigma, and the stiffness grows with sigma; a rate the rule
+    cannot reach says so."""
     import numpy as np
 
     from spinectl.model.config import load_preset
@@ -211,9 +212,11 @@ def test_the_decay_rate_table_is_what_design_answers():
     totals = []
     for sigma, row in zip(design.DECAY_RATES, rows, strict=True):
         chain = answer(load_preset("wagner2012"), *design.POINT, decay=sigma).chain
+        result = answer(load_preset("wagner2012"), *design.POINT, decay=sigma)
+        assert row[1] == (f"{result.activation:.4f}" if np.isfinite(result.activation) else "none in [0, 1]")
         if not np.isfinite(chain.fraction):
-            assert row[1] == "none up to k*"
+            assert row[2] == "none up to k*"
             continue
-        assert row[1] == f"{np.sum(chain.local_stiffness):.1f}" and float(row[3]) <= -sigma + 1e-6
-        totals.append(float(row[1]))
+        assert row[2] == f"{np.sum(chain.local_stiffness):.1f}" and float(row[4]) <= -sigma + 1e-6
+        totals.append(float(row[2]))
     assert totals == sorted(totals) and len(totals) >= 3

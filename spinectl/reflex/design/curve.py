@@ -33,8 +33,9 @@ def design(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None,
     kp, kd : float, optional
         Explicit gains for every segment and joint [N m/rad], [N m s/rad].
     decay : float
-        The chain's least decay rate sigma [1/s] (:func:`~spinectl.reflex.design.chain.chain_design`): every
-        characteristic root at the delay at Re s < -sigma; 0, stable at the delay. Joint by joint is unchanged.
+        A least decay rate sigma [1/s] for both criteria (:func:`~spinectl.reflex.design.joint.joint_design`,
+        :func:`~spinectl.reflex.design.chain.chain_design`): every characteristic root at the delay at
+        Re s < -sigma; 0, stable at the delay.
 
     Returns
     -------
@@ -47,7 +48,9 @@ def design(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None,
     """
     from ...model.source import header, provenance
 
-    activation, segments, optimum, status, largest, method = joint_design(model, eccentricity, lordosis, kp, kd)
+    activation, segments, optimum, status, largest, method = joint_design(
+        model, eccentricity, lordosis, kp, kd, decay
+    )
     pcsa = activation * optimum if np.isfinite(activation) else np.full_like(np.asarray(optimum, float), np.nan)
     at = model.reflex.activation  # the chain at the operating point of spinectl margins
     chain_answer = chain_design(

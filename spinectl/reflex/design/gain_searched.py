@@ -308,8 +308,9 @@ def answer(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None,
     ratio : float
         R >= 1: the design holds every delay up to R tau (the design at R tau).
     decay : float
-        A least decay rate sigma [1/s] instead: the chain's design has every root at the delay at
-        Re s < -sigma (:mod:`~spinectl.reflex.design.decay`); 0, none. Not with ``search`` or R > 1.
+        A least decay rate sigma [1/s] instead: both criteria's designs have every root at the delay at
+        Re s < -sigma (:mod:`~spinectl.reflex.design.decay`); 0, none. Not with ``search`` or R > 1; no
+        ``joint_searched`` beside it.
 
     Returns
     -------
@@ -346,7 +347,8 @@ def answer(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None,
         c = chain_design(longer, e, lam, pcsa, at.reflex.activation, kp, kd)
         cost = MarginCost(COST_RATIO, c.fraction, c.local_stiffness)
     searched = gain_searched_design(at, e, lam, pcsa, rule) if search and np.all(np.isfinite(pcsa)) else None
-    joint = joint_searched_design(at, e, lam, result, kp, kd)  # milliseconds: always beside the rule's
+    # milliseconds: always beside the rule's, but for a decay rate, which that grid does not certify
+    joint = joint_searched_design(at, e, lam, result, kp, kd) if not decay > 0 else None
     return replace(
         result, chain=rule, margin_ratio=float(ratio), nominal_delay=nominal, margin_cost=cost, searched=searched,
         joint_searched=joint,

@@ -279,6 +279,9 @@ class Design:
                 f"one activation for every segment (the largest above): {self.activation:.4f} x minimum PCSA "
                 f"({m2_to_cm2(self.pcsa):.2f} cm^2); tau_m: each segment's exact delay margin at its activation"
                 if np.isfinite(self.activation)
+                else f"no activation in [0, 1] meets the delay at every segment with every root at Re s < "
+                f"-{self.decay_rate:g} 1/s (--decay-rate)"
+                if self.decay_rate > 0
                 else f"no activation in [0, 1] meets the delay at every segment; the largest delay met: "
                 f"{delay_text(self.largest_delay)}"
             ),
@@ -304,6 +307,11 @@ class Design:
 
     def _joint_lines(self) -> list[str]:
         """Joint by joint: the reflex the answer assumes, and the answer over every segment's gains."""
+        if self.decay_rate > 0:
+            return [
+                f"  reflex assumed: the reflex rule at each activation; every root of each segment's loop at the "
+                f"delay at Re s < -{self.decay_rate:g} 1/s (--decay-rate; tau_m: its own exact delay margin)"
+            ]
         if self.joint_searched is None:
             return []
         return ["  reflex assumed: the reflex rule at each activation", *self.joint_searched.lines(self.activation)]
