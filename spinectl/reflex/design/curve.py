@@ -48,9 +48,7 @@ def design(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None,
     """
     from ...model.source import header, provenance
 
-    activation, segments, optimum, status, largest, method = joint_design(
-        model, eccentricity, lordosis, kp, kd, decay
-    )
+    activation, segments, optimum, status, largest, method = joint_design(model, eccentricity, lordosis, kp, kd, decay)
     pcsa = activation * optimum if np.isfinite(activation) else np.full_like(np.asarray(optimum, float), np.nan)
     at = model.reflex.activation  # the chain at the operating point of spinectl margins
     chain_answer = chain_design(
