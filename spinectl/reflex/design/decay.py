@@ -2,7 +2,8 @@
 
 The chain under the delayed, lagged reflex has the characteristic equation det(P(s) + Q(s) e^{-s tau}) = 0 with
 P(s) = (T_a s + 1)(M s^2 - D s - K) and Q(s) = K_p + K_d s (:mod:`spinectl.reflex.mimo`). Its roots with
-Re s < -sigma are those of the same equation in z = s + sigma with Re z < 0, and that equation has the same form:
+Re s < -sigma are those of the same equation in z = s + sigma with Re z < 0, and that equation has the same
+form::
 
     T_a s + 1          = c (T_a' z + 1),                  c = 1 - sigma T_a,  T_a' = T_a / c
     M s^2 - D s - K    = M z^2 - D' z - K',               D' = D + 2 sigma M,  K' = K - sigma^2 M - sigma D
