@@ -34,6 +34,7 @@ from ..model.stability import MARGINAL_TIME_CONSTANT, slowest_time_constant
 from .contract import AnatomyEngine
 from .engine import require_mujoco
 from .model import Anatomy
+from .naming import joint_labels
 
 RANK_TOLERANCE = 1e-9
 """A singular value below this times the largest counts as zero (the global muscles' rank)."""
@@ -594,13 +595,14 @@ class AnatomyResult:
             *self._angle_note(),
             *(["devices: " + "; ".join(self.devices)] if self.devices else []),
             "",
-            f"{'joint':<16}{'-K_jj [N m/rad]':>16}  joint by joint (others fixed)",
-            f"{'':<16}{'(> 0 restores)':>16}",
+            f"{'joint (level)':<24}{'-K_jj [N m/rad]':>16}  joint by joint (others fixed)",
+            f"{'':<24}{'(> 0 restores)':>16}",
         ]
-        verdicts = zip(free.joints, free.joint_stiffness, free.joint_self_stable, free.joint_marginal, strict=True)
+        labels = joint_labels(free.joints, self.plane)  # the model's name and the level: flex_extension (L5S1)
+        verdicts = zip(labels, free.joint_stiffness, free.joint_self_stable, free.joint_marginal, strict=True)
         for (name, s, ok, slow), tau in zip(verdicts, free.joint_time_constants, strict=True):
             marginal = f", marginal: slowest time constant {tau:.4g} s > {MARGINAL_TIME_CONSTANT:g} s" if slow else ""
-            lines.append(f"{name:<16}{s:>16.4g}  {'self-' + word[ok]}{marginal}")
+            lines.append(f"{name:<24}{s:>16.4g}  {'self-' + word[ok]}{marginal}")
         eig = ", ".join(f"{v:.4g}" for v in free.eigenvalues)
         lines += [
             "",

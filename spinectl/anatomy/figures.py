@@ -11,6 +11,8 @@ import numpy as np
 
 from ..canvas import new_figure, save_figures
 from .drawing import ModeShapes, SagittalProjection
+from .naming import joint_labels
+from .optimum import CURVE_AXIS, CURVE_AXIS_MEANING
 
 CLASS_COLOURS = {"global": "tab:blue", "local": "tab:red", "between": "tab:green", "non-lumbar": "tab:gray"}
 """Muscle class -> colour (:data:`spinectl.model.linear_chain.CONTROL_CLASSES`)."""
@@ -55,7 +57,7 @@ def sagittal_figure(projection: SagittalProjection, title: str = ""):
         ax.plot([], [], color=CLASS_COLOURS[cls], lw=2, label=f"{cls} muscles ({counts[cls]})")
     _spine_axes(ax, projection.cors, projection.thorax, color="black", lw=2.5, zorder=5)
     ax.plot(*projection.cors.T, "o", ms=7, mfc="white", mec="black", mew=1.5, zorder=6, label="CoRs (chain joints)")
-    for name, (x, y) in zip(projection.joints, projection.cors, strict=True):
+    for name, (x, y) in zip(joint_labels(projection.joints, "sagittal"), projection.cors, strict=True):
         ax.annotate(
             name,
             (x, y),
@@ -154,8 +156,7 @@ def lordosis_figure(curve: dict, title: str = ""):
     top.set_ylabel(r"least cost $\sum_i w_i a_i^2$ [1]")
     bottom.set_ylabel("least eigenvalue of -K [N m/rad]\n(free chain; < 0 unstable)")
     bottom.set_xlabel(
-        "lordosis: change of the chain's summed angle along the rhythm [deg] (+: +flex_extension)\n"
-        "the thorax tilts with it: not a lordosis at a fixed upright trunk",
+        f"{CURVE_AXIS}: {CURVE_AXIS_MEANING}\nthe thorax tilts with it: not a lordosis at a fixed upright trunk",
         fontsize=8,
     )
     top.legend(fontsize=8, title="criterion (star: least cost)", title_fontsize=8)

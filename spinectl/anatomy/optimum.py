@@ -437,21 +437,9 @@ class OptimisedResult:
         -------
         str
         """
-        crit = {
-            "chain": "the chain free, -K >= mu I",
-            "joints": "joint by joint, each -K_jj >= mu",
-            "rhythm": "the chain constrained by the rhythm, -K_c >= mu",
-            "none": "no stability criterion (classic static optimisation)",
-        }
-        lines = []
-        for label, opt in (("optimum", self.optimum), ("classic", self.classic)):
-            eig = ", ".join(f"{v:.4g}" for v in opt.eigenvalues)
-            lines.append(
-                f"{label}: {crit[opt.stability]} (mu = {self.margin:g} N m/rad), equilibrium {opt.equilibrium}: "
-                f"{opt.status}; cost {opt.cost:.4g}, sum of activations {np.sum(opt.activations):.4g}; "
-                f"eigenvalues of -K (free chain) {eig} N m/rad"
-            )
-        lines.append(f"price of stability (cost ratio): {self.price:.4g}")
+        rows = (("optimum", self.optimum), ("classic", self.classic))
+        lines = [_optimum_line(label, opt, self.margin) for label, opt in rows]
+        lines.append(self._price_line())
         if self.infeasible_constraint == "equilibrium":
             lines.append(EQUILIBRIUM_HINT.format(residual=self.classic.residual, rows=self.classic.net_torque.size))
         elif self.infeasible_constraint == "stability":
@@ -460,10 +448,42 @@ class OptimisedResult:
             lines += ["", "at the optimum's activations:", self.analysis.table()]
         return "\n".join(lines)
 
+    def _price_line(self) -> str:
+        """The price of stability, or why there is none (an infeasible optimum has no cost to compare)."""
+        if self.optimum.ok and self.classic.ok:
+            return f"price of stability (the optimum's cost over the classic one's): {self.price:.4g}"
+        which = "the optimum" if not self.optimum.ok else "the classic optimum"
+        return f"price of stability: none ({which} is infeasible, so it has no cost to compare)"
+
+
+CRITERION_TEXT = {
+    "chain": "the chain free, -K >= mu I",
+    "joints": "joint by joint, each -K_jj >= mu",
+    "rhythm": "the chain constrained by the rhythm, -K_c >= mu",
+    "none": "no stability criterion: classic static optimisation",
+}
+"""Each ``--stability`` criterion in the optimum's table: -K's least eigenvalue (or each diagonal entry) >= mu."""
+
+
+def _optimum_line(label: str, opt: Optimum, margin: float) -> str:
+    """One optimum in the table: its criterion (mu only where it has one), then its answer or 'infeasible'."""
+    mu = f", mu = {margin:g} N m/rad" if opt.stability != "none" else ""
+    head = f"{label} ({CRITERION_TEXT[opt.stability]}{mu}; equilibrium {opt.equilibrium}): "
+    if not opt.ok:
+        meet = "hold the posture" + (" and meet the criterion" if opt.stability != "none" else "")
+        status = f" (the solver: {opt.status})" if opt.status != "infeasible" else ""
+        return head + f"infeasible: no activations within their bounds {meet}{status}; no cost, activations or eigenvalues"
+    eig = ", ".join(f"{v:.4g}" for v in opt.eigenvalues)
+    return head + (
+        f"{opt.status}; cost {opt.cost:.4g}, sum of activations {np.sum(opt.activations):.4g}; "
+        f"eigenvalues of -K (free chain) {eig} N m/rad"
+    )
+
 
 INFEASIBLE_HINT = (
-    "no activations within their bounds meet the criterion: the model's joints have no stiffness of their own; "
-    "--joint-stiffness mapped or a value in N m/rad adds it (docs/anatomy.md, 'The optimum')"
+    "remedy: the stability criterion needs more stiffness than the muscles give (the classic optimum, without "
+    "it, is solved); --joint-stiffness mapped or a value in N m/rad adds stiffness at each chain joint "
+    "(docs/anatomy.md, 'The optimum')"
 )
 MAX_REMEDY = 1e5
 """The most stiffness per joint [N m/rad] the remedy searches (the paper's K is 15 N m/rad, Crisco and Panjabi's
@@ -682,6 +702,13 @@ CURVE_MEANING = (
     "not a lordosis at a fixed upright trunk"
 )
 """What the anatomy's lordosis axis is, said wherever its curve is shown (table and figure)."""
+
+CURVE_AXIS = "summed angle change [deg]"
+CURVE_AXIS_MEANING = (
+    "the chain's summed joint angle minus the model's posture's, moved along the rhythm (+: the rhythm's "
+    "positive direction, extension for MyoTorso)"
+)
+"""The lordosis curve's axis: its title (with its unit) and what it measures, in the table and the figure."""
 
 
 def lordosis_curve(

@@ -250,14 +250,19 @@ def _degrees(text: str):
 
 def _curve_table(curve: dict) -> str:
     """The lordosis curve as rows: each criterion's least cost (or its status) per posture."""
-    from ..anatomy.optimum import CURVE_MEANING
+    from ..anatomy.optimum import CURVE_AXIS, CURVE_AXIS_MEANING, CURVE_MEANING
 
-    lines = ["", f"lordosis curve ({CURVE_MEANING})", "lordosis [deg]  cost: classic  joint by joint  the chain (free)"]
+    lines = [
+        "",
+        f"lordosis curve ({CURVE_MEANING})",
+        f"{CURVE_AXIS}: {CURVE_AXIS_MEANING}; cost: the least sum of w_i a_i^2 [1] under each criterion",
+        f"{CURVE_AXIS}  cost: classic  joint by joint  the chain (free)",
+    ]
     for i, deg in enumerate(curve["lordosis_deg"]):
         cells = []
         for criterion in ("none", "joints", "chain"):
             row = curve[criterion]
             ok = row["status"][i] in ("optimal", "optimal_inaccurate")
             cells.append(f"{row['cost'][i]:.4g}" if ok else row["status"][i])
-        lines.append(f"{deg:>14.3g}  {cells[0]:>13}  {cells[1]:>14}  {cells[2]:>16}")
+        lines.append(f"{deg:>{len(CURVE_AXIS)}.3g}  {cells[0]:>13}  {cells[1]:>14}  {cells[2]:>16}")
     return "\n".join(lines)

@@ -66,6 +66,15 @@ def register(sub) -> None:
         "the delay); default 1, with the cost of 1.1 shown",
     )
     parser.add_argument(
+        "--decay-rate",
+        type=finite_float("--decay-rate"),
+        metavar="SIGMA",
+        help="instead of --margin, a least decay rate sigma [1/s]: both answers (the least co-contraction joint "
+        "by joint, the chain's least local stiffness) with every characteristic root at the delay at "
+        "Re s <= -sigma (disturbances die out at least as exp(-sigma t)), certified as the delay is, on the "
+        "loops shifted by sigma; below 1/T_a",
+    )
+    parser.add_argument(
         "--passive",
         metavar="START:STOP:NUM",
         help="instead: the chain's least global PCSA alone and least local stiffness against the passive "
@@ -96,10 +105,10 @@ PASSIVE_EXAMPLE = "in N m/rad, e.g. 0:80:41"
 DELAYS_EXAMPLE = "in seconds, e.g. 0:0.2:41"
 """The forms of ``--passive`` and ``--delays``, for a malformed one."""
 
-STATIC_ONLY = ("--delay", "--activation-lag", "--activation", "--kp", "--kd", "--gains", "--margin")
+STATIC_ONLY = ("--delay", "--activation-lag", "--activation", "--kp", "--kd", "--gains", "--margin", "--decay-rate")
 """The reflex's options, which ``--passive`` does not use: refused with it rather than ignored."""
 
-ONE_DELAY_ONLY = ("--delay", "--gains", "--margin")
+ONE_DELAY_ONLY = ("--delay", "--gains", "--margin", "--decay-rate")
 """Options of the one-delay design, refused with ``--delays`` rather than ignored."""
 
 OVERRIDES = (
@@ -154,7 +163,7 @@ def run(args) -> int:
     if args.passive is not None and args.delays is not None:
         raise ParameterError("--passive", "cannot go with --delays (one curve at a time)")
     for option in ONE_DELAY_ONLY if args.delays is not None else ():
-        if getattr(args, option.lstrip("-")) is not None:  # --delay was ignored without a word
+        if getattr(args, option.lstrip("-").replace("-", "_")) is not None:  # --delay was ignored without a word
             why = "whose delays are the curve's axis" if option == "--delay" else "which it does not take"
             raise ParameterError(option, f"cannot go with --delays, {why}: the one-delay design is --delay")
     if args.passive is not None:
@@ -163,12 +172,29 @@ def run(args) -> int:
         return _delays(model, args, kp, kd)
     delay = model.reflex.delay
     ratio = 1.0 if args.margin is None else in_range("--margin", args.margin, 1.0, MAX_DELAY / delay if delay else inf)
-    result = answer(model, args.E, args.Lambda, kp=kp, kd=kd, search=args.gains == "search", ratio=ratio)
+    decay = _decay_rate(args, model)
+    result = answer(model, args.E, args.Lambda, kp=kp, kd=kd, search=args.gains == "search", ratio=ratio, decay=decay)
     if args.json:
         emit_json(clinical.with_lordosis_angle(result.to_dict(), model))
     else:
         print(result.table())
     return 0
+
+
+def _decay_rate(args, model) -> float:
+    """``--decay-rate`` [1/s] checked (0 without it): one robustness requirement, on the rule's design."""
+    from ..errors import ParameterError
+    from ..reflex.design.decay import checked_decay_rate
+
+    if args.decay_rate is None:
+        return 0.0
+    for option, given in (("--margin", args.margin is not None), ("--gains search", args.gains == "search")):
+        if given:
+            raise ParameterError(
+                "--decay-rate", f"cannot go with {option}: one robustness requirement, on the rule's design"
+            )
+    reflex = model.reflex
+    return checked_decay_rate("--decay-rate", args.decay_rate, reflex.delay, reflex.activation_time_constant)
 
 
 def _axis(option: str, text: str, high: float, unit: str, example: str):

@@ -105,7 +105,7 @@ class PointNumbers:
             with massless levels); ``delay_margin_s`` (the exact multivariable delay margin [s]) and
             ``frequency_rad_s`` (its crossing [rad/s]); without reflex: ``modes`` (how many of how many
             grow), ``growth_times_s`` (by e, fastest and slowest growing mode [s]) and
-            ``slowest_time_constant_s`` (-1 / max Re lambda [s]; 'inf' while a mode grows).
+            ``slowest_time_constant_s`` (-1 / max Re lambda [s]; 'none: a mode grows' while one grows).
         """
         verdict, modes = self.chain, self.chain.modes
         growth = modes.growth_times  # fastest first
@@ -118,7 +118,9 @@ class PointNumbers:
             "frequency_rad_s": shown(verdict.exact.frequency),
             "modes": f"{growth.size} of {modes.eigenvalues.size} grow" if modes.defined else "undefined",
             "growth_times_s": " to ".join(extremes),
-            "slowest_time_constant_s": shown(modes.slowest_time_constant),
+            "slowest_time_constant_s": (
+                "none: a mode grows" if np.isinf(modes.slowest_time_constant) else shown(modes.slowest_time_constant)
+            ),
         }
 
     def verdicts(self) -> list[str]:
@@ -180,10 +182,16 @@ def shown(value) -> str:
     Returns
     -------
     str
-        E.g. ``'-3.142'``, ``'-1.5+2.25j'``, ``'inf'``, ``'nan'``.
+        E.g. ``'-3.142'``, ``'-1.5+2.25j'``; an infinite value (a delay margin or a largest delay met that no
+        delay bounds) ``'unbounded'``, as the command line prints it (:func:`spinectl.reflex.delay.delay_text`),
+        and a NaN (nothing to show) ``'none'``: never Python's 'inf' and 'nan'.
     """
     value = complex(value)
     if value.imag == 0:
+        if np.isnan(value.real):
+            return "none"
+        if np.isinf(value.real):
+            return "unbounded" if value.real > 0 else "-unbounded"
         return f"{value.real:.{DIGITS}g}"
     return f"{value.real:.{DIGITS}g}{value.imag:+.{DIGITS}g}j"
 

@@ -35,7 +35,7 @@ STATE_FIGURE_SIZE = (13.0, 8.0)
 """Size of the PNG export [in]."""
 LANDSCAPE_LABELS = {
     "min_pcsa_cm2": "minimum PCSA [cm²]",
-    "counter_torque_norm_Nm": "‖CT‖ [N m]",
+    "counter_torque_norm_Nm": "‖CT‖ [N m] at the minimum PCSA (Fig. 4)",
 }
 """The landscapes shown and their colour-bar labels."""
 

@@ -567,9 +567,9 @@ def _write(result: AtlasResult, out: Path, spec: AtlasSpec) -> None:
     """The four files, written into a staging folder that then replaces ``out`` as a whole (its chunks kept):
     an interruption leaves the previous atlas's four files or this one's, never a mix."""
     from ..canvas import save_file
-    from .atlas_report import density_figure, report_text
+    from .atlas_report import base_text, density_figure, report_text
 
-    figure = density_figure(base_landscape(spec, result.draws), result.draws, PAPER_OPTIMUM)
+    figure = density_figure(base_landscape(spec, result.draws), result.draws, PAPER_OPTIMUM, base_text(spec))
     with staged_directory(out, OUTPUT_FILES, replaces=OUTPUT_FILES) as stage:
         atomic_write_text(stage / "atlas.json", dumps(result.to_dict()))
         with atomic_path(stage / "draws.npz") as tmp, open(tmp, "wb") as handle:

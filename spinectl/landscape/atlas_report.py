@@ -58,7 +58,7 @@ def report_text(result, spec: AtlasSpec) -> str:
     ]
     for name, v in result.probabilities.items():
         lines.append(f"| {name} | {criterion(name, spec)} | {v['p']:.3f} | [{v['low']:.3f}, {v['high']:.3f}] |")
-    lines += ["", "## Sobol' indices (first order S1, total ST, with bootstrap intervals)", ""]
+    lines += ["", "## Sobol' indices (first order S1, total ST, with bootstrap intervals)", "", SOBOL_NOTE, ""]
     tables = result.sobol | {f"{name} (indicator)": t for name, t in result.sobol_verdicts.items()}
     for output, table in tables.items():
         lines += [f"### `{output}`", ""]
@@ -67,10 +67,32 @@ def report_text(result, spec: AtlasSpec) -> str:
             continue
         lines += ["| parameter | S1 | ST |", "|---|---|---|"]
         for name, s in table.items():
-            first, total = f"{s['S1']:.3f} ± {s['S1_conf']:.3f}", f"{s['ST']:.3f} ± {s['ST_conf']:.3f}"
+            first = f"{s['S1']:.3f} ± {s['S1_conf']:.3f}{_outside(s['S1'], s['S1_conf'])}"
+            total = f"{s['ST']:.3f} ± {s['ST_conf']:.3f}{_outside(s['ST'], s['ST_conf'])}"
             lines.append(f"| {markdown_cell_code(name)} | {first} | {total} |")
         lines.append("")
     return "\n".join(lines) + "\n"
+
+
+SOBOL_NOTE = (
+    "S1 is the share of an output's variance that a parameter causes alone, ST the share it takes part in "
+    "(with the others); both lie in [0, 1], and S1 <= ST. The numbers here are estimates from the draws: "
+    "sampling error can put one below 0 or above 1 (marked with how to read it) or S1 above "
+    "ST. Read such an estimate by its interval: -0.05 ± 0.2 is 'no effect detected', not a negative share; "
+    "more samples narrow the intervals."
+)
+"""The report's words on what S1 and ST are and how an estimate outside [0, 1] reads."""
+
+
+def _outside(value: float, interval: float) -> str:
+    """How to read an estimate outside [0, 1]: as the nearest possible value where its interval reaches it, else
+    a sign of too few samples; '' inside [0, 1]."""
+    if not np.isfinite(value) or 0.0 <= value <= 1.0:
+        return ""
+    nearest = 0 if value < 0 else 1
+    if abs(value - nearest) <= interval:
+        return f" (read as {nearest}: within its interval)"
+    return " (outside [0, 1] beyond its interval: too few samples)"
 
 
 def criterion(verdict: str, spec: AtlasSpec) -> str:
@@ -113,7 +135,40 @@ def _shown(value: float) -> str:
     return "–" if np.isnan(value) else f"{value:g}"
 
 
-def density_figure(landscape: dict, draws: dict, optimum: tuple[float, float]):
+DENSITY_LEVELS = (0.1, 0.3, 0.5, 0.7, 0.9)
+"""The density figure's contours, as fractions of the cohort density's peak."""
+
+
+def base_text(spec: AtlasSpec) -> str:
+    """What the density figure's background is computed at: the base model, its mass and K with units, and the
+    drawn parameters it does not follow (each draw's own mass or K is not the background's).
+
+    Parameters
+    ----------
+    spec : AtlasSpec
+
+    Returns
+    -------
+    str
+        E.g. ``"the base model (preset default): body.mass 40 kg, passive.stiffness K = 0 N m/rad; each draw's
+        own body.mass, passive.stiffness varies, the background does not"``.
+    """
+    from ..model.source import origin
+
+    model = spec.model
+    text = (
+        f"the base model ({origin(model)}): body.mass {model.body.mass:g} kg, passive.stiffness K = "
+        f"{model.passive.stiffness:g} N m/rad"
+    )
+    others = [p.parameter for p in spec.priors if p.parameter not in PLANE_PARAMETERS]
+    return text + (f"; each draw's own {', '.join(others)} varies, the background does not" if others else "")
+
+
+PLANE_PARAMETERS = ("eccentricity_m", "lordosis_m", "lordosis_angle_deg")
+"""The priors that place a draw on the figure's (E, Lambda) plane; the others vary what the background omits."""
+
+
+def density_figure(landscape: dict, draws: dict, optimum: tuple[float, float], base: str = ""):
     """The cohort's density of (E, Lambda) drawn over the landscape of min PCSA, with the paper's optimum.
 
     Parameters
@@ -124,27 +179,41 @@ def density_figure(landscape: dict, draws: dict, optimum: tuple[float, float]):
         ``eccentricity_m`` and ``lordosis_m`` of every draw [m].
     optimum : tuple of float
         (E, Lambda) to mark [m].
+    base : str
+        What the background is computed at (:func:`base_text`), in the colour bar's label.
 
     Returns
     -------
     matplotlib.figure.Figure
         Drawn on :func:`spinectl.canvas.new_figure`; axes in cm.
     """
-    fig = new_figure(figsize=(6.0, 4.8), layout="constrained")
+    import textwrap
+
+    from matplotlib.lines import Line2D
+
+    fig = new_figure(figsize=(6.4, 5.6), layout="constrained")
     ax = fig.add_subplot()
     e, lam = 100 * np.asarray(landscape["eccentricity_m"]), 100 * np.asarray(landscape["lordosis_m"])
     mesh = ax.pcolormesh(e, lam, np.asarray(landscape["min_pcsa_cm2"]).T, shading="nearest", cmap="viridis")
-    fig.colorbar(mesh, ax=ax, label="min PCSA [cm²] (joint by joint)")
+    fig.colorbar(mesh, ax=ax, label="background: min PCSA [cm²], joint by joint")
     points = 100 * np.stack([draws["eccentricity_m"], draws["lordosis_m"]])
+    handles = []
     if np.all(np.ptp(points, axis=1) > 0):  # a kernel density needs spread in both
         from scipy.stats import gaussian_kde
 
         x, y = np.meshgrid(e, lam, indexing="ij")
         density = gaussian_kde(points)(np.stack([x.ravel(), y.ravel()])).reshape(x.shape)
-        ax.contour(e, lam, density.T / density.max(), levels=(0.1, 0.3, 0.5, 0.7, 0.9), colors="white")
-    ax.plot(100 * optimum[0], 100 * optimum[1], "r*", markersize=14, label="the paper's optimum C")
+        ax.contour(e, lam, density.T / density.max(), levels=DENSITY_LEVELS, colors="white")
+        levels = ", ".join(f"{100 * v:g}" for v in DENSITY_LEVELS)
+        handles.append(Line2D([], [], color="white", label=f"cohort density: {levels} % of its peak"))
+    (star,) = ax.plot(100 * optimum[0], 100 * optimum[1], "r*", markersize=14, label="the paper's optimum C")
     ax.set_xlabel("eccentricity E [cm]")
     ax.set_ylabel("lordosis Λ [cm]")
-    ax.set_title("cohort density (white: 10 % to 90 % of its peak)")
-    ax.legend(loc="lower right")
+    ax.set_title(
+        f"where the cohort's {points.shape[1]} draws lie in (E, Λ), over the base model's min PCSA", fontsize=10
+    )
+    if base:
+        fig.supxlabel(textwrap.fill(f"background: {base}", 90), fontsize=8)
+    legend = ax.legend(handles=[*handles, star], loc="lower right", fontsize=8, facecolor="0.4", labelcolor="white")
+    legend.get_frame().set_alpha(0.8)
     return fig

@@ -48,6 +48,15 @@ PHASE_TICKS_MAX = 8
 """Most phase ticks at :data:`PHASE_TICKS` spacing."""
 
 
+NYQUIST_KEYS = (
+    ({"ls": "-"}, "solid: L(jw), w > 0, arrows in the direction of increasing w"),
+    ({"ls": "--"}, "dashed: w < 0, the mirror image"),
+    ({"ls": "", "marker": "+", "ms": 7, "color": "tab:red"}, "-1, the critical point: the closed loop is stable if\n"
+     "the curve circles it counter-clockwise once per unstable pole of L\n(none; one for a self-unstable segment)"),
+)  # fmt: skip
+"""The Nyquist legend's keys, beside the segments: the line styles and the critical point."""
+
+
 def _control_figure(rows: int, **subplots):
     """A figure with ``rows`` x 1 axes styled as python-control styles its own (its rcParams, tight layout)."""
     fig = new_figure()
@@ -173,6 +182,19 @@ def nyquist_figure(loops: Mapping[str, ct.TransferFunction], title: str = "") ->
     fig, axes = _control_figure(1)
     with ignoring_underflow():
         plot = ct.nyquist_plot(list(loops.values()), label=list(loops), ax=axes)
+    ax = axes[0, 0]
+    handles, texts = ax.get_legend_handles_labels()
+    if ax.get_legend() is not None:  # python-control's names the segments alone: the line styles unexplained
+        ax.get_legend().remove()
+    keys = [Line2D([], [], label=text, **({"color": "0.3"} | style)) for style, text in NYQUIST_KEYS]
+    fig.set_size_inches(*BODE_SIZE)
+    ax.legend(
+        [*handles, *keys],
+        [*texts, *(k.get_label() for k in keys)],
+        loc="upper center",
+        bbox_to_anchor=(0.5, -0.12),
+        fontsize=7,
+    )
     plot.set_plot_title(title or "Nyquist plot of L(jw)", frame="figure")
     return fig
 
@@ -301,16 +323,30 @@ def report_figures(report: MarginsReport, responses: ReportResponses) -> dict[st
     )
     figures = {}
     if responses.loops:
-        title = f"Reflex loops, Pade {report.pade_order}; {where}{_left_out(report, responses)}"
+        criteria = _loop_criteria(report)
+        title = f"Reflex loops L(jw), Pade {report.pade_order}; {where}\n{criteria}{_left_out(report, responses)}"
         by_name = {seg.name: seg for seg in report.segments}
         figures["bode.png"] = bode_figure(responses.loops, frequency_range(report), title, by_name)
-        nyquist_title = f"Nyquist, tau = {report.delay:g} s; {where}{_left_out(report, responses)}"
+        nyquist_title = f"Nyquist, tau = {report.delay:g} s; {where}\n{criteria}{_left_out(report, responses)}"
         figures["nyquist.png"] = nyquist_figure(responses.loops, nyquist_title)
     if responses.simulations:
         figures["response.png"] = response_figure(
             responses.simulations, f"Response to a perturbation; {where}", responses.chain, _chain_label(report)
         )
     return figures
+
+
+def _loop_criteria(report: MarginsReport) -> str:
+    """What the loop figures judge: each segment alone (joint by joint), and the chain's verdict, not drawn."""
+    lines = [f"each curve one segment's loop alone: {criterion('joint')}"]
+    chain = report.chain
+    if chain is not None:
+        verdict = "stable" if chain.stable_at_delay else "NOT stable"
+        lines.append(
+            f"{chain.criterion}, same reflex: {verdict} at {delay_text(report.delay)} (exact delay margin "
+            f"{delay_text(chain.exact.margin)}); a multi-input loop, not drawn here: its response in response.png"
+        )
+    return "\n".join(textwrap.fill(line, 80) for line in lines)
 
 
 def _chain_label(report: MarginsReport) -> str:

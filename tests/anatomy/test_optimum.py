@@ -144,6 +144,26 @@ def test_an_infeasible_chain_optimum_says_what_would_make_it_feasible(torso):
     assert INFEASIBLE_HINT not in optimised(torso, stability="chain", joint_stiffness=50).table()
 
 
+def test_the_optimum_table_says_infeasible_plainly_and_mu_only_where_there_is_a_criterion(torso):
+    """MyoTorso with no stiffness added: the chain optimum's row says 'infeasible' and that no activations meet it,
+    with no NaN cost, no NaN price and no NaN eigenvalues; mu (1 N m/rad) is named on the optimum's row, which has
+    a criterion, and not on the classic row, which has none; the price line says why there is none; the remedy
+    line begins 'remedy:'. The same with the joint-by-joint criterion and mu = 2 (a variant): feasible, its row
+    names mu = 2 and the price is the cost ratio."""
+    bare = optimised(torso, stability="chain").table().splitlines()
+    optimum, classic, price, remedy = bare[:4]
+    assert optimum.startswith("optimum (the chain free") and "mu = 1 N m/rad" in optimum
+    assert "infeasible: no activations in [0, 1] hold the posture and meet the criterion" in optimum
+    assert "mu =" not in classic and classic.startswith("classic (no stability criterion")
+    assert price == "price of stability: none (the optimum is infeasible, so it has no cost to compare)"
+    assert remedy.startswith("remedy: ") and "--joint-stiffness" in remedy
+    assert not any("nan" in line for line in bare)
+    solved = optimised(torso, stability="joints", margin=2.0)
+    optimum, classic, price = solved.table().splitlines()[:3]
+    assert "mu = 2 N m/rad" in optimum and "mu =" not in classic
+    assert price.endswith(f": {solved.optimum.cost / solved.classic.cost:.4g}")
+
+
 def test_the_remedy_is_the_least_joint_stiffness_that_makes_the_optimum_feasible(torso):
     """The remedy's bracket, checked by the optimum itself (a second call per side, not the search): feasible
     at the value named, infeasible 2 rtol below it; the table names a --joint-stiffness that is feasible and

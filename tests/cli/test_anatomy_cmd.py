@@ -126,8 +126,25 @@ def test_the_lordosis_curve_says_the_thorax_tilts_with_it(cached, capsys):
 
     assert main(["anatomy", "--lordosis", "-10:10:3", "--joint-stiffness", "50"]) == 0
     lines = capsys.readouterr().out.splitlines()
-    head = lines.index(next(line for line in lines if line.startswith("lordosis [deg]")))
-    assert lines[head - 1] == f"lordosis curve ({CURVE_MEANING})" and "thorax" in CURVE_MEANING
+    head = lines.index(next(line for line in lines if line.startswith("summed angle change [deg]  cost")))
+    assert lines[head - 2] == f"lordosis curve ({CURVE_MEANING})" and "thorax" in CURVE_MEANING
+    # the first column's title says what it is and its unit, explained on the line above (a reader saw a bare
+    # change in degrees and could not tell of what); each row's value sits under it
+    assert lines[head - 1].startswith("summed angle change [deg]: the chain's summed joint angle minus the model's")
+    assert [float(line.split()[0]) for line in lines[head + 1 : head + 4]] == [-10.0, 0.0, 10.0]
+
+
+def test_the_joint_table_names_each_joint_with_its_level(cached, capsys):
+    """MyoTorso's L5S1 joint is called flex_extension, the others L4_L5_FE ...: the table prints each with its
+    level (spinectl.anatomy.naming), in a column titled so, the same way for every joint; the JSON keeps the
+    model's names, which scripts match."""
+    assert main(["anatomy"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    head = next(i for i, line in enumerate(lines) if line.startswith("joint (level)"))
+    rows = [line.split("  ")[0].strip() for line in lines[head + 2 : head + 7]]
+    assert rows == ["flex_extension (L5S1)", "L4_L5_FE (L4L5)", "L3_L4_FE (L3L4)", "L2_L3_FE (L2L3)", "L1_L2_FE (L1L2)"]
+    assert main(["anatomy", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["joints"][0] == "flex_extension"
 
 
 def test_reflex_options_give_the_delay_margin(cached, capsys):

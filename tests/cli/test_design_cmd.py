@@ -238,6 +238,12 @@ def test_passive_refuses_the_reflexs_options_it_would_ignore(option, value, caps
         (["--delays", "0:0.1:3", "--delay", "0.15"], "--delay: cannot go with --delays, whose delays are the curve's"),
         (["--passive", "0:80:3", "--gains", "search"], "--gains: cannot go with --passive"),
         (["--passive", "0:80:3", "--margin", "1.2"], "--margin: cannot go with --passive"),
+        (["--decay-rate", "25"], "--decay-rate: must be a decay rate in [0, 20) 1/s, below 1/T_a"),
+        (["--decay-rate", "-0.5"], "--decay-rate: must be"),
+        (["--decay-rate", "0.1", "--margin", "1.2"], "--decay-rate: cannot go with --margin"),
+        (["--decay-rate", "0.1", "--gains", "search"], "--decay-rate: cannot go with --gains search"),
+        (["--delays", "0:0.1:3", "--decay-rate", "0.1"], "--decay-rate: cannot go with --delays"),
+        (["--passive", "0:80:3", "--decay-rate", "0.1"], "--decay-rate: cannot go with --passive"),
     ],
 )
 def test_a_margin_or_a_gain_search_where_it_does_not_apply_is_one_line_exit_2(argv, needle, capsys):
@@ -267,3 +273,41 @@ def test_margin_prints_the_design_at_r_times_the_delay(capsys):
     assert robust["margin_ratio"] == 1.2 and robust["nominal_delay_s"] == 0.1
     assert main([*point, "--delay", "0.1", "--margin", "1.2"]) == 0
     assert "holds every delay up to 120 ms" in capsys.readouterr().out
+
+
+def test_decay_rate_prints_the_design_whose_roots_lie_beyond_minus_sigma(capsys):
+    """``--decay-rate 0.1`` answers the chain's least local stiffness with every root at the delay at Re s < -0.1
+    1/s (its rightmost root, the chain's own, in the JSON and the table), above the plain design's, and says what
+    it is; joint by joint likewise needs more co-contraction, and has no 'largest delay met' (the shifted loops'
+    gains hold the one delay)."""
+    point = ["design", "--preset", "wagner2012", "--E", "0.03", "--Lambda", "0.04", "--delay", "0.1"]
+    assert main([*point, "--decay-rate", "0.1", "--json"]) == 0
+    robust = json.loads(capsys.readouterr().out)
+    assert main([*point, "--json"]) == 0
+    plain = json.loads(capsys.readouterr().out)
+    assert robust["decay_rate_per_s"] == 0.1 and "margin_cost" not in robust
+    assert robust["chain"]["max_root_real_per_s"] <= -0.1 + 1e-9
+    assert robust["chain"]["local_stiffness_fraction"] > plain["chain"]["local_stiffness_fraction"]
+    assert robust["activation"] > plain["activation"]  # joint by joint too: each segment's loop beyond -sigma
+    assert "largest_delay_met_s" in robust and robust["largest_delay_met_s"] is None
+    assert main([*point, "--decay-rate", "0.1"]) == 0
+    assert "designed for a least decay rate 0.1 1/s (--decay-rate)" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(("extra", "fixed_at"), [([], "K = 0 N m/rad"), (["--set", "passive.stiffness=10"], "K = 10")])
+def test_passive_says_which_minimum_its_fixed_global_pcsa_is(extra, fixed_at, capsys):
+    """``design --passive`` holds one global PCSA while K varies: the table says what it is, the least total PCSA
+    for every segment self-stable joint by joint (the paper's criterion), solved at the model's own K (the preset's
+    0, or 10 N m/rad set), and held at every K of the sweep (it said "the paper's minimum" without what over or
+    where); its value is solve_point's total at that K."""
+    from spinectl.optimise.reference import solve_point
+    from spinectl.units import m2_to_cm2
+
+    argv = ["design", "--preset", "wagner2012", "--passive", "0:80:3", "--E", "0.03", "--Lambda", "0.04", *extra]
+    assert main(argv) == 0
+    line = next(x for x in capsys.readouterr().out.splitlines() if x.startswith("least local stiffness at a fixed"))
+    assert "self-stable joint by joint (each CoR alone, the others fixed" in line
+    assert f"solved once at the model's own {fixed_at}" in line and "held, muscle by muscle, at every K" in line
+    stiffness = 10.0 if extra else 0.0
+    model = config.set_parameters(config.load_preset("wagner2012"), {"passive.stiffness": stiffness})
+    assert f"{m2_to_cm2(solve_point(model, 0.03, 0.04).pcsa.sum()):.2f} cm^2" in line

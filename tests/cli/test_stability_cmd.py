@@ -32,7 +32,12 @@ def test_coupled_table_with_a_given_pcsa(capsys):
     assert "mass M [kg m^2]" in out and "static margin" in out and "least local stiffness" in out
     model = config.set_parameter(config.load_preset("default"), "passive.stiffness", 15.0)
     result = coupled_stability_at(model, 0.0, 0.0, np.full(3, 10e-4))
-    assert f"static margin (smallest eigenvalue of -K) = {result.margin:.3f} N m/rad" in out
+    assert f"static margin (smallest eigenvalue of -K_chain) = {result.margin:.3f} N m/rad" in out
+    # the chain's stiffness matrix is not the header's passive stiffness K (15 here), which is a part of it: the
+    # matrix's title names it apart, and the local stiffness says where it adds
+    assert "K = 15 N m/rad" in out.splitlines()[0]
+    assert "stiffness matrix K_chain = dtau/dq [N m/rad]: global muscles, gravity and the passive stiffness" in out
+    assert "least local stiffness added to the diagonal of -K_chain [N m/rad] (beside the passive K)" in out
 
 
 def test_massless_levels_leave_the_eigenvalues_undefined(tmp_path, capsys):

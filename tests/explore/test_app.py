@@ -310,7 +310,7 @@ def test_the_design_button_shows_the_answer_for_its_state_and_marks_it_when_the_
     for key, value in shown.items():
         assert f'<span data-design="{key}">{html.escape(value)}</span>' in explorer.design.object
     assert answer.status == "ok" and "largest delay met" not in explorer.design.object  # said where none meets it
-    assert met == {"joint_largest_delay_s": "inf", "chain_largest_delay_s": "inf"}
+    assert met == {"joint_largest_delay_s": "unbounded", "chain_largest_delay_s": "unbounded"}
     assert "press again" not in explorer.design.object and not explorer.design_spinner.visible
     _drag(explorer.sliders["delay"], 40.0)
     assert "the sliders have moved since: press again" in explorer.design.object

@@ -13,6 +13,7 @@ from spinectl.model.config import load_preset, set_parameters
 from spinectl.model.stability import segment_stability
 from spinectl.optimise.reference import solve_point
 from spinectl.reflex.chain_verdict import chain_verdict, margins_with_chain
+from spinectl.reflex.delay import delay_text
 from spinectl.reflex.margins import margins_report, operating_point
 
 
@@ -70,14 +71,16 @@ def test_at_activation_one_every_segment_is_self_stable_one_at_the_margin(state)
 
 
 def test_shown_numbers():
-    """Four significant digits; complex as a+bj; inf and nan as Python writes them."""
+    """Four significant digits; complex as a+bj; an infinite margin 'unbounded' as the command line says it
+    (reflex.delay.delay_text), NaN 'none': the user saw Python's 'inf' and 'nan' beside the design's 'none'."""
     assert [nb.shown(x) for x in (np.pi, -1.5 + 2.25j, np.inf, np.nan, 1e-7)] == [
         "3.142",
         "-1.5+2.25j",
-        "inf",
-        "nan",
+        "unbounded",
+        "none",
         "1e-07",
     ]
+    assert delay_text(np.inf).startswith("unbounded") and delay_text(np.nan) == "none"
 
 
 def test_landscapes_match_the_reference_solver_at_grid_points(state):
@@ -133,7 +136,7 @@ def test_chain_modes_are_the_roots_of_the_quadratic_eigenproblem(state):
     assert growing.size > 0  # at this point the chain without reflex is unstable (docs/chain.md)
     assert row["modes"] == f"{growing.size} of {2 * n} grow"
     assert row["growth_times_s"] == f"{nb.shown(1 / growing[0])} to {nb.shown(1 / growing[-1])}"
-    assert row["slowest_time_constant_s"] == "inf"
+    assert row["slowest_time_constant_s"] == "none: a mode grows"  # no time constant while a mode grows
 
 
 def test_levels_without_mass_leave_the_chain_undefined():
@@ -143,7 +146,7 @@ def test_levels_without_mass_leave_the_chain_undefined():
     got = nb.point_numbers(base, initial_state(base))
     row = got.chain_row()
     assert row["stable_at_delay"] == "undefined" and row["modes"] == "undefined"
-    assert row["delay_margin_s"] == "nan" and row["growth_times_s"] == "none"
+    assert row["delay_margin_s"] == "none" and row["growth_times_s"] == "none"
     assert all(r["stable_at_delay"] in ("yes", "no") for r in got.rows())
 
 

@@ -56,6 +56,10 @@ def test_state_figure_png_has_six_panels_and_content(numbers):
     fig.savefig(buffer, format="png", dpi=40)
     image = imread(io.BytesIO(buffer.getvalue()))
     assert image.std() > 0.05 and len(np.unique(image.reshape(-1, image.shape[-1]), axis=0)) > 50
+    bars = [ax.get_ylabel() for ax in fig.axes if ax.get_label() == "<colorbar>"]
+    # the counter-torque landscape is the paper's Figure 4, at the minimum PCSA: its label says so (the point's
+    # panel shows CT at the chosen activation, another quantity)
+    assert bars == ["minimum PCSA [cm²]", "‖CT‖ [N m] at the minimum PCSA (Fig. 4)"]
     blank = views.state_figure(numbers, None)
     assert sum(ax.axison for ax in blank.axes) == 4  # the landscapes' places empty while they are solved
 

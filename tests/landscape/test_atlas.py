@@ -635,3 +635,52 @@ def test_the_console_table_says_k_is_drawn_where_a_prior_draws_it():
     assert "K drawn from its prior" in first and "K = " not in first
     fixed = atlas.AtlasResult(1, {}, {}, {}, {}, {"body.mass": np.array([40.0])}, spec.model)
     assert f"K = {spec.model.passive.stiffness:g} N m/rad" in fixed.table().splitlines()[0]
+
+
+def test_the_density_figure_says_what_it_draws_and_at_which_mass_and_k():
+    """density.png draws the cohort's (E, Lambda) over a min-PCSA landscape of the base model alone: its title
+    says so with the number of draws, the colour bar's label names the quantity and its unit, the legend names the
+    white contours (the density's levels, % of its peak) beside C, and the footer gives the base model's mass [kg]
+    and K [N m/rad], the ones the background is at, and the drawn parameters it does not follow (body.mass,
+    passive.stiffness, reflex.delay: each draw's own). A variant with K set to 12 N m/rad names 12."""
+    from spinectl.landscape.atlas_report import base_text, density_figure
+
+    spec = _spec()
+    grid = np.linspace(0.0, 0.08, 5)
+    landscape = {"eccentricity_m": grid, "lordosis_m": grid, "min_pcsa_cm2": np.ones((5, 5))}
+    rng = np.random.default_rng(0)
+    draws = {"eccentricity_m": rng.uniform(0, 0.08, 30), "lordosis_m": rng.uniform(0, 0.08, 30)}
+    fig = density_figure(landscape, draws, atlas.PAPER_OPTIMUM, base_text(spec))
+    ax, bar = fig.axes
+    assert "30 draws lie in (E, Λ)" in ax.get_title() and "base model's min PCSA" in ax.get_title()
+    assert bar.get_ylabel() == "background: min PCSA [cm²], joint by joint"
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == [
+        "cohort density: 10, 30, 50, 70, 90 % of its peak",
+        "the paper's optimum C",
+    ]
+    footer = " ".join(fig.get_supxlabel().split())
+    mass, k = spec.model.body.mass, spec.model.passive.stiffness
+    assert f"body.mass {mass:g} kg, passive.stiffness K = {k:g} N m/rad" in footer
+    assert "each draw's own body.mass, passive.stiffness, reflex.delay varies" in footer
+    stiff = dataclasses.replace(spec, model=set_parameters(spec.model, {"passive.stiffness": 12.0}))
+    assert "passive.stiffness K = 12 N m/rad" in base_text(stiff)
+
+
+def test_a_sobol_estimate_outside_zero_one_says_how_to_read_it():
+    """S1 and ST are variance shares in [0, 1]; their estimates are not (the report showed S1 = -0.158 ± 0.511 with
+    no word): the report says what they are and marks each estimate outside [0, 1], read as the nearest possible
+    value where its interval reaches it, else as too few samples; estimates inside are unmarked."""
+    from types import SimpleNamespace
+
+    from spinectl.landscape.atlas_report import SOBOL_NOTE, report_text
+
+    row = {"S1": -0.158, "S1_conf": 0.511, "ST": 0.222, "ST_conf": 0.419}
+    far = {"S1": 1.4, "S1_conf": 0.1, "ST": 0.5, "ST_conf": 0.1}
+    result = SimpleNamespace(
+        n_evaluations=4, probabilities={}, sobol={"min_pcsa_cm2": {"body.mass": row, "eccentricity_m": far}},
+        sobol_verdicts={}, draws={},
+    )  # fmt: skip
+    text = report_text(result, _spec(chain="false"))
+    assert SOBOL_NOTE in text and "not a negative share" in SOBOL_NOTE
+    assert "| `body.mass` | -0.158 ± 0.511 (read as 0: within its interval) | 0.222 ± 0.419 |" in text
+    assert "| `eccentricity_m` | 1.400 ± 0.100 (outside [0, 1] beyond its interval: too few samples) | 0.500" in text

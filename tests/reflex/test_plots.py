@@ -261,3 +261,35 @@ def test_the_response_names_each_criterion_and_draws_the_chain():
     assert with_reflex.alpha.shape[0] == without.alpha.shape[0] == 5  # one run per joint
     assert with_reflex.diverged.any()  # the simulation agrees with the exact verdict
     np.testing.assert_array_equal(with_reflex.kp, np.asarray(report.chain.kp))
+
+
+def test_the_loop_figures_name_their_criterion_and_the_chains_verdict_and_explain_their_lines(at_a):
+    """Bode and Nyquist draw each segment's loop alone: both titles say so (joint by joint, the paper's criterion)
+    and, where the report has the chain (``margins --plot``: wagner2012 at E = 3 cm, Lambda = 4 cm, 100 ms, where
+    every segment alone is stable and the chain is not), its exact verdict under the same reflex (not drawn: a
+    multi-input loop); the Nyquist legend names every segment and explains the solid and dashed lines and the
+    critical point -1, inside the figure (it had the segments alone, python-control's, the line styles
+    unexplained). Without the chain (the fixture at A) the titles name the segments' criterion alone."""
+    from spinectl import load_preset
+    from spinectl.reflex.chain_verdict import margins_with_chain
+
+    model = _reflex(load_preset("wagner2012"), activation=0.5, delay=0.1)
+    report = margins_with_chain(model, 0.03, 0.04)
+    assert report.chain is not None and not report.chain.stable_at_delay  # the premise
+    figures = plots.report_figures(report, margins.report_responses(model, report))
+    for name in ("bode.png", "nyquist.png"):
+        title = " ".join(figures[name].get_suptitle().split())
+        assert "each curve one segment's loop alone: joint by joint (each CoR alone" in title
+        assert "chain (all 5 CoRs free), same reflex: NOT stable at 100 ms" in title and "not drawn here" in title
+        bare = " ".join(at_a[1][name].get_suptitle().split())
+        assert "each curve one segment's loop alone: joint by joint" in bare and "chain (all" not in bare
+    fig = figures["nyquist.png"]
+    fig.draw_without_rendering()
+    legend = fig.axes[0].get_legend()
+    texts = [t.get_text() for t in legend.get_texts()]
+    drawn = [s.name for s in report.segments if s.name != "L5S1"]  # L5S1: kp = kd = 0, no loop (at_a's title)
+    assert texts[: len(drawn)] == drawn
+    assert any(t.startswith("solid:") for t in texts) and any(t.startswith("dashed:") for t in texts)
+    assert any(t.startswith("-1, the critical point") for t in texts)
+    box = legend.get_window_extent(fig.canvas.get_renderer())
+    assert fig.bbox.contains(box.x0, box.y0) and fig.bbox.contains(box.x1, box.y1)

@@ -24,6 +24,7 @@ DOCS = Path(__file__).resolve().parents[2] / "docs"
 sys.path.insert(0, str(DOCS / "_ext"))
 from spinectl_docs import (  # noqa: E402
     API_FOLDER,
+    design,
     guide,
     notebooks,
     parameters,
@@ -194,3 +195,28 @@ def test_reproduction_tables_list_every_landmark_and_free_parameter():
         assert verdicts.VERDICTS[mark.name].verdict in row
     params = reproduction.parameter_table()
     assert all(f"| `{p.name}` | {p.unit} | {p.lower:g} | {p.upper:g} |" in params for p in calibration.FREE_PARAMETERS)
+
+
+def test_the_decay_rate_table_is_what_design_answers():
+    """docs/reflex.md's --decay-rate table is generated: each row's co-contraction, total local stiffness and
+    rightmost root are those of spinectl.reflex.design.answer at that decay rate (the command's own numbers,
+    never typed), the rightmost root at or left of -sigma, and the stiffness grows with sigma; a rate the rule
+    cannot reach says so."""
+    import numpy as np
+
+    from spinectl.model.config import load_preset
+    from spinectl.reflex.design import answer
+
+    rows = [line.split(" | ") for line in design.decay_table().splitlines()[2:]]
+    assert len(rows) == len(design.DECAY_RATES)
+    totals = []
+    for sigma, row in zip(design.DECAY_RATES, rows, strict=True):
+        chain = answer(load_preset("wagner2012"), *design.POINT, decay=sigma).chain
+        result = answer(load_preset("wagner2012"), *design.POINT, decay=sigma)
+        assert row[1] == (f"{result.activation:.4f}" if np.isfinite(result.activation) else "none in [0, 1]")
+        if not np.isfinite(chain.fraction):
+            assert row[2] == "none up to k*"
+            continue
+        assert row[2] == f"{np.sum(chain.local_stiffness):.1f}" and float(row[4]) <= -sigma + 1e-6
+        totals.append(float(row[2]))
+    assert totals == sorted(totals) and len(totals) >= 3

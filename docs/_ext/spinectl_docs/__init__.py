@@ -16,7 +16,8 @@ a text changed, so that incremental builds stay incremental):
   ``_generated/landmark-assumptions.md``: the tables of ``reproduction.md`` (free parameters,
   verdict of every landmark, every landmark under each assumption, measured at the build);
 - ``_generated/export-eigenvalues.md``: the exports' eigenvalues in ``interchange.md``, spinectl's
-  and OpenSim's own linearisation of each file (measured at the build).
+  and OpenSim's own linearisation of each file (measured at the build);
+- ``_generated/design-decay.md``: ``design --decay-rate``'s answers in ``reflex.md`` (measured at the build).
 
 ``_generated/`` is excluded from the sources (its files are included by
 ``parameters.md``, ``index.md``, ``notebooks.md`` and ``reproduction.md``);
@@ -34,7 +35,7 @@ from __future__ import annotations
 import importlib.util
 from pathlib import Path
 
-from . import fields, guide, interchange, notebooks, parameters, reexports, reproduction
+from . import design, fields, guide, interchange, notebooks, parameters, reexports, reproduction
 
 GENERATED = "_generated"
 
@@ -61,6 +62,7 @@ def generate(app) -> None:
     write_if_changed(out / "landmark-verdicts.md", reproduction.landmark_table())
     write_if_changed(out / "landmark-assumptions.md", reproduction.assumption_table())
     write_if_changed(out / "export-eigenvalues.md", interchange.export_table())
+    write_if_changed(out / "design-decay.md", design.decay_table())
 
 
 def prune_api_pages(app) -> None:

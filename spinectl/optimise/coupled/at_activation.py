@@ -196,7 +196,8 @@ class CoupledStability:
         ]
         for title, matrix, fmt in (
             (
-                "stiffness K [N m/rad] (global muscles, gravity, passive; eq. 1's sign: -K > 0 restores)",
+                "stiffness matrix K_chain = dtau/dq [N m/rad]: global muscles, gravity and the passive stiffness "
+                "(the header's K, per joint, on the diagonal); eq. 1's sign: -K_chain > 0 restores",
                 self.stiffness,
                 "10.3f",
             ),
@@ -209,7 +210,7 @@ class CoupledStability:
         name = criterion("chain", len(names))
         lines += [
             "",
-            f"{name}: static margin (smallest eigenvalue of -K) = {self.margin:.3f} N m/rad "
+            f"{name}: static margin (smallest eigenvalue of -K_chain) = {self.margin:.3f} N m/rad "
             f"({'stable' if self.margin > 0 else 'UNSTABLE'})",
             "eigenvalues [1/s]: " + ", ".join(eigenvalue_text(z) for z in self.eigenvalues),
             f"{name}: global muscles alone, no reflex: "
@@ -219,7 +220,7 @@ class CoupledStability:
                 else f"{'dynamically stable' if self.self_stable else 'NOT stable'} "
                 f"({int(np.sum(self.eigenvalues.real >= 0))} of {self.eigenvalues.size} eigenvalues with Re >= 0)"
             ),
-            f"{name}: least local stiffness [N m/rad]: "
+            f"{name}: least local stiffness added to the diagonal of -K_chain [N m/rad] (beside the passive K): "
             + ", ".join(f"{n} {k:.2f}" for n, k in zip(names, local, strict=True))
             + f"  (total {np.sum(local):.2f}; local PCSA {m2_to_cm2(self.local.total_local_pcsa):.2f} cm^2; "
             f"{self.local.status}); with it: {'dynamically stable' if self.stable_with_local else 'NOT stable'}, "

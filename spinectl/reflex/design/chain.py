@@ -35,8 +35,9 @@ from ...model.params import Model
 from ...optimise.coupled import least_local_stiffness_stacked
 from .. import gains
 from ..chain_margins import stable_at
-from ..mimo import chain_delay_margin
+from ..mimo import chain_delay_margin, delay_free_poles
 from ..siso import from_crossings
+from .decay import shifted_lag, shifted_loop
 from .joint import BISECTIONS
 from .result import LOCAL_MAX, ChainDesign
 from .roots import SPECTRAL_NODES, rightmost_root
@@ -44,6 +45,12 @@ from .roots import SPECTRAL_NODES, rightmost_root
 CHAIN_SCAN = 11
 """Local-stiffness fractions in [0, top] whose exact margins give the largest delay met
 (:attr:`ChainDesign.largest_delay`) and whether the scan shows the set of designs met to be an interval."""
+
+
+DECAY_SCAN = 64
+"""Intervals of [0, top] scanned where a decay rate is not met at the top (:meth:`_Search._window`): with the
+rule, f = 1 leaves no reflex and a slow mode, so the fractions that meet a decay rate form a window below it,
+found if it is wider than 1/64 of the range."""
 
 
 def chain_loop_at(model: Model, linear: LinearChain, least_static, fraction, kp=None, kd=None):
@@ -98,12 +105,14 @@ class _Search:
     longer delay).
     """
 
-    def __init__(self, model: Model, e: float, lam: float, pcsa, kp=None, kd=None):
-        self.model, self.e, self.lam, self.kp, self.kd = model, e, lam, kp, kd
+    def __init__(self, model: Model, e: float, lam: float, pcsa, kp=None, kd=None, decay: float = 0.0):
+        self.model, self.e, self.lam, self.kp, self.kd, self.decay = model, e, lam, kp, kd, decay
         self.chain = chain_at(OperatingPoint(model, e, lam, pcsa, slip_check=False))
         self.mass = self.chain.mass_matrix
         _, least = least_local_stiffness_stacked(self.chain.stiffness_offset[None], model.optimisation.stability_margin)
         self.least, self.lag = least[0], model.reflex.activation_time_constant
+        if decay > 0:  # the loop shifted by sigma: its stability at the delay is every root at Re s < -sigma
+            self.lag = shifted_lag(self.lag, decay)
         self.margins: dict[float, object] = {}
         self.fails_from: dict[float, float] = {}  # f -> a delay at which f is unstable: f fails every longer one
         self.rooted: set[float] = set()  # the fractions whose rightmost root has been checked
@@ -112,7 +121,12 @@ class _Search:
         self.width = self.top / 2**BISECTIONS
 
     def loop(self, f):
-        return chain_loop_at(self.model, self.chain, self.least, f, self.kp, self.kd)
+        """K, D, K_p, K_d at f: the chain's, or with a decay rate sigma its loop shifted by sigma (decay.py)."""
+        k, d, p, dd = chain_loop_at(self.model, self.chain, self.least, f, self.kp, self.kd)
+        if not self.decay > 0:
+            return k, d, p, dd
+        lag = self.model.reflex.activation_time_constant
+        return shifted_loop(self.mass, k, d, p, dd, lag, self.model.reflex.delay, self.decay)[:4]
 
     def root(self, f, d, nodes: int = 0) -> complex:
         """The rightmost characteristic root at f and d, once per (f, d) (with ``nodes``, afresh)."""
@@ -130,11 +144,17 @@ class _Search:
         if f not in self.margins:
             k, dl, p, dd = self.loop(f)
             if not (np.any(p) or np.any(dd)):  # no reflex: stable at every delay or none (no crossing to find)
-                self.margins[f] = from_crossings(np.empty(0), np.empty(0), np.empty(0), coupled_margin(k) > 0)
+                self.margins[f] = from_crossings(np.empty(0), np.empty(0), np.empty(0), self._stable(k, dl, p, dd))
             else:
                 with arithmetic_guard(self.e, self.lam):
                     self.margins[f] = chain_delay_margin(self.mass, k, dl, p, dd, self.lag)
         return self.margins[f]
+
+    def _stable(self, k, dl, p, dd) -> bool:
+        """Without a reflex: the static criterion, or (shifted, its damping no longer dissipative) the poles."""
+        if not self.decay > 0:
+            return bool(coupled_margin(k) > 0)
+        return bool(np.all(delay_free_poles(self.mass, k, dl, p, dd, self.lag).real < 0))
 
     def met(self, f, d) -> bool:
         """The exact margin at f (already found) meets d."""
@@ -159,6 +179,8 @@ class _Search:
         if np.isnan(f) or self.meets(f, d):
             return f
         if not self.meets(self.top, d):
+            if self.decay > 0:  # the rule's f = 1 has no reflex and a slow mode: a decay rate is met in a window
+                return self._window(d)
             return np.nan  # no design meets this delay, nor (the answer does not fall with the delay) any longer one
         # the bracket first narrowed by every fraction already judged
         failing = [g for g, at in self.fails_from.items() if at <= d] + [g for g in self.margins if not self.met(g, d)]
@@ -166,6 +188,18 @@ class _Search:
         hi = min([self.top] + [g for g in self.rooted if g > lo and self.met(g, d)])
         estimate = _inverse_interpolant(self.margins, d, self.met)
         return _bracket_root(lambda x: self.meets(x, d), estimate, lo, hi, self.width)
+
+    def _window(self, d):
+        """The least fraction that meets d where the top does not: the first of :data:`DECAY_SCAN` + 1 grid
+        fractions in [0, top] that meets it, then bisected against the one below; NaN if none on the scan."""
+        scan = [i * self.top / DECAY_SCAN for i in range(DECAY_SCAN + 1)]
+        first = next((i for i, g in enumerate(scan) if self.meets(g, d)), None)
+        if first is None:
+            return np.nan
+        if first == 0:
+            return 0.0
+        estimate = _inverse_interpolant(self.margins, d, self.met)
+        return _bracket_root(lambda x: self.meets(x, d), estimate, scan[first - 1], scan[first], self.width)
 
     def margin_or_zero(self, f) -> float:
         """The exact margin at f [s]; 0 if unstable without delay."""
@@ -215,7 +249,9 @@ def chain_curve(model: Model, e: float, lam: float, pcsa, delays, kp=None, kd=No
     return fraction, search.least, margin, root
 
 
-def chain_design(model: Model, eccentricity: float, lordosis: float, pcsa, activation: float, kp=None, kd=None):
+def chain_design(
+    model: Model, eccentricity: float, lordosis: float, pcsa, activation: float, kp=None, kd=None, decay: float = 0.0
+):
     """The chain: the least local stiffness f k* for which the delayed chain is stable at ``reflex.delay``.
 
     :func:`chain_curve` at the one delay (the answer is the curve's there), with the certificate's rightmost
@@ -233,6 +269,11 @@ def chain_design(model: Model, eccentricity: float, lordosis: float, pcsa, activ
         Its fraction of the minimum stabilising PCSA [1], for the report.
     kp, kd : float, optional
         Explicit gains for every joint.
+    decay : float
+        A least decay rate sigma [1/s]: the design meets the delay with every characteristic root at
+        Re s < -sigma, judged on the loop shifted by sigma (:mod:`~spinectl.reflex.design.decay`); 0: stable
+        at the delay. With sigma > 0, ``largest_delay`` is NaN (the shifted loop's gains hold one delay) and
+        ``delay_margin`` and ``max_root_real`` are the chain's own, unshifted.
 
     Returns
     -------
@@ -243,23 +284,44 @@ def chain_design(model: Model, eccentricity: float, lordosis: float, pcsa, activ
         nan = np.full(n, np.nan)
         return ChainDesign(activation, np.nan, nan, nan, np.nan, np.nan, np.nan, "none: no global activation")
     e, lam = float(eccentricity), float(lordosis)
-    search = _Search(model, e, lam, pcsa, kp, kd)
+    search = _Search(model, e, lam, pcsa, kp, kd, decay)
     fraction = float(_answers(search, [delay])[0][0])
     scan = np.linspace(0.0, search.top, CHAIN_SCAN)
+    # the shifted loop's margins hold its gains at this delay's e^{sigma tau}: they say nothing of other delays
     largest = max(search.margin_or_zero(f) for f in [*scan, *list(search.margins)])
+    largest = largest if not decay > 0 else np.nan
     least = search.least
     if np.isnan(fraction):
         nan = np.full(n, np.nan)
-        method = f"no fraction up to {search.top:g} meets the delay"
+        method = f"no fraction up to {search.top:g} meets the delay" + (f" with decay rate {decay:g} 1/s" * (decay > 0))
         return ChainDesign(activation, np.nan, nan, least, np.nan, np.nan, float(largest), method)
     ok = np.array([search.met(f, delay) for f in scan])
     upper = bool(np.all(ok[np.argmax(ok) :])) if ok.any() else True  # once met, met for every larger f
     method = "interpolated bisection: " + (
         "met for every larger fraction on the scan" if upper else "not monotone on the scan"
     )
-    root = search.root(fraction, delay, SPECTRAL_NODES)
-    margin = float(search.exact(fraction).margin)
+    if decay > 0 and not search.met(search.top, delay):
+        method = (
+            f"the first of {DECAY_SCAN + 1} fractions in [0, {search.top:g}] with every root at Re s < -{decay:g} 1/s, "
+            "then bisected: met in a window below the top, where the reflex handed over leaves a slow mode"
+        )
+    if decay > 0:  # the certificate in the shifted loop; the chain's own margin and root reported
+        margin, root = _unshifted_certificate(search, fraction)
+    else:
+        root = search.root(fraction, delay, SPECTRAL_NODES)
+        margin = float(search.exact(fraction).margin)
     return ChainDesign(activation, fraction, fraction * least, least, margin, float(root.real), float(largest), method)
+
+
+def _unshifted_certificate(search: _Search, fraction: float):
+    """The chain's own exact delay margin [s] and rightmost root at the delay [1/s] at f, without the shift."""
+    k, dl, p, dd = chain_loop_at(search.model, search.chain, search.least, fraction, search.kp, search.kd)
+    lag, delay = search.model.reflex.activation_time_constant, search.model.reflex.delay
+    with arithmetic_guard(search.e, search.lam):
+        root = rightmost_root(search.mass, k, dl, p, dd, delay, lag, SPECTRAL_NODES)
+        if not (np.any(p) or np.any(dd)):  # no reflex: no delay to lose
+            return (np.inf if root.real < 0 else 0.0), root
+        return float(chain_delay_margin(search.mass, k, dl, p, dd, lag).margin), root
 
 
 def _inverse_interpolant(margins, d, met):

@@ -21,7 +21,7 @@ from .result import Design, DesignCurve
 
 
 @with_one_blas_thread
-def design(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None) -> Design:
+def design(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None, decay: float = 0.0) -> Design:
     """Both answers to the design question at ``model.reflex.delay`` (see the module).
 
     Parameters
@@ -32,6 +32,10 @@ def design(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None)
         E and Lambda [m].
     kp, kd : float, optional
         Explicit gains for every segment and joint [N m/rad], [N m s/rad].
+    decay : float
+        A least decay rate sigma [1/s] for both criteria (:func:`~spinectl.reflex.design.joint.joint_design`,
+        :func:`~spinectl.reflex.design.chain.chain_design`): every characteristic root at the delay at
+        Re s < -sigma; 0, stable at the delay.
 
     Returns
     -------
@@ -54,11 +58,11 @@ def design(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None)
     """
     from ...model.source import header, provenance
 
-    activation, segments, optimum, status, largest, method = joint_design(model, eccentricity, lordosis, kp, kd)
+    activation, segments, optimum, status, largest, method = joint_design(model, eccentricity, lordosis, kp, kd, decay)
     pcsa = activation * optimum if np.isfinite(activation) else np.full_like(np.asarray(optimum, float), np.nan)
     at = model.reflex.activation  # the chain at the operating point of spinectl margins
     chain_answer = chain_design(
-        model, float(eccentricity), float(lordosis), at * np.asarray(optimum, float), at, kp, kd
+        model, float(eccentricity), float(lordosis), at * np.asarray(optimum, float), at, kp, kd, decay
     )
     if status == "ok" and np.isnan(chain_answer.fraction):
         status = "chain_infeasible"
@@ -75,6 +79,7 @@ def design(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None)
         largest_delay=largest,
         method=method,
         model=provenance(model) | {"header": header(model)},
+        decay_rate=float(decay),
     )
 
 

@@ -292,7 +292,7 @@ def gain_searched_design(model: Model, eccentricity: float, lordosis: float, pcs
     )  # fmt: skip
 
 
-def answer(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None, search=False, ratio=1.0):
+def answer(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None, search=False, ratio=1.0, decay=0.0):
     """``spinectl design`` at one delay: the rule's design at R tau, labelled, with its cost and the searched answer.
 
     Parameters
@@ -307,6 +307,10 @@ def answer(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None,
         Also :func:`gain_searched_design` (tens of seconds).
     ratio : float
         R >= 1: the design holds every delay up to R tau (the design at R tau).
+    decay : float
+        A least decay rate sigma [1/s] instead: both criteria's designs have every root at the delay at
+        Re s < -sigma (:mod:`~spinectl.reflex.design.decay`); 0, none. Not with ``search`` or R > 1; no
+        ``joint_searched`` beside it.
 
     Returns
     -------
@@ -325,7 +329,7 @@ def answer(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None,
 
     nominal, e, lam = model.reflex.delay, float(eccentricity), float(lordosis)
     at = config.set_parameters(model, {"reflex.delay": ratio * nominal}) if ratio != 1.0 else model
-    result = design(at, e, lam, kp=kp, kd=kd)
+    result = design(at, e, lam, kp=kp, kd=kd, decay=decay)
     optimum = np.asarray(solve_point(at, e, lam).pcsa, float)
     pcsa = at.reflex.activation * optimum
     rule = result.chain
@@ -338,12 +342,13 @@ def answer(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None,
     label = RULE_REFLEX if at.reflex.gains == "rule" and kp is None and kd is None else GIVEN_REFLEX
     rule = replace(rule, pcsa=float(np.sum(pcsa)), kp=np.asarray(kp_used), kd=np.asarray(kd_used), reflex=label)
     cost = None
-    if ratio == 1.0 and np.all(np.isfinite(pcsa)) and COST_RATIO * nominal <= _max_delay():
+    if ratio == 1.0 and not decay > 0 and np.all(np.isfinite(pcsa)) and COST_RATIO * nominal <= _max_delay():
         longer = config.set_parameters(model, {"reflex.delay": COST_RATIO * nominal})
         c = chain_design(longer, e, lam, pcsa, at.reflex.activation, kp, kd)
         cost = MarginCost(COST_RATIO, c.fraction, c.local_stiffness)
     searched = gain_searched_design(at, e, lam, pcsa, rule) if search and np.all(np.isfinite(pcsa)) else None
-    joint = joint_searched_design(at, e, lam, result, kp, kd)  # milliseconds: always beside the rule's
+    # milliseconds: always beside the rule's, but for a decay rate, which that grid does not certify
+    joint = joint_searched_design(at, e, lam, result, kp, kd) if not decay > 0 else None
     return replace(
         result, chain=rule, margin_ratio=float(ratio), nominal_delay=nominal, margin_cost=cost, searched=searched,
         joint_searched=joint,

@@ -19,6 +19,7 @@ from ...model.params import Model
 from ...optimise.reference import solve_point
 from .. import gains
 from ..delay import delay_margin
+from .decay import shifted_loop
 from .result import SegmentDesign
 
 SCAN = 41
@@ -29,7 +30,9 @@ BISECTIONS = 20
 reaches the same precision, 2^-20 of its range)."""
 
 
-def segment_margins_at(model: Model, coefficients, optimum_pcsa, activations, kp=None, kd=None) -> np.ndarray:
+def segment_margins_at(
+    model: Model, coefficients, optimum_pcsa, activations, kp=None, kd=None, decay: float = 0.0
+) -> np.ndarray:
     """Every segment's exact delay margin with the lag at each activation, shape (n_activations, n_cor) [s].
 
     Parameters
@@ -44,6 +47,10 @@ def segment_margins_at(model: Model, coefficients, optimum_pcsa, activations, kp
         Fractions of it [1].
     kp, kd : float, optional
         Explicit gains [N m/rad], [N m s/rad].
+    decay : float
+        A least decay rate sigma [1/s]: the margins of each loop shifted by sigma at ``reflex.delay``
+        (:mod:`~spinectl.reflex.design.decay`), at least the delay exactly where every root of the segment's
+        loop at the delay has Re s < -sigma; 0, the loops themselves.
 
     Returns
     -------
@@ -56,7 +63,10 @@ def segment_margins_at(model: Model, coefficients, optimum_pcsa, activations, kp
     d = np.stack([coefficients.damping(p) for p in pcsa])
     theta = np.broadcast_to(coefficients.inertia, s.shape)
     kps, kds = gains.resolve_gains(s, d, theta, model.reflex, kp, kd)
-    return np.asarray(delay_margin(s, d, theta, kps, kds, model.reflex.activation_time_constant).margin)
+    lag = model.reflex.activation_time_constant
+    if decay > 0:  # the segment's loop is the chain's of one joint: theta, S, D for M, K, D
+        s, d, kps, kds, lag = shifted_loop(theta, s, d, kps, kds, lag, model.reflex.delay, decay)
+    return np.asarray(delay_margin(s, d, theta, kps, kds, lag).margin)
 
 
 def _nondecreasing(values: np.ndarray) -> np.ndarray:
@@ -66,12 +76,12 @@ def _nondecreasing(values: np.ndarray) -> np.ndarray:
     return np.all((steps >= 0) | (values[1:] == values[:-1]), axis=0)
 
 
-def scan_margins(model: Model, coefficients, optimum_pcsa, kp=None, kd=None):
+def scan_margins(model: Model, coefficients, optimum_pcsa, kp=None, kd=None, decay: float = 0.0):
     """The scanned activations and every segment's exact margin there (they do not depend on the delay).
 
     Parameters
     ----------
-    model, coefficients, optimum_pcsa, kp, kd
+    model, coefficients, optimum_pcsa, kp, kd, decay
         As in :func:`segment_margins_at`.
 
     Returns
@@ -82,16 +92,18 @@ def scan_margins(model: Model, coefficients, optimum_pcsa, kp=None, kd=None):
         [s].
     """
     scan = np.linspace(0.0, 1.0, SCAN)
-    return scan, segment_margins_at(model, coefficients, optimum_pcsa, scan, kp, kd)
+    return scan, segment_margins_at(model, coefficients, optimum_pcsa, scan, kp, kd, decay)
 
 
-def least_activations(model: Model, coefficients, optimum_pcsa, delays, scan, margins, kp=None, kd=None):
+def least_activations(
+    model: Model, coefficients, optimum_pcsa, delays, scan, margins, kp=None, kd=None, decay: float = 0.0
+):
     """Every delay's common least activation and each segment's, bisected together in the scan's brackets.
 
     Parameters
     ----------
-    model, coefficients, optimum_pcsa, kp, kd
-        As in :func:`segment_margins_at`.
+    model, coefficients, optimum_pcsa, kp, kd, decay
+        As in :func:`segment_margins_at` (a decay rate: ``delays`` is ``reflex.delay`` alone).
     delays : numpy.ndarray, shape (n_delays,)
         tau [s].
     scan, margins : numpy.ndarray
@@ -116,14 +128,14 @@ def least_activations(model: Model, coefficients, optimum_pcsa, delays, scan, ma
         active = found & (first > 0)
         for _ in range(BISECTIONS if active.any() else 0):
             mid = 0.5 * (lo + hi)
-            meets = value(segment_margins_at(model, coefficients, optimum_pcsa, mid, kp, kd)) >= delays
+            meets = value(segment_margins_at(model, coefficients, optimum_pcsa, mid, kp, kd, decay)) >= delays
             hi = np.where(active & meets, mid, hi)
             lo = np.where(active & ~meets, mid, lo)
         answers.append(np.where(found, hi, np.nan))
     return answers[-1], np.stack(answers[:-1], axis=1)
 
 
-def joint_design(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None):
+def joint_design(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None, decay: float = 0.0):
     """Joint by joint: each segment's and the common least activation whose margins meet ``reflex.delay``.
 
     The curve's search (:func:`least_activations`) at the one delay, so that the answer is the curve's there.
@@ -135,6 +147,10 @@ def joint_design(model: Model, eccentricity: float, lordosis: float, kp=None, kd
         E and Lambda [m].
     kp, kd : float, optional
         Explicit gains [N m/rad], [N m s/rad].
+    decay : float
+        A least decay rate sigma [1/s]: every segment's loop with every root at the delay at Re s < -sigma
+        (:func:`segment_margins_at`); the segments' margins reported are their own, unshifted, and
+        ``largest_delay`` NaN (the shifted loops' gains hold one delay).
 
     Returns
     -------
@@ -158,8 +174,9 @@ def joint_design(model: Model, eccentricity: float, lordosis: float, kp=None, kd
         return np.nan, nan, optimum.pcsa, optimum.status, np.nan, "none: no optimum"
     p = np.asarray(optimum.pcsa, float)
     with arithmetic_guard(e, lam):
-        scan, margins = scan_margins(model, coefficients, p, kp, kd)
-        common, each = least_activations(model, coefficients, p, np.array([model.reflex.delay]), scan, margins, kp, kd)
+        scan, margins = scan_margins(model, coefficients, p, kp, kd, decay)
+        delays = np.array([model.reflex.delay])
+        common, each = least_activations(model, coefficients, p, delays, scan, margins, kp, kd, decay)
         own = [
             np.nan if np.isnan(a) else segment_margins_at(model, coefficients, p, [a], kp, kd)[0, k]
             for k, a in enumerate(each[0])
@@ -171,5 +188,5 @@ def joint_design(model: Model, eccentricity: float, lordosis: float, kp=None, kd
     )
     activation = float(common[0])
     method = "bisection: monotone on the scan" if monotone.all() else "scan and refine: not monotone"
-    largest = float(np.max(np.min(margins, axis=1)))
+    largest = float(np.max(np.min(margins, axis=1))) if not decay > 0 else np.nan
     return activation, segments, p, ("ok" if np.isfinite(activation) else "infeasible"), largest, method

@@ -124,6 +124,9 @@ class PassiveCurve:
         The least global PCSA alone at K = ``crisco`` [m^2]; NaN if none.
     model : dict
         Provenance and header line.
+    fixed_at : str
+        The model's own passive stiffness, at which ``paper_pcsa`` is the minimum, e.g. ``"K = 0 N m/rad,
+        physical convention"``.
     """
 
     eccentricity: float
@@ -138,6 +141,7 @@ class PassiveCurve:
     crisco: float
     crisco_global_pcsa: float
     model: dict
+    fixed_at: str = ""
 
     def to_dict(self) -> dict:
         """The document of ``spinectl design --passive ... --json``.
@@ -201,8 +205,10 @@ class PassiveCurve:
             self.model.get("header", "preset unknown"),
             f"{criterion('chain', n)}: static stability against the passive stiffness per joint, "
             f"E = {self.eccentricity * 100:.2f} cm, Lambda = {self.lordosis * 100:.2f} cm",
-            f"least local stiffness at a fixed global PCSA of {_word(m2_to_cm2(self.paper_pcsa), 0, '.2f')} cm^2 "
-            "(the paper's minimum at the model's passive stiffness)",
+            f"least local stiffness at a fixed global PCSA of {_word(m2_to_cm2(self.paper_pcsa), 0, '.2f')} cm^2: "
+            "the least total PCSA of the global muscles for which every segment is self-stable joint by joint "
+            "(each CoR alone, the others fixed: the paper's minimum, eq. 1), solved once at the model's own "
+            f"{self.fixed_at or 'passive stiffness'} and held, muscle by muscle, at every K below",
             self.columns_note(),
             f"{'K[N m/rad]':>10} {'global alone[cm2]':>17} {'sum local k[N m/rad]':>20}",
         ]
@@ -270,6 +276,7 @@ def passive_curve(model: Model, eccentricity: float, lordosis: float, stiffnesse
         # K is swept: the header names the origin, not the model's own K
         model=provenance(model)
         | {"header": f"{origin(model)}; K swept, physical convention", "muscles": tuple(model.muscle_names)},
+        fixed_at=f"K = {model.passive.stiffness:g} N m/rad, {model.passive.convention} convention",
     )
 
 

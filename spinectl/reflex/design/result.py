@@ -182,6 +182,8 @@ class Design:
     joint_searched : object or None
         Joint by joint over every segment's PD gains
         (:class:`~spinectl.reflex.design.joint_searched.JointSearchedDesign`), or None.
+    decay_rate : float
+        sigma of ``--decay-rate``: the chain's design has every root at the delay at Re s < -sigma [1/s]; 0, none.
     """
 
     eccentricity: float
@@ -201,6 +203,7 @@ class Design:
     margin_cost: object = None
     searched: object = None
     joint_searched: object = None
+    decay_rate: float = 0.0
 
     def to_dict(self) -> dict:
         """The document of ``spinectl design --json``.
@@ -238,6 +241,8 @@ class Design:
         out = {}
         if np.isfinite(self.nominal_delay):
             out |= {"margin_ratio": self.margin_ratio, "nominal_delay_s": self.nominal_delay}
+        if self.decay_rate > 0:
+            out["decay_rate_per_s"] = self.decay_rate
         if self.margin_cost is not None:
             out["margin_cost"] = self.margin_cost.to_dict()
         if self.searched is not None:
@@ -274,6 +279,9 @@ class Design:
                 f"one activation for every segment (the largest above): {self.activation:.4f} x minimum PCSA "
                 f"({m2_to_cm2(self.pcsa):.2f} cm^2); tau_m: each segment's exact delay margin at its activation"
                 if np.isfinite(self.activation)
+                else f"no activation in [0, 1] meets the delay at every segment with every root at Re s < "
+                f"-{self.decay_rate:g} 1/s (--decay-rate)"
+                if self.decay_rate > 0
                 else f"no activation in [0, 1] meets the delay at every segment; the largest delay met: "
                 f"{delay_text(self.largest_delay)}"
             ),
@@ -287,15 +295,23 @@ class Design:
                 "local stiffness [N m/rad]: "
                 + ", ".join(f"{s.name} {k:.2f}" for s, k in zip(self.segments, c.local_stiffness, strict=True))
                 + f"  ({c.fraction:.4f} x the least for static stability, total {np.sum(c.local_stiffness):.1f})",
-                f"certificate: exact delay margin {delay_text(c.delay_margin)} >= {delay_text(self.delay)}; "
-                f"rightmost root at the delay Re s = {_word(c.max_root_real, 0, '.4g')} 1/s",
+                self._certificate_line(),
             ]
         else:
-            lines.append(f"no local stiffness meets the delay; the largest delay met: {delay_text(c.largest_delay)}")
+            lines.append(
+                f"no local stiffness meets the delay with every root at Re s < -{self.decay_rate:g} 1/s (--decay-rate)"
+                if self.decay_rate > 0
+                else f"no local stiffness meets the delay; the largest delay met: {delay_text(c.largest_delay)}"
+            )
         return "\n".join(lines + self._chain_lines())
 
     def _joint_lines(self) -> list[str]:
         """Joint by joint: the reflex the answer assumes, and the answer over every segment's gains."""
+        if self.decay_rate > 0:
+            return [
+                f"  reflex assumed: the reflex rule at each activation; every root of each segment's loop at the "
+                f"delay at Re s < -{self.decay_rate:g} 1/s (--decay-rate; tau_m: its own exact delay margin)"
+            ]
         if self.joint_searched is None:
             return []
         return ["  reflex assumed: the reflex rule at each activation", *self.joint_searched.lines(self.activation)]
@@ -325,9 +341,28 @@ class Design:
             f"{delay_text(self.nominal_delay)} (designed at {delay_text(self.delay)}: --margin {self.margin_ratio:g})"
         )
 
+    def _certificate_line(self) -> str:
+        """The chain's certificate: the exact margin and the rightmost root (with a decay rate, beyond -sigma)."""
+        c = self.chain
+        root = f"rightmost root at the delay Re s = {_word(c.max_root_real, 0, '.4g')} 1/s"
+        if not self.decay_rate > 0:
+            return f"certificate: exact delay margin {delay_text(c.delay_margin)} >= {delay_text(self.delay)}; {root}"
+        return (
+            f"certificate: every root at the delay has Re s < -{self.decay_rate:g} 1/s (the exact margin of the loop "
+            f"shifted by the decay rate meets the delay); {root} (<= -{self.decay_rate:g}); exact delay margin "
+            f"{delay_text(c.delay_margin)}"
+        )
+
     def _boundary_line(self) -> str:
         """The least value is a stability boundary; what a margin costs."""
         c = self.chain
+        if self.decay_rate > 0:
+            return (
+                f"  robust: designed for a least decay rate {self.decay_rate:g} 1/s (--decay-rate): every "
+                f"disturbance dies out at least as fast as exp(-{self.decay_rate:g} t), time constant "
+                f"{1 / self.decay_rate:.4g} s; the least value sits on that boundary (rightmost root at "
+                f"-{self.decay_rate:g} 1/s)"
+            )
         if self.margin_ratio != 1.0:
             return (
                 f"  robust: designed at {self.margin_ratio:g} x the delay {delay_text(self.nominal_delay)}, so "
