@@ -153,7 +153,7 @@ def test_the_optimum_table_says_infeasible_plainly_and_mu_only_where_there_is_a_
     bare = optimised(torso, stability="chain").table().splitlines()
     optimum, classic, price, remedy = bare[:4]
     assert optimum.startswith("optimum (the chain free") and "mu = 1 N m/rad" in optimum
-    assert "infeasible: no activations in [0, 1] hold the posture and meet the criterion" in optimum
+    assert "infeasible: no activations within their bounds hold the posture and meet the criterion" in optimum
     assert "mu =" not in classic and classic.startswith("classic (no stability criterion")
     assert price == "price of stability: none (the optimum is infeasible, so it has no cost to compare)"
     assert remedy.startswith("remedy: ") and "--joint-stiffness" in remedy
