@@ -31,9 +31,12 @@ from ..model.chain import dynamic_eigenvalues
 from ..model.chain import state_matrix as chain_state_matrix
 from ..model.linear_chain import LinearChain
 from ..model.stability import MARGINAL_TIME_CONSTANT, slowest_time_constant
-from .contract import AnatomyEngine
+from .contract import AnatomyEngine, identity_text, model_identity
 from .engine import require_mujoco
 from .model import Anatomy
+
+REFERENCE_POSTURE = "the model's reference posture"
+"""The posture analysed when none is given, as the table and the JSON's ``posture_source`` say it."""
 
 RANK_TOLERANCE = 1e-9
 """A singular value below this times the largest counts as zero (the global muscles' rank)."""
@@ -406,7 +409,8 @@ class AnatomyResult:
     Attributes
     ----------
     model : dict
-        ``name``, ``source``, ``sha256``.
+        The model's identity (:func:`~spinectl.anatomy.contract.model_identity`): ``name``, ``source``,
+        ``sha256``, ``sha256_short``, ``engine``, ``versions``.
     plane : str
         The plane.
     muscles : dict
@@ -437,6 +441,9 @@ class AnatomyResult:
     rhythm_size : int
         How many coordinates the model's rhythm ties to the chain; 0: no rhythm (no joint
         equality or coupler), the constrained chain is the free one.
+    posture_source : str
+        Where the posture comes from: the model's reference posture, ``"given"``, or a file and the time of
+        its frame (:mod:`spinectl.anatomy.recordings`).
     """
 
     model: dict
@@ -454,6 +461,7 @@ class AnatomyResult:
     control_unit: str = "1"
     activation_source: str = "given"
     rhythm_size: int = 1
+    posture_source: str = REFERENCE_POSTURE
 
     def referee_error(self) -> float:
         """Largest relative difference between spinectl's and MuJoCo's eigenvalues, matched one to one.
@@ -496,6 +504,7 @@ class AnatomyResult:
             "activation_mean": float(self.activations.mean()),
             "control_unit": self.control_unit,
             "activation_source": self.activation_source,
+            "posture_source": self.posture_source,
             "stiffness_matrix_Nm_per_rad": free.stiffness.tolist(),
             "damping_matrix_Nms_per_rad": free.damping.tolist(),
             "mass_matrix_kgm2": free.mass.tolist(),
@@ -547,7 +556,8 @@ class AnatomyResult:
         word = {True: "stable", False: "unstable"}
         counts = ", ".join(f"{len(v)} {k}" for k, v in self.muscles.items())
         lines = [
-            f"{self.model['name']} ({self.model['source']}), {plane_text(self.plane)}, "
+            identity_text(self.model),
+            f"{self.model['source']}, {plane_text(self.plane)}, posture: {self.posture_source}, "
             + (
                 f"mean activation {self.activations.mean():.3g}"
                 if self.control_unit == "1"
@@ -652,6 +662,7 @@ def analyse(
     joint_stiffness="none",
     check=False,
     reflex=None,
+    time=None,
 ) -> AnatomyResult:
     """Joint-by-joint and chain verdicts of a model at an activation, free and constrained.
 
@@ -661,10 +672,13 @@ def analyse(
         From :func:`spinectl.anatomy.load`.
     plane : str
         One of the mapping's planes.
-    activation : float, array_like, dict or None
-        Activations in [0, 1] (:func:`activations`); None: the model's keyframe 0's, else 0.
-    posture : array_like, optional
-        Full qpos; default the model's reference posture.
+    activation : float, array_like, dict, str, pathlib.Path or None
+        Activations in [0, 1] (:func:`activations`); None: the model's keyframe 0's, else 0; a file: an
+        OpenSim ``.sto`` with one column per muscle (:func:`spinectl.anatomy.recordings.anatomy_point`).
+    posture : array_like, dict, str, pathlib.Path, optional
+        The engine's form (MuJoCo: the full qpos; OpenSim: coordinate name -> value [rad]), or an OpenSim
+        ``.mot``/``.sto`` file of every coordinate (:func:`spinectl.anatomy.recordings.anatomy_point`);
+        default the model's reference posture.
     joint_stiffness : {"none", "mapped"} or float
         Intervertebral stiffness added at each chain joint [N m/rad].
     check : bool
@@ -672,11 +686,17 @@ def analyse(
         leading mode (:func:`mujoco_growth_rate`); reference posture only.
     reflex : tuple, optional
         ``(kp, kd, lag)``: also the free chain's exact delay margin under that reflex (:func:`reflex_margin`).
+    time : float, optional
+        The frame read from the posture and activation files [s]; default each file's first.
 
     Returns
     -------
     AnatomyResult
     """
+    from .recordings import recorded_point
+
+    point = recorded_point(anatomy, posture, activation, time)
+    posture, activation = point.posture, point.activation
     a = activations(anatomy, activation)
     free, con, lin = anatomy.chains(plane, posture, joint_stiffness)
     added = anatomy.added_stiffness(joint_stiffness, free.n_joints)
@@ -693,7 +713,7 @@ def analyse(
             rate = mujoco_growth_rate(anatomy, free, a, added, values[lead].real, vectors[: free.n_joints, lead].real)
     classes = anatomy.classes
     return AnatomyResult(
-        model={"name": anatomy.name, "source": anatomy.source, "sha256": anatomy.sha256},
+        model=model_identity(anatomy),
         plane=plane,
         muscles={
             c: tuple(m for m, k in zip(anatomy.muscles, classes, strict=True) if k == c)
@@ -709,8 +729,9 @@ def analyse(
         simulated_rate=rate,
         reflex=None if reflex is None else reflex_margin(free, a, *reflex),
         control_unit=anatomy.control_unit,
-        activation_source=_activation_source(anatomy, activation),
+        activation_source=point.activation_source or _activation_source(anatomy, activation),
         rhythm_size=anatomy.rhythm_size(plane, posture),
+        posture_source=point.posture_source or REFERENCE_POSTURE,
     )
 
 
