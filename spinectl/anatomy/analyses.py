@@ -556,14 +556,14 @@ class AnatomyResult:
         word = {True: "stable", False: "unstable"}
         counts = ", ".join(f"{len(v)} {k}" for k, v in self.muscles.items())
         lines = [
-            identity_text(self.model),
-            f"{self.model['source']}, {plane_text(self.plane)}, posture: {self.posture_source}, "
+            f"{identity_text(self.model)}, {plane_text(self.plane)}, posture: {self.posture_source}, "
             + (
                 f"mean activation {self.activations.mean():.3g}"
                 if self.control_unit == "1"
                 else f"mean control {self.activations.mean():.4g} {self.control_unit}"
             )
             + f" ({self.activation_source})",
+            f"source: {self.model['source']}",
             f"muscles: {counts}; global muscles' moment-arm rank {cert.rank} of {len(free.joints)} "
             f"(singular values {', '.join(f'{s:.3g}' for s in cert.singular_values)} m/rad)",
             f"joint stiffness added: {self.joint_stiffness_added[0]:.4g} N m/rad per joint",

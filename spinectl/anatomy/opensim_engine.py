@@ -772,9 +772,9 @@ class OsimAnatomy(MappedModel):
     def posture_columns(self):
         """A posture file's columns: each coordinate by name or by path (``/jointset/<joint>/<name>/value``).
 
-        The model's other states (speeds, activations, fibre lengths: a states file's columns) are
-        skipped; the coordinates that OpenSim converts from degrees (``SimbodyEngine.convertDegreesToRadians``
-        on a row of ones) are the rotational ones.
+        The model's other states (speeds, activations, fibre lengths: a states file's columns) and its
+        muscles' activations by name or path are skipped; the coordinates that OpenSim converts from
+        degrees (``SimbodyEngine.convertDegreesToRadians`` on a row of ones) are the rotational ones.
 
         Returns
         -------
@@ -794,7 +794,8 @@ class OsimAnatomy(MappedModel):
         model.getSimbodyEngine().convertDegreesToRadians(table)
         row = table.getRowAtIndex(0).to_numpy()
         rotational = [n for n, v in zip(names, row, strict=True) if v != 1.0]
-        return posture_columns_of(labels, names, self._states() - set(labels), rotational)
+        muscles = set(self.activation_columns().names)  # a states file's activations, even of a muscle without one
+        return posture_columns_of(labels, names, (self._states() | muscles) - set(labels), rotational)
 
     def activation_columns(self):
         """An activation file's columns: each muscle by name or by path (``/forceset/<name>/activation``).

@@ -214,8 +214,10 @@ def read_frame(source, columns: Columns, field: str, time=None) -> Frame:
             raise ParameterError("time", "selects a frame of a file; a dict is one frame (got a time with a dict)")
         labels, row = [str(k) for k in source], np.array([_number(field, k, v) for k, v in source.items()])
         return Frame(_matched(columns, labels, row, field, "the dict"), "given")
+    osim = _opensim(field)  # first: without it no file can be read
     path = _readable(source, field)
-    osim, table = _table(path, field)
+    _check_header(path, field)
+    table = _table(osim, path, field)
     degrees = _in_degrees(osim, table, path, field) if field == "posture" else False
     labels = list(table.getColumnLabels())
     times = np.asarray(table.getIndependentColumn(), float)
@@ -246,18 +248,43 @@ def _readable(source, field: str) -> Path:
     return path
 
 
-def _table(path: Path, field: str) -> tuple:
-    """OpenSim and the file as its ``TimeSeriesTable`` (its STOFileAdapter; times strictly increasing)."""
-    from .engine import engine_output_to_stderr, one_line
+def _check_header(path: Path, field: str) -> None:
+    """A line ``endheader`` and, after it, a line of column labels: else one line, before OpenSim reads the file.
+
+    OpenSim 4.6's STOFileAdapter never returns on a file that ends before those two lines (a text file that is
+    no table, a header cut short): the guard reads lines up to the labels, no further, and parses nothing.
+    """
+    ended = False
+    with path.open("rb") as lines:
+        for line in lines:
+            text = line.strip()
+            if ended and text:
+                return
+            ended = ended or text == b"endheader"
+    raise ParameterError(
+        field,
+        f"{show(str(path))} is no OpenSim .mot or .sto file: it needs a header ending in a line 'endheader', then "
+        f"a line of column labels ({'no labels after it' if ended else 'no endheader line'})",
+    )
+
+
+def _opensim(field: str):
+    """OpenSim, or one line: the option needs it to read its file."""
     from .export_osim import INSTALL_HINT, OpenSimUnavailable, require_opensim
 
     require_module(
         "opensim", OpenSimUnavailable, f"--{field} reads the file with OpenSim's STOFileAdapter: {INSTALL_HINT}"
     )
-    osim = require_opensim()
+    return require_opensim()
+
+
+def _table(osim, path: Path, field: str):
+    """The file as OpenSim's ``TimeSeriesTable`` (its STOFileAdapter; times strictly increasing)."""
+    from .engine import engine_output_to_stderr, one_line
+
     try:
         with engine_output_to_stderr():
-            return osim, osim.TimeSeriesTable(str(path))
+            return osim.TimeSeriesTable(str(path))
     except Exception as exc:  # OpenSim's own exception types: one line each, its words kept
         text = one_line(exc).replace("std::exception in ", "")
         text = text.split("': ", 1)[-1].split(" Thrown at ")[0].strip()

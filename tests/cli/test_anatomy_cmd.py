@@ -55,7 +55,8 @@ def test_json_is_the_results_dict(cached, capsys):
     out = capsys.readouterr().out
     doc = json.loads(out)
     assert all(key in doc for key in KEYS)
-    assert set(doc["model"]) == {"name", "source", "sha256"} and set(doc["muscles"]) == {"global", "local", "between"}
+    assert set(doc["model"]) == {"name", "source", "sha256", "sha256_short", "engine", "versions"}
+    assert set(doc["muscles"]) == {"global", "local", "between"}
     assert len(doc["mujoco_eigenvalues"]) == 10
     assert out == jsondoc.dumps(analyse(package.load(), activation=0.05, check=True).to_dict())
 
