@@ -9,6 +9,7 @@ paper's chain (five pin joints, thirty Millard muscles); the MJCF model is MyoTo
 from __future__ import annotations
 
 import hashlib
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -273,3 +274,34 @@ def test_myotorso_activations_by_actuator_name(torso, tmp_path):
     np.testing.assert_allclose(
         analyse(torso, activation=path).free.stiffness, analyse(torso, activation=a).free.stiffness, rtol=1e-12
     )
+
+
+CYCLIST = Path("/work/shared/models/allaire-cyclist")
+
+
+@pytest.mark.skipif(not CYCLIST.is_dir(), reason="the shared downloaded models (/work/shared/models) are absent")
+def test_the_cyclists_static_trial_is_read_as_published(tmp_path):
+    """The Bruno/Allaire cyclist (s01modelScaled.osim) and its static trial s01static.mot as distributed: a states
+    file of 1,349 columns (values, speeds, activations, fibre lengths; radians) gives all 171 coordinates and
+    520 activations; each equals the file's number read by numpy's own text reader. (The model's Thelen muscles
+    are read by no muscle law of this branch: the model is built without them through its engine.)"""
+    from spinectl.anatomy.mapping import read_mapping
+    from spinectl.anatomy.opensim_engine import OsimAnatomy, load_engine
+
+    engine = load_engine(CYCLIST / "s01modelScaled.osim")
+    muscles = engine.model.getMuscles()
+    names = tuple(muscles.get(i).getName() for i in range(muscles.getSize()))
+    mapping = tmp_path / "m.toml"
+    mapping.write_text(
+        '[bodies]\npelvis = ["pelvis"]\nvertebrae = ["lumbar1"]\nthorax = ["thoracic12"]\n'
+        '[planes]\nsagittal = ["L1_L2_FE"]\n'
+    )
+    model = OsimAnatomy(engine, read_mapping(mapping), names, ("between",) * len(names))
+    trial = CYCLIST / "s01static.mot"
+    point = anatomy_point(model, posture=trial, activations=trial)
+    labels = trial.read_text().splitlines()[6].split("\t")
+    row = np.loadtxt(trial, skiprows=7)
+    assert len(point.posture) == 171 and point.activation.shape == (520,)
+    assert point.posture["L5_S1_FE"] == row[labels.index("/jointset/L5_S1_IVDjnt/L5_S1_FE/value")]
+    assert point.activation[0] == row[labels.index(f"/forceset/{names[0]}/activation")]
+    assert point.posture_source == "s01static.mot at t = 0.01 s (its one frame)"
