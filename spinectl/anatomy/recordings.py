@@ -359,10 +359,11 @@ def _check_bounds(anatomy, a: np.ndarray, frame: Frame) -> None:
     out = np.flatnonzero((a < lower) | (a > upper))
     if out.size:
         i = int(out[0])
+        more = f"; {out.size - 1} more outside" if out.size > 1 else ""
         raise ParameterError(
             "activations",
             f"{frame.source}: must be in [{lower[i]:g}, {upper[i]:g}] (EMG normalised to its maximum) "
-            f"(got {a[i]:g} for {anatomy.muscles[i]!r}, and {out.size - 1} more outside)",
+            f"(got {a[i]:g} for {anatomy.muscles[i]!r}{more})",
         )
 
 
