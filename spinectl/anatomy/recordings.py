@@ -214,20 +214,88 @@ def read_frame(source, columns: Columns, field: str, time=None) -> Frame:
             raise ParameterError("time", "selects a frame of a file; a dict is one frame (got a time with a dict)")
         labels, row = [str(k) for k in source], np.array([_number(field, k, v) for k, v in source.items()])
         return Frame(_matched(columns, labels, row, field, "the dict"), "given")
+    return read_recording(source, field).frame(columns, time)
+
+
+@dataclass(frozen=True)
+class Recording:
+    """A file of frames as OpenSim read it, before its columns are matched to a model (:func:`read_recording`).
+
+    Read once, a recording gives any of its frames (:meth:`frame`), as a motion's analysis asks for each.
+
+    Attributes
+    ----------
+    path : pathlib.Path
+        The file.
+    field : str
+        ``"posture"`` or ``"activations"``: the field of every message.
+    labels : tuple of str
+        The column labels, as in the file.
+    times : numpy.ndarray, shape (t,)
+        The frames' times [s], strictly increasing (OpenSim's check).
+    values : numpy.ndarray, shape (t, len(labels))
+        As in the file (degrees where ``in_degrees``).
+    in_degrees : bool
+        The header's ``inDegrees`` (a posture's; False for activations).
+    """
+
+    path: Path
+    field: str
+    labels: tuple
+    times: np.ndarray
+    values: np.ndarray
+    in_degrees: bool = False
+
+    def frame(self, columns: Columns, time=None) -> Frame:
+        """The frame at ``time`` (default the first), matched to a model and in radians.
+
+        Parameters
+        ----------
+        columns : Columns
+            How the model reads the labels.
+        time : float, optional
+            A time of the file's frames [s] (to :data:`TIME_TOLERANCE`).
+
+        Returns
+        -------
+        Frame
+        """
+        index, chosen = _frame_index(self.times, time, self.path, self.field)
+        where = f"{printable(self.path.name)} at t = {self.times[index]:g} s ({chosen})"
+        values = _matched(columns, self.labels, self.values[index], self.field, where)
+        if self.in_degrees:
+            values = {k: float(np.radians(v)) if k in columns.rotational else v for k, v in values.items()}
+        return Frame(values, where, float(self.times[index]))
+
+
+def read_recording(source, field: str) -> Recording:
+    """A ``.mot`` or ``.sto`` file read by OpenSim's ``TimeSeriesTable`` (its ``STOFileAdapter``).
+
+    Parameters
+    ----------
+    source : str or pathlib.Path
+        The file.
+    field : str
+        ``"posture"`` (its header must say ``inDegrees``) or ``"activations"``.
+
+    Returns
+    -------
+    Recording
+
+    Raises
+    ------
+    ParameterError
+        One line: OpenSim missing (:class:`~spinectl.anatomy.export_osim.OpenSimUnavailable`), no regular file,
+        no ``endheader`` and labels, OpenSim's own refusal (times not increasing), no ``inDegrees`` in a posture.
+    """
     osim = _opensim(field)  # first: without it no file can be read
     path = _readable(source, field)
     _check_header(path, field)
     table = _table(osim, path, field)
     degrees = _in_degrees(osim, table, path, field) if field == "posture" else False
-    labels = list(table.getColumnLabels())
     times = np.asarray(table.getIndependentColumn(), float)
-    index, chosen = _frame_index(times, time, path, field)
-    row = table.getMatrix().to_numpy()[index] if times.size else np.zeros(0)
-    where = f"{printable(path.name)} at t = {times[index]:g} s ({chosen})"
-    values = _matched(columns, labels, row, field, where)
-    if degrees:
-        values = {k: float(np.radians(v)) if k in columns.rotational else v for k, v in values.items()}
-    return Frame(values, where, float(times[index]))
+    values = table.getMatrix().to_numpy() if times.size else np.zeros((0, table.getNumColumns()))
+    return Recording(path, field, tuple(table.getColumnLabels()), times, values, degrees)
 
 
 def _number(field: str, key, value) -> float:

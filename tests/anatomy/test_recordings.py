@@ -66,6 +66,25 @@ def test_a_posture_file_in_degrees_is_the_posture_given_in_radians(chain, tmp_pa
     assert read.posture_source == "ik.mot at t = 0.25 s (the time asked)"
 
 
+def test_a_recording_read_once_gives_each_frame(chain, tmp_path):
+    """read_recording reads a file once; each frame it gives is the one anatomy_point reads at that time (a motion
+    of three frames in degrees), and the frames differ (the test can fail)."""
+    from spinectl.anatomy.recordings import read_recording
+
+    loaded, _, names = chain
+    rows = [np.zeros(5), DEG, np.multiply(DEG, 2)]
+    path = write_table(tmp_path / "motion.mot", names, rows, times=[0.0, 0.01, 0.02], degrees="yes")
+    recording = read_recording(path, "posture")
+    columns = loaded.posture_columns()
+    frames = [recording.frame(columns, t).values for t in recording.times]
+    assert recording.times.tolist() == [0.0, 0.01, 0.02]
+    for t, values in zip(recording.times, frames, strict=True):
+        assert values == anatomy_point(loaded, posture=path, time=t).posture
+    assert frames[2]["L5S1"] == pytest.approx(2 * frames[1]["L5S1"]) and frames[1]["L5S1"] == pytest.approx(
+        np.radians(2)
+    )
+
+
 def test_radians_by_path_in_a_states_file_is_the_same_posture(chain, tmp_path):
     """A states file (OpenSim's full paths, speeds and activations beside the values, radians): the values are
     the posture, the other states skipped; the first frame by default, and the table says so."""
