@@ -323,7 +323,7 @@ def _check_header(path: Path, field: str) -> None:
     no table, a header cut short): the guard reads lines up to the labels, no further, and parses nothing.
     """
     ended = False
-    with path.open("rb") as lines:
+    with open(path, "rb") as lines:  # bytes: the encoding is OpenSim's to read
         for line in lines:
             text = line.strip()
             if ended and text:
