@@ -286,6 +286,44 @@ class AnatomyEngine(Protocol):
             Per muscle, a tuple of branches of shape (p_k, 2) [m].
         """
 
+    def engine_versions(self) -> dict:
+        """The versions of the packages that built and read the model (:func:`model_identity`).
+
+        Returns
+        -------
+        dict
+            Package -> version.
+        """
+
+    def posture_columns(self):
+        """How a posture file's columns name the model's coordinates (:mod:`spinectl.anatomy.recordings`).
+
+        Returns
+        -------
+        spinectl.anatomy.recordings.Columns
+        """
+
+    def activation_columns(self):
+        """How an activation file's columns name the model's muscles (:mod:`spinectl.anatomy.recordings`).
+
+        Returns
+        -------
+        spinectl.anatomy.recordings.Columns
+        """
+
+    def named_posture(self, values: dict):
+        """The posture in the engine's form (:meth:`posture`) from coordinate name -> value.
+
+        Parameters
+        ----------
+        values : dict
+            Coordinate name -> value [rad or m].
+
+        Returns
+        -------
+        object
+        """
+
 
 @dataclass
 class MappedModel:
