@@ -36,8 +36,8 @@ def register(sub) -> None:
         help="stability of an anatomical model's lumbar chain (MuJoCo or OpenSim; MyoTorso built in)",
         description="Load a musculoskeletal model (the built-in 'myotorso' from myo-sim, an MJCF file read by "
         "MuJoCo or an .osim file read by OpenSim, with --mapping), linearise its lumbar chain at the reference "
-        "posture and the model's own controls (or --activation), and report each joint's stiffness (joint by "
-        "joint, the others fixed), the chain's "
+        "posture (or --posture's) and the model's own controls (or --activation, --activations), and report "
+        "each joint's stiffness (joint by joint, the others fixed), the chain's "
         "eigenvalues (every joint free, equality constraints off), the chain constrained by the model's "
         "lumbar rhythm (if it has one), and the global muscles' rank. Needs pip install 'spinectl[anatomy]' "
         "(and 'spinectl[opensim]' for .osim). "
