@@ -273,10 +273,11 @@ class Anatomy(MappedModel):
         from .recordings import posture_columns_of
 
         mujoco = require_mujoco()
-        model, kind = self.engine.model, mujoco.mjtJoint
+        model = self.engine.model
+        hinge, slide = int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE)  # jnt_type holds ints
         named = [(j, mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, j)) for j in range(model.njnt)]
-        single = [(j, n) for j, n in named if n and model.jnt_type[j] in (kind.mjJNT_HINGE, kind.mjJNT_SLIDE)]
-        hinges = [n for j, n in single if model.jnt_type[j] == kind.mjJNT_HINGE]
+        single = [(j, n) for j, n in named if n and int(model.jnt_type[j]) in (hinge, slide)]
+        hinges = [n for j, n in single if int(model.jnt_type[j]) == hinge]
         return posture_columns_of({n: n for _, n in single}, [n for _, n in single], rotational=hinges)
 
     def named_posture(self, values: dict) -> np.ndarray:

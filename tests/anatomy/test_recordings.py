@@ -268,22 +268,30 @@ def test_opensim_missing_is_one_line_for_an_mjcf_model(torso, tmp_path, monkeypa
 
 
 def test_myotorso_posture_by_joint_name_in_degrees(torso, tmp_path):
-    """MyoTorso (MuJoCo): a posture file of every hinge joint by name, in degrees, is the qpos with those joints
-    set in radians; its linearisation equals the one at that qpos given directly."""
+    """MyoTorso (MuJoCo): a posture file of every joint by name, in degrees, is the qpos with the hinges set in
+    radians and the slides (the abdomen's translations) in metres, as given; its linearisation equals the one at
+    that qpos given directly."""
     import mujoco
 
     model = torso.engine.model
-    names = list(torso.posture_columns().required)
+    columns = torso.posture_columns()
+    names = list(columns.required)
+    kinds = np.bincount(model.jnt_type, minlength=4)  # MuJoCo's own count: 16 hinges, 2 slides (the abdomen's)
+    assert len(names) == model.njnt == kinds[2] + kinds[3] and len(columns.rotational) == kinds[3] == 16
+    ids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name) for name in names]
+    hinge = np.array([model.jnt_type[j] == int(mujoco.mjtJoint.mjJNT_HINGE) for j in ids])
     rng = np.random.default_rng(3)
-    deg = rng.uniform(-3, 3, len(names))
-    path = write_table(tmp_path / "torso.mot", names, [deg], degrees="yes")
+    given = np.where(hinge, rng.uniform(-3, 3, len(names)), rng.uniform(-0.003, 0.003, len(names)))  # [deg], [m]
+    path = write_table(tmp_path / "torso.mot", names, [given], degrees="yes")
     q = model.qpos0.copy()
-    for name, value in zip(names, deg, strict=True):
-        q[model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name)]] = np.radians(value)
+    q[model.jnt_qposadr[ids]] = np.where(hinge, np.radians(given), given)
     point = anatomy_point(torso, posture=path)
     np.testing.assert_allclose(point.posture, q, rtol=0, atol=1e-15)
-    read, given = analyse(torso, posture=path), analyse(torso, posture=q)
-    np.testing.assert_allclose(read.free.stiffness, given.free.stiffness, rtol=1e-12, atol=1e-12)
+    assert np.abs(q - model.qpos0).max() > np.radians(1)  # a posture away from the reference
+    read, direct = analyse(torso, posture=path), analyse(torso, posture=q)
+    # to MuJoCo's rounding: two linearisations at one qpos differ by 2e-11 relative (its scratch state)
+    np.testing.assert_allclose(read.free.stiffness, direct.free.stiffness, rtol=1e-9, atol=1e-8)
+    assert not np.allclose(read.free.stiffness, analyse(torso).free.stiffness, rtol=1e-6)
 
 
 def test_myotorso_activations_by_actuator_name(torso, tmp_path):
@@ -324,3 +332,22 @@ def test_the_cyclists_static_trial_is_read_as_published(tmp_path):
     assert point.posture["L5_S1_FE"] == row[labels.index("/jointset/L5_S1_IVDjnt/L5_S1_FE/value")]
     assert point.activation[0] == row[labels.index(f"/forceset/{names[0]}/activation")]
     assert point.posture_source == "s01static.mot at t = 0.01 s (its one frame)"
+
+
+def test_the_optimum_at_a_posture_file_is_the_optimum_at_that_posture(torso, tmp_path):
+    """optimised(posture=FILE): MyoTorso's chain optimum (50 N m/rad added) at a file's posture (every joint 2 deg
+    from the reference, radians) is the optimum at that qpos given directly (same cost), not the reference's, and
+    its analysis names the file."""
+    from spinectl.anatomy.optimum import optimised
+
+    names = list(torso.posture_columns().required)
+    q = torso.named_posture({n: 0.0 for n in names})
+    ids = torso.joint_ids(names)
+    moved = torso.engine.model.qpos0[torso.engine.model.jnt_qposadr[ids]] + np.radians(2.0)
+    path = write_table(tmp_path / "bent.sto", names, [moved], degrees="no")
+    q[torso.engine.model.jnt_qposadr[ids]] = moved
+    read = optimised(torso, joint_stiffness=50, posture=path)
+    given = optimised(torso, joint_stiffness=50, posture=q)
+    assert read.optimum.ok and read.optimum.cost == pytest.approx(given.optimum.cost, rel=1e-9)
+    assert read.optimum.cost != pytest.approx(optimised(torso, joint_stiffness=50).optimum.cost, rel=1e-3)
+    assert read.analysis.posture_source == "bent.sto at t = 0 s (its one frame)"
