@@ -31,10 +31,13 @@ from ..model.chain import dynamic_eigenvalues
 from ..model.chain import state_matrix as chain_state_matrix
 from ..model.linear_chain import CONTROL_CLASSES, LinearChain
 from ..model.stability import MARGINAL_TIME_CONSTANT, slowest_time_constant
-from .contract import AnatomyEngine
+from .contract import AnatomyEngine, identity_text, model_identity
 from .engine import require_mujoco
 from .model import Anatomy
 from .naming import joint_labels
+
+REFERENCE_POSTURE = "the model's reference posture"
+"""The posture analysed when none is given, as the table and the JSON's ``posture_source`` say it."""
 
 RANK_TOLERANCE = 1e-9
 """A singular value below this times the largest counts as zero (the global muscles' rank)."""
@@ -409,7 +412,8 @@ class AnatomyResult:
     Attributes
     ----------
     model : dict
-        ``name``, ``source``, ``sha256``.
+        The model's identity (:func:`~spinectl.anatomy.contract.model_identity`): ``name``, ``source``,
+        ``sha256``, ``sha256_short``, ``engine``, ``versions``.
     plane : str
         The plane.
     muscles : dict
@@ -450,6 +454,9 @@ class AnatomyResult:
     devices : tuple of str
         What the model holds besides muscles and how it enters the chain (welds, a free root fixed,
         passive tendons), one phrase each (:attr:`~spinectl.anatomy.engine.Engine.devices`).
+    posture_source : str
+        Where the posture comes from: the model's reference posture, ``"given"``, or a file and the time of
+        its frame (:mod:`spinectl.anatomy.recordings`).
     """
 
     model: dict
@@ -470,6 +477,7 @@ class AnatomyResult:
     joint_slopes: np.ndarray | None = None
     rhythm_left_out: tuple = ()
     devices: tuple = ()
+    posture_source: str = REFERENCE_POSTURE
 
     @property
     def activation_mean(self) -> float:
@@ -517,6 +525,7 @@ class AnatomyResult:
             "activation_mean": self.activation_mean,
             "control_unit": self.control_unit,
             "activation_source": self.activation_source,
+            "posture_source": self.posture_source,
             "stiffness_matrix_Nm_per_rad": free.stiffness.tolist(),
             "damping_matrix_Nms_per_rad": free.damping.tolist(),
             "mass_matrix_kgm2": free.mass.tolist(),
@@ -582,13 +591,14 @@ class AnatomyResult:
         word = {True: "stable", False: "unstable"}
         counts = ", ".join(f"{len(v)} {k}" for k, v in self.muscles.items())
         lines = [
-            f"{self.model['name']} ({self.model['source']}), {plane_text(self.plane)}, "
+            f"{identity_text(self.model)}, {plane_text(self.plane)}, posture: {self.posture_source}, "
             + (
                 f"mean activation {self.activation_mean:.3g}"
                 if self.control_unit == "1"
                 else f"mean control {self.activation_mean:.4g} {self.control_unit}"
             )
             + f" ({self.activation_source})",
+            f"source: {self.model['source']}",
             f"muscles: {counts}; global muscles' moment-arm rank {cert.rank} of {len(free.joints)} "
             f"(singular values {', '.join(f'{s:.3g}' for s in cert.singular_values)} m/rad)",
             f"joint stiffness added: {self.joint_stiffness_added[0]:.4g} N m/rad per joint",
@@ -695,6 +705,7 @@ def analyse(
     joint_stiffness="none",
     check=False,
     reflex=None,
+    time=None,
 ) -> AnatomyResult:
     """Joint-by-joint and chain verdicts of a model at an activation, free and constrained.
 
@@ -704,10 +715,13 @@ def analyse(
         From :func:`spinectl.anatomy.load`.
     plane : str
         One of the mapping's planes.
-    activation : float, array_like, dict or None
-        Activations in [0, 1] (:func:`activations`); None: the model's keyframe 0's, else 0.
-    posture : array_like, optional
-        Full qpos; default the model's reference posture.
+    activation : float, array_like, dict, str, pathlib.Path or None
+        Activations in [0, 1] (:func:`activations`); None: the model's keyframe 0's, else 0; a file: an
+        OpenSim ``.sto`` with one column per muscle (:func:`spinectl.anatomy.recordings.anatomy_point`).
+    posture : array_like, dict, str, pathlib.Path, optional
+        The engine's form (MuJoCo: the full qpos; OpenSim: coordinate name -> value [rad]), or an OpenSim
+        ``.mot``/``.sto`` file of every coordinate (:func:`spinectl.anatomy.recordings.anatomy_point`);
+        default the model's reference posture.
     joint_stiffness : {"none", "mapped"} or float
         Intervertebral stiffness added at each chain joint [N m/rad].
     check : bool
@@ -715,11 +729,17 @@ def analyse(
         leading mode (:func:`mujoco_growth_rate`); reference posture only.
     reflex : tuple, optional
         ``(kp, kd, lag)``: also the free chain's exact delay margin under that reflex (:func:`reflex_margin`).
+    time : float, optional
+        The frame read from the posture and activation files [s]; default each file's first.
 
     Returns
     -------
     AnatomyResult
     """
+    from .recordings import recorded_point
+
+    point = recorded_point(anatomy, posture, activation, time)
+    posture, activation = point.posture, point.activation
     a = activations(anatomy, activation)
     free, con, lin = anatomy.chains(plane, posture, joint_stiffness, activations=a)
     added = anatomy.added_stiffness(joint_stiffness, free.n_joints)
@@ -736,7 +756,7 @@ def analyse(
             rate = mujoco_growth_rate(anatomy, free, a, added, values[lead].real, vectors[: free.n_joints, lead].real)
     classes = anatomy.classes
     return AnatomyResult(
-        model={"name": anatomy.name, "source": anatomy.source, "sha256": anatomy.sha256},
+        model=model_identity(anatomy),
         plane=plane,
         muscles={c: tuple(m for m, k in zip(anatomy.muscles, classes, strict=True) if k == c) for c in CONTROL_CLASSES},
         activations=a,
@@ -749,11 +769,12 @@ def analyse(
         simulated_rate=rate,
         reflex=None if reflex is None else reflex_margin(free, a, *reflex),
         control_unit=anatomy.control_unit,
-        activation_source=_activation_source(anatomy, activation),
+        activation_source=point.activation_source or _activation_source(anatomy, activation),
         rhythm_size=anatomy.rhythm_size(plane, posture),
         joint_slopes=_slopes_shown(anatomy, plane, posture),
         rhythm_left_out=anatomy.rhythm(plane, posture)[0].left_out,
         devices=tuple(getattr(anatomy.engine, "devices", ())),
+        posture_source=point.posture_source or REFERENCE_POSTURE,
     )
 
 

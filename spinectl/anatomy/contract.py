@@ -305,6 +305,44 @@ class AnatomyEngine(Protocol):
             Per muscle, a tuple of branches of shape (p_k, 2) [m].
         """
 
+    def engine_versions(self) -> dict:
+        """The versions of the packages that built and read the model (:func:`model_identity`).
+
+        Returns
+        -------
+        dict
+            Package -> version.
+        """
+
+    def posture_columns(self):
+        """How a posture file's columns name the model's coordinates (:mod:`spinectl.anatomy.recordings`).
+
+        Returns
+        -------
+        spinectl.anatomy.recordings.Columns
+        """
+
+    def activation_columns(self):
+        """How an activation file's columns name the model's muscles (:mod:`spinectl.anatomy.recordings`).
+
+        Returns
+        -------
+        spinectl.anatomy.recordings.Columns
+        """
+
+    def named_posture(self, values: dict):
+        """The posture in the engine's form (:meth:`posture`) from coordinate name -> value.
+
+        Parameters
+        ----------
+        values : dict
+            Coordinate name -> value [rad or m].
+
+        Returns
+        -------
+        object
+        """
+
 
 @dataclass
 class MappedModel:
@@ -610,6 +648,107 @@ class MappedModel:
 
     def _no_geometry(self) -> ParameterError:
         return ParameterError("plot", f"{self.name}'s engine gives no geometry to draw; analyse it without --plot")
+
+    engine_kind = "unnamed engine"
+    """The engine's name as the model's identity gives it (``MuJoCo``, ``OpenSim``)."""
+
+    def engine_versions(self) -> dict:
+        """The versions of the packages that built and read the model (the model's identity).
+
+        Returns
+        -------
+        dict
+            Package -> version; empty for an engine that names none.
+        """
+        return {}
+
+    def posture_columns(self):
+        """How a posture file's columns name this model's coordinates; an engine without names refuses, one line.
+
+        Returns
+        -------
+        spinectl.anatomy.recordings.Columns
+            Never here: raises :class:`~spinectl.errors.ParameterError` (field ``posture``).
+        """
+        raise ParameterError("posture", f"{self.name}'s engine names no coordinates that a file could set")
+
+    def activation_columns(self):
+        """How an activation file's columns name this model's muscles: by their names.
+
+        Returns
+        -------
+        spinectl.anatomy.recordings.Columns
+        """
+        from .recordings import activation_columns_of
+
+        return activation_columns_of({m: m for m in self.muscles}, self.muscles)
+
+    def named_posture(self, values: dict):
+        """The posture in the engine's form from coordinate name -> value; an engine without names refuses.
+
+        Parameters
+        ----------
+        values : dict
+            Coordinate name -> value [rad or m].
+
+        Returns
+        -------
+        object
+            Never here: raises :class:`~spinectl.errors.ParameterError` (field ``posture``).
+        """
+        raise ParameterError("posture", f"{self.name}'s engine names no coordinates that a file could set")
+
+
+SHORT_HASH = 12
+"""Hex digits of the model file's SHA-256 that the table's first line shows (the JSON has all 64)."""
+
+
+def model_identity(anatomy) -> dict:
+    """What every output says of the model: its name, source, file hash, engine and package versions.
+
+    Two public versions of a model (MyoTorso from pip and from its repository) can differ by a factor in
+    stiffness: the table's first line and the JSON name exactly which file each analysed.
+
+    Parameters
+    ----------
+    anatomy : AnatomyEngine
+        The model.
+
+    Returns
+    -------
+    dict
+        ``name``, ``source``, ``sha256``, ``sha256_short`` (its first :data:`SHORT_HASH` digits), ``engine``
+        and ``versions`` (package -> version: the engine's, myo-sim's for MyoTorso, spinectl's).
+    """
+    from .._version import __version__
+
+    versions = dict(getattr(anatomy, "engine_versions", dict)())
+    versions["spinectl"] = __version__
+    return {
+        "name": anatomy.name,
+        "source": anatomy.source,
+        "sha256": anatomy.sha256,
+        "sha256_short": str(anatomy.sha256)[:SHORT_HASH],
+        "engine": getattr(anatomy, "engine_kind", "unnamed engine"),
+        "versions": versions,
+    }
+
+
+def identity_text(model: dict) -> str:
+    """The model's identity as the table's first line gives it.
+
+    Parameters
+    ----------
+    model : dict
+        :func:`model_identity`.
+
+    Returns
+    -------
+    str
+        E.g. ``"myotorso (sha256 4e1f0c2a9b3d; MuJoCo; mujoco 3.3.0, myo-sim 0.2.4, spinectl 0.1.0)"``.
+    """
+    versions = ", ".join(f"{k} {v}" for k, v in model["versions"].items())
+    return f"{model['name']} (sha256 {model['sha256_short']}; {model['engine']}; {versions})"
 
 
 def lordosis_direction(anatomy, rhy, n: int, degrees: float, slopes=None) -> np.ndarray:

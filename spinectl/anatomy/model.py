@@ -240,6 +240,64 @@ class Anatomy(MappedModel):
     def require_referee(self) -> None:
         """MuJoCo's own model is the referee of its chain (``check``): nothing to refuse."""
 
+    engine_kind = "MuJoCo"
+
+    def engine_versions(self) -> dict:
+        """MuJoCo's version, and myo-sim's for a model it ships (the model's identity).
+
+        Returns
+        -------
+        dict
+            Package -> version.
+        """
+        from importlib.metadata import PackageNotFoundError, version
+
+        from .engine import BUILTIN
+
+        out = {"mujoco": require_mujoco().__version__}
+        if self.name in BUILTIN:
+            try:
+                out["myo-sim"] = version("myo-sim")
+            except PackageNotFoundError:  # loaded from a checkout, not an installed distribution
+                out["myo-sim"] = "unknown"
+        return out
+
+    def posture_columns(self):
+        """A posture file's columns: the model's hinge and slide joints by name (hinges in radians or degrees).
+
+        Ball and free joints have no single value to name and stay at the reference posture.
+
+        Returns
+        -------
+        spinectl.anatomy.recordings.Columns
+        """
+        from .recordings import posture_columns_of
+
+        mujoco = require_mujoco()
+        model = self.engine.model
+        hinge, slide = int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE)  # jnt_type holds ints
+        named = [(j, mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, j)) for j in range(model.njnt)]
+        single = [(j, n) for j, n in named if n and int(model.jnt_type[j]) in (hinge, slide)]
+        hinges = [n for j, n in single if int(model.jnt_type[j]) == hinge]
+        return posture_columns_of({n: n for _, n in single}, [n for _, n in single], rotational=hinges)
+
+    def named_posture(self, values: dict) -> np.ndarray:
+        """The full qpos: the reference posture with the named hinge and slide joints set.
+
+        Parameters
+        ----------
+        values : dict
+            Joint name -> value [rad or m] (:meth:`posture_columns`).
+
+        Returns
+        -------
+        numpy.ndarray, shape (nq,)
+        """
+        q = self.posture()
+        for name, j in zip(values, self.joint_ids(values), strict=True):
+            q[self.engine.model.jnt_qposadr[j]] = values[name]
+        return q
+
     def _kinematics(self, qpos):
         """MuJoCo's positions (bodies, anchors, tendon paths) at qpos; the engine's scratch data."""
         mujoco = require_mujoco()

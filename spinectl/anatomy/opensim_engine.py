@@ -757,6 +757,79 @@ class OsimAnatomy(MappedModel):
         """Refused: MuJoCo is the referee, for MJCF only (:meth:`OsimEngine.spec_factory`)."""
         self.engine.spec_factory()
 
+    engine_kind = "OpenSim"
+
+    def engine_versions(self) -> dict:
+        """OpenSim's version (the model's identity).
+
+        Returns
+        -------
+        dict
+            Package -> version.
+        """
+        return {"opensim": require_opensim().__version__}
+
+    def posture_columns(self):
+        """A posture file's columns: each coordinate by name or by path (``/jointset/<joint>/<name>/value``).
+
+        The model's other states (speeds, activations, fibre lengths: a states file's columns) and its
+        muscles' activations by name or path are skipped; the coordinates that OpenSim converts from
+        degrees (``SimbodyEngine.convertDegreesToRadians`` on a row of ones) are the rotational ones.
+
+        Returns
+        -------
+        spinectl.anatomy.recordings.Columns
+        """
+        from .recordings import posture_columns_of
+
+        osim, model = require_opensim(), self.engine.model
+        coords = model.getCoordinateSet()
+        names = [coords.get(i).getName() for i in range(coords.getSize())]
+        labels = {n: n for n in names}
+        labels.update({coords.get(n).getAbsolutePathString() + "/value": n for n in names})
+        table = osim.TimeSeriesTable()
+        table.setColumnLabels(osim.StdVectorString(names))
+        table.appendRow(0.0, osim.RowVector(len(names), 1.0))
+        table.addTableMetaDataString("inDegrees", "yes")
+        model.getSimbodyEngine().convertDegreesToRadians(table)
+        row = table.getRowAtIndex(0).to_numpy()
+        rotational = [n for n, v in zip(names, row, strict=True) if v != 1.0]
+        muscles = set(self.activation_columns().names)  # a states file's activations, even of a muscle without one
+        return posture_columns_of(labels, names, (self._states() | muscles) - set(labels), rotational)
+
+    def activation_columns(self):
+        """An activation file's columns: each muscle by name or by path (``/forceset/<name>/activation``).
+
+        Returns
+        -------
+        spinectl.anatomy.recordings.Columns
+        """
+        from .recordings import activation_columns_of
+
+        muscles = self.engine.model.getMuscles()
+        labels = {m: m for m in self.muscles}
+        labels.update({muscles.get(m).getAbsolutePathString() + "/activation": m for m in self.muscles})
+        return activation_columns_of(labels, self.muscles, self._states() - set(labels))
+
+    def named_posture(self, values: dict) -> dict:
+        """The posture in OpenSim's form: coordinate name -> value.
+
+        Parameters
+        ----------
+        values : dict
+            Coordinate name -> value [rad or m].
+
+        Returns
+        -------
+        dict
+        """
+        return dict(values)
+
+    def _states(self) -> set:
+        """The paths of the model's state variables (a states file's columns)."""
+        states = self.engine.model.getStateVariableNames()
+        return {states.get(i) for i in range(states.getSize())}
+
     def sagittal_axes(self, joints, posture=None) -> tuple:
         """The sagittal plane's (horizontal, vertical) unit axes in ground: up x the first joint's axis.
 

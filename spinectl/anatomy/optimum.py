@@ -41,7 +41,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..model.linear_chain import LinearChain
-from .contract import AnatomyEngine
+from .contract import AnatomyEngine, identity_text, model_identity
 
 STABILITY = ("chain", "joints", "rhythm", "none")
 EQUILIBRIUM = ("rhythm", "free")
@@ -129,6 +129,8 @@ class Optimum:
     residual : float
         Where infeasible: the bounded least-squares residual of the equilibrium, min ||tau_per a +
         tau_0|| over the bounds (SciPy's ``lsq_linear``) [N m]; NaN where solved.
+    lumbar_joints : tuple of str
+        The names of ``lumbar_torque``'s rows (:func:`lumbar_joints`).
     """
 
     stability: str
@@ -141,6 +143,7 @@ class Optimum:
     eigenvalues: np.ndarray
     joint_stiffness: np.ndarray
     residual: float = float("nan")
+    lumbar_joints: tuple = ()
 
     @property
     def ok(self) -> bool:
@@ -189,7 +192,32 @@ def optimise(
     free, constrained, lin = anatomy.chains(plane, posture, joint_stiffness)
     rows, tau_per, tau_0 = anatomy.equilibrium_rows(lin, plane, posture, equilibrium)
     w = anatomy.volume_weights() if weights == "volume" else np.ones(free.n_controls)
-    return optimum_on_chains(free, constrained, lin, rows, tau_per, tau_0, w, stability, equilibrium, margin)
+    opt = optimum_on_chains(free, constrained, lin, rows, tau_per, tau_0, w, stability, equilibrium, margin)
+    return dataclasses.replace(opt, lumbar_joints=lumbar_joints(anatomy, plane, len(rows)))
+
+
+def lumbar_joints(anatomy: AnatomyEngine, plane: str, rows: int) -> tuple:
+    """The joints of the equilibrium's lumbar rows (:meth:`~spinectl.anatomy.contract.AnatomyEngine.equilibrium_rows`).
+
+    MuJoCo's rows are the mapping's ``3d`` joints (this plane's if it has none), OpenSim's the plane's
+    chain: whichever has as many joints as there are rows.
+
+    Parameters
+    ----------
+    anatomy : AnatomyEngine
+        The model.
+    plane : str
+        The chain.
+    rows : int
+        How many lumbar rows the equilibrium has.
+
+    Returns
+    -------
+    tuple of str
+    """
+    own = anatomy.plane_joints(plane)
+    every = tuple(anatomy.mapping.planes.get("3d", own))
+    return every if len(every) == rows else tuple(own)[:rows]
 
 
 def check_choices(stability, equilibrium, margin, weights="volume"):
@@ -299,6 +327,7 @@ def _optimum_dict(anatomy: AnatomyEngine, opt: Optimum) -> dict:
         "restoring_stiffness_Nm_per_rad": opt.joint_stiffness.tolist(),
         "net_torque_Nm": opt.net_torque.tolist(),
         "lumbar_torque_Nm": opt.lumbar_torque.tolist(),
+        "lumbar_joints": list(opt.lumbar_joints),
         "equilibrium_residual_Nm": opt.residual,
     }
 
@@ -306,6 +335,7 @@ def _optimum_dict(anatomy: AnatomyEngine, opt: Optimum) -> dict:
 KEPT_WHERE_INFEASIBLE = (
     "model",
     "plane",
+    "posture_source",
     "joints",
     "muscles",
     "control_unit",
@@ -425,7 +455,7 @@ class OptimisedResult:
         """The model and the chain, where there is no analysis (an infeasible optimum)."""
         anatomy = self.anatomy
         return {
-            "model": {"name": anatomy.name, "source": anatomy.source, "sha256": anatomy.sha256},
+            "model": model_identity(anatomy),
             "plane": self.plane,
             "joints": list(self.anatomy.plane_joints(self.plane)),
         }
@@ -438,7 +468,10 @@ class OptimisedResult:
         str
         """
         rows = (("optimum", self.optimum), ("classic", self.classic))
-        lines = [_optimum_line(label, opt, self.margin) for label, opt in rows]
+        lines = [identity_text(model_identity(self.anatomy))]
+        for label, opt in rows:
+            lines.append(_optimum_line(label, opt, self.margin))
+            lines += hidden_torque_lines(opt)
         lines.append(self._price_line())
         if self.infeasible_constraint == "equilibrium":
             lines.append(EQUILIBRIUM_HINT.format(residual=self.classic.residual, rows=self.classic.net_torque.size))
@@ -478,6 +511,38 @@ def _optimum_line(label: str, opt: Optimum, margin: float) -> str:
         f"{opt.status}; cost {opt.cost:.4g}, sum of activations {np.sum(opt.activations):.4g}; "
         f"eigenvalues of -K (free chain) {eig} N m/rad"
     )
+
+
+HIDDEN_TORQUE = (
+    "  torque the rhythm carries (equilibrium on the rhythm's coordinates only; the model's equalities, not its "
+    "muscles, hold the rest): largest {largest:.3g} N m at {joint}; per lumbar joint [N m]: {each}"
+)
+"""What the table says beside an optimum whose equilibrium holds on the rhythm's coordinates only."""
+
+
+def hidden_torque_lines(opt: Optimum) -> list:
+    """The torque the rhythm carries at each lumbar joint, as the table shows it beside the optimum's verdict.
+
+    With ``equilibrium="rhythm"`` the muscles balance the posture on the rhythm's independent coordinates
+    only (T^T tau = 0); each lumbar joint may still carry a net torque, which the model's joint equalities
+    (MuJoCo) or couplers (OpenSim) hold as constraint forces. The verdicts at that optimum rest on it.
+
+    Parameters
+    ----------
+    opt : Optimum
+        An optimum.
+
+    Returns
+    -------
+    list of str
+        One line, or none (equilibrium ``"free"``, where it is zero by construction; an infeasible optimum).
+    """
+    if opt.equilibrium != "rhythm" or not opt.ok or not opt.lumbar_joints:
+        return []
+    torque = opt.lumbar_torque
+    k = int(np.argmax(np.abs(torque)))
+    each = ", ".join(f"{j} {t:.3g}" for j, t in zip(opt.lumbar_joints, torque, strict=True))
+    return [HIDDEN_TORQUE.format(largest=abs(torque[k]), joint=opt.lumbar_joints[k], each=each)]
 
 
 INFEASIBLE_HINT = (
@@ -602,8 +667,10 @@ def optimised(
     equilibrium: str = "rhythm",
     check: bool = False,
     reflex=None,
+    posture=None,
+    time=None,
 ) -> OptimisedResult:
-    """The optimum with a criterion and without, at the reference posture, and the analysis at the optimum.
+    """The optimum with a criterion and without, at a posture, and the analysis at the optimum.
 
     Parameters
     ----------
@@ -624,27 +691,38 @@ def optimised(
     reflex : tuple, optional
         ``(kp, kd, lag)``: the chain's exact delay margin at the optimum
         (:func:`~spinectl.anatomy.analyses.reflex_margin`).
+    posture : optional
+        The engine's posture, or an OpenSim ``.mot``/``.sto`` file of every coordinate
+        (:func:`spinectl.anatomy.recordings.recorded_point`); default the model's reference posture.
+    time : float, optional
+        The posture file's frame [s]; default its first.
 
     Returns
     -------
     OptimisedResult
     """
     from .analyses import analyse
+    from .recordings import recorded_point
 
     if check:  # refused before any optimum is solved, on an engine MuJoCo cannot referee
         anatomy.require_referee()
+    point = recorded_point(anatomy, posture, None, time)
     kwargs = {"plane": plane, "margin": margin, "joint_stiffness": joint_stiffness, "equilibrium": equilibrium}
+    kwargs["posture"] = point.posture
     opt = optimise(anatomy, stability=stability, **kwargs)
     classic = opt if stability == "none" else optimise(anatomy, stability="none", **kwargs)
     analysis = None
+    at = {"posture": point.posture, "joint_stiffness": joint_stiffness, "reflex": reflex}
     if opt.ok:
-        analysis = analyse(anatomy, plane, opt.activations, joint_stiffness=joint_stiffness, check=check, reflex=reflex)
-    empty = skeleton(anatomy, opt, reflex=reflex, **kwargs)
+        analysis = analyse(anatomy, plane, opt.activations, check=check, **at)
+    empty = skeleton(anatomy, opt, **kwargs, reflex=reflex)
+    if point.posture_source:  # the file and its frame, where analyse saw the posture it read
+        analysis, empty = (r and dataclasses.replace(r, posture_source=point.posture_source) for r in (analysis, empty))
     fix = remedy(anatomy, optimise, opt, classic, joint_stiffness, kwargs)
     return OptimisedResult(anatomy, opt, classic, float(margin), plane, analysis, empty, fix)
 
 
-def skeleton(anatomy: AnatomyEngine, opt: Optimum, plane: str, joint_stiffness, reflex=None, **_):
+def skeleton(anatomy: AnatomyEngine, opt: Optimum, plane: str, joint_stiffness, reflex=None, posture=None, **_):
     """Where the optimum is infeasible, the analysis at the lower control bounds (its JSON's keys); else None.
 
     Parameters
@@ -659,6 +737,8 @@ def skeleton(anatomy: AnatomyEngine, opt: Optimum, plane: str, joint_stiffness, 
         Added at each chain joint [N m/rad].
     reflex : tuple, optional
         ``(kp, kd, lag)``.
+    posture : optional
+        The engine's posture; default the reference posture.
 
     Returns
     -------
@@ -669,7 +749,7 @@ def skeleton(anatomy: AnatomyEngine, opt: Optimum, plane: str, joint_stiffness, 
     if opt.ok:
         return None
     lower = anatomy.control_bounds()[0]
-    return analyse(anatomy, plane, lower, joint_stiffness=joint_stiffness, reflex=reflex)
+    return analyse(anatomy, plane, lower, posture=posture, joint_stiffness=joint_stiffness, reflex=reflex)
 
 
 def lordosis_posture(anatomy: AnatomyEngine, degrees: float, plane: str = "sagittal"):

@@ -7,7 +7,7 @@ import argparse
 from ..anatomy.mapping import MAX_STIFFNESS
 from ..errors import ParameterError
 from ..model.params.bounds import MAX_ACTIVATION_TIME_CONSTANT
-from ._common import emit_json, finite_float
+from ._common import emit_json, finite_float, input_name
 
 MAX_DERIVATIVE_GAIN = 1e6
 """Largest reflex derivative gain kd [N m s/rad]: the chain's delay margin scales as 1/kd from 1e3 to 1e6
@@ -36,8 +36,8 @@ def register(sub) -> None:
         help="stability of an anatomical model's lumbar chain (MuJoCo or OpenSim; MyoTorso built in)",
         description="Load a musculoskeletal model (the built-in 'myotorso' from myo-sim, an MJCF file read by "
         "MuJoCo or an .osim file read by OpenSim, with --mapping), linearise its lumbar chain at the reference "
-        "posture and the model's own controls (or --activation), and report each joint's stiffness (joint by "
-        "joint, the others fixed), the chain's "
+        "posture (or --posture's) and the model's own controls (or --activation, --activations), and report "
+        "each joint's stiffness (joint by joint, the others fixed), the chain's "
         "eigenvalues (every joint free, equality constraints off), the chain constrained by the model's "
         "lumbar rhythm (if it has one), and the global muscles' rank. Needs pip install 'spinectl[anatomy]' "
         "(and 'spinectl[opensim]' for .osim). "
@@ -60,6 +60,29 @@ def register(sub) -> None:
         help="activation of every muscle, in [0, 1] (or its control, e.g. a PCSA in cm^2 in spinectl's "
         "export) (default: the model's own controls: an MJCF's keyframe 0, an .osim's controllers at t = 0, "
         "spinectl's export's solution in both; else 0)",
+    )
+    parser.add_argument(
+        "--posture",
+        type=input_name,
+        metavar="FILE",
+        help="the posture from an OpenSim coordinates or states file (.mot, .sto: inverse kinematics, a "
+        "states file; degrees or radians as its header's inDegrees says), every coordinate of the model by name "
+        "or path (/jointset/J/C/value; an MJCF model's hinge and slide joints by name); needs OpenSim "
+        "(default: the model's reference posture)",
+    )
+    parser.add_argument(
+        "--activations",
+        type=input_name,
+        metavar="FILE",
+        help="the activations from an OpenSim .sto (static optimisation, CMC, Moco, EMG normalised to [0, 1]): "
+        "one column per muscle (an MJCF model's muscle actuators) by name or path ending /activation, every "
+        "muscle given; needs OpenSim",
+    )
+    parser.add_argument(
+        "--time",
+        type=finite_float("--time"),
+        metavar="T",
+        help="the frame of --posture and --activations read [s] (default: each file's first; the table says which)",
     )
     parser.add_argument(
         "--joint-stiffness",
@@ -179,10 +202,9 @@ def _answers(args) -> tuple:
     from ..anatomy import load
     from ..anatomy.analyses import analyse
 
+    _refuse_combinations(args)
     anatomy = load(args.model, args.mapping, cache=not args.no_cache)
     reflex = None if args.kp is None else (args.kp, args.kd, args.activation_lag)
-    if args.optimise and args.activation is not None:  # before: ignored without a word
-        raise ParameterError("--activation", "cannot go with --optimise, which finds the activations itself")
     if args.optimise:
         from ..anatomy.optimum import optimised
 
@@ -195,15 +217,19 @@ def _answers(args) -> tuple:
             equilibrium=args.equilibrium,
             check=args.check,
             reflex=reflex,
+            posture=args.posture,
+            time=args.time,
         )
     else:
         result = analyse(
             anatomy,
             plane=args.plane,
-            activation=args.activation,
+            activation=args.activations if args.activations is not None else args.activation,
             joint_stiffness=args.joint_stiffness,
             check=args.check,
             reflex=reflex,
+            posture=args.posture,
+            time=args.time,
         )
     curve = None
     if args.lordosis:
@@ -223,6 +249,21 @@ def _answers(args) -> tuple:
         analysis = result.analysis if args.optimise else result
         save_anatomy_figures(anatomy, analysis, curve, args.plot)
     return result, curve
+
+
+def _refuse_combinations(args) -> None:
+    """Options that cannot go together, refused before the model loads (before: one was ignored without a word)."""
+    given = args.activation is not None or args.activations is not None
+    if args.optimise and given:
+        option = "--activation" if args.activation is not None else "--activations"
+        raise ParameterError(option, "cannot go with --optimise, which finds the activations itself")
+    if args.activation is not None and args.activations is not None:
+        raise ParameterError("--activations", "cannot go with --activation: give the activations one way")
+    if args.time is not None and args.posture is None and args.activations is None:
+        raise ParameterError("--time", "selects a frame of --posture or --activations; neither was given")
+    for option, value in (("--lordosis", args.lordosis), ("--plot", args.plot)):
+        if value and args.posture is not None:  # both start from the model's reference posture
+            raise ParameterError(option, "starts from the model's reference posture; it cannot go with --posture")
 
 
 def _joint_stiffness(text: str):

@@ -114,7 +114,12 @@ def test_a_made_up_third_engine_runs_through_the_seams_alone(fake_engine, capsys
     assert isinstance(anatomy.load(fake_engine), AnatomyEngine)
     doc = run_json(["anatomy", fake_engine, "--json"], capsys)
     text = json.dumps(doc)
-    assert doc["model"] == {"name": "fake", "source": "model.fake", "sha256": "0" * 64}
+    assert {k: doc["model"][k] for k in ("name", "source", "sha256", "engine")} == {
+        "name": "fake",
+        "source": "model.fake",
+        "sha256": "0" * 64,
+        "engine": "unnamed engine",
+    }
     assert "-3.0" in text and "2.0" in text
     eig = sorted(np.linalg.eigvalsh([[-3.0, 2.0], [2.0, 2.0]]))
     assert np.allclose(eig, [-0.5 - np.sqrt(10.25), -0.5 + np.sqrt(10.25)])

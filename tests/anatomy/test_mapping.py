@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -253,3 +254,41 @@ def test_a_misspelt_mapped_stiffness_is_refused_at_the_command_line(tmp_path, ca
     assert main(["anatomy", "--mapping", str(path), "--joint-stiffness", "mapped"]) == 2
     captured = capsys.readouterr()
     assert captured.out == "" and captured.err.count("\n") == 1 and "did you mean 'joint_stiffness'?" in captured.err
+
+
+SHARED_MODELS = Path("/work/shared/models")
+PUBLISHED = {
+    "pose2sim.toml": "pose2sim-beaucage-gauvreau/Model_Pose2Sim_muscles_flex.osim",
+    "cyclist.toml": "allaire-cyclist/s01modelScaled.osim",
+    "christophy.toml": "christophy-skeleton/Christophy2012_axialRotationUpd_skeletonOnly.osim",
+}
+
+
+def _documented_mappings() -> list:
+    """The TOML blocks of docs/anatomy.md's "Published models", in the order of PUBLISHED."""
+    import re
+
+    text = (Path(__file__).resolve().parents[2] / "docs" / "anatomy.md").read_text(encoding="utf-8")
+    section = text.split("## Published models", 1)[1].split("\n## ", 1)[0]
+    return re.findall(r"```toml\n(.*?)```", section, flags=re.S)
+
+
+@pytest.mark.skipif(not SHARED_MODELS.is_dir(), reason="the shared downloaded models (/work/shared/models) are absent")
+@pytest.mark.parametrize("index", range(len(PUBLISHED)))
+def test_the_documented_mappings_name_the_published_models_bodies_and_coordinates(tmp_path, index):
+    """Each mapping of docs/anatomy.md's "Published models" reads as a mapping, and every body and coordinate it
+    names is one of its model's (OpenSim's own body and coordinate sets)."""
+    osim = pytest.importorskip("opensim", reason="needs the opensim extra: pip install 'spinectl[opensim]'")
+    from spinectl.anatomy.mapping import read_mapping
+
+    name, model_path = list(PUBLISHED.items())[index]
+    path = tmp_path / name
+    path.write_text(_documented_mappings()[index], encoding="utf-8")
+    mapping = read_mapping(path)
+    osim.Logger.setLevelString("error")
+    model = osim.Model(str(SHARED_MODELS / model_path))
+    bodies = {model.getBodySet().get(i).getName() for i in range(model.getBodySet().getSize())}
+    coordinates = {model.getCoordinateSet().get(i).getName() for i in range(model.getCoordinateSet().getSize())}
+    assert {b for names in mapping.bodies.values() for b in names} <= bodies
+    assert {c for names in mapping.planes.values() for c in names} <= coordinates
+    assert len(mapping.planes["sagittal"]) >= 5

@@ -208,3 +208,25 @@ def test_non_lumbar_muscles_take_no_effort_at_the_optimum(torso, optima):
     assert [torso.muscles[i] for i in non] == ["LTpT_T1_r", "LTpT_T1_l"]
     for opt in optima.values():
         assert np.abs(opt.activations[non]).max() <= 1e-9
+
+
+def test_the_torque_the_rhythm_carries_is_in_the_table_beside_the_verdict(torso):
+    """MyoTorso's chain optimum with 50 N m/rad added, equilibrium on the rhythm's coordinates: the table shows,
+    under the optimum's verdict, the net torque at each lumbar joint, which is MuJoCo's own generalised force at
+    the optimum's activations (mj_fwdActuation: actuators + passive - bias, constraint forces left out), largest
+    at L1_L2_FE (about 52 N m); with the equilibrium on every joint (free) it is zero and not shown."""
+    result = optimised(torso, stability="chain", joint_stiffness=50)
+    model, engine = torso.engine.model, torso.engine
+    act = np.zeros(model.na)
+    act[model.actuator_actadr[engine.muscle_ids()]] = result.optimum.activations
+    force = engine.generalised_force(model.qpos0, act)
+    joints = result.optimum.lumbar_joints
+    expected = force[[model.jnt_dofadr[j] for j in torso.joint_ids(joints)]]
+    lines = result.table().splitlines()
+    line = lines[lines.index(next(x for x in lines if x.startswith("optimum: "))) + 1]
+    shown = dict(cell.rsplit(" ", 1) for cell in line.split("per lumbar joint [N m]: ")[1].split(", "))
+    assert list(shown) == list(joints)
+    np.testing.assert_allclose([float(v) for v in shown.values()], expected, rtol=5e-3, atol=1e-3)
+    assert f"largest {abs(expected).max():.3g} N m at L1_L2_FE" in line and 45 < abs(expected).max() < 60
+    free = optimised(torso, stability="chain", joint_stiffness=50, equilibrium="free")
+    assert "torque the rhythm carries" not in free.table()

@@ -55,7 +55,7 @@ def test_json_is_the_results_dict(cached, capsys):
     out = capsys.readouterr().out
     doc = json.loads(out)
     assert all(key in doc for key in KEYS)
-    assert set(doc["model"]) == {"name", "source", "sha256"}
+    assert set(doc["model"]) == {"name", "source", "sha256", "sha256_short", "engine", "versions"}
     assert set(doc["muscles"]) == {"global", "local", "between", "non-lumbar"}
     assert len(doc["mujoco_eigenvalues"]) == 10
     assert out == jsondoc.dumps(analyse(package.load(), activation=0.05, check=True).to_dict())
@@ -267,3 +267,38 @@ def test_the_optimum_refuses_an_activation_it_would_ignore(cached, capsys):
     assert capsys.readouterr().err == (
         "spinectl: error: --activation: cannot go with --optimise, which finds the activations itself\n"
     )
+
+
+def test_json_with_a_posture_file_on_a_model_missing_its_meshes_is_json_alone(tmp_path):
+    """An .osim whose mesh file is absent (OpenSim warns as it builds it) analysed at a posture file's frame:
+    `anatomy --json` in a subprocess (OpenSim's C++ logger writes to file descriptor 1, which capsys does not see)
+    prints one JSON document on stdout, which names the file, the frame and the model's identity; the warning goes
+    to stderr."""
+    import subprocess
+    import sys
+
+    osim = pytest.importorskip("opensim", reason="needs the opensim extra: pip install 'spinectl[opensim]'")
+    from spinectl.anatomy.export_osim import export_osim
+    from spinectl.model.config import load_preset
+
+    exported = tmp_path / "chain.osim"
+    export_osim(load_preset("wagner2012"), 0.03, 0.04, exported)
+    built = osim.Model(str(exported))
+    built.getBodySet().get(0).attachGeometry(osim.Mesh("absent_mesh.vtp"))
+    built.finalizeConnections()
+    meshed = tmp_path / "meshed.osim"
+    built.printToXML(str(meshed))
+    names = ["L5S1", "L4L5", "L3L4", "L2L3", "L1L2"]
+    table = osim.TimeSeriesTable()
+    table.setColumnLabels(osim.StdVectorString(names))
+    for t in (0.0, 0.1):
+        table.appendRow(t, osim.RowVector(np.full(5, 10 * t)))
+    table.addTableMetaDataString("inDegrees", "yes")
+    osim.STOFileAdapter.write(table, str(tmp_path / "ik.mot"))
+    argv = ["anatomy", str(meshed), "--posture", str(tmp_path / "ik.mot"), "--time", "0.1", "--json"]
+    result = subprocess.run([sys.executable, "-m", "spinectl", *argv], capture_output=True, text=True, check=False)
+    assert result.returncode == 0, result.stderr
+    doc = json.loads(result.stdout)
+    assert doc["posture_source"] == "ik.mot at t = 0.1 s (the time asked)"
+    assert doc["model"]["engine"] == "OpenSim" and doc["model"]["versions"]["opensim"] == osim.__version__
+    assert "absent_mesh.vtp" in result.stderr and "absent_mesh.vtp" not in result.stdout
