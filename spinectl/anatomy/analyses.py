@@ -700,7 +700,7 @@ def reflex_margin(chain: LinearChain, a, kp: float, kd: float, lag: float) -> di
 def analyse(
     anatomy: AnatomyEngine,
     plane: str = "sagittal",
-    activation=0.0,
+    activation=None,
     posture=None,
     joint_stiffness="none",
     check=False,
@@ -716,7 +716,9 @@ def analyse(
     plane : str
         One of the mapping's planes.
     activation : float, array_like, dict, str, pathlib.Path or None
-        Activations in [0, 1] (:func:`activations`); None: the model's keyframe 0's, else 0; a file: an
+        Activations in [0, 1] (:func:`activations`); None (default): the model's own controls
+        (:meth:`~spinectl.anatomy.contract.AnatomyEngine.default_controls`: an MJCF's keyframe 0, else 0;
+        an ``.osim``'s controllers at t = 0, else each muscle's activation floor); a file: an
         OpenSim ``.sto`` with one column per muscle (:func:`spinectl.anatomy.recordings.anatomy_point`).
     posture : array_like, dict, str, pathlib.Path, optional
         The engine's form (MuJoCo: the full qpos; OpenSim: coordinate name -> value [rad]), or an OpenSim

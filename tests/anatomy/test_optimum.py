@@ -151,7 +151,11 @@ def test_the_optimum_table_says_infeasible_plainly_and_mu_only_where_there_is_a_
     line begins 'remedy:'. The same with the joint-by-joint criterion and mu = 2 (a variant): feasible, its row
     names mu = 2 and the price is the cost ratio."""
     bare = optimised(torso, stability="chain").table().splitlines()
-    optimum, classic, price, remedy = bare[:4]
+
+    def row(lines, prefix):  # the rows by their first word: the identity and the rhythm's torque lines between
+        return next(line for line in lines if line.startswith(prefix))
+
+    optimum, classic, price, remedy = (row(bare, p) for p in ("optimum", "classic", "price", "remedy"))
     assert optimum.startswith("optimum (the chain free") and "mu = 1 N m/rad" in optimum
     assert "infeasible: no activations within their bounds hold the posture and meet the criterion" in optimum
     assert "mu =" not in classic and classic.startswith("classic (no stability criterion")
@@ -159,7 +163,7 @@ def test_the_optimum_table_says_infeasible_plainly_and_mu_only_where_there_is_a_
     assert remedy.startswith("remedy: ") and "--joint-stiffness" in remedy
     assert not any("nan" in line for line in bare)
     solved = optimised(torso, stability="joints", margin=2.0)
-    optimum, classic, price = solved.table().splitlines()[:3]
+    optimum, classic, price = (row(solved.table().splitlines(), p) for p in ("optimum", "classic", "price"))
     assert "mu = 2 N m/rad" in optimum and "mu =" not in classic
     assert price.endswith(f": {solved.optimum.cost / solved.classic.cost:.4g}")
 
@@ -223,7 +227,7 @@ def test_the_torque_the_rhythm_carries_is_in_the_table_beside_the_verdict(torso)
     joints = result.optimum.lumbar_joints
     expected = force[[model.jnt_dofadr[j] for j in torso.joint_ids(joints)]]
     lines = result.table().splitlines()
-    line = lines[lines.index(next(x for x in lines if x.startswith("optimum: "))) + 1]
+    line = lines[lines.index(next(x for x in lines if x.startswith("optimum ("))) + 1]
     shown = dict(cell.rsplit(" ", 1) for cell in line.split("per lumbar joint [N m]: ")[1].split(", "))
     assert list(shown) == list(joints)
     np.testing.assert_allclose([float(v) for v in shown.values()], expected, rtol=5e-3, atol=1e-3)
