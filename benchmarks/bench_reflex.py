@@ -151,5 +151,6 @@ def main() -> None:
         print(f"  largest relative difference, {name:22} {difference:.1e}")
     print("(best CPU time of interleaved runs)")
 
+
 if __name__ == "__main__":
     main()

@@ -31,8 +31,9 @@ from ..model.chain import dynamic_eigenvalues
 from ..model.chain import state_matrix as chain_state_matrix
 from ..model.linear_chain import CONTROL_CLASSES, LinearChain
 from ..model.stability import MARGINAL_TIME_CONSTANT, slowest_time_constant
-from .contract import AnatomyEngine, identity_text, model_identity
+from .contract import AnatomyEngine
 from .engine import require_mujoco
+from .identity import identity_text, model_identity
 from .model import Anatomy
 from .naming import joint_labels
 
@@ -412,7 +413,7 @@ class AnatomyResult:
     Attributes
     ----------
     model : dict
-        The model's identity (:func:`~spinectl.anatomy.contract.model_identity`): ``name``, ``source``,
+        The model's identity (:func:`~spinectl.anatomy.identity.model_identity`): ``name``, ``source``,
         ``sha256``, ``sha256_short``, ``engine``, ``versions``.
     plane : str
         The plane.

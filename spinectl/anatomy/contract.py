@@ -24,7 +24,7 @@ from typing import Protocol, runtime_checkable
 import numpy as np
 
 from .._validate import printable, show
-from ..errors import ModelError, ParameterError
+from ..errors import ParameterError
 from ..model.linear_chain import LinearChain
 from .joint_angles import JointSlopes, linearisation_in_angles, rhythm_in_angles
 from .linearise import constrained_chain, free_chain
@@ -697,118 +697,6 @@ class MappedModel:
             Never here: raises :class:`~spinectl.errors.ParameterError` (field ``posture``).
         """
         raise ParameterError("posture", f"{self.name}'s engine names no coordinates that a file could set")
-
-
-SHORT_HASH = 12
-"""Hex digits of the model file's SHA-256 that the table's first line shows (the JSON has all 64)."""
-
-
-def model_identity(anatomy) -> dict:
-    """What every output says of the model: its name, source, file hash, engine and package versions.
-
-    Two public versions of a model (MyoTorso from pip and from its repository) can differ by a factor in
-    stiffness: the table's first line and the JSON name exactly which file each analysed.
-
-    Parameters
-    ----------
-    anatomy : AnatomyEngine
-        The model.
-
-    Returns
-    -------
-    dict
-        ``name``, ``source``, ``sha256``, ``sha256_short`` (its first :data:`SHORT_HASH` digits), ``engine``
-        and ``versions`` (package -> version: the engine's, myo-sim's for MyoTorso, spinectl's).
-    """
-    from .._version import __version__
-
-    versions = dict(getattr(anatomy, "engine_versions", dict)())
-    versions["spinectl"] = __version__
-    return {
-        "name": anatomy.name,
-        "source": anatomy.source,
-        "sha256": anatomy.sha256,
-        "sha256_short": str(anatomy.sha256)[:SHORT_HASH],
-        "engine": getattr(anatomy, "engine_kind", "unnamed engine"),
-        "versions": versions,
-    }
-
-
-def identity_text(model: dict) -> str:
-    """The model's identity as the table's first line gives it.
-
-    Parameters
-    ----------
-    model : dict
-        :func:`model_identity`.
-
-    Returns
-    -------
-    str
-        E.g. ``"myotorso (sha256 4e1f0c2a9b3d; MuJoCo; mujoco 3.3.0, myo-sim 0.2.4, spinectl 0.1.0)"``.
-    """
-    versions = ", ".join(f"{k} {v}" for k, v in model["versions"].items())
-    return f"{model['name']} (sha256 {model['sha256_short']}; {model['engine']}; {versions})"
-
-
-def lordosis_direction(anatomy, rhy, n: int, degrees: float, slopes=None) -> np.ndarray:
-    """The change of the involved coordinates [rad] that moves the chain's joint angles by ``degrees`` in sum.
-
-    The rhythm's first independent coordinate and the joints it slaves move as its column of T;
-    a chain whose first joint no rhythm ties to another has no lordosis to move along (one line).
-    The sum is of the joints' rotations (S T's column over the chain), not of their coordinates.
-
-    Parameters
-    ----------
-    anatomy : AnatomyEngine
-        The model (for its name).
-    rhy : spinectl.anatomy.linearise.Rhythm
-        The rhythm over the involved joints, the chain's n first.
-    n : int
-        The number of chain joints.
-    degrees : float
-        The change of the chain's summed joint angle [deg].
-    slopes : JointSlopes, optional
-        The chain's joint rotation per coordinate (:meth:`MappedModel.joint_slopes`); default the identity.
-
-    Returns
-    -------
-    numpy.ndarray, shape (len(rhy.dofs),)
-        In the rhythm's coordinates.
-    """
-    direction = rhy.transform[:, 0]
-    turned = direction[:n] if slopes is None or slopes.is_identity() else slopes.jacobian @ direction[:n]
-    if n > 1 and np.count_nonzero(direction[:n]) < 2:
-        raise ModelError(
-            f"lordosis: {anatomy.name} has no rhythm (joint equality or coordinate coupler) that ties its chain's "
-            "first joint to the others, so the chain has no lordosis to move along; give the model one "
-            "(spinectl's export: export it at another Lambda)"
-        )
-    return direction * np.radians(degrees) / turned.sum()
-
-
-def plane_axes(gravity, normal, default_up) -> tuple:
-    """A plane's (horizontal, vertical) unit axes: vertical against gravity, horizontal up x the plane's normal.
-
-    Parameters
-    ----------
-    gravity : array_like, shape (3,)
-        The engine's gravity in its world [m/s^2].
-    normal : array_like, shape (3,)
-        The plane's normal (the first chain joint's axis), in the same world.
-    default_up : array_like, shape (3,)
-        The world's up where there is no gravity (MuJoCo's +z, OpenSim's +y).
-
-    Returns
-    -------
-    tuple
-        (horizontal, up), numpy.ndarray of shape (3,) each.
-    """
-    gravity = np.asarray(gravity, float)
-    size = np.linalg.norm(gravity)
-    up = -gravity / size if size > 0 else np.asarray(default_up, float)
-    horizontal = np.cross(up, np.asarray(normal, float))
-    return horizontal / np.linalg.norm(horizontal), up
 
 
 MUJOCO = "spinectl.anatomy.model:load"

@@ -8,7 +8,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ModelError, ParameterError
-from .contract import MappedModel, lordosis_direction, plane_axes
+from .contract import MappedModel
+from .directions import lordosis_direction, plane_axes
 from .engine import CONTROL_UNIT, Engine, load_engine, require_mujoco
 from .linearise import Linearisation, linearise, rhythm
 from .mapping import Mapping, check_mapping, classify, default_mapping, read_mapping
@@ -217,7 +218,7 @@ class Anatomy(MappedModel):
         """The reference posture with the plane's chain moved along the model's rhythm by ``degrees`` in total.
 
         The chain's joints move as the rhythm's coefficients distribute them
-        (:func:`~spinectl.anatomy.contract.lordosis_direction`), and a joint off the chain that a joint
+        (:func:`~spinectl.anatomy.directions.lordosis_direction`), and a joint off the chain that a joint
         equality slaves to them (MyoTorso's abdomen, left out of the rhythm) follows its equality: the
         posture is the model's. The thorax is not held upright (it turns with the chain).
 

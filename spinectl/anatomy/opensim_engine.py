@@ -51,91 +51,21 @@ import numpy as np
 from .._validate import printable
 from ..errors import ModelError, ParameterError
 from . import osim_cache
-from .classes import Skeleton, classify_muscles
-from .contract import MappedModel, lordosis_direction, plane_axes
+from .contract import MappedModel
+from .directions import lordosis_direction, plane_axes
 from .engine import engine_output_to_stderr, model_file, one_line
 from .export_osim import require_opensim
 from .joint_angles import JointSlopes
-from .linearise import STEP, Linearisation, Rhythm
-from .mapping import Mapping, default_mapping, located, read_mapping
+from .linearise import STEP, Linearisation
+from .mapping import Mapping, default_mapping, read_mapping
 from .opensim_angles import joint_slopes
+from .opensim_classes import check_mapping, classify
+from .opensim_couplers import coupler_rhythm, followed, read_couplers
 from .opensim_muscles import activation_floor, check_muscle, compliant, tension_terms
 from .osim_geometry import geometry
 
 KEPT = 256
 """How many linearisations an engine keeps in memory (:attr:`OsimEngine.linearisations`), the latest."""
-
-
-@dataclass(frozen=True)
-class Coupler:
-    """One ``CoordinateCouplerConstraint``: q_dependent = function(q_independent...).
-
-    Attributes
-    ----------
-    name, dependent : str
-        The constraint's and its dependent coordinate's names.
-    independent : tuple of str
-        Its independent coordinates.
-    function : opensim.Function
-        The model's own function of the independent coordinates.
-    """
-
-    name: str
-    dependent: str
-    independent: tuple
-    function: object
-
-    def derivatives(self, values: dict, engine) -> tuple:
-        """The function's first and second derivatives in each independent coordinate at a posture.
-
-        Parameters
-        ----------
-        values : dict
-            Coordinate name -> value [rad] (others at their defaults).
-        engine : OsimEngine
-
-        Returns
-        -------
-        tuple
-            (slopes, curvatures), numpy.ndarray of shape (len(independent),) [1] and [1/rad].
-        """
-        osim = require_opensim()
-        x = osim.Vector(len(self.independent), 0.0)
-        for k, name in enumerate(self.independent):
-            x.set(k, float(values.get(name, engine.coordinate(name).getDefaultValue())))
-        slopes, curvatures, mixed = [], [], []
-        for k in range(len(self.independent)):
-            slopes.append(self.function.calcDerivative(_orders(osim, k), x))
-            curvatures.append(self.function.calcDerivative(_orders(osim, k, k), x))
-            mixed += [self.function.calcDerivative(_orders(osim, k, j), x) for j in range(k)]
-        if any(abs(v) > 0 for v in mixed):  # the reduction carries each coordinate's own curvature only
-            raise ModelError(f"{engine.name}: coupler {self.name} has mixed second derivatives, not supported")
-        return np.array(slopes), np.array(curvatures)
-
-    def describe(self, values: dict, engine) -> str:
-        """One phrase: the dependent coordinate, what it follows and the slopes at the posture.
-
-        Parameters
-        ----------
-        values : dict
-            Coordinate name -> value [rad].
-        engine : OsimEngine
-
-        Returns
-        -------
-        str
-        """
-        slopes, _ = self.derivatives(values, engine)
-        on = ", ".join(f"{n} slope {v:.4g}" for n, v in zip(self.independent, slopes, strict=True))
-        return f"{self.name} ({self.dependent} on {on})"
-
-
-def _orders(osim, *orders):
-    """OpenSim's derivative-order argument: the indices of the variables differentiated."""
-    out = osim.StdVectorInt()
-    for k in orders:
-        out.append(int(k))
-    return out
 
 
 @dataclass
@@ -148,7 +78,7 @@ class OsimEngine:
     state : SimTK.State
     name, source, sha256 : str
         The model's name, the file's path and the SHA-256 of its bytes.
-    couplers : tuple of Coupler
+    couplers : tuple of spinectl.anatomy.opensim_couplers.Coupler
         The model's ``CoordinateCouplerConstraint`` s, switched off in ``model`` (the free chain).
     mobilities : dict
         Coordinate name -> its mobility index, read once (:func:`_mobility_order`).
@@ -236,7 +166,7 @@ def load_engine(path, cache: bool = True) -> OsimEngine:
         with engine_output_to_stderr():  # OpenSim's warnings (e.g. of each missing mesh) are not our output
             model = osim.Model(str(path))
             schema = _schema(osim, model, path)
-            couplers = _couplers(osim, model)
+            couplers = read_couplers(osim, model)
             state = model.initSystem()
     except Exception as exc:  # OpenSim raises its own exception types, one line each
         if isinstance(exc, ParameterError):
@@ -246,7 +176,8 @@ def load_engine(path, cache: bool = True) -> OsimEngine:
     source = str(path.resolve()) + schema
     muscles = model.getMuscles()
     springs = sum(compliant(muscles.get(i)) for i in range(muscles.getSize()))
-    return OsimEngine(model, state, model.getName() or path.stem, source, digest, couplers, cache=cache, springs=springs)
+    name = model.getName() or path.stem
+    return OsimEngine(model, state, name, source, digest, couplers, cache=cache, springs=springs)
 
 
 def _one_line(exc) -> str:
@@ -272,133 +203,6 @@ def _schema(osim, model, path) -> str:
             f"({latest}); open it with that OpenSim",
         )
     return f" (schema {version}, upgraded by OpenSim {osim.__version__} to {latest})" if version < latest else ""
-
-
-def _couplers(osim, model) -> tuple:
-    """The model's coordinate couplers, each switched off (before ``initSystem``: the free chain)."""
-    constraints = model.updConstraintSet()
-    out = []
-    for i in range(constraints.getSize()):
-        coupler = osim.CoordinateCouplerConstraint.safeDownCast(constraints.get(i))
-        if coupler is None:
-            continue
-        names = coupler.getIndependentCoordinateNames()
-        independent = tuple(names.get(k) for k in range(names.getSize()))
-        coupler.set_isEnforced(False)
-        out.append(Coupler(coupler.getName(), coupler.getDependentCoordinateName(), independent, coupler.getFunction()))
-    return tuple(out)
-
-
-def coupler_rhythm(engine: OsimEngine, chain, values: dict) -> tuple:
-    """The couplers among the chain's own coordinates as a :class:`~spinectl.anatomy.linearise.Rhythm`.
-
-    A coupler is the rhythm where its dependent coordinate and every independent one are the
-    chain's; one that ties a coordinate off the chain to the chain (the Pose2Sim model's
-    ``Abs_r3_con``: its ``Abdomen`` routing body on ``L5_S1_Flex_Ext``; a chain coordinate that
-    follows one off it) is named in :attr:`~spinectl.anatomy.linearise.Rhythm.left_out` instead, as
-    MuJoCo's joint equalities are (:func:`spinectl.anatomy.linearise.rhythm`). Only couplers whose
-    independent coordinates no other coupler slaves are supported.
-
-    Parameters
-    ----------
-    engine : OsimEngine
-    chain : sequence of str
-        The chain's coordinates.
-    values : dict
-        Coordinate name -> value [rad] of the posture.
-
-    Returns
-    -------
-    tuple
-        (Rhythm, the involved coordinates' names (the chain's), the couplers of the rhythm).
-    """
-    chain = list(chain)
-    on_chain = [c for c in engine.couplers if c.dependent in chain and set(c.independent) <= set(chain)]
-    left_out = [
-        c.describe(values, engine)
-        for c in engine.couplers
-        if c not in on_chain and (c.dependent in chain or set(c.independent) & set(chain))
-    ]
-    slaved = {c.dependent: c for c in on_chain}
-    if any(name in slaved for c in on_chain for name in c.independent):
-        raise ModelError(f"{engine.name}: a coupler on a coordinate that another coupler slaves is not supported")
-    independent = [n for n in chain if n not in slaved]
-    used = [slaved[n] for n in chain if n in slaved]
-    T = np.zeros((len(chain), len(independent)))
-    C = np.zeros_like(T)
-    for row, name in enumerate(chain):
-        if name in slaved:
-            slopes, curvatures = slaved[name].derivatives(values, engine)
-            cols = [independent.index(n) for n in slaved[name].independent]
-            T[row, cols], C[row, cols] = slopes, curvatures
-        else:
-            T[row, independent.index(name)] = 1.0
-    rhy = Rhythm(tuple(chain.index(n) for n in independent), tuple(range(len(chain))), T, C, tuple(left_out))
-    return rhy, chain, tuple(used)
-
-
-def _base_body(frame) -> str:
-    """The body (or ground) a frame is fixed to."""
-    return frame.findBaseFrame().getName()
-
-
-def _check_mapping(engine: OsimEngine, mapping: Mapping) -> None:
-    """Every mapped body and coordinate exists: else one line (a model without muscles is its passive chain)."""
-    bodies = {engine.model.getGround().getName()} | {
-        engine.model.getBodySet().get(i).getName() for i in range(engine.model.getBodySet().getSize())
-    }
-    for group, names in mapping.bodies.items():
-        missing = [n for n in names if n not in bodies]
-        if missing:
-            lacks = f"names bodies that {engine.name} lacks: {missing}"
-            raise ParameterError(located(mapping.path, f"bodies.{group}"), lacks)
-    coords = engine.model.getCoordinateSet()
-    for plane, names in mapping.planes.items():
-        missing = [n for n in names if not coords.contains(n)]
-        if missing:
-            lacks = f"names coordinates that {engine.name} lacks: {missing}"
-            raise ParameterError(located(mapping.path, f"planes.{plane}"), lacks)
-
-
-def _classify(engine: OsimEngine, mapping: Mapping) -> tuple:
-    """Each muscle's class by the bodies its path points are fixed to (:mod:`spinectl.anatomy.classes`' rule)."""
-    tree = _skeleton(engine, mapping)
-    index = {name: b for b, name in enumerate(tree.names)}
-    muscles = engine.model.getMuscles()
-    attachments = []
-    for i in range(muscles.getSize()):
-        points = muscles.get(i).getGeometryPath().getPathPointSet()
-        attachments.append({index[_base_body(points.get(k).getParentFrame())] for k in range(points.getSize())})
-    return classify_muscles(tree, mapping.bodies, attachments)
-
-
-def _skeleton(engine: OsimEngine, mapping: Mapping) -> Skeleton:
-    """OpenSim's joint tree as a :class:`~spinectl.anatomy.classes.Skeleton`, ground first, parents first.
-
-    A body is rigid on its parent where its joint has no coordinate (a ``WeldJoint``) or every
-    one is locked (``Coordinate.getDefaultLocked``); a chain body where a mapped coordinate moves it.
-    """
-    model = engine.model
-    mapped = {n for names in mapping.planes.values() for n in names}
-    joints = model.getJointSet()
-    below: dict = {}
-    for i in range(joints.getSize()):
-        joint = joints.get(i)
-        coords = [joint.get_coordinates(k) for k in range(joint.numCoordinates())]
-        rigid = all(c.getDefaultLocked() for c in coords)  # True without coordinates: a weld
-        chain = any(c.getName() in mapped for c in coords)
-        child = _base_body(joint.getChildFrame())
-        below.setdefault(_base_body(joint.getParentFrame()), []).append((child, rigid, chain))
-    names, parent, rigid, chain = [model.getGround().getName()], [-1], [False], [False]
-    for b, name in enumerate(names):  # breadth first: the list grows as it is read
-        for child, fixed, moved in below.get(name, ()):
-            names.append(child)
-            parent.append(b)
-            rigid.append(fixed)
-            chain.append(moved)
-    return Skeleton(tuple(names), tuple(parent), tuple(rigid), tuple(chain))
-
-
 
 
 def _mobility_order(engine: OsimEngine) -> dict:
@@ -587,7 +391,7 @@ class OsimAnatomy(MappedModel):
         return dict(posture)
 
     def rhythm(self, plane: str = "sagittal", posture=None) -> tuple:
-        """The couplers that tie the plane's chain as a Rhythm, at a posture (:func:`coupler_rhythm`).
+        """The couplers that tie the plane's chain as a Rhythm, at a posture (``opensim_couplers.coupler_rhythm``).
 
         Parameters
         ----------
@@ -620,7 +424,8 @@ class OsimAnatomy(MappedModel):
         Returns
         -------
         tuple
-            (Linearisation, Rhythm of the couplers (:func:`coupler_rhythm`), the involved coordinates' names).
+            (Linearisation, Rhythm of the couplers (``opensim_couplers.coupler_rhythm``), the involved
+            coordinates' names).
         """
         values = self.posture(posture)
         rhy, involved = self.rhythm(plane, values)
@@ -729,7 +534,7 @@ class OsimAnatomy(MappedModel):
         """The default posture with the chain moved along the model's couplers by ``degrees`` in total.
 
         The couplers' first independent coordinate and the coordinates they slave to it move as the
-        couplers' slopes at the default posture distribute them (:func:`coupler_rhythm`), the chain's
+        couplers' slopes at the default posture distribute them (``opensim_couplers.coupler_rhythm``), the chain's
         joint angles (not its coordinates, :meth:`joint_slopes`) summing to ``degrees``; a coordinate off
         the chain that a coupler slaves to the chain (a routing body's, left out of the rhythm) follows
         its coupler, so the posture is the model's. The engine sets them through OpenSim's coordinates
@@ -751,7 +556,7 @@ class OsimAnatomy(MappedModel):
         step = lordosis_direction(self, rhy, n, degrees, self.joint_slopes(plane))
         engine = self.engine
         values = {n: engine.coordinate(n).getDefaultValue() + float(v) for n, v in zip(involved, step, strict=True)}
-        return _followed(engine, values)
+        return followed(engine, values)
 
     def require_referee(self) -> None:
         """Refused: MuJoCo is the referee, for MJCF only (:meth:`OsimEngine.spec_factory`)."""
@@ -921,19 +726,6 @@ class OsimAnatomy(MappedModel):
         return tuple(out)
 
 
-def _followed(engine: OsimEngine, values: dict) -> dict:
-    """``values`` with the dependent coordinate of every coupler whose independent ones it gives set by the coupler."""
-    osim = require_opensim()
-    out = dict(values)
-    for c in engine.couplers:
-        if c.dependent not in values and set(c.independent) <= set(values):
-            x = osim.Vector(len(c.independent), 0.0)
-            for k, name in enumerate(c.independent):
-                x.set(k, float(values[name]))
-            out[c.dependent] = float(c.function.calcValue(x))
-    return out
-
-
 def _vec3(vector) -> np.ndarray:
     """A SimTK Vec3 as a numpy array."""
     return np.array([vector.get(k) for k in range(3)])
@@ -984,7 +776,7 @@ def load_osim(path, mapping=None, cache: bool = True) -> OsimAnatomy:
         mapping = default_mapping(engine.name)
     elif not isinstance(mapping, Mapping):
         mapping = read_mapping(mapping)
-    _check_mapping(engine, mapping)
+    check_mapping(engine, mapping)
     muscles = engine.model.getMuscles()
     for i in range(muscles.getSize()):
         check_muscle(engine.name, muscles.get(i))
@@ -997,4 +789,4 @@ def load_osim(path, mapping=None, cache: bool = True) -> OsimAnatomy:
             "; coupler constraints (off in the free chain; those among the chain's coordinates linearised in the "
             f"constrained): {described}"
         )
-    return OsimAnatomy(engine, mapping, names, _classify(engine, mapping))
+    return OsimAnatomy(engine, mapping, names, classify(engine, mapping))

@@ -13,6 +13,7 @@ import json
 
 import numpy as np
 import pytest
+from shared_models import ABSENT, POSE2SIM  # noqa: E402 (tests/anatomy/shared_models.py)
 
 from spinectl.anatomy.classes import Skeleton, classify_muscles
 
@@ -356,7 +357,7 @@ def test_opensim_rhythm_leaves_the_routing_body_out(tmp_path, capsys):
     assert doc["constrained"]["joints"] == ["j1"]
 
 
-SHARED = "/work/shared/models/pose2sim-beaucage-gauvreau/Model_Pose2Sim_muscles_flex.osim"
+SHARED = str(POSE2SIM)
 
 
 def test_pose2sims_abdomen_coupler_is_left_out_of_the_rhythm():
@@ -366,9 +367,10 @@ def test_pose2sims_abdomen_coupler_is_left_out_of_the_rhythm():
     from pathlib import Path
 
     if not Path(SHARED).is_file():
-        pytest.skip("the shared downloaded models (/work/shared/models) are absent")
+        pytest.skip(ABSENT)
     pytest.importorskip("opensim", reason="needs the opensim extra: pip install 'spinectl[opensim]'")
-    from spinectl.anatomy.opensim_engine import coupler_rhythm, load_engine
+    from spinectl.anatomy.opensim_couplers import coupler_rhythm
+    from spinectl.anatomy.opensim_engine import load_engine
 
     engine = load_engine(SHARED)
     chain = [f"{j}_Flex_Ext" for j in ("L5_S1", "L4_L5", "L3_L4", "L2_L3", "L1_L2")]

@@ -16,6 +16,8 @@ import pytest
 
 osim = pytest.importorskip("opensim", reason="needs the opensim extra: pip install 'spinectl[opensim]'")
 
+from shared_models import ABSENT, CHRISTOPHY  # noqa: E402 (tests/anatomy/shared_models.py)
+
 from spinectl import anatomy  # noqa: E402
 from spinectl.anatomy.analyses import analyse  # noqa: E402
 from spinectl.anatomy.linearise import constrained_chain, free_chain  # noqa: E402
@@ -263,7 +265,8 @@ def test_a_model_without_muscles_answers_its_passive_chain_with_the_slopes_shown
     assert main(["anatomy", str(path), "--mapping", str(mapping), "--joint-stiffness", "20", "--json"]) == 0
     doc = json.loads(capsys.readouterr().out)
     assert doc["joint_rad_per_coordinate_rad"] == pytest.approx(list(SLOPES), rel=1e-12)
-    assert doc["muscles"] == {"global": [], "local": [], "between": [], "non-lumbar": []} and doc["chain_stable"] is True
+    assert doc["muscles"] == {"global": [], "local": [], "between": [], "non-lumbar": []}
+    assert doc["chain_stable"] is True
     assert doc["joint_stiffness_Nm_per_rad"] == [20.0] * 3
     assert main(["anatomy", str(path), "--mapping", str(mapping)]) == 0
     assert "the joints turn q1 0.5, q2 1, q3 0.25 rad per coordinate rad" in capsys.readouterr().out
@@ -288,14 +291,13 @@ def test_myotorsos_coordinates_are_its_joint_angles(torso):
     assert "joint_rad_per_coordinate_rad" not in analyse(torso).to_dict()
 
 
-CHRISTOPHY = Path("/work/shared/models/christophy-skeleton/Christophy2012_axialRotationUpd_skeletonOnly.osim")
 CHRISTOPHY_MAPPING = (
     '[bodies]\npelvis = ["sacrum"]\nvertebrae = ["lumbar5", "lumbar4", "lumbar3", "lumbar2", "lumbar1"]\n'
     'thorax = ["torso"]\n[planes]\nsagittal = ["flex_extension", "L4_L5_FE", "L3_L4_FE", "L2_L3_FE", "L1_L2_FE"]\n'
 )
 
 
-@pytest.mark.skipif(not CHRISTOPHY.is_file(), reason="the shared downloaded models (/work/shared/models) are absent")
+@pytest.mark.skipif(not CHRISTOPHY.is_file(), reason=ABSENT)
 def test_christophys_skeleton_turns_l5s1_by_its_transforms_slope_and_answers_its_passive_chain(tmp_path):
     """Christophy's skeleton as distributed: each chain joint's measured rotation per coordinate rad is its
     SpatialTransform's rotation1 function's derivative read through OpenSim's API (0.125 at L5/S1 for

@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from shared_models import ABSENT, SHARED_MODELS  # noqa: E402 (tests/anatomy/shared_models.py)
 
 from spinectl.errors import ParameterError
 
@@ -256,7 +257,6 @@ def test_a_misspelt_mapped_stiffness_is_refused_at_the_command_line(tmp_path, ca
     assert captured.out == "" and captured.err.count("\n") == 1 and "did you mean 'joint_stiffness'?" in captured.err
 
 
-SHARED_MODELS = Path("/work/shared/models")
 PUBLISHED = {
     "pose2sim.toml": "pose2sim-beaucage-gauvreau/Model_Pose2Sim_muscles_flex.osim",
     "cyclist.toml": "allaire-cyclist/s01modelScaled.osim",
@@ -273,7 +273,7 @@ def _documented_mappings() -> list:
     return re.findall(r"```toml\n(.*?)```", section, flags=re.S)
 
 
-@pytest.mark.skipif(not SHARED_MODELS.is_dir(), reason="the shared downloaded models (/work/shared/models) are absent")
+@pytest.mark.skipif(not SHARED_MODELS.is_dir(), reason=ABSENT)
 @pytest.mark.parametrize("index", range(len(PUBLISHED)))
 def test_the_documented_mappings_name_the_published_models_bodies_and_coordinates(tmp_path, index):
     """Each mapping of docs/anatomy.md's "Published models" reads as a mapping, and every body and coordinate it

@@ -9,12 +9,13 @@ tests derive the difference from Millard's curve values (OpenSim's calcValue / c
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 osim = pytest.importorskip("opensim", reason="needs the opensim extra: pip install 'spinectl[opensim]'")
+
+from shared_models import ABSENT, POSE2SIM  # noqa: E402 (tests/anatomy/shared_models.py)
 
 from spinectl import anatomy  # noqa: E402
 from spinectl.anatomy.export_mjcf import fibre_gains  # noqa: E402
@@ -383,10 +384,10 @@ def test_opensims_warnings_of_missing_meshes_stay_off_the_json(imported, tmp_pat
     assert "absent_mesh.vtp" in result.stderr and "absent_mesh.vtp" not in result.stdout
 
 
-SHARED = Path("/work/shared/models/pose2sim-beaucage-gauvreau/Model_Pose2Sim_muscles_flex.osim")
+SHARED = POSE2SIM
 
 
-@pytest.mark.skipif(not SHARED.is_file(), reason="the shared downloaded models (/work/shared/models) are absent")
+@pytest.mark.skipif(not SHARED.is_file(), reason=ABSENT)
 def test_a_downloaded_model_without_meshes_prints_nothing_but_spinectls_own(tmp_path):
     """The Pose2Sim model as distributed, without its Geometry folder: OpenSim warns about about a hundred missing
     meshes; stdout holds the JSON document alone (its De Groote muscles are read, spinectl.anatomy.opensim_muscles;

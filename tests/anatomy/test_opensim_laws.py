@@ -11,12 +11,12 @@ at each perturbed posture), differenced centrally in the coordinates (K) and in 
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
 osim = pytest.importorskip("opensim", reason="needs the opensim extra: pip install 'spinectl[opensim]'")
+
+from shared_models import ABSENT, SHARED_MODELS  # noqa: E402 (tests/anatomy/shared_models.py)
 
 from spinectl.anatomy.opensim_engine import linearise, load_engine, load_osim  # noqa: E402
 from spinectl.errors import ModelError  # noqa: E402
@@ -304,7 +304,7 @@ def test_an_unsupported_muscle_class_is_one_line(tmp_path):
     assert "Millard2012EquilibriumMuscle, Thelen2003Muscle, DeGrooteFregly2016Muscle" in message
 
 
-SHARED = Path("/work/shared/models")
+SHARED = SHARED_MODELS
 POSE2SIM = SHARED / "pose2sim-beaucage-gauvreau" / "Model_Pose2Sim_muscles_flex.osim"
 CYCLIST = SHARED / "allaire-cyclist" / "s01modelScaled.osim"
 
@@ -322,7 +322,7 @@ def _shared_check(path, names, levels, step):
     return out
 
 
-@pytest.mark.skipif(not POSE2SIM.is_file(), reason="the shared downloaded models (/work/shared/models) are absent")
+@pytest.mark.skipif(not POSE2SIM.is_file(), reason=ABSENT)
 def test_the_pose2sim_models_de_groote_muscles_are_opensims():
     """The Pose2Sim model as downloaded (318 rigid-tendon De Groote muscles, 212 pennate; before: refused) over
     L5/S1 ... L3/L4 flexion at a = 0.05 and 0.5: tau and D equal OpenSim's central differences to 1e-6 of their
@@ -340,7 +340,7 @@ def test_the_pose2sim_models_de_groote_muscles_are_opensims():
 
 
 @pytest.mark.slow
-@pytest.mark.skipif(not CYCLIST.is_file(), reason="the shared downloaded models (/work/shared/models) are absent")
+@pytest.mark.skipif(not CYCLIST.is_file(), reason=ABSENT)
 def test_the_cyclist_models_thelen_and_compliant_millard_muscles_are_opensims():
     """The Allaire/Bruno cyclist model as downloaded (Thelen and compliant Millard muscles; before: refused) over
     L5/S1 and L4/L5 flexion at a = 0.5: tau and K equal OpenSim's central differences (fibres in equilibrium at each

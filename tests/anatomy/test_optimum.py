@@ -137,7 +137,7 @@ def test_an_infeasible_chain_optimum_says_what_would_make_it_feasible(torso):
     no activation stabilises the free chain (the global muscles leave a mode unstable, test_linearise.py), so the
     chain optimum is infeasible and its table points to --joint-stiffness; at 50 N m/rad added it is feasible and
     the hint is gone."""
-    from spinectl.anatomy.optimum import INFEASIBLE_HINT
+    from spinectl.anatomy.remedy import INFEASIBLE_HINT
 
     bare = optimised(torso, stability="chain")
     assert bare.optimum.status == "infeasible" and INFEASIBLE_HINT in bare.table()
@@ -172,7 +172,7 @@ def test_the_remedy_is_the_least_joint_stiffness_that_makes_the_optimum_feasible
     """The remedy's bracket, checked by the optimum itself (a second call per side, not the search): feasible
     at the value named, infeasible 2 rtol below it; the table names a --joint-stiffness that is feasible and
     the JSON carries the value. MyoTorso (myo-sim 0.2.4) needs about 40 N m/rad at each joint (docs/anatomy.md)."""
-    from spinectl.anatomy.optimum import REMEDY_RTOL
+    from spinectl.anatomy.remedy import REMEDY_RTOL
 
     bare = optimised(torso, stability="chain")
     value = bare.remedy
@@ -188,7 +188,7 @@ def test_the_remedy_is_the_least_joint_stiffness_that_makes_the_optimum_feasible
 def test_the_remedy_search_brackets_a_known_threshold():
     """A feasibility that switches at c* = 39.87 (and at none): the bracket's upper end within rtol of c*,
     and inf where nothing up to MAX_REMEDY is feasible."""
-    from spinectl.anatomy.optimum import MAX_REMEDY, REMEDY_RTOL, least_joint_stiffness
+    from spinectl.anatomy.remedy import MAX_REMEDY, REMEDY_RTOL, least_joint_stiffness
 
     calls = []
 

@@ -18,6 +18,7 @@ import pytest
 osim = pytest.importorskip("opensim", reason="needs the opensim extra: pip install 'spinectl[opensim]'")
 
 from osim_reference import present_geometry, rigid_millard_copy  # noqa: E402 (tests/anatomy/osim_reference.py)
+from shared_models import ABSENT, POSE2SIM  # noqa: E402 (tests/anatomy/shared_models.py)
 
 from spinectl.anatomy import opensim_engine, osim_cache  # noqa: E402
 from spinectl.anatomy.export_osim import export_osim  # noqa: E402
@@ -205,11 +206,11 @@ def test_an_unwritable_cache_folder_is_no_cache(wrapped, tmp_path, monkeypatch):
     assert _identical(opensim_engine.load_osim(path).linearise("sagittal")[0], fresh)
 
 
-SHARED = Path("/work/shared/models/pose2sim-beaucage-gauvreau/Model_Pose2Sim_muscles_flex.osim")
+SHARED = POSE2SIM
 POSE2SIM_CHAIN = [f"{joint}_Flex_Ext" for joint in ("L5_S1", "L4_L5", "L3_L4", "L2_L3", "L1_L2", "L1_T12")]
 
 
-@pytest.mark.skipif(not SHARED.is_file(), reason="the shared downloaded models (/work/shared/models) are absent")
+@pytest.mark.skipif(not SHARED.is_file(), reason=ABSENT)
 def test_the_geometry_is_the_present_paths_on_a_published_model(tmp_path):
     """The Pose2Sim model (318 muscles, 41 wrap cylinders and 3 ellipsoids: latissimus dorsi over the torso), its
     muscles made rigid-tendon Millard in a temporary copy: arms, Hessians and passive torques over its lumbar

@@ -58,5 +58,6 @@ def test_an_mjcf_without_muscles_answers_its_passive_chain(tmp_path, capsys):
     np.testing.assert_allclose(free.stiffness_offset, expected, rtol=1e-6, atol=1e-6)
     assert main(["anatomy", str(model_path), "--mapping", str(mapping), "--joint-stiffness", "5", "--json"]) == 0
     doc = json.loads(capsys.readouterr().out)
-    assert doc["muscles"] == {"global": [], "local": [], "between": [], "non-lumbar": []} and doc["chain_stable"] is True
+    assert doc["muscles"] == {"global": [], "local": [], "between": [], "non-lumbar": []}
+    assert doc["chain_stable"] is True
     assert doc["activation_mean"] is None and "joint_rad_per_coordinate_rad" not in doc

@@ -9,12 +9,13 @@ paper's chain (five pin joints, thirty Millard muscles); the MJCF model is MyoTo
 from __future__ import annotations
 
 import hashlib
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 osim = pytest.importorskip("opensim", reason="needs the opensim extra: pip install 'spinectl[opensim]'")
+
+from shared_models import ABSENT, CYCLIST  # noqa: E402 (tests/anatomy/shared_models.py)
 
 from spinectl import anatomy  # noqa: E402
 from spinectl.anatomy.analyses import analyse  # noqa: E402
@@ -303,10 +304,7 @@ def test_myotorso_activations_by_actuator_name(torso, tmp_path):
     )
 
 
-CYCLIST = Path("/work/shared/models/allaire-cyclist")
-
-
-@pytest.mark.skipif(not CYCLIST.is_dir(), reason="the shared downloaded models (/work/shared/models) are absent")
+@pytest.mark.skipif(not CYCLIST.is_dir(), reason=ABSENT)
 def test_the_cyclists_static_trial_is_read_as_published(tmp_path):
     """The Bruno/Allaire cyclist (s01modelScaled.osim) and its static trial s01static.mot as distributed: a states
     file of 1,349 columns (values, speeds, activations, fibre lengths; radians) gives all 171 coordinates and
