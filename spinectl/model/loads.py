@@ -100,6 +100,11 @@ def point_loads(value) -> tuple:
     return tuple(item if isinstance(item, PointLoad) else PointLoad(item) for item in items)
 
 
+def loads_text(loads) -> str:
+    """What a chain's source adds for its loads: "; load F = ... N at the point mass, ..." each; "" without."""
+    return "".join(f"; load {load.text()}" for load in loads)
+
+
 def _forces(loads, angle=0.0) -> tuple:
     """Each load's force where the thorax has turned by ``angle`` [rad]: (..., L, 2), and the body-fixed mask."""
     force = np.array([load.force for load in loads], float).reshape(-1, 2)
@@ -191,4 +196,4 @@ def upright_load_torque(model: Model, cor, loads) -> np.ndarray:
     numpy.ndarray, shape (..., n_cor)
     """
     cor = np.asarray(cor, float)
-    return load_torque(model, cor, np.zeros(cor.shape[:-1]), loads)
+    return load_torque(model, cor, np.zeros(cor.shape[:-1]), loads) + 0.0  # + 0.0: no signed zero

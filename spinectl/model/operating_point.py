@@ -25,7 +25,7 @@ from .chain import chain_coefficients, linear_chain
 from . import geometry
 from .checks import arithmetic_guard, expand_pcsa, validate_position
 from .linear_chain import LinearChain
-from .loads import load_stiffness, point_loads, upright_load_torque
+from .loads import load_stiffness, loads_text, point_loads, upright_load_torque
 from .params import Model
 
 
@@ -162,15 +162,10 @@ def chain_at(point: OperatingPoint) -> LinearChain:
             free.at(np.zeros(free.n_controls)),
             stiffness_offset=stiffness,
             damping_offset=coefficients.damping(point.pcsa),
-            source=free.source + _loads_text(point.loads),
+            source=free.source + loads_text(point.loads),
         )
         # k = 0 leaves K and D as they are (LinearChain.at would add zeros, turning a -0.0 into 0.0)
         return fixed.at((), point.local_stiffness) if np.any(point.local_stiffness) else fixed
-
-
-def _loads_text(loads) -> str:
-    """What the chain's source adds for its loads: nothing without."""
-    return "".join(f"; load {load.text()}" for load in loads)
 
 
 def load_torque_at(point: OperatingPoint) -> np.ndarray:
