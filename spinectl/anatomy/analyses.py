@@ -33,6 +33,7 @@ from ..model.linear_chain import CONTROL_CLASSES, LinearChain
 from ..model.stability import MARGINAL_TIME_CONSTANT, slowest_time_constant
 from .contract import AnatomyEngine
 from .engine import require_mujoco
+from .loads import body_loads
 from .model import Anatomy
 from .naming import joint_labels
 
@@ -450,6 +451,8 @@ class AnatomyResult:
     devices : tuple of str
         What the model holds besides muscles and how it enters the chain (welds, a free root fixed,
         passive tendons), one phrase each (:attr:`~spinectl.anatomy.engine.Engine.devices`).
+    loads : tuple of BodyLoad
+        The external loads in the chains (:mod:`spinectl.anatomy.loads`); () none.
     """
 
     model: dict
@@ -470,6 +473,7 @@ class AnatomyResult:
     joint_slopes: np.ndarray | None = None
     rhythm_left_out: tuple = ()
     devices: tuple = ()
+    loads: tuple = ()
 
     @property
     def activation_mean(self) -> float:
@@ -549,6 +553,7 @@ class AnatomyResult:
                 "rhythm_left_out": list(self.rhythm_left_out),
             },
             "devices": list(self.devices),
+            **({"loads": [load.to_dict() for load in self.loads]} if self.loads else {}),
         }
         if self.joint_slopes is not None:  # only where the units differ: a hinge's output stays as it was
             out["joint_rad_per_coordinate_rad"] = self.joint_slopes.tolist()
@@ -594,6 +599,7 @@ class AnatomyResult:
             f"joint stiffness added: {self.joint_stiffness_added[0]:.4g} N m/rad per joint",
             *self._angle_note(),
             *(["devices: " + "; ".join(self.devices)] if self.devices else []),
+            *(f"load (in the equilibrium and K): {load.text()}" for load in self.loads),
             "",
             f"{'joint (level)':<24}{'-K_jj [N m/rad]':>16}  joint by joint (others fixed)",
             f"{'':<24}{'(> 0 restores)':>16}",
@@ -695,6 +701,7 @@ def analyse(
     joint_stiffness="none",
     check=False,
     reflex=None,
+    loads=(),
 ) -> AnatomyResult:
     """Joint-by-joint and chain verdicts of a model at an activation, free and constrained.
 
@@ -715,13 +722,18 @@ def analyse(
         leading mode (:func:`mujoco_growth_rate`); reference posture only.
     reflex : tuple, optional
         ``(kp, kd, lag)``: also the free chain's exact delay margin under that reflex (:func:`reflex_margin`).
+    loads : sequence of BodyLoad, optional
+        External loads (:mod:`spinectl.anatomy.loads`) in the chains' K and torque offset; not with ``check``.
 
     Returns
     -------
     AnatomyResult
     """
     a = activations(anatomy, activation)
-    free, con, lin = anatomy.chains(plane, posture, joint_stiffness, activations=a)
+    loads = body_loads(loads)
+    if check and loads:  # the referee's copy of the model holds no load
+        raise ParameterError("--check", "compares the chain without loads (MuJoCo's referee holds none)")
+    free, con, lin = anatomy.chains(plane, posture, joint_stiffness, activations=a, loads=loads)
     added = anatomy.added_stiffness(joint_stiffness, free.n_joints)
     arms = lin.moment_arms[:, list(lin.dofs[: lin.n])]
     referee, rate = None, float("nan")
@@ -754,6 +766,7 @@ def analyse(
         joint_slopes=_slopes_shown(anatomy, plane, posture),
         rhythm_left_out=anatomy.rhythm(plane, posture)[0].left_out,
         devices=tuple(getattr(anatomy.engine, "devices", ())),
+        loads=loads,
     )
 
 

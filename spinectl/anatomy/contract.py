@@ -471,7 +471,29 @@ class MappedModel:
         rhy, involved = self.rhythm(plane, posture)
         return rhythm_in_angles(rhy, self.joint_slopes(plane, posture), self.name), involved
 
-    def chains(self, plane: str = "sagittal", posture=None, joint_stiffness="none", activations=None) -> tuple:
+    def apply_loads(self, lin, posture, loads):
+        """The linearisation with external loads: their generalised force in the torque offset, K_load in K_0.
+
+        An engine that computes loads overrides this (MuJoCo: :func:`spinectl.anatomy.loads.load_terms`).
+
+        Parameters
+        ----------
+        lin : Linearisation
+            At the posture, over its dofs.
+        posture : optional
+            The operating point (:meth:`posture`).
+        loads : sequence of BodyLoad
+            Not empty.
+
+        Returns
+        -------
+        Linearisation
+        """
+        raise ParameterError("--load", f"is not available on this engine's models yet (got a load on {self.name})")
+
+    def chains(
+        self, plane: str = "sagittal", posture=None, joint_stiffness="none", activations=None, loads=()
+    ) -> tuple:
         """The free chain and the chain constrained by the model's rhythm, as LinearChain objects.
 
         Both per radian of each joint's rotation, the engine's coordinates changed to the joints' angles
@@ -488,6 +510,9 @@ class MappedModel:
         activations : array_like, shape (m,), optional
             The operating activations, for an engine that linearises there
             (:attr:`linearised_at_activations`); ignored by the others (exact at every activation).
+        loads : sequence of BodyLoad, optional
+            External loads (:mod:`spinectl.anatomy.loads`), in the torque offset and K_0 at the posture
+            (:meth:`apply_loads`, after the engine's linearisation: a linearisation cache holds none); default none.
 
         Returns
         -------
@@ -497,11 +522,13 @@ class MappedModel:
         """
         at = {"activations": activations} if activations is not None and self.linearised_at_activations else {}
         lin, rhy, involved = self.linearise(plane, posture, **at)
+        if loads:
+            lin = self.apply_loads(lin, posture, loads)
         slopes = self.joint_slopes(plane, posture)
         lin, rhy = linearisation_in_angles(lin, slopes, self.name), rhythm_in_angles(rhy, slopes, self.name)
         n = lin.n
         added = self.added_stiffness(joint_stiffness, n)
-        source = self.chain_source(plane, posture)
+        source = self.chain_source(plane, posture) + "".join(f"; load {load.text()}" for load in loads)
         controls = {"bounds": self.control_bounds(), "unit": self.control_unit}
         free = free_chain(lin, tuple(involved[:n]), self.muscles, self.classes, added, source, **controls)
         full_added = np.concatenate([added, np.zeros(len(involved) - n)])

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -11,6 +12,7 @@ from ..errors import ModelError, ParameterError
 from .contract import MappedModel, lordosis_direction, plane_axes
 from .engine import CONTROL_UNIT, Engine, load_engine, require_mujoco
 from .linearise import Linearisation, linearise, rhythm
+from .loads import load_terms
 from .mapping import Mapping, check_mapping, classify, default_mapping, read_mapping
 
 
@@ -158,6 +160,30 @@ class Anatomy(MappedModel):
         q = self.posture(posture)
         rhy, involved = self.rhythm(plane, q)
         return linearise(self.engine, q, rhy.dofs, len(self.plane_joints(plane))), rhy, involved
+
+    def apply_loads(self, lin: Linearisation, posture, loads) -> Linearisation:
+        """The linearisation with external loads: J^T F in the torque offset, d(J^T F)/dq in K_0.
+
+        Parameters
+        ----------
+        lin : Linearisation
+            At the posture (:meth:`linearise`).
+        posture : array_like, optional
+            Full qpos; default the model's reference posture.
+        loads : sequence of BodyLoad
+            (:func:`spinectl.anatomy.loads.load_terms`; docs/anatomy.md, "Loads").
+
+        Returns
+        -------
+        Linearisation
+        """
+        tau, stiffness = load_terms(self.engine, loads, self.posture(posture))
+        dofs = list(lin.dofs)
+        return dataclasses.replace(
+            lin,
+            stiffness_offset=lin.stiffness_offset + stiffness[np.ix_(dofs, dofs)],
+            torque_offset=lin.torque_offset + tau,
+        )
 
     def equilibrium_rows(self, lin, plane: str, posture, equilibrium: str) -> tuple:
         """The optimum's equilibrium: every lumbar joint (``"free"``) or the rhythm's independent coordinates.

@@ -157,6 +157,7 @@ def optimise(
     joint_stiffness="none",
     weights: str = "volume",
     equilibrium: str = "rhythm",
+    loads=(),
 ) -> Optimum:
     """The least-effort activations that hold the posture, with a stability criterion.
 
@@ -180,13 +181,15 @@ def optimise(
         ``"volume"`` or ``"none"`` (:func:`volume_weights`).
     equilibrium : str
         ``"rhythm"`` or ``"free"`` (module docstring).
+    loads : sequence of BodyLoad, optional
+        External loads held (:mod:`spinectl.anatomy.loads`): in the equilibrium and in K; default none.
 
     Returns
     -------
     Optimum
     """
     check_choices(stability, equilibrium, margin, weights)
-    free, constrained, lin = anatomy.chains(plane, posture, joint_stiffness)
+    free, constrained, lin = anatomy.chains(plane, posture, joint_stiffness, loads=loads)
     rows, tau_per, tau_0 = anatomy.equilibrium_rows(lin, plane, posture, equilibrium)
     w = anatomy.volume_weights() if weights == "volume" else np.ones(free.n_controls)
     return optimum_on_chains(free, constrained, lin, rows, tau_per, tau_0, w, stability, equilibrium, margin)
@@ -602,6 +605,7 @@ def optimised(
     equilibrium: str = "rhythm",
     check: bool = False,
     reflex=None,
+    loads=(),
 ) -> OptimisedResult:
     """The optimum with a criterion and without, at the reference posture, and the analysis at the optimum.
 
@@ -624,6 +628,8 @@ def optimised(
     reflex : tuple, optional
         ``(kp, kd, lag)``: the chain's exact delay margin at the optimum
         (:func:`~spinectl.anatomy.analyses.reflex_margin`).
+    loads : sequence of BodyLoad, optional
+        External loads held (:func:`optimise`); default none.
 
     Returns
     -------
@@ -634,17 +640,21 @@ def optimised(
     if check:  # refused before any optimum is solved, on an engine MuJoCo cannot referee
         anatomy.require_referee()
     kwargs = {"plane": plane, "margin": margin, "joint_stiffness": joint_stiffness, "equilibrium": equilibrium}
+    if loads:  # only then: the engines' optimise of a made-up engine need not know loads
+        kwargs["loads"] = loads
     opt = optimise(anatomy, stability=stability, **kwargs)
     classic = opt if stability == "none" else optimise(anatomy, stability="none", **kwargs)
     analysis = None
     if opt.ok:
-        analysis = analyse(anatomy, plane, opt.activations, joint_stiffness=joint_stiffness, check=check, reflex=reflex)
+        analysis = analyse(
+            anatomy, plane, opt.activations, joint_stiffness=joint_stiffness, check=check, reflex=reflex, loads=loads
+        )
     empty = skeleton(anatomy, opt, reflex=reflex, **kwargs)
     fix = remedy(anatomy, optimise, opt, classic, joint_stiffness, kwargs)
     return OptimisedResult(anatomy, opt, classic, float(margin), plane, analysis, empty, fix)
 
 
-def skeleton(anatomy: AnatomyEngine, opt: Optimum, plane: str, joint_stiffness, reflex=None, **_):
+def skeleton(anatomy: AnatomyEngine, opt: Optimum, plane: str, joint_stiffness, reflex=None, loads=(), **_):
     """Where the optimum is infeasible, the analysis at the lower control bounds (its JSON's keys); else None.
 
     Parameters
@@ -659,6 +669,8 @@ def skeleton(anatomy: AnatomyEngine, opt: Optimum, plane: str, joint_stiffness, 
         Added at each chain joint [N m/rad].
     reflex : tuple, optional
         ``(kp, kd, lag)``.
+    loads : sequence of BodyLoad, optional
+        External loads (:func:`optimise`).
 
     Returns
     -------
@@ -669,7 +681,7 @@ def skeleton(anatomy: AnatomyEngine, opt: Optimum, plane: str, joint_stiffness, 
     if opt.ok:
         return None
     lower = anatomy.control_bounds()[0]
-    return analyse(anatomy, plane, lower, joint_stiffness=joint_stiffness, reflex=reflex)
+    return analyse(anatomy, plane, lower, joint_stiffness=joint_stiffness, reflex=reflex, loads=loads)
 
 
 def lordosis_posture(anatomy: AnatomyEngine, degrees: float, plane: str = "sagittal"):
@@ -718,6 +730,7 @@ def lordosis_curve(
     margin: float = MARGIN,
     joint_stiffness="none",
     equilibrium: str = "rhythm",
+    loads=(),
 ) -> dict:
     """The three optima (classic, joint by joint, the chain) over the lordosis.
 
@@ -727,7 +740,7 @@ def lordosis_curve(
         The model.
     degrees : array_like
         Changes of the chain's summed angle about the reference posture [deg].
-    plane, margin, joint_stiffness, equilibrium
+    plane, margin, joint_stiffness, equilibrium, loads
         As in :func:`optimise`.
 
     Returns
@@ -749,6 +762,7 @@ def lordosis_curve(
                 posture=posture,
                 joint_stiffness=joint_stiffness,
                 equilibrium=equilibrium,
+                **({"loads": loads} if loads else {}),
             )
             for posture in postures
         ]
