@@ -26,6 +26,7 @@ import numpy as np
 from .._validate import printable, show
 from ..errors import ModelError, ParameterError
 from ..model.linear_chain import LinearChain
+from ..model.loads import loads_text
 from .joint_angles import JointSlopes, linearisation_in_angles, rhythm_in_angles
 from .linearise import constrained_chain, free_chain
 from .mapping import MAX_STIFFNESS, Mapping
@@ -528,7 +529,7 @@ class MappedModel:
         lin, rhy = linearisation_in_angles(lin, slopes, self.name), rhythm_in_angles(rhy, slopes, self.name)
         n = lin.n
         added = self.added_stiffness(joint_stiffness, n)
-        source = self.chain_source(plane, posture) + "".join(f"; load {load.text()}" for load in loads)
+        source = self.chain_source(plane, posture) + loads_text(loads)
         controls = {"bounds": self.control_bounds(), "unit": self.control_unit}
         free = free_chain(lin, tuple(involved[:n]), self.muscles, self.classes, added, source, **controls)
         full_added = np.concatenate([added, np.zeros(len(involved) - n)])

@@ -72,18 +72,26 @@ class BodyLoad:
         force = real_vector("loads", self.force, 3)
         point = real_vector("loads", self.point, 3)
         object.__setattr__(self, "force", tuple(in_range("loads", f, -MAX_LOAD, MAX_LOAD) for f in force))
-        object.__setattr__(
-            self, "point", tuple(in_range("loads", p, -MAX_LOAD_OFFSET, MAX_LOAD_OFFSET) for p in point)
-        )
+        object.__setattr__(self, "point", tuple(in_range("loads", p, -MAX_LOAD_OFFSET, MAX_LOAD_OFFSET) for p in point))
         if self.frame not in FRAMES:
             raise ParameterError("loads", f"a load's frame must be one of {FRAMES} (got {show(self.frame)})")
 
     def to_dict(self) -> dict:
-        """The load for outputs: body, force [N], point [m], frame."""
+        """The load for outputs: body, force [N], point [m], frame.
+
+        Returns
+        -------
+        dict
+        """
         return {"body": self.body, "force_N": list(self.force), "point_m": list(self.point), "frame": self.frame}
 
     def text(self) -> str:
-        """One line: the force, where and in which frame."""
+        """One line: the force, where and in which frame.
+
+        Returns
+        -------
+        str
+        """
         f, p = self.force, self.point
         return (
             f"F = ({f[0]:g}, {f[1]:g}, {f[2]:g}) N at ({p[0]:g}, {p[1]:g}, {p[2]:g}) m of {self.body}, "

@@ -582,6 +582,16 @@ def sagittal_load(text: str) -> tuple:
     """--load of the paper's model: ``FX,FY``, a force [N] at the point mass (x ventral, y up), fixed in the ground.
 
     Each component finite and within +-:data:`spinectl.model.loads.MAX_LOAD` N (docs/chain.md, "External loads").
+
+    Parameters
+    ----------
+    text : str
+        The option's value.
+
+    Returns
+    -------
+    tuple of float
+        (F_x, F_y) [N].
     """
     from ..model.loads import MAX_LOAD
 
@@ -598,6 +608,17 @@ def anatomy_load(text: str) -> dict:
     A force [N] at a point of BODY in its own frame [m] (default its origin), the force fixed in the ground
     (default) or in the body. Forces within +-:data:`spinectl.model.loads.MAX_LOAD` N, the point within
     +-:data:`spinectl.anatomy.loads.MAX_LOAD_OFFSET` m; the body is checked against the model when it is loaded.
+
+    Parameters
+    ----------
+    text : str
+        The option's value.
+
+    Returns
+    -------
+    dict
+        ``body``, ``force`` [N], ``point`` [m], ``frame``: the keywords of
+        :class:`spinectl.anatomy.loads.BodyLoad`.
     """
     from ..anatomy.loads import MAX_LOAD_OFFSET, SYNTAX
     from ..model.loads import FRAMES, MAX_LOAD

@@ -70,11 +70,21 @@ class PointLoad:
         object.__setattr__(self, "force", force)
 
     def to_dict(self) -> dict:
-        """The load for outputs: its force [N], frame and point."""
+        """The load for outputs: its force [N], frame and point.
+
+        Returns
+        -------
+        dict
+        """
         return {"force_N": list(self.force), "frame": self.frame, "at": "point mass"}
 
     def text(self) -> str:
-        """One line: the force, the frame, the point."""
+        """One line: the force, the frame, the point.
+
+        Returns
+        -------
+        str
+        """
         return f"F = ({self.force[0]:g}, {self.force[1]:g}) N at the point mass, fixed in the {self.frame}"
 
 
@@ -101,7 +111,17 @@ def point_loads(value) -> tuple:
 
 
 def loads_text(loads) -> str:
-    """What a chain's source adds for its loads: "; load F = ... N at the point mass, ..." each; "" without."""
+    """What a chain's source adds for its loads: "; load F = ... N at the point mass, ..." each; "" without.
+
+    Parameters
+    ----------
+    loads : sequence of PointLoad or BodyLoad
+        Anything with a ``text()``.
+
+    Returns
+    -------
+    str
+    """
     return "".join(f"; load {load.text()}" for load in loads)
 
 

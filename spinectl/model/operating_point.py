@@ -21,8 +21,8 @@ import numpy as np
 
 from .._validate import real, show
 from ..errors import ParameterError
-from .chain import chain_coefficients, linear_chain
 from . import geometry
+from .chain import chain_coefficients, linear_chain
 from .checks import arithmetic_guard, expand_pcsa, validate_position
 from .linear_chain import LinearChain
 from .loads import load_stiffness, loads_text, point_loads, upright_load_torque

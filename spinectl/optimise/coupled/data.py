@@ -15,9 +15,9 @@ import numpy as np
 
 from ...errors import ParameterError
 from ...model import chain, geometry
-from ...model.loads import load_stiffness, loads_text, point_loads
 from ...model.checks import arithmetic_guard, checked_coefficients
 from ...model.linear_chain import LinearChain
+from ...model.loads import load_stiffness, loads_text, point_loads
 from ...model.params import Model
 from ...units import M2_PER_CM2
 from ..problem import OK_STATUSES, ProblemData, problem_data, to_si
@@ -145,7 +145,8 @@ def loaded_chain(model: Model, linear: LinearChain, e: float, lam: float, loads)
     loads = point_loads(loads)
     if any(load.frame != "ground" for load in loads):
         raise ParameterError(
-            "loads", "must be fixed in the ground for the chain's static analyses (a follower force's K is not symmetric)"
+            "loads",
+            "must be fixed in the ground for the chain's static analyses (a follower force's K is not symmetric)",
         )
     k_load = load_stiffness(model, geometry.cor_positions(e, lam, model.geometry), loads)
     return dataclasses.replace(

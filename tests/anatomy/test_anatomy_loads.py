@@ -108,7 +108,7 @@ def test_two_hinges_closed_form(hinges):
 
 
 def test_chains_take_the_loads(torso, sagittal):
-    """The free chain's K_0 gains K_load over its joints, the linearisation's torque offset J^T F; unloaded again after."""
+    """The free chain's K_0 gains K_load, the linearisation's torque offset J^T F; unloaded again after."""
     load = LOADS[0]
     free, _, lin = torso.chains("sagittal", loads=[load])
     tau, k = load_terms(torso.engine, [load], torso.posture())
