@@ -472,7 +472,7 @@ class MappedModel:
         rhy, involved = self.rhythm(plane, posture)
         return rhythm_in_angles(rhy, self.joint_slopes(plane, posture), self.name), involved
 
-    def apply_loads(self, lin, posture, loads):
+    def apply_loads(self, lin, posture, loads, involved):
         """The linearisation with external loads: their generalised force in the torque offset, K_load in K_0.
 
         An engine that computes loads overrides this (MuJoCo: :func:`spinectl.anatomy.loads.load_terms`).
@@ -485,6 +485,8 @@ class MappedModel:
             The operating point (:meth:`posture`).
         loads : sequence of BodyLoad
             Not empty.
+        involved : sequence of str
+            The names of the linearisation's coordinates (its ``dofs``), the chain's first.
 
         Returns
         -------
@@ -524,7 +526,7 @@ class MappedModel:
         at = {"activations": activations} if activations is not None and self.linearised_at_activations else {}
         lin, rhy, involved = self.linearise(plane, posture, **at)
         if loads:
-            lin = self.apply_loads(lin, posture, loads)
+            lin = self.apply_loads(lin, posture, loads, involved)
         slopes = self.joint_slopes(plane, posture)
         lin, rhy = linearisation_in_angles(lin, slopes, self.name), rhythm_in_angles(rhy, slopes, self.name)
         n = lin.n

@@ -161,7 +161,7 @@ class Anatomy(MappedModel):
         rhy, involved = self.rhythm(plane, q)
         return linearise(self.engine, q, rhy.dofs, len(self.plane_joints(plane))), rhy, involved
 
-    def apply_loads(self, lin: Linearisation, posture, loads) -> Linearisation:
+    def apply_loads(self, lin: Linearisation, posture, loads, involved=()) -> Linearisation:
         """The linearisation with external loads: J^T F in the torque offset, d(J^T F)/dq in K_0.
 
         Parameters
@@ -172,6 +172,8 @@ class Anatomy(MappedModel):
             Full qpos; default the model's reference posture.
         loads : sequence of BodyLoad
             (:func:`spinectl.anatomy.loads.load_terms`; docs/anatomy.md, "Loads").
+        involved : sequence of str
+            The joints of ``lin.dofs`` (unused: MuJoCo's dofs index the linearisation).
 
         Returns
         -------

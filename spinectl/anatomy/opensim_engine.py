@@ -61,6 +61,7 @@ from .mapping import Mapping, default_mapping, located, read_mapping
 from .opensim_angles import joint_slopes
 from .opensim_muscles import activation_floor, check_muscle, compliant, tension_terms
 from .osim_geometry import geometry
+from .osim_loads import osim_load_terms
 
 KEPT = 256
 """How many linearisations an engine keeps in memory (:attr:`OsimEngine.linearisations`), the latest."""
@@ -626,6 +627,28 @@ class OsimAnatomy(MappedModel):
         rhy, involved = self.rhythm(plane, values)
         operating = self.default_controls() if activations is None else np.asarray(activations, float)
         return linearise(self.engine, involved, values, len(self.plane_joints(plane)), operating), rhy, involved
+
+    def apply_loads(self, lin: Linearisation, posture, loads, involved) -> Linearisation:
+        """The linearisation with external loads (:func:`spinectl.anatomy.osim_loads.osim_load_terms`).
+
+        Parameters
+        ----------
+        lin : Linearisation
+            Over ``involved`` at the posture (:meth:`linearise`; cached without loads).
+        posture : dict, optional
+            Coordinate name -> value [rad].
+        loads : sequence of BodyLoad
+        involved : sequence of str
+            The coordinates of ``lin``.
+
+        Returns
+        -------
+        Linearisation
+        """
+        tau, stiffness = osim_load_terms(
+            self.engine, loads, involved, self.posture(posture), _mobility_order(self.engine)
+        )
+        return replace(lin, stiffness_offset=lin.stiffness_offset + stiffness, torque_offset=lin.torque_offset + tau)
 
     def couplers(self, plane: str = "sagittal", posture=None) -> list:
         """The couplers that tie the plane's chain, each as one phrase with its slopes at the posture.

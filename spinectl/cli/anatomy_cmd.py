@@ -77,7 +77,7 @@ def register(sub) -> None:
         metavar="BODY:FX,FY,FZ[@X,Y,Z]",
         help="an external force [N] held at a point of BODY (in its frame [m], default its origin), fixed in the "
         "ground, or in the body with a :body suffix; in the equilibrium and the stiffness (its load stiffness "
-        "through the geometry, as gravity's); repeatable; MuJoCo models (docs/anatomy.md, Loads)",
+        "through the geometry, as gravity's); repeatable (docs/anatomy.md, Loads)",
     )
     parser.add_argument(
         "--check",
