@@ -33,7 +33,7 @@ from ..model.linear_chain import CONTROL_CLASSES, LinearChain
 from ..model.stability import MARGINAL_TIME_CONSTANT, slowest_time_constant
 from .contract import AnatomyEngine
 from .engine import require_mujoco
-from .loads import body_loads
+from .loads import analysed_loads
 from .model import Anatomy
 from .naming import joint_labels
 
@@ -451,8 +451,6 @@ class AnatomyResult:
     devices : tuple of str
         What the model holds besides muscles and how it enters the chain (welds, a free root fixed,
         passive tendons), one phrase each (:attr:`~spinectl.anatomy.engine.Engine.devices`).
-    loads : tuple of BodyLoad
-        The external loads in the chains (:mod:`spinectl.anatomy.loads`); () none.
     """
 
     model: dict
@@ -473,7 +471,7 @@ class AnatomyResult:
     joint_slopes: np.ndarray | None = None
     rhythm_left_out: tuple = ()
     devices: tuple = ()
-    loads: tuple = ()
+    loads: tuple = field(default=(), metadata={"doc": "the external loads in the chains (spinectl.anatomy.loads)"})
 
     @property
     def activation_mean(self) -> float:
@@ -722,17 +720,14 @@ def analyse(
         leading mode (:func:`mujoco_growth_rate`); reference posture only.
     reflex : tuple, optional
         ``(kp, kd, lag)``: also the free chain's exact delay margin under that reflex (:func:`reflex_margin`).
-    loads : sequence of BodyLoad, optional
-        External loads (:mod:`spinectl.anatomy.loads`) in the chains' K and torque offset; not with ``check``.
+    loads : sequence of BodyLoad, optional: external loads in K and the torque offset (not with check)
 
     Returns
     -------
     AnatomyResult
     """
     a = activations(anatomy, activation)
-    loads = body_loads(loads)
-    if check and loads:  # the referee's copy of the model holds no load
-        raise ParameterError("--check", "compares the chain without loads (MuJoCo's referee holds none)")
+    loads = analysed_loads(loads, check)
     free, con, lin = anatomy.chains(plane, posture, joint_stiffness, activations=a, loads=loads)
     added = anatomy.added_stiffness(joint_stiffness, free.n_joints)
     arms = lin.moment_arms[:, list(lin.dofs[: lin.n])]

@@ -29,6 +29,7 @@ from ..model.linear_chain import LinearChain
 from ..model.loads import loads_text
 from .joint_angles import JointSlopes, linearisation_in_angles, rhythm_in_angles
 from .linearise import constrained_chain, free_chain
+from .loads import refuse_loads
 from .mapping import MAX_STIFFNESS, Mapping
 
 
@@ -472,27 +473,7 @@ class MappedModel:
         rhy, involved = self.rhythm(plane, posture)
         return rhythm_in_angles(rhy, self.joint_slopes(plane, posture), self.name), involved
 
-    def apply_loads(self, lin, posture, loads, involved):
-        """The linearisation with external loads: their generalised force in the torque offset, K_load in K_0.
-
-        An engine that computes loads overrides this (MuJoCo: :func:`spinectl.anatomy.loads.load_terms`).
-
-        Parameters
-        ----------
-        lin : Linearisation
-            At the posture, over its dofs.
-        posture : optional
-            The operating point (:meth:`posture`).
-        loads : sequence of BodyLoad
-            Not empty.
-        involved : sequence of str
-            The names of the linearisation's coordinates (its ``dofs``), the chain's first.
-
-        Returns
-        -------
-        Linearisation
-        """
-        raise ParameterError("--load", f"is not available on this engine's models yet (got a load on {self.name})")
+    apply_loads = refuse_loads  # an engine that computes loads overrides it (docs/anatomy.md, "Loads")
 
     def chains(
         self, plane: str = "sagittal", posture=None, joint_stiffness="none", activations=None, loads=()
@@ -514,8 +495,7 @@ class MappedModel:
             The operating activations, for an engine that linearises there
             (:attr:`linearised_at_activations`); ignored by the others (exact at every activation).
         loads : sequence of BodyLoad, optional
-            External loads (:mod:`spinectl.anatomy.loads`), in the torque offset and K_0 at the posture
-            (:meth:`apply_loads`, after the engine's linearisation: a linearisation cache holds none); default none.
+            Loads in the torque offset and K_0 (:meth:`apply_loads`, after the linearisation: no cache has them).
 
         Returns
         -------
@@ -525,8 +505,7 @@ class MappedModel:
         """
         at = {"activations": activations} if activations is not None and self.linearised_at_activations else {}
         lin, rhy, involved = self.linearise(plane, posture, **at)
-        if loads:
-            lin = self.apply_loads(lin, posture, loads, involved)
+        lin = self.apply_loads(lin, posture, loads, involved) if loads else lin
         slopes = self.joint_slopes(plane, posture)
         lin, rhy = linearisation_in_angles(lin, slopes, self.name), rhythm_in_angles(rhy, slopes, self.name)
         n = lin.n

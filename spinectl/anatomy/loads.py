@@ -31,7 +31,7 @@ kinematic tree and its derivative). doi:10.1007/978-1-4899-7560-7.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -222,3 +222,92 @@ def load_terms(engine, loads, qpos) -> tuple:
         part = _one_load(engine, load, engine.names("body").index(load.body))
         tau, stiffness = tau + part[0], stiffness + part[1]
     return tau, stiffness
+
+
+def with_loads(lin, tau, stiffness, dofs):
+    """A linearisation with the loads' generalised force in its torque offset and their stiffness in K_0.
+
+    Parameters
+    ----------
+    lin : spinectl.anatomy.linearise.Linearisation
+    tau : numpy.ndarray
+        J^T F over the indices of ``lin.torque_offset`` [N m].
+    stiffness : numpy.ndarray
+        K_load over the same indices [N m/rad].
+    dofs : sequence of int
+        The indices of ``lin.dofs`` among them.
+
+    Returns
+    -------
+    Linearisation
+    """
+    k_load = np.asarray(stiffness)[np.ix_(list(dofs), list(dofs))]
+    return replace(lin, stiffness_offset=lin.stiffness_offset + k_load, torque_offset=lin.torque_offset + tau)
+
+
+def mujoco_apply_loads(self, lin, posture, loads, involved=()):
+    """MuJoCo's ``apply_loads``: J^T F in the torque offset, d(J^T F)/dq in K_0 (:func:`load_terms`).
+
+    Parameters
+    ----------
+    lin : spinectl.anatomy.linearise.Linearisation
+        At the posture (``Anatomy.linearise``).
+    posture : array_like, optional
+        Full qpos; default the model's reference posture.
+    loads : sequence of BodyLoad
+    involved : sequence of str
+        The joints of ``lin.dofs`` (unused: MuJoCo's dofs index the linearisation).
+
+    Returns
+    -------
+    Linearisation
+    """
+    return with_loads(lin, *load_terms(self.engine, loads, self.posture(posture)), lin.dofs)
+
+
+def refuse_loads(self, lin, posture, loads, involved):
+    """An engine's ``apply_loads`` by default: the linearisation with external loads, here refused in one line.
+
+    An engine that computes loads overrides it (MuJoCo: :func:`mujoco_apply_loads`; OpenSim:
+    :func:`spinectl.anatomy.osim_loads.osim_load_terms`): J^T F in the torque offset, K_load in K_0.
+
+    Parameters
+    ----------
+    lin : spinectl.anatomy.linearise.Linearisation
+        At the posture, over its dofs.
+    posture : optional
+        The operating point (``posture``).
+    loads : sequence of BodyLoad
+        Not empty.
+    involved : sequence of str
+        The names of the linearisation's coordinates (its ``dofs``), the chain's first.
+
+    Returns
+    -------
+    Linearisation
+
+    Raises
+    ------
+    ParameterError
+        Always: ``--load: is not available on this engine's models yet``.
+    """
+    raise ParameterError("--load", f"is not available on this engine's models yet (got a load on {self.name})")
+
+
+def analysed_loads(loads, check: bool) -> tuple:
+    """The loads of an analysis, validated; refused with the referee (``check``), whose copy of the model holds none.
+
+    Parameters
+    ----------
+    loads : sequence of BodyLoad or dict
+    check : bool
+        MuJoCo's referee asked for.
+
+    Returns
+    -------
+    tuple of BodyLoad
+    """
+    loads = body_loads(loads)
+    if check and loads:
+        raise ParameterError("--check", "compares the chain without loads (MuJoCo's referee holds none)")
+    return loads

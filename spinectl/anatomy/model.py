@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -12,7 +11,7 @@ from ..errors import ModelError, ParameterError
 from .contract import MappedModel, lordosis_direction, plane_axes
 from .engine import CONTROL_UNIT, Engine, load_engine, require_mujoco
 from .linearise import Linearisation, linearise, rhythm
-from .loads import load_terms
+from .loads import mujoco_apply_loads
 from .mapping import Mapping, check_mapping, classify, default_mapping, read_mapping
 
 
@@ -161,31 +160,7 @@ class Anatomy(MappedModel):
         rhy, involved = self.rhythm(plane, q)
         return linearise(self.engine, q, rhy.dofs, len(self.plane_joints(plane))), rhy, involved
 
-    def apply_loads(self, lin: Linearisation, posture, loads, involved=()) -> Linearisation:
-        """The linearisation with external loads: J^T F in the torque offset, d(J^T F)/dq in K_0.
-
-        Parameters
-        ----------
-        lin : Linearisation
-            At the posture (:meth:`linearise`).
-        posture : array_like, optional
-            Full qpos; default the model's reference posture.
-        loads : sequence of BodyLoad
-            (:func:`spinectl.anatomy.loads.load_terms`; docs/anatomy.md, "Loads").
-        involved : sequence of str
-            The joints of ``lin.dofs`` (unused: MuJoCo's dofs index the linearisation).
-
-        Returns
-        -------
-        Linearisation
-        """
-        tau, stiffness = load_terms(self.engine, loads, self.posture(posture))
-        dofs = list(lin.dofs)
-        return dataclasses.replace(
-            lin,
-            stiffness_offset=lin.stiffness_offset + stiffness[np.ix_(dofs, dofs)],
-            torque_offset=lin.torque_offset + tau,
-        )
+    apply_loads = mujoco_apply_loads  # docs/anatomy.md, "Loads"
 
     def equilibrium_rows(self, lin, plane: str, posture, equilibrium: str) -> tuple:
         """The optimum's equilibrium: every lumbar joint (``"free"``) or the rhythm's independent coordinates.

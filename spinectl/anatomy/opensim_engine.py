@@ -57,6 +57,7 @@ from .engine import engine_output_to_stderr, model_file, one_line
 from .export_osim import require_opensim
 from .joint_angles import JointSlopes
 from .linearise import STEP, Linearisation, Rhythm
+from .loads import with_loads
 from .mapping import Mapping, default_mapping, located, read_mapping
 from .opensim_angles import joint_slopes
 from .opensim_muscles import activation_floor, check_muscle, compliant, tension_terms
@@ -628,27 +629,9 @@ class OsimAnatomy(MappedModel):
         operating = self.default_controls() if activations is None else np.asarray(activations, float)
         return linearise(self.engine, involved, values, len(self.plane_joints(plane)), operating), rhy, involved
 
-    def apply_loads(self, lin: Linearisation, posture, loads, involved) -> Linearisation:
-        """The linearisation with external loads (:func:`spinectl.anatomy.osim_loads.osim_load_terms`).
-
-        Parameters
-        ----------
-        lin : Linearisation
-            Over ``involved`` at the posture (:meth:`linearise`; cached without loads).
-        posture : dict, optional
-            Coordinate name -> value [rad].
-        loads : sequence of BodyLoad
-        involved : sequence of str
-            The coordinates of ``lin``.
-
-        Returns
-        -------
-        Linearisation
-        """
-        tau, stiffness = osim_load_terms(
-            self.engine, loads, involved, self.posture(posture), _mobility_order(self.engine)
-        )
-        return replace(lin, stiffness_offset=lin.stiffness_offset + stiffness, torque_offset=lin.torque_offset + tau)
+    def apply_loads(self, lin: Linearisation, posture, loads, involved) -> Linearisation:  # MappedModel's doc
+        terms = osim_load_terms(self.engine, loads, involved, self.posture(posture), _mobility_order(self.engine))
+        return with_loads(lin, *terms, lin.dofs)
 
     def couplers(self, plane: str = "sagittal", posture=None) -> list:
         """The couplers that tie the plane's chain, each as one phrase with its slopes at the posture.

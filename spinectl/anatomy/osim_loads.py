@@ -75,17 +75,17 @@ def osim_load_terms(engine, loads, names, values: dict, order: dict) -> tuple:
     names = list(names)
     index = [order[c] for c in names]
     stiffness = np.zeros((len(names), len(names)))
+    def force_at(name: str, step: float) -> np.ndarray:  # J^T F with coordinate ``name`` moved by ``step``
+        moved = dict(values)
+        moved[name] = values.get(name, engine.coordinate(name).getDefaultValue()) + step
+        engine.set_posture(moved)
+        return _generalised_force(engine, loads)[index]
+
     try:
         engine.set_posture(values)
         tau = _generalised_force(engine, loads)[index]
-        for k, name in enumerate(names):
-            sides = []
-            for sign in (1.0, -1.0):
-                moved = dict(values)
-                moved[name] = values.get(name, engine.coordinate(name).getDefaultValue()) + sign * STEP
-                engine.set_posture(moved)
-                sides.append(_generalised_force(engine, loads)[index])
-            stiffness[:, k] = (sides[0] - sides[1]) / (2 * STEP)
+        for k, name in enumerate(names):  # column k: the central difference in coordinate k
+            stiffness[:, k] = (force_at(name, STEP) - force_at(name, -STEP)) / (2 * STEP)
     finally:
         engine.set_posture(values)
     return tau, stiffness

@@ -136,4 +136,4 @@ def test_unknown_body_and_bad_loads_refused(torso):
 def test_engine_without_loads_refuses_in_one_line():
     """An engine that does not override apply_loads (a made-up one) refuses a load naming --load."""
     with pytest.raises(ParameterError, match="--load: is not available"):
-        MappedModel.apply_loads(SimpleNamespace(name="made-up"), None, None, LOADS[:1])
+        MappedModel.apply_loads(SimpleNamespace(name="made-up"), None, None, LOADS[:1], ())
