@@ -137,3 +137,24 @@ def test_engine_without_loads_refuses_in_one_line():
     """An engine that does not override apply_loads (a made-up one) refuses a load naming --load."""
     with pytest.raises(ParameterError, match="--load: is not available"):
         MappedModel.apply_loads(SimpleNamespace(name="made-up"), None, None, LOADS[:1], ())
+
+
+def test_optimum_holds_the_load(torso):
+    """The least-effort optimum with a load balances the load's J^T F too: on the rhythm's rows (MuJoCo's equalities
+    carrying the rest), T^T (tau_per a + tau_0 + J^T F) = 0, J^T F from load_terms (MuJoCo's mj_applyFT, above)."""
+    import dataclasses
+
+    from spinectl.anatomy.optimum import optimise
+
+    loads = [BodyLoad("torso", (0.0, 0.0, -100.0), (0.1, 0.0, 0.3))]
+    opt = optimise(torso, stability="none", equilibrium="rhythm", loads=loads)
+    assert opt.ok
+    _, _, lin = torso.chains("sagittal")
+    _, per, offset = torso.equilibrium_rows(lin, "sagittal", None, "rhythm")
+    tau, _ = load_terms(torso.engine, loads, torso.posture())
+    _, _, held = torso.equilibrium_rows(dataclasses.replace(lin, torque_offset=tau), "sagittal", None, "rhythm")
+    residual = per @ opt.activations + offset + held
+    assert np.max(np.abs(residual)) <= 1e-6 * np.max(np.abs(held))
+    assert np.max(np.abs(per @ opt.activations + offset)) > 0.1 * np.max(np.abs(held))  # the load is what it holds
+    unloaded = optimise(torso, stability="none", equilibrium="rhythm")
+    assert opt.cost > unloaded.cost  # holding 100 N more costs effort
