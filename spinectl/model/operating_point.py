@@ -1,7 +1,8 @@
 """The operating point: the single input of every analysis of the paper's chain (docs/chain.md, "The operating point").
 
-An :class:`OperatingPoint` is the model, the posture (E, Lambda), the global PCSA of each muscle and the
-local stiffness added at each joint, validated once on construction. :func:`chain_at` builds from it the one
+An :class:`OperatingPoint` is the model, the posture (E, Lambda), the global PCSA of each muscle, the
+local stiffness added at each joint and the external loads held (:mod:`spinectl.model.loads`), validated once
+on construction. :func:`chain_at` builds from it the one
 :class:`~spinectl.model.linear_chain.LinearChain` that every analysis takes (the chain's modes, its verdict
 under the reflex, its least local stiffness, its delay margins, the designs): M, K and D at that point, on
 :func:`spinectl.model.chain.linear_chain`. A new analysis is a function of that chain (CONTRIBUTING.md,
