@@ -32,10 +32,10 @@ from ..model.chain import state_matrix as chain_state_matrix
 from ..model.linear_chain import CONTROL_CLASSES, LinearChain
 from ..model.stability import MARGINAL_TIME_CONSTANT, slowest_time_constant
 from .contract import AnatomyEngine
-from .engine import require_mujoco
 from .identity import identity_text, model_identity
-from .model import Anatomy
+from .loads import analysed_loads
 from .naming import joint_labels
+from .referee import mujoco_eigenvalues, mujoco_growth_rate
 
 REFERENCE_POSTURE = "the model's reference posture"
 """The posture analysed when none is given, as the table and the JSON's ``posture_source`` say it."""
@@ -268,144 +268,6 @@ def global_certificate(anatomy: AnatomyEngine, chain: LinearChain, arms, a) -> G
     )
 
 
-def referee_model(anatomy: Anatomy, chain: LinearChain, a, added) -> tuple:
-    """MuJoCo's model of the free chain, held at the reference posture (:func:`mujoco_eigenvalues`).
-
-    Parameters
-    ----------
-    anatomy : Anatomy
-        The model.
-    chain : LinearChain
-        The free chain, for its joints.
-    a : array_like, shape (m,)
-        Activations, set as MuJoCo's activation states and controls (so that they stay).
-    added : array_like, shape (n,)
-        Joint stiffness added at each chain joint [N m/rad].
-
-    Returns
-    -------
-    tuple
-        (mujoco.MjModel, mujoco.MjData) at the posture, forward dynamics run.
-    """
-    mujoco = require_mujoco()
-    spec = anatomy.engine.spec_factory()
-    keep = dict(zip(chain.joints, np.asarray(added, float), strict=True))
-    for joint in list(spec.joints):
-        if joint.name not in keep:
-            spec.delete(joint)
-    for equality in list(spec.equalities):
-        spec.delete(equality)
-    model = spec.compile()
-    for name, value in keep.items():
-        model.jnt_stiffness[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name)] = value
-    flags = mujoco.mjtDisableBit
-    model.opt.disableflags |= flags.mjDSBL_CONTACT | flags.mjDSBL_EQUALITY | flags.mjDSBL_LIMIT
-    model.opt.disableflags |= flags.mjDSBL_EULERDAMP
-    model.opt.integrator = mujoco.mjtIntegrator.mjINT_EULER
-    data = mujoco.MjData(model)
-    ctrl = anatomy.engine.held_controls()  # the actuators that are no muscle at their held controls
-    ctrl[anatomy.engine.muscle_ids()] = a
-    data.ctrl[:] = ctrl
-    stateful = model.actuator_actadr >= 0
-    data.act[model.actuator_actadr[stateful]] = ctrl[stateful]  # muscle dynamics drive act to ctrl: held
-    mujoco.mj_forward(model, data)
-    # held by constant torques where the posture is no equilibrium: off one, a step's
-    # derivative would also hold dM^-1/dq times the net torque, which K = dtau/dq leaves out
-    data.qfrc_applied[:] = -(data.qfrc_actuator + data.qfrc_passive - data.qfrc_bias)
-    mujoco.mj_forward(model, data)
-    return model, data
-
-
-def mujoco_growth_rate(anatomy: Anatomy, chain: LinearChain, a, added, eigenvalue, mode, duration=0.1, step=1e-4):
-    """The rate at which MuJoCo's own simulation (:func:`mujoco.mj_step`) grows or decays along a mode.
-
-    Starts at the posture displaced by 1e-5 rad along the mode (its velocity the eigenvalue times
-    that), steps MuJoCo's free chain (:func:`referee_model`, time step ``step``) for ``duration``
-    and fits the log of the displacement's projection on the mode against time (least squares).
-
-    Parameters
-    ----------
-    anatomy : Anatomy
-        The model.
-    chain : LinearChain
-        The free chain.
-    a : array_like, shape (m,)
-        Activations, held.
-    added : array_like, shape (n,)
-        Joint stiffness added [N m/rad].
-    eigenvalue : float
-        A real eigenvalue of the state matrix [1/s].
-    mode : array_like, shape (n,)
-        Its joint-angle part [rad].
-    duration, step : float
-        Simulated time and MuJoCo's time step [s].
-
-    Returns
-    -------
-    float
-        The fitted rate [1/s].
-    """
-    mujoco = require_mujoco()
-    model, data = referee_model(anatomy, chain, a, added)
-    model.opt.timestep = step
-    order = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in chain.joints]
-    qadr = np.array([model.jnt_qposadr[j] for j in order])
-    vadr = np.array([model.jnt_dofadr[j] for j in order])
-    v = np.asarray(mode, float) / np.linalg.norm(mode)
-    q0 = data.qpos[qadr].copy()
-    data.qpos[qadr] += 1e-5 * v
-    data.qvel[vadr] = 1e-5 * eigenvalue * v
-    times, amplitude = [], []
-    for k in range(int(round(duration / step))):
-        mujoco.mj_step(model, data)
-        times.append((k + 1) * step)
-        amplitude.append(abs(v @ (data.qpos[qadr] - q0)))
-    return float(np.polyfit(times, np.log(amplitude), 1)[0])
-
-
-def mujoco_eigenvalues(anatomy: Anatomy, chain: LinearChain, a, added) -> np.ndarray:
-    """MuJoCo's own linearisation of the free chain: eigenvalues from :func:`mujoco.mjd_transitionFD`.
-
-    The referee: a copy of the model with every joint off the chain removed (its body
-    welded at the reference posture), equality constraints, contacts and limits disabled,
-    the added stiffness as MuJoCo joint stiffness, the posture held by constant applied
-    torques where it is no equilibrium (as the paper's counter torques would), and Euler's
-    implicit joint damping off,
-    so that one step is v+ = v + h M^-1 f(q, v) exactly. Its discrete transition's velocity
-    rows give the continuous state matrix, [[0, I], [A_vq/h, (A_vv - I)/h]]; the
-    activations are states of their own, held.
-
-    Parameters
-    ----------
-    anatomy : Anatomy
-        The model (at its reference posture).
-    chain : LinearChain
-        The free chain, for its joints.
-    a : array_like, shape (m,)
-        Activations.
-    added : array_like, shape (n,)
-        Joint stiffness added at each chain joint [N m/rad].
-
-    Returns
-    -------
-    numpy.ndarray, shape (2n,)
-        Eigenvalues [1/s], by descending real part.
-    """
-    mujoco = require_mujoco()
-    model, data = referee_model(anatomy, chain, a, added)
-    n, h = model.nv, model.opt.timestep
-    order = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, j) for j in chain.joints]
-    size = 2 * n + model.na
-    A = np.zeros((size, size))
-    mujoco.mjd_transitionFD(model, data, 1e-6, True, A, None, None, None)
-    dofs = np.array([model.jnt_dofadr[j] for j in order])
-    a_vq = A[np.ix_(n + dofs, dofs)]
-    a_vv = A[np.ix_(n + dofs, n + dofs)]
-    cont = np.block([[np.zeros((n, n)), np.eye(n)], [a_vq / h, (a_vv - np.eye(n)) / h]])
-    dyn = np.linalg.eigvals(cont)
-    return dyn[np.lexsort((-dyn.imag, -dyn.real))]
-
-
 @dataclass(frozen=True)
 class AnatomyResult:
     """The analysis of one model, plane, posture and activation (:func:`analyse`).
@@ -436,7 +298,7 @@ class AnatomyResult:
         delay margin (:func:`reflex_margin`).
     simulated_rate : float
         With ``check``: the rate fitted to MuJoCo's simulation started along the free chain's
-        mode of largest real eigenvalue (:func:`mujoco_growth_rate`; NaN if that is complex) [1/s].
+        mode of largest real eigenvalue (``referee.mujoco_growth_rate``; NaN if that is complex) [1/s].
     control_unit : str
         The unit of ``activations``: ``"1"``, or e.g. ``"cm^2"`` (a PCSA, spinectl's export).
     activation_source : str
@@ -479,6 +341,7 @@ class AnatomyResult:
     rhythm_left_out: tuple = ()
     devices: tuple = ()
     posture_source: str = REFERENCE_POSTURE
+    loads: tuple = field(default=(), metadata={"doc": "the external loads in the chains (spinectl.anatomy.loads)"})
 
     @property
     def activation_mean(self) -> float:
@@ -559,6 +422,7 @@ class AnatomyResult:
                 "rhythm_left_out": list(self.rhythm_left_out),
             },
             "devices": list(self.devices),
+            **({"loads": [load.to_dict() for load in self.loads]} if self.loads else {}),
         }
         if self.joint_slopes is not None:  # only where the units differ: a hinge's output stays as it was
             out["joint_rad_per_coordinate_rad"] = self.joint_slopes.tolist()
@@ -605,6 +469,7 @@ class AnatomyResult:
             f"joint stiffness added: {self.joint_stiffness_added[0]:.4g} N m/rad per joint",
             *self._angle_note(),
             *(["devices: " + "; ".join(self.devices)] if self.devices else []),
+            *(f"load (in the equilibrium and K): {load.text()}" for load in self.loads),
             "",
             f"{'joint (level)':<24}{'-K_jj [N m/rad]':>16}  joint by joint (others fixed)",
             f"{'':<24}{'(> 0 restores)':>16}",
@@ -707,6 +572,7 @@ def analyse(
     check=False,
     reflex=None,
     time=None,
+    loads=(),
 ) -> AnatomyResult:
     """Joint-by-joint and chain verdicts of a model at an activation, free and constrained.
 
@@ -728,12 +594,15 @@ def analyse(
     joint_stiffness : {"none", "mapped"} or float
         Intervertebral stiffness added at each chain joint [N m/rad].
     check : bool
-        Also MuJoCo's own eigenvalues (:func:`mujoco_eigenvalues`) and its simulation along the
-        leading mode (:func:`mujoco_growth_rate`); reference posture only.
+        Also MuJoCo's own eigenvalues (:func:`~spinectl.anatomy.referee.mujoco_eigenvalues`) and its
+        simulation along the leading mode (:func:`~spinectl.anatomy.referee.mujoco_growth_rate`); reference
+        posture only.
     reflex : tuple, optional
         ``(kp, kd, lag)``: also the free chain's exact delay margin under that reflex (:func:`reflex_margin`).
     time : float, optional
         The frame read from the posture and activation files [s]; default each file's first.
+    loads : sequence of BodyLoad, optional
+        External loads in K and the torque offset (not with ``check``).
 
     Returns
     -------
@@ -744,7 +613,8 @@ def analyse(
     point = recorded_point(anatomy, posture, activation, time)
     posture, activation = point.posture, point.activation
     a = activations(anatomy, activation)
-    free, con, lin = anatomy.chains(plane, posture, joint_stiffness, activations=a)
+    loads = analysed_loads(loads, check)
+    free, con, lin = anatomy.chains(plane, posture, joint_stiffness, activations=a, loads=loads)
     added = anatomy.added_stiffness(joint_stiffness, free.n_joints)
     arms = lin.moment_arms[:, list(lin.dofs[: lin.n])]
     referee, rate = None, float("nan")
@@ -778,6 +648,7 @@ def analyse(
         rhythm_left_out=anatomy.rhythm(plane, posture)[0].left_out,
         devices=tuple(getattr(anatomy.engine, "devices", ())),
         posture_source=point.posture_source or REFERENCE_POSTURE,
+        loads=loads,
     )
 
 

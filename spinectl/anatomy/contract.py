@@ -26,8 +26,10 @@ import numpy as np
 from .._validate import printable, show
 from ..errors import ParameterError
 from ..model.linear_chain import LinearChain
+from ..model.loads import loads_text
 from .joint_angles import JointSlopes, linearisation_in_angles, rhythm_in_angles
 from .linearise import constrained_chain, free_chain
+from .loads import refuse_loads
 from .mapping import MAX_STIFFNESS, Mapping
 
 
@@ -509,7 +511,11 @@ class MappedModel:
         rhy, involved = self.rhythm(plane, posture)
         return rhythm_in_angles(rhy, self.joint_slopes(plane, posture), self.name), involved
 
-    def chains(self, plane: str = "sagittal", posture=None, joint_stiffness="none", activations=None) -> tuple:
+    apply_loads = refuse_loads  # an engine that computes loads overrides it (docs/anatomy.md, "Loads")
+
+    def chains(
+        self, plane: str = "sagittal", posture=None, joint_stiffness="none", activations=None, loads=()
+    ) -> tuple:
         """The free chain and the chain constrained by the model's rhythm, as LinearChain objects.
 
         Both per radian of each joint's rotation, the engine's coordinates changed to the joints' angles
@@ -526,6 +532,8 @@ class MappedModel:
         activations : array_like, shape (m,), optional
             The operating activations, for an engine that linearises there
             (:attr:`linearised_at_activations`); ignored by the others (exact at every activation).
+        loads : sequence of BodyLoad, optional
+            Loads in the torque offset and K_0 (:meth:`apply_loads`, after the linearisation: no cache has them).
 
         Returns
         -------
@@ -535,11 +543,12 @@ class MappedModel:
         """
         at = {"activations": activations} if activations is not None and self.linearised_at_activations else {}
         lin, rhy, involved = self.linearise(plane, posture, **at)
+        lin = self.apply_loads(lin, posture, loads, involved) if loads else lin
         slopes = self.joint_slopes(plane, posture)
         lin, rhy = linearisation_in_angles(lin, slopes, self.name), rhythm_in_angles(rhy, slopes, self.name)
         n = lin.n
         added = self.added_stiffness(joint_stiffness, n)
-        source = self.chain_source(plane, posture)
+        source = self.chain_source(plane, posture) + loads_text(loads)
         controls = {"bounds": self.control_bounds(), "unit": self.control_unit}
         free = free_chain(lin, tuple(involved[:n]), self.muscles, self.classes, added, source, **controls)
         full_added = np.concatenate([added, np.zeros(len(involved) - n)])

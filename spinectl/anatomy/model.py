@@ -12,6 +12,7 @@ from .contract import MappedModel
 from .directions import lordosis_direction, plane_axes
 from .engine import CONTROL_UNIT, Engine, load_engine, require_mujoco
 from .linearise import Linearisation, linearise, rhythm
+from .loads import mujoco_apply_loads
 from .mapping import Mapping, check_mapping, classify, default_mapping, read_mapping
 
 
@@ -159,6 +160,8 @@ class Anatomy(MappedModel):
         q = self.posture(posture)
         rhy, involved = self.rhythm(plane, q)
         return linearise(self.engine, q, rhy.dofs, len(self.plane_joints(plane))), rhy, involved
+
+    apply_loads = mujoco_apply_loads  # docs/anatomy.md, "Loads"
 
     def equilibrium_rows(self, lin, plane: str, posture, equilibrium: str) -> tuple:
         """The optimum's equilibrium: every lumbar joint (``"free"``) or the rhythm's independent coordinates.

@@ -57,12 +57,14 @@ from .engine import engine_output_to_stderr, model_file, one_line
 from .export_osim import require_opensim
 from .joint_angles import JointSlopes
 from .linearise import STEP, Linearisation
+from .loads import with_loads
 from .mapping import Mapping, default_mapping, read_mapping
 from .opensim_angles import joint_slopes
 from .opensim_classes import check_mapping, classify
 from .opensim_couplers import coupler_rhythm, followed, read_couplers
 from .opensim_muscles import activation_floor, check_muscle, compliant, tension_terms
 from .osim_geometry import geometry
+from .osim_loads import osim_load_terms
 
 KEPT = 256
 """How many linearisations an engine keeps in memory (:attr:`OsimEngine.linearisations`), the latest."""
@@ -431,6 +433,10 @@ class OsimAnatomy(MappedModel):
         rhy, involved = self.rhythm(plane, values)
         operating = self.default_controls() if activations is None else np.asarray(activations, float)
         return linearise(self.engine, involved, values, len(self.plane_joints(plane)), operating), rhy, involved
+
+    def apply_loads(self, lin: Linearisation, posture, loads, involved) -> Linearisation:  # MappedModel's doc
+        terms = osim_load_terms(self.engine, loads, involved, self.posture(posture), _mobility_order(self.engine))
+        return with_loads(lin, *terms, lin.dofs)
 
     def couplers(self, plane: str = "sagittal", posture=None) -> list:
         """The couplers that tie the plane's chain, each as one phrase with its slopes at the posture.

@@ -162,6 +162,7 @@ def optimise(
     joint_stiffness="none",
     weights: str = "volume",
     equilibrium: str = "rhythm",
+    loads=(),
 ) -> Optimum:
     """The least-effort activations that hold the posture, with a stability criterion.
 
@@ -185,13 +186,15 @@ def optimise(
         ``"volume"`` or ``"none"`` (:func:`volume_weights`).
     equilibrium : str
         ``"rhythm"`` or ``"free"`` (module docstring).
+    loads : sequence of BodyLoad, optional
+        External loads held (:mod:`spinectl.anatomy.loads`): in the equilibrium and in K; default none.
 
     Returns
     -------
     Optimum
     """
     check_choices(stability, equilibrium, margin, weights)
-    free, constrained, lin = anatomy.chains(plane, posture, joint_stiffness)
+    free, constrained, lin = anatomy.chains(plane, posture, joint_stiffness, loads=loads)
     rows, tau_per, tau_0 = anatomy.equilibrium_rows(lin, plane, posture, equilibrium)
     w = anatomy.volume_weights() if weights == "volume" else np.ones(free.n_controls)
     opt = optimum_on_chains(free, constrained, lin, rows, tau_per, tau_0, w, stability, equilibrium, margin)
@@ -568,6 +571,7 @@ def optimised(
     reflex=None,
     posture=None,
     time=None,
+    loads=(),
 ) -> OptimisedResult:
     """The optimum with a criterion and without, at a posture, and the analysis at the optimum.
 
@@ -586,7 +590,7 @@ def optimised(
     equilibrium : str
         One of :data:`EQUILIBRIUM`.
     check : bool
-        MuJoCo's own eigenvalues at the optimum (:func:`~spinectl.anatomy.analyses.mujoco_eigenvalues`).
+        MuJoCo's own eigenvalues at the optimum (:func:`~spinectl.anatomy.referee.mujoco_eigenvalues`).
     reflex : tuple, optional
         ``(kp, kd, lag)``: the chain's exact delay margin at the optimum
         (:func:`~spinectl.anatomy.analyses.reflex_margin`).
@@ -595,6 +599,8 @@ def optimised(
         (:func:`spinectl.anatomy.recordings.recorded_point`); default the model's reference posture.
     time : float, optional
         The posture file's frame [s]; default its first.
+    loads : sequence of BodyLoad, optional
+        External loads held (:func:`optimise`); default none.
 
     Returns
     -------
@@ -608,12 +614,14 @@ def optimised(
     point = recorded_point(anatomy, posture, None, time)
     kwargs = {"plane": plane, "margin": margin, "joint_stiffness": joint_stiffness, "equilibrium": equilibrium}
     kwargs["posture"] = point.posture
+    if loads:  # only then: the engines' optimise of a made-up engine need not know loads
+        kwargs["loads"] = loads
     opt = optimise(anatomy, stability=stability, **kwargs)
     classic = opt if stability == "none" else optimise(anatomy, stability="none", **kwargs)
     analysis = None
     at = {"posture": point.posture, "joint_stiffness": joint_stiffness, "reflex": reflex}
     if opt.ok:
-        analysis = analyse(anatomy, plane, opt.activations, check=check, **at)
+        analysis = analyse(anatomy, plane, opt.activations, check=check, loads=loads, **at)
     empty = skeleton(anatomy, opt, **kwargs, reflex=reflex)
     if point.posture_source:  # the file and its frame, where analyse saw the posture it read
         analysis, empty = (r and dataclasses.replace(r, posture_source=point.posture_source) for r in (analysis, empty))
@@ -621,7 +629,9 @@ def optimised(
     return OptimisedResult(anatomy, opt, classic, float(margin), plane, analysis, empty, fix)
 
 
-def skeleton(anatomy: AnatomyEngine, opt: Optimum, plane: str, joint_stiffness, reflex=None, posture=None, **_):
+def skeleton(
+    anatomy: AnatomyEngine, opt: Optimum, plane: str, joint_stiffness, reflex=None, posture=None, loads=(), **_
+):
     """Where the optimum is infeasible, the analysis at the lower control bounds (its JSON's keys); else None.
 
     Parameters
@@ -638,6 +648,8 @@ def skeleton(anatomy: AnatomyEngine, opt: Optimum, plane: str, joint_stiffness, 
         ``(kp, kd, lag)``.
     posture : optional
         The engine's posture; default the reference posture.
+    loads : sequence of BodyLoad, optional
+        External loads (:func:`optimise`).
 
     Returns
     -------
@@ -648,7 +660,7 @@ def skeleton(anatomy: AnatomyEngine, opt: Optimum, plane: str, joint_stiffness, 
     if opt.ok:
         return None
     lower = anatomy.control_bounds()[0]
-    return analyse(anatomy, plane, lower, posture=posture, joint_stiffness=joint_stiffness, reflex=reflex)
+    return analyse(anatomy, plane, lower, posture=posture, joint_stiffness=joint_stiffness, reflex=reflex, loads=loads)
 
 
 def lordosis_posture(anatomy: AnatomyEngine, degrees: float, plane: str = "sagittal"):
@@ -697,6 +709,7 @@ def lordosis_curve(
     margin: float = MARGIN,
     joint_stiffness="none",
     equilibrium: str = "rhythm",
+    loads=(),
 ) -> dict:
     """The three optima (classic, joint by joint, the chain) over the lordosis.
 
@@ -706,7 +719,7 @@ def lordosis_curve(
         The model.
     degrees : array_like
         Changes of the chain's summed angle about the reference posture [deg].
-    plane, margin, joint_stiffness, equilibrium
+    plane, margin, joint_stiffness, equilibrium, loads
         As in :func:`optimise`.
 
     Returns
@@ -728,6 +741,7 @@ def lordosis_curve(
                 posture=posture,
                 joint_stiffness=joint_stiffness,
                 equilibrium=equilibrium,
+                **({"loads": loads} if loads else {}),
             )
             for posture in postures
         ]

@@ -576,3 +576,67 @@ def scheduler_options(args: argparse.Namespace) -> dict:
     if args.worker_timeout is not None:
         options["worker_timeout"] = args.worker_timeout
     return options
+
+
+def sagittal_load(text: str) -> tuple:
+    """--load of the paper's model: ``FX,FY``, a force [N] at the point mass (x ventral, y up), fixed in the ground.
+
+    Each component finite and within +-:data:`spinectl.model.loads.MAX_LOAD` N (docs/chain.md, "External loads").
+
+    Parameters
+    ----------
+    text : str
+        The option's value.
+
+    Returns
+    -------
+    tuple of float
+        (F_x, F_y) [N].
+    """
+    from ..model.loads import MAX_LOAD
+
+    parts = text.split(",")
+    if len(parts) != 2:
+        raise argparse.ArgumentTypeError(f"--load must be FX,FY: two forces [N], e.g. 0,-200 (got {text!r})")
+    one = finite_float("--load", -MAX_LOAD, MAX_LOAD, " N, per component")
+    return tuple(one(part) for part in parts)
+
+
+def anatomy_load(text: str) -> dict:
+    """--load of ``spinectl anatomy``: ``BODY:FX,FY,FZ[@X,Y,Z][:ground|:body]`` (docs/anatomy.md, "Loads").
+
+    A force [N] at a point of BODY in its own frame [m] (default its origin), the force fixed in the ground
+    (default) or in the body. Forces within +-:data:`spinectl.model.loads.MAX_LOAD` N, the point within
+    +-:data:`spinectl.anatomy.loads.MAX_LOAD_OFFSET` m; the body is checked against the model when it is loaded.
+
+    Parameters
+    ----------
+    text : str
+        The option's value.
+
+    Returns
+    -------
+    dict
+        ``body``, ``force`` [N], ``point`` [m], ``frame``: the keywords of
+        :class:`spinectl.anatomy.loads.BodyLoad`.
+    """
+    from ..anatomy.loads import MAX_LOAD_OFFSET, SYNTAX
+    from ..model.loads import FRAMES, MAX_LOAD
+
+    body, sep, rest = text.partition(":")
+    frame = "ground"
+    head, colon, tail = rest.rpartition(":")
+    if colon and tail in FRAMES:
+        rest, frame = head, tail
+    force, at, point = rest.partition("@")
+    force, point = force.split(","), point.split(",") if at else ["0", "0", "0"]
+    if not (sep and body.strip() and len(force) == 3 and len(point) == 3):
+        raise argparse.ArgumentTypeError(f"--load must be {SYNTAX} (got {text!r})")
+    forces = finite_float("--load", -MAX_LOAD, MAX_LOAD, " N, per force component")
+    offsets = finite_float("--load", -MAX_LOAD_OFFSET, MAX_LOAD_OFFSET, " m, per point coordinate")
+    return {
+        "body": body,
+        "force": tuple(forces(f) for f in force),
+        "point": tuple(offsets(p) for p in point),
+        "frame": frame,
+    }

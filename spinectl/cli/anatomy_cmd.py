@@ -7,7 +7,7 @@ import argparse
 from ..anatomy.mapping import MAX_STIFFNESS
 from ..errors import ParameterError
 from ..model.params.bounds import MAX_ACTIVATION_TIME_CONSTANT
-from ._common import emit_json, finite_float, input_name
+from ._common import anatomy_load, emit_json, finite_float, input_name
 
 MAX_DERIVATIVE_GAIN = 1e6
 """Largest reflex derivative gain kd [N m s/rad]: the chain's delay margin scales as 1/kd from 1e3 to 1e6
@@ -91,6 +91,16 @@ def register(sub) -> None:
         metavar="K",
         help="intervertebral stiffness added at each chain joint: none (the model's own, default), "
         "mapped (the mapping's cited value) or a number [N m/rad]",
+    )
+    parser.add_argument(
+        "--load",
+        type=anatomy_load,
+        action="append",
+        default=[],
+        metavar="BODY:FX,FY,FZ[@X,Y,Z]",
+        help="an external force [N] held at a point of BODY (in its frame [m], default its origin), fixed in the "
+        "ground, or in the body with a :body suffix; in the equilibrium and the stiffness (its load stiffness "
+        "through the geometry, as gravity's); repeatable (docs/anatomy.md, Loads)",
     )
     parser.add_argument(
         "--check",
@@ -205,6 +215,7 @@ def _answers(args) -> tuple:
     _refuse_combinations(args)
     anatomy = load(args.model, args.mapping, cache=not args.no_cache)
     reflex = None if args.kp is None else (args.kp, args.kd, args.activation_lag)
+    loaded = {"loads": _loads(args.load)} if args.load else {}  # without: the calls as they were
     if args.optimise:
         from ..anatomy.optimum import optimised
 
@@ -219,6 +230,7 @@ def _answers(args) -> tuple:
             reflex=reflex,
             posture=args.posture,
             time=args.time,
+            **loaded,
         )
     else:
         result = analyse(
@@ -230,6 +242,7 @@ def _answers(args) -> tuple:
             reflex=reflex,
             posture=args.posture,
             time=args.time,
+            **loaded,
         )
     curve = None
     if args.lordosis:
@@ -242,6 +255,7 @@ def _answers(args) -> tuple:
             margin=args.margin,
             joint_stiffness=args.joint_stiffness,
             equilibrium=args.equilibrium,
+            **loaded,
         )
     if args.plot:
         from ..anatomy.figures import save_anatomy_figures
@@ -264,6 +278,13 @@ def _refuse_combinations(args) -> None:
     for option, value in (("--lordosis", args.lordosis), ("--plot", args.plot)):
         if value and args.posture is not None:  # both start from the model's reference posture
             raise ParameterError(option, "starts from the model's reference posture; it cannot go with --posture")
+
+
+def _loads(parsed) -> tuple:
+    """The --load options as the library's loads (their bodies checked when the model linearises)."""
+    from ..anatomy.loads import body_loads
+
+    return body_loads(parsed)
 
 
 def _joint_stiffness(text: str):

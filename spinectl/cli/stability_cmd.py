@@ -14,6 +14,8 @@ from ._common import (
     load_model,
     note_pcsa_slip,
     pcsa_option,
+    require,
+    sagittal_load,
 )
 
 
@@ -53,6 +55,15 @@ def register(sub) -> None:
         help="free all CoRs at once: the chain's stiffness, damping and mass matrices, its static margin, "
         "dynamic eigenvalues and least local stiffness (docs/chain.md)",
     )
+    parser.add_argument(
+        "--load",
+        type=sagittal_load,
+        action="append",
+        default=[],
+        metavar="FX,FY",
+        help="with --coupled: a force [N] held at the point mass, fixed in the ground (x ventral, y up; e.g. "
+        "0,-200 for about 20 kg held), in the chain's K and its least local stiffness; repeatable (docs/chain.md)",
+    )
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     add_model_options(parser)
     parser.set_defaults(func=run)
@@ -78,11 +89,14 @@ def run(args) -> int:
     model = load_model(args, body_aliases(args))
     check_position(model, args)
     given = args.pcsa is not None  # else the minimum stabilising PCSA
-    analysis = stability_at
+    require(args.coupled or not args.load, "--load", "goes with --coupled (the chain's K; each segment alone: not yet)")
+    analysis, loaded = stability_at, {}
     if args.coupled:  # only here: the chain's semidefinite programs import cvxpy
         from ..optimise.coupled import coupled_stability_at as analysis
+
+        loaded = {"loads": args.load}
     try:
-        result = analysis(model, args.E, args.Lambda, pcsa_option(args.pcsa), slip_check=False)
+        result = analysis(model, args.E, args.Lambda, pcsa_option(args.pcsa), slip_check=False, **loaded)
     except NoStabilisingActivation as exc:  # the library names its argument; the user types the option
         raise NoStabilisingActivation(str(exc).replace("(argument pcsa, [m^2])", "with --pcsa [cm2]")) from None
     source = "given" if given else "min_pcsa"

@@ -1,7 +1,8 @@
 """The operating point: the single input of every analysis of the paper's chain (docs/chain.md, "The operating point").
 
-An :class:`OperatingPoint` is the model, the posture (E, Lambda), the global PCSA of each muscle and the
-local stiffness added at each joint, validated once on construction. :func:`chain_at` builds from it the one
+An :class:`OperatingPoint` is the model, the posture (E, Lambda), the global PCSA of each muscle, the
+local stiffness added at each joint and the external loads held (:mod:`spinectl.model.loads`), validated once
+on construction. :func:`chain_at` builds from it the one
 :class:`~spinectl.model.linear_chain.LinearChain` that every analysis takes (the chain's modes, its verdict
 under the reflex, its least local stiffness, its delay margins, the designs): M, K and D at that point, on
 :func:`spinectl.model.chain.linear_chain`. A new analysis is a function of that chain (CONTRIBUTING.md,
@@ -21,9 +22,11 @@ import numpy as np
 
 from .._validate import real, show
 from ..errors import ParameterError
+from . import geometry
 from .chain import chain_coefficients, linear_chain
 from .checks import arithmetic_guard, expand_pcsa, validate_position
 from .linear_chain import LinearChain
+from .loads import load_stiffness, loads_text, point_loads, upright_load_torque
 from .params import Model
 
 
@@ -49,6 +52,10 @@ class OperatingPoint:
     slip_check : bool
         True (the default): a PCSA above :data:`spinectl.model.checks.MAX_PLAUSIBLE_PCSA` is refused
         as cm^2 typed where m^2 are meant. False: spinectl computed it, or the caller checked its unit.
+    loads : tuple of PointLoad
+        External forces held at the point mass (:class:`spinectl.model.loads.PointLoad`, or (F_x, F_y) [N]
+        pairs, fixed in the ground); default none. They enter the chain's K (:func:`chain_at`) and the
+        torque to be held (:func:`load_torque_at`).
     """
 
     model: Model
@@ -57,6 +64,7 @@ class OperatingPoint:
     pcsa: np.ndarray
     local_stiffness: np.ndarray = 0.0
     slip_check: bool = True
+    loads: tuple = ()
 
     def __post_init__(self):
         if not isinstance(self.model, Model):
@@ -70,6 +78,7 @@ class OperatingPoint:
         object.__setattr__(self, "lordosis", lam)
         object.__setattr__(self, "pcsa", _frozen(pcsa))
         object.__setattr__(self, "local_stiffness", _frozen(_local_stiffness(self.model, self.local_stiffness)))
+        object.__setattr__(self, "loads", point_loads(self.loads))
 
 
 def _local_stiffness(model: Model, value) -> np.ndarray:
@@ -96,7 +105,8 @@ def chain_at(point: OperatingPoint) -> LinearChain:
     """The chain at an operating point: the one :class:`~spinectl.model.linear_chain.LinearChain` every analysis takes.
 
     :func:`spinectl.model.chain.linear_chain` (its joints, M, c_loc and source) with every control fixed at the
-    point's PCSA and its local stiffness: no controls, K_0 = K(A) - diag(k) and D_0 = D(A) - c_loc diag(k).
+    point's PCSA and its local stiffness: no controls, K_0 = K(A) - diag(k) and D_0 = D(A) - c_loc diag(k);
+    with loads, K_0 + K_load (:func:`spinectl.model.loads.load_stiffness`; docs/chain.md, "External loads").
     K(A) and D(A) sum the muscles per m^2 of each (:meth:`spinectl.model.chain.ChainCoefficients.stiffness`),
     as every analysis did before this function: equal to ``linear_chain(...).at(x, k)`` (x the decision
     variables in cm^2) to rounding, and to what they printed bit for bit.
@@ -146,10 +156,34 @@ def chain_at(point: OperatingPoint) -> LinearChain:
     with arithmetic_guard(e, lam):
         coefficients = chain_coefficients(model, e, lam)
         free = linear_chain(model, e, lam, coefficients)
+        stiffness = coefficients.stiffness(point.pcsa)
+        if point.loads:  # without loads K stays bit for bit what it was
+            stiffness = stiffness + load_stiffness(model, geometry.cor_positions(e, lam, model.geometry), point.loads)
         fixed = dataclasses.replace(
             free.at(np.zeros(free.n_controls)),
-            stiffness_offset=coefficients.stiffness(point.pcsa),
+            stiffness_offset=stiffness,
             damping_offset=coefficients.damping(point.pcsa),
+            source=free.source + loads_text(point.loads),
         )
         # k = 0 leaves K and D as they are (LinearChain.at would add zeros, turning a -0.0 into 0.0)
         return fixed.at((), point.local_stiffness) if np.any(point.local_stiffness) else fixed
+
+
+def load_torque_at(point: OperatingPoint) -> np.ndarray:
+    """The torque of the point's loads on every joint at its posture [N m], which the muscles must hold too.
+
+    tau_j = (P - c_j) x F summed over the loads (:func:`spinectl.model.loads.upright_load_torque`): the
+    load's part of the equilibrium, as gravity's is the counter torque's.
+
+    Parameters
+    ----------
+    point : OperatingPoint
+
+    Returns
+    -------
+    numpy.ndarray, shape (n_cor,)
+        [N m], top to bottom; zeros without loads.
+    """
+    model = point.model
+    cor = geometry.cor_positions(point.eccentricity, point.lordosis, model.geometry)
+    return upright_load_torque(model, cor, point.loads)

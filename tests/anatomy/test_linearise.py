@@ -11,7 +11,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from spinectl.anatomy.analyses import analyse, mujoco_eigenvalues
+from spinectl.anatomy.analyses import analyse
+from spinectl.anatomy.referee import mujoco_eigenvalues
 
 H = 1e-6  # central-difference step [rad]: truncation ~1e-12, rounding ~1e-10 relative here
 

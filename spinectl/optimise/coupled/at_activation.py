@@ -7,6 +7,7 @@ eigenvalues with the global muscles alone and with the least local stiffness of 
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -15,7 +16,7 @@ from ..._validate import non_negative
 from ...model import chain
 from ...model.checks import arithmetic_guard, expand_pcsa
 from ...model.linear_chain import LinearChain
-from ...model.operating_point import OperatingPoint, chain_at
+from ...model.operating_point import OperatingPoint, chain_at, load_torque_at
 from ...model.params import Model
 from ...model.source import header, provenance
 from ...model.stability import criterion, eigenvalue_text, self_stable
@@ -53,6 +54,10 @@ class CoupledStability:
         Of the state matrix [[0, I], [M^-1 K, M^-1 D]], global muscles only [1/s].
     local_eigenvalues : numpy.ndarray, shape (2 n_cor,), complex
         The same with the least local stiffness added, K - diag(k) [1/s]; NaN if (a) failed.
+    loads : tuple of PointLoad
+        The loads held at the point mass (:mod:`spinectl.model.loads`), in K; () none.
+    load_torque : numpy.ndarray, shape (n_cor,), optional
+        Their torque on each joint at the posture [N m] (:func:`~spinectl.model.operating_point.load_torque_at`).
     """
 
     eccentricity: float
@@ -66,6 +71,8 @@ class CoupledStability:
     margin: float
     eigenvalues: np.ndarray
     local_eigenvalues: np.ndarray
+    loads: tuple = ()
+    load_torque: np.ndarray | None = None
 
     @property
     def linear_chain(self) -> LinearChain:
@@ -158,7 +165,17 @@ class CoupledStability:
                 "self_stable": self.self_stable,
                 "eigenvalues_with_local": [[float(z.real), float(z.imag)] for z in self.local_eigenvalues],
                 "stable_with_local": self.stable_with_local,
+                **self._loads_dict(),
             },
+        }
+
+    def _loads_dict(self) -> dict:
+        """The loads applied and their torque [N m] (in K): the operating point's identity; empty without."""
+        if not self.loads:
+            return {}
+        return {
+            "loads": [load.to_dict() for load in self.loads],
+            "load_torque_Nm": dict(zip(self.segment_names, np.asarray(self.load_torque).tolist(), strict=True)),
         }
 
     def table(self, model: Model, pcsa_source: str = "min_pcsa", activation: float = 1.0) -> str:
@@ -194,6 +211,13 @@ class CoupledStability:
             + ", ".join(f"{n} {p:.2f}" for n, p in zip(model.muscle_names, pcsa, strict=True))
             + f"  (total {pcsa.sum():.2f})",
         ]
+        for load in self.loads:  # the operating point's identity: K below includes them
+            lines.append(f"load (in K): {load.text()}")
+        if self.loads:
+            lines.append(
+                "load torque on each joint [N m]: "
+                + ", ".join(f"{n} {t:.2f}" for n, t in zip(self.segment_names, self.load_torque, strict=True))
+            )
         for title, matrix, fmt in (
             (
                 "stiffness matrix K_chain = dtau/dq [N m/rad]: global muscles, gravity and the passive stiffness "
@@ -265,7 +289,7 @@ def point_at_activation(
 
 
 def coupled_stability_at(
-    model: Model, eccentricity: float, lordosis: float, pcsa=None, *, slip_check: bool = True
+    model: Model, eccentricity: float, lordosis: float, pcsa=None, *, slip_check: bool = True, loads=()
 ) -> CoupledStability:
     """The coupled chain at a global activation, by default the per-segment optimum.
 
@@ -287,6 +311,9 @@ def coupled_stability_at(
         True (the default): a ``pcsa`` above :data:`spinectl.model.checks.MAX_PLAUSIBLE_PCSA` is refused
         as cm^2 typed where m^2 are meant. False: the caller has checked its unit (``--pcsa``, in cm^2), and
         it is analysed whatever its size, as a computed optimum is (docs/robustness.md, "Model evaluation").
+    loads : sequence of PointLoad or of (F_x, F_y) [N], optional
+        Ground-fixed loads held at the point mass (:mod:`spinectl.model.loads`): in K, in the least local
+        stiffness's programme and in the torque reported; the default PCSA stays the unloaded optimum's.
 
     Returns
     -------
@@ -312,8 +339,10 @@ def coupled_stability_at(
         if pcsa is None  # the PCSA's errors before the position's, as ever:
         else OperatingPoint(model, e, lam, expand_pcsa(model, pcsa, given=given), slip_check=given)
     )
-    pcsa, at_point, data = point.pcsa, chain_at(point), coupled_data(model, e, lam)
-    local = least_local_stiffness(model, e, lam, pcsa, given=given)  # the SDP, outside numpy's guard
+    if loads:
+        point = dataclasses.replace(point, loads=loads)  # validated again, the loads with the rest
+    pcsa, at_point, data = point.pcsa, chain_at(point), coupled_data(model, e, lam, point.loads)
+    local = least_local_stiffness(model, e, lam, pcsa, given=given, loads=point.loads)  # the SDP, outside numpy's guard
     with arithmetic_guard(e, lam):
         mass, stiffness, damping = at_point.mass_matrix, at_point.stiffness_offset, at_point.damping_offset
         eigenvalues = chain.dynamic_eigenvalues(mass, stiffness, damping)
@@ -331,4 +360,6 @@ def coupled_stability_at(
         margin=float(chain.coupled_margin(stiffness)),
         eigenvalues=eigenvalues,
         local_eigenvalues=with_local,
+        loads=point.loads,
+        load_torque=load_torque_at(point),
     )

@@ -8,13 +8,16 @@ local muscles' price; :class:`CoupledOptimum` is an answer of any of the paper's
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
 
-from ...model import chain
+from ...errors import ParameterError
+from ...model import chain, geometry
 from ...model.checks import arithmetic_guard, checked_coefficients
 from ...model.linear_chain import LinearChain
+from ...model.loads import load_stiffness, loads_text, point_loads
 from ...model.params import Model
 from ...units import M2_PER_CM2
 from ..problem import OK_STATUSES, ProblemData, problem_data, to_si
@@ -76,7 +79,7 @@ class CoupledData:
         return self.chain.stiffness(x, local_stiffness)
 
 
-def coupled_data(model: Model, eccentricity: float, lordosis: float) -> CoupledData:
+def coupled_data(model: Model, eccentricity: float, lordosis: float, loads=()) -> CoupledData:
     """Assemble :class:`CoupledData` at one configuration.
 
     Parameters
@@ -85,6 +88,9 @@ def coupled_data(model: Model, eccentricity: float, lordosis: float) -> CoupledD
         ``optimisation`` (activation, margins, bounds, tolerance) and ``local``.
     eccentricity, lordosis : float
         E and Lambda [m], inside the modelled range.
+    loads : sequence of PointLoad, optional
+        Loads held at the point mass, fixed in the ground (:mod:`spinectl.model.loads`): their stiffness
+        K_load joins the chain's K_0, so the programmes stabilise the loaded chain; default none.
 
     Returns
     -------
@@ -102,6 +108,8 @@ def coupled_data(model: Model, eccentricity: float, lordosis: float) -> CoupledD
     with arithmetic_guard(e, lam):
         coeffs = chain.chain_coefficients(model, e, lam)
         linear = chain.linear_chain(model, e, lam, coeffs)
+        if loads:
+            linear = loaded_chain(model, linear, e, lam, loads)
     return CoupledData(
         problem=data,
         coefficients=coeffs,
@@ -109,6 +117,42 @@ def coupled_data(model: Model, eccentricity: float, lordosis: float) -> CoupledD
         margin=model.optimisation.stability_margin,
         local_per_cm2=chain.local_stiffness_per_pcsa(model) * M2_PER_CM2,
         cost_weight=model.local.cost_weight,
+    )
+
+
+def loaded_chain(model: Model, linear: LinearChain, e: float, lam: float, loads) -> LinearChain:
+    """The chain with ground-fixed loads' stiffness in its K_0 (the programmes' LMI needs a symmetric K).
+
+    Parameters
+    ----------
+    model : Model
+    linear : LinearChain
+        :func:`spinectl.model.chain.linear_chain` at (E, Lambda).
+    e, lam : float
+        E and Lambda [m].
+    loads : sequence of PointLoad or of (F_x, F_y) [N]
+
+    Returns
+    -------
+    LinearChain
+        K_0 + K_load (:func:`spinectl.model.loads.load_stiffness`), the loads named in its source.
+
+    Raises
+    ------
+    ParameterError
+        A load fixed in the body: a follower force's K is not symmetric, which no static margin reads.
+    """
+    loads = point_loads(loads)
+    if any(load.frame != "ground" for load in loads):
+        raise ParameterError(
+            "loads",
+            "must be fixed in the ground for the chain's static analyses (a follower force's K is not symmetric)",
+        )
+    k_load = load_stiffness(model, geometry.cor_positions(e, lam, model.geometry), loads)
+    return dataclasses.replace(
+        linear,
+        stiffness_offset=linear.stiffness_offset + k_load,
+        source=linear.source + loads_text(loads),
     )
 
 

@@ -39,7 +39,7 @@ def least_local_stiffness_sdp(data: CoupledData, x) -> tuple[str, np.ndarray | N
 
 
 def least_local_stiffness(
-    model: Model, eccentricity: float, lordosis: float, pcsa, *, given: bool = True
+    model: Model, eccentricity: float, lordosis: float, pcsa, *, given: bool = True, loads=()
 ) -> CoupledOptimum:
     """(a) The least local stiffness that makes the chain stable at a global activation.
 
@@ -53,6 +53,8 @@ def least_local_stiffness(
         ``optimisation.activation`` says.
     given : bool
         False for a PCSA that spinectl computed (:func:`spinectl.model.checks.expand_pcsa`).
+    loads : sequence of PointLoad, optional
+        Ground-fixed loads at the point mass (:func:`~spinectl.optimise.coupled.data.coupled_data`); default none.
 
     Returns
     -------
@@ -73,7 +75,7 @@ def least_local_stiffness(
     Acta Orthop Scand Suppl 230:1-54. doi:10.3109/17453678909154177.
     """
     independent = model.replace(optimisation=dataclasses.replace(model.optimisation, activation="independent"))
-    data = coupled_data(independent, eccentricity, lordosis)  # one variable per muscle: x = pcsa in cm^2
+    data = coupled_data(independent, eccentricity, lordosis, loads)  # one variable per muscle: x = pcsa in cm^2
     x = expand_pcsa(model, pcsa, given=given) / M2_PER_CM2
     status, k = least_local_stiffness_sdp(data, x)
     return result(model, data, float(eccentricity), float(lordosis), status, x, k)
