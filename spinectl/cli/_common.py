@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import re
 import sys
 
 import numpy as np
@@ -576,3 +577,52 @@ def scheduler_options(args: argparse.Namespace) -> dict:
     if args.worker_timeout is not None:
         options["worker_timeout"] = args.worker_timeout
     return options
+
+
+def bounded_int(name: str, low: int, high: int):
+    """An argparse ``type`` accepting an integer in [low, high], naming the option on error.
+
+    Parameters
+    ----------
+    name : str
+        The option, e.g. ``"--contributions"``.
+    low, high : int
+        The closed interval allowed.
+    """
+
+    def convert(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name} must be an integer (got {text!r})") from None
+        if not low <= value <= high:
+            raise argparse.ArgumentTypeError(f"{name} must be in [{low}, {high}] (got {text!r})")
+        return value
+
+    convert.__name__ = name
+    return convert
+
+
+def named_pattern(name: str):
+    """An argparse ``type`` for ``NAME=REGEX``: a name and a regular expression (:mod:`re`), both non-empty.
+
+    Parameters
+    ----------
+    name : str
+        The option, e.g. ``"--group"``.
+    """
+
+    def convert(text: str) -> tuple[str, str]:
+        label, sep, pattern = text.partition("=")
+        if not sep or not label.strip() or not pattern:
+            raise argparse.ArgumentTypeError(f"{name} must be NAME=REGEX, e.g. erector=IL|LTp (got {text!r})")
+        try:
+            re.compile(pattern)
+        except re.error as exc:
+            raise argparse.ArgumentTypeError(
+                f"{name} must be NAME=REGEX, a valid regular expression ({exc}) (got {text!r})"
+            ) from None
+        return label.strip(), pattern
+
+    convert.__name__ = name
+    return convert

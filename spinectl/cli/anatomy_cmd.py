@@ -7,7 +7,7 @@ import argparse
 from ..anatomy.mapping import MAX_STIFFNESS
 from ..errors import ParameterError
 from ..model.params.bounds import MAX_ACTIVATION_TIME_CONSTANT
-from ._common import emit_json, finite_float
+from ._common import bounded_int, emit_json, finite_float, named_pattern
 
 MAX_DERIVATIVE_GAIN = 1e6
 """Largest reflex derivative gain kd [N m s/rad]: the chain's delay margin scales as 1/kd from 1e3 to 1e6
@@ -139,6 +139,25 @@ def register(sub) -> None:
         "(an .osim file's: its linearisations) ($SPINECTL_CACHE_DIR, else $XDG_CACHE_HOME/spinectl, "
         "else ~/.cache/spinectl)",
     )
+    parser.add_argument(
+        "--contributions",
+        nargs="?",
+        const=10,
+        type=bounded_int("--contributions", 1, 100000),
+        metavar="N",
+        help="also each muscle's contribution to the least eigenvalue of -K (d lambda/d a_i at the least-stable "
+        "mode) on the free and the constrained chain: the N largest (default 10) with their class, per class, "
+        "per --group, and the removal method (the optimum re-solved with --optimise); contributions.png with "
+        "--plot. See docs/contributions.md",
+    )
+    parser.add_argument(
+        "--group",
+        action="append",
+        type=named_pattern("--group"),
+        metavar="NAME=REGEX",
+        help="with --contributions: a named group of muscles, those whose names match REGEX at their start "
+        "(a prefix is one: erector=IL|LTp); repeatable",
+    )
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     parser.set_defaults(func=run)
 
@@ -222,7 +241,32 @@ def _answers(args) -> tuple:
 
         analysis = result.analysis if args.optimise else result
         save_anatomy_figures(anatomy, analysis, curve, args.plot)
+    if args.contributions is not None or args.group:
+        result = _contributions(args, anatomy, result)
     return result, curve
+
+
+def _contributions(args, anatomy, result):
+    """--contributions: the result with each muscle's contribution (contributions.png with --plot)."""
+    from ..anatomy.contributions import save_contributions_figure, with_contributions
+
+    if args.contributions is None:
+        raise ParameterError("--group", "goes with --contributions (got --group alone)")
+    optimum = (
+        {"stability": args.stability, "margin": args.margin, "equilibrium": args.equilibrium} if args.optimise else None
+    )
+    out = with_contributions(
+        anatomy,
+        result,
+        plane=args.plane,
+        joint_stiffness=args.joint_stiffness,
+        count=args.contributions,
+        groups=dict(args.group or ()),
+        optimum=optimum,
+    )
+    if args.plot and out.free is not None:
+        save_contributions_figure(out.free, args.plot, args.contributions)
+    return out
 
 
 def _joint_stiffness(text: str):
