@@ -49,6 +49,9 @@ DEGENERATE_RTOL = 1e-6
 """The least eigenvalue counts as repeated when the next one is within this times the largest |eigenvalue|
 of -sym(K): the first-order derivative then holds only for steps far below that gap, so it is not given."""
 
+ROUNDING = 1e-9
+"""A share below this times the largest |share| counts as none (a pair at 0 PCSA, up to the solver's rounding)."""
+
 
 @dataclass(frozen=True)
 class LeastMode:
@@ -465,3 +468,111 @@ def contributions(
     sets |= {f"group:{g}": m for g, m in named.items()}
     removals = {key: removal(chain, u, m, least.eigenvalue, k, resolve) for key, m in sets.items()}
     return dataclasses.replace(result, removals=removals)
+
+
+@dataclass(frozen=True)
+class PairContributions:
+    """The paper's chain at an operating point: each antagonistic pair's part of each CoR's and the chain's stability.
+
+    Attributes
+    ----------
+    contributions : Contributions
+        Per muscle (the chain with ``optimisation.activation = "independent"``, u the PCSA [cm^2]), the pairs as
+        its groups.
+    """
+
+    contributions: Contributions
+
+    @property
+    def pairs(self) -> tuple:
+        """The pairs' names."""
+        return tuple(self.contributions.groups)
+
+    def cor_share(self) -> np.ndarray:
+        """Each pair's part of each CoR's own stiffness -K_jj, the others fixed [N m/rad], shape (n, pairs)."""
+        c = self.contributions
+        return np.stack([c.joint_share[:, np.isin(c.controls, m)].sum(axis=1) for m in c.groups.values()], axis=1)
+
+    def chain_share(self) -> np.ndarray:
+        """Each pair's share u_i d lambda_min/du_i of the chain's least eigenvalue [N m/rad], shape (pairs,)."""
+        return np.array([self.contributions.sums(m)[1] for m in self.contributions.groups.values()])
+
+    def _name(self, index):
+        return None if index is None else self.pairs[index]
+
+    def to_dict(self) -> dict:
+        """JSON-ready: per pair and CoR, the chain's, the pair that stabilises most of each (null: none gives any
+        restoring stiffness), the per-muscle detail."""
+        cor, chain = self.cor_share(), self.chain_share()
+        c = self.contributions
+        return {
+            "pairs": list(self.pairs),
+            "cors": list(c.joints),
+            "cor_share_Nm_per_rad": cor.T.tolist(),
+            "cor_stabilised_most_by": [self._name(_most(row)) for row in cor],
+            "chain_share_Nm_per_rad": chain.tolist(),
+            "chain_stabilised_most_by": self._name(_most(chain)),
+            "muscles": c.to_dict(),
+        }
+
+    def table(self) -> str:
+        """Rows of pairs: their part of each CoR's -K_jj and of the chain's lambda_min, the largest of each marked."""
+        cor, chain = self.cor_share(), self.chain_share()
+        c = self.contributions
+        width = max(len(p) for p in self.pairs) + 2
+        lines = [
+            "",
+            f"each pair's part of each CoR's stiffness -K_jj (the others fixed) and of the chain's least eigenvalue "
+            f"lambda_min = {c.least.eigenvalue:.4g} N m/rad (u_i d lambda/du_i at the least-stable mode) [N m/rad]; "
+            "* the largest restoring part",
+            f"{'pair':<{width}}" + "".join(f"{j:>10}" for j in c.joints) + f"{'chain':>12}{'removed [%]':>13}",
+        ]
+        best_cor, best_chain = [_most(row) for row in cor], _most(chain)
+        for p, name in enumerate(self.pairs):
+            cells = "".join(f"{cor[j, p]:>9.4g}{'*' if best_cor[j] == p else ' '}" for j in range(len(c.joints)))
+            removed = _removed_cell(c.removals.get(f"group:{name}"))
+            lines.append(f"{name:<{width}}{cells}{chain[p]:>11.4g}{'*' if best_chain == p else ' '}{removed}")
+        if c.least.degenerate:
+            lines.append(c.degenerate_text())
+        lines.append("removed: lambda_min with the pair at 0, the others kept (Cholewicki & VanVliet 2002)")
+        return "\n".join(lines)
+
+
+def _most(values) -> int | None:
+    """The index of the largest positive value (restoring), None where none is above rounding (1e-9 of the largest)."""
+    values = np.asarray(values, float)
+    if not np.all(np.isfinite(values)) or values.max() <= ROUNDING * np.abs(values).max():
+        return None
+    return int(np.argmax(values))
+
+
+def pair_contributions(point) -> PairContributions:
+    """Each muscle's and pair's contribution at the paper's operating point (docs/contributions.md).
+
+    Parameters
+    ----------
+    point : OperatingPoint
+        The model, (E, Lambda), the PCSA of each muscle [m^2] and the local stiffness [N m/rad].
+
+    Returns
+    -------
+    PairContributions
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from spinectl import load_preset
+    >>> from spinectl.model.operating_point import OperatingPoint
+    >>> result = pair_contributions(OperatingPoint(load_preset("wagner2012"), 0.03, 0.04, np.full(6, 5e-4)))
+    >>> result.pairs
+    ('straight', 'oblique_outer', 'oblique_inner')
+    """
+    from ..units import M2_PER_CM2
+    from .chain import linear_chain
+
+    model = point.model
+    per_muscle = model.replace(optimisation=dataclasses.replace(model.optimisation, activation="independent"))
+    chain = linear_chain(per_muscle, point.eccentricity, point.lordosis)
+    pairs = {p: [f"{p}_{side}" for side in model.geometry.side_names] for p in model.pair_names}
+    u = np.asarray(point.pcsa, float) / M2_PER_CM2
+    return PairContributions(contributions(chain, u, point.local_stiffness, groups=pairs))

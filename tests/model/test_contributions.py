@@ -164,3 +164,41 @@ def test_per_class_and_group_sums_and_the_json():
     assert [row["name"] for row in doc["controls"]] == ["big", "load"]
     assert doc["groups"]["springs"]["share_Nm_per_rad"] == pytest.approx(10.0 + 0.5)
     assert doc["classes"]["global"]["derivative_Nm_per_rad_per_activation"] == pytest.approx(10 + 1 - 2)
+
+
+def _paper_point(e=0.03, lam=0.04, pcsa_cm2=(2.0, 8.0, 4.0)):
+    from spinectl.model.operating_point import OperatingPoint
+
+    model = load_preset("wagner2012")
+    return model, OperatingPoint(model, e, lam, np.repeat(pcsa_cm2, 2) * 1e-4)
+
+
+@pytest.mark.parametrize(("e", "lam", "pcsa"), [(0.03, 0.04, (2.0, 8.0, 4.0)), (0.01, 0.02, (6.0, 1.0, 3.0))])
+def test_pairs_sum_their_muscles_as_the_paired_chain_differentiates(e, lam, pcsa):
+    """A pair's PCSA x sets both its muscles, so on the paired chain (linear_chain's own controls)
+    d lambda/dx_pair = the sum of its two muscles' derivatives on the per-muscle chain that pair_contributions
+    builds: two chains, one identity. Each pair's part of a CoR's -K_jj and the offset sum to -K_jj(x)."""
+    from spinectl.model.contributions import pair_contributions
+
+    model, point = _paper_point(e, lam, pcsa)
+    pairs = pair_contributions(point)
+    paired = linear_chain(model, e, lam)
+    whole = contributions(paired, pcsa)
+    summed = [pairs.contributions.sums(m)[0] for m in pairs.contributions.groups.values()]
+    np.testing.assert_allclose(summed, whole.derivative, rtol=1e-10)
+    assert pairs.chain_share() == pytest.approx(whole.share, rel=1e-10)
+    restoring = -np.diag(paired.stiffness(pcsa)) + np.diag(paired.stiffness_offset)
+    np.testing.assert_allclose(pairs.cor_share().sum(axis=1), restoring, rtol=1e-10)
+
+
+def test_which_pair_stabilises_each_cor_and_the_chain():
+    """At docs/chain.md's point with only oblique_outer active (the paper's optimum is so: the other pairs at 0),
+    it is the pair that stabilises every CoR; no pair gives the chain's least mode restoring stiffness there
+    (its share is negative: the chain is unstable though each CoR is stable, docs/chain.md), said as none."""
+    from spinectl.model.contributions import pair_contributions
+
+    _, point = _paper_point(pcsa_cm2=(0.0, 18.0, 0.0))
+    doc = pair_contributions(point).to_dict()
+    assert doc["cor_stabilised_most_by"] == ["oblique_outer"] * 5
+    assert doc["chain_share_Nm_per_rad"][1] < 0 and doc["chain_stabilised_most_by"] is None
+    assert "* the largest" in pair_contributions(point).table()
