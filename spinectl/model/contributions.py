@@ -348,7 +348,8 @@ class Contributions:
         per = "activation" if self.control_unit == "1" else self.control_unit
         lines = [
             f"contributions to the least eigenvalue of -K, lambda_min = {self.least.eigenvalue:.4g} N m/rad "
-            f"(> 0 restores; gap to the next {self.least.gap:.3g} N m/rad)",
+            "(> 0 restores; "
+            + (f"gap to the next {self.least.gap:.3g} N m/rad)" if np.isfinite(self.least.gap) else "one coordinate)"),
         ]
         if self.least.degenerate:
             lines.append(self.degenerate_text())
