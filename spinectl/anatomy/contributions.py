@@ -89,7 +89,12 @@ class WithContributions:
     count: int = TOP
 
     def to_dict(self) -> dict:
-        """The result's document with ``contributions``: ``free`` and ``constrained`` (null where not computed)."""
+        """The result's document with ``contributions``: ``free`` and ``constrained`` (null where not computed).
+
+        Returns
+        -------
+        dict
+        """
         out = self.result.to_dict()
         if self.free is None:
             out["contributions"], out["contributions_reason"] = None, "not_computed"
@@ -102,7 +107,12 @@ class WithContributions:
         return out
 
     def table(self) -> str:
-        """The result's table, then the contributions on each chain."""
+        """The result's table, then the contributions on each chain.
+
+        Returns
+        -------
+        str
+        """
         lines = [self.result.table(), ""]
         if self.free is None:
             return "\n".join(lines + ["contributions: none (the optimum is infeasible, so it has no activations)"])

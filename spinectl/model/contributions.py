@@ -165,7 +165,12 @@ class Removal:
     status: str
 
     def to_dict(self) -> dict:
-        """JSON-ready, units in the keys."""
+        """JSON-ready, units in the keys.
+
+        Returns
+        -------
+        dict
+        """
         return {
             "members": list(self.members),
             "least_eigenvalue_Nm_per_rad": self.least_eigenvalue,
@@ -261,12 +266,28 @@ class Contributions:
         return self.controls_at * self.derivative
 
     def sums(self, members) -> tuple:
-        """(d lambda_min / d u summed, the share summed) over ``members`` [N m/rad per unit, N m/rad]."""
+        """The derivative and the share summed over ``members``.
+
+        Parameters
+        ----------
+        members : sequence of str
+            Control names.
+
+        Returns
+        -------
+        tuple of float
+            (sum of d lambda_min / d u_i [N m/rad per control unit], sum of u_i d lambda_min / d u_i [N m/rad]).
+        """
         pick = np.isin(np.array(self.controls, object), list(members))
         return float(self.derivative[pick].sum()), float(self.share[pick].sum())
 
     def classes(self) -> dict:
-        """Class -> its members (the classes present only)."""
+        """Each class present and its members.
+
+        Returns
+        -------
+        dict of str to tuple of str
+        """
         return {
             c: tuple(m for m, k in zip(self.controls, self.control_class, strict=True) if k == c)
             for c in CONTROL_CLASSES
@@ -274,12 +295,29 @@ class Contributions:
         }
 
     def largest(self, count: int) -> np.ndarray:
-        """Indices of the ``count`` controls of largest |d lambda_min / d u_i| (by |share| where repeated)."""
+        """The controls of largest |d lambda_min / d u_i|, first the largest.
+
+        Parameters
+        ----------
+        count : int
+            How many.
+
+        Returns
+        -------
+        numpy.ndarray of int, shape (min(count, m),)
+            Their indices; where lambda_min is repeated (no derivative), by |sum of their joint shares| instead.
+        """
         key = self.derivative if not self.least.degenerate else self.joint_share.sum(axis=0)
         return np.argsort(-np.abs(key), kind="stable")[: max(int(count), 0)]
 
     def degenerate_text(self) -> str:
-        """Why the derivatives are not given, or ''."""
+        """Why the derivatives are not given.
+
+        Returns
+        -------
+        str
+            A sentence; '' where lambda_min is simple.
+        """
         if not self.least.degenerate:
             return ""
         return (
@@ -490,12 +528,24 @@ class PairContributions:
         return tuple(self.contributions.groups)
 
     def cor_share(self) -> np.ndarray:
-        """Each pair's part of each CoR's own stiffness -K_jj, the others fixed [N m/rad], shape (n, pairs)."""
+        """Each pair's part of each CoR's own stiffness -K_jj, the others fixed.
+
+        Returns
+        -------
+        numpy.ndarray, shape (n, pairs)
+            [N m/rad].
+        """
         c = self.contributions
         return np.stack([c.joint_share[:, np.isin(c.controls, m)].sum(axis=1) for m in c.groups.values()], axis=1)
 
     def chain_share(self) -> np.ndarray:
-        """Each pair's share u_i d lambda_min/du_i of the chain's least eigenvalue [N m/rad], shape (pairs,)."""
+        """Each pair's share u_i d lambda_min/du_i of the chain's least eigenvalue.
+
+        Returns
+        -------
+        numpy.ndarray, shape (pairs,)
+            [N m/rad].
+        """
         return np.array([self.contributions.sums(m)[1] for m in self.contributions.groups.values()])
 
     def _name(self, index):
@@ -503,7 +553,12 @@ class PairContributions:
 
     def to_dict(self) -> dict:
         """JSON-ready: per pair and CoR, the chain's, the pair that stabilises most of each (null: none gives any
-        restoring stiffness), the per-muscle detail."""
+        restoring stiffness), the per-muscle detail.
+
+        Returns
+        -------
+        dict
+        """
         cor, chain = self.cor_share(), self.chain_share()
         c = self.contributions
         return {
@@ -517,7 +572,12 @@ class PairContributions:
         }
 
     def table(self) -> str:
-        """Rows of pairs: their part of each CoR's -K_jj and of the chain's lambda_min, the largest of each marked."""
+        """Rows of pairs: their part of each CoR's -K_jj and of the chain's lambda_min, the largest of each marked.
+
+        Returns
+        -------
+        str
+        """
         cor, chain = self.cor_share(), self.chain_share()
         c = self.contributions
         width = max(len(p) for p in self.pairs) + 2
