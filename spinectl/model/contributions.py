@@ -586,13 +586,13 @@ class PairContributions:
             f"each pair's part of each CoR's stiffness -K_jj (the others fixed) and of the chain's least eigenvalue "
             f"lambda_min = {c.least.eigenvalue:.4g} N m/rad (u_i d lambda/du_i at the least-stable mode) [N m/rad]; "
             "* the largest restoring part",
-            f"{'pair':<{width}}" + "".join(f"{j:>10}" for j in c.joints) + f"{'chain':>12}{'removed [%]':>13}",
+            f"{'pair':<{width}}" + "".join(f"{j:>12}" for j in c.joints) + f"{'chain':>13}{'removed [%]':>13}",
         ]
         best_cor, best_chain = [_most(row) for row in cor], _most(chain)
         for p, name in enumerate(self.pairs):
-            cells = "".join(f"{cor[j, p]:>9.4g}{'*' if best_cor[j] == p else ' '}" for j in range(len(c.joints)))
+            cells = "".join(f"{cor[j, p]:>11.4g}{'*' if best_cor[j] == p else ' '}" for j in range(len(c.joints)))
             removed = _removed_cell(c.removals.get(f"group:{name}"))
-            lines.append(f"{name:<{width}}{cells}{chain[p]:>11.4g}{'*' if best_chain == p else ' '}{removed}")
+            lines.append(f"{name:<{width}}{cells}{chain[p]:>12.4g}{'*' if best_chain == p else ' '}{removed}")
         if c.least.degenerate:
             lines.append(c.degenerate_text())
         lines.append("removed: lambda_min with the pair at 0, the others kept (Cholewicki & VanVliet 2002)")
