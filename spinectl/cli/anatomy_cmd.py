@@ -236,26 +236,32 @@ def _answers(args) -> tuple:
             joint_stiffness=args.joint_stiffness,
             equilibrium=args.equilibrium,
         )
+    # before any figure is written: a group that matches no muscle is refused with nothing written
+    parts = _contributions(args, anatomy, result) if args.contributions is not None or args.group else None
     if args.plot:
         from ..anatomy.figures import save_anatomy_figures
 
         analysis = result.analysis if args.optimise else result
         save_anatomy_figures(anatomy, analysis, curve, args.plot)
-    if args.contributions is not None or args.group:
-        result = _contributions(args, anatomy, result)
+    if parts is not None:
+        if args.plot and parts.free is not None:
+            from ..anatomy.contributions import save_contributions_figure
+
+            save_contributions_figure(parts.free, args.plot, args.contributions)
+        result = parts
     return result, curve
 
 
 def _contributions(args, anatomy, result):
-    """--contributions: the result with each muscle's contribution (contributions.png with --plot)."""
-    from ..anatomy.contributions import save_contributions_figure, with_contributions
+    """--contributions: the result with each muscle's contribution."""
+    from ..anatomy.contributions import with_contributions
 
     if args.contributions is None:
         raise ParameterError("--group", "goes with --contributions (got --group alone)")
     optimum = (
         {"stability": args.stability, "margin": args.margin, "equilibrium": args.equilibrium} if args.optimise else None
     )
-    out = with_contributions(
+    return with_contributions(
         anatomy,
         result,
         plane=args.plane,
@@ -264,9 +270,6 @@ def _contributions(args, anatomy, result):
         groups=dict(args.group or ()),
         optimum=optimum,
     )
-    if args.plot and out.free is not None:
-        save_contributions_figure(out.free, args.plot, args.contributions)
-    return out
 
 
 def _joint_stiffness(text: str):

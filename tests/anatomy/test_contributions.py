@@ -191,15 +191,17 @@ def test_the_command_prints_json_and_draws_the_figure(torso, tmp_path, capsys):
     ("extra", "said"),
     [
         (["--group", "x=IL"], "--group: goes with --contributions"),
-        (["--contributions", "--group", "x=("], "--group must be NAME=REGEX"),
+        (["--contributions", "--group", "x=("], "group x: must be a regular expression (got '('"),
         (["--contributions", "--group", "x=nothing_named_so"], "group x: must match at least one muscle"),
         (["--contributions", "0"], "--contributions must be in [1, 100000]"),
         (["--contributions", "--group", "noequals"], "--group must be NAME=REGEX"),
     ],
 )
-def test_the_commands_errors_are_one_line(torso, capsys, extra, said):
+def test_the_commands_errors_are_one_line(torso, tmp_path, capsys, extra, said):
     """A group without --contributions, a bad regular expression, a group matching no muscle, a count out of
-    range, a group without NAME=: one line on stderr, exit 2, nothing on stdout."""
-    assert main(["anatomy", "--activation", "0.05", *extra]) == 2
+    range, a group without NAME=: one line on stderr, exit 2, nothing on stdout, no figure written (--plot)."""
+    folder = tmp_path / "figs"
+    assert main(["anatomy", "--activation", "0.05", *extra, "--plot", str(folder)]) == 2
     err = capsys.readouterr()
     assert err.out == "" and said in err.err and len(err.err.strip().splitlines()) == 1
+    assert not folder.exists()
