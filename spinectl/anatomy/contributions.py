@@ -24,7 +24,7 @@ from ..model.contributions import Contributions, contributions
 from .contract import AnatomyEngine
 
 TOP = 10
-"""Muscles listed (and removed one by one) by default: the largest |d lambda_min / d a_i|."""
+"""Muscles listed (and removed one by one) by default: the largest abs(d lambda_min / d a_i)."""
 
 
 def optimum_resolver(anatomy: AnatomyEngine, plane, posture, joint_stiffness, stability, margin, equilibrium):
@@ -146,7 +146,7 @@ def with_contributions(
     joint_stiffness : {"none", "mapped"} or float
         Added at each chain joint [N m/rad] (part of the offset).
     count : int
-        Muscles listed and removed one by one, by |d lambda_min / d a_i| on the free chain.
+        Muscles listed and removed one by one, by abs(d lambda_min / d a_i) on the free chain.
     groups : dict, optional
         Named groups (:func:`spinectl.model.contributions.resolve_groups`).
     optimum : dict, optional

@@ -46,11 +46,11 @@ from ..errors import ParameterError
 from .linear_chain import CONTROL_CLASSES, LinearChain
 
 DEGENERATE_RTOL = 1e-6
-"""The least eigenvalue counts as repeated when the next one is within this times the largest |eigenvalue|
+"""The least eigenvalue counts as repeated when the next one is within this times the largest abs(eigenvalue)
 of -sym(K): the first-order derivative then holds only for steps far below that gap, so it is not given."""
 
 ROUNDING = 1e-9
-"""A share below this times the largest |share| counts as none (a pair at 0 PCSA, up to the solver's rounding)."""
+"""A share below this times the largest abs(share) counts as none (a pair at 0 PCSA, up to the solver's rounding)."""
 
 
 @dataclass(frozen=True)
@@ -154,7 +154,7 @@ class Removal:
     least_eigenvalue : float
         lambda_min without them [N m/rad]; NaN where the re-solved optimum is infeasible.
     percent_change : float
-        100 (lambda_removed - lambda_min) / |lambda_min| [%]; NaN where either is NaN or lambda_min is 0.
+        100 (lambda_removed - lambda_min) / abs(lambda_min) [%]; NaN where either is NaN or lambda_min is 0.
     status : str
         ``"removed"`` (the others kept), or the re-solved optimum's status.
     """
@@ -295,7 +295,7 @@ class Contributions:
         }
 
     def largest(self, count: int) -> np.ndarray:
-        """The controls of largest |d lambda_min / d u_i|, first the largest.
+        """The controls of largest abs(d lambda_min / d u_i), first the largest.
 
         Parameters
         ----------
@@ -305,7 +305,7 @@ class Contributions:
         Returns
         -------
         numpy.ndarray of int, shape (min(count, m),)
-            Their indices; where lambda_min is repeated (no derivative), by |sum of their joint shares| instead.
+            Their indices; where lambda_min is repeated (no derivative), by abs(sum of their joint shares) instead.
         """
         key = self.derivative if not self.least.degenerate else self.joint_share.sum(axis=0)
         return np.argsort(-np.abs(key), kind="stable")[: max(int(count), 0)]
@@ -332,7 +332,7 @@ class Contributions:
         Parameters
         ----------
         count : int, optional
-            How many controls to list, by |d lambda_min / d u_i|; None: all.
+            How many controls to list, by abs(d lambda_min / d u_i); None: all.
 
         Returns
         -------
@@ -372,7 +372,7 @@ class Contributions:
         }
 
     def table(self, count: int = 10) -> str:
-        """The ``count`` largest by |d lambda_min / d u_i|, with class; then per class and group; the removals.
+        """The ``count`` largest by abs(d lambda_min / d u_i), with class; then per class and group; the removals.
 
         Parameters
         ----------
