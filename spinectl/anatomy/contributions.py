@@ -205,7 +205,7 @@ def contributions_figure(contrib: Contributions, count: int = TOP, title: str = 
     ax_class.barh(list(contrib.classes()), sums, color=[colour[c] for c in contrib.classes()])
     ax_class.set_xlabel("sum per class")
     ax_class.axvline(0, color="0.3", lw=0.8)
-    fig.suptitle(title or f"contributions to lambda_min = {contrib.least.eigenvalue:.4g} N m/rad")
+    fig.suptitle(title or f"contributions to the least eigenvalue of -K, {contrib.least.eigenvalue:.4g} N m/rad")
     return fig
 
 
@@ -227,4 +227,5 @@ def save_contributions_figure(contrib: Contributions, folder, count: int = TOP, 
     -------
     list of pathlib.Path
     """
-    return save_figures({"contributions.png": contributions_figure(contrib, count)}, folder, dpi)
+    title = f"the free chain: contributions to the least eigenvalue of -K, {contrib.least.eigenvalue:.4g} N m/rad"
+    return save_figures({"contributions.png": contributions_figure(contrib, count, title)}, folder, dpi)

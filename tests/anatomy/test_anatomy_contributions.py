@@ -205,3 +205,17 @@ def test_the_commands_errors_are_one_line(torso, tmp_path, capsys, extra, said):
     err = capsys.readouterr()
     assert err.out == "" and said in err.err and len(err.err.strip().splitlines()) == 1
     assert not folder.exists()
+
+
+def test_the_figure_draws_the_listed_derivatives_and_the_class_sums(torso):
+    """contributions.png: one bar per listed muscle, its length d lambda_min / d a_i, the largest on top; one bar
+    per class, its length the class's sum (the numbers of the table, read back from the drawn rectangles)."""
+    from spinectl.anatomy.contributions import contributions_figure
+
+    free = torso.chains("sagittal")[0]
+    c = contributions(free, np.full(free.n_controls, 0.05))
+    figure = contributions_figure(c, count=6)
+    muscles, classes = figure.axes[0].patches, figure.axes[1].patches
+    order = c.largest(6)
+    assert [p.get_width() for p in muscles] == pytest.approx(list(c.derivative[order][::-1]))
+    assert [p.get_width() for p in classes] == pytest.approx([c.sums(m)[0] for m in c.classes().values()])
