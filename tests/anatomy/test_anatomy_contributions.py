@@ -219,3 +219,28 @@ def test_the_figure_draws_the_listed_derivatives_and_the_class_sums(torso):
     order = c.largest(6)
     assert [p.get_width() for p in muscles] == pytest.approx(list(c.derivative[order][::-1]))
     assert [p.get_width() for p in classes] == pytest.approx([c.sums(m)[0] for m in c.classes().values()])
+
+
+def test_the_papers_chain_exported_to_mujoco_gives_each_muscle_the_same_part(tmp_path):
+    """The paper's chain at E = 3 cm, Lambda = 4 cm exported as MJCF (each of the 30 fibres a MuJoCo actuator
+    whose control is its muscle's PCSA [cm^2]) and read back by MuJoCo: the index is the paper's, and each muscle's
+    derivative on the paper's chain (pair_contributions, spinectl's own formulas) is the sum of its fibres'
+    derivatives on MuJoCo's linearisation (its moment arms and their differences), to 1e-6 relative (the
+    re-import's tolerance, tests/anatomy/test_mjcf_import.py)."""
+    pytest.importorskip("mujoco", reason="needs the anatomy extra: pip install 'spinectl[anatomy]'")
+    from spinectl import anatomy
+    from spinectl.anatomy.export_mjcf import export_mjcf, fibre_gains
+    from spinectl.model.config import load_preset
+    from spinectl.model.contributions import pair_contributions
+    from spinectl.model.operating_point import OperatingPoint
+
+    model = load_preset("wagner2012")
+    solution = export_mjcf(model, 0.03, 0.04, tmp_path / "paper.xml")
+    loaded = anatomy.load(tmp_path / "paper.xml", cache=False)
+    free = loaded.chains("sagittal")[0]
+    ours = contributions(free, loaded.default_controls())
+    paper = pair_contributions(OperatingPoint(model, 0.03, 0.04, solution.pcsa, slip_check=False)).contributions
+    owner = fibre_gains(model).muscle
+    summed = [ours.derivative[owner == k].sum() for k in range(len(paper.controls))]
+    assert ours.least.eigenvalue == pytest.approx(paper.least.eigenvalue, rel=1e-6)
+    np.testing.assert_allclose(summed, paper.derivative, rtol=0, atol=1e-6 * np.max(np.abs(paper.derivative)))
