@@ -252,26 +252,6 @@ def _answers(args) -> tuple:
     return result, curve
 
 
-def _contributions(args, anatomy, result):
-    """--contributions: the result with each muscle's contribution."""
-    from ..anatomy.contributions import with_contributions
-
-    if args.contributions is None:
-        raise ParameterError("--group", "goes with --contributions (got --group alone)")
-    optimum = (
-        {"stability": args.stability, "margin": args.margin, "equilibrium": args.equilibrium} if args.optimise else None
-    )
-    return with_contributions(
-        anatomy,
-        result,
-        plane=args.plane,
-        joint_stiffness=args.joint_stiffness,
-        count=args.contributions,
-        groups=dict(args.group or ()),
-        optimum=optimum,
-    )
-
-
 def _joint_stiffness(text: str):
     """--joint-stiffness: ``none``, ``mapped`` or a stiffness in [0, MAX_STIFFNESS] N m/rad."""
     if text in ("none", "mapped"):
@@ -313,3 +293,23 @@ def _curve_table(curve: dict) -> str:
             cells.append(f"{row['cost'][i]:.4g}" if ok else row["status"][i])
         lines.append(f"{deg:>{len(CURVE_AXIS)}.3g}  {cells[0]:>13}  {cells[1]:>14}  {cells[2]:>16}")
     return "\n".join(lines)
+
+
+def _contributions(args, anatomy, result):
+    """--contributions: the result with each muscle's contribution."""
+    from ..anatomy.contributions import with_contributions
+
+    if args.contributions is None:
+        raise ParameterError("--group", "goes with --contributions (got --group alone)")
+    optimum = (
+        {"stability": args.stability, "margin": args.margin, "equilibrium": args.equilibrium} if args.optimise else None
+    )
+    return with_contributions(
+        anatomy,
+        result,
+        plane=args.plane,
+        joint_stiffness=args.joint_stiffness,
+        count=args.contributions,
+        groups=dict(args.group or ()),
+        optimum=optimum,
+    )
