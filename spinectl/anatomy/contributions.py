@@ -20,8 +20,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..canvas import new_figure, save_figures
+from ..errors import ParameterError
 from ..model.contributions import Contributions, contributions
 from .contract import AnatomyEngine
+
+CHAIN_RTOL = 1e-9
+"""The contributions' least eigenvalue and the analysis's agree to this times the largest abs(eigenvalue) of -K
+(the same chain, the same activations: equal to rounding), else the posture was not the analysed one."""
 
 TOP = 10
 """Muscles listed (and removed one by one) by default: the largest abs(d lambda_min / d a_i)."""
@@ -163,9 +168,23 @@ def with_contributions(
     resolve = None
     if optimum is not None:
         resolve = optimum_resolver(anatomy, plane, posture, joint_stiffness, **optimum)
-    return WithContributions(
+    out = WithContributions(
         result, _on(free, a, count, groups, resolve), _on(constrained, a, count, groups, resolve), int(count)
     )
+    _same_chain(out.free, result.analysis if optimum is not None else result)
+    return out
+
+
+def _same_chain(contrib: Contributions, analysis) -> None:
+    """Refuse contributions of another chain than the one analysed (a posture that is not the analysis's)."""
+    ours, theirs = contrib.least.eigenvalue, float(analysis.free.eigenvalues[0])
+    scale = max(float(np.max(np.abs(analysis.free.eigenvalues))), 1.0)
+    if abs(ours - theirs) > CHAIN_RTOL * scale:
+        raise ParameterError(
+            "posture",
+            f"must be the analysed one: the contributions' chain has least eigenvalue {ours:.6g} N m/rad, the "
+            f"analysis's {theirs:.6g} N m/rad (give with_contributions the posture analyse was given)",
+        )
 
 
 def _on(chain, a, count, groups, resolve) -> Contributions:

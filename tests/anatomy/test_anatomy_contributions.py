@@ -244,3 +244,18 @@ def test_the_papers_chain_exported_to_mujoco_gives_each_muscle_the_same_part(tmp
     summed = [ours.derivative[owner == k].sum() for k in range(len(paper.controls))]
     assert ours.least.eigenvalue == pytest.approx(paper.least.eigenvalue, rel=1e-6)
     np.testing.assert_allclose(summed, paper.derivative, rtol=0, atol=1e-6 * np.max(np.abs(paper.derivative)))
+
+
+def test_contributions_at_another_posture_than_the_analysed_are_refused(torso):
+    """with_contributions checks that its chain is the analysed one (their least eigenvalues agree to 1e-9 of the
+    largest): the analysis at a lordosis posture 10 degrees off the reference, the contributions asked at the
+    reference posture, is one ParameterError naming the posture; at the same posture it passes."""
+    from spinectl.anatomy.analyses import analyse
+    from spinectl.anatomy.contributions import with_contributions
+    from spinectl.errors import ParameterError
+
+    bent = torso.lordosis_posture(10.0)
+    result = analyse(torso, activation=0.05, posture=bent)
+    with pytest.raises(ParameterError, match="posture"):
+        with_contributions(torso, result)
+    assert with_contributions(torso, result, posture=bent).free is not None
