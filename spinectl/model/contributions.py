@@ -31,6 +31,8 @@ Cholewicki J, McGill SM (1996). Mechanical stability of the in vivo lumbar spine
 injury and chronic low back pain. Clin Biomech 11(1):1-15. doi:10.1016/0268-0033(95)00035-6.
 Cholewicki J, VanVliet JJ (2002). Relative contribution of trunk muscles to the stability of the
 lumbar spine during isometric exertions. Clin Biomech 17(2):99-105. doi:10.1016/S0268-0033(01)00118-8.
+Kato T (1995). Perturbation Theory for Linear Operators (reprint of the 1980 edition). Springer.
+doi:10.1007/978-3-642-66282-9.
 """
 
 from __future__ import annotations
@@ -67,12 +69,15 @@ class LeastMode:
         lambda_2 - lambda_min [N m/rad]; inf for a single joint.
     multiplicity : int
         How many eigenvalues lie within :data:`DEGENERATE_RTOL` of lambda_min (1: simple).
+    subspace : numpy.ndarray, shape (n, multiplicity)
+        Orthonormal eigenvectors of those eigenvalues (the first column ``mode`` up to its sign).
     """
 
     eigenvalue: float
     mode: np.ndarray
     gap: float
     multiplicity: int
+    subspace: np.ndarray | None = None
 
     @property
     def degenerate(self) -> bool:
@@ -98,7 +103,8 @@ def least_mode(stiffness) -> LeastMode:
     v = v if v[np.argmax(np.abs(v))] >= 0 else -v  # one sign, so that modes compare across operating points
     tol = DEGENERATE_RTOL * max(float(np.max(np.abs(values))), np.finfo(float).tiny)
     gap = float(values[1] - values[0]) if values.size > 1 else float("inf")
-    return LeastMode(float(values[0]), v, gap, int(np.sum(values - values[0] <= tol)))
+    count = int(np.sum(values - values[0] <= tol))
+    return LeastMode(float(values[0]), v, gap, count, vectors[:, :count])
 
 
 def resolve_groups(controls, patterns: dict) -> dict:
@@ -238,6 +244,10 @@ class Contributions:
         lambda_min [N m/rad], the mode, gap and multiplicity.
     derivative : numpy.ndarray, shape (m,)
         d lambda_min / d u_i = -v^T K_i v [N m/rad per control unit]; NaN where lambda_min is repeated.
+    derivative_up : numpy.ndarray, shape (m,)
+        The one-sided derivative as u_i rises [N m/rad per control unit]: where lambda_min is simple the derivative,
+        where it is repeated the least eigenvalue of V^T (-K_i) V over its eigenvectors V (the eigenvalues of a
+        symmetric matrix split along them; Kato 1995, ch. II).
     offset : float
         -v^T (K_0 - diag(k)) v [N m/rad]: what no control gives; NaN where repeated.
     joint_share : numpy.ndarray, shape (n, m)
@@ -257,6 +267,7 @@ class Contributions:
     derivative: np.ndarray
     offset: float
     joint_share: np.ndarray
+    derivative_up: np.ndarray | None = None
     groups: dict = field(default_factory=dict)
     removals: dict = field(default_factory=dict)
 
@@ -322,8 +333,9 @@ class Contributions:
             return ""
         return (
             f"the least eigenvalue is repeated ({self.least.multiplicity} eigenvalues within "
-            f"{DEGENERATE_RTOL:g} of the largest |eigenvalue|): it is not differentiable there, so no derivative "
-            "is given; the removal method still is"
+            f"{DEGENERATE_RTOL:g} times the largest |eigenvalue| of -K): it is not differentiable there, so no "
+            "derivative is given, only the one-sided rate as each control rises (derivative_up, the least "
+            "eigenvalue of V^T (-K_i) V over its eigenvectors V); the removal method still is"
         )
 
     def to_dict(self, count: int | None = None) -> dict:
@@ -346,6 +358,7 @@ class Contributions:
                 "class": self.control_class[i],
                 "control": float(self.controls_at[i]),
                 f"derivative_{unit}": float(self.derivative[i]),
+                f"derivative_up_{unit}": float(self.derivative_up[i]),
                 "share_Nm_per_rad": float(self.share[i]),
                 "joint_share_Nm_per_rad": self.joint_share[:, i].tolist(),
             }
@@ -396,13 +409,15 @@ class Contributions:
                 f"d lambda/du = -v^T K_i v [N m/rad per {per}] at the least-stable mode v; share = u_i d lambda/du "
                 f"[N m/rad]; they sum with the offset {self.offset:.4g} N m/rad (gravity, passive, added) to lambda_min"
             )
-        head = f"{'name':<28}{'class':<12}{'u':>10}{'d lambda/du':>14}{'share':>12}{'removed [%]':>13}"
+        rate = self.derivative_up if self.least.degenerate else self.derivative  # one-sided where repeated
+        label = "d+ lambda/du" if self.least.degenerate else "d lambda/du"
+        head = f"{'name':<28}{'class':<12}{'u':>10}{label:>14}{'share':>12}{'removed [%]':>13}"
         lines += ["", head]
         for i in self.largest(count):
             name = self.controls[i]
             cell = _removed_cell(self.removals.get(name))
             lines.append(
-                f"{name:<28}{self.control_class[i]:<12}{self.controls_at[i]:>10.4g}{self.derivative[i]:>14.4g}"
+                f"{name:<28}{self.control_class[i]:<12}{self.controls_at[i]:>10.4g}{rate[i]:>14.4g}"
                 f"{self.share[i]:>12.4g}{cell}"
             )
         sets = [(f"class:{c}", m) for c, m in self.classes().items()]
@@ -482,8 +497,11 @@ def contributions(
     v, k_i = least.mode, chain.stiffness_per_control
     if least.degenerate:
         derivative, offset = np.full(chain.n_controls, np.nan), float("nan")
+        block = -np.einsum("ai,abm,bj->mij", least.subspace, k_i, least.subspace)
+        up = np.linalg.eigvalsh(0.5 * (block + block.transpose(0, 2, 1)))[:, 0] if chain.n_controls else np.zeros(0)
     else:
         derivative = -np.einsum("a,abm,b->m", v, k_i, v)
+        up = derivative
         offset = float(-v @ (chain.stiffness_offset - np.diag(k)) @ v)
     diag = np.einsum("jjm->jm", k_i)
     named = resolve_groups(chain.controls, groups or {})
@@ -497,6 +515,7 @@ def contributions(
         derivative=derivative,
         offset=offset,
         joint_share=-diag * u,
+        derivative_up=up,
         groups=named,
     )
     unknown = sorted(set(remove) - set(chain.controls))

@@ -107,6 +107,24 @@ def test_a_repeated_least_eigenvalue_is_said_and_not_differentiated(n_repeated):
     assert np.all(np.isnan(c.derivative)) and np.isnan(c.offset)
     assert "repeated" in c.table() and c.to_dict()["degenerate"] is True
     assert c.removals["c0"].least_eigenvalue == pytest.approx(1.0)
+    # raised, the restoring control lifts joint 0 alone: lambda_min stays 1 (the other joints), rate 0
+    assert c.derivative_up[0] == pytest.approx(0.0, abs=1e-15)
+
+
+def test_the_one_sided_rate_at_a_repeated_eigenvalue_is_the_central_difference_going_up():
+    """At -K = diag(1, 1, 5) a control K_1 = [[1, 1, 0], [1, 0, 0], [0, 0, 0]] (coupling the two repeated
+    joints, destabilising joint 0): lambda_min(t) for small t > 0 is 1 + t mu, mu the least eigenvalue of
+    -[[1, 1], [1, 0]] = -(1 + sqrt 5)/2 (Kato 1995, ch. II); the one-sided difference (lambda(h) - lambda(0))/h,
+    h = 1e-7, agrees to 1e-6, and the two-sided derivative is not given."""
+    per = np.zeros((3, 3, 1))
+    per[:2, :2, 0] = [[1.0, 1.0], [1.0, 0.0]]
+    base = _diagonal_chain([-1.0, -1.0, -5.0], [[0.0, 0.0, 0.0]])
+    chain = LinearChain(**{**base.__dict__, "stiffness_per_control": per})
+    c = contributions(chain, [0.0])
+    mu = -(1 + np.sqrt(5)) / 2
+    h = 1e-7
+    assert c.derivative_up[0] == pytest.approx(mu, rel=1e-12) and np.isnan(c.derivative[0])
+    assert (_lambda_min(chain, [h]) - _lambda_min(chain, [0.0])) / h == pytest.approx(mu, rel=1e-6)
 
 
 def test_a_near_repeated_eigenvalue_outside_the_tolerance_is_differentiated():
