@@ -183,7 +183,8 @@ def _same_chain(contrib: Contributions, analysis) -> None:
         raise ParameterError(
             "posture",
             f"must be the analysed one: the contributions' chain has least eigenvalue {ours:.6g} N m/rad, the "
-            f"analysis's {theirs:.6g} N m/rad (give with_contributions the posture analyse was given)",
+            f"analysis's {theirs:.6g} N m/rad (give with_contributions the chain analyse was given: its posture, "
+            "its joint stiffness)",
         )
 
 
