@@ -640,3 +640,46 @@ def anatomy_load(text: str) -> dict:
         "point": tuple(offsets(p) for p in point),
         "frame": frame,
     }
+
+
+def bounded_int(name: str, low: int, high: int):
+    """An argparse ``type`` accepting an integer in [low, high], naming the option on error.
+
+    Parameters
+    ----------
+    name : str
+        The option, e.g. ``"--contributions"``.
+    low, high : int
+        The closed interval allowed.
+    """
+
+    def convert(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name} must be an integer (got {text!r})") from None
+        if not low <= value <= high:
+            raise argparse.ArgumentTypeError(f"{name} must be in [{low}, {high}] (got {text!r})")
+        return value
+
+    convert.__name__ = name
+    return convert
+
+
+def named_pattern(name: str):
+    """An argparse ``type`` for ``NAME=REGEX``: a name and a pattern, both non-empty, as a pair.
+
+    Parameters
+    ----------
+    name : str
+        The option, e.g. ``"--group"``.
+    """
+
+    def convert(text: str) -> tuple[str, str]:
+        label, sep, pattern = text.partition("=")
+        if not sep or not label.strip() or not pattern:
+            raise argparse.ArgumentTypeError(f"{name} must be NAME=REGEX, e.g. erector=IL|LTp (got {text!r})")
+        return label.strip(), pattern  # the expression is the library's to check (model.contributions.resolve_groups)
+
+    convert.__name__ = name
+    return convert

@@ -7,7 +7,7 @@ import argparse
 from ..anatomy.mapping import MAX_STIFFNESS
 from ..errors import ParameterError
 from ..model.params.bounds import MAX_ACTIVATION_TIME_CONSTANT
-from ._common import anatomy_load, emit_json, finite_float, input_name
+from ._common import anatomy_load, bounded_int, emit_json, finite_float, input_name, named_pattern
 
 MAX_DERIVATIVE_GAIN = 1e6
 """Largest reflex derivative gain kd [N m s/rad]: the chain's delay margin scales as 1/kd from 1e3 to 1e6
@@ -172,6 +172,25 @@ def register(sub) -> None:
         "(an .osim file's: its linearisations) ($SPINECTL_CACHE_DIR, else $XDG_CACHE_HOME/spinectl, "
         "else ~/.cache/spinectl)",
     )
+    parser.add_argument(
+        "--contributions",
+        nargs="?",
+        const=10,
+        type=bounded_int("--contributions", 1, 100000),
+        metavar="N",
+        help="also each muscle's contribution to the least eigenvalue of -K (d lambda/d a_i at the least-stable "
+        "mode) on the free and the constrained chain: the N largest (default 10) with their class, per class, "
+        "per --group, and the removal method (the optimum re-solved with --optimise); contributions.png with "
+        "--plot. See docs/contributions.md",
+    )
+    parser.add_argument(
+        "--group",
+        action="append",
+        type=named_pattern("--group"),
+        metavar="NAME=REGEX",
+        help="with --contributions: a named group of muscles, those whose names match REGEX at their start "
+        "(a prefix is one: erector=IL|LTp); repeatable",
+    )
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     parser.set_defaults(func=run)
 
@@ -257,11 +276,19 @@ def _answers(args) -> tuple:
             equilibrium=args.equilibrium,
             **loaded,
         )
+    # before any figure is written: a group that matches no muscle is refused with nothing written
+    parts = _contributions(args, anatomy, result) if args.contributions is not None or args.group else None
     if args.plot:
         from ..anatomy.figures import save_anatomy_figures
 
         analysis = result.analysis if args.optimise else result
         save_anatomy_figures(anatomy, analysis, curve, args.plot)
+    if parts is not None:
+        if args.plot and parts.free is not None:
+            from ..anatomy.contributions import save_contributions_figure
+
+            save_contributions_figure(parts.free, args.plot, args.contributions)
+        result = parts
     return result, curve
 
 
@@ -328,3 +355,23 @@ def _curve_table(curve: dict) -> str:
             cells.append(f"{row['cost'][i]:.4g}" if ok else row["status"][i])
         lines.append(f"{deg:>{len(CURVE_AXIS)}.3g}  {cells[0]:>13}  {cells[1]:>14}  {cells[2]:>16}")
     return "\n".join(lines)
+
+
+def _contributions(args, anatomy, result):
+    """--contributions: the result with each muscle's contribution."""
+    from ..anatomy.contributions import with_contributions
+
+    if args.contributions is None:
+        raise ParameterError("--group", "goes with --contributions (got --group alone)")
+    optimum = (
+        {"stability": args.stability, "margin": args.margin, "equilibrium": args.equilibrium} if args.optimise else None
+    )
+    return with_contributions(
+        anatomy,
+        result,
+        plane=args.plane,
+        joint_stiffness=args.joint_stiffness,
+        count=args.contributions,
+        groups=dict(args.group or ()),
+        optimum=optimum,
+    )

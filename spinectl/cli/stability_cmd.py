@@ -64,6 +64,12 @@ def register(sub) -> None:
         help="with --coupled: a force [N] held at the point mass, fixed in the ground (x ventral, y up; e.g. "
         "0,-200 for about 20 kg held), in the chain's K and its least local stiffness; repeatable (docs/chain.md)",
     )
+    parser.add_argument(
+        "--contributions",
+        action="store_true",
+        help="also each pair's part of each CoR's stiffness and of the chain's least eigenvalue of -K (which pair "
+        "stabilises each CoR and the chain), and the chain without each pair (docs/contributions.md)",
+    )
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     add_model_options(parser)
     parser.set_defaults(func=run)
@@ -100,9 +106,21 @@ def run(args) -> int:
     except NoStabilisingActivation as exc:  # the library names its argument; the user types the option
         raise NoStabilisingActivation(str(exc).replace("(argument pcsa, [m^2])", "with --pcsa [cm2]")) from None
     source = "given" if given else "min_pcsa"
+    pairs = _pair_contributions(model, args, result.pcsa) if args.contributions else None
     if args.json:
-        emit_json(clinical.with_lordosis_angle(result.to_dict(model, pcsa_source=source), model))
+        doc = clinical.with_lordosis_angle(result.to_dict(model, pcsa_source=source), model)
+        emit_json(doc if pairs is None else {**doc, "contributions": pairs.to_dict()})
     else:
         print(result.table(model, pcsa_source=source))
+        if pairs is not None:
+            print(pairs.table())
     note_pcsa_slip(args.pcsa)
     return 0
+
+
+def _pair_contributions(model, args, pcsa):
+    """--contributions: each pair's part at the analysed PCSA (the point's, computed or checked: any size)."""
+    from ..model.contributions import pair_contributions
+    from ..model.operating_point import OperatingPoint
+
+    return pair_contributions(OperatingPoint(model, args.E, args.Lambda, pcsa, slip_check=False))

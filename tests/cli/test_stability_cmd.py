@@ -107,3 +107,20 @@ def test_the_table_says_the_sign_of_s_and_d(capsys):
     lines = capsys.readouterr().out.splitlines()
     last_row = max(i for i, line in enumerate(lines) if line.startswith("L5S1"))
     assert lines[last_row + 1] == SIGN_NOTE and "S < 0 restores" in SIGN_NOTE and "D < 0 damps" in SIGN_NOTE
+
+
+def test_contributions_say_which_pair_stabilises_each_cor_and_the_chain(capsys):
+    """spinectl stability --contributions: each pair's part of each CoR's -K_jj, whose sum with the passive and
+    gravity terms is the table's own joint stiffness (spinectl.model.chain.linear_chain at the same PCSA), and of
+    the chain's least eigenvalue; in the table and the JSON (variant: a given PCSA, --json)."""
+    from spinectl.model.chain import linear_chain
+
+    assert main(["stability", "--E", "0.03", "--Lambda", "0.04", "--preset", "wagner2012", "--contributions"]) == 0
+    assert "each pair's part of each CoR's stiffness" in capsys.readouterr().out
+    args = ["stability", "--E", "0.01", "--Lambda", "0.02", "--pcsa", "2,8,4", "--preset", "wagner2012"]
+    assert main([*args, "--contributions", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)["contributions"]
+    chain = linear_chain(config.load_preset("wagner2012"), 0.01, 0.02)
+    muscles = -np.diag(chain.stiffness([2.0, 8.0, 4.0])) + np.diag(chain.stiffness_offset)
+    np.testing.assert_allclose(np.sum(doc["cor_share_Nm_per_rad"], axis=0), muscles, rtol=1e-10)
+    assert doc["pairs"] == ["straight", "oblique_outer", "oblique_inner"] and len(doc["cor_stabilised_most_by"]) == 5

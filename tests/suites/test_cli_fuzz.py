@@ -88,6 +88,8 @@ def well_formed(draw) -> list[str]:
         argv += [name, draw(values[name])]
     if command == "stability" and "--pcsa" not in argv and draw(st.booleans()):
         argv += ["--pcsa", draw(pcsa_lists)]
+    if command == "stability" and draw(st.booleans()):
+        argv.append("--contributions")  # each pair's part of the chain's index, at the same random point
     return argv + (["--json"] if command == "stability" and draw(st.booleans()) else [])
 
 

@@ -17,6 +17,7 @@ MODULES = {
     "spinectl.landscape.atlas": ("SALib",),
     "spinectl.model.config": (),
     "spinectl.model.chain": (),
+    "spinectl.model.contributions": (),
     "spinectl.model.operating_point": (),
     "spinectl.model.stability": (),
     "spinectl.optimise.reference": ("cvxpy",),
