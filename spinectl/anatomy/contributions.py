@@ -32,7 +32,7 @@ TOP = 10
 """Muscles listed (and removed one by one) by default: the largest abs(d lambda_min / d a_i)."""
 
 
-def optimum_resolver(anatomy: AnatomyEngine, plane, posture, joint_stiffness, stability, margin, equilibrium):
+def optimum_resolver(anatomy: AnatomyEngine, plane, posture, joint_stiffness, stability, margin, equilibrium, loads=()):
     """The optimum re-solved with some muscles held at 0: a :data:`~spinectl.model.contributions.Resolver`.
 
     The same programme as :func:`spinectl.anatomy.optimum.optimise` (volume weights), its held muscles'
@@ -42,7 +42,7 @@ def optimum_resolver(anatomy: AnatomyEngine, plane, posture, joint_stiffness, st
     ----------
     anatomy : AnatomyEngine
         The model.
-    plane, posture, joint_stiffness, stability, margin, equilibrium
+    plane, posture, joint_stiffness, stability, margin, equilibrium, loads
         As :func:`spinectl.anatomy.optimum.optimise`.
 
     Returns
@@ -52,7 +52,9 @@ def optimum_resolver(anatomy: AnatomyEngine, plane, posture, joint_stiffness, st
     """
     from .optimum import optimum_on_chains
 
-    free, constrained, lin = anatomy.chains(plane, posture, joint_stiffness)
+    free, constrained, lin = anatomy.chains(
+        plane, posture, joint_stiffness, **({"loads": tuple(loads)} if loads else {})
+    )
     rows, tau_per, tau_0 = anatomy.equilibrium_rows(lin, plane, posture, equilibrium)
     w = anatomy.volume_weights()
     solved = {}
@@ -135,6 +137,7 @@ def with_contributions(
     count: int = TOP,
     groups: dict | None = None,
     optimum: dict | None = None,
+    loads=(),
 ) -> WithContributions:
     """Each muscle's, class's and group's contribution at the activations of ``result``, free and constrained.
 
@@ -156,6 +159,8 @@ def with_contributions(
         Named groups (:func:`spinectl.model.contributions.resolve_groups`).
     optimum : dict, optional
         ``stability``, ``margin``, ``equilibrium`` of the optimum behind ``result``: the removal re-solves it.
+    loads : sequence of BodyLoad, optional
+        The external loads analysed (:mod:`spinectl.anatomy.loads`): in the chains and the re-solved optimum.
 
     Returns
     -------
@@ -164,10 +169,11 @@ def with_contributions(
     if optimum is not None and not result.optimum.ok:
         return WithContributions(result, None, None, count)
     a = result.optimum.activations if optimum is not None else result.activations
-    free, constrained, _ = anatomy.chains(plane, posture, joint_stiffness, activations=a)
+    loaded = {"loads": tuple(loads)} if loads else {}  # without: the engines' calls as they were
+    free, constrained, _ = anatomy.chains(plane, posture, joint_stiffness, activations=a, **loaded)
     resolve = None
     if optimum is not None:
-        resolve = optimum_resolver(anatomy, plane, posture, joint_stiffness, **optimum)
+        resolve = optimum_resolver(anatomy, plane, posture, joint_stiffness, **optimum, **loaded)
     out = WithContributions(
         result, _on(free, a, count, groups, resolve), _on(constrained, a, count, groups, resolve), int(count)
     )

@@ -360,6 +360,7 @@ def _curve_table(curve: dict) -> str:
 def _contributions(args, anatomy, result):
     """--contributions: the result with each muscle's contribution."""
     from ..anatomy.contributions import with_contributions
+    from ..anatomy.recordings import recorded_point
 
     if args.contributions is None:
         raise ParameterError("--group", "goes with --contributions (got --group alone)")
@@ -370,7 +371,9 @@ def _contributions(args, anatomy, result):
         anatomy,
         result,
         plane=args.plane,
+        posture=recorded_point(anatomy, args.posture, None, args.time).posture,  # the file's frame, as analysed
         joint_stiffness=args.joint_stiffness,
+        loads=_loads(args.load) if args.load else (),
         count=args.contributions,
         groups=dict(args.group or ()),
         optimum=optimum,

@@ -106,7 +106,7 @@ def run(args) -> int:
     except NoStabilisingActivation as exc:  # the library names its argument; the user types the option
         raise NoStabilisingActivation(str(exc).replace("(argument pcsa, [m^2])", "with --pcsa [cm2]")) from None
     source = "given" if given else "min_pcsa"
-    pairs = _pair_contributions(model, args, result.pcsa) if args.contributions else None
+    pairs = _pair_contributions(model, args, result.pcsa, loaded.get("loads", ())) if args.contributions else None
     if args.json:
         doc = clinical.with_lordosis_angle(result.to_dict(model, pcsa_source=source), model)
         emit_json(doc if pairs is None else {**doc, "contributions": pairs.to_dict()})
@@ -118,9 +118,9 @@ def run(args) -> int:
     return 0
 
 
-def _pair_contributions(model, args, pcsa):
+def _pair_contributions(model, args, pcsa, loads=()):
     """--contributions: each pair's part at the analysed PCSA (the point's, computed or checked: any size)."""
     from ..model.contributions import pair_contributions
     from ..model.operating_point import OperatingPoint
 
-    return pair_contributions(OperatingPoint(model, args.E, args.Lambda, pcsa, slip_check=False))
+    return pair_contributions(OperatingPoint(model, args.E, args.Lambda, pcsa, slip_check=False, loads=loads))

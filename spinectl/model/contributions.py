@@ -653,6 +653,14 @@ def pair_contributions(point) -> PairContributions:
     model = point.model
     per_muscle = model.replace(optimisation=dataclasses.replace(model.optimisation, activation="independent"))
     chain = linear_chain(per_muscle, point.eccentricity, point.lordosis)
+    if point.loads:  # their load stiffness in K_0, as chain_at adds it
+        from . import geometry
+        from .loads import load_stiffness
+
+        cor = geometry.cor_positions(point.eccentricity, point.lordosis, model.geometry)
+        chain = dataclasses.replace(
+            chain, stiffness_offset=chain.stiffness_offset + load_stiffness(model, cor, point.loads)
+        )
     pairs = {p: [f"{p}_{side}" for side in model.geometry.side_names] for p in model.pair_names}
     u = np.asarray(point.pcsa, float) / M2_PER_CM2
     return PairContributions(contributions(chain, u, point.local_stiffness, groups=pairs))
