@@ -56,9 +56,9 @@ class Coupler:
             x.set(k, float(values.get(name, engine.coordinate(name).getDefaultValue())))
         slopes, curvatures, mixed = [], [], []
         for k in range(len(self.independent)):
-            slopes.append(self.function.calcDerivative(_orders(osim, k), x))
-            curvatures.append(self.function.calcDerivative(_orders(osim, k, k), x))
-            mixed += [self.function.calcDerivative(_orders(osim, k, j), x) for j in range(k)]
+            slopes.append(self.function.calcDerivative(_orders(k), x))
+            curvatures.append(self.function.calcDerivative(_orders(k, k), x))
+            mixed += [self.function.calcDerivative(_orders(k, j), x) for j in range(k)]
         if any(abs(v) > 0 for v in mixed):  # the reduction carries each coordinate's own curvature only
             raise ModelError(f"{engine.name}: coupler {self.name} has mixed second derivatives, not supported")
         return np.array(slopes), np.array(curvatures)
@@ -81,12 +81,14 @@ class Coupler:
         return f"{self.name} ({self.dependent} on {on})"
 
 
-def _orders(osim, *orders):
-    """OpenSim's derivative-order argument: the indices of the variables differentiated."""
-    out = osim.StdVectorInt()
-    for k in orders:
-        out.append(int(k))
-    return out
+def _orders(*orders) -> list:
+    """OpenSim's derivative-order argument: the indices of the variables differentiated.
+
+    A Python list, which OpenSim's bindings convert themselves: an ``opensim.StdVectorInt`` is refused as
+    argument 2 of ``Function.calcDerivative`` once another SWIG-built package (cvxpy's solvers) was imported
+    before opensim, so a model with couplers failed to load after any optimum.
+    """
+    return [int(k) for k in orders]
 
 
 def read_couplers(osim, model) -> tuple:

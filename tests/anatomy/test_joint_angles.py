@@ -9,6 +9,8 @@ references are OpenSim's own: its inverse dynamics (the generalised forces), its
 from __future__ import annotations
 
 import json
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -379,3 +381,21 @@ def test_a_joint_turned_by_several_coordinates_is_linear_or_refused():
     np.testing.assert_allclose(ours.torque_offset, w.T @ np.array([1.0, -2.0]), rtol=1e-14)
     with pytest.raises(ModelError, match="several chain coordinates and not linearly"):
         linearisation_in_angles(lin, JointSlopes(jacobian, np.array([0.1, 0.0])))
+
+
+def test_a_model_with_couplers_loads_after_an_optimum_has_imported_cvxpy(tiny):
+    """A user who solves an optimum first (cvxpy and its SWIG-built solvers imported before opensim) then loads
+    an .osim with a coupler: OpenSim's Function.calcDerivative refused an opensim.StdVectorInt as its argument 2
+    in that import order (a TypeError); the coupler's slope read through the model is still COUPLING. A fresh
+    process, since the import order is the process's."""
+    path, mapping, _ = tiny
+    code = (
+        "import cvxpy, sys\n"
+        "from spinectl.anatomy import load\n"
+        f"anatomy = load({str(path)!r}, {str(mapping)!r})\n"
+        "slopes, _ = anatomy.engine.couplers[0].derivatives({}, anatomy.engine)\n"
+        "print(float(slopes[0]))\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert float(done.stdout.split()[-1]) == pytest.approx(COUPLING, rel=1e-12)
