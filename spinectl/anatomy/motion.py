@@ -186,57 +186,40 @@ def motion_response(
     if optimise != "none" and activations is not None:
         raise ParameterError("activations", "cannot go with optimise, which finds the activations itself")
     chosen = select_frames(recording.times, frames, rate)
+    points = [_read_point(anatomy, recording, activations, float(recording.times[i])) for i in chosen]  # every
+    # frame's columns, NaNs and activation times checked before the first is solved: a bad last frame costs no run
     rows = []
     with tqdm(total=chosen.size, unit="frame", desc="motion", disable=None if progress is None else not progress) as bar:
-        for index in chosen:
-            rows.append(_frame(anatomy, recording, activations, optimise, index, plane, joint_stiffness,
-                               least_stiffness))
+        for time, (values, a) in zip(recording.times[chosen], points, strict=True):
+            rows.append(_frame(anatomy, float(time), values, a, optimise, plane, joint_stiffness, least_stiffness))
             bar.update(1)
     return MotionResult(_dataset(anatomy, recording, activations, optimise, plane, joint_stiffness,
                                  least_stiffness, rows))
 
 
-def frame_point(anatomy, recording, activations, optimise, time, plane="sagittal", joint_stiffness="none"):
-    """One frame's operating point: (posture in the engine's form, coordinate values, activations, optimum).
-
-    Parameters
-    ----------
-    anatomy : AnatomyEngine
-        The model.
-    recording, activations : Recording, Recording or None
-        As :func:`motion_response`.
-    optimise : str
-        As :func:`motion_response`.
-    time : float
-        The frame's time [s].
-    plane, joint_stiffness
-        As :func:`motion_response`.
-
-    Returns
-    -------
-    tuple
-        (posture, dict coordinate -> value [rad or m], activations (m,), Optimum or None)
-    """
+def _read_point(anatomy, recording, activations, time) -> tuple:
+    """One frame's coordinates (name -> value [rad or m]) and activations (None: not from a file), checked."""
     values = recording.frame(anatomy.posture_columns(), time).values
+    if activations is None:
+        return values, None
+    frame = activations.frame(anatomy.activation_columns(), time)
+    return values, activation_vector(anatomy, np.array([frame.values[name] for name in anatomy.muscles]))
+
+
+def _activations_at(anatomy, posture, a, optimise, plane, joint_stiffness) -> tuple:
+    """The frame's activations (the file's, the optimum's or the model's own) and the optimum (or None)."""
+    if a is not None or optimise == "none":
+        return (activation_vector(anatomy, None) if a is None else a), None
+    from .optimum import optimise as optimum
+
+    opt = optimum(anatomy, plane, stability=optimise, posture=posture, joint_stiffness=joint_stiffness)
+    return opt.activations, opt
+
+
+def _frame(anatomy, time, values, a, optimise, plane, joint_stiffness, least_stiffness) -> dict:
+    """Everything the Dataset holds of one frame: its coordinates ``values`` and activations ``a`` (or None)."""
     posture = anatomy.named_posture(values)
-    opt = None
-    if activations is not None:
-        frame = activations.frame(anatomy.activation_columns(), time)
-        a = activation_vector(anatomy, np.array([frame.values[name] for name in anatomy.muscles]))
-    elif optimise != "none":
-        from .optimum import optimise as optimum
-
-        opt = optimum(anatomy, plane, stability=optimise, posture=posture, joint_stiffness=joint_stiffness)
-        a = opt.activations
-    else:
-        a = activation_vector(anatomy, None)
-    return posture, values, a, opt
-
-
-def _frame(anatomy, recording, activations, optimise, index, plane, joint_stiffness, least_stiffness) -> dict:
-    """Everything the Dataset holds of one frame."""
-    time = float(recording.times[index])
-    posture, values, a, opt = frame_point(anatomy, recording, activations, optimise, time, plane, joint_stiffness)
+    a, opt = _activations_at(anatomy, posture, a, optimise, plane, joint_stiffness)
     row = {"time": time, "activation": a, "optimum_status": "" if opt is None else opt.status}
     free_chain = anatomy.plane_joints(plane)
     row["posture"] = np.array([values.get(j, np.nan) for j in free_chain])
