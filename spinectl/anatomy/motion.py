@@ -67,8 +67,10 @@ class MotionResult:
         str
         """
         ds = self.dataset
-        lines = [f"{ds.attrs['model_identity_text']}, {ds.attrs['plane']} plane, {ds.sizes['time']} frames of "
-                 f"{ds.attrs['coordinates_file']} ({ds.attrs['activation_source']})"]
+        lines = [
+            f"{ds.attrs['model_identity_text']}, {ds.attrs['plane']} plane, {ds.sizes['time']} frames of "
+            f"{ds.attrs['coordinates_file']} ({ds.attrs['activation_source']})"
+        ]
         for name, criterion in (("free", FREE), ("constrained", CONSTRAINED)):
             index = ds[f"{name}_index"].values
             unstable = ds[f"{name}_unstable_modes"].values
@@ -117,8 +119,9 @@ def select_frames(times, frames=None, rate=None, fields=("frames", "rate")) -> n
         first, last, step = frames
         if not (0 <= first <= last < n) or step < 1:
             raise ParameterError(
-                fields[0], f"must be FIRST:LAST[:STEP] with 0 <= FIRST <= LAST <= {n - 1} (the file's {n} frames) "
-                f"and STEP >= 1 (got {first}:{last}:{step})"
+                fields[0],
+                f"must be FIRST:LAST[:STEP] with 0 <= FIRST <= LAST <= {n - 1} (the file's {n} frames) "
+                f"and STEP >= 1 (got {first}:{last}:{step})",
             )
         return np.arange(first, last + 1, step)
     if rate is None:
@@ -189,12 +192,15 @@ def motion_response(
     points = [_read_point(anatomy, recording, activations, float(recording.times[i])) for i in chosen]  # every
     # frame's columns, NaNs and activation times checked before the first is solved: a bad last frame costs no run
     rows = []
-    with tqdm(total=chosen.size, unit="frame", desc="motion", disable=None if progress is None else not progress) as bar:
+    with tqdm(
+        total=chosen.size, unit="frame", desc="motion", disable=None if progress is None else not progress
+    ) as bar:
         for time, (values, a) in zip(recording.times[chosen], points, strict=True):
             rows.append(_frame(anatomy, float(time), values, a, optimise, plane, joint_stiffness, least_stiffness))
             bar.update(1)
-    return MotionResult(_dataset(anatomy, recording, activations, optimise, plane, joint_stiffness,
-                                 least_stiffness, rows))
+    return MotionResult(
+        _dataset(anatomy, recording, activations, optimise, plane, joint_stiffness, least_stiffness, rows)
+    )
 
 
 def _read_point(anatomy, recording, activations, time) -> tuple:
@@ -252,6 +258,62 @@ def _stack(rows, key, width, part=None) -> np.ndarray:
     return out
 
 
+VARIABLES = {
+    "free_index": (("time",), "N m/rad", f"least eigenvalue of -K, {FREE} (per joint radian); > 0 stable"),
+    "constrained_index": (("time",), "N m/rad", f"least eigenvalue of -K, {CONSTRAINED}; > 0 stable"),
+    "free_eigenvalues": (("time", "mode"), "N m/rad", f"eigenvalues of -K, ascending, {FREE}"),
+    "constrained_eigenvalues": (
+        ("time", "constrained_mode"),
+        "N m/rad",
+        f"eigenvalues of -K, ascending, {CONSTRAINED}",
+    ),
+    "free_mode_shape": (("time", "joint"), "1", f"unit eigenvector of the least eigenvalue, largest entry > 0, {FREE}"),
+    "constrained_mode_shape": (
+        ("time", "coordinate"),
+        "1",
+        f"unit eigenvector of the least eigenvalue, largest entry > 0, {CONSTRAINED}",
+    ),
+    "free_unstable_modes": (("time",), "1", f"eigenvalues of -K <= 0 (NaN: no operating point), {FREE}"),
+    "constrained_unstable_modes": (("time",), "1", f"eigenvalues of -K <= 0 (NaN: no operating point), {CONSTRAINED}"),
+    "net_torque": (
+        ("time", "joint"),
+        "N m",
+        "net generalised force of muscles, gravity and passive tissue on each free-chain joint",
+    ),
+    "equilibrium_residual": (
+        ("time",),
+        "N m",
+        "norm of the net torque on the rhythm's coordinates (0: in equilibrium)",
+    ),
+    "posture": (("time", "joint"), "rad", "the chain's coordinates as the file gives them (converted from degrees)"),
+    "activation": (("time", "muscle"), "", "each muscle's control at the frame (units: the model's control unit)"),
+    "least_joint_stiffness": (
+        ("time", "joint"),
+        "N m/rad",
+        f"least added stiffness per joint with -K + diag(k) >= margin I (attribute margin), {FREE}",
+    ),
+}
+"""Every variable of the Dataset: dims, units, description (the criterion named where it is a verdict)."""
+
+
+def _values(rows, n: int, c: int, m: int) -> dict:
+    """The variables' values over the frames, NaN where a frame has none (an optimum not found)."""
+    return {
+        "free_index": _stack(rows, "free", n, 0)[:, 0],
+        "constrained_index": _stack(rows, "constrained", max(c, 1), 0)[:, 0],
+        "free_eigenvalues": _stack(rows, "free", n, 0),
+        "constrained_eigenvalues": _stack(rows, "constrained", c, 0),
+        "free_mode_shape": _stack(rows, "free", n, 1),
+        "constrained_mode_shape": _stack(rows, "constrained", c, 1),
+        "free_unstable_modes": _stack(rows, "free", 1, 2)[:, 0],
+        "constrained_unstable_modes": _stack(rows, "constrained", 1, 2)[:, 0],
+        "net_torque": _stack(rows, "net_torque", n),
+        "equilibrium_residual": _stack(rows, "residual", 1)[:, 0],
+        "posture": _stack(rows, "posture", n),
+        "activation": _stack(rows, "activation", m),
+    }
+
+
 def _dataset(anatomy, recording, activations, optimise, plane, joint_stiffness, least_stiffness, rows):
     """The frames as an xarray Dataset, units and descriptions on every variable, the model's identity."""
     import xarray as xr
@@ -260,58 +322,44 @@ def _dataset(anatomy, recording, activations, optimise, plane, joint_stiffness, 
 
     solved = [r for r in rows if "free" in r]
     joints = tuple(solved[0]["joints"]) if solved else tuple(anatomy.plane_joints(plane))
-    coords = tuple(solved[0]["coordinates"]) if solved else ()
-    n, c = len(joints), len(coords)
-    dims = {"t": ("time",), "tj": ("time", "joint"), "tm": ("time", "mode"), "tc": ("time", "coordinate"),
-            "tcm": ("time", "constrained_mode"), "ta": ("time", "muscle")}
-    variables = {
-        "free_index": ("t", _stack(rows, "free", n, 0)[:, 0], "N m/rad",
-                       f"least eigenvalue of -K, {FREE} (per joint radian); > 0 stable"),
-        "constrained_index": ("t", _stack(rows, "constrained", c, 0)[:, 0] if c else np.full(len(rows), np.nan),
-                              "N m/rad", f"least eigenvalue of -K, {CONSTRAINED}; > 0 stable"),
-        "free_eigenvalues": ("tm", _stack(rows, "free", n, 0), "N m/rad", f"eigenvalues of -K, ascending, {FREE}"),
-        "constrained_eigenvalues": ("tcm", _stack(rows, "constrained", c, 0), "N m/rad",
-                                    f"eigenvalues of -K, ascending, {CONSTRAINED}"),
-        "free_mode_shape": ("tj", _stack(rows, "free", n, 1), "1",
-                            f"unit eigenvector of the least eigenvalue, largest entry positive, {FREE}"),
-        "constrained_mode_shape": ("tc", _stack(rows, "constrained", c, 1), "1",
-                                   f"unit eigenvector of the least eigenvalue, largest entry positive, {CONSTRAINED}"),
-        "free_unstable_modes": ("t", _stack(rows, "free", 1, 2)[:, 0], "1",
-                                f"eigenvalues of -K <= 0 (NaN: no operating point), {FREE}"),
-        "constrained_unstable_modes": ("t", _stack(rows, "constrained", 1, 2)[:, 0], "1",
-                                       f"eigenvalues of -K <= 0 (NaN: no operating point), {CONSTRAINED}"),
-        "net_torque": ("tj", _stack(rows, "net_torque", n), "N m",
-                       "net generalised force of muscles, gravity and passive tissue on each free-chain joint"),
-        "equilibrium_residual": ("t", _stack(rows, "residual", 1)[:, 0], "N m",
-                                 "norm of the net torque on the rhythm's coordinates (0: in equilibrium)"),
-        "posture": ("tj", _stack(rows, "posture", n), "rad",
-                    "the chain's coordinates as the file gives them (converted from degrees)"),
-        "activation": ("ta", _stack(rows, "activation", len(anatomy.muscles)), anatomy.control_unit,
-                       "each muscle's control at the frame"),
-    }
+    coordinates = tuple(solved[0]["coordinates"]) if solved else ()
+    n, c = len(joints), len(coordinates)
+    values = _values(rows, n, c, len(anatomy.muscles))
     if least_stiffness is not None:
-        variables["least_joint_stiffness"] = ("tj", _stack(rows, "least", n), "N m/rad",
-                                              f"least added stiffness per joint with -K + diag(k) >= "
-                                              f"{least_stiffness:g} I, {FREE}")
-    data = {k: (dims[d], np.asarray(v), {"units": u, "description": w}) for k, (d, v, u, w) in variables.items()}
-    data["optimum_status"] = (("time",), np.array([r["optimum_status"] for r in rows], dtype=object),
-                              {"description": "the optimum's solver status per frame ('' without --optimise)"})
+        values["least_joint_stiffness"] = _stack(rows, "least", n)
+    data = {}
+    for name, value in values.items():
+        dims, units, description = VARIABLES[name]
+        data[name] = (dims, value, {"units": units or anatomy.control_unit, "description": description})
+    if least_stiffness is not None:
+        data["least_joint_stiffness"][2]["margin"] = float(least_stiffness)
+    status = np.array([r["optimum_status"] for r in rows], dtype=object)
+    data["optimum_status"] = (("time",), status, {"description": "the optimum's solver status ('' without one)"})
+    coords = {
+        "time": ("time", np.array([r["time"] for r in rows]), {"units": "s"}),
+        "joint": ("joint", list(joints)),
+        "mode": ("mode", np.arange(n)),
+        "coordinate": ("coordinate", list(coordinates)),
+        "constrained_mode": ("constrained_mode", np.arange(c)),
+        "muscle": ("muscle", list(anatomy.muscles)),
+    }
     identity = model_identity(anatomy)
     attrs = {
         "title": "Cholewicki-McGill stability index along a motion (spinectl motion)",
         "references": "Cholewicki J, McGill SM (1996) Clin Biomech 11:1-15, doi:10.1016/0268-0033(95)00035-6",
-        "model_name": identity["name"], "model_source": str(identity["source"]), "model_sha256": identity["sha256"],
-        "model_engine": identity["engine"], "model_identity": json.dumps(identity),
+        "model_name": identity["name"],
+        "model_source": str(identity["source"]),
+        "model_sha256": identity["sha256"],
+        "model_engine": identity["engine"],
+        "model_identity": json.dumps(identity),
         "model_identity_text": identity_text(identity),
-        "plane": plane, "coordinates_file": str(recording.path.name),
+        "plane": plane,
+        "coordinates_file": str(recording.path.name),
         "activation_source": _activation_source(anatomy, activations, optimise),
         "joint_stiffness_added": str(joint_stiffness),
-        "free_criterion": FREE, "constrained_criterion": CONSTRAINED,
+        "free_criterion": FREE,
+        "constrained_criterion": CONSTRAINED,
     }
-    coords = {"time": ("time", np.array([r["time"] for r in rows]), {"units": "s"}),
-              "joint": ("joint", list(joints)), "mode": ("mode", np.arange(n)),
-              "coordinate": ("coordinate", list(coords)), "constrained_mode": ("constrained_mode", np.arange(c)),
-              "muscle": ("muscle", list(anatomy.muscles))}
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
 

@@ -7,8 +7,8 @@ import sys
 
 from ..anatomy.mapping import MAX_STIFFNESS
 from ..errors import ParameterError
-from .anatomy_cmd import STIFFNESS_WHY, _joint_stiffness
 from ._common import finite_float, input_name
+from .anatomy_cmd import STIFFNESS_WHY, _joint_stiffness
 
 MAX_FRAME_RATE = 1e6
 """Largest --rate [Hz]: far above any motion capture's; the file's own rate is the real bound (checked later)."""
@@ -34,38 +34,53 @@ def register(sub) -> None:
     )
     parser.add_argument("model", help="'myotorso', an MJCF file or an OpenSim .osim file")
     parser.add_argument(
-        "--coordinates", required=True, type=input_name, metavar="FILE.mot",
+        "--coordinates",
+        required=True,
+        type=input_name,
+        metavar="FILE.mot",
         help="OpenSim coordinates (inverse kinematics .mot, or a states .sto), every coordinate of the model by "
         "name or path; degrees or radians as its header's inDegrees says",
     )
     parser.add_argument("--mapping", metavar="FILE", help="mapping TOML (default: the built-in one of the model)")
     parser.add_argument(
-        "--activations", type=input_name, metavar="FILE.sto",
+        "--activations",
+        type=input_name,
+        metavar="FILE.sto",
         help="activations per muscle (static optimisation, CMC, EMG normalised to [0, 1]), read at each frame's "
         "time (default: the model's own controls)",
     )
     parser.add_argument(
-        "--optimise", choices=("none", "joints", "chain"), default="none",
+        "--optimise",
+        choices=("none", "joints", "chain"),
+        default="none",
         help="the activations per frame: none (--activations, else the model's own controls; default), or the "
         "least-effort optimum holding the frame's posture with the stability criterion joint by joint or of "
         "the free chain (margin 1 N m/rad)",
     )
     parser.add_argument(
-        "--frames", type=_frames, metavar="A:B[:STEP]",
+        "--frames",
+        type=_frames,
+        metavar="A:B[:STEP]",
         help="the frames analysed, by index from 0, A to B included, every STEP-th (default: all)",
     )
     parser.add_argument(
-        "--rate", type=finite_float("--rate", 0.0, MAX_FRAME_RATE, " Hz"), metavar="HZ",
+        "--rate",
+        type=finite_float("--rate", 0.0, MAX_FRAME_RATE, " Hz"),
+        metavar="HZ",
         help="one frame every 1/HZ s (the nearest), HZ > 0 and at most the file's own rate (e.g. 3: "
         "Cholewicki & McGill's three times per second)",
     )
     parser.add_argument("--plane", default="sagittal", help="sagittal, coronal or 3d (default: sagittal)")
     parser.add_argument(
-        "--joint-stiffness", type=_joint_stiffness, default="none", metavar="K",
+        "--joint-stiffness",
+        type=_joint_stiffness,
+        default="none",
+        metavar="K",
         help="intervertebral stiffness added at each chain joint: none (default), mapped or a number [N m/rad]",
     )
     parser.add_argument(
-        "--least-stiffness", type=finite_float("--least-stiffness", 0.0, MAX_STIFFNESS, STIFFNESS_WHY),
+        "--least-stiffness",
+        type=finite_float("--least-stiffness", 0.0, MAX_STIFFNESS, STIFFNESS_WHY),
         metavar="MU",
         help="also the least joint stiffness added that makes the free chain's -K >= MU [N m/rad] at each frame "
         "(an SDP per frame)",
@@ -73,7 +88,9 @@ def register(sub) -> None:
     parser.add_argument("--out", required=True, metavar="FILE.nc", help="the NetCDF file written")
     parser.add_argument("--plot", metavar="DIR", help="write motion.png into DIR")
     parser.add_argument(
-        "--no-cache", action="store_true", help="compile the model anew, neither reading nor writing the cache",
+        "--no-cache",
+        action="store_true",
+        help="compile the model anew, neither reading nor writing the cache",
     )
     parser.set_defaults(func=run)
 
@@ -108,8 +125,15 @@ def run(args) -> int:
         anatomy = load(args.model, args.mapping, cache=not args.no_cache)
         activations = None if args.activations is None else read_recording(args.activations, "activations")
         result = motion_response(
-            anatomy, coordinates, activations, args.optimise, args.frames, args.rate, args.plane,
-            args.joint_stiffness, args.least_stiffness,
+            anatomy,
+            coordinates,
+            activations,
+            args.optimise,
+            args.frames,
+            args.rate,
+            args.plane,
+            args.joint_stiffness,
+            args.least_stiffness,
         )
     _write(result, args)
     print(result.summary())

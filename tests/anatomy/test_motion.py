@@ -77,8 +77,9 @@ def test_activations_from_a_file_are_read_at_each_frames_time(torso, tmp_path):
     rng = np.random.default_rng(7)
     a = rng.uniform(0.0, 0.3, (TIMES.size, len(torso.muscles)))
     sto = write_table(tmp_path / "so.sto", torso.muscles, a, times=TIMES)
-    result = motion_response(torso, read_recording(path, "posture"), read_recording(sto, "activations"),
-                             frames=(0, 20, 5), progress=False)
+    result = motion_response(
+        torso, read_recording(path, "posture"), read_recording(sto, "activations"), frames=(0, 20, 5), progress=False
+    )
     ds = _assert_as_analysed(result, torso, path, activation=sto)
     np.testing.assert_allclose(ds["activation"].values, a[::5], rtol=1e-15, atol=1e-16)  # the file's text round-off
     assert not np.allclose(ds["free_index"].values, analyse(torso, posture=path).free.eigenvalues[0])
@@ -176,9 +177,17 @@ def test_frames_and_rate_select_the_frames_meant():
 
 @pytest.mark.parametrize(
     ("frames", "rate", "word"),
-    [((0, 21, 1), None, "LAST <= 20"), ((5, 4, 1), None, "FIRST <= LAST"), ((-1, 3, 1), None, "0 <="),
-     ((0, 3, 0), None, "STEP >= 1"), (None, 0.0, "> 0"), (None, -2.0, "> 0"), (None, 20.5, "20 Hz"),
-     (None, float("nan"), "> 0"), ((0, 3, 1), 5.0, "cannot go with")],
+    [
+        ((0, 21, 1), None, "LAST <= 20"),
+        ((5, 4, 1), None, "FIRST <= LAST"),
+        ((-1, 3, 1), None, "0 <="),
+        ((0, 3, 0), None, "STEP >= 1"),
+        (None, 0.0, "> 0"),
+        (None, -2.0, "> 0"),
+        (None, 20.5, "20 Hz"),
+        (None, float("nan"), "> 0"),
+        ((0, 3, 1), 5.0, "cannot go with"),
+    ],
 )
 def test_a_frame_selection_outside_the_file_is_refused(frames, rate, word):
     """Out of range, a step below 1, a rate <= 0, above the file's rate or NaN, both given: one ParameterError."""

@@ -60,8 +60,23 @@ def test_the_file_opens_with_xarray_and_holds_the_librarys_numbers(torso, flexio
     from spinectl.anatomy.recordings import read_recording
 
     out, plots = tmp_path / "motion.nc", tmp_path / "figures"
-    assert main(["motion", "myotorso", "--coordinates", str(flexion), "--rate", "5", "--out", str(out),
-                 "--plot", str(plots)]) == 0
+    assert (
+        main(
+            [
+                "motion",
+                "myotorso",
+                "--coordinates",
+                str(flexion),
+                "--rate",
+                "5",
+                "--out",
+                str(out),
+                "--plot",
+                str(plots),
+            ]
+        )
+        == 0
+    )
     printed = capsys.readouterr().out
     assert "free" in printed and "rhythm" in printed
     with xr.open_dataset(out) as ds:
