@@ -13,6 +13,7 @@ import pytest
 
 osim = pytest.importorskip("opensim", reason="needs the opensim extra: pip install 'spinectl[opensim]'")
 
+from shared_models import ABSENT, POSE2SIM  # noqa: E402 (tests/anatomy/shared_models.py)
 from test_recordings import write_table  # noqa: E402 (tests/anatomy/test_recordings.py: OpenSim's STOFileAdapter)
 
 from spinectl import anatomy  # noqa: E402
@@ -203,3 +204,26 @@ def test_the_figure_names_its_criteria(torso_motion):
     labels = [t.get_text() for t in index.get_legend().get_texts()]
     assert any("free" in label for label in labels) and any("rhythm" in label for label in labels)
     assert "Cholewicki-McGill" in index.get_title() and len(posture.get_lines()) == 5
+
+
+@pytest.mark.skipif(not POSE2SIM.is_file(), reason=ABSENT)
+def test_the_pose2sim_models_index_is_analyse_at_each_frame(tmp_path):
+    """The shared Pose2Sim model (OpenSim, 232 muscles, its lumbar couplers as the rhythm), with docs/anatomy.md's
+    mapping: a flexion of its six sagittal joints from the model's default posture (every other coordinate at its
+    default), four frames; each frame's index, free and constrained, is analyse's at that time to 1e-12."""
+    from test_mapping import _documented_mappings  # tests/anatomy/test_mapping.py: the mapping as documented
+
+    mapping = tmp_path / "pose2sim.toml"
+    mapping.write_text(_documented_mappings()[0], encoding="utf-8")
+    model = anatomy.load(POSE2SIM, mapping)
+    names = list(model.posture_columns().required)
+    rotational = model.posture_columns().rotational
+    default = [model.engine.coordinate(n).getDefaultValue() for n in names]
+    rows = np.tile([np.degrees(v) if n in rotational else v for n, v in zip(names, default, strict=True)], (4, 1))
+    times = np.array([0.0, 0.25, 0.5, 0.75])
+    for joint in model.plane_joints("sagittal"):
+        rows[:, names.index(joint)] += -5.0 * np.sin(np.pi * times)
+    path = write_table(tmp_path / "flexion.mot", names, rows, times=times, degrees="yes")
+    result = motion_response(model, read_recording(path, "posture"), progress=False)
+    ds = _assert_as_analysed(result, model, path, rtol=1e-12)
+    assert np.ptp(ds["free_index"].values) > 1.0  # N m/rad: the posture matters
