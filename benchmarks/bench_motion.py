@@ -4,8 +4,8 @@
     python benchmarks/bench_motion.py --frames 300 --skip-optimum
 
 MyoTorso's lumbar flexion and return (-8 sin(pi t / T) deg at each sagittal joint) over ``--frames`` frames at
-50 Hz, and random activations in [0, 0.3] per frame, written through OpenSim's API (TimeSeriesTable,
-STOFileAdapter) into a temporary folder. Timed, wall clock, after one warm-up frame:
+50 Hz, and random activations in [0, 0.3] per frame, written through OpenSim's API (``write_motion``:
+TimeSeriesTable, STOFileAdapter) into a temporary folder. Timed, wall clock, after one warm-up frame:
 
 1. ``motion_response(activations=...)`` against ``analyse(posture=FILE, activation=FILE, time=t)`` per frame (the
    present API, which reads both files at every call); the indices must be equal (asserted);
@@ -31,8 +31,7 @@ sys.path.insert(0, str(ROOT))
 
 from spinectl import anatomy  # noqa: E402
 from spinectl.anatomy.analyses import analyse  # noqa: E402
-from spinectl.anatomy.export_osim import require_opensim  # noqa: E402
-from spinectl.anatomy.motion import motion_response  # noqa: E402
+from spinectl.anatomy.motion import motion_response, write_motion  # noqa: E402
 from spinectl.anatomy.optimum import optimise  # noqa: E402
 from spinectl.anatomy.recordings import read_recording  # noqa: E402
 
@@ -41,19 +40,6 @@ RATE = 50.0
 
 STIFFNESS = 50.0
 """Joint stiffness added for the optimum [N m/rad]: without it MyoTorso's stable optimum is infeasible."""
-
-
-def write(path, labels, times, rows, degrees):
-    """A .mot/.sto through OpenSim's STOFileAdapter."""
-    osim = require_opensim()
-    table = osim.TimeSeriesTable()
-    table.setColumnLabels(osim.StdVectorString(list(labels)))
-    for t, row in zip(times, rows, strict=True):
-        table.appendRow(float(t), osim.RowVector(np.asarray(row, float)))
-    if degrees is not None:
-        table.addTableMetaDataString("inDegrees", degrees)
-    osim.STOFileAdapter.write(table, str(path))
-    return path
 
 
 def files(model, folder: Path, n: int):
@@ -65,8 +51,8 @@ def files(model, folder: Path, n: int):
         rows[:, names.index(joint)] = -8.0 * np.sin(np.pi * times / times[-1])
     a = np.random.default_rng(0).uniform(0.0, 0.3, (n, len(model.muscles)))
     return (
-        write(folder / "flexion.mot", names, times, rows, "yes"),
-        write(folder / "so.sto", model.muscles, times, a, None),
+        write_motion(folder / "flexion.mot", names, times, rows),
+        write_motion(folder / "so.sto", model.muscles, times, a, in_degrees=None),
         times,
     )
 
@@ -114,6 +100,7 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as folder:
         mot, sto, times = files(model, Path(folder), args.frames)
         analyse(model, posture=mot, activation=sto, time=float(times[0]))  # warm-up: imports, OpenSim's reader
+        motion_response(model, read_recording(mot, "posture"), frames=(0, 0, 1), progress=False)  # xarray, tqdm
         ours, theirs = given(model, mot, sto, times)
         print(
             f"MyoTorso, {args.frames} frames, activations given: motion_response {ours:.2f} s "

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -369,6 +370,46 @@ def _activation_source(anatomy, activations, optimise) -> str:
     if optimise != "none":
         return f"the optimum per frame, stability criterion: {optimise}"
     return anatomy.default_controls_source()
+
+
+def write_motion(path, labels, times, values, in_degrees: bool = True):
+    """A motion written as an OpenSim ``.mot``/``.sto`` by OpenSim's own API, atomically (a lab's IK output's form).
+
+    ``opensim.TimeSeriesTable`` with the header's ``inDegrees``, written by ``opensim.STOFileAdapter`` to a
+    temporary name, then renamed (:func:`spinectl.atomic.atomic_path`): a worked example or a synthetic motion
+    is a file that :func:`~spinectl.anatomy.recordings.read_recording` and every OpenSim tool read.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The file written.
+    labels : sequence of str
+        The column labels (coordinate or muscle names, or OpenSim paths).
+    times : array_like, shape (t,)
+        Strictly increasing [s].
+    values : array_like, shape (t, len(labels))
+        One row per time [deg or rad, m; or activations 1].
+    in_degrees : bool or None
+        The header's ``inDegrees`` (``yes``/``no``); None: none written (an activations file).
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    from ..atomic import atomic_path
+    from .export_osim import require_opensim
+
+    osim = require_opensim()
+    values = np.asarray(values, float)
+    table = osim.TimeSeriesTable()
+    table.setColumnLabels(osim.StdVectorString([str(label) for label in labels]))
+    for t, row in zip(np.asarray(times, float), values, strict=True):
+        table.appendRow(float(t), osim.RowVector(row))
+    if in_degrees is not None:
+        table.addTableMetaDataString("inDegrees", "yes" if in_degrees else "no")
+    with atomic_path(path) as tmp:
+        osim.STOFileAdapter.write(table, str(tmp))
+    return Path(path)
 
 
 def motion_plot(result: MotionResult):

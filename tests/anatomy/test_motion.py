@@ -227,3 +227,18 @@ def test_the_pose2sim_models_index_is_analyse_at_each_frame(tmp_path):
     result = motion_response(model, read_recording(path, "posture"), progress=False)
     ds = _assert_as_analysed(result, model, path, rtol=1e-12)
     assert np.ptp(ds["free_index"].values) > 1.0  # N m/rad: the posture matters
+
+
+def test_write_motion_is_read_back_by_opensims_reader(tmp_path):
+    """write_motion: OpenSim's reader gives back the labels, times, values (to the 1e-15 of the file's text) and
+    inDegrees, for a posture in degrees and an activation file without the header key; no temporary is left."""
+    from spinectl.anatomy.motion import write_motion
+
+    rows = np.column_stack([FLEXION, 0.5 * FLEXION])
+    posture = read_recording(write_motion(tmp_path / "m.mot", ["a", "b"], TIMES, rows), "posture")
+    assert posture.labels == ("a", "b") and posture.in_degrees
+    np.testing.assert_allclose(posture.times, TIMES, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(posture.values, rows, rtol=1e-15, atol=1e-15)
+    acts = read_recording(write_motion(tmp_path / "a.sto", ["m1"], TIMES[:2], [[0.1], [0.2]], None), "activations")
+    np.testing.assert_allclose(acts.values[:, 0], [0.1, 0.2], rtol=1e-15)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.sto", "m.mot"]
