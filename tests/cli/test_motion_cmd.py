@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 osim = pytest.importorskip("opensim", reason="needs the opensim extra: pip install 'spinectl[opensim]'")
 pytest.importorskip("mujoco", reason="needs the anatomy extra: pip install 'spinectl[anatomy]'")
@@ -115,6 +117,8 @@ def test_frames_select_the_frames_meant(flexion, tmp_path):
         (["--optimise", "chain", "--activations", "a.sto"], "--optimise"),
         (["--optimise", "all"], "--optimise"),
         (["--joint-stiffness", "-3"], "--joint-stiffness"),
+        (["--least-stiffness", "-1"], "--least-stiffness"),
+        (["--frames", "0:3:-2"], "--frames"),
     ],
 )
 def test_a_malformed_option_is_one_line_and_writes_nothing(flexion, tmp_path, capsys, argv, word):
@@ -160,3 +164,40 @@ def test_a_column_the_model_lacks_is_one_line(torso, tmp_path, capsys):
     assert main(["motion", "myotorso", "--coordinates", str(path), "--out", str(out)]) == 2
     err = capsys.readouterr().err
     assert len(err.strip().splitlines()) == 1 and "flex_extension" in err and not out.exists()
+
+
+def test_out_naming_the_coordinates_file_is_refused(flexion, capsys):
+    """--out the --coordinates file itself: one line, exit 2, the input left as it was."""
+    before = flexion.read_bytes()
+    assert main(["motion", "myotorso", "--coordinates", str(flexion), "--out", str(flexion)]) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and "--out" in err and flexion.read_bytes() == before
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(
+    frames=st.one_of(
+        st.none(),
+        st.tuples(st.integers(-3, 25), st.integers(-3, 25), st.integers(-1, 12)).map(lambda t: ":".join(map(str, t))),
+        st.text("0123456789:-x.", max_size=8),
+    ),
+    rate=st.one_of(st.none(), st.floats(allow_nan=True, allow_infinity=True).map(repr), st.floats(-5, 30).map(repr)),
+)
+def test_random_frame_selections_end_in_a_file_or_one_line(flexion, tmp_path, capsys, frames, rate):
+    """Any --frames and --rate text: exit 0 with the file written and every time one of the file's frames, or exit
+    2 with one error line and no file (the contract of tests/suites/test_cli_fuzz.py, on this command's options)."""
+    import xarray as xr
+
+    out = tmp_path / "fuzz.nc"
+    out.unlink(missing_ok=True)
+    argv = ["motion", "myotorso", "--coordinates", str(flexion), "--out", str(out)]
+    argv += [f"--frames={frames}"] if frames is not None else []
+    argv += [f"--rate={rate}"] if rate is not None else []
+    code = main(argv)
+    printed, err = capsys.readouterr()
+    assert code in (0, 2), (argv, err)
+    if code == 2:
+        assert printed == "" and len(err.strip().splitlines()) == 1 and not out.exists(), (argv, err)
+    else:
+        with xr.open_dataset(out) as ds:
+            assert np.isin(np.round(ds["time"].values, 9), np.round(TIMES, 9)).all()
