@@ -369,7 +369,7 @@ def _activation_source(anatomy, activations, optimise) -> str:
         return f"activations from {activations.path.name}"
     if optimise != "none":
         return f"the optimum per frame, stability criterion: {optimise}"
-    return anatomy.default_controls_source()
+    return f"the model's own controls: {anatomy.default_controls_source()}"
 
 
 def write_motion(path, labels, times, values, in_degrees: bool = True):
