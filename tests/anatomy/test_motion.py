@@ -242,3 +242,13 @@ def test_write_motion_is_read_back_by_opensims_reader(tmp_path):
     acts = read_recording(write_motion(tmp_path / "a.sto", ["m1"], TIMES[:2], [[0.1], [0.2]], None), "activations")
     np.testing.assert_allclose(acts.values[:, 0], [0.1, 0.2], rtol=1e-15)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.sto", "m.mot"]
+
+
+def test_the_progress_bar_goes_to_stderr_when_asked(torso, torso_motion, capsys):
+    """progress=True: a bar named motion counting frames on stderr, nothing on stdout; progress=False: none."""
+    rec = read_recording(torso_motion[0], "posture")
+    motion_response(torso, rec, frames=(0, 2, 1), progress=True)
+    out, err = capsys.readouterr()
+    assert out == "" and "motion" in err and "3/3" in err and "frame" in err
+    motion_response(torso, rec, frames=(0, 2, 1), progress=False)
+    assert capsys.readouterr().err == ""

@@ -201,3 +201,27 @@ def test_random_frame_selections_end_in_a_file_or_one_line(flexion, tmp_path, ca
     else:
         with xr.open_dataset(out) as ds:
             assert np.isin(np.round(ds["time"].values, 9), np.round(TIMES, 9)).all()
+
+
+def test_activations_and_the_least_stiffness_reach_the_file(torso, flexion, tmp_path):
+    """--activations (a .sto at the same 21 times, written by OpenSim's API) and --least-stiffness 5: the file's
+    activations are the .sto's (to its text's round-off), its source names the file, and the least stiffness is
+    there with its margin, not zero where the free chain is unstable (tests/anatomy/test_motion.py checks that
+    it stabilises)."""
+    import xarray as xr
+
+    a = np.random.default_rng(11).uniform(0.0, 0.2, (TIMES.size, len(torso.muscles)))
+    table = osim.TimeSeriesTable()
+    table.setColumnLabels(osim.StdVectorString(list(torso.muscles)))
+    for t, row in zip(TIMES, a, strict=True):
+        table.appendRow(float(t), osim.RowVector(row))
+    sto = tmp_path / "so.sto"
+    osim.STOFileAdapter.write(table, str(sto))
+    out = tmp_path / "m.nc"
+    argv = ["motion", "myotorso", "--coordinates", str(flexion), "--activations", str(sto), "--frames", "0:20:20"]
+    assert main([*argv, "--least-stiffness", "5", "--out", str(out)]) == 0
+    with xr.open_dataset(out) as ds:
+        np.testing.assert_allclose(ds["activation"].values, a[[0, 20]], rtol=1e-15, atol=1e-16)
+        assert ds.attrs["activation_source"] == "activations from so.sto"
+        assert ds["least_joint_stiffness"].attrs["margin"] == 5.0
+        assert np.all(ds["least_joint_stiffness"].values.sum(axis=1) > 0)  # the free chain is unstable there
