@@ -112,13 +112,15 @@ def run(args) -> int:
     from ..anatomy.engine import engine_output_to_stderr
     from ..anatomy.motion import motion_response, select_frames
     from ..anatomy.recordings import read_recording
-    from ..atomic import check_distinct, check_writable
+    from ..atomic import check_distinct, check_folder, check_writable
 
     if args.optimise != "none" and args.activations is not None:
         raise ParameterError("--activations", "cannot go with --optimise, which finds the activations itself")
     inputs = {"--coordinates": args.coordinates, "--activations": args.activations}
     check_distinct({"--out": args.out}, {k: v for k, v in inputs.items() if v is not None})
     check_writable(args.out)  # a typo in --out costs a second, not the run
+    if args.plot:
+        check_folder(args.plot, ["motion.png"])  # and --plot's folder: never the file written without its figure
     with engine_output_to_stderr():
         coordinates = read_recording(args.coordinates, "posture")
         select_frames(coordinates.times, args.frames, args.rate, ("--frames", "--rate"))  # before the model loads

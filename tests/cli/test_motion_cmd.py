@@ -225,3 +225,14 @@ def test_activations_and_the_least_stiffness_reach_the_file(torso, flexion, tmp_
         assert ds.attrs["activation_source"] == "activations from so.sto"
         assert ds["least_joint_stiffness"].attrs["margin"] == 5.0
         assert np.all(ds["least_joint_stiffness"].values.sum(axis=1) > 0)  # the free chain is unstable there
+
+
+def test_an_unwritable_plot_folder_is_one_line_before_anything_is_written(flexion, tmp_path, capsys):
+    """--plot naming a regular file: one line, exit 2, before the run; the NetCDF file is not written either (the
+    figure is checked first, so the file never stands without it)."""
+    plots = tmp_path / "plots"
+    plots.write_text("a file")
+    out = tmp_path / "m.nc"
+    assert main(["motion", "myotorso", "--coordinates", str(flexion), "--out", str(out), "--plot", str(plots)]) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and "plots" in err and not out.exists()
