@@ -156,14 +156,17 @@ def test_a_nan_frame_in_the_middle_fails_and_leaves_nothing_half_written(torso, 
     assert [p.name for p in tmp_path.iterdir()] == ["nan.mot"]  # no temporary left either
 
 
-def test_a_column_the_model_lacks_is_one_line(torso, tmp_path, capsys):
-    """A coordinate of the model missing from the file: one line naming it, exit 2, nothing written."""
-    names = list(torso.posture_columns().required)[1:]
-    path = _write(tmp_path / "short.mot", names, np.zeros((TIMES.size, len(names))))
+@pytest.mark.parametrize(("change", "word"), [("missing", "flex_extension"), ("extra", "knee_angle_r")])
+def test_a_column_that_does_not_fit_the_model_is_one_line(torso, tmp_path, capsys, change, word):
+    """A coordinate of the model missing from the file, or a column naming none of its coordinates: one line naming
+    it, exit 2, nothing written (the rules of anatomy --posture, tests/anatomy/test_recordings.py)."""
+    names = list(torso.posture_columns().required)
+    names = names[1:] if change == "missing" else [*names, "knee_angle_r"]
+    path = _write(tmp_path / "bad.mot", names, np.zeros((TIMES.size, len(names))))
     out = tmp_path / "m.nc"
     assert main(["motion", "myotorso", "--coordinates", str(path), "--out", str(out)]) == 2
     err = capsys.readouterr().err
-    assert len(err.strip().splitlines()) == 1 and "flex_extension" in err and not out.exists()
+    assert len(err.strip().splitlines()) == 1 and word in err and not out.exists()
 
 
 def test_out_naming_the_coordinates_file_is_refused(flexion, capsys):
