@@ -24,12 +24,13 @@ TIMES = np.linspace(0.0, 1.0, 21)
 
 
 def _write(path, labels, rows, degrees="yes"):
-    """A .mot written by OpenSim's STOFileAdapter, one row per time of :data:`TIMES`."""
+    """A .mot/.sto written by OpenSim's STOFileAdapter, one row per time of :data:`TIMES`."""
     table = osim.TimeSeriesTable()
     table.setColumnLabels(osim.StdVectorString(list(labels)))
     for t, row in zip(TIMES, rows, strict=True):
         table.appendRow(float(t), osim.RowVector(np.asarray(row, float)))
-    table.addTableMetaDataString("inDegrees", degrees)
+    if degrees is not None:  # an activations file has no inDegrees
+        table.addTableMetaDataString("inDegrees", degrees)
     osim.STOFileAdapter.write(table, str(path))
     return path
 
@@ -214,12 +215,7 @@ def test_activations_and_the_least_stiffness_reach_the_file(torso, flexion, tmp_
     import xarray as xr
 
     a = np.random.default_rng(11).uniform(0.0, 0.2, (TIMES.size, len(torso.muscles)))
-    table = osim.TimeSeriesTable()
-    table.setColumnLabels(osim.StdVectorString(list(torso.muscles)))
-    for t, row in zip(TIMES, a, strict=True):
-        table.appendRow(float(t), osim.RowVector(row))
-    sto = tmp_path / "so.sto"
-    osim.STOFileAdapter.write(table, str(sto))
+    sto = _write(tmp_path / "so.sto", torso.muscles, a, degrees=None)
     out = tmp_path / "m.nc"
     argv = ["motion", "myotorso", "--coordinates", str(flexion), "--activations", str(sto), "--frames", "0:20:20"]
     assert main([*argv, "--least-stiffness", "5", "--out", str(out)]) == 0
