@@ -90,6 +90,9 @@ def test_the_file_opens_with_xarray_and_holds_the_librarys_numbers(torso, flexio
         expected = motion_response(torso, read_recording(flexion, "posture"), rate=5.0, progress=False).dataset
         np.testing.assert_array_equal(ds["free_index"].values, expected["free_index"].values)
         np.testing.assert_array_equal(ds["constrained_index"].values, expected["constrained_index"].values)
+        from spinectl.anatomy.motion_figures import motion_figure
+
+        assert len(motion_figure(ds).axes) == 3  # the file alone draws the figure again
     assert (plots / "motion.png").stat().st_size > 0
 
 
