@@ -40,6 +40,7 @@ COMMANDS = (
     "study_cmd",
     "calibrate_cmd",
     "anatomy_cmd",
+    "motion_cmd",
     "atlas_cmd",
     "export_cmd",
 )

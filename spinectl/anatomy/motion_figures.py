@@ -1,0 +1,51 @@
+"""The figure of a motion's stability index (:func:`spinectl.anatomy.motion.motion_plot`; docs/motion.md).
+
+Drawn on a :func:`spinectl.canvas.new_figure` from the Dataset of :func:`spinectl.anatomy.motion.motion_response`
+alone, so that a file written earlier draws the same figure; saving is :func:`spinectl.canvas.save_figures`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..canvas import new_figure
+
+
+def motion_figure(ds):
+    """The index of the free and the constrained chain, their unstable modes, and the posture, against time.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        From :func:`spinectl.anatomy.motion.motion_response` (or the NetCDF file it was written to).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Three panels sharing the time axis: the index [N m/rad] (zero marked), the number of unstable modes,
+        the chain's coordinates [deg].
+    """
+    figure = new_figure(figsize=(8.0, 8.0))
+    index, modes, posture = figure.subplots(3, 1, sharex=True)
+    t = ds["time"].values
+    for name, style in (("free", "-o"), ("constrained", "--s")):
+        criterion = ds.attrs[f"{name}_criterion"]
+        index.plot(t, ds[f"{name}_index"].values, style, ms=3, label=criterion)
+        modes.plot(t, ds[f"{name}_unstable_modes"].values, style, ms=3, drawstyle="steps-mid", label=criterion)
+    index.axhline(0.0, color="0.5", lw=0.8)
+    index.set_ylabel("least eigenvalue of -K\n[N m/rad]")
+    index.set_title(
+        f"{ds.attrs['model_name']}, {ds.attrs['plane']} plane: Cholewicki-McGill index (> 0 stable)\n"
+        "free chain and chain constrained by the rhythm",
+        fontsize=10,
+    )
+    index.legend(fontsize=7, loc="best")
+    modes.set_ylabel("unstable modes\n(eigenvalues of -K <= 0)")
+    modes.set_title("number of unstable modes, by the same two criteria", fontsize=10)
+    for j, joint in enumerate(ds["joint"].values):
+        posture.plot(t, np.degrees(ds["posture"].values[:, j]), label=str(joint))
+    posture.set_ylabel("coordinate [deg]")
+    posture.set_xlabel("time [s]")
+    posture.set_title(f"posture: the chain's coordinates ({ds.attrs['coordinates_file']})", fontsize=10)
+    posture.legend(fontsize=7, ncol=3, loc="best")
+    return figure

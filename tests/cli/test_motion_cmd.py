@@ -1,0 +1,240 @@
+"""``spinectl motion``: the NetCDF file and figure it writes, and one line for every malformed option (MyoTorso).
+
+The motion is MyoTorso's lumbar flexion and return over one second at 20 Hz (21 frames), written in the test
+through OpenSim's API (``TimeSeriesTable``, ``STOFileAdapter``); the numbers in the file are checked against
+the library's :func:`spinectl.anatomy.motion.motion_response` (tests/anatomy/test_motion.py checks those
+against ``analyse``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+osim = pytest.importorskip("opensim", reason="needs the opensim extra: pip install 'spinectl[opensim]'")
+pytest.importorskip("mujoco", reason="needs the anatomy extra: pip install 'spinectl[anatomy]'")
+pytest.importorskip("myo_sim", reason="needs the anatomy extra: pip install 'spinectl[anatomy]'")
+
+from spinectl.cli import main  # noqa: E402
+
+TIMES = np.linspace(0.0, 1.0, 21)
+"""One second at 20 Hz."""
+
+
+def _write(path, labels, rows, degrees="yes"):
+    """A .mot/.sto written by OpenSim's STOFileAdapter, one row per time of :data:`TIMES`."""
+    table = osim.TimeSeriesTable()
+    table.setColumnLabels(osim.StdVectorString(list(labels)))
+    for t, row in zip(TIMES, rows, strict=True):
+        table.appendRow(float(t), osim.RowVector(np.asarray(row, float)))
+    if degrees is not None:  # an activations file has no inDegrees
+        table.addTableMetaDataString("inDegrees", degrees)
+    osim.STOFileAdapter.write(table, str(path))
+    return path
+
+
+@pytest.fixture(scope="module")
+def torso():
+    from spinectl import anatomy
+
+    return anatomy.load("myotorso")
+
+
+@pytest.fixture(scope="module")
+def flexion(torso, tmp_path_factory):
+    """MyoTorso's flexion and return (-8 sin(pi t) deg at each sagittal chain joint), every coordinate given."""
+    names = list(torso.posture_columns().required)
+    rows = np.zeros((TIMES.size, len(names)))
+    for joint in torso.plane_joints("sagittal"):
+        rows[:, names.index(joint)] = -8.0 * np.sin(np.pi * TIMES)
+    return _write(tmp_path_factory.mktemp("motion") / "flexion.mot", names, rows)
+
+
+def test_the_file_opens_with_xarray_and_holds_the_librarys_numbers(torso, flexion, tmp_path, capsys):
+    """--rate 5 on a 20 Hz file: six frames (0, 0.2, ..., 1 s); the NetCDF file opens with xarray, has the dims,
+    the units and the model's hash, its index is the library's; --plot writes motion.png; the summary names both
+    criteria."""
+    import xarray as xr
+
+    from spinectl.anatomy.identity import model_identity
+    from spinectl.anatomy.motion import motion_response
+    from spinectl.anatomy.recordings import read_recording
+
+    out, plots = tmp_path / "motion.nc", tmp_path / "figures"
+    assert (
+        main(
+            [
+                "motion",
+                "myotorso",
+                "--coordinates",
+                str(flexion),
+                "--rate",
+                "5",
+                "--out",
+                str(out),
+                "--plot",
+                str(plots),
+            ]
+        )
+        == 0
+    )
+    printed = capsys.readouterr().out
+    assert "free" in printed and "rhythm" in printed
+    with xr.open_dataset(out) as ds:
+        np.testing.assert_allclose(ds["time"].values, np.linspace(0, 1, 6), atol=1e-12)
+        assert {"time", "joint", "mode", "muscle"} <= set(ds.sizes)
+        assert ds["free_index"].attrs["units"] == "N m/rad" and ds["net_torque"].attrs["units"] == "N m"
+        assert ds.attrs["model_sha256"] == model_identity(torso)["sha256"]
+        expected = motion_response(torso, read_recording(flexion, "posture"), rate=5.0, progress=False).dataset
+        np.testing.assert_array_equal(ds["free_index"].values, expected["free_index"].values)
+        np.testing.assert_array_equal(ds["constrained_index"].values, expected["constrained_index"].values)
+        from spinectl.anatomy.motion_figures import motion_figure
+
+        assert len(motion_figure(ds).axes) == 3  # the file alone draws the figure again
+    assert (plots / "motion.png").stat().st_size > 0
+
+
+def test_frames_select_the_frames_meant(flexion, tmp_path):
+    """--frames 2:14:4: frames 2, 6, 10, 14 (0.1, 0.3, 0.5, 0.7 s)."""
+    import xarray as xr
+
+    out = tmp_path / "m.nc"
+    assert main(["motion", "myotorso", "--coordinates", str(flexion), "--frames", "2:14:4", "--out", str(out)]) == 0
+    with xr.open_dataset(out) as ds:
+        np.testing.assert_allclose(ds["time"].values, TIMES[[2, 6, 10, 14]], atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("argv", "word"),
+    [
+        (["--frames", "0:21"], "--frames"),
+        (["--frames", "4:3"], "--frames"),
+        (["--frames", "1:x"], "--frames"),
+        (["--frames", "1"], "--frames"),
+        (["--rate", "0"], "--rate"),
+        (["--rate", "-1"], "--rate"),
+        (["--rate", "20.5"], "20 Hz"),
+        (["--rate", "nan"], "--rate"),
+        (["--rate", "5", "--frames", "0:3"], "cannot go with"),
+        (["--optimise", "chain", "--activations", "a.sto"], "--optimise"),
+        (["--optimise", "all"], "--optimise"),
+        (["--joint-stiffness", "-3"], "--joint-stiffness"),
+        (["--least-stiffness", "-1"], "--least-stiffness"),
+        (["--frames", "0:3:-2"], "--frames"),
+    ],
+)
+def test_a_malformed_option_is_one_line_and_writes_nothing(flexion, tmp_path, capsys, argv, word):
+    """Each: exit 2, one line on stderr naming the option, nothing on stdout, no file written."""
+    out = tmp_path / "m.nc"
+    assert main(["motion", "myotorso", "--coordinates", str(flexion), "--out", str(out), *argv]) == 2
+    printed, err = capsys.readouterr()
+    assert printed == "" and len(err.strip().splitlines()) == 1 and err.startswith("spinectl: error: ")
+    assert word in err and not out.exists()
+
+
+@pytest.mark.parametrize("where", ["folder", "file-as-folder"])
+def test_an_unwritable_out_is_one_line_before_the_run(flexion, tmp_path, capsys, where):
+    """--out a folder, or below a file: one line naming it, exit 2, before any frame is computed."""
+    (tmp_path / "folder").mkdir()
+    (tmp_path / "plain").write_text("x")
+    out = tmp_path / "folder" if where == "folder" else tmp_path / "plain" / "m.nc"
+    assert main(["motion", "myotorso", "--coordinates", str(flexion), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and str(out.name) in err
+
+
+def test_a_nan_frame_in_the_middle_fails_and_leaves_nothing_half_written(torso, tmp_path, capsys):
+    """A NaN at frame 12 of 21: exit 2, one line naming the column and time; neither the NetCDF file nor the
+    figure's folder exists (nothing is written before every frame is computed)."""
+    names = list(torso.posture_columns().required)
+    rows = np.zeros((TIMES.size, len(names)))
+    rows[12, names.index("L3_L4_FE")] = np.nan
+    path = _write(tmp_path / "nan.mot", names, rows)
+    out, plots = tmp_path / "m.nc", tmp_path / "figures"
+    assert main(["motion", "myotorso", "--coordinates", str(path), "--out", str(out), "--plot", str(plots)]) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and "L3_L4_FE" in err and "0.6" in err
+    assert not out.exists() and not plots.exists()
+    assert [p.name for p in tmp_path.iterdir()] == ["nan.mot"]  # no temporary left either
+
+
+@pytest.mark.parametrize(("change", "word"), [("missing", "flex_extension"), ("extra", "knee_angle_r")])
+def test_a_column_that_does_not_fit_the_model_is_one_line(torso, tmp_path, capsys, change, word):
+    """A coordinate of the model missing from the file, or a column naming none of its coordinates: one line naming
+    it, exit 2, nothing written (the rules of anatomy --posture, tests/anatomy/test_recordings.py)."""
+    names = list(torso.posture_columns().required)
+    names = names[1:] if change == "missing" else [*names, "knee_angle_r"]
+    path = _write(tmp_path / "bad.mot", names, np.zeros((TIMES.size, len(names))))
+    out = tmp_path / "m.nc"
+    assert main(["motion", "myotorso", "--coordinates", str(path), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and word in err and not out.exists()
+
+
+def test_out_naming_the_coordinates_file_is_refused(flexion, capsys):
+    """--out the --coordinates file itself: one line, exit 2, the input left as it was."""
+    before = flexion.read_bytes()
+    assert main(["motion", "myotorso", "--coordinates", str(flexion), "--out", str(flexion)]) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and "--out" in err and flexion.read_bytes() == before
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(
+    frames=st.one_of(
+        st.none(),
+        st.tuples(st.integers(-3, 25), st.integers(-3, 25), st.integers(-1, 12)).map(lambda t: ":".join(map(str, t))),
+        st.text("0123456789:-x.", max_size=8),
+    ),
+    rate=st.one_of(st.none(), st.floats(allow_nan=True, allow_infinity=True).map(repr), st.floats(-5, 30).map(repr)),
+)
+def test_random_frame_selections_end_in_a_file_or_one_line(flexion, tmp_path, capsys, frames, rate):
+    """Any --frames and --rate text: exit 0 with the file written and every time one of the file's frames, or exit
+    2 with one error line and no file (the contract of tests/suites/test_cli_fuzz.py, on this command's options)."""
+    import xarray as xr
+
+    out = tmp_path / "fuzz.nc"
+    out.unlink(missing_ok=True)
+    argv = ["motion", "myotorso", "--coordinates", str(flexion), "--out", str(out)]
+    argv += [f"--frames={frames}"] if frames is not None else []
+    argv += [f"--rate={rate}"] if rate is not None else []
+    code = main(argv)
+    printed, err = capsys.readouterr()
+    assert code in (0, 2), (argv, err)
+    if code == 2:
+        assert printed == "" and len(err.strip().splitlines()) == 1 and not out.exists(), (argv, err)
+    else:
+        with xr.open_dataset(out) as ds:
+            assert np.isin(np.round(ds["time"].values, 9), np.round(TIMES, 9)).all()
+
+
+def test_activations_and_the_least_stiffness_reach_the_file(torso, flexion, tmp_path):
+    """--activations (a .sto at the same 21 times, written by OpenSim's API) and --least-stiffness 5: the file's
+    activations are the .sto's (to its text's round-off), its source names the file, and the least stiffness is
+    there with its margin, not zero where the free chain is unstable (tests/anatomy/test_motion.py checks that
+    it stabilises)."""
+    import xarray as xr
+
+    a = np.random.default_rng(11).uniform(0.0, 0.2, (TIMES.size, len(torso.muscles)))
+    sto = _write(tmp_path / "so.sto", torso.muscles, a, degrees=None)
+    out = tmp_path / "m.nc"
+    argv = ["motion", "myotorso", "--coordinates", str(flexion), "--activations", str(sto), "--frames", "0:20:20"]
+    assert main([*argv, "--least-stiffness", "5", "--out", str(out)]) == 0
+    with xr.open_dataset(out) as ds:
+        np.testing.assert_allclose(ds["activation"].values, a[[0, 20]], rtol=1e-15, atol=1e-16)
+        assert ds.attrs["activation_source"] == "activations from so.sto"
+        assert ds["least_joint_stiffness"].attrs["margin"] == 5.0
+        assert np.all(ds["least_joint_stiffness"].values.sum(axis=1) > 0)  # the free chain is unstable there
+
+
+def test_an_unwritable_plot_folder_is_one_line_before_anything_is_written(flexion, tmp_path, capsys):
+    """--plot naming a regular file: one line, exit 2, before the run; the NetCDF file is not written either (the
+    figure is checked first, so the file never stands without it)."""
+    plots = tmp_path / "plots"
+    plots.write_text("a file")
+    out = tmp_path / "m.nc"
+    assert main(["motion", "myotorso", "--coordinates", str(flexion), "--out", str(out), "--plot", str(plots)]) == 2
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and "plots" in err and not out.exists()
