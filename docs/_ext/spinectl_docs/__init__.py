@@ -17,7 +17,14 @@ a text changed, so that incremental builds stay incremental):
   verdict of every landmark, every landmark under each assumption, measured at the build);
 - ``_generated/export-eigenvalues.md``: the exports' eigenvalues in ``interchange.md``, spinectl's
   and OpenSim's own linearisation of each file (measured at the build);
-- ``_generated/design-decay.md``: ``design --decay-rate``'s answers in ``reflex.md`` (measured at the build).
+- ``_generated/design-decay.md``: ``design --decay-rate``'s answers in ``reflex.md`` (measured at the build);
+- ``_generated/anatomy-*.md``: ``spinectl anatomy``'s tables on MyoTorso in ``anatomy.md`` (verdicts, optima,
+  lordosis, reflex; measured at the build, :mod:`.anatomy`).
+
+Numbers that a sentence quotes are the ``{measured}`` role's (:mod:`.values`): ``{measured}`anatomy.remedy```
+is replaced by what the code gives at the build; the pages that use it are read again at every build, so
+that they cannot go stale. The ``published-model`` directive (:mod:`.published`) analyses a published model
+with its mapping at the build: one table row of verdicts.
 
 ``_generated/`` is excluded from the sources (its files are included by
 ``parameters.md``, ``index.md``, ``notebooks.md`` and ``reproduction.md``);
@@ -35,7 +42,7 @@ from __future__ import annotations
 import importlib.util
 from pathlib import Path
 
-from . import design, fields, guide, interchange, notebooks, parameters, reexports, reproduction
+from . import anatomy, design, fields, guide, interchange, notebooks, parameters, published, reexports, reproduction, values
 
 GENERATED = "_generated"
 
@@ -63,6 +70,10 @@ def generate(app) -> None:
     write_if_changed(out / "landmark-assumptions.md", reproduction.assumption_table())
     write_if_changed(out / "export-eigenvalues.md", interchange.export_table())
     write_if_changed(out / "design-decay.md", design.decay_table())
+    write_if_changed(out / "anatomy-verdicts.md", anatomy.verdict_table())
+    write_if_changed(out / "anatomy-optimum.md", anatomy.optimum_table())
+    write_if_changed(out / "anatomy-lordosis.md", anatomy.lordosis_table())
+    write_if_changed(out / "anatomy-reflex.md", anatomy.reflex_table())
 
 
 def prune_api_pages(app) -> None:
@@ -86,4 +97,9 @@ def setup(app):
     # before numpydoc (priority 500) turns the sections into reST
     app.connect("autodoc-process-docstring", fields.add_parameters_section, priority=400)
     app.connect("missing-reference", reexports.resolve)
+    app.add_role("measured", values.measured_role)
+    app.add_directive("published-model", published.PublishedModel)
+    app.connect("env-get-outdated", values.outdated)
+    app.connect("env-purge-doc", values.purge)
+    app.connect("env-merge-info", values.merge)
     return {"version": "1", "parallel_read_safe": True, "parallel_write_safe": True}
