@@ -18,6 +18,8 @@ a text changed, so that incremental builds stay incremental):
 - ``_generated/export-eigenvalues.md``: the exports' eigenvalues in ``interchange.md``, spinectl's
   and OpenSim's own linearisation of each file (measured at the build);
 - ``_generated/design-decay.md``: ``design --decay-rate``'s answers in ``reflex.md`` (measured at the build);
+- ``_generated/chain-points.md``, ``chain-dynamics.md`` and ``chain-passive.md``: ``stability --coupled`` at four points and
+  ``design --passive`` at A in ``chain.md`` (measured at the build, :mod:`.chain`);
 - ``_generated/anatomy-*.md``: ``spinectl anatomy``'s tables on MyoTorso in ``anatomy.md`` (verdicts, optima,
   lordosis, reflex; measured at the build, :mod:`.anatomy`).
 
@@ -42,7 +44,7 @@ from __future__ import annotations
 import importlib.util
 from pathlib import Path
 
-from . import anatomy, design, fields, guide, interchange, notebooks, parameters, published, reexports, reproduction, values
+from . import anatomy, chain, design, fields, guide, interchange, notebooks, parameters, published, reexports, reproduction, values
 
 GENERATED = "_generated"
 
@@ -70,6 +72,9 @@ def generate(app) -> None:
     write_if_changed(out / "landmark-assumptions.md", reproduction.assumption_table())
     write_if_changed(out / "export-eigenvalues.md", interchange.export_table())
     write_if_changed(out / "design-decay.md", design.decay_table())
+    write_if_changed(out / "chain-points.md", chain.points_table())
+    write_if_changed(out / "chain-passive.md", chain.passive_table())
+    write_if_changed(out / "chain-dynamics.md", chain.dynamics_table())
     write_if_changed(out / "anatomy-verdicts.md", anatomy.verdict_table())
     write_if_changed(out / "anatomy-optimum.md", anatomy.optimum_table())
     write_if_changed(out / "anatomy-lordosis.md", anatomy.lordosis_table())
