@@ -44,7 +44,7 @@ from __future__ import annotations
 import importlib.util
 from pathlib import Path
 
-from . import anatomy, chain, design, fields, guide, interchange, notebooks, parameters, published, reexports, reproduction, values
+from . import anatomy, chain, design, errata, fields, guide, interchange, notebooks, parameters, published, reexports, reproduction, values
 
 GENERATED = "_generated"
 

@@ -195,3 +195,13 @@ def _zeta_range() -> str:
 
 value("chain.slowest_range")(_slowest_range)
 value("chain.zeta_range")(_zeta_range)
+
+
+def _unstable_range(preset: str, e: float, lam: float) -> str:
+    k = coupled(preset, e, lam).chain.stiffness_offset
+    eig = np.linalg.eigvalsh(-(k + k.T) / 2)
+    bad = eig[eig <= 0]
+    return f"{_minus(bad[0])} to {_minus(bad[-1])}"
+
+
+value("chain.unstable_range_wagner2012_A")(lambda: _unstable_range("wagner2012", 0.0, 0.0))
