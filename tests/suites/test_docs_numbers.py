@@ -127,7 +127,10 @@ def test_published_model_directive_on_the_pose2sim_model(tmp_path):
     """The Pose2Sim model (OpenSim) with its mapping inline, at its own controls: the row's rank and verdicts are
     `spinectl anatomy MODEL --mapping M --json`'s."""
     pytest.importorskip("opensim", reason="the opensim extra is not installed")
-    page = f"# Pose2Sim\n\n```{{published-model}} {POSE2SIM}\n:name: Pose2Sim\n:licence: BSD-3-Clause\n\n{POSE2SIM_MAPPING}```\n"
+    page = (
+        f"# Pose2Sim\n\n```{{published-model}} {POSE2SIM}\n:name: Pose2Sim\n:licence: BSD-3-Clause\n\n"
+        f"{POSE2SIM_MAPPING}```\n"
+    )
     done = build_site(tmp_path, page)
     assert done.returncode == 0, done.stderr
     (tmp_path / "pose2sim.toml").write_text(POSE2SIM_MAPPING)
@@ -251,8 +254,9 @@ def test_the_typed_number_scan_finds_what_it_is_for(tmp_path, monkeypatch):
     """The scan flags the typed outputs it was written for (anatomy.md's former sentences and table cells)
     and leaves inputs and the generated role alone."""
     (tmp_path / "x.md").write_text(
-        "from 40.2 N m/rad at every joint one does\n| 0 | −81.4, 62.9 | −126.5, +316.6 |\nrank 3, singular values 0.451\n"
-        "the chain optimum costs 14.98\n--joint-stiffness 50 and K = 10 N m/rad\nfrom {measured}`anatomy.remedy` N m/rad\n"
+        "from 40.2 N m/rad at every joint one does\n| 0 | −81.4, 62.9 | −126.5, +316.6 |\n"
+        "rank 3, singular values 0.451\nthe chain optimum costs 14.98\n"
+        "--joint-stiffness 50 and K = 10 N m/rad\nfrom {measured}`anatomy.remedy` N m/rad\n"
     )
     monkeypatch.setattr(sys.modules[__name__], "DOCS", tmp_path)
     monkeypatch.setattr(sys.modules[__name__], "ROOT", tmp_path)

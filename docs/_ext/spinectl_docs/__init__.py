@@ -18,7 +18,8 @@ a text changed, so that incremental builds stay incremental):
 - ``_generated/export-eigenvalues.md``: the exports' eigenvalues in ``interchange.md``, spinectl's
   and OpenSim's own linearisation of each file (measured at the build);
 - ``_generated/design-decay.md``: ``design --decay-rate``'s answers in ``reflex.md`` (measured at the build);
-- ``_generated/chain-points.md``, ``chain-dynamics.md`` and ``chain-passive.md``: ``stability --coupled`` at four points and
+- ``_generated/chain-points.md``, ``chain-dynamics.md`` and ``chain-passive.md``: ``stability --coupled`` at
+  four points and
   ``design --passive`` at A in ``chain.md`` (measured at the build, :mod:`.chain`);
 - ``_generated/anatomy-*.md``: ``spinectl anatomy``'s tables on MyoTorso in ``anatomy.md`` (verdicts, optima,
   lordosis, reflex; measured at the build, :mod:`.anatomy`).
@@ -44,12 +45,41 @@ from __future__ import annotations
 import importlib.util
 from pathlib import Path
 
-from . import anatomy, chain, design, errata, fields, guide, interchange, notebooks, parameters, published, reexports, reproduction, values
+from . import (
+    anatomy,
+    chain,
+    design,
+    errata,
+    fields,
+    guide,
+    interchange,
+    notebooks,
+    parameters,
+    published,
+    reexports,
+    reproduction,
+    values,
+)
 
 GENERATED = "_generated"
 
 API_FOLDER = "api"
 """The folder of autosummary's module pages (``:toctree: api`` in ``api.md``)."""
+
+
+MEASURED_TABLES = (
+    ("chain-points.md", chain.points_table),
+    ("chain-passive.md", chain.passive_table),
+    ("chain-dynamics.md", chain.dynamics_table),
+    ("anatomy-verdicts.md", anatomy.verdict_table),
+    ("anatomy-optimum.md", anatomy.optimum_table),
+    ("anatomy-lordosis.md", anatomy.lordosis_table),
+    ("anatomy-reflex.md", anatomy.reflex_table),
+)
+"""The tables of what commands print, measured at the build: (file in ``_generated/``, its generator)."""
+
+MEASURED_VALUES = (anatomy, chain, errata, interchange)
+"""The modules that register ``{measured}`` values (:func:`.values.value`) when imported."""
 
 
 def write_if_changed(path: Path, text: str) -> None:
@@ -59,8 +89,23 @@ def write_if_changed(path: Path, text: str) -> None:
         path.write_text(text)
 
 
+def opensim_first() -> None:
+    """Import OpenSim, where installed, before anything imports cvxpy.
+
+    Imported after cvxpy, OpenSim's SWIG wrappers refuse their own ``StdVectorInt`` in
+    ``Function.calcDerivative`` (a ``TypeError``; ``python -c "import cvxpy, opensim; ..."`` shows it), which
+    loading an ``.osim`` model with couplers calls; the build computes optima (cvxpy) before it analyses the
+    published models.
+    """
+    try:
+        import opensim  # noqa: F401
+    except ImportError:
+        pass
+
+
 def generate(app) -> None:
     """Write every generated page (the ``builder-inited`` handler)."""
+    opensim_first()
     src = Path(app.srcdir)
     out = src / GENERATED
     write_if_changed(out / "parameters.md", parameters.markdown())
@@ -72,13 +117,8 @@ def generate(app) -> None:
     write_if_changed(out / "landmark-assumptions.md", reproduction.assumption_table())
     write_if_changed(out / "export-eigenvalues.md", interchange.export_table())
     write_if_changed(out / "design-decay.md", design.decay_table())
-    write_if_changed(out / "chain-points.md", chain.points_table())
-    write_if_changed(out / "chain-passive.md", chain.passive_table())
-    write_if_changed(out / "chain-dynamics.md", chain.dynamics_table())
-    write_if_changed(out / "anatomy-verdicts.md", anatomy.verdict_table())
-    write_if_changed(out / "anatomy-optimum.md", anatomy.optimum_table())
-    write_if_changed(out / "anatomy-lordosis.md", anatomy.lordosis_table())
-    write_if_changed(out / "anatomy-reflex.md", anatomy.reflex_table())
+    for name, table in MEASURED_TABLES:
+        write_if_changed(out / name, table())
 
 
 def prune_api_pages(app) -> None:

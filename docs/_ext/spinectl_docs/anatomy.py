@@ -147,7 +147,9 @@ def optimum_table() -> str:
             "| --- |" + " --- |" * len(CRITERIA),
         ]
         for added in ADDED:
-            label = f"{mapped:.1f} (mapped)" if added == "mapped" else f"{added:g}" + (" (MyoTorso's)" if not added else "")
+            label = (
+                f"{mapped:.1f} (mapped)" if added == "mapped" else f"{added:g}" + (" (MyoTorso's)" if not added else "")
+            )
             lines.append(f"| {label} | " + " | ".join(cell(s, added) for s, _ in CRITERIA) + " |")
         return "\n".join(lines) + "\n"
 
@@ -164,8 +166,10 @@ def lordosis_table() -> str:
             "| --- |" + " --- |" * len(LORDOSIS),
         ]
         for key, label in (("none", "classic"), ("joints", "joint by joint"), ("chain", "the chain")):
-            costs = [f"{c:.2f}" if s.startswith("optimal") else "infeasible"
-                     for c, s in zip(curve[key]["cost"], curve[key]["status"], strict=True)]
+            costs = [
+                f"{c:.2f}" if s.startswith("optimal") else "infeasible"
+                for c, s in zip(curve[key]["cost"], curve[key]["status"], strict=True)
+            ]
             lines.append(f"| {label} | " + " | ".join(costs) + " |")
         return "\n".join(lines) + "\n"
 
@@ -230,9 +234,11 @@ value("anatomy.mapped_eigenvalues_02")(
 )
 value("anatomy.remedy")(lambda: f"{optimised_at('chain', 0.0).remedy:.3g}")
 value("anatomy.remedy_line", code=True)(
-    lambda: __import__("spinectl.anatomy.optimum", fromlist=["remedy_text"])
-    .remedy_text(optimised_at("chain", 0.0).remedy)
-    .lstrip("; ")
+    lambda: (
+        __import__("spinectl.anatomy.optimum", fromlist=["remedy_text"])
+        .remedy_text(optimised_at("chain", 0.0).remedy)
+        .lstrip("; ")
+    )
 )
 value("anatomy.classic_stable_from")(lambda: f"{classic_stable_from():.1f}")
 value("anatomy.price_50")(lambda: f"{optimum('chain', STIFFNESS).cost / optimum('none', STIFFNESS).cost:.2g}")
@@ -263,8 +269,10 @@ def _peak() -> str:
     curve = lordosis(0.0, LORDOSIS_FINE)
     costs = np.array(curve["joints"]["cost"])
     top = int(np.nanargmax(costs))
-    return f"{costs[0]:.1f} at {LORDOSIS_FINE[0]:+g}° to a peak of {costs[top]:.1f} at {LORDOSIS_FINE[top]:+g}°".replace(
-        "-", "\u2212"
+    return (
+        f"{costs[0]:.1f} at {LORDOSIS_FINE[0]:+g}° to a peak of {costs[top]:.1f} at {LORDOSIS_FINE[top]:+g}°".replace(
+            "-", "\u2212"
+        )
     )
 
 
@@ -301,13 +309,16 @@ value("anatomy.myotorso_joints_ends")(
 SHARED = Path(os.environ.get("SPINECTL_SHARED_MODELS", "/work/shared/models"))
 """The published models (not in the repository; CI has them), as the tests read them."""
 
-CHRISTOPHY = ("christophy-skeleton/Christophy2012_axialRotationUpd_skeletonOnly.osim", """[bodies]
+CHRISTOPHY = (
+    "christophy-skeleton/Christophy2012_axialRotationUpd_skeletonOnly.osim",
+    """[bodies]
 pelvis = ["sacrum"]
 vertebrae = ["lumbar5", "lumbar4", "lumbar3", "lumbar2", "lumbar1"]
 thorax = ["torso"]
 [planes]
 sagittal = ["flex_extension", "L4_L5_FE", "L3_L4_FE", "L2_L3_FE", "L1_L2_FE"]
-""")
+""",
+)
 """Christophy's skeleton (the file in SHARED) and its mapping."""
 
 
@@ -330,9 +341,7 @@ def _christophy_chain() -> str:
 value("anatomy.christophy_joints")(lambda: _numbers(christophy().free.joint_stiffness))
 value("anatomy.christophy_chain")(_christophy_chain)
 value("anatomy.christophy_constrained")(lambda: _numbers(christophy().constrained.eigenvalues, ".0f"))
-value("anatomy.versions")(
-    lambda: f"{model().source.split(',')[0]}, MuJoCo {__import__('mujoco').__version__}"
-)
+value("anatomy.versions")(lambda: f"{model().source.split(',')[0]}, MuJoCo {__import__('mujoco').__version__}")
 for _class in ("global", "local", "between", "non-lumbar"):
     value(f"anatomy.count_{_class}")(lambda c=_class: str(len(analysis(0.0).muscles[c])))
 

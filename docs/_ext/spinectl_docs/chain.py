@@ -65,7 +65,8 @@ def points_table() -> str:
     from spinectl.model.config import load_preset
 
     lines = [
-        "| preset | position | min. PCSA (per segment) | rank $\\partial l/\\partial q$ | eigenvalues of $-K$ [N m/rad] "
+        "| preset | position | min. PCSA (per segment) | rank $\\partial l/\\partial q$ "
+        "| eigenvalues of $-K$ [N m/rad] "
         "| unstable |",
         "| --- | --- | --- | --- | --- | --- |",
     ]
@@ -104,7 +105,8 @@ def dynamics_table() -> str:
         lines.append(
             f"| `{preset}` | {where.split(':')[0]} | {', '.join(f'{v:.1f}' for v in growing)} "
             f"| {', '.join(_minus(v) for v in decaying)} | {stable}; slowest {_minus(damped[0], '.2g')}, least ζ "
-            f"{damped[1]:.2f} (stiffness only: {_minus(springs[0], '.2g')}; ζ {springs[1]:.2g} at {springs[2]:.0f} Hz) |"
+            f"{damped[1]:.2f} (stiffness only: {_minus(springs[0], '.2g')}; ζ {springs[1]:.2g} "
+            f"at {springs[2]:.0f} Hz) |"
         )
     return "\n".join(lines) + "\n"
 
@@ -139,7 +141,9 @@ def passive_table() -> str:
         return curve.global_pcsa[_at(curve, k)]
 
     def local_at(curve):
-        return " / ".join(f"{np.sum(curve.local_stiffness[_at(curve, k)]):.1f}".replace(".0", ".0") for k in (0, 20, 40, 80))
+        return " / ".join(
+            f"{np.sum(curve.local_stiffness[_at(curve, k)]):.1f}".replace(".0", ".0") for k in (0, 20, 40, 80)
+        )
 
     lines = [
         "| | `wagner2012` | `default` |",
@@ -182,10 +186,7 @@ value("chain.paper_pcsa")(lambda: f"{1e4 * passive('wagner2012').paper_pcsa:.2f}
 
 def _slowest_range() -> str:
     slow = sorted((_damping(coupled(p, e, lam).local_eigenvalues)[0] for p, _, e, lam in POINTS), reverse=True)
-    return (
-        f"{_minus(slow[0], '.2g')} to {_minus(slow[-1], '.2g')} 1/s "
-        f"({-1 / slow[-1]:.0f} to {-1 / slow[0]:.0f} s)"
-    )
+    return f"{_minus(slow[0], '.2g')} to {_minus(slow[-1], '.2g')} 1/s ({-1 / slow[-1]:.0f} to {-1 / slow[0]:.0f} s)"
 
 
 def _zeta_range() -> str:

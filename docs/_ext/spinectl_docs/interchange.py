@@ -111,9 +111,7 @@ def _mujoco_check():
 
 value("interchange.fastest")(lambda: f"{exported('mjcf', 'millard', False)[1].eigenvalues.real.max():.2f}")
 value("interchange.mujoco_rate")(lambda: f"{_mujoco_check().simulated_rate:.2f}")
-value("interchange.slowest_local")(
-    lambda: _minus(exported("mjcf", "millard", True)[1].eigenvalues.real.max(), ".3g")
-)
+value("interchange.slowest_local")(lambda: _minus(exported("mjcf", "millard", True)[1].eigenvalues.real.max(), ".3g"))
 value("interchange.local_stiffness")(lambda: _and(exported("mjcf", "millard", True)[1].local_stiffness))
 value("interchange.local_total")(lambda: f"{np.sum(exported('mjcf', 'millard', True)[1].local_stiffness):.0f}")
 value("interchange.millard_diagonal")(
@@ -141,9 +139,11 @@ def _millard_opensim():
 
 
 value("interchange.millard_growing")(
-    lambda: f"{len(_growing(_millard_opensim()))} growing modes ("
-    + _and([f"{v:.3g}" for v in _growing(_millard_opensim())], "")
-    + " 1/s"
+    lambda: (
+        f"{len(_growing(_millard_opensim()))} growing modes ("
+        + _and([f"{v:.3g}" for v in _growing(_millard_opensim())], "")
+        + " 1/s"
+    )
 )
 value("interchange.spinectl_growing")(
     lambda: "{}, {} to {}".format(

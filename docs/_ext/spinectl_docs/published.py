@@ -85,7 +85,9 @@ def row(result, name: str, source: str, licence: str) -> str:
     counts = ", ".join(str(len(result.muscles[c])) for c in ("global", "local", "between", "non-lumbar"))
     joints = f"{sum(free.joint_self_stable)} of {free.joint_stiffness.size} ({_range(free.joint_stiffness)} N m/rad)"
     unstable = int(np.sum(free.eigenvalues <= 0))
-    chain = f"{word[free.chain_stable]}, {unstable} of {free.eigenvalues.size} modes unstable ({_range(free.eigenvalues)})"
+    chain = (
+        f"{word[free.chain_stable]}, {unstable} of {free.eigenvalues.size} modes unstable ({_range(free.eigenvalues)})"
+    )
     if result.rhythm_size:
         constrained = f"{word[con.chain_stable]} ({_range(con.eigenvalues)} N m/rad, {len(con.joints)} coordinate(s))"
     else:
@@ -105,7 +107,8 @@ def caption(result, activation, stiffness: float) -> str:
         else f"the model's own controls ({md_escape(result.activation_source)}, mean {result.activation_mean:.3g})"
     )
     return (
-        f"Measured at this build by spinectl {spinectl.__version__} (`spinectl anatomy`): {md_escape(result.model['source'])}, "
+        f"Measured at this build by spinectl {spinectl.__version__} (`spinectl anatomy`): "
+        f"{md_escape(result.model['source'])}, "
         f"the sagittal chain, the reference posture, {at}, {stiffness:g} N m/rad added per joint."
     )
 
@@ -164,4 +167,6 @@ class PublishedModel(Directive):
         except SpinectlError as error:  # a mapping the model refuses: the page is wrong, the build fails
             raise self.error(f"published-model {self.arguments[0]}: {error}") from None
         separator = "| " + " | ".join("---" for _ in range(HEADER.count("|") - 1)) + " |"
-        return "\n".join([HEADER, separator, row(result, name, source, licence), "", caption(result, activation, stiffness)])
+        return "\n".join(
+            [HEADER, separator, row(result, name, source, licence), "", caption(result, activation, stiffness)]
+        )

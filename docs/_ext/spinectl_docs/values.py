@@ -67,7 +67,7 @@ def measured_role(name, rawtext, text, lineno, inliner, options=None, content=No
     """The ``{measured}`` role: the registered value's text, computed now (an unknown name is an error)."""
     key = text.strip()
     if key not in VALUES:
-        known = ", ".join(sorted(VALUES))
+        known = ", ".join(sorted({name.split(".")[0] + ".*" for name in VALUES}))
         message = inliner.reporter.error(f"measured: unknown value {key!r} (known: {known})", line=lineno)
         return [inliner.problematic(rawtext, rawtext, message)], [message]
     env = inliner.document.settings.env
