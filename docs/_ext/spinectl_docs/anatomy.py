@@ -7,9 +7,7 @@ Without the anatomy extra (mujoco, myo-sim) at the build, the tables and values 
 
 from __future__ import annotations
 
-import os
 from functools import cache
-from pathlib import Path
 
 import numpy as np
 
@@ -306,8 +304,6 @@ value("anatomy.myotorso_joints_ends")(
 )
 
 
-SHARED = Path(os.environ.get("SPINECTL_SHARED_MODELS", "/work/shared/models"))
-"""The published models (not in the repository; CI has them), as the tests read them."""
 
 CHRISTOPHY = (
     "christophy-skeleton/Christophy2012_axialRotationUpd_skeletonOnly.osim",
@@ -319,16 +315,16 @@ thorax = ["torso"]
 sagittal = ["flex_extension", "L4_L5_FE", "L3_L4_FE", "L2_L3_FE", "L1_L2_FE"]
 """,
 )
-"""Christophy's skeleton (the file in SHARED) and its mapping."""
+"""Christophy's skeleton (its file in the published models' folder) and its mapping."""
 
 
 def christophy():
     """Christophy's skeleton upright with 50 N m/rad added per joint radian (``published-model``'s cache)."""
-    from .published import analysed
+    from .published import analysed, shared_models
 
-    path = SHARED / CHRISTOPHY[0]
+    path = shared_models() / CHRISTOPHY[0]
     if not path.is_file():
-        raise NotAtBuild(f"the published models ({SHARED}) are not at this build")
+        raise NotAtBuild(f"the published models ({shared_models()}) are not at this build")
     return analysed(str(path), CHRISTOPHY[1], None, STIFFNESS)
 
 

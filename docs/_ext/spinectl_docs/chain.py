@@ -1,4 +1,4 @@
-"""The numbers of ``docs/chain.md`` that ``spinectl stability --coupled`` and ``spinectl design --passive`` produce.
+"""The numbers of ``docs/chain.md`` (and atlas.md's) that ``stability --coupled`` and ``design --passive`` give.
 
 The chain at the paper's optimum at four points (both presets, A and (3, 4) cm), and the chain against the
 passive stiffness at A (``design --passive 0:80:41 --E 0 --Lambda 0``, about five seconds a preset), each
@@ -206,3 +206,25 @@ def _unstable_range(preset: str, e: float, lam: float) -> str:
 
 
 value("chain.unstable_range_wagner2012_A")(lambda: _unstable_range("wagner2012", 0.0, 0.0))
+
+
+def _local_total(preset: str, e: float, lam: float, scale: float) -> float:
+    """The chain's least local stiffness, summed [N m/rad], with the global muscles at ``scale`` times the
+    per-segment minimum PCSA (problem (a); ``stability --coupled --pcsa``)."""
+    from spinectl.model.config import load_preset
+    from spinectl.optimise.coupled.at_activation import coupled_stability_at
+
+    pcsa = coupled(preset, e, lam).pcsa
+    at = coupled(preset, e, lam) if scale == 1 else coupled_stability_at(load_preset(preset), e, lam, scale * pcsa)
+    return float(np.sum(at.local.local_stiffness))
+
+
+def _default_activation() -> float:
+    from spinectl.model.config import load_preset
+
+    return load_preset("default").reflex.activation
+
+
+value("atlas.local_full")(lambda: f"{_local_total('default', 0.03, 0.04, 1.0):.1f}")
+value("atlas.local_activation")(lambda: f"{_local_total('default', 0.03, 0.04, _default_activation()):.1f}")
+value("atlas.local_zero")(lambda: f"{_local_total('default', 0.03, 0.04, 0.0):.1f}")

@@ -2,7 +2,7 @@
 
 In ``docs/anatomy.md``::
 
-    ```{published-model} ../../shared/models/pose2sim-beaucage-gauvreau/Model_Pose2Sim_muscles_flex.osim
+    ```{published-model} shared:pose2sim-beaucage-gauvreau/Model_Pose2Sim_muscles_flex.osim
     :name: Pose2Sim (Beaucage-Gauvreau et al. 2019)
     :source: perfanalytics/pose2sim, Pose2Sim/OpenSim_Setup/Model_Pose2Sim_muscles_flex.osim
     :licence: BSD-3-Clause
@@ -12,8 +12,9 @@ In ``docs/anatomy.md``::
     ...
     ```
 
-The argument is the model (a path relative to the docs folder, or absolute, ``$VARIABLES`` expanded; or a
-built-in name such as ``myotorso``); the mapping is ``:mapping:`` (a file relative to the docs folder) or the
+The argument is the model (a path relative to the docs folder, or absolute, ``$VARIABLES`` expanded;
+``shared:<folder>/<file>`` in the published models' folder, :func:`shared_models`; or a built-in name such as
+``myotorso``); the mapping is ``:mapping:`` (a file relative to the docs folder) or the
 directive's content (the mapping TOML inline); neither: the model's built-in mapping. ``:activation:``
 (default: the model's own controls, as ``spinectl anatomy`` without ``--activation``) and
 ``:joint-stiffness:`` (default none) are ``spinectl anatomy``'s options. It renders one table: the model, its
@@ -47,8 +48,20 @@ HEADER = (
 )
 
 
+SHARED_PREFIX = "shared:"
+"""An argument ``shared:<folder>/<file>`` is a file of the published models' folder: ``$SPINECTL_SHARED_MODELS``,
+else ``/work/shared/models`` (where CI and the tests find them), wherever the checkout is."""
+
+
+def shared_models() -> Path:
+    """The published models' folder (not in the repository)."""
+    return Path(os.environ.get("SPINECTL_SHARED_MODELS", "/work/shared/models"))
+
+
 def resolve(model: str, docs: Path) -> str:
     """The model as ``spinectl.anatomy.load`` takes it: a built-in name, or the file's absolute path."""
+    if model.startswith(SHARED_PREFIX):
+        return str(shared_models() / model[len(SHARED_PREFIX) :])
     expanded = os.path.expandvars(model)
     if "/" not in expanded and "." not in expanded:
         return expanded  # a built-in name (myotorso)
