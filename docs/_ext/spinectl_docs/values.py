@@ -66,14 +66,14 @@ def text_of(name: str) -> str:
 def measured_role(name, rawtext, text, lineno, inliner, options=None, content=None):
     """The ``{measured}`` role: the registered value's text, computed now (an unknown name is an error)."""
     key = text.strip()
-    if key not in VALUES:
-        known = ", ".join(sorted({name.split(".")[0] + ".*" for name in VALUES}))
-        message = inliner.reporter.error(f"measured: unknown value {key!r} (known: {known})", line=lineno)
-        return [inliner.problematic(rawtext, rawtext, message)], [message]
     env = inliner.document.settings.env
     if not hasattr(env, "spinectl_measured"):
         env.spinectl_measured = set()
     env.spinectl_measured.add(env.docname)  # read again at the next build: the code may have changed
+    if key not in VALUES:
+        known = ", ".join(sorted({name.split(".")[0] + ".*" for name in VALUES}))
+        message = inliner.reporter.error(f"measured: unknown value {key!r} (known: {known})", line=lineno)
+        return [inliner.problematic(rawtext, rawtext, message)], [message]
     shown = text_of(key)
     node = nodes.literal(shown, shown) if VALUES[key][1] else nodes.Text(shown)
     return [node], []
