@@ -42,10 +42,11 @@ extensions = ["myst_parser"]
 exclude_patterns = ["_build"]
 
 
-def setup(app):  # the directive alone, without spinectl_docs' generated pages
-    from spinectl_docs import published
+def setup(app):  # the directive and the role alone, without spinectl_docs' generated pages
+    from spinectl_docs import errata, published, values
 
     app.add_directive("published-model", published.PublishedModel)
+    app.add_role("measured", values.measured_role)
 """
 
 
@@ -140,6 +141,24 @@ def test_published_model_directive_on_the_pose2sim_model(tmp_path):
     eig = doc["eigenvalues"]
     assert f"{doc['global_rank']} of {len(eig)}" in flat
     assert f"{sum(v <= 0 for v in eig)} of {len(eig)} modes unstable ({minus(eig[0])} … {minus(eig[-1])})" in flat
+
+
+def test_measured_role_puts_the_value_computed_now_and_refuses_an_unknown_name(tmp_path):
+    """{measured}`errata.rate_l1l2` renders as sqrt(g/r_y) of L1L2 with r_y = K_g/(m g), K_g the diagonal of the
+    chain's gravity stiffness at A (`wagner2012`), to two decimals; a name no generator registered fails the build
+    (-W) naming it."""
+    from spinectl.model.chain import chain_coefficients
+    from spinectl.model.config import load_preset
+
+    model = load_preset("wagner2012")
+    k_g = chain_coefficients(model, 0.0, 0.0).gravity_stiffness[0, 0]
+    g, m = model.body.gravity, model.body.mass
+    done = build_site(tmp_path, "# Rates\n\nL1L2 grows at {measured}`errata.rate_l1l2` 1/s.\n")
+    assert done.returncode == 0, done.stderr
+    assert f"L1L2 grows at {(g / (k_g / (m * g))) ** 0.5:.2f} 1/s." in page_text(tmp_path)
+    (tmp_path / "bad").mkdir()
+    failed = build_site(tmp_path / "bad", "# Bad\n\n{measured}`errata.no_such_value`\n")
+    assert failed.returncode != 0 and "unknown value 'errata.no_such_value'" in failed.stderr
 
 
 def test_anatomy_pages_numbers_are_spinectl_anatomys():
