@@ -230,7 +230,6 @@ ALLOWED = {
     ("reflex.md", "−6 1/s"): "pending: the same",
     ("reflex.md", "+3.0 N m/rad"): "pending: the margin cost",
     ("reflex.md", "margin 128.0 ms"): "pending: the joint-searched case",
-    ("reflex.md", "−0.10 N m/rad"): "pending: L1L2's stiffness in the margins example",
     ("interchange.md", "−0.0008 1/s"): "pending: the least local stiffness of OpenSim's K",
     ("interchange.md", "costs 0.21"): "the benchmark's run, a measurement of time",
     ("interchange.md", "8.3 1/s"): "the benchmark's run",

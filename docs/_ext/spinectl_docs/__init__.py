@@ -57,6 +57,7 @@ from . import (
     parameters,
     published,
     reexports,
+    reflex,
     reproduction,
     values,
 )
@@ -78,7 +79,7 @@ MEASURED_TABLES = (
 )
 """The tables of what commands print, measured at the build: (file in ``_generated/``, its generator)."""
 
-MEASURED_VALUES = (anatomy, chain, errata, interchange)
+MEASURED_VALUES = (anatomy, chain, errata, interchange, reflex)
 """The modules that register ``{measured}`` values (:func:`.values.value`) when imported."""
 
 

@@ -304,7 +304,6 @@ value("anatomy.myotorso_joints_ends")(
 )
 
 
-
 CHRISTOPHY = (
     "christophy-skeleton/Christophy2012_axialRotationUpd_skeletonOnly.osim",
     """[bodies]
