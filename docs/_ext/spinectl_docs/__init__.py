@@ -17,7 +17,17 @@ a text changed, so that incremental builds stay incremental):
   verdict of every landmark, every landmark under each assumption, measured at the build);
 - ``_generated/export-eigenvalues.md``: the exports' eigenvalues in ``interchange.md``, spinectl's
   and OpenSim's own linearisation of each file (measured at the build);
-- ``_generated/design-decay.md``: ``design --decay-rate``'s answers in ``reflex.md`` (measured at the build).
+- ``_generated/design-decay.md``: ``design --decay-rate``'s answers in ``reflex.md`` (measured at the build);
+- ``_generated/chain-points.md``, ``chain-dynamics.md`` and ``chain-passive.md``: ``stability --coupled`` at
+  four points and
+  ``design --passive`` at A in ``chain.md`` (measured at the build, :mod:`.chain`);
+- ``_generated/anatomy-*.md``: ``spinectl anatomy``'s tables on MyoTorso in ``anatomy.md`` (verdicts, optima,
+  lordosis, reflex; measured at the build, :mod:`.anatomy`).
+
+Numbers that a sentence quotes are the ``{measured}`` role's (:mod:`.values`): ``{measured}`anatomy.remedy```
+is replaced by what the code gives at the build; the pages that use it are read again at every build, so
+that they cannot go stale. The ``published-model`` directive (:mod:`.published`) analyses a published model
+with its mapping at the build: one table row of verdicts.
 
 ``_generated/`` is excluded from the sources (its files are included by
 ``parameters.md``, ``index.md``, ``notebooks.md`` and ``reproduction.md``);
@@ -35,12 +45,42 @@ from __future__ import annotations
 import importlib.util
 from pathlib import Path
 
-from . import design, fields, guide, interchange, notebooks, parameters, reexports, reproduction
+from . import (
+    anatomy,
+    chain,
+    design,
+    errata,
+    fields,
+    guide,
+    interchange,
+    notebooks,
+    parameters,
+    published,
+    reexports,
+    reflex,
+    reproduction,
+    values,
+)
 
 GENERATED = "_generated"
 
 API_FOLDER = "api"
 """The folder of autosummary's module pages (``:toctree: api`` in ``api.md``)."""
+
+
+MEASURED_TABLES = (
+    ("chain-points.md", chain.points_table),
+    ("chain-passive.md", chain.passive_table),
+    ("chain-dynamics.md", chain.dynamics_table),
+    ("anatomy-verdicts.md", anatomy.verdict_table),
+    ("anatomy-optimum.md", anatomy.optimum_table),
+    ("anatomy-lordosis.md", anatomy.lordosis_table),
+    ("anatomy-reflex.md", anatomy.reflex_table),
+)
+"""The tables of what commands print, measured at the build: (file in ``_generated/``, its generator)."""
+
+MEASURED_VALUES = (anatomy, chain, errata, interchange, reflex)
+"""The modules that register ``{measured}`` values (:func:`.values.value`) when imported."""
 
 
 def write_if_changed(path: Path, text: str) -> None:
@@ -50,8 +90,23 @@ def write_if_changed(path: Path, text: str) -> None:
         path.write_text(text)
 
 
+def opensim_first() -> None:
+    """Import OpenSim, where installed, before anything imports cvxpy.
+
+    Imported after cvxpy, OpenSim's SWIG wrappers refuse their own ``StdVectorInt`` in
+    ``Function.calcDerivative`` (a ``TypeError``; ``python -c "import cvxpy, opensim; ..."`` shows it), which
+    loading an ``.osim`` model with couplers calls; the build computes optima (cvxpy) before it analyses the
+    published models.
+    """
+    try:
+        import opensim  # noqa: F401
+    except ImportError:
+        pass
+
+
 def generate(app) -> None:
     """Write every generated page (the ``builder-inited`` handler)."""
+    opensim_first()
     src = Path(app.srcdir)
     out = src / GENERATED
     write_if_changed(out / "parameters.md", parameters.markdown())
@@ -63,6 +118,8 @@ def generate(app) -> None:
     write_if_changed(out / "landmark-assumptions.md", reproduction.assumption_table())
     write_if_changed(out / "export-eigenvalues.md", interchange.export_table())
     write_if_changed(out / "design-decay.md", design.decay_table())
+    for name, table in MEASURED_TABLES:
+        write_if_changed(out / name, table())
 
 
 def prune_api_pages(app) -> None:
@@ -86,4 +143,9 @@ def setup(app):
     # before numpydoc (priority 500) turns the sections into reST
     app.connect("autodoc-process-docstring", fields.add_parameters_section, priority=400)
     app.connect("missing-reference", reexports.resolve)
+    app.add_role("measured", values.measured_role)
+    app.add_directive("published-model", published.PublishedModel)
+    app.connect("env-get-outdated", values.outdated)
+    app.connect("env-purge-doc", values.purge)
+    app.connect("env-merge-info", values.merge)
     return {"version": "1", "parallel_read_safe": True, "parallel_write_safe": True}
