@@ -23,7 +23,11 @@ import pytest
 ROOT = Path(__file__).resolve().parents[2]
 DOCS = ROOT / "docs"
 sys.path.insert(0, str(DOCS / "_ext"))
-SHARED = Path("/work/shared/models")
+sys.path.insert(0, str(ROOT / "tests" / "anatomy"))
+from shared_models import ABSENT, SHARED_MODELS  # noqa: E402 (tests/anatomy/shared_models.py)
+
+SHARED = SHARED_MODELS
+
 POSE2SIM = SHARED / "pose2sim-beaucage-gauvreau" / "Model_Pose2Sim_muscles_flex.osim"
 POSE2SIM_MAPPING = """[bodies]
 pelvis = ["pelvis"]
@@ -123,7 +127,7 @@ def test_published_model_directive_gives_spinectl_anatomys_verdicts_on_myotorso(
     assert failed.returncode != 0 and "L4_L5_XX" in failed.stderr
 
 
-@pytest.mark.skipif(not POSE2SIM.is_file(), reason="the shared downloaded models (/work/shared/models) are absent")
+@pytest.mark.skipif(not POSE2SIM.is_file(), reason=ABSENT)
 def test_published_model_directive_on_the_pose2sim_model(tmp_path):
     """The Pose2Sim model (OpenSim) named in the published models' folder (``shared:``), its mapping inline, at its
     own controls: the row's rank and verdicts are `spinectl anatomy MODEL --mapping M --json`'s."""

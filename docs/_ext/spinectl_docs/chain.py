@@ -228,3 +228,35 @@ def _default_activation() -> float:
 value("atlas.local_full")(lambda: f"{_local_total('default', 0.03, 0.04, 1.0):.1f}")
 value("atlas.local_activation")(lambda: f"{_local_total('default', 0.03, 0.04, _default_activation()):.1f}")
 value("atlas.local_zero")(lambda: f"{_local_total('default', 0.03, 0.04, 0.0):.1f}")
+
+
+@cache
+def paper_pairs():
+    """``spinectl stability --preset wagner2012 --E 0.03 --Lambda 0.04 --contributions``'s pairs, as a dict."""
+    from spinectl import load_preset
+    from spinectl.model.contributions import pair_contributions
+    from spinectl.model.operating_point import OperatingPoint
+    from spinectl.optimise.stabilising import stability_at
+
+    model = load_preset("wagner2012")
+    result = stability_at(model, 0.03, 0.04, None, slip_check=False)
+    return pair_contributions(OperatingPoint(model, 0.03, 0.04, result.pcsa, slip_check=False)).to_dict()
+
+
+def _pair(name: str) -> int:
+    return paper_pairs()["pairs"].index(name)
+
+
+value("contributions.chain_index")(lambda: f"{paper_pairs()['muscles']['least_eigenvalue_Nm_per_rad']:.3g}")
+value("contributions.outer_share")(lambda: f"{paper_pairs()['chain_share_Nm_per_rad'][_pair('oblique_outer')]:.3g}")
+
+
+def _outer_cor_shares() -> list:
+    return paper_pairs()["cor_share_Nm_per_rad"][_pair("oblique_outer")]
+
+
+value("contributions.outer_cor_low")(lambda: f"{min(_outer_cor_shares()):.0f}")
+value("contributions.outer_cor_high")(lambda: f"{max(_outer_cor_shares()):.0f}")
+value("contributions.outer_removed")(
+    lambda: f"{paper_pairs()['muscles']['removal']['group:oblique_outer']['percent_change']:.0f}"
+)

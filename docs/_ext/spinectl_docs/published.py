@@ -50,12 +50,13 @@ HEADER = (
 
 SHARED_PREFIX = "shared:"
 """An argument ``shared:<folder>/<file>`` is a file of the published models' folder: ``$SPINECTL_SHARED_MODELS``,
-else ``/work/shared/models`` (where CI and the tests find them), wherever the checkout is."""
+else ``../shared/models`` beside the checkout (where CI and the tests find them, tests/anatomy/shared_models.py)."""
 
 
 def shared_models() -> Path:
     """The published models' folder (not in the repository)."""
-    return Path(os.environ.get("SPINECTL_SHARED_MODELS", "/work/shared/models"))
+    beside = Path(__file__).resolve().parents[4] / "shared" / "models"  # docs/_ext/spinectl_docs/ in the checkout
+    return Path(os.environ.get("SPINECTL_SHARED_MODELS") or beside)
 
 
 def resolve(model: str, docs: Path) -> str:
