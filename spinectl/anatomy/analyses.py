@@ -31,18 +31,16 @@ from ..model.chain import dynamic_eigenvalues
 from ..model.chain import state_matrix as chain_state_matrix
 from ..model.linear_chain import CONTROL_CLASSES, LinearChain
 from ..model.stability import MARGINAL_TIME_CONSTANT, slowest_time_constant
+from .certificate import RANK_TOLERANCE, GlobalCertificate, global_certificate  # noqa: F401 (their home before)
 from .contract import AnatomyEngine
 from .engine import require_mujoco
 from .identity import identity_text, model_identity
 from .model import Anatomy
 from .naming import joint_labels
+from .net_torque import NetTorque, net_torque
 
 REFERENCE_POSTURE = "the model's reference posture"
 """The posture analysed when none is given, as the table and the JSON's ``posture_source`` say it."""
-
-RANK_TOLERANCE = 1e-9
-"""A singular value below this times the largest counts as zero (the global muscles' rank)."""
-
 
 def activations(anatomy: AnatomyEngine, activation) -> np.ndarray:
     """The activation vector: one value for every muscle, a vector, or a dict by muscle name (others 0).
@@ -201,70 +199,6 @@ def verdict(chain: LinearChain, a) -> ChainVerdict:
         eigenvalues=values,
         modes=vectors,
         dynamic_eigenvalues=dyn,
-    )
-
-
-@dataclass(frozen=True)
-class GlobalCertificate:
-    """The global muscles' moment arms over the chain: rank, null space and what is left in it.
-
-    Attributes
-    ----------
-    muscles : tuple of str
-        The global muscles.
-    singular_values : numpy.ndarray, shape (n,)
-        Of their moment-arm matrix [m/rad].
-    rank : int
-        Singular values above :data:`RANK_TOLERANCE` times the largest.
-    null_space : numpy.ndarray, shape (n, n - rank)
-        Orthonormal directions in which no global muscle changes length.
-    null_space_stiffness : numpy.ndarray, shape (n - rank,)
-        Eigenvalues of -N^T K(a) N: the chain's stiffness there at the activations [N m/rad].
-    global_null_space_stiffness : numpy.ndarray, shape (n - rank,)
-        Eigenvalues of -N^T (sum over global i of K_i) N: what all global muscles at full activation add
-        there (their lengths' curvature only) [N m/rad].
-    """
-
-    muscles: tuple
-    singular_values: np.ndarray
-    rank: int
-    null_space: np.ndarray
-    null_space_stiffness: np.ndarray
-    global_null_space_stiffness: np.ndarray
-
-
-def global_certificate(anatomy: AnatomyEngine, chain: LinearChain, arms, a) -> GlobalCertificate:
-    """The global muscles' null-space certificate on a chain.
-
-    Parameters
-    ----------
-    anatomy : AnatomyEngine
-        The model (its muscle classes).
-    chain : LinearChain
-        The (free) chain.
-    arms : numpy.ndarray, shape (m, n)
-        The muscles' moment arms over the chain's coordinates [m/rad].
-    a : array_like, shape (m,)
-        Activations.
-
-    Returns
-    -------
-    GlobalCertificate
-    """
-    is_global = np.array([c == "global" for c in chain.control_class], bool)  # bool also without muscles
-    _, sv, vt = np.linalg.svd(arms[is_global], full_matrices=True)
-    sv = np.concatenate([sv, np.zeros(chain.n_joints - sv.size)])
-    rank = int(np.sum(sv > RANK_TOLERANCE * sv.max())) if sv.size and sv.max() > 0 else 0
-    null = vt[rank:].T
-    k = chain.stiffness(a)
-    k_global = chain.stiffness_per_control[..., is_global].sum(axis=-1)
-    return GlobalCertificate(
-        muscles=tuple(np.array(chain.controls, object)[is_global]),
-        singular_values=sv[: chain.n_joints],
-        rank=rank,
-        null_space=null,
-        null_space_stiffness=np.linalg.eigvalsh(-null.T @ k @ null) if null.size else np.zeros(0),
-        global_null_space_stiffness=np.linalg.eigvalsh(-null.T @ k_global @ null) if null.size else np.zeros(0),
     )
 
 
@@ -458,6 +392,9 @@ class AnatomyResult:
     posture_source : str
         Where the posture comes from: the model's reference posture, ``"given"``, or a file and the time of
         its frame (:mod:`spinectl.anatomy.recordings`).
+    net_torque : NetTorque or None
+        The net torque at each chain joint at the posture and activations, and whether it is far from
+        equilibrium (:mod:`spinectl.anatomy.net_torque`).
     """
 
     model: dict
@@ -479,6 +416,7 @@ class AnatomyResult:
     rhythm_left_out: tuple = ()
     devices: tuple = ()
     posture_source: str = REFERENCE_POSTURE
+    net_torque: NetTorque | None = None
 
     @property
     def activation_mean(self) -> float:
@@ -569,6 +507,8 @@ class AnatomyResult:
             out["mujoco_simulated_rate_per_s"] = self.simulated_rate
         if self.reflex is not None:
             out["reflex"] = self.reflex
+        if self.net_torque is not None:
+            out.update(self.net_torque.to_dict())
         return out
 
     def _angle_note(self) -> list:
@@ -605,6 +545,7 @@ class AnatomyResult:
             f"joint stiffness added: {self.joint_stiffness_added[0]:.4g} N m/rad per joint",
             *self._angle_note(),
             *(["devices: " + "; ".join(self.devices)] if self.devices else []),
+            *(self.net_torque.lines() if self.net_torque is not None else []),
             "",
             f"{'joint (level)':<24}{'-K_jj [N m/rad]':>16}  joint by joint (others fixed)",
             f"{'':<24}{'(> 0 restores)':>16}",
@@ -778,6 +719,7 @@ def analyse(
         rhythm_left_out=anatomy.rhythm(plane, posture)[0].left_out,
         devices=tuple(getattr(anatomy.engine, "devices", ())),
         posture_source=point.posture_source or REFERENCE_POSTURE,
+        net_torque=net_torque(lin, a, anatomy.control_bounds(), free.joints),
     )
 
 

@@ -1,0 +1,115 @@
+"""The net torque at the analysed posture (equilibrium residual) in the table and JSON, and its warning."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+mujoco = pytest.importorskip("mujoco", reason="needs the anatomy extra: pip install 'spinectl[anatomy]'")
+
+from shared_models import ABSENT, CYCLIST  # noqa: E402 (tests/anatomy/shared_models.py)
+
+from spinectl import anatomy  # noqa: E402
+from spinectl.anatomy.analyses import analyse  # noqa: E402
+from spinectl.anatomy.net_torque import EQUILIBRIUM_FLOOR, EQUILIBRIUM_FRACTION  # noqa: E402
+from spinectl.cli import main  # noqa: E402
+
+BARE = """<mujoco model="bare">
+  <worldbody>
+    <body name="pelvis">
+      <body name="v1" pos="0 0 0.1">
+        <joint name="j1" type="hinge" axis="0 1 0" stiffness="30"/>
+        <geom type="sphere" size="0.02" pos="0.02 0 0.05" mass="{mass}"/>
+        <body name="top" pos="0 0 0.1">
+          <joint name="j2" type="hinge" axis="0 1 0" stiffness="40"/>
+          <geom type="sphere" size="0.02" pos="0.02 0 0.05" mass="{mass}"/>
+        </body>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+MAPPING = '[bodies]\npelvis = ["pelvis"]\nvertebrae = ["v1"]\nthorax = ["top"]\n[planes]\nsagittal = ["j1", "j2"]\n'
+
+
+def _bare(tmp_path, mass: float):
+    model_path, mapping = tmp_path / "bare.xml", tmp_path / "bare.toml"
+    model_path.write_text(BARE.format(mass=mass))
+    mapping.write_text(MAPPING)
+    return model_path, mapping
+
+
+@pytest.mark.parametrize("mass", [2.0, 20.0])
+def test_a_model_without_muscles_reports_gravity_as_its_net_torque(tmp_path, capsys, mass):
+    """Two hinges each carrying masses 2 cm in front of them: the net torque is gravity's, MuJoCo's own -qfrc_bias
+    (by hand: m g 0.02 m per mass, 2 masses on j1); below 1 N m (2 kg: 0.78, 0.39 N m) it is near equilibrium, at
+    20 kg (7.8, 3.9 N m) far, since no muscle holds anything (the floor EQUILIBRIUM_FLOOR)."""
+    model_path, mapping = _bare(tmp_path, mass)
+    model = mujoco.MjModel.from_xml_string(BARE.format(mass=mass))
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    expected = -data.qfrc_bias
+    np.testing.assert_allclose(expected, [2 * mass * 9.81 * 0.02, mass * 9.81 * 0.02], rtol=1e-6)
+    assert main(["anatomy", str(model_path), "--mapping", str(mapping), "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    np.testing.assert_allclose([doc["net_torque_Nm"][j] for j in ("j1", "j2")], expected, rtol=1e-6)
+    far = bool(np.any(np.abs(expected) > EQUILIBRIUM_FLOOR))
+    assert doc["far_from_equilibrium"] == (["j1", "j2"] if far else [])
+    assert main(["anatomy", str(model_path), "--mapping", str(mapping)]) == 0
+    table = capsys.readouterr().out
+    line = next(x for x in table.splitlines() if x.startswith("net torque"))
+    assert f"largest {expected[0]:.3g} N m at j1" in line
+    assert any(x.startswith("warning: far from equilibrium") for x in table.splitlines()) == far
+
+
+def test_myotorso_net_torque_is_mujocos_and_far_is_relative_to_the_muscles(torso):
+    """MyoTorso at its reference posture and activation 0.05: the net torque on the chain is MuJoCo's own
+    qfrc_actuator + qfrc_passive - qfrc_bias at those activations (mj_forward, the reference); each joint is far
+    from equilibrium where that exceeds EQUILIBRIUM_FRACTION of sum_i |tau_ij| (the muscles' torque range)."""
+    a = 0.05
+    result = analyse(torso, "sagittal", a)
+    model = torso.engine.model
+    data = mujoco.MjData(model)
+    ctrl = torso.engine.held_controls()
+    ctrl[torso.engine.muscle_ids()] = a
+    data.ctrl[:] = ctrl
+    stateful = model.actuator_actadr >= 0
+    data.act[model.actuator_actadr[stateful]] = ctrl[stateful]
+    mujoco.mj_forward(model, data)
+    dofs = [model.jnt_dofadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, j)] for j in result.free.joints]
+    expected = (data.qfrc_actuator + data.qfrc_passive - data.qfrc_bias)[dofs]
+    np.testing.assert_allclose(result.net_torque.torque, expected, rtol=1e-6, atol=1e-6)
+    bound = np.maximum(EQUILIBRIUM_FRACTION * result.net_torque.capacity, EQUILIBRIUM_FLOOR)
+    joints = result.free.joints
+    assert result.net_torque.far == tuple(j for j, t, b in zip(joints, expected, bound, strict=True) if abs(t) > b)
+    assert np.all(result.net_torque.capacity > 100)  # 42 global muscles and more span each joint: hundreds of N m
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not CYCLIST.is_dir(), reason=ABSENT)
+def test_the_published_cyclist_at_its_static_trial_is_far_from_equilibrium(tmp_path):
+    """The Allaire cyclist at s01static.mot (posture and activations): every lumbar joint's net torque is hundreds
+    to thousands of N m (the trial found 287-7818 N m; OpenSim's passive fibre forces reach 35 F_max there), so the
+    table warns that its 'self-stable' verdicts are those of a moving body."""
+    pytest.importorskip("opensim", reason="needs the opensim extra: pip install 'spinectl[opensim]'")
+    mapping = _cyclist_mapping(tmp_path)
+    trial = CYCLIST / "s01static.mot"
+    loaded = anatomy.load(CYCLIST / "s01modelScaled.osim", mapping)
+    result = analyse(loaded, "sagittal", trial, posture=trial)
+    assert np.all(np.abs(result.net_torque.torque) > 200)
+    assert result.net_torque.far == result.free.joints
+    assert "warning: far from equilibrium at 6 of 6 joints" in result.table()
+
+
+def _cyclist_mapping(folder):
+    """docs/anatomy.md's cyclist.toml, written into ``folder`` (the models' folder is only read)."""
+    import re
+    from pathlib import Path
+
+    docs = (Path(__file__).resolve().parents[2] / "docs" / "anatomy.md").read_text(encoding="utf-8")
+    block = next(b for b in re.findall(r"```toml\n(.*?)```", docs, re.S) if b.startswith("# s01modelScaled"))
+    path = folder / "cyclist.toml"
+    path.write_text(block)
+    return path
