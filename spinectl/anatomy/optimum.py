@@ -43,7 +43,7 @@ from ..errors import ParameterError
 from ..model.linear_chain import LinearChain
 from .contract import AnatomyEngine
 from .identity import identity_text, model_identity
-from .remedy import INFEASIBLE_HINT, remedy, remedy_text
+from .remedy import INFEASIBLE_HINT, REMEDY_RERUN, remedy, remedy_text
 
 STABILITY = ("chain", "joints", "rhythm", "none")
 EQUILIBRIUM = ("rhythm", "free")
@@ -401,6 +401,9 @@ class OptimisedResult:
         (``--joint-stiffness``) from which the optimum is feasible (:func:`least_joint_stiffness`);
         inf where none up to :data:`MAX_REMEDY` is; NaN where not asked (the optimum solved, or the
         equilibrium fails).
+    rerun : str
+        What follows ``spinectl anatomy`` in the remedy's command to analyse this model again (its file and
+        mapping, :func:`~spinectl.anatomy.remedy.remedy_text`); the command line sets it.
     """
 
     anatomy: AnatomyEngine
@@ -411,6 +414,7 @@ class OptimisedResult:
     analysis: object
     skeleton: object = None
     remedy: float = float("nan")
+    rerun: str = REMEDY_RERUN
 
     @property
     def infeasible_constraint(self) -> str:
@@ -478,7 +482,7 @@ class OptimisedResult:
         if self.infeasible_constraint == "equilibrium":
             lines.append(EQUILIBRIUM_HINT.format(residual=self.classic.residual, rows=self.classic.net_torque.size))
         elif self.infeasible_constraint == "stability":
-            lines.append(INFEASIBLE_HINT + remedy_text(self.remedy))
+            lines.append(INFEASIBLE_HINT + remedy_text(self.remedy, self.rerun))
         if self.analysis is not None:
             lines += ["", "at the optimum's activations:", self.analysis.table()]
         return "\n".join(lines)

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
+import shlex
 
 from ..anatomy.mapping import MAX_STIFFNESS
 from ..errors import ParameterError
@@ -220,6 +222,7 @@ def _answers(args) -> tuple:
             posture=args.posture,
             time=args.time,
         )
+        result = dataclasses.replace(result, rerun=_rerun(args))
     else:
         result = analyse(
             anatomy,
@@ -264,6 +267,25 @@ def _refuse_combinations(args) -> None:
     for option, value in (("--lordosis", args.lordosis), ("--plot", args.plot)):
         if value and args.posture is not None:  # both start from the model's reference posture
             raise ParameterError(option, "starts from the model's reference posture; it cannot go with --posture")
+
+
+def _rerun(args) -> str:
+    """What follows ``spinectl anatomy`` to optimise the same model again: the model, its mapping and the options
+    that set the optimum (each only where given or not its default), quoted for a shell; the remedy's command."""
+    words = [str(args.model)]
+    options = (
+        ("--mapping", args.mapping, None),
+        ("--plane", args.plane, "sagittal"),
+        ("--posture", args.posture, None),
+        ("--time", args.time, None),
+        ("--stability", args.stability, "chain"),
+        ("--equilibrium", args.equilibrium, "rhythm"),
+        ("--margin", args.margin, 1.0),
+    )
+    for option, value, default in options:
+        if value is not None and value != default:
+            words += [option, f"{value:g}" if isinstance(value, float) else str(value)]
+    return shlex.join(words)
 
 
 def _joint_stiffness(text: str):
