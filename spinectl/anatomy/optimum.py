@@ -686,6 +686,12 @@ CURVE_MEANING = (
 )
 """What the anatomy's lordosis axis is, said wherever its curve is shown (table and figure)."""
 
+CURVE_INACCURATE = (
+    "WARNING: {count} inaccurate (status optimal_inaccurate, marked {mark}: the solver did not meet its tolerances, "
+    "values may be far off)"
+)
+"""What the lordosis curve's table and figure say where some optima are ``optimal_inaccurate``, as ``sweep`` does."""
+
 CURVE_AXIS = "summed angle change [deg]"
 CURVE_AXIS_MEANING = (
     "the chain's summed joint angle minus the model's posture's, moved along the rhythm (+: the rhythm's "

@@ -313,7 +313,7 @@ def _degrees(text: str):
 
 def _curve_table(curve: dict) -> str:
     """The lordosis curve as rows: each criterion's least cost (or its status) per posture."""
-    from ..anatomy.optimum import CURVE_AXIS, CURVE_AXIS_MEANING, CURVE_MEANING
+    from ..anatomy.optimum import CURVE_AXIS, CURVE_AXIS_MEANING, CURVE_INACCURATE, CURVE_MEANING
 
     lines = [
         "",
@@ -321,11 +321,20 @@ def _curve_table(curve: dict) -> str:
         f"{CURVE_AXIS}: {CURVE_AXIS_MEANING}; cost: the least sum of w_i a_i^2 [1] under each criterion",
         f"{CURVE_AXIS}  cost: classic  joint by joint  the chain (free)",
     ]
+    inaccurate = 0
     for i, deg in enumerate(curve["lordosis_deg"]):
         cells = []
         for criterion in ("none", "joints", "chain"):
             row = curve[criterion]
-            ok = row["status"][i] in ("optimal", "optimal_inaccurate")
-            cells.append(f"{row['cost'][i]:.4g}" if ok else row["status"][i])
+            status = row["status"][i]
+            inaccurate += status == "optimal_inaccurate"
+            mark = INACCURATE_MARK if status == "optimal_inaccurate" else ""
+            cells.append(f"{row['cost'][i]:.4g}{mark}" if status in ("optimal", "optimal_inaccurate") else status)
         lines.append(f"{deg:>{len(CURVE_AXIS)}.3g}  {cells[0]:>13}  {cells[1]:>14}  {cells[2]:>16}")
+    if inaccurate:
+        lines.append(CURVE_INACCURATE.format(count=inaccurate, mark=f"'{INACCURATE_MARK}' after the cost"))
     return "\n".join(lines)
+
+
+INACCURATE_MARK = "!"
+"""What follows a cost in the lordosis table where its optimum is ``optimal_inaccurate``."""
