@@ -66,6 +66,8 @@ def activations(anatomy: AnatomyEngine, activation) -> np.ndarray:
         allowed = f"[floor, 1], each muscle's floor its law's minimum activation ({lower.min():g} ... {lower.max():g})"
     if activation is None:
         a = anatomy.default_controls()
+    elif m == 0 and np.size(activation) > 0:  # before: analysed as given, its mean NaN
+        raise ParameterError("activation", f"{anatomy.name} has no muscles: its passive chain has no activation to give")
     elif isinstance(activation, dict):
         unknown = sorted(set(activation) - set(anatomy.muscles))
         if unknown:
@@ -511,6 +513,14 @@ class AnatomyResult:
             out.update(self.net_torque.to_dict())
         return out
 
+    def _activation_text(self) -> str:
+        """The first line's activations: their mean and source, or that the model has none."""
+        if not self.activations.size:
+            return "no muscles (the passive chain)"
+        if self.control_unit != "1":
+            return f"mean control {self.activation_mean:.4g} {self.control_unit} ({self.activation_source})"
+        return f"mean activation {self.activation_mean:.3g} ({self.activation_source})"
+
     def _angle_note(self) -> list:
         """One line where the coordinates are not the joints' angles: the slopes, and what the table is per."""
         if self.joint_slopes is None:
@@ -533,12 +543,7 @@ class AnatomyResult:
         counts = ", ".join(f"{len(v)} {k}" for k, v in self.muscles.items())
         lines = [
             f"{identity_text(self.model)}, {plane_text(self.plane)}, posture: {self.posture_source}, "
-            + (
-                f"mean activation {self.activation_mean:.3g}"
-                if self.control_unit == "1"
-                else f"mean control {self.activation_mean:.4g} {self.control_unit}"
-            )
-            + f" ({self.activation_source})",
+            + self._activation_text(),
             f"source: {self.model['source']}",
             f"muscles: {counts}; global muscles' moment-arm rank {cert.rank} of {len(free.joints)} "
             f"(singular values {', '.join(f'{s:.3g}' for s in cert.singular_values)} m/rad)",
@@ -554,6 +559,8 @@ class AnatomyResult:
         verdicts = zip(labels, free.joint_stiffness, free.joint_self_stable, free.joint_marginal, strict=True)
         for (name, s, ok, slow), tau in zip(verdicts, free.joint_time_constants, strict=True):
             marginal = f", marginal: slowest time constant {tau:.4g} s > {MARGINAL_TIME_CONSTANT:g} s" if slow else ""
+            if slow and np.isinf(tau):  # a real part of 0: no damping at all, not a slow decay
+                marginal = ", marginal: undamped (no damping at this joint: it oscillates without decay)"
             lines.append(f"{name:<24}{s:>16.4g}  {'self-' + word[ok]}{marginal}")
         eig = ", ".join(f"{v:.4g}" for v in free.eigenvalues)
         lines += [

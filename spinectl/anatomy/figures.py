@@ -197,7 +197,8 @@ def anatomy_figures(anatomy, analysis, curve: dict | None = None) -> dict:
     name = anatomy.name
     figures = {"sagittal.png": sagittal_figure(sagittal_projection(anatomy), f"{name}: sagittal projection")}
     if analysis is not None and analysis.plane == "sagittal":
-        title = f"{name}, sagittal, mean activation {analysis.activation_mean:.3g}"
+        held = f"mean activation {analysis.activation_mean:.3g}" if analysis.activations.size else "no muscles"
+        title = f"{name}, sagittal, {held}"
         figures["modes.png"] = modes_figure(mode_shapes(anatomy, analysis.free), title)
     if curve is not None:
         figures["lordosis.png"] = lordosis_figure(curve, f"{name}: the three optima over the lordosis")

@@ -191,6 +191,10 @@ def optimise(
     Optimum
     """
     check_choices(stability, equilibrium, margin, weights)
+    if not len(anatomy.muscles):  # before: numpy's warnings, then the solver's solver_error
+        raise ParameterError(
+            "optimise", f"{anatomy.name} has no muscles: there are no activations to optimise (--optimise, --lordosis)"
+        )
     free, constrained, lin = anatomy.chains(plane, posture, joint_stiffness)
     rows, tau_per, tau_0 = anatomy.equilibrium_rows(lin, plane, posture, equilibrium)
     w = anatomy.volume_weights() if weights == "volume" else np.ones(free.n_controls)
