@@ -478,7 +478,7 @@ class OptimisedResult:
         str
         """
         rows = (("optimum", self.optimum), ("classic", self.classic))
-        lines = [identity_text(model_identity(self.anatomy))]
+        lines = [self._first_line()]
         for label, opt in rows:
             lines.append(_optimum_line(label, opt, self.margin))
             lines += hidden_torque_lines(opt)
@@ -490,6 +490,24 @@ class OptimisedResult:
         if self.analysis is not None:
             lines += ["", "at the optimum's activations:", self.analysis.table()]
         return "\n".join(lines)
+
+    def _first_line(self) -> str:
+        """The model, plane, posture and whose activations; for compliant tendons, where they were linearised."""
+        from .analyses import REFERENCE_POSTURE, plane_text
+
+        shown = self.analysis or self.skeleton
+        posture = shown.posture_source if shown is not None else REFERENCE_POSTURE
+        line = (
+            f"{identity_text(model_identity(self.anatomy))}, {plane_text(self.plane)}, posture: {posture}, "
+            "activations: the optimum's"
+        )
+        springs = getattr(getattr(self.anatomy, "engine", None), "springs", 0)
+        if springs:  # the optimum's chains were taken without activations: the tangent at each floor
+            line += (
+                f"; {springs} compliant-tendon muscles linearised at their activation floors for the optimum, at "
+                "the optimum's activations for the analysis below"
+            )
+        return line
 
     def _price_line(self) -> str:
         """The price of stability, or why there is none (an infeasible optimum has no cost to compare)."""
@@ -622,6 +640,7 @@ def optimised(
     at = {"posture": point.posture, "joint_stiffness": joint_stiffness, "reflex": reflex}
     if opt.ok:
         analysis = analyse(anatomy, plane, opt.activations, check=check, **at)
+        analysis = dataclasses.replace(analysis, activation_source="the optimum's")
     empty = skeleton(anatomy, opt, **kwargs, reflex=reflex)
     if point.posture_source:  # the file and its frame, where analyse saw the posture it read
         analysis, empty = (r and dataclasses.replace(r, posture_source=point.posture_source) for r in (analysis, empty))
