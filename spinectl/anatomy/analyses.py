@@ -397,6 +397,9 @@ class AnatomyResult:
     net_torque : NetTorque or None
         The net torque at each chain joint at the posture and activations, and whether it is far from
         equilibrium (:mod:`spinectl.anatomy.net_torque`).
+    rhythm_turns : tuple of float
+        Per independent coordinate of the rhythm, the chain's joints' rotation summed per its radian [rad/rad]:
+        the constrained chain's stiffness is per radian of that coordinate, which turns the chain this much.
     """
 
     model: dict
@@ -419,6 +422,7 @@ class AnatomyResult:
     devices: tuple = ()
     posture_source: str = REFERENCE_POSTURE
     net_torque: NetTorque | None = None
+    rhythm_turns: tuple = ()
 
     @property
     def activation_mean(self) -> float:
@@ -497,6 +501,7 @@ class AnatomyResult:
                 "rhythm": bool(self.rhythm_size),
                 "modes_removed": free.stiffness.shape[0] - con.stiffness.shape[0],
                 "rhythm_left_out": list(self.rhythm_left_out),
+                "chain_turn_rad_per_coordinate_rad": list(self.rhythm_turns),
             },
             "devices": list(self.devices),
         }
@@ -512,6 +517,16 @@ class AnatomyResult:
         if self.net_torque is not None:
             out.update(self.net_torque.to_dict())
         return out
+
+    def _per_coordinate(self) -> str:
+        """What the constrained chain's stiffness is per: a radian of the rhythm's coordinate, turning the chain more."""
+        if not self.rhythm_turns:
+            return ""
+        turns = "; ".join(
+            f"one radian of {j} turns the chain's joints {t:.3g} rad in all"
+            for j, t in zip(self.constrained.joints, self.rhythm_turns, strict=True)
+        )
+        return f" per radian of the rhythm's coordinate, not of one joint ({turns})"
 
     def _activation_text(self) -> str:
         """The first line's activations: their mean and source, or that the model has none."""
@@ -578,7 +593,7 @@ class AnatomyResult:
             lines.append(
                 f"the chain constrained by the model's rhythm ({len(con.joints)} coordinate(s): "
                 f"{', '.join(con.joints)}): "
-                f"eigenvalues of -K {', '.join(f'{v:.4g}' for v in con.eigenvalues)} N m/rad: "
+                f"eigenvalues of -K {', '.join(f'{v:.4g}' for v in con.eigenvalues)} N m/rad{self._per_coordinate()}: "
                 f"{word[con.chain_stable]}; the rhythm removes {len(free.joints) - len(con.joints)} modes"
             )
         if self.rhythm_left_out:
@@ -727,7 +742,15 @@ def analyse(
         devices=tuple(getattr(anatomy.engine, "devices", ())),
         posture_source=point.posture_source or REFERENCE_POSTURE,
         net_torque=net_torque(lin, a, anatomy.control_bounds(), free.joints),
+        rhythm_turns=_rhythm_turns(anatomy, plane, posture) if anatomy.rhythm_size(plane, posture) else (),
     )
+
+
+def _rhythm_turns(anatomy: AnatomyEngine, plane: str, posture) -> tuple:
+    """Per independent coordinate of the rhythm, the chain's joints' rotation summed per its radian [rad/rad]."""
+    rhy, _ = anatomy.joint_rhythm(plane, posture)
+    n = len(anatomy.plane_joints(plane))
+    return tuple(float(t) for t in np.asarray(rhy.transform)[:n].sum(axis=0))
 
 
 def _slopes_shown(anatomy: AnatomyEngine, plane: str, posture) -> np.ndarray | None:
