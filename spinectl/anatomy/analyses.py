@@ -42,6 +42,7 @@ from .net_torque import NetTorque, net_torque
 REFERENCE_POSTURE = "the model's reference posture"
 """The posture analysed when none is given, as the table and the JSON's ``posture_source`` say it."""
 
+
 def activations(anatomy: AnatomyEngine, activation) -> np.ndarray:
     """The activation vector: one value for every muscle, a vector, or a dict by muscle name (others 0).
 
@@ -67,7 +68,9 @@ def activations(anatomy: AnatomyEngine, activation) -> np.ndarray:
     if activation is None:
         a = anatomy.default_controls()
     elif m == 0 and np.size(activation) > 0:  # before: analysed as given, its mean NaN
-        raise ParameterError("activation", f"{anatomy.name} has no muscles: its passive chain has no activation to give")
+        raise ParameterError(
+            "activation", f"{anatomy.name} has no muscles: its passive chain has no activation to give"
+        )
     elif isinstance(activation, dict):
         unknown = sorted(set(activation) - set(anatomy.muscles))
         if unknown:
@@ -519,7 +522,7 @@ class AnatomyResult:
         return out
 
     def _per_coordinate(self) -> str:
-        """What the constrained chain's stiffness is per: a radian of the rhythm's coordinate, turning the chain more."""
+        """What the constrained chain's stiffness is per: a radian of the rhythm's coordinate, which turns the chain."""
         if not self.rhythm_turns:
             return ""
         turns = "; ".join(

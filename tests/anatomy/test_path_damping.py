@@ -6,7 +6,6 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
-
 from shared_models import ABSENT, POSE2SIM  # noqa: E402 (tests/anatomy/shared_models.py)
 
 from spinectl.anatomy import opensim_muscles
