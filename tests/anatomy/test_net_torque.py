@@ -10,35 +10,18 @@ import pytest
 mujoco = pytest.importorskip("mujoco", reason="needs the anatomy extra: pip install 'spinectl[anatomy]'")
 
 from shared_models import ABSENT, CYCLIST  # noqa: E402 (tests/anatomy/shared_models.py)
+from test_passive_chain import BARE, MAPPING  # noqa: E402 (two hinges with springs, masses of 2 kg)
 
 from spinectl import anatomy  # noqa: E402
 from spinectl.anatomy.analyses import analyse  # noqa: E402
 from spinectl.anatomy.net_torque import EQUILIBRIUM_FLOOR, EQUILIBRIUM_FRACTION  # noqa: E402
 from spinectl.cli import main  # noqa: E402
 
-BARE = """<mujoco model="bare">
-  <worldbody>
-    <body name="pelvis">
-      <body name="v1" pos="0 0 0.1">
-        <joint name="j1" type="hinge" axis="0 1 0" stiffness="30"/>
-        <geom type="sphere" size="0.02" pos="0.02 0 0.05" mass="{mass}"/>
-        <body name="top" pos="0 0 0.1">
-          <joint name="j2" type="hinge" axis="0 1 0" stiffness="40"/>
-          <geom type="sphere" size="0.02" pos="0.02 0 0.05" mass="{mass}"/>
-        </body>
-      </body>
-    </body>
-  </worldbody>
-</mujoco>
-"""
-MAPPING = '[bodies]\npelvis = ["pelvis"]\nvertebrae = ["v1"]\nthorax = ["top"]\n[planes]\nsagittal = ["j1", "j2"]\n'
 
-
-def _bare(tmp_path, mass: float):
-    model_path, mapping = tmp_path / "bare.xml", tmp_path / "bare.toml"
-    model_path.write_text(BARE.format(mass=mass))
-    mapping.write_text(MAPPING)
-    return model_path, mapping
+def _bare(mass: float) -> str:
+    """test_passive_chain's two hinges, their masses ``mass`` [kg] each."""
+    assert BARE.count('mass="2"') == 2
+    return BARE.replace('mass="2"', f'mass="{mass:g}"')
 
 
 @pytest.mark.parametrize("mass", [2.0, 20.0])
@@ -46,8 +29,10 @@ def test_a_model_without_muscles_reports_gravity_as_its_net_torque(tmp_path, cap
     """Two hinges each carrying masses 2 cm in front of them: the net torque is gravity's, MuJoCo's own -qfrc_bias
     (by hand: m g 0.02 m per mass, 2 masses on j1); below 1 N m (2 kg: 0.78, 0.39 N m) it is near equilibrium, at
     20 kg (7.8, 3.9 N m) far, since no muscle holds anything (the floor EQUILIBRIUM_FLOOR)."""
-    model_path, mapping = _bare(tmp_path, mass)
-    model = mujoco.MjModel.from_xml_string(BARE.format(mass=mass))
+    model_path, mapping = tmp_path / "bare.xml", tmp_path / "bare.toml"
+    model_path.write_text(_bare(mass))
+    mapping.write_text(MAPPING)
+    model = mujoco.MjModel.from_xml_string(_bare(mass))
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)
     expected = -data.qfrc_bias
