@@ -744,9 +744,17 @@ def analyse(
         rhythm_left_out=anatomy.rhythm(plane, posture)[0].left_out,
         devices=tuple(getattr(anatomy.engine, "devices", ())),
         posture_source=point.posture_source or REFERENCE_POSTURE,
-        net_torque=net_torque(lin, a, anatomy.control_bounds(), free.joints),
+        net_torque=_net_torque(anatomy, lin, a, plane, posture, free.joints),
         rhythm_turns=_rhythm_turns(anatomy, plane, posture) if anatomy.rhythm_size(plane, posture) else (),
     )
+
+
+def _net_torque(anatomy: AnatomyEngine, lin, a, plane: str, posture, joints) -> NetTorque:
+    """The net torque per chain joint and, where the model has a rhythm, on its coordinates (the optimum's rows)."""
+    rhythm = None
+    if anatomy.rhythm_size(plane, posture):
+        rhythm = anatomy.equilibrium_rows(lin, plane, posture, "rhythm")[1:]
+    return net_torque(lin, a, anatomy.control_bounds(), joints, rhythm)
 
 
 def _rhythm_turns(anatomy: AnatomyEngine, plane: str, posture) -> tuple:

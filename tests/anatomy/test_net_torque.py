@@ -98,3 +98,24 @@ def _cyclist_mapping(folder):
     path = folder / "cyclist.toml"
     path.write_text(block)
     return path
+
+
+def test_an_optimum_held_by_the_rhythm_is_not_called_far(torso):
+    """MyoTorso's classic optimum (10 N m/rad added, equilibrium on the rhythm's coordinates): the net torque on the
+    rhythm's coordinates is 0 to the solver's tolerance (the optimum's equality rows), each chain joint's is the
+    torque the rhythm carries that the optimum's table prints (its lumbar_torque), so the table says the posture is
+    held by the rhythm, without the warning; at activation 0 (the variant) nothing holds it and the warning
+    names the rhythm's coordinates too."""
+    from spinectl.anatomy.optimum import optimised
+
+    result = optimised(torso, stability="none", joint_stiffness=10.0)
+    held = result.analysis.net_torque
+    assert np.max(np.abs(held.rhythm_torque)) < 1e-6 * np.max(held.rhythm_capacity)
+    lumbar = dict(zip(result.optimum.lumbar_joints, result.optimum.lumbar_torque, strict=True))
+    np.testing.assert_allclose(held.torque, [lumbar[j] for j in held.joints], rtol=1e-6, atol=1e-9)
+    lines = result.analysis.table().splitlines()
+    assert held.far and not held.rhythm_far  # 50 N m at L1_L2_FE on the free joints, carried by the equalities
+    assert any(x.startswith("held on the rhythm's coordinates") for x in lines)
+    assert not any(x.startswith("warning: far") for x in lines)
+    loose = analyse(torso, "sagittal", 0.0)
+    assert loose.net_torque.rhythm_far and "joints and on the rhythm's coordinates" in loose.table()
