@@ -31,17 +31,16 @@ from ..model.chain import dynamic_eigenvalues
 from ..model.chain import state_matrix as chain_state_matrix
 from ..model.linear_chain import CONTROL_CLASSES, LinearChain
 from ..model.stability import MARGINAL_TIME_CONSTANT, slowest_time_constant
+from .certificate import GlobalCertificate, global_certificate
 from .contract import AnatomyEngine
 from .identity import identity_text, model_identity
 from .loads import analysed_loads
 from .naming import joint_labels
+from .net_torque import NetTorque, net_torque
 from .referee import mujoco_eigenvalues, mujoco_growth_rate
 
 REFERENCE_POSTURE = "the model's reference posture"
 """The posture analysed when none is given, as the table and the JSON's ``posture_source`` say it."""
-
-RANK_TOLERANCE = 1e-9
-"""A singular value below this times the largest counts as zero (the global muscles' rank)."""
 
 
 def activations(anatomy: AnatomyEngine, activation) -> np.ndarray:
@@ -68,6 +67,10 @@ def activations(anatomy: AnatomyEngine, activation) -> np.ndarray:
         allowed = f"[floor, 1], each muscle's floor its law's minimum activation ({lower.min():g} ... {lower.max():g})"
     if activation is None:
         a = anatomy.default_controls()
+    elif m == 0 and np.size(activation) > 0:  # before: analysed as given, its mean NaN
+        raise ParameterError(
+            "activation", f"{anatomy.name} has no muscles: its passive chain has no activation to give"
+        )
     elif isinstance(activation, dict):
         unknown = sorted(set(activation) - set(anatomy.muscles))
         if unknown:
@@ -205,70 +208,6 @@ def verdict(chain: LinearChain, a) -> ChainVerdict:
 
 
 @dataclass(frozen=True)
-class GlobalCertificate:
-    """The global muscles' moment arms over the chain: rank, null space and what is left in it.
-
-    Attributes
-    ----------
-    muscles : tuple of str
-        The global muscles.
-    singular_values : numpy.ndarray, shape (n,)
-        Of their moment-arm matrix [m/rad].
-    rank : int
-        Singular values above :data:`RANK_TOLERANCE` times the largest.
-    null_space : numpy.ndarray, shape (n, n - rank)
-        Orthonormal directions in which no global muscle changes length.
-    null_space_stiffness : numpy.ndarray, shape (n - rank,)
-        Eigenvalues of -N^T K(a) N: the chain's stiffness there at the activations [N m/rad].
-    global_null_space_stiffness : numpy.ndarray, shape (n - rank,)
-        Eigenvalues of -N^T (sum over global i of K_i) N: what all global muscles at full activation add
-        there (their lengths' curvature only) [N m/rad].
-    """
-
-    muscles: tuple
-    singular_values: np.ndarray
-    rank: int
-    null_space: np.ndarray
-    null_space_stiffness: np.ndarray
-    global_null_space_stiffness: np.ndarray
-
-
-def global_certificate(anatomy: AnatomyEngine, chain: LinearChain, arms, a) -> GlobalCertificate:
-    """The global muscles' null-space certificate on a chain.
-
-    Parameters
-    ----------
-    anatomy : AnatomyEngine
-        The model (its muscle classes).
-    chain : LinearChain
-        The (free) chain.
-    arms : numpy.ndarray, shape (m, n)
-        The muscles' moment arms over the chain's coordinates [m/rad].
-    a : array_like, shape (m,)
-        Activations.
-
-    Returns
-    -------
-    GlobalCertificate
-    """
-    is_global = np.array([c == "global" for c in chain.control_class], bool)  # bool also without muscles
-    _, sv, vt = np.linalg.svd(arms[is_global], full_matrices=True)
-    sv = np.concatenate([sv, np.zeros(chain.n_joints - sv.size)])
-    rank = int(np.sum(sv > RANK_TOLERANCE * sv.max())) if sv.size and sv.max() > 0 else 0
-    null = vt[rank:].T
-    k = chain.stiffness(a)
-    k_global = chain.stiffness_per_control[..., is_global].sum(axis=-1)
-    return GlobalCertificate(
-        muscles=tuple(np.array(chain.controls, object)[is_global]),
-        singular_values=sv[: chain.n_joints],
-        rank=rank,
-        null_space=null,
-        null_space_stiffness=np.linalg.eigvalsh(-null.T @ k @ null) if null.size else np.zeros(0),
-        global_null_space_stiffness=np.linalg.eigvalsh(-null.T @ k_global @ null) if null.size else np.zeros(0),
-    )
-
-
-@dataclass(frozen=True)
 class AnatomyResult:
     """The analysis of one model, plane, posture and activation (:func:`analyse`).
 
@@ -320,6 +259,12 @@ class AnatomyResult:
     posture_source : str
         Where the posture comes from: the model's reference posture, ``"given"``, or a file and the time of
         its frame (:mod:`spinectl.anatomy.recordings`).
+    net_torque : NetTorque or None
+        The net torque at each chain joint at the posture and activations, and whether it is far from
+        equilibrium (:mod:`spinectl.anatomy.net_torque`).
+    rhythm_turns : tuple of float
+        Per independent coordinate of the rhythm, the chain's joints' rotation summed per its radian [rad/rad]:
+        the constrained chain's stiffness is per radian of that coordinate, which turns the chain this much.
     """
 
     model: dict
@@ -342,6 +287,8 @@ class AnatomyResult:
     devices: tuple = ()
     posture_source: str = REFERENCE_POSTURE
     loads: tuple = field(default=(), metadata={"doc": "the external loads in the chains (spinectl.anatomy.loads)"})
+    net_torque: NetTorque | None = None
+    rhythm_turns: tuple = ()
 
     @property
     def activation_mean(self) -> float:
@@ -420,6 +367,7 @@ class AnatomyResult:
                 "rhythm": bool(self.rhythm_size),
                 "modes_removed": free.stiffness.shape[0] - con.stiffness.shape[0],
                 "rhythm_left_out": list(self.rhythm_left_out),
+                "chain_turn_rad_per_coordinate_rad": list(self.rhythm_turns),
             },
             "devices": list(self.devices),
             **({"loads": [load.to_dict() for load in self.loads]} if self.loads else {}),
@@ -433,7 +381,27 @@ class AnatomyResult:
             out["mujoco_simulated_rate_per_s"] = self.simulated_rate
         if self.reflex is not None:
             out["reflex"] = self.reflex
+        if self.net_torque is not None:
+            out.update(self.net_torque.to_dict())
         return out
+
+    def _per_coordinate(self) -> str:
+        """What the constrained chain's stiffness is per: a radian of the rhythm's coordinate, which turns the chain."""
+        if not self.rhythm_turns:
+            return ""
+        turns = "; ".join(
+            f"one radian of {j} turns the chain's joints {t:.3g} rad in all"
+            for j, t in zip(self.constrained.joints, self.rhythm_turns, strict=True)
+        )
+        return f" per radian of the rhythm's coordinate, not of one joint ({turns})"
+
+    def _activation_text(self) -> str:
+        """The first line's activations: their mean and source, or that the model has none."""
+        if not self.activations.size:
+            return "no muscles (the passive chain)"
+        if self.control_unit != "1":
+            return f"mean control {self.activation_mean:.4g} {self.control_unit} ({self.activation_source})"
+        return f"mean activation {self.activation_mean:.3g} ({self.activation_source})"
 
     def _angle_note(self) -> list:
         """One line where the coordinates are not the joints' angles: the slopes, and what the table is per."""
@@ -457,12 +425,7 @@ class AnatomyResult:
         counts = ", ".join(f"{len(v)} {k}" for k, v in self.muscles.items())
         lines = [
             f"{identity_text(self.model)}, {plane_text(self.plane)}, posture: {self.posture_source}, "
-            + (
-                f"mean activation {self.activation_mean:.3g}"
-                if self.control_unit == "1"
-                else f"mean control {self.activation_mean:.4g} {self.control_unit}"
-            )
-            + f" ({self.activation_source})",
+            + self._activation_text(),
             f"source: {self.model['source']}",
             f"muscles: {counts}; global muscles' moment-arm rank {cert.rank} of {len(free.joints)} "
             f"(singular values {', '.join(f'{s:.3g}' for s in cert.singular_values)} m/rad)",
@@ -470,6 +433,7 @@ class AnatomyResult:
             *self._angle_note(),
             *(["devices: " + "; ".join(self.devices)] if self.devices else []),
             *(f"load (in the equilibrium and K): {load.text()}" for load in self.loads),
+            *(self.net_torque.lines() if self.net_torque is not None else []),
             "",
             f"{'joint (level)':<24}{'-K_jj [N m/rad]':>16}  joint by joint (others fixed)",
             f"{'':<24}{'(> 0 restores)':>16}",
@@ -478,6 +442,8 @@ class AnatomyResult:
         verdicts = zip(labels, free.joint_stiffness, free.joint_self_stable, free.joint_marginal, strict=True)
         for (name, s, ok, slow), tau in zip(verdicts, free.joint_time_constants, strict=True):
             marginal = f", marginal: slowest time constant {tau:.4g} s > {MARGINAL_TIME_CONSTANT:g} s" if slow else ""
+            if slow and np.isinf(tau):  # a real part of 0: no damping at all, not a slow decay
+                marginal = ", marginal: undamped (no damping at this joint: it oscillates without decay)"
             lines.append(f"{name:<24}{s:>16.4g}  {'self-' + word[ok]}{marginal}")
         eig = ", ".join(f"{v:.4g}" for v in free.eigenvalues)
         lines += [
@@ -495,7 +461,7 @@ class AnatomyResult:
             lines.append(
                 f"the chain constrained by the model's rhythm ({len(con.joints)} coordinate(s): "
                 f"{', '.join(con.joints)}): "
-                f"eigenvalues of -K {', '.join(f'{v:.4g}' for v in con.eigenvalues)} N m/rad: "
+                f"eigenvalues of -K {', '.join(f'{v:.4g}' for v in con.eigenvalues)} N m/rad{self._per_coordinate()}: "
                 f"{word[con.chain_stable]}; the rhythm removes {len(free.joints) - len(con.joints)} modes"
             )
         if self.rhythm_left_out:
@@ -649,7 +615,24 @@ def analyse(
         devices=tuple(getattr(anatomy.engine, "devices", ())),
         posture_source=point.posture_source or REFERENCE_POSTURE,
         loads=loads,
+        net_torque=_net_torque(anatomy, lin, a, plane, posture, free.joints),
+        rhythm_turns=_rhythm_turns(anatomy, plane, posture) if anatomy.rhythm_size(plane, posture) else (),
     )
+
+
+def _net_torque(anatomy: AnatomyEngine, lin, a, plane: str, posture, joints) -> NetTorque:
+    """The net torque per chain joint and, where the model has a rhythm, on its coordinates (the optimum's rows)."""
+    rhythm = None
+    if anatomy.rhythm_size(plane, posture):
+        rhythm = anatomy.equilibrium_rows(lin, plane, posture, "rhythm")[1:]
+    return net_torque(lin, a, anatomy.control_bounds(), joints, rhythm)
+
+
+def _rhythm_turns(anatomy: AnatomyEngine, plane: str, posture) -> tuple:
+    """Per independent coordinate of the rhythm, the chain's joints' rotation summed per its radian [rad/rad]."""
+    rhy, _ = anatomy.joint_rhythm(plane, posture)
+    n = len(anatomy.plane_joints(plane))
+    return tuple(float(t) for t in np.asarray(rhy.transform)[:n].sum(axis=0))
 
 
 def _slopes_shown(anatomy: AnatomyEngine, plane: str, posture) -> np.ndarray | None:

@@ -30,7 +30,7 @@ from ..model.loads import loads_text
 from .joint_angles import JointSlopes, linearisation_in_angles, rhythm_in_angles
 from .linearise import constrained_chain, free_chain
 from .loads import refuse_loads
-from .mapping import MAX_STIFFNESS, Mapping
+from .mapping import MAX_STIFFNESS, Mapping, located
 
 
 @runtime_checkable
@@ -425,6 +425,12 @@ class MappedModel:
         if joint_stiffness == "none":
             value = 0.0
         elif joint_stiffness == "mapped":
+            if not self.mapping.stiffness_mapped:  # before: 0 added without a word
+                raise ParameterError(
+                    located(self.mapping.path, "joint_stiffness.Nm_per_rad"),
+                    "is missing (no [joint_stiffness] section gives it) and --joint-stiffness mapped reads it: add "
+                    "the section, or give --joint-stiffness a number [N m/rad]",
+                )
             value = self.mapping.joint_stiffness
         else:
             try:

@@ -7,12 +7,14 @@ all files or none).
 
 from __future__ import annotations
 
+import textwrap
+
 import numpy as np
 
 from ..canvas import new_figure, save_figures
 from .drawing import ModeShapes, SagittalProjection
 from .naming import joint_labels
-from .optimum import CURVE_AXIS, CURVE_AXIS_MEANING
+from .optimum import CURVE_AXIS, CURVE_AXIS_MEANING, CURVE_INACCURATE
 
 CLASS_COLOURS = {"global": "tab:blue", "local": "tab:red", "between": "tab:green", "non-lumbar": "tab:gray"}
 """Muscle class -> colour (:data:`spinectl.model.linear_chain.CONTROL_CLASSES`)."""
@@ -138,15 +140,21 @@ def lordosis_figure(curve: dict, title: str = ""):
     degrees = np.asarray(curve["lordosis_deg"], float)
     fig = new_figure(figsize=(7.0, 6.4), layout="constrained")
     top, bottom = fig.subplots(2, 1, sharex=True)
+    inaccurate = 0
     for key, label, colour in CRITERIA:
         row = curve[key]
         ok = np.array([s in ("optimal", "optimal_inaccurate") for s in row["status"]])
         cost = np.where(ok, np.asarray(row["cost"], float), np.nan)
         margin = np.where(ok, np.asarray(row["margin_Nm_per_rad"], float), np.nan)
         top.plot(degrees, cost, "-o", ms=3, color=colour, label=label)
+        rough = np.array([s == "optimal_inaccurate" for s in row["status"]])
+        inaccurate += int(rough.sum())
         if np.any(np.isfinite(cost)):
-            best = int(np.nanargmin(cost))
-            top.plot(degrees[best], cost[best], "*", ms=14, color=colour, mec="black", zorder=5)
+            best = int(np.nanargmin(cost))  # hollow where that optimum is inaccurate
+            face = "none" if rough[best] else colour
+            top.plot(degrees[best], cost[best], "*", ms=14, color=colour, mfc=face, mec="black", zorder=5)
+        for ax, values in ((top, cost), (bottom, margin)):  # each inaccurate optimum crossed, as the table marks it
+            ax.plot(degrees[rough], values[rough], "x", ms=8, mew=1.5, color="black", zorder=6)
         bottom.plot(degrees, margin, "-o", ms=3, color=colour, label=label)
     for ax in (top, bottom):
         ax.axvline(0.0, color="black", lw=0.8, ls="--")
@@ -161,6 +169,9 @@ def lordosis_figure(curve: dict, title: str = ""):
     )
     top.legend(fontsize=8, title="criterion (star: least cost)", title_fontsize=8)
     top.set_title(title or "the three optima over the lordosis", fontsize=10)
+    if inaccurate:
+        warning = CURVE_INACCURATE.format(count=inaccurate, mark="x, a hollow star")
+        fig.suptitle(textwrap.fill(warning, 120), fontsize=7, color="tab:red")
     return fig
 
 
@@ -186,7 +197,8 @@ def anatomy_figures(anatomy, analysis, curve: dict | None = None) -> dict:
     name = anatomy.name
     figures = {"sagittal.png": sagittal_figure(sagittal_projection(anatomy), f"{name}: sagittal projection")}
     if analysis is not None and analysis.plane == "sagittal":
-        title = f"{name}, sagittal, mean activation {analysis.activation_mean:.3g}"
+        held = f"mean activation {analysis.activation_mean:.3g}" if analysis.activations.size else "no muscles"
+        title = f"{name}, sagittal, {held}"
         figures["modes.png"] = modes_figure(mode_shapes(anatomy, analysis.free), title)
     if curve is not None:
         figures["lordosis.png"] = lordosis_figure(curve, f"{name}: the three optima over the lordosis")

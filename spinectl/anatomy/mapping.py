@@ -45,6 +45,9 @@ class Mapping:
         The published source of :attr:`joint_stiffness`.
     path : str
         The file it was read from.
+    stiffness_mapped : bool
+        Whether the file gives ``[joint_stiffness] Nm_per_rad``: without it ``joint_stiffness="mapped"`` is
+        refused (:meth:`~spinectl.anatomy.contract.MappedModel.added_stiffness`), not 0 added without a word.
     """
 
     bodies: dict
@@ -52,6 +55,7 @@ class Mapping:
     joint_stiffness: float
     stiffness_source: str
     path: str
+    stiffness_mapped: bool = True
 
 
 MAX_STIFFNESS = 1e6
@@ -153,7 +157,8 @@ def _mapping(doc: dict, path: str) -> Mapping:
     source = stiff.get("source", "")
     if not isinstance(source, str):
         raise ParameterError("joint_stiffness.source", f"must be a string (got {v.show(source)})")
-    return Mapping(bodies=mapped, planes=chains, joint_stiffness=value, stiffness_source=source, path=path)
+    given = "Nm_per_rad" in stiff
+    return Mapping(mapped, chains, value, source, path, stiffness_mapped=given)
 
 
 def _names(key: str, value) -> tuple:

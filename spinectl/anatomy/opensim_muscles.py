@@ -172,7 +172,8 @@ def _path_damping(engine, acts, arms, names, rows) -> np.ndarray:
     """dF/dV of the rigid muscles ``rows`` at the realised state, by central differences in one coordinate's speed.
 
     Each muscle's speed is set through the coordinate of its largest moment arm; a muscle with no
-    arm on ``names`` gets 0 (it adds nothing to D).
+    arm on ``names``, or whose lengthening speed that coordinate's speed does not change, gets 0 (it adds
+    nothing to D).
     """
     state = engine.state
     out = np.zeros(arms.shape[0])
@@ -189,7 +190,11 @@ def _path_damping(engine, acts, arms, names, rows) -> np.ndarray:
             sides.append((_read(engine, "getTendonForce"), _read(engine, "getLengtheningSpeed")))
         coordinate.setSpeedValue(state, 0.0)
         for i in mine:
-            out[i] = (sides[0][0][i] - sides[1][0][i]) / (sides[0][1][i] - sides[1][1][i])
+            speed = sides[0][1][i] - sides[1][1][i]
+            # a path that does not lengthen with the coordinate adds no damping through it: its largest arm is
+            # round-off (Pose2Sim's LD_R12_r on L1_T12_Flex_Ext at -10 deg: 1.4e-17 m/rad), its speed and force
+            # unchanged, 0/0 (before: NaN in D, the chain refused)
+            out[i] = (sides[0][0][i] - sides[1][0][i]) / speed if speed != 0 else 0.0
     _activate(engine, acts)
     return out
 

@@ -43,7 +43,7 @@ from ..errors import ParameterError
 from ..model.linear_chain import LinearChain
 from .contract import AnatomyEngine
 from .identity import identity_text, model_identity
-from .remedy import INFEASIBLE_HINT, remedy, remedy_text
+from .remedy import INFEASIBLE_HINT, REMEDY_RERUN, remedy, remedy_text
 
 STABILITY = ("chain", "joints", "rhythm", "none")
 EQUILIBRIUM = ("rhythm", "free")
@@ -194,7 +194,11 @@ def optimise(
     Optimum
     """
     check_choices(stability, equilibrium, margin, weights)
-    free, constrained, lin = anatomy.chains(plane, posture, joint_stiffness, loads=loads)
+    if not len(anatomy.muscles):  # before: numpy's warnings, then the solver's solver_error
+        raise ParameterError(
+            "optimise", f"{anatomy.name} has no muscles: there are no activations to optimise (--optimise, --lordosis)"
+        )
+        free, constrained, lin = anatomy.chains(plane, posture, joint_stiffness, loads=loads)
     rows, tau_per, tau_0 = anatomy.equilibrium_rows(lin, plane, posture, equilibrium)
     w = anatomy.volume_weights() if weights == "volume" else np.ones(free.n_controls)
     opt = optimum_on_chains(free, constrained, lin, rows, tau_per, tau_0, w, stability, equilibrium, margin)
@@ -404,6 +408,9 @@ class OptimisedResult:
         (``--joint-stiffness``) from which the optimum is feasible (:func:`least_joint_stiffness`);
         inf where none up to :data:`MAX_REMEDY` is; NaN where not asked (the optimum solved, or the
         equilibrium fails).
+    rerun : str
+        What follows ``spinectl anatomy`` in the remedy's command to analyse this model again (its file and
+        mapping, :func:`~spinectl.anatomy.remedy.remedy_text`); the command line sets it.
     """
 
     anatomy: AnatomyEngine
@@ -414,6 +421,7 @@ class OptimisedResult:
     analysis: object
     skeleton: object = None
     remedy: float = float("nan")
+    rerun: str = REMEDY_RERUN
 
     @property
     def infeasible_constraint(self) -> str:
@@ -473,7 +481,7 @@ class OptimisedResult:
         str
         """
         rows = (("optimum", self.optimum), ("classic", self.classic))
-        lines = [identity_text(model_identity(self.anatomy))]
+        lines = [self._first_line()]
         for label, opt in rows:
             lines.append(_optimum_line(label, opt, self.margin))
             lines += hidden_torque_lines(opt)
@@ -481,10 +489,28 @@ class OptimisedResult:
         if self.infeasible_constraint == "equilibrium":
             lines.append(EQUILIBRIUM_HINT.format(residual=self.classic.residual, rows=self.classic.net_torque.size))
         elif self.infeasible_constraint == "stability":
-            lines.append(INFEASIBLE_HINT + remedy_text(self.remedy))
+            lines.append(INFEASIBLE_HINT + remedy_text(self.remedy, self.rerun))
         if self.analysis is not None:
             lines += ["", "at the optimum's activations:", self.analysis.table()]
         return "\n".join(lines)
+
+    def _first_line(self) -> str:
+        """The model, plane, posture and whose activations; for compliant tendons, where they were linearised."""
+        from .analyses import REFERENCE_POSTURE, plane_text
+
+        shown = self.analysis or self.skeleton
+        posture = shown.posture_source if shown is not None else REFERENCE_POSTURE
+        line = (
+            f"{identity_text(model_identity(self.anatomy))}, {plane_text(self.plane)}, posture: {posture}, "
+            "activations: the optimum's"
+        )
+        springs = getattr(getattr(self.anatomy, "engine", None), "springs", 0)
+        if springs:  # the optimum's chains were taken without activations: the tangent at each floor
+            line += (
+                f"; {springs} compliant-tendon muscles linearised at their activation floors for the optimum, at "
+                "the optimum's activations for the analysis below"
+            )
+        return line
 
     def _price_line(self) -> str:
         """The price of stability, or why there is none (an infeasible optimum has no cost to compare)."""
@@ -622,6 +648,7 @@ def optimised(
     at = {"posture": point.posture, "joint_stiffness": joint_stiffness, "reflex": reflex}
     if opt.ok:
         analysis = analyse(anatomy, plane, opt.activations, check=check, loads=loads, **at)
+        analysis = dataclasses.replace(analysis, activation_source="the optimum's")
     empty = skeleton(anatomy, opt, **kwargs, reflex=reflex)
     if point.posture_source:  # the file and its frame, where analyse saw the posture it read
         analysis, empty = (r and dataclasses.replace(r, posture_source=point.posture_source) for r in (analysis, empty))
@@ -693,6 +720,12 @@ CURVE_MEANING = (
     "not a lordosis at a fixed upright trunk"
 )
 """What the anatomy's lordosis axis is, said wherever its curve is shown (table and figure)."""
+
+CURVE_INACCURATE = (
+    "WARNING: {count} inaccurate (status optimal_inaccurate, marked {mark}: the solver did not meet its tolerances, "
+    "values may be far off)"
+)
+"""What the lordosis curve's table and figure say where some optima are ``optimal_inaccurate``, as ``sweep`` does."""
 
 CURVE_AXIS = "summed angle change [deg]"
 CURVE_AXIS_MEANING = (

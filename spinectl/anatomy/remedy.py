@@ -17,6 +17,8 @@ INFEASIBLE_HINT = (
 MAX_REMEDY = 1e5
 """The most stiffness per joint [N m/rad] the remedy searches (the paper's K is 15 N m/rad, Crisco and Panjabi's
 passive lumbar segments tens): a model that needs more has no remedy in added joint stiffness, and says so."""
+REMEDY_RERUN = "MODEL --mapping MAPPING"
+"""The model's place in the remedy's command where it was not run from the command line (the Python API)."""
 REMEDY_RTOL = 1e-3
 """Relative width of the bracket :func:`least_joint_stiffness` certifies (its upper end is feasible)."""
 
@@ -85,19 +87,23 @@ def remedy(anatomy, optimise_at, opt, classic, joint_stiffness, kwargs: dict) ->
     return least_joint_stiffness(feasible, given)
 
 
-def remedy_text(value: float) -> str:
+def remedy_text(value: float, rerun: str = REMEDY_RERUN) -> str:
     """The remedy as the table's hint ends it.
 
     Parameters
     ----------
     value : float
         :attr:`OptimisedResult.remedy` [N m/rad].
+    rerun : str, optional
+        What follows ``spinectl anatomy`` to analyse the same model again: the model and ``--mapping`` as given
+        (and the posture, plane and criterion where not the defaults), so that the suggested command runs on the
+        model analysed, not on MyoTorso; default :data:`REMEDY_RERUN` (the Python API, which has no command line).
 
     Returns
     -------
     str
-        ``"; feasible from 39.9 N m/rad at each chain joint: spinectl anatomy --optimise --joint-stiffness 40"``
-        (the value named rounded up to 3 digits, so still feasible); ``""`` for NaN.
+        ``"; feasible from 39.9 N m/rad at each chain joint: spinectl anatomy m.osim --mapping m.toml --optimise
+        --joint-stiffness 40"`` (the value named rounded up to 3 digits, so still feasible); ``""`` for NaN.
     """
     if np.isnan(value):
         return ""
@@ -105,7 +111,7 @@ def remedy_text(value: float) -> str:
         return f"; none up to {MAX_REMEDY:g} N m/rad at each chain joint makes it feasible"
     step = 10.0 ** (np.floor(np.log10(value)) - 2)  # three significant digits, rounded up: still feasible
     return (
-        f"; feasible from {value:.3g} N m/rad at each chain joint: spinectl anatomy --optimise "
+        f"; feasible from {value:.3g} N m/rad at each chain joint: spinectl anatomy {rerun} --optimise "
         f"--joint-stiffness {np.ceil(value / step) * step:.3g}"
     )
 

@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
+import shlex
 
 from ..anatomy.mapping import MAX_STIFFNESS
 from ..errors import ParameterError
@@ -251,6 +253,7 @@ def _answers(args) -> tuple:
             time=args.time,
             **loaded,
         )
+        result = dataclasses.replace(result, rerun=_rerun(args))
     else:
         result = analyse(
             anatomy,
@@ -314,6 +317,25 @@ def _loads(parsed) -> tuple:
     return body_loads(parsed)
 
 
+def _rerun(args) -> str:
+    """What follows ``spinectl anatomy`` to optimise the same model again: the model, its mapping and the options
+    that set the optimum (each only where given or not its default), quoted for a shell; the remedy's command."""
+    words = [str(args.model)]
+    options = (
+        ("--mapping", args.mapping, None),
+        ("--plane", args.plane, "sagittal"),
+        ("--posture", args.posture, None),
+        ("--time", args.time, None),
+        ("--stability", args.stability, "chain"),
+        ("--equilibrium", args.equilibrium, "rhythm"),
+        ("--margin", args.margin, 1.0),
+    )
+    for option, value, default in options:
+        if value is not None and value != default:
+            words += [option, f"{value:g}" if isinstance(value, float) else str(value)]
+    return shlex.join(words)
+
+
 def _joint_stiffness(text: str):
     """--joint-stiffness: ``none``, ``mapped`` or a stiffness in [0, MAX_STIFFNESS] N m/rad."""
     if text in ("none", "mapped"):
@@ -339,7 +361,7 @@ def _degrees(text: str):
 
 def _curve_table(curve: dict) -> str:
     """The lordosis curve as rows: each criterion's least cost (or its status) per posture."""
-    from ..anatomy.optimum import CURVE_AXIS, CURVE_AXIS_MEANING, CURVE_MEANING
+    from ..anatomy.optimum import CURVE_AXIS, CURVE_AXIS_MEANING, CURVE_INACCURATE, CURVE_MEANING
 
     lines = [
         "",
@@ -347,13 +369,18 @@ def _curve_table(curve: dict) -> str:
         f"{CURVE_AXIS}: {CURVE_AXIS_MEANING}; cost: the least sum of w_i a_i^2 [1] under each criterion",
         f"{CURVE_AXIS}  cost: classic  joint by joint  the chain (free)",
     ]
+    inaccurate = 0
     for i, deg in enumerate(curve["lordosis_deg"]):
         cells = []
         for criterion in ("none", "joints", "chain"):
             row = curve[criterion]
-            ok = row["status"][i] in ("optimal", "optimal_inaccurate")
-            cells.append(f"{row['cost'][i]:.4g}" if ok else row["status"][i])
+            status = row["status"][i]
+            inaccurate += status == "optimal_inaccurate"
+            mark = INACCURATE_MARK if status == "optimal_inaccurate" else ""
+            cells.append(f"{row['cost'][i]:.4g}{mark}" if status in ("optimal", "optimal_inaccurate") else status)
         lines.append(f"{deg:>{len(CURVE_AXIS)}.3g}  {cells[0]:>13}  {cells[1]:>14}  {cells[2]:>16}")
+    if inaccurate:
+        lines.append(CURVE_INACCURATE.format(count=inaccurate, mark=f"'{INACCURATE_MARK}' after the cost"))
     return "\n".join(lines)
 
 
@@ -378,3 +405,7 @@ def _contributions(args, anatomy, result):
         groups=dict(args.group or ()),
         optimum=optimum,
     )
+
+
+INACCURATE_MARK = "!"
+"""What follows a cost in the lordosis table where its optimum is ``optimal_inaccurate``."""

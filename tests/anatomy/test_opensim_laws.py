@@ -350,3 +350,22 @@ def test_the_cyclist_models_thelen_and_compliant_millard_muscles_are_opensims():
     assert "compliant-tendon muscle(s)" in lin.notes[0]
     _close(tau, ref_tau)
     _close(K, ref_K)
+
+
+def test_the_optimums_first_line_says_where_compliant_tendons_were_linearised(tmp_path):
+    """The optimum on four compliant Millard muscles: its table's first line names the plane, the posture, whose
+    activations ('the optimum's', not 'given') and that the optimum took their tangent at the activation floors
+    (``optimise`` linearises without activations), the analysis below at the optimum's own (before: the identity
+    only). Rigid De Groote muscles (the variant): no such clause, they are exact at every activation."""
+    from spinectl.anatomy.optimum import optimised
+
+    path = build(tmp_path / "chain.osim", "millard", compliant=True, pennation=PENNATION)
+    first = optimised(load_osim(path, mapping=_mapping(tmp_path)), stability="none").table().splitlines()[0]
+    assert ", sagittal plane, posture: the model's reference posture, activations: the optimum's" in first
+    assert first.endswith(
+        "4 compliant-tendon muscles linearised at their activation floors for the optimum, at the optimum's "
+        "activations for the analysis below"
+    )
+    rigid = build(tmp_path / "degroote.osim", "degroote")
+    first = optimised(load_osim(rigid, mapping=_mapping(tmp_path)), stability="none").table().splitlines()[0]
+    assert first.endswith("activations: the optimum's")

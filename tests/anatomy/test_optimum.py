@@ -234,3 +234,16 @@ def test_the_torque_the_rhythm_carries_is_in_the_table_beside_the_verdict(torso)
     assert f"largest {abs(expected).max():.3g} N m at L1_L2_FE" in line and 45 < abs(expected).max() < 60
     free = optimised(torso, stability="chain", joint_stiffness=50, equilibrium="free")
     assert "torque the rhythm carries" not in free.table()
+
+
+def test_the_optimums_table_names_plane_posture_and_the_optimums_activations(torso):
+    """MyoTorso's optimum (10 N m/rad added: feasible in the coronal plane too): the first line names the plane, the
+    posture and 'activations: the optimum's'; the analysis at the optimum says '(the optimum's)' and its JSON
+    ``activation_source`` too (before: 'given')."""
+    for plane, words in (("sagittal", "sagittal plane"), ("coronal", "coronal plane")):
+        result = optimised(torso, plane=plane, stability="none", joint_stiffness=10.0)
+        lines = result.table().splitlines()
+        assert f", {words}, posture: the model's reference posture, activations: the optimum's" in lines[0]
+        assert result.to_dict()["activation_source"] == "the optimum's"
+        analysed = lines[lines.index("at the optimum's activations:") + 1]
+        assert analysed.endswith("(the optimum's)")

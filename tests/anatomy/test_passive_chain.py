@@ -61,3 +61,24 @@ def test_an_mjcf_without_muscles_answers_its_passive_chain(tmp_path, capsys):
     assert doc["muscles"] == {"global": [], "local": [], "between": [], "non-lumbar": []}
     assert doc["chain_stable"] is True
     assert doc["activation_mean"] is None and "joint_rad_per_coordinate_rad" not in doc
+
+
+def test_a_model_without_muscles_says_so_and_refuses_activations(tmp_path, capsys):
+    """The table's first line says 'no muscles' (before: 'mean activation nan'); a joint that restores without any
+    damping is 'undamped' (its eigenvalues +-i w: before 'slowest time constant inf s'); --activation and
+    --optimise are refused in one line each, with no numpy warning (before: 'Mean of empty slice', then
+    'infeasible (the solver: solver_error)')."""
+    model_path, mapping = tmp_path / "bare.xml", tmp_path / "bare.toml"
+    model_path.write_text(BARE)
+    mapping.write_text(MAPPING)
+    base = ["anatomy", str(model_path), "--mapping", str(mapping)]
+    assert main(base) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].endswith("no muscles (the passive chain)") and "nan" not in lines[0]
+    j1 = next(x for x in lines if x.startswith("j1 "))  # 30 N m/rad spring beats gravity's 0.78 N m over 0.05 m
+    assert "self-stable, marginal: undamped" in j1 and "inf" not in j1
+    for extra, field in ((["--activation", "0.5"], "activation"), (["--optimise"], "optimise")):
+        assert main(base + extra) == 2
+        err = capsys.readouterr().err
+        assert err == f"spinectl: error: {field}: bare has no muscles" + err.split("has no muscles", 1)[1]
+        assert err.count("\n") == 1 and "warning" not in err
