@@ -198,7 +198,7 @@ def optimise(
         raise ParameterError(
             "optimise", f"{anatomy.name} has no muscles: there are no activations to optimise (--optimise, --lordosis)"
         )
-        free, constrained, lin = anatomy.chains(plane, posture, joint_stiffness, loads=loads)
+    free, constrained, lin = anatomy.chains(plane, posture, joint_stiffness, loads=loads)
     rows, tau_per, tau_0 = anatomy.equilibrium_rows(lin, plane, posture, equilibrium)
     w = anatomy.volume_weights() if weights == "volume" else np.ones(free.n_controls)
     opt = optimum_on_chains(free, constrained, lin, rows, tau_per, tau_0, w, stability, equilibrium, margin)

@@ -21,3 +21,7 @@ ABSENT = f"the shared downloaded models ({SHARED_MODELS}) are absent"
 POSE2SIM = SHARED_MODELS / "pose2sim-beaucage-gauvreau" / "Model_Pose2Sim_muscles_flex.osim"
 CYCLIST = SHARED_MODELS / "allaire-cyclist"
 CHRISTOPHY = SHARED_MODELS / "christophy-skeleton" / "Christophy2012_axialRotationUpd_skeletonOnly.osim"
+
+DOCUMENTED_MAPPINGS = Path(__file__).resolve().parents[2] / "docs" / "mappings"
+"""The published models' mappings that docs/anatomy.md shows ("Published models"): ``pose2sim.toml``,
+``cyclist.toml``, ``christophy.toml``."""

@@ -9,7 +9,7 @@ import pytest
 
 mujoco = pytest.importorskip("mujoco", reason="needs the anatomy extra: pip install 'spinectl[anatomy]'")
 
-from shared_models import ABSENT, CYCLIST  # noqa: E402 (tests/anatomy/shared_models.py)
+from shared_models import ABSENT, CYCLIST, DOCUMENTED_MAPPINGS  # noqa: E402 (tests/anatomy/shared_models.py)
 from test_passive_chain import BARE, MAPPING  # noqa: E402 (two hinges with springs, masses of 2 kg)
 
 from spinectl import anatomy  # noqa: E402
@@ -89,15 +89,8 @@ def test_the_published_cyclist_at_its_static_trial_is_far_from_equilibrium(tmp_p
 
 
 def _cyclist_mapping(folder):
-    """docs/anatomy.md's cyclist.toml, written into ``folder`` (the models' folder is only read)."""
-    import re
-    from pathlib import Path
-
-    docs = (Path(__file__).resolve().parents[2] / "docs" / "anatomy.md").read_text(encoding="utf-8")
-    block = next(b for b in re.findall(r"```toml\n(.*?)```", docs, re.S) if b.startswith("# s01modelScaled"))
-    path = folder / "cyclist.toml"
-    path.write_text(block)
-    return path
+    """docs/anatomy.md's cyclist.toml (docs/mappings/, as the page shows it)."""
+    return DOCUMENTED_MAPPINGS / "cyclist.toml"
 
 
 def test_an_optimum_held_by_the_rhythm_is_not_called_far(torso):

@@ -6,7 +6,7 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
-from shared_models import ABSENT, POSE2SIM  # noqa: E402 (tests/anatomy/shared_models.py)
+from shared_models import ABSENT, DOCUMENTED_MAPPINGS, POSE2SIM  # noqa: E402 (tests/anatomy/shared_models.py)
 
 from spinectl.anatomy import opensim_muscles
 
@@ -52,15 +52,10 @@ def test_pose2sims_chain_at_minus_ten_degrees_has_finite_damping(tmp_path):
     """Pose2Sim moved -10 deg along its rhythm (the trial's --lordosis -10:10:5 failed there): the chains are
     built, their damping finite."""
     pytest.importorskip("opensim", reason="needs the opensim extra: pip install 'spinectl[opensim]'")
-    import re
-    from pathlib import Path
 
     from spinectl import anatomy
 
-    docs = (Path(__file__).resolve().parents[2] / "docs" / "anatomy.md").read_text(encoding="utf-8")
-    block = next(b for b in re.findall(r"```toml\n(.*?)```", docs, re.S) if b.startswith("# Model_Pose2Sim"))
-    mapping = tmp_path / "pose2sim.toml"
-    mapping.write_text(block)
+    mapping = DOCUMENTED_MAPPINGS / "pose2sim.toml"  # docs/anatomy.md's, as the page shows it
     loaded = anatomy.load(POSE2SIM, mapping, cache=False)
     free, constrained, _ = loaded.chains("sagittal", loaded.lordosis_posture(-10.0, "sagittal"))
     assert np.all(np.isfinite(free.damping_per_control)) and np.all(np.isfinite(constrained.damping_per_control))
