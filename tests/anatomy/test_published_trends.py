@@ -11,69 +11,17 @@ The index is the least eigenvalue lambda_min of -sym(K) of the free sagittal lum
 
 from __future__ import annotations
 
-import dataclasses
-import re
-
 import numpy as np
 import pytest
 
 from spinectl.anatomy.contributions import optimum_resolver
-from spinectl.anatomy.loads import BodyLoad
-from spinectl.anatomy.optimum import _lumbar_only, optimise, solve_on_chain
+from spinectl.anatomy.optimum import optimise
+from spinectl.anatomy.trends import GROUPS, co_contraction_path, stability_price
 from spinectl.model.contributions import contributions, least_mode
 
-GRAVITY = 9.81
-"""[m/s^2]."""
-
-BODY_MASS = 75.0
-"""Body mass [kg] whose weight scales the held loads: a nominal adult. MyoTorso models the pelvis, lumbar spine,
+BODY_WEIGHT = 75.0 * 9.81
+"""A nominal adult's weight [N] (75 kg) that scales the loads held: MyoTorso models the pelvis, lumbar spine,
 thorax and head only (37 kg), so its own mass is no body weight."""
-
-GROUPS = {
-    "erector_spinae": "IL|LTp",  # iliocostalis, longissimus thoracis pars thoracis (LTpT) and lumborum (LTpL)
-    "multifidus": "MF",
-    "quadratus_lumborum": "QL",
-    "psoas": "Ps",
-    "obliques": "EO|IO",  # external and internal obliques
-    "rectus": "rect",  # rectus abdominis (rect_abd_r, rect_abd_l)
-}
-"""Cholewicki & VanVliet's muscle groups as MyoTorso's name prefixes (each matched at the start of a name)."""
-
-ABDOMINALS = "EO|IO|rect"
-"""The antagonists of an upright hold (its net moment is an extension moment): the abdominal flexors."""
-
-
-def _lambda_min(chain, a) -> float:
-    return least_mode(chain.stiffness(a)).eigenvalue
-
-
-def _co_contraction(torso, floors, joint_stiffness="mapped"):
-    """The least-effort activations holding the reference posture with every abdominal muscle at least at each
-    floor [1] (the extensors re-solved so that the net moment stays that of the upright hold): the free chain,
-    each optimum's activations and the lumbar muscles' force per unit activation [N]."""
-    free, _, lin = torso.chains("sagittal", None, joint_stiffness)
-    _, tau_per, tau_0 = torso.equilibrium_rows(lin, "sagittal", None, "rhythm")
-    lumbar = _lumbar_only(free)
-    abdominal = np.array([bool(re.match(ABDOMINALS, c)) for c in free.controls])
-    weights = torso.volume_weights()
-    out = []
-    for floor in floors:
-        chain = dataclasses.replace(lumbar, lower=np.where(abdominal, floor, lumbar.lower))
-        status, a = solve_on_chain(chain, tau_per, tau_0, weights, "none", 1.0)
-        assert status == "optimal"
-        assert np.max(np.abs(tau_per @ a + tau_0)) < 1e-6  # the net moment kept [N m]
-        out.append(a)
-    return free, np.array(out), _muscle_force_per_activation(torso)
-
-
-def _muscle_force_per_activation(torso) -> np.ndarray:
-    """Each muscle's force at full activation at the reference posture, zero velocity [N] (MuJoCo's own)."""
-    import mujoco
-
-    engine = torso.engine
-    engine.set_state(torso.posture(), np.ones(engine.model.na))
-    mujoco.mj_fwdActuation(engine.model, engine.data)
-    return -engine.data.actuator_force[engine.muscle_ids()]  # MuJoCo's muscle force is a pull: negative
 
 
 def test_co_contraction_raises_stability_less_than_compression_on_myotorso_granata_marras_2000(torso):
@@ -101,23 +49,13 @@ def test_co_contraction_raises_stability_less_than_compression_on_myotorso_grana
     Asserted: both rise strictly, and their relative rises are below 0.2 of the compression's (measured 0.07 and
     0.05), so a change that brings the model to the paper's ratio fails here and is seen.
     """
-    from scipy.optimize import brentq
-
-    floors = np.linspace(0.0, 0.08, 5)
-    free, path, force = _co_contraction(torso, floors)
-    lumbar = np.array([c != "non-lumbar" for c in free.control_class])
-    compression = path[:, lumbar] @ force[lumbar]
-    index = np.array([_lambda_min(free, a) for a in path])
-    loaded, _, _ = torso.chains("sagittal", None, "mapped", loads=[BodyLoad("torso", (0.0, 0.0, -1.0))])
-    per_newton = loaded.stiffness_offset - free.stiffness_offset  # K_load of 1 N downward [N m/rad per N]
-    critical = np.array(
-        [brentq(lambda p, k=free.stiffness(a): least_mode(k + p * per_newton).eigenvalue, 0.0, 1e6) for a in path]
-    )
-    assert np.all(np.diff(index) > 0) and np.all(np.diff(critical) > 0)  # the paper's direction
-    assert np.all(np.diff(compression) > 0)
-    rise = compression[-1] / compression[0] - 1
-    assert index[-1] / index[0] - 1 < 0.2 * rise  # the paper: 34-64 % against 12-18 %
-    assert critical[-1] / critical[0] - 1 < 0.2 * rise
+    path = co_contraction_path(torso, np.linspace(0.0, 0.08, 5))
+    assert np.all(path.residual < 1e-6)  # the net moment kept [N m]
+    assert np.all(np.diff(path.index) > 0) and np.all(np.diff(path.critical_load) > 0)  # the paper's direction
+    assert np.all(np.diff(path.compression) > 0)
+    rise = path.rise(path.compression)
+    assert path.rise(path.index) < 0.2 * rise  # the paper: 34-64 % against 12-18 %
+    assert path.rise(path.critical_load) < 0.2 * rise
 
 
 def test_the_co_activation_stability_needs_rises_with_the_load_held_cholewicki_1997(torso):
@@ -128,30 +66,27 @@ def test_the_co_activation_stability_needs_rises_with_the_load_held_cholewicki_1
     stability to the lumbar spine".
 
     Computed: a vertical load at the thorax (``torso``'s origin, fixed in the ground), 0 to 60 % of a 75 kg body's
-    weight (:data:`BODY_MASS`; Cholewicki & VanVliet 2002 loaded 0-60 % of body weight), at MyoTorso's reference
+    weight (:data:`BODY_WEIGHT`; Cholewicki & VanVliet 2002 loaded 0-60 % of body weight), at MyoTorso's reference
     posture; the least effort sum w_i a_i^2 with the chain criterion (-K >= 1 N m/rad) and without (equilibrium
-    only); their difference is the effort stability costs, the model's co-activation for stability. The added
-    joint stiffness is 100 N m/rad: at the mapping's 344 N m/rad the classic optimum is stable at every load here,
-    so the criterion never binds and the model needs no co-activation at all (a disagreement at that stiffness: the
-    passive joints carry the stability); at 50 N m/rad the criterion is infeasible from 40 % of body weight on.
-    Asserted: the stability's price rises strictly with the load and the optimum with the criterion costs more at
-    60 % than unloaded (measured 0.04 unloaded to 10.7 at 60 %), while the classic optimum's cost stays within
-    20 % (the load's moment about the joints is small: it acts near the joints' line), so the rise is the
-    stability's, not the moment's.
+    only), :func:`spinectl.anatomy.trends.stability_price`; their difference is the effort stability costs, the
+    model's co-activation for stability. The added joint stiffness is 100 N m/rad. Where the model disagrees: at
+    the mapping's 344 N m/rad (Miller et al. 1986) the classic optimum is stable at every load here, so the
+    criterion never binds and the model needs no co-activation at all (the passive joints carry the stability;
+    their stiffness, measured under large loads, is the upper end of what the literature gives); at 50 N m/rad
+    the criterion is infeasible from 30 % of body weight on (no activation stabilises the chain).
+    Asserted: at 100 N m/rad the stability's price rises strictly with the load, from under a tenth of its value
+    at 60 % unloaded (measured 0.04 to 10.7), while the classic optimum's cost stays within 20 % of its unloaded
+    value (measured: it falls by 11 %: the load at the thorax's origin lessens the moment the extensors hold), so
+    the rise is the stability's, not the moment's; at the mapped stiffness the price is 0 at every load (to
+    1e-6 of the cost: the solver's tolerance).
     """
-    loads = np.linspace(0.0, 0.6, 7) * BODY_MASS * GRAVITY
-    chain_cost, classic_cost = [], []
-    for load in loads:
-        held = [BodyLoad("torso", (0.0, 0.0, -float(load)))]
-        stable = optimise(torso, stability="chain", joint_stiffness=100.0, loads=held)
-        classic = optimise(torso, stability="none", joint_stiffness=100.0, loads=held)
-        assert stable.ok and classic.ok
-        chain_cost.append(stable.cost)
-        classic_cost.append(classic.cost)
-    price = np.array(chain_cost) - np.array(classic_cost)
-    assert np.all(np.diff(price) > 0)
-    assert price[0] < 0.1 * price[-1]
-    assert np.ptp(classic_cost) < 0.2 * classic_cost[0]
+    result = stability_price(torso, np.linspace(0.0, 0.6, 7) * BODY_WEIGHT, joint_stiffness=100.0)
+    assert np.all(np.isfinite(result.stable_cost))
+    assert np.all(np.diff(result.price) > 0)
+    assert result.price[0] < 0.1 * result.price[-1]
+    assert np.ptp(result.classic_cost) < 0.2 * result.classic_cost[0]
+    passive = stability_price(torso, np.linspace(0.0, 0.6, 7) * BODY_WEIGHT, joint_stiffness="mapped")
+    assert np.all(np.abs(passive.price) < 1e-6 * passive.classic_cost)  # the disagreement: no price at all
 
 
 def test_no_group_removal_changes_stability_by_more_than_30_percent_in_an_upright_hold_cholewicki_vanvliet_2002(
@@ -197,7 +132,26 @@ def test_at_a_stability_constrained_optimum_a_group_removal_changes_the_index_by
     """
     free, _, _ = torso.chains("sagittal", None, 50.0)
     opt = optimise(torso, stability="chain", joint_stiffness=50.0)
-    assert opt.ok and _lambda_min(free, opt.activations) == pytest.approx(1.0, abs=1e-6)
+    assert opt.ok and least_mode(free.stiffness(opt.activations)).eigenvalue == pytest.approx(1.0, abs=1e-6)
     kept = contributions(free, opt.activations, groups=GROUPS).removals
     for group in ("erector_spinae", "obliques", "quadratus_lumborum", "multifidus"):
         assert kept[f"group:{group}"].percent_change < -100.0, group
+
+
+@pytest.mark.parametrize(
+    ("call", "field"),
+    [
+        (lambda t: co_contraction_path(t, [0.0, 1.5]), "floors"),
+        (lambda t: co_contraction_path(t, [[0.0, 0.1]]), "floors"),
+        (lambda t: co_contraction_path(t, [0.0], antagonists="nomuscle"), "antagonists"),
+        (lambda t: co_contraction_path(t, [0.9]), "floors"),  # every abdominal at 0.9: the hold is infeasible
+        (lambda t: stability_price(t, [0.0, -10.0]), "loads"),
+    ],
+)
+def test_the_trends_refuse_what_they_cannot_compute_in_one_line(torso, call, field):
+    """Floors outside [0, 1] or not a vector, an expression that matches no muscle, a floor at which the hold is
+    infeasible, an upward load: one ParameterError naming the field."""
+    from spinectl.errors import ParameterError
+
+    with pytest.raises(ParameterError, match=field):
+        call(torso)
