@@ -147,7 +147,7 @@ def co_contraction_path(
             dataclasses.replace(lumbar, lower=np.where(chosen, floor, lumbar.lower)), tau_per, tau_0, weights, "none", 0
         )
         if not np.all(np.isfinite(a)):
-            raise ParameterError("floors", f"leave the hold infeasible at {floor:g} ({status})")
+            raise ParameterError("floors", f"must leave the hold feasible (got {floor:g}: the optimum is {status})")
         path.append(a)
     path = np.array(path)
     crossing = np.array([c != "non-lumbar" for c in free.control_class])

@@ -45,7 +45,8 @@ def test_co_contraction_raises_stability_less_than_compression_on_myotorso_grana
     where the paper's is 34-64 % against 12-18 % (a ratio of about 2 to 5). Why: in MyoTorso at the mapped
     stiffness the index is mostly the passive joints' (the muscles add 0.68 N m/rad per 0.01 of abdominal
     activation against 344 N m/rad per joint), and the abdominals' stiffness along the least-stable mode is small
-    against their force; Granata & Marras's eight-muscle model had no passive joint stiffness of this size.
+    against their force (the abstract does not say what passive stiffness their model had, so the test does not
+    claim the cause of the difference lies there; it says where the model's index comes from).
     Asserted: both rise strictly, and their relative rises are below 0.2 of the compression's (measured 0.07 and
     0.05), so a change that brings the model to the paper's ratio fails here and is seen.
     """
