@@ -72,11 +72,11 @@ def test_the_co_activation_stability_needs_rises_with_the_load_held_cholewicki_1
     only), :func:`spinectl.anatomy.trends.stability_price`; their difference is the effort stability costs, the
     model's co-activation for stability. The added joint stiffness is 100 N m/rad. Where the model disagrees: at
     the mapping's 344 N m/rad (Miller et al. 1986) the classic optimum is stable at every load here, so the
-    criterion never binds and the model needs no co-activation at all (the passive joints carry the stability;
-    their stiffness, measured under large loads, is the upper end of what the literature gives); at 50 N m/rad
+    criterion never binds and the model needs no co-activation at all (the passive joints carry the stability);
+    at 50 N m/rad
     the criterion is infeasible from 30 % of body weight on (no activation stabilises the chain).
-    Asserted: at 100 N m/rad the stability's price rises strictly with the load, from under a tenth of its value
-    at 60 % unloaded (measured 0.04 to 10.7), while the classic optimum's cost stays within 20 % of its unloaded
+    Asserted: at 100 N m/rad the stability's price rises strictly with the load, unloaded under a tenth of its
+    value at 60 % (measured 0.04 and 10.7), while the classic optimum's cost stays within 20 % of its unloaded
     value (measured: it falls by 11 %: the load at the thorax's origin lessens the moment the extensors hold), so
     the rise is the stability's, not the moment's; at the mapped stiffness the price is 0 at every load (to
     1e-6 of the cost: the solver's tolerance).
@@ -100,7 +100,9 @@ def test_no_group_removal_changes_stability_by_more_than_30_percent_in_an_uprigh
 
     Computed: MyoTorso's upright hold (reference posture, the mapping's passive stiffness 344 N m/rad), the
     least-effort optimum with equilibrium only (standing in for their EMG-driven forces), and the removal method
-    (:func:`spinectl.model.contributions.contributions`) of each group of :data:`GROUPS` with the optimum re-solved
+    (:func:`spinectl.model.contributions.contributions`) of six groups by MyoTorso's name prefixes
+    (:data:`spinectl.anatomy.trends.GROUPS`: erector spinae IL|LTp, multifidus MF, quadratus lumborum QL, psoas
+    Ps, obliques EO|IO, rectus abdominis rect; the paper had ten) with the optimum re-solved
     (:func:`spinectl.anatomy.contributions.optimum_resolver`), and with the others kept.
 
     The model agrees for every group whose removal still holds the posture: each changes lambda_min by less than
@@ -128,8 +130,9 @@ def test_at_a_stability_constrained_optimum_a_group_removal_changes_the_index_by
     50 N m/rad, margin 1 N m/rad: the least effort that is just stable) the index is the margin, so any group's
     removal with the others kept changes it by multiples of itself (measured: erector spinae -2800 %, obliques
     -2700 %, quadratus lumborum -930 %, multifidus -130 %), and re-solved it returns to the margin (0 %) or is
-    infeasible. A percent change of an index held at its least value is not the paper's measure: their subjects'
-    index was far from 0. Asserted: the four active groups each below -100 % with the others kept.
+    infeasible. A percent change of an index that an optimiser holds at its least value is not the paper's
+    measure (theirs was of the index from EMG-driven forces). Asserted: the four active groups each below -100 %
+    with the others kept.
     """
     free, _, _ = torso.chains("sagittal", None, 50.0)
     opt = optimise(torso, stability="chain", joint_stiffness=50.0)
