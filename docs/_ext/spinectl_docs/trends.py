@@ -104,6 +104,15 @@ value("trends.compression_rise")(lambda: _percent(co_contraction().rise(co_contr
 value("trends.price_low")(lambda: f"{price().price[0]:.2g}")
 value("trends.price_high")(lambda: f"{price().price[-1]:.3g}")
 value("trends.classic_fall")(lambda: _percent(1 - price().classic_cost[-1] / price().classic_cost[0]))
+
+
+def _infeasible_from(joint_stiffness: float = 50.0) -> str:
+    """The least fraction of body weight at which the chain criterion is infeasible [%]."""
+    infeasible = np.flatnonzero(~np.isfinite(price(joint_stiffness).stable_cost))
+    return f"{100 * FRACTIONS[infeasible[0]]:.0f}" if infeasible.size else "(none: feasible at every load)"
+
+
+value("trends.infeasible_from_50")(_infeasible_from)
 value("trends.removal_largest")(_largest_feasible_removal)
 value("trends.erector_kept")(lambda: f"{removals()['kept']['group:erector_spinae'].percent_change:.1f}")
 value("trends.chain_low")(lambda: f"{chain_stiffness()[0]:.0f}")
