@@ -31,9 +31,9 @@ def test_the_least_added_stiffness_rises_with_the_load_held_on_the_papers_chain_
     (:func:`spinectl.optimise.coupled.local.least_local_stiffness`, the SDP with margin mu), the model's measure
     of the stability that must be added. A weight held destabilises as gravity does (K_load = -F_y h on a single
     joint), so the need rises: measured 252 N m/rad unloaded to 1283 N m/rad at 60 %, strictly at each step
-    (one joint's share may fall while the sum rises: L4L5's does up to 30 %). Asserted: strictly rising, and the
-    chain at the least stiffness is stable (lambda_min of -K > 0) at each load, and the chain without local
-    stiffness loses stability (its lambda_min falls) at each step.
+    (one joint's share may fall while the sum rises: L4L5's and L5S1's do up to 20 %, L5S1's again at 40 %).
+    Asserted: strictly rising, and the chain at the least stiffness is stable (lambda_min of -K > 0) at each
+    load, and the chain without local stiffness loses stability (its lambda_min falls) at each step.
     """
     model = load_preset("wagner2012")
     point = point_at_activation(model, 0.03, 0.04)
