@@ -86,7 +86,18 @@ class CoContraction:
     residual: np.ndarray
 
     def rise(self, values) -> float:
-        """The relative rise of ``values`` from the first floor to the last [1]."""
+        """The relative rise of ``values`` from the first floor to the last.
+
+        Parameters
+        ----------
+        values : array_like, shape (p,)
+            One of the path's series (``index``, ``critical_load``, ``compression``).
+
+        Returns
+        -------
+        float
+            values[-1] / values[0] - 1 [1].
+        """
         return float(values[-1] / values[0] - 1.0)
 
 
