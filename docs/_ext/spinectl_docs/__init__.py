@@ -59,6 +59,7 @@ from . import (
     reexports,
     reflex,
     reproduction,
+    trends,
     values,
 )
 
@@ -79,7 +80,7 @@ MEASURED_TABLES = (
 )
 """The tables of what commands print, measured at the build: (file in ``_generated/``, its generator)."""
 
-MEASURED_VALUES = (anatomy, chain, errata, interchange, reflex)
+MEASURED_VALUES = (anatomy, chain, errata, interchange, reflex, trends)
 """The modules that register ``{measured}`` values (:func:`.values.value`) when imported."""
 
 
