@@ -80,8 +80,10 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=1, help="runs per configuration, taking turns; fastest counts")
     args = parser.parse_args()
     runs = {"1 worker": ["--workers", "1"], "2 workers": ["--workers", "2"]}
-    print(f"== study of motions: {args.frames} MyoTorso frames in {args.trials} trials, chunks of "
-          f"{args.chunk_frames} frames, activations given; {os.cpu_count()} cores")
+    print(
+        f"== study of motions: {args.frames} MyoTorso frames in {args.trials} trials, chunks of "
+        f"{args.chunk_frames} frames, activations given; {os.cpu_count()} cores"
+    )
     with tempfile.TemporaryDirectory() as folder:
         path = study_file(Path(folder), args.frames, args.trials, args.chunk_frames)
         print(f"{load_motion_study(path).n_chunks} chunks")
@@ -99,8 +101,10 @@ def main() -> None:
                 if name not in best or r["wall"] < best[name]["wall"]:
                     best[name] = r
         one, two = best["1 worker"], best["2 workers"]
-        print(f"speed-up 1 -> 2 workers: {one['wall'] / two['wall']:.2f}x (wall), {one['run'] / two['run']:.2f}x (run)"
-              f"; target (issue 35): 1.6x")
+        print(
+            f"speed-up 1 -> 2 workers: {one['wall'] / two['wall']:.2f}x (wall), {one['run'] / two['run']:.2f}x (run)"
+            f"; target (issue 35): 1.6x"
+        )
         trials = {name: load_motions(r["store"]) for name, r in best.items()}
         first, *others = trials.values()
         for other in others:

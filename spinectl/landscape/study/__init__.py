@@ -3,9 +3,9 @@
 A study file (``docs/studies.md``) names a base model, the E x Lambda grid, any number of
 parameter axes and Monte-Carlo draws, and the outputs. :func:`load_study` validates it into a
 :class:`Study`; :func:`run_study` solves it chunk by chunk (in-process, on a local Dask cluster or
-on an existing one) into a Zarr store that it can resume; :func:`load` reads the store back. A study of motions (``[[trials]]``,
-docs/motion.md) runs :func:`spinectl.anatomy.motion.motion_response` on every trial, chunked by frames, on the same
-executor (:func:`run_motion_study`, :func:`load_motions`). The
+on an existing one) into a Zarr store that it can resume; :func:`load` reads the store back.
+A study of motions (``[[trials]]``, docs/motion.md) runs :func:`spinectl.anatomy.motion.motion_response`
+on every trial, chunked by frames, on the same executor (:func:`run_motion_study`, :func:`load_motions`). The
 modules: CONTRIBUTING.md's map.
 """
 

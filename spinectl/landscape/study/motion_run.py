@@ -25,6 +25,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+from ..._threads import with_one_blas_thread
 from ...atomic import atomic_path
 from ...errors import OutputError, ParameterError
 from .. import netcdf
@@ -84,6 +85,7 @@ def _recording(path: str, field: str):
     return read_recording(path, field)
 
 
+@with_one_blas_thread  # many small matrices per frame, as the CLI's commands; picklable by its module's name
 def solve_motion_chunk(task: MotionTask) -> tuple:
     """One chunk: :func:`~spinectl.anatomy.motion.motion_response` on the trial's frames ``task.frames``.
 
@@ -122,8 +124,16 @@ def motion_tasks(study: MotionStudy, indices):
         chunk = study.chunk(index)
         t = study.trials[chunk.trial]
         yield MotionTask(
-            int(index), t.model, t.mapping, t.coordinates, t.activations, t.optimise, chunk.frames, t.plane,
-            t.joint_stiffness, t.least_stiffness,
+            int(index),
+            t.model,
+            t.mapping,
+            t.coordinates,
+            t.activations,
+            t.optimise,
+            chunk.frames,
+            t.plane,
+            t.joint_stiffness,
+            t.least_stiffness,
         )
 
 
@@ -284,7 +294,9 @@ def _concatenated(datasets):
 
     if len(datasets) == 1:
         return datasets[0]
-    return xr.concat(datasets, dim="time", data_vars="minimal", coords="minimal", join="outer", combine_attrs="override")
+    return xr.concat(
+        datasets, dim="time", data_vars="minimal", coords="minimal", join="outer", combine_attrs="override"
+    )
 
 
 def load_motions(path: str | Path) -> dict:

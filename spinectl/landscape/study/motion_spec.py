@@ -135,7 +135,9 @@ class MotionStudy:
     text: str = field(default="", compare=False)
 
     def __post_init__(self):
-        object.__setattr__(self, "chunk_frames", v.integer("study.chunk_frames", self.chunk_frames, 1, MAX_CHUNK_FRAMES))
+        object.__setattr__(
+            self, "chunk_frames", v.integer("study.chunk_frames", self.chunk_frames, 1, MAX_CHUNK_FRAMES)
+        )
         if not isinstance(self.description, str):
             raise ParameterError("study.description", f"must be a string (got {show(self.description)})")
         chunks = [(t, f) for t, trial in enumerate(self.trials) for f in trial.chunks(self.chunk_frames)]
@@ -168,7 +170,9 @@ class MotionStudy:
         trials = []
         for t in self.trials:
             files = {k: _file_digest(getattr(t, k)) for k in ("model", "mapping", "coordinates", "activations")}
-            trials.append([t.name, t.optimise, list(t.frames), t.plane, str(t.joint_stiffness), t.least_stiffness, files])
+            trials.append(
+                [t.name, t.optimise, list(t.frames), t.plane, str(t.joint_stiffness), t.least_stiffness, files]
+            )
         content = {"format": MOTION_FORMAT, "trials": trials, "chunk_frames": self.chunk_frames}
         return hashlib.sha256(json.dumps(content, sort_keys=True).encode()).hexdigest()
 
@@ -265,8 +269,10 @@ def _trial(where: str, row: dict, base: Path) -> Trial:
         raise ParameterError(f"{where}.name", f"must not contain '/' (it names the trial's file; got {show(name)})")
     model = _string(f"{where}.model", row["model"])
     model = model if model in BUILTIN_MODELS else _file(f"{where}.model", model, base)
-    files = {k: _file(f"{where}.{k}", _string(f"{where}.{k}", row[k]), base) if k in row else None
-             for k in ("mapping", "coordinates", "activations")}
+    files = {
+        k: _file(f"{where}.{k}", _string(f"{where}.{k}", row[k]), base) if k in row else None
+        for k in ("mapping", "coordinates", "activations")
+    }
     optimise = v.choice(f"{where}.optimise", row.get("optimise", "none"), OPTIMISE)
     if optimise != "none" and files["activations"] is not None:
         raise ParameterError(f"{where}.activations", "cannot go with optimise, which finds the activations itself")
@@ -286,7 +292,9 @@ def _trial(where: str, row: dict, base: Path) -> Trial:
         frames=frames,
         plane=_string(f"{where}.plane", row.get("plane", "sagittal")),
         joint_stiffness=_stiffness(f"{where}.joint_stiffness", row.get("joint_stiffness", "none")),
-        least_stiffness=None if "least_stiffness" not in row else _bounded(f"{where}.least_stiffness", row["least_stiffness"]),
+        least_stiffness=None
+        if "least_stiffness" not in row
+        else _bounded(f"{where}.least_stiffness", row["least_stiffness"]),
     )
 
 
@@ -326,7 +334,9 @@ def _frames(where: str, value, n: int) -> tuple:
         if not all(isinstance(x, int) and not isinstance(x, bool) for x in numbers):
             raise ValueError
     except ValueError:
-        raise ParameterError(where, f"must be \"FIRST:LAST\" or \"FIRST:LAST:STEP\", frame indices from 0 (got {show(value)})") from None
+        raise ParameterError(
+            where, f'must be "FIRST:LAST" or "FIRST:LAST:STEP", frame indices from 0 (got {show(value)})'
+        ) from None
     return tuple((numbers + [1])[:3])
 
 
