@@ -242,3 +242,20 @@ def test_cli_runs_resumes_and_refuses_in_one_line(folder, tmp_path, capsys):
     err = capsys.readouterr().err
     assert err.startswith("spinectl: error: trials[0].coordinates:") and err.count("\n") == 1
     assert not (tmp_path / "t").exists()
+
+
+@pytest.mark.parametrize(("key", "field"), [("model", "model"), ("mapping", "mapping")])
+def test_a_model_that_does_not_load_is_one_line_naming_the_trial_and_leaves_no_store(
+    folder, tmp_path, capsys, key, field
+):
+    """A model or mapping file that its engine refuses (read by the worker, once): one line naming the file's
+    field and the trial, exit 2, no store made (it is made at the first chunk written)."""
+    (tmp_path / "bad.xml").write_text("<mujoco")
+    text = TRIAL.replace("'flexion.mot'", repr(str(folder / "flexion.mot")))
+    text += f"{key} = {str(tmp_path / 'bad.xml')!r}\n" if key == "mapping" else ""
+    text = text.replace("'myotorso'", repr(str(tmp_path / "bad.xml"))) if key == "model" else text
+    out = tmp_path / "s"
+    assert main(["study", str(write(tmp_path, text)), "--out", str(out), "--scheduler", "synchronous"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"spinectl: error: {field}:") and err.rstrip().endswith("(trial 'a')")
+    assert err.count("\n") == 1 and not out.exists()

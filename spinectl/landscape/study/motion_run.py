@@ -55,6 +55,8 @@ class MotionTask:
         As :func:`spinectl.anatomy.motion.motion_response` takes them.
     frames : tuple of int
         ``(first, last, step)`` of the file's frames.
+    trial : str
+        The trial's name, for messages.
     """
 
     index: int
@@ -67,6 +69,7 @@ class MotionTask:
     plane: str
     joint_stiffness: object
     least_stiffness: float | None
+    trial: str = ""
 
 
 @functools.lru_cache(maxsize=8)
@@ -102,7 +105,10 @@ def solve_motion_chunk(task: MotionTask) -> tuple:
     """
     from ...anatomy.motion import motion_response
 
-    anatomy = _anatomy(task.model, task.mapping)
+    try:
+        anatomy = _anatomy(task.model, task.mapping)
+    except ParameterError as exc:  # a model or mapping that does not load: say which trial's
+        raise type(exc)(exc.field, f"{exc.message} (trial {task.trial!r})") from None
     activations = None if task.activations is None else _recording(task.activations, "activations")
     result = motion_response(
         anatomy,
@@ -134,6 +140,7 @@ def motion_tasks(study: MotionStudy, indices):
             t.plane,
             t.joint_stiffness,
             t.least_stiffness,
+            t.name,
         )
 
 
@@ -197,10 +204,9 @@ def run_motion_study(
             results = where.as_completed(
                 solve_motion_chunk, motion_tasks(study, todo), key=lambda task: f"{prefix}-{task.index}"
             )
-            if not out.exists():
-                _create(study, out)
             _write_chunks(study, out, done, results, progress)
-        _assemble(study, out, done)
+        if out.exists():
+            _assemble(study, out, done)
     seconds = time.perf_counter() - start
     return StudyResult(out, study.n_chunks, done_before, len(todo), seconds, where.where, where.addresses)
 
@@ -265,6 +271,8 @@ def _write_chunks(study: MotionStudy, out: Path, done: set, results, progress: b
     disable = None if progress is None else not progress
     with tqdm(total=study.n_chunks, initial=len(done), unit="chunk", desc="motions", disable=disable) as bar:
         for index, dataset in results:
+            if not out.exists():  # at the first chunk: a model that does not load leaves no store behind
+                _create(study, out)
             netcdf.save(dataset, _chunk_path(out, index))
             done.add(index)
             bar.update()
