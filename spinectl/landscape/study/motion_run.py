@@ -27,12 +27,12 @@ from pathlib import Path
 
 from ..._threads import with_one_blas_thread
 from ...atomic import atomic_path
-from ...errors import OutputError, ParameterError
+from ...errors import ParameterError
 from .. import netcdf
 from . import store
-from .executor import CONNECT_TIMEOUT, WORKER_TIMEOUT, check_options, executor
+from .executor import CONNECT_TIMEOUT, WORKER_TIMEOUT, executor
 from .motion_spec import MOTION_FORMAT, MotionStudy
-from .run import StudyResult
+from .run import StudyResult, check_run_options
 
 MANIFEST = "motion_study.json"
 """The store's description: format, the study's digest and file."""
@@ -189,9 +189,7 @@ def run_motion_study(
         ``out`` exists without ``resume``, or cannot be written.
     """
     timeouts = {"connect_timeout": connect_timeout, "worker_timeout": worker_timeout}
-    check_options(scheduler, workers, **timeouts)
-    if max_chunks is not None and (isinstance(max_chunks, bool) or not isinstance(max_chunks, int) or max_chunks < 0):
-        raise ParameterError("max_chunks", f"must be an integer >= 0 (got {max_chunks!r})")
+    check_run_options(scheduler, workers, max_chunks, **timeouts)
     start, notify = time.perf_counter(), notify or (lambda line: None)
     out = Path(out)
     with store.locked(out):
@@ -225,10 +223,7 @@ def _existing(study: MotionStudy, out: Path, resume: bool, notify) -> set:
     if not (out.exists() or out.is_symlink()):
         return set()
     if not resume:
-        raise OutputError(
-            f"{str(out)!r} exists: add --resume to continue the study it holds, or remove it to start "
-            "afresh (a study store is filled in place and never replaced, which would discard its chunks)"
-        )
+        store.refuse_existing(out)
     digest = _manifest(out).get("study_digest")
     if digest != study.digest():
         raise ParameterError(
