@@ -3,8 +3,8 @@
     python benchmarks/bench_motion_study.py                  # 1,000 MyoTorso frames, activations given
     python benchmarks/bench_motion_study.py --frames 200 --repeats 2
 
-MyoTorso's lumbar flexion and return over ``--frames`` frames at 50 Hz and random activations in [0, 0.3], written
-through OpenSim's API (``spinectl.anatomy.motion.write_motion``), split into ``--trials`` trials of equal length
+MyoTorso's lumbar flexion and return over ``--frames`` frames at 50 Hz and random activations in [0, 0.3],
+written through OpenSim's API as ``bench_motion.py`` writes them, split into ``--trials`` trials of equal length
 (default 4, as a study of several trials; the frames are the same), ``--chunk-frames`` frames per chunk. Each
 configuration runs the command line in a fresh process (cluster start, model loads and writes included), in
 turns; each keeps its fastest run of ``--repeats``. Reported: wall time, the run's own time (the command's
@@ -30,31 +30,22 @@ import xarray as xr
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from spinectl import anatomy  # noqa: E402
-from spinectl.anatomy.motion import write_motion  # noqa: E402
-from spinectl.landscape.study import load_motion_study, load_motions  # noqa: E402
+from bench_motion import files  # noqa: E402 (benchmarks/bench_motion.py: the same flexion and activations)
 
-RATE = 50.0
-"""Frames per second of the motion written [Hz]."""
+from spinectl import anatomy  # noqa: E402
+from spinectl.landscape.study import load_motion_study, load_motions  # noqa: E402
 
 
 def study_file(folder: Path, frames: int, trials: int, chunk: int) -> Path:
-    """The motion's files and a study of ``trials`` trials over consecutive ranges of its frames."""
-    model = anatomy.load("myotorso")
-    names = list(model.posture_columns().required)
-    times = np.arange(frames) / RATE
-    rows = np.zeros((frames, len(names)))
-    for joint in model.plane_joints("sagittal"):
-        rows[:, names.index(joint)] = -8.0 * np.sin(np.pi * times / times[-1])
-    a = np.random.default_rng(0).uniform(0.0, 0.3, (frames, len(model.muscles)))
-    write_motion(folder / "lift.mot", names, times, rows)
-    write_motion(folder / "lift.sto", model.muscles, times, a, in_degrees=None)
+    """The motion's files (bench_motion's flexion and activations) and a study of ``trials`` trials over
+    consecutive ranges of its frames."""
+    files(anatomy.load("myotorso"), folder, frames)
     bounds = np.linspace(0, frames, trials + 1).astype(int)
     text = f"[study]\nchunk_frames = {chunk}\n"
     for i, (first, end) in enumerate(zip(bounds[:-1], bounds[1:], strict=True)):
         text += (
-            f'\n[[trials]]\nname = "trial{i}"\nmodel = "myotorso"\ncoordinates = "lift.mot"\n'
-            f'activations = "lift.sto"\nframes = "{first}:{end - 1}"\n'
+            f'\n[[trials]]\nname = "trial{i}"\nmodel = "myotorso"\ncoordinates = "flexion.mot"\n'
+            f'activations = "so.sto"\nframes = "{first}:{end - 1}"\n'
         )
     path = folder / "study.toml"
     path.write_text(text, encoding="utf-8")
