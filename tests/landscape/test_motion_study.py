@@ -259,3 +259,32 @@ def test_a_model_that_does_not_load_is_one_line_naming_the_trial_and_leaves_no_s
     err = capsys.readouterr().err
     assert err.startswith(f"spinectl: error: {field}:") and err.rstrip().endswith("(trial 'a')")
     assert err.count("\n") == 1 and not out.exists()
+
+
+def test_a_full_disk_while_a_chunk_is_written_is_one_line_and_resumable(
+    folder, reference, tmp_path, capsys, monkeypatch
+):
+    """ENOSPC from the NetCDF writer at the second chunk (simulated): one line naming the chunk's file, exit 2, no
+    temporary left; the chunk written before is kept and --resume finishes the store with the reference's bits."""
+    import errno
+
+    real, calls = xr.Dataset.to_netcdf, []
+
+    def full_at_second(self, *args, **kwargs):
+        calls.append(1)
+        if len(calls) == 2:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        return real(self, *args, **kwargs)
+
+    out = tmp_path / "s"
+    arguments = ["study", str(write(folder)), "--out", str(out), "--scheduler", "synchronous"]
+    monkeypatch.setattr(xr.Dataset, "to_netcdf", full_at_second)
+    assert main(arguments) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "No space left on device" in err and "chunks/1.nc" in err
+    assert sorted(p.name for p in (out / "chunks").iterdir()) == ["0.nc"]  # no temporary
+    monkeypatch.setattr(xr.Dataset, "to_netcdf", real)
+    assert main([*arguments, "--resume"]) == 0
+    assert "(3 computed now, 1 before)" in capsys.readouterr().out
+    for name, expected in reference.items():
+        xr.testing.assert_identical(load_motions(out)[name], expected)
