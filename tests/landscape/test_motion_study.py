@@ -288,3 +288,29 @@ def test_a_full_disk_while_a_chunk_is_written_is_one_line_and_resumable(
     assert "(3 computed now, 1 before)" in capsys.readouterr().out
     for name, expected in reference.items():
         xr.testing.assert_identical(load_motions(out)[name], expected)
+
+
+def test_every_option_of_a_trial_is_motion_responses(torso, folder, tmp_path):
+    """Activations from a file, the optimum per frame, the least stiffness: each trial (chunks of one frame) equals
+    motion_response with the same options on the trial alone, bit for bit."""
+    a = np.random.default_rng(1).uniform(0.0, 0.3, (TIMES.size, len(torso.muscles)))
+    write_motion(folder / "so.sto", torso.muscles, TIMES, a, in_degrees=None)
+    text = (
+        "[study]\nchunk_frames = 1\n"
+        + TRIAL.replace("'a'", "'acts'")
+        + "activations = 'so.sto'\nframes = '0:20:10'\n"
+        + TRIAL.replace("'a'", "'opt'")
+        + "optimise = 'chain'\njoint_stiffness = 50.0\nframes = '0:10:10'\n"
+        + TRIAL.replace("'a'", "'least'")
+        + "least_stiffness = 5.0\nframes = '0:20:10'\n"
+    )
+    run_motion_study(load_motion_study(write(folder, text)), tmp_path / "s", scheduler="synchronous", progress=False)
+    got = load_motions(tmp_path / "s")
+    rec = read_recording(folder / "flexion.mot", "posture")
+    expected = {
+        "acts": motion_response(torso, rec, read_recording(folder / "so.sto", "activations"), frames=(0, 20, 10)),
+        "opt": motion_response(torso, rec, optimise="chain", joint_stiffness=50.0, frames=(0, 10, 10)),
+        "least": motion_response(torso, rec, least_stiffness=5.0, frames=(0, 20, 10)),
+    }
+    for name, result in expected.items():
+        xr.testing.assert_identical(got[name], result.dataset)
