@@ -206,9 +206,7 @@ def run_study(
         store estimated would not fit on its file system's free space.
     """
     timeouts = {"connect_timeout": connect_timeout, "worker_timeout": worker_timeout}
-    check_options(scheduler, workers, **timeouts)
-    if max_chunks is not None and (isinstance(max_chunks, bool) or not isinstance(max_chunks, int) or max_chunks < 0):
-        raise ParameterError("max_chunks", f"must be an integer >= 0 (got {max_chunks!r})")
+    check_run_options(scheduler, workers, max_chunks, **timeouts)
     start = time.perf_counter()
     notify = notify or (lambda line: None)
     with store.locked(out):  # before the existence check: two runs cannot both pass it
@@ -233,6 +231,26 @@ def run_study(
             store.consolidate(out)
     seconds = time.perf_counter() - start
     return StudyResult(Path(out), study.n_chunks, done_before, todo.size, seconds, chunks.where, chunks.addresses)
+
+
+def check_run_options(scheduler, workers, max_chunks, **timeouts) -> None:
+    """Refuse in one line a run's options (:func:`~.executor.check_options`, and ``max_chunks``), before any work.
+
+    Parameters
+    ----------
+    scheduler, workers, max_chunks :
+        As :func:`run_study` takes them.
+    **timeouts
+        ``connect_timeout`` and ``worker_timeout`` [s].
+
+    Raises
+    ------
+    ParameterError
+        Naming the option and what it allows.
+    """
+    check_options(scheduler, workers, **timeouts)
+    if max_chunks is not None and (isinstance(max_chunks, bool) or not isinstance(max_chunks, int) or max_chunks < 0):
+        raise ParameterError("max_chunks", f"must be an integer >= 0 (got {max_chunks!r})")
 
 
 def estimate(study: Study, n_todo: int, probe: dict[str, np.ndarray], processes: int = 1) -> budget.Estimate:

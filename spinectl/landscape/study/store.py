@@ -230,10 +230,7 @@ def existing(
     if not (path.exists() or path.is_symlink()):
         return None
     if not resume:
-        raise OutputError(
-            f"{str(path)!r} exists: add --resume to continue the study it holds, or remove it to start "
-            "afresh (a study store is filled in place and never replaced, which would discard its chunks)"
-        )
+        refuse_existing(path)
     counts = _done_counts(study, path)
     missing = damaged_chunks(path, counts)
     _check_writable(path)  # before any work: a read-only store would fail at its first chunk
@@ -242,6 +239,20 @@ def existing(
         notify(f"study: {_missing_text(path, missing)}; computing {'it' if missing.size == 1 else 'them'} again")
         counts[missing] = 0
     return counts
+
+
+def refuse_existing(path: str | Path) -> None:
+    """Raise the :class:`OutputError` of a store that exists when no resume was asked (every kind of study's).
+
+    Parameters
+    ----------
+    path : str or Path
+        The store.
+    """
+    raise OutputError(
+        f"{str(path)!r} exists: add --resume to continue the study it holds, or remove it to start "
+        "afresh (a study store is filled in place and never replaced, which would discard its chunks)"
+    )
 
 
 def _check_unblocked(path: Path, chunks) -> None:

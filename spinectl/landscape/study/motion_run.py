@@ -1,0 +1,336 @@
+"""Running a study of motions (:mod:`.motion_spec`) on the study engine's executor, into a resumable store.
+
+Each chunk is a trial's range of frames, solved by :func:`spinectl.anatomy.motion.motion_response` with that
+range (``frames``), so a chunk's numbers are those of the trial run alone, bit for bit. The executor, the
+store's lock, the progress bar, the resume rules and the closing line are the parameter study's
+(:mod:`.executor`, :func:`.store.locked`, :func:`.run.describe`).
+
+The store (a folder, made atomically) holds ``motion_study.json`` (the study's digest and file) and
+``chunks/<index>.nc``, each chunk's Dataset as a NetCDF file with its checksums
+(:func:`spinectl.landscape.netcdf.save`, written to a temporary name and renamed): a chunk is done when its
+file is there and its checksums hold, so a killed run leaves whole chunks or none, and a resume computes only
+the others. Once every chunk of a trial is done, the trial's Dataset (its chunks along ``time``) is written
+beside them as ``<trial>.nc``; :func:`load_motions` reads those back.
+
+A worker loads each model once (:func:`_anatomy`, a cache per process): loading MyoTorso or an ``.osim`` takes
+seconds, a chunk of frames less.
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..._threads import with_one_blas_thread
+from ...atomic import atomic_path
+from ...errors import ParameterError
+from .. import netcdf
+from . import store
+from .executor import CONNECT_TIMEOUT, WORKER_TIMEOUT, executor
+from .motion_spec import MOTION_FORMAT, MotionStudy
+from .run import StudyResult, check_run_options
+
+MANIFEST = "motion_study.json"
+"""The store's description: format, the study's digest and file."""
+
+CHUNKS = "chunks"
+"""The store's folder of chunk files."""
+
+
+@dataclass(frozen=True)
+class MotionTask:
+    """What a worker needs for one chunk (no store, no study file).
+
+    Attributes
+    ----------
+    index : int
+        The chunk.
+    model, mapping, coordinates, activations : str or None
+        As the trial names them (absolute paths, or ``"myotorso"``).
+    optimise, plane, joint_stiffness, least_stiffness :
+        As :func:`spinectl.anatomy.motion.motion_response` takes them.
+    frames : tuple of int
+        ``(first, last, step)`` of the file's frames.
+    trial : str
+        The trial's name, for messages.
+    """
+
+    index: int
+    model: str
+    mapping: str | None
+    coordinates: str
+    activations: str | None
+    optimise: str
+    frames: tuple
+    plane: str
+    joint_stiffness: object
+    least_stiffness: float | None
+    trial: str = ""
+
+
+@functools.lru_cache(maxsize=8)
+def _anatomy(model: str, mapping: str | None):
+    """The model, loaded once per process: every chunk of every trial of it on this worker shares it."""
+    from ...anatomy import load
+
+    return load(model, mapping)
+
+
+@functools.lru_cache(maxsize=64)
+def _recording(path: str, field: str):
+    """A coordinates or activations file, read once per process."""
+    from ...anatomy.recordings import read_recording
+
+    return read_recording(path, field)
+
+
+@with_one_blas_thread  # many small matrices per frame, as the CLI's commands; picklable by its module's name
+def solve_motion_chunk(task: MotionTask) -> tuple:
+    """One chunk: :func:`~spinectl.anatomy.motion.motion_response` on the trial's frames ``task.frames``.
+
+    Parameters
+    ----------
+    task : MotionTask
+
+    Returns
+    -------
+    index : int
+        ``task.index``.
+    dataset : xarray.Dataset
+        The frames' Dataset, as ``motion_response`` gives it.
+    """
+    from ...anatomy.motion import motion_response
+
+    try:
+        anatomy = _anatomy(task.model, task.mapping)
+    except ParameterError as exc:  # a model or mapping that does not load: say which trial's
+        raise type(exc)(exc.field, f"{exc.message} (trial {task.trial!r})") from None
+    activations = None if task.activations is None else _recording(task.activations, "activations")
+    result = motion_response(
+        anatomy,
+        _recording(task.coordinates, "posture"),
+        activations,
+        task.optimise,
+        frames=task.frames,
+        plane=task.plane,
+        joint_stiffness=task.joint_stiffness,
+        least_stiffness=task.least_stiffness,
+        progress=False,
+    )
+    return task.index, result.dataset
+
+
+def motion_tasks(study: MotionStudy, indices):
+    """The :class:`MotionTask` of each chunk in ``indices``, made when asked for."""
+    for index in indices:
+        chunk = study.chunk(index)
+        t = study.trials[chunk.trial]
+        yield MotionTask(
+            int(index),
+            t.model,
+            t.mapping,
+            t.coordinates,
+            t.activations,
+            t.optimise,
+            chunk.frames,
+            t.plane,
+            t.joint_stiffness,
+            t.least_stiffness,
+            t.name,
+        )
+
+
+def run_motion_study(
+    study: MotionStudy,
+    out: str | Path,
+    *,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    resume: bool = False,
+    max_chunks: int | None = None,
+    progress: bool | None = None,
+    connect_timeout: float = CONNECT_TIMEOUT,
+    worker_timeout: float = WORKER_TIMEOUT,
+    notify: Callable[[str], None] | None = None,
+) -> StudyResult:
+    """Run ``study`` into the store ``out``: every chunk not yet done, written as it finishes.
+
+    The options are those of :func:`spinectl.landscape.study.run_study`, with the same meaning.
+
+    Parameters
+    ----------
+    study : MotionStudy
+    out : str or Path
+        The store (a folder), created atomically; an existing one is refused unless ``resume``.
+    scheduler, workers, connect_timeout, worker_timeout :
+        Where the chunks run (:func:`spinectl.landscape.study.executor.executor`).
+    resume : bool
+        Continue the study in ``out``, computing only its missing (or damaged) chunks.
+    max_chunks : int or None
+        Stop after this many chunks (the store stays resumable).
+    progress : bool or None
+        A progress bar of chunks on stderr; None: on a terminal only.
+    notify : callable or None
+        Told lines for the user (chunks found damaged, a remote cluster's workers).
+
+    Returns
+    -------
+    StudyResult
+
+    Raises
+    ------
+    ParameterError
+        Bad options, a store of another study, a frame a model cannot read (from its worker).
+    OutputError
+        ``out`` exists without ``resume``, or cannot be written.
+    """
+    timeouts = {"connect_timeout": connect_timeout, "worker_timeout": worker_timeout}
+    check_run_options(scheduler, workers, max_chunks, **timeouts)
+    start, notify = time.perf_counter(), notify or (lambda line: None)
+    out = Path(out)
+    with store.locked(out):
+        done = _existing(study, out, resume, notify)
+        todo = [i for i in range(study.n_chunks) if i not in done][: None if max_chunks is None else max_chunks]
+        done_before = len(done)
+        again = "the store holds every chunk finished; start a worker and run again with --resume"
+        with executor(scheduler, workers, len(todo), **timeouts, notify=notify, again=again, name="motions") as where:
+            prefix = f"spinectl-motion-{study.digest()[:16]}"
+            results = where.as_completed(
+                solve_motion_chunk, motion_tasks(study, todo), key=lambda task: f"{prefix}-{task.index}"
+            )
+            _write_chunks(study, out, done, results, progress)
+        if out.exists():
+            _assemble(study, out, done)
+    seconds = time.perf_counter() - start
+    return StudyResult(out, study.n_chunks, done_before, len(todo), seconds, where.where, where.addresses)
+
+
+def _create(study: MotionStudy, out: Path) -> None:
+    """The store, atomically: its manifest and an empty folder of chunks."""
+    manifest = {"format": MOTION_FORMAT, "study_digest": study.digest(), "study_toml": study.text}
+    manifest |= {"trials": [t.name for t in study.trials], "chunks": study.n_chunks}
+    with atomic_path(out, directory=True) as tmp:
+        (tmp / CHUNKS).mkdir()
+        (tmp / MANIFEST).write_text(json.dumps(manifest, indent=1), encoding="utf-8")
+
+
+def _existing(study: MotionStudy, out: Path, resume: bool, notify) -> set:
+    """The chunks done in an existing store (file present, checksums holding); empty if there is none yet."""
+    if not (out.exists() or out.is_symlink()):
+        return set()
+    if not resume:
+        store.refuse_existing(out)
+    digest = _manifest(out).get("study_digest")
+    if digest != study.digest():
+        raise ParameterError(
+            "store",
+            f"{str(out)!r} holds another study (or its files changed since; digest {str(digest)[:12]}, this file "
+            f"{study.digest()[:12]}): resume with the study and files that made it, or write to another store",
+        )
+    done, damaged = set(), []
+    for index in range(study.n_chunks):
+        path = _chunk_path(out, index)
+        if path.is_file():
+            try:
+                netcdf._verify(path)
+                done.add(index)
+            except ParameterError:
+                damaged.append(index)
+    if damaged:
+        notify(f"motions: {len(damaged)} chunk file(s) damaged ({damaged[:5]}); computing them again")
+    return done
+
+
+def _manifest(out: Path) -> dict:
+    try:
+        manifest = json.loads((out / MANIFEST).read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, ValueError):
+        manifest = None
+    if not isinstance(manifest, dict) or manifest.get("format") != MOTION_FORMAT:
+        raise ParameterError("store", f"{str(out)!r} is not a spinectl motion study store (no {MANIFEST} of it)")
+    return manifest
+
+
+def _chunk_path(out: Path, index: int) -> Path:
+    return Path(out) / CHUNKS / f"{index}.nc"
+
+
+def _write_chunks(study: MotionStudy, out: Path, done: set, results, progress: bool | None) -> None:
+    """Write each chunk's Dataset as it comes (atomically, with its checksums), with a progress bar."""
+    from tqdm import tqdm  # plain, as the parameter study's
+
+    disable = None if progress is None else not progress
+    with tqdm(total=study.n_chunks, initial=len(done), unit="chunk", desc="motions", disable=disable) as bar:
+        for index, dataset in results:
+            if not out.exists():  # at the first chunk: a model that does not load leaves no store behind
+                _create(study, out)
+            netcdf.save(dataset, _chunk_path(out, index))
+            done.add(index)
+            bar.update()
+
+
+def _assemble(study: MotionStudy, out: Path, done: set) -> None:
+    """Each trial whose chunks are all done, as one Dataset along time: ``<trial>.nc`` in the store."""
+    for t, trial in enumerate(study.trials):
+        path = out / f"{trial.name}.nc"
+        chunks = study.chunks_of(t)
+        if path.exists() or not all(c.index in done for c in chunks):
+            continue
+        netcdf.save(_concatenated([_read_chunk(out, c.index) for c in chunks]), path)
+
+
+def _read_chunk(out: Path, index: int):
+    import xarray as xr
+
+    path = _chunk_path(out, index)
+    netcdf._verify(path)
+    return netcdf._unstamped(xr.load_dataset(path, engine="netcdf4"))
+
+
+def _concatenated(datasets):
+    """Chunks of one trial along ``time``, as :func:`motion_response` gives the whole trial."""
+    import xarray as xr
+
+    if len(datasets) == 1:
+        return datasets[0]
+    return xr.concat(
+        datasets, dim="time", data_vars="minimal", coords="minimal", join="outer", combine_attrs="override"
+    )
+
+
+def load_motions(path: str | Path) -> dict:
+    """The trials of a motion study's store, each one Dataset (dims time, joint, mode, ..., muscle).
+
+    Parameters
+    ----------
+    path : str or Path
+        The store of :func:`run_motion_study`.
+
+    Returns
+    -------
+    dict of str to xarray.Dataset
+        Trial name -> its Dataset, for the trials whose chunks are all done, in the study's order.
+
+    Raises
+    ------
+    ParameterError
+        Not a motion study's store, or a trial's file damaged (its checksums).
+    """
+    import xarray as xr
+
+    out = Path(path)
+    names = _manifest(out).get("trials", [])
+    trials = {}
+    for name in names:
+        file = out / f"{name}.nc"
+        if file.is_file():
+            netcdf._verify(file)
+            trials[name] = netcdf._unstamped(xr.load_dataset(file, engine="netcdf4"))
+    return trials
+
+
+__all__ = ["MotionTask", "load_motions", "run_motion_study", "solve_motion_chunk"]
