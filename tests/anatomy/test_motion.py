@@ -352,3 +352,15 @@ def test_the_delay_margin_at_a_frame_is_analyses_reflex_margin(torso, tmp_path):
     assert ds["delay_margin_status"].values[0] == one["delay_margin_status"]
     np.testing.assert_array_equal(ds["delay_margin_frequency"].values[0], one["delay_margin_frequency_rad_s"])
     assert ds["delay_margin"].attrs["kp"] == 400.0
+
+
+def test_the_figure_has_a_class_panel_with_contributions(torso, tmp_path):
+    """contributions=True: a fourth panel between the modes and the posture, one line per class, its values the
+    Dataset's free_class_contribution (the figure draws the file's numbers)."""
+    path = flexion_file(torso, tmp_path / "flexion.mot")
+    result = motion_response(torso, read_recording(path, "posture"), frames=(0, 20, 10), contributions=True,
+                             progress=False)
+    axes = motion_plot(result).axes
+    ds = result.dataset
+    assert len(axes) == 4 and len(axes[2].get_lines()) == ds.sizes["muscle_class"] + 1  # and the zero line
+    np.testing.assert_array_equal(axes[2].get_lines()[0].get_ydata(), ds["free_class_contribution"].values[:, 0])
