@@ -73,7 +73,10 @@ class MotionResult:
             f"{ds.attrs['model_identity_text']}, {ds.attrs['plane']} plane, {ds.sizes['time']} frames of "
             f"{ds.attrs['coordinates_file']} ({ds.attrs['activation_source']})"
         ]
-        lines += [f"load (in the equilibrium and K, every frame): {text}" for text in json.loads(ds.attrs.get("loads_text", "[]"))]
+        lines += [
+            f"load (in the equilibrium and K, every frame): {text}"
+            for text in json.loads(ds.attrs.get("loads_text", "[]"))
+        ]
         for name, criterion in (("free", FREE), ("constrained", CONSTRAINED)):
             index = ds[f"{name}_index"].values
             unstable = ds[f"{name}_unstable_modes"].values

@@ -7,9 +7,8 @@ import sys
 
 from ..anatomy.mapping import MAX_STIFFNESS
 from ..errors import ParameterError
-from ..model.params.bounds import MAX_ACTIVATION_TIME_CONSTANT
-from ._common import anatomy_load, finite_float, input_name
-from .anatomy_cmd import MAX_DERIVATIVE_GAIN, STIFFNESS_WHY, _joint_stiffness, _loads
+from ._common import finite_float, input_name
+from .anatomy_cmd import STIFFNESS_WHY, _joint_stiffness, _loads, add_load_option, add_reflex_options
 
 MAX_FRAME_RATE = 1e6
 """Largest --rate [Hz]: far above any motion capture's; the file's own rate is the real bound (checked later)."""
@@ -86,41 +85,14 @@ def register(sub) -> None:
         help="also the least joint stiffness added that makes the free chain's -K >= MU [N m/rad] at each frame "
         "(an SDP per frame)",
     )
-    parser.add_argument(
-        "--load",
-        type=anatomy_load,
-        action="append",
-        default=[],
-        metavar="BODY:FX,FY,FZ[@X,Y,Z]",
-        help="an external force [N] held at a point of BODY (in its frame [m], default its origin), fixed in the "
-        "ground, or in the body with a :body suffix; the same at every frame, in the equilibrium, the stiffness "
-        "and the optimum; repeatable (docs/anatomy.md, Loads)",
-    )
+    add_load_option(parser, ", the same at every frame, and in the optimum")
     parser.add_argument(
         "--contributions",
         action="store_true",
         help="also each muscle's and each class's d lambda_min / d a_i at every frame, on the free and the "
         "constrained chain (docs/contributions.md)",
     )
-    parser.add_argument(
-        "--kp",
-        type=finite_float("--kp", 0.0, MAX_STIFFNESS, STIFFNESS_WHY),
-        help="also the free chain's exact delay margin at every frame under a delayed PD reflex with this "
-        "proportional gain at every joint [N m/rad] (with --kd)",
-    )
-    parser.add_argument(
-        "--kd",
-        type=finite_float("--kd", 0.0, MAX_DERIVATIVE_GAIN, " N m s/rad"),
-        default=0.0,
-        help="the reflex's derivative gain [N m s/rad] (default: 0)",
-    )
-    parser.add_argument(
-        "--activation-lag",
-        type=finite_float("--activation-lag", 0.0, MAX_ACTIVATION_TIME_CONSTANT, " s"),
-        default=0.05,
-        metavar="T_A",
-        help="time constant of the reflex's force generation [s] (default: 0.05)",
-    )
+    add_reflex_options(parser, " at every frame")
     parser.add_argument("--out", required=True, metavar="FILE.nc", help="the NetCDF file written")
     parser.add_argument("--plot", metavar="DIR", help="write motion.png into DIR")
     parser.add_argument(

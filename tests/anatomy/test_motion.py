@@ -317,7 +317,12 @@ def test_the_contributions_at_a_frame_are_contributions_on_that_frames_chain(tor
     a = np.random.default_rng(3).uniform(0.0, 0.3, (TIMES.size, len(torso.muscles)))
     sto = write_table(tmp_path / "so.sto", torso.muscles, a, times=TIMES)
     result = motion_response(
-        torso, rec, read_recording(sto, "activations"), frames=(0, 20, 10), loads=HAND_LOAD, contributions=True,
+        torso,
+        rec,
+        read_recording(sto, "activations"),
+        frames=(0, 20, 10),
+        loads=HAND_LOAD,
+        contributions=True,
         progress=False,
     )
     ds = result.dataset
@@ -344,7 +349,11 @@ def test_the_delay_margin_at_a_frame_is_analyses_reflex_margin(torso, tmp_path):
     path = flexion_file(torso, tmp_path / "flexion.mot")
     reflex = (400.0, 20.0, 0.05)
     ds = motion_response(
-        torso, read_recording(path, "posture"), frames=(10, 10, 1), joint_stiffness=200.0, reflex=reflex,
+        torso,
+        read_recording(path, "posture"),
+        frames=(10, 10, 1),
+        joint_stiffness=200.0,
+        reflex=reflex,
         progress=False,
     ).dataset
     one = analyse(torso, posture=path, time=0.5, joint_stiffness=200.0, reflex=reflex).reflex
@@ -358,8 +367,9 @@ def test_the_figure_has_a_class_panel_with_contributions(torso, tmp_path):
     """contributions=True: a fourth panel between the modes and the posture, one line per class, its values the
     Dataset's free_class_contribution (the figure draws the file's numbers)."""
     path = flexion_file(torso, tmp_path / "flexion.mot")
-    result = motion_response(torso, read_recording(path, "posture"), frames=(0, 20, 10), contributions=True,
-                             progress=False)
+    result = motion_response(
+        torso, read_recording(path, "posture"), frames=(0, 20, 10), contributions=True, progress=False
+    )
     axes = motion_plot(result).axes
     ds = result.dataset
     assert len(axes) == 4 and len(axes[2].get_lines()) == ds.sizes["muscle_class"] + 1  # and the zero line

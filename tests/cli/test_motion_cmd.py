@@ -257,8 +257,14 @@ def test_a_load_contributions_and_a_reflex_reach_the_file(torso, flexion, tmp_pa
     assert "F = (0, 0, -100) N at (0, 0, 0) m of torso" in capsys.readouterr().out
     load = body_loads([{"body": "torso", "force": (0.0, 0.0, -100.0)}])
     expected = motion_response(
-        torso, read_recording(flexion, "posture"), frames=(0, 20, 20), joint_stiffness=200.0, loads=load,
-        contributions=True, reflex=(400.0, 20.0, 0.05), progress=False,
+        torso,
+        read_recording(flexion, "posture"),
+        frames=(0, 20, 20),
+        joint_stiffness=200.0,
+        loads=load,
+        contributions=True,
+        reflex=(400.0, 20.0, 0.05),
+        progress=False,
     ).dataset
     with xr.open_dataset(out) as ds:
         for name in ("free_index", "free_contribution", "constrained_class_contribution", "delay_margin"):

@@ -86,8 +86,13 @@ def myotorso_lift():
         path = _lift(model, Path(folder) / "lift.mot")
         recording = read_recording(path, "posture")
         return motion_response(
-            model, recording, optimise=OPTIMISE, joint_stiffness=STIFFNESS, loads=MYOTORSO_LOAD,
-            contributions=True, progress=False,
+            model,
+            recording,
+            optimise=OPTIMISE,
+            joint_stiffness=STIFFNESS,
+            loads=MYOTORSO_LOAD,
+            contributions=True,
+            progress=False,
         )
 
 
@@ -108,8 +113,12 @@ def pose2sim_lift():
     with tempfile.TemporaryDirectory() as folder:
         path = _lift(model, Path(folder) / "lift.mot")
         return motion_response(
-            model, read_recording(path, "posture"), frames=(0, FRAMES - 1, 2), loads=POSE2SIM_LOAD,
-            contributions=True, progress=False,
+            model,
+            read_recording(path, "posture"),
+            frames=(0, FRAMES - 1, 2),
+            loads=POSE2SIM_LOAD,
+            contributions=True,
+            progress=False,
         )
 
 
