@@ -357,10 +357,11 @@ def test_the_delay_margin_at_a_frame_is_analyses_reflex_margin(torso, tmp_path):
         progress=False,
     ).dataset
     one = analyse(torso, posture=path, time=0.5, joint_stiffness=200.0, reflex=reflex).reflex
-    assert ds["delay_margin"].values[0] == one["delay_margin_s"]
+    # the same exact margin: an iterative root, whose last bit varies with the solver's warm state
+    np.testing.assert_allclose(ds["delay_margin"].values[0], one["delay_margin_s"], rtol=1e-12)
     assert ds["delay_margin_status"].values[0] == one["delay_margin_status"]
-    np.testing.assert_array_equal(ds["delay_margin_frequency"].values[0], one["delay_margin_frequency_rad_s"])
-    assert ds["delay_margin"].attrs["kp"] == 400.0
+    np.testing.assert_allclose(ds["delay_margin_frequency"].values[0], one["delay_margin_frequency_rad_s"], rtol=1e-9)
+    assert ds["delay_margin"].attrs["kp"] == 400.0 and 0 < ds["delay_margin"].values[0] < np.inf
 
 
 def test_the_figure_has_a_class_panel_with_contributions(torso, tmp_path):

@@ -267,8 +267,10 @@ def test_a_load_contributions_and_a_reflex_reach_the_file(torso, flexion, tmp_pa
         progress=False,
     ).dataset
     with xr.open_dataset(out) as ds:
-        for name in ("free_index", "free_contribution", "constrained_class_contribution", "delay_margin"):
+        for name in ("free_index", "free_contribution", "constrained_class_contribution"):
             np.testing.assert_array_equal(ds[name].values, expected[name].values)
+        # the delay margin is an iterative root (its last bit varies with the solver's warm state): to 1e-12
+        np.testing.assert_allclose(ds["delay_margin"].values, expected["delay_margin"].values, rtol=1e-12)
         assert ds["delay_margin"].attrs["kd"] == 20.0 and ds.sizes["muscle_class"] >= 2
         assert "torso" in ds.attrs["loads"]
 
