@@ -12,7 +12,7 @@ TimeSeriesTable, STOFileAdapter) into a temporary folder. Timed, wall clock, aft
 2. ``motion_response(optimise="chain", joint_stiffness=50)`` against ``optimise(posture=...)`` then ``analyse``
    per frame at that posture and those activations.
 
-The issue's targets (issue 35): 100 frames with activations given in at most 10 s, with the optimum per frame in
+The targets: 100 frames with activations given in at most 10 s, with the optimum per frame in
 at most 60 s. Needs the anatomy and opensim extras. Timings on a shared machine are noisy.
 """
 

@@ -8,7 +8,7 @@ written through OpenSim's API as ``bench_motion.py`` writes them, split into ``-
 (default 4, as a study of several trials; the frames are the same), ``--chunk-frames`` frames per chunk. Each
 configuration runs the command line in a fresh process (cluster start, model loads and writes included), in
 turns; each keeps its fastest run of ``--repeats``. Reported: wall time, the run's own time (the command's
-closing line), frames per second, and the ratio of 2 workers to 1. The issue's target (issue 35): at least
+closing line), frames per second, and the ratio of 2 workers to 1. The target: at least
 1.6x on 2 workers for 1,000 frames. The machine is shared: the load average at each start is printed, and the
 ratio cannot exceed what the free cores allow. Every store's trials are checked equal bit for bit.
 """
@@ -94,7 +94,7 @@ def main() -> None:
         one, two = best["1 worker"], best["2 workers"]
         print(
             f"speed-up 1 -> 2 workers: {one['wall'] / two['wall']:.2f}x (wall), {one['run'] / two['run']:.2f}x (run)"
-            f"; target (issue 35): 1.6x"
+            f"; target: 1.6x"
         )
         trials = {name: load_motions(r["store"]) for name, r in best.items()}
         first, *others = trials.values()

@@ -26,8 +26,9 @@ import numpy as np
 from .._validate import show
 from ..errors import ParameterError
 from .analyses import activations as activation_vector
-from .analyses import verdict
+from .analyses import reflex_margin, verdict
 from .identity import model_identity
+from .loads import analysed_loads
 
 OPTIMISE = ("none", "joints", "chain")
 """``--optimise``: none (the activations file, or the model's own controls), or the anatomy optimum per frame
@@ -71,6 +72,10 @@ class MotionResult:
         lines = [
             f"{ds.attrs['model_identity_text']}, {ds.attrs['plane']} plane, {ds.sizes['time']} frames of "
             f"{ds.attrs['coordinates_file']} ({ds.attrs['activation_source']})"
+        ]
+        lines += [
+            f"load (in the equilibrium and K, every frame): {text}"
+            for text in json.loads(ds.attrs.get("loads_text", "[]"))
         ]
         for name, criterion in (("free", FREE), ("constrained", CONSTRAINED)):
             index = ds[f"{name}_index"].values
@@ -147,6 +152,9 @@ def motion_response(
     joint_stiffness="none",
     least_stiffness=None,
     progress=None,
+    loads=(),
+    contributions=False,
+    reflex=None,
 ) -> MotionResult:
     """The stability index, free and constrained, at each frame of a recorded motion.
 
@@ -172,6 +180,15 @@ def motion_response(
         [N m/rad] (the SDP :func:`spinectl.optimise.coupled.sdp.least_local_stiffness_at`).
     progress : bool or None
         A progress bar on stderr; None: on a terminal only (as the study and the atlas).
+    loads : sequence of BodyLoad or dict, optional
+        External loads (:mod:`spinectl.anatomy.loads`), the same at every frame: in the equilibrium, in K and in
+        the optimum, as ``analyse(..., loads=)``.
+    contributions : bool
+        Also each muscle's and each class's d lambda_min / d a_i on both chains
+        (:func:`spinectl.model.contributions.contributions`; NaN where lambda_min is repeated).
+    reflex : tuple, optional
+        ``(kp, kd, lag)``: also the free chain's exact delay margin under that reflex at each frame
+        (:func:`spinectl.anatomy.analyses.reflex_margin`).
 
     Returns
     -------
@@ -189,6 +206,8 @@ def motion_response(
         raise ParameterError("optimise", f"must be one of {OPTIMISE} (got {show(optimise)})")
     if optimise != "none" and activations is not None:
         raise ParameterError("activations", "cannot go with optimise, which finds the activations itself")
+    loads = analysed_loads(loads, False)
+    extras = {"loads": loads, "contributions": bool(contributions), "reflex": reflex}
     chosen = select_frames(recording.times, frames, rate)
     points = [_read_point(anatomy, recording, activations, float(recording.times[i])) for i in chosen]  # every
     # frame's columns, NaNs and activation times checked before the first is solved: a bad last frame costs no run
@@ -197,10 +216,12 @@ def motion_response(
         total=chosen.size, unit="frame", desc="motion", disable=None if progress is None else not progress
     ) as bar:
         for time, (values, a) in zip(recording.times[chosen], points, strict=True):
-            rows.append(_frame(anatomy, float(time), values, a, optimise, plane, joint_stiffness, least_stiffness))
+            rows.append(
+                _frame(anatomy, float(time), values, a, optimise, plane, joint_stiffness, least_stiffness, extras)
+            )
             bar.update(1)
     return MotionResult(
-        _dataset(anatomy, recording, activations, optimise, plane, joint_stiffness, least_stiffness, rows)
+        _dataset(anatomy, recording, activations, optimise, plane, joint_stiffness, least_stiffness, rows, extras)
     )
 
 
@@ -213,26 +234,29 @@ def _read_point(anatomy, recording, activations, time) -> tuple:
     return values, activation_vector(anatomy, np.array([frame.values[name] for name in anatomy.muscles]))
 
 
-def _activations_at(anatomy, posture, a, optimise, plane, joint_stiffness) -> tuple:
+def _activations_at(anatomy, posture, a, optimise, plane, joint_stiffness, loads=()) -> tuple:
     """The frame's activations (the file's, the optimum's or the model's own) and the optimum (or None)."""
     if a is not None or optimise == "none":
         return (activation_vector(anatomy, None) if a is None else a), None
     from .optimum import optimise as optimum
 
-    opt = optimum(anatomy, plane, stability=optimise, posture=posture, joint_stiffness=joint_stiffness)
+    loaded = {"loads": loads} if loads else {}  # without: the optimum's call as it was
+    opt = optimum(anatomy, plane, stability=optimise, posture=posture, joint_stiffness=joint_stiffness, **loaded)
     return opt.activations, opt
 
 
-def _frame(anatomy, time, values, a, optimise, plane, joint_stiffness, least_stiffness) -> dict:
+def _frame(anatomy, time, values, a, optimise, plane, joint_stiffness, least_stiffness, extras) -> dict:
     """Everything the Dataset holds of one frame: its coordinates ``values`` and activations ``a`` (or None)."""
     posture = anatomy.named_posture(values)
-    a, opt = _activations_at(anatomy, posture, a, optimise, plane, joint_stiffness)
+    loads = extras["loads"]
+    a, opt = _activations_at(anatomy, posture, a, optimise, plane, joint_stiffness, loads)
     row = {"time": time, "activation": a, "optimum_status": "" if opt is None else opt.status}
     free_chain = anatomy.plane_joints(plane)
     row["posture"] = np.array([values.get(j, np.nan) for j in free_chain])
     if not np.all(np.isfinite(a)):  # an optimum not found: no operating point, no index
         return row
-    free, con, lin = anatomy.chains(plane, posture, joint_stiffness, activations=a)
+    loaded = {"loads": loads} if loads else {}  # without: the engines' calls as they were
+    free, con, lin = anatomy.chains(plane, posture, joint_stiffness, activations=a, **loaded)
     eq_rows, tau_per, tau_0 = anatomy.equilibrium_rows(lin, plane, posture, "rhythm")
     dofs = list(lin.dofs[: lin.n])
     row["net_torque"] = lin.torque_per_muscle[dofs] @ a + lin.torque_offset[dofs]
@@ -247,7 +271,36 @@ def _frame(anatomy, time, values, a, optimise, plane, joint_stiffness, least_sti
 
         status, k = least_local_stiffness_at(free.stiffness(a), least_stiffness)
         row["least"] = np.full(free.n_joints, np.nan) if k is None else k
+    if extras["contributions"]:
+        row.update(_contributions(anatomy, free, con, a))
+    if extras["reflex"] is not None:
+        margin = reflex_margin(free, a, *extras["reflex"])
+        row["delay_margin"] = (margin["delay_margin_s"], margin["delay_margin_frequency_rad_s"])
+        row["delay_margin_status"] = margin["delay_margin_status"]
     return row
+
+
+def _contributions(anatomy, free, con, a) -> dict:
+    """d lambda_min / d a_i per muscle (in the model's muscle order) and per class, on both chains."""
+    from ..model.contributions import contributions
+
+    out = {}
+    for name, chain in (("free", free), ("constrained", con)):
+        c = contributions(chain, a)
+        by_name = dict(zip(c.controls, c.derivative, strict=True))
+        per_class = c.classes()
+        out[f"{name}_contribution"] = np.array([by_name.get(m, np.nan) for m in anatomy.muscles])
+        out[f"{name}_class_contribution"] = np.array(
+            [c.sums(per_class[k])[0] if k in per_class else np.nan for k in _classes(anatomy)]
+        )
+    return out
+
+
+def _classes(anatomy) -> tuple:
+    """The control classes of the model's muscles, in :data:`~spinectl.model.linear_chain.CONTROL_CLASSES` order."""
+    from ..model.linear_chain import CONTROL_CLASSES
+
+    return tuple(c for c in CONTROL_CLASSES if c in set(anatomy.classes))
 
 
 def _stack(rows, key, width, part=None) -> np.ndarray:
@@ -293,6 +346,32 @@ VARIABLES = {
         "N m/rad",
         f"least added stiffness per joint with -K + diag(k) >= margin I (attribute margin), {FREE}",
     ),
+    "free_contribution": (
+        ("time", "muscle"),
+        "N m/rad per control unit",
+        f"d lambda_min / d a_i = v^T (-K_i) v at the least mode v (NaN: lambda_min repeated), {FREE}",
+    ),
+    "constrained_contribution": (
+        ("time", "muscle"),
+        "N m/rad per control unit",
+        f"d lambda_min / d a_i = v^T (-K_i) v at the least mode v (NaN: lambda_min repeated), {CONSTRAINED}",
+    ),
+    "free_class_contribution": (
+        ("time", "muscle_class"),
+        "N m/rad per control unit",
+        f"d lambda_min / d a_i summed over the class's muscles, {FREE}",
+    ),
+    "constrained_class_contribution": (
+        ("time", "muscle_class"),
+        "N m/rad per control unit",
+        f"d lambda_min / d a_i summed over the class's muscles, {CONSTRAINED}",
+    ),
+    "delay_margin": (
+        ("time",),
+        "s",
+        f"exact delay margin of the reflex (attributes kp, kd, activation_lag; inf: any delay), {FREE}",
+    ),
+    "delay_margin_frequency": (("time",), "rad/s", f"the crossing frequency at the delay margin, {FREE}"),
 }
 """Every variable of the Dataset: dims, units, description (the criterion named where it is a verdict)."""
 
@@ -315,7 +394,7 @@ def _values(rows, n: int, c: int, m: int) -> dict:
     }
 
 
-def _dataset(anatomy, recording, activations, optimise, plane, joint_stiffness, least_stiffness, rows):
+def _dataset(anatomy, recording, activations, optimise, plane, joint_stiffness, least_stiffness, rows, extras):
     """The frames as an xarray Dataset, units and descriptions on every variable, the model's identity."""
     import xarray as xr
 
@@ -328,14 +407,19 @@ def _dataset(anatomy, recording, activations, optimise, plane, joint_stiffness, 
     values = _values(rows, n, c, len(anatomy.muscles))
     if least_stiffness is not None:
         values["least_joint_stiffness"] = _stack(rows, "least", n)
+    values |= _extra_values(anatomy, rows, extras)
     data = {}
     for name, value in values.items():
         dims, units, description = VARIABLES[name]
         data[name] = (dims, value, {"units": units or anatomy.control_unit, "description": description})
     if least_stiffness is not None:
         data["least_joint_stiffness"][2]["margin"] = float(least_stiffness)
+    _extra_attributes(data, extras)
     status = np.array([r["optimum_status"] for r in rows], dtype=object)
     data["optimum_status"] = (("time",), status, {"description": "the optimum's solver status ('' without one)"})
+    if extras["reflex"] is not None:
+        margin = np.array([r.get("delay_margin_status", "") for r in rows], dtype=object)
+        data["delay_margin_status"] = (("time",), margin, {"description": "the delay margin's status ('' unsolved)"})
     coords = {
         "time": ("time", np.array([r["time"] for r in rows]), {"units": "s"}),
         "joint": ("joint", list(joints)),
@@ -344,6 +428,8 @@ def _dataset(anatomy, recording, activations, optimise, plane, joint_stiffness, 
         "constrained_mode": ("constrained_mode", np.arange(c)),
         "muscle": ("muscle", list(anatomy.muscles)),
     }
+    if extras["contributions"]:
+        coords["muscle_class"] = ("muscle_class", list(_classes(anatomy)))
     identity = model_identity(anatomy)
     attrs = {
         "title": "Cholewicki-McGill stability index along a motion (spinectl motion)",
@@ -360,8 +446,32 @@ def _dataset(anatomy, recording, activations, optimise, plane, joint_stiffness, 
         "joint_stiffness_added": str(joint_stiffness),
         "free_criterion": FREE,
         "constrained_criterion": CONSTRAINED,
+        "loads": json.dumps([load.to_dict() for load in extras["loads"]]),
+        "loads_text": json.dumps([load.text() for load in extras["loads"]]),
     }
     return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+def _extra_values(anatomy, rows, extras) -> dict:
+    """The contributions' and the delay margin's variables, where asked for."""
+    out = {}
+    if extras["contributions"]:
+        for name in ("free", "constrained"):
+            out[f"{name}_contribution"] = _stack(rows, f"{name}_contribution", len(anatomy.muscles))
+            out[f"{name}_class_contribution"] = _stack(rows, f"{name}_class_contribution", len(_classes(anatomy)))
+    if extras["reflex"] is not None:
+        out["delay_margin"] = _stack(rows, "delay_margin", 2)[:, 0]
+        out["delay_margin_frequency"] = _stack(rows, "delay_margin", 2)[:, 1]
+    return out
+
+
+def _extra_attributes(data, extras) -> None:
+    """The reflex's gains on its variables, and the margin's status per frame."""
+    if extras["reflex"] is None:
+        return
+    gains = dict(zip(("kp", "kd", "activation_lag"), (float(x) for x in extras["reflex"]), strict=True))
+    data["delay_margin"][2].update(gains)
+    data["delay_margin_frequency"][2].update(gains)
 
 
 def _activation_source(anatomy, activations, optimise) -> str:

@@ -23,10 +23,15 @@ def motion_figure(ds):
     -------
     matplotlib.figure.Figure
         Three panels sharing the time axis: the index [N m/rad] (zero marked), the number of unstable modes,
-        the chain's coordinates [deg].
+        the chain's coordinates [deg]; a fourth between the last two where the Dataset has contributions: each
+        class's d lambda_min / d a_i on the free chain.
     """
-    figure = new_figure(figsize=(8.0, 8.0))
-    index, modes, posture = figure.subplots(3, 1, sharex=True)
+    shares = "free_class_contribution" in ds
+    figure = new_figure(figsize=(8.0, 10.5 if shares else 8.0))
+    axes = figure.subplots(4 if shares else 3, 1, sharex=True)
+    index, modes, posture = axes[0], axes[1], axes[-1]
+    if shares:
+        _classes_panel(axes[2], ds)
     t = ds["time"].values
     for name, style in (("free", "-o"), ("constrained", "--s")):
         criterion = ds.attrs[f"{name}_criterion"]
@@ -49,3 +54,14 @@ def motion_figure(ds):
     posture.set_title(f"posture: the chain's coordinates ({ds.attrs['coordinates_file']})", fontsize=10)
     posture.legend(fontsize=7, ncol=3, loc="best")
     return figure
+
+
+def _classes_panel(ax, ds) -> None:
+    """Each class's d lambda_min / d a_i on the free chain against time (NaN where lambda_min is repeated)."""
+    t = ds["time"].values
+    for k, name in enumerate(ds["muscle_class"].values):
+        ax.plot(t, ds["free_class_contribution"].values[:, k], "-o", ms=3, label=str(name))
+    ax.axhline(0.0, color="0.5", lw=0.8)
+    ax.set_ylabel("d lambda_min / d a\nper class [N m/rad]")
+    ax.set_title("each class's contribution to the free chain's index (summed over its muscles)", fontsize=10)
+    ax.legend(fontsize=7, ncol=4, loc="best")

@@ -94,16 +94,7 @@ def register(sub) -> None:
         help="intervertebral stiffness added at each chain joint: none (the model's own, default), "
         "mapped (the mapping's cited value) or a number [N m/rad]",
     )
-    parser.add_argument(
-        "--load",
-        type=anatomy_load,
-        action="append",
-        default=[],
-        metavar="BODY:FX,FY,FZ[@X,Y,Z]",
-        help="an external force [N] held at a point of BODY (in its frame [m], default its origin), fixed in the "
-        "ground, or in the body with a :body suffix; in the equilibrium and the stiffness (its load stiffness "
-        "through the geometry, as gravity's); repeatable (docs/anatomy.md, Loads)",
-    )
+    add_load_option(parser)
     parser.add_argument(
         "--check",
         action="store_true",
@@ -135,25 +126,7 @@ def register(sub) -> None:
         default=1.0,
         help="with --optimise: the static margin mu of the stability criterion [N m/rad] (default: 1)",
     )
-    parser.add_argument(
-        "--kp",
-        type=finite_float("--kp", 0.0, MAX_STIFFNESS, STIFFNESS_WHY),
-        help="also the free chain's exact delay margin under a delayed PD reflex with this proportional gain "
-        "at every joint [N m/rad] (with --kd)",
-    )
-    parser.add_argument(
-        "--kd",
-        type=finite_float("--kd", 0.0, MAX_DERIVATIVE_GAIN, " N m s/rad"),
-        default=0.0,
-        help="the reflex's derivative gain [N m s/rad]",
-    )
-    parser.add_argument(
-        "--activation-lag",
-        type=finite_float("--activation-lag", 0.0, MAX_ACTIVATION_TIME_CONSTANT, " s"),
-        default=0.05,
-        metavar="T_A",
-        help="time constant of the reflex's force generation [s] (default: 0.05)",
-    )
+    add_reflex_options(parser)
     parser.add_argument(
         "--lordosis",
         metavar="START:STOP:N",
@@ -195,6 +168,57 @@ def register(sub) -> None:
     )
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     parser.set_defaults(func=run)
+
+
+def add_load_option(parser, where: str = "") -> None:
+    """``--load`` (repeatable, :func:`~spinectl.cli._common.anatomy_load`): of ``anatomy`` and ``motion``.
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+    where : str
+        Said after "in the equilibrium and the stiffness" (e.g. ", the same at every frame").
+    """
+    parser.add_argument(
+        "--load",
+        type=anatomy_load,
+        action="append",
+        default=[],
+        metavar="BODY:FX,FY,FZ[@X,Y,Z]",
+        help="an external force [N] held at a point of BODY (in its frame [m], default its origin), fixed in the "
+        "ground, or in the body with a :body suffix; in the equilibrium and the stiffness (its load stiffness "
+        f"through the geometry, as gravity's){where}; repeatable (docs/anatomy.md, Loads)",
+    )
+
+
+def add_reflex_options(parser, where: str = "") -> None:
+    """``--kp``, ``--kd``, ``--activation-lag``: a delayed PD reflex's gains, of ``anatomy`` and ``motion``.
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+    where : str
+        Said after "the free chain's exact delay margin" (e.g. " at every frame").
+    """
+    parser.add_argument(
+        "--kp",
+        type=finite_float("--kp", 0.0, MAX_STIFFNESS, STIFFNESS_WHY),
+        help=f"also the free chain's exact delay margin{where} under a delayed PD reflex with this proportional "
+        "gain at every joint [N m/rad] (with --kd)",
+    )
+    parser.add_argument(
+        "--kd",
+        type=finite_float("--kd", 0.0, MAX_DERIVATIVE_GAIN, " N m s/rad"),
+        default=0.0,
+        help="the reflex's derivative gain [N m s/rad]",
+    )
+    parser.add_argument(
+        "--activation-lag",
+        type=finite_float("--activation-lag", 0.0, MAX_ACTIVATION_TIME_CONSTANT, " s"),
+        default=0.05,
+        metavar="T_A",
+        help="time constant of the reflex's force generation [s] (default: 0.05)",
+    )
 
 
 def run(args) -> int:

@@ -8,7 +8,7 @@ import sys
 from ..anatomy.mapping import MAX_STIFFNESS
 from ..errors import ParameterError
 from ._common import finite_float, input_name
-from .anatomy_cmd import STIFFNESS_WHY, _joint_stiffness
+from .anatomy_cmd import STIFFNESS_WHY, _joint_stiffness, _loads, add_load_option, add_reflex_options
 
 MAX_FRAME_RATE = 1e6
 """Largest --rate [Hz]: far above any motion capture's; the file's own rate is the real bound (checked later)."""
@@ -85,6 +85,14 @@ def register(sub) -> None:
         help="also the least joint stiffness added that makes the free chain's -K >= MU [N m/rad] at each frame "
         "(an SDP per frame)",
     )
+    add_load_option(parser, ", the same at every frame, and in the optimum")
+    parser.add_argument(
+        "--contributions",
+        action="store_true",
+        help="also each muscle's and each class's d lambda_min / d a_i at every frame, on the free and the "
+        "constrained chain (docs/contributions.md)",
+    )
+    add_reflex_options(parser, " at every frame")
     parser.add_argument("--out", required=True, metavar="FILE.nc", help="the NetCDF file written")
     parser.add_argument("--plot", metavar="DIR", help="write motion.png into DIR")
     parser.add_argument(
@@ -136,6 +144,9 @@ def run(args) -> int:
             args.plane,
             args.joint_stiffness,
             args.least_stiffness,
+            loads=_loads(args.load),
+            contributions=args.contributions,
+            reflex=None if args.kp is None else (args.kp, args.kd, args.activation_lag),
         )
     _write(result, args)
     print(result.summary())

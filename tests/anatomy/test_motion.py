@@ -8,6 +8,8 @@ one second at 20 Hz (21 frames), on MyoTorso (MuJoCo) and on spinectl's export o
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
@@ -20,6 +22,7 @@ from spinectl import anatomy  # noqa: E402
 from spinectl.anatomy.analyses import analyse  # noqa: E402
 from spinectl.anatomy.export_osim import export_osim  # noqa: E402
 from spinectl.anatomy.identity import model_identity  # noqa: E402
+from spinectl.anatomy.loads import body_loads  # noqa: E402
 from spinectl.anatomy.motion import motion_plot, motion_response, select_frames  # noqa: E402
 from spinectl.anatomy.recordings import read_recording  # noqa: E402
 from spinectl.errors import ParameterError  # noqa: E402
@@ -252,3 +255,123 @@ def test_the_progress_bar_goes_to_stderr_when_asked(torso, torso_motion, capsys)
     assert out == "" and "motion" in err and "3/3" in err and "frame" in err
     motion_response(torso, rec, frames=(0, 2, 1), progress=False)
     assert capsys.readouterr().err == ""
+
+
+HAND_LOAD = body_loads(({"body": "torso", "force": (0.0, 0.0, -100.0), "point": (0.3, 0.0, 0.0), "frame": "ground"},))
+"""100 N down, 0.3 m off the torso body's origin (a load held ahead of the thorax), fixed in the ground."""
+
+
+def test_a_load_enters_every_frame_as_analyse_with_that_load(torso, tmp_path):
+    """loads=: each frame's index, mode and unstable count equal analyse(..., loads=) at that frame's time, bit for
+    bit; the net torque differs from the unloaded motion's (the load is in the equilibrium: the test can fail);
+    the Dataset's attributes and the summary name the load."""
+    path = flexion_file(torso, tmp_path / "flexion.mot")
+    rec = read_recording(path, "posture")
+    loaded = motion_response(torso, rec, frames=(0, 20, 10), loads=HAND_LOAD, progress=False)
+    ds = loaded.dataset
+    for i, t in enumerate(ds["time"].values):
+        one = analyse(torso, posture=path, time=float(t), loads=HAND_LOAD)
+        for name, chain in (("free", one.free), ("constrained", one.constrained)):
+            np.testing.assert_array_equal(ds[f"{name}_eigenvalues"].values[i], chain.eigenvalues)
+    bare = motion_response(torso, rec, frames=(0, 20, 10), progress=False).dataset
+    assert not np.allclose(ds["net_torque"].values, bare["net_torque"].values)
+    assert not np.allclose(ds["free_index"].values, bare["free_index"].values)
+    assert json.loads(ds.attrs["loads"])[0]["force_N"] == [0.0, 0.0, -100.0]
+    assert "F = (0, 0, -100) N at (0.3, 0, 0) m of torso" in loaded.summary()
+
+
+def test_a_load_enters_the_optimum_per_frame(torso, tmp_path):
+    """optimise='chain' with a load: the frame's activations are optimise(posture=, loads=)'s (the optimum holds
+    the load), not the unloaded optimum's."""
+    from spinectl.anatomy.optimum import optimise
+
+    path = flexion_file(torso, tmp_path / "flexion.mot")
+    rec = read_recording(path, "posture")
+    ds = motion_response(
+        torso, rec, optimise="chain", frames=(10, 10, 1), joint_stiffness=50.0, loads=HAND_LOAD, progress=False
+    ).dataset
+    posture = torso.named_posture(rec.frame(torso.posture_columns(), 0.5).values)
+    opt = optimise(torso, stability="chain", posture=posture, joint_stiffness=50.0, loads=HAND_LOAD)
+    np.testing.assert_array_equal(ds["activation"].values[0], opt.activations)
+    bare = optimise(torso, stability="chain", posture=posture, joint_stiffness=50.0)
+    assert not np.allclose(opt.activations, bare.activations)
+
+
+def test_a_load_on_a_body_the_model_lacks_is_one_line(torso, tmp_path):
+    """A load on a body MyoTorso has not: ParameterError naming loads (before any frame's result is kept)."""
+    path = flexion_file(torso, tmp_path / "flexion.mot")
+    bad = ({"body": "no_such_body", "force": (0.0, 0.0, -10.0)},)
+    with pytest.raises(ParameterError, match="no_such_body"):
+        motion_response(torso, read_recording(path, "posture"), frames=(0, 0, 1), loads=bad, progress=False)
+
+
+def test_the_contributions_at_a_frame_are_contributions_on_that_frames_chain(torso, tmp_path):
+    """contributions=True, with a load and random activations: at each frame the per-muscle d lambda_min / d a_i
+    of both chains is spinectl.model.contributions.contributions on the chain that frame linearises (chains() at
+    that posture, a second path), the class sums are its sums; Euler's identity holds (offset + sum a_i d_i =
+    the index); they change along the motion (the test can fail)."""
+    from spinectl.model.contributions import contributions
+
+    path = flexion_file(torso, tmp_path / "flexion.mot")
+    rec = read_recording(path, "posture")
+    a = np.random.default_rng(3).uniform(0.0, 0.3, (TIMES.size, len(torso.muscles)))
+    sto = write_table(tmp_path / "so.sto", torso.muscles, a, times=TIMES)
+    result = motion_response(
+        torso,
+        rec,
+        read_recording(sto, "activations"),
+        frames=(0, 20, 10),
+        loads=HAND_LOAD,
+        contributions=True,
+        progress=False,
+    )
+    ds = result.dataset
+    classes = list(ds["muscle_class"].values)
+    for i, t in enumerate(ds["time"].values):
+        posture = torso.named_posture(rec.frame(torso.posture_columns(), t).values)
+        at = ds["activation"].values[i]
+        free, con, _ = torso.chains("sagittal", posture, activations=at, loads=HAND_LOAD)
+        for name, chain in (("free", free), ("constrained", con)):
+            c = contributions(chain, at)
+            assert list(c.controls) == list(ds["muscle"].values)
+            np.testing.assert_array_equal(ds[f"{name}_contribution"].values[i], c.derivative)
+            sums = [c.sums(c.classes()[k])[0] for k in classes]
+            np.testing.assert_array_equal(ds[f"{name}_class_contribution"].values[i], sums)
+            np.testing.assert_allclose(c.offset + at @ c.derivative, ds[f"{name}_index"].values[i], rtol=1e-9)
+    assert not np.allclose(ds["free_contribution"].values[0], ds["free_contribution"].values[1])
+    assert ds["free_contribution"].attrs["units"] == "N m/rad per control unit"
+
+
+def test_the_delay_margin_at_a_frame_is_analyses_reflex_margin(torso, tmp_path):
+    """reflex=(kp, kd, lag) with 200 N m/rad added so that the chain is stable without delay: each frame's delay
+    margin and crossing frequency are analyse(..., reflex=)'s at that frame (the same exact margin); finite and
+    positive (the test can fail)."""
+    path = flexion_file(torso, tmp_path / "flexion.mot")
+    reflex = (400.0, 20.0, 0.05)
+    ds = motion_response(
+        torso,
+        read_recording(path, "posture"),
+        frames=(10, 10, 1),
+        joint_stiffness=200.0,
+        reflex=reflex,
+        progress=False,
+    ).dataset
+    one = analyse(torso, posture=path, time=0.5, joint_stiffness=200.0, reflex=reflex).reflex
+    # the same exact margin: an iterative root, whose last bit varies with the solver's warm state
+    np.testing.assert_allclose(ds["delay_margin"].values[0], one["delay_margin_s"], rtol=1e-12)
+    assert ds["delay_margin_status"].values[0] == one["delay_margin_status"]
+    np.testing.assert_allclose(ds["delay_margin_frequency"].values[0], one["delay_margin_frequency_rad_s"], rtol=1e-9)
+    assert ds["delay_margin"].attrs["kp"] == 400.0 and 0 < ds["delay_margin"].values[0] < np.inf
+
+
+def test_the_figure_has_a_class_panel_with_contributions(torso, tmp_path):
+    """contributions=True: a fourth panel between the modes and the posture, one line per class, its values the
+    Dataset's free_class_contribution (the figure draws the file's numbers)."""
+    path = flexion_file(torso, tmp_path / "flexion.mot")
+    result = motion_response(
+        torso, read_recording(path, "posture"), frames=(0, 20, 10), contributions=True, progress=False
+    )
+    axes = motion_plot(result).axes
+    ds = result.dataset
+    assert len(axes) == 4 and len(axes[2].get_lines()) == ds.sizes["muscle_class"] + 1  # and the zero line
+    np.testing.assert_array_equal(axes[2].get_lines()[0].get_ydata(), ds["free_class_contribution"].values[:, 0])

@@ -238,3 +238,58 @@ def test_an_unwritable_plot_folder_is_one_line_before_anything_is_written(flexio
     assert main(["motion", "myotorso", "--coordinates", str(flexion), "--out", str(out), "--plot", str(plots)]) == 2
     err = capsys.readouterr().err
     assert len(err.strip().splitlines()) == 1 and "plots" in err and not out.exists()
+
+
+def test_a_load_contributions_and_a_reflex_reach_the_file(torso, flexion, tmp_path, capsys):
+    """--load, --contributions, --kp/--kd: the file holds the library's numbers with the same load (a second
+    call of motion_response), the load in its attributes and the summary, per-muscle and per-class contributions
+    and the delay margin with its gains."""
+    import xarray as xr
+
+    from spinectl.anatomy.loads import body_loads
+    from spinectl.anatomy.motion import motion_response
+    from spinectl.anatomy.recordings import read_recording
+
+    out = tmp_path / "m.nc"
+    argv = ["motion", "myotorso", "--coordinates", str(flexion), "--frames", "0:20:20", "--load", "torso:0,0,-100"]
+    argv += ["--contributions", "--kp", "400", "--kd", "20", "--joint-stiffness", "200", "--out", str(out)]
+    assert main(argv) == 0
+    assert "F = (0, 0, -100) N at (0, 0, 0) m of torso" in capsys.readouterr().out
+    load = body_loads([{"body": "torso", "force": (0.0, 0.0, -100.0)}])
+    expected = motion_response(
+        torso,
+        read_recording(flexion, "posture"),
+        frames=(0, 20, 20),
+        joint_stiffness=200.0,
+        loads=load,
+        contributions=True,
+        reflex=(400.0, 20.0, 0.05),
+        progress=False,
+    ).dataset
+    with xr.open_dataset(out) as ds:
+        for name in ("free_index", "free_contribution", "constrained_class_contribution"):
+            np.testing.assert_array_equal(ds[name].values, expected[name].values)
+        # the delay margin is an iterative root (its last bit varies with the solver's warm state): to 1e-12
+        np.testing.assert_allclose(ds["delay_margin"].values, expected["delay_margin"].values, rtol=1e-12)
+        assert ds["delay_margin"].attrs["kd"] == 20.0 and ds.sizes["muscle_class"] >= 2
+        assert "torso" in ds.attrs["loads"]
+
+
+@pytest.mark.parametrize(
+    ("argv", "word"),
+    [
+        (["--load", "torso:0,0"], "--load"),
+        (["--load", "torso:0,0,nan"], "--load"),
+        (["--load", "torso:0,0,1e12"], "--load"),
+        (["--load", "no_such_body:0,0,-10"], "no_such_body"),
+        (["--kp", "-1"], "--kp"),
+        (["--kp", "10", "--activation-lag", "inf"], "--activation-lag"),
+    ],
+)
+def test_a_malformed_load_or_reflex_is_one_line_and_writes_nothing(flexion, tmp_path, capsys, argv, word):
+    """Each: exit 2, one line on stderr naming the option (or the unknown body), nothing written."""
+    out = tmp_path / "m.nc"
+    assert main(["motion", "myotorso", "--coordinates", str(flexion), "--frames", "0:0", "--out", str(out), *argv]) == 2
+    printed, err = capsys.readouterr()
+    assert len(err.strip().splitlines()) == 1 and err.startswith("spinectl: error: ")
+    assert word in err and not out.exists()

@@ -22,7 +22,8 @@ a text changed, so that incremental builds stay incremental):
   four points and
   ``design --passive`` at A in ``chain.md`` (measured at the build, :mod:`.chain`);
 - ``_generated/anatomy-*.md``: ``spinectl anatomy``'s tables on MyoTorso in ``anatomy.md`` (verdicts, optima,
-  lordosis, reflex; measured at the build, :mod:`.anatomy`).
+  lordosis, reflex; measured at the build, :mod:`.anatomy`);
+- ``_generated/motion-lift.png``: the lift of ``motion.md`` on MyoTorso (:mod:`.lift`).
 
 Numbers that a sentence quotes are the ``{measured}`` role's (:mod:`.values`): ``{measured}`anatomy.remedy```
 is replaced by what the code gives at the build; the pages that use it are read again at every build, so
@@ -53,6 +54,7 @@ from . import (
     fields,
     guide,
     interchange,
+    lift,
     notebooks,
     parameters,
     published,
@@ -80,7 +82,7 @@ MEASURED_TABLES = (
 )
 """The tables of what commands print, measured at the build: (file in ``_generated/``, its generator)."""
 
-MEASURED_VALUES = (anatomy, chain, errata, interchange, reflex, trends)
+MEASURED_VALUES = (anatomy, chain, errata, interchange, lift, reflex, trends)
 """The modules that register ``{measured}`` values (:func:`.values.value`) when imported."""
 
 
@@ -121,6 +123,7 @@ def generate(app) -> None:
     write_if_changed(out / "design-decay.md", design.decay_table())
     for name, table in MEASURED_TABLES:
         write_if_changed(out / name, table())
+    lift.write_figure(out)
 
 
 def prune_api_pages(app) -> None:
