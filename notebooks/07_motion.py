@@ -23,6 +23,7 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
+from IPython.display import display
 
 from spinectl import anatomy
 from spinectl.anatomy.motion import motion_plot, motion_response, write_motion
@@ -62,8 +63,7 @@ result = motion_response(
 print(result.summary())
 
 # %%
-figure = motion_plot(result)
-figure
+display(motion_plot(result))
 
 # %% [markdown]
 # The Dataset holds every number (xarray; `result.dataset.to_netcdf(...)` or `spinectl motion --out` write it). The
