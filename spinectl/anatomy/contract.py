@@ -345,6 +345,9 @@ class AnatomyEngine(Protocol):
         object
         """
 
+    def body_weight(self, body: str) -> tuple:
+        """Gravity in the ground's frame [m/s^2], shape (3,), and ``body``'s centre of mass in its frame [m]."""
+
 
 @dataclass
 class MappedModel:

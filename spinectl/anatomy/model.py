@@ -241,6 +241,20 @@ class Anatomy(MappedModel):
         q[list(rhy.dofs)] += lordosis_direction(self, rhy, len(self.plane_joints(plane)), degrees)
         return _followed(self.engine.model, q)
 
+    def body_weight(self, body: str) -> tuple:
+        """Gravity in the ground's frame [m/s^2] and ``body``'s centre of mass in its own frame [m] (``body_ipos``).
+
+        Raises
+        ------
+        ParameterError
+            ``body`` is no body of the model.
+        """
+        model = self.engine.model
+        i = require_mujoco().mj_name2id(model, require_mujoco().mjtObj.mjOBJ_BODY, body)
+        if i < 0:
+            raise ParameterError("body", f"must be a body of {self.name} (got {body!r})")
+        return model.opt.gravity.copy(), model.body_ipos[i].copy()
+
     def require_referee(self) -> None:
         """MuJoCo's own model is the referee of its chain (``check``): nothing to refuse."""
 

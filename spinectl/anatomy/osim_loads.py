@@ -19,6 +19,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._validate import printable
+from ..errors import ParameterError
 from .export_osim import require_opensim
 from .linearise import STEP
 from .loads import body_loads, check_bodies
@@ -90,3 +92,18 @@ def osim_load_terms(engine, loads, names, values: dict, order: dict) -> tuple:
     finally:
         engine.set_posture(values)
     return tau, stiffness
+
+
+def osim_body_weight(self, body: str) -> tuple:
+    """Gravity in the ground's frame [m/s^2] and ``body``'s centre of mass in its own frame [m] (OsimAnatomy's).
+
+    Raises
+    ------
+    ParameterError
+        ``body`` is no body of the model.
+    """
+    bodies = self.engine.model.getBodySet()
+    if not bodies.contains(body):
+        raise ParameterError("body", f"must be a body of {self.name} (got {printable(body)})")
+    vector = (self.engine.model.getGravity(), bodies.get(body).getMassCenter())
+    return tuple(np.array([v.get(i) for i in range(3)]) for v in vector)
