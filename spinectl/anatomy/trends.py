@@ -33,8 +33,9 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..model.contributions import least_mode
-from .buckling import critical_load, load_stiffness_per_newton, weight_load
+from .buckling import critical_load, load_stiffness_per_newton
 from .contract import AnatomyEngine
+from .loads import BodyLoad
 from .optimum import MARGIN, _lumbar_only, optimise, solve_on_chain
 
 GROUPS = {
@@ -204,7 +205,7 @@ class StabilityPrice:
     Attributes
     ----------
     loads : numpy.ndarray, shape (p,)
-        The loads along gravity at the thorax's centre of mass [N].
+        The downward vertical loads at the thorax [N].
     stable_cost, classic_cost : numpy.ndarray, shape (p,)
         sum w_i a_i^2 of the optimum with the chain criterion and without one (NaN where infeasible).
     """
@@ -227,10 +228,9 @@ def stability_price(
     Parameters
     ----------
     anatomy : AnatomyEngine
-        The model (the load along gravity at its thorax's centre of mass:
-        :func:`~spinectl.anatomy.buckling.weight_load`).
+        The model (the load at the origin of its mapping's thorax body, fixed in the ground).
     loads : array_like, shape (p,)
-        Loads along gravity [N], >= 0.
+        Downward loads [N], >= 0.
     joint_stiffness : {"none", "mapped"} or float
         Added at each chain joint [N m/rad].
     margin : float
@@ -249,9 +249,10 @@ def stability_price(
     loads = np.asarray(loads, float)
     if loads.ndim != 1 or not np.all(loads >= 0):
         raise ParameterError("loads", f"must be downward forces >= 0 [N] (got {loads.tolist()!r})")
+    thorax = anatomy.mapping.bodies["thorax"][-1]
     costs = {"chain": [], "none": []}
     for load in loads:
-        held = [weight_load(anatomy, load)]
+        held = [BodyLoad(thorax, (0.0, 0.0, -float(load)))]
         for criterion, out in costs.items():
             opt = optimise(anatomy, plane, criterion, margin, joint_stiffness=joint_stiffness, loads=held)
             out.append(opt.cost if opt.ok else float("nan"))
