@@ -64,13 +64,25 @@ class BucklingLoad:
     cap: float = MAX_LOAD
 
     def to_dict(self) -> dict:
-        """The loads for JSON: a number [N], or None where there is none up to the cap."""
+        """The buckling load for JSON (``buckling_load_N``).
+
+        Returns
+        -------
+        dict
+            ``free``, ``constrained`` [N] (None where there is none up to the cap), ``body``, ``point_m``,
+            ``direction``, ``cap_N``.
+        """
         shown = {k: (None if np.isinf(v) else v) for k, v in (("free", self.free), ("constrained", self.constrained))}
         return {**shown, "body": self.body, "point_m": list(self.point), "direction": list(self.direction),
                 "cap_N": self.cap}  # fmt: skip
 
     def text(self) -> str:
-        """The table's line."""
+        """The table's line.
+
+        Returns
+        -------
+        str
+        """
         return (
             f"buckling load (a load at {self.body}'s centre of mass, along gravity, at which the chain loses "
             f"stability): free chain {self._shown(self.free)}, constrained {self._shown(self.constrained)}"
@@ -83,12 +95,35 @@ class BucklingLoad:
 
 
 def thorax_body(anatomy: AnatomyEngine) -> str:
-    """The body that holds the load: the first of the mapping's ``bodies.thorax`` (the one nearest the chain)."""
+    """The body that holds the load: the first of the mapping's ``bodies.thorax`` (the one nearest the chain).
+
+    Parameters
+    ----------
+    anatomy : AnatomyEngine
+        The model.
+
+    Returns
+    -------
+    str
+    """
     return anatomy.mapping.bodies["thorax"][0]
 
 
 def weight_load(anatomy: AnatomyEngine, newtons: float, body: str | None = None) -> BodyLoad:
-    """A load of ``newtons`` [N] along gravity at a body's centre of mass (default :func:`thorax_body`).
+    """A load along gravity at a body's centre of mass, fixed in the ground (a weight held).
+
+    Parameters
+    ----------
+    anatomy : AnatomyEngine
+        The model (its ``body_weight``).
+    newtons : float
+        The load's magnitude [N].
+    body : str, optional
+        Default :func:`thorax_body`.
+
+    Returns
+    -------
+    BodyLoad
 
     Raises
     ------
@@ -99,7 +134,10 @@ def weight_load(anatomy: AnatomyEngine, newtons: float, body: str | None = None)
     gravity, centre = anatomy.body_weight(body)
     g = float(np.linalg.norm(gravity))
     if not g > 0:
-        raise ModelError(f"{anatomy.name}: gravity is zero: a load along gravity has no direction")
+        raise ModelError(
+            f"buckling: {anatomy.name} has no gravity (0 m/s^2), so a load along gravity has no direction; "
+            "hold a --load of your own instead"
+        )
     force = tuple(float(newtons) * np.asarray(gravity, float) / g)
     return BodyLoad(body, force, tuple(float(c) for c in centre))
 
@@ -109,7 +147,12 @@ def load_stiffness_per_newton(
 ) -> tuple:
     """K_1 of the free and the constrained chain: 1 N along gravity at the thorax's centre of mass [N m/rad per N].
 
-    Parameters are those of :meth:`~spinectl.anatomy.contract.AnatomyEngine.chains`.
+    Parameters
+    ----------
+    anatomy : AnatomyEngine
+        The model.
+    plane, posture, joint_stiffness, activations, loads
+        The operating point, as :meth:`~spinectl.anatomy.contract.AnatomyEngine.chains` takes it.
 
     Returns
     -------

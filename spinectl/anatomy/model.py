@@ -242,7 +242,17 @@ class Anatomy(MappedModel):
         return _followed(self.engine.model, q)
 
     def body_weight(self, body: str) -> tuple:
-        """Gravity in the ground's frame [m/s^2] and ``body``'s centre of mass in its own frame [m] (``body_ipos``).
+        """Gravity (``opt.gravity``) and ``body``'s centre of mass (``body_ipos``): the contract's ``body_weight``.
+
+        Parameters
+        ----------
+        body : str
+            A body of the model.
+
+        Returns
+        -------
+        tuple
+            (gravity in the ground's frame [m/s^2], the centre of mass in the body's frame [m]), each shape (3,).
 
         Raises
         ------

@@ -95,7 +95,19 @@ def osim_load_terms(engine, loads, names, values: dict, order: dict) -> tuple:
 
 
 def osim_body_weight(self, body: str) -> tuple:
-    """Gravity in the ground's frame [m/s^2] and ``body``'s centre of mass in its own frame [m] (OsimAnatomy's).
+    """OsimAnatomy's ``body_weight``: gravity (``Model.getGravity``) and a centre of mass (``Body.getMassCenter``).
+
+    Parameters
+    ----------
+    self : OsimAnatomy
+        The model.
+    body : str
+        A body of the model.
+
+    Returns
+    -------
+    tuple
+        (gravity in the ground's frame [m/s^2], the centre of mass in the body's frame [m]), each shape (3,).
 
     Raises
     ------

@@ -33,11 +33,11 @@ def closed_form(k: float, g: float, spring: float = 0.0) -> float:
     return (k + spring - g * (M1 * H1 + M * H)) / H
 
 
-def hinge(tmp_path, y_up=False, spring=0.0):
+def hinge(tmp_path, y_up=False, spring=0.0, g=9.81):
     """The single hinge of the module docstring through MuJoCo's MjSpec: z up (hinge about y) or y up (about z)."""
     spec = mujoco.MjSpec()
     up, axis = ((0, 1, 0), (0, 0, 1)) if y_up else ((0, 0, 1), (0, 1, 0))
-    spec.option.gravity = -9.81 * np.array(up, float)
+    spec.option.gravity = -g * np.array(up, float)
     pelvis = spec.worldbody.add_body(name="pelvis")
     v1 = pelvis.add_body(name="v1", mass=M1, ipos=H1 * np.array(up, float), inertia=[0.01, 0.01, 0.01])
     v1.add_joint(name="j1", type=mujoco.mjtJoint.mjJNT_HINGE, axis=axis, stiffness=spring)
@@ -184,3 +184,31 @@ def test_christophys_skeleton_answers_its_buckling_load(capsys):
     argv = ["anatomy", str(CHRISTOPHY), "--mapping", str(mapping), "--joint-stiffness", "1000", "--buckling"]
     assert main(argv) == 0
     assert f"free chain {found.free:.6g} N, constrained {found.constrained:.6g} N" in capsys.readouterr().out
+
+
+def test_a_model_without_gravity_is_refused_in_one_line(tmp_path, capsys):
+    """Gravity 0 (MuJoCo's option): the load has no direction; one line naming --buckling and the model, exit 2,
+    nothing on stdout (without --buckling the model answers: only the buckling load needs gravity)."""
+    model_path, mapping = hinge(tmp_path, y_up=True, g=0.0)
+    base = ["anatomy", str(model_path), "--mapping", str(mapping)]
+    assert main([*base, "--buckling"]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err.count("\n") == 1
+    assert err.startswith("spinectl: error: buckling: hinge has no gravity (0 m/s^2)")
+    assert main(base) == 0
+
+
+def test_an_engine_without_gravity_and_centres_of_mass_refuses_in_one_line(monkeypatch, capsys):
+    """A third engine that does not override ``body_weight`` (test_contract.py's made-up one) still answers the
+    table, and refuses --buckling in one line, exit 2, nothing on stdout (MappedModel's default)."""
+    from test_contract import load_fake
+
+    from spinectl.anatomy.contract import ENGINES, register_engine
+
+    monkeypatch.setitem(ENGINES, ".fake", None)  # restored (removed) after the test
+    register_engine(".FAKE", load_fake)
+    assert main(["anatomy", "model.fake"]) == 0
+    capsys.readouterr()
+    assert main(["anatomy", "model.fake", "--buckling"]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err == "spinectl: error: buckling: is not available on this engine's models yet (got fake)\n"
