@@ -212,3 +212,19 @@ def test_an_engine_without_gravity_and_centres_of_mass_refuses_in_one_line(monke
     assert main(["anatomy", "model.fake", "--buckling"]) == 2
     out, err = capsys.readouterr()
     assert out == "" and err == "spinectl: error: buckling: is not available on this engine's models yet (got fake)\n"
+
+
+def test_the_command_buckles_the_optimum_at_its_own_activations(capsys):
+    """With --optimise the load is found at the optimum's activations (the JSON's ``activations``), not the model's
+    own controls: the library's buckling_load at those activations is the command's."""
+    argv = ["anatomy", "myotorso", "--optimise", "--joint-stiffness", "100", "--buckling", "--json"]
+    assert main(argv) == 0
+    doc = json.loads(capsys.readouterr().out)
+    torso = anatomy.load("myotorso")
+    activations = doc["activations"]
+    a = np.array([activations[m] for m in torso.muscles]) if isinstance(activations, dict) else np.array(activations)
+    found = buckling_load(torso, joint_stiffness=100.0, activations=a)
+    assert doc["buckling_load_N"]["free"] == pytest.approx(found.free, rel=1e-9)
+    assert doc["buckling_load_N"]["constrained"] == pytest.approx(found.constrained, rel=1e-9)
+    own = buckling_load(torso, joint_stiffness=100.0, activations=torso.default_controls())
+    assert own.free != pytest.approx(found.free, rel=1e-3)  # the activations matter: the test can tell them apart
