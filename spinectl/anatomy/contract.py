@@ -29,12 +29,12 @@ from ..model.linear_chain import LinearChain
 from ..model.loads import loads_text
 from .joint_angles import JointSlopes, linearisation_in_angles, rhythm_in_angles
 from .linearise import constrained_chain, free_chain
-from .loads import refuse_loads
+from .loads import BodyWeight, refuse_body_weight, refuse_loads
 from .mapping import MAX_STIFFNESS, Mapping, located
 
 
 @runtime_checkable
-class AnatomyEngine(Protocol):
+class AnatomyEngine(BodyWeight, Protocol):
     """An anatomical model on one engine, mapped onto the chain: what the anatomy functions call.
 
     Attributes
@@ -518,6 +518,7 @@ class MappedModel:
         return rhythm_in_angles(rhy, self.joint_slopes(plane, posture), self.name), involved
 
     apply_loads = refuse_loads  # an engine that computes loads overrides it (docs/anatomy.md, "Loads")
+    body_weight = refuse_body_weight  # an engine that reads gravity and centres of mass overrides it
 
     def chains(
         self, plane: str = "sagittal", posture=None, joint_stiffness="none", activations=None, loads=()

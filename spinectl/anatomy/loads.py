@@ -32,6 +32,7 @@ kinematic tree and its derivative). doi:10.1007/978-1-4899-7560-7.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import Protocol
 
 import numpy as np
 
@@ -311,3 +312,42 @@ def analysed_loads(loads, check: bool) -> tuple:
     if check and loads:
         raise ParameterError("--check", "compares the chain without loads (MuJoCo's referee holds none)")
     return loads
+
+
+class BodyWeight(Protocol):
+    """The engine contract's part for a load along gravity (:class:`~spinectl.anatomy.contract.AnatomyEngine`'s)."""
+
+    def body_weight(self, body: str) -> tuple:
+        """Gravity and a body's centre of mass: where and which way a weight held on it acts.
+
+        Parameters
+        ----------
+        body : str
+            A body of the model.
+
+        Returns
+        -------
+        tuple
+            (gravity in the ground's frame [m/s^2], the body's centre of mass in its own frame [m]), each shape (3,).
+        """
+
+
+def refuse_body_weight(self, body: str) -> tuple:
+    """An engine's ``body_weight`` by default: refused in one line (MuJoCo's and OpenSim's models override it).
+
+    Parameters
+    ----------
+    body : str
+        A body of the model.
+
+    Returns
+    -------
+    tuple
+        Never: it raises.
+
+    Raises
+    ------
+    ParameterError
+        Always: ``buckling: is not available on this engine's models yet``.
+    """
+    raise ParameterError("buckling", f"is not available on this engine's models yet (got {self.name})")

@@ -241,6 +241,30 @@ class Anatomy(MappedModel):
         q[list(rhy.dofs)] += lordosis_direction(self, rhy, len(self.plane_joints(plane)), degrees)
         return _followed(self.engine.model, q)
 
+    def body_weight(self, body: str) -> tuple:
+        """Gravity (``opt.gravity``) and ``body``'s centre of mass (``body_ipos``): the contract's ``body_weight``.
+
+        Parameters
+        ----------
+        body : str
+            A body of the model.
+
+        Returns
+        -------
+        tuple
+            (gravity in the ground's frame [m/s^2], the centre of mass in the body's frame [m]), each shape (3,).
+
+        Raises
+        ------
+        ParameterError
+            ``body`` is no body of the model.
+        """
+        model = self.engine.model
+        i = require_mujoco().mj_name2id(model, require_mujoco().mjtObj.mjOBJ_BODY, body)
+        if i < 0:
+            raise ParameterError("body", f"must be a body of {self.name} (got {body!r})")
+        return model.opt.gravity.copy(), model.body_ipos[i].copy()
+
     def require_referee(self) -> None:
         """MuJoCo's own model is the referee of its chain (``check``): nothing to refuse."""
 

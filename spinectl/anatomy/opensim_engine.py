@@ -64,7 +64,7 @@ from .opensim_classes import check_mapping, classify
 from .opensim_couplers import coupler_rhythm, followed, read_couplers
 from .opensim_muscles import activation_floor, check_muscle, compliant, tension_terms
 from .osim_geometry import geometry
-from .osim_loads import osim_load_terms
+from .osim_loads import osim_body_weight, osim_load_terms
 
 KEPT = 256
 """How many linearisations an engine keeps in memory (:attr:`OsimEngine.linearisations`), the latest."""
@@ -313,6 +313,7 @@ class OsimAnatomy(MappedModel):
 
     rhythm_name = "couplers"
     linearised_at_activations = True  # compliant tendons: the tangent at the operating activations
+    body_weight = osim_body_weight  # the contract's body_weight: gravity and a body's centre of mass
 
     def control_bounds(self) -> tuple:
         """Each muscle's activation range: [its law's floor, 1] (Millard's and Thelen's ``minimum_activation``).

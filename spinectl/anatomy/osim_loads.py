@@ -19,6 +19,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._validate import printable
+from ..errors import ParameterError
 from .export_osim import require_opensim
 from .linearise import STEP
 from .loads import body_loads, check_bodies
@@ -90,3 +92,30 @@ def osim_load_terms(engine, loads, names, values: dict, order: dict) -> tuple:
     finally:
         engine.set_posture(values)
     return tau, stiffness
+
+
+def osim_body_weight(self, body: str) -> tuple:
+    """OsimAnatomy's ``body_weight``: gravity (``Model.getGravity``) and a centre of mass (``Body.getMassCenter``).
+
+    Parameters
+    ----------
+    self : OsimAnatomy
+        The model.
+    body : str
+        A body of the model.
+
+    Returns
+    -------
+    tuple
+        (gravity in the ground's frame [m/s^2], the centre of mass in the body's frame [m]), each shape (3,).
+
+    Raises
+    ------
+    ParameterError
+        ``body`` is no body of the model.
+    """
+    bodies = self.engine.model.getBodySet()
+    if not bodies.contains(body):
+        raise ParameterError("body", f"must be a body of {self.name} (got {printable(body)})")
+    vector = (self.engine.model.getGravity(), bodies.get(body).getMassCenter())
+    return tuple(np.array([v.get(i) for i in range(3)]) for v in vector)

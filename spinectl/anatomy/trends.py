@@ -33,6 +33,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..model.contributions import least_mode
+from .buckling import critical_load, load_stiffness_per_newton
 from .contract import AnatomyEngine
 from .loads import BodyLoad
 from .optimum import MARGIN, _lumbar_only, optimise, solve_on_chain
@@ -53,7 +54,7 @@ ABDOMINALS = "EO|IO|rect"
 """MyoTorso's abdominal flexors: the antagonists of an upright hold, whose net moment the extensors make."""
 
 MAX_CRITICAL_LOAD = 1e5
-"""The largest vertical load searched for the critical load [N]: :data:`spinectl.model.loads.MAX_LOAD`."""
+"""The largest load searched for the critical load [N]: :data:`spinectl.model.loads.MAX_LOAD`."""
 
 
 @dataclass(frozen=True)
@@ -69,7 +70,8 @@ class CoContraction:
     index : numpy.ndarray, shape (p,)
         lambda_min of -sym(K) of the free chain [N m/rad].
     critical_load : numpy.ndarray, shape (p,)
-        The least downward vertical load at the thorax at which lambda_min reaches 0, the activations fixed [N]
+        The least load along gravity at the thorax's centre of mass at which lambda_min reaches 0, the
+        activations fixed [N] (:func:`spinectl.anatomy.buckling.critical_load`)
         (0 where already unstable, inf where none up to :data:`MAX_CRITICAL_LOAD` is).
     compression : numpy.ndarray, shape (p,)
         The sum of the forces of the muscles that cross the lumbar chain [N]: the compression they add if each
@@ -162,12 +164,12 @@ def co_contraction_path(
         path.append(a)
     path = np.array(path)
     crossing = np.array([c != "non-lumbar" for c in free.control_class])
-    per_newton = _load_stiffness_per_newton(anatomy, plane, posture, joint_stiffness, free)
+    per_newton = load_stiffness_per_newton(anatomy, plane, posture, joint_stiffness)[0]
     return CoContraction(
         floors=floors,
         activations=path,
         index=np.array([least_mode(free.stiffness(a)).eigenvalue for a in path]),
-        critical_load=np.array([_critical_load(free.stiffness(a), per_newton) for a in path]),
+        critical_load=np.array([critical_load(free.stiffness(a), per_newton, MAX_CRITICAL_LOAD) for a in path]),
         compression=path[:, crossing] @ muscle_force_per_activation(anatomy, posture)[crossing],
         residual=np.max(np.abs(path @ tau_per.T + tau_0), axis=1),
     )
@@ -194,28 +196,6 @@ def muscle_force_per_activation(anatomy: AnatomyEngine, posture=None) -> np.ndar
     engine.set_state(anatomy.posture(posture), np.ones(engine.model.na))
     mujoco.mj_fwdActuation(engine.model, engine.data)
     return -engine.data.actuator_force[engine.muscle_ids()].copy()  # MuJoCo's muscle force is negative
-
-
-def _load_stiffness_per_newton(anatomy, plane, posture, joint_stiffness, free) -> np.ndarray:
-    """K_load of 1 N downward at the thorax's origin, fixed in the ground [N m/rad per N]: linear in the force."""
-    thorax = anatomy.mapping.bodies["thorax"][-1]
-    unit = [BodyLoad(thorax, (0.0, 0.0, -1.0))]
-    loaded, _, _ = anatomy.chains(plane, posture, joint_stiffness, loads=unit)
-    return loaded.stiffness_offset - free.stiffness_offset
-
-
-def _critical_load(stiffness, per_newton) -> float:
-    """The least P >= 0 with lambda_min(-sym(K + P K_load)) = 0 [N]; 0 if unstable at 0, inf if none below the cap."""
-    from scipy.optimize import brentq
-
-    def index(p):
-        return least_mode(stiffness + p * per_newton).eigenvalue
-
-    if index(0.0) <= 0:
-        return 0.0
-    if index(MAX_CRITICAL_LOAD) > 0:
-        return float("inf")
-    return float(brentq(index, 0.0, MAX_CRITICAL_LOAD, xtol=1e-9))
 
 
 @dataclass(frozen=True)

@@ -166,6 +166,13 @@ def register(sub) -> None:
         help="with --contributions: a named group of muscles, those whose names match REGEX at their start "
         "(a prefix is one: erector=IL|LTp); repeatable",
     )
+    parser.add_argument(
+        "--buckling",
+        action="store_true",
+        help="also the buckling load: the least load along gravity at the thorax's centre of mass at which the "
+        "free and the constrained chain lose stability, at the analysed activations, posture, --joint-stiffness "
+        "and --load s (docs/anatomy.md, 'Buckling load')",
+    )
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     parser.set_defaults(func=run)
 
@@ -239,21 +246,25 @@ def run(args) -> int:
     from ..anatomy.engine import engine_output_to_stderr
 
     with engine_output_to_stderr():  # the engines' own prints (OpenSim's warnings) are not the table or JSON
-        result, curve = _answers(args)
+        result, curve, buckling = _answers(args)
     if args.json:
         doc = result.to_dict()
         if curve is not None:
             doc["lordosis_curve"] = curve
+        if buckling is not None:
+            doc["buckling_load_N"] = buckling.to_dict()
         emit_json(doc)
     else:
         print(result.table())
+        if buckling is not None:
+            print(buckling.text())
         if curve is not None:
             print(_curve_table(curve))
     return 0
 
 
 def _answers(args) -> tuple:
-    """The analysis (or the optimum) and the lordosis curve (None without --lordosis); figures written."""
+    """The analysis (or the optimum), the lordosis curve and the buckling load (None without the option); figures."""
     from ..anatomy import load
     from ..anatomy.analyses import analyse
 
@@ -303,6 +314,7 @@ def _answers(args) -> tuple:
             equilibrium=args.equilibrium,
             **loaded,
         )
+    buckling = _buckling(args, anatomy, result.analysis if args.optimise else result) if args.buckling else None
     # before any figure is written: a group that matches no muscle is refused with nothing written
     parts = _contributions(args, anatomy, result) if args.contributions is not None or args.group else None
     if args.plot:
@@ -316,7 +328,22 @@ def _answers(args) -> tuple:
 
             save_contributions_figure(parts.free, args.plot, args.contributions)
         result = parts
-    return result, curve
+    return result, curve, buckling
+
+
+def _buckling(args, anatomy, analysis):
+    """--buckling: the buckling load at the analysed operating point (its activations, posture and loads)."""
+    from ..anatomy.buckling import buckling_load
+    from ..anatomy.recordings import recorded_point
+
+    return buckling_load(
+        anatomy,
+        plane=args.plane,
+        posture=recorded_point(anatomy, args.posture, None, args.time).posture,  # the file's frame, as analysed
+        joint_stiffness=args.joint_stiffness,
+        activations=analysis.activations,
+        loads=_loads(args.load) if args.load else (),
+    )
 
 
 def _refuse_combinations(args) -> None:
