@@ -125,7 +125,20 @@ def solve_motion_chunk(task: MotionTask) -> tuple:
 
 
 def motion_tasks(study: MotionStudy, indices):
-    """The :class:`MotionTask` of each chunk in ``indices``, made when asked for."""
+    """The :class:`MotionTask` of each chunk in ``indices``, made when asked for.
+
+    Parameters
+    ----------
+    study : MotionStudy
+        The study.
+    indices : iterable of int
+        Chunk positions (0 <= index < ``study.n_chunks``).
+
+    Returns
+    -------
+    iterator of MotionTask
+        One per index, in their order.
+    """
     for index in indices:
         chunk = study.chunk(index)
         t = study.trials[chunk.trial]

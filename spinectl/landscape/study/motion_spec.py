@@ -88,7 +88,18 @@ class Trial:
     least_stiffness: float | None = None
 
     def chunks(self, size: int) -> list[tuple]:
-        """The trial's frames cut into runs of ``size`` analysed frames, as ``(first, last, step)`` each."""
+        """The trial's frames cut into runs of ``size`` analysed frames, as ``(first, last, step)`` each.
+
+        Parameters
+        ----------
+        size : int
+            Analysed frames per run (the study's ``chunk_frames``).
+
+        Returns
+        -------
+        list of tuple
+            ``(first, last, step)`` frame indices of each run, in order.
+        """
         first, last, step = self.frames
         starts = range(first, last + 1, step * size)
         return [(a, min(a + step * (size - 1), last), step) for a in starts]
@@ -149,11 +160,31 @@ class MotionStudy:
         return len(self._chunks)
 
     def chunk(self, index: int) -> MotionChunk:
-        """The chunk at position ``index`` (0 <= index < :attr:`n_chunks`)."""
+        """The chunk at position ``index``.
+
+        Parameters
+        ----------
+        index : int
+            0 <= index < :attr:`n_chunks`.
+
+        Returns
+        -------
+        MotionChunk
+        """
         return self._chunks[int(index)]
 
     def chunks_of(self, trial: int) -> list[MotionChunk]:
-        """The chunks of one trial, in the order of its frames."""
+        """The chunks of one trial, in the order of its frames.
+
+        Parameters
+        ----------
+        trial : int
+            The trial's position in :attr:`trials`.
+
+        Returns
+        -------
+        list of MotionChunk
+        """
         return [c for c in self._chunks if c.trial == trial]
 
     def digest(self) -> str:
@@ -234,7 +265,26 @@ def load_motion_study(path: str | Path) -> MotionStudy:
 
 
 def parse_motion_study(text: str, base_dir: str | Path = ".", source: str = "study") -> MotionStudy:
-    """A :class:`MotionStudy` from the text of its file (see :func:`load_motion_study`)."""
+    """A :class:`MotionStudy` from the text of its file (see :func:`load_motion_study`).
+
+    Parameters
+    ----------
+    text : str
+        The study file's TOML text.
+    base_dir : str or pathlib.Path
+        The folder the file's relative paths are read from (the study file's).
+    source : str
+        The name errors give the file.
+
+    Returns
+    -------
+    MotionStudy
+
+    Raises
+    ------
+    spinectl.errors.ConfigError
+        One line naming the key as written and what is allowed.
+    """
     try:
         data = parse(text, source)
     except ConfigError as exc:
