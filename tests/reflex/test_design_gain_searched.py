@@ -174,3 +174,25 @@ def test_joint_by_joint_over_every_gain_is_certified_and_below_the_rule(delay, e
     lines = [line for line in result.table().splitlines() if line.startswith("over any PD gains per segment")]
     assert lines and (extra or lines[0] in DOCS.read_text(encoding="utf-8"))  # docs/reflex.md quotes the 120 ms one
     assert result.to_dict()["joint_gain_searched"]["activation"] == j.activation
+
+
+@pytest.mark.parametrize(("delay", "stiffness"), [(0.1, 200.0), (0.15, 150.0)])
+def test_rule_infeasible_joint_by_joint_names_the_reflex_and_searches_from_no_reflex(delay, stiffness):
+    """With K = 200 N m/rad at 100 ms (the issue's case; 150 at 150 ms, a variant) the rule has no activation, yet
+    with no reflex every segment's exact margin (delay_margin with k_p = k_d = 0, recomputed here) is unbounded: the
+    searched answer starts from no reflex instead of reporting none, is certified (margin >= the delay) and the
+    table names the rule's k_d as what the infeasibility rests on, with the remedy."""
+    model = _model(delay, **{"passive.stiffness": stiffness})
+    result = dz.answer(model, 0.0, 0.0)
+    assert result.status == "infeasible" and np.isnan(result.activation)
+    j = result.joint_searched
+    assert np.isfinite(j.activation) and np.all(j.delay_margin >= delay)
+    coefficients = checked_coefficients(model, 0.0, 0.0)
+    pcsa = j.activation * np.asarray(solve_point(model, 0.0, 0.0).pcsa, float)
+    s, d, theta = coefficients.stiffness(pcsa), coefficients.damping(pcsa), coefficients.inertia
+    assert np.all(np.isinf(delay_margin(s, d, theta, 0.0 * s, 0.0 * s, 0.05).margin))
+    table = result.table()
+    assert "the infeasibility rests on the reflex rule" in table and "destabilise the segments" in table
+    assert "margins unbounded" in table and "--gains search" in table
+    assert "none (the rule has no design" not in table
+    assert result.to_dict()["joint_gain_searched"]["no_reflex_delay_margin_s"] == [None] * len(s)
