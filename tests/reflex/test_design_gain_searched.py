@@ -196,3 +196,24 @@ def test_rule_infeasible_joint_by_joint_names_the_reflex_and_searches_from_no_re
     assert "margins unbounded" in table and "--gains search" in table
     assert "none (the rule has no design" not in table
     assert result.to_dict()["joint_gain_searched"]["no_reflex_delay_margin_s"] == [None] * len(s)
+
+
+def test_default_answer_says_it_is_the_rules_least_and_both_sit_on_their_boundary():
+    """At 100 ms (`wagner2012`, (3, 4) cm) the chain's heading says 'under the reflex rule', one line points to
+    --gains search, and the joint-by-joint answer carries a boundary note, true because the segment setting the
+    common activation has tau_m = the delay (the bisection stops on the margin, to 1e-3 of it)."""
+    result = dz.answer(_model(0.1), *AT)
+    table = result.table()
+    assert "least local stiffness under the reflex rule at activation 0.5000" in table
+    assert "  the least under the reflex rule; other diagonal PD gains may need less: --gains search" in table
+    joint = [line for line in table.splitlines() if line.startswith("  boundary: the least value sits on")]
+    assert len(joint) == 2  # joint by joint and the chain
+    binding = max(result.segments, key=lambda s: s.activation)
+    assert binding.delay_margin == pytest.approx(0.1, rel=1e-3)
+
+
+def test_given_gains_are_not_called_the_rule():
+    """With explicit gains (a variant: k_p = 20, k_d = 2 at every joint) the answer is not the rule's: no 'under the
+    reflex rule' heading and no pointer that other gains may need less than the rule."""
+    table = dz.answer(_model(0.04), *AT, kp=20.0, kd=2.0).table()
+    assert "under the reflex rule" not in table and "--gains search" not in table.split("chain (")[1]

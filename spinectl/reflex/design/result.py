@@ -287,7 +287,7 @@ class Design:
             ),
             *self._joint_lines(),
             "",
-            f"{criterion('chain', len(c.local_stiffness))}: least local stiffness at activation "
+            f"{criterion('chain', len(c.local_stiffness))}: least local stiffness{_under(c.reflex)} at activation "
             f"{_word(c.activation, 0, '.4f')} ({c.method})",
         ]
         if np.isfinite(c.fraction):
@@ -314,7 +314,25 @@ class Design:
             ]
         if self.joint_searched is None:
             return []
-        return ["  reflex assumed: the reflex rule at each activation", *self.joint_searched.lines(self.activation)]
+        return [
+            "  reflex assumed: the reflex rule at each activation",
+            *self._joint_boundary_lines(),
+            *self.joint_searched.lines(self.activation),
+        ]
+
+    def _joint_boundary_lines(self) -> list[str]:
+        """Joint by joint, the least co-contraction is a stability boundary, as the chain's is."""
+        if not (np.isfinite(self.activation) and self.activation > 0):
+            return []
+        if self.margin_ratio != 1.0:
+            return [
+                f"  robust: designed at {self.margin_ratio:g} x the delay {delay_text(self.nominal_delay)}, so "
+                f"it holds every delay up to {delay_text(self.delay)} (--margin {self.margin_ratio:g})"
+            ]
+        return [
+            "  boundary: the least value sits on its stability boundary (the margin of the segment that sets it "
+            "= the delay; less co-contraction is unstable at this delay); a margin costs more: --margin R"
+        ]
 
     def _chain_lines(self) -> list[str]:
         """The reflex the chain's answer assumes, its PCSA and gains, the margin it has and the searched answer."""
@@ -331,6 +349,8 @@ class Design:
             lines.append(self._boundary_line())
         if self.searched is not None:
             lines += self.searched.lines(names, c.fraction, c.least_static)
+        elif np.isfinite(c.fraction) and _under(c.reflex):
+            lines.append("  the least under the reflex rule; other diagonal PD gains may need less: --gains search")
         return lines
 
     def _delay_words(self) -> str:
@@ -392,6 +412,11 @@ class Design:
             "the truth value of a Design is ambiguous: use design.status == 'ok' (both criteria met), or "
             "design.activation / design.chain.fraction (NaN where none meets the delay)"
         )
+
+
+def _under(reflex: str) -> str:
+    """' under the reflex rule' where the chain's design assumes the rule's gains; '' otherwise."""
+    return " under the reflex rule" if reflex and reflex.startswith("the reflex rule") else ""
 
 
 def gains_text(names, kp, kd) -> str:
