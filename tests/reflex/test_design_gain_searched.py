@@ -217,3 +217,21 @@ def test_given_gains_are_not_called_the_rule():
     reflex rule' heading and no pointer that other gains may need less than the rule."""
     table = dz.answer(_model(0.04), *AT, kp=20.0, kd=2.0).table()
     assert "under the reflex rule" not in table and "--gains search" not in table.split("chain (")[1]
+
+
+@pytest.mark.parametrize(("delay", "ratio"), [(0.1, 1.2), (0.04, 1.5)])
+def test_margin_design_names_the_designed_delay_and_shows_the_nominal_cost(delay, ratio):
+    """--margin R (the issue's 100 ms x 1.2; 40 ms x 1.5, a variant): the certificate's root is at R tau and says so,
+    and beside it stands the design at tau itself, the same local stiffness as the plain design at tau (dz.design,
+    computed here separately), so the margin's cost is visible and not negative."""
+    result = dz.answer(_model(delay), *AT, ratio=ratio)
+    plain = dz.design(_model(delay), *AT).chain
+    nominal = result.nominal_design
+    np.testing.assert_allclose(nominal.local_stiffness, plain.local_stiffness, rtol=1e-9)
+    table = result.table()
+    designed = f"rightmost root at the designed delay {1000 * ratio * delay:.4g} ms Re s ="
+    assert designed in table
+    total = np.sum(plain.local_stiffness)
+    assert f"the design at {1000 * delay:.4g} ms itself needs {total:.1f} N m/rad" in table
+    assert np.sum(result.chain.local_stiffness) >= total
+    assert result.to_dict()["nominal_design"]["local_stiffness_fraction"] == nominal.fraction

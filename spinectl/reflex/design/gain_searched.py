@@ -316,6 +316,7 @@ def answer(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None,
     -------
     Design
         With ``margin_ratio``, ``nominal_delay``, ``margin_cost`` (at :data:`COST_RATIO` where R = 1),
+        ``nominal_design`` (the chain's at tau where R > 1),
         ``searched``, ``joint_searched`` and the chain's ``pcsa``, ``kp``, ``kd`` and ``reflex``.
 
     Raises
@@ -346,12 +347,16 @@ def answer(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None,
         longer = config.set_parameters(model, {"reflex.delay": COST_RATIO * nominal})
         c = chain_design(longer, e, lam, pcsa, at.reflex.activation, kp, kd)
         cost = MarginCost(COST_RATIO, c.fraction, c.local_stiffness)
+    nominal_design = None
+    if ratio != 1.0 and np.all(np.isfinite(pcsa)):  # the design at the delay asked for: what the margin costs
+        c = chain_design(model, e, lam, pcsa, at.reflex.activation, kp, kd)
+        nominal_design = MarginCost(1.0, c.fraction, c.local_stiffness)
     searched = gain_searched_design(at, e, lam, pcsa, rule) if search and np.all(np.isfinite(pcsa)) else None
     # milliseconds: always beside the rule's, but for a decay rate, which that grid does not certify
     joint = joint_searched_design(at, e, lam, result, kp, kd) if not decay > 0 else None
     return replace(
         result, chain=rule, margin_ratio=float(ratio), nominal_delay=nominal, margin_cost=cost, searched=searched,
-        joint_searched=joint,
+        joint_searched=joint, nominal_design=nominal_design,
     )  # fmt: skip
 
 

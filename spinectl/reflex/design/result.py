@@ -184,6 +184,9 @@ class Design:
         (:class:`~spinectl.reflex.design.joint_searched.JointSearchedDesign`), or None.
     decay_rate : float
         sigma of ``--decay-rate``: the chain's design has every root at the delay at Re s < -sigma [1/s]; 0, none.
+    nominal_design : object or None
+        Where ``--margin R`` > 1: the chain's design at the delay asked for (:attr:`nominal_delay`), a
+        :class:`~spinectl.reflex.design.gain_searched.MarginCost` with ratio 1, what the margin is paid against.
     """
 
     eccentricity: float
@@ -204,6 +207,7 @@ class Design:
     searched: object = None
     joint_searched: object = None
     decay_rate: float = 0.0
+    nominal_design: object = None
 
     def to_dict(self) -> dict:
         """The document of ``spinectl design --json``.
@@ -245,6 +249,8 @@ class Design:
             out["decay_rate_per_s"] = self.decay_rate
         if self.margin_cost is not None:
             out["margin_cost"] = self.margin_cost.to_dict()
+        if self.nominal_design is not None:
+            out["nominal_design"] = self.nominal_design.to_dict()
         if self.searched is not None:
             out["chain_gain_searched"] = self.searched.to_dict()
         if self.joint_searched is not None:
@@ -364,7 +370,8 @@ class Design:
     def _certificate_line(self) -> str:
         """The chain's certificate: the exact margin and the rightmost root (with a decay rate, beyond -sigma)."""
         c = self.chain
-        root = f"rightmost root at the delay Re s = {_word(c.max_root_real, 0, '.4g')} 1/s"
+        at = "the delay" if self.margin_ratio == 1.0 else f"the designed delay {delay_text(self.delay)}"
+        root = f"rightmost root at {at} Re s = {_word(c.max_root_real, 0, '.4g')} 1/s"
         if not self.decay_rate > 0:
             return f"certificate: exact delay margin {delay_text(c.delay_margin)} >= {delay_text(self.delay)}; {root}"
         return (
@@ -387,6 +394,7 @@ class Design:
             return (
                 f"  robust: designed at {self.margin_ratio:g} x the delay {delay_text(self.nominal_delay)}, so "
                 f"it holds every delay up to {delay_text(self.delay)} (--margin {self.margin_ratio:g})"
+                + self._nominal_words()
             )
         ratio = c.delay_margin / self.delay if self.delay > 0 else np.inf
         if ratio > 1.0 + BOUNDARY_RTOL:  # the margin jumped past the delay at the least value: no delay sets it
@@ -406,6 +414,19 @@ class Design:
         elif cost is not None:
             text += f"; no local stiffness holds {cost.ratio:g} x the delay"
         return text
+
+    def _nominal_words(self) -> str:
+        """Beside a --margin design: the chain's design at the delay asked for, so that the margin's cost shows."""
+        nominal = self.nominal_design
+        if nominal is None:
+            return ""
+        if not np.isfinite(nominal.fraction):
+            return f"; at {delay_text(self.nominal_delay)} itself no local stiffness meets the delay"
+        total, here = np.sum(nominal.local_stiffness), np.sum(self.chain.local_stiffness)
+        return (
+            f"; the design at {delay_text(self.nominal_delay)} itself needs {total:.1f} N m/rad "
+            f"({nominal.fraction:.4f} x k*): the margin costs {here - total:+.1f}"
+        )
 
     def __bool__(self):
         raise TypeError(
