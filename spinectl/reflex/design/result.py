@@ -506,6 +506,10 @@ class DesignCurve:
         (:func:`~spinectl.reflex.design.roots.rightmost_root` with ``nodes`` = 0).
     names : tuple of str
     model : dict
+    reflex : str
+        The reflex every value assumes (:func:`curve_reflex`).
+    global_pcsa : float
+        The chain's global PCSA, ``chain_activation`` x the minimum stabilising PCSA at this K [m^2].
     """
 
     eccentricity: float
@@ -522,6 +526,8 @@ class DesignCurve:
     max_root_real: np.ndarray
     names: tuple[str, ...]
     model: dict
+    reflex: str = ""
+    global_pcsa: float = float("nan")
 
     def to_dict(self) -> dict:
         """The document of ``spinectl design --delays ... --json``.
@@ -563,8 +569,33 @@ class DesignCurve:
             "Lambda_m": self.lordosis,
             "delays_s": self.delays.tolist(),
             "reaction_times_s": [{"delay_s": t, "label": label} for t, label in REACTION_TIMES],
+            "reflex": self.reflex,
+            "global_pcsa_cm2": float(m2_to_cm2(self.global_pcsa)),
+            "reading": " ".join(self.notes()),
             "curves": curves,
         }
+
+    def notes(self) -> list[str]:
+        """What every value rests on: the reflex, that it is a boundary, what tau_m is and a zero row.
+
+        Returns
+        -------
+        list of str
+        """
+        notes = [
+            f"reflex assumed: {self.reflex}.",
+            "Each nonzero value is the least, a stability boundary: less is unstable at that delay (a margin costs "
+            "more: design --delay D --margin R); a 0 needs none: the reflex alone holds that delay (no boundary).",
+            "tau_m: the chain's exact delay margin at its design (joint by joint every segment's is at least the "
+            "delay).",
+        ]
+        zero = np.isclose(self.delays, 0.0)
+        if zero.any():
+            notes.append(
+                "0 ms: the reflex acting without delay; where it holds by itself (answers 0: no co-contraction, no "
+                "local stiffness) tau_m is the delay that reflex alone holds, not a designed margin."
+            )
+        return notes
 
     def table(self) -> str:
         """The curves as rows per lag: both criteria's required design per delay.
@@ -577,21 +608,23 @@ class DesignCurve:
         n = len(self.names)
         lines = [
             self.model.get("header", "preset unknown"),
-            f"E = {self.eccentricity * 100:.2f} cm, Lambda = {self.lordosis * 100:.2f} cm; joint by joint: "
-            f"{criterion('joint', n)}; chain: {criterion('chain', n)} at activation {self.chain_activation:.4g}",
+            f"E = {self.eccentricity * 100:.2f} cm, Lambda = {self.lordosis * 100:.2f} cm; {criterion('joint', n)}; "
+            f"{criterion('chain', n)} at activation {self.chain_activation:.4g} (global PCSA "
+            f"{m2_to_cm2(self.global_pcsa):.2f} cm^2: the minimum stabilising PCSA at this K times it)",
+            *self.notes(),
         ]
         for i, lag in enumerate(self.lags):
             lines += [
                 "",
                 f"activation lag T_a = {lag * 1000:.4g} ms",
                 f"{'delay[ms]':>9} {'joint: activation':>17} {'PCSA[cm2]':>10} {'chain: sum k[N m/rad]':>21} "
-                f"{'x k*':>7} {'tau_m[ms]':>10}",
+                f"{'x k*':>7} {'chain tau_m[ms]':>16}",
             ]
             lines += [
                 f"{d * 1000:9.4g} {_word(self.activation[i, j], 17, '.4f')} "
                 f"{_word(m2_to_cm2(self.pcsa[i, j]), 10, '.2f')} "
                 f"{_word(float(np.sum(self.local_stiffness[i, j])), 21, '.1f')} "
-                f"{_word(self.local_fraction[i, j], 7, '.4f')} {_word(self.chain_margin[i, j] * 1000, 10, '.4g')}"
+                f"{_word(self.local_fraction[i, j], 7, '.4f')} {_word(self.chain_margin[i, j] * 1000, 16, '.4g')}"
                 for j, d in enumerate(self.delays)
             ]
         return "\n".join(lines)
