@@ -62,8 +62,9 @@ def test_interchange_page_generates_its_growth_rates_and_names_opensims_linearis
     import pytest
 
     pytest.importorskip("opensim", reason="OpenSim is not installed")
-    from spinectl.anatomy.interchange import opensim_eigenvalues
     from spinectl_docs import interchange
+
+    from spinectl.anatomy.interchange import opensim_eigenvalues
 
     page = (ROOT / "docs" / "interchange.md").read_text(encoding="utf-8")
     assert "no linearisation of its own" not in page and "OpenSim's own linearisation" in page

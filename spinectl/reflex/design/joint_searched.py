@@ -147,7 +147,6 @@ class JointSearchedDesign:
             f"(grid {GRID} x {GRID} gains, {DECADES:g} decades each side, {HALVINGS} halvings)",
         ]
 
-
     def _rule_failure_lines(self) -> list[str]:
         """Where the rule has no design: the reflex its infeasibility rests on, and the remedy."""
         if self.rule_kd is None or self.no_reflex_margin is None:
