@@ -17,7 +17,7 @@ from ...model.params import Model
 from ...optimise.reference import solve_point
 from .chain import chain_curve, chain_design
 from .joint import joint_design, least_activations, scan_margins
-from .result import Design, DesignCurve
+from .result import GIVEN_REFLEX, Design, DesignCurve
 
 
 @with_one_blas_thread
@@ -170,8 +170,6 @@ def curve_reflex(model: Model, kp=None, kd=None) -> str:
     -------
     str
     """
-    from .gain_searched import GIVEN_REFLEX
-
     if model.reflex.gains == "rule" and kp is None and kd is None:
         return (
             "the reflex rule (joint by joint, at each activation; the chain, (1 - f)+ x the rule's gains); other "

@@ -41,7 +41,7 @@ from ..gain_search import search_chain_gains
 from ..mimo import chain_delay_margin
 from .chain import chain_design
 from .joint_searched import joint_searched_design
-from .result import gains_text
+from .result import GIVEN_REFLEX, RULE_REFLEX, gains_text
 from .roots import SPECTRAL_NODES, rightmost_root
 
 SEARCH_STEPS = 5
@@ -61,10 +61,9 @@ SEARCH_SEED = 0
 COST_RATIO = 1.1
 """The modest delay-margin ratio whose cost the table shows by default: the design at 1.1 times the delay."""
 
-RULE_REFLEX = "the reflex rule, (1 - f)+ x the rule's gains"
-GIVEN_REFLEX = "the given gains kp, kd at every joint"
 SEARCHED_REFLEX = "any diagonal PD gains, searched"
-"""The reflex each answer assumes, as the table and JSON label it."""
+"""The reflex the searched answer assumes, as the table and JSON label it (the rule's and the given gains' labels,
+RULE_REFLEX and GIVEN_REFLEX, are in :mod:`~spinectl.reflex.design.result`, which the curve shares)."""
 
 
 @dataclass(frozen=True)

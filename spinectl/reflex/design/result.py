@@ -20,6 +20,11 @@ LOCAL_MAX = 2.0
 (the rule's reflex vanishes at 1 k*, where the search ends)."""
 
 
+RULE_REFLEX = "the reflex rule, (1 - f)+ x the rule's gains"
+GIVEN_REFLEX = "the given gains kp, kd at every joint"
+"""The reflex the chain's answer assumes, as the table and JSON label it: the rule's, or the gains given."""
+
+
 BOUNDARY_RTOL = 1e-3
 """A chain design's margin more than this above the delay (relative) did not stop on the delay: the least
 stiffness is where the margin jumps past it (at K = 40 N m/rad, 376 ms against 120 ms), not a boundary at it."""
@@ -437,7 +442,7 @@ class Design:
 
 def _under(reflex: str) -> str:
     """' under the reflex rule' where the chain's design assumes the rule's gains; '' otherwise."""
-    return " under the reflex rule" if reflex and reflex.startswith("the reflex rule") else ""
+    return " under the reflex rule" if reflex == RULE_REFLEX else ""
 
 
 def gains_text(names, kp, kd) -> str:
