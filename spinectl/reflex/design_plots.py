@@ -135,10 +135,15 @@ def delay_figure(curve: DesignCurve) -> Figure:
         top.plot(ms, curve.activation[i], "o-", ms=3, color=f"C{i}", label=label)
         bottom.plot(ms, curve.local_stiffness[i].sum(axis=1), "o-", ms=3, color=f"C{i}", label=label)
     top.set_ylabel("least activation [x minimum PCSA]")
-    top.set_title("joint by joint (each CoR alone, the others fixed): every segment's margin >= delay", fontsize=10)
+    rule = "the reflex rule" if curve.reflex.startswith("the reflex rule") else "the given gains"
+    top.set_title(
+        f"joint by joint (each CoR alone, the others fixed): every segment's margin >= delay, {rule}", fontsize=10
+    )
     bottom.set_ylabel("least local stiffness, sum [N m/rad]")
     bottom.set_title(
-        f"chain (all CoRs free), global activation {curve.chain_activation:.3g}: stable at the delay", fontsize=10
+        f"chain (all CoRs free), global activation {curve.chain_activation:.3g} "
+        f"({m2_to_cm2(curve.global_pcsa):.2f} cm²), {rule}: stable at the delay",
+        fontsize=10,
     )
     bottom.set_xlabel("reflex delay [ms]")
     for ax in (top, bottom):
@@ -148,7 +153,8 @@ def delay_figure(curve: DesignCurve) -> Figure:
         ax.set_ylim(bottom=0)
     top.legend(fontsize=7, loc="upper left")
     fig.suptitle(
-        f"{curve.model.get('header', '')}\nE = {curve.eccentricity * 100:.1f} cm, Λ = {curve.lordosis * 100:.1f} cm",
+        f"{curve.model.get('header', '')}\nE = {curve.eccentricity * 100:.1f} cm, Λ = {curve.lordosis * 100:.1f} cm; "
+        "each value the least, a stability boundary",
         fontsize=9,
     )
     return fig

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 
 import numpy as np
+import pytest
 
 from spinectl import jsondoc
 from spinectl.cli import main
@@ -124,3 +125,15 @@ def test_contributions_say_which_pair_stabilises_each_cor_and_the_chain(capsys):
     muscles = -np.diag(chain.stiffness([2.0, 8.0, 4.0])) + np.diag(chain.stiffness_offset)
     np.testing.assert_allclose(np.sum(doc["cor_share_Nm_per_rad"], axis=0), muscles, rtol=1e-10)
     assert doc["pairs"] == ["straight", "oblique_outer", "oblique_inner"] and len(doc["cor_stabilised_most_by"]) == 5
+
+
+@pytest.mark.parametrize("argv", [["--preset", "wagner2012"], ["--preset", "default", "--K", "15", "--E", "0.02"]])
+def test_coupled_damping_matrix_says_its_sign(argv, capsys):
+    """stability --coupled prints D with every diagonal entry negative (the muscles damp): its title says which sign
+    damps, as the per-segment table does ('D < 0 damps'); the issue's default and a variant (default, K 15, E 2 cm)."""
+    assert main(["stability", "--coupled", *argv]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    title = next(line for line in lines if line.startswith("damping D [N m s/rad]"))
+    assert "D < 0 damps" in title
+    first_row = lines[lines.index(title) + 2].split()
+    assert float(first_row[1]) < 0  # the diagonal entry the note describes

@@ -86,3 +86,32 @@ def test_a_negative_delay_or_lag_is_refused(delays, lags, field):
     """A delay or lag below 0: ParameterError naming the option."""
     with pytest.raises(ParameterError, match=field):
         dz.delay_curve(_subject(), 0.03, 0.04, delays, lags)
+
+
+def test_the_curve_names_its_reflex_global_pcsa_boundary_and_zero_row():
+    """The issue's ``--delays 0:0.2:5`` (table, JSON, figure titles): the header no longer reads 'joint by joint:
+    joint by joint', names the reflex rule and the global PCSA (0.5 x the minimum stabilising PCSA, recomputed here
+    from solve_point), says each value is a boundary, that tau_m is the chain's, and explains the 0 ms row."""
+    from spinectl.optimise.reference import solve_point
+    from spinectl.reflex.design_plots import delay_figure
+
+    model = config.load_preset("wagner2012")
+    curve = dz.delay_curve(model, 0.0, 0.0, np.linspace(0.0, 0.2, 5))
+    expected = 0.5 * float(np.sum(solve_point(model, 0.0, 0.0).pcsa)) * 1e4
+    assert curve.to_dict()["global_pcsa_cm2"] == pytest.approx(expected, rel=1e-12)
+    table = curve.table()
+    assert "joint by joint: joint by joint" not in table
+    assert f"(global PCSA {expected:.2f} cm^2" in table and "reflex assumed: the reflex rule" in table
+    assert "a stability boundary" in table and "chain tau_m[ms]" in table and "0 ms: the reflex acting" in table
+    document = curve.to_dict()
+    assert document["reflex"].startswith("the reflex rule") and "stability boundary" in document["reading"]
+    fig = delay_figure(curve)
+    titles = " ".join([fig._suptitle.get_text()] + [ax.get_title() for ax in fig.axes])
+    assert "the reflex rule" in titles and f"{expected:.2f} cm²" in titles and "stability boundary" in titles
+
+
+def test_the_curve_with_given_gains_says_so_and_has_no_zero_row_note():
+    """A variant: explicit gains (k_p 40, k_d 4) and no 0 ms delay: the reflex is the gains given, no 0 ms note."""
+    curve = dz.delay_curve(_subject(), 0.03, 0.04, [0.02, 0.04], kp=40.0, kd=4.0)
+    table = curve.table()
+    assert "reflex assumed: the given gains kp, kd at every joint" in table and "0 ms:" not in table

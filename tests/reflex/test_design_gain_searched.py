@@ -174,3 +174,64 @@ def test_joint_by_joint_over_every_gain_is_certified_and_below_the_rule(delay, e
     lines = [line for line in result.table().splitlines() if line.startswith("over any PD gains per segment")]
     assert lines and (extra or lines[0] in DOCS.read_text(encoding="utf-8"))  # docs/reflex.md quotes the 120 ms one
     assert result.to_dict()["joint_gain_searched"]["activation"] == j.activation
+
+
+@pytest.mark.parametrize(("delay", "stiffness"), [(0.1, 200.0), (0.15, 150.0)])
+def test_rule_infeasible_joint_by_joint_names_the_reflex_and_searches_from_no_reflex(delay, stiffness):
+    """With K = 200 N m/rad at 100 ms (the issue's case; 150 at 150 ms, a variant) the rule has no activation, yet
+    with no reflex every segment's exact margin (delay_margin with k_p = k_d = 0, recomputed here) is unbounded: the
+    searched answer starts from no reflex instead of reporting none, is certified (margin >= the delay) and the
+    table names the rule's k_d as what the infeasibility rests on, with the remedy."""
+    model = _model(delay, **{"passive.stiffness": stiffness})
+    result = dz.answer(model, 0.0, 0.0)
+    assert result.status == "infeasible" and np.isnan(result.activation)
+    j = result.joint_searched
+    assert np.isfinite(j.activation) and np.all(j.delay_margin >= delay)
+    coefficients = checked_coefficients(model, 0.0, 0.0)
+    pcsa = j.activation * np.asarray(solve_point(model, 0.0, 0.0).pcsa, float)
+    s, d, theta = coefficients.stiffness(pcsa), coefficients.damping(pcsa), coefficients.inertia
+    assert np.all(np.isinf(delay_margin(s, d, theta, 0.0 * s, 0.0 * s, 0.05).margin))
+    table = result.table()
+    assert "the infeasibility rests on the reflex rule" in table and "destabilise the segments" in table
+    assert "margins unbounded" in table and "--gains search" in table
+    assert "none (the rule has no design" not in table
+    assert result.to_dict()["joint_gain_searched"]["no_reflex_delay_margin_s"] == [None] * len(s)
+
+
+def test_default_answer_says_it_is_the_rules_least_and_both_sit_on_their_boundary():
+    """At 100 ms (`wagner2012`, (3, 4) cm) the chain's heading says 'under the reflex rule', one line points to
+    --gains search, and the joint-by-joint answer carries a boundary note, true because the segment setting the
+    common activation has tau_m = the delay (the bisection stops on the margin, to 1e-3 of it)."""
+    result = dz.answer(_model(0.1), *AT)
+    table = result.table()
+    assert "least local stiffness under the reflex rule at activation 0.5000" in table
+    assert "  the least under the reflex rule; other diagonal PD gains may need less: --gains search" in table
+    joint = [line for line in table.splitlines() if line.startswith("  boundary: the least value sits on")]
+    assert len(joint) == 2  # joint by joint and the chain
+    binding = max(result.segments, key=lambda s: s.activation)
+    assert binding.delay_margin == pytest.approx(0.1, rel=1e-3)
+
+
+def test_given_gains_are_not_called_the_rule():
+    """With explicit gains (a variant: k_p = 20, k_d = 2 at every joint) the answer is not the rule's: no 'under the
+    reflex rule' heading and no pointer that other gains may need less than the rule."""
+    table = dz.answer(_model(0.04), *AT, kp=20.0, kd=2.0).table()
+    assert "under the reflex rule" not in table and "--gains search" not in table.split("chain (")[1]
+
+
+@pytest.mark.parametrize(("delay", "ratio"), [(0.1, 1.2), (0.04, 1.5)])
+def test_margin_design_names_the_designed_delay_and_shows_the_nominal_cost(delay, ratio):
+    """--margin R (the issue's 100 ms x 1.2; 40 ms x 1.5, a variant): the certificate's root is at R tau and says so,
+    and beside it stands the design at tau itself, the same local stiffness as the plain design at tau (dz.design,
+    computed here separately), so the margin's cost is visible and not negative."""
+    result = dz.answer(_model(delay), *AT, ratio=ratio)
+    plain = dz.design(_model(delay), *AT).chain
+    nominal = result.nominal_design
+    np.testing.assert_allclose(nominal.local_stiffness, plain.local_stiffness, rtol=1e-9)
+    table = result.table()
+    designed = f"rightmost root at the designed delay {1000 * ratio * delay:.4g} ms Re s ="
+    assert designed in table
+    total = np.sum(plain.local_stiffness)
+    assert f"the design at {1000 * delay:.4g} ms itself needs {total:.1f} N m/rad" in table
+    assert np.sum(result.chain.local_stiffness) >= total
+    assert result.to_dict()["nominal_design"]["local_stiffness_fraction"] == nominal.fraction

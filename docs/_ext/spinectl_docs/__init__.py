@@ -82,7 +82,7 @@ MEASURED_TABLES = (
 )
 """The tables of what commands print, measured at the build: (file in ``_generated/``, its generator)."""
 
-MEASURED_VALUES = (anatomy, chain, errata, interchange, lift, reflex, trends)
+MEASURED_VALUES = (anatomy, chain, errata, interchange, lift, reflex, reproduction, trends)
 """The modules that register ``{measured}`` values (:func:`.values.value`) when imported."""
 
 

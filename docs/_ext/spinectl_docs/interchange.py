@@ -153,3 +153,15 @@ value("interchange.spinectl_growing")(
 )
 value("interchange.millard_fastest")(lambda: f"{_growing(_millard_opensim())[0]:.2f}")
 value("interchange.fastest_6")(lambda: f"{exported('mjcf', 'millard', False)[1].eigenvalues.real.max():.6g}")
+
+
+@cache
+def _millard_local_opensim():
+    """OpenSim's own linearisation of the Millard export with spinectl's least local stiffness (and damping)."""
+    from spinectl.anatomy.interchange import opensim_eigenvalues
+
+    path, solution = exported("osim", "millard", True)
+    return opensim_eigenvalues(path, solution.model.geometry.cor_names)
+
+
+value("interchange.millard_local_fastest")(lambda: f"{_growing(_millard_local_opensim())[0]:.2f}")

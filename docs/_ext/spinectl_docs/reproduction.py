@@ -14,6 +14,7 @@ from spinectl.model.config import load_preset
 from spinectl.paper import assumptions, calibration, verdicts
 
 from .markup import md_escape
+from .values import value
 
 
 def parameter_table() -> str:
@@ -45,3 +46,27 @@ def assumption_table() -> str:
 def landmark_table() -> str:
     """The documented verdict of every landmark (:func:`spinectl.paper.verdicts.documented_table`)."""
     return verdicts.documented_table()
+
+
+def _documented(name: str) -> str:
+    """A landmark's documented value for ``wagner2012``, as the landmark table prints it (the tests check it
+    against a fresh measurement: tests/paper/test_verdicts.py)."""
+    return verdicts.format_number(verdicts.VERDICTS[name].value)
+
+
+def claim() -> str:
+    """'reproduced' or 'not reproduced': the paper's main claim, from its two landmarks' documented verdicts."""
+    both = all(verdicts.VERDICTS[n].verdict == verdicts.REPRODUCED for n in ("optimum_lordosis", "ct_optimum"))
+    return "reproduced" if both else "not reproduced"
+
+
+def agreeing() -> str:
+    """'11 of 22': how many landmarks the documented verdicts call reproduced, of all."""
+    marks = verdicts.VERDICTS.values()
+    return f"{sum(v.verdict == verdicts.REPRODUCED for v in marks)} of {len(marks)}"
+
+
+value("reproduction.claim")(claim)
+value("reproduction.optimum_lordosis")(lambda: _documented("optimum_lordosis"))
+value("reproduction.ct_optimum")(lambda: _documented("ct_optimum"))
+value("reproduction.agreeing")(agreeing)

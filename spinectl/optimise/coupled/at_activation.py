@@ -225,7 +225,7 @@ class CoupledStability:
                 self.stiffness,
                 "10.3f",
             ),
-            ("damping D [N m s/rad]", self.damping, "10.4f"),
+            ("damping D [N m s/rad]: eq. 1's sign: D < 0 damps (theta phi'' = S phi + D phi')", self.damping, "10.4f"),
             ("mass M [kg m^2]", self.mass, "10.4f"),
         ):
             lines += ["", title, " " * 8 + "".join(f"{n:>10}" for n in names)]

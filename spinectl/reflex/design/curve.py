@@ -17,7 +17,7 @@ from ...model.params import Model
 from ...optimise.reference import solve_point
 from .chain import chain_curve, chain_design
 from .joint import joint_design, least_activations, scan_margins
-from .result import Design, DesignCurve
+from .result import GIVEN_REFLEX, Design, DesignCurve
 
 
 @with_one_blas_thread
@@ -152,7 +152,30 @@ def delay_curve(model: Model, eccentricity: float, lordosis: float, delays, lags
         max_root_real=roots,
         names=tuple(names),
         model=provenance(model) | {"header": header(model)},
+        reflex=curve_reflex(model, kp, kd),
+        global_pcsa=model.reflex.activation * float(np.sum(optimum)),
     )
+
+
+def curve_reflex(model: Model, kp=None, kd=None) -> str:
+    """The reflex the curve's values assume, in words (both criteria).
+
+    Parameters
+    ----------
+    model : Model
+    kp, kd : float, optional
+        Explicit gains [N m/rad], [N m s/rad].
+
+    Returns
+    -------
+    str
+    """
+    if model.reflex.gains == "rule" and kp is None and kd is None:
+        return (
+            "the reflex rule (joint by joint, at each activation; the chain, (1 - f)+ x the rule's gains); other "
+            "diagonal PD gains may need less (design --delay D --gains search)"
+        )
+    return GIVEN_REFLEX
 
 
 def _curve_at_lag(model, e, lam, coefficients, optimum, delays, kp, kd):

@@ -41,7 +41,7 @@ from ..gain_search import search_chain_gains
 from ..mimo import chain_delay_margin
 from .chain import chain_design
 from .joint_searched import joint_searched_design
-from .result import gains_text
+from .result import GIVEN_REFLEX, RULE_REFLEX, gains_text
 from .roots import SPECTRAL_NODES, rightmost_root
 
 SEARCH_STEPS = 5
@@ -61,10 +61,9 @@ SEARCH_SEED = 0
 COST_RATIO = 1.1
 """The modest delay-margin ratio whose cost the table shows by default: the design at 1.1 times the delay."""
 
-RULE_REFLEX = "the reflex rule, (1 - f)+ x the rule's gains"
-GIVEN_REFLEX = "the given gains kp, kd at every joint"
 SEARCHED_REFLEX = "any diagonal PD gains, searched"
-"""The reflex each answer assumes, as the table and JSON label it."""
+"""The reflex the searched answer assumes, as the table and JSON label it (the rule's and the given gains' labels,
+RULE_REFLEX and GIVEN_REFLEX, are in :mod:`~spinectl.reflex.design.result`, which the curve shares)."""
 
 
 @dataclass(frozen=True)
@@ -316,6 +315,7 @@ def answer(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None,
     -------
     Design
         With ``margin_ratio``, ``nominal_delay``, ``margin_cost`` (at :data:`COST_RATIO` where R = 1),
+        ``nominal_design`` (the chain's at tau where R > 1),
         ``searched``, ``joint_searched`` and the chain's ``pcsa``, ``kp``, ``kd`` and ``reflex``.
 
     Raises
@@ -346,12 +346,16 @@ def answer(model: Model, eccentricity: float, lordosis: float, kp=None, kd=None,
         longer = config.set_parameters(model, {"reflex.delay": COST_RATIO * nominal})
         c = chain_design(longer, e, lam, pcsa, at.reflex.activation, kp, kd)
         cost = MarginCost(COST_RATIO, c.fraction, c.local_stiffness)
+    nominal_design = None
+    if ratio != 1.0 and np.all(np.isfinite(pcsa)):  # the design at the delay asked for: what the margin costs
+        c = chain_design(model, e, lam, pcsa, at.reflex.activation, kp, kd)
+        nominal_design = MarginCost(1.0, c.fraction, c.local_stiffness)
     searched = gain_searched_design(at, e, lam, pcsa, rule) if search and np.all(np.isfinite(pcsa)) else None
     # milliseconds: always beside the rule's, but for a decay rate, which that grid does not certify
     joint = joint_searched_design(at, e, lam, result, kp, kd) if not decay > 0 else None
     return replace(
         result, chain=rule, margin_ratio=float(ratio), nominal_delay=nominal, margin_cost=cost, searched=searched,
-        joint_searched=joint,
+        joint_searched=joint, nominal_design=nominal_design,
     )  # fmt: skip
 
 

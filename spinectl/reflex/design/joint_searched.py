@@ -8,7 +8,8 @@ scale where the rule gives none), with the rule's gains and none at all; the bes
 certificate of the chain's design, its margin at least the delay and the rightmost root of the segment's
 characteristic equation at the delay (:func:`~spinectl.reflex.design.roots.rightmost_root` on the 1 x 1
 chain, Chebyshev seeds) on the left. Each segment's activation is bisected in [0, a_rule] (its rule's
-answer, a candidate with the rule's gains, so never above it) in :data:`HALVINGS` halvings; the common
+answer, a candidate with the rule's gains, so never above it; in [0, 1] where the rule has none, so that the
+search starts from no reflex and the grid rather than from the rule) in :data:`HALVINGS` halvings; the common
 activation is the largest of them, certified again at every segment. As for the chain, whether the least
 activation is monotone for some gains is not known, so the answer is the least certified, not a proof.
 A grid of the segment's two gains costs milliseconds, so the whole answer does too.
@@ -60,6 +61,11 @@ class JointSearchedDesign:
         Their exact margins there [s].
     max_root_real : numpy.ndarray, shape (n_cor,)
         Re of each segment's rightmost root at the delay [1/s].
+    rule_kd : numpy.ndarray or None, shape (n_cor,)
+        Where the rule has no design: the rule's k_d of each segment at the searched activation
+        [N m s/rad], the reflex the rule's infeasibility rests on; None otherwise.
+    no_reflex_margin : numpy.ndarray or None, shape (n_cor,)
+        Where the rule has no design: each segment's exact margin there with no reflex (k_p = k_d = 0) [s].
     """
 
     activation: float
@@ -70,6 +76,8 @@ class JointSearchedDesign:
     kd: np.ndarray
     delay_margin: np.ndarray
     max_root_real: np.ndarray
+    rule_kd: np.ndarray | None = None
+    no_reflex_margin: np.ndarray | None = None
 
     def to_dict(self) -> dict:
         """``reflex``, ``activation``, ``pcsa_cm2``, ``segments`` (name, activation, gains, margin, root), ``grid``.
@@ -95,7 +103,14 @@ class JointSearchedDesign:
             "pcsa_cm2": 1e4 * self.pcsa,
             "segments": segments,
             "grid": {"gains_per_axis": GRID, "decades_each_side": DECADES, "halvings": HALVINGS},
-        }
+        } | self._failure_dict()
+
+    def _failure_dict(self) -> dict:
+        """Where the rule has no design: its k_d and the margins with no reflex at the searched activation."""
+        if self.rule_kd is None or self.no_reflex_margin is None:
+            return {}
+        margins = [None if np.isinf(m) else float(m) for m in self.no_reflex_margin]
+        return {"rule_kd_Nms_per_rad": self.rule_kd.tolist(), "no_reflex_delay_margin_s": margins}
 
     def lines(self, rule_activation: float) -> list[str]:
         """The table's lines, beside the rule's common activation.
@@ -110,11 +125,19 @@ class JointSearchedDesign:
         list of str
         """
         if not np.isfinite(self.activation):
-            return [f"over {SEARCHED_JOINT_REFLEX}: none (the rule has no design to start from)"]
-        less = 100 * (1 - self.activation / rule_activation) if rule_activation > 0 else 0.0
+            return [
+                f"over {SEARCHED_JOINT_REFLEX}: none in [0, 1] either (searched from no reflex and the grid, "
+                "the rule having no design)"
+            ]
+        if np.isfinite(rule_activation):
+            less = 100 * (1 - self.activation / rule_activation) if rule_activation > 0 else 0.0
+            beside = f"the rule's {rule_activation:.4f}, {less:.0f} % less"
+        else:
+            beside = "the rule has none: searched in [0, 1]"
         return [
+            *self._rule_failure_lines(),
             f"over {SEARCHED_JOINT_REFLEX}: activation {self.activation:.4f} x minimum PCSA "
-            f"({1e4 * self.pcsa:.2f} cm^2; the rule's {rule_activation:.4f}, {less:.0f} % less)",
+            f"({1e4 * self.pcsa:.2f} cm^2; {beside})",
             "  each segment's own: "
             + ", ".join(f"{n} {a:.4f}" for n, a in zip(self.names, self.segment_activation, strict=True)),
             "  gains there: " + gains_text(self.names, self.kp, self.kd),
@@ -122,6 +145,24 @@ class JointSearchedDesign:
             + ", ".join(f"{1000 * m:.1f}" for m in self.delay_margin)
             + f" ms; rightmost roots Re s <= {np.max(self.max_root_real):.4g} 1/s "
             f"(grid {GRID} x {GRID} gains, {DECADES:g} decades each side, {HALVINGS} halvings)",
+        ]
+
+    def _rule_failure_lines(self) -> list[str]:
+        """Where the rule has no design: the reflex its infeasibility rests on, and the remedy."""
+        if self.rule_kd is None or self.no_reflex_margin is None:
+            return []
+        free = bool(np.all(self.no_reflex_margin >= 0) and np.all(np.isinf(self.no_reflex_margin)))
+        without = (
+            "without a reflex every segment is stable at every delay (margins unbounded: margins --kp 0 --kd 0)"
+            if free
+            else "without a reflex the exact margins are "
+            + ", ".join(f"{1000 * m:.1f}" for m in self.no_reflex_margin)
+            + " ms"
+        )
+        return [
+            f"  the infeasibility rests on the reflex rule: at activation {self.activation:.4f} its own gains "
+            f"(k_d {np.min(self.rule_kd):.3g}-{np.max(self.rule_kd):.3g} N m s/rad) destabilise the segments; "
+            f"{without}; remedy: no reflex, or other gains (below; the chain's: --gains search)"
         ]
 
 
@@ -156,6 +197,17 @@ class _Segments:
         i = int(np.nanargmax(np.where(np.isnan(margins), -np.inf, margins)))
         return kps[i], kds[i], float(margins[i])
 
+    def rule_kd(self, k: int, a: float) -> float:
+        """The rule's (or the explicit) k_d of segment k at activation a [N m s/rad]."""
+        s, d, theta = self.plant(k, a)
+        return float(gains.resolve_gains([s], [d], [theta], self.model.reflex, self.kp, self.kd)[1][0])
+
+    def no_reflex_margin(self, k: int, a: float) -> float:
+        """Segment k's exact margin at activation a with no reflex [s]."""
+        s, d, theta = self.plant(k, a)
+        with np.errstate(all="ignore"):
+            return float(np.asarray(delay_margin(s, d, theta, 0.0, 0.0, self.lag).margin))
+
     def certify(self, k: int, a: float):
         """(kp, kd, margin, root's Re) if the best gains hold segment k at a at the delay, else None."""
         kp, kd, margin = self.best(k, a)
@@ -166,9 +218,16 @@ class _Segments:
         return (kp, kd, margin, float(root.real)) if root.real < 0 else None
 
     def least(self, k: int, rule: float) -> float:
-        """Segment k's least activation certified in [0, rule] (the rule's answer, itself certified by the rule)."""
+        """Segment k's least activation certified in [0, rule] (the rule's answer, itself certified by the rule).
+
+        Where the rule has none (``rule`` NaN) in [0, 1], NaN if the grid holds the segment nowhere there.
+        """
         if self.certify(k, 0.0) is not None:
             return 0.0
+        if not np.isfinite(rule):
+            if self.certify(k, 1.0) is None:
+                return np.nan
+            rule = 1.0
         lo, hi = 0.0, rule
         for _ in range(HALVINGS):
             mid = 0.5 * (lo + hi)
@@ -199,20 +258,27 @@ def joint_searched_design(model: Model, eccentricity: float, lordosis: float, de
     names = tuple(s.name for s in design.segments)
     rule = np.array([s.activation for s in design.segments], float)
     n = len(names)
-    if not np.isfinite(design.activation):
-        nan = np.full(n, np.nan)
-        return JointSearchedDesign(np.nan, np.nan, names, nan, nan, nan, nan, nan)
+    nan = np.full(n, np.nan)
     segments = _Segments(model, e, lam, kp, kd)
+    if not np.all(np.isfinite(segments.optimum)):
+        return JointSearchedDesign(np.nan, np.nan, names, nan, nan, nan, nan, nan)
     with arithmetic_guard(e, lam):
         own = np.array([segments.least(k, rule[k]) for k in range(n)])
+        if not np.all(np.isfinite(own)):  # the grid holds some segment nowhere in [0, 1]
+            return JointSearchedDesign(np.nan, np.nan, names, own, nan, nan, nan, nan)
         common = float(np.max(own))
         held = [segments.certify(k, common) for k in range(n)]
-        if any(h is None for h in held):  # a segment the grid holds below but not at the common activation
+        if any(h is None for h in held) and np.isfinite(design.activation):  # held below, not at the common one
             common = design.activation
             held = [segments.certify(k, common) for k in range(n)]
     if any(h is None for h in held):  # the rule's own gains at its answer are the certificate there
-        nan = np.full(n, np.nan)
         return JointSearchedDesign(design.activation, design.pcsa, names, rule, nan, nan, nan, nan)
     kps, kds, margins, roots = (np.array(x, float) for x in zip(*held, strict=True))
     pcsa = common * float(np.sum(segments.optimum))
-    return JointSearchedDesign(common, pcsa, names, own, kps, kds, margins, roots)
+    failure = {}
+    if not np.isfinite(design.activation):  # name the reflex the rule's infeasibility rests on
+        failure = {
+            "rule_kd": np.array([segments.rule_kd(k, common) for k in range(n)]),
+            "no_reflex_margin": np.array([segments.no_reflex_margin(k, common) for k in range(n)]),
+        }
+    return JointSearchedDesign(common, pcsa, names, own, kps, kds, margins, roots, **failure)

@@ -20,6 +20,11 @@ LOCAL_MAX = 2.0
 (the rule's reflex vanishes at 1 k*, where the search ends)."""
 
 
+RULE_REFLEX = "the reflex rule, (1 - f)+ x the rule's gains"
+GIVEN_REFLEX = "the given gains kp, kd at every joint"
+"""The reflex the chain's answer assumes, as the table and JSON label it: the rule's, or the gains given."""
+
+
 BOUNDARY_RTOL = 1e-3
 """A chain design's margin more than this above the delay (relative) did not stop on the delay: the least
 stiffness is where the margin jumps past it (at K = 40 N m/rad, 376 ms against 120 ms), not a boundary at it."""
@@ -184,6 +189,9 @@ class Design:
         (:class:`~spinectl.reflex.design.joint_searched.JointSearchedDesign`), or None.
     decay_rate : float
         sigma of ``--decay-rate``: the chain's design has every root at the delay at Re s < -sigma [1/s]; 0, none.
+    nominal_design : object or None
+        Where ``--margin R`` > 1: the chain's design at the delay asked for (:attr:`nominal_delay`), a
+        :class:`~spinectl.reflex.design.gain_searched.MarginCost` with ratio 1, what the margin is paid against.
     """
 
     eccentricity: float
@@ -204,6 +212,7 @@ class Design:
     searched: object = None
     joint_searched: object = None
     decay_rate: float = 0.0
+    nominal_design: object = None
 
     def to_dict(self) -> dict:
         """The document of ``spinectl design --json``.
@@ -245,6 +254,8 @@ class Design:
             out["decay_rate_per_s"] = self.decay_rate
         if self.margin_cost is not None:
             out["margin_cost"] = self.margin_cost.to_dict()
+        if self.nominal_design is not None:
+            out["nominal_design"] = self.nominal_design.to_dict()
         if self.searched is not None:
             out["chain_gain_searched"] = self.searched.to_dict()
         if self.joint_searched is not None:
@@ -287,7 +298,7 @@ class Design:
             ),
             *self._joint_lines(),
             "",
-            f"{criterion('chain', len(c.local_stiffness))}: least local stiffness at activation "
+            f"{criterion('chain', len(c.local_stiffness))}: least local stiffness{_under(c.reflex)} at activation "
             f"{_word(c.activation, 0, '.4f')} ({c.method})",
         ]
         if np.isfinite(c.fraction):
@@ -314,7 +325,25 @@ class Design:
             ]
         if self.joint_searched is None:
             return []
-        return ["  reflex assumed: the reflex rule at each activation", *self.joint_searched.lines(self.activation)]
+        return [
+            "  reflex assumed: the reflex rule at each activation",
+            *self._joint_boundary_lines(),
+            *self.joint_searched.lines(self.activation),
+        ]
+
+    def _joint_boundary_lines(self) -> list[str]:
+        """Joint by joint, the least co-contraction is a stability boundary, as the chain's is."""
+        if not (np.isfinite(self.activation) and self.activation > 0):
+            return []
+        if self.margin_ratio != 1.0:
+            return [
+                f"  robust: designed at {self.margin_ratio:g} x the delay {delay_text(self.nominal_delay)}, so "
+                f"it holds every delay up to {delay_text(self.delay)} (--margin {self.margin_ratio:g})"
+            ]
+        return [
+            "  boundary: the least value sits on its stability boundary (the margin of the segment that sets it "
+            "= the delay; less co-contraction is unstable at this delay); a margin costs more: --margin R"
+        ]
 
     def _chain_lines(self) -> list[str]:
         """The reflex the chain's answer assumes, its PCSA and gains, the margin it has and the searched answer."""
@@ -331,6 +360,8 @@ class Design:
             lines.append(self._boundary_line())
         if self.searched is not None:
             lines += self.searched.lines(names, c.fraction, c.least_static)
+        elif np.isfinite(c.fraction) and _under(c.reflex):
+            lines.append("  the least under the reflex rule; other diagonal PD gains may need less: --gains search")
         return lines
 
     def _delay_words(self) -> str:
@@ -344,7 +375,8 @@ class Design:
     def _certificate_line(self) -> str:
         """The chain's certificate: the exact margin and the rightmost root (with a decay rate, beyond -sigma)."""
         c = self.chain
-        root = f"rightmost root at the delay Re s = {_word(c.max_root_real, 0, '.4g')} 1/s"
+        at = "the delay" if self.margin_ratio == 1.0 else f"the designed delay {delay_text(self.delay)}"
+        root = f"rightmost root at {at} Re s = {_word(c.max_root_real, 0, '.4g')} 1/s"
         if not self.decay_rate > 0:
             return f"certificate: exact delay margin {delay_text(c.delay_margin)} >= {delay_text(self.delay)}; {root}"
         return (
@@ -367,6 +399,7 @@ class Design:
             return (
                 f"  robust: designed at {self.margin_ratio:g} x the delay {delay_text(self.nominal_delay)}, so "
                 f"it holds every delay up to {delay_text(self.delay)} (--margin {self.margin_ratio:g})"
+                + self._nominal_words()
             )
         ratio = c.delay_margin / self.delay if self.delay > 0 else np.inf
         if ratio > 1.0 + BOUNDARY_RTOL:  # the margin jumped past the delay at the least value: no delay sets it
@@ -387,11 +420,29 @@ class Design:
             text += f"; no local stiffness holds {cost.ratio:g} x the delay"
         return text
 
+    def _nominal_words(self) -> str:
+        """Beside a --margin design: the chain's design at the delay asked for, so that the margin's cost shows."""
+        nominal = self.nominal_design
+        if nominal is None:
+            return ""
+        if not np.isfinite(nominal.fraction):
+            return f"; at {delay_text(self.nominal_delay)} itself no local stiffness meets the delay"
+        total, here = np.sum(nominal.local_stiffness), np.sum(self.chain.local_stiffness)
+        return (
+            f"; the design at {delay_text(self.nominal_delay)} itself needs {total:.1f} N m/rad "
+            f"({nominal.fraction:.4f} x k*): the margin costs {here - total:+.1f}"
+        )
+
     def __bool__(self):
         raise TypeError(
             "the truth value of a Design is ambiguous: use design.status == 'ok' (both criteria met), or "
             "design.activation / design.chain.fraction (NaN where none meets the delay)"
         )
+
+
+def _under(reflex: str) -> str:
+    """' under the reflex rule' where the chain's design assumes the rule's gains; '' otherwise."""
+    return " under the reflex rule" if reflex == RULE_REFLEX else ""
 
 
 def gains_text(names, kp, kd) -> str:
@@ -460,6 +511,10 @@ class DesignCurve:
         (:func:`~spinectl.reflex.design.roots.rightmost_root` with ``nodes`` = 0).
     names : tuple of str
     model : dict
+    reflex : str
+        The reflex every value assumes (:func:`curve_reflex`).
+    global_pcsa : float
+        The chain's global PCSA, ``chain_activation`` x the minimum stabilising PCSA at this K [m^2].
     """
 
     eccentricity: float
@@ -476,6 +531,8 @@ class DesignCurve:
     max_root_real: np.ndarray
     names: tuple[str, ...]
     model: dict
+    reflex: str = ""
+    global_pcsa: float = float("nan")
 
     def to_dict(self) -> dict:
         """The document of ``spinectl design --delays ... --json``.
@@ -517,8 +574,33 @@ class DesignCurve:
             "Lambda_m": self.lordosis,
             "delays_s": self.delays.tolist(),
             "reaction_times_s": [{"delay_s": t, "label": label} for t, label in REACTION_TIMES],
+            "reflex": self.reflex,
+            "global_pcsa_cm2": float(m2_to_cm2(self.global_pcsa)),
+            "reading": " ".join(self.notes()),
             "curves": curves,
         }
+
+    def notes(self) -> list[str]:
+        """What every value rests on: the reflex, that it is a boundary, what tau_m is and a zero row.
+
+        Returns
+        -------
+        list of str
+        """
+        notes = [
+            f"reflex assumed: {self.reflex}.",
+            "Each nonzero value is the least, a stability boundary: less is unstable at that delay (a margin costs "
+            "more: design --delay D --margin R); a 0 needs none: the reflex alone holds that delay (no boundary).",
+            "tau_m: the chain's exact delay margin at its design (joint by joint every segment's is at least the "
+            "delay).",
+        ]
+        zero = np.isclose(self.delays, 0.0)
+        if zero.any():
+            notes.append(
+                "0 ms: the reflex acting without delay; where it holds by itself (answers 0: no co-contraction, no "
+                "local stiffness) tau_m is the delay that reflex alone holds, not a designed margin."
+            )
+        return notes
 
     def table(self) -> str:
         """The curves as rows per lag: both criteria's required design per delay.
@@ -531,21 +613,23 @@ class DesignCurve:
         n = len(self.names)
         lines = [
             self.model.get("header", "preset unknown"),
-            f"E = {self.eccentricity * 100:.2f} cm, Lambda = {self.lordosis * 100:.2f} cm; joint by joint: "
-            f"{criterion('joint', n)}; chain: {criterion('chain', n)} at activation {self.chain_activation:.4g}",
+            f"E = {self.eccentricity * 100:.2f} cm, Lambda = {self.lordosis * 100:.2f} cm; {criterion('joint', n)}; "
+            f"{criterion('chain', n)} at activation {self.chain_activation:.4g} (global PCSA "
+            f"{m2_to_cm2(self.global_pcsa):.2f} cm^2: the minimum stabilising PCSA at this K times it)",
+            *self.notes(),
         ]
         for i, lag in enumerate(self.lags):
             lines += [
                 "",
                 f"activation lag T_a = {lag * 1000:.4g} ms",
                 f"{'delay[ms]':>9} {'joint: activation':>17} {'PCSA[cm2]':>10} {'chain: sum k[N m/rad]':>21} "
-                f"{'x k*':>7} {'tau_m[ms]':>10}",
+                f"{'x k*':>7} {'chain tau_m[ms]':>16}",
             ]
             lines += [
                 f"{d * 1000:9.4g} {_word(self.activation[i, j], 17, '.4f')} "
                 f"{_word(m2_to_cm2(self.pcsa[i, j]), 10, '.2f')} "
                 f"{_word(float(np.sum(self.local_stiffness[i, j])), 21, '.1f')} "
-                f"{_word(self.local_fraction[i, j], 7, '.4f')} {_word(self.chain_margin[i, j] * 1000, 10, '.4g')}"
+                f"{_word(self.local_fraction[i, j], 7, '.4f')} {_word(self.chain_margin[i, j] * 1000, 16, '.4g')}"
                 for j, d in enumerate(self.delays)
             ]
         return "\n".join(lines)
