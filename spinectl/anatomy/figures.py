@@ -123,7 +123,7 @@ def modes_figure(shapes: ModeShapes, title: str = ""):
 
 
 def lordosis_figure(curve: dict, title: str = ""):
-    """The three optima over the lordosis: least cost (top) and the chain's margin (bottom), in degrees.
+    """The three optima along the rhythm: least cost (top) and the chain's margin (bottom), in degrees.
 
     Parameters
     ----------
@@ -146,7 +146,15 @@ def lordosis_figure(curve: dict, title: str = ""):
         ok = np.array([s in ("optimal", "optimal_inaccurate") for s in row["status"]])
         cost = np.where(ok, np.asarray(row["cost"], float), np.nan)
         margin = np.where(ok, np.asarray(row["margin_Nm_per_rad"], float), np.nan)
-        top.plot(degrees, cost, "-o", ms=3, color=colour, label=label)
+        feasible = bool(np.any(np.isfinite(cost)))  # a criterion with no point drawn says why in its legend entry
+        top.plot(
+            degrees,
+            cost,
+            "-o",
+            ms=3,
+            color=colour,
+            label=label if feasible else f"{label}: infeasible at every posture",
+        )
         rough = np.array([s == "optimal_inaccurate" for s in row["status"]])
         inaccurate += int(rough.sum())
         if np.any(np.isfinite(cost)):
@@ -163,12 +171,10 @@ def lordosis_figure(curve: dict, title: str = ""):
     bottom.axhline(0.0, color="tab:red", lw=0.8)
     top.set_ylabel(r"least cost $\sum_i w_i a_i^2$ [1]")
     bottom.set_ylabel("least eigenvalue of -K [N m/rad]\n(free chain; < 0 unstable)")
-    bottom.set_xlabel(
-        f"{CURVE_AXIS}: {CURVE_AXIS_MEANING}\nthe thorax tilts with it: not a lordosis at a fixed upright trunk",
-        fontsize=8,
-    )
+    meaning = f"{CURVE_AXIS}: {CURVE_AXIS_MEANING}; the thorax tilts with it: not a lordosis at a fixed upright trunk"
+    bottom.set_xlabel(textwrap.fill(meaning, 95), fontsize=8)  # wrapped: one line ran past both edges
     top.legend(fontsize=8, title="criterion (star: least cost)", title_fontsize=8)
-    top.set_title(title or "the three optima over the lordosis", fontsize=10)
+    top.set_title(title or f"the three optima along the rhythm ({CURVE_AXIS})", fontsize=10)
     if inaccurate:
         warning = CURVE_INACCURATE.format(count=inaccurate, mark="x, a hollow star")
         fig.suptitle(textwrap.fill(warning, 120), fontsize=7, color="tab:red")
@@ -201,7 +207,7 @@ def anatomy_figures(anatomy, analysis, curve: dict | None = None) -> dict:
         title = f"{name}, sagittal, {held}"
         figures["modes.png"] = modes_figure(mode_shapes(anatomy, analysis.free), title)
     if curve is not None:
-        figures["lordosis.png"] = lordosis_figure(curve, f"{name}: the three optima over the lordosis")
+        figures["lordosis.png"] = lordosis_figure(curve, f"{name}: the three optima along the rhythm ({CURVE_AXIS})")
     return figures
 
 

@@ -66,3 +66,21 @@ def test_the_lordosis_figure_leaves_infeasible_postures_as_gaps():
     top, bottom = fig.axes
     costs = [line.get_ydata() for line in top.lines if len(line.get_xdata()) == 3]
     assert len(costs) == 3 and all(np.isnan(c[1]) for c in costs)
+
+
+def test_the_lordosis_figure_reads_its_axis_whole_and_says_a_criterion_drawn_nowhere_is_infeasible():
+    """The axis label (what the summed angle change means) is wrapped so that no line is wider than the figure's
+    text column (before: one line ran past both edges of lordosis.png), the title names the rhythm, not 'the
+    lordosis', and a criterion infeasible at every posture (no point drawn: MyoTorso's free chain with no stiffness
+    added) says so in its legend entry; a feasible one's entry is its label alone (the variant)."""
+    curve = {"lordosis_deg": [-1.0, 0.0, 1.0]}
+    for key in ("none", "joints"):
+        curve[key] = {"cost": [1.0, 0.5, 2.0], "status": ["optimal"] * 3, "margin_Nm_per_rad": [1.0, 1.0, 1.0]}
+    curve["chain"] = {"cost": [np.nan] * 3, "status": ["infeasible"] * 3, "margin_Nm_per_rad": [np.nan] * 3}
+    fig = figures.lordosis_figure(curve)
+    top, bottom = fig.axes
+    assert max(len(line) for line in bottom.get_xlabel().splitlines()) <= 95
+    assert "along the rhythm" in top.get_title() and "over the lordosis" not in top.get_title()
+    labels = [text.get_text() for text in top.get_legend().get_texts()]
+    assert sum(label.endswith(": infeasible at every posture") for label in labels) == 1
+    assert not any(label.endswith("infeasible at every posture") for label in labels[:2])

@@ -235,3 +235,24 @@ def test_margin_design_names_the_designed_delay_and_shows_the_nominal_cost(delay
     assert f"the design at {1000 * delay:.4g} ms itself needs {total:.1f} N m/rad" in table
     assert np.sum(result.chain.local_stiffness) >= total
     assert result.to_dict()["nominal_design"]["local_stiffness_fraction"] == nominal.fraction
+
+
+def test_the_searched_certificate_under_a_margin_names_the_designed_delay_too():
+    """With --margin 1.2 at 100 ms the searched answer is certified at R tau = 120 ms, as the rule's is: its
+    certificate line says 'at the designed delay 120 ms', not 'at the delay' (before: the rule's line said the
+    designed delay, the searched one 'the delay', which reads as 100 ms). A made-up searched answer stands in
+    for the seeded search (its numbers do not matter here, only the wording); without a margin it says 'the
+    delay' (the variant)."""
+    import dataclasses
+
+    from spinectl.reflex.design.gain_searched import GainSearchedDesign
+
+    n = 5
+    fake = GainSearchedDesign(0.5, np.ones(n), np.ones(n), np.ones(n), 0.13, -1e-3, 1, 1, "made up")
+    robust = dataclasses.replace(dz.answer(_model(0.1), *AT, ratio=1.2), searched=fake).table()
+    searched = next(line for line in robust.splitlines() if "certificate: exact delay margin 130" in line)
+    assert "rightmost root at the designed delay 120 ms" in searched
+    plain = dataclasses.replace(dz.answer(_model(0.1), *AT), searched=fake).table()
+    assert "rightmost root at the delay Re s" in next(
+        line for line in plain.splitlines() if "certificate: exact delay margin 130" in line
+    )

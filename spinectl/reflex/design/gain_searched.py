@@ -122,7 +122,7 @@ class GainSearchedDesign:
             "method": self.method,
         }
 
-    def lines(self, names, rule_fraction: float, least_static) -> list[str]:
+    def lines(self, names, rule_fraction: float, least_static, at: str = "the delay") -> list[str]:
         """The table's lines for this answer, beside the rule's f.
 
         Parameters
@@ -133,6 +133,9 @@ class GainSearchedDesign:
             The rule's answer f, of k*.
         least_static : array_like, shape (n,)
             k*, the least local stiffness for static stability [N m/rad].
+        at : str
+            The delay the certificate's root is at, in words: ``"the delay"``, or with ``--margin R`` the
+            designed delay R tau (the rule's certificate names it the same way).
 
         Returns
         -------
@@ -144,7 +147,7 @@ class GainSearchedDesign:
             f"over {SEARCHED_REFLEX}: local stiffness {total:.1f} N m/rad ({self.fraction:.4f} x k*; the rule's "
             f"{rule_total:.1f}, {100 * (1 - total / rule_total) if rule_total > 0 else 0.0:.0f} % less)",
             "  gains: " + gains_text(names, self.kp, self.kd),
-            f"  certificate: exact delay margin {delay_text(self.delay_margin)}; rightmost root at the delay "
+            f"  certificate: exact delay margin {delay_text(self.delay_margin)}; rightmost root at {at} "
             f"Re s = {self.max_root_real:.4g} 1/s",
             f"  search: {self.method}; {self.searches} seeded gain searches, {self.evaluations} margin evaluations "
             f"(budget: {SEARCH_STEPS} bisections, each search {_budget_text()}, seed {SEARCH_SEED})",

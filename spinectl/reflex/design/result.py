@@ -359,7 +359,7 @@ class Design:
         if np.isfinite(c.fraction):
             lines.append(self._boundary_line())
         if self.searched is not None:
-            lines += self.searched.lines(names, c.fraction, c.least_static)
+            lines += self.searched.lines(names, c.fraction, c.least_static, self._designed_delay())
         elif np.isfinite(c.fraction) and _under(c.reflex):
             lines.append("  the least under the reflex rule; other diagonal PD gains may need less: --gains search")
         return lines
@@ -372,11 +372,14 @@ class Design:
             f"{delay_text(self.nominal_delay)} (designed at {delay_text(self.delay)}: --margin {self.margin_ratio:g})"
         )
 
+    def _designed_delay(self) -> str:
+        """The delay the certificates' roots are at, in words: with --margin R, R tau."""
+        return "the delay" if self.margin_ratio == 1.0 else f"the designed delay {delay_text(self.delay)}"
+
     def _certificate_line(self) -> str:
         """The chain's certificate: the exact margin and the rightmost root (with a decay rate, beyond -sigma)."""
         c = self.chain
-        at = "the delay" if self.margin_ratio == 1.0 else f"the designed delay {delay_text(self.delay)}"
-        root = f"rightmost root at {at} Re s = {_word(c.max_root_real, 0, '.4g')} 1/s"
+        root = f"rightmost root at {self._designed_delay()} Re s = {_word(c.max_root_real, 0, '.4g')} 1/s"
         if not self.decay_rate > 0:
             return f"certificate: exact delay margin {delay_text(c.delay_margin)} >= {delay_text(self.delay)}; {root}"
         return (
