@@ -19,7 +19,7 @@ import numpy as np
 EQUILIBRIUM_FRACTION = 0.1
 """A joint is far from equilibrium where its net torque exceeds this fraction of what the muscles could hold there.
 
-What the muscles could hold at joint j is their torque range over their control bounds, sum_i |tau_ij| (u_i -
+What the muscles could hold at joint j is their torque range over their control bounds, sum_i abs(tau_ij) (u_i -
 l_i) [N m]. A net torque above a tenth of it is one that the muscles would need a tenth of their whole range at
 that joint to cancel: no small reserve, nor a static optimisation's residual, but a posture these activations do
 not hold."""
@@ -41,7 +41,7 @@ class NetTorque:
         tau_0 + sum_i a_i tau_i at each joint: muscles at the activations, passive forces and gravity [N m]
         (per radian of each joint's rotation, as the chain).
     capacity : numpy.ndarray, shape (n,)
-        What the muscles could hold at each joint, sum_i |tau_ij| (u_i - l_i) [N m] (0 without muscles).
+        What the muscles could hold at each joint, sum_i abs(tau_ij) (u_i - l_i) [N m] (0 without muscles).
     rhythm_torque, rhythm_capacity : numpy.ndarray, shape (r,) or None
         The same on the rhythm's independent coordinates, T^T tau (the model's equalities carry the rest);
         None without a rhythm [N m].

@@ -206,7 +206,7 @@ def _attachment_candidates(cor, points):
 
     Rounding is monotonic, so over the box that the CoR's coordinates span on the grid
     [lo, hi], |fl(c - P)| >= fl(max(lo - P, P - hi, 0)) per coordinate, and the scale
-    |c|_1 + |P|_1 is at most its value at the largest |c_x| and |c_y|: a pair whose lower
+    |c|_1 + |P|_1 is at most its value at the largest abs(c_x) and abs(c_y): a pair whose lower
     bound of the offset exceeds the tolerance times that upper bound of the scale is "on"
     nowhere (the bound rules out every pair of the presets). Coordinates near the overflow
     threshold keep every pair, so that the arithmetic (and its overflow) is that of the

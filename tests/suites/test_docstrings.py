@@ -21,8 +21,10 @@ import dataclasses
 import importlib
 import inspect
 import pkgutil
+import re
 import textwrap
 import types
+from pathlib import Path
 
 import pytest
 from numpydoc.docscrape import NumpyDocString
@@ -364,3 +366,26 @@ def test_returns_checker_fails_when_a_returns_section_is_removed():
 def test_private_modules_are_exempt_from_the_returns_check():
     assert private_module("spinectl._validate") and private_module("spinectl.model._toml")
     assert not private_module("spinectl.model.stability")
+
+
+SUBSTITUTION = re.compile(r"(?<![|\w])\|[A-Za-z_]\w*\|(?![|\w])")
+"""``|name|``: a reST substitution reference, which Sphinx refuses as undefined (the docs build fails)."""
+
+
+def test_no_docstring_holds_a_rest_substitution_reference():
+    """A docstring with ``|tau_ij|`` (an absolute value written as in maths) failed the docs build with 'Undefined
+    substitution referenced': write abs(x) or ``|x|`` in double backquotes. Every string statement of the package
+    is read by ast (module, class, function and attribute docstrings), so the build's failure is caught here."""
+    found = []
+    for path in sorted(Path(spinectl.__file__).parent.rglob("*.py")):
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        for node in ast.walk(tree):
+            if (
+                isinstance(node, ast.Expr)
+                and isinstance(node.value, ast.Constant)
+                and isinstance(node.value.value, str)
+            ):
+                text = node.value.value
+                plain = re.sub(r"``.*?``", "", text, flags=re.S)  # inline literals are not substitutions
+                found += [f"{path.name}: {m.group(0)}" for m in SUBSTITUTION.finditer(plain)]
+    assert not found, found
