@@ -1,11 +1,12 @@
 """The worked example of ``docs/motion.md``: a lift analysed along its frames, measured at the build.
 
-A flexion of the lumbar joints and its return over :data:`DURATION` seconds is written as an OpenSim ``.mot``
-by :func:`spinectl.anatomy.motion.write_motion` (OpenSim's own ``STOFileAdapter``) into a temporary folder, then
-analysed by :func:`spinectl.anatomy.motion.motion_response` with a load, the contributions and the
-joint-by-joint optimum per frame, on MyoTorso and, where the shared folder has it, on the Pose2Sim model. The
-figure is written into ``_generated/`` at ``builder-inited`` (:func:`write_figure`), the numbers that the page's
-sentences quote are ``{measured}`motion.*``` values. Each motion is computed once per build.
+A flexion of the lumbar joints and its return over :data:`DURATION` seconds is written as an OpenSim ``.mot`` by
+:func:`spinectl.anatomy.motion.write_motion` (OpenSim's own ``STOFileAdapter``) into a temporary folder, then
+analysed by :func:`spinectl.anatomy.motion.motion_response` with a load, the contributions and the joint-by-joint
+optimum per frame, on MyoTorso and, where a copy of the published Pose2Sim model is present (docs/anatomy.md,
+"Published models"), on it. The figure is written into ``_generated/`` at ``builder-inited`` (:func:`write_figure`),
+the numbers that the page's sentences quote are ``{measured}`motion.*``` values. Each motion is computed once per
+build.
 """
 
 from __future__ import annotations
