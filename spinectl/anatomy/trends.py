@@ -223,14 +223,15 @@ class StabilityPrice:
 def stability_price(
     anatomy: AnatomyEngine, loads, joint_stiffness="mapped", margin: float = MARGIN, plane: str = "sagittal"
 ) -> StabilityPrice:
-    """The effort stability costs above equilibrium alone, against a vertical load at the thorax (Cholewicki 1997).
+    """The effort stability costs above equilibrium alone, against a mass added to the torso (Cholewicki 1997).
 
     Parameters
     ----------
     anatomy : AnatomyEngine
-        The model (the load at the origin of its mapping's thorax body, fixed in the ground).
+        The model. The load acts along gravity at the centre of mass of its mapping's thorax body (the contract's
+        ``body_weight``), as a mass added to the torso does (the protocol of Cholewicki et al. 1997).
     loads : array_like, shape (p,)
-        Downward loads [N], >= 0.
+        Downward loads [N], >= 0 (the added mass times g).
     joint_stiffness : {"none", "mapped"} or float
         Added at each chain joint [N m/rad].
     margin : float
@@ -250,9 +251,11 @@ def stability_price(
     if loads.ndim != 1 or not np.all(loads >= 0):
         raise ParameterError("loads", f"must be downward forces >= 0 [N] (got {loads.tolist()!r})")
     thorax = anatomy.mapping.bodies["thorax"][-1]
+    gravity, centre = anatomy.body_weight(thorax)
+    down = np.asarray(gravity, float) / np.linalg.norm(gravity)  # a mass's weight, in the ground's frame
     costs = {"chain": [], "none": []}
     for load in loads:
-        held = [BodyLoad(thorax, (0.0, 0.0, -float(load)))]
+        held = [BodyLoad(thorax, tuple(float(load) * down), tuple(centre))]
         for criterion, out in costs.items():
             opt = optimise(anatomy, plane, criterion, margin, joint_stiffness=joint_stiffness, loads=held)
             out.append(opt.cost if opt.ok else float("nan"))

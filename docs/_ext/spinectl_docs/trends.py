@@ -102,8 +102,24 @@ value("trends.index_rise")(lambda: _percent(co_contraction().rise(co_contraction
 value("trends.critical_rise")(lambda: _percent(co_contraction().rise(co_contraction().critical_load)))
 value("trends.compression_rise")(lambda: _percent(co_contraction().rise(co_contraction().compression)))
 value("trends.price_low")(lambda: f"{price().price[0]:.2g}")
-value("trends.price_high")(lambda: f"{price().price[-1]:.3g}")
+
+
+def _last_feasible() -> int:
+    """The index of the largest load at which the chain criterion is feasible (100 N m/rad)."""
+    return int(np.flatnonzero(np.isfinite(price().stable_cost))[-1])
+
+
+def _priced_from() -> str:
+    """The least load at which stability costs anything at the mapping's stiffness [% of body weight]."""
+    mapped = price("mapped")
+    priced = np.flatnonzero(mapped.price > 1e-6 * mapped.classic_cost)
+    return f"{100 * FRACTIONS[priced[0]]:.0f}" if priced.size else "(none: no price at any load)"
+
+
+value("trends.price_high")(lambda: f"{price().price[_last_feasible()]:.3g}")
+value("trends.price_high_at")(lambda: f"{100 * FRACTIONS[_last_feasible()]:.0f}")
 value("trends.classic_fall")(lambda: _percent(1 - price().classic_cost[-1] / price().classic_cost[0]))
+value("trends.mapped_priced_from")(_priced_from)
 
 
 def _infeasible_from(joint_stiffness: float = 50.0) -> str:
@@ -113,6 +129,7 @@ def _infeasible_from(joint_stiffness: float = 50.0) -> str:
 
 
 value("trends.infeasible_from_50")(_infeasible_from)
+value("trends.infeasible_from_100")(lambda: _infeasible_from(STIFFNESS))
 value("trends.removal_largest")(_largest_feasible_removal)
 value("trends.erector_kept")(lambda: f"{removals()['kept']['group:erector_spinae'].percent_change:.1f}")
 value("trends.chain_low")(lambda: f"{chain_stiffness()[0]:.0f}")
