@@ -16,9 +16,9 @@ in the run, as a first analysis of a recording is):
 On each, a flexion and return of the mapped sagittal joints (-8 sin(pi t / T) deg added to the model's default
 posture, every other coordinate at its default) over ``--frames`` frames at 10 Hz, and random activations in
 [0.05, 0.3] per frame, both written through OpenSim's API (``write_motion``: TimeSeriesTable, STOFileAdapter).
-Timed, wall clock, after a warm-up at another posture (imports, OpenSim's reader, xarray) and with the
-engine's in-memory linearisations emptied before each timed run (a run would otherwise read the frames the
-previous one linearised):
+Timed, wall clock, after a warm-up at another posture (imports, OpenSim's reader, xarray), with the
+engine's in-memory linearisations emptied before each timed call (a call would otherwise read the frames the
+previous one linearised), each the least of ``--repeat`` alternated runs:
 
 1. ``motion_response(activations=...)`` (the library call of ``spinectl motion --activations``) against
    ``analyse(posture=FILE, activation=FILE, time=t)`` per frame (the present API, which reads both files at
@@ -40,7 +40,6 @@ import os
 import pstats
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
@@ -111,45 +110,62 @@ def warm_up(model, folder: Path) -> None:
     model.engine.linearisations.clear()
 
 
-def given(model, mot, sto, times) -> tuple:
+def best(model, runs: int, ours, theirs) -> tuple:
+    """The least wall time of ``runs`` alternated calls of ``ours`` and of ``theirs`` [s], the load averages
+    before and after, and each one's last result. The least: a shared machine's bursts of other work lengthen
+    a timing, never shorten it. The engine's in-memory linearisations are emptied before every call."""
+    before, spent, outs = load_average(), [[], []], [None, None]
+    for _ in range(runs):
+        for k, run in enumerate((ours, theirs)):
+            model.engine.linearisations.clear()
+            elapsed, outs[k] = timed(run)
+            spent[k].append(elapsed)
+    model.engine.linearisations.clear()
+    return min(spent[0]), min(spent[1]), f"{before} -> {load_average()}", outs
+
+
+def given(model, mot, sto, times, runs: int) -> tuple:
     """(motion's time, frame-by-frame time, load averages) with activations from the file; indices asserted equal."""
     rec, act = read_recording(mot, "posture"), read_recording(sto, "activations")
-    before = load_average()
-    ours, ds = timed(lambda: motion_response(model, rec, act, progress=False).dataset)
-    model.engine.linearisations.clear()
-    theirs, old = timed(lambda: [analyse(model, posture=mot, activation=sto, time=float(t)) for t in times])
-    model.engine.linearisations.clear()
+    ours, theirs, loads, (ds, old) = best(
+        model,
+        runs,
+        lambda: motion_response(model, rec, act, progress=False).dataset,
+        lambda: [analyse(model, posture=mot, activation=sto, time=float(t)) for t in times],
+    )
     for name in ("free", "constrained"):
         assert np.array_equal(ds[f"{name}_index"].values, [getattr(r, name).eigenvalues[0] for r in old]), name
-    return ours, theirs, f"{before} -> {load_average()}"
+    return ours, theirs, loads
 
 
-def optimum(model, mot, frames: int) -> tuple:
-    """(motion's time, frame-by-frame time, frames solved, load averages) with the optimum (joints) per frame."""
+def optimum(model, mot, frames: int, runs: int) -> tuple:
+    """(motion's time, frame-by-frame time, load averages, frames solved) with the optimum (joints) per frame."""
     rec = read_recording(mot, "posture")
-    chosen = (0, frames - 1, 1)
-    before = load_average()
-    ours, ds = timed(lambda: motion_response(model, rec, optimise="joints", frames=chosen, progress=False).dataset)
-    model.engine.linearisations.clear()
+    columns = model.posture_columns()
 
     def frame_by_frame():
-        columns = model.posture_columns()
         for t in rec.times[:frames]:
             posture = model.named_posture(rec.frame(columns, float(t)).values)
             opt = optimise(model, stability="joints", posture=posture)
             if opt.ok:
                 analyse(model, posture=posture, activation=opt.activations)
 
-    theirs, _ = timed(frame_by_frame)
-    model.engine.linearisations.clear()
-    return ours, theirs, int(np.isfinite(ds["free_index"].values).sum()), f"{before} -> {load_average()}"
+    ours, theirs, loads, (ds, _) = best(
+        model,
+        runs,
+        lambda: motion_response(model, rec, optimise="joints", frames=(0, frames - 1, 1), progress=False).dataset,
+        frame_by_frame,
+    )
+    return ours, theirs, loads, int(np.isfinite(ds["free_index"].values).sum())
 
 
-def report(label: str, what: str, frames: int, ours: float, theirs: float, loads: str) -> None:
-    per = ours / frames
-    print(f"{label}, {frames} frames, {what}: motion {per:.2f} s/frame (target <= {TARGET:g} s: ratio {per / TARGET:.2f}),")
-    print(f"    analyse frame by frame {theirs / frames:.2f} s/frame: ratio frame by frame / motion {theirs / ours:.2f}")
-    print(f"    load average (1 min) {loads}")
+def report(label: str, what: str, frames: int, ours: float, theirs: float, loads: str, runs: int) -> None:
+    """Seconds per frame, the ratio to the target and to the frame-by-frame calls, the load average."""
+    per, previous = ours / frames, theirs / frames
+    print(f"{label}, {frames} frames, {what}:")
+    print(f"    motion {per:.2f} s/frame: ratio to the {TARGET:g} s target {per / TARGET:.2f}")
+    print(f"    analyse frame by frame {previous:.2f} s/frame: ratio frame by frame / motion {theirs / ours:.2f}")
+    print(f"    load average (1 min) {loads}; each the least of {runs} alternated run(s)")
 
 
 def profile(model, mot, sto) -> None:
@@ -171,12 +187,12 @@ def bench(label: str, path: Path, mapping, args) -> None:
     with tempfile.TemporaryDirectory(prefix="spinectl-bench-osim-motion-") as folder:
         mot, sto, times = files(model, Path(folder), args.frames)
         warm_up(model, Path(folder))
-        ours, theirs, loads = given(model, mot, sto, times)
-        report(label, "activations given", args.frames, ours, theirs, loads)
+        ours, theirs, loads = given(model, mot, sto, times, args.repeat)
+        report(label, "activations given", args.frames, ours, theirs, loads, args.repeat)
         if not args.skip_optimum:
             frames = min(args.optimum_frames, args.frames)
-            ours, theirs, solved, loads = optimum(model, mot, frames)
-            report(label, f"the optimum per frame (joints; {solved} solved)", frames, ours, theirs, loads)
+            ours, theirs, loads, solved = optimum(model, mot, frames, args.repeat)
+            report(label, f"the optimum per frame (joints; {solved} solved)", frames, ours, theirs, loads, args.repeat)
         if args.profile:
             profile(model, mot, sto)
 
@@ -185,12 +201,13 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--frames", type=int, default=20, help="frames of the motion (>= 2)")
     parser.add_argument("--optimum-frames", type=int, default=5, help="of them, solved with the optimum")
+    parser.add_argument("--repeat", type=int, default=2, help="runs of each, alternated; the least time kept")
     parser.add_argument("--skip-optimum", action="store_true")
     parser.add_argument("--skip-built", action="store_true", help="the shared Pose2Sim model only")
     parser.add_argument("--profile", action="store_true", help="cProfile of one motion run per model")
     args = parser.parse_args()
-    if args.frames < 2 or args.optimum_frames < 1:
-        parser.error("--frames must be >= 2 and --optimum-frames >= 1")
+    if args.frames < 2 or args.optimum_frames < 1 or args.repeat < 1:
+        parser.error("--frames must be >= 2, --optimum-frames and --repeat >= 1")
     with tempfile.TemporaryDirectory(prefix="spinectl-bench-osim-") as folder:
         if not args.skip_built:
             with engine_output_to_stderr():

@@ -39,7 +39,8 @@ def test_the_pose2sim_motion_with_activations_is_analyse_frame_by_frame_linearis
     columns = model.posture_columns()
     names = list(columns.required)
     default = [model.engine.coordinate(n).getDefaultValue() for n in names]
-    rows = np.tile([np.degrees(v) if n in columns.rotational else v for n, v in zip(names, default, strict=True)], (2, 1))
+    upright = [np.degrees(v) if n in columns.rotational else v for n, v in zip(names, default, strict=True)]
+    rows = np.tile(upright, (2, 1))
     for joint in model.plane_joints("sagittal"):
         rows[:, names.index(joint)] += FLEXION
     mot = write_motion(tmp_path / "flexion.mot", names, TIMES, rows)
