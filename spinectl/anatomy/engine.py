@@ -21,6 +21,7 @@ import contextlib
 import ctypes
 import hashlib
 import os
+import re
 import sys
 import warnings
 from dataclasses import dataclass, field
@@ -120,6 +121,27 @@ def one_line(message: str) -> str:
         Its non-blank lines, stripped and joined by "; ", control characters escaped.
     """
     return printable("; ".join(line.strip() for line in str(message).splitlines() if line.strip()))
+
+
+def opensim_message(exc: BaseException) -> str:
+    """OpenSim's exception as one line of its own words: the C++ wrapper's prefix and the source location dropped.
+
+    OpenSim raises ``std::exception in '<signature>': <reason> ... Thrown at <file>:<line> in <function>.``;
+    the reason (Simbody's "The given Node was not an Element", a muscle's "Fiber length is nan" and the object
+    it names) is what a user can act on.
+
+    Parameters
+    ----------
+    exc : BaseException
+        The exception OpenSim raised.
+
+    Returns
+    -------
+    str
+        The reason on one line (:func:`one_line`), or the exception's type name if it has no message.
+    """
+    text = re.sub(r"^std::exception in '[^']*': ", "", one_line(exc))
+    return re.split(r";? ?Thrown at ", text)[0].strip(" ;") or type(exc).__name__
 
 
 @contextlib.contextmanager

@@ -216,9 +216,12 @@ def motion_response(
         total=chosen.size, unit="frame", desc="motion", disable=None if progress is None else not progress
     ) as bar:
         for time, (values, a) in zip(recording.times[chosen], points, strict=True):
-            rows.append(
-                _frame(anatomy, float(time), values, a, optimise, plane, joint_stiffness, least_stiffness, extras)
-            )
+            try:
+                rows.append(
+                    _frame(anatomy, float(time), values, a, optimise, plane, joint_stiffness, least_stiffness, extras)
+                )
+            except ParameterError as exc:  # a frame the engine cannot linearise: say which
+                raise type(exc)(exc.field, f"at t = {float(time):g} s of the motion: {exc.message}") from None
             bar.update(1)
     return MotionResult(
         _dataset(anatomy, recording, activations, optimise, plane, joint_stiffness, least_stiffness, rows, extras)

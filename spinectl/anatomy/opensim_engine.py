@@ -43,7 +43,6 @@ spine. Biomech Model Mechanobiol 11(1-2):19-34. doi:10.1007/s10237-011-0290-6.
 from __future__ import annotations
 
 import hashlib
-import re
 from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
@@ -53,7 +52,7 @@ from ..errors import ModelError, ParameterError
 from . import osim_cache
 from .contract import MappedModel
 from .directions import lordosis_direction, plane_axes
-from .engine import engine_output_to_stderr, model_file, one_line
+from .engine import engine_output_to_stderr, model_file, opensim_message
 from .export_osim import require_opensim
 from .joint_angles import JointSlopes
 from .linearise import STEP, Linearisation
@@ -173,20 +172,13 @@ def load_engine(path, cache: bool = True) -> OsimEngine:
     except Exception as exc:  # OpenSim raises its own exception types, one line each
         if isinstance(exc, ParameterError):
             raise
-        raise ParameterError("model", f"OpenSim cannot build {path}: {_one_line(exc)}") from None
+        raise ParameterError("model", f"OpenSim cannot build {path}: {opensim_message(exc)}") from None
     digest = hashlib.sha256(path.read_bytes()).hexdigest()
     source = str(path.resolve()) + schema
     muscles = model.getMuscles()
     springs = sum(compliant(muscles.get(i)) for i in range(muscles.getSize()))
     name = model.getName() or path.stem
     return OsimEngine(model, state, name, source, digest, couplers, cache=cache, springs=springs)
-
-
-def _one_line(exc) -> str:
-    """OpenSim's message on one line: its lines joined, the C++ wrapper's prefix dropped, so that the reason
-    (e.g. Simbody's "The given Node was not an Element", on a later line) is kept."""
-    text = one_line(exc) or type(exc).__name__
-    return re.sub(r"^std::exception in '[^']*': ", "", text)
 
 
 def _schema(osim, model, path) -> str:

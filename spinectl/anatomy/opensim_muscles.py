@@ -49,7 +49,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import ModelError
+from ..errors import ModelError, ParameterError
+from .engine import opensim_message
 from .export_osim import require_opensim
 
 SUPPORTED = ("Millard2012EquilibriumMuscle", "Thelen2003Muscle", "DeGrooteFregly2016Muscle")
@@ -135,7 +136,12 @@ def _state_at(engine, values: dict, acts) -> None:
     """The posture at zero speed, each muscle at its activation, compliant fibres in equilibrium, realised."""
     engine.set_posture(values)
     _activate(engine, acts)
-    engine.model.equilibrateMuscles(engine.state)  # a no-op for rigid tendons
+    try:
+        engine.model.equilibrateMuscles(engine.state)  # a no-op for rigid tendons
+    except Exception as exc:  # OpenSim's own exception types; a compliant fibre with no equilibrium there
+        raise ParameterError(
+            "posture", f"OpenSim cannot put the muscles' fibres in equilibrium at this posture: {opensim_message(exc)}"
+        ) from None
     _activate(engine, acts)
 
 

@@ -348,14 +348,13 @@ def _opensim(field: str):
 
 def _table(osim, path: Path, field: str):
     """The file as OpenSim's ``TimeSeriesTable`` (its STOFileAdapter; times strictly increasing)."""
-    from .engine import engine_output_to_stderr, one_line
+    from .engine import engine_output_to_stderr, opensim_message
 
     try:
         with engine_output_to_stderr():
             return osim.TimeSeriesTable(str(path))
     except Exception as exc:  # OpenSim's own exception types: one line each, its words kept
-        text = one_line(exc).replace("std::exception in ", "")
-        text = text.split("': ", 1)[-1].split(" Thrown at ")[0].strip()
+        text = opensim_message(exc)
         raise ParameterError(field, f"OpenSim cannot read {show(str(path))} as a time series: {text}") from None
 
 

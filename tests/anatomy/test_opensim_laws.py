@@ -274,6 +274,8 @@ def test_an_activation_below_the_floor_is_refused_naming_the_floor(tmp_path):
     """``activation=0`` on Millard muscles (floor 0.01, OpenSim's default) is one line naming the floor, not
     "[0, 1]"; 0.01 is analysed; on De Groote muscles (no floor) 0 is analysed."""
     from spinectl.anatomy.analyses import analyse
+    from spinectl.anatomy.motion import motion_response
+    from spinectl.anatomy.recordings import read_recording
     from spinectl.errors import ParameterError
 
     millard = load_osim(build(tmp_path / "millard.osim", "millard"), mapping=_mapping(tmp_path))
@@ -369,3 +371,67 @@ def test_the_optimums_first_line_says_where_compliant_tendons_were_linearised(tm
     rigid = build(tmp_path / "degroote.osim", "degroote")
     first = optimised(load_osim(rigid, mapping=_mapping(tmp_path)), stability="none").table().splitlines()[0]
     assert first.endswith("activations: the optimum's")
+
+
+def test_opensims_message_keeps_its_reason_and_drops_the_wrapper_and_source_location():
+    """OpenSim's exceptions read ``std::exception in '<signature>': <reason> ... Thrown at <file>:<line> ...``
+    (the shape of the cyclist model's Thelen failure below): the one line keeps the reason and its object only."""
+    from spinectl.anatomy.engine import opensim_message
+
+    exc = RuntimeError(
+        "std::exception in 'void OpenSim::Model::equilibrateMuscles(SimTK::State &)': Unable to compute "
+        "equilibrium.\n  Fiber length is nan\n\n\tIn Object 'E0_R5_r' of type Thelen2003Muscle.\n"
+        "\tThrown at Thelen2003Muscle.cpp:374 in computeInitialFiberEquilibrium()."
+    )
+    assert opensim_message(exc) == (
+        "Unable to compute equilibrium.; Fiber length is nan; In Object 'E0_R5_r' of type Thelen2003Muscle."
+    )
+    assert opensim_message(RuntimeError("")) == "RuntimeError"
+
+
+def _posture_file(path, model_file, moved: dict) -> str:
+    """Two frames: every coordinate of the model at its default at t = 0 s, and at t = 1 s those of ``moved``
+    turned by their value [rad]; an .sto written through OpenSim's own adapter."""
+    model = osim.Model(str(model_file))
+    coordinates = model.getCoordinateSet()
+    labels = osim.StdVectorString()
+    rows = [osim.RowVector(coordinates.getSize(), 0.0) for _ in range(2)]
+    for i in range(coordinates.getSize()):
+        c = coordinates.get(i)
+        labels.append(c.getName())
+        rows[0][i] = c.getDefaultValue()
+        rows[1][i] = c.getDefaultValue() + moved.get(c.getName(), 0.0)
+    table = osim.TimeSeriesTable()
+    table.setColumnLabels(labels)
+    for time, row in enumerate(rows):
+        table.appendRow(float(time), row)
+    table.addTableMetaDataString("inDegrees", "no")
+    osim.STOFileAdapter.write(table, str(path))
+    return str(path)
+
+
+@pytest.mark.skipif(not CYCLIST.is_file(), reason=ABSENT)
+def test_a_posture_where_opensim_finds_no_fibre_equilibrium_is_one_line_naming_the_muscle(tmp_path):
+    """The cyclist model (Thelen 2003 muscles) with its six lumbar flexion coordinates 8 degrees past their
+    defaults: OpenSim's ``equilibrateMuscles`` finds no fibre length for E0_R5_r (a RuntimeError that escaped as a
+    traceback, exit 1). Now one ParameterError on the posture, OpenSim's reason and the muscle kept; along a
+    motion, the frame's time is named too."""
+    from shared_models import DOCUMENTED_MAPPINGS
+
+    from spinectl import anatomy
+    from spinectl.anatomy.analyses import analyse
+    from spinectl.anatomy.motion import motion_response
+    from spinectl.anatomy.recordings import read_recording
+    from spinectl.errors import ParameterError
+
+    joints = ["L5_S1_FE", "L4_L5_FE", "L3_L4_FE", "L2_L3_FE", "L1_L2_FE", "T12_L1_FE"]
+    posture = _posture_file(tmp_path / "extended.sto", CYCLIST, dict.fromkeys(joints, np.radians(8.0)))
+    model = anatomy.load(CYCLIST, DOCUMENTED_MAPPINGS / "cyclist.toml")
+    with pytest.raises(ParameterError) as raised:
+        analyse(model, "sagittal", posture=posture, time=1.0)
+    message = str(raised.value)
+    assert raised.value.field == "posture" and "\n" not in message
+    assert "fibres in equilibrium" in message and "'E0_R5_r' of type Thelen2003Muscle" in message
+    assert "Thrown at" not in message
+    with pytest.raises(ParameterError, match=r"^posture: at t = 1 s of the motion: OpenSim cannot put"):
+        motion_response(model, read_recording(posture, "posture"), progress=False)
