@@ -211,7 +211,7 @@ def test_the_figure_names_its_criteria(torso_motion):
 
 @pytest.mark.skipif(not POSE2SIM.is_file(), reason=ABSENT)
 def test_the_pose2sim_models_index_is_analyse_at_each_frame(tmp_path):
-    """The shared Pose2Sim model (OpenSim, 232 muscles, its lumbar couplers as the rhythm), with docs/anatomy.md's
+    """The shared Pose2Sim model (OpenSim, 318 muscles, its lumbar couplers as the rhythm), with docs/anatomy.md's
     mapping: a flexion of its six sagittal joints from the model's default posture (every other coordinate at its
     default), four frames; each frame's index, free and constrained, is analyse's at that time to 1e-12."""
     from test_mapping import _documented_mappings  # tests/anatomy/test_mapping.py: the mapping as documented
