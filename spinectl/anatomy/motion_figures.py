@@ -98,7 +98,8 @@ def removal_figure(ds):
         for n, k in enumerate(groups):
             line = ax.plot(t, change[:, k], "-o", ms=3, color=f"C{n}", label=str(ds["group"].values[k]))[0]
             failed = np.char.startswith(ds["removal_status"].values[:, k].astype(str), "re-solved: infeasible")
-            ax.plot(t[failed], np.full(int(failed.sum()), 0.03), "x", color=line.get_color(), transform=foot)
+            # at the foot, one height per group so that two groups failing at one frame both show
+            ax.plot(t[failed], np.full(int(failed.sum()), 0.03 + 0.03 * n), "x", color=line.get_color(), transform=foot)
         ax.axhline(0.0, color="0.5", lw=0.8)
         ax.set_ylabel("change of the index\nwhen removed [%]")
         ax.set_title(ds.attrs[f"{name}_criterion"], fontsize=9)
