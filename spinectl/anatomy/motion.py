@@ -29,7 +29,7 @@ from .analyses import activations as activation_vector
 from .analyses import reflex_margin, verdict
 from .identity import model_identity
 from .loads import analysed_loads
-from .motion_removal import frame_removal, removal_data, removal_spec, removal_summary
+from .motion_removal import REMOVAL_REFERENCE, frame_removal, removal_data, removal_spec, removal_summary
 
 OPTIMISE = ("none", "joints", "chain")
 """``--optimise``: none (the activations file, or the model's own controls), or the anatomy optimum per frame
@@ -51,8 +51,9 @@ class MotionResult:
     ----------
     dataset : xarray.Dataset
         Dims ``time``, ``joint`` (the free chain's), ``mode`` (of the free chain), ``coordinate`` and
-        ``constrained_mode`` (the constrained chain's), ``muscle``; every variable's ``units`` and
-        ``description`` in its attributes, the model's identity in the Dataset's.
+        ``constrained_mode`` (the constrained chain's), ``muscle`` (and ``muscle_class`` with the contributions,
+        ``group`` with the removal); every variable's ``units`` and ``description`` in its attributes, the
+        model's identity in the Dataset's.
     """
 
     dataset: object
@@ -468,6 +469,8 @@ def _dataset(anatomy, recording, activations, optimise, plane, joint_stiffness, 
         "loads": json.dumps([load.to_dict() for load in extras["loads"]]),
         "loads_text": json.dumps([load.text() for load in extras["loads"]]),
     }
+    if extras["removal"] is not None:
+        attrs["references"] += f"; {REMOVAL_REFERENCE}"
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
 

@@ -26,6 +26,9 @@ import numpy as np
 from .._validate import show
 from ..errors import ParameterError
 
+REMOVAL_REFERENCE = "Cholewicki J, VanVliet JJ (2002) Clin Biomech 17:99-105, doi:10.1016/S0268-0033(01)00118-8"
+"""The removal method's source, in the Dataset's ``references``."""
+
 REMOVAL = ("groups", "muscles")
 """``removal``: each class and named group removed in turn, or also each muscle (not with the optimum per frame)."""
 
@@ -272,5 +275,7 @@ def removal_summary(ds) -> list:
             f"({ds['group'].values[k]} removed, t = {ds['time'].values[t]:g} s)"
         )
     if infeasible:
-        lines.append(f"  the re-solved optimum infeasible in {infeasible} of {ds['removal_status'].size} removals (NaN)")
+        lines.append(
+            f"  the re-solved optimum infeasible in {infeasible} of {ds['removal_status'].size} removals (NaN)"
+        )
     return lines

@@ -148,7 +148,8 @@ def run(args) -> int:
     check_distinct({"--out": args.out}, {k: v for k, v in inputs.items() if v is not None})
     check_writable(args.out)  # a typo in --out costs a second, not the run
     if args.plot:
-        check_folder(args.plot, ["motion.png"] + (["removal.png"] if args.removal else []))  # and --plot's folder: never the file written without its figure
+        # and --plot's folder: never the file written without its figures
+        check_folder(args.plot, ["motion.png"] + (["removal.png"] if args.removal else []))
     with engine_output_to_stderr():
         coordinates = read_recording(args.coordinates, "posture")
         select_frames(coordinates.times, args.frames, args.rate, ("--frames", "--rate"))  # before the model loads

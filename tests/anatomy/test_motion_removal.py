@@ -187,6 +187,7 @@ def test_the_removal_figure_draws_the_files_changes(torso, files, tmp_path):
     with xr.open_dataset(tmp_path / "m.nc") as ds:
         assert ds["free_removed_change"].attrs["units"] == "%" and ds["free_removed_index"].attrs["units"] == "N m/rad"
         assert ds["removal_status"].values[0, 0] == "removed"
+        assert "VanVliet" in ds.attrs["references"] and "McGill" in ds.attrs["references"]
         assert json.loads(ds["group"].attrs["members"])["group:back"][0].startswith(("IL", "LTp"))
         np.testing.assert_array_equal(ds["constrained_removed_index"], result.dataset["constrained_removed_index"])
     axes = removal_plot(result).axes
