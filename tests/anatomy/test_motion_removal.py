@@ -195,3 +195,33 @@ def test_the_removal_figure_draws_the_files_changes(torso, files, tmp_path):
     assert [line.get_label() for line in drawn] == list(result.dataset["group"].values[:6])
     np.testing.assert_array_equal(drawn[4].get_ydata(), result.dataset["free_removed_change"].values[:, 4])
     assert "least change" in result.summary()
+
+
+def test_the_exported_osim_chains_removal_is_the_one_posture_removal(tmp_path):
+    """OpenSim (spinectl's export of the paper's chain, its own controls, PCSA in cm^2): removal='muscles' with a
+    group, at 0, 0.5 and 1 s, equals with_contributions on analyse at that time (the one-posture removal of
+    ``spinectl anatomy --contributions``, every muscle listed) to 1e-12 relative; a muscle's removal changes the
+    index (the test can fail)."""
+    from spinectl import anatomy
+    from spinectl.anatomy.analyses import analyse
+    from spinectl.anatomy.contributions import with_contributions
+    from spinectl.anatomy.export_osim import export_osim
+    from spinectl.anatomy.recordings import recorded_point
+    from spinectl.model.config import load_preset
+
+    export_osim(load_preset("wagner2012"), 0.03, 0.04, tmp_path / "chain.osim")
+    loaded = anatomy.load(tmp_path / "chain.osim")
+    path = flexion_file(loaded, tmp_path / "flexion.mot")
+    groups = {"straight": "straight"}
+    ds = motion_response(
+        loaded, read_recording(path, "posture"), frames=(0, 20, 10), removal="muscles", groups=groups, progress=False
+    ).dataset
+    for i, t in enumerate(ds["time"].values):
+        one = analyse(loaded, posture=path, time=float(t))
+        posture = recorded_point(loaded, path, None, float(t)).posture
+        parts = with_contributions(loaded, one, posture=posture, count=len(loaded.muscles), groups=groups)
+        for name, contrib in (("free", parts.free), ("constrained", parts.constrained)):
+            expected = [contrib.removals[str(key)].least_eigenvalue for key in ds["group"].values]
+            np.testing.assert_allclose(ds[f"{name}_removed_index"].values[i], expected, rtol=1e-12, atol=0)
+    muscle = loaded.muscles[0]
+    assert ds["free_removed_index"].sel(group=muscle).values[0] != ds["free_index"].values[0]
