@@ -220,7 +220,7 @@ def _removed(result, name: str = "free") -> str:
 
 
 def _removal_extremes(result) -> str:
-    """The largest fall of either chain's index on a removal over the lift, and how many re-solves failed."""
+    """The lowest change of either chain's index on a removal over the lift, and how many re-solves failed."""
     ds = result.dataset
     parts = []
     for name in ("free", "constrained"):
