@@ -172,9 +172,8 @@ def frame_removal(anatomy, chains, a, posture, plane, joint_stiffness, optimise,
         chosen = [removals[key] for key in spec.keys]
         out[f"{name}_removed_index"] = np.array([r.least_eigenvalue for r in chosen])
         out[f"{name}_removed_change"] = np.array([r.percent_change for r in chosen])
-        out[f"{name}_removal_status"] = np.array([r.status for r in chosen], dtype=object)
-    out["removal_status"] = out.pop("free_removal_status")  # one resolve(held) serves both chains: the same
-    out.pop("constrained_removal_status")
+        if name == "free":  # one resolve(held) serves both chains: the constrained chain's statuses are these
+            out["removal_status"] = np.array([r.status for r in chosen], dtype=object)
     return out
 
 
