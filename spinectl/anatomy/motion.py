@@ -29,6 +29,7 @@ from .analyses import activations as activation_vector
 from .analyses import reflex_margin, verdict
 from .identity import model_identity
 from .loads import analysed_loads
+from .motion_removal import REMOVAL_REFERENCE, frame_removal, removal_data, removal_spec, removal_summary
 
 OPTIMISE = ("none", "joints", "chain")
 """``--optimise``: none (the activations file, or the model's own controls), or the anatomy optimum per frame
@@ -50,8 +51,9 @@ class MotionResult:
     ----------
     dataset : xarray.Dataset
         Dims ``time``, ``joint`` (the free chain's), ``mode`` (of the free chain), ``coordinate`` and
-        ``constrained_mode`` (the constrained chain's), ``muscle``; every variable's ``units`` and
-        ``description`` in its attributes, the model's identity in the Dataset's.
+        ``constrained_mode`` (the constrained chain's), ``muscle`` (and ``muscle_class`` with the contributions,
+        ``group`` with the removal); every variable's ``units`` and ``description`` in its attributes, the
+        model's identity in the Dataset's.
     """
 
     dataset: object
@@ -88,7 +90,7 @@ class MotionResult:
                 f"{criterion}: least index {index[at]:.4g} N m/rad at t = {self.times[at]:g} s; "
                 f"unstable in {int(np.sum(unstable > 0))} of {index.size} frames"
             )
-        return "\n".join(lines)
+        return "\n".join(lines + removal_summary(ds))
 
 
 def select_frames(times, frames=None, rate=None, fields=("frames", "rate")) -> np.ndarray:
@@ -155,6 +157,8 @@ def motion_response(
     loads=(),
     contributions=False,
     reflex=None,
+    removal=None,
+    groups=None,
 ) -> MotionResult:
     """The stability index, free and constrained, at each frame of a recorded motion.
 
@@ -189,6 +193,13 @@ def motion_response(
     reflex : tuple, optional
         ``(kp, kd, lag)``: also the free chain's exact delay margin under that reflex at each frame
         (:func:`spinectl.anatomy.analyses.reflex_margin`).
+    removal : {None, "groups", "muscles"}
+        Also the removal method at each frame (:mod:`spinectl.anatomy.motion_removal`): the index of both chains
+        with each muscle class and each of ``groups`` removed (``"muscles"``: each muscle too, not with
+        ``optimise``); the others' activations kept, or with ``optimise`` the optimum re-solved without them
+        (one re-solve per class and group per frame).
+    groups : dict, optional
+        Named groups removed (:func:`spinectl.model.contributions.resolve_groups`); they go with ``removal``.
 
     Returns
     -------
@@ -198,7 +209,8 @@ def motion_response(
     ------
     ParameterError
         One line: ``optimise`` and ``activations`` both given, a frame selection outside the file, a frame
-        that the model cannot read (a missing coordinate, NaN), activations missing at a frame's time.
+        that the model cannot read (a missing coordinate, NaN), activations missing at a frame's time; a removal
+        refused (:func:`spinectl.anatomy.motion_removal.check_removal`), a group that matches no muscle.
     """
     from tqdm import tqdm  # plain: tqdm.auto warns in kernels without ipywidgets (as the study)
 
@@ -208,6 +220,7 @@ def motion_response(
         raise ParameterError("activations", "cannot go with optimise, which finds the activations itself")
     loads = analysed_loads(loads, False)
     extras = {"loads": loads, "contributions": bool(contributions), "reflex": reflex}
+    extras["removal"] = removal_spec(anatomy, removal, groups, optimise, _classes(anatomy))  # before any frame
     chosen = select_frames(recording.times, frames, rate)
     points = [_read_point(anatomy, recording, activations, float(recording.times[i])) for i in chosen]  # every
     # frame's columns, NaNs and activation times checked before the first is solved: a bad last frame costs no run
@@ -276,6 +289,9 @@ def _frame(anatomy, time, values, a, optimise, plane, joint_stiffness, least_sti
         row["least"] = np.full(free.n_joints, np.nan) if k is None else k
     if extras["contributions"]:
         row.update(_contributions(anatomy, free, con, a))
+    if extras["removal"] is not None:
+        at = (posture, plane, joint_stiffness, optimise, loads, extras["removal"])
+        row.update(frame_removal(anatomy, (free, con), a, *at))
     if extras["reflex"] is not None:
         margin = reflex_margin(free, a, *extras["reflex"])
         row["delay_margin"] = (margin["delay_margin_s"], margin["delay_margin_frequency_rad_s"])
@@ -433,6 +449,10 @@ def _dataset(anatomy, recording, activations, optimise, plane, joint_stiffness, 
     }
     if extras["contributions"]:
         coords["muscle_class"] = ("muscle_class", list(_classes(anatomy)))
+    if extras["removal"] is not None:
+        removed, group = removal_data(rows, extras["removal"], optimise, {"free": FREE, "constrained": CONSTRAINED})
+        data |= removed
+        coords |= group
     identity = model_identity(anatomy)
     attrs = {
         "title": "Cholewicki-McGill stability index along a motion (spinectl motion)",
@@ -452,6 +472,8 @@ def _dataset(anatomy, recording, activations, optimise, plane, joint_stiffness, 
         "loads": json.dumps([load.to_dict() for load in extras["loads"]]),
         "loads_text": json.dumps([load.text() for load in extras["loads"]]),
     }
+    if extras["removal"] is not None:
+        attrs["references"] += f"; {REMOVAL_REFERENCE}"
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
@@ -539,3 +561,20 @@ def motion_plot(result: MotionResult):
     from .motion_figures import motion_figure
 
     return motion_figure(result.dataset)
+
+
+def removal_plot(result: MotionResult):
+    """The relative change of the index per class and group removed, against time (:mod:`.motion_figures`).
+
+    Parameters
+    ----------
+    result : MotionResult
+        With ``removal``.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    from .motion_figures import removal_figure
+
+    return removal_figure(result.dataset)

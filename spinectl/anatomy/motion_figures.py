@@ -6,9 +6,12 @@ alone, so that a file written earlier draws the same figure; saving is :func:`sp
 
 from __future__ import annotations
 
+import textwrap
+
 import numpy as np
 
 from ..canvas import new_figure
+from .motion_removal import KEPT
 
 
 def motion_figure(ds):
@@ -65,3 +68,44 @@ def _classes_panel(ax, ds) -> None:
     ax.set_ylabel("d lambda_min / d a\nper class [N m/rad]")
     ax.set_title("each class's contribution to the free chain's index (summed over its muscles)", fontsize=10)
     ax.legend(fontsize=7, ncol=4, loc="best")
+
+
+def removal_figure(ds):
+    """The relative change of the index when each class and named group is removed, against time, on both chains.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        From :func:`spinectl.anatomy.motion.motion_response` with ``removal`` (or its NetCDF file).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Two panels sharing the time axis, the free chain above the constrained one: one line per class and
+        group (single muscles, with ``removal="muscles"``, are in the file, not drawn) of ``*_removed_change``
+        [%], zero marked; an x at the panel's foot where the re-solved optimum is infeasible (its NaN).
+    """
+    from matplotlib.transforms import blended_transform_factory
+
+    figure = new_figure(figsize=(8.0, 7.0), layout="constrained")
+    axes = figure.subplots(2, 1, sharex=True)
+    t = ds["time"].values
+    groups = [k for k, name in enumerate(ds["group"].values) if str(name).startswith(("class:", "group:"))]
+    method = ds["free_removed_change"].attrs["method"]
+    for ax, name in zip(axes, ("free", "constrained"), strict=True):
+        change = ds[f"{name}_removed_change"].values
+        foot = blended_transform_factory(ax.transData, ax.transAxes)
+        for n, k in enumerate(groups):
+            line = ax.plot(t, change[:, k], "-o", ms=3, color=f"C{n}", label=str(ds["group"].values[k]))[0]
+            failed = np.char.startswith(ds["removal_status"].values[:, k].astype(str), "re-solved: infeasible")
+            # at the foot, one height per group so that two groups failing at one frame both show
+            ax.plot(t[failed], np.full(int(failed.sum()), 0.03 + 0.03 * n), "x", color=line.get_color(), transform=foot)
+        ax.axhline(0.0, color="0.5", lw=0.8)
+        ax.set_ylabel("change of the index\nwhen removed [%]")
+        ax.set_title(ds.attrs[f"{name}_criterion"], fontsize=9)
+        ax.legend(fontsize=7, ncol=3, loc="best")
+    axes[-1].set_xlabel("time [s]")
+    failed = "; x: the re-solved optimum infeasible" if method != KEPT else ""
+    what = textwrap.fill(f"{method}{failed}", 90)
+    figure.suptitle(f"{ds.attrs['model_name']}: the removal method (Cholewicki & VanVliet 2002)\n{what}", fontsize=10)
+    return figure

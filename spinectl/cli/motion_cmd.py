@@ -7,7 +7,7 @@ import sys
 
 from ..anatomy.mapping import MAX_STIFFNESS
 from ..errors import ParameterError
-from ._common import finite_float, input_name
+from ._common import finite_float, input_name, named_pattern
 from .anatomy_cmd import STIFFNESS_WHY, _joint_stiffness, _loads, add_load_option, add_reflex_options
 
 MAX_FRAME_RATE = 1e6
@@ -92,6 +92,24 @@ def register(sub) -> None:
         help="also each muscle's and each class's d lambda_min / d a_i at every frame, on the free and the "
         "constrained chain (docs/contributions.md)",
     )
+    parser.add_argument(
+        "--removal",
+        nargs="?",
+        const="groups",
+        choices=("groups", "muscles"),
+        help="also the removal method at every frame (Cholewicki & VanVliet 2002): the index of both chains with "
+        "each muscle class and each --group removed, the others' activations kept (the equilibrium not "
+        "re-solved), or with --optimise the optimum re-solved without them (one re-solve per group per frame); "
+        "'muscles': each muscle too (not with --optimise); removal.png with --plot (docs/motion.md)",
+    )
+    parser.add_argument(
+        "--group",
+        action="append",
+        type=named_pattern("--group"),
+        metavar="NAME=REGEX",
+        help="with --removal: a named group of muscles, those whose names match REGEX at their start "
+        "(a prefix is one: back=IL|LTp); repeatable",
+    )
     add_reflex_options(parser, " at every frame")
     parser.add_argument("--out", required=True, metavar="FILE.nc", help="the NetCDF file written")
     parser.add_argument("--plot", metavar="DIR", help="write motion.png into DIR")
@@ -119,16 +137,19 @@ def run(args) -> int:
     from ..anatomy import load
     from ..anatomy.engine import engine_output_to_stderr
     from ..anatomy.motion import motion_response, select_frames
+    from ..anatomy.motion_removal import check_removal
     from ..anatomy.recordings import read_recording
     from ..atomic import check_distinct, check_folder, check_writable
 
     if args.optimise != "none" and args.activations is not None:
         raise ParameterError("--activations", "cannot go with --optimise, which finds the activations itself")
+    check_removal(args.removal, args.group, args.optimise, ("--removal", "--group"))  # before any file is read
     inputs = {"--coordinates": args.coordinates, "--activations": args.activations}
     check_distinct({"--out": args.out}, {k: v for k, v in inputs.items() if v is not None})
     check_writable(args.out)  # a typo in --out costs a second, not the run
     if args.plot:
-        check_folder(args.plot, ["motion.png"])  # and --plot's folder: never the file written without its figure
+        # and --plot's folder: never the file written without its figures
+        check_folder(args.plot, ["motion.png"] + (["removal.png"] if args.removal else []))
     with engine_output_to_stderr():
         coordinates = read_recording(args.coordinates, "posture")
         select_frames(coordinates.times, args.frames, args.rate, ("--frames", "--rate"))  # before the model loads
@@ -147,6 +168,8 @@ def run(args) -> int:
             loads=_loads(args.load),
             contributions=args.contributions,
             reflex=None if args.kp is None else (args.kp, args.kd, args.activation_lag),
+            removal=args.removal,
+            groups=dict(args.group or ()),
         )
     _write(result, args)
     print(result.summary())
@@ -157,18 +180,21 @@ def _write(result, args) -> None:
     """The NetCDF file (with its checksums, as a landscape's) and, with --plot, the figure: each atomic."""
     from ..landscape.netcdf import save
 
-    figure = None
+    figures = {}
     if args.plot:
-        from ..anatomy.motion import motion_plot
+        from ..anatomy.motion import motion_plot, removal_plot
 
-        figure = motion_plot(result)  # drawn before anything is written: a failure leaves nothing behind
+        figures["motion.png"] = motion_plot(result)  # drawn before anything is written: a failure leaves nothing
+        if args.removal:
+            figures["removal.png"] = removal_plot(result)
     save(result.dataset, args.out)
     print(f"wrote {args.out}", file=sys.stderr)
-    if figure is not None:
+    if figures:
         from ..canvas import save_figures
 
-        save_figures({"motion.png": figure}, args.plot, 150.0)
-        print(f"wrote {args.plot}/motion.png", file=sys.stderr)
+        save_figures(figures, args.plot, 150.0)
+        for name in figures:
+            print(f"wrote {args.plot}/{name}", file=sys.stderr)
 
 
 def _frames(text: str) -> tuple:

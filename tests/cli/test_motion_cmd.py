@@ -123,6 +123,12 @@ def test_frames_select_the_frames_meant(flexion, tmp_path):
         (["--joint-stiffness", "-3"], "--joint-stiffness"),
         (["--least-stiffness", "-1"], "--least-stiffness"),
         (["--frames", "0:3:-2"], "--frames"),
+        (["--removal", "muscles", "--optimise", "joints"], "--removal"),
+        (["--removal", "every"], "--removal"),
+        (["--group", "back=IL"], "--group"),
+        (["--removal", "--group", "back"], "--group"),
+        (["--removal", "--group", "back=zzz"], "zzz"),
+        (["--removal", "--group", "back=IL["], "regular expression"),
     ],
 )
 def test_a_malformed_option_is_one_line_and_writes_nothing(flexion, tmp_path, capsys, argv, word):
@@ -293,3 +299,34 @@ def test_a_malformed_load_or_reflex_is_one_line_and_writes_nothing(flexion, tmp_
     printed, err = capsys.readouterr()
     assert len(err.strip().splitlines()) == 1 and err.startswith("spinectl: error: ")
     assert word in err and not out.exists()
+
+
+def test_the_removal_reaches_the_file_and_its_figure(torso, flexion, tmp_path, capsys):
+    """--removal --group with --activations and --plot: the file's removal is the library's (motion_response with
+    the same arguments, bit for bit), its status 'removed'; removal.png is written beside motion.png and the
+    summary names the method."""
+    import xarray as xr
+
+    from spinectl.anatomy.motion import motion_response
+    from spinectl.anatomy.recordings import read_recording
+
+    a = np.random.default_rng(5).uniform(0.0, 0.2, (TIMES.size, len(torso.muscles)))
+    sto = _write(tmp_path / "so.sto", torso.muscles, a, degrees=None)
+    out, plots = tmp_path / "m.nc", tmp_path / "figures"
+    argv = ["motion", "myotorso", "--coordinates", str(flexion), "--activations", str(sto), "--frames", "0:20:10"]
+    assert main([*argv, "--removal", "--group", "back=IL|LTp", "--out", str(out), "--plot", str(plots)]) == 0
+    assert "removal: the removed muscles at 0" in capsys.readouterr().out
+    expected = motion_response(
+        torso,
+        read_recording(flexion, "posture"),
+        read_recording(sto, "activations"),
+        frames=(0, 20, 10),
+        removal="groups",
+        groups={"back": "IL|LTp"},
+        progress=False,
+    ).dataset
+    with xr.open_dataset(out) as ds:
+        assert list(ds["group"].values)[-1] == "group:back" and set(ds["removal_status"].values.ravel()) == {"removed"}
+        for name in ("free_removed_index", "constrained_removed_change"):
+            np.testing.assert_array_equal(ds[name].values, expected[name].values)
+    assert (plots / "removal.png").stat().st_size > 0 and (plots / "motion.png").is_file()

@@ -215,6 +215,8 @@ BAD = [
     (TRIAL + "joint_stiffness=-1\n", ParameterError, "trials[0].joint_stiffness"),
     (TRIAL.replace("'a'", "'a/b'"), ParameterError, "trials[0].name"),
     (TRIAL.replace("'myotorso'", "'absent.xml'"), ParameterError, "trials[0].model"),
+    (TRIAL + "removal='groups'\n", ParameterError, "trials[0].removal: is not supported in a study of motions"),
+    (TRIAL + "group={back='IL|LTp'}\n", ParameterError, "trials[0].group: is not supported in a study"),
 ]
 
 

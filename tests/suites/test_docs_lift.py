@@ -27,8 +27,9 @@ from spinectl.cli import main  # noqa: E402
 
 def test_the_lifts_numbers_are_the_commands(tmp_path, capsys):
     """`spinectl motion myotorso --coordinates lift.mot --optimise joints --joint-stiffness 50 --load
-    torso:0,0,-100 --contributions` (docs/motion.md's command) on the generator's lift file: the file's index,
-    unstable modes and class contributions equal the generator's, and the page's values quote them."""
+    torso:0,0,-100 --contributions --removal --group back=... --group abs=...` (docs/motion.md's command) on the
+    generator's lift file: the file's index, unstable modes, class contributions and removals equal the
+    generator's, and the page's values quote them."""
     import xarray as xr
 
     from spinectl import anatomy
@@ -36,22 +37,33 @@ def test_the_lifts_numbers_are_the_commands(tmp_path, capsys):
     path = lift._lift(anatomy.load("myotorso"), tmp_path / "lift.mot")
     out = tmp_path / "lift.nc"
     argv = ["motion", "myotorso", "--coordinates", str(path), "--optimise", "joints", "--joint-stiffness", "50"]
-    assert main([*argv, "--load", "torso:0,0,-100", "--contributions", "--out", str(out)]) == 0
+    argv += ["--load", "torso:0,0,-100", "--contributions", "--removal"]
+    argv += [word for name, rx in lift.GROUPS.items() for word in ("--group", f"{name}={rx}")]
+    assert main([*argv, "--out", str(out)]) == 0
     ours = lift.myotorso_lift().dataset
     with xr.open_dataset(out) as ds:
         for name in ("free_index", "constrained_index", "free_unstable_modes", "free_class_contribution"):
             np.testing.assert_array_equal(ds[name].values, ours[name].values)
+        for name in ("free_removed_change", "constrained_removed_change", "removal_status"):
+            np.testing.assert_array_equal(ds[name].values, ours[name].values)
         least = int(np.argmin(ds["free_index"].values))
         quoted = f"{ds['free_index'].values[least]:.3g} N m/rad at t = {ds['time'].values[least]:.1f} s"
+        change = ds["free_removed_change"].values[least]
+        most = int(np.nanargmax(np.abs(change)))  # the removal quoted first: the largest change at that frame
+        removed = f"{ds['group'].values[most]} {change[most]:+.3g} %"
     assert values.text_of("motion.lift_free_least") == quoted
+    assert values.text_of("motion.lift_removal_free").startswith(removed)
     assert ours.sizes["time"] == lift.FRAMES and ours.attrs["loads_text"].count("100") == 1
 
 
 def test_the_figure_is_written_for_the_page(tmp_path):
-    """write_figure puts motion-lift.png (the name motion.md's image directive gives) into the folder."""
+    """write_figure puts motion-lift.png and motion-lift-removal.png (the names motion.md's image directives
+    give) into the folder."""
     lift.write_figure(tmp_path)
-    assert (tmp_path / lift.FIGURE).stat().st_size > 10_000
-    assert f"_generated/{lift.FIGURE}" in (ROOT / "docs" / "motion.md").read_text(encoding="utf-8")
+    page = (ROOT / "docs" / "motion.md").read_text(encoding="utf-8")
+    for figure in (lift.FIGURE, lift.REMOVAL_FIGURE):
+        assert (tmp_path / figure).stat().st_size > 10_000
+        assert f"_generated/{figure}" in page
 
 
 def test_the_pose2sim_sentence_says_it_is_not_at_this_build_when_absent(tmp_path, monkeypatch):

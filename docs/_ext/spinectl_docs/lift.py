@@ -46,8 +46,19 @@ POSE2SIM_LOAD = tuple(
 ROUNDING = 1e-9
 """A class's sum below this times the largest is shown as 0 (the eigensolver's rounding)."""
 
+SOLVER_ROUNDING = 1e-3
+"""A removal's change of the index below this [%] is shown as 0: a set whose removal leaves the optimum as it was
+(no lumbar torque) is re-solved to the solver's tolerance, not to the bit."""
+
 FIGURE = "motion-lift.png"
 """The figure in ``_generated/``."""
+
+GROUPS = {"back": "IL|LTp", "abs": "rect_abd|EO|IO"}
+"""The named groups removed (``--group back='IL|LTp' --group abs='rect_abd|EO|IO'``): MyoTorso's erector spinae
+(iliocostalis, longissimus) and abdominal muscles, beside each class."""
+
+REMOVAL_FIGURE = "motion-lift-removal.png"
+"""The removal's figure in ``_generated/``."""
 
 
 def _lift(model, path: Path) -> Path:
@@ -93,6 +104,8 @@ def myotorso_lift():
             joint_stiffness=STIFFNESS,
             loads=MYOTORSO_LOAD,
             contributions=True,
+            removal="groups",
+            groups=GROUPS,
             progress=False,
         )
 
@@ -124,16 +137,16 @@ def pose2sim_lift():
 
 
 def write_figure(folder: Path) -> None:
-    """MyoTorso's lift figure (:func:`spinectl.anatomy.motion.motion_plot`) into ``folder``; without the extras,
-    nothing (the page's values say what is missing)."""
+    """MyoTorso's lift figures (:func:`spinectl.anatomy.motion.motion_plot`, ``removal_plot``) into ``folder``;
+    without the extras, nothing (the page's values say what is missing)."""
     try:
         result = myotorso_lift()
     except ImportError:
         return
-    from spinectl.anatomy.motion import motion_plot
+    from spinectl.anatomy.motion import motion_plot, removal_plot
     from spinectl.canvas import save_figures
 
-    save_figures({FIGURE: motion_plot(result)}, folder, 100.0)
+    save_figures({FIGURE: motion_plot(result), REMOVAL_FIGURE: removal_plot(result)}, folder, 100.0)
 
 
 def _least(result, name: str = "free") -> str:
@@ -190,6 +203,46 @@ def _myotorso_classes() -> str:
 @value("motion.lift_top_muscle")
 def _myotorso_top_muscle() -> str:
     return _top_muscle(myotorso_lift())
+
+
+def _removed(result, name: str = "free") -> str:
+    """Each removed set's change of the index [%] at the frame of the least free index, largest first; the sets
+    whose re-solved optimum is infeasible named apart."""
+    ds = result.dataset
+    at = int(np.nanargmin(ds["free_index"].values))
+    change = ds[f"{name}_removed_change"].values[at]
+    groups = [str(g) for g in ds["group"].values]
+    order = [k for k in np.argsort(-np.abs(np.nan_to_num(change))) if np.isfinite(change[k])]
+    change = np.where(np.abs(change) < SOLVER_ROUNDING, 0.0, change)
+    text = ", ".join(f"{groups[k]} {change[k]:+.3g} %" for k in order)
+    failed = [groups[k] for k in range(len(groups)) if ds["removal_status"].values[at, k] == "re-solved: infeasible"]
+    return text + (f"; without {' or '.join(failed)} the re-solved optimum is infeasible" if failed else "")
+
+
+def _removal_extremes(result) -> str:
+    """The lowest change of either chain's index on a removal over the lift, and how many re-solves failed."""
+    ds = result.dataset
+    parts = []
+    for name in ("free", "constrained"):
+        change = ds[f"{name}_removed_change"].values
+        t, k = np.unravel_index(int(np.nanargmin(change)), change.shape)
+        parts.append(
+            f"{change[t, k]:+.3g} % on the {name} chain ({ds['group'].values[k]} removed at t = "
+            f"{ds['time'].values[t]:.1f} s)"
+        )
+    status = ds["removal_status"].values
+    failed = int(np.sum(status == "re-solved: infeasible"))
+    return f"{' and '.join(parts)}; the re-solved optimum is infeasible in {failed} of {status.size} removals"
+
+
+@value("motion.lift_removal_free")
+def _myotorso_removal_free() -> str:
+    return _removed(myotorso_lift())
+
+
+@value("motion.lift_removal_extremes")
+def _myotorso_removal_extremes() -> str:
+    return _removal_extremes(myotorso_lift())
 
 
 @value("motion.pose2sim")

@@ -38,6 +38,10 @@ TRIAL_KEYS = (
     "least_stiffness",
 )
 
+NOT_IN_A_STUDY = ("removal", "group", "groups")
+"""Options of ``spinectl motion`` that a trial does not take (the removal method per frame: run the command on
+the trial), refused in one line rather than as an unknown key."""
+
 DEFAULT_CHUNK_FRAMES = 50
 """Frames per chunk: a MyoTorso frame with given activations takes tens of ms, so a chunk is seconds of work,
 long beside Dask's few ms per task, short enough that a killed run loses little."""
@@ -310,6 +314,12 @@ def _trial(where: str, row: dict, base: Path) -> Trial:
     """One ``[[trials]]`` table: keys, values, files; its frames checked against its coordinates file."""
     from ...anatomy.motion import OPTIMISE, select_frames
 
+    for key in NOT_IN_A_STUDY:
+        if key in row:
+            raise ParameterError(
+                f"{where}.{key}",
+                "is not supported in a study of motions: run spinectl motion --removal [--group] on the trial",
+            )
     check_keys(row, TRIAL_KEYS, where)
     for key in ("name", "model", "coordinates"):
         if key not in row:
