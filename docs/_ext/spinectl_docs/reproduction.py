@@ -5,10 +5,16 @@ from the ``wagner2012`` preset), and the documented verdict of every landmark.
 The assumption table is measured at each build (:mod:`spinectl.paper.assumptions`,
 on a coarse grid); the test suite checks the documented values against a fresh
 measurement of the preset (tests/paper/test_verdicts.py) and the documented
-assumptions against that table (tests/paper/test_assumptions.py).
+assumptions against that table (tests/paper/test_assumptions.py). The chain's numbers of "The whole chain"
+are measured at the build too: the landscape's chain margin (``spinectl sweep`` on the paper's 1 mm grid,
+about a second) and the chain at the paper's optimum (:mod:`.chain`'s computations).
 """
 
 from __future__ import annotations
+
+from functools import cache
+
+import numpy as np
 
 from spinectl.model.config import load_preset
 from spinectl.paper import assumptions, calibration, verdicts
@@ -70,3 +76,85 @@ value("reproduction.claim")(claim)
 value("reproduction.optimum_lordosis")(lambda: _documented("optimum_lordosis"))
 value("reproduction.ct_optimum")(lambda: _documented("ct_optimum"))
 value("reproduction.agreeing")(agreeing)
+
+
+# --- "The whole chain: what the paper's conclusions become" (numbers of ``docs/chain.md``'s computations) ---
+
+LANDSCAPE_POINTS = 81
+"""Points per axis of the E x Lambda landscape over 0-8 cm whose chain margin the page quotes (the paper's 1 mm)."""
+
+OPTIMUM = (0.03, 0.04)
+"""The paper's optimum (E, Lambda) [m], where the page reads the chain (docs/chain.md's tables)."""
+
+
+@cache
+def chain_margins():
+    """``spinectl sweep`` of ``wagner2012`` on the paper's grid: the chain's static margin with the global
+    muscles alone at each point's per-segment optimum, ``coupled_margin_Nm_per_rad`` [N m/rad]."""
+    from spinectl.landscape.sweep import sweep
+    from spinectl.paper.grid import paper_axis
+
+    axis = paper_axis(LANDSCAPE_POINTS)
+    return sweep(load_preset(verdicts.PRESET), axis, axis, progress=False)["coupled_margin_Nm_per_rad"]
+
+
+def _largest_margin() -> str:
+    """The landscape's largest chain margin; the page says every point is unstable, so a non-negative one fails."""
+    largest = float(chain_margins().max())
+    if not largest < 0:
+        raise RuntimeError(
+            f"docs/reproduction.md says the chain is unstable at every point; its margin reaches {largest}"
+        )
+    return f"{largest:.0f}".replace("-", "\u2212")
+
+
+def _growing() -> str:
+    """'4 of its 10 dynamic eigenvalues grow, at 18 to 68 1/s' at :data:`OPTIMUM`."""
+    from .chain import coupled
+
+    real = np.real(coupled(verdicts.PRESET, *OPTIMUM).eigenvalues)
+    up = np.sort(real[real > 0])
+    return f"{up.size} of its {real.size} dynamic eigenvalues grow, at {up[0]:.0f} to {up[-1]:.0f} 1/s"
+
+
+def _local(preset: str) -> float:
+    from .chain import coupled
+
+    return float(np.sum(coupled(preset, *OPTIMUM).local.local_stiffness))
+
+
+@cache
+def _joint():
+    """The joint optimum (c) of the preset at :data:`OPTIMUM`."""
+    from spinectl.optimise.coupled.joint import joint_optimum
+
+    return joint_optimum(load_preset(verdicts.PRESET), *OPTIMUM)
+
+
+def _cm2(m2: float, fmt: str = ".1f") -> str:
+    return f"{1e4 * m2:{fmt}}"
+
+
+def _local_pcsa(k: float) -> float:
+    """The local muscles' PCSA [m^2] for a local stiffness ``k`` [N m/rad] (docs/chain.md's kappa)."""
+    from spinectl.model.local_muscles import local_stiffness_per_pcsa
+
+    return k / local_stiffness_per_pcsa(load_preset(verdicts.PRESET))
+
+
+def _segment_total() -> float:
+    from .chain import coupled
+
+    return float(np.sum(coupled(verdicts.PRESET, *OPTIMUM).pcsa))
+
+
+value("reproduction.chain_margin_max")(_largest_margin)
+value("reproduction.chain_growing")(_growing)
+value("reproduction.local_total")(lambda: f"{_local(verdicts.PRESET):.0f}")
+value("reproduction.local_total_default")(lambda: f"{_local('default'):.0f}")
+value("reproduction.local_pcsa")(lambda: _cm2(_local_pcsa(_local(verdicts.PRESET))))
+value("reproduction.joint_global")(lambda: _cm2(_joint().total_pcsa))
+value("reproduction.joint_local")(lambda: _cm2(_joint().total_local_pcsa))
+value("reproduction.segment_global")(lambda: _cm2(_segment_total()))
+value("reproduction.joint_less")(lambda: "less" if _joint().total_pcsa + _joint().total_local_pcsa < _segment_total()
+                                  else "no less")  # fmt: skip
