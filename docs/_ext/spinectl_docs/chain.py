@@ -312,6 +312,22 @@ def _levels_unstable() -> str:
     return "the unstable modes go from " + ", ".join(f"{a} to {b}" for a, b in counts)
 
 
+def _diagonal_shift(preset: str) -> float:
+    """The largest change of K's diagonal at A that the levels' weight makes [N m/rad]."""
+    a, b = coupled(preset, 0.0, 0.0), weighted(preset, 0.0, 0.0)
+    return float(np.max(np.abs(np.diag(b.chain.stiffness_offset) - np.diag(a.chain.stiffness_offset))))
+
+
+def _mass_eigenvalues(preset: str) -> np.ndarray:
+    """The eigenvalues of the chain's M at A [kg m^2], ascending."""
+    return np.linalg.eigvalsh(coupled(preset, 0.0, 0.0).mass)
+
+
+value("chain.levels_diagonal_shift")(lambda: f"{_diagonal_shift('default'):.1f}")
+value("chain.mass_range_default")(
+    lambda: f"{_mass_eigenvalues('default')[0]:.2g} to {_mass_eigenvalues('default')[-1]:.3g}"
+)  # fmt: skip
+value("chain.mass_top_wagner2012")(lambda: f"{_mass_eigenvalues('wagner2012')[-1]:.2g}")
 value("chain.levels_margin_fall")(
     lambda: _span([_static(a)[0] - _static(b)[0] for a, b in _levels_pairs()], ".1f")
 )  # fmt: skip

@@ -158,3 +158,82 @@ value("reproduction.joint_local")(lambda: _cm2(_joint().total_local_pcsa))
 value("reproduction.segment_global")(lambda: _cm2(_segment_total()))
 value("reproduction.joint_less")(lambda: "less" if _joint().total_pcsa + _joint().total_local_pcsa < _segment_total()
                                   else "no less")  # fmt: skip
+
+
+# --- the optimal lordosis against the local stiffness, at E = 3 cm ---
+
+LORDOSES = np.linspace(0.0, 0.08, 33)
+"""Lambda [m] of the sweep at E = 3 cm that the page reads: 0 to 8 cm in 2.5 mm steps."""
+
+
+@cache
+def lordosis_sweep(preset: str) -> dict:
+    """``spinectl sweep --coupled`` at E = 3 cm over :data:`LORDOSES`: where the counter torques are least, the
+    chain's least local stiffness there, its largest and its least over Lambda, each with its Lambda [cm]."""
+    from spinectl.landscape.sweep import sweep
+
+    land = sweep(load_preset(preset), [OPTIMUM[0]], LORDOSES, progress=False, coupled=True).isel(E=0)
+    torque = land["counter_torque_norm_Nm"].values
+    local = land["local_stiffness_total_Nm_per_rad"].values
+    at, most, least = (int(i) for i in (np.nanargmin(torque), np.nanargmax(local), np.nanargmin(local)))
+    cm = 100 * LORDOSES
+    return {"at": (cm[at], local[at]), "most": (cm[most], local[most]), "least": (cm[least], local[least]),
+            "edge": least == len(LORDOSES) - 1}  # fmt: skip
+
+
+def _both(text) -> str:
+    """``wagner2012``'s text and ``default``'s in brackets: 'a (b)'."""
+    return f"{text(verdicts.PRESET)} ({text('default')})"
+
+
+def _within(preset: str) -> str:
+    row = lordosis_sweep(preset)
+    return f"{100 * (1 - row['at'][1] / row['most'][1]):.0f}"
+
+
+def _over_least(preset: str) -> str:
+    row = lordosis_sweep(preset)
+    return f"{100 * (row['at'][1] / row['least'][1] - 1):.0f}"
+
+
+def _least_where() -> str:
+    """'at the grid's edge Lambda = 8 cm' where both presets' least lies at the sweep's end, else where it lies."""
+    rows = [lordosis_sweep(p) for p in (verdicts.PRESET, "default")]
+    if all(r["edge"] for r in rows) and rows[0]["least"][0] == rows[1]["least"][0]:
+        return f"at the grid's edge Λ = {rows[0]['least'][0]:g} cm"
+    return "at Λ = " + _both(lambda p: f"{lordosis_sweep(p)['least'][0]:g}") + " cm"
+
+
+value("reproduction.lordosis_ct")(lambda: _both(lambda p: f"{lordosis_sweep(p)['at'][0]:g} cm"))
+value("reproduction.lordosis_local")(lambda: f"{lordosis_sweep(verdicts.PRESET)['at'][1]:.0f}")
+value("reproduction.lordosis_local_default")(lambda: f"{lordosis_sweep('default')['at'][1]:.0f}")
+value("reproduction.lordosis_within")(lambda: _both(lambda p: f"{_within(p)} %"))
+value("reproduction.lordosis_most")(
+    lambda: "; ".join(f"{lordosis_sweep(p)['most'][1]:.0f} at {lordosis_sweep(p)['most'][0]:g} cm"
+                      for p in (verdicts.PRESET, "default"))
+)  # fmt: skip
+value("reproduction.lordosis_over_least")(lambda: _both(lambda p: f"{_over_least(p)} %"))
+value("reproduction.lordosis_least")(lambda: _both(lambda p: f"{lordosis_sweep(p)['least'][1]:.0f}"))
+value("reproduction.lordosis_least_where")(_least_where)
+
+
+# --- the reflex: one joint at a time against the chain, at A ---
+
+
+@cache
+def _joint_margin(preset: str) -> float:
+    """The least delay margin over the joints, each alone [s] (``spinectl margins --E 0 --Lambda 0``)."""
+    from spinectl.reflex.margins import margins_report
+
+    return min(s.delay_margin for s in margins_report(load_preset(preset), 0.0, 0.0).segments)
+
+
+def _chain_rule_margin(preset: str) -> str:
+    """The rule's reflex on the chain at A at ``reflex.activation`` 0.5 with the lag [ms] (docs/chain.md's table)."""
+    from .chain import rule_margin
+
+    return f"{1e3 * rule_margin(preset, 0.5, 0.05).margin:.3f}"
+
+
+value("reproduction.joint_reflex_margin")(lambda: _both(lambda p: f"{1e3 * _joint_margin(p):.0f}") + " ms")
+value("reproduction.chain_reflex_margin")(lambda: _both(_chain_rule_margin) + " ms")
