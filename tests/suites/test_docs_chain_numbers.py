@@ -89,3 +89,15 @@ def test_chain_md_pareto_front_words_hold():
     again = result(model, coupled_data(model, 0.0, 0.0), 0.0, 0.0,
                    *least_global_within_budget_sdp(coupled_data(model, 0.0, 0.0), float(k[0])))  # fmt: skip
     assert text_of("chain.pareto_first_global") == f"{1e4 * again.total_pcsa:.2f}"
+
+
+def test_reproduction_md_lordosis_reading_is_the_chains_least_local_stiffness_there():
+    """At E = 3 cm and the Lambda of the least counter torques (the sweep's), the page's local stiffness is the
+    least local stiffness of ``stability --coupled`` at that point (a per-point SDP, not the sweep's chunk), between
+    the least and the most over Lambda that the page compares it with."""
+    from spinectl.optimise.coupled.at_activation import coupled_stability_at
+
+    row = reproduction.lordosis_sweep("wagner2012")
+    at = coupled_stability_at(load_preset("wagner2012"), reproduction.OPTIMUM[0], row["at"][0] / 100)
+    assert text_of("reproduction.lordosis_local") == f"{np.sum(at.local.local_stiffness):.0f}"
+    assert row["least"][1] <= row["at"][1] <= row["most"][1]
