@@ -20,7 +20,8 @@ a text changed, so that incremental builds stay incremental):
 - ``_generated/design-decay.md``: ``design --decay-rate``'s answers in ``reflex.md`` (measured at the build);
 - ``_generated/chain-points.md``, ``chain-dynamics.md`` and ``chain-passive.md``: ``stability --coupled`` at
   four points and
-  ``design --passive`` at A in ``chain.md`` (measured at the build, :mod:`.chain`);
+  ``design --passive`` at A in ``chain.md`` (measured at the build, :mod:`.chain`); ``chain-margins.md``: the rule's
+  reflex on the chain at A (``margins --coupled``);
 - ``_generated/anatomy-*.md``: ``spinectl anatomy``'s tables on MyoTorso in ``anatomy.md`` (verdicts, optima,
   lordosis, reflex; measured at the build, :mod:`.anatomy`);
 - ``_generated/motion-lift.png``: the lift of ``motion.md`` on MyoTorso (:mod:`.lift`).
@@ -75,6 +76,7 @@ MEASURED_TABLES = (
     ("chain-points.md", chain.points_table),
     ("chain-passive.md", chain.passive_table),
     ("chain-dynamics.md", chain.dynamics_table),
+    ("chain-margins.md", chain.margins_table),
     ("anatomy-verdicts.md", anatomy.verdict_table),
     ("anatomy-optimum.md", anatomy.optimum_table),
     ("anatomy-lordosis.md", anatomy.lordosis_table),

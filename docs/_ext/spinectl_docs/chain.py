@@ -2,7 +2,11 @@
 
 The chain at the paper's optimum at four points (both presets, A and (3, 4) cm), and the chain against the
 passive stiffness at A (``design --passive 0:80:41 --E 0 --Lambda 0``, about five seconds a preset), each
-computed once per build and feeding the generated tables and the ``{measured}`chain.*``` values.
+computed once per build and feeding the generated tables and the ``{measured}`chain.*``` values. Also the
+page's other examples, each computed once per build (a few seconds in all): the four points with the levels'
+weight in K_g, the Pareto front at A, the narrow crossing band of the exact delay margin and the rule's reflex
+on the chain at A (``margins --coupled``). The gain searches of "The delayed reflex on the chain" are not
+generated: each costs minutes (the page says its margins are those of runs made when it was written).
 """
 
 from __future__ import annotations
@@ -260,3 +264,271 @@ value("contributions.outer_cor_high")(lambda: f"{max(_outer_cor_shares()):.0f}")
 value("contributions.outer_removed")(
     lambda: f"{paper_pairs()['muscles']['removal']['group:oblique_outer']['percent_change']:.0f}"
 )
+
+
+# --- "The weight of the levels": the four points of the tables with ``levels.weight_in_gravity`` = 1 ---
+
+
+@cache
+def weighted(preset: str, e: float, lam: float):
+    """``stability --coupled`` with the levels' full weight in K_g (``--set levels.weight_in_gravity=1``)."""
+    from spinectl.model.config import load_preset, set_parameters
+    from spinectl.optimise.coupled.at_activation import coupled_stability_at
+
+    return coupled_stability_at(set_parameters(load_preset(preset), {"levels.weight_in_gravity": 1.0}), e, lam)
+
+
+def _static(c) -> np.ndarray:
+    """The eigenvalues of the chain's -K (symmetric part) at the optimum, ascending [N m/rad]."""
+    k = c.chain.stiffness_offset
+    return np.linalg.eigvalsh(-(k + k.T) / 2)
+
+
+def _span(values, fmt: str) -> str:
+    """``a–b`` from the least to the largest of ``values`` (one value where both print alike)."""
+    low, high = f"{min(values):{fmt}}", f"{max(values):{fmt}}"
+    return low if low == high else f"{low}–{high}"
+
+
+def _levels_pairs() -> list:
+    """(without, with the levels' weight) ``stability --coupled`` at every point of the tables."""
+    return [(coupled(p, e, lam), weighted(p, e, lam)) for p, _, e, lam in POINTS]
+
+
+def _local_sum(c) -> float:
+    return float(np.sum(c.local.local_stiffness))
+
+
+def _local_change(preset: str) -> str:
+    """``391 → 402``: the least local stiffness [N m/rad] at A without and with the levels' weight."""
+    return " → ".join(f"{_local_sum(c):.0f}" for c in (coupled(preset, 0.0, 0.0), weighted(preset, 0.0, 0.0)))
+
+
+def _levels_unstable() -> str:
+    """How many modes of -K are unstable with the levels' weight, and whether that is as many as without."""
+    counts = [(int(np.sum(_static(a) <= 0)), int(np.sum(_static(b) <= 0))) for a, b in _levels_pairs()]
+    if all(a == b == counts[0][0] for a, b in counts):
+        return f"{counts[0][0]} modes stay unstable"
+    return "the unstable modes go from " + ", ".join(f"{a} to {b}" for a, b in counts)
+
+
+def _diagonal_shift(preset: str) -> float:
+    """The largest change of K's diagonal at A that the levels' weight makes [N m/rad]."""
+    a, b = coupled(preset, 0.0, 0.0), weighted(preset, 0.0, 0.0)
+    return float(np.max(np.abs(np.diag(b.chain.stiffness_offset) - np.diag(a.chain.stiffness_offset))))
+
+
+def _mass_eigenvalues(preset: str) -> np.ndarray:
+    """The eigenvalues of the chain's M at A [kg m^2], ascending."""
+    return np.linalg.eigvalsh(coupled(preset, 0.0, 0.0).mass)
+
+
+value("chain.levels_diagonal_shift")(lambda: f"{_diagonal_shift('default'):.1f}")
+value("chain.mass_range_default")(
+    lambda: f"{_mass_eigenvalues('default')[0]:.2g} to {_mass_eigenvalues('default')[-1]:.3g}"
+)  # fmt: skip
+value("chain.mass_top_wagner2012")(lambda: f"{_mass_eigenvalues('wagner2012')[-1]:.2g}")
+value("chain.levels_margin_fall")(
+    lambda: _span([_static(a)[0] - _static(b)[0] for a, b in _levels_pairs()], ".1f")
+)  # fmt: skip
+value("chain.levels_local_rise")(
+    lambda: _span([100 * (_local_sum(b) / _local_sum(a) - 1) for a, b in _levels_pairs()], ".0f")
+)  # fmt: skip
+value("chain.levels_local_default")(lambda: _local_change("default"))
+value("chain.levels_local_wagner2012")(lambda: _local_change("wagner2012"))
+value("chain.levels_unstable")(_levels_unstable)
+
+
+# --- "The Pareto front": global PCSA against local stiffness at A ---
+
+PARETO_POINTS = 7
+"""Budgets on the front of the page's example (``points`` of :func:`~spinectl.optimise.coupled.joint.pareto_front`)."""
+
+PARETO_INNER = 200.0
+"""A budget below the front's kink [N m/rad], where the page reads the front's slope there."""
+
+STIFF = {"passive.stiffness": 100.0}
+"""The page's second example: ``default`` with a passive stiffness of 100 N m/rad."""
+
+
+def _model(preset: str, changes: dict | None = None):
+    from spinectl.model.config import load_preset, set_parameters
+
+    return set_parameters(load_preset(preset), changes) if changes else load_preset(preset)
+
+
+@cache
+def pareto(preset: str = "wagner2012", stiff: bool = False):
+    """:func:`~spinectl.optimise.coupled.joint.pareto_front` at A, :data:`PARETO_POINTS` budgets."""
+    from spinectl.optimise.coupled.joint import pareto_front
+
+    return pareto_front(_model(preset, STIFF if stiff else None), 0.0, 0.0, PARETO_POINTS)
+
+
+@cache
+def pareto_inner():
+    """The front of ``wagner2012`` at A at the budget :data:`PARETO_INNER` (the same epsilon-constraint SDP)."""
+    from spinectl.optimise.coupled.data import coupled_data, result
+    from spinectl.optimise.coupled.joint import least_global_within_budget_sdp
+
+    model = _model("wagner2012")
+    return result(model, coupled_data(model, 0.0, 0.0), 0.0, 0.0,
+                  *least_global_within_budget_sdp(coupled_data(model, 0.0, 0.0), PARETO_INNER))  # fmt: skip
+
+
+@cache
+def joint():
+    """The joint optimum (c) of ``wagner2012`` at A (its ``local.cost_weight``, 1)."""
+    from spinectl.optimise.coupled.joint import joint_optimum
+
+    return joint_optimum(_model("wagner2012"), 0.0, 0.0)
+
+
+def _kappa() -> float:
+    """kappa [N m/rad per cm^2] of ``wagner2012``'s local muscles."""
+    from spinectl.model.local_muscles import local_stiffness_per_pcsa
+
+    return local_stiffness_per_pcsa(_model("wagner2012")) * 1e-4
+
+
+def _front() -> tuple:
+    """The feasible points of the front: global totals [cm^2] and local totals [N m/rad]."""
+    front = pareto()
+    ok = np.array([p.status == "optimal" for p in front.points])
+    return 1e4 * front.global_total[ok], front.local_total[ok]
+
+
+def _beyond_rate() -> float:
+    """Local stiffness that one cm^2 of global muscle replaces from the first feasible point on [N m/rad/cm^2]."""
+    g, k = _front()
+    return (k[-1] - k[0]) / (g[0] - g[-1])
+
+
+def _inner_rate() -> float:
+    """The same between the budget :data:`PARETO_INNER` and the first feasible point [N m/rad/cm^2]."""
+    g, k = _front()
+    return (k[0] - PARETO_INNER) / (1e4 * pareto_inner().total_pcsa - g[0])
+
+
+def _shape() -> str:
+    """How far the feasible points lie from the straight line between the first and the last: 'in a straight
+    line' to 0.1 % of the fall, 'almost in a straight line' to 1 %, else 'along a convex curve'."""
+    g, k = _front()
+    line = g[0] + (g[-1] - g[0]) * (k - k[0]) / (k[-1] - k[0])
+    off = np.max(np.abs(g - line)) / (g[0] - g[-1])
+    return "in a straight line" if off < 1e-3 else "almost in a straight line" if off < 1e-2 else "along a convex curve"
+
+
+def _stiff():
+    """The front of ``default`` with :data:`STIFF` at A."""
+    return pareto("default", True)
+
+
+def _b0(stiff: bool) -> str:
+    return (_stiff() if stiff else pareto()).points[0].status
+
+
+value("chain.pareto_b0")(lambda: "infeasible" if _b0(False) != "optimal" else "feasible")
+value("chain.pareto_first_global")(lambda: f"{_front()[0][0]:.2f}")
+value("chain.pareto_first_local")(lambda: f"{_front()[1][0]:.1f}")
+value("chain.pareto_first_local_round")(lambda: f"{_front()[1][0]:.0f}")
+value("chain.pareto_first_local_pcsa")(lambda: f"{_front()[1][0] / _kappa():.1f}")
+value("chain.pareto_shape")(_shape)
+value("chain.pareto_last_global")(lambda: f"{_front()[0][-1]:.2g}")
+value("chain.pareto_bmax")(lambda: f"{_front()[1][-1]:.0f}")
+value("chain.pareto_bmax_pcsa")(lambda: f"{_front()[1][-1] / _kappa():.1f}")
+value("chain.pareto_rate")(lambda: f"{_beyond_rate():.0f}")
+value("chain.pareto_rate_pcsa")(lambda: f"{_beyond_rate() / _kappa():.1f}")
+value("chain.kappa")(lambda: f"{_kappa():.0f}")
+value("chain.pareto_inner_global")(lambda: f"{1e4 * pareto_inner().total_pcsa:.2f}")
+value("chain.pareto_inner_rate")(lambda: f"{_inner_rate():.0f}")
+value("chain.pareto_inner_rate_pcsa")(lambda: f"{_inner_rate() / _kappa():.2f}")
+value("chain.pareto_inner_steeper")(lambda: "steeper" if _inner_rate() < _beyond_rate() else "no steeper")
+value("chain.joint_global")(lambda: f"{1e4 * joint().total_pcsa:.2f}")
+value("chain.joint_local")(lambda: f"{np.sum(joint().local_stiffness):.1f}")
+value("chain.pareto_stiff_b0")(lambda: "suffice" if _b0(True) == "optimal" else "do not suffice")
+value("chain.pareto_stiff_first")(lambda: f"{1e4 * _stiff().global_total[0]:.2f}")
+value("chain.pareto_stiff_last")(lambda: f"{1e4 * _stiff().global_total[-1]:.2g}")
+value("chain.pareto_stiff_bmax")(lambda: f"{_stiff().local_total[-1]:.0f}")
+
+
+# --- "The exact delay margin": the narrow band that the former sweep stepped over ---
+
+BAND = {"body.mass": 35.0, "passive.stiffness": 10.0, "local.damping": 0.0}
+"""The case: ``wagner2012``'s subject of docs/reflex.md, the local muscles as springs only."""
+
+BAND_POINT, BAND_ACTIVATION, BAND_FRACTION = (0.03, 0.04), 0.189, 0.9999
+"""(E, Lambda) [m], the global muscles' fraction of the minimum PCSA and the local stiffness's of k*."""
+
+
+@cache
+def band():
+    """The case's exact delay margin (:func:`spinectl.reflex.mimo.chain_delay_margin`) with the rule's reflex
+    times 1 - f (:func:`spinectl.reflex.design.chain.chain_loop_at`), as ``design``'s chain search meets it."""
+    from spinectl.model.operating_point import OperatingPoint, chain_at
+    from spinectl.optimise.coupled import least_local_stiffness_stacked
+    from spinectl.optimise.reference import solve_point
+    from spinectl.reflex.design.chain import chain_loop_at
+    from spinectl.reflex.mimo import chain_delay_margin
+
+    model = _model("wagner2012", BAND)
+    pcsa = BAND_ACTIVATION * np.asarray(solve_point(model, *BAND_POINT).pcsa, float)
+    linear = chain_at(OperatingPoint(model, *BAND_POINT, pcsa, slip_check=False))
+    least = least_local_stiffness_stacked(linear.stiffness_offset[None], model.optimisation.stability_margin)[1][0]
+    stiffness, damping, kp, kd = chain_loop_at(model, linear, least, BAND_FRACTION)
+    return chain_delay_margin(linear.mass_matrix, stiffness, damping, kp, kd, model.reflex.activation_time_constant)
+
+
+def _band_crossings() -> np.ndarray:
+    crossings = np.sort(band().crossovers)
+    if band().status != "finite" or crossings.size != 2:
+        raise RuntimeError(f"docs/chain.md's narrow band: expected two crossings, found {crossings} ({band().status})")
+    return crossings
+
+
+value("chain.band_crossings")(lambda: " and ".join(f"{w:.2f}" for w in _band_crossings()))
+value("chain.band_apart")(lambda: f"{100 * np.ptp(_band_crossings()) / _band_crossings()[0]:.2g}")
+value("chain.band_margin")(lambda: f"{1e3 * band().margin:.3g}")
+
+
+# --- "What it finds": the rule's reflex on the chain at A, exact delay margins ---
+
+RULE_CASES = (("default", 0.5, 0.05), ("default", 0.5, 0.0), ("default", 1.0, 0.05), ("default", 1.0, 0.0),
+              ("wagner2012", 0.5, 0.05), ("wagner2012", 1.0, 0.05), ("wagner2012", 1.0, 0.0))  # fmt: skip
+"""The table's rows: preset, ``reflex.activation`` [1] and ``reflex.activation_time_constant`` T_a [s]."""
+
+
+@cache
+def rule_margin(preset: str, activation: float, lag: float):
+    """``spinectl margins --coupled --E 0 --Lambda 0 --set reflex.activation=A --set
+    reflex.activation_time_constant=T``: the exact delay margin of the rule's reflex on the chain."""
+    from spinectl.reflex.chain_margins import coupled_margins
+
+    changes = {"reflex.activation": activation, "reflex.activation_time_constant": lag}
+    return coupled_margins(_model(preset, changes), 0.0, 0.0).exact
+
+
+def _rule_cells(exact) -> str:
+    if exact.status == "unstable_without_delay":
+        return "0 (unstable without delay) | "
+    return f"{1e3 * exact.margin:.3f} | {exact.frequency:,.0f}".replace(",", "\u2009")
+
+
+def margins_table() -> str:
+    """The rule's reflex on the chain at A: exact delay margin and crossing frequency per preset, activation, lag."""
+    lines = [
+        "| preset | activation | $T_a$ [s] | exact delay margin [ms] | at $\\omega$ [rad/s] |",
+        "| --- | --- | --- | --- | --- |",
+    ]
+    for preset, activation, lag in RULE_CASES:
+        lines.append(f"| `{preset}` | {activation:g} | {lag:g} | {_rule_cells(rule_margin(preset, activation, lag))} |")
+    return "\n".join(lines) + "\n"
+
+
+def _rule_pair(activation: float, lag: float) -> str:
+    """'0.252 and 0.991': the rule's margins [ms] of ``default`` and ``wagner2012`` in one case."""
+    return " and ".join(f"{1e3 * rule_margin(p, activation, lag).margin:.3f}" for p in ("default", "wagner2012"))
+
+
+value("chain.rule_margins_lagless")(lambda: _rule_pair(1.0, 0.0))
+value("chain.rule_margins_half")(lambda: _rule_pair(0.5, 0.05))

@@ -3,7 +3,9 @@
 The paper's model (``wagner2012``) at E = 3 cm, Lambda = 4 cm exported as MJCF and as OpenSim files with each
 muscle model, without and with spinectl's least local stiffness: spinectl's verdict on its chain beside
 OpenSim's own linearisation of the file written (:func:`spinectl.anatomy.interchange.export_verdicts`), so
-that the page's numbers are those the commands print, never typed.
+that the page's numbers are those the commands print, never typed; and the page's recipe for Millard's
+muscles (the least local stiffness of OpenSim's own K added to the file's springs, and OpenSim's
+linearisation of that file).
 """
 
 from __future__ import annotations
@@ -165,3 +167,50 @@ def _millard_local_opensim():
 
 
 value("interchange.millard_local_fastest")(lambda: f"{_growing(_millard_local_opensim())[0]:.2f}")
+
+
+# --- Millard's chain made stable: the least local stiffness computed on OpenSim's own K ---
+
+
+@cache
+def own_local() -> np.ndarray:
+    """``least_local_stiffness_at(K, mu)`` on K of OpenSim's linearisation of the plain Millard export [N m/rad]."""
+    from spinectl.optimise.coupled.sdp import least_local_stiffness_at
+
+    margin = load_preset("wagner2012").optimisation.stability_margin
+    status, local = least_local_stiffness_at(opensim_k("millard", False), margin)
+    if status != "optimal":
+        raise RuntimeError(f"docs/interchange.md: the least local stiffness of OpenSim's K is {status}")
+    return np.asarray(local, float)
+
+
+@cache
+def _own_local_opensim() -> np.ndarray:
+    """OpenSim's own linearisation of the plain Millard export with :func:`own_local` added to its springs."""
+    import opensim as osim
+
+    from spinectl.anatomy.interchange import opensim_eigenvalues
+
+    path, solution = exported("osim", "millard", False)
+    names = solution.model.geometry.cor_names
+    built = osim.Model(str(path))
+    for k, name in enumerate(names):  # the export's joint springs, one per coordinate (docs/interchange.md)
+        spring = osim.SpringGeneralizedForce.safeDownCast(built.getForceSet().get(f"{name}_stiffness"))
+        spring.setStiffness(spring.getStiffness() + float(own_local()[k]))
+    stable = Path(_folder()) / "millard_own_local.osim"
+    built.printToXML(str(stable))
+    return opensim_eigenvalues(stable, names)
+
+
+def _slowest(eigenvalues) -> str:
+    """'decays at -0.0008 1/s' (one significant figure), or 'grows at ...' where a mode does not decay."""
+    top = float(np.max(np.real(eigenvalues)))
+    return f"{'decays' if top < 0 else 'grows'} at {_minus(top, '.1g')} 1/s"
+
+
+value("interchange.own_local")(lambda: _and(own_local()))
+value("interchange.own_local_total")(lambda: f"{np.sum(own_local()):.0f}")
+value("interchange.own_local_ratio")(
+    lambda: f"{np.sum(own_local()) / np.sum(exported('mjcf', 'millard', True)[1].local_stiffness):.1f}"
+)
+value("interchange.own_local_slowest")(lambda: _slowest(_own_local_opensim()))

@@ -5,10 +5,16 @@ from the ``wagner2012`` preset), and the documented verdict of every landmark.
 The assumption table is measured at each build (:mod:`spinectl.paper.assumptions`,
 on a coarse grid); the test suite checks the documented values against a fresh
 measurement of the preset (tests/paper/test_verdicts.py) and the documented
-assumptions against that table (tests/paper/test_assumptions.py).
+assumptions against that table (tests/paper/test_assumptions.py). The chain's numbers of "The whole chain"
+are measured at the build too: the landscape's chain margin (``spinectl sweep`` on the paper's 1 mm grid,
+about a second) and the chain at the paper's optimum (:mod:`.chain`'s computations).
 """
 
 from __future__ import annotations
+
+from functools import cache
+
+import numpy as np
 
 from spinectl.model.config import load_preset
 from spinectl.paper import assumptions, calibration, verdicts
@@ -70,3 +76,164 @@ value("reproduction.claim")(claim)
 value("reproduction.optimum_lordosis")(lambda: _documented("optimum_lordosis"))
 value("reproduction.ct_optimum")(lambda: _documented("ct_optimum"))
 value("reproduction.agreeing")(agreeing)
+
+
+# --- "The whole chain: what the paper's conclusions become" (numbers of ``docs/chain.md``'s computations) ---
+
+LANDSCAPE_POINTS = 81
+"""Points per axis of the E x Lambda landscape over 0-8 cm whose chain margin the page quotes (the paper's 1 mm)."""
+
+OPTIMUM = (0.03, 0.04)
+"""The paper's optimum (E, Lambda) [m], where the page reads the chain (docs/chain.md's tables)."""
+
+
+@cache
+def chain_margins():
+    """``spinectl sweep`` of ``wagner2012`` on the paper's grid: the chain's static margin with the global
+    muscles alone at each point's per-segment optimum, ``coupled_margin_Nm_per_rad`` [N m/rad]."""
+    from spinectl.landscape.sweep import sweep
+    from spinectl.paper.grid import paper_axis
+
+    axis = paper_axis(LANDSCAPE_POINTS)
+    return sweep(load_preset(verdicts.PRESET), axis, axis, progress=False)["coupled_margin_Nm_per_rad"]
+
+
+def _largest_margin() -> str:
+    """The landscape's largest chain margin; the page says every point is unstable, so a non-negative one fails."""
+    largest = float(chain_margins().max())
+    if not largest < 0:
+        raise RuntimeError(
+            f"docs/reproduction.md says the chain is unstable at every point; its margin reaches {largest}"
+        )
+    return f"{largest:.0f}".replace("-", "\u2212")
+
+
+def _growing() -> str:
+    """'4 of its 10 dynamic eigenvalues grow, at 18 to 68 1/s' at :data:`OPTIMUM`."""
+    from .chain import coupled
+
+    real = np.real(coupled(verdicts.PRESET, *OPTIMUM).eigenvalues)
+    up = np.sort(real[real > 0])
+    return f"{up.size} of its {real.size} dynamic eigenvalues grow, at {up[0]:.0f} to {up[-1]:.0f} 1/s"
+
+
+def _local(preset: str) -> float:
+    from .chain import coupled
+
+    return float(np.sum(coupled(preset, *OPTIMUM).local.local_stiffness))
+
+
+@cache
+def _joint():
+    """The joint optimum (c) of the preset at :data:`OPTIMUM`."""
+    from spinectl.optimise.coupled.joint import joint_optimum
+
+    return joint_optimum(load_preset(verdicts.PRESET), *OPTIMUM)
+
+
+def _cm2(m2: float, fmt: str = ".1f") -> str:
+    return f"{1e4 * m2:{fmt}}"
+
+
+def _local_pcsa(k: float) -> float:
+    """The local muscles' PCSA [m^2] for a local stiffness ``k`` [N m/rad] (docs/chain.md's kappa)."""
+    from spinectl.model.local_muscles import local_stiffness_per_pcsa
+
+    return k / local_stiffness_per_pcsa(load_preset(verdicts.PRESET))
+
+
+def _segment_total() -> float:
+    from .chain import coupled
+
+    return float(np.sum(coupled(verdicts.PRESET, *OPTIMUM).pcsa))
+
+
+value("reproduction.chain_margin_max")(_largest_margin)
+value("reproduction.chain_growing")(_growing)
+value("reproduction.local_total")(lambda: f"{_local(verdicts.PRESET):.0f}")
+value("reproduction.local_total_default")(lambda: f"{_local('default'):.0f}")
+value("reproduction.local_pcsa")(lambda: _cm2(_local_pcsa(_local(verdicts.PRESET))))
+value("reproduction.joint_global")(lambda: _cm2(_joint().total_pcsa))
+value("reproduction.joint_local")(lambda: _cm2(_joint().total_local_pcsa))
+value("reproduction.segment_global")(lambda: _cm2(_segment_total()))
+value("reproduction.joint_less")(lambda: "less" if _joint().total_pcsa + _joint().total_local_pcsa < _segment_total()
+                                  else "no less")  # fmt: skip
+
+
+# --- the optimal lordosis against the local stiffness, at E = 3 cm ---
+
+LORDOSES = np.linspace(0.0, 0.08, 33)
+"""Lambda [m] of the sweep at E = 3 cm that the page reads: 0 to 8 cm in 2.5 mm steps."""
+
+
+@cache
+def lordosis_sweep(preset: str) -> dict:
+    """``spinectl sweep --coupled`` at E = 3 cm over :data:`LORDOSES`: where the counter torques are least, the
+    chain's least local stiffness there, its largest and its least over Lambda, each with its Lambda [cm]."""
+    from spinectl.landscape.sweep import sweep
+
+    land = sweep(load_preset(preset), [OPTIMUM[0]], LORDOSES, progress=False, coupled=True).isel(E=0)
+    torque = land["counter_torque_norm_Nm"].values
+    local = land["local_stiffness_total_Nm_per_rad"].values
+    at, most, least = (int(i) for i in (np.nanargmin(torque), np.nanargmax(local), np.nanargmin(local)))
+    cm = 100 * LORDOSES
+    return {"at": (cm[at], local[at]), "most": (cm[most], local[most]), "least": (cm[least], local[least]),
+            "edge": least == len(LORDOSES) - 1}  # fmt: skip
+
+
+def _both(text) -> str:
+    """``wagner2012``'s text and ``default``'s in brackets: 'a (b)'."""
+    return f"{text(verdicts.PRESET)} ({text('default')})"
+
+
+def _within(preset: str) -> str:
+    row = lordosis_sweep(preset)
+    return f"{100 * (1 - row['at'][1] / row['most'][1]):.0f}"
+
+
+def _over_least(preset: str) -> str:
+    row = lordosis_sweep(preset)
+    return f"{100 * (row['at'][1] / row['least'][1] - 1):.0f}"
+
+
+def _least_where() -> str:
+    """'at the grid's edge Lambda = 8 cm' where both presets' least lies at the sweep's end, else where it lies."""
+    rows = [lordosis_sweep(p) for p in (verdicts.PRESET, "default")]
+    if all(r["edge"] for r in rows) and rows[0]["least"][0] == rows[1]["least"][0]:
+        return f"at the grid's edge Λ = {rows[0]['least'][0]:g} cm"
+    return "at Λ = " + _both(lambda p: f"{lordosis_sweep(p)['least'][0]:g}") + " cm"
+
+
+value("reproduction.lordosis_ct")(lambda: _both(lambda p: f"{lordosis_sweep(p)['at'][0]:g} cm"))
+value("reproduction.lordosis_local")(lambda: f"{lordosis_sweep(verdicts.PRESET)['at'][1]:.0f}")
+value("reproduction.lordosis_local_default")(lambda: f"{lordosis_sweep('default')['at'][1]:.0f}")
+value("reproduction.lordosis_within")(lambda: _both(lambda p: f"{_within(p)} %"))
+value("reproduction.lordosis_most")(
+    lambda: "; ".join(f"{lordosis_sweep(p)['most'][1]:.0f} at {lordosis_sweep(p)['most'][0]:g} cm"
+                      for p in (verdicts.PRESET, "default"))
+)  # fmt: skip
+value("reproduction.lordosis_over_least")(lambda: _both(lambda p: f"{_over_least(p)} %"))
+value("reproduction.lordosis_least")(lambda: _both(lambda p: f"{lordosis_sweep(p)['least'][1]:.0f}"))
+value("reproduction.lordosis_least_where")(_least_where)
+
+
+# --- the reflex: one joint at a time against the chain, at A ---
+
+
+@cache
+def _joint_margin(preset: str) -> float:
+    """The least delay margin over the joints, each alone [s] (``spinectl margins --E 0 --Lambda 0``)."""
+    from spinectl.reflex.margins import margins_report
+
+    return min(s.delay_margin for s in margins_report(load_preset(preset), 0.0, 0.0).segments)
+
+
+def _chain_rule_margin(preset: str) -> str:
+    """The rule's reflex on the chain at A at ``reflex.activation`` 0.5 with the lag [ms] (docs/chain.md's table)."""
+    from .chain import rule_margin
+
+    return f"{1e3 * rule_margin(preset, 0.5, 0.05).margin:.3f}"
+
+
+value("reproduction.joint_reflex_margin")(lambda: _both(lambda p: f"{1e3 * _joint_margin(p):.0f}") + " ms")
+value("reproduction.chain_reflex_margin")(lambda: _both(_chain_rule_margin) + " ms")
