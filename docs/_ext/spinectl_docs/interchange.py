@@ -35,9 +35,11 @@ EXPORTS = (
 
 
 def _cells(eigenvalues) -> str:
-    """Largest and smallest real part [1/s] and the count of growing modes."""
+    """The largest real part [1/s], the real part nearest 0 with its sign (the slowest mode, growing if > 0), and
+    the count of growing modes."""
     real = np.real(eigenvalues)
-    return f"{real.max():.4g} | {np.abs(real).min():.3g} | {int(np.sum(real >= 0))} of {real.size}"
+    slowest = real[np.argmin(np.abs(real))]
+    return f"{real.max():.4g} | {slowest:+.3g} | {int(np.sum(real >= 0))} of {real.size}"
 
 
 @cache
@@ -80,7 +82,7 @@ def export_table() -> str:
 
     model = load_preset("wagner2012")
     lines = [
-        "| export | local stiffness | whose linearisation | largest Re [1/s] | least abs(Re) [1/s] | growing modes |",
+        "| export | local stiffness | whose linearisation | largest Re [1/s] | Re nearest 0 [1/s] (the slowest mode; > 0 grows) | growing modes |",
         "| --- | --- | --- | --- | --- | --- |",
     ]
     for fmt, muscle, local in EXPORTS:
