@@ -1,4 +1,4 @@
-"""The design answers of ``docs/reflex.md`` over every reflex's gains, and the rule's beside them, measured at the build.
+"""``docs/reflex.md``'s design answers over every reflex's gains and the rule's beside them, measured at the build.
 
 ``spinectl design --delay D --E 0.03 --Lambda 0.04 [--gains search]`` on ``wagner2012`` and on the page's 35 kg
 subject (``--mass 35 --K 10``, :data:`.reflex.SUBJECT`): the chain's least local stiffness under the reflex rule
@@ -114,9 +114,8 @@ def full_gain_ratio(who: str, delay: float) -> tuple[float, float]:
 
 def sci(v: float) -> str:
     """A small number in the page's form: −5.4e−5."""
-    mantissa, exponent = f"{v:.2g}".split("e") if "e" in f"{v:.2g}" else (f"{v:.2g}", "")
-    text = mantissa + (f"e{int(exponent)}" if exponent else "")
-    return text.replace("-", MINUS)
+    mantissa, _, exponent = f"{v:.2g}".partition("e")
+    return (mantissa + (f"e{int(exponent)}" if exponent else "")).replace("-", MINUS)
 
 
 def ms(seconds: float, digits: int = 4) -> str:
@@ -131,6 +130,7 @@ def span(values, fmt: str, unit: str = "") -> str:
 
 
 def percent(v: float) -> str:
+    """A share [%] to the unit."""
     return f"{v:.0f} %"
 
 
@@ -186,15 +186,10 @@ def issue_40ms() -> tuple[float, float, float]:
     rightmost root's Re [1/s] of 0.40 k_p and 0.30 k_d of the rule's full gains, and the exact margin [s] of the
     rule's own hand-over gains, (1 - 0.9 f) of them (``tests/reflex/test_design_gain_searched.py`` recomputes
     them from the model's chain)."""
-    from spinectl.optimise.reference import solve_point
-    from spinectl.reflex.design.gain_searched import _Chain
     from spinectl.reflex.design.roots import SPECTRAL_NODES, rightmost_root
     from spinectl.reflex.mimo import chain_delay_margin
 
-    at, c = model("wagner2012", 0.04), rule("wagner2012", 0.04)
-    pcsa = at.reflex.activation * np.asarray(solve_point(at, *POSITION).pcsa, float)
-    chain = _Chain(at, *POSITION, pcsa, c.least_static)  # the loop the gain search judges
-    f = 0.9 * c.fraction
+    chain, f = loop("wagner2012", 0.04), 0.9 * rule("wagner2012", 0.04).fraction
     kp0, kd0 = chain.gains(0.0)
     k, d = chain.loop(f)
     lag = chain.lag
@@ -204,20 +199,27 @@ def issue_40ms() -> tuple[float, float, float]:
     return float(margin), float(root), float(handed)
 
 
-def crossing(who: str, delay: float) -> float:
-    """The frequency at which the rule's chain design loses stability, its first crossing [rad/s]."""
+def loop(who: str, delay: float):
+    """The chain at the rule's operating point (its global PCSA, its k*), as the gain search judges it: the
+    library's own loop at each local stiffness f k* (``.loop(f)``) and the rule's gains (``.gains(f)``)."""
     from spinectl.optimise.reference import solve_point
     from spinectl.reflex.design.gain_searched import _Chain
+
+    at = model(who, delay)
+    pcsa = at.reflex.activation * np.asarray(solve_point(at, *POSITION).pcsa, float)
+    return _Chain(at, *POSITION, pcsa, rule(who, delay).least_static)
+
+
+def crossing(who: str, delay: float) -> float:
+    """The frequency at which the rule's chain design loses stability, its first crossing [rad/s]."""
     from spinectl.reflex.mimo import chain_delay_margin
 
-    at, c = model(who, delay), rule(who, delay)
-    pcsa = at.reflex.activation * np.asarray(solve_point(at, *POSITION).pcsa, float)
-    chain = _Chain(at, *POSITION, pcsa, c.least_static)
+    chain, c = loop(who, delay), rule(who, delay)
     k, d = chain.loop(c.fraction)
     return float(chain_delay_margin(chain.mass, k, d, c.kp, c.kd, chain.lag).frequency)
 
 
-def binding(who: str, delay: float) -> str:
+def binding(who: str, delay: float) -> tuple[str, str]:
     """Joint by joint under the rule: the segment that sets the common activation, and how the margins ran."""
     answer = design(who, delay)
     first = max(answer.segments, key=lambda s: s.activation)
@@ -238,9 +240,17 @@ def _cost(who: str, delay: float) -> float:
     return total(design(who, delay).margin_cost) - total(rule(who, delay))
 
 
+def cost_words(who: str, delay: float) -> str:
+    """What a margin of 1.1 costs the rule's design, from and to [N m/rad]: ``+3.0 N m/rad (223.7 to 226.7)``."""
+    more = f"{_cost(who, delay):+.1f}".replace("-", MINUS)
+    return f"{more} N m/rad ({total(rule(who, delay)):.1f} to {total(design(who, delay).margin_cost):.1f})"
+
+
 def _subject_delays(function, fmt: str, delays=(*REACTION, 0.12)) -> str:
-    return ", ".join(format(function("subject", d), fmt) for d in delays[:-1]) + " and " + format(
-        function("subject", delays[-1]), fmt
+    return (
+        ", ".join(format(function("subject", d), fmt) for d in delays[:-1])
+        + " and "
+        + format(function("subject", delays[-1]), fmt)
     )
 
 
@@ -278,21 +288,22 @@ value("reflex.subject_scan_120")(lambda: binding("subject", 0.12)[1])
 value("reflex.subject_l5s1_120")(lambda: f"{design('subject', 0.12).segments[-1].activation:.3f}")
 # a design sits on its boundary; the searched ones need not; what a margin costs
 value("reflex.boundary_margins")(
-    lambda: f"{ms(rule('wagner2012', 0.04).delay_margin)} at 40 ms and {ms(rule('wagner2012', 0.12).delay_margin)} "
-    "at 120 ms"
+    lambda: (
+        f"{ms(rule('wagner2012', 0.04).delay_margin)} at 40 ms and {ms(rule('wagner2012', 0.12).delay_margin)} "
+        "at 120 ms"
+    )
 )
 value("reflex.boundary_roots")(
     lambda: f"{sci(rule('wagner2012', 0.04).max_root_real)} and {sci(rule('wagner2012', 0.12).max_root_real)}"
 )
 value("reflex.boundary_root_subject")(lambda: sci(rule("subject", 0.12).max_root_real))
 value("reflex.searched_margins")(
-    lambda: f"{ms(search('wagner2012', 0.04).delay_margin, 2)} at 40 ms and "
-    f"{ms(search('subject', REACTION[0]).delay_margin, 2)} at {1e3 * REACTION[0]:.0f} ms"
+    lambda: (
+        f"{ms(search('wagner2012', 0.04).delay_margin, 2)} at 40 ms and "
+        f"{ms(search('subject', REACTION[0]).delay_margin, 2)} at {1e3 * REACTION[0]:.0f} ms"
+    )
 )
-value("reflex.cost_53")(
-    lambda: f"{_cost('subject', REACTION[0]):+.1f}".replace("-", MINUS)
-    + f" N m/rad ({total(rule('subject', REACTION[0])):.1f} to {total(design('subject', REACTION[0]).margin_cost):.1f})"
-)
+value("reflex.cost_53")(lambda: cost_words("subject", REACTION[0]))
 value("reflex.cost_120")(lambda: f"{_cost('subject', 0.12):+.1f}".replace("-", MINUS))
 # joint by joint over every segment's gains
 value("reflex.l1l2_rule_margin")(lambda: ms(l1l2_case()[0], 1))
