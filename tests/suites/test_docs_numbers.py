@@ -3,6 +3,8 @@
 - the ``published-model`` directive (docs/_ext/spinectl_docs/published.py), built in a small Sphinx site:
   its row is what ``spinectl anatomy --json`` prints for the same model and mapping;
 - the ``{measured}`` values and generated tables of docs/anatomy.md are the command's own numbers;
+- docs/reflex.md's generated design lines (joint by joint and the chain over every reflex's gains) are lines
+  that ``spinectl design`` prints;
 - a scan of docs/*.md and README.md for numbers typed beside the words of a command's output (the patterns
   of the numbers that were typed and are now generated), with an allow-list of citations, inputs and
   history, so that a new typed output fails here.
@@ -185,6 +187,53 @@ def test_anatomy_pages_numbers_are_spinectl_anatomys():
     assert np.isclose(float(text_of("anatomy.remedy")), optimum["feasible_from_joint_stiffness_Nm_per_rad"], rtol=2e-3)
 
 
+def spinectl_design(*args: str) -> str:
+    """What ``spinectl design ... --E 0.03 --Lambda 0.04`` prints (the command's own output, the referee)."""
+    done = subprocess.run(
+        [sys.executable, "-m", "spinectl", "design", *args, "--E", "0.03", "--Lambda", "0.04"],
+        capture_output=True, text=True, timeout=900,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    return done.stdout
+
+
+def block_lines(block: str) -> list[str]:
+    """The lines of a generated ``text`` block that the command printed (not the fence, the command, the ellipsis)."""
+    return [line for line in block.splitlines() if not line.startswith(("```", "$ ", "..."))]
+
+
+def test_reflex_pages_joint_searched_lines_and_boundary_are_spinectl_designs():
+    """docs/reflex.md's generated joint-by-joint searched lines at 120 ms (``wagner2012``, (3, 4) cm) are lines of
+    the table `spinectl design --delay 0.12` prints, and the boundary sentence's margin at 120 ms is the JSON's
+    chain ``delay_margin_s`` of the same command, in ms to four decimals."""
+    from spinectl_docs import searched
+    from spinectl_docs.values import text_of
+
+    printed = spinectl_design("--delay", "0.12").splitlines()
+    lines = block_lines(searched.joint_search_table())
+    assert lines[0].startswith("over any PD gains per segment") and len(lines) == 4
+    for line in lines:
+        assert line in printed, line
+    margin = json.loads(spinectl_design("--delay", "0.12", "--json"))["chain"]["delay_margin_s"]
+    assert text_of("reflex.boundary_margins").endswith(f"and {1e3 * margin:.4f} ms at 120 ms")
+
+
+@pytest.mark.slow
+def test_reflex_pages_chain_searched_lines_are_spinectl_design_gains_search():
+    """docs/reflex.md's generated lines of the chain's answer over every diagonal PD reflex at 40 ms are lines of
+    the table `spinectl design --delay 0.04 --gains search` prints (the seeded search: the same lines), and the
+    rule's f the page quotes is the table's (``0.5617 x the least for static stability`` when written)."""
+    from spinectl_docs import searched
+    from spinectl_docs.values import text_of
+
+    printed = spinectl_design("--delay", "0.04", "--gains", "search").splitlines()
+    lines = block_lines(searched.chain_search_table())
+    assert lines[0].startswith("over any diagonal PD gains, searched") and len(lines) == 4
+    for line in lines:
+        assert line in printed, line
+    assert any(f"({text_of('reflex.rule_f_40')} x the least for static stability" in line for line in printed)
+
+
 # --- typed outputs ---------------------------------------------------------------------------------------------
 
 OUTPUT_PATTERNS = {
@@ -226,15 +275,6 @@ ALLOWED = {
     ("reflex.md", "3.9 N m s/rad"): "the issue's quoted case (L1L2 at k_d = 8 instead of 3.9), an input",
     # pending: still typed, to be generated (each is a gain search of about a minute, over the build's budget,
     # or an OpenSim simulation); this list only shrinks, and an entry that no longer matches fails the test
-    ("reflex.md", "78.9 N m/rad"): "pending: design --gains search at 40 ms (the printed table)",
-    ("reflex.md", "-0.04642 1/s"): "pending: the same",
-    ("reflex.md", "margin 40.56 ms"): "pending: the same",
-    ("reflex.md", "249.0 N m/rad"): "pending: the subject's rule and searched designs at 53, 70, 120 ms",
-    ("reflex.md", "241.2 N m/rad"): "pending: the same",
-    ("reflex.md", "−5 1/s"): "pending: the designs' rightmost roots",
-    ("reflex.md", "−6 1/s"): "pending: the same",
-    ("reflex.md", "+3.0 N m/rad"): "pending: the margin cost",
-    ("reflex.md", "margin 128.0 ms"): "pending: the joint-searched case",
 }
 """(page, the matched text) -> why it stays typed; ``*`` allows a whole page."""
 

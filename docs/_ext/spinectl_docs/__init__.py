@@ -18,6 +18,8 @@ a text changed, so that incremental builds stay incremental):
 - ``_generated/export-eigenvalues.md``: the exports' eigenvalues in ``interchange.md``, spinectl's
   and OpenSim's own linearisation of each file (measured at the build);
 - ``_generated/design-decay.md``: ``design --decay-rate``'s answers in ``reflex.md`` (measured at the build);
+- ``_generated/design-chain-searched.md`` and ``design-joint-searched.md``: ``design --gains search``'s lines in
+  ``reflex.md`` (:mod:`.searched`);
 - ``_generated/chain-points.md``, ``chain-dynamics.md`` and ``chain-passive.md``: ``stability --coupled`` at
   four points and
   ``design --passive`` at A in ``chain.md`` (measured at the build, :mod:`.chain`); ``chain-margins.md``: the rule's
@@ -62,6 +64,7 @@ from . import (
     reexports,
     reflex,
     reproduction,
+    searched,
     trends,
     values,
 )
@@ -81,10 +84,12 @@ MEASURED_TABLES = (
     ("anatomy-optimum.md", anatomy.optimum_table),
     ("anatomy-lordosis.md", anatomy.lordosis_table),
     ("anatomy-reflex.md", anatomy.reflex_table),
+    ("design-chain-searched.md", searched.chain_search_table),
+    ("design-joint-searched.md", searched.joint_search_table),
 )
 """The tables of what commands print, measured at the build: (file in ``_generated/``, its generator)."""
 
-MEASURED_VALUES = (anatomy, chain, errata, interchange, lift, reflex, reproduction, trends)
+MEASURED_VALUES = (anatomy, chain, errata, interchange, lift, reflex, reproduction, searched, trends)
 """The modules that register ``{measured}`` values (:func:`.values.value`) when imported."""
 
 
