@@ -273,8 +273,6 @@ ALLOWED = {
     ("interchange.md", "rank 3"): "the rank theorem, read off OpenSim's arms by the test",
     ("reflex.md", "−25 N m s/rad"): "a bound of the gain search, an input",
     ("reflex.md", "3.9 N m s/rad"): "the issue's quoted case (L1L2 at k_d = 8 instead of 3.9), an input",
-    # pending: still typed, to be generated (each is a gain search of about a minute, over the build's budget,
-    # or an OpenSim simulation); this list only shrinks, and an entry that no longer matches fails the test
 }
 """(page, the matched text) -> why it stays typed; ``*`` allows a whole page."""
 
