@@ -250,7 +250,7 @@ class Explorer:
         self.status = pn.pane.Markdown("", name="status")
         self.progress = pn.indicators.Progress(active=False, visible=False, width=200)
         self.design_button = pn.widgets.Button(label=DESIGN_LABEL, width=260)
-        self.design_search = pn.widgets.Checkbox(name=SEARCH_LABEL, value=False, width=260)
+        self.design_search = pn.widgets.Checkbox(label=SEARCH_LABEL, value=False, width=260)
         self.design_spinner = pn.indicators.LoadingSpinner(value=False, visible=False, width=24, height=24)
         self.design = pn.pane.HTML("", name="design", width=DESIGN_PIXELS)  # its long lines wrap in the column
         self.design_status = pn.pane.Markdown("", name="design_status", width=260)
