@@ -97,10 +97,11 @@ CHAIN_HEADERS = (
 """Their headers."""
 DESIGN_LABEL = "design for this delay"
 """The button that answers the design question at the sliders' delay (seconds: on request only)."""
-SEARCH_LABEL = f"{SEARCH_WORDS} (tens of seconds)"
+SEARCH_CHOICES = {"the reflex rule alone": False, f"{SEARCH_WORDS} (tens of s)": True}
+"""The chain's reflex the design answers for: the rule's alone, or also every diagonal PD reflex (``--gains
+search``); buttons, since a check box's label does not toggle it in Bokeh (a click on its words did nothing)."""
 DESIGN_PLACE = "under the numbers table"
 """Where the design answer shows, below the first screen: the line under the button says so."""
-"""The box that adds the chain's answer over every diagonal PD reflex to the design (``--gains search``)."""
 
 
 def png_bytes(fig, dpi: float = DPI) -> bytes:
@@ -250,7 +251,9 @@ class Explorer:
         self.status = pn.pane.Markdown("", name="status")
         self.progress = pn.indicators.Progress(active=False, visible=False, width=200)
         self.design_button = pn.widgets.Button(label=DESIGN_LABEL, width=260)
-        self.design_search = pn.widgets.Checkbox(label=SEARCH_LABEL, value=False, width=260)
+        self.design_search = pn.widgets.RadioButtonGroup(
+            name="the chain's reflex", options=SEARCH_CHOICES, value=False, orientation="vertical", width=275
+        )
         self.design_spinner = pn.indicators.LoadingSpinner(value=False, visible=False, width=24, height=24)
         self.design = pn.pane.HTML("", name="design", width=DESIGN_PIXELS)  # its long lines wrap in the column
         self.design_status = pn.pane.Markdown("", name="design_status", width=260)

@@ -22,8 +22,8 @@ TOML_NAME = "spinectl-explore.toml"
 PARTS = ("joint_title", "joint_table", "joint", "chain_title", "chain")
 """The parts of :func:`~spinectl.explore.numbers.design_rows` shown under the headline, in the command's order."""
 
-SEARCH_WORDS = "over every diagonal PD reflex too"
-"""The explorer's box that adds ``--gains search`` to its design, as the panel names it."""
+SEARCH_WORDS = "and every diagonal PD reflex"
+"""The explorer's choice under its design button that adds ``--gains search``, as the panel names it."""
 
 NOTE_STYLE = "margin-left:1.5em"
 """A note on the line above it (two spaces in the command's table) is indented under it, as the command does."""
@@ -36,7 +36,7 @@ def design_command(state: ExploreState, search: bool = False) -> str:
     ----------
     state : ExploreState
     search : bool
-        With ``--gains search``, as the explorer's box *over every diagonal PD reflex too*.
+        With ``--gains search``, as the explorer's choice :data:`SEARCH_WORDS`.
 
     Returns
     -------
@@ -87,8 +87,8 @@ def design_html(answer: Design, state: ExploreState, current: bool) -> str:
             ]
     command = html.escape(design_command(state, answer.searched is not None))
     parts.append(
-        "<p>the options named above are those of spinectl design (--gains search is also the box "
-        f"<i>{html.escape(SEARCH_WORDS)}</i>): <b>export TOML config</b>, then "
+        "<p>the options named above are those of spinectl design (--gains search is also the choice "
+        f"<i>{html.escape(SEARCH_WORDS)}</i> under the button): <b>export TOML config</b>, then "
         f'<code data-design="command">{command}</code> prints this answer</p>'
     )
     return '<div class="spinectl-design">' + "".join(parts) + "</div>"

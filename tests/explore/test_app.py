@@ -305,7 +305,7 @@ def test_the_design_button_shows_the_answer_for_its_state_and_marks_it_when_the_
     assert explorer.design.object == ""  # seconds of work: only on request
     explorer.design_button.clicks += 1
     state, base, answer = explorer.design_answer
-    assert state == explorer.state and base is explorer.base and answer.searched is None  # the box is off
+    assert state == explorer.state and base is explorer.base and answer.searched is None  # the rule alone
     assert explorer.design.object == design_panel.design_html(answer, state, current=True)
     for key, lines in nb.design_rows(answer).items():
         for line, _ in lines:
@@ -325,8 +325,8 @@ def test_the_design_button_shows_the_answer_for_its_state_and_marks_it_when_the_
     assert not explorer.design_button.disabled and not explorer.design_spinner.value
 
 
-def test_the_search_box_asks_for_the_answer_over_every_diagonal_reflex(monkeypatch):
-    """The box over every diagonal PD reflex hands search=True to design_numbers (spinectl design --gains
+def test_the_search_choice_asks_for_the_answer_over_every_diagonal_reflex(monkeypatch):
+    """The choice *also over every diagonal PD reflex* hands search=True to design_numbers (spinectl design --gains
     search), and the command the panel gives says --gains search; off, neither (the search itself, tens of
     seconds: tests/reflex/test_design_gain_searched.py)."""
     asked = []
@@ -341,7 +341,7 @@ def test_the_search_box_asks_for_the_answer_over_every_diagonal_reflex(monkeypat
     monkeypatch.setattr(design_panel, "design_rows", lambda design: nb.design_rows(answer))  # object() has no lines
     explorer.run_design()
     assert "--gains search" not in _command(explorer.design.object)
-    explorer.design_search.value = True
+    explorer.design_search.value = app.SEARCH_CHOICES[f"{design_panel.SEARCH_WORDS} (tens of s)"]
     explorer.run_design()
     assert asked == [False, True]
     assert _command(explorer.design.object) == design_panel.design_command(explorer.state) + " --gains search"
