@@ -252,7 +252,7 @@ class Explorer:
         self.progress = pn.indicators.Progress(active=False, visible=False, width=200)
         self.design_button = pn.widgets.Button(label=DESIGN_LABEL, width=260)
         self.design_search = pn.widgets.RadioButtonGroup(
-            name="the chain's reflex", options=SEARCH_CHOICES, value=False, orientation="vertical", width=275
+            options=SEARCH_CHOICES, value=False, orientation="vertical", width=275
         )
         self.design_spinner = pn.indicators.LoadingSpinner(value=False, visible=False, width=24, height=24)
         self.design = pn.pane.HTML("", name="design", width=DESIGN_PIXELS)  # its long lines wrap in the column
