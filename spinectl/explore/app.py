@@ -38,11 +38,11 @@ from ..paper.landmarks import CT_LIMIT
 from ..reflex.design import Design
 from ..units import CM_PER_M, m2_to_cm2
 from . import views
+from .design_panel import SEARCH_WORDS, TOML_NAME, design_html
 from .numbers import (
     LANDSCAPE_POINTS,
     PointNumbers,
     design_numbers,
-    design_rows,
     landscape_axis,
     landscapes,
     point_numbers,
@@ -69,6 +69,8 @@ EIGENVALUE_LEGEND_PIXELS = 70
 """Width of the eigenvalue view's legend, beside the plane [px]."""
 LANDSCAPE_PIXELS = 300
 """Width and height of a landscape view [px]."""
+DESIGN_PIXELS = 1040
+"""Width of the design panel [px]: the views' column, so that its lines wrap there instead of widening the page."""
 CONFIG_CHOICE = "--config"
 """The preset selector's entry for the model of ``--config``."""
 ROW_KEYS = ("segment", "eigenvalue_1", "eigenvalue_2", "counter_torque_Nm", "delay_margin_s", "stable_at_delay")
@@ -95,6 +97,11 @@ CHAIN_HEADERS = (
 """Their headers."""
 DESIGN_LABEL = "design for this delay"
 """The button that answers the design question at the sliders' delay (seconds: on request only)."""
+SEARCH_CHOICES = {"the reflex rule alone": False, f"{SEARCH_WORDS} (tens of s)": True}
+"""The chain's reflex the design answers for: the rule's alone, or also every diagonal PD reflex (``--gains
+search``); buttons, since a check box's label does not toggle it in Bokeh (a click on its words did nothing)."""
+DESIGN_PLACE = "under the numbers table"
+"""Where the design answer shows, below the first screen: the line under the button says so."""
 
 
 def png_bytes(fig, dpi: float = DPI) -> bytes:
@@ -211,43 +218,6 @@ def chain_html(numbers: PointNumbers) -> str:
     return f'<table class="spinectl-chain">{caption}<tr>{head}</tr><tr>{cells}</tr></table>'
 
 
-def design_html(answer: Design, current: bool) -> str:
-    """The design answer of :func:`spinectl.explore.numbers.design_rows` as HTML, one line per criterion.
-
-    Parameters
-    ----------
-    answer : Design
-    current : bool
-        Whether the answer is for the sliders' state; if not, it says so.
-
-    Returns
-    -------
-    str
-        Each value in a ``<span data-design="key">``.
-    """
-    row = {key: html.escape(value) for key, value in design_rows(answer).items()}
-
-    def value(key: str) -> str:
-        return f'<span data-design="{key}">{row[key]}</span>'
-
-    stale = "" if current else " <b>(the sliders have moved since: press again)</b>"
-
-    def unmet(met: float, key: str) -> str:  # the largest delay met, where none meets the delay
-        return "" if np.isfinite(met) else f"; none meets it, the largest delay met {value(key)} s"
-
-    return (
-        f"<p>design for τ = {answer.delay * 1000:.4g} ms, lag {answer.activation_time_constant * 1000:.4g} ms: "
-        f"status {value('status')}{stale}</p><ul>"
-        f"<li>{value('joint_criterion')}: least co-contraction {value('activation')} × minimum PCSA "
-        f"({value('pcsa_cm2')} cm² in all){unmet(answer.activation, 'joint_largest_delay_s')}</li>"
-        f"<li>{value('chain_criterion')}: at activation {value('chain_activation')}, least local stiffness "
-        f"[N m/rad] {value('local_stiffness_Nm_per_rad')} ({value('local_stiffness_fraction')} × the least "
-        f"for static stability); certificate: exact delay margin {value('chain_delay_margin_s')} s, rightmost "
-        f"root Re s = {value('max_root_real_per_s')} 1/s{unmet(answer.chain.fraction, 'chain_largest_delay_s')}</li>"
-        "</ul>"
-    )
-
-
 class Explorer:
     """One session of the explorer: its state, widgets and views.
 
@@ -281,8 +251,12 @@ class Explorer:
         self.status = pn.pane.Markdown("", name="status")
         self.progress = pn.indicators.Progress(active=False, visible=False, width=200)
         self.design_button = pn.widgets.Button(label=DESIGN_LABEL, width=260)
+        self.design_search = pn.widgets.RadioButtonGroup(
+            options=SEARCH_CHOICES, value=False, orientation="vertical", width=275
+        )
         self.design_spinner = pn.indicators.LoadingSpinner(value=False, visible=False, width=24, height=24)
-        self.design = pn.pane.HTML("", name="design")
+        self.design = pn.pane.HTML("", name="design", width=DESIGN_PIXELS)  # its long lines wrap in the column
+        self.design_status = pn.pane.Markdown("", name="design_status", width=260)
         self.design_answer: tuple[ExploreState, Model, Design] | None = None
         self._design_generation = 0
         self.design_button.on_click(lambda event: self.run_design())
@@ -314,7 +288,7 @@ class Explorer:
     def _layout(self) -> pn.viewable.Viewable:
         toml = pn.widgets.FileDownload(
             callback=lambda: io.StringIO(state_toml(self.base, self.state)),
-            filename="spinectl-explore.toml",
+            filename=TOML_NAME,
             label="export TOML config",
             width=260,
         )
@@ -333,6 +307,8 @@ class Explorer:
             self.progress,
             self.status,
             pn.Row(self.design_button, self.design_spinner),
+            self.design_search,
+            self.design_status,
             width=290,
         )
         point = pn.Row(self.drawing, self.views["eigenvalues"].pane, self.views["counter_torques"].pane)
@@ -481,20 +457,21 @@ class Explorer:
         a state the sliders have left is shown as such. Outside a session it is computed at once.
         """
         self._design_generation += 1
-        generation, state, base = self._design_generation, self.state, self.base
+        generation, state, base, search = self._design_generation, self.state, self.base, self.design_search.value
         self.design_spinner.param.update(value=True, visible=True)
         self.design_button.disabled = True
+        self.design_status.object = f"designing… the answer comes {DESIGN_PLACE}"
 
         async def solve():
             answer, error = None, "internal error (the server's log has the traceback)"
             try:
-                answer, error = await asyncio.to_thread(_designed, base, state)
+                answer, error = await asyncio.to_thread(_designed, base, state, search)
             finally:  # a bug too stops the spinner
                 if generation == self._design_generation:
                     self._design_done(state, base, answer, error)
 
         if not in_session():
-            self._design_done(state, base, *_designed(base, state))
+            self._design_done(state, base, *_designed(base, state, search))
             return
         pn.state.execute(solve)
 
@@ -504,6 +481,11 @@ class Explorer:
             self.design_button.disabled = False
             self.design_answer = None if answer is None else (state, base, answer)
             self.errors["design"] = error
+            self.design_status.object = (
+                f"design: status {answer.status}, {DESIGN_PLACE}"
+                if answer is not None
+                else f"design not found: {DESIGN_PLACE}"
+            )
             self._show_design()
 
     def _show_design(self) -> None:
@@ -512,7 +494,7 @@ class Explorer:
             self.design.object = f"<p><b>design not found:</b> {html.escape(self.errors['design'])}</p>"
         elif self.design_answer is not None:
             state, base, answer = self.design_answer
-            self.design.object = design_html(answer, state == self.state and base is self.base)
+            self.design.object = design_html(answer, state, state == self.state and base is self.base)
 
     def _show_landscapes(self, dataset: xr.Dataset | None, elapsed: float, error: str | None = None) -> None:
         """Show the landscapes solved, or keep the last ones (each titled with its own mass and K) and the error."""
@@ -569,10 +551,10 @@ def status_text(seconds: dict[str, float], errors: dict[str, str | None], solvin
     return f"**refused:** {html.escape(errors['input'])}; {text}" if errors["input"] else text
 
 
-def _designed(base: Model, state: ExploreState) -> tuple[Design | None, str | None]:
+def _designed(base: Model, state: ExploreState, search: bool) -> tuple[Design | None, str | None]:
     """The design answer of :func:`spinectl.explore.numbers.design_numbers`, or its one-line error."""
     try:
-        return design_numbers(base, state), None
+        return design_numbers(base, state, search), None
     except SpinectlError as exc:
         return None, printable(str(exc))
 

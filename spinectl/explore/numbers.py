@@ -7,8 +7,9 @@ analysis and calculation of counter torques"; :func:`spinectl.model.stability.se
 :attr:`PointNumbers.chain` is the chain's verdict under the same reflex, every CoR free
 (:func:`spinectl.reflex.chain_verdict.margins_with_chain`, docs/chain.md), beside the segments', each
 judged alone (the paper's criterion); :func:`design_numbers` answers the design question at the
-state's delay (:func:`spinectl.reflex.design.curve.design`, docs/reflex.md, "The design question"), which
-takes seconds, so the explorer runs it only on request.
+state's delay as ``spinectl design`` does (:func:`spinectl.reflex.design.gain_searched.answer`, docs/reflex.md,
+"The design question"), which takes seconds, so the explorer runs it only on request; :func:`design_rows` gives
+its words, those of the command's table.
 :func:`landscapes` is the minimum PCSA and ||CT|| over the paper's range on a coarse grid,
 solved on the stacked fast path (:func:`spinectl.landscape.sweep.sweep`, docs/optimisation.md).
 """
@@ -28,9 +29,8 @@ from ..paper import grid
 from ..reflex.chain_margins import stable_at
 from ..reflex.chain_verdict import ChainReflexVerdict, margins_with_chain
 from ..reflex.delay import delay_text
-from ..reflex.design import Design, design
+from ..reflex.design import Design, answer
 from ..reflex.margins import MarginsReport, margins_report
-from ..units import m2_to_cm2
 from .state import ExploreState, model_at
 
 LANDSCAPE_POINTS = 41
@@ -243,16 +243,22 @@ def point_numbers(base: Model, state: ExploreState, previous: PointNumbers | Non
     return PointNumbers(state, model, report, eigenvalues, counter_torque)
 
 
-def design_numbers(base: Model, state: ExploreState) -> Design:
-    """The design answer at the state's delay: least co-contraction joint by joint, least local stiffness for the chain.
+def design_numbers(base: Model, state: ExploreState, search: bool = False) -> Design:
+    """The design answer at the state's delay, as ``spinectl design`` gives it: both criteria, labelled.
 
-    :func:`spinectl.reflex.design.curve.design` of the state's model at its point, as ``spinectl design``
-    computes it; seconds (a scan and bisection per criterion), so the explorer runs it on request.
+    :func:`spinectl.reflex.design.gain_searched.answer` of the state's model at its point, the function
+    ``spinectl design`` calls: joint by joint the least co-contraction, for the chain the least local stiffness
+    under the reflex rule, each with the reflex it assumes, the chain's global PCSA and gains, that the least
+    value is a stability boundary and what a margin of 1.1 x the delay costs; seconds, so the explorer runs it
+    on request.
 
     Parameters
     ----------
     base : Model
     state : ExploreState
+    search : bool
+        Also the chain's answer over every diagonal PD reflex (``spinectl design --gains search``: a seeded
+        gain search, each candidate certified; tens of seconds).
 
     Returns
     -------
@@ -264,42 +270,30 @@ def design_numbers(base: Model, state: ExploreState) -> Design:
     ParameterError
         A state outside the model's allowed ranges.
     """
-    return design(model_at(base, state), state.eccentricity, state.lordosis)
+    return answer(model_at(base, state), state.eccentricity, state.lordosis, search=search)
 
 
-def design_rows(answer: Design) -> dict[str, str]:
-    """The design answer as the explorer shows it (:func:`shown`), one entry per criterion and its certificate.
+def design_rows(design: Design) -> dict[str, list[tuple[str, bool]]]:
+    """The design answer as the explorer shows it: the words of ``spinectl design``'s table, part by part.
+
+    :meth:`spinectl.reflex.design.result.Design.readings`, whose lines the command prints; a line the command
+    indents by two spaces, a note on the line above it, is marked as one (the explorer indents it so).
 
     Parameters
     ----------
-    answer : Design
+    design : Design
+        An answer of :func:`design_numbers`.
 
     Returns
     -------
-    dict
-        ``status``; joint by joint: ``joint_criterion``, ``activation`` (the least for every segment
-        at once [1]), ``pcsa_cm2`` (the total PCSA there [cm^2]), ``joint_largest_delay_s`` (the
-        largest delay met on the scan [s]); the chain: ``chain_criterion``, ``chain_activation`` (its
-        global activation [1]), ``local_stiffness_Nm_per_rad`` (per joint, comma-separated),
-        ``local_stiffness_fraction`` (of the least for static stability), ``chain_delay_margin_s``
-        and ``max_root_real_per_s`` (the certificate), ``chain_largest_delay_s``.
+    dict of str to list of (str, bool)
+        The keys of :meth:`~spinectl.reflex.design.result.Design.readings` (``header``, ``headline``,
+        ``joint_title``, ``joint_table``, ``joint``, ``chain_title``, ``chain``), each a list of (the line
+        without its indent, whether it is a note); the segments' fixed-width table (``joint_table``) as printed.
     """
-    chain = answer.chain
     return {
-        "status": answer.status,
-        "joint_criterion": criterion("joint", len(answer.segments)),
-        "activation": shown(answer.activation),
-        "pcsa_cm2": shown(m2_to_cm2(answer.pcsa)),
-        "joint_largest_delay_s": shown(answer.largest_delay),
-        "chain_criterion": criterion("chain", len(chain.local_stiffness)),
-        "chain_activation": shown(chain.activation),
-        "local_stiffness_Nm_per_rad": ", ".join(
-            f"{s.name} {shown(k)}" for s, k in zip(answer.segments, chain.local_stiffness, strict=True)
-        ),
-        "local_stiffness_fraction": shown(chain.fraction),
-        "chain_delay_margin_s": shown(chain.delay_margin),
-        "max_root_real_per_s": shown(chain.max_root_real),
-        "chain_largest_delay_s": shown(chain.largest_delay),
+        key: [(line if key == "joint_table" else line.strip(), line.startswith("  ")) for line in lines]
+        for key, lines in design.readings().items()
     }
 
 

@@ -150,15 +150,18 @@ def model_at(base: Model, state: ExploreState) -> Model:
     Returns
     -------
     Model
-        A new model; ``base`` is unchanged.
+        A new model; ``base`` is unchanged. Its source lists as overridden only the sliders moved off
+        ``base``'s own values (every output's header names them, :func:`spinectl.model.source.header`): before,
+        it listed all five at the opening state, as if the user had changed them.
 
     Raises
     ------
     ParameterError
         A value outside its parameter's allowed range.
     """
-    values = {s.parameter: getattr(state, s.field) for s in SLIDERS if s.parameter}
-    return set_parameters(base, values)
+    own = initial_state(base)  # the base's values: set again, they would be listed as overridden
+    moved = [s for s in SLIDERS if s.parameter and getattr(state, s.field) != getattr(own, s.field)]
+    return set_parameters(base, {s.parameter: getattr(state, s.field) for s in moved})
 
 
 def state_toml(base: Model, state: ExploreState) -> str:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import asyncio
+import dataclasses
 import html
 import xml.etree.ElementTree as ET
 
@@ -11,7 +12,7 @@ import param
 import pytest
 
 from spinectl.errors import ModelError
-from spinectl.explore import app
+from spinectl.explore import app, design_panel
 from spinectl.explore import numbers as nb
 from spinectl.explore.state import initial_state, replace, slider_for
 from spinectl.model.config import load_config, load_preset
@@ -298,30 +299,86 @@ def test_the_table_gives_the_chains_verdict_beside_the_segments():
 
 def test_the_design_button_shows_the_answer_for_its_state_and_marks_it_when_the_sliders_move(monkeypatch):
     """The button runs numbers.design_numbers at the sliders' state (here outside a server session, at once) and
-    shows design_rows of its answer (the largest delay met only where none meets the delay); a moved slider
-    marks it as for another state; an error is one line."""
+    shows design_panel.design_html of its answer, every line of design_rows in it; the line under the button
+    says where; a moved slider marks it as for another state; an error is one line."""
     explorer = app.Explorer(load_preset("default"), "default")
     assert explorer.design.object == ""  # seconds of work: only on request
     explorer.design_button.clicks += 1
     state, base, answer = explorer.design_answer
-    assert state == explorer.state and base is explorer.base
-    shown = nb.design_rows(answer)
-    met = {key: shown.pop(key) for key in ("joint_largest_delay_s", "chain_largest_delay_s")}
-    for key, value in shown.items():
-        assert f'<span data-design="{key}">{html.escape(value)}</span>' in explorer.design.object
-    assert answer.status == "ok" and "largest delay met" not in explorer.design.object  # said where none meets it
-    assert met == {"joint_largest_delay_s": "unbounded", "chain_largest_delay_s": "unbounded"}
+    assert state == explorer.state and base is explorer.base and answer.searched is None  # the rule alone
+    assert explorer.design.object == design_panel.design_html(answer, state, current=True)
+    for key, lines in nb.design_rows(answer).items():
+        for line, _ in lines:
+            assert html.escape(line) in explorer.design.object, key
+    assert explorer.design_status.object == f"design: status {answer.status}, {app.DESIGN_PLACE}"
     assert "press again" not in explorer.design.object and not explorer.design_spinner.visible
     _drag(explorer.sliders["delay"], 40.0)
     assert "the sliders have moved since: press again" in explorer.design.object
 
-    def refused(base, state):
+    def refused(base, state, search):
         raise ModelError("levels.mass: must be > 0 for the chain")
 
     monkeypatch.setattr(app, "design_numbers", refused)
     explorer.run_design()
     assert explorer.design.object == "<p><b>design not found:</b> levels.mass: must be &gt; 0 for the chain</p>"
+    assert explorer.design_status.object == f"design not found: {app.DESIGN_PLACE}"
     assert not explorer.design_button.disabled and not explorer.design_spinner.value
+
+
+def test_the_search_choice_asks_for_the_answer_over_every_diagonal_reflex(monkeypatch):
+    """The choice *also over every diagonal PD reflex* hands search=True to design_numbers (spinectl design --gains
+    search), and the command the panel gives says --gains search; off, neither (the search itself, tens of
+    seconds: tests/reflex/test_design_gain_searched.py)."""
+    asked = []
+    explorer = app.Explorer(load_preset("default"), "default")
+    answer = nb.design_numbers(explorer.base, explorer.state)
+
+    def recorded(base, state, search):
+        asked.append(search)
+        return dataclasses.replace(answer, searched=object()) if search else answer
+
+    monkeypatch.setattr(app, "design_numbers", recorded)
+    monkeypatch.setattr(design_panel, "design_rows", lambda design: nb.design_rows(answer))  # object() has no lines
+    explorer.run_design()
+    assert "--gains search" not in _command(explorer.design.object)
+    explorer.design_search.value = app.SEARCH_CHOICES[f"{design_panel.SEARCH_WORDS} (tens of s)"]
+    explorer.run_design()
+    assert asked == [False, True]
+    assert _command(explorer.design.object) == design_panel.design_command(explorer.state) + " --gains search"
+
+
+def _command(page: str) -> str:
+    """The command line the design panel gives, unescaped."""
+    return html.unescape(page.split('<code data-design="command">')[1].split("</code>")[0])
+
+
+def test_design_html_puts_each_line_of_the_answer_in_its_part():
+    """design_html at a state other than the opening one (wagner2012, 200 ms, activation 0.3, K 10): each
+    part of design_rows in elements whose data-design is the part, in the command's order; a note indented,
+    the segments' table one <pre> of its lines; the command for the state's TOML export last; an answer for
+    another state marked."""
+    base = load_preset("wagner2012")
+    state = replace(initial_state(base), delay=0.2, activation=0.3, stiffness=10.0)
+    answer = nb.design_numbers(base, state)
+    page = design_panel.design_html(answer, state, current=True)
+    rows = nb.design_rows(answer)
+    positions = []
+    for key in design_panel.PARTS[2:]:  # the lines of the answers: joint, chain_title, chain
+        for line, note in rows[key]:
+            if key == "chain_title":
+                element = f'<b data-design="{key}">{html.escape(line)}</b>'
+            else:
+                style = f' style="{design_panel.NOTE_STYLE}"' if note else ""
+                element = f'<div data-design="{key}"{style}>{html.escape(line)}</div>'
+            assert element in page
+            positions.append(page.index(element))
+    assert positions == sorted(positions)
+    table = "\n".join(line for line, _ in rows["joint_table"])
+    assert f'<pre data-design="joint_table">{html.escape(table)}</pre>' in page
+    assert any(note for _, note in rows["chain"]) and any(not note for _, note in rows["chain"])
+    assert page.index('data-design="command"') > positions[-1]
+    assert _command(page) == f"spinectl design --config spinectl-explore.toml --E {0.03!r} --Lambda {0.04!r}"
+    assert "press again" not in page and "press again" in design_panel.design_html(answer, state, current=False)
 
 
 def test_in_a_session_the_design_runs_in_a_worker_and_the_sliders_stay_free(monkeypatch):
@@ -333,7 +390,7 @@ def test_in_a_session_the_design_runs_in_a_worker_and_the_sliders_stay_free(monk
     monkeypatch.setattr(app.pn.state, "onload", lambda callback, **options: None)
     monkeypatch.setattr(app.pn.state, "execute", lambda function, **options: tasks.append(function))
 
-    def refused(base, state):
+    def refused(base, state, search):
         asked.append(state)
         raise ModelError("levels.mass: must be > 0 for the chain")
 

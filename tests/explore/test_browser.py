@@ -215,3 +215,47 @@ def test_a_page_of_another_site_cannot_load_the_explorer(served_url, served_log,
         tab.close()
     assert statuses[f"{served_url}?img"] == 403 and statuses[f"{served_url}?frame"] == 403
     assert [line for line in served_log[start:] if "session opened" in line] == []
+
+
+def _words(text: str) -> str:
+    """Text with its whitespace as a browser lays it out: runs of it as one space (the command's two spaces too)."""
+    return " ".join(text.split())
+
+
+def test_a_design_in_the_browser_reads_as_spinectl_design(served_url, browser_tab):
+    """A new tab at the opening state: its first screen gives the chain's verdict with its criterion (above the
+    fold, the library's words, PointNumbers.verdicts); the button *design for this delay* shows, line by line,
+    the words of spinectl design's table (numbers.design_rows of the library's answer at the same state), among
+    them the reflex each answer assumes and the boundary lines; the line under the button says where; the
+    command that prints the same is last (design_panel.design_command)."""
+    from playwright.sync_api import expect
+
+    from spinectl.explore.design_panel import design_command
+
+    base = load_preset()
+    state = initial_state(base)
+    tab = browser_tab.context.new_page()
+    tab.set_default_timeout(browser_harness.TIMEOUT_S * 1000)
+    try:
+        tab.goto(served_url)
+        chain = tab.locator("[data-verdict=chain]")
+        expect(chain).to_have_text(nb.point_numbers(base, state).verdicts()[1])
+        assert chain.bounding_box()["y"] + chain.bounding_box()["height"] < browser_harness.VIEWPORT["height"]
+        answer = nb.design_numbers(base, state)  # the library's, at the same state
+        rows = nb.design_rows(answer)
+        tab.get_by_role("button", name=app.DESIGN_LABEL).click()
+        tab.locator("[data-design=command]").wait_for()
+        for key in ("headline", "joint_title", "joint", "chain_title", "chain"):
+            shown = [_words(text) for text in tab.locator(f"[data-design={key}]").all_inner_texts()]
+            assert shown == [_words(line) for line, _ in rows[key]], key
+        table = tab.locator("[data-design=joint_table]").inner_text()
+        assert table.splitlines() == [line for line, _ in rows["joint_table"]]
+        assumed = [line for key in ("joint", "chain") for line, _ in rows[key] if line.startswith("reflex assumed:")]
+        bounds = [line for key in ("joint", "chain") for line, _ in rows[key] if line.startswith("boundary:")]
+        assert len(assumed) == 2 and len(bounds) == 2  # one each per criterion, in the library's answer
+        page_text = _words(tab.locator(".spinectl-design").inner_text())
+        assert all(_words(line) in page_text for line in assumed + bounds)
+        assert tab.locator("[data-design=command]").inner_text() == design_command(state)
+        expect(tab.get_by_text(f"design: status {answer.status}, {app.DESIGN_PLACE}")).to_be_visible()
+    finally:
+        tab.close()

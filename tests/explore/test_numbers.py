@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 import scipy.linalg
@@ -14,6 +17,8 @@ from spinectl.model.stability import segment_stability
 from spinectl.optimise.reference import solve_point
 from spinectl.reflex.chain_verdict import chain_verdict, margins_with_chain
 from spinectl.reflex.delay import delay_text
+from spinectl.reflex.design import COST_RATIO
+from spinectl.reflex.design.result import RULE_REFLEX
 from spinectl.reflex.margins import margins_report, operating_point
 
 
@@ -175,20 +180,65 @@ def test_design_meets_the_delay_checked_by_the_margins_report(answer):
     assert design.chain.delay_margin >= state.delay and design.chain.max_root_real < 0
 
 
-def test_design_rows_show_both_criteria_and_the_certificate(answer):
-    """design_rows: each criterion named, every number as shown() writes the Design's own field."""
+def test_design_is_the_commands_answer_with_the_reflex_it_assumes(answer):
+    """design_numbers answers as `spinectl design` does (reflex.design.gain_searched.answer, the function the
+    command calls): the chain's answer labelled with the rule's reflex, its global PCSA (activation x the
+    minimum stabilising PCSA, solve_point here) and gains recorded, the cost of 1.1 x the delay beside it, and
+    joint by joint the answer over every segment's gains (before: reflex.design.curve.design, none of these)."""
+    base, state, design = answer
+    assert design.chain.reflex == RULE_REFLEX and design.searched is None
+    optimum = solve_point(model_at(base, state), state.eccentricity, state.lordosis).pcsa
+    assert design.chain.pcsa == pytest.approx(state.activation * np.sum(optimum), rel=1e-6)
+    assert np.all(np.isfinite(design.chain.kp)) and np.all(np.isfinite(design.chain.kd))
+    assert design.margin_cost.ratio == COST_RATIO and design.joint_searched is not None
+
+
+def test_design_rows_are_the_lines_spinectl_design_prints(answer):
+    """design_rows: Design.readings part by part, each line as Design.table() prints it (the command's table),
+    without the two spaces of a note, marked as one instead; among them the reflex-assumed lines and the
+    boundary lines of both criteria (their words the library's: RULE_REFLEX)."""
     _, _, design = answer
     rows = nb.design_rows(design)
-    assert rows["joint_criterion"].startswith("joint by joint (each CoR alone")
-    assert rows["chain_criterion"] == "chain (all 5 CoRs free)"
-    assert rows["activation"] == nb.shown(design.activation)
-    assert rows["pcsa_cm2"] == nb.shown(design.pcsa * 1e4)
-    assert rows["chain_delay_margin_s"] == nb.shown(design.chain.delay_margin)
-    assert rows["max_root_real_per_s"] == nb.shown(design.chain.max_root_real)
-    names = design.model.get("cor_names", ("L1L2", "L2L3", "L3L4", "L4L5", "L5S1"))
-    assert rows["local_stiffness_Nm_per_rad"] == ", ".join(
-        f"{name} {nb.shown(k)}" for name, k in zip(names, design.chain.local_stiffness, strict=True)
+    table = design.table().splitlines()
+    assert [line for part in rows.values() for line, _ in part] == [
+        line if line in design.readings()["joint_table"] else line.strip() for line in table if line
+    ]
+    notes = {line.strip() for line in table if line.startswith("  ")}
+    assert {line for part in rows.values() for line, note in part if note} == notes
+    chain = [line for line, _ in rows["chain"]]
+    assert f"reflex assumed: {RULE_REFLEX}" in "\n".join(chain)
+    assert any(line.startswith("boundary: the least value sits on its stability boundary") for line in chain)
+    assert any(line.startswith("boundary:") for line, _ in rows["joint"])
+    assert rows["chain_title"][0][0].startswith("chain (all 5 CoRs free): least local stiffness under the reflex rule")
+
+
+def test_the_explorers_design_is_what_the_command_prints_for_its_toml_export(tmp_path):
+    """The state's TOML export (state_toml) and the command the panel gives (design_panel.design_command),
+    run as a user would: `spinectl design` prints the lines of design_rows, the header apart (the command names
+    the file, the explorer the preset). A state with three sliders moved off the preset's values, not the
+    opening one."""
+    from spinectl.explore.design_panel import TOML_NAME, design_command
+    from spinectl.explore.state import state_toml
+
+    base = load_preset("wagner2012")
+    state = ExploreState(0.025, 0.05, mass=base.body.mass, stiffness=20.0, delay=0.07, activation=0.4,
+                         activation_lag=base.reflex.activation_time_constant)  # fmt: skip
+    (tmp_path / TOML_NAME).write_text(state_toml(base, state))
+    argv = design_command(state).split()
+    assert argv[:2] == ["spinectl", "design"]
+    done = subprocess.run(
+        [sys.executable, "-m", "spinectl", *argv[1:]], cwd=tmp_path, capture_output=True, text=True, timeout=600
     )
+    assert done.returncode == 0, done.stderr
+    printed = [line for line in done.stdout.splitlines() if line]
+    rows = nb.design_rows(nb.design_numbers(base, state))
+    shown = [line for key, part in rows.items() if key != "header" for line, _ in part]
+    assert printed[0].startswith(f"preset wagner2012, K = 20 N m/rad, convention physical; config {TOML_NAME}")
+    assert [line if line in rows["joint_table"] else line.strip() for line in printed[1:]] == shown
+    assert rows["header"][0][0] == (
+        "preset wagner2012, K = 20 N m/rad, convention physical; overridden: passive.stiffness, reflex.delay, "
+        "reflex.activation"
+    )  # the sliders moved, and only those (before: all five, moved or not)
 
 
 @pytest.mark.parametrize("change", [{"delay": 0.0}, {"delay": 0.2}, {"activation_lag": 0.1}, {"activation": 0.3}])

@@ -260,3 +260,21 @@ def test_the_searched_certificate_under_a_margin_names_the_designed_delay_too():
     assert "rightmost root at the delay Re s" in next(
         line for line in plain.splitlines() if "certificate: exact delay margin 130" in line
     )
+
+
+@pytest.mark.parametrize(("delay", "decay"), [(0.1, 0.0), (0.1, 2.0)])
+def test_the_readings_are_the_tables_lines_part_by_part(delay, decay):
+    """Design.readings (what the explorer's design panel shows) holds every line of Design.table (what spinectl
+    design prints), in its order, part by part: the model, the headline, each criterion's title, the segments'
+    table and the answer with its notes; the reflex assumed and the boundary (or, with a decay rate of 2 1/s where
+    no design meets it, the decay-rate lines) are in each criterion's part, not elsewhere."""
+    result = dz.answer(_model(delay), *AT, decay=decay)
+    parts = result.readings()
+    assert list(parts) == ["header", "headline", "joint_title", "joint_table", "joint", "chain_title", "chain"]
+    assert [line for lines in parts.values() for line in lines] == [x for x in result.table().splitlines() if x]
+    assert parts["joint"][1].startswith("  reflex assumed: the reflex rule at each activation")
+    assert any(x.startswith("  reflex assumed: the reflex rule, (1 - f)+") for x in parts["chain"])
+    if decay:
+        assert "(--decay-rate)" in parts["joint"][0] and "(--decay-rate)" in parts["chain"][0]
+    else:
+        assert any(x.startswith("  boundary: the least value sits on its stability boundary") for x in parts["chain"])

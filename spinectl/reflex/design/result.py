@@ -268,53 +268,87 @@ class Design:
         Returns
         -------
         str
-            No final newline.
+            No final newline: the lines of :meth:`readings`, each criterion after an empty line.
+        """
+        r = self.readings()
+        return "\n".join(
+            [*r["header"], *r["headline"], "", *r["joint_title"], *r["joint_table"], *r["joint"], "",
+             *r["chain_title"], *r["chain"]]
+        )  # fmt: skip
+
+    def readings(self) -> dict[str, list[str]]:
+        """The design's words, part by part: what :meth:`table` prints and the explorer shows.
+
+        Returns
+        -------
+        dict of str to list of str
+            ``header`` (the model), ``headline`` (the point, the delay, the status); joint by joint
+            ``joint_title`` (its criterion), ``joint_table`` (the segments' columns, fixed width) and
+            ``joint`` (the answer, the reflex it assumes, its boundary, the answer over every segment's
+            gains); the chain ``chain_title`` (its criterion and the reflex) and ``chain`` (the answer, its
+            certificate, the reflex assumed, the global PCSA, the gains, the boundary and what a margin costs,
+            the searched answer or where to get it). A line that starts with two spaces is a note on the line
+            above it.
         """
         c = self.chain
-        lines = [
-            self.model.get("header", "preset unknown"),
-            f"E = {self.eccentricity * 100:.2f} cm, Lambda = {self.lordosis * 100:.2f} cm, delay "
-            f"{self._delay_words()}, activation lag {self.activation_time_constant * 1000:.4g} ms; "
-            f"status {self.status}",
-            "",
-            f"{criterion('joint', len(self.segments))}: least co-contraction ({self.method})",
-            f"{'segment':8} {'activation':>10} {'PCSA[cm2]':>10} {'tau_m[s]':>10}",
-        ]
-        lines += [
+        return {
+            "header": [self.model.get("header", "preset unknown")],
+            "headline": [
+                f"E = {self.eccentricity * 100:.2f} cm, Lambda = {self.lordosis * 100:.2f} cm, delay "
+                f"{self._delay_words()}, activation lag {self.activation_time_constant * 1000:.4g} ms; "
+                f"status {self.status}"
+            ],
+            "joint_title": [f"{criterion('joint', len(self.segments))}: least co-contraction ({self.method})"],
+            "joint_table": self._segment_lines(),
+            "joint": [self._joint_answer(), *self._joint_lines()],
+            "chain_title": [
+                f"{criterion('chain', len(c.local_stiffness))}: least local stiffness{_under(c.reflex)} at "
+                f"activation {_word(c.activation, 0, '.4f')} ({c.method})"
+            ],
+            "chain": [*self._chain_answer(), *self._chain_lines()],
+        }
+
+    def _segment_lines(self) -> list[str]:
+        """Joint by joint, each segment's least activation, PCSA and margin: a fixed-width table with its head."""
+        lines = [f"{'segment':8} {'activation':>10} {'PCSA[cm2]':>10} {'tau_m[s]':>10}"]
+        return lines + [
             f"{s.name:8} {_word(s.activation, 10, '.4f')} {_word(m2_to_cm2(s.pcsa), 10, '.2f')} "
             f"{_word(s.delay_margin, 10, '.4f')}"
             for s in self.segments
         ]
-        lines += [
-            (
+
+    def _joint_answer(self) -> str:
+        """Joint by joint, the one activation for every segment, or why there is none."""
+        if np.isfinite(self.activation):
+            return (
                 f"one activation for every segment (the largest above): {self.activation:.4f} x minimum PCSA "
                 f"({m2_to_cm2(self.pcsa):.2f} cm^2); tau_m: each segment's exact delay margin at its activation"
-                if np.isfinite(self.activation)
-                else f"no activation in [0, 1] meets the delay at every segment with every root at Re s < "
+            )
+        if self.decay_rate > 0:
+            return (
+                f"no activation in [0, 1] meets the delay at every segment with every root at Re s < "
                 f"-{self.decay_rate:g} 1/s (--decay-rate)"
-                if self.decay_rate > 0
-                else f"no activation in [0, 1] meets the delay at every segment; the largest delay met: "
-                f"{delay_text(self.largest_delay)}"
-            ),
-            *self._joint_lines(),
-            "",
-            f"{criterion('chain', len(c.local_stiffness))}: least local stiffness{_under(c.reflex)} at activation "
-            f"{_word(c.activation, 0, '.4f')} ({c.method})",
-        ]
+            )
+        return (
+            f"no activation in [0, 1] meets the delay at every segment; the largest delay met: "
+            f"{delay_text(self.largest_delay)}"
+        )
+
+    def _chain_answer(self) -> list[str]:
+        """The chain's local stiffness per joint and its certificate, or why there is none."""
+        c = self.chain
         if np.isfinite(c.fraction):
-            lines += [
+            return [
                 "local stiffness [N m/rad]: "
                 + ", ".join(f"{s.name} {k:.2f}" for s, k in zip(self.segments, c.local_stiffness, strict=True))
                 + f"  ({c.fraction:.4f} x the least for static stability, total {np.sum(c.local_stiffness):.1f})",
                 self._certificate_line(),
             ]
-        else:
-            lines.append(
+        if self.decay_rate > 0:
+            return [
                 f"no local stiffness meets the delay with every root at Re s < -{self.decay_rate:g} 1/s (--decay-rate)"
-                if self.decay_rate > 0
-                else f"no local stiffness meets the delay; the largest delay met: {delay_text(c.largest_delay)}"
-            )
-        return "\n".join(lines + self._chain_lines())
+            ]
+        return [f"no local stiffness meets the delay; the largest delay met: {delay_text(c.largest_delay)}"]
 
     def _joint_lines(self) -> list[str]:
         """Joint by joint: the reflex the answer assumes, and the answer over every segment's gains."""
