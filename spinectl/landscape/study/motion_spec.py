@@ -298,7 +298,8 @@ def parse_motion_study(text: str, base_dir: str | Path = ".", source: str = "stu
         raise ParameterError("trials", "must be one or more [[trials]] tables")
     if len(rows) > MAX_TRIALS:
         raise ParameterError("trials", f"at most {MAX_TRIALS:,} trials (got {len(rows):,})")
-    trials = tuple(_trial(f"trials[{i}]", row, Path(base_dir)) for i, row in enumerate(rows))
+    read = _reader()  # trials of one motion file read (and check) it once: OpenSim's reader takes 0.1-0.5 s a file
+    trials = tuple(_trial(f"trials[{i}]", row, Path(base_dir), read) for i, row in enumerate(rows))
     names = [t.name for t in trials]
     for i, name in enumerate(names):
         if name in names[:i]:
@@ -306,8 +307,11 @@ def parse_motion_study(text: str, base_dir: str | Path = ".", source: str = "stu
     return MotionStudy(trials, head.get("chunk_frames", DEFAULT_CHUNK_FRAMES), head.get("description", ""), text)
 
 
-def _trial(where: str, row: dict, base: Path) -> Trial:
-    """One ``[[trials]]`` table: keys, values, files; its frames checked against its coordinates file."""
+def _trial(where: str, row: dict, base: Path, read=None) -> Trial:
+    """One ``[[trials]]`` table: keys, values, files; its frames checked against its coordinates file.
+
+    ``read(where, path, field)`` reads a recording (default :func:`_read`): the caller's may keep those read.
+    """
     from ...anatomy.motion import OPTIMISE, select_frames
 
     check_keys(row, TRIAL_KEYS, where)
@@ -326,9 +330,10 @@ def _trial(where: str, row: dict, base: Path) -> Trial:
     optimise = v.choice(f"{where}.optimise", row.get("optimise", "none"), OPTIMISE)
     if optimise != "none" and files["activations"] is not None:
         raise ParameterError(f"{where}.activations", "cannot go with optimise, which finds the activations itself")
-    recording = _read(f"{where}.coordinates", files["coordinates"], "posture")  # OpenSim's reader, once here
+    read = read or _read
+    recording = read(f"{where}.coordinates", files["coordinates"], "posture")  # OpenSim's reader, once here
     if files["activations"] is not None:
-        _read(f"{where}.activations", files["activations"], "activations")
+        read(f"{where}.activations", files["activations"], "activations")
     n = recording.times.size
     frames = _frames(f"{where}.frames", row.get("frames"), n)
     select_frames(recording.times, frames, None, (f"{where}.frames", "rate"))
@@ -346,6 +351,18 @@ def _trial(where: str, row: dict, base: Path) -> Trial:
         if "least_stiffness" not in row
         else _bounded(f"{where}.least_stiffness", row["least_stiffness"]),
     )
+
+
+def _reader():
+    """:func:`_read`, keeping each file's recording: a file named by many trials is read once."""
+    kept = {}
+
+    def read(where: str, path: str, field: str):
+        if (path, field) not in kept:
+            kept[path, field] = _read(where, path, field)
+        return kept[path, field]
+
+    return read
 
 
 def _read(where: str, path: str, field: str):
