@@ -414,7 +414,7 @@ def _write_chunks(study: MotionStudy, out: Path, done: set, results, progress: b
             if kind == "trial":
                 continue
             if dataset is None:  # its worker wrote it: its checksums must hold, as a resume would find them
-                netcdf._verify(_chunk_path(out, index))
+                _check_written(_chunk_path(out, index))
             else:
                 if not out.exists():  # at the first chunk: a model that does not load leaves no store behind
                     _create(study, out)
@@ -422,6 +422,15 @@ def _write_chunks(study: MotionStudy, out: Path, done: set, results, progress: b
             done.add(index)
             trials.done(index)
             bar.update()
+
+
+def _check_written(path: Path) -> None:
+    """Raise :class:`ParameterError` (field ``store``) if the chunk file a worker wrote fails its checksums."""
+    try:
+        netcdf._verify(path)
+    except ParameterError as exc:
+        reason = exc.message.removesuffix("; write it again")
+        raise ParameterError("store", f"{reason}: run again with --resume, which computes that chunk again") from None
 
 
 def _assemble(study: MotionStudy, out: Path, done: set) -> None:
