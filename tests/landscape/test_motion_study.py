@@ -252,6 +252,21 @@ def test_the_study_file_reads_each_recording_once(folder, monkeypatch):
     assert calls == [(str(folder / "flexion.mot"), "posture")]
 
 
+def test_the_workers_take_the_recordings_the_study_read(folder, reference, monkeypatch, tmp_path):
+    """The run (in-process here) reads no recording again: each chunk carries those the study file's check read,
+    so a worker imports no OpenSim and parses no file (before: each worker read them); the bits are the
+    reference's."""
+    import spinectl.anatomy.recordings as recordings
+
+    parsed, calls, real = load_motion_study(write(folder)), [], recordings.read_recording
+    monkeypatch.setattr(recordings, "read_recording", lambda *a: calls.append(a) or real(*a))
+    motion_run._recording.cache_clear()
+    run_motion_study(parsed, tmp_path / "s", scheduler="synchronous", progress=False)
+    assert calls == []
+    for name, expected in reference.items():
+        xr.testing.assert_identical(load_motions(tmp_path / "s")[name], expected)
+
+
 def test_a_store_is_refused_without_resume_and_for_another_study(folder, tmp_path):
     """An existing store: refused without resume; with resume, refused if the study (or a file) differs."""
     parsed, out = load_motion_study(write(folder)), tmp_path / "s"

@@ -70,6 +70,9 @@ class MotionTask:
     store : str or None
         The store's folder (absolute), where the worker writes the chunk's file once the store exists
         (:func:`run_motion_task`); None: the Dataset is returned, for the caller to write.
+    recordings : tuple
+        The coordinates' and the activations' :class:`~spinectl.anatomy.recordings.Recording` as the study
+        read them (:attr:`MotionStudy.recordings`), or None each: the worker reads the file.
     """
 
     index: int
@@ -84,6 +87,7 @@ class MotionTask:
     least_stiffness: float | None
     trial: str = ""
     store: str | None = None
+    recordings: tuple = (None, None)
 
 
 @dataclass(frozen=True)
@@ -145,10 +149,15 @@ def solve_motion_chunk(task: MotionTask) -> tuple:
         anatomy = _anatomy(task.model, task.mapping)
     except ParameterError as exc:  # a model or mapping that does not load: say which trial's
         raise type(exc)(exc.field, f"{exc.message} (trial {task.trial!r})") from None
-    activations = None if task.activations is None else _recording(task.activations, "activations")
+    # as the study read them (no OpenSim to import, no file to parse in the worker), else from the files
+    posture, activations = task.recordings
+    if posture is None:
+        posture = _recording(task.coordinates, "posture")
+    if activations is None and task.activations is not None:
+        activations = _recording(task.activations, "activations")
     result = motion_response(
         anatomy,
-        _recording(task.coordinates, "posture"),
+        posture,
         activations,
         task.optimise,
         frames=task.frames,
@@ -228,6 +237,7 @@ def motion_tasks(study: MotionStudy, indices, store: str | None = None):
             t.least_stiffness,
             t.name,
             store,
+            (study.recordings.get((t.coordinates, "posture")), study.recordings.get((t.activations, "activations"))),
         )
 
 

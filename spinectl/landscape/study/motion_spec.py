@@ -138,12 +138,17 @@ class MotionStudy:
         Free text, stored with the results.
     text : str
         The study file as written, stored with the results.
+    recordings : dict
+        ``(path, field)`` -> the :class:`~spinectl.anatomy.recordings.Recording` read when the file was
+        checked (:func:`parse_motion_study`), for the workers, which then need neither the file nor OpenSim;
+        empty: each worker reads the files.
     """
 
     trials: tuple
     chunk_frames: int = DEFAULT_CHUNK_FRAMES
     description: str = ""
     text: str = field(default="", compare=False)
+    recordings: dict = field(default_factory=dict, compare=False, repr=False)
 
     def __post_init__(self):
         object.__setattr__(
@@ -298,13 +303,14 @@ def parse_motion_study(text: str, base_dir: str | Path = ".", source: str = "stu
         raise ParameterError("trials", "must be one or more [[trials]] tables")
     if len(rows) > MAX_TRIALS:
         raise ParameterError("trials", f"at most {MAX_TRIALS:,} trials (got {len(rows):,})")
-    read = _reader()  # trials of one motion file read (and check) it once: OpenSim's reader takes 0.1-0.5 s a file
-    trials = tuple(_trial(f"trials[{i}]", row, Path(base_dir), read) for i, row in enumerate(rows))
+    kept = {}  # trials of one motion file read (and check) it once: OpenSim's reader takes 0.1-0.5 s a file
+    trials = tuple(_trial(f"trials[{i}]", row, Path(base_dir), _reader(kept)) for i, row in enumerate(rows))
     names = [t.name for t in trials]
     for i, name in enumerate(names):
         if name in names[:i]:
             raise ParameterError(f"trials[{i}].name", f"must be unique among the trials (repeated: {show(name)})")
-    return MotionStudy(trials, head.get("chunk_frames", DEFAULT_CHUNK_FRAMES), head.get("description", ""), text)
+    chunk_frames, description = head.get("chunk_frames", DEFAULT_CHUNK_FRAMES), head.get("description", "")
+    return MotionStudy(trials, chunk_frames, description, text, kept)
 
 
 def _trial(where: str, row: dict, base: Path, read=None) -> Trial:
@@ -353,9 +359,9 @@ def _trial(where: str, row: dict, base: Path, read=None) -> Trial:
     )
 
 
-def _reader():
-    """:func:`_read`, keeping each file's recording: a file named by many trials is read once."""
-    kept = {}
+def _reader(kept: dict):
+    """:func:`_read`, keeping each file's recording in ``kept`` (by path and field): a file named by many trials
+    is read once."""
 
     def read(where: str, path: str, field: str):
         if (path, field) not in kept:
