@@ -267,6 +267,23 @@ def test_the_workers_take_the_recordings_the_study_read(folder, reference, monke
         xr.testing.assert_identical(load_motions(tmp_path / "s")[name], expected)
 
 
+def test_recordings_past_the_memory_bound_are_read_by_the_workers(folder, reference, monkeypatch, tmp_path):
+    """With no bytes to keep (KEPT_BYTES = 0; 256 MiB by default) the study keeps no recording: the run reads the
+    file itself (once, its cache), to the reference's bits."""
+    import spinectl.anatomy.recordings as recordings
+    from spinectl.landscape.study import motion_spec
+
+    monkeypatch.setattr(motion_spec, "KEPT_BYTES", 0)
+    parsed, calls, real = load_motion_study(write(folder)), [], recordings.read_recording
+    assert parsed.recordings == {}
+    monkeypatch.setattr(recordings, "read_recording", lambda *a: calls.append(a) or real(*a))
+    motion_run._recording.cache_clear()
+    run_motion_study(parsed, tmp_path / "s", scheduler="synchronous", progress=False)
+    assert calls == [(str(folder / "flexion.mot"), "posture")]
+    for name, expected in reference.items():
+        xr.testing.assert_identical(load_motions(tmp_path / "s")[name], expected)
+
+
 def test_a_store_is_refused_without_resume_and_for_another_study(folder, tmp_path):
     """An existing store: refused without resume; with resume, refused if the study (or a file) differs."""
     parsed, out = load_motion_study(write(folder)), tmp_path / "s"

@@ -359,14 +359,25 @@ def _trial(where: str, row: dict, base: Path, read=None) -> Trial:
     )
 
 
+KEPT_BYTES = 256 * 2**20
+"""The most bytes of recordings a study keeps for its workers (:attr:`MotionStudy.recordings`); the files
+past it are read by the workers, so that a study of many long trials does not hold them all in memory."""
+
+
 def _reader(kept: dict):
-    """:func:`_read`, keeping each file's recording in ``kept`` (by path and field): a file named by many trials
-    is read once."""
+    """:func:`_read`, keeping each file's recording in ``kept`` (by path and field) up to :data:`KEPT_BYTES`:
+    a file named by many trials is read once."""
+
+    held = [0]  # bytes kept so far
 
     def read(where: str, path: str, field: str):
-        if (path, field) not in kept:
-            kept[path, field] = _read(where, path, field)
-        return kept[path, field]
+        if (path, field) in kept:
+            return kept[path, field]
+        recording = _read(where, path, field)
+        size = recording.values.nbytes + recording.times.nbytes
+        if held[0] + size <= KEPT_BYTES:
+            kept[path, field], held[0] = recording, held[0] + size
+        return recording
 
     return read
 
