@@ -218,9 +218,9 @@ def test_a_trial_is_written_once_its_chunks_are_done_before_the_next_chunk(folde
 
 
 def test_a_chunk_file_its_worker_wrote_is_checked_before_it_counts(folder, monkeypatch, tmp_path, capsys):
-    """A chunk file written by its worker (in-process here) with a byte changed after its checksums: this process
-    checks it before counting it done: one line naming it (it cannot be read), exit 2 (unchecked, the store would
-    count a damaged chunk done, found only by a resume); the resume computes it again."""
+    """A chunk file written by its worker (in-process here) whose writer left a byte changed after the checksums:
+    the worker reads it back before it counts, one line naming it (it cannot be read), exit 2 (unchecked, the
+    store would count a damaged chunk done, found only by a resume); the resume computes it again."""
     real = motion_run.netcdf.save
 
     def damaging(data, path):
@@ -240,6 +240,29 @@ def test_a_chunk_file_its_worker_wrote_is_checked_before_it_counts(folder, monke
     monkeypatch.setattr(motion_run.netcdf, "save", real)
     assert main([*arguments[:-2], "--resume"]) == 0
     assert "(3 computed now, 1 before)" in capsys.readouterr().out
+
+
+def test_a_chunk_file_changed_after_its_worker_wrote_it_does_not_count(folder, monkeypatch, tmp_path, capsys):
+    """Chunk 1's file, written and checked by its worker (in-process here), then given one byte more (NetCDF still
+    reads it, its checksums hold): the run's process compares the bytes with the CRC-32 the worker sent, one
+    line naming the file, exit 2; the resume finds it intact by its checksums and computes the others."""
+    real, out = motion_run.run_motion_task, tmp_path / "s"
+
+    def then_changed(task):
+        result = real(task)
+        if result[:3] == ("chunk", 1, None):
+            path = out / "chunks" / "1.nc"
+            path.write_bytes(path.read_bytes() + b"\0")
+        return result
+
+    monkeypatch.setattr(motion_run, "run_motion_task", then_changed)
+    arguments = ["study", str(write(folder)), "--out", str(out), "--scheduler", "synchronous"]
+    assert main(arguments) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "chunks/1.nc' is not the file its worker wrote" in err
+    monkeypatch.setattr(motion_run, "run_motion_task", real)
+    assert main([*arguments, "--resume"]) == 0
+    assert "(2 computed now, 2 before)" in capsys.readouterr().out
 
 
 def test_the_study_file_reads_each_recording_once(folder, monkeypatch):
