@@ -206,6 +206,25 @@ def test_local_workers_write_the_chunk_and_trial_files_themselves(folder, refere
         xr.testing.assert_identical(load_motions(out)[name], expected)
 
 
+def test_an_existing_clusters_workers_send_the_chunks_back(folder, reference, tmp_path, monkeypatch):
+    """``scheduler='tcp://...'``: its workers may not see the store, so they write nothing; this process writes
+    the four chunk files and the two trials' (counted here), with the reference's bits."""
+    from distributed import LocalCluster
+
+    monkeypatch.setenv("PYTHONPATH", str(ROOT))
+    written, real = [], motion_run.netcdf.save
+    monkeypatch.setattr(
+        motion_run.netcdf, "save", lambda data, path: written.append(Path(path).name) or real(data, path)
+    )
+    with LocalCluster(n_workers=1, threads_per_worker=1, host="127.0.0.1", dashboard_address=None) as cluster:
+        result = run_motion_study(
+            load_motion_study(write(folder)), tmp_path / "s", scheduler=cluster.scheduler_address, progress=False
+        )
+    assert result.complete and sorted(written) == ["0.nc", "1.nc", "2.nc", "3.nc", "all.nc", "stiff.nc"]
+    for name, expected in reference.items():
+        xr.testing.assert_identical(load_motions(tmp_path / "s")[name], expected)
+
+
 def test_a_trial_is_written_once_its_chunks_are_done_before_the_next_chunk(folder, monkeypatch, tmp_path):
     """In-process, chunks 0-2 are trial "all", chunk 3 trial "stiff": "all" is assembled right after chunk 2,
     before chunk 3 is solved (on a cluster, while the others compute), not every trial at the end."""
