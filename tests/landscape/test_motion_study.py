@@ -189,6 +189,143 @@ def test_two_local_workers_give_the_same_bits(folder, reference, tmp_path, monke
         xr.testing.assert_identical(load_motions(tmp_path / "s")[name], expected)
 
 
+def test_local_workers_write_the_chunk_and_trial_files_themselves(folder, reference, tmp_path, monkeypatch):
+    """The store made by a first run (one chunk), a resume on two local workers: this process writes no file of
+    the store (netcdf.save here is counted; the workers are other processes), yet every chunk and trial file is
+    there with the reference's bits. Before, this process wrote all five (three chunks, two trials)."""
+    monkeypatch.setenv("PYTHONPATH", str(ROOT))
+    parsed, out = load_motion_study(write(folder)), tmp_path / "s"
+    run_motion_study(parsed, out, scheduler="synchronous", max_chunks=1, progress=False)
+    written, real = [], motion_run.netcdf.save
+    monkeypatch.setattr(motion_run.netcdf, "save", lambda data, path: written.append(path) or real(data, path))
+    result = run_motion_study(parsed, out, workers=2, resume=True, progress=False)
+    assert (result.where, result.computed) == ("2 local workers", 3)
+    assert written == []
+    assert sorted(p.name for p in (out / "chunks").iterdir()) == ["0.nc", "1.nc", "2.nc", "3.nc"]
+    for name, expected in reference.items():
+        xr.testing.assert_identical(load_motions(out)[name], expected)
+
+
+def test_an_existing_clusters_workers_send_the_chunks_back(folder, reference, tmp_path, monkeypatch):
+    """``scheduler='tcp://...'``: its workers may not see the store, so they write nothing; this process writes
+    the four chunk files and the two trials' (counted here), with the reference's bits."""
+    from distributed import LocalCluster
+
+    monkeypatch.setenv("PYTHONPATH", str(ROOT))
+    written, real = [], motion_run.netcdf.save
+    monkeypatch.setattr(
+        motion_run.netcdf, "save", lambda data, path: written.append(Path(path).name) or real(data, path)
+    )
+    with LocalCluster(n_workers=1, threads_per_worker=1, host="127.0.0.1", dashboard_address=None) as cluster:
+        result = run_motion_study(
+            load_motion_study(write(folder)), tmp_path / "s", scheduler=cluster.scheduler_address, progress=False
+        )
+    assert result.complete and sorted(written) == ["0.nc", "1.nc", "2.nc", "3.nc", "all.nc", "stiff.nc"]
+    for name, expected in reference.items():
+        xr.testing.assert_identical(load_motions(tmp_path / "s")[name], expected)
+
+
+def test_a_trial_is_written_once_its_chunks_are_done_before_the_next_chunk(folder, monkeypatch, tmp_path):
+    """In-process, chunks 0-2 are trial "all", chunk 3 trial "stiff": "all" is assembled right after chunk 2,
+    before chunk 3 is solved (on a cluster, while the others compute), not every trial at the end."""
+    events = []
+    solve, trial = motion_run.solve_motion_chunk, motion_run._write_trial
+    monkeypatch.setattr(motion_run, "solve_motion_chunk", lambda task: events.append(task.index) or solve(task))
+    monkeypatch.setattr(motion_run, "_write_trial", lambda out, name, c: events.append(name) or trial(out, name, c))
+    run_motion_study(load_motion_study(write(folder)), tmp_path / "s", scheduler="synchronous", progress=False)
+    assert events == [0, 1, 2, "all", 3, "stiff"]
+
+
+def test_a_chunk_file_its_worker_wrote_is_checked_before_it_counts(folder, monkeypatch, tmp_path, capsys):
+    """A chunk file written by its worker (in-process here) whose writer left a byte changed after the checksums:
+    the worker reads it back before it counts, one line naming it (it cannot be read), exit 2 (unchecked, the
+    store would count a damaged chunk done, found only by a resume); the resume computes it again."""
+    real = motion_run.netcdf.save
+
+    def damaging(data, path):
+        real(data, path)
+        if Path(path).name == "1.nc":
+            raw = bytearray(Path(path).read_bytes())
+            raw[-200] ^= 0xFF
+            Path(path).write_bytes(bytes(raw))
+        return Path(path)
+
+    monkeypatch.setattr(motion_run.netcdf, "save", damaging)
+    out = tmp_path / "s"
+    arguments = ["study", str(write(folder)), "--out", str(out), "--scheduler", "synchronous", "--max-chunks", "2"]
+    assert main(arguments) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "chunks/1.nc" in err and "run again with --resume" in err
+    monkeypatch.setattr(motion_run.netcdf, "save", real)
+    assert main([*arguments[:-2], "--resume"]) == 0
+    assert "(3 computed now, 1 before)" in capsys.readouterr().out
+
+
+def test_a_chunk_file_changed_after_its_worker_wrote_it_does_not_count(folder, monkeypatch, tmp_path, capsys):
+    """Chunk 1's file, written and checked by its worker (in-process here), then given one byte more (NetCDF still
+    reads it, its checksums hold): the run's process compares the bytes with the CRC-32 the worker sent, one
+    line naming the file, exit 2; the resume finds it intact by its checksums and computes the others."""
+    real, out = motion_run.run_motion_task, tmp_path / "s"
+
+    def then_changed(task):
+        result = real(task)
+        if result[:3] == ("chunk", 1, None):
+            path = out / "chunks" / "1.nc"
+            path.write_bytes(path.read_bytes() + b"\0")
+        return result
+
+    monkeypatch.setattr(motion_run, "run_motion_task", then_changed)
+    arguments = ["study", str(write(folder)), "--out", str(out), "--scheduler", "synchronous"]
+    assert main(arguments) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "chunks/1.nc' is not the file its worker wrote" in err
+    monkeypatch.setattr(motion_run, "run_motion_task", real)
+    assert main([*arguments, "--resume"]) == 0
+    assert "(2 computed now, 2 before)" in capsys.readouterr().out
+
+
+def test_the_study_file_reads_each_recording_once(folder, monkeypatch):
+    """Two trials of one motion file: OpenSim's reader reads it once (before: once per trial)."""
+    import spinectl.anatomy.recordings as recordings
+
+    calls, real = [], recordings.read_recording
+    monkeypatch.setattr(recordings, "read_recording", lambda *a: calls.append(a) or real(*a))
+    load_motion_study(write(folder))
+    assert calls == [(str(folder / "flexion.mot"), "posture")]
+
+
+def test_the_workers_take_the_recordings_the_study_read(folder, reference, monkeypatch, tmp_path):
+    """The run (in-process here) reads no recording again: each chunk carries those the study file's check read,
+    so a worker imports no OpenSim and parses no file (before: each worker read them); the bits are the
+    reference's."""
+    import spinectl.anatomy.recordings as recordings
+
+    parsed, calls, real = load_motion_study(write(folder)), [], recordings.read_recording
+    monkeypatch.setattr(recordings, "read_recording", lambda *a: calls.append(a) or real(*a))
+    motion_run._recording.cache_clear()
+    run_motion_study(parsed, tmp_path / "s", scheduler="synchronous", progress=False)
+    assert calls == []
+    for name, expected in reference.items():
+        xr.testing.assert_identical(load_motions(tmp_path / "s")[name], expected)
+
+
+def test_recordings_past_the_memory_bound_are_read_by_the_workers(folder, reference, monkeypatch, tmp_path):
+    """With no bytes to keep (KEPT_BYTES = 0; 256 MiB by default) the study keeps no recording: the run reads the
+    file itself (once, its cache), to the reference's bits."""
+    import spinectl.anatomy.recordings as recordings
+    from spinectl.landscape.study import motion_spec
+
+    monkeypatch.setattr(motion_spec, "KEPT_BYTES", 0)
+    parsed, calls, real = load_motion_study(write(folder)), [], recordings.read_recording
+    assert parsed.recordings == {}
+    monkeypatch.setattr(recordings, "read_recording", lambda *a: calls.append(a) or real(*a))
+    motion_run._recording.cache_clear()
+    run_motion_study(parsed, tmp_path / "s", scheduler="synchronous", progress=False)
+    assert calls == [(str(folder / "flexion.mot"), "posture")]
+    for name, expected in reference.items():
+        xr.testing.assert_identical(load_motions(tmp_path / "s")[name], expected)
+
+
 def test_a_store_is_refused_without_resume_and_for_another_study(folder, tmp_path):
     """An existing store: refused without resume; with resume, refused if the study (or a file) differs."""
     parsed, out = load_motion_study(write(folder)), tmp_path / "s"

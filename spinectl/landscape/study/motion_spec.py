@@ -142,12 +142,17 @@ class MotionStudy:
         Free text, stored with the results.
     text : str
         The study file as written, stored with the results.
+    recordings : dict
+        ``(path, field)`` -> the :class:`~spinectl.anatomy.recordings.Recording` read when the file was
+        checked (:func:`parse_motion_study`), for the workers, which then need neither the file nor OpenSim;
+        empty: each worker reads the files.
     """
 
     trials: tuple
     chunk_frames: int = DEFAULT_CHUNK_FRAMES
     description: str = ""
     text: str = field(default="", compare=False)
+    recordings: dict = field(default_factory=dict, compare=False, repr=False)
 
     def __post_init__(self):
         object.__setattr__(
@@ -302,16 +307,21 @@ def parse_motion_study(text: str, base_dir: str | Path = ".", source: str = "stu
         raise ParameterError("trials", "must be one or more [[trials]] tables")
     if len(rows) > MAX_TRIALS:
         raise ParameterError("trials", f"at most {MAX_TRIALS:,} trials (got {len(rows):,})")
-    trials = tuple(_trial(f"trials[{i}]", row, Path(base_dir)) for i, row in enumerate(rows))
+    kept = {}  # trials of one motion file read (and check) it once: OpenSim's reader takes 0.1-0.5 s a file
+    trials = tuple(_trial(f"trials[{i}]", row, Path(base_dir), _reader(kept)) for i, row in enumerate(rows))
     names = [t.name for t in trials]
     for i, name in enumerate(names):
         if name in names[:i]:
             raise ParameterError(f"trials[{i}].name", f"must be unique among the trials (repeated: {show(name)})")
-    return MotionStudy(trials, head.get("chunk_frames", DEFAULT_CHUNK_FRAMES), head.get("description", ""), text)
+    chunk_frames, description = head.get("chunk_frames", DEFAULT_CHUNK_FRAMES), head.get("description", "")
+    return MotionStudy(trials, chunk_frames, description, text, kept)
 
 
-def _trial(where: str, row: dict, base: Path) -> Trial:
-    """One ``[[trials]]`` table: keys, values, files; its frames checked against its coordinates file."""
+def _trial(where: str, row: dict, base: Path, read=None) -> Trial:
+    """One ``[[trials]]`` table: keys, values, files; its frames checked against its coordinates file.
+
+    ``read(where, path, field)`` reads a recording (default :func:`_read`): the caller's may keep those read.
+    """
     from ...anatomy.motion import OPTIMISE, select_frames
 
     for key in NOT_IN_A_STUDY:
@@ -336,9 +346,10 @@ def _trial(where: str, row: dict, base: Path) -> Trial:
     optimise = v.choice(f"{where}.optimise", row.get("optimise", "none"), OPTIMISE)
     if optimise != "none" and files["activations"] is not None:
         raise ParameterError(f"{where}.activations", "cannot go with optimise, which finds the activations itself")
-    recording = _read(f"{where}.coordinates", files["coordinates"], "posture")  # OpenSim's reader, once here
+    read = read or _read
+    recording = read(f"{where}.coordinates", files["coordinates"], "posture")  # OpenSim's reader, once here
     if files["activations"] is not None:
-        _read(f"{where}.activations", files["activations"], "activations")
+        read(f"{where}.activations", files["activations"], "activations")
     n = recording.times.size
     frames = _frames(f"{where}.frames", row.get("frames"), n)
     select_frames(recording.times, frames, None, (f"{where}.frames", "rate"))
@@ -356,6 +367,29 @@ def _trial(where: str, row: dict, base: Path) -> Trial:
         if "least_stiffness" not in row
         else _bounded(f"{where}.least_stiffness", row["least_stiffness"]),
     )
+
+
+KEPT_BYTES = 256 * 2**20
+"""The most bytes of recordings a study keeps for its workers (:attr:`MotionStudy.recordings`); the files
+past it are read by the workers, so that a study of many long trials does not hold them all in memory."""
+
+
+def _reader(kept: dict):
+    """:func:`_read`, keeping each file's recording in ``kept`` (by path and field) up to :data:`KEPT_BYTES`:
+    a file named by many trials is read once."""
+
+    held = [0]  # bytes kept so far
+
+    def read(where: str, path: str, field: str):
+        if (path, field) in kept:
+            return kept[path, field]
+        recording = _read(where, path, field)
+        size = recording.values.nbytes + recording.times.nbytes
+        if held[0] + size <= KEPT_BYTES:
+            kept[path, field], held[0] = recording, held[0] + size
+        return recording
+
+    return read
 
 
 def _read(where: str, path: str, field: str):
