@@ -79,9 +79,39 @@ def test_the_searched_answer_is_certified_and_below_the_rules(searched_40ms):
     assert root.real < 0 and root.real == pytest.approx(s.max_root_real, rel=1e-6, abs=1e-9)
     assert {"reflex", "kp_Nm_per_rad", "budget"} <= set(searched_40ms.to_dict()["chain_gain_searched"])
     table = searched_40ms.table()
-    assert "any diagonal PD gains, searched" in table and "the reflex rule, (1 - f)+" in table
-    quoted = [line for line in table.splitlines() if line.startswith("over any diagonal PD gains")]
-    assert quoted[0] in DOCS.read_text(encoding="utf-8")  # docs/reflex.md quotes the table, not a typed number
+    assert "over diagonal PD gains (the rule's shape" in table and "the reflex rule, (1 - f)+" in table
+    lines = table.splitlines()
+    at = next(k for k, line in enumerate(lines) if line.startswith("over diagonal PD gains"))
+    docs = DOCS.read_text(encoding="utf-8")
+    assert lines[at] in docs and lines[at + 1] in docs  # docs/reflex.md quotes the table, not a typed number
+
+
+def test_the_searched_heading_names_the_stage_that_found_the_gains(searched_40ms):
+    """The issue's 40 ms case: the certified gains are exactly the rule's full gains (recomputed by _chain_at from
+    the model's chain and gains.chain_gains, not by the module) times the shape factors the answer reports, so the
+    first stage found them, and the table says so ("found by the first stage, the rule's shape: k_p x a, k_d x b"),
+    under a heading that says "at most" (a search is no proof of least) and names both stages, the search's members
+    those of gain_search.population_members for its budget (before: "over any diagonal PD gains, searched: local
+    stiffness ...", read as the free search's answer, and "population 1" beside docs' "10 members")."""
+    from spinectl.reflex.design import gain_searched as gs
+    from spinectl.reflex.gain_search import population_members
+
+    s = searched_40ms.searched
+    assert s.found_by == "shape" and s.shape[0] in gs.SHAPE_FACTORS and s.shape[1] in gs.SHAPE_FACTORS
+    _, _, _, kp0, kd0 = _chain_at(_model(0.04), s.fraction)
+    np.testing.assert_allclose(s.kp, s.shape[0] * kp0, rtol=1e-9)
+    np.testing.assert_allclose(s.kd, s.shape[1] * kd0, rtol=1e-9)
+    table = searched_40ms.table()
+    members = population_members(gs.SEARCH_BUDGET["population"], len(s.kp))
+    heading = (
+        f"over diagonal PD gains (the rule's shape at {len(gs.SHAPE_FACTORS) ** 2} strengths, then a budgeted search "
+        f"of {members} members): at most {np.sum(s.local_stiffness):.1f} N m/rad, certified"
+    )
+    assert heading in table
+    assert f"found by the first stage, the rule's shape: k_p x {s.shape[0]:g}, k_d x {s.shape[1]:g}" in table
+    assert f"differential evolution of {members} members" in table and "population 1 per gain" in table
+    assert f"{members} members, 3 generations" in DOCS.read_text(encoding="utf-8")  # the docs say the same
+    assert searched_40ms.to_dict()["chain_gain_searched"]["shape_factors"] == list(s.shape)
 
 
 def test_the_rules_answer_is_the_searched_answer_when_no_smaller_fraction_is_certified(monkeypatch):
@@ -98,6 +128,7 @@ def test_the_rules_answer_is_the_searched_answer_when_no_smaller_fraction_is_cer
     np.testing.assert_array_equal(s.kp, rule.kp)
     np.testing.assert_array_equal(s.kd, rule.kd)
     assert "0 % less" in result.table()
+    assert s.found_by == "rule" and "found: the rule's own gains (no smaller fraction certified)" in result.table()
 
 
 @pytest.mark.parametrize(("delay", "ratio"), [(0.1, 1.2), (0.04, 1.5)])
