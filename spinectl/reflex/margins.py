@@ -530,11 +530,15 @@ class ReportResponses:
         The chain, every CoR free (:func:`spinectl.reflex.simulate.simulate_chain` of its nonlinear plant), with
         the chain's reflex and without it, every joint perturbed alike; one run per joint each. None where the
         report has no chain verdict or no segment was simulated.
+    divergence : float
+        ``reflex.sim_divergence`` [rad] of the simulations: a run stops where abs(alpha) exceeds it (its angles
+        frozen after); NaN if not recorded.
     """
 
     loops: dict
     simulations: dict
     chain: tuple | None = None
+    divergence: float = float("nan")
 
 
 RESPONSE_SPAN = 5.0
@@ -653,7 +657,10 @@ def report_responses(model: Model, report: MarginsReport) -> ReportResponses:
         )
         for k, s in usable
     }
-    return ReportResponses(loops=transfer, simulations=simulations, chain=_chain_responses(model, report, simulations))
+    return ReportResponses(
+        loops=transfer, simulations=simulations, chain=_chain_responses(model, report, simulations),
+        divergence=model.reflex.sim_divergence,
+    )  # fmt: skip
 
 
 def _chain_responses(model: Model, report: MarginsReport, simulations: dict) -> tuple | None:
