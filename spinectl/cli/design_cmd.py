@@ -33,8 +33,9 @@ def register(sub) -> None:
         "others fixed; the paper's criterion), the least activation of the minimum stabilising PCSA for which "
         "every segment's exact delay margin with the lag is at least the delay; for the chain (all CoRs free), "
         "at the reflex's activation, the least local stiffness for which the chain under the delayed reflex is "
-        "stable at the delay, with its certificate. A delay no design meets is an answer (status infeasible, "
-        "with the largest delay met). See docs/reflex.md.",
+        "stable at the delay, with its certificate. A delay no design meets is an answer (the status names "
+        "which failed, e.g. 'status (the rule, joint by joint): infeasible', with the largest delay met). See "
+        "docs/reflex.md.",
     )
     add_position_options(parser)
     parser.add_argument("--delay", type=finite_float("--delay"), help="reflex delay tau [s] (default: config, 0.1)")

@@ -223,6 +223,9 @@ def test_rule_infeasible_joint_by_joint_names_the_reflex_and_searches_from_no_re
     s, d, theta = coefficients.stiffness(pcsa), coefficients.damping(pcsa), coefficients.inertia
     assert np.all(np.isinf(delay_margin(s, d, theta, 0.0 * s, 0.0 * s, 0.05).margin))
     table = result.table()
+    # the status is joint by joint's under the rule, not the table's: the chain's and the searched answers exist
+    assert "; status (the rule, joint by joint): infeasible" in table.splitlines()[1] and "status infeasible" not in table
+    assert np.isfinite(result.chain.fraction) and np.isfinite(j.activation)
     assert "the infeasibility rests on the reflex rule" in table and "destabilise the segments" in table
     assert "margins unbounded" in table and "--gains search" in table
     assert "none (the rule has no design" not in table
@@ -287,3 +290,22 @@ def test_the_searched_certificate_under_a_margin_names_the_designed_delay_too():
     assert "rightmost root at the delay Re s" in next(
         line for line in plain.splitlines() if "certificate: exact delay margin 130" in line
     )
+
+
+def test_the_status_names_the_criterion_and_the_reflex_it_is_about():
+    """The status words scope each failure (the JSON status keeps its value): the chain's ('chain_infeasible'), with
+    given gains (a variant: kp = 20, kd = 2) named as such, and 'ok' left as it was; the optimum's own status where
+    the optimum failed (method 'none: no optimum', joint.joint_design)."""
+    import dataclasses
+
+    rule = dz.answer(_model(0.1), *AT)
+    given = dz.answer(_model(0.04), *AT, kp=20.0, kd=2.0)
+    assert rule.status_text() == "status ok" and "; status ok" in rule.table().splitlines()[1]
+    chain_failed = dataclasses.replace(rule, status="chain_infeasible")
+    assert chain_failed.status_text() == "status (the rule, the chain): infeasible"
+    assert "status (the rule, the chain): infeasible" in chain_failed.table()
+    assert dataclasses.replace(given, status="infeasible").status_text() == (
+        "status (the given gains, joint by joint): infeasible"
+    )
+    no_optimum = dataclasses.replace(rule, status="solver_error", method="none: no optimum")
+    assert no_optimum.status_text() == "status (the per-segment optimum): solver_error"
