@@ -309,3 +309,16 @@ def test_the_status_names_the_criterion_and_the_reflex_it_is_about():
     )
     no_optimum = dataclasses.replace(rule, status="solver_error", method="none: no optimum")
     assert no_optimum.status_text() == "status (the per-segment optimum): solver_error"
+
+
+@pytest.mark.parametrize(("kp", "kd", "top"), [(30.0, 8.0, "LOCAL_MAX"), (300.0, 0.0, "LOCAL_MAX")])
+def test_no_chain_design_names_the_top_as_a_multiple_of_k_star(kp, kd, top):
+    """``design --kp 30 --kd 8`` (the issue's case; 300 and 0, a variant) finds no local stiffness for the chain:
+    the method said "no fraction up to 2 meets the delay", 2 of nothing named; it says the top as a multiple of
+    k*, the least local stiffness for static stability (the top is result.LOCAL_MAX with given gains)."""
+    from spinectl.reflex.design import result as rs
+
+    design = dz.answer(_model(0.1), *AT, kp=kp, kd=kd)
+    assert np.isnan(design.chain.fraction)  # the premise
+    words = f"no local stiffness up to {getattr(rs, top):g} x k* (k*: the least for static stability) meets the delay"
+    assert design.chain.method == words and words in design.table()
