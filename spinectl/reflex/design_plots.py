@@ -16,8 +16,8 @@ from matplotlib.figure import Figure
 
 from ..canvas import new_figure, save_figures
 from ..units import m2_to_cm2
-from .design.passive import GLOBAL_ALONE
 from .design import PAPER_PASSIVE, REACTION_TIMES, DesignCurve, PassiveCurve
+from .design.passive import GLOBAL_ALONE
 
 DPI = 110
 """Resolution of the PNG files [dots per inch]."""

@@ -418,7 +418,6 @@ class MarginsReport:
             lines += self.chain.lines()
         return "\n".join(lines)
 
-
     def _kd_note(self) -> list[str]:
         """Where the rule's kd is 0, its formula once: the muscles' own damping is enough there (not a missing kd)."""
         if "explicit" in self.gains and "rule kd" not in self.gains:

@@ -224,7 +224,9 @@ def test_rule_infeasible_joint_by_joint_names_the_reflex_and_searches_from_no_re
     assert np.all(np.isinf(delay_margin(s, d, theta, 0.0 * s, 0.0 * s, 0.05).margin))
     table = result.table()
     # the status is joint by joint's under the rule, not the table's: the chain's and the searched answers exist
-    assert "; status (the rule, joint by joint): infeasible" in table.splitlines()[1] and "status infeasible" not in table
+    assert (
+        "; status (the rule, joint by joint): infeasible" in table.splitlines()[1] and "status infeasible" not in table
+    )
     assert np.isfinite(result.chain.fraction) and np.isfinite(j.activation)
     assert "the infeasibility rests on the reflex rule" in table and "destabilise the segments" in table
     assert "margins unbounded" in table and "--gains search" in table
