@@ -169,6 +169,8 @@ def export_verdicts(solution, out, fmt: str, osim_muscle: str = "millard") -> li
     all CoRs free). An OpenSim file with Millard muscles carries Millard's curves, not the paper's, so its
     dynamics differ (docs/interchange.md): its second line is OpenSim's own linearisation of the file
     written (:func:`~spinectl.anatomy.export_osim.opensim_linearisation`), the referee of what OpenSim will do.
+    A file with the paper's curves gets that line too: there OpenSim's linearisation is the chain's, and the
+    line shows it (a few dozen inverse-dynamics calls, well under a second).
 
     Parameters
     ----------
@@ -186,7 +188,8 @@ def export_verdicts(solution, out, fmt: str, osim_muscle: str = "millard") -> li
     list of str
         What was exported (the global PCSA, the local stiffness as springs), then one line per verdict:
         ``"spinectl's chain with them (all CoRs free, the paper's muscle laws): stable, largest real part
-        -0.0327 1/s"``, then for a Millard file OpenSim's, with the remedy where it grows.
+        -0.0327 1/s"``, then for an OpenSim file OpenSim's, naming its muscle curves, with the remedy where a
+        Millard file grows.
     """
     springs = float(np.sum(solution.local_stiffness))
     what = f"global PCSA {m2_to_cm2(np.sum(solution.pcsa)):.2f} cm^2 (the per-segment optimum unless given), " + (
@@ -196,13 +199,15 @@ def export_verdicts(solution, out, fmt: str, osim_muscle: str = "millard") -> li
         f"exported: {what}",
         _verdict_line("spinectl's chain with them (all CoRs free, the paper's muscle laws)", solution.eigenvalues),
     ]
-    if fmt == "osim" and osim_muscle == "millard":
+    if fmt == "osim":  # the engine as referee for both muscle models: for the paper's it confirms the chain's
         eigenvalues = opensim_eigenvalues(out, solution.model.geometry.cor_names)
         growing = int(np.sum(eigenvalues.real >= 0))
+        millard = osim_muscle == "millard"
+        curves = "Millard's muscle curves" if millard else "the paper's curves on a RigidTendonMuscle"
         lines.append(
-            _verdict_line("OpenSim's own linearisation of the file (Millard's muscle curves)", eigenvalues)
+            _verdict_line(f"OpenSim's own linearisation of the file ({curves})", eigenvalues)
             + f", {growing} of {eigenvalues.size} eigenvalues with Re >= 0"
-            + ("; for a file whose dynamics are spinectl's chain: --osim-muscle paper" if growing else "")
+            + ("; for a file whose dynamics are spinectl's chain: --osim-muscle paper" if growing and millard else "")
         )
     return lines
 

@@ -403,6 +403,29 @@ def refuse_set_twice(assignments: list[str], options: dict) -> None:
             raise ParameterError(options[dotted], f"sets {dotted}, as does --set {dotted}: give one of them")
 
 
+def refuse_set_unused(assignments: list[str], unused: dict) -> None:
+    """Refuse ``--set FIELD=...`` of a field the command's mode does not use, as its own option is refused.
+
+    Parameters
+    ----------
+    assignments : list of str
+        The ``--set`` arguments, ``SECTION.FIELD=VALUE``.
+    unused : dict
+        What to refuse and why: a dotted field (``"passive.stiffness"``) or a whole section with its dot
+        (``"reflex."``) -> the reason, e.g. ``"cannot go with --passive, which varies K"``.
+
+    Raises
+    ------
+    ParameterError
+        Naming ``--set FIELD`` and the reason (before: the value was taken and ignored without a word).
+    """
+    for text in assignments:
+        dotted = text.partition("=")[0].strip()
+        for key, why in unused.items():
+            if dotted == key or (key.endswith(".") and dotted.startswith(key)):
+                raise ParameterError(f"--set {dotted}", why)
+
+
 def finite_float(name: str, low: float | None = None, high: float | None = None, why: str = ""):
     """An argparse ``type`` accepting finite floats only (in [low, high] where given), naming the option on error.
 

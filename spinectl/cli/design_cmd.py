@@ -15,6 +15,7 @@ from ._common import (
     finite_float,
     float_list,
     load_model,
+    refuse_set_unused,
 )
 
 
@@ -33,8 +34,9 @@ def register(sub) -> None:
         "others fixed; the paper's criterion), the least activation of the minimum stabilising PCSA for which "
         "every segment's exact delay margin with the lag is at least the delay; for the chain (all CoRs free), "
         "at the reflex's activation, the least local stiffness for which the chain under the delayed reflex is "
-        "stable at the delay, with its certificate. A delay no design meets is an answer (status infeasible, "
-        "with the largest delay met). See docs/reflex.md.",
+        "stable at the delay, with its certificate. A delay no design meets is an answer (the status names "
+        "which failed, e.g. 'status (the rule, joint by joint): infeasible', with the largest delay met). See "
+        "docs/reflex.md.",
     )
     add_position_options(parser)
     parser.add_argument("--delay", type=finite_float("--delay"), help="reflex delay tau [s] (default: config, 0.1)")
@@ -108,6 +110,14 @@ DELAYS_EXAMPLE = "in seconds, e.g. 0:0.2:41"
 STATIC_ONLY = ("--delay", "--activation-lag", "--activation", "--kp", "--kd", "--gains", "--margin", "--decay-rate")
 """The reflex's options, which ``--passive`` does not use: refused with it rather than ignored."""
 
+PASSIVE_IS_STATIC = (
+    "cannot go with --passive, whose answers are static (no reflex: the global PCSA alone and the least local "
+    "stiffness at the minimum PCSA); a reflex's design is --delay or --delays without --passive"
+)
+PASSIVE_VARIES_K = "cannot go with --passive, which varies K"
+"""Why ``--passive`` refuses the reflex's options (and ``--set reflex.*``), and ``--K`` (``--set passive.stiffness``
+is the model's own K, where the fixed global PCSA is solved: it is used)."""
+
 ONE_DELAY_ONLY = ("--delay", "--gains", "--margin", "--decay-rate")
 """Options of the one-delay design, refused with ``--delays`` rather than ignored."""
 
@@ -143,15 +153,12 @@ def run(args) -> int:
     aliases = {dotted: ("--" + option.replace("_", "-"), getattr(args, option)) for option, dotted in OVERRIDES}
     aliases |= body_aliases(args)  # --K and --mass, as on stability and margins
     if args.passive is not None and args.K is not None:
-        raise ParameterError("--K", "cannot go with --passive, which varies K")
+        raise ParameterError("--K", PASSIVE_VARIES_K)
     for option in STATIC_ONLY if args.passive is not None else ():
         if getattr(args, option.lstrip("-").replace("-", "_")) is not None:  # before: ignored without a word
-            raise ParameterError(
-                option,
-                "cannot go with --passive, whose answers are static (no reflex: the global PCSA alone and the "
-                "least local stiffness at the minimum PCSA); a reflex's design is --delay or --delays without "
-                "--passive",
-            )
+            raise ParameterError(option, PASSIVE_IS_STATIC)
+    if args.passive is not None:  # the same fields by --set: refused as their options are, not ignored
+        refuse_set_unused(args.assignments or [], {"reflex.": PASSIVE_IS_STATIC})
     model = load_model(args, aliases)
     check_position(model, args)
     kp = None if args.kp is None else non_negative("--kp", args.kp)

@@ -8,6 +8,7 @@ figures with the Agg canvas (:func:`spinectl.canvas.new_figure`) and write nothi
 
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -16,6 +17,7 @@ from matplotlib.figure import Figure
 from ..canvas import new_figure, save_figures
 from ..units import m2_to_cm2
 from .design import PAPER_PASSIVE, REACTION_TIMES, DesignCurve, PassiveCurve
+from .design.passive import GLOBAL_ALONE
 
 DPI = 110
 """Resolution of the PNG files [dots per inch]."""
@@ -42,10 +44,10 @@ def passive_figure(curve: PassiveCurve) -> Figure:
     top.plot(k, m2_to_cm2(curve.global_pcsa), "o-", ms=3, color="C0")
     top.set_ylabel("least global PCSA alone [cm²]")
     top.set_title(
-        "chain (all CoRs free): static stability without local muscles\n"
-        "at problem (b)'s own least distribution at each K",
+        "chain (all CoRs free): static stability without local muscles\n" + textwrap.fill(GLOBAL_ALONE, 100)
+        + ", at each K",
         fontsize=9,
-    )
+    )  # fmt: skip
     bottom.plot(k, curve.local_stiffness.sum(axis=1), "o-", ms=3, color="C1")
     bottom.set_ylabel("least local stiffness, sum [N m/rad]")
     bottom.set_title(

@@ -297,6 +297,24 @@ class GainSearch:
         }
 
 
+def population_members(population: int, n_joints: int) -> int:
+    """The differential evolution's members for ``population`` per gain: ``population`` x 2 n, at least 5.
+
+    Parameters
+    ----------
+    population : int
+        Members per parameter (scipy's ``popsize``) [1].
+    n_joints : int
+        Joints n; the search has 2 n parameters, k_p and k_d per joint.
+
+    Returns
+    -------
+    int
+        The members of the Latin hypercube that starts the evolution [1].
+    """
+    return max(int(population) * 2 * int(n_joints), 5)
+
+
 def search_chain_gains(
     chain: LinearChain,
     rule_kp,
@@ -384,7 +402,7 @@ def search_chain_gains(
         return seen[key][0]
 
     rng = np.random.default_rng(seed)
-    members = max(int(population) * 2 * n, 5)
+    members = population_members(population, n)
     start = scipy.stats.qmc.scale(scipy.stats.qmc.LatinHypercube(d=2 * n, seed=rng).random(members), lower, upper)
     rule_gains = np.concatenate([rule_kp, rule_kd])
     # a gain the rule sets to 0 starts at its scale: at the box's floor its effect (and the grading's slope) vanishes

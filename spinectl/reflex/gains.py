@@ -53,6 +53,10 @@ def default_gains(stiffness, damping, inertia, gain_factor, damping_ratio):
     return kp, _derivative_gain(kp, s, d, theta, damping_ratio)
 
 
+KD_RULE = "kd = max(0, 2 zeta sqrt(theta (kp - S)) + D)"
+"""The rule's derivative gain in words (:func:`default_gains`), as the outputs that print a rule's kd say it."""
+
+
 def _derivative_gain(kp, stiffness, damping, inertia, damping_ratio):
     """kd = max(0, 2 zeta sqrt(theta (kp - S)) + D): the rule's damping (see :func:`default_gains`)."""
     # theta s^2 + (kd - D) s + (kp - S) has the damping ratio zeta when kd - D = 2 zeta sqrt(theta (kp - S));

@@ -409,6 +409,7 @@ class MarginsReport:
             "S, kp in N m/rad; D, kd in N m s/rad; theta in kg m^2; w_c in rad/s. T_slow: slowest time constant",
             "of the segment without reflex. GM: stable range of a common factor on kp and kd. tau_m: exact delay",
             "margin (unbounded: any delay; 0: unstable without delay).",
+            *self._kd_note(),
             stability.SIGN_NOTE,
             "",
             self.verdict(),
@@ -416,6 +417,18 @@ class MarginsReport:
         if self.chain is not None:
             lines += self.chain.lines()
         return "\n".join(lines)
+
+    def _kd_note(self) -> list[str]:
+        """Where the rule's kd is 0, its formula once: the muscles' own damping is enough there (not a missing kd)."""
+        if "explicit" in self.gains and "rule kd" not in self.gains:
+            return []
+        zero = [s.name for s in self.segments if s.kd == 0.0]
+        if not zero:
+            return []
+        return [
+            f"kd: the rule's {gains.KD_RULE} = 0 here at {', '.join(zero)} (the muscles' own damping -D covers "
+            "the damping ratio; the chain's rule, margins --coupled and design, has its own kd from the chain)."
+        ]
 
 
 def _row(s: SegmentMargins) -> str:
@@ -530,11 +543,15 @@ class ReportResponses:
         The chain, every CoR free (:func:`spinectl.reflex.simulate.simulate_chain` of its nonlinear plant), with
         the chain's reflex and without it, every joint perturbed alike; one run per joint each. None where the
         report has no chain verdict or no segment was simulated.
+    divergence : float
+        ``reflex.sim_divergence`` [rad] of the simulations: a run stops where abs(alpha) exceeds it (its angles
+        frozen after); NaN if not recorded.
     """
 
     loops: dict
     simulations: dict
     chain: tuple | None = None
+    divergence: float = float("nan")
 
 
 RESPONSE_SPAN = 5.0
@@ -653,7 +670,10 @@ def report_responses(model: Model, report: MarginsReport) -> ReportResponses:
         )
         for k, s in usable
     }
-    return ReportResponses(loops=transfer, simulations=simulations, chain=_chain_responses(model, report, simulations))
+    return ReportResponses(
+        loops=transfer, simulations=simulations, chain=_chain_responses(model, report, simulations),
+        divergence=model.reflex.sim_divergence,
+    )  # fmt: skip
 
 
 def _chain_responses(model: Model, report: MarginsReport, simulations: dict) -> tuple | None:

@@ -200,7 +200,12 @@ def nyquist_figure(loops: Mapping[str, ct.TransferFunction], title: str = "") ->
 
 
 def response_figure(
-    responses: Mapping[str, Simulation], title: str = "", chain: tuple | None = None, chain_label: str = ""
+    responses: Mapping[str, Simulation],
+    title: str = "",
+    chain: tuple | None = None,
+    chain_label: str = "",
+    joints=(),
+    divergence: float = float("nan"),
 ) -> Figure:
     """Angle after the perturbation, with the reflex (run 0) and without it (run 1), per segment.
 
@@ -221,6 +226,11 @@ def response_figure(
         panel, every joint's angle, under its own criterion.
     chain_label : str, optional
         The chain's verdict at the delay, as its panel's title says it (the exact one, not the simulation's).
+    joints : sequence of str, optional
+        The chain's joints, in the order of its runs: the chain panel's legend names each colour.
+    divergence : float, optional
+        ``reflex.sim_divergence`` [rad]: where a chain run diverged, the panel says its traces stop there (the
+        angles are frozen after, not a new posture).
 
     Returns
     -------
@@ -241,7 +251,7 @@ def response_figure(
         ax.set_xlim(sim.time[0], sim.time[-1])
         ax.legend(loc="best", fontsize="small")
     if chain is not None:
-        _chain_panel(axes[-1, 0], chain, chain_label)
+        _chain_panel(axes[-1, 0], chain, chain_label, joints, divergence)
     axes[-1, 0].set_xlabel("time [s]")
     default = "Response to a perturbation (nonlinear, true delay)"
     joint = f"segments: {criterion('joint')}"
@@ -251,8 +261,10 @@ def response_figure(
     return fig
 
 
-def _chain_panel(ax, chain: tuple, label: str) -> None:
-    """The chain's joints with the reflex (solid) and without (dashed), scaled to the response with the reflex."""
+def _chain_panel(ax, chain: tuple, label: str, joints=(), divergence: float = float("nan")) -> None:
+    """The chain's joints with the reflex (solid) and without (dashed), scaled to the response with the reflex;
+    a legend names the joints' colours, and a diverged run's stop at ``divergence`` is said, not left to look
+    like a new resting posture."""
     scale = 1e3  # mrad
     with_reflex, without = chain
     for j, alpha in enumerate(with_reflex.alpha):
@@ -262,7 +274,40 @@ def _chain_panel(ax, chain: tuple, label: str) -> None:
     ax.set_ylim(-top, top)
     ax.set_xlim(with_reflex.time[0], _shown_until(with_reflex))
     ax.set_ylabel("chain\nalpha [mrad]")
-    ax.set_title(textwrap.fill(label, 90), fontsize="small")
+    title = textwrap.fill(label, 90)
+    note = divergence_note(chain, divergence)
+    if note:
+        title += "\n" + textwrap.fill(note, 90)
+        for sign in (-1, 1):  # the limit the traces stop at
+            ax.axhline(sign * divergence * scale, color="0.6", lw=0.6, ls=":")
+    ax.set_title(title, fontsize="small")
+    names = list(joints) if len(joints) == with_reflex.alpha.shape[0] else []
+    handles = [Line2D([], [], color=f"C{j}", lw=1.0, label=name) for j, name in enumerate(names)]
+    if handles:
+        ax.legend(handles=handles, loc="center left", bbox_to_anchor=(1.01, 0.5), fontsize="x-small")
+
+
+def divergence_note(chain: tuple, divergence: float) -> str:
+    """What the chain panel says where a run diverged: its traces stop at the divergence limit.
+
+    Parameters
+    ----------
+    chain : tuple of Simulation
+        The chain's runs, with the reflex and without.
+    divergence : float
+        ``reflex.sim_divergence`` [rad].
+
+    Returns
+    -------
+    str
+        '' if no run diverged or the limit is not known.
+    """
+    if not np.isfinite(divergence) or not any(np.any(sim.diverged) for sim in chain):
+        return ""
+    return (
+        f"each trace stops where its |alpha| would pass {divergence * 1e3:g} mrad: diverged "
+        "(reflex.sim_divergence); the flat lines after are angles frozen there, not a posture"
+    )
 
 
 def _shown_until(sim: Simulation) -> float:
@@ -331,8 +376,9 @@ def report_figures(report: MarginsReport, responses: ReportResponses) -> dict[st
         figures["nyquist.png"] = nyquist_figure(responses.loops, nyquist_title)
     if responses.simulations:
         figures["response.png"] = response_figure(
-            responses.simulations, f"Response to a perturbation; {where}", responses.chain, _chain_label(report)
-        )
+            responses.simulations, f"Response to a perturbation; {where}", responses.chain, _chain_label(report),
+            [seg.name for seg in report.segments], responses.divergence,
+        )  # fmt: skip
     return figures
 
 

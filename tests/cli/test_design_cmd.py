@@ -229,6 +229,26 @@ def test_passive_refuses_the_reflexs_options_it_would_ignore(option, value, caps
 
 
 @pytest.mark.parametrize(
+    ("assignment", "why"),
+    [
+        ("reflex.delay=0.1", "cannot go with --passive, whose answers are static"),  # the issue's case
+        ("reflex.activation_time_constant=0.03", "cannot go with --passive, whose answers are static"),
+        ("reflex.activation=0.3", "cannot go with --passive, whose answers are static"),  # as --activation is
+    ],
+)
+def test_passive_refuses_the_same_fields_by_set(assignment, why, capsys):
+    """--set of a field --passive does not use was taken and ignored without a word, where its option (--delay,
+    --activation-lag, --activation) is refused: one line naming --set FIELD, exit 2, the option's own reason; a
+    field it uses (body.mass) still runs."""
+    field = assignment.partition("=")[0]
+    assert main(["design", "--passive", "0:80:3", "--set", assignment]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err == f"spinectl: error: --set {field}: {why}" + err.split(why, 1)[1]
+    assert err.count("\n") == 1
+    assert main(["design", "--passive", "40", "--set", "body.mass=35", "--json"]) == 0
+
+
+@pytest.mark.parametrize(
     ("argv", "needle"),
     [
         (["--margin", "0.9"], "--margin: must be in [1, "),

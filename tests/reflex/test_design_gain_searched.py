@@ -79,12 +79,40 @@ def test_the_searched_answer_is_certified_and_below_the_rules(searched_40ms):
     assert root.real < 0 and root.real == pytest.approx(s.max_root_real, rel=1e-6, abs=1e-9)
     assert {"reflex", "kp_Nm_per_rad", "budget"} <= set(searched_40ms.to_dict()["chain_gain_searched"])
     table = searched_40ms.table()
-    assert "any diagonal PD gains, searched" in table and "the reflex rule, (1 - f)+" in table
-    quoted = [line for line in table.splitlines() if line.startswith("over any diagonal PD gains")]
+    assert "over diagonal PD gains (the rule's shape" in table and "the reflex rule, (1 - f)+" in table
+    quoted = [line for line in table.splitlines() if line.startswith("over diagonal PD gains")]
     assert quoted
     # docs/reflex.md includes these lines as generated at the build, not typed (tests/suites/test_docs_numbers.py
     # compares them with the command's)
     assert "{include} _generated/design-chain-searched.md" in DOCS.read_text(encoding="utf-8")
+
+
+def test_the_searched_heading_names_the_stage_that_found_the_gains(searched_40ms):
+    """The issue's 40 ms case: the certified gains are exactly the rule's full gains (recomputed by _chain_at from
+    the model's chain and gains.chain_gains, not by the module) times the shape factors the answer reports, so the
+    first stage found them, and the table says so ("found by the first stage, the rule's shape: k_p x a, k_d x b"),
+    under a heading that says "at most" (a search is no proof of least) and names both stages, the search's members
+    those of gain_search.population_members for its budget (before: "over any diagonal PD gains, searched: local
+    stiffness ...", read as the free search's answer, and "population 1" beside docs' "10 members")."""
+    from spinectl.reflex.design import gain_searched as gs
+    from spinectl.reflex.gain_search import population_members
+
+    s = searched_40ms.searched
+    assert s.found_by == "shape" and s.shape[0] in gs.SHAPE_FACTORS and s.shape[1] in gs.SHAPE_FACTORS
+    _, _, _, kp0, kd0 = _chain_at(_model(0.04), s.fraction)
+    np.testing.assert_allclose(s.kp, s.shape[0] * kp0, rtol=1e-9)
+    np.testing.assert_allclose(s.kd, s.shape[1] * kd0, rtol=1e-9)
+    table = searched_40ms.table()
+    members = population_members(gs.SEARCH_BUDGET["population"], len(s.kp))
+    heading = (
+        f"over diagonal PD gains (the rule's shape at {len(gs.SHAPE_FACTORS) ** 2} strengths, then a budgeted search "
+        f"of {members} members): at most {np.sum(s.local_stiffness):.1f} N m/rad, certified"
+    )
+    assert heading in table
+    assert f"found by the first stage, the rule's shape: k_p x {s.shape[0]:g}, k_d x {s.shape[1]:g}" in table
+    assert f"differential evolution of {members} members" in table and "population 1 per gain" in table
+    assert f"{members} members, 3 generations" in DOCS.read_text(encoding="utf-8")  # the docs say the same
+    assert searched_40ms.to_dict()["chain_gain_searched"]["shape_factors"] == list(s.shape)
 
 
 def test_the_rules_answer_is_the_searched_answer_when_no_smaller_fraction_is_certified(monkeypatch):
@@ -101,6 +129,7 @@ def test_the_rules_answer_is_the_searched_answer_when_no_smaller_fraction_is_cer
     np.testing.assert_array_equal(s.kp, rule.kp)
     np.testing.assert_array_equal(s.kd, rule.kd)
     assert "0 % less" in result.table()
+    assert s.found_by == "rule" and "found: the rule's own gains (no smaller fraction certified)" in result.table()
 
 
 @pytest.mark.parametrize(("delay", "ratio"), [(0.1, 1.2), (0.04, 1.5)])
@@ -196,6 +225,11 @@ def test_rule_infeasible_joint_by_joint_names_the_reflex_and_searches_from_no_re
     s, d, theta = coefficients.stiffness(pcsa), coefficients.damping(pcsa), coefficients.inertia
     assert np.all(np.isinf(delay_margin(s, d, theta, 0.0 * s, 0.0 * s, 0.05).margin))
     table = result.table()
+    # the status is joint by joint's under the rule, not the table's: the chain's and the searched answers exist
+    assert (
+        "; status (the rule, joint by joint): infeasible" in table.splitlines()[1] and "status infeasible" not in table
+    )
+    assert np.isfinite(result.chain.fraction) and np.isfinite(j.activation)
     assert "the infeasibility rests on the reflex rule" in table and "destabilise the segments" in table
     assert "margins unbounded" in table and "--gains search" in table
     assert "none (the rule has no design" not in table
@@ -278,3 +312,35 @@ def test_the_readings_are_the_tables_lines_part_by_part(delay, decay):
         assert "(--decay-rate)" in parts["joint"][0] and "(--decay-rate)" in parts["chain"][0]
     else:
         assert any(x.startswith("  boundary: the least value sits on its stability boundary") for x in parts["chain"])
+
+
+def test_the_status_names_the_criterion_and_the_reflex_it_is_about():
+    """The status words scope each failure (the JSON status keeps its value): the chain's ('chain_infeasible'), with
+    given gains (a variant: kp = 20, kd = 2) named as such, and 'ok' left as it was; the optimum's own status where
+    the optimum failed (method 'none: no optimum', joint.joint_design)."""
+    import dataclasses
+
+    rule = dz.answer(_model(0.1), *AT)
+    given = dz.answer(_model(0.04), *AT, kp=20.0, kd=2.0)
+    assert rule.status_text() == "status ok" and "; status ok" in rule.table().splitlines()[1]
+    chain_failed = dataclasses.replace(rule, status="chain_infeasible")
+    assert chain_failed.status_text() == "status (the rule, the chain): infeasible"
+    assert "status (the rule, the chain): infeasible" in chain_failed.table()
+    assert dataclasses.replace(given, status="infeasible").status_text() == (
+        "status (the given gains, joint by joint): infeasible"
+    )
+    no_optimum = dataclasses.replace(rule, status="solver_error", method="none: no optimum")
+    assert no_optimum.status_text() == "status (the per-segment optimum): solver_error"
+
+
+@pytest.mark.parametrize(("kp", "kd", "top"), [(30.0, 8.0, "LOCAL_MAX"), (300.0, 0.0, "LOCAL_MAX")])
+def test_no_chain_design_names_the_top_as_a_multiple_of_k_star(kp, kd, top):
+    """``design --kp 30 --kd 8`` (the issue's case; 300 and 0, a variant) finds no local stiffness for the chain:
+    the method said "no fraction up to 2 meets the delay", 2 of nothing named; it says the top as a multiple of
+    k*, the least local stiffness for static stability (the top is result.LOCAL_MAX with given gains)."""
+    from spinectl.reflex.design import result as rs
+
+    design = dz.answer(_model(0.1), *AT, kp=kp, kd=kd)
+    assert np.isnan(design.chain.fraction)  # the premise
+    words = f"no local stiffness up to {getattr(rs, top):g} x k* (k*: the least for static stability) meets the delay"
+    assert design.chain.method == words and words in design.table()

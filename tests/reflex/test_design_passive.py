@@ -131,6 +131,8 @@ def test_the_two_columns_are_at_different_distributions_and_the_note_says_so(nea
     note = curve.columns_note()
     assert doc["columns_note"] == note and note in curve.table().splitlines()
     assert "problem (b)" in note and "joint-by-joint minimum, 36.30 cm^2" in note
+    # problem (b) said in words where it is named (before: "problem (b)'s own least distribution", undefined)
+    assert passive.GLOBAL_ALONE in note and "statically stable with no local muscles" in passive.GLOBAL_ALONE
 
 
 def test_the_figure_draws_crisco_and_the_threshold_apart_and_names_no_swept_k(near_crisco):
@@ -152,3 +154,4 @@ def test_the_figure_draws_crisco_and_the_threshold_apart_and_names_no_swept_k(ne
     titles = [fig.get_suptitle(), top.get_title(), bottom.get_title()]
     assert not any("K = 0" in t for t in titles) and "K swept" in titles[0]
     assert "joint-by-joint minimum" in titles[2]
+    assert " ".join(passive.GLOBAL_ALONE.split()) in " ".join(titles[1].split())  # (b) in words on passive.png too

@@ -213,7 +213,8 @@ def test_report_responses_without_reflex_or_optimum(model):
     responses = margins.report_responses(stable, margins.margins_report(stable, E, LAMBDA))
     assert responses.loops == {} and len(responses.simulations) == 5
     tiny = _with_reflex(model.replace(optimisation=Optimisation(pcsa_max=1e-8)), activation=0.5)
-    assert margins.report_responses(tiny, margins.margins_report(tiny, E, LAMBDA)) == margins.ReportResponses({}, {})
+    empty = margins.ReportResponses({}, {}, divergence=tiny.reflex.sim_divergence)  # the limit: the model's
+    assert margins.report_responses(tiny, margins.margins_report(tiny, E, LAMBDA)) == empty
 
 
 @pytest.mark.parametrize(
@@ -245,3 +246,27 @@ def test_kp_range_without_delay_is_the_hurwitz_range_with_the_lag(model):
             high = s + (theta - lag * d) * (kd - d - lag * s) / (lag * theta)
             assert seg.kp_min == pytest.approx(s) and seg.kp_max == pytest.approx(high, rel=1e-12)
             assert seg.stable_at_delay == (s < seg.kp < high)
+
+
+@pytest.mark.parametrize("activation", [0.5, 0.4, 0.2])
+def test_a_rule_kd_of_zero_says_the_rules_formula_once(activation):
+    """``margins`` at wagner2012 (3, 4) cm printed "kd 0.00" at every segment at activation 0.5 (the issue's case)
+    while the chain's design has k_d 1.2-1.8: both are the rule's max(0, ...), which the table did not say. One
+    line now gives the formula (gains.KD_RULE) and names exactly the segments whose kd is 0, recomputed by
+    gains.default_gains from each segment's S, D and theta; at 0.4 and 0.2 (variants) fewer or none are 0, and
+    with no zero kd, or explicit gains, there is no such line."""
+    from spinectl import load_preset
+    from spinectl.reflex import gains
+
+    model = _with_reflex(load_preset("wagner2012"), activation=activation, delay=0.1)
+    report = margins.margins_report(model, 0.03, 0.04)
+    s, d, theta = (np.array([getattr(x, k) for x in report.segments]) for k in ("stiffness", "damping", "inertia"))
+    _, kd = gains.default_gains(s, d, theta, model.reflex.gain_factor, model.reflex.damping_ratio)
+    zero = [x.name for x, k in zip(report.segments, kd, strict=True) if k == 0.0]
+    notes = [line for line in report.table().splitlines() if line.startswith("kd: the rule's")]
+    if zero:
+        assert len(notes) == 1 and f"{gains.KD_RULE} = 0 here at {', '.join(zero)} (" in notes[0]
+    else:
+        assert notes == []
+    explicit = margins.margins_report(model, 0.03, 0.04, kp=20.0, kd=0.0)
+    assert not any(line.startswith("kd: the rule's") for line in explicit.table().splitlines())

@@ -293,3 +293,40 @@ def test_the_loop_figures_name_their_criterion_and_the_chains_verdict_and_explai
     assert any(t.startswith("-1, the critical point") for t in texts)
     box = legend.get_window_extent(fig.canvas.get_renderer())
     assert fig.bbox.contains(box.x0, box.y0) and fig.bbox.contains(box.x1, box.y1)
+
+
+@pytest.mark.parametrize("divergence", [None, 0.1])
+def test_the_chain_panel_says_its_traces_stop_at_the_divergence_limit_and_names_its_joints(divergence):
+    """``margins --delay 0.1 --plot`` (wagner2012 at E = 3 cm, Lambda = 4 cm, activation 0.5): the chain's runs
+    diverge and stop at reflex.sim_divergence (the preset's 0.2 rad; 0.1 rad, a variant), their angles frozen after,
+    which read as a new resting posture: the panel's title says where the traces stop and why (the limit read from
+    the model, in mrad), and a legend names each joint's colour (the model's CoR names, the runs' order)."""
+    from spinectl import load_preset
+    from spinectl.reflex.chain_verdict import margins_with_chain
+
+    model = _reflex(load_preset("wagner2012"), activation=0.5, delay=0.1)
+    if divergence is not None:
+        model = _reflex(model, sim_divergence=divergence)
+    report = margins_with_chain(model, 0.03, 0.04)
+    responses = margins.report_responses(model, report)
+    assert responses.chain[0].diverged.any()  # the premise: the chain's run with the reflex stops at the limit
+    limit = model.reflex.sim_divergence
+    assert np.max(np.abs(responses.chain[0].alpha)) == pytest.approx(limit, rel=0.1)  # flat near the limit
+    chain_ax = plots.report_figures(report, responses)["response.png"].axes[-1]
+    title = " ".join(chain_ax.get_title().split())
+    assert f"each trace stops where its |alpha| would pass {limit * 1e3:g} mrad: diverged" in title
+    assert "(reflex.sim_divergence)" in title and "not a posture" in title
+    legend = chain_ax.get_legend()
+    assert legend is not None and [t.get_text() for t in legend.get_texts()] == list(model.geometry.cor_names)
+    colours = [line.get_color() for line in legend.get_lines()]
+    assert colours == [chain_ax.get_lines()[2 * j].get_color() for j in range(len(colours))]
+
+
+def test_the_chain_panel_says_nothing_of_divergence_where_no_run_diverged(model):
+    """A run that stays inside the limit gets no divergence note (the note would be false): the chain runs of the
+    figure function itself, here two made-up runs that never diverge."""
+    runs = _runs(model)
+    sim = runs["L3L4"]
+    calm = dataclasses.replace(sim, diverged=np.zeros_like(sim.diverged))
+    assert plots.divergence_note((calm, calm), 0.2) == ""
+    assert plots.divergence_note((dataclasses.replace(calm, diverged=np.ones_like(sim.diverged)), calm), 0.2)

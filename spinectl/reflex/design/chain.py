@@ -293,7 +293,10 @@ def chain_design(
     least = search.least
     if np.isnan(fraction):
         nan = np.full(n, np.nan)
-        method = f"no fraction up to {search.top:g} meets the delay" + (f" with decay rate {decay:g} 1/s" * (decay > 0))
+        method = (
+            f"no local stiffness up to {search.top:g} x k* (k*: the least for static stability) meets the delay"
+            + (f" with decay rate {decay:g} 1/s" * (decay > 0))
+        )
         return ChainDesign(activation, np.nan, nan, least, np.nan, np.nan, float(largest), method)
     ok = np.array([search.met(f, delay) for f in scan])
     upper = bool(np.all(ok[np.argmax(ok) :])) if ok.any() else True  # once met, met for every larger f

@@ -37,7 +37,7 @@ from ...model.params import Model
 from .. import gains
 from ..chain_margins import stable_at
 from ..delay import delay_text
-from ..gain_search import search_chain_gains
+from ..gain_search import population_members, search_chain_gains
 from ..mimo import chain_delay_margin
 from .chain import chain_design
 from .joint_searched import joint_searched_design
@@ -48,8 +48,9 @@ SEARCH_STEPS = 5
 """Bisections of [0, f_rule] in the gain-searched design: the answer to f_rule / 32 above the least found."""
 
 SEARCH_BUDGET = {"population": 1, "generations": 3, "restarts": 2, "restart_evaluations": 100}
-"""The budget of each gain search (:func:`spinectl.reflex.gain_search.search_chain_gains`): 10 members over
-4 generations, then at most two Nelder-Mead runs of 100 exact margins: about 250 exact margins, 5-20 s."""
+"""The budget of each gain search (:func:`spinectl.reflex.gain_search.search_chain_gains`): a population of 1
+per gain (10 members for the 5 joints' 10 gains, :func:`~spinectl.reflex.gain_search.population_members`) over
+3 generations, then at most two Nelder-Mead runs of 100 exact margins: about 250 exact margins, 5-20 s."""
 
 SHAPE_FACTORS = (0.2, 0.3, 0.4, 0.6, 1.0)
 """Multiples of the rule's full gains (before the hand-over), k_p and k_d apart, tried as the search's start:
@@ -87,6 +88,12 @@ class GainSearchedDesign:
     evaluations : int
         Exact margins (or delay-free root checks) computed.
     method : str
+    found_by : str
+        The stage whose gains hold the answer: ``"rule"`` (the rule's own design: no smaller fraction
+        certified), ``"shape"`` (the rule's shape at one of the strengths :data:`SHAPE_FACTORS`, the first
+        stage) or ``"search"`` (the seeded gain search, the second); ``""`` if not known.
+    shape : tuple of float
+        (a, b) where ``found_by`` is ``"shape"``: the gains are a k_p and b k_d of the rule's full gains; else ().
     """
 
     fraction: float
@@ -98,6 +105,8 @@ class GainSearchedDesign:
     searches: int
     evaluations: int
     method: str
+    found_by: str = ""
+    shape: tuple = ()
 
     def to_dict(self) -> dict:
         """``reflex``, ``local_stiffness_fraction``, ``local_stiffness_Nm_per_rad``, ``kp_Nm_per_rad``, ....
@@ -106,7 +115,8 @@ class GainSearchedDesign:
         -------
         dict
             Also ``kd_Nms_per_rad``, ``delay_margin_s``, ``max_root_real_per_s``, ``searches``,
-            ``evaluations``, ``budget`` (steps, seed and each search's budget) and ``method``.
+            ``evaluations``, ``budget`` (steps, seed and each search's budget), ``method``, ``found_by`` and
+            ``shape_factors`` ([a, b] of the rule's k_p and k_d where the rule's shape found the gains, else null).
         """
         return {
             "reflex": SEARCHED_REFLEX,
@@ -120,6 +130,8 @@ class GainSearchedDesign:
             "evaluations": self.evaluations,
             "budget": {"bisections": SEARCH_STEPS, "seed": SEARCH_SEED} | SEARCH_BUDGET,
             "method": self.method,
+            "found_by": self.found_by,
+            "shape_factors": list(self.shape) or None,
         }
 
     def lines(self, names, rule_fraction: float, least_static, at: str = "the delay") -> list[str]:
@@ -143,15 +155,38 @@ class GainSearchedDesign:
         """
         total = float(np.sum(self.local_stiffness))
         rule_total = rule_fraction * float(np.sum(least_static))
+        # "at most": a budgeted search certifies what it found, it does not prove that nothing less holds
         return [
-            f"over {SEARCHED_REFLEX}: local stiffness {total:.1f} N m/rad ({self.fraction:.4f} x k*; the rule's "
-            f"{rule_total:.1f}, {100 * (1 - total / rule_total) if rule_total > 0 else 0.0:.0f} % less)",
+            f"over diagonal PD gains ({stages_text(len(self.kp))}): at most {total:.1f} N m/rad, certified "
+            f"({self.fraction:.4f} x k*; the rule's {rule_total:.1f}, "
+            f"{100 * (1 - total / rule_total) if rule_total > 0 else 0.0:.0f} % less)",
+            f"  {self.found_text()}",
             "  gains: " + gains_text(names, self.kp, self.kd),
             f"  certificate: exact delay margin {delay_text(self.delay_margin)}; rightmost root at {at} "
             f"Re s = {self.max_root_real:.4g} 1/s",
-            f"  search: {self.method}; {self.searches} seeded gain searches, {self.evaluations} margin evaluations "
-            f"(budget: {SEARCH_STEPS} bisections, each search {_budget_text()}, seed {SEARCH_SEED})",
+            f"  search: {self.method}; {self.searches} seeded gain searches run, {self.evaluations} margin "
+            f"evaluations (budget: {SEARCH_STEPS} bisections, each search {_budget_text(len(self.kp))}, "
+            f"seed {SEARCH_SEED})",
         ]
+
+    def found_text(self) -> str:
+        """Which stage found the gains, in words (the rule's shape and its strengths, or the search).
+
+        Returns
+        -------
+        str
+        """
+        if self.found_by == "shape":
+            a, b = self.shape
+            return (
+                f"found by the first stage, the rule's shape: k_p x {a:g}, k_d x {b:g} of the rule's gains (before "
+                "the hand-over)"
+            )
+        if self.found_by == "search":
+            return "found by the budgeted search (no strength of the rule's shape held this fraction)"
+        if self.found_by == "rule":
+            return "found: the rule's own gains (no smaller fraction certified)"
+        return "found by the search's stages"
 
 
 @dataclass(frozen=True)
@@ -186,8 +221,30 @@ class MarginCost:
         }
 
 
-def _budget_text() -> str:
-    return ", ".join(f"{k} {v}" for k, v in SEARCH_BUDGET.items())
+def stages_text(n_joints: int) -> str:
+    """The two stages of the search over the gains, in words: the rule's shape's strengths, the search's members.
+
+    Parameters
+    ----------
+    n_joints : int
+        Joints n (the search's members grow with its 2 n gains).
+
+    Returns
+    -------
+    str
+    """
+    members = population_members(SEARCH_BUDGET["population"], n_joints)
+    return f"the rule's shape at {len(SHAPE_FACTORS) ** 2} strengths, then a budgeted search of {members} members"
+
+
+def _budget_text(n_joints: int) -> str:
+    b = SEARCH_BUDGET
+    members = population_members(b["population"], n_joints)
+    return (
+        f"differential evolution of {members} members (population {b['population']} per gain) over "
+        f"{b['generations']} generations, then at most {b['restarts']} Nelder-Mead runs of "
+        f"{b['restart_evaluations']} evaluations"
+    )
 
 
 class _Chain:
@@ -231,16 +288,19 @@ class _Chain:
         return (margin, float(root.real)) if root.real < 0 else None
 
     def search(self, f, starts):
-        """Gains for f: the best of ``starts`` if it holds f, else the seeded search's best from it (kp, kd)."""
-        kp, kd = max(starts, key=lambda g: self.margin(f, *g))
+        """Gains for f: the best of ``starts`` if it holds f, else the seeded search's best from it.
+
+        ``starts`` are (kp, kd, found_by, shape); so is the answer, ``found_by`` ``"search"`` for the search's.
+        """
+        kp, kd, found_by, shape = max(starts, key=lambda g: self.margin(f, g[0], g[1]))
         if self.certify(f, kp, kd) is not None:
-            return kp, kd
+            return kp, kd, found_by, shape
         self.searches += 1
         found = search_chain_gains(
             self.at(f), kp, kd, self.lag, seed=SEARCH_SEED, **SEARCH_BUDGET
         )  # fmt: skip
         self.evaluations += found.evaluations
-        return found.kp, found.kd
+        return found.kp, found.kd, "search", ()
 
 
 def gain_searched_design(model: Model, eccentricity: float, lordosis: float, pcsa, rule) -> GainSearchedDesign:
@@ -269,28 +329,29 @@ def gain_searched_design(model: Model, eccentricity: float, lordosis: float, pcs
         return GainSearchedDesign(np.nan, nan, nan, nan, np.nan, np.nan, 0, 0, "none: the rule has no design")
     chain = _Chain(model, float(eccentricity), float(lordosis), pcsa, rule.least_static)
     kp0, kd0 = chain.gains(0.0)  # the rule's gains before the hand-over: its shape, at other strengths
-    shapes = [(a * kp0, b * kd0) for a in SHAPE_FACTORS for b in SHAPE_FACTORS]
-    best = (rule.fraction, rule.kp, rule.kd, rule.delay_margin, rule.max_root_real)
+    shapes = [(a * kp0, b * kd0, "shape", (a, b)) for a in SHAPE_FACTORS for b in SHAPE_FACTORS]
+    # best: f, kp, kd, found_by, shape, margin, root; the gains keep the name of the stage that found them
+    best = (rule.fraction, rule.kp, rule.kd, "rule", (), rule.delay_margin, rule.max_root_real)
     lo, hi = 0.0, rule.fraction
     for _ in range(SEARCH_STEPS):
         f = 0.5 * (lo + hi)
         held = chain.certify(f, best[1], best[2])  # the gains in hand first: no search if they hold f
-        gains = (best[1], best[2])
+        gains = best[1:5]
         if held is None:
             gains = chain.search(f, [gains, *shapes])
-            held = chain.certify(f, *gains)
+            held = chain.certify(f, gains[0], gains[1])
         if held is None:
             lo = f
         else:
             hi, best = f, (f, *gains, *held)
-    f, kp, kd, margin, root = best
+    f, kp, kd, found_by, shape, margin, root = best
     method = (
         f"bisection of [0, f_rule] over the gains: the least fraction certified ({SEARCH_STEPS} halvings, "
         f"to {rule.fraction / 2**SEARCH_STEPS:.4f} x k*); a lower one may need gains the search missed"
     )
     return GainSearchedDesign(
         float(f), f * rule.least_static, np.asarray(kp, float), np.asarray(kd, float), float(margin),
-        float(root), chain.searches, chain.evaluations, method,
+        float(root), chain.searches, chain.evaluations, method, found_by, tuple(float(x) for x in shape),
     )  # fmt: skip
 
 

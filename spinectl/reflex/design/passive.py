@@ -26,6 +26,12 @@ CRISCO_LOAD = 88.0
 PAPER_PASSIVE = 15.0
 """The paper's passive stiffness per joint [N m/rad] (Wagner et al. 2012), marked on the passive-stiffness curve."""
 
+GLOBAL_ALONE = (
+    "the least global PCSA alone: the least total global PCSA that makes the chain (all CoRs free) statically "
+    "stable with no local muscles (docs/chain.md, problem (b))"
+)
+"""Problem (b) in words, where the curve's outputs name it (the table's note and passive.png)."""
+
 THRESHOLD_TOLERANCE = 0.01
 """Width of the bracket of the least passive stiffness at which global muscles alone suffice [N m/rad]."""
 
@@ -182,11 +188,11 @@ class PassiveCurve:
         Returns
         -------
         str
-            One line: the global-alone column is problem (b)'s least distribution at each K, the local
+            One line: the global-alone column is :data:`GLOBAL_ALONE` at each K, in its distribution; the local
             column the paper's joint-by-joint minimum held fixed, which is not the chain's best.
         """
         return (
-            "note: 'global alone' is problem (b)'s own least distribution at each K (its total); 'sum local k' "
+            f"note: 'global alone' is {GLOBAL_ALONE}, in its own least distribution at each K; 'sum local k' "
             f"is at the paper's joint-by-joint minimum, {_word(m2_to_cm2(self.paper_pcsa), 0, '.2f')} cm^2 held "
             "fixed in its own distribution, which is not the chain's best: a larger total can need local stiffness "
             "where a smaller one alone suffices"

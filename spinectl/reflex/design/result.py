@@ -296,7 +296,7 @@ class Design:
             "headline": [
                 f"E = {self.eccentricity * 100:.2f} cm, Lambda = {self.lordosis * 100:.2f} cm, delay "
                 f"{self._delay_words()}, activation lag {self.activation_time_constant * 1000:.4g} ms; "
-                f"status {self.status}"
+                f"{self.status_text()}"
             ],
             "joint_title": [f"{criterion('joint', len(self.segments))}: least co-contraction ({self.method})"],
             "joint_table": self._segment_lines(),
@@ -349,6 +349,27 @@ class Design:
                 f"no local stiffness meets the delay with every root at Re s < -{self.decay_rate:g} 1/s (--decay-rate)"
             ]
         return [f"no local stiffness meets the delay; the largest delay met: {delay_text(c.largest_delay)}"]
+
+    def status_text(self) -> str:
+        """The status as the table's heading says it, scoped to the answer it is about.
+
+        'infeasible' is joint by joint's answer under its reflex, 'chain_infeasible' the chain's: the other answers
+        (the chain's, those over other gains) may exist below it, so the words name which one failed.
+
+        Returns
+        -------
+        str
+            ``"status ok"``, ``"status (the rule, joint by joint): infeasible"``, ``"status (the rule, the chain):
+            infeasible"`` (``"the given gains"`` for explicit gains), or the optimum's status where it failed.
+        """
+        if self.status == "ok":
+            return "status ok"
+        reflex = "the given gains" if self.chain.reflex == GIVEN_REFLEX else "the rule"
+        if self.status == "infeasible":
+            return f"status ({reflex}, joint by joint): infeasible"
+        if self.status == "chain_infeasible":
+            return f"status ({reflex}, the chain): infeasible"
+        return f"status (the per-segment optimum): {self.status}"
 
     def _joint_lines(self) -> list[str]:
         """Joint by joint: the reflex the answer assumes, and the answer over every segment's gains."""
