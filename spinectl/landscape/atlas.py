@@ -489,6 +489,7 @@ def _solve(spec: AtlasSpec, values: dict, folder: Path | None, progress, where: 
     kept = f"every chunk finished is saved in {str(folder)!r}" if folder else "no folder, nothing saved"
     options = {"notify": notify, "name": "atlas", "again": f"{kept}; start a worker and run the atlas again"}
     with (
+        _saved_on_interrupt(folder, parts, len(names)),
         tqdm(total=n, initial=done, unit="draw", disable=_no_bar(progress), desc="atlas") as bar,
         executor(n_chunks=len(todo), **where, **options) as chunks,
     ):
@@ -498,6 +499,17 @@ def _solve(spec: AtlasSpec, values: dict, folder: Path | None, progress, where: 
             parts[index] = found
             bar.update(found["status"].size)
     return {k: np.concatenate([parts[i][k] for i in range(len(names))]) for k in parts[0]}
+
+
+def _saved_on_interrupt(folder: Path | None, parts: dict, n_chunks: int):
+    """Ctrl-C says how many chunks ``folder`` holds and that a second run resumes from them (none without one)."""
+    from contextlib import nullcontext
+
+    from .study.interrupt import saved_on_interrupt
+
+    if folder is None:
+        return nullcontext()
+    return saved_on_interrupt(lambda: len(parts), n_chunks, str(folder), "run the atlas again to continue from them")
 
 
 def _part(values: dict, spec: AtlasSpec, index: int) -> dict:

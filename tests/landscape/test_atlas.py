@@ -276,8 +276,11 @@ def test_an_interrupted_cluster_run_resumes_to_the_same_bits(in_process, tmp_pat
         saved.append(path.name)
 
     monkeypatch.setattr(atlas, "_save", interrupted)
-    with pytest.raises(KeyboardInterrupt):
+    with pytest.raises(KeyboardInterrupt) as caught:
         atlas.run_atlas(spec, tmp_path / "cut", workers=2, progress=False)
+    folder = str(tmp_path / "cut" / "chunks")  # the line the command prints: the three saved, how to go on
+    again = "run the atlas again to continue from them"
+    assert str(caught.value) == f"interrupted: 3 of 7 chunks saved in {folder!r}; {again}"
     assert sorted(p.name for p in (tmp_path / "cut" / "chunks").iterdir()) == sorted(saved)
     assert sorted(p.name for p in (tmp_path / "cut").iterdir()) == ["chunks"]  # no temporaries, no answer
 
