@@ -47,6 +47,11 @@ def saved_on_interrupt(saved: Callable[[], int], total: int, where: str, again: 
         The chunks saved, counted when the interruption comes.
     total, where, again :
         As :func:`interrupted_text`.
+
+    Returns
+    -------
+    contextlib.AbstractContextManager
+        The block's guard; it re-raises any other exception as it came.
     """
     try:
         yield
