@@ -86,16 +86,20 @@ class AtlasResult:
         str
             The base model (:func:`~spinectl.landscape.priors.model_line`), then a line per verdict and per output.
         """
+        from .atlas_report import console_st_note, verdict_criterion
+
         lines = [model_line(self.model, self.draws)] if self.model is not None else []
         lines.append(f"{self.n_evaluations} evaluations")
         for name, v in self.probabilities.items():
-            lines.append(f"P({name}) = {v['p']:.3f}  [{v['low']:.3f}, {v['high']:.3f}]  ({VERDICTS[name]})")
+            said = VERDICTS[name] if self.model is None else verdict_criterion(name, self.draws, self.model)
+            lines.append(f"P({name}) = {v['p']:.3f}  [{v['low']:.3f}, {v['high']:.3f}]  ({said})")
         for output, table in self.sobol.items():
             if table is None:
                 lines.append(f"{output}: not finite at {self.nonfinite[output]} draws, no Sobol' indices")
                 continue
             top = max(table, key=lambda name: table[name]["ST"])
-            lines.append(f"{output}: largest ST {table[top]['ST']:.3f} +- {table[top]['ST_conf']:.3f} ({top})")
+            note = console_st_note(table[top]["ST"], self.n_evaluations // (len(table) + 2))  # N (d + 2) draws
+            lines.append(f"{output}: largest ST {table[top]['ST']:.3f} +- {table[top]['ST_conf']:.3f} ({top}){note}")
         return "\n".join(lines)
 
     def to_dict(self) -> dict:
