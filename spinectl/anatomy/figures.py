@@ -228,6 +228,30 @@ def anatomy_figures(anatomy, analysis, curve: dict | None = None) -> dict:
     return figures
 
 
+def figures_left_out(analysis) -> str:
+    """What :func:`anatomy_figures` leaves out for ``analysis`` and why, for the user; '' if nothing.
+
+    Parameters
+    ----------
+    analysis : AnatomyResult or None
+        The analysis drawn.
+
+    Returns
+    -------
+    str
+        E.g. ``"modes.png not drawn: the mode shapes are drawn for the sagittal plane only (this analysis: all three
+        planes (3-D)); --plane sagittal draws them"`` (before: the file was dropped without a word).
+    """
+    from .analyses import plane_text
+
+    if analysis is None or analysis.plane == "sagittal":
+        return ""
+    return (
+        f"modes.png not drawn: the mode shapes are drawn for the sagittal plane only (this analysis: "
+        f"{plane_text(analysis.plane)}); --plane sagittal draws them"
+    )
+
+
 def save_anatomy_figures(anatomy, analysis, curve, folder, dpi: float = 150.0) -> list:
     """:func:`anatomy_figures` written into ``folder``, all of them or none.
 
