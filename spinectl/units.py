@@ -14,6 +14,22 @@ CM_PER_M = 100.0
 """Centimetres per metre: lengths on the figures' axes."""
 
 
+def position_text(eccentricity: float, lordosis: float) -> str:
+    """A point of the (E, Lambda) plane as the console prints it, in cm as every command does.
+
+    Parameters
+    ----------
+    eccentricity, lordosis : float
+        E and Lambda [m].
+
+    Returns
+    -------
+    str
+        ``"E = 3 cm, Lambda = 4 cm"`` (four significant digits at most; before, ``export`` printed m).
+    """
+    return f"E = {eccentricity * CM_PER_M:.4g} cm, Lambda = {lordosis * CM_PER_M:.4g} cm"
+
+
 def cm2_to_m2(value):
     """PCSA [cm^2] -> [m^2].
 

@@ -140,7 +140,7 @@ def lordosis_figure(curve: dict, title: str = ""):
     degrees = np.asarray(curve["lordosis_deg"], float)
     fig = new_figure(figsize=(7.0, 6.4), layout="constrained")
     top, bottom = fig.subplots(2, 1, sharex=True)
-    inaccurate = 0
+    inaccurate, hollow = 0, 0
     for key, label, colour in CRITERIA:
         row = curve[key]
         ok = np.array([s in ("optimal", "optimal_inaccurate") for s in row["status"]])
@@ -160,6 +160,7 @@ def lordosis_figure(curve: dict, title: str = ""):
         if np.any(np.isfinite(cost)):
             best = int(np.nanargmin(cost))  # hollow where that optimum is inaccurate
             face = "none" if rough[best] else colour
+            hollow += bool(rough[best])
             top.plot(degrees[best], cost[best], "*", ms=14, color=colour, mfc=face, mec="black", zorder=5)
         for ax, values in ((top, cost), (bottom, margin)):  # each inaccurate optimum crossed, as the table marks it
             ax.plot(degrees[rough], values[rough], "x", ms=8, mew=1.5, color="black", zorder=6)
@@ -176,9 +177,25 @@ def lordosis_figure(curve: dict, title: str = ""):
     top.legend(fontsize=8, title="criterion (star: least cost)", title_fontsize=8)
     top.set_title(title or f"the three optima along the rhythm ({CURVE_AXIS})", fontsize=10)
     if inaccurate:
-        warning = CURVE_INACCURATE.format(count=inaccurate, mark="x, a hollow star")
+        warning = CURVE_INACCURATE.format(count=inaccurate, mark=inaccurate_marks(hollow))
         fig.suptitle(textwrap.fill(warning, 120), fontsize=7, color="tab:red")
     return fig
+
+
+def inaccurate_marks(hollow: int) -> str:
+    """The marks the lordosis figure draws on its inaccurate optima, as its warning names them.
+
+    Parameters
+    ----------
+    hollow : int
+        Least-cost stars drawn hollow (a curve's least cost that is itself inaccurate).
+
+    Returns
+    -------
+    str
+        ``"x"``, with the hollow star only where one is drawn (before: "x, a hollow star" beside an x alone).
+    """
+    return "x" if not hollow else "x; a curve's least cost, a hollow star"
 
 
 def anatomy_figures(anatomy, analysis, curve: dict | None = None) -> dict:
@@ -209,6 +226,30 @@ def anatomy_figures(anatomy, analysis, curve: dict | None = None) -> dict:
     if curve is not None:
         figures["lordosis.png"] = lordosis_figure(curve, f"{name}: the three optima along the rhythm ({CURVE_AXIS})")
     return figures
+
+
+def figures_left_out(analysis) -> str:
+    """What :func:`anatomy_figures` leaves out for ``analysis`` and why, for the user; '' if nothing.
+
+    Parameters
+    ----------
+    analysis : AnatomyResult or None
+        The analysis drawn.
+
+    Returns
+    -------
+    str
+        E.g. ``"modes.png not drawn: the mode shapes are drawn for the sagittal plane only (this analysis: all three
+        planes (3-D)); --plane sagittal draws them"`` (before: the file was dropped without a word).
+    """
+    from .analyses import plane_text
+
+    if analysis is None or analysis.plane == "sagittal":
+        return ""
+    return (
+        f"modes.png not drawn: the mode shapes are drawn for the sagittal plane only (this analysis: "
+        f"{plane_text(analysis.plane)}); --plane sagittal draws them"
+    )
 
 
 def save_anatomy_figures(anatomy, analysis, curve, folder, dpi: float = 150.0) -> list:

@@ -261,8 +261,8 @@ def _run(argv) -> int:
     except (_UsageError, SpinectlError) as exc:  # argparse's and the library's errors read alike
         print(f"spinectl: error: {printable(str(exc))}", file=sys.stderr)
         return EXIT_USAGE
-    except KeyboardInterrupt:
-        print("spinectl: interrupted", file=sys.stderr)
+    except KeyboardInterrupt as exc:  # a study's or an atlas's says what is saved (landscape.study.interrupt)
+        print(f"spinectl: {printable(str(exc)) or 'interrupted'}", file=sys.stderr)
         return 130
     sys.stdout.flush()  # a full device shows here, not in the interpreter's exit (a traceback, exit 120)
     for note in NOTES if code == 0 else ():  # after the answer: a failed run says its error alone

@@ -541,7 +541,9 @@ def input_name(text: str) -> str:
 
 
 def add_scheduler_options(
-    parser: argparse.ArgumentParser, default: str = "a local cluster on 127.0.0.1, started and closed by the command"
+    parser: argparse.ArgumentParser,
+    default: str = "a local cluster on 127.0.0.1, started and closed by the command",
+    workers: str = "one per core, at most one per chunk",
 ) -> None:
     """``--scheduler``, ``--workers`` and ``--worker-timeout``: where the chunks run (``study``, ``atlas``).
 
@@ -554,6 +556,8 @@ def add_scheduler_options(
         The sub-command's parser.
     default : str
         Where the chunks run without ``--scheduler``, for the help.
+    workers : str
+        What runs without ``--workers``, for the help (the atlas: no cluster at all).
     """
     parser.add_argument(
         "--scheduler",
@@ -568,7 +572,7 @@ def add_scheduler_options(
         help="how long to wait for a first worker of --scheduler if it has none, and for a worker again "
         "once every worker has gone mid-run (default: spinectl.landscape.study.executor.WORKER_TIMEOUT)",
     )
-    parser.add_argument("--workers", type=_workers, metavar="N", help="local worker processes (default: cores)")
+    parser.add_argument("--workers", type=_workers, metavar="N", help=f"local worker processes (default: {workers})")
 
 
 def _workers(text: str) -> int:

@@ -9,7 +9,7 @@ import shlex
 from ..anatomy.mapping import MAX_STIFFNESS
 from ..errors import ParameterError
 from ..model.params.bounds import MAX_ACTIVATION_TIME_CONSTANT
-from ._common import anatomy_load, bounded_int, emit_json, finite_float, input_name, named_pattern
+from ._common import anatomy_load, bounded_int, emit_json, finite_float, input_name, named_pattern, note_after
 
 MAX_DERIVATIVE_GAIN = 1e6
 """Largest reflex derivative gain kd [N m s/rad]: the chain's delay margin scales as 1/kd from 1e3 to 1e6
@@ -322,6 +322,7 @@ def _answers(args) -> tuple:
 
         analysis = result.analysis if args.optimise else result
         save_anatomy_figures(anatomy, analysis, curve, args.plot)
+        _note_left_out(analysis)
     if parts is not None:
         if args.plot and parts.free is not None:
             from ..anatomy.contributions import save_contributions_figure
@@ -329,6 +330,14 @@ def _answers(args) -> tuple:
             save_contributions_figure(parts.free, args.plot, args.contributions)
         result = parts
     return result, curve, buckling
+
+
+def _note_left_out(analysis) -> None:
+    """A figure --plot does not draw for this analysis, said after the answer (anatomy.figures.figures_left_out)."""
+    from ..anatomy.figures import figures_left_out
+
+    if text := figures_left_out(analysis):
+        note_after(text)
 
 
 def _buckling(args, anatomy, analysis):

@@ -35,7 +35,11 @@ def register(sub) -> None:
         help="the lordosis angle [deg] where no prior varies it (default: [atlas] lordosis_m, 4 cm)",
     )
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
-    add_scheduler_options(parser, default="in this process; with --workers N a local cluster")
+    add_scheduler_options(
+        parser,
+        default="in this process; with --workers N a local cluster",
+        workers="none: the draws run in this process; N starts a local Dask cluster of N processes",
+    )
     add_model_options(parser)
     parser.set_defaults(func=run)
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from ..units import position_text
 from ._common import add_model_options, add_position_options, check_position, float_list, load_model, pcsa_option
 
 
@@ -80,7 +81,7 @@ def run(args) -> int:
         from ..anatomy.export_osim import controls_path
 
         written = f"{args.out} and {controls_path(args.out)}"
-    print(f"wrote {written} ({fmt}): E = {args.E:g} m, Lambda = {args.Lambda:g} m")
+    print(f"wrote {written} ({fmt}): {position_text(args.E, args.Lambda)}")
     for line in export_verdicts(solution, args.out, fmt, args.osim_muscle):
         print(line)
     return 0

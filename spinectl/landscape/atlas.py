@@ -86,16 +86,20 @@ class AtlasResult:
         str
             The base model (:func:`~spinectl.landscape.priors.model_line`), then a line per verdict and per output.
         """
+        from .atlas_report import console_st_note, verdict_criterion
+
         lines = [model_line(self.model, self.draws)] if self.model is not None else []
         lines.append(f"{self.n_evaluations} evaluations")
         for name, v in self.probabilities.items():
-            lines.append(f"P({name}) = {v['p']:.3f}  [{v['low']:.3f}, {v['high']:.3f}]  ({VERDICTS[name]})")
+            said = VERDICTS[name] if self.model is None else verdict_criterion(name, self.draws, self.model)
+            lines.append(f"P({name}) = {v['p']:.3f}  [{v['low']:.3f}, {v['high']:.3f}]  ({said})")
         for output, table in self.sobol.items():
             if table is None:
                 lines.append(f"{output}: not finite at {self.nonfinite[output]} draws, no Sobol' indices")
                 continue
             top = max(table, key=lambda name: table[name]["ST"])
-            lines.append(f"{output}: largest ST {table[top]['ST']:.3f} +- {table[top]['ST_conf']:.3f} ({top})")
+            note = console_st_note(table[top]["ST"], self.n_evaluations // (len(table) + 2))  # N (d + 2) draws
+            lines.append(f"{output}: largest ST {table[top]['ST']:.3f} +- {table[top]['ST_conf']:.3f} ({top}){note}")
         return "\n".join(lines)
 
     def to_dict(self) -> dict:
@@ -489,6 +493,7 @@ def _solve(spec: AtlasSpec, values: dict, folder: Path | None, progress, where: 
     kept = f"every chunk finished is saved in {str(folder)!r}" if folder else "no folder, nothing saved"
     options = {"notify": notify, "name": "atlas", "again": f"{kept}; start a worker and run the atlas again"}
     with (
+        _saved_on_interrupt(folder, parts, len(names)),
         tqdm(total=n, initial=done, unit="draw", disable=_no_bar(progress), desc="atlas") as bar,
         executor(n_chunks=len(todo), **where, **options) as chunks,
     ):
@@ -498,6 +503,17 @@ def _solve(spec: AtlasSpec, values: dict, folder: Path | None, progress, where: 
             parts[index] = found
             bar.update(found["status"].size)
     return {k: np.concatenate([parts[i][k] for i in range(len(names))]) for k in parts[0]}
+
+
+def _saved_on_interrupt(folder: Path | None, parts: dict, n_chunks: int):
+    """Ctrl-C says how many chunks ``folder`` holds and that a second run resumes from them (none without one)."""
+    from contextlib import nullcontext
+
+    from .study.interrupt import saved_on_interrupt
+
+    if folder is None:
+        return nullcontext()
+    return saved_on_interrupt(lambda: len(parts), n_chunks, str(folder), "run the atlas again to continue from them")
 
 
 def _part(values: dict, spec: AtlasSpec, index: int) -> dict:

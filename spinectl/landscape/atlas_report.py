@@ -62,6 +62,11 @@ def report_text(result, spec: AtlasSpec) -> str:
     tables = result.sobol | {f"{name} (indicator)": t for name, t in result.sobol_verdicts.items()}
     for output, table in tables.items():
         lines += [f"### `{output}`", ""]
+        verdict = output.removesuffix(" (indicator)")
+        if verdict in result.probabilities and (
+            rare := rare_outcome_note(result.probabilities[verdict]["p"], 2 * spec.samples)
+        ):
+            lines += [rare, ""]
         if table is None:
             lines += [_not_finite(result.draws.get(output)), ""]
             continue
@@ -108,12 +113,84 @@ def criterion(verdict: str, spec: AtlasSpec) -> str:
     -------
     str
     """
+    return verdict_criterion(verdict, spec.names, spec.model)
+
+
+def verdict_criterion(verdict: str, varied, model) -> str:
+    """A verdict's criterion (:data:`VERDICTS`), the delay verdict's with the delay it was judged at.
+
+    Parameters
+    ----------
+    verdict : str
+        A key of :data:`VERDICTS`.
+    varied : iterable of str
+        The parameters the priors vary.
+    model : Model
+        The base model (its reflex delay where no prior draws one).
+
+    Returns
+    -------
+    str
+        E.g. ``"..., the model's 53 ms at every draw (no prior draws it)"`` for ``spine_stable_at_delay``.
+    """
     text = VERDICTS[verdict]
     if verdict != "spine_stable_at_delay":
         return text
-    if "reflex.delay" in spec.names:
+    if "reflex.delay" in set(varied):
         return f"{text}, each draw's delay drawn from its prior"
-    return f"{text}, the model's {spec.model.reflex.delay * 1e3:g} ms at every draw (no prior draws it)"
+    return f"{text}, the model's {model.reflex.delay * 1e3:g} ms at every draw (no prior draws it)"
+
+
+RARE_OUTCOMES = 20
+"""Fewer draws than this on a verdict's rarer side (failures, or successes) leave its indicator's Sobol' indices
+unestimated: their bootstrap intervals span most of [0, 1] (0.756 ± 1.259 at 4 failures of 512)."""
+
+
+def rare_outcome_note(probability: float, draws: int) -> str:
+    """The note over a verdict indicator's Sobol' table when too few draws fail (or pass) to estimate them; ''.
+
+    Parameters
+    ----------
+    probability : float
+        The verdict's probability over ``draws``.
+    draws : int
+        The draws it is counted over (2 N).
+
+    Returns
+    -------
+    str
+        E.g. ``"Too few failures to estimate these indices (4 of 512 draws fail): read them as unknown, not as
+        shares."``; '' when both sides have at least :data:`RARE_OUTCOMES` draws.
+    """
+    failures = round((1.0 - probability) * draws)
+    rare, side = (failures, "failures") if failures <= draws - failures else (draws - failures, "successes")
+    if rare >= RARE_OUTCOMES:
+        return ""
+    verb = "fail" if side == "failures" else "pass"
+    return (
+        f"Too few {side} to estimate these indices ({rare} of {draws} draws {verb}; fewer than {RARE_OUTCOMES}): "
+        "read them as unknown, not as shares."
+    )
+
+
+def console_st_note(value: float, samples: int) -> str:
+    """The console's reading of a total-order index above 1 (the report marks each, :func:`_outside`); ''.
+
+    Parameters
+    ----------
+    value : float
+        The estimate ST.
+    samples : int
+        The atlas's N.
+
+    Returns
+    -------
+    str
+        E.g. ``" (ST > 1 is sampling error at N = 256: read as 1; more samples narrow it)"``.
+    """
+    if not np.isfinite(value) or value <= 1.0:
+        return ""
+    return f" (ST > 1 is sampling error at N = {samples}: read as 1; more samples narrow it)"
 
 
 def _checked(source: str) -> str:

@@ -465,7 +465,7 @@ def draw_model(
         _label_cors(ax, model, cors * CM_PER_M, arrows)
     _limits(ax, model, cors, tips)
     if annotate:
-        ax.set_xlabel("x [cm] (ventral / right →)")
+        ax.set_xlabel(f"x [cm] ({model.geometry.side_names[0]} →)")  # the plane's own +x side: right if coronal
         ax.set_ylabel("y [cm] (above P2)")
         lines = [f"E = {eccentricity * CM_PER_M:g} cm, Λ = {lordosis * CM_PER_M:g} cm; {source}"]
         if pcsa_used is not None:

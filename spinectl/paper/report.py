@@ -291,6 +291,24 @@ def presets_section(run: Run) -> str:
     return "\n".join(lines)
 
 
+K_GLOSS = (
+    "K is the passive stiffness of the ligaments at each joint (eq. 2): a torsional spring in N m/rad; eq. 2 as "
+    "printed subtracts it from the slope of the angular acceleration, where it reads in 1/s² (docs/model.md, "
+    '"Passive stiffness: two conventions").'
+)
+"""What K is, under the report's first lines that give it in two units."""
+
+
+def _separately(run: Run) -> str:
+    """Where the presets' counts come from, beside this run's count: another grid, measured afresh."""
+    if not run.presets:
+        return ""
+    return (
+        f"; the calibrated presets' counts that follow are measured afresh on a separate {run.preset_points} × "
+        f"{run.preset_points} grid"
+    )
+
+
 def render(measurements: Sequence[Measurement], run: Run) -> str:
     """The Markdown report of a reproduction run.
 
@@ -318,6 +336,7 @@ the effect of passive stiffness (Figure S1) on the paper's grid: E and Λ from 0
 to 8 cm, {run.points} × {run.points} points, K = 0 and K = {grid.PAPER_STIFFNESS:g} N m/rad.
 Parameters: {markdown_text(run.preset)}; K = 0 and {k} {own} with the `{run.convention}` convention,
 {k} {other} also with the `{run.other_convention}` convention. Wall time: {run.seconds:.1f} s.
+{K_GLOSS}
 
 ## The paper's question and spinectl's answer
 
@@ -327,7 +346,8 @@ Parameters: {markdown_text(run.preset)}; K = 0 and {k} {own} with the `{run.conv
 
 {_provenance(run)}
 
-**{agree} of {len(measurements)} landmarks agree** with the paper.
+**{agree} of {len(measurements)} landmarks agree** with the paper, measured on this run's {run.points} × {run.points}
+landscapes (the Landmarks table below{_separately(run)}).
 
 {presets_section(run)}
 

@@ -52,3 +52,19 @@ def test_the_figure_crosses_inaccurate_optima_and_hollows_their_star():
     fig = lordosis_figure(_curve(["optimal"] * 3))
     stars, crosses = markers(fig)
     assert crosses == [] and all(s.get_markerfacecolor() != "none" for s in stars) and fig._suptitle is None
+
+
+def test_the_figures_warning_names_only_the_marks_it_draws():
+    """The warning said "marked x, a hollow star" where only an x was drawn (an inaccurate optimum that is no
+    curve's least cost): it names the hollow star only where one is drawn (figures.inaccurate_marks)."""
+    pytest.importorskip("matplotlib")
+    from spinectl.anatomy.figures import inaccurate_marks, lordosis_figure
+
+    crossed = lordosis_figure(_curve(["optimal_inaccurate", "optimal", "optimal"]))  # the least cost is accurate
+    top = crossed.axes[0]
+    assert all(ln.get_markerfacecolor() != "none" for ln in top.lines if ln.get_marker() == "*")
+    assert (
+        f"marked {inaccurate_marks(0)}:" in crossed._suptitle.get_text() and "star" not in crossed._suptitle.get_text()
+    )
+    starred = lordosis_figure(_curve(["optimal", "optimal_inaccurate", "optimal"]))  # the least cost inaccurate
+    assert f"marked {inaccurate_marks(1)}:" in starred._suptitle.get_text() and "hollow star" in inaccurate_marks(1)

@@ -284,7 +284,7 @@ def test_the_millard_exports_verdicts_are_spinectls_and_opensims(exported, tmp_p
     assert main([*argv, "--out", str(out)]) == 0
     lines = capsys.readouterr().out.splitlines()
     growth = np.max(_modes(linearisation)[0].real)
-    assert lines[0] == f"wrote {out} and {out.with_name('m_controls.sto')} (osim): E = 0.03 m, Lambda = 0.04 m"
+    assert lines[0] == f"wrote {out} and {out.with_name('m_controls.sto')} (osim): E = 3 cm, Lambda = 4 cm"  # as all
     assert lines[1].startswith("exported: global PCSA") and "N m/rad in all as joint springs" in lines[1]
     assert lines[2] == (
         "spinectl's chain with them (all CoRs free, the paper's muscle laws): stable, largest real part of its "

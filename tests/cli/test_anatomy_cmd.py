@@ -172,6 +172,23 @@ def test_plot_writes_the_figures(cached, capsys, tmp_path):
         assert (tmp_path / "fig" / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
+def test_plot_in_3d_says_modes_png_is_not_drawn(cached, capsys, tmp_path):
+    """``--plane 3d --plot`` wrote sagittal.png alone, modes.png dropped without a word: one line after the answer
+    says so (anatomy.figures.figures_left_out); the sagittal plane's --plot draws both and says nothing."""
+    from types import SimpleNamespace
+
+    from spinectl.anatomy.analyses import plane_text
+    from spinectl.anatomy.figures import figures_left_out
+
+    assert main(["anatomy", "--plane", "3d", "--plot", str(tmp_path / "fig")]) == 0
+    err = capsys.readouterr().err
+    assert sorted(p.name for p in (tmp_path / "fig").iterdir()) == ["sagittal.png"]
+    assert err == f"spinectl: warning: {figures_left_out(SimpleNamespace(plane='3d'))}\n"
+    assert err.startswith("spinectl: warning: modes.png not drawn") and plane_text("3d") in err
+    assert main(["anatomy", "--plot", str(tmp_path / "sagittal")]) == 0
+    assert "modes.png" not in capsys.readouterr().err and (tmp_path / "sagittal" / "modes.png").exists()
+
+
 def test_plot_into_an_unwritable_folder_is_one_line(cached, capsys, tmp_path):
     """``--plot`` under a regular file: one line naming the path, exit 2, no table printed, nothing written."""
     blocker = tmp_path / "file"

@@ -163,3 +163,14 @@ def test_a_cut_chunk_is_one_line_on_stderr_and_solved_again(tmp_path, capsys):
     lines = [line for line in captured.err.splitlines() if line.startswith("atlas:")]
     assert len(lines) == 1 and "cannot be read (cut short" in lines[0] and "computing them again" in lines[0]
     assert json.loads(captured.out) == first
+
+
+def test_the_help_says_the_atlas_runs_in_process_without_workers(capsys):
+    """The atlas's --help said "--workers N ... (default: cores)", a local cluster, while the atlas runs in this
+    process without --workers (run_atlas: no scheduler and no workers is 'synchronous'); study's is one per core."""
+    import re
+
+    for command, default in (("atlas", "none: the draws run in this process"), ("study", "one per core")):
+        assert main([command, "--help"]) == 0
+        text = re.sub(r"\s+", " ", capsys.readouterr().out)
+        assert f"--workers N local worker processes (default: {default}" in text and "(default: cores)" not in text

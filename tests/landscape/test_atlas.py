@@ -276,8 +276,11 @@ def test_an_interrupted_cluster_run_resumes_to_the_same_bits(in_process, tmp_pat
         saved.append(path.name)
 
     monkeypatch.setattr(atlas, "_save", interrupted)
-    with pytest.raises(KeyboardInterrupt):
+    with pytest.raises(KeyboardInterrupt) as caught:
         atlas.run_atlas(spec, tmp_path / "cut", workers=2, progress=False)
+    folder = str(tmp_path / "cut" / "chunks")  # the line the command prints: the three saved, how to go on
+    again = "run the atlas again to continue from them"
+    assert str(caught.value) == f"interrupted: 3 of 7 chunks saved in {folder!r}; {again}"
     assert sorted(p.name for p in (tmp_path / "cut" / "chunks").iterdir()) == sorted(saved)
     assert sorted(p.name for p in (tmp_path / "cut").iterdir()) == ["chunks"]  # no temporaries, no answer
 
@@ -635,6 +638,68 @@ def test_the_console_table_says_k_is_drawn_where_a_prior_draws_it():
     assert "K drawn from its prior" in first and "K = " not in first
     fixed = atlas.AtlasResult(1, {}, {}, {}, {}, {"body.mass": np.array([40.0])}, spec.model)
     assert f"K = {spec.model.passive.stiffness:g} N m/rad" in fixed.table().splitlines()[0]
+
+
+def test_the_console_states_the_delay_verdicts_delay_and_reads_an_st_above_one():
+    """The console's delay verdict said "at the reflex delay" with no delay: it says the one the report does
+    (atlas_report.verdict_criterion): each draw's, drawn, or the model's in ms. A largest ST above 1 (1.133 in a
+    newcomer's N = 256 atlas) is read in the same line as sampling error at this N; one in [0, 1] has no note."""
+    from spinectl.landscape.atlas_report import verdict_criterion
+
+    spec = _spec(chain="false")
+    band = {"p": 0.5, "low": 0.4, "high": 0.6}
+    sobol = {"counter_torque_norm_Nm": {p: {"S1": 0.1, "S1_conf": 0.1, "ST": 0.2, "ST_conf": 0.1} for p in spec.names}}
+    sobol["counter_torque_norm_Nm"]["eccentricity_m"]["ST"] = 1.133
+    n = 256 * (len(spec.names) + 2)
+    drawn = atlas.AtlasResult(
+        n, {"spine_stable_at_delay": band}, sobol, {}, {}, {"reflex.delay": np.ones(1)}, spec.model
+    )
+    lines = drawn.table().splitlines()
+    assert lines[2].endswith(f"({verdict_criterion('spine_stable_at_delay', spec.names, spec.model)})")
+    assert lines[2].endswith("each draw's delay drawn from its prior)")
+    assert lines[3].endswith(
+        "(eccentricity_m) (ST > 1 is sampling error at N = 256: read as 1; more samples narrow it)"
+    )
+    fixed = atlas.AtlasResult(n, {"spine_stable_at_delay": band}, {}, {}, {}, {"body.mass": np.ones(1)}, spec.model)
+    assert (
+        fixed.table()
+        .splitlines()[2]
+        .endswith(f"the model's {spec.model.reflex.delay * 1e3:g} ms at every draw (no prior draws it))")
+    )
+    sobol["counter_torque_norm_Nm"]["eccentricity_m"]["ST"] = 0.99
+    assert "sampling error" not in drawn.table()
+
+
+@pytest.mark.parametrize(
+    ("p", "rare"),
+    [
+        (0.992, "Too few failures to estimate these indices (4 of 512 draws fail;"),
+        (0.02, "Too few successes to estimate these indices (10 of 512 draws pass;"),
+        (0.5, None),
+    ],
+)
+def test_a_verdict_with_few_failures_says_its_indices_are_not_estimated(p, rare):
+    """The report's "0.756 ± 1.259" for a verdict with p = 0.992 (4 failures of 2 N = 512 draws) read as a share:
+    the verdict's indicator table now says there are too few failures (or successes) to estimate it; p = 0.5 not."""
+    from types import SimpleNamespace
+
+    from spinectl.landscape.atlas_report import RARE_OUTCOMES, report_text
+
+    spec = dataclasses.replace(_spec(chain="false"), samples=256)
+    table = {name: {"S1": 0.0, "S1_conf": 0.02, "ST": 0.756, "ST_conf": 1.259} for name in spec.names}
+    result = SimpleNamespace(
+        n_evaluations=256 * (len(spec.names) + 2),
+        probabilities={"chain_stabilisable_locally": {"p": p, "low": 0.0, "high": 1.0}},
+        sobol={},
+        sobol_verdicts={"chain_stabilisable_locally": table},
+        draws={},
+    )
+    lines = report_text(result, spec).splitlines()
+    below = lines[lines.index("### `chain_stabilisable_locally (indicator)`") + 2]
+    if rare is None:
+        assert below == "| parameter | S1 | ST |"
+    else:
+        assert below.startswith(rare) and f"fewer than {RARE_OUTCOMES})" in below
 
 
 def test_the_density_figure_says_what_it_draws_and_at_which_mass_and_k():

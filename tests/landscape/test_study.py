@@ -487,6 +487,30 @@ def test_cli_runs_and_resumes_a_study(tmp_path, capsys):
     assert "12 of 12 chunks done (8 computed now, 4 before)" in capsys.readouterr().out
 
 
+def test_an_interrupted_study_says_how_much_is_saved_and_how_to_continue(tmp_path, capsys, monkeypatch):
+    """Ctrl-C while the third chunk is written: the line counts the two chunks in the store (the resume
+    computes exactly the other ten) and says how to continue; before, it said only "spinectl: interrupted"."""
+    from spinectl.landscape.study.interrupt import interrupted_text
+
+    path, out = write(tmp_path), tmp_path / "s.zarr"
+    write_chunk, written = study_store.Writer.write, []
+
+    def interrupted(self, chunk, outputs):
+        if len(written) == 2:
+            raise KeyboardInterrupt
+        write_chunk(self, chunk, outputs)
+        written.append(chunk.index)
+
+    monkeypatch.setattr(study_store.Writer, "write", interrupted)
+    assert main(["study", str(path), "--out", str(out), "--scheduler", "synchronous"]) == 130
+    expected = interrupted_text(2, 12, str(out), run.RESUME)
+    assert capsys.readouterr().err == f"spinectl: {expected}\n"
+    assert expected.endswith("; continue with --resume")
+    monkeypatch.setattr(study_store.Writer, "write", write_chunk)
+    assert main(["study", str(path), "--out", str(out), "--scheduler", "synchronous", "--resume"]) == 0
+    assert "12 of 12 chunks done (10 computed now, 2 before)" in capsys.readouterr().out
+
+
 @pytest.mark.parametrize(
     ("arguments", "needle"),
     [

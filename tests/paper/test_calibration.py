@@ -193,6 +193,31 @@ def test_independent_activation_trades_the_counter_torques_for_the_fall(model):
     assert values["ct_B_over_C"] < 1.0 and values["ct_optimum"] > 30.0
 
 
+def test_progress_says_the_generation_of_how_many_and_the_time_left(model):
+    """Each generation's line says "of" the generations asked and the time left (before: "generation 9: ..., 101 s"
+    alone). The evolution makes exactly the evaluations planned when no refinement follows (refine=0), so the
+    last generation's line has none left; a line's time left is the time per evaluation so far times those left."""
+    from spinectl.landscape.budget import duration
+    from spinectl.paper.calibration.fit import _planned, progress_line
+
+    parameters, lines = calibration.parameter_set(["mass", "spread"]), []
+    base = grid.with_stiffness(model, 0.0, "paper")
+    calibration.calibrate(
+        base, parameters, conventions=("paper",), points=5, verify_points=5, popsize=1, generations=2, refine=0,
+        progress=lines.append,
+    )  # fmt: skip
+    planned = _planned(1, 1, 2, 0, 2, 1)  # five members (the least), the initial population and 2 generations
+    evolution = [line.split(", ") for line in lines if "generation" in line]
+    assert [parts[1].split(":")[0] for parts in evolution] == ["generation 1 of 2", "generation 2 of 2"]
+    assert [parts[2] for parts in evolution] == [f"{2 * planned // 3} evaluations", f"{planned} evaluations"]
+    assert evolution[0][-1].startswith("about ") and evolution[1][-1] == "about 0 s left"
+    line = progress_line("start 1/1, generation", 9, 16, 1.335, 420, 840, 101.0)  # 420 left at 101 s per 420
+    assert line == f"start 1/1, generation 9 of 16: best loss 1.335, 420 evaluations, 101 s, about {duration(101)} left"
+    assert progress_line("refining (paper), iteration", 20, None, 1.0, 5, 0, 3.0) == (
+        "refining (paper), iteration 20: best loss 1, 5 evaluations, 3 s"  # no fixed count, no estimate
+    )
+
+
 def test_cli_writes_a_loadable_preset(tmp_path, capsys):
     """A tiny run end to end: progress on stderr, the residual table on stdout, a preset TOML whose header
     says how it was made, whose comment above a fitted value says it is fitted, and which loads back as the

@@ -253,3 +253,17 @@ def test_the_labels_of_long_arrows_stay_inside_the_frame(model, e, lam, pcsa):
         for gid in (f"counter torque label {name}", f"cor label {name}"):
             box = _extent(artists[gid], renderer)
             assert frame.x0 <= box.x0 and box.x1 <= frame.x1 and frame.y0 <= box.y0 and box.y1 <= frame.y1, gid
+
+
+def test_the_x_label_names_the_planes_own_side():
+    """The drawing's x label read "ventral / right →" for every model: it names the +x side of the model's own
+    plane (geometry.side_names[0]): "right" for examples/coronal.toml, "ventral" for the sagittal preset."""
+    from pathlib import Path
+
+    from spinectl.model.config import load_config
+
+    coronal = load_config(str(Path(__file__).resolve().parents[2] / "examples" / "coronal.toml"))
+    assert coronal.geometry.side_names[0] == "right"  # the premise: the example's own words
+    label = drawing.draw_model(coronal, 0.0, 0.02).axes[0].get_xlabel()
+    assert label == "x [cm] (right →)" and "ventral" not in label
+    assert drawing.draw_model(Model(), 0.03, 0.04).axes[0].get_xlabel() == "x [cm] (ventral →)"

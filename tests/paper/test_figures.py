@@ -583,6 +583,27 @@ def test_a_wrapped_title_keeps_settings_units_and_short_parentheses_whole(width)
     assert " ".join(lines) == title
 
 
+def test_on_an_angle_axis_a_corner_names_e_lambda_and_theta_and_k_0_has_its_unit(results):
+    """`plot --lordosis-axis angle`: a corner's box read "0, 4.92 cm" beside a θ [deg] axis, and the title "K = 0":
+    each corner now names E and Λ in cm and its θ in degrees (model.clinical.lordosis_angle, the axis's own
+    conversion), and K = 0 carries its unit (N m/rad under the physical convention)."""
+    from spinectl.model.clinical import lordosis_angle
+    from spinectl.paper.figures.sets import angle_ticks
+
+    dataset = netcdf.load(results).sel(K=0.0)
+    model = netcdf.model_of(dataset)
+    fig = figures.min_pcsa_figure(dataset)
+    angle_ticks(fig, model)
+    ax = fig.axes[0]
+    assert ax.get_title().replace("\n", " ").endswith("K = 0 N m/rad")
+    corners = [t for t in ax.texts if (t.get_gid() or "").startswith("label ") and len(t.get_gid()) > len("label A")]
+    assert corners  # the paper's grid: the corner (8, 8) cm is none of A-D
+    for label in corners:
+        e_cm, lambda_cm = label.xy
+        theta = float(lordosis_angle(np.array([lambda_cm / 100.0]), model)[0])
+        assert label.get_text() == f"E {e_cm:.3g} cm, Λ {lambda_cm:.3g} cm (θ {theta:.0f}°)"
+
+
 def test_a_corner_read_from_an_angle_axis_is_labelled_to_three_digits():
     """An axis even in degrees (sweep --lordosis-angle) puts its corners at Lambda values such as
     0.0699162 m: the label reads 6.99 cm (3 significant digits), not 6.99162 cm."""

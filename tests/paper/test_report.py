@@ -163,3 +163,19 @@ def test_the_answer_says_reproduced_when_both_landmarks_agree():
     ]
     text = report.answer(measured)
     assert "**The paper's main claim is reproduced:**" in text and "not reproduced" not in text
+
+
+def test_the_count_says_which_grid_it_rests_on_and_k_is_glossed():
+    """A newcomer read "11 of 22 landmarks agree" as the presets' count on their separate 41 × 41 grid (the same
+    number there): this run's count now names this run's grid, and the presets' counts their own; "K = 15 1/s²"
+    beside "K = 15 N m/rad" comes with one sentence on what K is (report.K_GLOSS)."""
+    measured = _measurements()
+    agree = sum(m.agrees for m in measured)
+    run = dataclasses.replace(RUN, presets=(("wagner2012", 24.1, tuple(measured)),), preset_points=41)
+    lines = report.render(measured, run).splitlines()
+    first = next(i for i, line in enumerate(lines) if f"{agree} of {len(measured)}" in line)
+    said = " ".join(lines[first : first + 2])
+    assert f"measured on this run's {RUN.points} × {RUN.points}" in said and "separate 41 × 41 grid" in said
+    head = report.render(measured, RUN).split("## The paper's question")[0]
+    assert report.K_GLOSS in head and "1/s²" in head and report.K_GLOSS.startswith("K is the passive stiffness")
+    assert "separate" not in report.render(measured, RUN).split("## Landmarks")[0]  # no presets, no other grid

@@ -24,7 +24,11 @@ from ...model.params import Model
 from .. import budget, columns, schema
 from . import store
 from .executor import CONNECT_TIMEOUT, WORKER_TIMEOUT, check_options, executor, local_processes
+from .interrupt import saved_on_interrupt
 from .spec import Study
+
+RESUME = "continue with --resume"
+"""How an interrupted study continues (:func:`.interrupt.interrupted_text`)."""
 
 
 @dataclass(frozen=True)
@@ -290,7 +294,9 @@ def _run_chunks(study: Study, out, done: np.ndarray, results, progress: bool | N
     """Write each chunk of ``results`` as it comes, with a progress bar of the whole study."""
     writer = store.Writer(study, out, done)
     initial = int(np.count_nonzero(done))
-    with tqdm(total=study.n_chunks, initial=initial, unit="chunk", desc="study", disable=_disabled(progress)) as bar:
+    saved = saved_on_interrupt(lambda: int(np.count_nonzero(done)), study.n_chunks, str(out), RESUME)
+    bar = tqdm(total=study.n_chunks, initial=initial, unit="chunk", desc="study", disable=_disabled(progress))
+    with saved, bar:  # the bar closed first: the interruption's line comes after it
         for index, outputs in results:
             writer.write(study.chunk(index), outputs)
             bar.update()

@@ -16,6 +16,7 @@ import numpy as np
 
 from ... import _validate as v
 from ...errors import ModelError, ParameterError
+from ...landscape.budget import duration
 from ...model.params import Model
 from .. import grid, landmarks
 from ..landmarks import Landmarks
@@ -179,10 +180,13 @@ def _initial_population(base: Model, parameters, popsize: int, seed: int) -> np.
     return init
 
 
-def _reporter(objective: _Objective, say, label: str, every: int, started: float, convention: str | None = None):
+def _reporter(
+    objective: _Objective, say, label: str, every: int, started: float, convention=None, *, total=None, planned=0
+):
     """A per-iteration callback of the optimisers: every ``every`` iterations, say how far the run is.
 
-    The best loss quoted is that of ``convention``, or the least over all conventions if None.
+    The best loss quoted is that of ``convention``, or the least over all conventions if None; ``total``
+    iterations of this stage (None: no fixed number), ``planned`` evaluations of the whole fit (:func:`_planned`).
     """
     count = [0]
 
@@ -191,14 +195,57 @@ def _reporter(objective: _Objective, say, label: str, every: int, started: float
         if count[0] % every == 0:
             best = objective.best(convention)[1] if convention else np.nanmin(np.array(objective.losses))
             say(
-                f"{label} {count[0]}: best loss {best:.4g}, {len(objective.losses)} evaluations, "
-                f"{time.perf_counter() - started:.0f} s"
+                progress_line(
+                    label, count[0], total, best, len(objective.losses), planned, time.perf_counter() - started
+                )
             )
 
     return iteration
 
 
-def _evolve(objective: _Objective, parameters, *, seed, starts, popsize, generations, say, started) -> list:
+def progress_line(label: str, count: int, total, best: float, evaluations: int, planned: int, seconds: float) -> str:
+    """A calibration's progress: ``start 1/1, generation 9 of 16: best loss 1.335, 420 evaluations, 101 s, about 1.2
+    min left``.
+
+    Parameters
+    ----------
+    label : str
+        The stage and its iteration's name.
+    count : int
+        Iterations of the stage done.
+    total : int or None
+        Iterations of the stage (None: no fixed number, as Nelder-Mead's).
+    best : float
+        The best loss so far.
+    evaluations : int
+        Loss evaluations so far.
+    planned : int
+        Evaluations the fit will make at most (:func:`_planned`); 0: no estimate of the time left.
+    seconds : float
+        Time since the fit started [s].
+
+    Returns
+    -------
+    str
+        The line; the time left is the time per evaluation so far times the evaluations left (at most
+        ``planned``: a refinement may stop earlier), the verification's larger grids not counted.
+    """
+    of = "" if total is None else f" of {total}"
+    line = f"{label} {count}{of}: best loss {best:.4g}, {evaluations} evaluations, {seconds:.0f} s"
+    if planned <= 0 or evaluations <= 0:
+        return line
+    left = seconds / evaluations * max(planned - evaluations, 0)
+    return f"{line}, about {duration(left)} left"
+
+
+def _planned(starts: int, popsize: int, generations: int, refine: int, n_parameters: int, n_conventions: int) -> int:
+    """The evaluations a fit makes at most: each start's initial population and its generations (each a
+    population: ``polish`` is off), then each convention's refinement (at most ``refine``)."""
+    population = max(5, popsize * n_parameters)  # as _initial_population draws it
+    return starts * (generations + 1) * population + refine * n_conventions
+
+
+def _evolve(objective: _Objective, parameters, *, seed, starts, popsize, generations, say, started, planned) -> list:
     """The global stage: differential evolution, ``starts`` times, over all conventions at once."""
     import scipy.optimize
 
@@ -214,13 +261,13 @@ def _evolve(objective: _Objective, parameters, *, seed, starts, popsize, generat
                 init=_initial_population(objective.base, parameters, popsize, seed + start),
                 tol=0.0,
                 polish=False,
-                callback=_reporter(objective, say, label, 1, started),
+                callback=_reporter(objective, say, label, 1, started, total=generations, planned=planned),
             )
         )
     return reports
 
 
-def _refine(objective: _Objective, parameters, convention: str, evaluations: int, say, started):
+def _refine(objective: _Objective, parameters, convention: str, evaluations: int, say, started, planned: int):
     """The local stage: Nelder-Mead from the best vector of ``convention``, in coordinates scaled to the bounds.
 
     Nelder-Mead needs no gradient, so the steps of the loss (grid arg-maxima
@@ -242,7 +289,9 @@ def _refine(objective: _Objective, parameters, convention: str, evaluations: int
         u0,
         method="Nelder-Mead",
         bounds=[(0.0, 1.0)] * len(u0),
-        callback=_reporter(objective, say, f"refining ({convention}), iteration", 20, started, convention),
+        callback=_reporter(
+            objective, say, f"refining ({convention}), iteration", 20, started, convention, planned=planned
+        ),
         options={"maxfev": evaluations, "initial_simplex": simplex, "adaptive": True},
     )
 
@@ -385,9 +434,10 @@ def calibrate(
     objective = _Objective(base, parameters, targets, points, conventions)
     say = progress or (lambda line: None)
     budget = {"seed": seed, "starts": starts, "popsize": popsize, "generations": generations}
-    reports = _evolve(objective, parameters, **budget, say=say, started=started)
+    planned = _planned(starts, popsize, generations, refine, len(parameters), len(conventions))
+    reports = _evolve(objective, parameters, **budget, say=say, started=started, planned=planned)
     if refine > 0:
-        reports += [_refine(objective, parameters, c, refine, say, started) for c in conventions]
+        reports += [_refine(objective, parameters, c, refine, say, started, planned) for c in conventions]
     fits = _verify(objective, conventions, verify_points, say)
     best = min(fits.values(), key=lambda f: f.loss)
     settings = {

@@ -22,6 +22,7 @@ from .files import DPI, FORMATS, check_dpi, coupled_ratio_name, figure_names, ra
 from .landscape import LAMBDA_LABEL
 from .min_pcsa import min_pcsa_figure
 from .ratios import COUPLED_VARIABLE, coupled_ratio_figure, ratio_figure
+from .style import cm_text
 
 LORDOSIS_AXES = ("lambda", "angle")
 """The lordosis axis of the landscapes: Lambda [cm], or the lordosis angle [deg] (:class:`FigureOptions`)."""
@@ -167,6 +168,29 @@ def angle_ticks(fig: Figure, model, step: float = 10.0) -> None:
         ax.set_yticks(100.0 * lordosis_from_angle(ticks, model), [f"{t:g}" for t in ticks])
         ax.set_ylim(low, high)
         ax.set_ylabel("lordosis angle θ [deg]")
+        for label in ax.texts:  # a corner's "0, 4.92 cm" read as a Λ on a θ axis
+            if (label.get_gid() or "").startswith("label ") and len(label.get_text()) > 1:
+                label.set_text(corner_text(*label.xy, model))
+
+
+def corner_text(e_cm: float, lambda_cm: float, model) -> str:
+    """A grid corner's label on an angle axis: ``E 0 cm, Λ 4.92 cm (θ 80°)``, each coordinate named.
+
+    Parameters
+    ----------
+    e_cm, lambda_cm : float
+        The corner [cm].
+    model : Model
+        Its spine length and end conditions convert Λ to θ (:func:`spinectl.model.clinical.lordosis_angle`).
+
+    Returns
+    -------
+    str
+    """
+    from ...model.clinical import lordosis_angle
+
+    theta = float(lordosis_angle(np.array([lambda_cm / 100.0]), model)[0])
+    return f"E {cm_text(e_cm / 100.0)} cm, Λ {cm_text(lambda_cm / 100.0)} cm (θ {theta:.0f}°)"
 
 
 def draw_figures(

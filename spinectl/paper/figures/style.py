@@ -99,7 +99,7 @@ def k_unit(convention: str) -> str:
 
 def _k_label(dataset: xr.Dataset) -> str:
     stiffness = float(dataset["K"])
-    if stiffness == 0:
-        return "K = 0"
     convention = dataset.attrs.get("passive_convention", "?")
+    if stiffness == 0:  # no convention: 0 is 0 in both, but it has a unit (before: "K = 0" alone)
+        return f"K = 0 {k_unit(convention if convention in _CONVENTION else 'physical')}"
     return f"K = {stiffness:g} {k_unit(convention)} (K convention: {_CONVENTION.get(convention, convention)})"
