@@ -383,6 +383,34 @@ def test_cli_runs_resumes_and_refuses_in_one_line(folder, tmp_path, capsys):
     assert not (tmp_path / "t").exists()
 
 
+def test_an_interrupted_study_of_motions_says_how_much_is_saved_and_how_to_continue(
+    folder, tmp_path, capsys, monkeypatch
+):
+    """Ctrl-C while the third chunk file is saved: the line counts the two chunks in the store and says how to
+    continue (the parameter study's words, run.RESUME); the resume computes exactly the other two. Before, a study
+    of motions said only "spinectl: interrupted"."""
+    from spinectl.landscape.study import run
+    from spinectl.landscape.study.interrupt import interrupted_text
+
+    path, out = write(folder), tmp_path / "s"
+    save, saved = motion_run.netcdf.save, []
+
+    def interrupted(dataset, target, *args, **kwargs):
+        if "chunks" in str(target) and len(saved) == 2:
+            raise KeyboardInterrupt
+        written = save(dataset, target, *args, **kwargs)
+        saved.append(target)
+        return written
+
+    monkeypatch.setattr(motion_run.netcdf, "save", interrupted)
+    arguments = ["study", str(path), "--out", str(out), "--scheduler", "synchronous"]
+    assert main(arguments) == 130
+    assert capsys.readouterr().err == f"spinectl: {interrupted_text(2, 4, str(out), run.RESUME)}\n"
+    monkeypatch.setattr(motion_run.netcdf, "save", save)
+    assert main([*arguments, "--resume"]) == 0
+    assert capsys.readouterr().out.startswith("study: 4 of 4 chunks done (2 computed now, 2 before)")
+
+
 @pytest.mark.parametrize(("key", "field"), [("model", "model"), ("mapping", "mapping")])
 def test_a_model_that_does_not_load_is_one_line_naming_the_trial_and_leaves_no_store(
     folder, tmp_path, capsys, key, field

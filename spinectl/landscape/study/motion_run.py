@@ -43,8 +43,9 @@ from ...errors import ParameterError
 from .. import netcdf
 from . import store
 from .executor import CONNECT_TIMEOUT, SYNCHRONOUS, WORKER_TIMEOUT, executor
+from .interrupt import saved_on_interrupt
 from .motion_spec import MOTION_FORMAT, MotionStudy
-from .run import StudyResult, check_run_options
+from .run import RESUME, StudyResult, check_run_options
 
 MANIFEST = "motion_study.json"
 """The store's description: format, the study's digest and file."""
@@ -425,7 +426,9 @@ def _write_chunks(study: MotionStudy, out: Path, done: set, results, progress: b
     from tqdm import tqdm  # plain, as the parameter study's
 
     disable = None if progress is None else not progress
-    with tqdm(total=study.n_chunks, initial=len(done), unit="chunk", desc="motions", disable=disable) as bar:
+    saved = saved_on_interrupt(lambda: len(done), study.n_chunks, str(out), RESUME)
+    bar = tqdm(total=study.n_chunks, initial=len(done), unit="chunk", desc="motions", disable=disable)
+    with saved, bar:  # the bar closed first: the interruption's line comes after it
         for kind, index, dataset, crc in results:
             if kind == "trial":
                 continue
