@@ -51,6 +51,7 @@ from pathlib import Path
 
 from . import (
     anatomy,
+    bends,
     chain,
     design,
     errata,
@@ -89,7 +90,7 @@ MEASURED_TABLES = (
 )
 """The tables of what commands print, measured at the build: (file in ``_generated/``, its generator)."""
 
-MEASURED_VALUES = (anatomy, chain, errata, interchange, lift, reflex, reproduction, searched, trends)
+MEASURED_VALUES = (anatomy, bends, chain, errata, interchange, lift, reflex, reproduction, searched, trends)
 """The modules that register ``{measured}`` values (:func:`.values.value`) when imported."""
 
 
