@@ -118,7 +118,9 @@ value("reflex.k_fraction")(lambda: ", ".join(f"{against_k(k)[1].fraction:.3f}" f
 value("reflex.k_static")(lambda: ", ".join(f"{np.sum(against_k(k)[1].least_static):.0f}" for k in STIFFNESSES))
 value("reflex.passive_threshold")(lambda: f"{passive().threshold:.2f}")
 value("reflex.curve_free")(
-    lambda: f"{free_until(0.0)} without lag, {free_until(0.05)} with T_a = 50 ms and {free_until(0.1)} with T_a = 100 ms"
+    lambda: (
+        f"{free_until(0.0)} without lag, {free_until(0.05)} with T_a = 50 ms and {free_until(0.1)} with T_a = 100 ms"
+    )
 )
 value("reflex.curve_free_50")(lambda: free_until(0.05))
 value("reflex.curve_activation_120_slow")(lambda: f"{activation(0.1, 0.12):.3f}")
