@@ -59,6 +59,7 @@ from . import (
     guide,
     interchange,
     lift,
+    millard,
     notebooks,
     parameters,
     published,
@@ -90,7 +91,7 @@ MEASURED_TABLES = (
 )
 """The tables of what commands print, measured at the build: (file in ``_generated/``, its generator)."""
 
-MEASURED_VALUES = (anatomy, bends, chain, errata, interchange, lift, reflex, reproduction, searched, trends)
+MEASURED_VALUES = (anatomy, bends, chain, errata, interchange, lift, millard, reflex, reproduction, searched, trends)
 """The modules that register ``{measured}`` values (:func:`.values.value`) when imported."""
 
 
