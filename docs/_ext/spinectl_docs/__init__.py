@@ -56,6 +56,7 @@ from . import (
     design,
     errata,
     fields,
+    gainsearch,
     guide,
     interchange,
     lift,
@@ -91,7 +92,20 @@ MEASURED_TABLES = (
 )
 """The tables of what commands print, measured at the build: (file in ``_generated/``, its generator)."""
 
-MEASURED_VALUES = (anatomy, bends, chain, errata, interchange, lift, millard, reflex, reproduction, searched, trends)
+MEASURED_VALUES = (
+    anatomy,
+    bends,
+    chain,
+    errata,
+    gainsearch,
+    interchange,
+    lift,
+    millard,
+    reflex,
+    reproduction,
+    searched,
+    trends,
+)
 """The modules that register ``{measured}`` values (:func:`.values.value`) when imported."""
 
 

@@ -59,6 +59,28 @@ def against_k(k: float):
 
 
 @cache
+def springs_only():
+    """The chain's rule design of ``design --delay 0.12 --E 0.03 --Lambda 0.04 --mass 35 --K 10 --set
+    local.damping=0``: the page's subject with its local muscles as springs only (a ChainDesign)."""
+    from spinectl._threads import one_blas_thread
+    from spinectl.model.config import load_preset, set_parameters
+    from spinectl.optimise.reference import solve_point
+    from spinectl.reflex.design.chain import chain_design
+
+    changes = SUBJECT | {"reflex.delay": K_DELAY, "local.damping": 0.0}
+    model = set_parameters(load_preset("wagner2012"), changes)
+    with one_blas_thread():
+        pcsa = model.reflex.activation * np.asarray(solve_point(model, *POSITION).pcsa, float)
+        return chain_design(model, *POSITION, pcsa, model.reflex.activation)
+
+
+def springs_share() -> str:
+    """What the delayed reflex carries of k* with springs-only local muscles, in words."""
+    share = 100 * (1 - springs_only().fraction)
+    return "almost none of it" if share < 1 else f"{share:.0f} % of it"
+
+
+@cache
 def passive():
     """``spinectl design --passive 30:40:11 --E 0.03 --Lambda 0.04`` on ``wagner2012``."""
     from spinectl.model.config import load_preset
@@ -130,3 +152,5 @@ value("reflex.curve_f_40")(lambda: f"{fraction(0.05, 0.04):.2f}")
 value("reflex.curve_f_200")(lambda: f"{fraction(0.05, 0.2):.2f}")
 value("reflex.curve_f_slow")(lambda: _and(f"{fraction(0.1, d):.2f}" for d in (0.005, 0.04, 0.12, 0.2)))
 value("reflex.curve_f_no_lag")(lambda: plateau(0.0))
+value("reflex.subject_f_120_springs")(lambda: f"{springs_only().fraction:.4f}")
+value("reflex.subject_share_120_springs")(springs_share)
