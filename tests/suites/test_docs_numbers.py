@@ -246,10 +246,15 @@ OUTPUT_PATTERNS = {
     "a rank": re.compile(r"\brank [1-9]\d*\b"),
     "singular values": re.compile(r"\bsingular values? \d"),
     "a table cell of numbers": re.compile(r"\|\s*[−\-+]?\d+\.\d+(?:,\s*[−\-+]?\d+\.\d+)+"),
+    "a ratio's range": re.compile(r"\b\d+\.\d+ to \d+\.\d+ times\b"),
+    "a signed value of an engine": re.compile(r"[−\-+]\d+(?:\.\d+)? in (?:OpenSim|spinectl|MuJoCo)\b"),
+    "a fraction of k*": re.compile(r"\b\d+\.\d+ (?:times )?k\*"),
+    "a preset's margin": re.compile(r"\b\d+\.\d+ ms,? \(`(?:default|wagner2012)`"),
 }
 """The rule: what a command prints, typed beside the words that name it. The patterns of the numbers that were
 typed in docs/anatomy.md (-K_jj and eigenvalues in N m/rad, rates in 1/s, costs, the rank and singular values,
-"feasible from 40.2 N m/rad") and of those still typed elsewhere; an integer without a sign before a unit is an
+"feasible from 40.2 N m/rad") and of those still typed elsewhere (interchange.md's "1.12 to 1.18 times" and
+"+39.0 in OpenSim", reflex.md's "0.28 k*", chain.md's "0.909 ms (`default`)"); an integer without a sign before a unit is an
 input (``--joint-stiffness 50``, ``K = 10 N m/rad``) and is not matched."""
 
 ALLOWED = {
@@ -306,9 +311,11 @@ def test_the_typed_number_scan_finds_what_it_is_for(tmp_path, monkeypatch):
         "from 40.2 N m/rad at every joint one does\n| 0 | −81.4, 62.9 | −126.5, +316.6 |\n"
         "rank 3, singular values 0.451\nthe chain optimum costs 14.98\n"
         "--joint-stiffness 50 and K = 10 N m/rad\nfrom {measured}`anatomy.remedy` N m/rad\n"
+        "D is 1.12 to 1.18 times the chain's, L1L2-L2L3 +39.0 in OpenSim\nwith T_a = 50 ms 0.28 k* at 5 ms\n"
+        "found 0.909 ms (`default`) and 2.90 ms (`wagner2012`)\n10 times below 100 ms, 0 k* at 0 ms\n"
     )
     monkeypatch.setattr(sys.modules[__name__], "DOCS", tmp_path)
     monkeypatch.setattr(sys.modules[__name__], "ROOT", tmp_path)
     (tmp_path / "README.md").write_text("")
     lines = sorted({(n, w) for _, n, _, w in typed_outputs()})
-    assert [n for n, _ in lines] == [1, 2, 3, 3, 4]
+    assert [n for n, _ in lines] == [1, 2, 3, 3, 4, 7, 7, 8, 9]

@@ -100,6 +100,26 @@ def curve():
         return delay_curve(set_parameters(load_preset("wagner2012"), SUBJECT), *POSITION, CURVE_DELAYS, CURVE_LAGS)
 
 
+@cache
+def springs_curve():
+    """``design --delays 0:0.2:41 --lags 0,0.05,0.1 --E 0.03 --Lambda 0.04 --mass 35 --K 10 --set
+    local.damping=0``: the subject's curve with the local muscles as springs only (about 2 s of CPU)."""
+    from spinectl._threads import one_blas_thread
+    from spinectl.model.config import load_preset, set_parameters
+    from spinectl.reflex.design import delay_curve
+
+    model = set_parameters(load_preset("wagner2012"), SUBJECT | {"local.damping": 0.0})
+    with one_blas_thread():
+        return delay_curve(model, *POSITION, CURVE_DELAYS, CURVE_LAGS)
+
+
+def springs_least() -> str:
+    """The least f of the springs-only curve from 10 ms, every lag, rounded down: ``at least 0.999``."""
+    c = springs_curve()
+    least = float(np.min(c.local_fraction[:, c.delays >= 0.01 - 1e-12]))
+    return f"at least {np.floor(1e3 * least) / 1e3:.3f}"
+
+
 def _at(array, lag: float, delay: float) -> float:
     """The curve's value at the lag and delay [s] (both on the curve's axes)."""
     c = curve()
@@ -154,3 +174,4 @@ value("reflex.curve_f_slow")(lambda: _and(f"{fraction(0.1, d):.2f}" for d in (0.
 value("reflex.curve_f_no_lag")(lambda: plateau(0.0))
 value("reflex.subject_f_120_springs")(lambda: f"{springs_only().fraction:.4f}")
 value("reflex.subject_share_120_springs")(springs_share)
+value("reflex.curve_springs_least")(springs_least)
