@@ -246,11 +246,16 @@ OUTPUT_PATTERNS = {
     "a rank": re.compile(r"\brank [1-9]\d*\b"),
     "singular values": re.compile(r"\bsingular values? \d"),
     "a table cell of numbers": re.compile(r"\|\s*[−\-+]?\d+\.\d+(?:,\s*[−\-+]?\d+\.\d+)+"),
+    "a ratio's range": re.compile(r"\b\d+\.\d+ to \d+\.\d+ times\b"),
+    "a signed value of an engine": re.compile(r"[−\-+]\d+(?:\.\d+)? in (?:OpenSim|spinectl|MuJoCo)\b"),
+    "a fraction of k*": re.compile(r"\b\d+\.\d+ (?:times )?k\*"),
+    "a preset's margin": re.compile(r"\b\d+\.\d+ ms,? \(`(?:default|wagner2012)`"),
 }
 """The rule: what a command prints, typed beside the words that name it. The patterns of the numbers that were
 typed in docs/anatomy.md (-K_jj and eigenvalues in N m/rad, rates in 1/s, costs, the rank and singular values,
-"feasible from 40.2 N m/rad") and of those still typed elsewhere; an integer without a sign before a unit is an
-input (``--joint-stiffness 50``, ``K = 10 N m/rad``) and is not matched."""
+"feasible from 40.2 N m/rad") and of those still typed elsewhere (interchange.md's "1.12 to 1.18 times" and
+"+39.0 in OpenSim", reflex.md's "0.28 k*", chain.md's "0.909 ms (`default`)"); an integer without a sign before a
+unit is an input (``--joint-stiffness 50``, ``K = 10 N m/rad``) and is not matched."""
 
 ALLOWED = {
     # inputs, definitions and citations: not a command's output
@@ -306,9 +311,46 @@ def test_the_typed_number_scan_finds_what_it_is_for(tmp_path, monkeypatch):
         "from 40.2 N m/rad at every joint one does\n| 0 | −81.4, 62.9 | −126.5, +316.6 |\n"
         "rank 3, singular values 0.451\nthe chain optimum costs 14.98\n"
         "--joint-stiffness 50 and K = 10 N m/rad\nfrom {measured}`anatomy.remedy` N m/rad\n"
+        "D is 1.12 to 1.18 times the chain's, L1L2-L2L3 +39.0 in OpenSim\nwith T_a = 50 ms 0.28 k* at 5 ms\n"
+        "found 0.909 ms (`default`) and 2.90 ms (`wagner2012`)\n10 times below 100 ms, 0 k* at 0 ms\n"
     )
     monkeypatch.setattr(sys.modules[__name__], "DOCS", tmp_path)
     monkeypatch.setattr(sys.modules[__name__], "ROOT", tmp_path)
     (tmp_path / "README.md").write_text("")
     lines = sorted({(n, w) for _, n, _, w in typed_outputs()})
-    assert [n for n, _ in lines] == [1, 2, 3, 3, 4]
+    assert [n for n, _ in lines] == [1, 2, 3, 3, 4, 7, 7, 8, 9]
+
+
+def test_reflex_pages_design_against_k_is_spinectl_design_at_that_k():
+    """docs/reflex.md's design against K (bends.py calls the chain's design alone, not the command): at K = 40
+    N m/rad the global PCSA, the local stiffness, f and k* the page quotes (the second of each list) are the
+    JSON's chain of `spinectl design --delay 0.12 --K 40` (global_pcsa_cm2, the sum of
+    local_stiffness_Nm_per_rad, local_stiffness_fraction, the sum of least_static_local_stiffness_Nm_per_rad)."""
+    from spinectl_docs.values import text_of
+
+    chain = json.loads(spinectl_design("--delay", "0.12", "--K", "40", "--json"))["chain"]
+    second = {
+        name: re.split(r", | and ", text_of(f"reflex.{name}"))[1]
+        for name in ("k_pcsa", "k_local", "k_fraction", "k_static")
+    }
+    assert second == {
+        "k_pcsa": f"{chain['global_pcsa_cm2']:.2f}",
+        "k_local": f"{sum(chain['local_stiffness_Nm_per_rad']):.0f}",
+        "k_fraction": f"{chain['local_stiffness_fraction']:.3f}",
+        "k_static": f"{sum(chain['least_static_local_stiffness_Nm_per_rad']):.0f}",
+    }
+
+
+def test_interchange_pages_causes_together_are_opensims_own_k():
+    """docs/interchange.md's causes of Millard's instability (millard.py puts Millard's activation floor, curve
+    value and slope into spinectl's chain one at a time): all three together give OpenSim's own linearised K of
+    the Millard export with the least local stiffness to 1e-6 of its largest entry (the derivation that
+    tests/anatomy/test_osim_replay.py checks), so each alone is that model's, not a guess."""
+    pytest.importorskip("opensim", reason="the opensim extra is not installed")
+    from spinectl_docs import interchange, millard
+
+    together, opensim_k = millard.chain_with(millard.CAUSES), interchange.opensim_k("millard", True)
+    assert np.max(np.abs(together - opensim_k)) <= 1e-6 * np.max(np.abs(opensim_k))
+    assert millard.least(millard.chain_with(())) == pytest.approx(
+        millard.least(interchange.exported("osim", "millard", True)[1].stiffness)
+    )

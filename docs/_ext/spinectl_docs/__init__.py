@@ -31,7 +31,9 @@ a text changed, so that incremental builds stay incremental):
 Numbers that a sentence quotes are the ``{measured}`` role's (:mod:`.values`): ``{measured}`anatomy.remedy```
 is replaced by what the code gives at the build; the pages that use it are read again at every build, so
 that they cannot go stale. The ``published-model`` directive (:mod:`.published`) analyses a published model
-with its mapping at the build: one table row of verdicts.
+with its mapping at the build: one table row of verdicts. Besides the tables' modules, :mod:`.bends` measures
+``reflex.md``'s design against K and its design curve's readings, :mod:`.millard` ``interchange.md``'s causes of
+Millard's instability and :mod:`.gainsearch` ``chain.md``'s gain search (a small stated budget) and bounds.
 
 ``_generated/`` is excluded from the sources (its files are included by
 ``parameters.md``, ``index.md``, ``notebooks.md`` and ``reproduction.md``);
@@ -51,13 +53,16 @@ from pathlib import Path
 
 from . import (
     anatomy,
+    bends,
     chain,
     design,
     errata,
     fields,
+    gainsearch,
     guide,
     interchange,
     lift,
+    millard,
     notebooks,
     parameters,
     published,
@@ -89,7 +94,20 @@ MEASURED_TABLES = (
 )
 """The tables of what commands print, measured at the build: (file in ``_generated/``, its generator)."""
 
-MEASURED_VALUES = (anatomy, chain, errata, interchange, lift, reflex, reproduction, searched, trends)
+MEASURED_VALUES = (
+    anatomy,
+    bends,
+    chain,
+    errata,
+    gainsearch,
+    interchange,
+    lift,
+    millard,
+    reflex,
+    reproduction,
+    searched,
+    trends,
+)
 """The modules that register ``{measured}`` values (:func:`.values.value`) when imported."""
 
 

@@ -64,12 +64,17 @@ def exported(fmt: str, muscle: str, local: bool):
 
 
 @cache
-def opensim_k(muscle: str, local: bool) -> np.ndarray:
-    """K [N m/rad] of OpenSim's own linearisation of the ``.osim`` export."""
+def opensim_linearised(muscle: str, local: bool) -> tuple:
+    """OpenSim's own linearisation of the ``.osim`` export: (f0 [N m], K [N m/rad], D [N m s/rad], M [kg m^2])."""
     from spinectl.anatomy.export_osim import opensim_linearisation
 
     path, solution = exported("osim", muscle, local)
-    return opensim_linearisation(path, solution.model.geometry.cor_names)[1]
+    return opensim_linearisation(path, solution.model.geometry.cor_names)
+
+
+def opensim_k(muscle: str, local: bool) -> np.ndarray:
+    """K [N m/rad] of OpenSim's own linearisation of the ``.osim`` export."""
+    return opensim_linearised(muscle, local)[1]
 
 
 def export_table() -> str:

@@ -4,7 +4,7 @@ The 35 kg subject (``wagner2012`` with ``body.mass = 35``, ``passive.stiffness =
 and a 120 ms delay (``margins --delay 0.12 --E 0.03 --Lambda 0.04 --set body.mass=35 --set
 passive.stiffness=10``), and ``wagner2012`` at (0, 0) (``stability --E 0 --Lambda 0``), each computed once per
 build. The page's design answers (the rule's and the gain searches) are :mod:`.searched`'s; the design against K
-is not generated yet.
+and the design curve's readings :mod:`.bends`'.
 """
 
 from __future__ import annotations
