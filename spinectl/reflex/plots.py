@@ -305,8 +305,8 @@ def divergence_note(chain: tuple, divergence: float) -> str:
     if not np.isfinite(divergence) or not any(np.any(sim.diverged) for sim in chain):
         return ""
     return (
-        f"each trace stops where its |alpha| would pass {divergence * 1e3:g} mrad: diverged "
-        "(reflex.sim_divergence); the flat lines after are angles frozen there, not a posture"
+        f"diverged: each trace is held flat from its last step before |alpha| passes {divergence * 1e3:g} mrad "
+        "(reflex.sim_divergence); the flat part is where it stopped, not a posture"
     )
 
 

@@ -344,3 +344,23 @@ def test_no_chain_design_names_the_top_as_a_multiple_of_k_star(kp, kd, top):
     assert np.isnan(design.chain.fraction)  # the premise
     words = f"no local stiffness up to {getattr(rs, top):g} x k* (k*: the least for static stability) meets the delay"
     assert design.chain.method == words and words in design.table()
+
+
+def test_joint_by_joint_with_given_gains_names_them_and_where_the_margin_jumps():
+    """``design --kp 30 --kd 8`` at 100 ms: the joint-by-joint answer rests on the given gains, not the rule (it
+    said "reflex assumed: the reflex rule at each activation" and "the rule's 0.3682"), and the segment that sets the
+    common activation (the largest, L2L3) has its exact margin far above the delay (444.7 ms measured), so the
+    boundary line says the margin jumps past the delay with that segment's ratio, computed here from the table's own
+    segments; the rule's design (the variant) keeps the boundary at the delay."""
+    given = dz.answer(_model(0.1), *AT, kp=30.0, kd=8.0)
+    lines = given.readings()["joint"]
+    setting = max(given.segments, key=lambda s: s.activation)
+    ratio = setting.delay_margin / 0.1
+    assert ratio > 1.1  # the premise: the margin is not at the delay
+    assert "  reflex assumed: the given gains kp, kd at each segment" in lines
+    assert any(f"({setting.name}) jumps past the delay" in x and f"({ratio:.3g} x the delay)" in x for x in lines)
+    assert any(f"the given gains' {given.activation:.4f}" in x for x in lines)
+    assert not any("the rule" in x for x in lines)
+    rule = dz.answer(_model(0.1), *AT).readings()["joint"]
+    assert "  reflex assumed: the reflex rule at each activation" in rule
+    assert any(x.startswith("  boundary: the least value sits on its stability boundary") for x in rule)

@@ -314,7 +314,7 @@ def test_the_chain_panel_says_its_traces_stop_at_the_divergence_limit_and_names_
     assert np.max(np.abs(responses.chain[0].alpha)) == pytest.approx(limit, rel=0.1)  # flat near the limit
     chain_ax = plots.report_figures(report, responses)["response.png"].axes[-1]
     title = " ".join(chain_ax.get_title().split())
-    assert f"each trace stops where its |alpha| would pass {limit * 1e3:g} mrad: diverged" in title
+    assert f"diverged: each trace is held flat from its last step before |alpha| passes {limit * 1e3:g} mrad" in title
     assert "(reflex.sim_divergence)" in title and "not a posture" in title
     legend = chain_ax.get_legend()
     assert legend is not None and [t.get_text() for t in legend.get_texts()] == list(model.geometry.cor_names)

@@ -112,13 +112,15 @@ class JointSearchedDesign:
         margins = [None if np.isinf(m) else float(m) for m in self.no_reflex_margin]
         return {"rule_kd_Nms_per_rad": self.rule_kd.tolist(), "no_reflex_delay_margin_s": margins}
 
-    def lines(self, rule_activation: float) -> list[str]:
-        """The table's lines, beside the rule's common activation.
+    def lines(self, rule_activation: float, whose: str = "the rule's") -> list[str]:
+        """The table's lines, beside the rule's (or the given gains') common activation.
 
         Parameters
         ----------
         rule_activation : float
-            The rule's answer, one activation for every segment [x minimum PCSA].
+            The answer under the design's own reflex, one activation for every segment [x minimum PCSA].
+        whose : str
+            Whose answer that is, as the line names it: ``"the rule's"`` or ``"the given gains'"``.
 
         Returns
         -------
@@ -131,9 +133,9 @@ class JointSearchedDesign:
             ]
         if np.isfinite(rule_activation):
             less = 100 * (1 - self.activation / rule_activation) if rule_activation > 0 else 0.0
-            beside = f"the rule's {rule_activation:.4f}, {less:.0f} % less"
+            beside = f"{whose} {rule_activation:.4f}, {less:.0f} % less"
         else:
-            beside = "the rule has none: searched in [0, 1]"
+            beside = f"{whose.removesuffix(chr(39) + 's').removesuffix(chr(39))} have none: searched in [0, 1]"
         return [
             *self._rule_failure_lines(),
             f"over {SEARCHED_JOINT_REFLEX}: activation {self.activation:.4f} x minimum PCSA "

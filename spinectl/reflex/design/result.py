@@ -380,10 +380,12 @@ class Design:
             ]
         if self.joint_searched is None:
             return []
+        given = self.chain.reflex == GIVEN_REFLEX  # the same gains go to every segment's loop
+        reflex = "the given gains kp, kd at each segment" if given else "the reflex rule at each activation"
         return [
-            "  reflex assumed: the reflex rule at each activation",
+            f"  reflex assumed: {reflex}",
             *self._joint_boundary_lines(),
-            *self.joint_searched.lines(self.activation),
+            *self.joint_searched.lines(self.activation, "the given gains'" if given else "the rule's"),
         ]
 
     def _joint_boundary_lines(self) -> list[str]:
@@ -394,6 +396,15 @@ class Design:
             return [
                 f"  robust: designed at {self.margin_ratio:g} x the delay {delay_text(self.nominal_delay)}, so "
                 f"it holds every delay up to {delay_text(self.delay)} (--margin {self.margin_ratio:g})"
+            ]
+        setting = max(self.segments, key=lambda seg: seg.activation)  # the segment that sets the common activation
+        ratio = setting.delay_margin / self.delay if self.delay > 0 else np.inf
+        if ratio > 1.0 + BOUNDARY_RTOL:  # its margin jumped past the delay at the least value (as the chain's can)
+            return [
+                f"  boundary: the least value is where the margin of the segment that sets it ({setting.name}) jumps "
+                f"past the delay, to {delay_text(setting.delay_margin)} ({ratio:.3g} x the delay), not where it "
+                f"equals the delay: less co-contraction is unstable at this delay, and any margin up to "
+                f"{ratio:.3g} x costs nothing more"
             ]
         return [
             "  boundary: the least value sits on its stability boundary (the margin of the segment that sets it "
