@@ -274,8 +274,6 @@ def test_an_activation_below_the_floor_is_refused_naming_the_floor(tmp_path):
     """``activation=0`` on Millard muscles (floor 0.01, OpenSim's default) is one line naming the floor, not
     "[0, 1]"; 0.01 is analysed; on De Groote muscles (no floor) 0 is analysed."""
     from spinectl.anatomy.analyses import analyse
-    from spinectl.anatomy.motion import motion_response
-    from spinectl.anatomy.recordings import read_recording
     from spinectl.errors import ParameterError
 
     millard = load_osim(build(tmp_path / "millard.osim", "millard"), mapping=_mapping(tmp_path))

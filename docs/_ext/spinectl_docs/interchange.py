@@ -87,7 +87,8 @@ def export_table() -> str:
 
     model = load_preset("wagner2012")
     lines = [
-        "| export | local stiffness | whose linearisation | largest Re [1/s] | Re nearest 0 [1/s] (the slowest mode; > 0 grows) | growing modes |",
+        "| export | local stiffness | whose linearisation | largest Re [1/s] "
+        "| Re nearest 0 [1/s] (the slowest mode; > 0 grows) | growing modes |",
         "| --- | --- | --- | --- | --- | --- |",
     ]
     for fmt, muscle, local in EXPORTS:

@@ -69,9 +69,9 @@ def printed(who: str, delay: float, first: str) -> str:
 
 def chain_search_table() -> str:
     """``design --delay 0.04 --gains search`` on ``wagner2012``: the searched answer's lines."""
-    from spinectl.reflex.design.gain_searched import SEARCHED_REFLEX
+    from spinectl.reflex.design.gain_searched import SEARCHED_HEADING
 
-    return printed("wagner2012", 0.04, f"over {SEARCHED_REFLEX}")
+    return printed("wagner2012", 0.04, SEARCHED_HEADING)
 
 
 def joint_search_table() -> str:

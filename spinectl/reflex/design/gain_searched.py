@@ -62,6 +62,9 @@ SEARCH_SEED = 0
 COST_RATIO = 1.1
 """The modest delay-margin ratio whose cost the table shows by default: the design at 1.1 times the delay."""
 
+SEARCHED_HEADING = "over diagonal PD gains"
+"""How the searched answer's line starts in the table (the docs cut the table's lines from it)."""
+
 SEARCHED_REFLEX = "any diagonal PD gains, searched"
 """The reflex the searched answer assumes, as the table and JSON label it (the rule's and the given gains' labels,
 RULE_REFLEX and GIVEN_REFLEX, are in :mod:`~spinectl.reflex.design.result`, which the curve shares)."""
@@ -157,7 +160,7 @@ class GainSearchedDesign:
         rule_total = rule_fraction * float(np.sum(least_static))
         # "at most": a budgeted search certifies what it found, it does not prove that nothing less holds
         return [
-            f"over diagonal PD gains ({stages_text(len(self.kp))}): at most {total:.1f} N m/rad, certified "
+            f"{SEARCHED_HEADING} ({stages_text(len(self.kp))}): at most {total:.1f} N m/rad, certified "
             f"({self.fraction:.4f} x k*; the rule's {rule_total:.1f}, "
             f"{100 * (1 - total / rule_total) if rule_total > 0 else 0.0:.0f} % less)",
             f"  {self.found_text()}",
