@@ -33,7 +33,9 @@ is replaced by what the code gives at the build; the pages that use it are read 
 that they cannot go stale. The ``published-model`` directive (:mod:`.published`) analyses a published model
 with its mapping at the build: one table row of verdicts. Besides the tables' modules, :mod:`.bends` measures
 ``reflex.md``'s design against K and its design curve's readings, :mod:`.millard` ``interchange.md``'s causes of
-Millard's instability and :mod:`.gainsearch` ``chain.md``'s gain search (a small stated budget) and bounds.
+Millard's instability (and its curves and re-imported chain), :mod:`.together` ``chain.md``'s local and joint
+optima at the first table's points (and ``figures.md``'s coupled ratio) and :mod:`.gainsearch` ``chain.md``'s
+gain search (a small stated budget) and bounds.
 
 ``_generated/`` is excluded from the sources (its files are included by
 ``parameters.md``, ``index.md``, ``notebooks.md`` and ``reproduction.md``);
@@ -70,6 +72,7 @@ from . import (
     reflex,
     reproduction,
     searched,
+    together,
     trends,
     values,
 )
@@ -106,6 +109,7 @@ MEASURED_VALUES = (
     reflex,
     reproduction,
     searched,
+    together,
     trends,
 )
 """The modules that register ``{measured}`` values (:func:`.values.value`) when imported."""

@@ -132,7 +132,7 @@ def upright() -> dict:
     activation = solution.pcsa / (REFERENCE_PCSA_CM2 * M2_PER_CM2)
     floor = osim.Millard2012EquilibriumMuscle.safeDownCast(muscles.get(0)).getMinimumActivation()
     active = [(n, p, a) for n, p, a in zip(model.muscle_names, solution.pcsa, activation, strict=True) if a > floor]
-    return {"millard": rows[0, 1:3], "paper": rows[0, 3:5], "active": active, "floor": floor,
+    return {"x": rows[0, 0], "millard": rows[0, 1:3], "paper": rows[0, 3:5], "active": active, "floor": floor,
             "idle": len(model.muscle_names) - len(active), "reference_cm2": REFERENCE_PCSA_CM2}  # fmt: skip
 
 
@@ -154,6 +154,14 @@ def active_words() -> str:
             f"activation {span([a for _, _, a in active], '.3f')})")  # fmt: skip
 
 
+def _change(millard: float, paper: float) -> str:
+    """Millard's value against the paper's: '+11 %'."""
+    return _minus(100 * (millard / paper - 1), ".0f") + " %"
+
+
+value("interchange.upright_length")(lambda: f"{upright()['x']:.3f}")
+value("interchange.curve_change")(lambda: _change(upright()["millard"][0], upright()["paper"][0]))
+value("interchange.slope_change")(lambda: _change(upright()["millard"][1], upright()["paper"][1]))
 value("interchange.millard_curve")(lambda: "{:.3f}".format(upright()["millard"][0]))
 value("interchange.millard_curve_slope")(lambda: "{:.2f}".format(upright()["millard"][1]))
 value("interchange.paper_curve")(lambda: "{:.3f}".format(upright()["paper"][0]))
