@@ -20,7 +20,7 @@ from spinectl.model.config import load_preset
 from spinectl.paper import assumptions, calibration, verdicts
 
 from .markup import md_escape
-from .values import value
+from .values import VALUES, value
 
 
 def parameter_table() -> str:
@@ -76,6 +76,9 @@ value("reproduction.claim")(claim)
 value("reproduction.optimum_lordosis")(lambda: _documented("optimum_lordosis"))
 value("reproduction.ct_optimum")(lambda: _documented("ct_optimum"))
 value("reproduction.agreeing")(agreeing)
+for _name in verdicts.VERDICTS:  # every landmark's documented value: {measured}`reproduction.<landmark>`
+    if f"reproduction.{_name}" not in VALUES:
+        value(f"reproduction.{_name}")(lambda n=_name: _documented(n))
 
 
 # --- "The whole chain: what the paper's conclusions become" (numbers of ``docs/chain.md``'s computations) ---
