@@ -24,6 +24,8 @@ a text changed, so that incremental builds stay incremental):
   four points and
   ``design --passive`` at A in ``chain.md`` (measured at the build, :mod:`.chain`); ``chain-margins.md``: the rule's
   reflex on the chain at A (``margins --coupled``);
+- ``_generated/reflex-margins-*.md``: ``spinectl margins`` joint by joint in ``reflex.md`` (the lag's cost and
+  each preset's activations, :mod:`.segment_margins`);
 - ``_generated/anatomy-*.md``: ``spinectl anatomy``'s tables on MyoTorso in ``anatomy.md`` (verdicts, optima,
   lordosis, reflex; measured at the build, :mod:`.anatomy`);
 - ``_generated/motion-lift.png``: the lift of ``motion.md`` on MyoTorso (:mod:`.lift`).
@@ -72,6 +74,7 @@ from . import (
     reflex,
     reproduction,
     searched,
+    segment_margins,
     together,
     trends,
     values,
@@ -94,6 +97,9 @@ MEASURED_TABLES = (
     ("anatomy-reflex.md", anatomy.reflex_table),
     ("design-chain-searched.md", searched.chain_search_table),
     ("design-joint-searched.md", searched.joint_search_table),
+    ("reflex-margins-lag.md", segment_margins.lag_table),
+    ("reflex-margins-default.md", lambda: segment_margins.preset_table("default")),
+    ("reflex-margins-wagner2012.md", lambda: segment_margins.preset_table("wagner2012")),
 )
 """The tables of what commands print, measured at the build: (file in ``_generated/``, its generator)."""
 
@@ -109,6 +115,7 @@ MEASURED_VALUES = (
     reflex,
     reproduction,
     searched,
+    segment_margins,
     together,
     trends,
 )
