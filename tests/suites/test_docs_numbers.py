@@ -228,7 +228,7 @@ def test_reflex_pages_chain_searched_lines_are_spinectl_design_gains_search():
 
     printed = spinectl_design("--delay", "0.04", "--gains", "search").splitlines()
     lines = block_lines(searched.chain_search_table())
-    assert lines[0].startswith("over any diagonal PD gains, searched") and len(lines) == 4
+    assert lines[0].startswith("over diagonal PD gains (") and len(lines) >= 4
     for line in lines:
         assert line in printed, line
     assert any(f"({text_of('reflex.rule_f_40')} x the least for static stability" in line for line in printed)

@@ -68,10 +68,9 @@ def printed(who: str, delay: float, first: str) -> str:
 
 
 def chain_search_table() -> str:
-    """``design --delay 0.04 --gains search`` on ``wagner2012``: the searched answer's lines."""
-    from spinectl.reflex.design.gain_searched import SEARCHED_REFLEX
-
-    return printed("wagner2012", 0.04, f"over {SEARCHED_REFLEX}")
+    """``design --delay 0.04 --gains search`` on ``wagner2012``: the searched answer's lines (the table's line
+    ``over diagonal PD gains (<its stages>): ...``, :meth:`GainSearchedDesign.lines`)."""
+    return printed("wagner2012", 0.04, "over diagonal PD gains (")
 
 
 def joint_search_table() -> str:
