@@ -167,6 +167,25 @@ def test_measured_role_puts_the_value_computed_now_and_refuses_an_unknown_name(t
     assert failed.returncode != 0 and "unknown value 'errata.no_such_value'" in failed.stderr
 
 
+def test_a_value_whose_generator_imports_a_moved_name_fails_and_a_missing_extra_is_a_note(monkeypatch):
+    """A value whose generator imports a name spinectl no longer has (as anatomy.md's `least_joint_stiffness` after
+    it moved to spinectl.anatomy.remedy) raises at the build instead of printing "not installed"; an extra's
+    package that is absent (mujoco, or a module of it) gives the page's note."""
+    from spinectl_docs import values
+
+    def moved():
+        from spinectl.anatomy.optimum import no_such_name  # noqa: F401
+
+    def absent():
+        raise ModuleNotFoundError("No module named 'mujoco'", name="mujoco")
+
+    monkeypatch.setitem(values.VALUES, "test.moved", (moved, False))
+    monkeypatch.setitem(values.VALUES, "test.absent", (absent, False))
+    with pytest.raises(ImportError, match="no_such_name"):
+        values.text_of("test.moved")
+    assert values.text_of("test.absent") == "(not computed: mujoco is not installed at this build)"
+
+
 def test_anatomy_pages_numbers_are_spinectl_anatomys():
     """docs/anatomy.md's generated verdict table and its remedy are what `spinectl anatomy` prints: the row at
     activation 0 holds the JSON's -K_jj and eigenvalues of -K, and the remedy value is the JSON's
