@@ -167,6 +167,25 @@ def test_measured_role_puts_the_value_computed_now_and_refuses_an_unknown_name(t
     assert failed.returncode != 0 and "unknown value 'errata.no_such_value'" in failed.stderr
 
 
+def test_a_value_whose_generator_imports_a_moved_name_fails_and_a_missing_extra_is_a_note(monkeypatch):
+    """A value whose generator imports a name spinectl no longer has (as anatomy.md's `least_joint_stiffness` after
+    it moved to spinectl.anatomy.remedy) raises at the build instead of printing "not installed"; an extra's
+    package that is absent (mujoco, or a module of it) gives the page's note."""
+    from spinectl_docs import values
+
+    def moved():
+        from spinectl.anatomy.optimum import no_such_name  # noqa: F401
+
+    def absent():
+        raise ModuleNotFoundError("No module named 'mujoco'", name="mujoco")
+
+    monkeypatch.setitem(values.VALUES, "test.moved", (moved, False))
+    monkeypatch.setitem(values.VALUES, "test.absent", (absent, False))
+    with pytest.raises(ImportError, match="no_such_name"):
+        values.text_of("test.moved")
+    assert values.text_of("test.absent") == "(not computed: mujoco is not installed at this build)"
+
+
 def test_anatomy_pages_numbers_are_spinectl_anatomys():
     """docs/anatomy.md's generated verdict table and its remedy are what `spinectl anatomy` prints: the row at
     activation 0 holds the JSON's -K_jj and eigenvalues of -K, and the remedy value is the JSON's
@@ -250,12 +269,14 @@ OUTPUT_PATTERNS = {
     "a signed value of an engine": re.compile(r"[−\-+]\d+(?:\.\d+)? in (?:OpenSim|spinectl|MuJoCo)\b"),
     "a fraction of k*": re.compile(r"\b\d+\.\d+ (?:times )?k\*"),
     "a preset's margin": re.compile(r"\b\d+\.\d+ ms,? \(`(?:default|wagner2012)`"),
+    "a margin beside its lagless one": re.compile(r"\b\d+\.\d+ s \(\d+\.\d+\)"),
 }
 """The rule: what a command prints, typed beside the words that name it. The patterns of the numbers that were
 typed in docs/anatomy.md (-K_jj and eigenvalues in N m/rad, rates in 1/s, costs, the rank and singular values,
 "feasible from 40.2 N m/rad") and of those still typed elsewhere (interchange.md's "1.12 to 1.18 times" and
-"+39.0 in OpenSim", reflex.md's "0.28 k*", chain.md's "0.909 ms (`default`)"); an integer without a sign before a
-unit is an input (``--joint-stiffness 50``, ``K = 10 N m/rad``) and is not matched."""
+"+39.0 in OpenSim", reflex.md's "0.28 k*", chain.md's "0.909 ms (`default`)", reflex.md's margins tables'
+"0.057 s (0.101)"); an integer without a sign before a unit is an input (``--joint-stiffness 50``,
+``K = 10 N m/rad``) and is not matched."""
 
 ALLOWED = {
     # inputs, definitions and citations: not a command's output
@@ -313,12 +334,13 @@ def test_the_typed_number_scan_finds_what_it_is_for(tmp_path, monkeypatch):
         "--joint-stiffness 50 and K = 10 N m/rad\nfrom {measured}`anatomy.remedy` N m/rad\n"
         "D is 1.12 to 1.18 times the chain's, L1L2-L2L3 +39.0 in OpenSim\nwith T_a = 50 ms 0.28 k* at 5 ms\n"
         "found 0.909 ms (`default`) and 2.90 ms (`wagner2012`)\n10 times below 100 ms, 0 k* at 0 ms\n"
+        "| 0.5 | 0.195 s (0.243) | unbounded |\nT_a = 0.1 s (a lag of 0.1 s) and 3.7 s of CPU\n"
     )
     monkeypatch.setattr(sys.modules[__name__], "DOCS", tmp_path)
     monkeypatch.setattr(sys.modules[__name__], "ROOT", tmp_path)
     (tmp_path / "README.md").write_text("")
     lines = sorted({(n, w) for _, n, _, w in typed_outputs()})
-    assert [n for n, _ in lines] == [1, 2, 3, 3, 4, 7, 7, 8, 9]
+    assert [n for n, _ in lines] == [1, 2, 3, 3, 4, 7, 7, 8, 9, 11]
 
 
 def test_reflex_pages_design_against_k_is_spinectl_design_at_that_k():

@@ -24,6 +24,8 @@ a text changed, so that incremental builds stay incremental):
   four points and
   ``design --passive`` at A in ``chain.md`` (measured at the build, :mod:`.chain`); ``chain-margins.md``: the rule's
   reflex on the chain at A (``margins --coupled``);
+- ``_generated/reflex-margins-*.md``: ``spinectl margins`` joint by joint in ``reflex.md`` (the lag's cost and
+  each preset's activations, :mod:`.segment_margins`);
 - ``_generated/anatomy-*.md``: ``spinectl anatomy``'s tables on MyoTorso in ``anatomy.md`` (verdicts, optima,
   lordosis, reflex; measured at the build, :mod:`.anatomy`);
 - ``_generated/motion-lift.png``: the lift of ``motion.md`` on MyoTorso (:mod:`.lift`).
@@ -33,7 +35,9 @@ is replaced by what the code gives at the build; the pages that use it are read 
 that they cannot go stale. The ``published-model`` directive (:mod:`.published`) analyses a published model
 with its mapping at the build: one table row of verdicts. Besides the tables' modules, :mod:`.bends` measures
 ``reflex.md``'s design against K and its design curve's readings, :mod:`.millard` ``interchange.md``'s causes of
-Millard's instability and :mod:`.gainsearch` ``chain.md``'s gain search (a small stated budget) and bounds.
+Millard's instability (and its curves and re-imported chain), :mod:`.together` ``chain.md``'s local and joint
+optima at the first table's points (and ``figures.md``'s coupled ratio) and :mod:`.gainsearch` ``chain.md``'s
+gain search (a small stated budget) and bounds.
 
 ``_generated/`` is excluded from the sources (its files are included by
 ``parameters.md``, ``index.md``, ``notebooks.md`` and ``reproduction.md``);
@@ -70,6 +74,8 @@ from . import (
     reflex,
     reproduction,
     searched,
+    segment_margins,
+    together,
     trends,
     values,
 )
@@ -91,6 +97,9 @@ MEASURED_TABLES = (
     ("anatomy-reflex.md", anatomy.reflex_table),
     ("design-chain-searched.md", searched.chain_search_table),
     ("design-joint-searched.md", searched.joint_search_table),
+    ("reflex-margins-lag.md", segment_margins.lag_table),
+    ("reflex-margins-default.md", lambda: segment_margins.preset_table("default")),
+    ("reflex-margins-wagner2012.md", lambda: segment_margins.preset_table("wagner2012")),
 )
 """The tables of what commands print, measured at the build: (file in ``_generated/``, its generator)."""
 
@@ -106,6 +115,8 @@ MEASURED_VALUES = (
     reflex,
     reproduction,
     searched,
+    segment_margins,
+    together,
     trends,
 )
 """The modules that register ``{measured}`` values (:func:`.values.value`) when imported."""

@@ -72,7 +72,8 @@ def optimised_at(stability: str = "chain", added=0.0, check: bool = False):
 @cache
 def classic_stable_from() -> float:
     """The least stiffness added at each joint [N m/rad] from which the classic optimum meets the chain criterion."""
-    from spinectl.anatomy.optimum import MARGIN, least_joint_stiffness
+    from spinectl.anatomy.optimum import MARGIN
+    from spinectl.anatomy.remedy import least_joint_stiffness
 
     # to 1e-4 rather than the remedy's 0.1 %: the page quotes it to 0.1 N m/rad
     return least_joint_stiffness(lambda c: optimum("none", c).eigenvalues[0] >= MARGIN, rtol=1e-4)

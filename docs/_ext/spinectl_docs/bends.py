@@ -175,3 +175,29 @@ value("reflex.curve_f_no_lag")(lambda: plateau(0.0))
 value("reflex.subject_f_120_springs")(lambda: f"{springs_only().fraction:.4f}")
 value("reflex.subject_share_120_springs")(springs_share)
 value("reflex.curve_springs_least")(springs_least)
+
+
+@cache
+def springs_only_wagner():
+    """The chain's rule design of ``design --delay 0.12 --E 0.03 --Lambda 0.04 --set local.damping=0`` on
+    ``wagner2012`` at its own K (a ChainDesign): the page's example of a margin the table writes in s."""
+    from spinectl._threads import one_blas_thread
+    from spinectl.model.config import load_preset, set_parameters
+    from spinectl.optimise.reference import solve_point
+    from spinectl.reflex.design.chain import chain_design
+
+    model = set_parameters(load_preset("wagner2012"), {"reflex.delay": K_DELAY, "local.damping": 0.0})
+    with one_blas_thread():
+        pcsa = model.reflex.activation * np.asarray(solve_point(model, *POSITION).pcsa, float)
+        return chain_design(model, *POSITION, pcsa, model.reflex.activation)
+
+
+def seconds_example() -> str:
+    """'f = 0.998 is 329.8 s': the example of a delay the table writes in s (a margin of 1 s or more)."""
+    design = springs_only_wagner()
+    if not 1.0 <= design.delay_margin < np.inf:
+        raise RuntimeError(f"docs/reflex.md's example of a margin in s has {design.delay_margin} s")
+    return f"f = {design.fraction:.3f} is {design.delay_margin:.1f} s"
+
+
+value("reflex.seconds_example")(seconds_example)

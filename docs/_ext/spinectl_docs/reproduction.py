@@ -20,7 +20,7 @@ from spinectl.model.config import load_preset
 from spinectl.paper import assumptions, calibration, verdicts
 
 from .markup import md_escape
-from .values import value
+from .values import VALUES, value
 
 
 def parameter_table() -> str:
@@ -76,6 +76,9 @@ value("reproduction.claim")(claim)
 value("reproduction.optimum_lordosis")(lambda: _documented("optimum_lordosis"))
 value("reproduction.ct_optimum")(lambda: _documented("ct_optimum"))
 value("reproduction.agreeing")(agreeing)
+for _name in verdicts.VERDICTS:  # every landmark's documented value: {measured}`reproduction.<landmark>`
+    if f"reproduction.{_name}" not in VALUES:
+        value(f"reproduction.{_name}")(lambda n=_name: _documented(n))
 
 
 # --- "The whole chain: what the paper's conclusions become" (numbers of ``docs/chain.md``'s computations) ---
@@ -88,14 +91,20 @@ OPTIMUM = (0.03, 0.04)
 
 
 @cache
-def chain_margins():
-    """``spinectl sweep`` of ``wagner2012`` on the paper's grid: the chain's static margin with the global
-    muscles alone at each point's per-segment optimum, ``coupled_margin_Nm_per_rad`` [N m/rad]."""
+def landscape():
+    """``spinectl sweep`` of ``wagner2012`` on the paper's grid (:data:`LANDSCAPE_POINTS` per axis, about a
+    second): the landscape whose chain margin and counter torques the page quotes."""
     from spinectl.landscape.sweep import sweep
     from spinectl.paper.grid import paper_axis
 
     axis = paper_axis(LANDSCAPE_POINTS)
-    return sweep(load_preset(verdicts.PRESET), axis, axis, progress=False)["coupled_margin_Nm_per_rad"]
+    return sweep(load_preset(verdicts.PRESET), axis, axis, progress=False)
+
+
+def chain_margins():
+    """The chain's static margin with the global muscles alone at each point's per-segment optimum,
+    ``coupled_margin_Nm_per_rad`` of :func:`landscape` [N m/rad]."""
+    return landscape()["coupled_margin_Nm_per_rad"]
 
 
 def _largest_margin() -> str:
@@ -237,3 +246,38 @@ def _chain_rule_margin(preset: str) -> str:
 
 value("reproduction.joint_reflex_margin")(lambda: _both(lambda p: f"{1e3 * _joint_margin(p):.0f}") + " ms")
 value("reproduction.chain_reflex_margin")(lambda: _both(_chain_rule_margin) + " ms")
+
+
+# --- the ±30 N m region and the least counter torque against E ("Almost independent of E") ---
+
+CT_ECCENTRICITIES = np.arange(1, 9) / 100
+"""E [m] at which the page reads the least counter torque over Lambda: 1, ..., 8 cm."""
+
+
+def least_counter_torques() -> np.ndarray:
+    """The least ``counter_torque_norm_Nm`` over Lambda of :func:`landscape` at each of :data:`CT_ECCENTRICITIES`."""
+    torque = landscape()["counter_torque_norm_Nm"]
+    return np.array([float(torque.sel(E=e, method="nearest").min()) for e in CT_ECCENTRICITIES])
+
+
+def _grows() -> str:
+    """The least counter torques against E, guarding the page's "it grows": '9.5, 19.0, … and 74.2'."""
+    torques = least_counter_torques()
+    if not np.all(np.diff(torques) > 0):
+        raise RuntimeError(f"docs/reproduction.md says the least counter torque grows with E; it is {torques}")
+    texts = [f"{t:.1f}" for t in torques]
+    return ", ".join(texts[:-1]) + " and " + texts[-1]
+
+
+def _region() -> tuple[float, float]:
+    """The share of the grid where ‖CT‖ < 30 N m (the paper's limit) [%] and the largest E there [cm]."""
+    from spinectl.paper.landmarks import CT_LIMIT
+
+    torque = landscape()["counter_torque_norm_Nm"]
+    inside = torque < CT_LIMIT
+    return 100 * float(inside.mean()), 100 * float(torque["E"].where(inside).max())
+
+
+value("reproduction.least_ct_by_e")(_grows)
+value("reproduction.ct_region_share")(lambda: f"{_region()[0]:.0f} %")
+value("reproduction.ct_region_e")(lambda: f"{_region()[1]:.1f}")

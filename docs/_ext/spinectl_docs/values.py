@@ -46,6 +46,12 @@ def missing_extra(error: ImportError) -> str:
     return f"(not computed: {getattr(error, 'name', None) or error} is not installed at this build)"
 
 
+def is_missing_extra(error: ImportError) -> bool:
+    """Whether ``error`` is an extra's package absent (``No module named 'mujoco'``), not a name of spinectl's own
+    that a generator still imports after it moved (``cannot import name ... from 'spinectl...'``)."""
+    return isinstance(error, ModuleNotFoundError) and not (error.name or "spinectl").startswith("spinectl")
+
+
 def text_of(name: str) -> str:
     """The text of a registered value, or the note on the extra that is missing.
 
@@ -53,11 +59,16 @@ def text_of(name: str) -> str:
     ------
     KeyError
         For a name no generator registered.
+    ImportError
+        Where a generator imports a name that spinectl no longer has (the build fails rather than print a note
+        that an extra is missing).
     """
     function, _ = VALUES[name]
     try:
         return function()
     except ImportError as error:
+        if not is_missing_extra(error):  # spinectl's own name gone (moved or renamed): the generator is stale
+            raise
         return missing_extra(error)
     except NotAtBuild as error:
         return f"(not computed: {error})"
