@@ -270,6 +270,7 @@ OUTPUT_PATTERNS = {
     "a fraction of k*": re.compile(r"\b\d+\.\d+ (?:times )?k\*"),
     "a preset's margin": re.compile(r"\b\d+\.\d+ ms,? \(`(?:default|wagner2012)`"),
     "a margin beside its lagless one": re.compile(r"\b\d+\.\d+ s \(\d+\.\d+\)"),
+    "a largest delay met": re.compile(r"\blargest\s+delay\s+met:? \d+(?:\.\d+)? ms"),
 }
 """The rule: what a command prints, typed beside the words that name it. The patterns of the numbers that were
 typed in docs/anatomy.md (-K_jj and eigenvalues in N m/rad, rates in 1/s, costs, the rank and singular values,
@@ -335,12 +336,13 @@ def test_the_typed_number_scan_finds_what_it_is_for(tmp_path, monkeypatch):
         "D is 1.12 to 1.18 times the chain's, L1L2-L2L3 +39.0 in OpenSim\nwith T_a = 50 ms 0.28 k* at 5 ms\n"
         "found 0.909 ms (`default`) and 2.90 ms (`wagner2012`)\n10 times below 100 ms, 0 k* at 0 ms\n"
         "| 0.5 | 0.195 s (0.243) | unbounded |\nT_a = 0.1 s (a lag of 0.1 s) and 3.7 s of CPU\n"
+        "no activation (largest delay met 26.36 ms)\n"
     )
     monkeypatch.setattr(sys.modules[__name__], "DOCS", tmp_path)
     monkeypatch.setattr(sys.modules[__name__], "ROOT", tmp_path)
     (tmp_path / "README.md").write_text("")
     lines = sorted({(n, w) for _, n, _, w in typed_outputs()})
-    assert [n for n, _ in lines] == [1, 2, 3, 3, 4, 7, 7, 8, 9, 11]
+    assert [n for n, _ in lines] == [1, 2, 3, 3, 4, 7, 7, 8, 9, 11, 13]
 
 
 def test_reflex_pages_design_against_k_is_spinectl_design_at_that_k():
@@ -361,6 +363,18 @@ def test_reflex_pages_design_against_k_is_spinectl_design_at_that_k():
         "k_fraction": f"{chain['local_stiffness_fraction']:.3f}",
         "k_static": f"{sum(chain['least_static_local_stiffness_Nm_per_rad']):.0f}",
     }
+
+
+def test_reflex_pages_stiff_passive_case_is_spinectl_designs_table():
+    """docs/reflex.md's case where the rule has no design (`design --delay 0.1 --K 200`; reflex.py calls the
+    library's answer): the largest delay met and the rule's k_d range the page quotes are the command's own
+    line ('the largest delay met: ...') and its 'k_d 22.3-35.2 N m s/rad' rounded to integers."""
+    from spinectl_docs.values import text_of
+
+    printed = spinectl_design("--delay", "0.1", "--K", "200")
+    assert f"the largest delay met: {text_of('reflex.stiff_largest_delay')}" in printed
+    low, high = re.search(r"k_d (\d+\.\d+)-(\d+\.\d+) N m s/rad", printed).groups()
+    assert text_of("reflex.stiff_rule_kd") == f"{float(low):.0f}\u2013{float(high):.0f}"
 
 
 def test_interchange_pages_causes_together_are_opensims_own_k():
