@@ -377,6 +377,40 @@ def test_reflex_pages_stiff_passive_case_is_spinectl_designs_table():
     assert text_of("reflex.stiff_rule_kd") == f"{float(low):.0f}\u2013{float(high):.0f}"
 
 
+def test_reproduction_pages_counter_torque_is_offset_times_force():
+    """docs/reproduction.md's ‖CT‖ = ‖x‖ F at (3, 4) cm: the counter torques `spinectl stability --E 0.03 --Lambda
+    0.04` computes (its optimum's CT_k) are -x_k F, x_k the CoRs' offsets (geometry.cor_positions) and F the
+    page's generated force, to its printed rounding; the page's ‖x‖ is that of those offsets."""
+    from spinectl.model.config import load_preset
+    from spinectl.model.geometry import cor_positions
+    from spinectl.optimise.stabilising import stability_at
+    from spinectl_docs.values import text_of
+
+    model = load_preset("wagner2012")
+    ct = stability_at(model, 0.03, 0.04).counter_torque
+    x = cor_positions(0.03, 0.04, model.geometry)[:, 0]
+    force = float(text_of("reproduction.optimum_force"))
+    assert np.allclose(np.abs(ct), np.abs(x) * force, rtol=1e-3, atol=0)
+    assert text_of("reproduction.optimum_offset") == f"{100 * np.linalg.norm(x):.1f}"
+
+
+def test_reproduction_pages_ratios_are_the_documented_landmarks():
+    """docs/reproduction.md's ratios of the paper's 81 x 81 grid (3.4346 and 2.038 when written) round to the
+    landmark values of spinectl.paper.verdicts (which tests/paper/test_verdicts.py checks against a fresh
+    measurement), and its ‖x‖ ratios times F's ratio give those counter-torque ratios (‖CT‖ = ‖x‖ F)."""
+    from spinectl.paper.verdicts import VERDICTS
+    from spinectl_docs import reproduction
+    from spinectl_docs.values import text_of
+
+    assert float(text_of("reproduction.grid_D_over_C_text")) == pytest.approx(VERDICTS["ct_D_over_C_text"].value,
+                                                                               abs=0.005)  # fmt: skip
+    assert float(text_of("reproduction.grid_B_over_C_ridge")) == pytest.approx(VERDICTS["ct_B_over_C_ridge"].value,
+                                                                                abs=0.005)  # fmt: skip
+    b, c = (float(f) for f in text_of("reproduction.force_B_over_C_ridge").split("/"))
+    ratio = reproduction.offset_norm((0.08, 0.0)) / reproduction.offset_norm((0.047, 0.08))  # the grid's points
+    assert ratio * b / c == pytest.approx(float(text_of("reproduction.grid_B_over_C_ridge")), rel=2e-3)
+
+
 def test_interchange_pages_causes_together_are_opensims_own_k():
     """docs/interchange.md's causes of Millard's instability (millard.py puts Millard's activation floor, curve
     value and slope into spinectl's chain one at a time): all three together give OpenSim's own linearised K of

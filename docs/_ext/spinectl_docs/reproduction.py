@@ -44,9 +44,22 @@ def parameter_table() -> str:
     return "\n".join(lines) + "\n"
 
 
+@cache
+def assumption_rows() -> dict:
+    """Every landmark under each choice the paper does not make, measured once per build (a coarse grid, a few
+    seconds): landmark name -> :class:`spinectl.paper.assumptions.Row`, the table's and the sentences' source."""
+    return {row.name: row for row in assumptions.documented_rows()}
+
+
 def assumption_table() -> str:
-    """Every landmark under each choice the paper does not make, measured now (a coarse grid, about half a minute)."""
-    return assumptions.markdown(assumptions.documented_rows())
+    """Every landmark under each choice the paper does not make, measured now (:func:`assumption_rows`)."""
+    return assumptions.markdown(list(assumption_rows().values()))
+
+
+def _under(name: str, column: str) -> float:
+    """A landmark's value in a column of the assumption table (``"mass"``: the mass-free preset's;
+    ``"activation"``: independent activation; ``"chosen"``: ``wagner2012`` on the table's grid)."""
+    return assumption_rows()[name].values[column][0]
 
 
 def landmark_table() -> str:
@@ -281,3 +294,124 @@ def _region() -> tuple[float, float]:
 value("reproduction.least_ct_by_e")(_grows)
 value("reproduction.ct_region_share")(lambda: f"{_region()[0]:.0f} %")
 value("reproduction.ct_region_e")(lambda: f"{_region()[1]:.1f}")
+
+
+# --- the counter torques as ‖x‖ times F ("D twice C", "Minimal along the bisector", "The ±30 N m region") ---
+
+
+def offset_norm(position) -> float:
+    """‖x‖ [m] at (E, Lambda) [m]: the CoRs' horizontal offsets x_k = -E + Lambda phi_k (the spline alone)."""
+    from spinectl.model.geometry import cor_positions
+
+    return float(np.linalg.norm(cor_positions(*position, load_preset(verdicts.PRESET).geometry)[:, 0]))
+
+
+def _grid(position) -> tuple[float, float]:
+    """The point of :func:`landscape` that the landmarks read for ``position`` (the nearest, as ``readings.at``)."""
+    from spinectl.paper.readings import grid_point
+
+    return grid_point(landscape(), position)
+
+
+def counter_torque(position) -> float:
+    """‖CT‖ [N m] of :func:`landscape` at the grid point nearest ``position``."""
+    from spinectl.paper.readings import at
+
+    return at(landscape(), "counter_torque_norm_Nm", position)
+
+
+def vertical_force(position) -> float:
+    """F = ‖CT‖ / ‖x‖ [N] at the grid point nearest ``position``: the weight and the muscles' vertical pull."""
+    return counter_torque(position) / offset_norm(_grid(position))
+
+
+C_READING_POINTS = {"corner": "C", "interior": "OPTIMUM", "ridge": "RIDGE_C"}
+"""The three readings of C, by the name of their position in :mod:`spinectl.paper.landmarks` (grid or landmarks)."""
+
+
+def c_position(reading: str):
+    """(E, Lambda) [m] of C under a reading (:data:`C_READING_POINTS`)."""
+    from spinectl.paper import landmarks
+    from spinectl.paper.grid import POSITIONS
+
+    return POSITIONS["C"] if reading == "corner" else getattr(landmarks, C_READING_POINTS[reading])
+
+
+def offset_ratio(corner: str, reading: str) -> str:
+    """‖x(corner)‖ / ‖x(C)‖ at the positions themselves (the spline alone, no grid), to 2 decimals."""
+    from spinectl.paper.grid import POSITIONS
+
+    return f"{offset_norm(POSITIONS[corner]) / offset_norm(c_position(reading)):.2f}"
+
+
+def _force_ratio() -> str:
+    """'598/910': F at B and at C on the ridge reading [N]."""
+    from spinectl.paper.grid import POSITIONS
+
+    return f"{vertical_force(POSITIONS['B']):.0f}/{vertical_force(c_position('ridge')):.0f}"
+
+
+def _grid_ratio(top: str, reading: str, digits: int) -> str:
+    """‖CT(top)‖ / ‖CT(C)‖ on the paper's 81 x 81 grid (the report's landmark table), to ``digits`` decimals."""
+    from spinectl.paper.grid import POSITIONS
+
+    return f"{counter_torque(POSITIONS[top]) / counter_torque(c_position(reading)):.{digits}f}"
+
+
+def _valley() -> str:
+    """'1.24 ± 0.002': the valley floor's slope on the paper's grid and its standard error (landmarks' fit)."""
+    from spinectl.paper.readings import crest_fit
+
+    fit = crest_fit(landscape(), "counter_torque_norm_Nm", "min")
+    return f"{fit.slope:.2f} ± {fit.uncertainty:.1g}"
+
+
+def _mass_free_mass() -> str:
+    return f"{load_preset(assumptions.MASS_FREE_PRESET).body.mass:.1f} kg"
+
+
+def _mass_free_halving() -> str:
+    """'0.56 with `paper`, 0.51 with `physical`': the mass-free preset's halving under its own K convention and
+    the other."""
+    own = load_preset(assumptions.MASS_FREE_PRESET).passive.convention
+    other = "physical" if own == "paper" else "paper"
+    return (f"{verdicts.format_number(_under('halving_K15', 'mass'))} with `{own}`, "
+            f"{verdicts.format_number(_under('halving_K15_other', 'mass'))} with `{other}`")  # fmt: skip
+
+
+def _spline_slope() -> str:
+    """sum phi / sum phi^2: where ‖x‖ is least, Lambda over E [1]."""
+    from spinectl.model.geometry import lordosis_shape
+
+    phi = lordosis_shape(load_preset(verdicts.PRESET).geometry)
+    return f"{np.sum(phi) / np.sum(phi**2):.2f}"
+
+
+def _least_offset() -> str:
+    """sqrt(5 - (sum phi)^2 / sum phi^2): the least ‖x‖ over Lambda per unit E [1]."""
+    from spinectl.model.geometry import lordosis_shape
+
+    phi = lordosis_shape(load_preset(verdicts.PRESET).geometry)
+    return f"{np.sqrt(phi.size - np.sum(phi) ** 2 / np.sum(phi**2)):.2f}"
+
+
+value("reproduction.optimum_offset")(lambda: f"{100 * offset_norm(OPTIMUM):.1f}")
+value("reproduction.optimum_force")(lambda: f"{vertical_force(OPTIMUM):.0f}")
+value("reproduction.valley_slope")(_valley)
+value("reproduction.spline_slope")(_spline_slope)
+value("reproduction.least_offset")(_least_offset)
+value("reproduction.mass_free_ridge_over_B")(lambda: verdicts.format_number(_under("ridge_over_B", "mass")))
+value("reproduction.mass_free_mass")(_mass_free_mass)
+value("reproduction.mass_free_valley")(lambda: verdicts.format_number(_under("ct_valley_slope", "mass")))
+value("reproduction.mass_free_halving")(_mass_free_halving)
+value("reproduction.independent_D_over_C")(
+    lambda: verdicts.format_number(_under("ct_D_over_C_text", "activation"))
+)
+value("reproduction.summary_B_over_C_ridge")(lambda: verdicts.format_number(_under("ct_B_over_C_ridge", "chosen")))
+value("reproduction.grid_D_over_C_text")(lambda: _grid_ratio("D", "interior", 4))
+value("reproduction.grid_B_over_C_ridge")(lambda: _grid_ratio("B", "ridge", 3))
+value("reproduction.force_B_over_C_ridge")(_force_ratio)
+for _corner in ("D", "B"):
+    for _reading in C_READING_POINTS:
+        value(f"reproduction.offset_{_corner}_over_C_{_reading}")(lambda c=_corner, r=_reading: offset_ratio(c, r))
+
