@@ -411,6 +411,25 @@ def test_reproduction_pages_ratios_are_the_documented_landmarks():
     assert ratio * b / c == pytest.approx(float(text_of("reproduction.grid_B_over_C_ridge")), rel=2e-3)
 
 
+def test_errata_pages_removed_fractions_are_the_models_stiffness_ratios():
+    """docs/errata.md's table of the fraction of gravity stiffness that K = 15 N m/rad removes at A (errata.py
+    writes K r/g and K/(m g r) in closed form) is the model's own passive over gravity stiffness
+    (segment_coefficients of `wagner2012` with K = 15 in each convention), to the table's two decimals; and the
+    header's loss pair the page quotes is the preset's own convention first."""
+    from spinectl.model.checks import checked_coefficients
+    from spinectl.model.config import load_preset
+    from spinectl.paper import grid
+    from spinectl_docs.values import text_of
+
+    model = load_preset("wagner2012")
+    for convention in ("paper", "physical"):
+        c = checked_coefficients(grid.with_stiffness(model, grid.PAPER_STIFFNESS, convention), 0.0, 0.0)
+        shown = [float(text_of(f"errata.{convention}_{k}")) for k in range(5)]
+        np.testing.assert_allclose(shown, np.abs(c.passive_stiffness / c.gravity_stiffness), atol=0.005 + 1e-9)
+    own, other = (float(v) for v in text_of("reproduction.wagner_loss_pair").split(" against "))
+    assert own < other and model.passive.convention == "physical"
+
+
 def test_interchange_pages_causes_together_are_opensims_own_k():
     """docs/interchange.md's causes of Millard's instability (millard.py puts Millard's activation floor, curve
     value and slope into spinectl's chain one at a time): all three together give OpenSim's own linearised K of

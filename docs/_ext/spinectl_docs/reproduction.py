@@ -371,12 +371,12 @@ def _mass_free_mass() -> str:
 
 
 def _mass_free_halving() -> str:
-    """'0.56 with `paper`, 0.51 with `physical`': the mass-free preset's halving under its own K convention and
+    """'0.557 with paper, 0.511 with physical': the mass-free preset's halving under its own K convention and
     the other."""
     own = load_preset(assumptions.MASS_FREE_PRESET).passive.convention
     other = "physical" if own == "paper" else "paper"
-    return (f"{verdicts.format_number(_under('halving_K15', 'mass'))} with `{own}`, "
-            f"{verdicts.format_number(_under('halving_K15_other', 'mass'))} with `{other}`")  # fmt: skip
+    return (f"{verdicts.format_number(_under('halving_K15', 'mass'))} with {own}, "
+            f"{verdicts.format_number(_under('halving_K15_other', 'mass'))} with {other}")  # fmt: skip
 
 
 def _spline_slope() -> str:
@@ -415,3 +415,66 @@ for _corner in ("D", "B"):
     for _reading in C_READING_POINTS:
         value(f"reproduction.offset_{_corner}_over_C_{_reading}")(lambda c=_corner, r=_reading: offset_ratio(c, r))
 
+
+
+# --- what the calibrated presets' headers record (read, never a calibration run at the build) ---
+
+
+def preset_header(preset: str) -> list[str]:
+    """The comment lines at the head of a built-in preset's TOML (``spinectl calibrate`` writes its run there)."""
+    from importlib import resources
+
+    from spinectl.model.config import PRESET_PACKAGE
+
+    text = resources.files(PRESET_PACKAGE).joinpath(f"{preset}.toml").read_text(encoding="utf-8")
+    return [line[1:].strip() for line in text.splitlines() if line.startswith("#")]
+
+
+def _header_line(preset: str, words: str) -> str:
+    line = next((line for line in preset_header(preset) if words in line), None)
+    if line is None:
+        raise RuntimeError(f"the {preset} preset's header no longer says {words!r}: docs/reproduction.md reads it")
+    return line
+
+
+def convention_losses(preset: str) -> dict[str, float]:
+    """Each convention's loss at the preset's vector, as its header records them ('picked at ...')."""
+    import re
+
+    line = _header_line(preset, "picked at")
+    return {c: float(v) for c, v in re.findall(r"\b(physical|paper) (\d+\.\d+)", line)}
+
+
+def calibration_loss(preset: str) -> tuple[float, str]:
+    """The preset's loss on the verifying grid and how many landmarks agree ('11 of 22'), from its header."""
+    import re
+
+    found = re.search(r"Loss: (\d+\.\d+) .*?(\d+ of \d+) landmarks agree", _header_line(preset, "Loss: "))
+    return float(found.group(1)), found.group(2)
+
+
+def search_time(preset: str) -> tuple[int, int]:
+    """The calibration's wall time [s] and loss evaluations, from the preset's header."""
+    import re
+
+    found = re.search(r"wall time (\d+) s, (\d+) loss evaluations", _header_line(preset, "wall time"))
+    return int(found.group(1)), int(found.group(2))
+
+
+def _loss_pair(preset: str) -> str:
+    """'0.891 against 0.977': the loss of the preset's own convention at its vector and the other's, 3 digits."""
+    own = load_preset(preset).passive.convention
+    losses = convention_losses(preset)
+    other = next(c for c in losses if c != own)
+    return f"{losses[own]:.3f} against {losses[other]:.3f}"
+
+
+value("reproduction.wagner_convention", code=True)(lambda: load_preset(verdicts.PRESET).passive.convention)
+value("reproduction.wagner_loss_pair")(lambda: _loss_pair(verdicts.PRESET))
+value("reproduction.wagner_search")(lambda: "{:,} s ({} evaluations)".format(*search_time(verdicts.PRESET)))
+value("reproduction.mass_free_search")(lambda: f"{search_time(assumptions.MASS_FREE_PRESET)[0]:,} s")
+value("reproduction.mass_free_convention", code=True)(
+    lambda: load_preset(assumptions.MASS_FREE_PRESET).passive.convention
+)
+value("reproduction.mass_free_loss")(lambda: f"{calibration_loss(assumptions.MASS_FREE_PRESET)[0]:.3f}")
+value("reproduction.mass_free_agree")(lambda: calibration_loss(assumptions.MASS_FREE_PRESET)[1])
