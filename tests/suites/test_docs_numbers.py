@@ -430,6 +430,21 @@ def test_errata_pages_removed_fractions_are_the_models_stiffness_ratios():
     assert own < other and model.passive.convention == "physical"
 
 
+def test_atlas_pages_angle_range_is_what_the_command_refuses_beyond():
+    """docs/atlas.md's '±10 cm is ±119.2°' (atlas.py converts the model's Lambda range) is the range that
+    `spinectl stability --lordosis-angle` states when it refuses an angle beyond it (its own message)."""
+    from spinectl_docs.values import text_of
+
+    angle = float(re.search(r"±(\d+\.\d+)°", text_of("atlas.range_angles")).group(1))
+    done = subprocess.run(
+        [sys.executable, "-m", "spinectl", "stability", "--E", "0", "--lordosis-angle", "150"],
+        capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert done.returncode == 2
+    low, high = (float(v) for v in re.search(r"\[(-?\d+\.\d+), (\d+\.\d+)\] deg", done.stderr).groups())
+    assert (round(low, 1), round(high, 1)) == (-angle, angle)
+
+
 def test_interchange_pages_causes_together_are_opensims_own_k():
     """docs/interchange.md's causes of Millard's instability (millard.py puts Millard's activation floor, curve
     value and slope into spinectl's chain one at a time): all three together give OpenSim's own linearised K of

@@ -57,6 +57,7 @@ from pathlib import Path
 
 from . import (
     anatomy,
+    atlas,
     bends,
     chain,
     design,
@@ -105,6 +106,7 @@ MEASURED_TABLES = (
 
 MEASURED_VALUES = (
     anatomy,
+    atlas,
     bends,
     chain,
     errata,
