@@ -445,6 +445,18 @@ def test_atlas_pages_angle_range_is_what_the_command_refuses_beyond():
     assert (round(low, 1), round(high, 1)) == (-angle, angle)
 
 
+def test_cli_pages_margin_is_spinectl_margins_json():
+    """docs/cli.md's L1L2 margin (reproduction.py calls margins_report) is `spinectl margins --json`'s first
+    segment's delay_margin_s to the page's four decimals, and its last segment's margin is null, 'unbounded'."""
+    from spinectl_docs.values import text_of
+
+    done = subprocess.run([sys.executable, "-m", "spinectl", "margins", "--json"], capture_output=True, text=True,
+                          timeout=300)  # fmt: skip
+    first, last = json.loads(done.stdout)["segments"][0], json.loads(done.stdout)["segments"][-1]
+    assert text_of("cli.l1l2_margin") == f"{first['delay_margin_s']:.4f}"
+    assert last["delay_margin_s"] is None and last["delay_margin_s_reason"] == "unbounded"
+
+
 def test_interchange_pages_causes_together_are_opensims_own_k():
     """docs/interchange.md's causes of Millard's instability (millard.py puts Millard's activation floor, curve
     value and slope into spinectl's chain one at a time): all three together give OpenSim's own linearised K of

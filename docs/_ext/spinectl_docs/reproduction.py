@@ -243,11 +243,28 @@ value("reproduction.lordosis_least_where")(_least_where)
 
 
 @cache
-def _joint_margin(preset: str) -> float:
-    """The least delay margin over the joints, each alone [s] (``spinectl margins --E 0 --Lambda 0``)."""
+def margins_at_a(preset: str):
+    """``spinectl margins --preset P --E 0 --Lambda 0``: each joint alone (a MarginsReport)."""
     from spinectl.reflex.margins import margins_report
 
-    return min(s.delay_margin for s in margins_report(load_preset(preset), 0.0, 0.0).segments)
+    return margins_report(load_preset(preset), 0.0, 0.0)
+
+
+def _joint_margin(preset: str) -> float:
+    """The least delay margin over the joints, each alone [s] (``spinectl margins --E 0 --Lambda 0``)."""
+    return min(s.delay_margin for s in margins_at_a(preset).segments)
+
+
+def _cli_margins() -> str:
+    """'0.1962': L1L2's delay margin [s] of ``spinectl margins --json`` with its defaults, guarding the page's
+    'L5S1 is self-stable' (its margin unbounded)."""
+    segments = margins_at_a(verdicts.PRESET).segments
+    if np.isfinite(segments[-1].delay_margin):
+        raise RuntimeError("docs/cli.md says L5S1's margin is unbounded (self-stable) under margins' defaults")
+    return f"{segments[0].delay_margin:.4f}"
+
+
+value("cli.l1l2_margin")(_cli_margins)
 
 
 def _chain_rule_margin(preset: str) -> str:
