@@ -28,7 +28,9 @@ a text changed, so that incremental builds stay incremental):
   each preset's activations, :mod:`.segment_margins`);
 - ``_generated/anatomy-*.md``: ``spinectl anatomy``'s tables on MyoTorso in ``anatomy.md`` (verdicts, optima,
   lordosis, reflex; measured at the build, :mod:`.anatomy`);
-- ``_generated/motion-lift.png``: the lift of ``motion.md`` on MyoTorso (:mod:`.lift`).
+- ``_generated/motion-lift.png``: the lift of ``motion.md`` on MyoTorso (:mod:`.lift`);
+- ``_generated/studies-estimate.md``: the line ``spinectl study`` states before a long run, in ``studies.md``
+  (:mod:`.studies`).
 
 Numbers that a sentence quotes are the ``{measured}`` role's (:mod:`.values`): ``{measured}`anatomy.remedy```
 is replaced by what the code gives at the build; the pages that use it are read again at every build, so
@@ -76,6 +78,7 @@ from . import (
     reproduction,
     searched,
     segment_margins,
+    studies,
     together,
     trends,
     values,
@@ -101,6 +104,7 @@ MEASURED_TABLES = (
     ("reflex-margins-lag.md", segment_margins.lag_table),
     ("reflex-margins-default.md", lambda: segment_margins.preset_table("default")),
     ("reflex-margins-wagner2012.md", lambda: segment_margins.preset_table("wagner2012")),
+    ("studies-estimate.md", studies.estimate_block),
 )
 """The tables of what commands print, measured at the build: (file in ``_generated/``, its generator)."""
 
