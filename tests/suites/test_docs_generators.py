@@ -226,8 +226,9 @@ def test_the_study_estimate_line_is_the_estimate_of_the_pages_example(monkeypatc
     """docs/studies.md's estimate line (studies.py) is the one `spinectl study` states before a long run: for
     the page's example (1000 x 1000 points x 100 values of K) it counts 100,000,000 points, and it follows the
     benchmark's cost a point (here doubled: the line's CPU time doubles), not a typed figure."""
-    from spinectl.landscape import budget
     from spinectl_docs import studies
+
+    from spinectl.landscape import budget
 
     line = studies.estimate_line()
     assert line.startswith("study: 100,000,000 points, about ") and line.endswith(" of CPU (estimated)")

@@ -381,10 +381,11 @@ def test_reproduction_pages_counter_torque_is_offset_times_force():
     """docs/reproduction.md's ‖CT‖ = ‖x‖ F at (3, 4) cm: the counter torques `spinectl stability --E 0.03 --Lambda
     0.04` computes (its optimum's CT_k) are -x_k F, x_k the CoRs' offsets (geometry.cor_positions) and F the
     page's generated force, to its printed rounding; the page's ‖x‖ is that of those offsets."""
+    from spinectl_docs.values import text_of
+
     from spinectl.model.config import load_preset
     from spinectl.model.geometry import cor_positions
     from spinectl.optimise.stabilising import stability_at
-    from spinectl_docs.values import text_of
 
     model = load_preset("wagner2012")
     ct = stability_at(model, 0.03, 0.04).counter_torque
@@ -398,9 +399,10 @@ def test_reproduction_pages_ratios_are_the_documented_landmarks():
     """docs/reproduction.md's ratios of the paper's 81 x 81 grid (3.4346 and 2.038 when written) round to the
     landmark values of spinectl.paper.verdicts (which tests/paper/test_verdicts.py checks against a fresh
     measurement), and its ‖x‖ ratios times F's ratio give those counter-torque ratios (‖CT‖ = ‖x‖ F)."""
-    from spinectl.paper.verdicts import VERDICTS
     from spinectl_docs import reproduction
     from spinectl_docs.values import text_of
+
+    from spinectl.paper.verdicts import VERDICTS
 
     assert float(text_of("reproduction.grid_D_over_C_text")) == pytest.approx(VERDICTS["ct_D_over_C_text"].value,
                                                                                abs=0.005)  # fmt: skip
@@ -416,10 +418,11 @@ def test_errata_pages_removed_fractions_are_the_models_stiffness_ratios():
     writes K r/g and K/(m g r) in closed form) is the model's own passive over gravity stiffness
     (segment_coefficients of `wagner2012` with K = 15 in each convention), to the table's two decimals; and the
     header's loss pair the page quotes is the preset's own convention first."""
+    from spinectl_docs.values import text_of
+
     from spinectl.model.checks import checked_coefficients
     from spinectl.model.config import load_preset
     from spinectl.paper import grid
-    from spinectl_docs.values import text_of
 
     model = load_preset("wagner2012")
     for convention in ("paper", "physical"):

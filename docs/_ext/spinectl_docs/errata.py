@@ -65,7 +65,9 @@ def eccentric_difference() -> str:
 
     model, axis = load_preset("wagner2012"), grid.paper_axis(grid.PAPER_POINTS)
     printed = set_parameter(model, "errata.eccentric_constant", "printed")
-    a, b = (calibration.coarse_landscape(m, axis, counter_torque=False)["min_pcsa_cm2"].values for m in (model, printed))
+    a, b = (
+        calibration.coarse_landscape(m, axis, counter_torque=False)["min_pcsa_cm2"].values for m in (model, printed)
+    )
     return f"{float(np.nanmax(np.abs(a - b))):.1f} cm²"
 
 
@@ -97,7 +99,9 @@ for _kind, _fmt in (("paper", ".2f"), ("physical", ".2f"), ("half", ".1f")):  # 
     for _k in range(5):
         value(f"errata.{_kind}_{_k}")(lambda kind=_kind, k=_k, fmt=_fmt: f"{removed_fractions()[kind][k]:{fmt}}")
 value("errata.fraction_mass")(lambda: f"{removed_fractions()['mass']:.1f} kg")
-value("errata.left_l5s1")(lambda: f"1 − {removed_fractions()['paper'][-1]:.2f} = {1 - removed_fractions()['paper'][-1]:.2f}")
+value("errata.left_l5s1")(
+    lambda: f"1 − {removed_fractions()['paper'][-1]:.2f} = {1 - removed_fractions()['paper'][-1]:.2f}"
+)
 value("errata.left_l4l5")(lambda: f"{1 - removed_fractions()['paper'][-2]:.2f}")
 value("errata.halving_mass_range")(
     lambda: f"{np.min(removed_fractions()['half']):.0f}–{np.max(removed_fractions()['half']):.0f} kg"

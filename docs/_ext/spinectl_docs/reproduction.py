@@ -421,9 +421,7 @@ value("reproduction.mass_free_ridge_over_B")(lambda: verdicts.format_number(_und
 value("reproduction.mass_free_mass")(_mass_free_mass)
 value("reproduction.mass_free_valley")(lambda: verdicts.format_number(_under("ct_valley_slope", "mass")))
 value("reproduction.mass_free_halving")(_mass_free_halving)
-value("reproduction.independent_D_over_C")(
-    lambda: verdicts.format_number(_under("ct_D_over_C_text", "activation"))
-)
+value("reproduction.independent_D_over_C")(lambda: verdicts.format_number(_under("ct_D_over_C_text", "activation")))
 value("reproduction.summary_B_over_C_ridge")(lambda: verdicts.format_number(_under("ct_B_over_C_ridge", "chosen")))
 value("reproduction.grid_D_over_C_text")(lambda: _grid_ratio("D", "interior", 4))
 value("reproduction.grid_B_over_C_ridge")(lambda: _grid_ratio("B", "ridge", 3))
@@ -431,7 +429,6 @@ value("reproduction.force_B_over_C_ridge")(_force_ratio)
 for _corner in ("D", "B"):
     for _reading in C_READING_POINTS:
         value(f"reproduction.offset_{_corner}_over_C_{_reading}")(lambda c=_corner, r=_reading: offset_ratio(c, r))
-
 
 
 # --- what the calibrated presets' headers record (read, never a calibration run at the build) ---
