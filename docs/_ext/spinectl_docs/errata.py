@@ -113,3 +113,6 @@ value("errata.ridge_k15")(lambda: _k15("min_pcsa_ridge_K15", "chosen"))
 value("errata.ridge_k15_other")(lambda: _k15("min_pcsa_ridge_K15", "convention"))
 value("errata.halving")(lambda: _k15("halving_K15", "chosen"))
 value("errata.halving_other")(lambda: _k15("halving_K15", "convention"))
+value("errata.low_cors_range")(
+    lambda: f"{removed_fractions()['paper'][-2]:.2f}–{removed_fractions()['paper'][-1]:.2f}"
+)  # L4L5 and L5S1 under `paper`: docs/reproduction.md's "which would halve it"

@@ -492,3 +492,15 @@ value("reproduction.mass_free_convention", code=True)(
 )
 value("reproduction.mass_free_loss")(lambda: f"{calibration_loss(assumptions.MASS_FREE_PRESET)[0]:.3f}")
 value("reproduction.mass_free_agree")(lambda: calibration_loss(assumptions.MASS_FREE_PRESET)[1])
+
+
+def _limit_pcsa() -> str:
+    """'17.1 cm²': the paper's ±30 N m limit as local muscle at its 7 cm lever arm (``wagner2012``'s tension)."""
+    from spinectl.paper.landmarks import CT_LIMIT, local_pcsa_equivalent
+
+    return (
+        f"{1e4 * float(local_pcsa_equivalent(CT_LIMIT, load_preset(verdicts.PRESET).fibre.specific_tension)):.1f} cm²"
+    )
+
+
+value("reproduction.limit_pcsa")(_limit_pcsa)
