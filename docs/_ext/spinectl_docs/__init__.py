@@ -39,7 +39,7 @@ with its mapping at the build: one table row of verdicts. Besides the tables' mo
 ``reflex.md``'s design against K and its design curve's readings, :mod:`.millard` ``interchange.md``'s causes of
 Millard's instability (and its curves and re-imported chain), :mod:`.together` ``chain.md``'s local and joint
 optima at the first table's points (and ``figures.md``'s coupled ratio) and :mod:`.gainsearch` ``chain.md``'s
-gain search (a small stated budget) and bounds.
+gain search (a small stated budget) and bounds; :mod:`.atlas` ``atlas.md``'s lordosis angle conversions.
 
 ``_generated/`` is excluded from the sources (its files are included by
 ``parameters.md``, ``index.md``, ``notebooks.md`` and ``reproduction.md``);

@@ -7,7 +7,11 @@ on a coarse grid); the test suite checks the documented values against a fresh
 measurement of the preset (tests/paper/test_verdicts.py) and the documented
 assumptions against that table (tests/paper/test_assumptions.py). The chain's numbers of "The whole chain"
 are measured at the build too: the landscape's chain margin (``spinectl sweep`` on the paper's 1 mm grid,
-about a second) and the chain at the paper's optimum (:mod:`.chain`'s computations).
+about a second) and the chain at the paper's optimum (:mod:`.chain`'s computations). The counter torques'
+readings as ‖x‖ times F (the spline's offsets and the landscape's ‖CT‖), the mass-free preset's and
+independent activation's landmarks (the assumption table's rows, measured once) and what the calibrated
+presets' headers record (losses, conventions, run times: read, never a calibration at the build) feed the
+sentences of those sections.
 """
 
 from __future__ import annotations
