@@ -220,3 +220,18 @@ def test_the_decay_rate_table_is_what_design_answers():
         assert row[2] == f"{np.sum(chain.local_stiffness):.1f}" and float(row[4]) <= -sigma + 1e-6
         totals.append(float(row[2]))
     assert totals == sorted(totals) and len(totals) >= 3
+
+
+def test_the_study_estimate_line_is_the_estimate_of_the_pages_example(monkeypatch):
+    """docs/studies.md's estimate line (studies.py) is the one `spinectl study` states before a long run: for
+    the page's example (1000 x 1000 points x 100 values of K) it counts 100,000,000 points, and it follows the
+    benchmark's cost a point (here doubled: the line's CPU time doubles), not a typed figure."""
+    from spinectl_docs import studies
+
+    from spinectl.landscape import budget
+
+    line = studies.estimate_line()
+    assert line.startswith("study: 100,000,000 points, about ") and line.endswith(" of CPU (estimated)")
+    hours = float(line.split(", ")[-1].split(" h ")[0])
+    monkeypatch.setattr(budget, "STUDY_SECONDS_PER_POINT", 2 * budget.STUDY_SECONDS_PER_POINT)
+    assert float(studies.estimate_line().split(", ")[-1].split(" h ")[0]) == pytest.approx(2 * hours, rel=0.05)

@@ -270,6 +270,7 @@ OUTPUT_PATTERNS = {
     "a fraction of k*": re.compile(r"\b\d+\.\d+ (?:times )?k\*"),
     "a preset's margin": re.compile(r"\b\d+\.\d+ ms,? \(`(?:default|wagner2012)`"),
     "a margin beside its lagless one": re.compile(r"\b\d+\.\d+ s \(\d+\.\d+\)"),
+    "a largest delay met": re.compile(r"\blargest\s+delay\s+met:? \d+(?:\.\d+)? ms"),
 }
 """The rule: what a command prints, typed beside the words that name it. The patterns of the numbers that were
 typed in docs/anatomy.md (-K_jj and eigenvalues in N m/rad, rates in 1/s, costs, the rank and singular values,
@@ -335,12 +336,13 @@ def test_the_typed_number_scan_finds_what_it_is_for(tmp_path, monkeypatch):
         "D is 1.12 to 1.18 times the chain's, L1L2-L2L3 +39.0 in OpenSim\nwith T_a = 50 ms 0.28 k* at 5 ms\n"
         "found 0.909 ms (`default`) and 2.90 ms (`wagner2012`)\n10 times below 100 ms, 0 k* at 0 ms\n"
         "| 0.5 | 0.195 s (0.243) | unbounded |\nT_a = 0.1 s (a lag of 0.1 s) and 3.7 s of CPU\n"
+        "no activation (largest delay met 26.36 ms)\n"
     )
     monkeypatch.setattr(sys.modules[__name__], "DOCS", tmp_path)
     monkeypatch.setattr(sys.modules[__name__], "ROOT", tmp_path)
     (tmp_path / "README.md").write_text("")
     lines = sorted({(n, w) for _, n, _, w in typed_outputs()})
-    assert [n for n, _ in lines] == [1, 2, 3, 3, 4, 7, 7, 8, 9, 11]
+    assert [n for n, _ in lines] == [1, 2, 3, 3, 4, 7, 7, 8, 9, 11, 13]
 
 
 def test_reflex_pages_design_against_k_is_spinectl_design_at_that_k():
@@ -361,6 +363,101 @@ def test_reflex_pages_design_against_k_is_spinectl_design_at_that_k():
         "k_fraction": f"{chain['local_stiffness_fraction']:.3f}",
         "k_static": f"{sum(chain['least_static_local_stiffness_Nm_per_rad']):.0f}",
     }
+
+
+def test_reflex_pages_stiff_passive_case_is_spinectl_designs_table():
+    """docs/reflex.md's case where the rule has no design (`design --delay 0.1 --K 200`; reflex.py calls the
+    library's answer): the largest delay met and the rule's k_d range the page quotes are the command's own
+    line ('the largest delay met: ...') and its 'k_d 22.3-35.2 N m s/rad' rounded to integers."""
+    from spinectl_docs.values import text_of
+
+    printed = spinectl_design("--delay", "0.1", "--K", "200")
+    assert f"the largest delay met: {text_of('reflex.stiff_largest_delay')}" in printed
+    low, high = re.search(r"k_d (\d+\.\d+)-(\d+\.\d+) N m s/rad", printed).groups()
+    assert text_of("reflex.stiff_rule_kd") == f"{float(low):.0f}\u2013{float(high):.0f}"
+
+
+def test_reproduction_pages_counter_torque_is_offset_times_force():
+    """docs/reproduction.md's ‖CT‖ = ‖x‖ F at (3, 4) cm: the counter torques `spinectl stability --E 0.03 --Lambda
+    0.04` computes (its optimum's CT_k) are -x_k F, x_k the CoRs' offsets (geometry.cor_positions) and F the
+    page's generated force, to its printed rounding; the page's ‖x‖ is that of those offsets."""
+    from spinectl_docs.values import text_of
+
+    from spinectl.model.config import load_preset
+    from spinectl.model.geometry import cor_positions
+    from spinectl.optimise.stabilising import stability_at
+
+    model = load_preset("wagner2012")
+    ct = stability_at(model, 0.03, 0.04).counter_torque
+    x = cor_positions(0.03, 0.04, model.geometry)[:, 0]
+    force = float(text_of("reproduction.optimum_force"))
+    assert np.allclose(np.abs(ct), np.abs(x) * force, rtol=1e-3, atol=0)
+    assert text_of("reproduction.optimum_offset") == f"{100 * np.linalg.norm(x):.1f}"
+
+
+def test_reproduction_pages_ratios_are_the_documented_landmarks():
+    """docs/reproduction.md's ratios of the paper's 81 x 81 grid (3.4346 and 2.038 when written) round to the
+    landmark values of spinectl.paper.verdicts (which tests/paper/test_verdicts.py checks against a fresh
+    measurement), and its ‖x‖ ratios times F's ratio give those counter-torque ratios (‖CT‖ = ‖x‖ F)."""
+    from spinectl_docs import reproduction
+    from spinectl_docs.values import text_of
+
+    from spinectl.paper.verdicts import VERDICTS
+
+    assert float(text_of("reproduction.grid_D_over_C_text")) == pytest.approx(VERDICTS["ct_D_over_C_text"].value,
+                                                                               abs=0.005)  # fmt: skip
+    assert float(text_of("reproduction.grid_B_over_C_ridge")) == pytest.approx(VERDICTS["ct_B_over_C_ridge"].value,
+                                                                                abs=0.005)  # fmt: skip
+    b, c = (float(f) for f in text_of("reproduction.force_B_over_C_ridge").split("/"))
+    ratio = reproduction.offset_norm((0.08, 0.0)) / reproduction.offset_norm((0.047, 0.08))  # the grid's points
+    assert ratio * b / c == pytest.approx(float(text_of("reproduction.grid_B_over_C_ridge")), rel=2e-3)
+
+
+def test_errata_pages_removed_fractions_are_the_models_stiffness_ratios():
+    """docs/errata.md's table of the fraction of gravity stiffness that K = 15 N m/rad removes at A (errata.py
+    writes K r/g and K/(m g r) in closed form) is the model's own passive over gravity stiffness
+    (segment_coefficients of `wagner2012` with K = 15 in each convention), to the table's two decimals; and the
+    header's loss pair the page quotes is the preset's own convention first."""
+    from spinectl_docs.values import text_of
+
+    from spinectl.model.checks import checked_coefficients
+    from spinectl.model.config import load_preset
+    from spinectl.paper import grid
+
+    model = load_preset("wagner2012")
+    for convention in ("paper", "physical"):
+        c = checked_coefficients(grid.with_stiffness(model, grid.PAPER_STIFFNESS, convention), 0.0, 0.0)
+        shown = [float(text_of(f"errata.{convention}_{k}")) for k in range(5)]
+        np.testing.assert_allclose(shown, np.abs(c.passive_stiffness / c.gravity_stiffness), atol=0.005 + 1e-9)
+    own, other = (float(v) for v in text_of("reproduction.wagner_loss_pair").split(" against "))
+    assert own < other and model.passive.convention == "physical"
+
+
+def test_atlas_pages_angle_range_is_what_the_command_refuses_beyond():
+    """docs/atlas.md's '±10 cm is ±119.2°' (atlas.py converts the model's Lambda range) is the range that
+    `spinectl stability --lordosis-angle` states when it refuses an angle beyond it (its own message)."""
+    from spinectl_docs.values import text_of
+
+    angle = float(re.search(r"±(\d+\.\d+)°", text_of("atlas.range_angles")).group(1))
+    done = subprocess.run(
+        [sys.executable, "-m", "spinectl", "stability", "--E", "0", "--lordosis-angle", "150"],
+        capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert done.returncode == 2
+    low, high = (float(v) for v in re.search(r"\[(-?\d+\.\d+), (\d+\.\d+)\] deg", done.stderr).groups())
+    assert (round(low, 1), round(high, 1)) == (-angle, angle)
+
+
+def test_cli_pages_margin_is_spinectl_margins_json():
+    """docs/cli.md's L1L2 margin (reproduction.py calls margins_report) is `spinectl margins --json`'s first
+    segment's delay_margin_s to the page's four decimals, and its last segment's margin is null, 'unbounded'."""
+    from spinectl_docs.values import text_of
+
+    done = subprocess.run([sys.executable, "-m", "spinectl", "margins", "--json"], capture_output=True, text=True,
+                          timeout=300)  # fmt: skip
+    first, last = json.loads(done.stdout)["segments"][0], json.loads(done.stdout)["segments"][-1]
+    assert text_of("cli.l1l2_margin") == f"{first['delay_margin_s']:.4f}"
+    assert last["delay_margin_s"] is None and last["delay_margin_s_reason"] == "unbounded"
 
 
 def test_interchange_pages_causes_together_are_opensims_own_k():

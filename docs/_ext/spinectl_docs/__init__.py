@@ -28,7 +28,9 @@ a text changed, so that incremental builds stay incremental):
   each preset's activations, :mod:`.segment_margins`);
 - ``_generated/anatomy-*.md``: ``spinectl anatomy``'s tables on MyoTorso in ``anatomy.md`` (verdicts, optima,
   lordosis, reflex; measured at the build, :mod:`.anatomy`);
-- ``_generated/motion-lift.png``: the lift of ``motion.md`` on MyoTorso (:mod:`.lift`).
+- ``_generated/motion-lift.png``: the lift of ``motion.md`` on MyoTorso (:mod:`.lift`);
+- ``_generated/studies-estimate.md``: the line ``spinectl study`` states before a long run, in ``studies.md``
+  (:mod:`.studies`).
 
 Numbers that a sentence quotes are the ``{measured}`` role's (:mod:`.values`): ``{measured}`anatomy.remedy```
 is replaced by what the code gives at the build; the pages that use it are read again at every build, so
@@ -37,7 +39,7 @@ with its mapping at the build: one table row of verdicts. Besides the tables' mo
 ``reflex.md``'s design against K and its design curve's readings, :mod:`.millard` ``interchange.md``'s causes of
 Millard's instability (and its curves and re-imported chain), :mod:`.together` ``chain.md``'s local and joint
 optima at the first table's points (and ``figures.md``'s coupled ratio) and :mod:`.gainsearch` ``chain.md``'s
-gain search (a small stated budget) and bounds.
+gain search (a small stated budget) and bounds; :mod:`.atlas` ``atlas.md``'s lordosis angle conversions.
 
 ``_generated/`` is excluded from the sources (its files are included by
 ``parameters.md``, ``index.md``, ``notebooks.md`` and ``reproduction.md``);
@@ -57,6 +59,7 @@ from pathlib import Path
 
 from . import (
     anatomy,
+    atlas,
     bends,
     chain,
     design,
@@ -75,6 +78,7 @@ from . import (
     reproduction,
     searched,
     segment_margins,
+    studies,
     together,
     trends,
     values,
@@ -100,11 +104,13 @@ MEASURED_TABLES = (
     ("reflex-margins-lag.md", segment_margins.lag_table),
     ("reflex-margins-default.md", lambda: segment_margins.preset_table("default")),
     ("reflex-margins-wagner2012.md", lambda: segment_margins.preset_table("wagner2012")),
+    ("studies-estimate.md", studies.estimate_block),
 )
 """The tables of what commands print, measured at the build: (file in ``_generated/``, its generator)."""
 
 MEASURED_VALUES = (
     anatomy,
+    atlas,
     bends,
     chain,
     errata,

@@ -71,3 +71,34 @@ value("reflex.subject_growth")(_growth_times)
 value("reflex.l1l2_stiffness")(lambda: f"{stability(False, 0.0, 0.0).stiffness[0]:.2f}".replace("-", "\u2212"))
 value("reflex.l1l2_slowest_00")(lambda: f"{slowest(False, 0.0, 0.0):.0f} s")
 value("reflex.l1l2_slowest_subject")(lambda: f"{slowest(True, 0.03, 0.04):.0f} s")
+
+
+@cache
+def stiff_passive():
+    """``spinectl design --delay 0.1 --E 0.03 --Lambda 0.04 --K 200`` on ``wagner2012``: where the rule has no
+    joint-by-joint design (about 9 s of CPU, one BLAS thread)."""
+    from spinectl._threads import one_blas_thread
+    from spinectl.model.config import load_preset, set_parameters
+    from spinectl.reflex.design import answer
+
+    model = set_parameters(load_preset("wagner2012"), {"reflex.delay": 0.1, "passive.stiffness": 200.0})
+    with one_blas_thread():
+        return answer(model, 0.03, 0.04)
+
+
+def _stiff_largest() -> str:
+    from spinectl.reflex.delay import delay_text
+
+    design = stiff_passive()
+    if np.isfinite(design.activation):
+        raise RuntimeError("docs/reflex.md: design --delay 0.1 --K 200 now has a rule design; the paragraph is stale")
+    return delay_text(design.largest_delay)
+
+
+def _stiff_rule_kd() -> str:
+    kd = stiff_passive().joint_searched.rule_kd
+    return f"{np.min(kd):.0f}\u2013{np.max(kd):.0f}"
+
+
+value("reflex.stiff_largest_delay")(_stiff_largest)
+value("reflex.stiff_rule_kd")(_stiff_rule_kd)

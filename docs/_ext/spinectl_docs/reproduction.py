@@ -7,7 +7,11 @@ on a coarse grid); the test suite checks the documented values against a fresh
 measurement of the preset (tests/paper/test_verdicts.py) and the documented
 assumptions against that table (tests/paper/test_assumptions.py). The chain's numbers of "The whole chain"
 are measured at the build too: the landscape's chain margin (``spinectl sweep`` on the paper's 1 mm grid,
-about a second) and the chain at the paper's optimum (:mod:`.chain`'s computations).
+about a second) and the chain at the paper's optimum (:mod:`.chain`'s computations). The counter torques'
+readings as ‖x‖ times F (the spline's offsets and the landscape's ‖CT‖), the mass-free preset's and
+independent activation's landmarks (the assumption table's rows, measured once) and what the calibrated
+presets' headers record (losses, conventions, run times: read, never a calibration at the build) feed the
+sentences of those sections.
 """
 
 from __future__ import annotations
@@ -44,9 +48,22 @@ def parameter_table() -> str:
     return "\n".join(lines) + "\n"
 
 
+@cache
+def assumption_rows() -> dict:
+    """Every landmark under each choice the paper does not make, measured once per build (a coarse grid, a few
+    seconds): landmark name -> :class:`spinectl.paper.assumptions.Row`, the table's and the sentences' source."""
+    return {row.name: row for row in assumptions.documented_rows()}
+
+
 def assumption_table() -> str:
-    """Every landmark under each choice the paper does not make, measured now (a coarse grid, about half a minute)."""
-    return assumptions.markdown(assumptions.documented_rows())
+    """Every landmark under each choice the paper does not make, measured now (:func:`assumption_rows`)."""
+    return assumptions.markdown(list(assumption_rows().values()))
+
+
+def _under(name: str, column: str) -> float:
+    """A landmark's value in a column of the assumption table (``"mass"``: the mass-free preset's;
+    ``"activation"``: independent activation; ``"chosen"``: ``wagner2012`` on the table's grid)."""
+    return assumption_rows()[name].values[column][0]
 
 
 def landmark_table() -> str:
@@ -230,11 +247,28 @@ value("reproduction.lordosis_least_where")(_least_where)
 
 
 @cache
-def _joint_margin(preset: str) -> float:
-    """The least delay margin over the joints, each alone [s] (``spinectl margins --E 0 --Lambda 0``)."""
+def margins_at_a(preset: str):
+    """``spinectl margins --preset P --E 0 --Lambda 0``: each joint alone (a MarginsReport)."""
     from spinectl.reflex.margins import margins_report
 
-    return min(s.delay_margin for s in margins_report(load_preset(preset), 0.0, 0.0).segments)
+    return margins_report(load_preset(preset), 0.0, 0.0)
+
+
+def _joint_margin(preset: str) -> float:
+    """The least delay margin over the joints, each alone [s] (``spinectl margins --E 0 --Lambda 0``)."""
+    return min(s.delay_margin for s in margins_at_a(preset).segments)
+
+
+def _cli_margins() -> str:
+    """'0.1962': L1L2's delay margin [s] of ``spinectl margins --json`` with its defaults, guarding the page's
+    'L5S1 is self-stable' (its margin unbounded)."""
+    segments = margins_at_a(verdicts.PRESET).segments
+    if np.isfinite(segments[-1].delay_margin):
+        raise RuntimeError("docs/cli.md says L5S1's margin is unbounded (self-stable) under margins' defaults")
+    return f"{segments[0].delay_margin:.4f}"
+
+
+value("cli.l1l2_margin")(_cli_margins)
 
 
 def _chain_rule_margin(preset: str) -> str:
@@ -281,3 +315,196 @@ def _region() -> tuple[float, float]:
 value("reproduction.least_ct_by_e")(_grows)
 value("reproduction.ct_region_share")(lambda: f"{_region()[0]:.0f} %")
 value("reproduction.ct_region_e")(lambda: f"{_region()[1]:.1f}")
+
+
+# --- the counter torques as ‖x‖ times F ("D twice C", "Minimal along the bisector", "The ±30 N m region") ---
+
+
+def offset_norm(position) -> float:
+    """‖x‖ [m] at (E, Lambda) [m]: the CoRs' horizontal offsets x_k = -E + Lambda phi_k (the spline alone)."""
+    from spinectl.model.geometry import cor_positions
+
+    return float(np.linalg.norm(cor_positions(*position, load_preset(verdicts.PRESET).geometry)[:, 0]))
+
+
+def _grid(position) -> tuple[float, float]:
+    """The point of :func:`landscape` that the landmarks read for ``position`` (the nearest, as ``readings.at``)."""
+    from spinectl.paper.readings import grid_point
+
+    return grid_point(landscape(), position)
+
+
+def counter_torque(position) -> float:
+    """‖CT‖ [N m] of :func:`landscape` at the grid point nearest ``position``."""
+    from spinectl.paper.readings import at
+
+    return at(landscape(), "counter_torque_norm_Nm", position)
+
+
+def vertical_force(position) -> float:
+    """F = ‖CT‖ / ‖x‖ [N] at the grid point nearest ``position``: the weight and the muscles' vertical pull."""
+    return counter_torque(position) / offset_norm(_grid(position))
+
+
+C_READING_POINTS = {"corner": "C", "interior": "OPTIMUM", "ridge": "RIDGE_C"}
+"""The three readings of C, by the name of their position in :mod:`spinectl.paper.landmarks` (grid or landmarks)."""
+
+
+def c_position(reading: str):
+    """(E, Lambda) [m] of C under a reading (:data:`C_READING_POINTS`)."""
+    from spinectl.paper import landmarks
+    from spinectl.paper.grid import POSITIONS
+
+    return POSITIONS["C"] if reading == "corner" else getattr(landmarks, C_READING_POINTS[reading])
+
+
+def offset_ratio(corner: str, reading: str) -> str:
+    """‖x(corner)‖ / ‖x(C)‖ at the positions themselves (the spline alone, no grid), to 2 decimals."""
+    from spinectl.paper.grid import POSITIONS
+
+    return f"{offset_norm(POSITIONS[corner]) / offset_norm(c_position(reading)):.2f}"
+
+
+def _force_ratio() -> str:
+    """'598/910': F at B and at C on the ridge reading [N]."""
+    from spinectl.paper.grid import POSITIONS
+
+    return f"{vertical_force(POSITIONS['B']):.0f}/{vertical_force(c_position('ridge')):.0f}"
+
+
+def _grid_ratio(top: str, reading: str, digits: int) -> str:
+    """‖CT(top)‖ / ‖CT(C)‖ on the paper's 81 x 81 grid (the report's landmark table), to ``digits`` decimals."""
+    from spinectl.paper.grid import POSITIONS
+
+    return f"{counter_torque(POSITIONS[top]) / counter_torque(c_position(reading)):.{digits}f}"
+
+
+def _valley() -> str:
+    """'1.24 ± 0.002': the valley floor's slope on the paper's grid and its standard error (landmarks' fit)."""
+    from spinectl.paper.readings import crest_fit
+
+    fit = crest_fit(landscape(), "counter_torque_norm_Nm", "min")
+    return f"{fit.slope:.2f} ± {fit.uncertainty:.1g}"
+
+
+def _mass_free_mass() -> str:
+    return f"{load_preset(assumptions.MASS_FREE_PRESET).body.mass:.1f} kg"
+
+
+def _mass_free_halving() -> str:
+    """'0.557 with paper, 0.511 with physical': the mass-free preset's halving under its own K convention and
+    the other."""
+    own = load_preset(assumptions.MASS_FREE_PRESET).passive.convention
+    other = "physical" if own == "paper" else "paper"
+    return (f"{verdicts.format_number(_under('halving_K15', 'mass'))} with {own}, "
+            f"{verdicts.format_number(_under('halving_K15_other', 'mass'))} with {other}")  # fmt: skip
+
+
+def _spline_slope() -> str:
+    """sum phi / sum phi^2: where ‖x‖ is least, Lambda over E [1]."""
+    from spinectl.model.geometry import lordosis_shape
+
+    phi = lordosis_shape(load_preset(verdicts.PRESET).geometry)
+    return f"{np.sum(phi) / np.sum(phi**2):.2f}"
+
+
+def _least_offset() -> str:
+    """sqrt(5 - (sum phi)^2 / sum phi^2): the least ‖x‖ over Lambda per unit E [1]."""
+    from spinectl.model.geometry import lordosis_shape
+
+    phi = lordosis_shape(load_preset(verdicts.PRESET).geometry)
+    return f"{np.sqrt(phi.size - np.sum(phi) ** 2 / np.sum(phi**2)):.2f}"
+
+
+value("reproduction.optimum_offset")(lambda: f"{100 * offset_norm(OPTIMUM):.1f}")
+value("reproduction.optimum_force")(lambda: f"{vertical_force(OPTIMUM):.0f}")
+value("reproduction.valley_slope")(_valley)
+value("reproduction.spline_slope")(_spline_slope)
+value("reproduction.least_offset")(_least_offset)
+value("reproduction.mass_free_ridge_over_B")(lambda: verdicts.format_number(_under("ridge_over_B", "mass")))
+value("reproduction.mass_free_mass")(_mass_free_mass)
+value("reproduction.mass_free_valley")(lambda: verdicts.format_number(_under("ct_valley_slope", "mass")))
+value("reproduction.mass_free_halving")(_mass_free_halving)
+value("reproduction.independent_D_over_C")(lambda: verdicts.format_number(_under("ct_D_over_C_text", "activation")))
+value("reproduction.summary_B_over_C_ridge")(lambda: verdicts.format_number(_under("ct_B_over_C_ridge", "chosen")))
+value("reproduction.grid_D_over_C_text")(lambda: _grid_ratio("D", "interior", 4))
+value("reproduction.grid_B_over_C_ridge")(lambda: _grid_ratio("B", "ridge", 3))
+value("reproduction.force_B_over_C_ridge")(_force_ratio)
+for _corner in ("D", "B"):
+    for _reading in C_READING_POINTS:
+        value(f"reproduction.offset_{_corner}_over_C_{_reading}")(lambda c=_corner, r=_reading: offset_ratio(c, r))
+
+
+# --- what the calibrated presets' headers record (read, never a calibration run at the build) ---
+
+
+def preset_header(preset: str) -> list[str]:
+    """The comment lines at the head of a built-in preset's TOML (``spinectl calibrate`` writes its run there)."""
+    from importlib import resources
+
+    from spinectl.model.config import PRESET_PACKAGE
+
+    text = resources.files(PRESET_PACKAGE).joinpath(f"{preset}.toml").read_text(encoding="utf-8")
+    return [line[1:].strip() for line in text.splitlines() if line.startswith("#")]
+
+
+def _header_line(preset: str, words: str) -> str:
+    line = next((line for line in preset_header(preset) if words in line), None)
+    if line is None:
+        raise RuntimeError(f"the {preset} preset's header no longer says {words!r}: docs/reproduction.md reads it")
+    return line
+
+
+def convention_losses(preset: str) -> dict[str, float]:
+    """Each convention's loss at the preset's vector, as its header records them ('picked at ...')."""
+    import re
+
+    line = _header_line(preset, "picked at")
+    return {c: float(v) for c, v in re.findall(r"\b(physical|paper) (\d+\.\d+)", line)}
+
+
+def calibration_loss(preset: str) -> tuple[float, str]:
+    """The preset's loss on the verifying grid and how many landmarks agree ('11 of 22'), from its header."""
+    import re
+
+    found = re.search(r"Loss: (\d+\.\d+) .*?(\d+ of \d+) landmarks agree", _header_line(preset, "Loss: "))
+    return float(found.group(1)), found.group(2)
+
+
+def search_time(preset: str) -> tuple[int, int]:
+    """The calibration's wall time [s] and loss evaluations, from the preset's header."""
+    import re
+
+    found = re.search(r"wall time (\d+) s, (\d+) loss evaluations", _header_line(preset, "wall time"))
+    return int(found.group(1)), int(found.group(2))
+
+
+def _loss_pair(preset: str) -> str:
+    """'0.891 against 0.977': the loss of the preset's own convention at its vector and the other's, 3 digits."""
+    own = load_preset(preset).passive.convention
+    losses = convention_losses(preset)
+    other = next(c for c in losses if c != own)
+    return f"{losses[own]:.3f} against {losses[other]:.3f}"
+
+
+value("reproduction.wagner_convention", code=True)(lambda: load_preset(verdicts.PRESET).passive.convention)
+value("reproduction.wagner_loss_pair")(lambda: _loss_pair(verdicts.PRESET))
+value("reproduction.wagner_search")(lambda: "{:,} s ({} evaluations)".format(*search_time(verdicts.PRESET)))
+value("reproduction.mass_free_search")(lambda: f"{search_time(assumptions.MASS_FREE_PRESET)[0]:,} s")
+value("reproduction.mass_free_convention", code=True)(
+    lambda: load_preset(assumptions.MASS_FREE_PRESET).passive.convention
+)
+value("reproduction.mass_free_loss")(lambda: f"{calibration_loss(assumptions.MASS_FREE_PRESET)[0]:.3f}")
+value("reproduction.mass_free_agree")(lambda: calibration_loss(assumptions.MASS_FREE_PRESET)[1])
+
+
+def _limit_pcsa() -> str:
+    """'17.1 cm²': the paper's ±30 N m limit as local muscle at its 7 cm lever arm (``wagner2012``'s tension)."""
+    from spinectl.paper.landmarks import CT_LIMIT, local_pcsa_equivalent
+
+    return (
+        f"{1e4 * float(local_pcsa_equivalent(CT_LIMIT, load_preset(verdicts.PRESET).fibre.specific_tension)):.1f} cm²"
+    )
+
+
+value("reproduction.limit_pcsa")(_limit_pcsa)
