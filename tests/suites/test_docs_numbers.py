@@ -473,3 +473,32 @@ def test_interchange_pages_causes_together_are_opensims_own_k():
     assert millard.least(millard.chain_with(())) == pytest.approx(
         millard.least(interchange.exported("osim", "millard", True)[1].stiffness)
     )
+
+
+def test_atlas_pages_shares_and_indices_are_what_the_command_prints(tmp_path):
+    """docs/atlas.md's shares, Sobol' rankings and E < Lambda share (atlas_run.py, the library in-process) are
+    what `spinectl atlas examples/atlas.toml --json` prints and writes (draws.npz) in a subprocess."""
+    from spinectl_docs import atlas_run
+    from spinectl_docs.values import text_of
+
+    done = subprocess.run(
+        [sys.executable, "-m", "spinectl", "atlas", str(ROOT / "examples" / "atlas.toml"), "--out", str(tmp_path),
+         "--json"],
+        capture_output=True, text=True, timeout=600,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    printed = json.loads(done.stdout)
+    for verdict, v in printed["probabilities"].items():
+        if verdict == "stabilisable_joint_by_joint":
+            continue  # p = 1: shown as '100 %'
+        shown = [float(x) for x in re.findall(r"\d+\.\d", text_of(f"atlas.share.{verdict}"))]
+        np.testing.assert_allclose(shown, [100 * v["p"], 100 * v["low"], 100 * v["high"]], atol=0.05 + 1e-9)
+    table = printed["sobol"]["min_pcsa_cm2"]
+    first = max(table, key=lambda name: table[name]["ST"])
+    assert text_of("atlas.rank.min_pcsa_cm2").startswith(f"{atlas_run.WORDS[first]} (ST {table[first]['ST']:.2f}")
+    assert f"{printed['nonfinite']['spine_delay_margin_s']} draws" in text_of("atlas.margin_nonfinite")
+    draws = np.load(tmp_path / "draws.npz")
+    step = len(atlas_run.WORDS) + 2  # Saltelli's A and B rows: the first and last of each block of D + 2
+    rows = np.sort(np.concatenate([np.arange(0, draws["eccentricity_m"].size, step) + k for k in (0, step - 1)]))
+    behind = 100 * np.mean(draws["eccentricity_m"][rows] < draws["lordosis_m"][rows])
+    assert text_of("atlas.behind_apex") == f"{behind:.0f} %"

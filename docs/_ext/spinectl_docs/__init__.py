@@ -39,7 +39,8 @@ with its mapping at the build: one table row of verdicts. Besides the tables' mo
 ``reflex.md``'s design against K and its design curve's readings, :mod:`.millard` ``interchange.md``'s causes of
 Millard's instability (and its curves and re-imported chain), :mod:`.together` ``chain.md``'s local and joint
 optima at the first table's points (and ``figures.md``'s coupled ratio) and :mod:`.gainsearch` ``chain.md``'s
-gain search (a small stated budget) and bounds; :mod:`.atlas` ``atlas.md``'s lordosis angle conversions.
+gain search (a small stated budget) and bounds; :mod:`.atlas` ``atlas.md``'s lordosis angle conversions
+and :mod:`.atlas_run` its shipped atlas's shares and Sobol' indices (the atlas run once per build).
 
 ``_generated/`` is excluded from the sources (its files are included by
 ``parameters.md``, ``index.md``, ``notebooks.md`` and ``reproduction.md``);
@@ -60,6 +61,7 @@ from pathlib import Path
 from . import (
     anatomy,
     atlas,
+    atlas_run,
     bends,
     chain,
     design,
@@ -111,6 +113,7 @@ MEASURED_TABLES = (
 MEASURED_VALUES = (
     anatomy,
     atlas,
+    atlas_run,
     bends,
     chain,
     errata,

@@ -2,8 +2,8 @@
 
 The default preset's spine (L = 176 mm, natural end conditions): the paper's optimum Lambda = 4 cm as an angle,
 Yukawa et al.'s (2019) mean standing angle (49.8 deg, a citation) as a Lambda, and the model's Lambda range as the
-angles ``--lordosis-angle`` accepts. The atlas's probabilities and Sobol' indices stay typed: no atlas result
-ships with the project, and the page's run (``spinectl atlas examples/atlas.toml``) is not repeated at the build.
+angles ``--lordosis-angle`` accepts. The atlas's probabilities and Sobol' indices are
+:mod:`.atlas_run`'s (the page's run of ``spinectl atlas examples/atlas.toml``, repeated at the build).
 """
 
 from __future__ import annotations
