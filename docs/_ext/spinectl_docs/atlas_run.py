@@ -119,7 +119,8 @@ def run_line() -> str:
     found, spec = result()
     names = {8: "eight", 7: "seven", 9: "nine"}
     d = len(spec.priors)
-    return f"N = {spec.samples}; {names.get(d, d)} priors, {found.n_evaluations:,} evaluations".replace(",", " ")
+    evaluations = f"{found.n_evaluations:,}".replace(",", " ")  # the docs' thin-space thousands
+    return f"N = {spec.samples}; {names.get(d, d)} priors, {evaluations} evaluations"
 
 
 value("atlas.run_line")(run_line)
