@@ -21,7 +21,7 @@ Models, each built in a temporary folder through OpenSim's API:
 1. spinectl's export of the paper's chain (``export_osim``, 30 Millard muscles) with muscles added
    to reach ``--muscles`` (rigid-tendon Millard, two or three path points on random chain bodies)
    and couplers tying L4L5 ... L1L2 to L5S1 (a lumbar rhythm, as the Christophy family's);
-2. where the shared models (../shared/models beside the checkout) are present, the Pose2Sim model
+2. where a copy of the published models is present (tests/anatomy/shared_models.py), the Pose2Sim model
    (Beaucage-Gauvreau's lumbar spine,
    318 muscles, 44 wrap objects, 18 lumbar couplers) with its muscles made rigid-tendon Millard
    (the present path's reference reads Millard muscles only), its lumbar flexion chain mapped.
@@ -46,7 +46,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests" / "anatomy"))  # osim_reference: the previous path, shared with the tests
 
-from shared_models import POSE2SIM as SHARED  # noqa: E402 (tests/anatomy/shared_models.py: ../shared/models)
+from shared_models import POSE2SIM as SHARED  # noqa: E402 (tests/anatomy/shared_models.py)
 
 POSE2SIM_MAPPING = """[bodies]
 pelvis = ["pelvis", "sacrum"]

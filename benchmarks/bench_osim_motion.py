@@ -9,8 +9,8 @@ in the run, as a first analysis of a recording is):
 
 1. the 324-muscle model of ``bench_osim_anatomy.py`` (spinectl's export of the paper's chain with
    rigid-tendon Millard muscles added and couplers tying its joints to L5S1), built through OpenSim's API;
-2. where the shared models are present (``$SPINECTL_SHARED_MODELS``, else ``../shared/models`` beside the
-   checkout; tests/anatomy/shared_models.py), the Pose2Sim model as published (318 DeGrooteFregly muscles,
+2. where a copy of the published models is present (``$SPINECTL_SHARED_MODELS``;
+   tests/anatomy/shared_models.py), the Pose2Sim model as published (318 DeGrooteFregly muscles,
    44 wrap objects, 18 lumbar couplers) with docs/mappings/pose2sim.toml; else a line says it is skipped.
 
 On each, a flexion and return of the mapped sagittal joints (-8 sin(pi t / T) deg added to the model's default

@@ -49,8 +49,8 @@ HEADER = (
 
 
 SHARED_PREFIX = "shared:"
-"""An argument ``shared:<folder>/<file>`` is a file of the published models' folder: ``$SPINECTL_SHARED_MODELS``,
-else ``../shared/models`` beside the checkout (where CI and the tests find them, tests/anatomy/shared_models.py)."""
+"""An argument ``shared:<folder>/<file>`` is a file of a copy of the published models (docs/anatomy.md, "Published
+models"), found where the tests find it (tests/anatomy/shared_models.py, ``$SPINECTL_SHARED_MODELS``)."""
 
 
 def shared_models() -> Path:
