@@ -33,9 +33,8 @@ import numpy as np
 
 from ..errors import ParameterError
 from ..model.contributions import least_mode
-from .buckling import critical_load, load_stiffness_per_newton
+from .buckling import critical_load, load_stiffness_per_newton, weight_load
 from .contract import AnatomyEngine
-from .loads import BodyLoad
 from .optimum import MARGIN, _lumbar_only, optimise, solve_on_chain
 
 GROUPS = {
@@ -228,8 +227,9 @@ def stability_price(
     Parameters
     ----------
     anatomy : AnatomyEngine
-        The model. The load acts along gravity at the centre of mass of its mapping's thorax body (the contract's
-        ``body_weight``), as a mass added to the torso does (the protocol of Cholewicki et al. 1997).
+        The model. The load acts along gravity at the centre of mass of its mapping's thorax body
+        (:func:`spinectl.anatomy.buckling.weight_load`), as a mass added to the torso does (the protocol of
+        Cholewicki et al. 1997).
     loads : array_like, shape (p,)
         Downward loads [N], >= 0 (the added mass times g).
     joint_stiffness : {"none", "mapped"} or float
@@ -250,12 +250,9 @@ def stability_price(
     loads = np.asarray(loads, float)
     if loads.ndim != 1 or not np.all(loads >= 0):
         raise ParameterError("loads", f"must be downward forces >= 0 [N] (got {loads.tolist()!r})")
-    thorax = anatomy.mapping.bodies["thorax"][-1]
-    gravity, centre = anatomy.body_weight(thorax)
-    down = np.asarray(gravity, float) / np.linalg.norm(gravity)  # a mass's weight, in the ground's frame
     costs = {"chain": [], "none": []}
     for load in loads:
-        held = [BodyLoad(thorax, tuple(float(load) * down), tuple(centre))]
+        held = [weight_load(anatomy, float(load))]  # a mass added to the torso: its weight at the thorax's CoM
         for criterion, out in costs.items():
             opt = optimise(anatomy, plane, criterion, margin, joint_stiffness=joint_stiffness, loads=held)
             out.append(opt.cost if opt.ok else float("nan"))
